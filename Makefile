@@ -1,0 +1,36 @@
+# The two commands of the README's Quick start, and a few more for developers.
+#   make run    install what is missing, build (Release), simulate the default example
+#   make test   install what is missing, build, run every test through ctest
+BUILD ?= build
+JOBS ?= $(shell nproc)
+MODEL ?= sled
+
+.PHONY: run test build deps bench asan clean
+
+deps:
+	@bash scripts/install-deps
+
+build: deps
+	@cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release $(if $(CI),-DNHDYN_WERROR=ON) >/dev/null
+	@cmake --build $(BUILD) -j $(JOBS)
+
+run: build
+	@mkdir -p results
+	$(BUILD)/apps/nhdyn/nhdyn simulate $(MODEL) -o results/$(MODEL).csv --plot results/$(MODEL).png
+
+test: build
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+bench: build
+	$(BUILD)/bench/nhdyn_bench --benchmark_min_time=0.2
+
+# The tests again under AddressSanitizer and UndefinedBehaviorSanitizer (what CI runs too).
+asan: deps
+	@cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNHDYN_SANITIZE=ON \
+	  -DNHDYN_WERROR=ON -DNHDYN_BUILD_BENCH=OFF >/dev/null
+	@cmake --build build-asan -j $(JOBS)
+	cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  ctest --output-on-failure -j $(JOBS)
+
+clean:
+	rm -rf $(BUILD) build-asan results

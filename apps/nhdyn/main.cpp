@@ -1,0 +1,33 @@
+// nhdyn: simulate constrained mechanical systems in the form of Do Sanh. This file only wires the
+// subcommands together and turns nhdyn's exceptions into messages and exit codes.
+#include <fmt/format.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "commands.hpp"
+#include "nhdyn/core/error.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"nhdyn: equations of motion of constrained mechanical systems (Do Sanh form)", "nhdyn"};
+  app.require_subcommand(1);
+  const auto simulate = nhdyn::cli::add_simulate_command(app);
+  const auto list = nhdyn::cli::add_list_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  try {
+    if (app.got_subcommand("simulate")) return simulate();
+    if (app.got_subcommand("list")) return list();
+  } catch (const nhdyn::Error& e) {
+    fmt::print(stderr, "nhdyn: error: {}\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "nhdyn: internal error: {}\n", e.what());
+    return 3;
+  }
+  return 0;
+}

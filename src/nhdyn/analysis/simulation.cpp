@@ -1,0 +1,129 @@
+#include "nhdyn/analysis/simulation.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "nhdyn/analysis/residuals.hpp"
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/formulation/diagnosis.hpp"
+
+namespace nhdyn {
+namespace {
+
+// Outputs beyond this many rows are refused: at ~100 bytes a row that is a 10 GB file.
+constexpr double kMaxOutputs = 1e8;
+
+// y = [q; q'], y' = [q'; q''].
+class MechanicalOde final : public OdeSystem {
+ public:
+  MechanicalOde(const Model& model, Data& data, const FormulationOptions& options)
+      : model_(model), data_(data), options_(options), n_(model.n()) {}
+
+  int size() const override { return 2 * n_; }
+
+  Status rhs(double t, const double* y, double* ydot) override {
+    const Status status = compute_dynamics(model_, data_, options_, t, y, y + n_);
+    if (status != Status::ok) return status;
+    std::memcpy(ydot, y + n_, sizeof(double) * static_cast<std::size_t>(n_));
+    std::memcpy(ydot + n_, data_.qdd.data(), sizeof(double) * static_cast<std::size_t>(n_));
+    return Status::ok;
+  }
+
+ private:
+  const Model& model_;
+  Data& data_;
+  const FormulationOptions& options_;
+  int n_;
+};
+
+double max_abs(const Vector& v) { return v.size() > 0 ? v.cwiseAbs().maxCoeff() : 0.0; }
+
+}  // namespace
+
+std::vector<double> make_output_times(double t0, double t_end, double output_step) {
+  if (!std::isfinite(t_end) || !(t_end > t0))
+    throw InputError(fmt::format("the end time t_end = {} must be a finite time after the start time {}",
+                                 t_end, t0));
+  if (!std::isfinite(output_step) || !(output_step > 0.0))
+    throw InputError(fmt::format("the output step {} must be a positive, finite time", output_step));
+  const double count = std::floor((t_end - t0) / output_step + 1e-9);
+  if (count > kMaxOutputs)
+    throw InputError(fmt::format("an output step of {} over [{}, {}] gives {:.3g} rows, more than the "
+                                 "limit of {:.0g}; choose a larger output step",
+                                 output_step, t0, t_end, count, kMaxOutputs));
+  std::vector<double> times;
+  times.reserve(static_cast<std::size_t>(count) + 2);
+  for (long i = 0; i <= static_cast<long>(count); ++i) times.push_back(t0 + static_cast<double>(i) * output_step);
+  // The last output is t_end itself, whether or not the step divides the interval.
+  if (t_end - times.back() > 1e-9 * output_step) times.push_back(t_end);
+  else times.back() = t_end;
+  return times;
+}
+
+void check_simulation_options(const Model& model, const SimulationOptions& options) {
+  make_output_times(model.t0, options.t_end, options.output_step);
+  const IntegratorOptions& io = options.integrator;
+  if (io.kind != IntegratorKind::rk4) {
+    if (!std::isfinite(io.rtol) || !(io.rtol > 0.0))
+      throw InputError(fmt::format("the relative tolerance rtol = {} must be positive and finite (e.g. 1e-8)", io.rtol));
+    if (!std::isfinite(io.atol) || !(io.atol > 0.0))
+      throw InputError(fmt::format("the absolute tolerance atol = {} must be positive and finite (e.g. 1e-10)", io.atol));
+    if (io.rtol < 1e-15)
+      throw InputError(fmt::format("the relative tolerance rtol = {} is below what double precision can "
+                                   "deliver; use 1e-14 or more", io.rtol));
+  }
+  if (!std::isfinite(io.step) || io.step < 0.0)
+    throw InputError(fmt::format("the step {} must be positive (or 0 for the default)", io.step));
+  if (options.formulation.complement == Complement::analytic && !model.evaluator->has_complement())
+    throw InputError(fmt::format("model '{}' has no analytic D; choose --complement qr or partition", model.name));
+}
+
+SimulationSummary simulate(const Model& model, const SimulationOptions& options, const RowFn& row) {
+  check_simulation_options(model, options);
+  const std::vector<double> times = make_output_times(model.t0, options.t_end, options.output_step);
+  Data data = make_data(model);
+  check_state_or_throw(model, data, model.t0, model.q0.data(), model.v0.data());
+
+  const int n = model.n();
+  std::vector<double> y0(static_cast<std::size_t>(2 * n));
+  std::copy(model.q0.data(), model.q0.data() + n, y0.begin());
+  std::copy(model.v0.data(), model.v0.data() + n, y0.begin() + n);
+
+  SimulationSummary summary;
+  summary.has_energy = model.evaluator->has_energy();
+  MechanicalOde ode(model, data, options.formulation);
+  const OutputFn output = [&](double t, const double* y) -> Status {
+    const Status status = compute_dynamics(model, data, options.formulation, t, y, y + n);
+    if (status != Status::ok) return status;
+    compute_residuals(model, data);
+    compute_energy(model, data);
+    if (summary.outputs == 0) summary.energy_initial = data.energy;
+    summary.max_position_residual = std::max(summary.max_position_residual, max_abs(data.phi));
+    summary.max_velocity_residual = std::max(summary.max_velocity_residual, max_abs(data.f));
+    summary.max_acceleration_residual = std::max(summary.max_acceleration_residual, max_abs(data.e));
+    if (summary.has_energy)
+      summary.energy_drift = std::max(summary.energy_drift, std::abs(data.energy - summary.energy_initial));
+    ++summary.outputs;
+    row(data);
+    return Status::ok;
+  };
+
+  const auto start = std::chrono::steady_clock::now();
+  const IntegrationResult result = integrate(ode, options.integrator, model.t0, y0.data(), times, output);
+  summary.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.status = result.status;
+  summary.t_reached = result.t_reached;
+  summary.stats = result.stats;
+  if (result.status != Status::ok) {
+    // The kernels recorded the details of a failed evaluation in data; prefer those words.
+    summary.message = data.status != Status::ok ? explain_failure(model, data) : result.message;
+    if (summary.message.empty()) summary.message = fmt::format("{} at t = {:.6g}", describe(result.status), result.t_reached);
+  }
+  return summary;
+}
+
+}  // namespace nhdyn

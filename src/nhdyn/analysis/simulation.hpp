@@ -1,0 +1,55 @@
+// The simulation driver: adapts a Model and a formulation to a first-order ODE y = [q; q'],
+// integrates it, and at every output time evaluates the accelerations, reactions, residuals and
+// energy, hands them to the caller (who writes CSV rows), and keeps the summary a user reads:
+// steps, right-hand-side evaluations, wall time, maximum residual per level, energy drift.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/integrators/ode.hpp"
+#include "nhdyn/model/data.hpp"
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn {
+
+struct SimulationOptions {
+  double t_end = 10.0;        // end time [s], > t0
+  double output_step = 0.01;  // spacing of output times [s], > 0
+  FormulationOptions formulation;
+  IntegratorOptions integrator;
+};
+
+struct SimulationSummary {
+  Status status = Status::ok;
+  std::string message;              // empty when ok: what went wrong, where
+  double t_reached = 0.0;
+  IntegratorStats stats;
+  long outputs = 0;                 // rows handed to the caller
+  double wall_time = 0.0;           // [s], integration and output evaluation
+  double max_position_residual = 0.0;      // max |phi| over outputs and constraints
+  double max_velocity_residual = 0.0;      // max |f|
+  double max_acceleration_residual = 0.0;  // max |b q'' + b0|
+  bool has_energy = false;
+  double energy_initial = 0.0;
+  double energy_drift = 0.0;        // max |E(t) - E(t0)| over outputs
+};
+
+// Called at every output time with Data holding t, q, q', q'', R, residuals and energy.
+using RowFn = std::function<void(const Data&)>;
+
+// The output times t0, t0 + h, ..., ending exactly at t_end. Throws InputError on t_end <= t0
+// or output_step <= 0 (or too many outputs to store), naming the value.
+std::vector<double> make_output_times(double t0, double t_end, double output_step);
+
+// Throws InputError for options that cannot make a run (times, tolerances, analytic D missing),
+// naming the value and what to do.
+void check_simulation_options(const Model& model, const SimulationOptions& options);
+
+// Checks the options and the initial state (throws InputError / ModelError before any step),
+// then integrates. Numerical trouble during the run ends it with summary.status and message set.
+SimulationSummary simulate(const Model& model, const SimulationOptions& options, const RowFn& row);
+
+}  // namespace nhdyn

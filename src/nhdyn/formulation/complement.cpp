@@ -1,0 +1,103 @@
+#include "nhdyn/formulation/complement.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/model/terms.hpp"
+
+namespace nhdyn {
+namespace {
+
+// A factor's rank test: pivots of a column-pivoted QR decrease in magnitude, so the last one
+// against the first measures how close the constraints are to dependent.
+bool pivots_show_full_rank(const Matrix& qr_matrix, int s) {
+  if (s == 0) return true;
+  const double first = std::abs(qr_matrix(0, 0));
+  const double last = std::abs(qr_matrix(s - 1, s - 1));
+  const double eps = std::numeric_limits<double>::epsilon();
+  return first > 0.0 && last > first * eps * 16.0 * static_cast<double>(qr_matrix.rows() + s);
+}
+
+Status compute_partitioned(const Model& model, Data& data) {
+  const int n = model.n();
+  const int s = model.s();
+  const int k = model.k();
+  // Column pivoting on b picks, one after another, the coordinates whose columns of b are the
+  // most independent: they become the dependent ones, so that b_dep is as well conditioned as
+  // this greedy choice allows.
+  data.qr_b.compute(data.b);
+  if (!pivots_show_full_rank(data.qr_b.matrixQR(), s))
+    return record_failure(data, Status::dependent_constraints, "constraint matrix b");
+  std::fill(data.is_dependent.begin(), data.is_dependent.end(), 0);
+  for (int j = 0; j < s; ++j) data.is_dependent[static_cast<std::size_t>(data.qr_b.colsPermutation().indices()(j))] = 1;
+  int di = 0, ii = 0;
+  for (int c = 0; c < n; ++c) {
+    if (data.is_dependent[static_cast<std::size_t>(c)]) {
+      data.dependent[static_cast<std::size_t>(di)] = c;
+      data.b_dep.col(di++) = data.b.col(c);
+    } else {
+      data.independent[static_cast<std::size_t>(ii)] = c;
+      data.b_ind.col(ii++) = data.b.col(c);
+    }
+  }
+  data.lu_s.compute(data.b_dep);
+  data.X = data.lu_s.solve(data.b_ind);
+  // D = [I_k, (-b_dep^-1 b_ind)^T] with its columns put back in the order of q.
+  data.D.setZero();
+  for (int r = 0; r < k; ++r) {
+    data.D(r, data.independent[static_cast<std::size_t>(r)]) = 1.0;
+    for (int j = 0; j < s; ++j) data.D(r, data.dependent[static_cast<std::size_t>(j)]) = -data.X(j, r);
+  }
+  return Status::ok;
+}
+
+}  // namespace
+
+Status compute_constraint_basis(const Model& model, Data& data) {
+  const int s = model.s();
+  data.bt = data.b.transpose();
+  data.qr_bt.compute(data.bt);
+  if (!pivots_show_full_rank(data.qr_bt.matrixQR(), s))
+    return record_failure(data, Status::dependent_constraints, "constraint matrix b");
+  data.qr_bt.householderQ().evalTo(data.Q_full, data.hh_work);
+  return Status::ok;
+}
+
+Status compute_complement(const Model& model, Data& data, Complement complement) {
+  if (data.stage < Stage::terms)
+    throw std::logic_error("compute_complement: call compute_terms first for the current state");
+  const int k = model.k();
+  const int s = model.s();
+  switch (complement) {
+    case Complement::qr: {
+      if (s == 0) {
+        data.D.setIdentity();
+        return Status::ok;
+      }
+      const Status status = compute_constraint_basis(model, data);
+      if (status != Status::ok) return status;
+      data.D = data.Q_full.rightCols(k).transpose();
+      return Status::ok;
+    }
+    case Complement::partition:
+      if (s == 0) {
+        data.D.setIdentity();
+        return Status::ok;
+      }
+      return compute_partitioned(model, data);
+    case Complement::analytic:
+      if (!model.evaluator->has_complement())
+        throw InputError("model '" + model.name +
+                         "' has no analytic D; choose the QR basis (qr) or coordinate partitioning "
+                         "(partition) instead");
+      model.evaluator->complement(data.t, data.q.data(), data.v.data(), data.scratch.data(), data.D.data());
+      if (!data.D.allFinite()) return record_failure(data, Status::non_finite, "complement D");
+      return Status::ok;
+  }
+  return Status::ok;
+}
+
+}  // namespace nhdyn

@@ -1,0 +1,24 @@
+// The complement D of the constraint matrix b: a k x n matrix of rank k with D b^T = 0 (2.8),
+// whose rows span the admissible directions of acceleration. Three choices (FORMULATION.md §3):
+// the model's analytic D, coordinate partitioning, and an orthonormal basis of null(b) from a
+// column-pivoted QR factorization of b^T (the default: well conditioned whatever the coordinates).
+#pragma once
+
+#include "nhdyn/core/status.hpp"
+#include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/model/data.hpp"
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn {
+
+// Requires compute_terms. Writes data.D (and data.independent for partitioning).
+// Returns Status::dependent_constraints when b has rank below s. Throws InputError when the
+// analytic D is asked of a model that has none. Allocates nothing.
+Status compute_complement(const Model& model, Data& data, Complement complement);
+
+// The column-pivoted QR factorization b^T P = Q [R1; 0] in data.qr_bt and the full orthogonal
+// factor in data.Q_full (n x n): its first s columns span range(b^T), the last k span null(b).
+// Returns Status::dependent_constraints when b has rank below s. Allocates nothing.
+Status compute_constraint_basis(const Model& model, Data& data);
+
+}  // namespace nhdyn

@@ -1,0 +1,25 @@
+// Words for numerical trouble: turns the Status a kernel recorded in Data into a message a user
+// can act on (which constraints are dependent and how badly, the smallest eigenvalue of A, which
+// quantity went non-finite at which t), and checks a state before a run starts. This is the cold
+// path: it may allocate.
+#pragma once
+
+#include <string>
+
+#include "nhdyn/core/status.hpp"
+#include "nhdyn/model/data.hpp"
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn {
+
+// Explains data.status for the state held in data (terms must have been computed for it).
+std::string explain_failure(const Model& model, const Data& data);
+
+// Checks the terms in data (after compute_terms): A symmetric positive definite and b of full
+// row rank. Returns the first problem found, recording it in data, or Status::ok.
+Status check_terms(const Model& model, Data& data);
+
+// compute_terms at (t, q, v) then check_terms; throws ModelError with explain_failure's words.
+void check_state_or_throw(const Model& model, Data& data, double t, const double* q, const double* v);
+
+}  // namespace nhdyn

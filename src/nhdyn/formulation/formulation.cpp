@@ -1,0 +1,74 @@
+#include "nhdyn/formulation/formulation.hpp"
+
+#include <stdexcept>
+#include <string>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/formulation/lagrange.hpp"
+#include "nhdyn/formulation/nullspace.hpp"
+#include "nhdyn/formulation/sanh.hpp"
+#include "nhdyn/formulation/udwadia_kalaba.hpp"
+#include "nhdyn/model/terms.hpp"
+
+namespace nhdyn {
+
+std::string_view method_name(Method method) {
+  switch (method) {
+    case Method::sanh: return "sanh";
+    case Method::lagrange: return "lagrange";
+    case Method::udwadia_kalaba: return "udwadia-kalaba";
+    case Method::nullspace: return "nullspace";
+  }
+  return "?";
+}
+
+Method parse_method(std::string_view name) {
+  for (Method m : {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace})
+    if (name == method_name(m)) return m;
+  throw InputError("unknown method '" + std::string(name) +
+                   "'; choose one of: sanh, lagrange, udwadia-kalaba, nullspace");
+}
+
+std::string_view complement_name(Complement complement) {
+  switch (complement) {
+    case Complement::qr: return "qr";
+    case Complement::partition: return "partition";
+    case Complement::analytic: return "analytic";
+  }
+  return "?";
+}
+
+Complement parse_complement(std::string_view name) {
+  for (Complement c : {Complement::qr, Complement::partition, Complement::analytic})
+    if (name == complement_name(c)) return c;
+  throw InputError("unknown choice of D '" + std::string(name) +
+                   "'; choose one of: qr, partition, analytic");
+}
+
+Status compute_acceleration(const Model& model, Data& data, const FormulationOptions& options) {
+  if (data.stage < Stage::terms)
+    throw std::logic_error("compute_acceleration: call compute_terms first for the current state");
+  data.has_multipliers = false;
+  Status status = Status::ok;
+  switch (options.method) {
+    case Method::sanh: status = compute_sanh_acceleration(model, data, options.complement); break;
+    case Method::lagrange: status = compute_lagrange_acceleration(model, data); break;
+    case Method::udwadia_kalaba: status = compute_udwadia_kalaba_acceleration(model, data); break;
+    case Method::nullspace: status = compute_nullspace_acceleration(model, data, options.complement); break;
+  }
+  if (status != Status::ok) return status;
+  if (!data.qdd.allFinite()) return record_failure(data, Status::non_finite, "accelerations q''");
+  if (!data.R.allFinite()) return record_failure(data, Status::non_finite, "reactions R");
+  data.stage = Stage::acceleration;
+  ++data.acceleration_solves;
+  return Status::ok;
+}
+
+Status compute_dynamics(const Model& model, Data& data, const FormulationOptions& options, double t,
+                        const double* q, const double* v) {
+  const Status status = compute_terms(model, data, t, q, v);
+  if (status != Status::ok) return status;
+  return compute_acceleration(model, data, options);
+}
+
+}  // namespace nhdyn

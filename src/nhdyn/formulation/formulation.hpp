@@ -1,0 +1,43 @@
+// The four formulations of the equations of motion behind one entry point, chosen at run time:
+// sanh (the stacked Do Sanh system, the default), lagrange (KKT), udwadia-kalaba and nullspace
+// (Maggi). Each fills q'' and the reactions R in Data (and the multipliers where they exist).
+// FORMULATION.md sections 3 and 5.
+#pragma once
+
+#include <string_view>
+
+#include "nhdyn/core/status.hpp"
+#include "nhdyn/model/data.hpp"
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn {
+
+enum class Method { sanh, lagrange, udwadia_kalaba, nullspace };
+
+// Where D comes from (FORMULATION.md section 3): the model's analytic D, coordinate
+// partitioning, or an orthonormal basis of null(b) from a QR factorization (the default).
+enum class Complement { qr, partition, analytic };
+
+struct FormulationOptions {
+  Method method = Method::sanh;
+  Complement complement = Complement::qr;
+};
+
+// "sanh", "lagrange", "udwadia-kalaba", "nullspace".
+std::string_view method_name(Method method);
+Method parse_method(std::string_view name);  // throws InputError listing valid names
+// "qr", "partition", "analytic".
+std::string_view complement_name(Complement complement);
+Complement parse_complement(std::string_view name);  // throws InputError listing valid names
+
+// Requires compute_terms for the current state (Stage::terms). Writes data.qdd, data.R,
+// data.lambda (when the method has multipliers), data.D (sanh, nullspace) and sets
+// Stage::acceleration. Allocates nothing. On numerical trouble returns a non-ok status, records
+// it in data, and leaves stage at Stage::terms; explain_failure (diagnosis.hpp) gives the words.
+Status compute_acceleration(const Model& model, Data& data, const FormulationOptions& options);
+
+// Terms then acceleration at (t, q, v): the right-hand side of the equations of motion.
+Status compute_dynamics(const Model& model, Data& data, const FormulationOptions& options, double t,
+                        const double* q, const double* v);
+
+}  // namespace nhdyn

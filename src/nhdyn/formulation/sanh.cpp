@@ -1,0 +1,44 @@
+#include "nhdyn/formulation/sanh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "nhdyn/formulation/complement.hpp"
+#include "nhdyn/model/terms.hpp"
+
+namespace nhdyn {
+
+bool lu_is_singular(const Eigen::PartialPivLU<Matrix>& lu) {
+  const Matrix& LU = lu.matrixLU();
+  double largest = 0.0;
+  double smallest = std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 0; i < LU.rows(); ++i) {
+    const double d = std::abs(LU(i, i));
+    largest = std::max(largest, d);
+    smallest = std::min(smallest, d);
+  }
+  // Only an exactly or numerically zero pivot: rows of [D A; b] carry different units, so a
+  // tighter test would refuse well-posed but badly scaled systems.
+  return !(smallest > largest * std::numeric_limits<double>::epsilon() * static_cast<double>(LU.rows()));
+}
+
+Status compute_sanh_acceleration(const Model& model, Data& data, Complement complement) {
+  const int k = model.k();
+  const int s = model.s();
+  const Status status = compute_complement(model, data, complement);
+  if (status != Status::ok) return status;
+  data.h = data.Q + data.G;
+  data.M.topRows(k).noalias() = data.D * data.A;
+  data.M.bottomRows(s) = data.b;
+  data.rhs.head(k).noalias() = data.D * data.h;
+  data.rhs.tail(s) = -data.b0;
+  data.lu_n.compute(data.M);
+  if (lu_is_singular(data.lu_n)) return record_failure(data, Status::singular_system, "stacked matrix [D A; b]");
+  data.qdd = data.lu_n.solve(data.rhs);
+  data.R.noalias() = data.A * data.qdd;
+  data.R -= data.h;
+  return Status::ok;
+}
+
+}  // namespace nhdyn

@@ -1,0 +1,371 @@
+#include "nhdyn/integrators/explicit_rk.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+namespace nhdyn {
+namespace {
+
+constexpr double eps = std::numeric_limits<double>::epsilon();
+
+// One explicit Runge-Kutta step for any tableau. Owns the stage derivatives k_i and a scratch
+// state, allocated once per integrate() call.
+template <class Tableau>
+class Stepper {
+ public:
+  explicit Stepper(int n) : n_(n), y_stage_(static_cast<std::size_t>(n)) {
+    for (std::vector<double>& k : k_) k.assign(static_cast<std::size_t>(n), 0.0);
+  }
+
+  double* k(int i) { return k_[static_cast<std::size_t>(i)].data(); }
+  const double* k(int i) const { return k_[static_cast<std::size_t>(i)].data(); }
+  double* scratch() { return y_stage_.data(); }
+
+  // The FSAL stage of one step is the first of the next: swapping the buffers saves a copy.
+  void reuse_last_stage() { std::swap(k_.front(), k_.back()); }
+
+  // Evaluates stages 2..s of a step of size h from (t, y), k(0) holding f(t, y) on entry, and
+  // writes y1 = y + h sum b_i k_i. On a non-ok status, t_fail is where the rhs failed.
+  Status step(OdeSystem& system, double t, const double* y, double h, double* y1,
+              IntegratorStats& stats, double& t_fail) {
+    constexpr int s_count = Tableau::stages;
+    for (int s = 1; s < s_count; ++s) {
+      // With FSAL the last row of a equals b, so the last stage state is y1 itself.
+      double* target = (Tableau::fsal && s == s_count - 1) ? y1 : y_stage_.data();
+      combine(Tableau::a[static_cast<std::size_t>(s)], s, y, h, target);
+      const double ts = t + Tableau::c[static_cast<std::size_t>(s)] * h;
+      ++stats.rhs_evaluations;
+      const Status status = system.rhs(ts, target, k(s));
+      if (status != Status::ok) {
+        t_fail = ts;
+        return status;
+      }
+    }
+    if constexpr (!Tableau::fsal) combine(Tableau::b, s_count, y, h, y1);
+    return Status::ok;
+  }
+
+ private:
+  // target = y + h sum_{j < count} w_j k_j, skipping the zeros that sparse tableaus are full of.
+  void combine(const std::array<double, Tableau::stages>& w, int count, const double* y, double h,
+               double* target) const {
+    std::copy(y, y + n_, target);
+    for (int j = 0; j < count; ++j) {
+      if (w[static_cast<std::size_t>(j)] == 0.0) continue;
+      const double coef = h * w[static_cast<std::size_t>(j)];
+      const double* kj = k(j);
+      for (int i = 0; i < n_; ++i) target[i] += coef * kj[i];
+    }
+  }
+
+  int n_;
+  std::vector<double> y_stage_;
+  std::array<std::vector<double>, Tableau::stages> k_;
+};
+
+bool all_finite(const double* y, int n) {
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(y[i])) return false;
+  return true;
+}
+
+IntegrationResult rhs_failure(std::string_view method, Status status, double t_fail,
+                              double t_reached, const IntegratorStats& stats) {
+  IntegrationResult result;
+  result.status = status;
+  result.t_reached = t_reached;
+  result.stats = stats;
+  result.message = fmt::format("{}: the right-hand side failed at t = {}: {}", method, t_fail,
+                               describe(status));
+  return result;
+}
+
+IntegrationResult budget_exhausted(std::string_view method, long max_steps, double t,
+                                   const IntegratorStats& stats) {
+  IntegrationResult result;
+  result.status = Status::too_many_steps;
+  result.t_reached = t;
+  result.stats = stats;
+  result.message = fmt::format(
+      "{}: the budget of {} steps (accepted + rejected) was used up at t = {}; raise max_steps or "
+      "loosen the tolerances",
+      method, max_steps, t);
+  return result;
+}
+
+IntegrationResult stopped_at(double t, const IntegratorStats& stats) {
+  IntegrationResult result;
+  result.status = Status::stopped;
+  result.t_reached = t;
+  result.stats = stats;
+  return result;
+}
+
+// RMS norm of v / (atol + rtol |w|), the weights of Hairer's initial step heuristic.
+double weighted_rms(const double* v, const double* w, int n, double rtol, double atol) {
+  double sum = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double r = v[i] / (atol + rtol * std::abs(w[i]));
+    sum += r * r;
+  }
+  return std::sqrt(sum / n);
+}
+
+// Hairer-Norsett-Wanner I, II.4 "Starting step size": an explicit Euler step of size h0 measures
+// the second derivative, and h makes the local error of a method of order p about 0.01.
+// Uses one rhs evaluation; scratch and f1 are n-vectors it may overwrite.
+Status initial_step(OdeSystem& system, const IntegratorOptions& options, int order, double t0,
+                    const double* y0, const double* f0, double hmax, double* scratch, double* f1,
+                    IntegratorStats& stats, double& h) {
+  const int n = system.size();
+  const double d0 = weighted_rms(y0, y0, n, options.rtol, options.atol);
+  const double d1 = weighted_rms(f0, y0, n, options.rtol, options.atol);
+  double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+  h0 = std::min(h0, hmax);
+  for (int i = 0; i < n; ++i) scratch[i] = y0[i] + h0 * f0[i];
+  ++stats.rhs_evaluations;
+  const Status status = system.rhs(t0 + h0, scratch, f1);
+  if (status != Status::ok) return status;
+  for (int i = 0; i < n; ++i) scratch[i] = f1[i] - f0[i];
+  const double d2 = weighted_rms(scratch, y0, n, options.rtol, options.atol) / h0;
+  const double dmax = std::max(d1, d2);
+  const double h1 =
+      dmax <= 1e-15 ? std::max(1e-6, h0 * 1e-3) : std::pow(0.01 / dmax, 1.0 / (order + 1));
+  h = std::min({100.0 * h0, h1, hmax});
+  return Status::ok;
+}
+
+// Hairer's CONTD5: y(t + theta h) from the stages of the step (t, y) -> (t + h, y1), whose
+// last stage is f(t + h, y1). Order 4, continuous across steps.
+void continuous_extension(const Stepper<rk::DormandPrince54>& stepper, int n, const double* y,
+                          const double* y1, double h, double theta, double* out) {
+  using Tableau = rk::DormandPrince54;
+  const double theta1 = 1.0 - theta;
+  const double* k_first = stepper.k(0);
+  const double* k_last = stepper.k(Tableau::stages - 1);
+  for (int i = 0; i < n; ++i) {
+    const double ydiff = y1[i] - y[i];
+    const double bspl = h * k_first[i] - ydiff;
+    const double hermite = ydiff - h * k_last[i] - bspl;
+    double dk = 0.0;
+    for (int j = 0; j < Tableau::stages; ++j)
+      dk += Tableau::d[static_cast<std::size_t>(j)] * stepper.k(j)[i];
+    out[i] = y[i] + theta * (ydiff + theta1 * (bspl + theta * (hermite + theta1 * h * dk)));
+  }
+}
+
+}  // namespace
+
+IntegrationResult integrate_rk4(OdeSystem& system, const IntegratorOptions& options, double t0,
+                                const double* y0, std::span<const double> output_times,
+                                const OutputFn& output) {
+  constexpr std::string_view method = "rk4";
+  const int n = system.size();
+  IntegrationResult result;
+  result.t_reached = t0;
+  if (output_times.empty()) return result;
+
+  std::vector<double> y(y0, y0 + n);
+  std::vector<double> y1(static_cast<std::size_t>(n));
+  Stepper<rk::ClassicRk4> stepper(n);
+  IntegratorStats stats;
+
+  std::size_t next = 0;
+  if (output_times.front() == t0) {
+    if (output(t0, y.data()) == Status::stopped) return stopped_at(t0, stats);
+    ++next;
+  }
+  const std::size_t intervals = output_times.size() - next;
+  if (intervals == 0) return result;
+  const double h_nominal =
+      options.step > 0.0 ? options.step
+                         : (output_times.back() - t0) / static_cast<double>(intervals) / 10.0;
+
+  double t = t0;
+  for (; next < output_times.size(); ++next) {
+    const double t_start = t;
+    const double t_out = output_times[next];
+    // The slack keeps an interval that is a whole number of steps up to round-off from gaining
+    // one more step.
+    const double ratio = std::min((t_out - t_start) / h_nominal * (1.0 - 1e-12), 1e18);
+    const long steps = std::max(1L, static_cast<long>(std::ceil(ratio)));
+    const double h = (t_out - t_start) / static_cast<double>(steps);
+    for (long j = 1; j <= steps; ++j) {
+      if (stats.steps >= options.max_steps)
+        return budget_exhausted(method, options.max_steps, t, stats);
+      ++stats.rhs_evaluations;
+      Status status = system.rhs(t, y.data(), stepper.k(0));
+      double t_fail = t;
+      if (status == Status::ok)
+        status = stepper.step(system, t, y.data(), h, y1.data(), stats, t_fail);
+      if (status != Status::ok) return rhs_failure(method, status, t_fail, t, stats);
+      // Multiplying rather than accumulating keeps round-off from drifting the step ends; the
+      // last one is the output time itself.
+      const double t_new = j == steps ? t_out : t_start + static_cast<double>(j) * h;
+      if (!all_finite(y1.data(), n)) {
+        IntegrationResult failure = rhs_failure(method, Status::non_finite, t_new, t, stats);
+        failure.message = fmt::format(
+            "{}: the step from t = {} to t = {} gave a non-finite state; reduce the step", method,
+            t, t_new);
+        return failure;
+      }
+      std::swap(y, y1);
+      ++stats.steps;
+      t = t_new;
+      // Nothing is carried from one rk4 step to the next, so a changed state needs no restart.
+      system.after_step(t, y.data());
+    }
+    if (output(t, y.data()) == Status::stopped) return stopped_at(t, stats);
+  }
+  result.t_reached = t;
+  result.stats = stats;
+  return result;
+}
+
+IntegrationResult integrate_dopri5(OdeSystem& system, const IntegratorOptions& options, double t0,
+                                   const double* y0, std::span<const double> output_times,
+                                   const OutputFn& output) {
+  using Tableau = rk::DormandPrince54;
+  constexpr std::string_view method = "dopri5";
+  // Hairer's DOPRI5 defaults: PI control with beta = 0.04, new step within [h/5, 10 h],
+  // safety factor 0.9.
+  constexpr double beta = 0.04;
+  constexpr double expo1 = 1.0 / (Tableau::embedded_order + 1) - 0.75 * beta;
+  constexpr double fac_min = 0.2;
+  constexpr double fac_max = 10.0;
+  constexpr double safety = 0.9;
+
+  const int n = system.size();
+  IntegrationResult result;
+  result.t_reached = t0;
+  if (output_times.empty()) return result;
+
+  std::vector<double> y(y0, y0 + n);
+  std::vector<double> y1(static_cast<std::size_t>(n));
+  std::vector<double> y_out(static_cast<std::size_t>(n));
+  Stepper<Tableau> stepper(n);
+  IntegratorStats stats;
+
+  std::size_t next = 0;
+  if (output_times.front() == t0) {
+    if (output(t0, y.data()) == Status::stopped) return stopped_at(t0, stats);
+    ++next;
+  }
+  if (next == output_times.size()) return result;
+  const double t_end = output_times.back();
+  const double hmax = options.max_step > 0.0 ? std::min(options.max_step, t_end - t0) : t_end - t0;
+
+  double t = t0;
+  ++stats.rhs_evaluations;
+  Status status = system.rhs(t, y.data(), stepper.k(0));
+  if (status != Status::ok) return rhs_failure(method, status, t, t, stats);
+  double h = 0.0;
+  if (options.step > 0.0) {
+    h = std::min(options.step, hmax);
+  } else {
+    status = initial_step(system, options, Tableau::order, t, y.data(), stepper.k(0), hmax,
+                          stepper.scratch(), stepper.k(1), stats, h);
+    if (status != Status::ok) return rhs_failure(method, status, t, t, stats);
+  }
+
+  double err_old = 1e-4;  // Hairer's FACOLD: the previous accepted error, floored
+  bool last_rejected = false;
+  bool last_error_finite = true;
+  for (;;) {
+    if (stats.steps + stats.rejected_steps >= options.max_steps)
+      return budget_exhausted(method, options.max_steps, t, stats);
+    if (!(h >= 16.0 * eps * std::max(std::abs(t), std::numeric_limits<double>::min()))) {
+      IntegrationResult failure;
+      failure.status = last_error_finite ? Status::step_size_underflow : Status::non_finite;
+      failure.t_reached = t;
+      failure.stats = stats;
+      failure.message =
+          last_error_finite
+              ? fmt::format("{}: step size underflow at t = {} (h = {}): the solution may be "
+                            "singular there, or the tolerances too tight",
+                            method, t, h)
+              : fmt::format("{}: non-finite states at t = {} for every step size down to h = {}",
+                            method, t, h);
+      return failure;
+    }
+    // Reaching t_end within 1% of a step is done in that step; stretching the last step a little
+    // is cheaper than a sliver of a step after it.
+    const bool last = t + 1.01 * h >= t_end;
+    if (last) h = t_end - t;
+
+    double t_fail = t;
+    status = stepper.step(system, t, y.data(), h, y1.data(), stats, t_fail);
+    if (status != Status::ok) return rhs_failure(method, status, t_fail, t, stats);
+
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+      double e = 0.0;
+      for (int j = 0; j < Tableau::stages; ++j)
+        e += Tableau::e[static_cast<std::size_t>(j)] * stepper.k(j)[i];
+      const double sk = options.atol + options.rtol * std::max(std::abs(y[i]), std::abs(y1[i]));
+      const double r = h * e / sk;
+      sum += r * r;
+    }
+    const double err = std::sqrt(sum / n);
+    last_error_finite = std::isfinite(err);
+
+    if (!last_error_finite) {
+      // An overflow in a too-long step: retreat as far as the controller ever does.
+      ++stats.rejected_steps;
+      last_rejected = true;
+      h *= fac_min;
+      continue;
+    }
+    const double fac11 = std::pow(err, expo1);
+    if (err > 1.0) {
+      ++stats.rejected_steps;
+      last_rejected = true;
+      h /= std::min(1.0 / fac_min, fac11 / safety);
+      continue;
+    }
+
+    const double fac =
+        std::clamp(fac11 / std::pow(err_old, beta) / safety, 1.0 / fac_max, 1.0 / fac_min);
+    double h_new = h / fac;
+    err_old = std::max(err, 1e-4);
+    // Right after a rejection, growing the step again invites another one.
+    if (last_rejected) h_new = std::min(h_new, h);
+    last_rejected = false;
+    ++stats.steps;
+
+    const double t_new = last ? t_end : t + h;
+    // Outputs inside the step follow the step's own solution; after_step acts at the step end,
+    // so an output there sees the state it leaves.
+    for (; next < output_times.size() && output_times[next] < t_new; ++next) {
+      const double t_out = output_times[next];
+      continuous_extension(stepper, n, y.data(), y1.data(), h, (t_out - t) / h, y_out.data());
+      if (output(t_out, y_out.data()) == Status::stopped) return stopped_at(t_out, stats);
+    }
+    if (system.after_step(t_new, y1.data())) {
+      // The FSAL stage belongs to the state before the change.
+      ++stats.rhs_evaluations;
+      status = system.rhs(t_new, y1.data(), stepper.k(Tableau::stages - 1));
+      if (status != Status::ok) return rhs_failure(method, status, t_new, t_new, stats);
+    }
+    if (next < output_times.size() && output_times[next] == t_new) {
+      if (output(t_new, y1.data()) == Status::stopped) return stopped_at(t_new, stats);
+      ++next;
+    }
+
+    std::swap(y, y1);
+    stepper.reuse_last_stage();
+    t = t_new;
+    if (last) break;
+    h = std::min(h_new, hmax);
+  }
+  result.t_reached = t;
+  result.stats = stats;
+  return result;
+}
+
+}  // namespace nhdyn

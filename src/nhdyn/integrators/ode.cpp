@@ -1,0 +1,104 @@
+#include "nhdyn/integrators/ode.hpp"
+
+#include <array>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/integrators/explicit_rk.hpp"
+#include "nhdyn/integrators/sundials/cvode.hpp"
+
+namespace nhdyn {
+namespace {
+
+constexpr std::array<IntegratorKind, 4> all_kinds{IntegratorKind::rk4, IntegratorKind::dopri5,
+                                                  IntegratorKind::cvode_bdf,
+                                                  IntegratorKind::cvode_adams};
+
+bool is_adaptive(IntegratorKind kind) { return kind != IntegratorKind::rk4; }
+
+// Everything the integrators rely on without checking again: bad values here are the user's
+// (a model file, a command line), so they throw rather than return a status.
+void require_valid_input(const OdeSystem& system, const IntegratorOptions& options, double t0,
+                         const double* y0, std::span<const double> output_times) {
+  const int n = system.size();
+  if (n < 1)
+    throw InputError(fmt::format("the system to integrate has {} states; it needs at least 1", n));
+  if (!std::isfinite(t0)) throw InputError(fmt::format("initial time t0 = {} is not finite", t0));
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(y0[i]))
+      throw InputError(fmt::format("initial state y0[{}] = {} is not finite", i, y0[i]));
+
+  if (is_adaptive(options.kind)) {
+    if (!(options.rtol >= 0.0) || !std::isfinite(options.rtol))
+      throw InputError(fmt::format("rtol = {} must be a finite number >= 0", options.rtol));
+    if (!(options.atol > 0.0) || !std::isfinite(options.atol))
+      throw InputError(fmt::format(
+          "atol = {} must be a finite number > 0 (pure relative error control fails where a "
+          "state crosses zero)",
+          options.atol));
+  }
+  if (!(options.step >= 0.0) || !std::isfinite(options.step))
+    throw InputError(fmt::format("step = {} must be a finite number >= 0 (0 = automatic)",
+                                 options.step));
+  if (!(options.max_step >= 0.0) || !std::isfinite(options.max_step))
+    throw InputError(fmt::format("max_step = {} must be a finite number >= 0 (0 = unlimited)",
+                                 options.max_step));
+  if (options.max_steps < 1)
+    throw InputError(fmt::format("max_steps = {} must be at least 1", options.max_steps));
+
+  double previous = t0;
+  for (std::size_t i = 0; i < output_times.size(); ++i) {
+    const double t = output_times[i];
+    if (!std::isfinite(t))
+      throw InputError(fmt::format("output time {} (index {}) is not finite", t, i));
+    if (i == 0 && t < t0)
+      throw InputError(fmt::format(
+          "output time {} (index 0) is before the initial time t0 = {}; output times must be >= t0",
+          t, t0));
+    if (i > 0 && !(t > previous))
+      throw InputError(fmt::format(
+          "output time {} (index {}) is not after the previous one, {}; output times must be "
+          "strictly increasing",
+          t, i, previous));
+    previous = t;
+  }
+}
+
+}  // namespace
+
+std::string_view integrator_name(IntegratorKind kind) {
+  switch (kind) {
+    case IntegratorKind::rk4: return "rk4";
+    case IntegratorKind::dopri5: return "dopri5";
+    case IntegratorKind::cvode_bdf: return "cvode-bdf";
+    case IntegratorKind::cvode_adams: return "cvode-adams";
+  }
+  return "unknown";
+}
+
+IntegratorKind parse_integrator(std::string_view name) {
+  for (IntegratorKind kind : all_kinds)
+    if (integrator_name(kind) == name) return kind;
+  throw InputError(fmt::format(
+      "unknown integrator '{}'; valid names are rk4, dopri5, cvode-bdf, cvode-adams", name));
+}
+
+IntegrationResult integrate(OdeSystem& system, const IntegratorOptions& options, double t0,
+                            const double* y0, std::span<const double> output_times,
+                            const OutputFn& output) {
+  require_valid_input(system, options, t0, y0, output_times);
+  switch (options.kind) {
+    case IntegratorKind::rk4:
+      return integrate_rk4(system, options, t0, y0, output_times, output);
+    case IntegratorKind::dopri5:
+      return integrate_dopri5(system, options, t0, y0, output_times, output);
+    case IntegratorKind::cvode_bdf:
+    case IntegratorKind::cvode_adams:
+      return integrate_cvode(system, options, t0, y0, output_times, output);
+  }
+  throw InputError(fmt::format("invalid integrator kind {}", static_cast<int>(options.kind)));
+}
+
+}  // namespace nhdyn

@@ -1,0 +1,68 @@
+// The interface between a mechanical model and the time integrators: a first-order system
+// y' = f(t, y) with y = [q; q'] (size 2n), output at user-chosen times independent of the steps,
+// and a hook after each accepted step (used by constraint projection). Integrators know nothing
+// of mechanics; the simulation driver (analysis/simulation.hpp) adapts a Model to OdeSystem.
+#pragma once
+
+#include <functional>
+#include <span>
+#include <string_view>
+#include <string>
+
+#include "nhdyn/core/status.hpp"
+
+namespace nhdyn {
+
+class OdeSystem {
+ public:
+  virtual ~OdeSystem() = default;
+  // Number of states.
+  virtual int size() const = 0;
+  // ydot = f(t, y). Returns Status::ok or the reason the right-hand side cannot be evaluated;
+  // an integrator stops at the first non-ok status and reports it.
+  virtual Status rhs(double t, const double* y, double* ydot) = 0;
+  // Called after every accepted step with the new state; may change y in place (projection onto
+  // the constraint manifold) and then returns true, so that the integrator restarts from the
+  // changed state (drops FSAL derivatives, re-initializes multistep history).
+  virtual bool after_step(double /*t*/, double* /*y*/) { return false; }
+};
+
+enum class IntegratorKind { rk4, dopri5, cvode_bdf, cvode_adams };
+
+// "rk4", "dopri5", "cvode-bdf", "cvode-adams".
+std::string_view integrator_name(IntegratorKind kind);
+// Inverse of integrator_name; throws InputError listing the valid names.
+IntegratorKind parse_integrator(std::string_view name);
+
+struct IntegratorOptions {
+  IntegratorKind kind = IntegratorKind::dopri5;
+  double rtol = 1e-8;        // relative tolerance (adaptive methods)
+  double atol = 1e-10;       // absolute tolerance (adaptive methods)
+  double step = 0.0;         // rk4: largest step; 0 = output step / 10. Adaptive: first step, 0 = automatic
+  double max_step = 0.0;     // adaptive: largest step, 0 = unlimited
+  long max_steps = 50'000'000;  // budget of accepted + rejected steps for the whole run
+};
+
+struct IntegratorStats {
+  long steps = 0;             // accepted steps
+  long rejected_steps = 0;    // rejected by the error test (adaptive) or failed (CVODE)
+  long rhs_evaluations = 0;   // calls of OdeSystem::rhs, including those for Jacobians
+};
+
+struct IntegrationResult {
+  Status status = Status::ok;
+  double t_reached = 0.0;     // last time the solution is known at
+  IntegratorStats stats;
+  std::string message;        // empty when ok; otherwise what went wrong, with t
+};
+
+// Called at each output time with the interpolated state; return Status::stopped to end the run.
+using OutputFn = std::function<Status(double t, const double* y)>;
+
+// Integrates from (t0, y0) and calls `output` at every time of `output_times` (strictly increasing,
+// all >= t0; the first may equal t0). Does not throw on numerical trouble: the result says.
+IntegrationResult integrate(OdeSystem& system, const IntegratorOptions& options, double t0,
+                            const double* y0, std::span<const double> output_times,
+                            const OutputFn& output);
+
+}  // namespace nhdyn

@@ -1,0 +1,120 @@
+#include "nhdyn/io/csv.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "nhdyn/core/error.hpp"
+
+namespace nhdyn {
+namespace {
+
+std::string quote_if_needed(const std::string& name) {
+  if (name.find_first_of(",\"\n") == std::string::npos) return name;
+  std::string out = "\"";
+  for (char c : name) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::vector<std::string> split_header(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cell;
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') cell += line[++i];
+      else if (c == '"') quoted = false;
+      else cell += c;
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      out.push_back(cell);
+      cell.clear();
+    } else if (c != '\r') {
+      cell += c;
+    }
+  }
+  out.push_back(cell);
+  return out;
+}
+
+}  // namespace
+
+CsvWriter::CsvWriter(const std::filesystem::path& target, const std::vector<std::string>& columns)
+    : file_(target), columns_(columns.size()) {
+  std::string header;
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    if (i) header += ',';
+    header += quote_if_needed(columns[i]);
+  }
+  header += '\n';
+  file_.write(header);
+  buffer_.reserve(1 << 16);
+}
+
+void CsvWriter::write_row(std::span<const double> values) {
+  if (values.size() != columns_)
+    throw std::logic_error(fmt::format("CsvWriter: a row of {} values for {} columns", values.size(), columns_));
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (i) buffer_ += ',';
+    fmt::format_to(std::back_inserter(buffer_), "{}", values[i]);
+  }
+  buffer_ += '\n';
+  if (buffer_.size() > (1 << 15)) {
+    file_.write(buffer_);
+    buffer_.clear();
+  }
+}
+
+void CsvWriter::commit() {
+  file_.write(buffer_);
+  buffer_.clear();
+  file_.commit();
+}
+
+int CsvTable::column(const std::string& name) const {
+  for (std::size_t i = 0; i < header.size(); ++i)
+    if (header[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
+CsvTable load_csv(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw FileError(fmt::format("cannot read '{}'", path.string()));
+  CsvTable table;
+  std::string line;
+  if (!std::getline(in, line)) throw FileError(fmt::format("'{}' is empty; expected a header row", path.string()));
+  table.header = split_header(line);
+  long line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.empty()) continue;
+    std::vector<double> row;
+    row.reserve(table.header.size());
+    const char* p = line.c_str();
+    while (*p) {
+      char* end = nullptr;
+      const double value = std::strtod(p, &end);
+      if (end == p)
+        throw FileError(fmt::format("{}:{}: not a number at column {}", path.string(), line_number, row.size() + 1));
+      row.push_back(value);
+      p = end;
+      if (*p == ',') ++p;
+      else if (*p == '\r') ++p;
+      else if (*p) throw FileError(fmt::format("{}:{}: unexpected character '{}'", path.string(), line_number, *p));
+    }
+    if (row.size() != table.header.size())
+      throw FileError(fmt::format("{}:{}: {} values for {} columns", path.string(), line_number, row.size(),
+                                  table.header.size()));
+    table.rows.push_back(std::move(row));
+  }
+  return table;
+}
+
+}  // namespace nhdyn

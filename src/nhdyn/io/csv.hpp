@@ -1,0 +1,39 @@
+// CSV output of a simulation: a header row naming every column, then one row of numbers per
+// output time, written through an AtomicFile so that a failed run leaves no partial file.
+// Numbers are printed in the shortest form that reads back to the same double.
+#pragma once
+
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "nhdyn/io/atomic_file.hpp"
+
+namespace nhdyn {
+
+class CsvWriter {
+ public:
+  // Opens the temporary file at once (FileError if the target cannot be written) and writes the
+  // header. Names containing a comma or a quote are quoted.
+  CsvWriter(const std::filesystem::path& target, const std::vector<std::string>& columns);
+
+  void write_row(std::span<const double> values);  // values.size() must equal the column count
+  void commit();                                  // the file appears whole, or FileError
+  std::size_t columns() const { return columns_; }
+
+ private:
+  AtomicFile file_;
+  std::size_t columns_;
+  std::string buffer_;
+};
+
+// Reads a CSV written by CsvWriter (header and numeric rows); for tests and comparisons.
+struct CsvTable {
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  int column(const std::string& name) const;  // index, or -1
+};
+CsvTable load_csv(const std::filesystem::path& path);  // throws FileError naming file and line
+
+}  // namespace nhdyn

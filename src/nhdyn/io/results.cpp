@@ -1,0 +1,40 @@
+#include "nhdyn/io/results.hpp"
+
+namespace nhdyn {
+
+ResultColumns make_result_columns(const Model& model) {
+  ResultColumns c;
+  c.all.push_back("t");
+  for (const std::string& q : model.coordinates) c.coordinates.push_back(q);
+  for (const std::string& q : model.coordinates) c.reactions.push_back("R_" + q);
+  for (const Constraint& con : model.constraints)
+    if (con.level == ConstraintLevel::position) c.residuals.push_back("residual_pos_" + con.name);
+  for (const Constraint& con : model.constraints)
+    if (con.level != ConstraintLevel::acceleration) c.residuals.push_back("residual_vel_" + con.name);
+  for (const Constraint& con : model.constraints) c.residuals.push_back("residual_acc_" + con.name);
+  c.all.insert(c.all.end(), c.coordinates.begin(), c.coordinates.end());
+  for (const std::string& q : model.coordinates) c.all.push_back(q + "'");
+  for (const std::string& q : model.coordinates) c.all.push_back(q + "''");
+  c.all.insert(c.all.end(), c.reactions.begin(), c.reactions.end());
+  c.all.insert(c.all.end(), c.residuals.begin(), c.residuals.end());
+  if (model.evaluator && model.evaluator->has_energy()) {
+    c.energy = "energy";
+    c.all.push_back(c.energy);
+  }
+  return c;
+}
+
+void fill_result_row(const Model& model, const Data& data, std::vector<double>& row) {
+  row.clear();
+  row.push_back(data.t);
+  for (int i = 0; i < model.n(); ++i) row.push_back(data.q(i));
+  for (int i = 0; i < model.n(); ++i) row.push_back(data.v(i));
+  for (int i = 0; i < model.n(); ++i) row.push_back(data.qdd(i));
+  for (int i = 0; i < model.n(); ++i) row.push_back(data.R(i));
+  for (Eigen::Index i = 0; i < data.phi.size(); ++i) row.push_back(data.phi(i));
+  for (Eigen::Index i = 0; i < data.f.size(); ++i) row.push_back(data.f(i));
+  for (Eigen::Index i = 0; i < data.e.size(); ++i) row.push_back(data.e(i));
+  if (model.evaluator->has_energy()) row.push_back(data.energy);
+}
+
+}  // namespace nhdyn

@@ -1,0 +1,31 @@
+// The layout of a simulation's results, one row per output time, in this order:
+//   t, the coordinates q (by name), their velocities (x'), accelerations (x''), reactions (R_x),
+//   the constraint residuals — position level (residual_pos_<constraint>), velocity level
+//   (residual_vel_<constraint>), acceleration level (residual_acc_<constraint>) — and energy
+//   (when the model defines one).
+// Shared by the CSV writer and the plots so that both name the columns the same way.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "nhdyn/model/data.hpp"
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn {
+
+struct ResultColumns {
+  std::vector<std::string> all;          // every column, in order
+  std::vector<std::string> coordinates;  // q
+  std::vector<std::string> reactions;    // R
+  std::vector<std::string> residuals;    // the three levels
+  std::string energy;                    // empty when the model defines none
+};
+
+ResultColumns make_result_columns(const Model& model);
+
+// Fills `row` (sized to the column count; no allocation after the first call) from Data after
+// compute_acceleration, compute_residuals and compute_energy.
+void fill_result_row(const Model& model, const Data& data, std::vector<double>& row);
+
+}  // namespace nhdyn

@@ -1,0 +1,55 @@
+// The numeric face of a mechanical system: at (t, q, q') an Evaluator yields the terms of the
+// equations of motion (A, Q, G, b, b0), optionally an analytic complement D, the residuals of the
+// constraints at the level they were given, and the energy. Built-in C++ models implement it by
+// hand; model files (through the symbolic compiler) and generated code are other implementations.
+// It is stateless: any workspace it needs is the `scratch` array that Data owns.
+#pragma once
+
+#include <cstddef>
+
+namespace nhdyn {
+
+// Where an Evaluator writes the terms. All matrices are column-major and contiguous, with a
+// leading dimension equal to their number of rows (the layout of Eigen::MatrixXd).
+struct TermsOut {
+  double* A;   // n x n inertia matrix, d2T/dq'2 (FORMULATION.md (2.4))
+  double* Q;   // n generalized forces, -dV/dq + nonconservative forces
+  double* G;   // n velocity terms of the kinetic energy (FORMULATION.md section 1)
+  double* b;   // s x n constraint matrix at acceleration level, b q'' + b0 = 0 (2.5)
+  double* b0;  // s
+};
+
+class Evaluator {
+ public:
+  virtual ~Evaluator() = default;
+
+  // Number of doubles of workspace every call below needs (0 for hand-written models).
+  virtual std::size_t scratch_size() const { return 0; }
+
+  // Fills every entry of A, Q, G, b and b0.
+  virtual void terms(double t, const double* q, const double* v, double* scratch,
+                     const TermsOut& out) const = 0;
+
+  // Whether complement() is implemented (the model carries an analytic D).
+  virtual bool has_complement() const { return false; }
+  // D: k x n (k = n - s), column-major, rank k, D b^T = 0 (2.8).
+  virtual void complement(double /*t*/, const double* /*q*/, const double* /*v*/,
+                          double* /*scratch*/, double* /*D*/) const {}
+
+  // phi(t, q): one value per constraint given at position level, in constraint order.
+  virtual void position_residual(double /*t*/, const double* /*q*/, double* /*scratch*/,
+                                 double* /*phi*/) const {}
+  // One value per constraint given at position or velocity level, in constraint order:
+  // d phi/dt = phi_q q' + phi_t for a position-level one, f(t, q, q') for a velocity-level one.
+  virtual void velocity_residual(double /*t*/, const double* /*q*/, const double* /*v*/,
+                                 double* /*scratch*/, double* /*f*/) const {}
+
+  // Whether energy() is defined (T + V of a system whose other forces do no work).
+  virtual bool has_energy() const { return false; }
+  virtual double energy(double /*t*/, const double* /*q*/, const double* /*v*/,
+                        double* /*scratch*/) const {
+    return 0.0;
+  }
+};
+
+}  // namespace nhdyn

@@ -1,0 +1,46 @@
+#include "nhdyn/model/model.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <set>
+
+#include "nhdyn/core/error.hpp"
+
+namespace nhdyn {
+
+int Model::position_constraints() const {
+  return static_cast<int>(std::count_if(constraints.begin(), constraints.end(), [](const Constraint& c) {
+    return c.level == ConstraintLevel::position;
+  }));
+}
+
+int Model::velocity_constraints() const {
+  return static_cast<int>(std::count_if(constraints.begin(), constraints.end(), [](const Constraint& c) {
+    return c.level != ConstraintLevel::acceleration;
+  }));
+}
+
+void check_model_shape(const Model& model) {
+  const std::string who = fmt::format("model '{}'", model.name);
+  if (model.n() == 0) throw ModelError(who + ": it has no coordinates");
+  if (model.s() >= model.n())
+    throw ModelError(fmt::format("{}: {} constraints on {} coordinates leave no freedom of motion; "
+                                 "a model needs fewer constraints than coordinates",
+                                 who, model.s(), model.n()));
+  if (!model.evaluator) throw ModelError(who + ": it has no evaluator");
+  if (model.q0.size() != model.n() || model.v0.size() != model.n())
+    throw ModelError(fmt::format("{}: initial state has {} coordinates and {} velocities, expected {}",
+                                 who, model.q0.size(), model.v0.size(), model.n()));
+  std::set<std::string> seen;
+  for (const std::string& c : model.coordinates)
+    if (!seen.insert(c).second) throw ModelError(fmt::format("{}: coordinate '{}' appears twice", who, c));
+  for (const Constraint& c : model.constraints)
+    if (!seen.insert(c.name).second)
+      throw ModelError(fmt::format("{}: the name '{}' is used twice (constraint names must differ "
+                                   "from each other and from coordinate names)", who, c.name));
+  if (model.path && (model.path->x >= model.n() || model.path->y >= model.n()))
+    throw ModelError(who + ": the planar path names a coordinate that does not exist");
+}
+
+}  // namespace nhdyn

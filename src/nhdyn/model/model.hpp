@@ -1,0 +1,69 @@
+// Model: a frozen, numeric description of one constrained mechanical system — its coordinates,
+// constraints, parameters, initial state, simulation defaults, and the Evaluator that computes its
+// terms. Built once (by a built-in model's make_* function, and later by the model compiler),
+// then only read. Everything that changes in time lives in Data (data.hpp).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "nhdyn/core/types.hpp"
+#include "nhdyn/model/evaluator.hpp"
+
+namespace nhdyn {
+
+// The level at which a constraint is given (FORMULATION.md section 2).
+enum class ConstraintLevel { position, velocity, acceleration };
+
+struct Constraint {
+  std::string name;
+  ConstraintLevel level = ConstraintLevel::velocity;
+  std::string expression;  // as a user reads it, e.g. "y' - tan(phi) x' = 0"
+};
+
+struct Parameter {
+  std::string name;
+  double value = 0.0;
+  std::string unit;
+};
+
+// What a run of this model does when the user says nothing else.
+struct SimulationDefaults {
+  double t_end = 10.0;
+  double output_step = 0.01;
+};
+
+// A pair of coordinates that a plot may draw as a path y(x) (planar systems).
+struct PlanarPath {
+  int x = 0;
+  int y = 1;
+};
+
+struct Model {
+  std::string name;
+  std::string description;
+  std::vector<std::string> coordinates;  // n names, in the order of q
+  std::vector<Constraint> constraints;   // s, in the order of the rows of b
+  std::vector<Parameter> parameters;     // for display; values are baked into the evaluator
+  double t0 = 0.0;
+  Vector q0;                             // n, initial coordinates
+  Vector v0;                             // n, initial velocities
+  SimulationDefaults defaults;
+  std::optional<PlanarPath> path;
+  std::shared_ptr<const Evaluator> evaluator;
+
+  int n() const { return static_cast<int>(coordinates.size()); }
+  int s() const { return static_cast<int>(constraints.size()); }
+  int k() const { return n() - s(); }
+  // Number of constraints given at position level, and at position or velocity level.
+  int position_constraints() const;
+  int velocity_constraints() const;
+};
+
+// Checks the dimensions and names of a model before use; throws ModelError naming what is wrong.
+void check_model_shape(const Model& model);
+
+}  // namespace nhdyn

@@ -1,0 +1,43 @@
+#include "nhdyn/model/terms.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+namespace nhdyn {
+
+Status record_failure(Data& data, Status status, const char* quantity) {
+  data.status = status;
+  // assign() within the reserved capacity does not allocate.
+  data.failed_quantity.assign(quantity, std::min<std::size_t>(std::strlen(quantity), 63));
+  data.failed_t = data.t;
+  return status;
+}
+
+const char* find_non_finite_term(const Data& data) {
+  if (!data.A.allFinite()) return "inertia matrix A";
+  if (!data.Q.allFinite()) return "generalized forces Q";
+  if (!data.G.allFinite()) return "velocity terms G";
+  if (!data.b.allFinite()) return "constraint matrix b";
+  if (!data.b0.allFinite()) return "constraint term b0";
+  return nullptr;
+}
+
+Status compute_terms(const Model& model, Data& data, double t, const double* q, const double* v) {
+  const int n = model.n();
+  data.t = t;
+  // Copy only when the caller does not pass Data's own storage.
+  if (q != data.q.data()) std::memcpy(data.q.data(), q, sizeof(double) * static_cast<std::size_t>(n));
+  if (v != data.v.data()) std::memcpy(data.v.data(), v, sizeof(double) * static_cast<std::size_t>(n));
+  data.stage = Stage::empty;
+  TermsOut out{data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data()};
+  model.evaluator->terms(t, data.q.data(), data.v.data(), data.scratch.data(), out);
+  ++data.term_evaluations;
+  if (!data.q.allFinite()) return record_failure(data, Status::non_finite, "coordinates q");
+  if (!data.v.allFinite()) return record_failure(data, Status::non_finite, "velocities q'");
+  if (const char* bad = find_non_finite_term(data)) return record_failure(data, Status::non_finite, bad);
+  data.status = Status::ok;
+  data.stage = Stage::terms;
+  return Status::ok;
+}
+
+}  // namespace nhdyn

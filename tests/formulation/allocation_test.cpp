@@ -1,0 +1,126 @@
+// The acceleration solve allocates nothing after Data exists: every formulation and every choice
+// of D is run once, then again under a counting global operator new that must stay at zero.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+#include <vector>
+
+#include "nhdyn/analysis/residuals.hpp"
+#include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/model/appell.hpp"
+#include "nhdyn/model/sled.hpp"
+
+namespace {
+std::atomic<long> g_allocations{0};
+std::atomic<bool> g_counting{false};
+void count() {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+}
+}  // namespace
+
+#if defined(__SANITIZE_ADDRESS__)
+// AddressSanitizer owns malloc; count at operator new, which sees the standard containers
+// (Eigen allocates through malloc, so the release build below is the complete check).
+void* operator new(std::size_t size) {
+  count();
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return ::operator new(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+constexpr bool kCountsMalloc = false;
+#else
+// Eigen allocates with malloc, not operator new, so the count sits at malloc itself: these
+// definitions interpose glibc's for the whole executable, library code included.
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* __libc_memalign(std::size_t, std::size_t);
+void __libc_free(void*);
+void* malloc(std::size_t size) {
+  count();
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t n, std::size_t size) {
+  count();
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, std::size_t size) {
+  count();
+  return __libc_realloc(p, size);
+}
+void* memalign(std::size_t alignment, std::size_t size) {
+  count();
+  return __libc_memalign(alignment, size);
+}
+void* aligned_alloc(std::size_t alignment, std::size_t size) {
+  count();
+  return __libc_memalign(alignment, size);
+}
+int posix_memalign(void** out, std::size_t alignment, std::size_t size) {
+  count();
+  *out = __libc_memalign(alignment, size);
+  return *out ? 0 : 12;  // ENOMEM
+}
+void free(void* p) { __libc_free(p); }
+}
+constexpr bool kCountsMalloc = true;
+#endif
+
+namespace nhdyn {
+namespace {
+
+TEST(Allocation, AccelerationSolveAllocatesNothingAfterTheFirstCall) {
+  for (const Model& model : {make_sled_model(), make_sled_model(SledVariant::paper), make_appell_model()}) {
+    Data data = make_data(model);
+    for (Method m : {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace})
+      for (Complement c : {Complement::qr, Complement::partition, Complement::analytic}) {
+        Vector q(3), v(3);
+        q << 0.1, 0.2, 0.3;
+        v << 0.5, 0.6, 0.7;
+        const FormulationOptions options{m, c};
+        ASSERT_EQ(compute_dynamics(model, data, options, 0.0, q.data(), v.data()), Status::ok);
+        g_allocations = 0;
+        g_counting = true;
+        for (int i = 0; i < 10; ++i) {
+          q(2) += 0.01;
+          v(0) += 0.01;
+          compute_dynamics(model, data, options, 0.1 * i, q.data(), v.data());
+          compute_residuals(model, data);
+          compute_energy(model, data);
+        }
+        g_counting = false;
+        EXPECT_EQ(g_allocations.load(), 0) << model.name << " " << method_name(m) << "/" << complement_name(c);
+      }
+  }
+}
+
+TEST(Allocation, TheCounterSeesAnAllocation) {
+  // Guards the test above against a counter that cannot count.
+  g_allocations = 0;
+  g_counting = true;
+  {
+    std::vector<double> numbers(100);
+    numbers[7] = 1.0;
+    g_counting = false;
+    EXPECT_EQ(numbers[7], 1.0);
+  }
+  EXPECT_GE(g_allocations.load(), 1);
+  if (kCountsMalloc) {
+    g_allocations = 0;
+    g_counting = true;
+    Vector v = Vector::Constant(100, 2.0);
+    g_counting = false;
+    EXPECT_EQ(v.sum(), 200.0);
+    EXPECT_GE(g_allocations.load(), 1) << "an Eigen allocation went uncounted";
+  }
+}
+
+}  // namespace
+}  // namespace nhdyn

@@ -1,0 +1,100 @@
+// The failure modes of the kernel: dependent or conflicting constraints, an inertia matrix that
+// is not positive definite, and non-finite values must each come back as a status with words
+// that name the constraints, the eigenvalue or the quantity and t.
+#include "nhdyn/formulation/diagnosis.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <string>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/model/appell.hpp"
+#include "support/test_models.hpp"
+
+namespace nhdyn {
+namespace {
+
+const Method kMethods[] = {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace};
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+TEST(Diagnosis, DependentConstraintsAreNamedWithAConditionEstimate) {
+  Matrix b(3, 4);
+  b << 1, 0, 0, 0,
+       0, 1, 1, 0,
+       2, 0, 0, 0;  // c3 = 2 c1
+  const Model model = testing::make_constant_model(Matrix::Identity(4, 4), Vector::Ones(4), b, Vector::Zero(3));
+  for (Method m : kMethods) {
+    Data data = make_data(model);
+    const Status status = compute_dynamics(model, data, {m, Complement::qr}, 0.0, model.q0.data(), model.v0.data());
+    ASSERT_NE(status, Status::ok) << method_name(m);
+    const std::string message = explain_failure(model, data);
+    EXPECT_TRUE(contains(message, "'c1'") && contains(message, "'c3'")) << method_name(m) << ": " << message;
+    EXPECT_FALSE(contains(message, "'c2'")) << message;
+    EXPECT_TRUE(contains(message, "condition estimate")) << message;
+  }
+  Data data = make_data(model);
+  EXPECT_EQ(compute_dynamics(model, data, {Method::sanh, Complement::partition}, 0.0, model.q0.data(), model.v0.data()),
+            Status::dependent_constraints);
+  try {
+    check_state_or_throw(model, data, 0.0, model.q0.data(), model.v0.data());
+    FAIL() << "expected ModelError";
+  } catch (const ModelError& e) {
+    EXPECT_TRUE(contains(e.what(), "dependent")) << e.what();
+  }
+}
+
+TEST(Diagnosis, IndefiniteInertiaIsReportedWithItsSmallestEigenvalue) {
+  Matrix A = Matrix::Identity(3, 3);
+  A(2, 2) = -2.0;
+  Matrix b(1, 3);
+  b << 1, 0, 0;
+  const Model model = testing::make_constant_model(A, Vector::Ones(3), b, Vector::Zero(1));
+  Data data = make_data(model);
+  EXPECT_EQ(compute_dynamics(model, data, {Method::udwadia_kalaba, Complement::qr}, 0.0, model.q0.data(),
+                             model.v0.data()),
+            Status::inertia_not_positive_definite);
+  EXPECT_EQ(compute_dynamics(model, data, {Method::nullspace, Complement::qr}, 0.0, model.q0.data(), model.v0.data()),
+            Status::inertia_not_positive_definite);
+  try {
+    check_state_or_throw(model, data, 0.0, model.q0.data(), model.v0.data());
+    FAIL() << "expected ModelError";
+  } catch (const ModelError& e) {
+    EXPECT_TRUE(contains(e.what(), "not positive definite")) << e.what();
+    EXPECT_TRUE(contains(e.what(), "-2")) << e.what();
+  }
+}
+
+TEST(Diagnosis, NonFiniteTermsNameTheQuantityAndTime) {
+  // Appell's constraint in the paper's form divides by z': at z' = 0 the term b is infinite.
+  const Model model = make_appell_model();
+  Data data = make_data(model);
+  Vector q = Vector::Zero(3), v(3);
+  v << 1.0, 0.0, 0.0;
+  for (Method m : kMethods) {
+    const Status status = compute_dynamics(model, data, {m, Complement::qr}, 2.5, q.data(), v.data());
+    ASSERT_EQ(status, Status::non_finite) << method_name(m);
+    const std::string message = explain_failure(model, data);
+    EXPECT_TRUE(contains(message, "constraint matrix b")) << message;
+    EXPECT_TRUE(contains(message, "t = 2.5")) << message;
+  }
+  // A NaN in the state itself is named as such.
+  q(0) = std::numeric_limits<double>::quiet_NaN();
+  v(2) = 1.0;
+  EXPECT_EQ(compute_dynamics(model, data, {}, 0.0, q.data(), v.data()), Status::non_finite);
+  EXPECT_TRUE(contains(explain_failure(model, data), "coordinates q"));
+}
+
+TEST(Diagnosis, AnalyticComplementOfAModelWithoutOneIsAnInputError) {
+  Matrix b(1, 2);
+  b << 1, 1;
+  const Model model = testing::make_constant_model(Matrix::Identity(2, 2), Vector::Ones(2), b, Vector::Zero(1));
+  Data data = make_data(model);
+  EXPECT_THROW(compute_dynamics(model, data, {Method::sanh, Complement::analytic}, 0.0, model.q0.data(), model.v0.data()),
+               InputError);
+}
+
+}  // namespace
+}  // namespace nhdyn
