@@ -1,0 +1,37 @@
+// The derivation of the equations of motion from a Spec (FORMULATION.md sections 1-3), with
+// GiNaC: A = d2T/dq'2, G = dT/dq - (d2T/dq'dq) q' - d2T/dq'dt, Q = -dV/dq + forces, and every
+// constraint at acceleration level b q'' + b0 = 0 (position level differentiated twice, velocity
+// level once, explicit time dependence included). D is the user's analytic one, or the
+// partitioned one when the user names the independent coordinates. Expressions keep the
+// parameters as symbols (so that `nhdyn equations` shows them); compile_model substitutes values.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "nhdyn/symbolic/spec.hpp"
+
+namespace nhdyn::symbolic {
+
+struct Derivation {
+  GiNaC::matrix A;                  // n x n
+  GiNaC::matrix Q;                  // n x 1
+  GiNaC::matrix G;                  // n x 1
+  GiNaC::matrix b;                  // s x n
+  GiNaC::matrix b0;                 // s x 1
+  std::optional<GiNaC::matrix> D;   // k x n: analytic (spec.complement) or partitioned (spec.independent)
+  std::vector<GiNaC::ex> phi;       // position-level residuals, one per position constraint
+  std::vector<GiNaC::ex> f;         // velocity-level residuals, one per position or velocity constraint
+  std::optional<GiNaC::ex> energy;  // T + V when there are no nonconservative forces and T, V do not depend on t
+};
+
+// Throws ModelError naming the constraint (and its location) that does not involve the
+// velocities or accelerations after differentiation, or a kinetic energy that is not quadratic
+// in the velocities (A depends on the velocities).
+Derivation derive(const Spec& spec);
+
+// A0 = D A and C = D (Q + G) (FORMULATION.md (2.17)); requires derivation.D.
+GiNaC::matrix reduced_inertia(const Derivation& derivation);
+GiNaC::matrix reduced_forces(const Derivation& derivation);
+
+}  // namespace nhdyn::symbolic

@@ -1,0 +1,74 @@
+#include "nhdyn/symbolic/spec.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/symbolic/suggest.hpp"
+
+namespace nhdyn::symbolic {
+
+std::string SourceLocation::describe() const {
+  if (file.empty() && line == 0) return "";
+  std::string out = file.empty() ? std::string("<model>") : file;
+  if (line > 0) out += fmt::format(":{}", line);
+  if (line > 0 && column > 0) out += fmt::format(":{}", column);
+  return out;
+}
+
+SymbolTable::SymbolTable() : t_("t") { by_name_.emplace("t", t_); }
+
+int SymbolTable::add_coordinate(const std::string& name) {
+  q_.emplace_back(name);
+  v_.emplace_back(name + "'");
+  a_.emplace_back(name + "''");
+  by_name_.emplace(name, q_.back());
+  by_name_.emplace(name + "'", v_.back());
+  by_name_.emplace(name + "''", a_.back());
+  return static_cast<int>(q_.size()) - 1;
+}
+
+void SymbolTable::add_parameter(const std::string& name) { by_name_.emplace(name, GiNaC::symbol(name)); }
+
+const GiNaC::symbol& SymbolTable::parameter(const std::string& name) const { return by_name_.at(name); }
+
+std::optional<GiNaC::symbol> SymbolTable::find(const std::string& name) const {
+  const auto it = by_name_.find(name);
+  if (it == by_name_.end()) return std::nullopt;
+  return it->second;
+}
+
+std::vector<std::string> SymbolTable::names() const {
+  std::vector<std::string> out;
+  for (const auto& [name, symbol] : by_name_) out.push_back(name);
+  return out;
+}
+
+GiNaC::symtab SymbolTable::parser_table() const {
+  GiNaC::symtab table;
+  for (const auto& [name, symbol] : by_name_) table[name] = symbol;
+  table["pi"] = GiNaC::Pi;
+  return table;
+}
+
+GiNaC::lst Spec::parameter_values() const {
+  GiNaC::lst values;
+  for (const SpecParameter& p : parameters) values.append(symbols.parameter(p.name) == GiNaC::numeric(p.value));
+  return values;
+}
+
+void Spec::set_parameter(const std::string& name, double value) {
+  for (SpecParameter& p : parameters)
+    if (p.name == name) {
+      p.value = value;
+      return;
+    }
+  std::vector<std::string> names;
+  for (const SpecParameter& p : parameters) names.push_back(p.name);
+  const std::string nearest = nearest_name(name, names);
+  throw InputError(fmt::format("model '{}' has no parameter '{}'{}", this->name, name,
+                               nearest.empty() ? "" : fmt::format("; did you mean '{}'?", nearest)));
+}
+
+}  // namespace nhdyn::symbolic

@@ -1,0 +1,105 @@
+// Spec: the symbolic, editable description of a mechanical system, as a user writes it in a paper
+// — coordinates, parameters, kinetic and potential energy, nonconservative forces, constraints at
+// position, velocity or acceleration level, optional independent coordinates or analytic D,
+// initial conditions and simulation defaults. Built by SpecBuilder (spec_builder.hpp), which the
+// model-file loader uses too; derived by derive() (derivation.hpp) and compiled into a numeric
+// Model by compile_model() (compile.hpp). GiNaC stays inside the symbolic module.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn::symbolic {
+
+// Where a piece of a spec came from, for error messages: "file.toml:12:7". Empty file for specs
+// built in C++; line and column are 1-based, 0 when unknown.
+struct SourceLocation {
+  std::string file;
+  int line = 0;
+  int column = 0;
+  // "file:line:column" (or fewer parts when unknown); "" when nothing is known.
+  std::string describe() const;
+};
+
+// One symbol table per spec owns every symbol: GiNaC tells symbols apart by identity, so every
+// expression of a spec must be built from these. Names: "t"; each coordinate "x", its velocity
+// "x'" and acceleration "x''"; each parameter.
+class SymbolTable {
+ public:
+  SymbolTable();
+  const GiNaC::symbol& time() const { return t_; }
+  // Adds a coordinate with its velocity and acceleration symbols; returns its index.
+  int add_coordinate(const std::string& name);
+  void add_parameter(const std::string& name);
+  int coordinates() const { return static_cast<int>(q_.size()); }
+  const GiNaC::symbol& coordinate(int i) const { return q_[static_cast<std::size_t>(i)]; }
+  const GiNaC::symbol& velocity(int i) const { return v_[static_cast<std::size_t>(i)]; }
+  const GiNaC::symbol& acceleration(int i) const { return a_[static_cast<std::size_t>(i)]; }
+  const GiNaC::symbol& parameter(const std::string& name) const;  // throws std::out_of_range
+  bool has(const std::string& name) const { return by_name_.count(name) > 0; }
+  // The symbol called `name`, if any ("t", "x", "x'", "x''", a parameter).
+  std::optional<GiNaC::symbol> find(const std::string& name) const;
+  // Every known name, for suggestions in error messages.
+  std::vector<std::string> names() const;
+  // The parser's table: every name mapped to its symbol, plus the constant pi.
+  GiNaC::symtab parser_table() const;
+
+ private:
+  GiNaC::symbol t_;
+  std::vector<GiNaC::symbol> q_, v_, a_;
+  std::map<std::string, GiNaC::symbol> by_name_;
+};
+
+struct SpecParameter {
+  std::string name;
+  double value = 0.0;
+  std::string unit;
+  SourceLocation where;
+};
+
+struct SpecConstraint {
+  std::string name;
+  ConstraintLevel level = ConstraintLevel::velocity;
+  GiNaC::ex expression;  // phi(t, q), f(t, q, q') or g(t, q, q', q''); the constraint is expression = 0
+  std::string text;      // as the user wrote it
+  SourceLocation where;
+};
+
+struct Spec {
+  std::string name;
+  std::string description;
+  SourceLocation where;
+  SymbolTable symbols;
+  std::vector<std::string> coordinates;      // n, in order
+  std::vector<SpecParameter> parameters;
+  GiNaC::ex kinetic_energy;                  // T(t, q, q')
+  GiNaC::ex potential_energy = 0;            // V(t, q)
+  std::vector<GiNaC::ex> forces;             // n nonconservative generalized forces (0 if none)
+  std::vector<SpecConstraint> constraints;
+  std::vector<std::string> independent;      // optional: k coordinates kept independent (partitioned D)
+  std::optional<GiNaC::matrix> complement;   // optional analytic D, k x n
+  SourceLocation complement_where;
+  double t0 = 0.0;
+  std::vector<GiNaC::ex> q0, v0;             // n initial values, expressions in the parameters
+  SimulationDefaults defaults;
+  std::string method;                        // default formulation, "" = sanh
+  std::string integrator;                    // default integrator, "" = dopri5
+  std::optional<double> rtol, atol;
+  std::optional<std::pair<std::string, std::string>> path;  // coordinates to draw as y(x)
+
+  int n() const { return static_cast<int>(coordinates.size()); }
+  int s() const { return static_cast<int>(constraints.size()); }
+  // The numeric values of the parameters as a substitution list (parameter symbol == value).
+  GiNaC::lst parameter_values() const;
+  // Sets a parameter's value (for `--set name=value`); throws InputError naming the unknown name
+  // and the nearest known one.
+  void set_parameter(const std::string& name, double value);
+};
+
+}  // namespace nhdyn::symbolic

@@ -1,0 +1,64 @@
+// The C++ model-building API: builds a Spec the way a model stands in a paper, from names and
+// expressions written as text. The model-file loader (io/model_file.hpp) is a thin layer over it.
+//
+// Expressions use GiNaC's syntax (+ - * / ^, parentheses, sin cos tan exp log sqrt abs asin acos
+// atan atan2 sinh cosh tanh, the constant pi), the time t, the coordinates by name, velocities
+// with one prime (x') and accelerations with two (x''), and the parameters by name.
+// Every error is a ModelError whose message starts with the SourceLocation given (file:line:col).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "nhdyn/symbolic/spec.hpp"
+
+namespace nhdyn::symbolic {
+
+class SpecBuilder {
+ public:
+  explicit SpecBuilder(std::string name, SourceLocation where = {});
+
+  SpecBuilder& description(std::string text);
+  // Coordinates and parameters must be declared before the expressions that use them.
+  SpecBuilder& coordinate(const std::string& name, SourceLocation where = {});
+  SpecBuilder& parameter(const std::string& name, double value, std::string unit = "", SourceLocation where = {});
+
+  // Parses `text` against the symbols declared so far. An unknown name is reported with the
+  // nearest known one ("unknown symbol 'rh0'; did you mean 'rho'?"), the velocity of an unknown
+  // coordinate as such ("'u'' is the velocity of 'u', which is not a coordinate").
+  GiNaC::ex parse(const std::string& text, const SourceLocation& where = {}) const;
+
+  SpecBuilder& kinetic_energy(const std::string& text, SourceLocation where = {});
+  SpecBuilder& potential_energy(const std::string& text, SourceLocation where = {});
+  // Nonconservative generalized force on one coordinate (added to -dV/dq).
+  SpecBuilder& force(const std::string& coordinate, const std::string& text, SourceLocation where = {});
+  // A constraint `text = 0` given at `level`. The level must match the expression: a position
+  // constraint may not contain velocities, a velocity constraint must contain some velocity and no
+  // acceleration, an acceleration constraint must contain some acceleration.
+  SpecBuilder& constraint(const std::string& name, ConstraintLevel level, const std::string& text,
+                          SourceLocation where = {});
+  // The same with the level inferred from the highest derivative present.
+  SpecBuilder& constraint(const std::string& name, const std::string& text, SourceLocation where = {});
+  // k coordinates to keep independent: the partitioned D is then the one for this choice.
+  SpecBuilder& independent(const std::vector<std::string>& coordinates, SourceLocation where = {});
+  // An analytic D, k rows of n expressions each.
+  SpecBuilder& complement(const std::vector<std::vector<std::string>>& rows, SourceLocation where = {});
+  // Initial value of one coordinate and its velocity (expressions in the parameters).
+  SpecBuilder& initial(const std::string& coordinate, const std::string& q0, const std::string& v0,
+                       SourceLocation where = {});
+  SpecBuilder& initial_time(double t0);
+  SpecBuilder& defaults(const SimulationDefaults& defaults);
+  SpecBuilder& method(const std::string& name);
+  SpecBuilder& integrator(const std::string& name);
+  SpecBuilder& tolerances(std::optional<double> rtol, std::optional<double> atol);
+  SpecBuilder& path(const std::string& x, const std::string& y);
+
+  // Checks completeness (coordinates, a kinetic energy, fewer constraints than coordinates,
+  // names unique, initial values for all or none — none means zero) and returns the Spec.
+  Spec build() const;
+
+ private:
+  Spec spec_;
+};
+
+}  // namespace nhdyn::symbolic
