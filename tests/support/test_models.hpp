@@ -79,4 +79,49 @@ inline Model make_blowup_model(double t_end) {
   return m;
 }
 
+// A planar pendulum in Cartesian coordinates: mass m on a rod of length l, y up,
+// phi = x^2 + y^2 - l^2 = 0 (position level).
+class PendulumEvaluator final : public Evaluator {
+ public:
+  // l2 is the squared rod length; a negative one makes a constraint without solution.
+  PendulumEvaluator(double m, double g, double l2) : m_(m), g_(g), l2_(l2) {}
+  void terms(double, const double* q, const double* v, double*, const TermsOut& out) const override {
+    out.A[0] = m_;
+    out.A[1] = 0.0;
+    out.A[2] = 0.0;
+    out.A[3] = m_;
+    out.Q[0] = 0.0;
+    out.Q[1] = -m_ * g_;
+    out.G[0] = out.G[1] = 0.0;
+    out.b[0] = 2.0 * q[0];
+    out.b[1] = 2.0 * q[1];
+    out.b0[0] = 2.0 * (v[0] * v[0] + v[1] * v[1]);
+  }
+  void position_residual(double, const double* q, double*, double* phi) const override {
+    phi[0] = q[0] * q[0] + q[1] * q[1] - l2_;
+  }
+  void velocity_residual(double, const double* q, const double* v, double*, double* f) const override {
+    f[0] = 2.0 * (q[0] * v[0] + q[1] * v[1]);
+  }
+  bool has_energy() const override { return true; }
+  double energy(double, const double* q, const double* v, double*) const override {
+    return 0.5 * m_ * (v[0] * v[0] + v[1] * v[1]) + m_ * g_ * q[1];
+  }
+
+ private:
+  double m_, g_, l2_;
+};
+
+inline Model make_pendulum_model(double m = 1.0, double g = 9.81, double l = 1.0) {
+  Model model;
+  model.name = "pendulum";
+  model.coordinates = {"x", "y"};
+  model.constraints = {{"rod", ConstraintLevel::position, "x^2 + y^2 - l^2 = 0"}};
+  model.q0 = Vector(2);
+  model.q0 << l, 0.0;
+  model.v0 = Vector::Zero(2);
+  model.evaluator = std::make_shared<PendulumEvaluator>(m, g, l * l);
+  return model;
+}
+
 }  // namespace nhdyn::testing

@@ -87,13 +87,22 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   const std::vector<double> times = make_output_times(model.t0, options.t_end, options.output_step);
   Data data = make_data(model);
   check_state_or_throw(model, data, model.t0, model.q0.data(), model.v0.data());
+  SimulationSummary summary;
+  Vector q0 = model.q0, v0 = model.v0;
+  if (options.fix_initial) {
+    summary.initial_fix = fix_initial_state(model, data, model.t0, q0, v0);
+    q0 = summary.initial_fix->q;
+    v0 = summary.initial_fix->v;
+    check_state_or_throw(model, data, model.t0, q0.data(), v0.data());
+  } else {
+    check_initial_state(model, data, model.t0, q0, v0, options.initial_tolerance);
+  }
 
   const int n = model.n();
   std::vector<double> y0(static_cast<std::size_t>(2 * n));
-  std::copy(model.q0.data(), model.q0.data() + n, y0.begin());
-  std::copy(model.v0.data(), model.v0.data() + n, y0.begin() + n);
+  std::copy(q0.data(), q0.data() + n, y0.begin());
+  std::copy(v0.data(), v0.data() + n, y0.begin() + n);
 
-  SimulationSummary summary;
   summary.has_energy = model.evaluator->has_energy();
   MechanicalOde ode(model, data, options.formulation);
   const OutputFn output = [&](double t, const double* y) -> Status {

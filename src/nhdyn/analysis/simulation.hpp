@@ -5,9 +5,11 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "nhdyn/analysis/initial_state.hpp"
 #include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/integrators/ode.hpp"
 #include "nhdyn/model/data.hpp"
@@ -20,6 +22,11 @@ struct SimulationOptions {
   double output_step = 0.01;  // spacing of output times [s], > 0
   FormulationOptions formulation;
   IntegratorOptions integrator;
+  // The initial state must satisfy the position and velocity constraints to this tolerance, or
+  // the run is refused with each residual listed ...
+  double initial_tolerance = 1e-9;
+  // ... unless it is moved onto them first (analysis/initial_state.hpp).
+  bool fix_initial = false;
 };
 
 struct SimulationSummary {
@@ -35,6 +42,7 @@ struct SimulationSummary {
   bool has_energy = false;
   double energy_initial = 0.0;
   double energy_drift = 0.0;        // max |E(t) - E(t0)| over outputs
+  std::optional<InitialFix> initial_fix;  // set when options.fix_initial moved the initial state
 };
 
 // Called at every output time with Data holding t, q, q', q'', R, residuals and energy.

@@ -30,6 +30,12 @@ struct Derivation {
 // in the velocities (A depends on the velocities).
 Derivation derive(const Spec& spec);
 
+// The partitioned complement D = [I_k, (-b_d^-1 b_i)^T] in the original coordinate order
+// (FORMULATION.md section 3, choice 2): rows in the order of `independent` (k indices into q,
+// ascending), the other s columns dependent. std::nullopt when the s x s block b_d of the dependent
+// columns is singular (its determinant simplifies to 0). Entries simplified (simplify.hpp).
+std::optional<GiNaC::matrix> partitioned_complement(const GiNaC::matrix& b, const std::vector<int>& independent);
+
 // A0 = D A and C = D (Q + G) (FORMULATION.md (2.17)); requires derivation.D.
 GiNaC::matrix reduced_inertia(const Derivation& derivation);
 GiNaC::matrix reduced_forces(const Derivation& derivation);

@@ -59,6 +59,9 @@ class SpecBuilder {
 
  private:
   Spec spec_;
+  // Bookkeeping for the checks of build(), not part of the Spec.
+  std::vector<bool> initial_given_;   // per coordinate: initial() was called for it
+  SourceLocation independent_where_;  // where independent() was called
 };
 
 }  // namespace nhdyn::symbolic

@@ -1,0 +1,736 @@
+// The model-file loader: TOML (toml++) in, SpecBuilder calls out. The format is documented in
+// docs/model-format.md; this file checks only what TOML cannot (which keys exist, their types, the
+// shape of each section) and leaves every question about the mechanics to SpecBuilder, passing it
+// the source location of each node. Every toml++ node is reached through a type-checked accessor
+// (as_string, as_table, ...), so no input can make the loader dereference a missing node.
+#include "nhdyn/io/model_file.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/symbolic/spec_builder.hpp"
+#include "nhdyn/symbolic/suggest.hpp"
+
+namespace nhdyn {
+namespace {
+
+using symbolic::SourceLocation;
+using symbolic::SpecBuilder;
+
+// The keys of each table of the format (docs/model-format.md), in the order the doc lists them.
+const std::vector<std::string> top_level_keys = {
+    "name",           "description", "coordinates", "parameters",  "kinetic_energy",
+    "potential_energy", "forces",    "constraints", "independent", "complement",
+    "initial",        "simulation",  "plot"};
+const std::vector<std::string> parameter_keys = {"value", "unit"};
+const std::vector<std::string> constraint_keys = {"name", "position", "velocity", "acceleration"};
+const std::vector<std::string> initial_keys = {"t0", "position", "velocity"};
+const std::vector<std::string> simulation_keys = {"t_end", "output_step", "integrator", "method", "rtol", "atol"};
+const std::vector<std::string> plot_keys = {"path"};
+
+// The names that formulation/formulation.cpp (parse_method) and integrators/ode.cpp
+// (parse_integrator) accept. io may not depend on those modules, so the lists are repeated here;
+// tests/io/model_file_test.cpp checks that they agree.
+const std::vector<std::string> method_names = {"sanh", "lagrange", "udwadia-kalaba", "nullspace"};
+const std::vector<std::string> integrator_names = {"rk4", "dopri5", "cvode-bdf", "cvode-adams"};
+
+std::string join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
+std::string_view type_name(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a floating-point number";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::date: return "a date";
+    case toml::node_type::time: return "a time";
+    case toml::node_type::date_time: return "a date-time";
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::none: break;
+  }
+  return "nothing";
+}
+
+// One key = value of a table, in the order of the file.
+struct Entry {
+  const toml::key* key;
+  const toml::node* value;
+};
+
+bool before(const toml::source_position& a, const toml::source_position& b) {
+  return a.line != b.line ? a.line < b.line : a.column < b.column;
+}
+
+// toml++ keeps a table's keys sorted by name; errors and parameters follow the file's order.
+std::vector<Entry> in_file_order(const toml::table& table) {
+  std::vector<Entry> entries;
+  for (auto&& [key, value] : table) entries.push_back({&key, &value});
+  std::stable_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    return before(a.key->source().begin, b.key->source().begin);
+  });
+  return entries;
+}
+
+// A double as text that GiNaC's parser reads back to the same value ("0.5", "1e-05", "3").
+std::string number_text(double value) {
+  if (value == std::floor(value) && std::fabs(value) < 1e15) return fmt::format("{}", static_cast<long long>(value));
+  return fmt::format("{}", value);
+}
+
+class Loader {
+ public:
+  Loader(std::string_view text, std::string file) : text_(text), file_(std::move(file)) {}
+
+  symbolic::Spec load() {
+    toml::table root;
+    try {
+      root = toml::parse(text_, std::string_view(file_));
+    } catch (const toml::parse_error& e) {
+      fail(at(e.source()), fmt::format("TOML syntax error: {} (docs/model-format.md describes the format)",
+                                       e.description()));
+    }
+    check_keys(root, top_level_keys, "at the top level");
+
+    const toml::node* name = required(root, "name", "the model's name, e.g. name = \"sled\"");
+    SpecBuilder builder(string_of(*name, "name", "name = \"sled\""), at(*name));
+    if (const toml::node* description = root.get("description"))
+      builder.description(string_of(*description, "description", "description = \"A sled on an inclined plane\""));
+
+    load_coordinates(root, builder);
+    if (const toml::node* parameters = root.get("parameters")) load_parameters(*parameters, builder);
+
+    const toml::node* kinetic = required(root, "kinetic_energy",
+                                         "the kinetic energy in the velocities x', e.g. "
+                                         "kinetic_energy = \"m/2 * (x'^2 + y'^2)\"");
+    const std::string kinetic_text =
+        expression_string(*kinetic, "kinetic_energy", "kinetic_energy = \"m/2 * x'^2\"");
+    located(*kinetic, [&] { builder.kinetic_energy(kinetic_text, content_at(*kinetic)); });
+    if (const toml::node* potential = root.get("potential_energy")) {
+      const std::string potential_text =
+          expression_string(*potential, "potential_energy", "potential_energy = \"-m * g * z\"");
+      located(*potential, [&] { builder.potential_energy(potential_text, content_at(*potential)); });
+    }
+
+    if (const toml::node* forces = root.get("forces")) load_forces(*forces, builder);
+    if (const toml::node* constraints = root.get("constraints")) load_constraints(*constraints, builder);
+    load_complement(root, builder);
+    if (const toml::node* initial = root.get("initial")) load_initial(*initial, builder);
+    if (const toml::node* simulation = root.get("simulation")) load_simulation(*simulation, builder);
+    if (const toml::node* plot = root.get("plot")) load_plot(*plot, builder);
+    return builder.build();
+  }
+
+ private:
+  // ---- Locations and errors ----------------------------------------------------------------
+
+  SourceLocation at(const toml::source_region& region) const {
+    return {file_, static_cast<int>(region.begin.line), static_cast<int>(region.begin.column)};
+  }
+  SourceLocation at(const toml::node& node) const { return at(node.source()); }
+  SourceLocation at(const toml::key& key) const { return at(key.source()); }
+  // Where a table is: its header, or for a table that has none (made implicit by [a.b] or a
+  // dotted key) the key that names it.
+  SourceLocation at(const toml::node& table, const toml::key& key) const {
+    return table.source().begin.line > 0 ? at(table) : at(key);
+  }
+
+  [[noreturn]] void fail(const SourceLocation& where, const std::string& message) const {
+    const std::string place = where.describe();
+    throw ModelError(place.empty() ? message : place + ": " + message);
+  }
+
+  // Byte offset in text_ of a 1-based (line, column), toml++ counting columns in code points.
+  std::optional<std::size_t> offset_of(const toml::source_position& position) const {
+    if (position.line == 0 || position.column == 0) return std::nullopt;
+    std::size_t p = 0;
+    for (toml::source_index line = 1; line < position.line; ++line) {
+      p = text_.find('\n', p);
+      if (p == std::string_view::npos) return std::nullopt;
+      ++p;
+    }
+    for (toml::source_index column = 1; column < position.column; ++column) {
+      if (p >= text_.size()) return std::nullopt;
+      ++p;
+      while (p < text_.size() && (static_cast<unsigned char>(text_[p]) & 0xC0u) == 0x80u) ++p;
+    }
+    return p;
+  }
+
+  // The (line, column) of byte offset p of text_.
+  SourceLocation location_of(std::size_t p) const {
+    p = std::min(p, text_.size());
+    int line = 1;
+    std::size_t line_start = 0;
+    for (std::size_t i = 0; i < p; ++i)
+      if (text_[i] == '\n') {
+        ++line;
+        line_start = i + 1;
+      }
+    int column = 1;
+    for (std::size_t i = line_start; i < p; ++i)
+      if ((static_cast<unsigned char>(text_[i]) & 0xC0u) != 0x80u) ++column;
+    return {file_, line, column};
+  }
+
+  // Where byte `offset` of the content of a string value sits in the file, following the quotes,
+  // escapes and line continuations of TOML's four kinds of string. Falls back to the node itself.
+  SourceLocation string_position(const toml::node& node, std::size_t offset) const {
+    const std::optional<std::size_t> start = offset_of(node.source().begin);
+    if (!start || !node.is_string()) return at(node);
+    std::size_t p = *start;
+    const std::string_view rest = text_.substr(p);
+    const bool multiline = rest.starts_with("\"\"\"") || rest.starts_with("'''");
+    const bool basic = rest.starts_with('"');
+    if (!basic && !rest.starts_with('\'')) return at(node);
+    p += multiline ? 3 : 1;
+    if (multiline) {
+      if (text_.substr(p).starts_with('\n')) p += 1;
+      else if (text_.substr(p).starts_with("\r\n")) p += 2;
+    }
+    const auto is_space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
+    const auto continuation = [&](std::size_t at) {
+      return basic && multiline && at + 1 < text_.size() && text_[at] == '\\' && is_space(text_[at + 1]);
+    };
+    std::size_t decoded = 0;
+    // Up to the character at `offset`, and past a line continuation that ends there.
+    while ((decoded < offset || continuation(p)) && p < text_.size()) {
+      const char c = text_[p];
+      const char next = p + 1 < text_.size() ? text_[p + 1] : '\0';
+      if (basic && c == '\\') {
+        if (next == 'u' || next == 'U') {
+          const std::size_t digits = next == 'u' ? 4 : 8;
+          unsigned long code = 0;
+          for (std::size_t i = 0; i < digits && p + 2 + i < text_.size(); ++i) {
+            const char h = text_[p + 2 + i];
+            const int v = h >= '0' && h <= '9' ? h - '0' : (h | 0x20) >= 'a' && (h | 0x20) <= 'f' ? (h | 0x20) - 'a' + 10 : 0;
+            code = code * 16 + static_cast<unsigned long>(v);
+          }
+          p += 2 + digits;
+          decoded += code < 0x80 ? 1 : code < 0x800 ? 2 : code < 0x10000 ? 3 : 4;
+        } else if (multiline && is_space(next)) {
+          // A line-ending backslash: the newline and the whitespace after it vanish.
+          ++p;
+          while (p < text_.size() && is_space(text_[p])) ++p;
+        } else {
+          p += 2;
+          decoded += 1;
+        }
+      } else if (c == '\r' && next == '\n') {
+        p += 2;  // read as one '\n'
+        decoded += 1;
+      } else {
+        p += 1;
+        decoded += 1;
+      }
+    }
+    return location_of(p);
+  }
+
+  // Where the text of a value starts: inside the quotes for a string.
+  SourceLocation content_at(const toml::node& node) const { return string_position(node, 0); }
+
+  // Runs a SpecBuilder call that was given content_at(node) and moves the position of its error
+  // to the file. SpecBuilder counts from content_at(node) through the text as TOML delivers it
+  // (escapes decoded, line continuations removed); string_position follows the raw file instead.
+  template <class Call>
+  auto located(const toml::node& node, Call&& call) const -> decltype(call()) {
+    try {
+      return call();
+    } catch (const ModelError& e) {
+      std::optional<std::string> moved = move_into_file(node, e.what());
+      if (!moved) throw;
+      throw ModelError(*moved);
+    }
+  }
+
+  // The message with its leading "file:line:column" replaced by the file position of the same
+  // character, when that position lies inside the string value `node`; nullopt otherwise.
+  std::optional<std::string> move_into_file(const toml::node& node, std::string_view message) const {
+    const toml::value<std::string>* value = node.as_string();
+    if (value == nullptr || !message.starts_with(file_ + ":")) return std::nullopt;
+    std::size_t p = file_.size() + 1;
+    const auto read_number = [&]() -> long {
+      long number = 0;
+      const std::size_t first = p;
+      while (p < message.size() && message[p] >= '0' && message[p] <= '9' && p - first < 9)
+        number = number * 10 + (message[p++] - '0');
+      return p > first ? number : -1;
+    };
+    const long line = read_number();
+    if (line < 0 || p >= message.size() || message[p] != ':') return std::nullopt;
+    ++p;
+    const long column = read_number();
+    if (column < 0 || !message.substr(p).starts_with(": ")) return std::nullopt;
+    const SourceLocation start = content_at(node);
+    const toml::source_region& region = node.source();
+    if (line < start.line || line > static_cast<long>(region.end.line) || (line == start.line && column < start.column))
+      return std::nullopt;
+    // The same (line, column) counted in the decoded text, from `start`, as SpecBuilder counts.
+    const std::string& text = value->get();
+    long text_line = line - start.line;
+    long text_column = text_line == 0 ? column - start.column + 1 : column;
+    std::size_t offset = 0;
+    while (text_line > 0 && offset < text.size())
+      if (text[offset++] == '\n') --text_line;
+    while (text_column > 1 && offset < text.size() && text[offset] != '\n') {
+      ++offset;
+      while (offset < text.size() && (static_cast<unsigned char>(text[offset]) & 0xC0u) == 0x80u) ++offset;
+      --text_column;
+    }
+    if (text_line > 0 || text_column > 1) return std::nullopt;  // not inside this string
+    return string_position(node, offset).describe() + std::string(message.substr(p));
+  }
+
+  // ---- Type-checked access -------------------------------------------------------------------
+
+  // A top-level key found inside a section was written below that section's header: say so.
+  void check_not_misplaced(const toml::key& key, std::string_view context) const {
+    const std::string name(key.str());
+    if (std::find(top_level_keys.begin(), top_level_keys.end(), name) == top_level_keys.end()) return;
+    fail(at(key), fmt::format("'{}' is {}, because it comes after that section's header; TOML puts every key "
+                              "below a [section] header into that section: move '{}' above the first [section]",
+                              name, context, name));
+  }
+
+  // Every key of `table` must be one of `allowed`; `context` says where we are ("in [plot]").
+  void check_keys(const toml::table& table, const std::vector<std::string>& allowed, std::string_view context) const {
+    for (const Entry& entry : in_file_order(table)) {
+      const std::string key(entry.key->str());
+      if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+      if (&allowed != &top_level_keys) check_not_misplaced(*entry.key, context);
+      const std::string nearest = symbolic::nearest_name(key, allowed);
+      fail(at(*entry.key), nearest.empty()
+                               ? fmt::format("unknown key '{}' {}; the keys here are: {}", key, context, join(allowed))
+                               : fmt::format("unknown key '{}' {}; did you mean '{}'?", key, context, nearest));
+    }
+  }
+
+  const toml::node* required(const toml::table& root, std::string_view key, std::string_view what) const {
+    const toml::node* node = root.get(key);
+    if (node == nullptr)
+      fail({file_, 1, 1}, fmt::format("missing key '{}' at the top level: give {}", key, what));
+    return node;
+  }
+
+  const toml::table& table_of(const toml::node& node, std::string_view what, std::string_view example) const {
+    const toml::table* table = node.as_table();
+    if (table == nullptr)
+      fail(at(node), fmt::format("'{}' must be a table, e.g. {}; it is {}", what, example, type_name(node)));
+    return *table;
+  }
+
+  const toml::array& array_of(const toml::node& node, std::string_view what, std::string_view example) const {
+    const toml::array* array = node.as_array();
+    if (array == nullptr)
+      fail(at(node), fmt::format("'{}' must be an array, e.g. {}; it is {}", what, example, type_name(node)));
+    return *array;
+  }
+
+  std::string string_of(const toml::node& node, std::string_view what, std::string_view example) const {
+    const toml::value<std::string>* value = node.as_string();
+    if (value == nullptr)
+      fail(at(node), fmt::format("'{}' must be a string, e.g. {}; it is {}", what, example, type_name(node)));
+    return value->get();
+  }
+
+  // An expression must be written as a string (in double or single quotes).
+  std::string expression_string(const toml::node& node, std::string_view what, std::string_view example) const {
+    const toml::value<std::string>* value = node.as_string();
+    if (value == nullptr)
+      fail(at(node), fmt::format("'{}' must be an expression written as a string, e.g. {}; it is {}", what,
+                                 example, type_name(node)));
+    return value->get();
+  }
+
+  // A number (integer or floating point), finite.
+  std::optional<double> number_value(const toml::node& node, std::string_view what) const {
+    double value = 0.0;
+    if (const toml::value<std::int64_t>* integer = node.as_integer()) value = static_cast<double>(integer->get());
+    else if (const toml::value<double>* real = node.as_floating_point()) value = real->get();
+    else return std::nullopt;
+    if (!std::isfinite(value)) fail(at(node), fmt::format("'{}' must be a finite number, not {}", what, value));
+    return value;
+  }
+
+  double number_of(const toml::node& node, std::string_view what, std::string_view example) const {
+    const std::optional<double> value = number_value(node, what);
+    if (!value) fail(at(node), fmt::format("'{}' must be a number, e.g. {}; it is {}", what, example, type_name(node)));
+    return *value;
+  }
+
+  // A number or an expression string, as text for SpecBuilder (initial values, entries of D).
+  std::string number_or_expression(const toml::node& node, std::string_view what, std::string_view example) const {
+    if (node.is_string()) return node.as_string()->get();
+    const std::optional<double> value = number_value(node, what);
+    if (!value)
+      fail(at(node), fmt::format("'{}' must be a number or an expression written as a string, e.g. {}; it is {}",
+                                 what, example, type_name(node)));
+    return number_text(*value);
+  }
+
+  // A coordinate named by a key or a string; returns its index.
+  int coordinate_index(const std::string& name, const SourceLocation& where, std::string_view context) const {
+    for (std::size_t i = 0; i < coordinates_.size(); ++i)
+      if (coordinates_[i] == name) return static_cast<int>(i);
+    const std::string nearest = symbolic::nearest_name(name, coordinates_);
+    fail(where, fmt::format("'{}' {} is not a coordinate; {}", name, context,
+                            nearest.empty() ? fmt::format("the coordinates are: {}", join(coordinates_))
+                                            : fmt::format("did you mean '{}'?", nearest)));
+  }
+
+  // ---- Sections ------------------------------------------------------------------------------
+
+  void load_coordinates(const toml::table& root, SpecBuilder& builder) {
+    const toml::node* node = required(root, "coordinates",
+                                      "the generalized coordinates in order, e.g. coordinates = [\"x\", \"y\", \"phi\"]");
+    const toml::array& array = array_of(*node, "coordinates", "coordinates = [\"x\", \"y\", \"phi\"]");
+    if (array.empty())
+      fail(at(*node), "'coordinates' is empty: list the generalized coordinates, e.g. coordinates = [\"x\", \"y\"]");
+    for (std::size_t i = 0; i < array.size(); ++i) {
+      const toml::node& element = *array.get(i);
+      const std::string name =
+          string_of(element, fmt::format("coordinates[{}]", i + 1), "coordinates = [\"x\", \"y\", \"phi\"]");
+      builder.coordinate(name, at(element));
+      coordinates_.push_back(name);
+    }
+  }
+
+  void load_parameters(const toml::node& node, SpecBuilder& builder) {
+    const toml::table& table = table_of(node, "parameters", "[parameters] followed by m = 1.0");
+    for (const Entry& entry : in_file_order(table)) {
+      check_not_misplaced(*entry.key, "in [parameters]");
+      const std::string name(entry.key->str());
+      const toml::node* value = entry.value;
+      std::string unit;
+      if (const toml::table* full = value->as_table()) {
+        check_keys(*full, parameter_keys, fmt::format("in parameter '{}'", name));
+        value = full->get("value");
+        if (value == nullptr)
+          fail(at(*entry.value, *entry.key),
+               fmt::format("parameter '{}' has no value: write {} = {{ value = 0.5, unit = \"m\" }}", name, name));
+        if (const toml::node* unit_node = full->get("unit"))
+          unit = string_of(*unit_node, fmt::format("{}.unit", name), "unit = \"m\"");
+      }
+      const double number = parameter_value(*value, name, builder);
+      builder.parameter(name, number, unit, at(*entry.key));
+      parameter_values_.emplace_back(name, number);
+    }
+  }
+
+  // A number, or a constant expression in pi and the parameters above ("pi/6", "2*a").
+  double parameter_value(const toml::node& node, const std::string& name, const SpecBuilder& builder) const {
+    if (const std::optional<double> number = number_value(node, name)) return *number;
+    if (!node.is_string())
+      fail(at(node), fmt::format("parameter '{}' must be a number, an expression in pi and the parameters above it "
+                                 "(e.g. \"pi/6\"), or {{ value = ..., unit = \"...\" }}; it is {}",
+                                 name, type_name(node)));
+    const std::string& text = node.as_string()->get();
+    const SourceLocation where = content_at(node);
+    const GiNaC::ex parsed = located(node, [&] { return builder.parse(text, where); });
+    try {
+      GiNaC::lst values;
+      for (GiNaC::const_preorder_iterator it = parsed.preorder_begin(); it != parsed.preorder_end(); ++it) {
+        if (!GiNaC::is_a<GiNaC::symbol>(*it)) continue;
+        const std::string symbol = GiNaC::ex_to<GiNaC::symbol>(*it).get_name();
+        const auto known = std::find_if(parameter_values_.begin(), parameter_values_.end(),
+                                        [&](const auto& p) { return p.first == symbol; });
+        if (known == parameter_values_.end())
+          fail(where, fmt::format("the value of parameter '{}' uses '{}'; a parameter's value may use only numbers, "
+                                  "pi and the parameters above it",
+                                  name, symbol));
+        values.append(*it == GiNaC::numeric(known->second));
+      }
+      const GiNaC::ex value = parsed.subs(values).evalf();
+      if (GiNaC::is_a<GiNaC::numeric>(value) && GiNaC::ex_to<GiNaC::numeric>(value).is_real()) {
+        const double number = GiNaC::ex_to<GiNaC::numeric>(value).to_double();
+        if (std::isfinite(number)) return number;
+      }
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception& e) {
+      fail(where, fmt::format("the value of parameter '{}', \"{}\", cannot be evaluated: {}", name, text, e.what()));
+    }
+    fail(where, fmt::format("the value of parameter '{}', \"{}\", is not a finite real number", name, text));
+  }
+
+  void load_forces(const toml::node& node, SpecBuilder& builder) const {
+    const toml::table& table = table_of(node, "forces", "[forces] followed by x = \"-c * x'\"");
+    for (const Entry& entry : in_file_order(table)) {
+      check_not_misplaced(*entry.key, "in [forces]");
+      const std::string coordinate(entry.key->str());
+      coordinate_index(coordinate, at(*entry.key), "in [forces]");
+      const std::string what = fmt::format("forces.{}", coordinate);
+      const std::string text = expression_string(*entry.value, what, "x = \"-c * x'\"");
+      located(*entry.value, [&] { builder.force(coordinate, text, content_at(*entry.value)); });
+    }
+  }
+
+  void load_constraints(const toml::node& node, SpecBuilder& builder) const {
+    const toml::array& array =
+        array_of(node, "constraints", "[[constraints]] followed by name = \"blade\" and velocity = \"...\"");
+    std::vector<std::pair<std::string, SourceLocation>> names;
+    int number = 0;
+    for (const toml::node& element : array) {
+      ++number;
+      const std::string context = fmt::format("in constraint {}", number);
+      const toml::table* table = element.as_table();
+      if (table == nullptr)
+        fail(at(element), fmt::format("constraint {} must be a table with a name and one of position, velocity, "
+                                      "acceleration (write it as [[constraints]]); it is {}",
+                                      number, type_name(element)));
+      check_keys(*table, constraint_keys, context);
+
+      std::string name = fmt::format("c{}", number);
+      SourceLocation name_at = at(element);
+      if (const toml::node* name_node = table->get("name")) {
+        name = string_of(*name_node, "name", "name = \"blade\"");
+        name_at = at(*name_node);
+      }
+      for (const auto& [other, other_at] : names)
+        if (other == name)
+          fail(name_at, fmt::format("constraint name '{}' is used twice (first at line {}); give each constraint "
+                                    "its own name",
+                                    name, other_at.line));
+      names.emplace_back(name, name_at);
+
+      const toml::node* level_node = nullptr;
+      std::string level_key;
+      ConstraintLevel level = ConstraintLevel::velocity;
+      for (const Entry& entry : in_file_order(*table)) {
+        const std::string key(entry.key->str());
+        ConstraintLevel this_level;
+        if (key == "position") this_level = ConstraintLevel::position;
+        else if (key == "velocity") this_level = ConstraintLevel::velocity;
+        else if (key == "acceleration") this_level = ConstraintLevel::acceleration;
+        else continue;
+        if (level_node != nullptr)
+          fail(at(*entry.key), fmt::format("constraint '{}' is given both as {} and as {}; give exactly one of "
+                                           "position, velocity, acceleration",
+                                           name, level_key, key));
+        level_node = entry.value;
+        level_key = key;
+        level = this_level;
+      }
+      if (level_node == nullptr)
+        fail(at(element), fmt::format("constraint '{}' has no expression: give exactly one of position = \"...\", "
+                                      "velocity = \"...\" or acceleration = \"...\" (the constraint is expression = 0)",
+                                      name));
+      const std::string text = expression_string(*level_node, fmt::format("{}.{}", name, level_key),
+                                                 "velocity = \"y' - tan(phi) * x'\"");
+      located(*level_node, [&] { builder.constraint(name, level, text, content_at(*level_node)); });
+    }
+  }
+
+  void load_complement(const toml::table& root, SpecBuilder& builder) const {
+    const toml::node* independent = root.get("independent");
+    const toml::node* complement = root.get("complement");
+    if (independent != nullptr && complement != nullptr)
+      fail(at(*complement), "give either 'independent' or 'complement', not both: 'independent' chooses the "
+                            "coordinates kept independent, 'complement' writes D itself");
+    if (independent != nullptr) {
+      const toml::array& array = array_of(*independent, "independent", "independent = [\"x\", \"phi\"]");
+      std::vector<std::string> names;
+      for (std::size_t i = 0; i < array.size(); ++i) {
+        const toml::node& element = *array.get(i);
+        const std::string name =
+            string_of(element, fmt::format("independent[{}]", i + 1), "independent = [\"x\", \"phi\"]");
+        coordinate_index(name, at(element), "in 'independent'");
+        names.push_back(name);
+      }
+      builder.independent(names, at(*independent));
+    }
+    if (complement != nullptr) {
+      constexpr std::string_view example = "complement = [[\"1\", \"tan(phi)\", \"0\"], [0, 0, 1]]";
+      const toml::array& rows = array_of(*complement, "complement", example);
+      std::vector<std::vector<std::string>> texts;
+      for (const toml::node& row_node : rows) {
+        const std::string row_what = fmt::format("complement row {}", texts.size() + 1);
+        const toml::array& row = array_of(row_node, row_what, "[\"1\", \"tan(phi)\", \"0\"]");
+        if (row.size() != coordinates_.size())
+          fail(at(row_node), fmt::format("{} has {} entries; D needs one column per coordinate ({}): {}", row_what,
+                                         row.size(), coordinates_.size(), join(coordinates_)));
+        std::vector<std::string>& out = texts.emplace_back();
+        for (const toml::node& entry : row) {
+          const std::string text = number_or_expression(entry, row_what, "\"tan(phi)\" or 0");
+          // SpecBuilder locates errors in D from the one location it is given. To point at the
+          // entry, each expression is first given in a D of zeros that ends with it, so that the
+          // builder names its row and column (complement() sets D: the call for the whole matrix
+          // below replaces these probes).
+          if (entry.is_string()) {
+            std::vector<std::vector<std::string>> probe(texts.size(), std::vector<std::string>(out.size() + 1, "0"));
+            probe.back().back() = text;
+            located(entry, [&] { builder.complement(probe, content_at(entry)); });
+          }
+          out.push_back(text);
+        }
+      }
+      builder.complement(texts, at(*complement));
+    }
+  }
+
+  struct InitialValue {
+    std::string text = "0";
+    SourceLocation where;
+    const toml::node* node = nullptr;
+    bool given = false;
+  };
+
+  void load_initial_values(const toml::node& node, std::string_view which, std::vector<InitialValue>& values) const {
+    const std::string what = fmt::format("initial.{}", which);
+    const toml::table& table = table_of(node, what, fmt::format("{} = {{ x = 0, phi = \"pi/4\" }}", which));
+    for (const Entry& entry : in_file_order(table)) {
+      const std::string coordinate(entry.key->str());
+      const int i = coordinate_index(coordinate, at(*entry.key), fmt::format("in [{}]", what));
+      InitialValue& value = values[static_cast<std::size_t>(i)];
+      value.text = number_or_expression(*entry.value, fmt::format("{}.{}", what, coordinate), "1.5 or \"a/2\"");
+      value.where = content_at(*entry.value);
+      value.node = entry.value;
+      value.given = true;
+    }
+  }
+
+  void load_initial(const toml::node& node, SpecBuilder& builder) {
+    const toml::table& table = table_of(node, "initial", "[initial] followed by velocity = { x = 1 }");
+    check_keys(table, initial_keys, "in [initial]");
+    if (const toml::node* t0 = table.get("t0")) {
+      t0_ = number_of(*t0, "initial.t0", "t0 = 0");
+      builder.initial_time(t0_);
+    }
+    std::vector<InitialValue> q0(coordinates_.size()), v0(coordinates_.size());
+    if (const toml::node* position = table.get("position")) load_initial_values(*position, "position", q0);
+    if (const toml::node* velocity = table.get("velocity")) load_initial_values(*velocity, "velocity", v0);
+    const bool any = std::any_of(q0.begin(), q0.end(), [](const InitialValue& v) { return v.given; }) ||
+                     std::any_of(v0.begin(), v0.end(), [](const InitialValue& v) { return v.given; });
+    if (!any) return;
+    // SpecBuilder::initial takes a coordinate's value and velocity with one location. To point at
+    // the faulty one, the value is checked first with velocity 0; the second call, which sets both,
+    // can then fail only on the velocity (initial() sets, so the second call replaces the first).
+    for (std::size_t i = 0; i < coordinates_.size(); ++i) {
+      const std::string& c = coordinates_[i];
+      if (q0[i].given) located(*q0[i].node, [&] { builder.initial(c, q0[i].text, "0", q0[i].where); });
+      if (v0[i].given) located(*v0[i].node, [&] { builder.initial(c, q0[i].text, v0[i].text, v0[i].where); });
+      else if (!q0[i].given) builder.initial(c, "0", "0", at(node));
+    }
+  }
+
+  void load_simulation(const toml::node& node, SpecBuilder& builder) const {
+    const toml::table& table = table_of(node, "simulation", "[simulation] followed by t_end = 10");
+    check_keys(table, simulation_keys, "in [simulation]");
+    SimulationDefaults defaults;
+    if (const toml::node* t_end = table.get("t_end")) {
+      defaults.t_end = number_of(*t_end, "simulation.t_end", "t_end = 10");
+      if (!(defaults.t_end > t0_))
+        fail(at(*t_end), fmt::format("simulation.t_end = {} must be after the initial time t0 = {}", defaults.t_end, t0_));
+    }
+    if (const toml::node* step = table.get("output_step")) {
+      defaults.output_step = number_of(*step, "simulation.output_step", "output_step = 0.01");
+      if (!(defaults.output_step > 0.0))
+        fail(at(*step), fmt::format("simulation.output_step = {} must be positive", defaults.output_step));
+    }
+    builder.defaults(defaults);
+    if (const toml::node* integrator = table.get("integrator"))
+      builder.integrator(one_of(*integrator, "simulation.integrator", integrator_names));
+    if (const toml::node* method = table.get("method"))
+      builder.method(one_of(*method, "simulation.method", method_names));
+    std::optional<double> rtol, atol;
+    if (const toml::node* node_rtol = table.get("rtol")) {
+      rtol = number_of(*node_rtol, "simulation.rtol", "rtol = 1e-8");
+      if (!(*rtol > 0.0)) fail(at(*node_rtol), fmt::format("simulation.rtol = {} must be positive", *rtol));
+    }
+    if (const toml::node* node_atol = table.get("atol")) {
+      atol = number_of(*node_atol, "simulation.atol", "atol = 1e-10");
+      if (!(*atol > 0.0))
+        fail(at(*node_atol), fmt::format("simulation.atol = {} must be positive (pure relative error control fails "
+                                         "where a state crosses zero)",
+                                         *atol));
+    }
+    if (rtol || atol) builder.tolerances(rtol, atol);
+  }
+
+  std::string one_of(const toml::node& node, std::string_view what, const std::vector<std::string>& names) const {
+    const std::string name = string_of(node, what, fmt::format("\"{}\"", names.front()));
+    if (std::find(names.begin(), names.end(), name) == names.end()) {
+      const std::string nearest = symbolic::nearest_name(name, names);
+      fail(at(node), fmt::format("unknown {} '{}'; {}choose one of: {}", what, name,
+                                 nearest.empty() ? "" : fmt::format("did you mean '{}'? ", nearest), join(names)));
+    }
+    return name;
+  }
+
+  void load_plot(const toml::node& node, SpecBuilder& builder) const {
+    const toml::table& table = table_of(node, "plot", "[plot] followed by path = [\"x\", \"y\"]");
+    check_keys(table, plot_keys, "in [plot]");
+    if (const toml::node* path = table.get("path")) {
+      const toml::array& array = array_of(*path, "plot.path", "path = [\"x\", \"y\"]");
+      if (array.size() != 2)
+        fail(at(*path), fmt::format("plot.path must name two coordinates, the horizontal and the vertical axis, "
+                                    "e.g. path = [\"x\", \"y\"]; it has {}",
+                                    array.size()));
+      std::array<std::string, 2> axes;
+      for (std::size_t i = 0; i < 2; ++i) {
+        axes[i] = string_of(*array.get(i), fmt::format("plot.path[{}]", i + 1), "path = [\"x\", \"y\"]");
+        coordinate_index(axes[i], at(*array.get(i)), "in plot.path");
+      }
+      builder.path(axes[0], axes[1]);
+    }
+  }
+
+  std::string_view text_;
+  std::string file_;
+  std::vector<std::string> coordinates_;
+  std::vector<std::pair<std::string, double>> parameter_values_;
+  double t0_ = 0.0;
+};
+
+}  // namespace
+
+symbolic::Spec load_model_string(std::string_view text, std::string file_name) {
+  return Loader(text, std::move(file_name)).load();
+}
+
+symbolic::Spec load_model_file(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status))
+    throw FileError(fmt::format("{}: no such model file; check the path (model files end in .toml, e.g. "
+                                "examples/sled.toml)",
+                                path.string()));
+  if (std::filesystem::is_directory(status))
+    throw FileError(fmt::format("{}: is a directory, not a model file; give the path of a .toml file", path.string()));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const int error = errno;
+    throw FileError(fmt::format("{}: cannot open the model file: {}", path.string(),
+                                error != 0 ? std::strerror(error) : "unknown error"));
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw FileError(fmt::format("{}: cannot read the model file", path.string()));
+  return load_model_string(text.str(), path.string());
+}
+
+}  // namespace nhdyn

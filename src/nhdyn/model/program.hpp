@@ -1,0 +1,189 @@
+// Straight-line programs on doubles: the numeric form of a model compiled from symbols
+// (symbolic/compile.hpp). A Program is a flat array of instructions in single-assignment form with
+// no branches and no allocation when it runs, so its cost is one switch dispatch per instruction
+// plus the arithmetic. Registers: r[0] = t, r[1 + i] = q_i, r[1 + n + i] = q'_i (the inputs, copied
+// in when the program starts), then instruction j writes register inputs() + j and reads only
+// registers below it. Outputs are registers or constants; constant outputs cost no instruction.
+// ProgramEvaluator runs such programs as an Evaluator: all the terms A, Q, G, b, b0 in one
+// program (common subexpressions computed once), the complement D, the residuals and the energy
+// in their own. Generated C++ (symbolic/codegen.hpp) prints the same programs as source code.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "nhdyn/model/evaluator.hpp"
+
+namespace nhdyn {
+
+// One operation. `a`, `b`, `c` are operand registers, `k` an immediate double; r is the register
+// the instruction writes. Integer powers are repeated multiplications, never std::pow.
+enum class Op : std::uint8_t {
+  constant,     // r = k
+  add,          // r = a + b
+  sub,          // r = a - b
+  mul,          // r = a * b
+  div,          // r = a / b
+  neg,          // r = -a
+  add_k,        // r = a + k
+  mul_k,        // r = k * a
+  mulk,         // r = k * (a * b)
+  div_k,        // r = k / a       (k = 1: the reciprocal)
+  muladd,       // r = a * b + c   (two roundings: not std::fma)
+  mulsub,       // r = c - a * b
+  mulk_add,     // r = k * a + b
+  mulk_muladd,  // r = k * (a * b) + c
+  square,       // r = a * a
+  cube,         // r = a * a * a
+  powi,         // r = a^k for an integer k != 0, by repeated squaring (negative: 1 / a^-k)
+  pow,          // r = std::pow(a, b)
+  pow_k,        // r = std::pow(a, k)
+  sqrt,
+  sin,
+  cos,
+  sincos,       // r = sin(a) and r + 1 = cos(a); the next instruction is its `nop` companion
+  tan,
+  exp,
+  log,
+  abs,
+  asin,
+  acos,
+  atan,
+  atan2,        // r = atan2(a, b)
+  sinh,
+  cosh,
+  tanh,
+  nop,          // the cos slot of a sincos; never pushed on its own
+};
+
+// Number of register operands of `op` (0, 1, 2 or 3).
+int operand_count(Op op);
+// The instruction's name as printed by describe() ("mulk_add", "sin", ...).
+const char* op_name(Op op);
+
+struct Instruction {
+  Op op = Op::nop;
+  std::int32_t a = 0;
+  std::int32_t b = 0;
+  std::int32_t c = 0;
+  double k = 0.0;
+};
+
+// An output of a program: register `reg`, or the constant `value` when reg < 0.
+struct Output {
+  int reg = -1;
+  double value = 0.0;
+};
+
+class Program {
+ public:
+  // A program of a system with `coordinates` coordinates (its inputs are t, q and q').
+  explicit Program(int coordinates = 0);
+
+  int coordinates() const { return n_; }
+  // The input registers: t, q_i, q'_i; inputs() = 1 + 2 n of them.
+  int inputs() const { return 1 + 2 * n_; }
+  static constexpr int time_register() { return 0; }
+  int coordinate_register(int i) const;  // throws std::invalid_argument out of [0, n)
+  int velocity_register(int i) const;
+
+  // Appends an instruction and returns the register it writes. Throws std::invalid_argument when
+  // an operand register is not written yet, a powi exponent is not a nonzero integer of magnitude
+  // at most 2^20, or op is `nop`. A sincos also appends its companion: it returns the register of
+  // the sine, the cosine is the next one.
+  int push(Op op, int a = 0, int b = 0, int c = 0, double k = 0.0);
+  int push_constant(double value) { return push(Op::constant, 0, 0, 0, value); }
+  // Appends the next output: a register, or a constant (which costs no instruction).
+  void add_output(int reg);
+  void add_constant_output(double value);
+
+  // Number of registers run() needs: the inputs, then one per instruction.
+  int registers() const { return inputs() + static_cast<int>(code_.size()); }
+  int outputs() const { return static_cast<int>(outputs_.size()); }
+  const std::vector<Instruction>& code() const { return code_; }
+  const std::vector<Output>& output_list() const { return outputs_; }
+  // Number of instructions with this op.
+  int count(Op op) const;
+  bool reads_time() const { return reads_[0]; }
+  bool reads_coordinates() const { return reads_[1]; }
+  bool reads_velocities() const { return reads_[2]; }
+
+  // Runs the program: q and v hold coordinates() values (v may be null when the program reads no
+  // velocity), `registers` registers() doubles, `outputs` outputs() doubles. Allocates nothing.
+  void run(double t, const double* q, const double* v, double* registers, double* outputs) const;
+  // The same without writing the outputs: register outputs stay in registers[output_list()[i].reg].
+  void execute(double t, const double* q, const double* v, double* registers) const;
+
+  // One line per instruction ("r9 = mul q2 r8"), then the outputs: for debugging and tests.
+  std::string describe() const;
+  // "t", "q2", "v0" for an input register, "r12" otherwise.
+  std::string register_name(int reg) const;
+
+ private:
+  friend class ProgramEvaluator;  // runs the terms' code inline
+  void note_read(int reg);
+
+  int n_ = 0;
+  std::vector<Instruction> code_;
+  std::vector<Output> outputs_;
+  bool reads_[3] = {false, false, false};  // t, q, q'
+};
+
+// The programs of a compiled model, with the output each must have (n coordinates, s
+// constraints, p of them at position level, r = number at position or velocity level).
+struct ModelPrograms {
+  Program terms;                     // outputs: A (n x n, col-major), Q (n), G (n), b (s x n, col-major), b0 (s)
+  std::optional<Program> complement;  // outputs: D, k x n col-major (k = n - s)
+  Program position_residual;         // outputs: phi (p); reads no velocity
+  Program velocity_residual;         // outputs: f (r)
+  std::optional<Program> energy;     // one output: T + V
+};
+
+// An Evaluator that runs straight-line programs. scratch_size() is the largest register count
+// of its programs; outputs go from the registers straight into the caller's arrays (constant
+// entries from a prepared image, the others scattered from their registers).
+class ProgramEvaluator final : public Evaluator {
+ public:
+  // Throws std::invalid_argument when a program's output count or coordinate count does not
+  // match n and s, or the position residual reads velocities.
+  ProgramEvaluator(int n, int s, ModelPrograms programs);
+
+  int n() const { return n_; }
+  int s() const { return s_; }
+  const ModelPrograms& programs() const { return programs_; }
+
+  std::size_t scratch_size() const override { return scratch_; }
+  // The Evaluator interface; each call runs one program and writes its outputs.
+  void terms(double t, const double* q, const double* v, double* scratch, const TermsOut& out) const override;
+  bool has_complement() const override { return programs_.complement.has_value(); }
+  void complement(double t, const double* q, const double* v, double* scratch, double* D) const override;
+  void position_residual(double t, const double* q, double* scratch, double* phi) const override;
+  void velocity_residual(double t, const double* q, const double* v, double* scratch, double* f) const override;
+  bool has_energy() const override { return programs_.energy.has_value(); }
+  double energy(double t, const double* q, const double* v, double* scratch) const override;
+
+ private:
+  // A register output of the terms: TermsOut array (0 A, 1 Q, 2 G, 3 b, 4 b0), index, register.
+  struct Entry {
+    std::int32_t array = 0, index = 0, reg = 0;
+  };
+  // Writes the terms' outputs: the constant image copied whole, then the register entries.
+  using Writer = void (*)(const ProgramEvaluator& self, const double* registers, const TermsOut& out);
+  template <int N, int S>
+  static void write_fixed(const ProgramEvaluator& self, const double* registers, const TermsOut& out);
+  static void write_any(const ProgramEvaluator& self, const double* registers, const TermsOut& out);
+  static Writer choose_writer(int n, int s);
+
+  int n_ = 0;
+  int s_ = 0;
+  ModelPrograms programs_;
+  std::size_t scratch_ = 0;
+  std::vector<double> image_;      // every output of the terms, A Q G b b0; 0 where it is a register
+  std::vector<Entry> entries_;     // the register outputs of the terms
+  Writer writer_ = nullptr;        // sizes fixed at compile time for n <= 4, else write_any
+};
+
+}  // namespace nhdyn

@@ -1,0 +1,353 @@
+#include "nhdyn/symbolic/codegen.hpp"
+
+#include <fmt/format.h>
+
+#include <cctype>
+#include <cmath>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/model/program.hpp"
+#include "nhdyn/symbolic/compile.hpp"
+
+namespace nhdyn::symbolic {
+namespace {
+
+constexpr const char* kKeywords[] = {
+    "alignas",   "alignof",      "and",          "and_eq",      "asm",        "auto",         "bitand",
+    "bitor",     "bool",         "break",        "case",        "catch",      "char",         "char8_t",
+    "char16_t",  "char32_t",     "class",        "compl",       "concept",    "const",        "consteval",
+    "constexpr", "constinit",    "const_cast",   "continue",    "co_await",   "co_return",    "co_yield",
+    "decltype",  "default",      "delete",       "do",          "double",     "dynamic_cast", "else",
+    "enum",      "explicit",     "export",       "extern",      "false",      "float",        "for",
+    "friend",    "goto",         "if",           "inline",      "int",        "long",         "mutable",
+    "namespace", "new",          "noexcept",     "not",         "not_eq",     "nullptr",      "operator",
+    "or",        "or_eq",        "private",      "protected",   "public",     "register",     "reinterpret_cast",
+    "requires",  "return",       "short",        "signed",      "sizeof",     "static",       "static_assert",
+    "static_cast", "struct",     "switch",       "template",    "this",       "thread_local", "throw",
+    "true",      "try",          "typedef",      "typeid",      "typename",   "union",        "unsigned",
+    "using",     "virtual",      "void",         "volatile",    "wchar_t",    "while",        "xor",
+    "xor_eq"};
+
+bool is_keyword(const std::string& s) {
+  for (const char* k : kKeywords)
+    if (s == k) return true;
+  return false;
+}
+
+bool is_identifier(const std::string& s) {
+  if (s.empty() || std::isdigit(static_cast<unsigned char>(s[0]))) return false;
+  for (char ch : s)
+    if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_')) return false;
+  // Names with "__" or "_X" are reserved to the implementation.
+  if (s.find("__") != std::string::npos) return false;
+  if (s[0] == '_' && s.size() > 1 && std::isupper(static_cast<unsigned char>(s[1]))) return false;
+  return !is_keyword(s);
+}
+
+std::string camel_case(const std::string& identifier) {
+  std::string out;
+  bool upper = true;
+  for (char ch : identifier) {
+    if (ch == '_') {
+      upper = true;
+      continue;
+    }
+    out += upper ? static_cast<char>(std::toupper(static_cast<unsigned char>(ch))) : ch;
+    upper = false;
+  }
+  return out;
+}
+
+// A double as a C++ literal that reads back to the same value ({:.17g}), always of type double.
+std::string literal(double x) {
+  if (std::isnan(x)) return "NAN";
+  if (std::isinf(x)) return x > 0 ? "HUGE_VAL" : "(-HUGE_VAL)";
+  std::string s = fmt::format("{:.17g}", x);
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
+  return x < 0 || std::signbit(x) ? "(" + s + ")" : s;
+}
+
+// A C++ string literal; bytes outside printable ASCII as octal escapes (UTF-8 survives as bytes).
+std::string quoted(const std::string& s) {
+  std::string out = "\"";
+  for (unsigned char ch : s) {
+    if (ch == '"' || ch == '\\') {
+      out += '\\';
+      out += static_cast<char>(ch);
+    } else if (ch == '\n') {
+      out += "\\n";
+    } else if (ch < 0x20 || ch >= 0x7f) {
+      out += fmt::format("\\{:03o}", static_cast<unsigned>(ch));
+    } else {
+      out += static_cast<char>(ch);
+    }
+  }
+  return out + "\"";
+}
+
+// A comment line safe to print (no line breaks, no "*/").
+std::string comment_text(const std::string& s) {
+  std::string out;
+  for (char ch : s) out += (ch == '\n' || ch == '\r') ? ' ' : ch;
+  return out;
+}
+
+// A register as C++: the inputs by their parameter (t, q[i], v[i]), the others rN.
+std::string reg(const Program& program, int r) {
+  const int n = program.coordinates();
+  if (r == Program::time_register()) return "t";
+  if (r <= n) return fmt::format("q[{}]", r - 1);
+  if (r <= 2 * n) return fmt::format("v[{}]", r - 1 - n);
+  return "r" + std::to_string(r);
+}
+
+// The right-hand side of instruction `in` (not a sincos).
+std::string expression(const Program& program, const Instruction& in) {
+  const int count = operand_count(in.op);
+  const std::string a = count >= 1 ? reg(program, in.a) : "", b = count >= 2 ? reg(program, in.b) : "",
+                    c = count >= 3 ? reg(program, in.c) : "";
+  switch (in.op) {
+    case Op::constant: return literal(in.k);
+    case Op::add: return a + " + " + b;
+    case Op::sub: return a + " - " + b;
+    case Op::mul: return a + " * " + b;
+    case Op::div: return a + " / " + b;
+    case Op::neg: return "-" + a;
+    case Op::add_k: return a + " + " + literal(in.k);
+    case Op::mul_k: return literal(in.k) + " * " + a;
+    case Op::mulk: return literal(in.k) + " * (" + a + " * " + b + ")";
+    case Op::div_k: return literal(in.k) + " / " + a;
+    case Op::muladd: return a + " * " + b + " + " + c;
+    case Op::mulsub: return c + " - " + a + " * " + b;
+    case Op::mulk_add: return literal(in.k) + " * " + a + " + " + b;
+    case Op::mulk_muladd: return literal(in.k) + " * (" + a + " * " + b + ") + " + c;
+    case Op::square: return a + " * " + a;
+    case Op::cube: return a + " * " + a + " * " + a;
+    case Op::powi: return fmt::format("powi({}, {})", a, static_cast<int>(in.k));
+    case Op::pow: return "std::pow(" + a + ", " + b + ")";
+    case Op::pow_k: return "std::pow(" + a + ", " + literal(in.k) + ")";
+    case Op::atan2: return "std::atan2(" + a + ", " + b + ")";
+    case Op::sincos:
+    case Op::nop: break;
+    default: return std::string("std::") + op_name(in.op) + "(" + a + ")";
+  }
+  return "";
+}
+
+struct Body {
+  std::string code;
+  bool reads_t = false, reads_q = false, reads_v = false;
+};
+
+// The statements of a program, then `sink(i, register)` for each output i.
+Body print_body(const Program& program, const std::function<std::string(int, const std::string&)>& sink) {
+  Body body;
+  body.reads_t = program.reads_time();
+  body.reads_q = program.reads_coordinates();
+  body.reads_v = program.reads_velocities();
+  const std::vector<Instruction>& code = program.code();
+  for (std::size_t i = 0; i < code.size(); ++i) {
+    const Instruction& in = code[i];
+    const int r = program.inputs() + static_cast<int>(i);
+    if (in.op == Op::nop) continue;
+    if (in.op == Op::sincos) {
+      body.code += fmt::format("    const double {} = std::sin({});\n", reg(program, r), reg(program, in.a));
+      body.code += fmt::format("    const double {} = std::cos({});\n", reg(program, r + 1), reg(program, in.a));
+      continue;
+    }
+    body.code += fmt::format("    const double {} = {};\n", reg(program, r), expression(program, in));
+  }
+  const std::vector<Output>& outputs = program.output_list();
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const Output& o = outputs[i];
+    body.code += sink(static_cast<int>(i), o.reg < 0 ? literal(o.value) : reg(program, o.reg));
+  }
+  return body;
+}
+
+std::string parameter(bool used, const char* declaration, const char* name) {
+  return used ? fmt::format("{} {}", declaration, name) : fmt::format("{} /*{}*/", declaration, name);
+}
+
+std::string level_name(ConstraintLevel level) {
+  switch (level) {
+    case ConstraintLevel::position: return "position";
+    case ConstraintLevel::velocity: return "velocity";
+    case ConstraintLevel::acceleration: return "acceleration";
+  }
+  return "velocity";
+}
+
+bool uses_powi(const ModelPrograms& p) {
+  const auto in = [](const Program& program) { return program.count(Op::powi) > 0; };
+  return in(p.terms) || (p.complement && in(*p.complement)) || in(p.position_residual) ||
+         in(p.velocity_residual) || (p.energy && in(*p.energy));
+}
+
+}  // namespace
+
+std::string make_identifier(const std::string& name) {
+  std::string out;
+  for (char ch : name) {
+    const bool keep = std::isalnum(static_cast<unsigned char>(ch)) && static_cast<unsigned char>(ch) < 0x80;
+    if (keep) {
+      out += ch;
+    } else if (!out.empty() && out.back() != '_') {
+      out += '_';
+    }
+  }
+  while (!out.empty() && out.back() == '_') out.pop_back();
+  if (out.empty()) return "model";
+  if (std::isdigit(static_cast<unsigned char>(out[0]))) out = "model_" + out;
+  if (is_keyword(out)) out += '_';
+  return out;
+}
+
+std::string generate_code(const Spec& spec, const Derivation& derivation, const CodegenOptions& options) {
+  const std::string id = options.identifier.empty() ? make_identifier(spec.name) : options.identifier;
+  if (!is_identifier(id))
+    throw InputError(fmt::format("codegen: '{}' is not a valid C++ identifier for the generated names", id));
+  std::vector<std::string> namespaces;
+  if (!options.namespace_name.empty()) {
+    std::string rest = options.namespace_name;
+    if (rest.rfind("::", 0) == 0) rest = rest.substr(2);
+    for (std::size_t pos; (pos = rest.find("::")) != std::string::npos; rest = rest.substr(pos + 2))
+      namespaces.push_back(rest.substr(0, pos));
+    namespaces.push_back(rest);
+    for (const std::string& part : namespaces)
+      if (!is_identifier(part))
+        throw InputError(fmt::format("codegen: the namespace '{}' is not '::'-separated C++ identifiers",
+                                     options.namespace_name));
+    if (namespaces.front() == "std") throw InputError("codegen: the generated code may not go into namespace std");
+  }
+
+  const Model model = compile_model(spec, derivation);
+  const auto* evaluator = dynamic_cast<const ProgramEvaluator*>(model.evaluator.get());
+  if (evaluator == nullptr) throw std::logic_error("generate_code: compile_model did not make a ProgramEvaluator");
+  const ModelPrograms& programs = evaluator->programs();
+  const int n = model.n(), s = model.s();
+  const std::string cls = camel_case(id) + "Evaluator";
+  const auto q_name = [&](int i) { return comment_text(model.coordinates[static_cast<std::size_t>(i)]); };
+  const auto c_name = [&](int i) { return comment_text(model.constraints[static_cast<std::size_t>(i)].name); };
+
+  std::string out;
+  out += fmt::format("// Generated by nhdyn (symbolic/codegen.hpp) from the model '{}'. Do not edit: regenerate.\n",
+                     comment_text(model.name));
+  if (!model.description.empty()) out += fmt::format("// {}\n", comment_text(model.description));
+  const auto operations = [](const Program& p) { return p.code().size() - static_cast<std::size_t>(p.count(Op::nop)); };
+  out += fmt::format("// Operations: terms {}, complement {}, residuals {} + {}, energy {}.\n",
+                     operations(programs.terms), programs.complement ? operations(*programs.complement) : 0,
+                     operations(programs.position_residual), operations(programs.velocity_residual),
+                     programs.energy ? operations(*programs.energy) : 0);
+  out += "#pragma once\n\n#include <cmath>\n#include <memory>\n\n";
+  out += "#include \"nhdyn/model/evaluator.hpp\"\n#include \"nhdyn/model/model.hpp\"\n\n";
+  for (const std::string& part : namespaces) out += fmt::format("namespace {} {{\n", part);
+  if (!namespaces.empty()) out += "\n";
+
+  out += fmt::format("class {} final : public ::nhdyn::Evaluator {{\n public:\n", cls);
+
+  // terms
+  {
+    const Body body = print_body(programs.terms, [&](int i, const std::string& r) {
+      const int nn = n * n;
+      if (i < nn) return fmt::format("    out.A[{}] = {};  // A({}, {})\n", i, r, q_name(i % n), q_name(i / n));
+      i -= nn;
+      if (i < n) return fmt::format("    out.Q[{}] = {};  // Q({})\n", i, r, q_name(i));
+      i -= n;
+      if (i < n) return fmt::format("    out.G[{}] = {};  // G({})\n", i, r, q_name(i));
+      i -= n;
+      if (i < s * n) return fmt::format("    out.b[{}] = {};  // b({}, {})\n", i, r, c_name(i % s), q_name(i / s));
+      i -= s * n;
+      return fmt::format("    out.b0[{}] = {};  // b0({})\n", i, r, c_name(i));
+    });
+    out += fmt::format("  void terms({}, {}, {}, double* /*scratch*/, const ::nhdyn::TermsOut& out) const override {{\n",
+                       parameter(body.reads_t, "double", "t"), parameter(body.reads_q, "const double*", "q"),
+                       parameter(body.reads_v, "const double*", "v"));
+    out += body.code + "  }\n";
+  }
+  // complement
+  if (programs.complement) {
+    const int k = n - s;
+    const Body body = print_body(*programs.complement, [&](int i, const std::string& r) {
+      return fmt::format("    D[{}] = {};  // D({}, {})\n", i, r, i % k + 1, q_name(i / k));
+    });
+    out += "\n  bool has_complement() const override { return true; }\n";
+    out += fmt::format("  void complement({}, {}, {}, double* /*scratch*/, double* D) const override {{\n",
+                       parameter(body.reads_t, "double", "t"), parameter(body.reads_q, "const double*", "q"),
+                       parameter(body.reads_v, "const double*", "v"));
+    out += body.code + "  }\n";
+  }
+  // residuals
+  if (programs.position_residual.outputs() > 0) {
+    const Body body = print_body(programs.position_residual, [&](int i, const std::string& r) {
+      return fmt::format("    phi[{}] = {};\n", i, r);
+    });
+    out += fmt::format("\n  void position_residual({}, {}, double* /*scratch*/, double* phi) const override {{\n",
+                       parameter(body.reads_t, "double", "t"), parameter(body.reads_q, "const double*", "q"));
+    out += body.code + "  }\n";
+  }
+  if (programs.velocity_residual.outputs() > 0) {
+    const Body body = print_body(programs.velocity_residual, [&](int i, const std::string& r) {
+      return fmt::format("    f[{}] = {};\n", i, r);
+    });
+    out += fmt::format("\n  void velocity_residual({}, {}, {}, double* /*scratch*/, double* f) const override {{\n",
+                       parameter(body.reads_t, "double", "t"), parameter(body.reads_q, "const double*", "q"),
+                       parameter(body.reads_v, "const double*", "v"));
+    out += body.code + "  }\n";
+  }
+  // energy
+  if (programs.energy) {
+    const Body body = print_body(*programs.energy, [&](int, const std::string& r) {
+      return fmt::format("    return {};\n", r);
+    });
+    out += "\n  bool has_energy() const override { return true; }\n";
+    out += fmt::format("  double energy({}, {}, {}, double* /*scratch*/) const override {{\n",
+                       parameter(body.reads_t, "double", "t"), parameter(body.reads_q, "const double*", "q"),
+                       parameter(body.reads_v, "const double*", "v"));
+    out += body.code + "  }\n";
+  }
+  if (uses_powi(programs)) {
+    // The interpreter's algorithm (model/program.cpp), so that both round alike.
+    out += "\n private:\n";
+    out += "  // a^n by repeated squaring, n != 0.\n";
+    out += "  static double powi(double a, int n) {\n";
+    out += "    unsigned m = n < 0 ? 0u - static_cast<unsigned>(n) : static_cast<unsigned>(n);\n";
+    out += "    double result = 1.0;\n    double base = a;\n";
+    out += "    for (;;) {\n      if (m & 1u) result *= base;\n      m >>= 1u;\n      if (m == 0u) break;\n";
+    out += "      base *= base;\n    }\n    return n < 0 ? 1.0 / result : result;\n  }\n";
+  }
+  out += "};\n\n";
+
+  // make_<id>_model
+  out += fmt::format("inline ::nhdyn::Model make_{}_model() {{\n", id);
+  out += "  ::nhdyn::Model model;\n";
+  out += fmt::format("  model.name = {};\n", quoted(model.name));
+  out += fmt::format("  model.description = {};\n", quoted(model.description));
+  out += "  model.coordinates = {";
+  for (int i = 0; i < n; ++i) out += (i ? ", " : "") + quoted(model.coordinates[static_cast<std::size_t>(i)]);
+  out += "};\n";
+  for (const Constraint& c : model.constraints)
+    out += fmt::format("  model.constraints.push_back({{{}, ::nhdyn::ConstraintLevel::{}, {}}});\n", quoted(c.name),
+                       level_name(c.level), quoted(c.expression));
+  for (const Parameter& p : model.parameters)
+    out += fmt::format("  model.parameters.push_back({{{}, {}, {}}});\n", quoted(p.name), literal(p.value),
+                       quoted(p.unit));
+  out += fmt::format("  model.t0 = {};\n", literal(model.t0));
+  out += fmt::format("  model.q0 = ::nhdyn::Vector({});\n  model.v0 = ::nhdyn::Vector({});\n", n, n);
+  for (int i = 0; i < n; ++i) out += fmt::format("  model.q0[{}] = {};\n", i, literal(model.q0[i]));
+  for (int i = 0; i < n; ++i) out += fmt::format("  model.v0[{}] = {};\n", i, literal(model.v0[i]));
+  out += fmt::format("  model.defaults = ::nhdyn::SimulationDefaults{{{}, {}}};\n", literal(model.defaults.t_end),
+                     literal(model.defaults.output_step));
+  if (model.path) out += fmt::format("  model.path = ::nhdyn::PlanarPath{{{}, {}}};\n", model.path->x, model.path->y);
+  out += fmt::format("  model.evaluator = std::make_shared<{}>();\n", cls);
+  out += "  return model;\n}\n";
+
+  if (!namespaces.empty()) out += "\n";
+  for (auto it = namespaces.rbegin(); it != namespaces.rend(); ++it) out += fmt::format("}}  // namespace {}\n", *it);
+  return out;
+}
+
+}  // namespace nhdyn::symbolic

@@ -1,0 +1,253 @@
+#include "nhdyn/symbolic/derivation.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/symbolic/simplify.hpp"
+
+namespace nhdyn::symbolic {
+namespace {
+
+std::string prefix(const SourceLocation& where) {
+  const std::string location = where.describe();
+  return location.empty() ? "" : location + ": ";
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i > 0 ? ", " : "") + items[i];
+  return out;
+}
+
+std::string printed(const GiNaC::ex& e) {
+  std::ostringstream out;
+  out << e;
+  return out.str();
+}
+
+// The total time derivative of an expression in (t, q, q') along the motion, without the terms
+// in q'': sum_i (de/dq_i) q'_i + de/dt. (The q'' terms are sum_i (de/dq'_i) q''_i.)
+GiNaC::ex convective_derivative(const GiNaC::ex& e, const SymbolTable& symbols, int n) {
+  GiNaC::ex out = e.diff(symbols.time());
+  for (int i = 0; i < n; ++i) out += e.diff(symbols.coordinate(i)) * symbols.velocity(i);
+  return out;
+}
+
+// The first symbol of `symbols(i)`, i < n, that `e` contains, or -1.
+template <class Get>
+int first_contained(const GiNaC::ex& e, int n, Get get) {
+  for (int i = 0; i < n; ++i)
+    if (e.has(get(i))) return i;
+  return -1;
+}
+
+}  // namespace
+
+std::optional<GiNaC::matrix> partitioned_complement(const GiNaC::matrix& b, const std::vector<int>& independent) {
+  const unsigned s = b.rows(), n = b.cols();
+  const auto k = static_cast<unsigned>(independent.size());
+  std::vector<unsigned> dependent;
+  for (unsigned j = 0; j < n; ++j)
+    if (std::find(independent.begin(), independent.end(), static_cast<int>(j)) == independent.end())
+      dependent.push_back(j);
+  GiNaC::matrix D(k, n);
+  for (unsigned r = 0; r < k; ++r) D(r, static_cast<unsigned>(independent[r])) = 1;
+  if (s == 0) return D;
+  GiNaC::matrix bd(s, s), bi(s, k);
+  for (unsigned i = 0; i < s; ++i) {
+    for (unsigned j = 0; j < s; ++j) bd(i, j) = b(i, dependent[j]);
+    for (unsigned j = 0; j < k; ++j) bi(i, j) = b(i, static_cast<unsigned>(independent[j]));
+  }
+  if (symbolic::is_zero(bd.determinant())) return std::nullopt;
+  GiNaC::matrix inverse;
+  try {
+    inverse = bd.inverse();
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  // X = -b_d^-1 b_i (s x k); D's dependent columns are X^T.
+  const GiNaC::matrix X = inverse.mul(bi).mul_scalar(-1);
+  for (unsigned r = 0; r < k; ++r)
+    for (unsigned j = 0; j < s; ++j) D(r, dependent[j]) = simplify(X(j, r));
+  return D;
+}
+
+Derivation derive(const Spec& spec) {
+  const SymbolTable& symbols = spec.symbols;
+  const int n = spec.n(), s = spec.s(), k = n - s;
+  const auto un = static_cast<unsigned>(n), us = static_cast<unsigned>(s);
+  const std::string model = fmt::format("{}model '{}': ", prefix(spec.where), spec.name);
+  if (n == 0) throw ModelError(model + "no coordinates");
+  if (s >= n)
+    throw ModelError(model + fmt::format("{} constraints for {} coordinates: there must be fewer (s < n)", s, n));
+  const GiNaC::symbol& t = symbols.time();
+  const auto q = [&](int i) { return symbols.coordinate(i); };
+  const auto v = [&](int i) { return symbols.velocity(i); };
+  const auto a = [&](int i) { return symbols.acceleration(i); };
+  const auto name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
+
+  const GiNaC::ex& T = spec.kinetic_energy;
+  const GiNaC::ex& V = spec.potential_energy;
+  if (first_contained(T, n, a) >= 0 || first_contained(V, n, a) >= 0)
+    throw ModelError(model + "the kinetic and potential energies may not contain accelerations");
+  if (const int i = first_contained(V, n, v); i >= 0)
+    throw ModelError(model + fmt::format("the potential energy V contains the velocity {}'", name(i)));
+
+  Derivation d;
+  // A = d2T/dq'2 (FORMULATION.md (2.4)); T must be quadratic in q' so that A does not depend on q'.
+  d.A = GiNaC::matrix(un, un);
+  std::vector<GiNaC::ex> Tv(un);
+  for (int i = 0; i < n; ++i) Tv[static_cast<std::size_t>(i)] = T.diff(v(i));
+  for (unsigned i = 0; i < un; ++i)
+    for (unsigned j = i; j < un; ++j) {
+      const GiNaC::ex entry = simplify(Tv[i].diff(v(static_cast<int>(j))));
+      if (const int m = first_contained(entry, n, v); m >= 0)
+        throw ModelError(model + fmt::format("the kinetic energy T is not quadratic in the velocities: "
+                                             "A = d2T/dq'2 depends on {}' (entry ({}, {}) is {})",
+                                             name(m), name(static_cast<int>(i)), name(static_cast<int>(j)),
+                                             printed(entry)));
+      d.A(i, j) = d.A(j, i) = entry;
+    }
+  if (d.A.is_zero_matrix()) throw ModelError(model + "the kinetic energy T does not depend on the velocities");
+
+  // G = dT/dq - (d2T/dq'dq) q' - d2T/dq'dt and Q = -dV/dq + forces (FORMULATION.md section 1).
+  d.G = GiNaC::matrix(un, 1);
+  d.Q = GiNaC::matrix(un, 1);
+  for (int i = 0; i < n; ++i) {
+    const auto ui = static_cast<unsigned>(i);
+    d.G(ui, 0) = simplify(T.diff(q(i)) - convective_derivative(Tv[ui], symbols, n));
+    const GiNaC::ex force = ui < spec.forces.size() ? spec.forces[ui] : GiNaC::ex(0);
+    if (const int m = first_contained(force, n, a); m >= 0)
+      throw ModelError(model + fmt::format("the force on '{}' contains the acceleration {}''", name(i), name(m)));
+    d.Q(ui, 0) = simplify(-V.diff(q(i)) + force);
+  }
+
+  // Every constraint at acceleration level, b q'' + b0 = 0 (FORMULATION.md (2.5)).
+  d.b = GiNaC::matrix(us, un);
+  d.b0 = GiNaC::matrix(us, 1);
+  for (unsigned r = 0; r < us; ++r) {
+    const SpecConstraint& c = spec.constraints[r];
+    const std::string where = fmt::format("{}constraint '{}'", prefix(c.where), c.name);
+    const GiNaC::ex& e = c.expression;
+    GiNaC::ex b0;
+    std::vector<GiNaC::ex> row(un);
+    const char* involve = "the velocities";
+    switch (c.level) {
+      case ConstraintLevel::position: {
+        if (const int m = first_contained(e, n, v); m >= 0)
+          throw ModelError(where + fmt::format(" is given at position level but contains the velocity {}'", name(m)));
+        if (const int m = first_contained(e, n, a); m >= 0)
+          throw ModelError(where +
+                           fmt::format(" is given at position level but contains the acceleration {}''", name(m)));
+        // phi' = phi_q q' + phi_t; phi'' = b q'' + b0 with b = phi_q and
+        // b0 = (d/dq (phi_q q')) q' + 2 phi_qt q' + phi_tt, the q''-free part of d/dt phi'.
+        const GiNaC::ex phidot = convective_derivative(e, symbols, n);
+        for (int j = 0; j < n; ++j) row[static_cast<std::size_t>(j)] = e.diff(q(j));
+        b0 = convective_derivative(phidot, symbols, n);
+        d.phi.push_back(e);
+        d.f.push_back(simplify(phidot));
+        break;
+      }
+      case ConstraintLevel::velocity: {
+        if (const int m = first_contained(e, n, a); m >= 0)
+          throw ModelError(where +
+                           fmt::format(" is given at velocity level but contains the acceleration {}''", name(m)));
+        // f' = (df/dq') q'' + (df/dq) q' + df/dt.
+        for (int j = 0; j < n; ++j) row[static_cast<std::size_t>(j)] = e.diff(v(j));
+        b0 = convective_derivative(e, symbols, n);
+        d.f.push_back(e);
+        break;
+      }
+      case ConstraintLevel::acceleration: {
+        involve = "the accelerations";
+        GiNaC::lst at_rest;
+        for (int j = 0; j < n; ++j) {
+          row[static_cast<std::size_t>(j)] = e.diff(a(j));
+          at_rest.append(a(j) == 0);
+        }
+        for (int i = 0; i < n; ++i)
+          for (int j = 0; j < n; ++j)
+            if (!symbolic::is_zero(row[static_cast<std::size_t>(i)].diff(a(j))))
+              throw ModelError(where + fmt::format(" must be linear in the accelerations, but it is not linear in "
+                                                   "{}'' (its derivative by {}'' depends on {}'')",
+                                                   name(i), name(i), name(j)));
+        b0 = e.subs(at_rest);
+        break;
+      }
+    }
+    bool zero = true;
+    for (unsigned j = 0; j < un; ++j) {
+      d.b(r, j) = simplify(row[j]);
+      zero = zero && d.b(r, j).is_zero();
+    }
+    if (zero)
+      throw ModelError(where + fmt::format(" does not involve {} after differentiation: its row of b is zero "
+                                           "(a {}-level constraint must depend on {})",
+                                           involve,
+                                           c.level == ConstraintLevel::position   ? "position"
+                                           : c.level == ConstraintLevel::velocity ? "velocity"
+                                                                                  : "acceleration",
+                                           c.level == ConstraintLevel::position   ? "the coordinates"
+                                           : c.level == ConstraintLevel::velocity ? "the velocities"
+                                                                                  : "the accelerations"));
+    d.b0(r, 0) = simplify(b0);
+  }
+
+  // D: analytic, or partitioned for the named independent coordinates.
+  if (spec.complement) {
+    const GiNaC::matrix& D = *spec.complement;
+    if (static_cast<int>(D.rows()) != k || static_cast<int>(D.cols()) != n)
+      throw ModelError(fmt::format("{}complement D: D is {} x {} but must be k x n = {} x {}",
+                                   prefix(spec.complement_where), D.rows(), D.cols(), k, n));
+    d.D = D;
+  } else if (!spec.independent.empty()) {
+    std::vector<int> independent;
+    for (const std::string& coordinate : spec.independent) {
+      const auto it = std::find(spec.coordinates.begin(), spec.coordinates.end(), coordinate);
+      if (it == spec.coordinates.end())
+        throw ModelError(model + fmt::format("independent coordinate '{}' is not a coordinate", coordinate));
+      independent.push_back(static_cast<int>(it - spec.coordinates.begin()));
+    }
+    std::sort(independent.begin(), independent.end());
+    if (std::adjacent_find(independent.begin(), independent.end()) != independent.end() ||
+        static_cast<int>(independent.size()) != k)
+      throw ModelError(model + fmt::format("independent coordinates ({}): k = n - s = {} distinct coordinates are "
+                                           "needed",
+                                           join(spec.independent), k));
+    d.D = partitioned_complement(d.b, independent);
+    if (!d.D) {
+      std::vector<std::string> dependent;
+      for (int j = 0; j < n; ++j)
+        if (!std::binary_search(independent.begin(), independent.end(), j)) dependent.push_back(name(j));
+      throw ModelError(model + fmt::format("cannot keep {} independent: the columns of b for the dependent "
+                                           "coordinates ({}) form a singular matrix; choose other independent "
+                                           "coordinates",
+                                           join(spec.independent), join(dependent)));
+    }
+  }
+
+  // T + V is conserved when no other force acts and nothing depends on t explicitly.
+  bool conservative = symbolic::is_zero(T.diff(t)) && symbolic::is_zero(V.diff(t));
+  for (const GiNaC::ex& force : spec.forces) conservative = conservative && symbolic::is_zero(force);
+  if (conservative) d.energy = simplify(T + V);
+  return d;
+}
+
+GiNaC::matrix reduced_inertia(const Derivation& derivation) {
+  if (!derivation.D)
+    throw ModelError("A0 = D A needs a complement D: name the independent coordinates or give an analytic D");
+  return simplify(derivation.D->mul(derivation.A));
+}
+
+GiNaC::matrix reduced_forces(const Derivation& derivation) {
+  if (!derivation.D)
+    throw ModelError("C = D (Q + G) needs a complement D: name the independent coordinates or give an analytic D");
+  return simplify(derivation.D->mul(derivation.Q.add(derivation.G)));
+}
+
+}  // namespace nhdyn::symbolic

@@ -1,0 +1,758 @@
+#include "nhdyn/symbolic/equations.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "nhdyn/symbolic/simplify.hpp"
+
+namespace nhdyn::symbolic {
+namespace {
+
+using GiNaC::ex;
+
+// ---------------------------------------------------------------------------------------------
+// Names
+
+const std::map<std::string, std::string>& greek() {
+  static const std::map<std::string, std::string> table = {
+      {"alpha", "\\alpha"},     {"beta", "\\beta"},       {"gamma", "\\gamma"},   {"delta", "\\delta"},
+      {"epsilon", "\\varepsilon"}, {"zeta", "\\zeta"},    {"eta", "\\eta"},       {"theta", "\\theta"},
+      {"iota", "\\iota"},       {"kappa", "\\kappa"},     {"lambda", "\\lambda"}, {"mu", "\\mu"},
+      {"nu", "\\nu"},           {"xi", "\\xi"},           {"rho", "\\rho"},       {"sigma", "\\sigma"},
+      {"tau", "\\tau"},         {"upsilon", "\\upsilon"}, {"phi", "\\varphi"},    {"chi", "\\chi"},
+      {"psi", "\\psi"},         {"omega", "\\omega"},     {"Gamma", "\\Gamma"},   {"Delta", "\\Delta"},
+      {"Theta", "\\Theta"},     {"Lambda", "\\Lambda"},   {"Xi", "\\Xi"},         {"Pi", "\\Pi"},
+      {"Sigma", "\\Sigma"},     {"Upsilon", "\\Upsilon"}, {"Phi", "\\Phi"},       {"Psi", "\\Psi"},
+      {"Omega", "\\Omega"},     {"varphi", "\\varphi"},   {"vartheta", "\\vartheta"}};
+  return table;
+}
+
+std::string latex_escape(const std::string& s) {
+  std::string out;
+  for (const char c : s) {
+    if (c == '_' || c == '&' || c == '%' || c == '$' || c == '#' || c == '{' || c == '}') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
+std::string latex_word(const std::string& word) {
+  if (const auto it = greek().find(word); it != greek().end()) return it->second;
+  if (word.size() == 1) return word;
+  if (std::all_of(word.begin(), word.end(), [](char c) { return c >= '0' && c <= '9'; })) return word;
+  return "\\mathrm{" + latex_escape(word) + "}";
+}
+
+// A name as LaTeX, with `dots` dots over its head: theta_2 -> \theta_{2}, x1 -> x_{1},
+// phi with one dot -> \dot{\varphi}.
+std::string latex_name(const std::string& name, int dots = 0) {
+  std::string head = name, sub;
+  if (const std::size_t underscore = name.find('_'); underscore != std::string::npos && underscore > 0) {
+    head = name.substr(0, underscore);
+    sub = name.substr(underscore + 1);
+  } else if (const std::size_t last = name.find_last_not_of("0123456789");
+             last != std::string::npos && last + 1 < name.size()) {
+    head = name.substr(0, last + 1);
+    sub = name.substr(last + 1);
+  }
+  std::string out = latex_word(head);
+  if (dots == 1) out = "\\dot{" + out + "}";
+  if (dots == 2) out = "\\ddot{" + out + "}";
+  if (!sub.empty()) out += "_{" + latex_word(sub) + "}";
+  return out;
+}
+
+std::string join(const std::vector<std::string>& items, const std::string& separator) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i > 0 ? separator : "") + items[i];
+  return out;
+}
+
+const char* level_name(ConstraintLevel level) {
+  switch (level) {
+    case ConstraintLevel::position: return "position";
+    case ConstraintLevel::velocity: return "velocity";
+    default: return "acceleration";
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The printer: terms and factors in an order that depends on names only.
+
+std::pair<GiNaC::numeric, ex> split_coefficient(const ex& term) {
+  if (GiNaC::is_a<GiNaC::numeric>(term)) return {GiNaC::ex_to<GiNaC::numeric>(term), 1};
+  if (GiNaC::is_a<GiNaC::mul>(term)) {
+    GiNaC::numeric c = 1;
+    ex rest = 1;
+    for (std::size_t i = 0; i < term.nops(); ++i) {
+      if (GiNaC::is_a<GiNaC::numeric>(term.op(i)))
+        c *= GiNaC::ex_to<GiNaC::numeric>(term.op(i));
+      else
+        rest *= term.op(i);
+    }
+    return {c, rest};
+  }
+  return {1, term};
+}
+
+// Whether the first term of a sum (by canonical_key) has a negative coefficient: GiNaC picks the
+// sign of a sum inside a product by its own term order, the printer picks it by this rule.
+bool leads_negative(const ex& sum) {
+  std::string best;
+  bool negative = false;
+  for (std::size_t i = 0; i < sum.nops(); ++i) {
+    const auto [c, rest] = split_coefficient(sum.op(i));
+    const std::string key = canonical_key(rest);
+    if (i == 0 || key < best) {
+      best = key;
+      negative = c.is_negative();
+    }
+  }
+  return negative;
+}
+
+bool power_of_ten(const GiNaC::numeric& q) {
+  std::ostringstream s;
+  s << q;
+  const std::string text = s.str();
+  return text.size() > 1 && text[0] == '1' && text.find_first_not_of('0', 1) == std::string::npos;
+}
+
+std::string number(const GiNaC::numeric& x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
+// p / 10^k as a decimal.
+std::string decimal(const GiNaC::numeric& p, const GiNaC::numeric& q) {
+  std::string digits = number(GiNaC::abs(p));
+  const std::size_t k = number(q).size() - 1;
+  if (digits.size() <= k) digits = std::string(k + 1 - digits.size(), '0') + digits;
+  return digits.substr(0, digits.size() - k) + "." + digits.substr(digits.size() - k);
+}
+
+struct Factor {
+  ex base;
+  ex exponent;  // a positive number, or an expression
+};
+
+struct Term {
+  GiNaC::numeric coefficient = 1;
+  std::vector<Factor> numerator, denominator;
+};
+
+struct Printed {
+  std::string text;       // the magnitude
+  bool negative = false;  // the sign in front
+  bool fraction = false;  // something below the line
+};
+
+class Printer {
+ public:
+  Printer(const Spec& spec, EquationFormat format) : latex_(format == EquationFormat::latex) {
+    for (std::size_t p = 0; p < spec.parameters.size(); ++p) {
+      const std::string& name = spec.parameters[p].name;
+      symbols_[name] = {0, static_cast<int>(p), name, latex_name(name)};
+    }
+    symbols_["t"] = {4, 0, "t", "t"};
+    for (std::size_t i = 0; i < spec.coordinates.size(); ++i) {
+      const std::string& c = spec.coordinates[i];
+      const int order = static_cast<int>(i);
+      symbols_[c] = {3, order, c, latex_name(c)};
+      symbols_[c + "'"] = {5, order, c + "'", latex_name(c, 1)};
+      symbols_[c + "''"] = {6, order, c + "''", latex_name(c, 2)};
+    }
+  }
+
+  bool latex() const { return latex_; }
+
+  std::string symbol(const std::string& name) const {
+    const auto it = symbols_.find(name);
+    if (it != symbols_.end()) return latex_ ? it->second.latex : it->second.text;
+    return latex_ ? latex_name(name) : name;
+  }
+
+  std::string paren(const std::string& s) const { return latex_ ? "\\left(" + s + "\\right)" : "(" + s + ")"; }
+
+  // A whole expression (not simplified here).
+  std::string expression(const ex& e) const {
+    std::vector<Printed> terms;
+    if (GiNaC::is_a<GiNaC::add>(e)) {
+      for (std::size_t i = 0; i < e.nops(); ++i) terms.push_back(term(e.op(i)));
+      sort(terms);
+    } else {
+      terms.push_back(term(e));
+    }
+    return joined(terms);
+  }
+
+  // Sum of coefficient * symbol, in the given order, followed by the terms of `rest`.
+  std::string combination(const std::vector<std::pair<ex, std::string>>& products, const ex& rest) const {
+    std::vector<Printed> terms;
+    for (const auto& [coefficient, name] : products) {
+      if (coefficient.is_zero()) continue;
+      if (GiNaC::is_a<GiNaC::add>(coefficient)) {
+        terms.push_back({paren(expression(coefficient)) + " " + name, false, false});
+        continue;
+      }
+      Printed p = term(coefficient);
+      if (p.text == "1")
+        p.text = name;
+      else if (p.fraction && !latex_)
+        p.text = "(" + p.text + ") " + name;
+      else
+        p.text += " " + name;
+      terms.push_back(p);
+    }
+    std::vector<Printed> others;
+    if (GiNaC::is_a<GiNaC::add>(rest)) {
+      for (std::size_t i = 0; i < rest.nops(); ++i) others.push_back(term(rest.op(i)));
+      sort(others);
+    } else if (!rest.is_zero()) {
+      others.push_back(term(rest));
+    }
+    terms.insert(terms.end(), others.begin(), others.end());
+    return joined(terms);
+  }
+
+ private:
+  struct SymbolInfo {
+    int category = 7;  // parameters, pi, functions, coordinates, t, velocities, accelerations, other
+    int order = 0;
+    std::string text, latex;
+  };
+
+  static void sort(std::vector<Printed>& terms) {
+    std::sort(terms.begin(), terms.end(), [](const Printed& a, const Printed& b) {
+      return a.text != b.text ? a.text < b.text : a.negative < b.negative;
+    });
+  }
+
+  static std::string joined(const std::vector<Printed>& terms) {
+    if (terms.empty()) return "0";
+    std::string out = terms[0].negative ? "-" + terms[0].text : terms[0].text;
+    for (std::size_t i = 1; i < terms.size(); ++i) out += (terms[i].negative ? " - " : " + ") + terms[i].text;
+    return out;
+  }
+
+  std::tuple<int, int, std::string> factor_key(const Factor& f) const {
+    const ex& base = f.base;
+    std::string key = canonical_key(base) + "^" + canonical_key(f.exponent);
+    if (GiNaC::is_a<GiNaC::symbol>(base)) {
+      const auto it = symbols_.find(GiNaC::ex_to<GiNaC::symbol>(base).get_name());
+      if (it != symbols_.end()) return {it->second.category, it->second.order, key};
+      return {7, 0, key};
+    }
+    if (GiNaC::is_a<GiNaC::constant>(base)) return {1, 0, key};
+    if (GiNaC::is_a<GiNaC::function>(base)) return {2, 0, key};
+    if (GiNaC::is_a<GiNaC::add>(base)) return {9, 0, key};
+    return {8, 0, key};
+  }
+
+  // sin(u)^p / cos(u)^r -> tan(u)^min(p, r) ... (and the hyperbolic ones), for display only.
+  static void fold_tangents(std::vector<std::pair<ex, ex>>& factors, const char* s, const char* c,
+                            ex (*tangent)(const ex&)) {
+    const auto named = [](const ex& e, const char* name) {
+      return GiNaC::is_a<GiNaC::function>(e) && GiNaC::ex_to<GiNaC::function>(e).get_name() == name;
+    };
+    const auto integer = [](const ex& e) {
+      return GiNaC::is_a<GiNaC::numeric>(e) && GiNaC::ex_to<GiNaC::numeric>(e).is_integer();
+    };
+    std::vector<std::pair<ex, ex>> added;
+    for (auto& [up, p] : factors) {
+      if (!named(up, s) || !integer(p) || !GiNaC::ex_to<GiNaC::numeric>(p).is_positive()) continue;
+      for (auto& [down, r] : factors) {
+        if (!named(down, c) || !integer(r) || !GiNaC::ex_to<GiNaC::numeric>(r).is_negative()) continue;
+        if (canonical_key(up.op(0)) != canonical_key(down.op(0))) continue;
+        const GiNaC::numeric m = std::min(GiNaC::ex_to<GiNaC::numeric>(p), -GiNaC::ex_to<GiNaC::numeric>(r));
+        added.emplace_back(tangent(up.op(0)), m);
+        p = p - m;
+        r = r + m;
+        break;
+      }
+    }
+    factors.insert(factors.end(), added.begin(), added.end());
+    factors.erase(std::remove_if(factors.begin(), factors.end(), [](const auto& f) { return f.second.is_zero(); }),
+                  factors.end());
+  }
+
+  static ex make_tan(const ex& u) { return GiNaC::tan(u); }
+  static ex make_tanh(const ex& u) { return GiNaC::tanh(u); }
+
+  Term decompose(const ex& e) const {
+    Term t;
+    std::vector<std::pair<ex, ex>> factors;
+    const auto add_factor = [&](const ex& f) {
+      if (GiNaC::is_a<GiNaC::numeric>(f))
+        t.coefficient *= GiNaC::ex_to<GiNaC::numeric>(f);
+      else if (GiNaC::is_a<GiNaC::power>(f))
+        factors.emplace_back(f.op(0), f.op(1));
+      else
+        factors.emplace_back(f, 1);
+    };
+    if (GiNaC::is_a<GiNaC::mul>(e))
+      for (std::size_t i = 0; i < e.nops(); ++i) add_factor(e.op(i));
+    else
+      add_factor(e);
+    for (auto& [base, exponent] : factors) {
+      if (!GiNaC::is_a<GiNaC::add>(base) || !GiNaC::is_a<GiNaC::numeric>(exponent)) continue;
+      const GiNaC::numeric n = GiNaC::ex_to<GiNaC::numeric>(exponent);
+      if (!n.is_integer() || !leads_negative(base)) continue;
+      base = GiNaC::expand(-base);
+      if (n.is_odd()) t.coefficient = -t.coefficient;
+    }
+    // Folding the tangent back is skipped for expressions with an explicit tan left in them.
+    fold_tangents(factors, "sin", "cos", &make_tan);
+    fold_tangents(factors, "sinh", "cosh", &make_tanh);
+    for (const auto& [base, exponent] : factors) {
+      if (GiNaC::is_a<GiNaC::numeric>(exponent) && GiNaC::ex_to<GiNaC::numeric>(exponent).is_negative())
+        t.denominator.push_back({base, -exponent});
+      else
+        t.numerator.push_back({base, exponent});
+    }
+    const auto by_key = [this](const Factor& a, const Factor& b) { return factor_key(a) < factor_key(b); };
+    std::sort(t.numerator.begin(), t.numerator.end(), by_key);
+    std::sort(t.denominator.begin(), t.denominator.end(), by_key);
+    return t;
+  }
+
+  Printed term(const ex& e) const {
+    const Term t = decompose(e);
+    Printed out;
+    GiNaC::numeric c = t.coefficient;
+    if (c.is_real() && c.is_negative()) {
+      out.negative = true;
+      c = -c;
+    }
+    std::vector<std::string> up, down;
+    if (c.is_rational()) {
+      const GiNaC::numeric p = c.numer(), q = c.denom();
+      if (q != 1 && power_of_ten(q)) {
+        up.push_back(decimal(p, q));
+      } else {
+        if (p != 1) up.push_back(number(p));
+        if (q != 1) down.push_back(number(q));
+      }
+    } else {
+      up.push_back(number(c));
+    }
+    for (const Factor& f : t.numerator) up.push_back(factor(f));
+    for (const Factor& f : t.denominator) down.push_back(factor(f));
+    const std::string top = up.empty() ? "1" : join(up, " ");
+    out.fraction = !down.empty();
+    if (down.empty())
+      out.text = top;
+    else if (latex_)
+      out.text = "\\frac{" + top + "}{" + join(down, " ") + "}";
+    else
+      out.text = top + "/" + (down.size() == 1 ? down[0] : "(" + join(down, " ") + ")");
+    return out;
+  }
+
+  static bool is_number(const ex& e, int p, int q = 1) {
+    return GiNaC::is_a<GiNaC::numeric>(e) && GiNaC::ex_to<GiNaC::numeric>(e) == GiNaC::numeric(p, q);
+  }
+
+  std::string factor(const Factor& f) const {
+    const ex& base = f.base;
+    const ex& exponent = f.exponent;
+    if (is_number(exponent, 1)) return atom(base);
+    if (is_number(exponent, 1, 2))
+      return latex_ ? "\\sqrt{" + expression(base) + "}" : "sqrt(" + expression(base) + ")";
+    const bool integer =
+        GiNaC::is_a<GiNaC::numeric>(exponent) && GiNaC::ex_to<GiNaC::numeric>(exponent).is_pos_integer();
+    std::string power;
+    if (integer)
+      power = number(GiNaC::ex_to<GiNaC::numeric>(exponent));
+    else if (GiNaC::is_a<GiNaC::numeric>(exponent))
+      power = latex_ ? number(GiNaC::ex_to<GiNaC::numeric>(exponent)) : "(" + number(GiNaC::ex_to<GiNaC::numeric>(exponent)) + ")";
+    else if (latex_ || GiNaC::is_a<GiNaC::symbol>(exponent))
+      power = expression(exponent);
+    else
+      power = "(" + expression(exponent) + ")";
+    if (latex_ && integer && GiNaC::is_a<GiNaC::function>(base)) {
+      // \sin^{2}(\varphi)
+      const std::string name = GiNaC::ex_to<GiNaC::function>(base).get_name();
+      if (const std::string command = latex_operator(name); !command.empty())
+        return command + "^{" + power + "}" + latex_argument(base.op(0));
+    }
+    return latex_ ? atom(base) + "^{" + power + "}" : atom(base) + "^" + power;
+  }
+
+  // A base or factor: symbols, constants, functions and positive numbers as they are, anything
+  // else in parentheses.
+  std::string atom(const ex& e) const {
+    if (GiNaC::is_a<GiNaC::symbol>(e)) return symbol(GiNaC::ex_to<GiNaC::symbol>(e).get_name());
+    if (GiNaC::is_a<GiNaC::constant>(e)) {
+      if (e.is_equal(GiNaC::Pi)) return latex_ ? "\\pi" : "pi";
+      return number_or_print(e);
+    }
+    if (GiNaC::is_a<GiNaC::function>(e)) return function(e);
+    if (GiNaC::is_a<GiNaC::numeric>(e)) {
+      const GiNaC::numeric& n = GiNaC::ex_to<GiNaC::numeric>(e);
+      if (n.is_pos_integer()) return number(n);
+      return paren(expression(e));
+    }
+    if (GiNaC::is_a<GiNaC::add>(e) || GiNaC::is_a<GiNaC::mul>(e) || GiNaC::is_a<GiNaC::power>(e))
+      return paren(expression(e));
+    return number_or_print(e);
+  }
+
+  std::string number_or_print(const ex& e) const {
+    std::ostringstream s;
+    if (latex_) s << GiNaC::latex;
+    s << e;
+    return s.str();
+  }
+
+  static std::string latex_operator(const std::string& name) {
+    static const std::map<std::string, std::string> table = {
+        {"sin", "\\sin"},       {"cos", "\\cos"},       {"tan", "\\tan"},   {"sinh", "\\sinh"},
+        {"cosh", "\\cosh"},     {"tanh", "\\tanh"},     {"log", "\\ln"},    {"asin", "\\arcsin"},
+        {"acos", "\\arccos"},   {"atan", "\\arctan"}};
+    const auto it = table.find(name);
+    return it == table.end() ? "" : it->second;
+  }
+
+  std::string latex_argument(const ex& argument) const {
+    if (GiNaC::is_a<GiNaC::symbol>(argument) || GiNaC::is_a<GiNaC::constant>(argument) ||
+        (GiNaC::is_a<GiNaC::numeric>(argument) && GiNaC::ex_to<GiNaC::numeric>(argument).is_pos_integer()))
+      return "(" + atom(argument) + ")";  // \cos(\varphi): a bare \cos \varphi x reads ambiguously
+    return "\\left(" + expression(argument) + "\\right)";
+  }
+
+  std::string function(const ex& e) const {
+    const std::string name = GiNaC::ex_to<GiNaC::function>(e).get_name();
+    std::vector<std::string> arguments;
+    for (std::size_t i = 0; i < e.nops(); ++i) arguments.push_back(expression(e.op(i)));
+    if (!latex_) return name + "(" + join(arguments, ", ") + ")";
+    if (const std::string command = latex_operator(name); !command.empty()) return command + latex_argument(e.op(0));
+    if (name == "exp") return "e^{" + arguments[0] + "}";
+    if (name == "abs") return "\\left|" + arguments[0] + "\\right|";
+    return "\\operatorname{" + latex_escape(name) + "}\\left(" + join(arguments, ", ") + "\\right)";
+  }
+
+  bool latex_;
+  std::map<std::string, SymbolInfo> symbols_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// What is shown, computed once for both formats.
+
+struct ConstraintView {
+  std::string name;
+  ConstraintLevel level;
+  ex expression;
+  std::vector<ex> b;
+  ex b0;
+};
+
+struct Content {
+  ex T, V;
+  GiNaC::matrix A, Q, G;
+  std::vector<ConstraintView> constraints;
+  std::optional<GiNaC::matrix> D;
+  enum class Origin { analytic, independent, none_constraints, fallback, unavailable } origin = Origin::unavailable;
+  std::vector<std::string> independent;  // names, for independent and fallback
+  std::optional<GiNaC::matrix> A0, C;
+  std::optional<ex> energy;
+};
+
+// The first choice of k independent coordinates (in lexicographic order of their indices) for
+// which the partitioned D exists; at most `budget` choices are tried.
+std::optional<std::pair<std::vector<int>, GiNaC::matrix>> first_partition(const GiNaC::matrix& b, int n, int k) {
+  std::vector<int> choice(static_cast<std::size_t>(k));
+  for (int i = 0; i < k; ++i) choice[static_cast<std::size_t>(i)] = i;
+  for (int budget = 200; budget > 0; --budget) {
+    if (std::optional<GiNaC::matrix> D = partitioned_complement(b, choice)) return std::make_pair(choice, *D);
+    int i = k - 1;
+    while (i >= 0 && choice[static_cast<std::size_t>(i)] == n - k + i) --i;
+    if (i < 0) break;
+    ++choice[static_cast<std::size_t>(i)];
+    for (int j = i + 1; j < k; ++j) choice[static_cast<std::size_t>(j)] = choice[static_cast<std::size_t>(j - 1)] + 1;
+  }
+  return std::nullopt;
+}
+
+Content make_content(const Spec& spec, const Derivation& d) {
+  Content c;
+  const int n = spec.n(), s = spec.s(), k = n - s;
+  c.T = simplify(spec.kinetic_energy);
+  c.V = simplify(spec.potential_energy);
+  c.A = simplify(d.A);
+  c.Q = simplify(d.Q);
+  c.G = simplify(d.G);
+  for (unsigned r = 0; r < static_cast<unsigned>(s); ++r) {
+    ConstraintView view{spec.constraints[r].name, spec.constraints[r].level, simplify(spec.constraints[r].expression),
+                        {}, simplify(d.b0(r, 0))};
+    for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) view.b.push_back(simplify(d.b(r, j)));
+    c.constraints.push_back(std::move(view));
+  }
+  Derivation with_d = d;
+  if (d.D) {
+    c.origin = spec.complement ? Content::Origin::analytic : Content::Origin::independent;
+    if (!spec.complement) {
+      for (const std::string& name : spec.coordinates)
+        if (std::find(spec.independent.begin(), spec.independent.end(), name) != spec.independent.end())
+          c.independent.push_back(name);
+    }
+  } else if (s == 0) {
+    c.origin = Content::Origin::none_constraints;
+    with_d.D = GiNaC::ex_to<GiNaC::matrix>(GiNaC::unit_matrix(static_cast<unsigned>(n)));
+  } else if (const auto partition = first_partition(d.b, n, k)) {
+    c.origin = Content::Origin::fallback;
+    for (const int i : partition->first) c.independent.push_back(spec.coordinates[static_cast<std::size_t>(i)]);
+    with_d.D = partition->second;
+  }
+  if (with_d.D) {
+    c.D = simplify(*with_d.D);
+    c.A0 = reduced_inertia(with_d);
+    c.C = reduced_forces(with_d);
+  }
+  if (d.energy) c.energy = simplify(*d.energy);
+  return c;
+}
+
+// Every acceleration symbol as printed, in the order of q.
+std::vector<std::string> accelerations(const Spec& spec, const Printer& p) {
+  std::vector<std::string> out;
+  for (const std::string& c : spec.coordinates) out.push_back(p.symbol(c + "''"));
+  return out;
+}
+
+std::string parameter_list(const Spec& spec) {
+  std::vector<std::string> items;
+  for (const SpecParameter& p : spec.parameters)
+    items.push_back(fmt::format("{} = {}{}", p.name, p.value, p.unit.empty() ? "" : " " + p.unit));
+  return join(items, ", ");
+}
+
+std::string independent_hint(const std::vector<std::string>& names) {
+  std::vector<std::string> quoted;
+  for (const std::string& name : names) quoted.push_back("\"" + name + "\"");
+  return "independent = [" + join(quoted, ", ") + "]";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Text
+
+std::string text_matrix(const Printer& p, const GiNaC::matrix& m, const std::string& indent) {
+  std::vector<std::vector<std::string>> cells(m.rows());
+  std::vector<std::size_t> width(m.cols(), 0);
+  for (unsigned i = 0; i < m.rows(); ++i)
+    for (unsigned j = 0; j < m.cols(); ++j) {
+      cells[i].push_back(p.expression(m(i, j)));
+      width[j] = std::max(width[j], cells[i].back().size());
+    }
+  std::string out;
+  for (unsigned i = 0; i < m.rows(); ++i) {
+    out += indent + "[ ";
+    for (unsigned j = 0; j < m.cols(); ++j) {
+      out += cells[i][j] + std::string(width[j] - cells[i][j].size(), ' ');
+      if (j + 1 < m.cols()) out += "  ";
+    }
+    out += " ]\n";
+  }
+  return out;
+}
+
+std::string text_vector(const Printer& p, const std::string& name, const GiNaC::matrix& v,
+                        const std::vector<std::string>& labels) {
+  std::size_t width = 0;
+  for (const std::string& label : labels) width = std::max(width, label.size());
+  std::string out;
+  for (unsigned i = 0; i < v.rows(); ++i) {
+    const std::string& label = labels[i];
+    out += fmt::format("  {}_{}{} = {}\n", name, label, std::string(width - label.size(), ' '), p.expression(v(i, 0)));
+  }
+  return out;
+}
+
+std::string format_text(const Spec& spec, const Content& c) {
+  const Printer p(spec, EquationFormat::text);
+  const int n = spec.n(), s = spec.s(), k = n - s;
+  std::string out = fmt::format("Model {}{}\n", spec.name, spec.description.empty() ? "" : ": " + spec.description);
+  out += fmt::format("  q = ({}); n = {} coordinates, s = {} constraint{}, k = n - s = {}\n",
+                     join(spec.coordinates, ", "), n, s, s == 1 ? "" : "s", k);
+  if (!spec.parameters.empty()) out += "  parameters: " + parameter_list(spec) + "\n";
+
+  out += "\nKinetic energy\n  T = " + p.expression(c.T) + "\n";
+  out += "Potential energy\n  V = " + p.expression(c.V) + "\n";
+  out += "\nInertia matrix A = d2T/dq'2\n" + text_matrix(p, c.A, "  ");
+  out += "Generalized forces Q = -dV/dq + forces\n" + text_vector(p, "Q", c.Q, spec.coordinates);
+  out += "Velocity terms G = dT/dq - (d2T/dq'dq) q' - d2T/dq'dt\n" + text_vector(p, "G", c.G, spec.coordinates);
+
+  if (s > 0) {
+    out += "\nConstraints, at acceleration level b q'' + b0 = 0\n";
+    for (const ConstraintView& v : c.constraints) {
+      out += fmt::format("  {} ({} level): {} = 0\n", v.name, level_name(v.level), p.expression(v.expression));
+      GiNaC::matrix row(1, static_cast<unsigned>(n));
+      for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) row(0, j) = v.b[j];
+      out += "    b  = " + text_matrix(p, row, "");
+      out += "    b0 = " + p.expression(v.b0) + "\n";
+    }
+  }
+
+  out += "\n";
+  switch (c.origin) {
+    case Content::Origin::analytic: out += fmt::format("Complement D ({} x {}), analytic (given with the model)\n", k, n); break;
+    case Content::Origin::independent:
+      out += fmt::format("Complement D ({} x {}), partitioned with {} independent\n", k, n, join(c.independent, ", "));
+      break;
+    case Content::Origin::none_constraints: out += "Complement D: no constraints, D = I\n"; break;
+    case Content::Origin::fallback:
+      out += fmt::format("Complement D: none in the model (no independent coordinates, no analytic D)\n"
+                         "  The solver chooses the dependent coordinates numerically at each step. Shown here is the\n"
+                         "  partitioned D ({} x {}) with {} independent; add {} to the model to use it:\n",
+                         k, n, join(c.independent, ", "), independent_hint(c.independent));
+      break;
+    case Content::Origin::unavailable:
+      out += fmt::format("Complement D: the model gives none (no independent coordinates, no analytic D), and no "
+                         "choice of {} independent coordinates gives a regular partition symbolically\n",
+                         k);
+      break;
+  }
+  if (!c.D || !c.A0 || !c.C) {
+    out += fmt::format("Reduced inertia A0 = D A and reduced forces C = D (Q + G): unavailable without D; add "
+                       "`independent = [...]` with k = {} coordinate names to the model\n",
+                       k);
+  } else {
+    if (c.origin != Content::Origin::none_constraints) out += text_matrix(p, *c.D, "  ");
+    out += "Reduced inertia A0 = D A\n" + text_matrix(p, *c.A0, "  ");
+    std::vector<std::string> rows;
+    for (int i = 1; i <= k; ++i) rows.push_back(std::to_string(i));
+    out += "Reduced forces C = D (Q + G)\n" + text_vector(p, "C", *c.C, rows);
+    out += "\nEquations of motion A0 q'' = C";
+    out += s > 0 ? ", b q'' + b0 = 0\n" : "\n";
+    const std::vector<std::string> names = accelerations(spec, p);
+    for (unsigned i = 0; i < static_cast<unsigned>(k); ++i) {
+      std::vector<std::pair<ex, std::string>> products;
+      for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) products.emplace_back((*c.A0)(i, j), names[j]);
+      out += "  " + p.combination(products, 0) + " = " + p.expression((*c.C)(i, 0)) + "\n";
+    }
+    for (const ConstraintView& v : c.constraints) {
+      std::vector<std::pair<ex, std::string>> products;
+      for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) products.emplace_back(v.b[j], names[j]);
+      out += "  " + p.combination(products, v.b0) + " = 0   (" + v.name + ")\n";
+    }
+  }
+  if (c.energy) out += "\nEnergy E = T + V\n  E = " + p.expression(*c.energy) + "\n";
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// LaTeX
+
+std::string latex_matrix(const Printer& p, const GiNaC::matrix& m) {
+  std::vector<std::string> rows;
+  for (unsigned i = 0; i < m.rows(); ++i) {
+    std::vector<std::string> cells;
+    for (unsigned j = 0; j < m.cols(); ++j) cells.push_back(p.expression(m(i, j)));
+    rows.push_back(join(cells, " & "));
+  }
+  return "\\begin{pmatrix} " + join(rows, " \\\\ ") + " \\end{pmatrix}";
+}
+
+std::string format_latex(const Spec& spec, const Content& c) {
+  const Printer p(spec, EquationFormat::latex);
+  const int n = spec.n(), s = spec.s(), k = n - s;
+  std::vector<std::string> names;
+  for (const std::string& coordinate : spec.coordinates) names.push_back(p.symbol(coordinate));
+  std::string out = fmt::format("% Equations of motion of the model '{}' in the form of Do Sanh, by nhdyn.\n", spec.name);
+  if (!spec.description.empty()) out += "% " + spec.description + "\n";
+  if (!spec.parameters.empty()) out += "% Parameters: " + parameter_list(spec) + "\n";
+  out += "% Needs \\usepackage{amsmath}.\n";
+
+  std::vector<std::string> rows;
+  rows.push_back("q &= \\left(" + join(names, ", ") + "\\right)");
+  rows.push_back("T &= " + p.expression(c.T));
+  rows.push_back("V &= " + p.expression(c.V));
+  rows.push_back("A &= \\frac{\\partial^2 T}{\\partial \\dot{q}^2} = " + latex_matrix(p, c.A));
+  rows.push_back("Q &= -\\frac{\\partial V}{\\partial q} + F = " + latex_matrix(p, c.Q));
+  rows.push_back("G &= \\frac{\\partial T}{\\partial q} - \\frac{\\partial^2 T}{\\partial \\dot{q}\\, \\partial q} "
+                 "\\dot{q} - \\frac{\\partial^2 T}{\\partial \\dot{q}\\, \\partial t} = " +
+                 latex_matrix(p, c.G));
+  for (const ConstraintView& v : c.constraints) {
+    const std::string name = latex_escape(v.name);
+    rows.push_back(fmt::format("\\intertext{{Constraint \\texttt{{{}}}, given at {} level:}}", name, level_name(v.level)) +
+                   p.expression(v.expression) + " &= 0");
+    GiNaC::matrix row(1, static_cast<unsigned>(n));
+    for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) row(0, j) = v.b[j];
+    rows.push_back("b_{\\text{" + name + "}} &= " + latex_matrix(p, row) + ", \\qquad b_{0,\\text{" + name +
+                   "}} = " + p.expression(v.b0));
+  }
+  std::vector<std::string> independent;
+  for (const std::string& name : c.independent)
+    independent.push_back(p.symbol(name));
+  std::string heading;
+  switch (c.origin) {
+    case Content::Origin::analytic: heading = "Complement $D$, analytic (given with the model):"; break;
+    case Content::Origin::independent:
+      heading = "Complement $D$, partitioned with $" + join(independent, ", ") + "$ independent:";
+      break;
+    case Content::Origin::none_constraints: heading = "No constraints: $D = I$."; break;
+    case Content::Origin::fallback:
+      heading = "The model gives no complement $D$; the solver picks the dependent coordinates numerically. "
+                "With $" + join(independent, ", ") + "$ independent (add \\texttt{" +
+                latex_escape(independent_hint(c.independent)) + "} to the model to fix this choice):";
+      break;
+    case Content::Origin::unavailable:
+      heading = fmt::format("The model gives no complement $D$ and no choice of {} independent coordinates gives a "
+                            "regular partition symbolically.",
+                            k);
+      break;
+  }
+  if (!c.D || !c.A0 || !c.C) {
+    rows.push_back("\\intertext{" + heading +
+                   fmt::format(" $A_0 = D A$ and $C = D (Q + G)$ are unavailable without $D$; add "
+                               "\\texttt{{independent = [...]}} with $k = {}$ coordinate names to the model.}}",
+                               k) +
+                   "k &= n - s = " + std::to_string(k));
+  } else {
+    const std::string d_row = c.origin == Content::Origin::none_constraints ? "D &= I" : "D &= " + latex_matrix(p, *c.D);
+    rows.push_back("\\intertext{" + heading + "}" + d_row);
+    rows.push_back("A_0 &= D A = " + latex_matrix(p, *c.A0));
+    rows.push_back("C &= D (Q + G) = " + latex_matrix(p, *c.C));
+    const std::vector<std::string> accelerations_ = accelerations(spec, p);
+    bool first = true;
+    for (unsigned i = 0; i < static_cast<unsigned>(k); ++i) {
+      std::vector<std::pair<ex, std::string>> products;
+      for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) products.emplace_back((*c.A0)(i, j), accelerations_[j]);
+      std::string row = p.combination(products, 0) + " &= " + p.expression((*c.C)(i, 0));
+      if (first) row = std::string("\\intertext{Equations of motion $A_0 \\ddot{q} = C$") +
+                       (s > 0 ? ", $b \\ddot{q} + b_0 = 0$" : "") + ":}" + row;
+      first = false;
+      rows.push_back(row);
+    }
+    for (const ConstraintView& v : c.constraints) {
+      std::vector<std::pair<ex, std::string>> products;
+      for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) products.emplace_back(v.b[j], accelerations_[j]);
+      rows.push_back(p.combination(products, v.b0) + " &= 0");
+    }
+  }
+  if (c.energy) rows.push_back("\\intertext{Energy:}E &= T + V = " + p.expression(*c.energy));
+  out += "\\begin{align*}\n  " + join(rows, " \\\\\n  ") + "\n\\end{align*}\n";
+  return out;
+}
+
+}  // namespace
+
+std::string format_expression(const Spec& spec, const GiNaC::ex& e, EquationFormat format) {
+  return Printer(spec, format).expression(simplify(e));
+}
+
+std::string format_equations(const Spec& spec, const Derivation& derivation, EquationFormat format) {
+  const Content content = make_content(spec, derivation);
+  return format == EquationFormat::latex ? format_latex(spec, content) : format_text(spec, content);
+}
+
+}  // namespace nhdyn::symbolic

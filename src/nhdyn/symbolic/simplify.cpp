@@ -1,0 +1,253 @@
+#include "nhdyn/symbolic/simplify.hpp"
+
+#include <algorithm>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace nhdyn::symbolic {
+namespace {
+
+using GiNaC::ex;
+
+bool is_function(const ex& e, const char* name) {
+  return GiNaC::is_a<GiNaC::function>(e) && GiNaC::ex_to<GiNaC::function>(e).get_name() == name;
+}
+
+// Number of nodes of the expression tree: the measure of "shorter".
+std::size_t size_of(const ex& e) {
+  std::size_t n = 1;
+  for (std::size_t i = 0; i < e.nops(); ++i) n += size_of(e.op(i));
+  return n;
+}
+
+// Bottom-up: every function argument is simplified on its own; tan and tanh become quotients.
+struct Rewrite : GiNaC::map_function {
+  ex operator()(const ex& e) override {
+    if (GiNaC::is_a<GiNaC::function>(e)) {
+      struct Arguments : GiNaC::map_function {
+        ex operator()(const ex& arg) override { return simplify(arg); }
+      } arguments;
+      const ex f = e.map(arguments);
+      if (is_function(f, "tan")) return GiNaC::sin(f.op(0)) / GiNaC::cos(f.op(0));
+      if (is_function(f, "tanh")) return GiNaC::sinh(f.op(0)) / GiNaC::cosh(f.op(0));
+      return f;
+    }
+    return e.map(*this);
+  }
+};
+
+// The term of a sum split into its numeric coefficient and the rest.
+std::pair<GiNaC::numeric, ex> split_coefficient(const ex& term) {
+  if (GiNaC::is_a<GiNaC::numeric>(term)) return {GiNaC::ex_to<GiNaC::numeric>(term), 1};
+  if (GiNaC::is_a<GiNaC::mul>(term)) {
+    GiNaC::numeric c = 1;
+    ex rest = 1;
+    for (std::size_t i = 0; i < term.nops(); ++i) {
+      if (GiNaC::is_a<GiNaC::numeric>(term.op(i)))
+        c *= GiNaC::ex_to<GiNaC::numeric>(term.op(i));
+      else
+        rest *= term.op(i);
+    }
+    return {c, rest};
+  }
+  return {1, term};
+}
+
+struct Fraction {
+  ex numerator;
+  ex denominator;
+};
+
+// numerator / denominator, both expanded and coprime, with a unit fixed independently of GiNaC's
+// term order: the denominator has integer coefficients without common factor, and its first term
+// (by canonical_key) a positive coefficient.
+Fraction normal_fraction(const ex& e) {
+  const ex nd = GiNaC::normal(e).numer_denom();
+  ex n = GiNaC::expand(nd.op(0));
+  ex d = GiNaC::expand(nd.op(1));
+  if (n.is_zero()) return {0, 1};
+  const GiNaC::numeric content = GiNaC::ex_to<GiNaC::numeric>(d.integer_content());
+  GiNaC::numeric unit = content.is_zero() ? GiNaC::numeric(1) : content;
+  const ex first = [&] {
+    if (!GiNaC::is_a<GiNaC::add>(d)) return d;
+    std::size_t best = 0;
+    std::string best_key;
+    for (std::size_t i = 0; i < d.nops(); ++i) {
+      const std::string key = canonical_key(split_coefficient(d.op(i)).second);
+      if (i == 0 || key < best_key) {
+        best = i;
+        best_key = key;
+      }
+    }
+    return d.op(best);
+  }();
+  if (split_coefficient(first).first.is_negative()) unit = -unit;
+  if (unit != 1) {
+    n = GiNaC::expand(n / unit);
+    d = GiNaC::expand(d / unit);
+  }
+  return {n, d};
+}
+
+ex assemble(const Fraction& f) {
+  if (f.denominator.is_equal(1)) return f.numerator;
+  // A single product below the line reads best distributed: a/c + b/c, not (a + b)/c.
+  if (!GiNaC::is_a<GiNaC::add>(f.denominator)) return GiNaC::expand(f.numerator / f.denominator);
+  return f.numerator / f.denominator;
+}
+
+// A pair of functions tied by a quadratic relation, at one argument: sin/cos or sinh/cosh.
+struct Family {
+  bool hyperbolic = false;
+  ex argument;
+  std::string key;
+};
+
+void collect_families(const ex& e, std::vector<Family>& out) {
+  if (GiNaC::is_a<GiNaC::function>(e)) {
+    const std::string name = GiNaC::ex_to<GiNaC::function>(e).get_name();
+    const bool trig = name == "sin" || name == "cos";
+    const bool hyperbolic = name == "sinh" || name == "cosh";
+    if (trig || hyperbolic) {
+      Family family{hyperbolic, e.op(0), (hyperbolic ? "h:" : "t:") + canonical_key(e.op(0))};
+      const bool known = std::any_of(out.begin(), out.end(),
+                                     [&](const Family& f) { return f.key == family.key; });
+      if (!known) out.push_back(std::move(family));
+    }
+    return;  // arguments were simplified on their own
+  }
+  for (std::size_t i = 0; i < e.nops(); ++i) collect_families(e.op(i), out);
+}
+
+// Reduces a polynomial modulo the relations of the families: with s, c the two functions of a
+// family, eliminate_first replaces s^2 by 1 - c^2 (sinh^2 by cosh^2 - 1), otherwise c^2 by
+// 1 - s^2 (cosh^2 by 1 + sinh^2). The result has degree at most 1 in the eliminated function.
+ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool eliminate_first) {
+  std::vector<GiNaC::symbol> first(families.size()), second(families.size());
+  GiNaC::lst to_symbols, back;
+  for (std::size_t i = 0; i < families.size(); ++i) {
+    const ex& u = families[i].argument;
+    const ex f = families[i].hyperbolic ? GiNaC::sinh(u) : GiNaC::sin(u);
+    const ex g = families[i].hyperbolic ? GiNaC::cosh(u) : GiNaC::cos(u);
+    to_symbols.append(f == first[i]);
+    to_symbols.append(g == second[i]);
+    back.append(first[i] == f);
+    back.append(second[i] == g);
+  }
+  ex q = GiNaC::expand(p.subs(to_symbols));
+  for (std::size_t i = 0; i < families.size(); ++i) {
+    const GiNaC::symbol& s = first[i];
+    const GiNaC::symbol& c = second[i];
+    const GiNaC::symbol& x = eliminate_first ? s : c;  // the function whose square goes
+    ex square;                                         // what x^2 becomes
+    if (!families[i].hyperbolic)
+      square = 1 - GiNaC::pow(eliminate_first ? c : s, 2);
+    else
+      square = eliminate_first ? GiNaC::pow(c, 2) - 1 : 1 + GiNaC::pow(s, 2);
+    const int degree = q.degree(x);
+    if (degree < 2 || q.ldegree(x) < 0) continue;
+    ex reduced = 0;
+    for (int k = 0; k <= degree; ++k) {
+      const ex coefficient = q.coeff(x, k);
+      if (coefficient.is_zero()) continue;
+      reduced += coefficient * GiNaC::pow(x, k % 2) * GiNaC::pow(square, k / 2);
+    }
+    q = GiNaC::expand(reduced);
+  }
+  return q.subs(back);
+}
+
+Fraction reduce(const Fraction& start, const std::vector<Family>& families, bool eliminate_first) {
+  Fraction f = start;
+  // Cancelling common factors cannot raise the degree in the eliminated function, so one round
+  // usually suffices; a few more make sure a fixpoint is reached.
+  for (int round = 0; round < 4; ++round) {
+    const ex n = reduce_polynomial(f.numerator, families, eliminate_first);
+    const ex d = reduce_polynomial(f.denominator, families, eliminate_first);
+    const Fraction next = normal_fraction(n / d);
+    const bool same = next.numerator.is_equal(f.numerator) && next.denominator.is_equal(f.denominator);
+    f = next;
+    if (same || f.numerator.is_zero()) break;
+  }
+  return f;
+}
+
+}  // namespace
+
+std::string canonical_key(const ex& e) {
+  auto operands = [&](const char* tag, bool sorted) {
+    std::vector<std::string> keys;
+    for (std::size_t i = 0; i < e.nops(); ++i) keys.push_back(canonical_key(e.op(i)));
+    if (sorted) std::sort(keys.begin(), keys.end());
+    std::string out = tag;
+    out += '(';
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      if (i > 0) out += ',';
+      out += keys[i];
+    }
+    out += ')';
+    return out;
+  };
+  if (GiNaC::is_a<GiNaC::symbol>(e)) return GiNaC::ex_to<GiNaC::symbol>(e).get_name();
+  if (GiNaC::is_a<GiNaC::add>(e)) return operands("+", true);
+  if (GiNaC::is_a<GiNaC::mul>(e)) return operands("*", true);
+  if (GiNaC::is_a<GiNaC::power>(e)) return operands("^", false);
+  if (GiNaC::is_a<GiNaC::function>(e))
+    return operands(GiNaC::ex_to<GiNaC::function>(e).get_name().c_str(), false);
+  std::ostringstream out;
+  out << e;
+  return out.str();
+}
+
+GiNaC::ex simplify(const GiNaC::ex& e) {
+  if (GiNaC::is_a<GiNaC::numeric>(e) || GiNaC::is_a<GiNaC::symbol>(e)) return e;
+  Rewrite rewrite;
+  const Fraction base = normal_fraction(rewrite(e));
+  if (base.numerator.is_zero()) return 0;
+  std::vector<Family> families;
+  collect_families(base.numerator, families);
+  collect_families(base.denominator, families);
+  if (families.empty()) return assemble(base);
+  std::sort(families.begin(), families.end(),
+            [](const Family& a, const Family& b) { return a.key < b.key; });
+
+  // The canonical form first: an identity reduces to 0 here.
+  const Fraction first = reduce(base, families, true);
+  if (first.numerator.is_zero()) return 0;
+  const Fraction second = reduce(base, families, false);
+  ex best = assemble(base);
+  std::size_t best_size = size_of(best);
+  for (const Fraction* candidate : {&first, &second}) {
+    const ex form = assemble(*candidate);
+    const std::size_t size = size_of(form);
+    if (size < best_size) {
+      best = form;
+      best_size = size;
+    }
+  }
+  return best;
+}
+
+GiNaC::matrix simplify(const GiNaC::matrix& m) {
+  GiNaC::matrix out(m.rows(), m.cols());
+  for (unsigned i = 0; i < m.rows(); ++i)
+    for (unsigned j = 0; j < m.cols(); ++j) out(i, j) = simplify(m(i, j));
+  return out;
+}
+
+bool is_zero(const GiNaC::ex& e) {
+  if (e.is_zero()) return true;
+  if (GiNaC::is_a<GiNaC::numeric>(e) || GiNaC::is_a<GiNaC::symbol>(e)) return false;
+  return simplify(e).is_zero();
+}
+
+bool is_zero(const GiNaC::matrix& m) {
+  for (unsigned i = 0; i < m.rows(); ++i)
+    for (unsigned j = 0; j < m.cols(); ++j)
+      if (!symbolic::is_zero(m(i, j))) return false;
+  return true;
+}
+
+}  // namespace nhdyn::symbolic

@@ -1,0 +1,39 @@
+// Deterministic simplification of the expressions of mechanics, used by derive() on every term it
+// returns, by `nhdyn equations` for display, and by the tests to decide that two expressions agree
+// (STYLE.md: compare by simplifying the difference to zero, never by printed strings).
+//
+// simplify() rewrites tan and tanh through sin/cos and sinh/cosh, brings the expression to one
+// fraction with expanded, coprime numerator and denominator (GiNaC's normal()), and reduces
+// sin(u)^2 + cos(u)^2 = 1 (and cosh(u)^2 - sinh(u)^2 = 1) for every argument u. The reduction that
+// eliminates sin(u)^2 is a canonical form for polynomials in sin(u), cos(u), so every identity
+// built from these relations (for one argument at a time, e.g. not sin(2 x) = 2 sin(x) cos(x))
+// simplifies to exactly 0. Of the candidate forms (no reduction, sin^2 eliminated, cos^2
+// eliminated) the smallest is returned; a fraction whose denominator is a single product is
+// distributed over the terms of the numerator (m g sin(alpha) + m a phi'^2/cos(phi)).
+// The result depends only on the value of the input, never on GiNaC's internal term order.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <string>
+
+namespace nhdyn::symbolic {
+
+GiNaC::ex simplify(const GiNaC::ex& e);
+// Entry by entry.
+GiNaC::matrix simplify(const GiNaC::matrix& m);
+
+// True when simplify(e) is 0; false when it is not or when simplify() cannot tell. Call it as
+// symbolic::is_zero: argument-dependent lookup also finds GiNaC::is_zero, which only tests whether
+// the expression is literally the number 0.
+bool is_zero(const GiNaC::ex& e);
+// True when every entry is zero in the sense above.
+bool is_zero(const GiNaC::matrix& m);
+
+// A serialization of `e` that does not depend on the order in which GiNaC keeps the terms of sums
+// and the factors of products (which follows symbol creation order): operands are sorted by their
+// own keys. Two expressions of the same structure have the same key; used to order terms for
+// display and to make choices in simplify() reproducible.
+std::string canonical_key(const GiNaC::ex& e);
+
+}  // namespace nhdyn::symbolic

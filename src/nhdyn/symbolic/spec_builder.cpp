@@ -1,0 +1,810 @@
+#include "nhdyn/symbolic/spec_builder.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <exception>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/symbolic/suggest.hpp"
+
+namespace nhdyn::symbolic {
+namespace {
+
+// The functions an expression may call (spec_builder.hpp), with their number of arguments.
+const std::vector<std::pair<std::string, int>>& functions() {
+  static const std::vector<std::pair<std::string, int>> table = {
+      {"sin", 1},  {"cos", 1},  {"tan", 1},  {"exp", 1},  {"log", 1},   {"sqrt", 1}, {"abs", 1},
+      {"asin", 1}, {"acos", 1}, {"atan", 1}, {"atan2", 2}, {"sinh", 1}, {"cosh", 1}, {"tanh", 1}};
+  return table;
+}
+
+int function_arity(const std::string& name) {
+  for (const auto& [function, arity] : functions())
+    if (function == name) return arity;
+  return -1;
+}
+
+std::vector<std::string> function_names() {
+  std::vector<std::string> names;
+  for (const auto& entry : functions()) names.push_back(entry.first);
+  return names;
+}
+
+std::string join(const std::vector<std::string>& items, const char* separator = ", ") {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (i > 0) out += separator;
+    out += items[i];
+  }
+  return out;
+}
+
+std::string compose(const SourceLocation& where, const std::string& context, const std::string& problem) {
+  std::string out;
+  const std::string location = where.describe();
+  if (!location.empty()) out += location + ": ";
+  if (!context.empty()) out += context + ": ";
+  return out + problem;
+}
+
+[[noreturn]] void fail(const SourceLocation& where, const std::string& context, const std::string& problem) {
+  throw ModelError(compose(where, context, problem));
+}
+
+// GiNaC identifiers cannot contain a prime, and a user's name may collide with GiNaC's own
+// literals (I, Pi, Euler, Catalan): the parser sees every symbol under an internal name.
+std::string internal_name(const std::string& name) {
+  std::string base = name;
+  std::string suffix;
+  if (base.size() > 2 && base.compare(base.size() - 2, 2, "''") == 0) {
+    base.resize(base.size() - 2);
+    suffix = "__ddot";
+  } else if (base.size() > 1 && base.back() == '\'') {
+    base.pop_back();
+    suffix = "__dot";
+  }
+  return "n__" + base + suffix;
+}
+
+bool identifier_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) != 0 || c == '_'; }
+bool identifier_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_'; }
+bool digit(char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; }
+
+enum class SymbolKind { time, constant, coordinate, velocity, acceleration, parameter };
+
+// One occurrence of a symbol in the user's text.
+struct Occurrence {
+  SymbolKind kind;
+  std::string name;  // as written, e.g. "x'"
+  GiNaC::symbol symbol;
+  std::size_t position;  // byte offset in the text
+};
+
+struct Parsed {
+  GiNaC::ex value;
+  std::vector<Occurrence> symbols;  // in the order they appear
+};
+
+// Where a piece of text sits, to turn byte offsets into file positions.
+struct Site {
+  const std::string& text;
+  SourceLocation where;
+  std::string context;
+
+  // Line (0-based, within the text) and column (1-based, in characters) of a byte offset.
+  std::pair<int, int> position(std::size_t offset) const {
+    int line = 0, column = 1;
+    for (std::size_t i = 0; i < offset && i < text.size(); ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        column = 1;
+      } else if ((static_cast<unsigned char>(text[i]) & 0xC0) != 0x80) {
+        ++column;
+      }
+    }
+    return {line, column};
+  }
+
+  // The location of a byte offset: the site's location moved to it when the site has one
+  // (its column is that of the text's first character); otherwise the column is spelled out.
+  [[noreturn]] void fail_at(std::size_t offset, const std::string& problem) const {
+    const auto [line, column] = position(offset);
+    SourceLocation at = where;
+    std::string message = problem;
+    if (where.line > 0) {
+      if (line == 0) {
+        if (where.column > 0) at.column = where.column + column - 1;
+      } else {
+        at.line = where.line + line;
+        at.column = column;
+      }
+    } else if (line == 0) {
+      message += fmt::format(" (column {} of \"{}\")", column, text);
+    } else {
+      message += fmt::format(" (line {}, column {} of \"{}\")", line + 1, column, text);
+    }
+    throw ModelError(compose(at, context, message));
+  }
+
+  // An error about the whole text.
+  [[noreturn]] void fail_whole(const std::string& problem) const {
+    throw ModelError(compose(where, context, problem));
+  }
+};
+
+enum class TokenKind { number, identifier, plus, minus, times, divide, power, open, close, comma, end };
+
+struct Token {
+  TokenKind kind;
+  std::size_t begin, end;  // byte offsets in the text
+  std::string name;        // identifier without primes
+  int primes = 0;
+};
+
+bool operand_start(TokenKind kind) {
+  return kind == TokenKind::number || kind == TokenKind::identifier || kind == TokenKind::open;
+}
+
+std::vector<Token> lex(const Site& site, std::size_t begin, std::size_t end) {
+  const std::string& s = site.text;
+  std::vector<Token> tokens;
+  std::size_t i = begin;
+  while (i < end) {
+    const char c = s[i];
+    if (c == ' ' || c == '\t' || c == '\n' || c == '\r') {
+      ++i;
+      continue;
+    }
+    Token token{TokenKind::end, i, i + 1, "", 0};
+    if (digit(c) || (c == '.' && i + 1 < end && digit(s[i + 1]))) {
+      std::size_t j = i;
+      while (j < end && digit(s[j])) ++j;
+      if (j < end && s[j] == '.') {
+        ++j;
+        while (j < end && digit(s[j])) ++j;
+      }
+      if (j < end && (s[j] == 'e' || s[j] == 'E')) {
+        std::size_t k = j + 1;
+        if (k < end && (s[k] == '+' || s[k] == '-')) ++k;
+        if (k < end && digit(s[k])) {
+          j = k;
+          while (j < end && digit(s[j])) ++j;
+        }
+      }
+      token.kind = TokenKind::number;
+      token.end = j;
+    } else if (identifier_start(c)) {
+      std::size_t j = i;
+      while (j < end && identifier_char(s[j])) ++j;
+      token.kind = TokenKind::identifier;
+      token.name = s.substr(i, j - i);
+      while (j < end && s[j] == '\'') {
+        ++token.primes;
+        ++j;
+      }
+      token.end = j;
+    } else {
+      switch (c) {
+        case '+': token.kind = TokenKind::plus; break;
+        case '-': token.kind = TokenKind::minus; break;
+        case '*':
+          if (i + 1 < end && s[i + 1] == '*')
+            site.fail_at(i, "'**' is not an operator: write ^ for a power, as in x^2");
+          token.kind = TokenKind::times;
+          break;
+        case '/': token.kind = TokenKind::divide; break;
+        case '^': token.kind = TokenKind::power; break;
+        case '(': token.kind = TokenKind::open; break;
+        case ')': token.kind = TokenKind::close; break;
+        case ',': token.kind = TokenKind::comma; break;
+        case '\'':
+          site.fail_at(i, "syntax error: a prime must follow a coordinate's name directly, as in x' or x''");
+        case '=':
+          site.fail_at(i, "syntax error: unexpected '=' (only a constraint may be written as lhs = rhs)");
+        default: {
+          std::size_t j = i + 1;
+          while (j < end && (static_cast<unsigned char>(s[j]) & 0xC0) == 0x80) ++j;
+          site.fail_at(i, fmt::format("syntax error: unexpected character '{}'", s.substr(i, j - i)));
+        }
+      }
+    }
+    tokens.push_back(token);
+    i = token.end;
+  }
+  tokens.push_back(Token{TokenKind::end, end, end, "", 0});
+  return tokens;
+}
+
+// A decimal literal as an exact rational, so that 0.5 m x'^2 stays exact through the derivation.
+std::string exact_number(const std::string& literal) {
+  std::string digits;
+  long long scale = 0;  // value = digits * 10^scale
+  std::size_t i = 0;
+  for (; i < literal.size() && digit(literal[i]); ++i) digits += literal[i];
+  if (i < literal.size() && literal[i] == '.') {
+    for (++i; i < literal.size() && digit(literal[i]); ++i) {
+      digits += literal[i];
+      --scale;
+    }
+  }
+  if (i < literal.size() && (literal[i] == 'e' || literal[i] == 'E')) scale += std::stoll(literal.substr(i + 1));
+  const std::size_t nonzero = digits.find_first_not_of('0');
+  digits = nonzero == std::string::npos ? "0" : digits.substr(nonzero);
+  if (scale == 0) return digits;
+  if (scale > 0) return fmt::format("({}*10^{})", digits, scale);
+  return fmt::format("({}/10^{})", digits, -scale);
+}
+
+const char* describe_token(TokenKind kind) {
+  switch (kind) {
+    case TokenKind::plus: return "'+'";
+    case TokenKind::minus: return "'-'";
+    case TokenKind::times: return "'*'";
+    case TokenKind::divide: return "'/'";
+    case TokenKind::power: return "'^'";
+    case TokenKind::open: return "'('";
+    case TokenKind::close: return "')'";
+    case TokenKind::comma: return "','";
+    case TokenKind::end: return "the end of the expression";
+    default: return "an operand";
+  }
+}
+
+// Recursive-descent check of the user's text, which reports every syntax error with its column
+// (GiNaC's parser reports none), and writes the text GiNaC parses: internal names, exact numbers,
+// explicit (-1)* for a leading sign. GiNaC's own parser then builds the expression.
+class Reader {
+ public:
+  Reader(const Site& site, const Spec& spec, std::vector<Token> tokens)
+      : site_(site), spec_(spec), tokens_(std::move(tokens)) {}
+
+  Parsed read() {
+    if (tokens_.front().kind == TokenKind::end) site_.fail_at(tokens_.front().begin, "empty expression");
+    expression();
+    const Token& next = peek();
+    if (next.kind != TokenKind::end) {
+      if (next.kind == TokenKind::close) site_.fail_at(next.begin, "syntax error: unmatched ')'");
+      unexpected(next);
+    }
+    GiNaC::symtab table;
+    for (const auto& [name, value] : spec_.symbols.parser_table()) table[internal_name(name)] = value;
+    Parsed parsed;
+    try {
+      GiNaC::parser parser(table, /*strict=*/true);
+      parsed.value = parser(out_);
+    } catch (const std::exception& e) {
+      site_.fail_at(tokens_.front().begin, fmt::format("cannot parse the expression: {}", e.what()));
+    }
+    parsed.symbols = std::move(symbols_);
+    return parsed;
+  }
+
+ private:
+  const Token& peek() const { return tokens_[index_]; }
+  const Token& next() { return tokens_[index_++]; }
+  std::string spelled(const Token& token) const {
+    return site_.text.substr(token.begin, token.end - token.begin);
+  }
+
+  [[noreturn]] void unexpected(const Token& token) {
+    if (operand_start(token.kind) && index_ > 0)
+      site_.fail_at(token.begin, fmt::format("syntax error: missing operator between '{}' and '{}' "
+                                             "(write * for a product)",
+                                             spelled(tokens_[index_ - 1]), spelled(token)));
+    const std::string what = token.kind == TokenKind::end ? describe_token(token.kind) : "'" + spelled(token) + "'";
+    site_.fail_at(token.begin, "syntax error: unexpected " + what);
+  }
+
+  void no_sign_after(const Token& op) {
+    const Token& token = peek();
+    if (token.kind == TokenKind::plus || token.kind == TokenKind::minus)
+      site_.fail_at(token.begin, fmt::format("syntax error: a sign directly after '{}' needs parentheses, "
+                                             "as in x{}(-y)",
+                                             spelled(op), spelled(op)));
+  }
+
+  // expression: [sign] factor ((+ | - | * | /) factor)*
+  void expression() {
+    if (peek().kind == TokenKind::plus) {
+      next();
+    } else if (peek().kind == TokenKind::minus) {
+      next();
+      out_ += "(-1)*";
+    }
+    factor();
+    for (;;) {
+      const Token& token = peek();
+      if (token.kind == TokenKind::plus || token.kind == TokenKind::minus || token.kind == TokenKind::times ||
+          token.kind == TokenKind::divide) {
+        next();
+        out_ += spelled(token);
+        no_sign_after(token);
+        factor();
+      } else if (operand_start(token.kind)) {
+        unexpected(token);
+      } else {
+        return;
+      }
+    }
+  }
+
+  // factor: operand [^ operand]; x^a^b is refused as ambiguous.
+  void factor() {
+    operand();
+    if (peek().kind != TokenKind::power) return;
+    const Token& op = next();
+    out_ += "^";
+    no_sign_after(op);
+    operand();
+    if (peek().kind == TokenKind::power)
+      site_.fail_at(peek().begin, "syntax error: x^a^b is ambiguous; write (x^a)^b or x^(a^b)");
+  }
+
+  void operand() {
+    const Token& token = peek();
+    switch (token.kind) {
+      case TokenKind::number:
+        next();
+        out_ += exact_number(spelled(token));
+        return;
+      case TokenKind::identifier:
+        identifier();
+        return;
+      case TokenKind::open: {
+        next();
+        out_ += "(";
+        expression();
+        if (peek().kind != TokenKind::close) {
+          if (peek().kind == TokenKind::end)
+            site_.fail_at(token.begin, "syntax error: this '(' is never closed");
+          unexpected(peek());
+        }
+        next();
+        out_ += ")";
+        return;
+      }
+      case TokenKind::end:
+        site_.fail_at(token.begin, "syntax error: the expression ends where an operand is expected");
+      default:
+        site_.fail_at(token.begin, fmt::format("syntax error: an operand is expected before '{}'", spelled(token)));
+    }
+  }
+
+  void identifier() {
+    const Token token = next();
+    const std::string& name = token.name;
+    const std::string written = spelled(token);
+    if (token.primes > 2)
+      site_.fail_at(token.begin, fmt::format("'{}': only velocities (one prime, {}') and accelerations "
+                                             "(two primes, {}'') may be written",
+                                             written, name, name));
+    const int arity = function_arity(name);
+    if (peek().kind == TokenKind::open) {
+      if (arity < 0 || token.primes > 0) {
+        if (token.primes > 0 || spec_.symbols.has(name))
+          site_.fail_at(token.begin, fmt::format("'{}' is not a function; write {}*(...) for a product",
+                                                 written, written));
+        const std::string nearest = nearest_name(name, function_names());
+        site_.fail_at(token.begin, fmt::format("unknown function '{}'{}", name,
+                                               nearest.empty() ? "" : fmt::format("; did you mean '{}'?", nearest)));
+      }
+      const Token& open = next();
+      out_ += name + "(";
+      int arguments = 1;
+      expression();
+      while (peek().kind == TokenKind::comma) {
+        next();
+        out_ += ",";
+        expression();
+        ++arguments;
+      }
+      if (peek().kind != TokenKind::close) {
+        if (peek().kind == TokenKind::end)
+          site_.fail_at(open.begin, fmt::format("syntax error: the '(' of {}( is never closed", name));
+        unexpected(peek());
+      }
+      next();
+      out_ += ")";
+      if (arguments != arity)
+        site_.fail_at(token.begin, fmt::format("{} takes {} argument{}, not {}", name, arity,
+                                               arity == 1 ? "" : "s", arguments));
+      return;
+    }
+    if (arity >= 0)
+      site_.fail_at(token.begin, fmt::format("'{}' is a function; write {}(...)", written, name));
+
+    if (token.primes == 0) {
+      SymbolKind kind = SymbolKind::parameter;
+      if (name == "pi") {
+        symbols_.push_back({SymbolKind::constant, name, GiNaC::symbol(), token.begin});
+        out_ += internal_name(name);
+        return;
+      }
+      const std::optional<GiNaC::symbol> symbol = spec_.symbols.find(name);
+      if (!symbol) {
+        std::vector<std::string> known = {"t", "pi"};
+        for (const std::string& c : spec_.coordinates) known.push_back(c);
+        for (const SpecParameter& p : spec_.parameters) known.push_back(p.name);
+        const std::string nearest = nearest_name(name, known);
+        site_.fail_at(token.begin, fmt::format("unknown symbol '{}'{}", name,
+                                               nearest.empty() ? "" : fmt::format("; did you mean '{}'?", nearest)));
+      }
+      if (name == "t")
+        kind = SymbolKind::time;
+      else if (std::find(spec_.coordinates.begin(), spec_.coordinates.end(), name) != spec_.coordinates.end())
+        kind = SymbolKind::coordinate;
+      symbols_.push_back({kind, name, *symbol, token.begin});
+      out_ += internal_name(name);
+      return;
+    }
+
+    const char* what = token.primes == 1 ? "velocity" : "acceleration";
+    const bool coordinate =
+        std::find(spec_.coordinates.begin(), spec_.coordinates.end(), name) != spec_.coordinates.end();
+    if (!coordinate) {
+      std::string why = "which is not a coordinate";
+      if (name == "t")
+        why = "the time, not a coordinate";
+      else if (spec_.symbols.has(name))
+        why = "which is a parameter, not a coordinate";
+      const std::string nearest = spec_.symbols.has(name) ? "" : nearest_name(name, spec_.coordinates);
+      site_.fail_at(token.begin,
+                    fmt::format("'{}' is the {} of '{}', {}{}", written, what, name, why,
+                                nearest.empty() ? "" : fmt::format("; did you mean '{}{}'?", nearest,
+                                                                   std::string(static_cast<std::size_t>(token.primes), '\''))));
+    }
+    symbols_.push_back({token.primes == 1 ? SymbolKind::velocity : SymbolKind::acceleration, written,
+                        *spec_.symbols.find(written), token.begin});
+    out_ += internal_name(written);
+  }
+
+  const Site& site_;
+  const Spec& spec_;
+  std::vector<Token> tokens_;
+  std::size_t index_ = 0;
+  std::string out_;
+  std::vector<Occurrence> symbols_;
+};
+
+Parsed read(const Spec& spec, const Site& site, std::size_t begin, std::size_t end) {
+  return Reader(site, spec, lex(site, begin, end)).read();
+}
+
+Parsed read(const Spec& spec, const Site& site) { return read(spec, site, 0, site.text.size()); }
+
+// The first occurrence of a symbol of `kind` that the expression still contains (x' - x' does not).
+const Occurrence* first_of(const Parsed& parsed, SymbolKind kind) {
+  for (const Occurrence& o : parsed.symbols)
+    if (o.kind == kind && parsed.value.has(o.symbol)) return &o;
+  return nullptr;
+}
+
+// Refuses the symbols of `kind` in an expression, naming the first one found ({} in `problem`).
+void refuse(const Parsed& parsed, const Site& site, SymbolKind kind, const std::string& problem) {
+  if (const Occurrence* o = first_of(parsed, kind))
+    site.fail_at(o->position, fmt::format(fmt::runtime(problem), o->name));
+}
+
+bool valid_name(const std::string& name) {
+  if (name.empty() || !std::isalpha(static_cast<unsigned char>(name[0]))) return false;
+  if (name.find("__") != std::string::npos) return false;
+  return std::all_of(name.begin(), name.end(), identifier_char);
+}
+
+int index_of(const std::vector<std::string>& names, const std::string& name) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+}
+
+std::string did_you_mean(const std::string& name, const std::vector<std::string>& known) {
+  const std::string nearest = nearest_name(name, known);
+  return nearest.empty() ? "" : fmt::format("; did you mean '{}'?", nearest);
+}
+
+// Names of coordinates and parameters share one space with t, pi and the functions.
+void check_new_name(const Spec& spec, const std::string& name, const char* what, const SourceLocation& where) {
+  const std::string context = fmt::format("{} '{}'", what, name);
+  if (!valid_name(name))
+    fail(where, context, "not a valid name: use letters, digits and single underscores, starting with a letter");
+  if (name == "t") fail(where, context, "'t' is the time and cannot be declared");
+  if (name == "pi") fail(where, context, "'pi' is the constant pi and cannot be declared");
+  if (function_arity(name) >= 0) fail(where, context, fmt::format("'{}' is the name of a function", name));
+  if (index_of(spec.coordinates, name) >= 0)
+    fail(where, context, fmt::format("duplicated name: '{}' is already a coordinate", name));
+  for (const SpecParameter& p : spec.parameters)
+    if (p.name == name) {
+      const std::string at = p.where.describe();
+      fail(where, context, fmt::format("duplicated name: '{}' is already a parameter{}", name,
+                                       at.empty() ? "" : " (declared at " + at + ")"));
+    }
+}
+
+}  // namespace
+
+SpecBuilder::SpecBuilder(std::string name, SourceLocation where) {
+  spec_.name = std::move(name);
+  spec_.where = std::move(where);
+}
+
+SpecBuilder& SpecBuilder::description(std::string text) {
+  spec_.description = std::move(text);
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::coordinate(const std::string& name, SourceLocation where) {
+  check_new_name(spec_, name, "coordinate", where);
+  spec_.symbols.add_coordinate(name);
+  spec_.coordinates.push_back(name);
+  spec_.forces.resize(spec_.coordinates.size(), GiNaC::ex(0));
+  spec_.q0.resize(spec_.coordinates.size(), GiNaC::ex(0));
+  spec_.v0.resize(spec_.coordinates.size(), GiNaC::ex(0));
+  initial_given_.resize(spec_.coordinates.size(), false);
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::parameter(const std::string& name, double value, std::string unit, SourceLocation where) {
+  check_new_name(spec_, name, "parameter", where);
+  if (!std::isfinite(value))
+    fail(where, fmt::format("parameter '{}'", name), fmt::format("value {} is not a finite number", value));
+  spec_.symbols.add_parameter(name);
+  spec_.parameters.push_back({name, value, std::move(unit), std::move(where)});
+  return *this;
+}
+
+GiNaC::ex SpecBuilder::parse(const std::string& text, const SourceLocation& where) const {
+  return read(spec_, Site{text, where, ""}).value;
+}
+
+SpecBuilder& SpecBuilder::kinetic_energy(const std::string& text, SourceLocation where) {
+  const Site site{text, where, "kinetic energy T"};
+  const Parsed parsed = read(spec_, site);
+  refuse(parsed, site, SymbolKind::acceleration, "the kinetic energy may not contain accelerations (found {})");
+  spec_.kinetic_energy = parsed.value;
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::potential_energy(const std::string& text, SourceLocation where) {
+  const Site site{text, where, "potential energy V"};
+  const Parsed parsed = read(spec_, site);
+  refuse(parsed, site, SymbolKind::velocity,
+         "the potential energy may not contain velocities (found {}); give velocity-dependent "
+         "forces as nonconservative forces");
+  refuse(parsed, site, SymbolKind::acceleration, "the potential energy may not contain accelerations (found {})");
+  spec_.potential_energy = parsed.value;
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::force(const std::string& coordinate, const std::string& text, SourceLocation where) {
+  const int i = index_of(spec_.coordinates, coordinate);
+  if (i < 0)
+    fail(where, fmt::format("force on '{}'", coordinate),
+         fmt::format("'{}' is not a coordinate{}", coordinate, did_you_mean(coordinate, spec_.coordinates)));
+  const Site site{text, where, fmt::format("force on '{}'", coordinate)};
+  const Parsed parsed = read(spec_, site);
+  refuse(parsed, site, SymbolKind::acceleration, "a force may not contain accelerations (found {})");
+  // Several forces on one coordinate add up.
+  spec_.forces[static_cast<std::size_t>(i)] += parsed.value;
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel level, const std::string& text,
+                                     SourceLocation where) {
+  const std::string context = fmt::format("constraint '{}'", name);
+  if (name.empty() || !std::isalpha(static_cast<unsigned char>(name[0])) ||
+      !std::all_of(name.begin(), name.end(), [](char c) { return identifier_char(c) || c == '-'; }))
+    fail(where, context, "not a valid constraint name: use letters, digits, '_' and '-', starting with a letter");
+  for (const SpecConstraint& c : spec_.constraints)
+    if (c.name == name) {
+      const std::string at = c.where.describe();
+      fail(where, context, fmt::format("duplicated constraint name '{}'{}", name,
+                                       at.empty() ? "" : " (first given at " + at + ")"));
+    }
+  const Site site{text, where, context};
+  // `lhs = rhs` is read as lhs - rhs = 0.
+  Parsed parsed;
+  const std::size_t equals = text.find('=');
+  if (equals == std::string::npos) {
+    parsed = read(spec_, site);
+  } else {
+    if (text.find('=', equals + 1) != std::string::npos)
+      site.fail_at(text.find('=', equals + 1), "syntax error: a constraint has at most one '='");
+    Parsed lhs = read(spec_, site, 0, equals);
+    Parsed rhs = read(spec_, site, equals + 1, text.size());
+    parsed.value = lhs.value - rhs.value;
+    parsed.symbols = std::move(lhs.symbols);
+    parsed.symbols.insert(parsed.symbols.end(), rhs.symbols.begin(), rhs.symbols.end());
+  }
+  const bool velocities = first_of(parsed, SymbolKind::velocity) != nullptr;
+  const bool accelerations = first_of(parsed, SymbolKind::acceleration) != nullptr;
+  switch (level) {
+    case ConstraintLevel::position:
+      refuse(parsed, site, SymbolKind::velocity,
+             "a position-level constraint may not contain velocities (found {}); give it at velocity level");
+      refuse(parsed, site, SymbolKind::acceleration,
+             "a position-level constraint may not contain accelerations (found {}); give it at acceleration "
+             "level");
+      break;
+    case ConstraintLevel::velocity:
+      refuse(parsed, site, SymbolKind::acceleration,
+             "a velocity-level constraint may not contain accelerations (found {}); give it at acceleration "
+             "level");
+      if (!velocities)
+        site.fail_whole("a velocity-level constraint must contain some velocity; without one it is a "
+                  "position-level constraint");
+      break;
+    case ConstraintLevel::acceleration:
+      if (!accelerations)
+        site.fail_whole(fmt::format("an acceleration-level constraint must contain some acceleration; "
+                              "without one it is a {}-level constraint",
+                              velocities ? "velocity" : "position"));
+      break;
+  }
+  spec_.constraints.push_back({name, level, parsed.value, text, std::move(where)});
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::constraint(const std::string& name, const std::string& text, SourceLocation where) {
+  // The level of the highest derivative present; read once just to find it.
+  const Site site{text, where, fmt::format("constraint '{}'", name)};
+  ConstraintLevel level = ConstraintLevel::position;
+  const std::size_t equals = text.find('=');
+  std::vector<Parsed> sides;
+  if (equals == std::string::npos || text.find('=', equals + 1) != std::string::npos) {
+    if (equals == std::string::npos) sides.push_back(read(spec_, site));
+  } else {
+    sides.push_back(read(spec_, site, 0, equals));
+    sides.push_back(read(spec_, site, equals + 1, text.size()));
+  }
+  for (const Parsed& side : sides) {
+    if (first_of(side, SymbolKind::acceleration))
+      level = ConstraintLevel::acceleration;
+    else if (first_of(side, SymbolKind::velocity) && level == ConstraintLevel::position)
+      level = ConstraintLevel::velocity;
+  }
+  return constraint(name, level, text, std::move(where));
+}
+
+SpecBuilder& SpecBuilder::independent(const std::vector<std::string>& coordinates, SourceLocation where) {
+  const std::string context = "independent coordinates";
+  for (std::size_t i = 0; i < coordinates.size(); ++i) {
+    const std::string& name = coordinates[i];
+    if (index_of(spec_.coordinates, name) < 0)
+      fail(where, context, fmt::format("'{}' is not a coordinate{}", name, did_you_mean(name, spec_.coordinates)));
+    if (std::find(coordinates.begin(), coordinates.begin() + static_cast<std::ptrdiff_t>(i), name) !=
+        coordinates.begin() + static_cast<std::ptrdiff_t>(i))
+      fail(where, context, fmt::format("duplicated: '{}' is listed twice", name));
+  }
+  spec_.independent = coordinates;
+  independent_where_ = std::move(where);
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::complement(const std::vector<std::vector<std::string>>& rows, SourceLocation where) {
+  std::size_t columns = 0;
+  for (const auto& row : rows) columns = std::max(columns, row.size());
+  GiNaC::matrix D(static_cast<unsigned>(rows.size()), static_cast<unsigned>(columns));
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (rows[i].size() != columns)
+      fail(where, "complement D",
+           fmt::format("row {} has {} entries but row {} has {}; every row needs one entry per coordinate", i + 1,
+                       rows[i].size(), 1 + (rows[0].size() == columns ? 0 : i), columns));
+    for (std::size_t j = 0; j < columns; ++j) {
+      const Site site{rows[i][j], where, fmt::format("complement D, row {}, column {}", i + 1, j + 1)};
+      const Parsed parsed = read(spec_, site);
+      refuse(parsed, site, SymbolKind::acceleration, "D may not contain accelerations (found {})");
+      D(static_cast<unsigned>(i), static_cast<unsigned>(j)) = parsed.value;
+    }
+  }
+  spec_.complement = D;
+  spec_.complement_where = std::move(where);
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::initial(const std::string& coordinate, const std::string& q0, const std::string& v0,
+                                  SourceLocation where) {
+  const int i = index_of(spec_.coordinates, coordinate);
+  if (i < 0)
+    fail(where, fmt::format("initial value of '{}'", coordinate),
+         fmt::format("'{}' is not a coordinate{}", coordinate, did_you_mean(coordinate, spec_.coordinates)));
+  const auto value = [&](const std::string& text, const char* what) {
+    const Site site{text, where, fmt::format("initial {} of '{}'", what, coordinate)};
+    const Parsed parsed = read(spec_, site);
+    for (const Occurrence& o : parsed.symbols)
+      if (o.kind != SymbolKind::parameter && o.kind != SymbolKind::constant && parsed.value.has(o.symbol))
+        site.fail_at(o.position, fmt::format("an initial value may depend on the parameters only, not on '{}'", o.name));
+    return parsed.value;
+  };
+  spec_.q0[static_cast<std::size_t>(i)] = value(q0, "value");
+  spec_.v0[static_cast<std::size_t>(i)] = value(v0, "velocity");
+  initial_given_[static_cast<std::size_t>(i)] = true;
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::initial_time(double t0) {
+  if (!std::isfinite(t0)) fail(spec_.where, fmt::format("model '{}'", spec_.name), "the initial time is not finite");
+  spec_.t0 = t0;
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::defaults(const SimulationDefaults& defaults) {
+  spec_.defaults = defaults;
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::method(const std::string& name) {
+  spec_.method = name;
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::integrator(const std::string& name) {
+  spec_.integrator = name;
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::tolerances(std::optional<double> rtol, std::optional<double> atol) {
+  const auto check = [&](const std::optional<double>& value, const char* what) {
+    if (value && !(*value > 0.0 && std::isfinite(*value)))
+      fail(spec_.where, fmt::format("model '{}'", spec_.name),
+           fmt::format("{} must be a positive number, not {}", what, *value));
+  };
+  check(rtol, "rtol");
+  check(atol, "atol");
+  spec_.rtol = rtol;
+  spec_.atol = atol;
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::path(const std::string& x, const std::string& y) {
+  for (const std::string& name : {x, y})
+    if (index_of(spec_.coordinates, name) < 0)
+      fail(spec_.where, "path", fmt::format("'{}' is not a coordinate{}", name, did_you_mean(name, spec_.coordinates)));
+  spec_.path = std::make_pair(x, y);
+  return *this;
+}
+
+Spec SpecBuilder::build() const {
+  const std::string context = fmt::format("model '{}'", spec_.name);
+  const int n = spec_.n(), s = spec_.s();
+  if (n == 0) fail(spec_.where, context, "no coordinates are declared");
+  if (spec_.kinetic_energy.is_zero())
+    fail(spec_.where, context, "missing kinetic energy T (it defines the inertia matrix A = d2T/dq'2)");
+  if (s >= n)
+    fail(spec_.where, context,
+         fmt::format("{} constraints for {} coordinates: there must be fewer constraints than coordinates (s < n)",
+                     s, n));
+  const int k = n - s;
+  if (!spec_.independent.empty() && static_cast<int>(spec_.independent.size()) != k)
+    fail(independent_where_, "independent coordinates",
+         fmt::format("{} given ({}), but k = n - s = {} - {} = {} are needed", spec_.independent.size(),
+                     join(spec_.independent), n, s, k));
+  if (spec_.complement) {
+    const GiNaC::matrix& D = *spec_.complement;
+    if (static_cast<int>(D.rows()) != k || static_cast<int>(D.cols()) != n)
+      fail(spec_.complement_where, "complement D",
+           fmt::format("D is {} x {} but must be k x n = {} x {} (k = n - s = {} - {})", D.rows(), D.cols(), k, n, n,
+                       s));
+  }
+  const auto given = static_cast<std::size_t>(std::count(initial_given_.begin(), initial_given_.end(), true));
+  if (given != 0 && given != initial_given_.size()) {
+    std::vector<std::string> missing;
+    for (std::size_t i = 0; i < initial_given_.size(); ++i)
+      if (!initial_given_[i]) missing.push_back(spec_.coordinates[i]);
+    fail(spec_.where, context,
+         fmt::format("initial values are given for some coordinates but not for {}: give all or none "
+                     "(none means all zero)",
+                     join(missing)));
+  }
+  Spec spec = spec_;
+  spec.forces.resize(static_cast<std::size_t>(n), GiNaC::ex(0));
+  spec.q0.resize(static_cast<std::size_t>(n), GiNaC::ex(0));
+  spec.v0.resize(static_cast<std::size_t>(n), GiNaC::ex(0));
+  return spec;
+}
+
+}  // namespace nhdyn::symbolic

@@ -1,0 +1,326 @@
+// Straight-line programs: every instruction against the std:: function it stands for, the
+// validation of operands, the sincos companion, ProgramEvaluator's layout of the terms, and a run
+// that allocates nothing (counted at malloc, as in tests/formulation/allocation_test.cpp).
+#include "nhdyn/model/program.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <stdexcept>
+#include <vector>
+
+#include "nhdyn/model/data.hpp"
+#include "nhdyn/model/model.hpp"
+#include "nhdyn/model/terms.hpp"
+
+namespace {
+std::atomic<long> g_allocations{0};
+std::atomic<bool> g_counting{false};
+void count() {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+}
+}  // namespace
+
+#if defined(__SANITIZE_ADDRESS__)
+// AddressSanitizer owns malloc: count at operator new (the release build counts malloc itself).
+// GCC 12 sees gtest's `new T` inlined next to these definitions and reports the free() as a
+// mismatched deallocation: it is not (every operator new here is malloc).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+#endif
+void* operator new(std::size_t size) {
+  count();
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return ::operator new(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#else
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* __libc_memalign(std::size_t, std::size_t);
+void __libc_free(void*);
+void* malloc(std::size_t size) {
+  count();
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t n, std::size_t size) {
+  count();
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, std::size_t size) {
+  count();
+  return __libc_realloc(p, size);
+}
+void* memalign(std::size_t alignment, std::size_t size) {
+  count();
+  return __libc_memalign(alignment, size);
+}
+void* aligned_alloc(std::size_t alignment, std::size_t size) {
+  count();
+  return __libc_memalign(alignment, size);
+}
+int posix_memalign(void** out, std::size_t alignment, std::size_t size) {
+  count();
+  *out = __libc_memalign(alignment, size);
+  return *out ? 0 : 12;  // ENOMEM
+}
+void free(void* p) { __libc_free(p); }
+}
+#endif
+
+namespace nhdyn {
+namespace {
+
+// Runs `program` at (t, q, v) and returns its outputs.
+std::vector<double> run(const Program& program, double t, const std::vector<double>& q, const std::vector<double>& v) {
+  std::vector<double> registers(static_cast<std::size_t>(program.registers()));
+  std::vector<double> outputs(static_cast<std::size_t>(program.outputs()));
+  program.run(t, q.data(), v.data(), registers.data(), outputs.data());
+  return outputs;
+}
+
+TEST(Program, InputsAreRegistersAndConstantsAreOutputs) {
+  Program p(2);
+  EXPECT_EQ(p.inputs(), 5);
+  EXPECT_EQ(p.registers(), 5);
+  EXPECT_FALSE(p.reads_time());
+  p.add_output(Program::time_register());
+  p.add_output(p.coordinate_register(1));
+  EXPECT_FALSE(p.reads_velocities());
+  p.add_output(p.velocity_register(0));
+  p.add_output(p.push_constant(-2.5));
+  p.add_constant_output(7.25);
+  EXPECT_EQ(p.registers(), 6);
+  const std::vector<double> out = run(p, 0.75, {1.0, 2.0}, {3.0, 4.0});
+  EXPECT_EQ(out, (std::vector<double>{0.75, 2.0, 3.0, -2.5, 7.25}));
+  EXPECT_TRUE(p.reads_time());
+  EXPECT_TRUE(p.reads_coordinates());
+  EXPECT_TRUE(p.reads_velocities());
+  EXPECT_EQ(p.describe(), "r5 = constant -2.5\noutputs: t q1 v0 r5 7.25\n");
+  EXPECT_THROW(p.coordinate_register(2), std::invalid_argument);
+  EXPECT_THROW(p.velocity_register(-1), std::invalid_argument);
+}
+
+TEST(Program, EveryInstructionMatchesTheStandardLibrary) {
+  const double x = 0.37, y = -1.9, z = 2.6, k = 1.75;
+  Program p(3);
+  const int a = p.coordinate_register(0);
+  const int b = p.coordinate_register(1);
+  const int c = p.coordinate_register(2);
+  std::vector<double> expected;
+  const auto out = [&](int r, double value) {
+    p.add_output(r);
+    expected.push_back(value);
+  };
+  out(p.push(Op::add, a, b), x + y);
+  out(p.push(Op::sub, a, b), x - y);
+  out(p.push(Op::mul, a, b), x * y);
+  out(p.push(Op::div, a, b), x / y);
+  out(p.push(Op::neg, b), -y);
+  out(p.push(Op::add_k, a, 0, 0, k), x + k);
+  out(p.push(Op::mul_k, a, 0, 0, k), k * x);
+  out(p.push(Op::mulk, a, b, 0, k), k * (x * y));
+  out(p.push(Op::div_k, b, 0, 0, k), k / y);
+  const std::size_t muladd = expected.size();
+  out(p.push(Op::muladd, a, b, c), x * y + z);
+  out(p.push(Op::mulsub, a, b, c), z - x * y);
+  out(p.push(Op::mulk_add, a, b, 0, k), k * x + y);
+  out(p.push(Op::mulk_muladd, a, b, c, k), k * (x * y) + z);
+  out(p.push(Op::square, b), y * y);
+  out(p.push(Op::cube, b), y * y * y);
+  const std::size_t powi5 = expected.size();
+  out(p.push(Op::powi, b, 0, 0, 5), y * y * y * y * y);
+  out(p.push(Op::powi, b, 0, 0, -1), 1.0 / y);
+  out(p.push(Op::powi, b, 0, 0, -2), 1.0 / (y * y));
+  out(p.push(Op::powi, c, 0, 0, 7), std::pow(z, 7));
+  out(p.push(Op::pow, c, a), std::pow(z, x));
+  out(p.push(Op::pow_k, c, 0, 0, k), std::pow(z, k));
+  out(p.push(Op::sqrt, c), std::sqrt(z));
+  out(p.push(Op::sin, a), std::sin(x));
+  out(p.push(Op::cos, a), std::cos(x));
+  const int sc = p.push(Op::sincos, b);
+  out(sc, std::sin(y));
+  out(sc + 1, std::cos(y));
+  out(p.push(Op::tan, a), std::tan(x));
+  out(p.push(Op::exp, b), std::exp(y));
+  out(p.push(Op::log, c), std::log(z));
+  out(p.push(Op::abs, b), std::abs(y));
+  out(p.push(Op::asin, a), std::asin(x));
+  out(p.push(Op::acos, a), std::acos(x));
+  out(p.push(Op::atan, b), std::atan(y));
+  out(p.push(Op::atan2, b, a), std::atan2(y, x));
+  out(p.push(Op::sinh, b), std::sinh(y));
+  out(p.push(Op::cosh, b), std::cosh(y));
+  out(p.push(Op::tanh, b), std::tanh(y));
+  const std::vector<double> got = run(p, 0.0, {x, y, z}, {0.0, 0.0, 0.0});
+  ASSERT_EQ(got.size(), expected.size());
+  for (std::size_t i = 0; i < got.size(); ++i)
+    EXPECT_NEAR(got[i], expected[i], 4e-16 * std::abs(expected[i])) << "output " << i << "\n" << p.describe();
+  // Products and quotients are exactly the C++ expressions, no fused multiply-add.
+  EXPECT_EQ(got[muladd], x * y + z);
+  EXPECT_EQ(got[powi5], y * ((y * y) * (y * y)));  // by repeated squaring
+  EXPECT_FALSE(p.reads_time());
+  EXPECT_FALSE(p.reads_velocities());
+}
+
+TEST(Program, SincosWritesTwoRegistersAndItsCompanionIsSkipped) {
+  Program p(1);
+  const int x = p.coordinate_register(0);
+  const int sc = p.push(Op::sincos, x);
+  EXPECT_EQ(sc, 3);
+  EXPECT_EQ(p.registers(), 5);
+  EXPECT_EQ(p.code()[1].op, Op::nop);
+  const int sum = p.push(Op::add, sc, sc + 1);
+  p.add_output(sum);
+  EXPECT_DOUBLE_EQ(run(p, 0.0, {0.4}, {0.0})[0], std::sin(0.4) + std::cos(0.4));
+  EXPECT_NE(p.describe().find("r3, r4 = sincos q0"), std::string::npos) << p.describe();
+}
+
+TEST(Program, RefusesOperandsNotYetWritten) {
+  Program p(2);
+  const int x = p.coordinate_register(0);
+  EXPECT_THROW(p.push(Op::add, x, 5), std::invalid_argument);
+  EXPECT_THROW(p.push(Op::neg, -1), std::invalid_argument);
+  EXPECT_THROW(p.push(Op::nop), std::invalid_argument);
+  EXPECT_THROW(p.push(Op::powi, x, 0, 0, 0.5), std::invalid_argument);
+  EXPECT_THROW(p.push(Op::powi, x, 0, 0, 0.0), std::invalid_argument);
+  EXPECT_THROW(p.push(Op::powi, x, 0, 0, 1e7), std::invalid_argument);
+  EXPECT_THROW(p.add_output(5), std::invalid_argument);
+  const int sc = p.push(Op::sincos, x);
+  EXPECT_EQ(p.push(Op::mul, sc, sc + 1), 7);  // the cosine is readable
+  EXPECT_EQ(p.count(Op::sincos), 1);
+}
+
+// A 2-coordinate system: A = diag(m, m q0^2), Q = (-k q0, 0), G = (m q0 v1^2, -2 m q0 v0 v1),
+// one constraint q0' sin(q1) - q1' = 0 at velocity level, given as b = (sin q1, -1),
+// b0 = q0' q1' cos(q1); D = (1, sin q1); energy m/2 (v0^2 + q0^2 v1^2) + k/2 q0^2.
+ModelPrograms polar_programs(double m, double k) {
+  ModelPrograms p{Program(2), std::nullopt, Program(2), Program(2), std::nullopt};
+  Program& t = p.terms;
+  const int q0 = t.coordinate_register(0), q1 = t.coordinate_register(1);
+  const int v0 = t.velocity_register(0), v1 = t.velocity_register(1);
+  const int zero = t.push_constant(0.0);
+  const int sc = t.push(Op::sincos, q1);
+  const int q0q0 = t.push(Op::square, q0);
+  // A, column-major
+  t.add_constant_output(m);
+  t.add_output(zero);
+  t.add_constant_output(0.0);
+  t.add_output(t.push(Op::mul_k, q0q0, 0, 0, m));
+  // Q
+  t.add_output(t.push(Op::mul_k, q0, 0, 0, -k));
+  t.add_output(zero);
+  // G
+  const int v1v1 = t.push(Op::square, v1);
+  t.add_output(t.push(Op::mulk, q0, v1v1, 0, m));
+  t.add_output(t.push(Op::mul_k, t.push(Op::mul, t.push(Op::mul, q0, v0), v1), 0, 0, -2.0 * m));
+  // b (1 x 2), b0
+  t.add_output(sc);
+  t.add_constant_output(-1.0);
+  t.add_output(t.push(Op::mul, t.push(Op::mul, v0, v1), sc + 1));
+
+  Program d(2);
+  d.add_constant_output(1.0);
+  d.add_output(d.push(Op::sin, d.coordinate_register(1)));
+  p.complement = d;
+
+  Program& f = p.velocity_residual;
+  f.add_output(f.push(Op::sub, f.push(Op::mul, f.velocity_register(0), f.push(Op::sin, f.coordinate_register(1))),
+                      f.velocity_register(1)));
+
+  Program e(2);
+  const int x = e.coordinate_register(0), u = e.velocity_register(0), w = e.velocity_register(1);
+  const int T = e.push(Op::mul_k, e.push(Op::muladd, e.push(Op::square, x), e.push(Op::square, w), e.push(Op::square, u)),
+                       0, 0, 0.5 * m);
+  e.add_output(e.push(Op::mulk_add, e.push(Op::square, x), T, 0, 0.5 * k));
+  p.energy = e;
+  return p;
+}
+
+TEST(ProgramEvaluator, FillsTheTermsInTheirLayout) {
+  const double m = 1.3, k = 2.1;
+  const ProgramEvaluator evaluator(2, 1, polar_programs(m, k));
+  EXPECT_TRUE(evaluator.has_complement());
+  EXPECT_TRUE(evaluator.has_energy());
+  EXPECT_EQ(evaluator.scratch_size(), static_cast<std::size_t>(evaluator.programs().terms.registers()));
+  const double q[2] = {0.8, -0.4}, v[2] = {0.3, 1.7};
+  std::vector<double> scratch(evaluator.scratch_size());
+  double A[4], Q[2], G[2], b[2], b0[1], D[2], f[1];
+  evaluator.terms(0.0, q, v, scratch.data(), TermsOut{A, Q, G, b, b0});
+  EXPECT_EQ(A[0], m);
+  EXPECT_EQ(A[1], 0.0);
+  EXPECT_EQ(A[2], 0.0);
+  EXPECT_DOUBLE_EQ(A[3], m * q[0] * q[0]);
+  EXPECT_DOUBLE_EQ(Q[0], -k * q[0]);
+  EXPECT_EQ(Q[1], 0.0);
+  EXPECT_DOUBLE_EQ(G[0], m * q[0] * v[1] * v[1]);
+  EXPECT_DOUBLE_EQ(G[1], -2.0 * m * q[0] * v[0] * v[1]);
+  EXPECT_DOUBLE_EQ(b[0], std::sin(q[1]));
+  EXPECT_EQ(b[1], -1.0);
+  EXPECT_DOUBLE_EQ(b0[0], v[0] * v[1] * std::cos(q[1]));
+  evaluator.complement(0.0, q, v, scratch.data(), D);
+  EXPECT_EQ(D[0], 1.0);
+  EXPECT_DOUBLE_EQ(D[1], std::sin(q[1]));
+  evaluator.velocity_residual(0.0, q, v, scratch.data(), f);
+  EXPECT_DOUBLE_EQ(f[0], v[0] * std::sin(q[1]) - v[1]);
+  EXPECT_DOUBLE_EQ(evaluator.energy(0.0, q, v, scratch.data()),
+                   0.5 * m * (v[0] * v[0] + q[0] * q[0] * v[1] * v[1]) + 0.5 * k * q[0] * q[0]);
+}
+
+TEST(ProgramEvaluator, RefusesProgramsOfTheWrongShape) {
+  ModelPrograms p = polar_programs(1.0, 1.0);
+  EXPECT_THROW(ProgramEvaluator(2, 0, p), std::invalid_argument);  // terms outputs for s = 1
+  EXPECT_THROW(ProgramEvaluator(3, 1, p), std::invalid_argument);  // programs read 2 coordinates
+  ModelPrograms bad_position = polar_programs(1.0, 1.0);
+  bad_position.position_residual.add_output(bad_position.position_residual.velocity_register(0));
+  EXPECT_THROW(ProgramEvaluator(2, 1, bad_position), std::invalid_argument);
+  ModelPrograms bad_energy = polar_programs(1.0, 1.0);
+  bad_energy.energy->add_constant_output(0.0);
+  EXPECT_THROW(ProgramEvaluator(2, 1, bad_energy), std::invalid_argument);
+}
+
+TEST(ProgramEvaluator, RunsWithoutAllocating) {
+  Model model;
+  model.name = "polar";
+  model.coordinates = {"r", "theta"};
+  model.constraints = {{"c", ConstraintLevel::velocity, "r' sin(theta) - theta' = 0"}};
+  model.q0 = Vector::Constant(2, 0.5);
+  model.v0 = Vector::Constant(2, 0.25);
+  model.evaluator = std::make_shared<ProgramEvaluator>(2, 1, polar_programs(1.0, 2.0));
+  Data data = make_data(model);
+  const double q[2] = {0.8, -0.4}, v[2] = {0.3, 1.7};
+  std::vector<double> outputs(16);
+  const Program& terms = static_cast<const ProgramEvaluator&>(*model.evaluator).programs().terms;
+  ASSERT_EQ(compute_terms(model, data, 0.0, q, v), Status::ok);
+  g_allocations = 0;
+  g_counting = true;
+  double energy = 0.0;
+  for (int i = 0; i < 10; ++i) {
+    compute_terms(model, data, 0.1 * i, q, v);
+    terms.run(0.0, q, v, data.scratch.data(), outputs.data());
+    model.evaluator->complement(0.0, q, v, data.scratch.data(), data.D.data());
+    model.evaluator->velocity_residual(0.0, q, v, data.scratch.data(), data.f.data());
+    energy += model.evaluator->energy(0.0, q, v, data.scratch.data());
+  }
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0);
+  EXPECT_GT(energy, 0.0);
+  // The counter counts.
+  g_counting = true;
+  std::vector<double> numbers(100);
+  g_counting = false;
+  numbers[3] = 1.0;
+  EXPECT_GE(g_allocations.load(), 1);
+}
+
+}  // namespace
+}  // namespace nhdyn
