@@ -11,5 +11,7 @@ namespace nhdyn::cli {
 // Each returns the function that runs the subcommand once the command line is parsed.
 std::function<int()> add_simulate_command(CLI::App& app);
 std::function<int()> add_list_command(CLI::App& app);
+std::function<int()> add_equations_command(CLI::App& app);
+std::function<int()> add_codegen_command(CLI::App& app);
 
 }  // namespace nhdyn::cli

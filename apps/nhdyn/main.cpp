@@ -14,6 +14,18 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   const auto simulate = nhdyn::cli::add_simulate_command(app);
   const auto list = nhdyn::cli::add_list_command(app);
+  const auto equations = nhdyn::cli::add_equations_command(app);
+  const auto codegen = nhdyn::cli::add_codegen_command(app);
+  if (argc > 1 && argv[1][0] != '-') {
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+      known = known || sub->get_name() == argv[1];
+    if (!known) {
+      fmt::print(stderr, "nhdyn: error: unknown command '{}'; the commands are simulate, list, equations, codegen "
+                         "(see nhdyn --help)\n", argv[1]);
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -22,6 +34,8 @@ int main(int argc, char** argv) {
   try {
     if (app.got_subcommand("simulate")) return simulate();
     if (app.got_subcommand("list")) return list();
+    if (app.got_subcommand("equations")) return equations();
+    if (app.got_subcommand("codegen")) return codegen();
   } catch (const nhdyn::Error& e) {
     fmt::print(stderr, "nhdyn: error: {}\n", e.what());
     return 2;

@@ -16,6 +16,7 @@
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/io/results.hpp"
+#include "nhdyn/symbolic/spec.hpp"
 #include "progress.hpp"
 
 namespace nhdyn::cli {
@@ -25,11 +26,13 @@ struct SimulateArgs {
   std::string model;
   std::optional<double> t_end;
   std::optional<double> output_step;
-  std::string method = "sanh";
+  std::optional<std::string> method;      // default: the model file's, else sanh
   std::string complement = "qr";
-  std::string integrator = "dopri5";
-  double rtol = 1e-8;
-  double atol = 1e-10;
+  std::optional<std::string> integrator;  // default: the model file's, else dopri5
+  std::optional<double> rtol;             // default: the model file's, else 1e-8
+  std::optional<double> atol;             // default: the model file's, else 1e-10
+  std::vector<std::string> sets;
+  bool fix_initial = false;
   double step = 0.0;
   std::string output;
   std::string plot;
@@ -39,33 +42,49 @@ struct SimulateArgs {
 std::string format_residual(double value, bool defined) { return defined ? fmt::format("{:.3g}", value) : "-"; }
 
 int run_simulate(const SimulateArgs& args) {
-  const Model model = resolve_model(args.model);
+  const ResolvedModel resolved = resolve_model(args.model, args.sets);
+  const Model& model = resolved.model;
+  const symbolic::Spec* spec = resolved.spec ? &*resolved.spec : nullptr;
+  auto from_file = [&](const std::string& value, const char* fallback) {
+    return spec && !value.empty() ? value : std::string(fallback);
+  };
   SimulationOptions options;
   options.t_end = args.t_end.value_or(model.defaults.t_end);
   options.output_step = args.output_step.value_or(model.defaults.output_step);
-  options.formulation.method = parse_method(args.method);
+  options.formulation.method = parse_method(args.method.value_or(from_file(spec ? spec->method : "", "sanh")));
   options.formulation.complement = parse_complement(args.complement);
-  options.integrator.kind = parse_integrator(args.integrator);
-  options.integrator.rtol = args.rtol;
-  options.integrator.atol = args.atol;
+  options.integrator.kind =
+      parse_integrator(args.integrator.value_or(from_file(spec ? spec->integrator : "", "dopri5")));
+  options.integrator.rtol = args.rtol.value_or(spec && spec->rtol ? *spec->rtol : 1e-8);
+  options.integrator.atol = args.atol.value_or(spec && spec->atol ? *spec->atol : 1e-10);
   options.integrator.step = args.step;
+  options.fix_initial = args.fix_initial;
   check_simulation_options(model, options);
 
-  std::filesystem::path csv_path = args.output;
-  if (csv_path.empty()) {
-    // The default place is ours to create; a path the user names must already be writable.
-    csv_path = std::filesystem::path("results") / (model.name + ".csv");
-    std::filesystem::create_directories(csv_path.parent_path());
-  }
-  const ResultColumns columns = make_result_columns(model);
-  CsvWriter writer(csv_path, columns.all);  // refuses an unwritable path before any step
+  namespace fs = std::filesystem;
+  const bool default_csv = args.output.empty();
+  const fs::path csv_path = default_csv ? fs::path("results") / (model.name + ".csv") : fs::path(args.output);
   std::optional<AtomicFile> plot_probe;
   if (!args.plot.empty()) {
+    std::error_code ec;
+    if (fs::weakly_canonical(args.plot, ec) == fs::weakly_canonical(csv_path, ec))
+      throw InputError(fmt::format("--plot {} and the CSV output {} are the same file; give them different names",
+                                   args.plot, csv_path.string()));
     if (!gnuplot_available())
       throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
                       "or run without --plot");
     plot_probe.emplace(args.plot);  // checks the plot's directory now; removed unused
   }
+  if (default_csv) {
+    // The default place is ours to create; a path the user names must already be writable.
+    std::error_code ec;
+    fs::create_directories(csv_path.parent_path(), ec);
+    if (ec)
+      throw FileError(fmt::format("cannot create the directory '{}' for the results: {}; give another path with -o",
+                                  csv_path.parent_path().string(), ec.message()));
+  }
+  const ResultColumns columns = make_result_columns(model);
+  CsvWriter writer(csv_path, columns.all);  // refuses an unwritable path before any step
 
   std::vector<double> row;
   row.reserve(columns.all.size());
@@ -113,6 +132,15 @@ int run_simulate(const SimulateArgs& args) {
                format_residual(summary.max_position_residual, model.position_constraints() > 0),
                format_residual(summary.max_velocity_residual, model.velocity_constraints() > 0),
                format_residual(summary.max_acceleration_residual, model.s() > 0));
+    if (summary.initial_fix) {
+      const InitialFix& fix = *summary.initial_fix;
+      fmt::print("  initial state moved onto the constraints (--fix-initial):\n");
+      for (int i = 0; i < model.n(); ++i) {
+        const std::string& c = model.coordinates[static_cast<std::size_t>(i)];
+        if (fix.dq(i) != 0.0) fmt::print("    {} = {:.12g} (changed by {:+.3g})\n", c, fix.q(i), fix.dq(i));
+        if (fix.dv(i) != 0.0) fmt::print("    {}' = {:.12g} (changed by {:+.3g})\n", c, fix.v(i), fix.dv(i));
+      }
+    }
     if (summary.has_energy)
       fmt::print("  energy drift: {:.3g} (E0 = {:.10g})\n", summary.energy_drift, summary.energy_initial);
     if (!args.plot.empty()) fmt::print("  plot -> {}\n", args.plot);
@@ -125,16 +153,18 @@ int run_simulate(const SimulateArgs& args) {
 std::function<int()> add_simulate_command(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
   CLI::App* cmd = app.add_subcommand("simulate", "Simulate a model and write its results as CSV");
-  cmd->add_option("MODEL", args->model, "A built-in model (see `nhdyn list`)")->required();
+  cmd->add_option("MODEL", args->model, "A model file (.toml) or a built-in model (see `nhdyn list`)")->required();
+  cmd->add_option("--set", args->sets, "Override a model file's parameter, NAME=VALUE (repeatable)");
+  cmd->add_flag("--fix-initial", args->fix_initial,
+                "Move the initial state onto the constraints with the smallest inertia-weighted change");
   cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
   cmd->add_option("--output-step", args->output_step, "Time between output rows [s] (default: the model's)");
-  cmd->add_option("--method", args->method, "Formulation: sanh | lagrange | udwadia-kalaba | nullspace")
-      ->capture_default_str();
+  cmd->add_option("--method", args->method, "Formulation: sanh (default) | lagrange | udwadia-kalaba | nullspace");
   cmd->add_option("--complement", args->complement, "Where D comes from (sanh, nullspace): qr | partition | analytic")
       ->capture_default_str();
-  cmd->add_option("--integrator", args->integrator, "rk4 | dopri5 | cvode-bdf | cvode-adams")->capture_default_str();
-  cmd->add_option("--rtol", args->rtol, "Relative tolerance (adaptive integrators)")->capture_default_str();
-  cmd->add_option("--atol", args->atol, "Absolute tolerance (adaptive integrators)")->capture_default_str();
+  cmd->add_option("--integrator", args->integrator, "rk4 | dopri5 (default) | cvode-bdf | cvode-adams");
+  cmd->add_option("--rtol", args->rtol, "Relative tolerance of the adaptive integrators (default 1e-8)");
+  cmd->add_option("--atol", args->atol, "Absolute tolerance of the adaptive integrators (default 1e-10)");
   cmd->add_option("--step", args->step, "rk4: step size [s] (default output step / 10); adaptive: first step");
   cmd->add_option("-o,--output", args->output, "CSV file to write (default results/MODEL.csv)");
   cmd->add_option("--plot", args->plot, "PNG file to draw with gnuplot");

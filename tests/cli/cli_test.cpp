@@ -601,7 +601,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"output_directory_missing", {"appell", o, "nodir/x.csv"}, {"nodir"}},
         BadInput{"output_is_a_directory", {"appell", o, "existing"}, {"existing", "directory"}},
         BadInput{"output_is_a_directory_with_slash", {"appell", o, "existing/"}, {"existing", "directory"}},
-        BadInput{"model_file_toml", {"foo.toml", o, out}, {"foo.toml", "appell"}},
+        BadInput{"model_file_toml", {"foo.toml", o, out}, {"foo.toml", "no such model file"}},
         BadInput{"model_file_path", {"./appell", o, out}, {"./appell"}},
         BadInput{"unknown_model_default_output", {"bogus"}, {"bogus"}},
         BadInput{"t_end_zero_default_output", {"sled", "--t-end", "0"}, {"t_end = 0|--t-end 0"}},
@@ -698,7 +698,7 @@ TEST(CliUsage, TopLevelHelpListsTheSubcommands) {
 
 // apps/nhdyn/simulate.cpp:58 calls std::filesystem::create_directories, whose
 // filesystem_error is not an nhdyn::Error: a file named `results` turns into "internal error", exit 3.
-TEST(CliKnownDefects, DISABLED_DefaultOutputBlockedByAFileIsBadInput) {
+TEST(CliKnownDefects, DefaultOutputBlockedByAFileIsBadInput) {
   ScratchDir dir;
   write_bytes(dir / "results", "a file, not a directory\n");
   const std::vector<std::string> args{"simulate", "appell", "--t-end", "0.1"};
@@ -709,7 +709,7 @@ TEST(CliKnownDefects, DISABLED_DefaultOutputBlockedByAFileIsBadInput) {
 }
 
 // The same path for -o and --plot: the PNG silently replaces the CSV, exit code 0.
-TEST(CliKnownDefects, DISABLED_CsvAndPlotOnTheSamePathAreRefused) {
+TEST(CliKnownDefects, CsvAndPlotOnTheSamePathAreRefused) {
   if (!gnuplot_available()) GTEST_SKIP() << "gnuplot with a PNG terminal is not installed";
   ScratchDir dir;
   const std::vector<std::string> args{"simulate", "appell", "--t-end", "0.1", "-o", "same", "--plot", "same"};
@@ -720,7 +720,7 @@ TEST(CliKnownDefects, DISABLED_CsvAndPlotOnTheSamePathAreRefused) {
 
 // The default results/ directory is created (simulate.cpp:58) before --plot's directory is
 // checked (simulate.cpp:67), so a refused run leaves an empty results/ behind.
-TEST(CliKnownDefects, DISABLED_RefusedRunCreatesNoResultsDirectory) {
+TEST(CliKnownDefects, RefusedRunCreatesNoResultsDirectory) {
   ScratchDir dir;
   const std::vector<std::string> args{"simulate", "appell", "--t-end", "0.1", "--plot", "nodir/p.png"};
   const RunResult r = nhdyn(args, dir.path());
@@ -729,7 +729,7 @@ TEST(CliKnownDefects, DISABLED_RefusedRunCreatesNoResultsDirectory) {
 }
 
 // `nhdyn bogus` says "A subcommand is required" without naming 'bogus'.
-TEST(CliKnownDefects, DISABLED_UnknownSubcommandIsNamed) {
+TEST(CliKnownDefects, UnknownSubcommandIsNamed) {
   ScratchDir dir;
   const RunResult r = nhdyn({"bogus"}, dir.path());
   EXPECT_EQ(r.exit_code, 2);

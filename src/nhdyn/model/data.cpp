@@ -55,8 +55,10 @@ Data make_data(const Model& model) {
   d.lu_s = Eigen::PartialPivLU<Matrix>(s);
   d.qr_bt = Eigen::ColPivHouseholderQR<Matrix>(n, s);
   d.qr_b = Eigen::ColPivHouseholderQR<Matrix>(s, n);
-  d.llt_k = Eigen::LLT<Matrix>(k);
-  d.llt_n = Eigen::LLT<Matrix>(n);
+  // Factor an identity once rather than assign a default-constructed LLT, whose status is
+  // uninitialized (copying it is undefined behaviour); the storage is sized either way.
+  d.llt_k.compute(Matrix::Identity(k, k));
+  d.llt_n.compute(Matrix::Identity(n, n));
   d.qr_bWt = Eigen::ColPivHouseholderQR<Matrix>(n, s);
   return d;
 }

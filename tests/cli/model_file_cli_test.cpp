@@ -1,0 +1,133 @@
+// End-to-end runs of the commands that read model files: simulate FILE.toml (with --set and
+// --fix-initial), equations (text and LaTeX) and codegen, and their refusals of bad input.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int exit_code;
+  std::string out;  // stdout and stderr together
+};
+
+Outcome nhdyn(const std::string& args, const fs::path& dir) {
+  const std::string command = "cd '" + dir.string() + "' && '" + NHDYN_CLI_PATH + "' " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buffer{};
+  while (std::size_t got = std::fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), got);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::string example(const std::string& name) { return std::string(NHDYN_SOURCE_DIR) + "/examples/" + name; }
+
+class ModelFileCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("nhdyn_mfcli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string read(const std::string& file) {
+    std::ifstream in(dir_ / file);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  fs::path dir_;
+};
+
+TEST_F(ModelFileCli, SimulatesAModelFileLikeTheBuiltInModel) {
+  const Outcome file = nhdyn("simulate " + example("sled.toml") + " --t-end 1 -o file.csv", dir_);
+  ASSERT_EQ(file.exit_code, 0) << file.out;
+  const Outcome builtin = nhdyn("simulate sled --t-end 1 -o builtin.csv", dir_);
+  ASSERT_EQ(builtin.exit_code, 0) << builtin.out;
+  // Same header; the last rows agree to the integrator's tolerance (the file model is
+  // interpreted, the built-in one hand-written, so round-off may differ).
+  const std::string a = read("file.csv"), b = read("builtin.csv");
+  EXPECT_EQ(a.substr(0, a.find('\n')), b.substr(0, b.find('\n')));
+  auto last_x = [](const std::string& csv) {
+    const std::string last = csv.substr(csv.rfind('\n', csv.size() - 2) + 1);
+    std::stringstream s(last);
+    std::string t, x;
+    std::getline(s, t, ',');
+    std::getline(s, x, ',');
+    return std::stod(x);
+  };
+  EXPECT_NEAR(last_x(a), last_x(b), 1e-7 * (1.0 + std::abs(last_x(b))));
+}
+
+TEST_F(ModelFileCli, SetOverridesAParameterAndRefusesUnknownOnes) {
+  const Outcome heavy = nhdyn("simulate " + example("sled.toml") + " --set alpha=0 --t-end 1 -o flat.csv", dir_);
+  ASSERT_EQ(heavy.exit_code, 0) << heavy.out;
+  const Outcome typo = nhdyn("simulate " + example("sled.toml") + " --set rh=1", dir_);
+  EXPECT_EQ(typo.exit_code, 2);
+  EXPECT_NE(typo.out.find("did you mean 'rho'"), std::string::npos) << typo.out;
+  const Outcome nan = nhdyn("simulate " + example("sled.toml") + " --set rho=abc", dir_);
+  EXPECT_EQ(nan.exit_code, 2);
+  EXPECT_NE(nan.out.find("not a finite number"), std::string::npos) << nan.out;
+  const Outcome builtin = nhdyn("simulate sled --set rho=1", dir_);
+  EXPECT_EQ(builtin.exit_code, 2);
+  EXPECT_NE(builtin.out.find("examples/sled.toml"), std::string::npos) << builtin.out;
+}
+
+TEST_F(ModelFileCli, ViolatedInitialStateIsRefusedOrFixed) {
+  std::ifstream in(example("sled.toml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string toml = text.str();
+  // A sideways initial velocity: the blade forbids it.
+  const std::string from = "velocity = { x = 1.0, y = 0, phi = 1.0 }";
+  const std::size_t at = toml.find(from);
+  ASSERT_NE(at, std::string::npos) << "examples/sled.toml changed its initial velocity";
+  toml.replace(at, from.size(), "velocity = { x = 1.0, y = 0.3, phi = 1.0 }");
+  std::ofstream(dir_ / "bad.toml") << toml;
+  const Outcome refused = nhdyn("simulate bad.toml --t-end 1 -o out.csv", dir_);
+  EXPECT_EQ(refused.exit_code, 2) << refused.out;
+  EXPECT_NE(refused.out.find("blade (velocity level): residual 0.3"), std::string::npos) << refused.out;
+  EXPECT_FALSE(fs::exists(dir_ / "out.csv"));
+  const Outcome fixed = nhdyn("simulate bad.toml --t-end 1 -o out.csv --fix-initial", dir_);
+  EXPECT_EQ(fixed.exit_code, 0) << fixed.out;
+  EXPECT_NE(fixed.out.find("y' = "), std::string::npos) << fixed.out;
+}
+
+TEST_F(ModelFileCli, EquationsInTextAndLatex) {
+  const Outcome text = nhdyn("equations " + example("sled_paper.toml"), dir_);
+  ASSERT_EQ(text.exit_code, 0) << text.out;
+  EXPECT_NE(text.out.find("m x'' + m tan(phi) y''"), std::string::npos) << text.out;
+  const Outcome latex = nhdyn("equations " + example("sled_paper.toml") + " --format latex", dir_);
+  ASSERT_EQ(latex.exit_code, 0) << latex.out;
+  EXPECT_NE(latex.out.find("\\ddot"), std::string::npos);
+  const Outcome bad = nhdyn("equations " + example("sled.toml") + " --format pdf", dir_);
+  EXPECT_EQ(bad.exit_code, 2);
+  const Outcome builtin = nhdyn("equations appell", dir_);
+  EXPECT_EQ(builtin.exit_code, 2);
+  EXPECT_NE(builtin.out.find("examples/appell.toml"), std::string::npos) << builtin.out;
+}
+
+TEST_F(ModelFileCli, CodegenWritesAHeaderOrNothing) {
+  const Outcome ok = nhdyn("codegen " + example("appell.toml") + " -o appell_model.hpp", dir_);
+  ASSERT_EQ(ok.exit_code, 0) << ok.out;
+  const std::string header = read("appell_model.hpp");
+  EXPECT_NE(header.find("make_appell_model"), std::string::npos);
+  EXPECT_EQ(header.find("ginac"), std::string::npos);
+  const Outcome missing = nhdyn("codegen nosuch.toml -o x.hpp", dir_);
+  EXPECT_EQ(missing.exit_code, 2) << missing.out;
+  EXPECT_FALSE(fs::exists(dir_ / "x.hpp"));
+  const Outcome nodir = nhdyn("codegen " + example("appell.toml") + " -o nodir/x.hpp", dir_);
+  EXPECT_EQ(nodir.exit_code, 2) << nodir.out;
+}
+
+}  // namespace
