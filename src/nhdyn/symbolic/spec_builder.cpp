@@ -472,8 +472,29 @@ class Reader {
   std::vector<Occurrence> symbols_;
 };
 
+// Exponents beyond this make the derivation's expansion explode (a hang, not an answer); no
+// kinetic energy, potential or constraint of mechanics needs them.
+constexpr long kLargestExponent = 64;
+
+bool has_huge_exponent(const GiNaC::ex& e) {
+  if (GiNaC::is_a<GiNaC::power>(e)) {
+    const GiNaC::ex exponent = e.op(1);
+    if (GiNaC::is_a<GiNaC::numeric>(exponent) &&
+        GiNaC::abs(GiNaC::ex_to<GiNaC::numeric>(exponent)) > GiNaC::numeric(kLargestExponent))
+      return true;
+  }
+  for (std::size_t i = 0; i < e.nops(); ++i)
+    if (has_huge_exponent(e.op(i))) return true;
+  return false;
+}
+
 Parsed read(const Spec& spec, const Site& site, std::size_t begin, std::size_t end) {
-  return Reader(site, spec, lex(site, begin, end)).read();
+  Parsed parsed = Reader(site, spec, lex(site, begin, end)).read();
+  if (has_huge_exponent(parsed.value))
+    site.fail_whole(fmt::format("an exponent larger than {} in magnitude; nhdyn expands powers symbolically, "
+                                "so rewrite the expression (e.g. with exp and log) or use a smaller power",
+                                kLargestExponent));
+  return parsed;
 }
 
 Parsed read(const Spec& spec, const Site& site) { return read(spec, site, 0, site.text.size()); }
