@@ -222,6 +222,8 @@ std::vector<Token> lex(const Site& site, std::size_t begin, std::size_t end) {
 }
 
 // A decimal literal as an exact rational, so that 0.5 m x'^2 stays exact through the derivation.
+// The literal as an exact rational in GiNaC's syntax, or "" when its decimal exponent is beyond
+// what a double holds (such numbers would take minutes to build exactly).
 std::string exact_number(const std::string& literal) {
   std::string digits;
   long long scale = 0;  // value = digits * 10^scale
@@ -233,7 +235,13 @@ std::string exact_number(const std::string& literal) {
       --scale;
     }
   }
-  if (i < literal.size() && (literal[i] == 'e' || literal[i] == 'E')) scale += std::stoll(literal.substr(i + 1));
+  if (i < literal.size() && (literal[i] == 'e' || literal[i] == 'E')) {
+    const std::string exponent = literal.substr(i + 1);
+    std::size_t digits_start = exponent.find_first_not_of("+-");
+    if (digits_start == std::string::npos || exponent.size() - digits_start > 4) return "";
+    scale += std::stoll(exponent);
+  }
+  if (scale > 330 || scale < -330 - static_cast<long long>(digits.size())) return "";
   const std::size_t nonzero = digits.find_first_not_of('0');
   digits = nonzero == std::string::npos ? "0" : digits.substr(nonzero);
   if (scale == 0) return digits;
@@ -311,6 +319,13 @@ class Reader {
 
   // expression: [sign] factor ((+ | - | * | /) factor)*
   void expression() {
+    // Nesting deeper than any formula needs would overflow the stack of this recursive reader.
+    if (++depth_ > kMaxNesting) site_.fail_at(peek().begin, fmt::format("expression nested deeper than {} levels", kMaxNesting));
+    expression_body();
+    --depth_;
+  }
+
+  void expression_body() {
     if (peek().kind == TokenKind::plus) {
       next();
     } else if (peek().kind == TokenKind::minus) {
@@ -350,9 +365,14 @@ class Reader {
     const Token& token = peek();
     switch (token.kind) {
       case TokenKind::number:
+      {
         next();
-        out_ += exact_number(spelled(token));
+        const std::string exact = exact_number(spelled(token));
+        if (exact.empty())
+          site_.fail_at(token.begin, fmt::format("the number {} is out of the range of double precision", spelled(token)));
+        out_ += exact;
         return;
+      }
       case TokenKind::identifier:
         identifier();
         return;
@@ -464,6 +484,8 @@ class Reader {
     out_ += internal_name(written);
   }
 
+  static constexpr int kMaxNesting = 256;
+  int depth_ = 0;
   const Site& site_;
   const Spec& spec_;
   std::vector<Token> tokens_;
