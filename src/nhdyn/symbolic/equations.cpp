@@ -87,21 +87,6 @@ const char* level_name(ConstraintLevel level) {
 // ---------------------------------------------------------------------------------------------
 // The printer: terms and factors in an order that depends on names only.
 
-std::pair<GiNaC::numeric, ex> split_coefficient(const ex& term) {
-  if (GiNaC::is_a<GiNaC::numeric>(term)) return {GiNaC::ex_to<GiNaC::numeric>(term), 1};
-  if (GiNaC::is_a<GiNaC::mul>(term)) {
-    GiNaC::numeric c = 1;
-    ex rest = 1;
-    for (std::size_t i = 0; i < term.nops(); ++i) {
-      if (GiNaC::is_a<GiNaC::numeric>(term.op(i)))
-        c *= GiNaC::ex_to<GiNaC::numeric>(term.op(i));
-      else
-        rest *= term.op(i);
-    }
-    return {c, rest};
-  }
-  return {1, term};
-}
 
 // Whether the first term of a sum (by canonical_key) has a negative coefficient: GiNaC picks the
 // sign of a sum inside a product by its own term order, the printer picks it by this rule.

@@ -38,22 +38,6 @@ struct Rewrite : GiNaC::map_function {
   }
 };
 
-// The term of a sum split into its numeric coefficient and the rest.
-std::pair<GiNaC::numeric, ex> split_coefficient(const ex& term) {
-  if (GiNaC::is_a<GiNaC::numeric>(term)) return {GiNaC::ex_to<GiNaC::numeric>(term), 1};
-  if (GiNaC::is_a<GiNaC::mul>(term)) {
-    GiNaC::numeric c = 1;
-    ex rest = 1;
-    for (std::size_t i = 0; i < term.nops(); ++i) {
-      if (GiNaC::is_a<GiNaC::numeric>(term.op(i)))
-        c *= GiNaC::ex_to<GiNaC::numeric>(term.op(i));
-      else
-        rest *= term.op(i);
-    }
-    return {c, rest};
-  }
-  return {1, term};
-}
 
 struct Fraction {
   ex numerator;
@@ -175,6 +159,22 @@ Fraction reduce(const Fraction& start, const std::vector<Family>& families, bool
 }
 
 }  // namespace
+
+std::pair<GiNaC::numeric, ex> split_coefficient(const ex& term) {
+  if (GiNaC::is_a<GiNaC::numeric>(term)) return {GiNaC::ex_to<GiNaC::numeric>(term), 1};
+  if (GiNaC::is_a<GiNaC::mul>(term)) {
+    GiNaC::numeric c = 1;
+    ex rest = 1;
+    for (std::size_t i = 0; i < term.nops(); ++i) {
+      if (GiNaC::is_a<GiNaC::numeric>(term.op(i)))
+        c *= GiNaC::ex_to<GiNaC::numeric>(term.op(i));
+      else
+        rest *= term.op(i);
+    }
+    return {c, rest};
+  }
+  return {1, term};
+}
 
 std::string canonical_key(const ex& e) {
   auto operands = [&](const char* tag, bool sorted) {

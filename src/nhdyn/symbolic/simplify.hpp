@@ -16,6 +16,7 @@
 #include <ginac/ginac.h>
 
 #include <string>
+#include <utility>
 
 namespace nhdyn::symbolic {
 
@@ -35,5 +36,8 @@ bool is_zero(const GiNaC::matrix& m);
 // own keys. Two expressions of the same structure have the same key; used to order terms for
 // display and to make choices in simplify() reproducible.
 std::string canonical_key(const GiNaC::ex& e);
+
+// A term of a sum split into its numeric coefficient and the rest: 3 x y -> (3, x y).
+std::pair<GiNaC::numeric, GiNaC::ex> split_coefficient(const GiNaC::ex& term);
 
 }  // namespace nhdyn::symbolic
