@@ -28,7 +28,7 @@ bench: build
 
 # GiNaC's number library keeps global tables until exit: suppressed for LeakSanitizer (test
 # discovery runs the executables at build time, so the build needs the same environment).
-SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/scripts/lsan.supp \
+SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/scripts/lsan.supp:print_suppressions=0 \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 
 # The tests again under AddressSanitizer and UndefinedBehaviorSanitizer (what CI runs too).
