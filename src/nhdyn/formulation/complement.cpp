@@ -6,6 +6,7 @@
 #include <string>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/formulation/small_dense.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {
@@ -75,6 +76,11 @@ Status compute_complement(const Model& model, Data& data, Complement complement)
     case Complement::qr: {
       if (s == 0) {
         data.D.setIdentity();
+        return Status::ok;
+      }
+      if (const small::Kernels* kernels = data.small_kernels ? small::find_kernels(model.n(), s) : nullptr) {
+        if (!kernels->null_space_basis(data.b.data(), data.D.data()))
+          return record_failure(data, Status::dependent_constraints, "constraint matrix b");
         return Status::ok;
       }
       const Status status = compute_constraint_basis(model, data);

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/finite.hpp"
 #include "nhdyn/formulation/lagrange.hpp"
 #include "nhdyn/formulation/nullspace.hpp"
 #include "nhdyn/formulation/sanh.hpp"
@@ -57,8 +58,10 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
     case Method::nullspace: status = compute_nullspace_acceleration(model, data, options.complement); break;
   }
   if (status != Status::ok) return status;
-  if (!data.qdd.allFinite()) return record_failure(data, Status::non_finite, "accelerations q''");
-  if (!data.R.allFinite()) return record_failure(data, Status::non_finite, "reactions R");
+  if (accumulate_non_finite(accumulate_non_finite(0.0, data.qdd), data.R) != 0.0) {
+    if (!data.qdd.allFinite()) return record_failure(data, Status::non_finite, "accelerations q''");
+    return record_failure(data, Status::non_finite, "reactions R");
+  }
   data.stage = Stage::acceleration;
   ++data.acceleration_solves;
   return Status::ok;

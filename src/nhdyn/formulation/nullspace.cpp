@@ -1,6 +1,7 @@
 #include "nhdyn/formulation/nullspace.hpp"
 
 #include "nhdyn/formulation/complement.hpp"
+#include "nhdyn/formulation/small_dense.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {
@@ -12,7 +13,11 @@ Status compute_nullspace_acceleration(const Model& model, Data& data, Complement
   // The particular solution comes from b^T P = Q1 R1: with p = Q1 y, b p = P R1^T y = -b0.
   data.p.setZero();
   if (s > 0) {
-    if (complement != Complement::qr) {
+    // The dynamic QR complement leaves the factorization behind; the others, and the fixed-size
+    // QR kernel, do not.
+    const bool basis_is_current = complement == Complement::qr &&
+                                  !(data.small_kernels && small::find_kernels(model.n(), s) != nullptr);
+    if (!basis_is_current) {
       status = compute_constraint_basis(model, data);
       if (status != Status::ok) return status;
     }

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "nhdyn/formulation/complement.hpp"
+#include "nhdyn/formulation/small_dense.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {
@@ -28,6 +29,12 @@ Status compute_sanh_acceleration(const Model& model, Data& data, Complement comp
   const int s = model.s();
   const Status status = compute_complement(model, data, complement);
   if (status != Status::ok) return status;
+  if (const small::Kernels* kernels = data.small_kernels ? small::find_kernels(model.n(), s) : nullptr) {
+    if (!kernels->solve_stacked(data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data(),
+                                data.D.data(), data.h.data(), data.qdd.data(), data.R.data()))
+      return record_failure(data, Status::singular_system, "stacked matrix [D A; b]");
+    return Status::ok;
+  }
   data.h = data.Q + data.G;
   data.M.topRows(k).noalias() = data.D * data.A;
   data.M.bottomRows(s) = data.b;

@@ -62,6 +62,9 @@ struct Data {
   long acceleration_solves = 0;  // successful calls of compute_acceleration
 
   // --- scratch (owned by the kernels; sizes fixed by make_data) ---------------------------------
+  // Whether the formulations may take their fixed-size path for small n (formulation/
+  // small_dense.hpp). Both paths compute the same values; tests clear it to compare them.
+  bool small_kernels = true;
   std::vector<double> scratch;   // evaluator workspace, Evaluator::scratch_size()
   Vector h;                      // n, Q + G
   Matrix M;                      // n x n, stacked sanh matrix [D A; b]

@@ -9,7 +9,9 @@ namespace {
 
 class SledEvaluator final : public Evaluator {
  public:
-  SledEvaluator(SledVariant variant, const SledParameters& p) : variant_(variant), p_(p) {}
+  // m g sin(alpha) is a constant of the model: computed once, not at every evaluation.
+  SledEvaluator(SledVariant variant, const SledParameters& p)
+      : variant_(variant), p_(p), mg_sin_alpha_(p.m * p.g * std::sin(p.alpha)) {}
 
   void terms(double, const double* q, const double* v, double*, const TermsOut& out) const override {
     const double m = p_.m, a = p_.a;
@@ -19,7 +21,7 @@ class SledEvaluator final : public Evaluator {
     out.A[0] = m;          out.A[3] = 0.0;        out.A[6] = -m * a * s;
     out.A[1] = 0.0;        out.A[4] = m;          out.A[7] = m * a * c;
     out.A[2] = -m * a * s; out.A[5] = m * a * c;  out.A[8] = m * p_.rho * p_.rho;
-    const double mgs = m * p_.g * std::sin(p_.alpha);
+    const double mgs = mg_sin_alpha_;
     out.Q[0] = mgs;
     out.Q[1] = 0.0;
     out.Q[2] = variant_ == SledVariant::centre_of_mass ? -mgs * a * s : 0.0;
@@ -66,12 +68,13 @@ class SledEvaluator final : public Evaluator {
     const double T = 0.5 * m * (v[0] * v[0] + v[1] * v[1]) + m * a * v[2] * (-s * v[0] + c * v[1]) +
                      0.5 * m * p_.rho * p_.rho * v[2] * v[2];
     const double height = variant_ == SledVariant::centre_of_mass ? q[0] + a * c : q[0];
-    return T - m * p_.g * std::sin(p_.alpha) * height;
+    return T - mg_sin_alpha_ * height;
   }
 
  private:
   SledVariant variant_;
   SledParameters p_;
+  double mg_sin_alpha_;
 };
 
 }  // namespace

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include "nhdyn/core/finite.hpp"
+
 namespace nhdyn {
 
 Status record_failure(Data& data, Status status, const char* quantity) {
@@ -32,9 +34,19 @@ Status compute_terms(const Model& model, Data& data, double t, const double* q, 
   TermsOut out{data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data()};
   model.evaluator->terms(t, data.q.data(), data.v.data(), data.scratch.data(), out);
   ++data.term_evaluations;
-  if (!data.q.allFinite()) return record_failure(data, Status::non_finite, "coordinates q");
-  if (!data.v.allFinite()) return record_failure(data, Status::non_finite, "velocities q'");
-  if (const char* bad = find_non_finite_term(data)) return record_failure(data, Status::non_finite, bad);
+  double acc = accumulate_non_finite(0.0, data.q);
+  acc = accumulate_non_finite(acc, data.v);
+  acc = accumulate_non_finite(acc, data.A);
+  acc = accumulate_non_finite(acc, data.Q);
+  acc = accumulate_non_finite(acc, data.G);
+  acc = accumulate_non_finite(acc, data.b);
+  acc = accumulate_non_finite(acc, data.b0);
+  if (acc != 0.0) {
+    if (!data.q.allFinite()) return record_failure(data, Status::non_finite, "coordinates q");
+    if (!data.v.allFinite()) return record_failure(data, Status::non_finite, "velocities q'");
+    const char* bad = find_non_finite_term(data);
+    return record_failure(data, Status::non_finite, bad ? bad : "terms");
+  }
   data.status = Status::ok;
   data.stage = Stage::terms;
   return Status::ok;

@@ -1,0 +1,161 @@
+// Dense kernels for small systems (n <= kSmallMaxN), written as plain-double loops with n and s
+// known at compile time. At n = 3 a dynamic-size Eigen call costs more in dispatch than in
+// arithmetic (docs/performance.md); these loops let the compiler unroll everything. They compute
+// the same quantities as the dynamic path, with the same rank and singularity tests, so that the
+// choice between them changes nothing but the time. Internal to the formulation module.
+//
+// Storage is column-major as in Eigen: A(i, j) = A[i + n j], b(i, j) = b[i + s j],
+// D(i, j) = D[i + k j].
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace nhdyn::small {
+
+inline constexpr int kSmallMaxN = 8;
+inline constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+// An orthonormal basis of null(b) as the rows of D (k x n): the last k columns of Q in a
+// Householder QR factorization with column pivoting b^T P = Q [R1; 0]. The rank test is that of
+// the dynamic path (complement.cpp): the last pivot of R1 against the first. Returns false when
+// b has rank below s.
+template <int N, int S>
+bool null_space_basis(const double* b, double* D) {
+  constexpr int K = N - S;
+  if constexpr (S == 0) {
+    for (int i = 0; i < K * N; ++i) D[i] = 0.0;
+    for (int i = 0; i < N; ++i) D[i + K * i] = 1.0;
+    return true;
+  } else {
+    std::array<double, N * S> bt;  // b^T, overwritten by the reflectors
+    std::array<double, S> tau;
+    for (int i = 0; i < S; ++i)
+      for (int j = 0; j < N; ++j) bt[j + N * i] = b[i + S * j];
+    double first_pivot = 0.0;
+    for (int j = 0; j < S; ++j) {
+      int p = j;
+      double best = -1.0;
+      for (int c = j; c < S; ++c) {
+        double norm2 = 0.0;
+        for (int i = j; i < N; ++i) norm2 += bt[i + N * c] * bt[i + N * c];
+        if (norm2 > best) {
+          best = norm2;
+          p = c;
+        }
+      }
+      if (p != j)
+        for (int i = 0; i < N; ++i) std::swap(bt[i + N * j], bt[i + N * p]);
+      double* v = bt.data() + N * j;
+      const double norm = std::sqrt(best);
+      if (j == 0) first_pivot = norm;
+      if (!(norm > first_pivot * kEps * 16.0 * (N + S)) || !(first_pivot > 0.0)) return false;
+      const double alpha = v[j] >= 0.0 ? -norm : norm;  // R1(j, j)
+      const double v0 = v[j] - alpha;
+      for (int i = j + 1; i < N; ++i) v[i] /= v0;  // essential part; the reflector's v[j] is 1
+      tau[j] = -v0 / alpha;                         // H_j = I - tau v v^T
+      for (int c = j + 1; c < S; ++c) {
+        double* w = bt.data() + N * c;
+        double d = w[j];
+        for (int i = j + 1; i < N; ++i) d += v[i] * w[i];
+        d *= tau[j];
+        w[j] -= d;
+        for (int i = j + 1; i < N; ++i) w[i] -= d * v[i];
+      }
+    }
+    // Column s + r of Q = H_1 ... H_s e_{s+r}: apply the reflectors from the last to the first.
+    for (int r = 0; r < K; ++r) {
+      std::array<double, N> y{};
+      y[S + r] = 1.0;
+      for (int j = S - 1; j >= 0; --j) {
+        const double* v = bt.data() + N * j;
+        double d = y[j];
+        for (int i = j + 1; i < N; ++i) d += v[i] * y[i];
+        d *= tau[j];
+        y[j] -= d;
+        for (int i = j + 1; i < N; ++i) y[i] -= d * v[i];
+      }
+      for (int i = 0; i < N; ++i) D[r + K * i] = y[i];
+    }
+    return true;
+  }
+}
+
+// The stacked system [D A; b] q'' = [D h; -b0] with h = Q + G, by Gaussian elimination with
+// partial pivoting, then R = A q'' - h. The singularity test is that of lu_is_singular
+// (sanh.cpp): the smallest pivot against the largest. Returns false when the system is singular.
+template <int N, int S>
+bool solve_stacked(const double* A, const double* Q, const double* G, const double* b, const double* b0,
+                   const double* D, double* h, double* qdd, double* R) {
+  constexpr int K = N - S;
+  std::array<double, N * N> M;
+  std::array<double, N> r;
+  for (int i = 0; i < N; ++i) h[i] = Q[i] + G[i];
+  for (int i = 0; i < K; ++i) {
+    for (int c = 0; c < N; ++c) {
+      double acc = 0.0;
+      for (int l = 0; l < N; ++l) acc += D[i + K * l] * A[l + N * c];
+      M[i + N * c] = acc;
+    }
+    double acc = 0.0;
+    for (int l = 0; l < N; ++l) acc += D[i + K * l] * h[l];
+    r[i] = acc;
+  }
+  for (int i = 0; i < S; ++i) {
+    for (int c = 0; c < N; ++c) M[K + i + N * c] = b[i + S * c];
+    r[K + i] = -b0[i];
+  }
+  double largest = 0.0;
+  double smallest = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < N; ++c) {
+    int p = c;
+    for (int i = c + 1; i < N; ++i)
+      if (std::abs(M[i + N * c]) > std::abs(M[p + N * c])) p = i;
+    if (p != c) {
+      for (int j = c; j < N; ++j) std::swap(M[c + N * j], M[p + N * j]);
+      std::swap(r[c], r[p]);
+    }
+    const double pivot = M[c + N * c];
+    largest = std::max(largest, std::abs(pivot));
+    smallest = std::min(smallest, std::abs(pivot));
+    if (pivot == 0.0) return false;
+    const double inverse = 1.0 / pivot;
+    for (int i = c + 1; i < N; ++i) {
+      const double l = M[i + N * c] * inverse;
+      for (int j = c + 1; j < N; ++j) M[i + N * j] -= l * M[c + N * j];
+      r[i] -= l * r[c];
+    }
+  }
+  if (!(smallest > largest * kEps * N)) return false;
+  for (int i = N - 1; i >= 0; --i) {
+    double acc = r[i];
+    for (int j = i + 1; j < N; ++j) acc -= M[i + N * j] * qdd[j];
+    qdd[i] = acc / M[i + N * i];
+  }
+  for (int i = 0; i < N; ++i) {
+    double acc = -h[i];
+    for (int j = 0; j < N; ++j) acc += A[i + N * j] * qdd[j];
+    R[i] = acc;
+  }
+  return true;
+}
+
+}  // namespace nhdyn::small
+
+namespace nhdyn::small {
+
+// The instantiations of the kernels above for one (n, s).
+struct Kernels {
+  bool (*null_space_basis)(const double* b, double* D);
+  bool (*solve_stacked)(const double* A, const double* Q, const double* G, const double* b, const double* b0,
+                        const double* D, double* h, double* qdd, double* R);
+};
+
+// The kernels for n coordinates and s constraints, or nullptr when n > kSmallMaxN (the caller
+// then takes the dynamic path).
+const Kernels* find_kernels(int n, int s);
+
+}  // namespace nhdyn::small

@@ -1,0 +1,111 @@
+// The fixed-size kernels for small n (formulation/small_dense.hpp) against the dynamic Eigen
+// path, on random systems of every size they cover and a few beyond: same q'' and R, a D that
+// is an orthonormal basis of null(b), and the same verdict on dependent constraints and on a
+// singular stacked matrix. Each q'' is also checked against the constraints and the equations
+// projected on null(b), so that two paths that agreed on a wrong answer would still fail.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+
+#include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/model/data.hpp"
+#include "support/test_models.hpp"
+
+namespace nhdyn {
+namespace {
+
+struct RandomSystem {
+  Matrix A, b;
+  Vector Q, b0;
+};
+
+RandomSystem random_system(int n, int s, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  RandomSystem r;
+  const Matrix L = Matrix::NullaryExpr(n, n, [&] { return u(rng); });
+  r.A = L * L.transpose() + 0.5 * Matrix::Identity(n, n);
+  r.Q = Vector::NullaryExpr(n, [&] { return u(rng); });
+  r.b = Matrix::NullaryExpr(s, n, [&] { return u(rng); });
+  r.b0 = Vector::NullaryExpr(s, [&] { return u(rng); });
+  return r;
+}
+
+struct Solution {
+  Status status;
+  Matrix D;
+  Vector qdd, R;
+};
+
+Solution solve(const Model& model, bool small, Complement complement, Method method = Method::sanh) {
+  Data data = make_data(model);
+  data.small_kernels = small;
+  Solution s;
+  s.status = compute_dynamics(model, data, {method, complement}, 0.0, model.q0.data(), model.v0.data());
+  s.D = data.D;
+  s.qdd = data.qdd;
+  s.R = data.R;
+  return s;
+}
+
+TEST(SmallKernels, SameAccelerationsAsTheDynamicPathForEverySize) {
+  std::mt19937 rng(20261123);
+  for (int n = 1; n <= 10; ++n) {
+    for (int s = 0; s < n; ++s) {
+      for (int trial = 0; trial < 3; ++trial) {
+        const RandomSystem sys = random_system(n, s, rng);
+        const Model model = testing::make_constant_model(sys.A, sys.Q, sys.b, sys.b0);
+        const std::string where = "n = " + std::to_string(n) + ", s = " + std::to_string(s);
+        for (Method method : {Method::sanh, Method::nullspace}) {
+          for (Complement c : {Complement::qr, Complement::partition}) {
+            const Solution fast = solve(model, true, c, method);
+            const Solution slow = solve(model, false, c, method);
+            ASSERT_EQ(fast.status, Status::ok) << where;
+            ASSERT_EQ(slow.status, Status::ok) << where;
+            const double scale = 1.0 + slow.qdd.norm();
+            EXPECT_LT((fast.qdd - slow.qdd).norm(), 1e-10 * scale) << where;
+            EXPECT_LT((fast.R - slow.R).norm(), 1e-10 * (1.0 + slow.R.norm())) << where;
+            // The constraints hold, and the equations hold along null(b): R is normal to it.
+            if (s > 0) {
+              EXPECT_LT((sys.b * fast.qdd + sys.b0).norm(), 1e-10 * scale) << where;
+            }
+            EXPECT_LT((fast.D * (sys.A * fast.qdd - sys.Q)).norm(), 1e-10 * scale) << where;
+          }
+        }
+        const Solution qr = solve(model, true, Complement::qr);
+        ASSERT_EQ(qr.D.rows(), n - s);
+        if (s > 0) {
+          EXPECT_LT((qr.D * sys.b.transpose()).norm(), 1e-12) << where << ": D b^T";
+        }
+        EXPECT_LT((qr.D * qr.D.transpose() - Matrix::Identity(n - s, n - s)).norm(), 1e-12)
+            << where << ": D D^T";
+      }
+    }
+  }
+}
+
+TEST(SmallKernels, DependentConstraintsAreRefusedAsOnTheDynamicPath) {
+  std::mt19937 rng(7);
+  for (int n : {3, 4, 8}) {
+    RandomSystem sys = random_system(n, 2, rng);
+    sys.b.row(1) = 3.0 * sys.b.row(0);
+    const Model model = testing::make_constant_model(sys.A, sys.Q, sys.b, sys.b0);
+    EXPECT_EQ(solve(model, true, Complement::qr).status, Status::dependent_constraints) << "n = " << n;
+    EXPECT_EQ(solve(model, false, Complement::qr).status, Status::dependent_constraints) << "n = " << n;
+  }
+}
+
+TEST(SmallKernels, SingularStackedMatrixIsRefusedAsOnTheDynamicPath) {
+  // A zero inertia matrix makes D A zero: the stacked matrix has rank s < n.
+  std::mt19937 rng(11);
+  for (int n : {2, 3, 6}) {
+    RandomSystem sys = random_system(n, 1, rng);
+    sys.A.setZero();
+    const Model model = testing::make_constant_model(sys.A, sys.Q, sys.b, sys.b0);
+    EXPECT_EQ(solve(model, true, Complement::qr).status, Status::singular_system) << "n = " << n;
+    EXPECT_EQ(solve(model, false, Complement::qr).status, Status::singular_system) << "n = " << n;
+  }
+}
+
+}  // namespace
+}  // namespace nhdyn
