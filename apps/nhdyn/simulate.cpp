@@ -33,6 +33,10 @@ struct SimulateArgs {
   std::optional<double> atol;             // default: the model file's, else 1e-10
   std::vector<std::string> sets;
   bool fix_initial = false;
+  std::string stabilize = "none";
+  double baumgarte_alpha = BaumgarteGains{}.alpha;
+  double baumgarte_beta = BaumgarteGains{}.beta;
+  double projection_tolerance = ProjectionOptions{}.tolerance;
   double step = 0.0;
   std::string output;
   std::string plot;
@@ -59,6 +63,10 @@ int run_simulate(const SimulateArgs& args) {
   options.integrator.atol = args.atol.value_or(spec && spec->atol ? *spec->atol : 1e-10);
   options.integrator.step = args.step;
   options.fix_initial = args.fix_initial;
+  options.stabilization = parse_stabilization(args.stabilize);
+  options.formulation.baumgarte.alpha = args.baumgarte_alpha;
+  options.formulation.baumgarte.beta = args.baumgarte_beta;
+  options.projection.tolerance = args.projection_tolerance;
   check_simulation_options(model, options);
 
   namespace fs = std::filesystem;
@@ -124,6 +132,14 @@ int run_simulate(const SimulateArgs& args) {
                method_name(options.formulation.method), complement_name(options.formulation.complement),
                integrator_name(options.integrator.kind),
                adaptive ? fmt::format(" (rtol {:g}, atol {:g})", options.integrator.rtol, options.integrator.atol) : "");
+    if (options.stabilization == Stabilization::baumgarte)
+      fmt::print("  stabilization: baumgarte (alpha {:g} 1/s, beta {:g} 1/s)\n", options.formulation.baumgarte.alpha,
+                 options.formulation.baumgarte.beta);
+    if (options.stabilization == Stabilization::projection)
+      fmt::print("  stabilization: projection, {} projections ({} Newton iterations), largest correction "
+                 "{:.3g} in a coordinate, {:.3g} in a velocity\n",
+                 summary.projections, summary.projection_iterations, summary.max_position_correction,
+                 summary.max_velocity_correction);
     fmt::print("  t = {:g} .. {:g} s, {} rows -> {}\n", model.t0, options.t_end, summary.outputs, csv_path.string());
     fmt::print("  steps {} (rejected {}), right-hand-side evaluations {}, wall time {:.3g} ms\n",
                summary.stats.steps, summary.stats.rejected_steps, summary.stats.rhs_evaluations,
@@ -157,6 +173,14 @@ std::function<int()> add_simulate_command(CLI::App& app) {
   cmd->add_option("--set", args->sets, "Override a model file's parameter, NAME=VALUE (repeatable)");
   cmd->add_flag("--fix-initial", args->fix_initial,
                 "Move the initial state onto the constraints with the smallest inertia-weighted change");
+  cmd->add_option("--stabilize", args->stabilize,
+                  "Keep the solution on the constraints: none (default) | baumgarte | projection");
+  cmd->add_option("--baumgarte-alpha", args->baumgarte_alpha,
+                  "Baumgarte: damping rate of the velocity residual [1/s]")->capture_default_str();
+  cmd->add_option("--baumgarte-beta", args->baumgarte_beta,
+                  "Baumgarte: rate of the position residual [1/s]")->capture_default_str();
+  cmd->add_option("--projection-tolerance", args->projection_tolerance,
+                  "Projection: residual at which Newton stops")->capture_default_str();
   cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
   cmd->add_option("--output-step", args->output_step, "Time between output rows [s] (default: the model's)");
   cmd->add_option("--method", args->method, "Formulation: sanh (default) | lagrange | udwadia-kalaba | nullspace");

@@ -132,9 +132,9 @@ class Oscillator : public OdeSystem {
     ydot[1] = -y[0];
     return Status::ok;
   }
-  bool after_step(double t, double* /*y*/) override {
+  StepEnd after_step(double t, double* /*y*/) override {
     step_ends.push_back(t);
-    return false;
+    return {};
   }
   std::vector<double> step_ends;
 };

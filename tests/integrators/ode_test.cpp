@@ -55,9 +55,9 @@ class Oscillator : public OdeSystem {
     ydot[1] = -y[0];
     return Status::ok;
   }
-  bool after_step(double /*t*/, double* /*y*/) override {
+  StepEnd after_step(double /*t*/, double* /*y*/) override {
     ++after_step_calls;
-    return false;
+    return {};
   }
   long calls = 0;
   long after_step_calls = 0;
@@ -74,11 +74,11 @@ class Circle : public OdeSystem {
     ydot[1] = y[0] + growth_ * y[1];
     return Status::ok;
   }
-  bool after_step(double /*t*/, double* y) override {
+  StepEnd after_step(double /*t*/, double* y) override {
     const double r = std::hypot(y[0], y[1]);
     y[0] /= r;
     y[1] /= r;
-    return true;
+    return {Status::ok, true};
   }
 
  private:
@@ -95,11 +95,11 @@ class Jump : public OdeSystem {
     ydot[0] = -y[0];
     return Status::ok;
   }
-  bool after_step(double t, double* y) override {
-    if (t_jump >= 0.0 || t < 1.0) return false;
+  StepEnd after_step(double t, double* y) override {
+    if (t_jump >= 0.0 || t < 1.0) return {};
     t_jump = t;
     y[0] *= 2.0;
-    return true;
+    return {Status::ok, true};
   }
   double t_jump = -1.0;
 };

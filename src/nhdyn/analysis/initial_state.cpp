@@ -4,7 +4,9 @@
 
 #include <cmath>
 
+#include "nhdyn/analysis/projection.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/formulation/diagnosis.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {
@@ -31,51 +33,6 @@ Vector residual(const Model& model, Data& data, double t, const Vector& q, const
   return r;
 }
 
-double max_abs(const Vector& r) { return r.size() ? r.cwiseAbs().maxCoeff() : 0.0; }
-
-// Newton on r(x) = 0 with minimum-A-norm steps; x is q (position level) or v (velocity level).
-int newton(const Model& model, Data& data, double t, Vector& q, Vector& v, ConstraintLevel level, double tolerance,
-           int max_iterations, double& final_residual) {
-  const std::vector<int> rows = rows_at(model, level);
-  if (rows.empty()) return 0;
-  const char* what = level == ConstraintLevel::position ? "position" : "velocity";
-  Vector r = residual(model, data, t, q, v, level);
-  int iteration = 0;
-  while (max_abs(r) > tolerance) {
-    if (iteration == max_iterations || !r.allFinite()) {
-      std::string names;
-      for (int row : rows) names += (names.empty() ? "'" : ", '") + model.constraints[static_cast<std::size_t>(row)].name + "'";
-      throw ModelError(fmt::format(
-          "model '{}': moving the initial state onto the {} constraints ({}) did not converge: the residual "
-          "is still {:.3g} after {} Newton steps. The constraints may have no solution near the given state; "
-          "correct the initial values by hand.",
-          model.name, what, names, max_abs(r), iteration));
-    }
-    if (compute_terms(model, data, t, q.data(), v.data()) != Status::ok)
-      throw ModelError(fmt::format("model '{}': a term is not finite at the initial state ({}) while fixing it",
-                                   model.name, data.failed_quantity));
-    Matrix J(static_cast<Eigen::Index>(rows.size()), model.n());
-    for (std::size_t i = 0; i < rows.size(); ++i) J.row(static_cast<Eigen::Index>(i)) = data.b.row(rows[i]);
-    Eigen::LLT<Matrix> llt(data.A);
-    if (llt.info() != Eigen::Success)
-      throw ModelError(fmt::format("model '{}': the inertia matrix is not positive definite at the initial state",
-                                   model.name));
-    const Matrix AinvJt = llt.solve(J.transpose());
-    const Matrix S = J * AinvJt;
-    Eigen::ColPivHouseholderQR<Matrix> qr(S);
-    if (qr.rank() < S.rows())
-      throw ModelError(fmt::format("model '{}': the {} constraints are dependent at the initial state; "
-                                   "fixing it needs independent constraints",
-                                   model.name, what));
-    const Vector step = -AinvJt * qr.solve(r);
-    (level == ConstraintLevel::position ? q : v) += step;
-    r = residual(model, data, t, q, v, level);
-    ++iteration;
-  }
-  final_residual = max_abs(r);
-  return iteration;
-}
-
 }  // namespace
 
 std::vector<ConstraintResidual> calc_initial_residuals(const Model& model, Data& data, double t, const Vector& q,
@@ -95,11 +52,28 @@ InitialFix fix_initial_state(const Model& model, Data& data, double t, const Vec
   InitialFix fix;
   fix.q = q;
   fix.v = v;
-  fix.position_iterations =
-      newton(model, data, t, fix.q, fix.v, ConstraintLevel::position, tolerance, max_iterations, fix.position_residual);
-  // The velocity constraints are taken at the corrected positions.
-  fix.velocity_iterations =
-      newton(model, data, t, fix.q, fix.v, ConstraintLevel::velocity, tolerance, max_iterations, fix.velocity_residual);
+  ProjectionResult result;
+  const Status status = compute_projection(model, data, t, fix.q.data(), fix.v.data(),
+                                           ProjectionOptions{tolerance, max_iterations}, result);
+  if (status == Status::projection_failed) {
+    const ConstraintLevel level =
+        data.failed_quantity.rfind("position", 0) == 0 ? ConstraintLevel::position : ConstraintLevel::velocity;
+    std::string names;
+    for (int row : rows_at(model, level))
+      names += (names.empty() ? "'" : ", '") + model.constraints[static_cast<std::size_t>(row)].name + "'";
+    throw ModelError(fmt::format(
+        "model '{}': moving the initial state onto the {} ({}) did not converge: the residual is still {:.3g} "
+        "after {} Newton steps. The constraints may have no solution near the given state; correct the "
+        "initial values by hand.",
+        model.name, data.failed_quantity, names, data.failed_value, max_iterations));
+  }
+  if (status != Status::ok)
+    throw ModelError(fmt::format("model '{}': while moving the initial state onto the constraints: {}", model.name,
+                                 explain_failure(model, data)));
+  fix.position_iterations = result.position_iterations;
+  fix.velocity_iterations = result.velocity_iterations;
+  fix.position_residual = result.position_residual;
+  fix.velocity_residual = result.velocity_residual;
   fix.dq = fix.q - q;
   fix.dv = fix.v - v;
   return fix;

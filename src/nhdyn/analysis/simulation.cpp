@@ -17,11 +17,26 @@ namespace {
 // Outputs beyond this many rows are refused: at ~100 bytes a row that is a 10 GB file.
 constexpr double kMaxOutputs = 1e8;
 
+StepEnd project(const Model& model, Data& data, const ProjectionOptions& options, double t, double* y,
+                SimulationSummary& summary) {
+  ProjectionResult result;
+  const Status status = compute_projection(model, data, t, y, y + model.n(), options, result);
+  if (status != Status::ok) return {status, false};
+  if (result.changed()) {
+    ++summary.projections;
+    summary.projection_iterations += result.position_iterations + result.velocity_iterations;
+    summary.max_position_correction = std::max(summary.max_position_correction, result.position_change);
+    summary.max_velocity_correction = std::max(summary.max_velocity_correction, result.velocity_change);
+  }
+  return {Status::ok, result.changed()};
+}
+
 // y = [q; q'], y' = [q'; q''].
 class MechanicalOde final : public OdeSystem {
  public:
-  MechanicalOde(const Model& model, Data& data, const FormulationOptions& options)
-      : model_(model), data_(data), options_(options), n_(model.n()) {}
+  MechanicalOde(const Model& model, Data& data, const FormulationOptions& options, const SimulationOptions& run,
+                SimulationSummary& summary)
+      : model_(model), data_(data), options_(options), run_(run), summary_(summary), n_(model.n()) {}
 
   int size() const override { return 2 * n_; }
 
@@ -33,16 +48,39 @@ class MechanicalOde final : public OdeSystem {
     return Status::ok;
   }
 
+  StepEnd after_step(double t, double* y) override {
+    if (run_.stabilization != Stabilization::projection) return {};
+    return project(model_, data_, run_.projection, t, y, summary_);
+  }
+
  private:
   const Model& model_;
   Data& data_;
   const FormulationOptions& options_;
+  const SimulationOptions& run_;
+  SimulationSummary& summary_;
   int n_;
 };
 
 double max_abs(const Vector& v) { return v.size() > 0 ? v.cwiseAbs().maxCoeff() : 0.0; }
 
+
 }  // namespace
+
+std::string_view stabilization_name(Stabilization stabilization) {
+  switch (stabilization) {
+    case Stabilization::none: return "none";
+    case Stabilization::baumgarte: return "baumgarte";
+    case Stabilization::projection: return "projection";
+  }
+  return "?";
+}
+
+Stabilization parse_stabilization(std::string_view name) {
+  for (Stabilization s : {Stabilization::none, Stabilization::baumgarte, Stabilization::projection})
+    if (name == stabilization_name(s)) return s;
+  throw InputError("unknown stabilization '" + std::string(name) + "'; choose one of: none, baumgarte, projection");
+}
 
 std::vector<double> make_output_times(double t0, double t_end, double output_step) {
   if (!std::isfinite(t_end) || !(t_end > t0))
@@ -78,6 +116,15 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
   }
   if (!std::isfinite(io.step) || io.step < 0.0)
     throw InputError(fmt::format("the step {} must be positive (or 0 for the default)", io.step));
+  if (options.stabilization == Stabilization::baumgarte) check_baumgarte_gains(options.formulation.baumgarte);
+  if (options.stabilization == Stabilization::projection) {
+    if (!std::isfinite(options.projection.tolerance) || !(options.projection.tolerance > 0.0))
+      throw InputError(fmt::format("the projection tolerance {} must be positive and finite (e.g. 1e-13)",
+                                   options.projection.tolerance));
+    if (options.projection.max_iterations < 1)
+      throw InputError(fmt::format("the projection needs at least one Newton iteration, not {}",
+                                   options.projection.max_iterations));
+  }
   if (options.formulation.complement == Complement::analytic && !model.evaluator->has_complement())
     throw InputError(fmt::format("model '{}' has no analytic D; choose --complement qr or partition", model.name));
 }
@@ -104,10 +151,27 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   std::copy(v0.data(), v0.data() + n, y0.begin() + n);
 
   summary.has_energy = model.evaluator->has_energy();
-  MechanicalOde ode(model, data, options.formulation);
+  FormulationOptions formulation = options.formulation;
+  formulation.baumgarte.enabled = options.stabilization == Stabilization::baumgarte;
+  MechanicalOde ode(model, data, formulation, options, summary);
+  std::vector<double> y_out(static_cast<std::size_t>(2 * n));
+  Status output_failure = Status::ok;
   const OutputFn output = [&](double t, const double* y) -> Status {
-    const Status status = compute_dynamics(model, data, options.formulation, t, y, y + n);
-    if (status != Status::ok) return status;
+    if (options.stabilization == Stabilization::projection) {
+      // Between step ends the integrator interpolates; the solution it reports is the projected one.
+      std::copy(y, y + 2 * n, y_out.begin());
+      y = y_out.data();
+      const StepEnd end = project(model, data, options.projection, t, y_out.data(), summary);
+      if (end.status != Status::ok) {
+        output_failure = end.status;
+        return Status::stopped;
+      }
+    }
+    const Status status = compute_dynamics(model, data, formulation, t, y, y + n);
+    if (status != Status::ok) {
+      output_failure = status;
+      return Status::stopped;
+    }
     compute_residuals(model, data);
     compute_energy(model, data);
     if (summary.outputs == 0) summary.energy_initial = data.energy;
@@ -124,13 +188,13 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   const auto start = std::chrono::steady_clock::now();
   const IntegrationResult result = integrate(ode, options.integrator, model.t0, y0.data(), times, output);
   summary.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  summary.status = result.status;
+  summary.status = output_failure != Status::ok ? output_failure : result.status;
   summary.t_reached = result.t_reached;
   summary.stats = result.stats;
-  if (result.status != Status::ok) {
+  if (summary.status != Status::ok) {
     // The kernels recorded the details of a failed evaluation in data; prefer those words.
     summary.message = data.status != Status::ok ? explain_failure(model, data) : result.message;
-    if (summary.message.empty()) summary.message = fmt::format("{} at t = {:.6g}", describe(result.status), result.t_reached);
+    if (summary.message.empty()) summary.message = fmt::format("{} at t = {:.6g}", describe(summary.status), result.t_reached);
   }
   return summary;
 }

@@ -10,12 +10,24 @@
 #include <vector>
 
 #include "nhdyn/analysis/initial_state.hpp"
+#include "nhdyn/analysis/projection.hpp"
 #include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/integrators/ode.hpp"
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/model/model.hpp"
 
 namespace nhdyn {
+
+// How a run keeps the solution on the constraints (docs/stabilization.md).
+enum class Stabilization {
+  none,        // the paper's form as it stands: the residuals measure the integration error
+  baumgarte,   // the acceleration constraint with the gains of formulation.baumgarte
+  projection,  // after every accepted step, and at every output, onto phi = 0 and then f = 0
+};
+
+// "none", "baumgarte", "projection".
+std::string_view stabilization_name(Stabilization stabilization);
+Stabilization parse_stabilization(std::string_view name);  // throws InputError listing valid names
 
 struct SimulationOptions {
   double t_end = 10.0;        // end time [s], > t0
@@ -27,6 +39,9 @@ struct SimulationOptions {
   double initial_tolerance = 1e-9;
   // ... unless it is moved onto them first (analysis/initial_state.hpp).
   bool fix_initial = false;
+  // Baumgarte's gains are formulation.baumgarte.{alpha, beta}; `baumgarte` switches them on.
+  Stabilization stabilization = Stabilization::none;
+  ProjectionOptions projection;
 };
 
 struct SimulationSummary {
@@ -43,6 +58,12 @@ struct SimulationSummary {
   double energy_initial = 0.0;
   double energy_drift = 0.0;        // max |E(t) - E(t0)| over outputs
   std::optional<InitialFix> initial_fix;  // set when options.fix_initial moved the initial state
+  // Stabilization::projection: projections that changed the state (after steps and at outputs),
+  // their Newton iterations, and the largest change of a coordinate and of a velocity.
+  long projections = 0;
+  long projection_iterations = 0;
+  double max_position_correction = 0.0;
+  double max_velocity_correction = 0.0;
 };
 
 // Called at every output time with Data holding t, q, q', q'', R, residuals and energy.

@@ -13,6 +13,7 @@ std::string_view describe(Status status) {
     case Status::too_many_steps: return "too many steps";
     case Status::integrator_failure: return "integrator failure";
     case Status::stopped: return "stopped";
+    case Status::projection_failed: return "projection onto the constraints did not converge";
   }
   return "unknown status";
 }

@@ -16,6 +16,7 @@ enum class Status {
   too_many_steps,                 // the step budget of the run was used up
   integrator_failure,             // any other failure reported by an integrator
   stopped,                        // an observer asked to stop
+  projection_failed,              // Newton's method did not bring the state onto the constraints
 };
 
 // A short name for the status, e.g. "dependent constraints".

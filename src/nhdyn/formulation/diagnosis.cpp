@@ -80,6 +80,12 @@ std::string explain_failure(const Model& model, const Data& data) {
       return fmt::format("the {} is singular at t = {:.6g} although A is positive definite and b has "
                          "full rank; this points to a D that is not a complement of b",
                          data.failed_quantity, data.failed_t);
+    case Status::projection_failed:
+      return fmt::format("the projection onto the {} did not converge at t = {:.6g}: the residual is still "
+                         "{:.3g} after the Newton iterations. The step left the state too far from the "
+                         "constraints for the projection to bring it back: tighten the integrator's "
+                         "tolerances (--rtol, --atol), or use --stabilize baumgarte",
+                         data.failed_quantity, data.failed_t, data.failed_value);
     default: return fmt::format("{} at t = {:.6g}", describe(data.status), data.failed_t);
   }
 }

@@ -50,6 +50,11 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
   if (data.stage < Stage::terms)
     throw std::logic_error("compute_acceleration: call compute_terms first for the current state");
   data.has_multipliers = false;
+  if (options.baumgarte.enabled) {
+    compute_baumgarte_terms(model, data, options.baumgarte);
+    data.b0_model = data.b0;
+    data.b0 += data.stabilization;
+  }
   Status status = Status::ok;
   switch (options.method) {
     case Method::sanh: status = compute_sanh_acceleration(model, data, options.complement); break;
@@ -57,6 +62,7 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
     case Method::udwadia_kalaba: status = compute_udwadia_kalaba_acceleration(model, data); break;
     case Method::nullspace: status = compute_nullspace_acceleration(model, data, options.complement); break;
   }
+  if (options.baumgarte.enabled) data.b0 = data.b0_model;
   if (status != Status::ok) return status;
   if (accumulate_non_finite(accumulate_non_finite(0.0, data.qdd), data.R) != 0.0) {
     if (!data.qdd.allFinite()) return record_failure(data, Status::non_finite, "accelerations q''");

@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "nhdyn/core/status.hpp"
+#include "nhdyn/formulation/baumgarte.hpp"
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/model/model.hpp"
 
@@ -19,8 +20,13 @@ enum class Method { sanh, lagrange, udwadia_kalaba, nullspace };
 enum class Complement { qr, partition, analytic };
 
 struct FormulationOptions {
+  // A constructor rather than an aggregate, so that the usual {method, complement} leaves the
+  // gains at their defaults without -Wmissing-field-initializers.
+  FormulationOptions(Method m = Method::sanh, Complement c = Complement::qr, BaumgarteGains gains = {})
+      : method(m), complement(c), baumgarte(gains) {}
   Method method = Method::sanh;
   Complement complement = Complement::qr;
+  BaumgarteGains baumgarte;  // off unless enabled (baumgarte.hpp)
 };
 
 // "sanh", "lagrange", "udwadia-kalaba", "nullspace".
@@ -32,7 +38,9 @@ Complement parse_complement(std::string_view name);  // throws InputError listin
 
 // Requires compute_terms for the current state (Stage::terms). Writes data.qdd, data.R,
 // data.lambda (when the method has multipliers), data.D (sanh, nullspace) and sets
-// Stage::acceleration. Allocates nothing. On numerical trouble returns a non-ok status, records
+// Stage::acceleration. With Baumgarte gains enabled, the formulation solves the stabilized
+// constraint (b0 + data.stabilization in place of b0); data.b0 keeps the model's b0 on return.
+// Allocates nothing. On numerical trouble returns a non-ok status, records
 // it in data, and leaves stage at Stage::terms; explain_failure (diagnosis.hpp) gives the words.
 Status compute_acceleration(const Model& model, Data& data, const FormulationOptions& options);
 

@@ -85,6 +85,15 @@ IntegrationResult rhs_failure(std::string_view method, Status status, double t_f
   return result;
 }
 
+IntegrationResult step_end_failure(std::string_view method, Status status, double t, const IntegratorStats& stats) {
+  IntegrationResult result;
+  result.status = status;
+  result.t_reached = t;
+  result.stats = stats;
+  result.message = fmt::format("{}: after the step to t = {}: {}", method, t, describe(status));
+  return result;
+}
+
 IntegrationResult budget_exhausted(std::string_view method, long max_steps, double t,
                                    const IntegratorStats& stats) {
   IntegrationResult result;
@@ -218,7 +227,8 @@ IntegrationResult integrate_rk4(OdeSystem& system, const IntegratorOptions& opti
       ++stats.steps;
       t = t_new;
       // Nothing is carried from one rk4 step to the next, so a changed state needs no restart.
-      system.after_step(t, y.data());
+      const StepEnd end = system.after_step(t, y.data());
+      if (end.status != Status::ok) return step_end_failure(method, end.status, t, stats);
     }
     if (output(t, y.data()) == Status::stopped) return stopped_at(t, stats);
   }
@@ -346,7 +356,9 @@ IntegrationResult integrate_dopri5(OdeSystem& system, const IntegratorOptions& o
       continuous_extension(stepper, n, y.data(), y1.data(), h, (t_out - t) / h, y_out.data());
       if (output(t_out, y_out.data()) == Status::stopped) return stopped_at(t_out, stats);
     }
-    if (system.after_step(t_new, y1.data())) {
+    const StepEnd end = system.after_step(t_new, y1.data());
+    if (end.status != Status::ok) return step_end_failure(method, end.status, t_new, stats);
+    if (end.changed) {
       // The FSAL stage belongs to the state before the change.
       ++stats.rhs_evaluations;
       status = system.rhs(t_new, y1.data(), stepper.k(Tableau::stages - 1));

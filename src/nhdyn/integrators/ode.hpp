@@ -13,6 +13,12 @@
 
 namespace nhdyn {
 
+// What OdeSystem::after_step did to the state.
+struct StepEnd {
+  Status status = Status::ok;
+  bool changed = false;
+};
+
 class OdeSystem {
  public:
   virtual ~OdeSystem() = default;
@@ -22,9 +28,10 @@ class OdeSystem {
   // an integrator stops at the first non-ok status and reports it.
   virtual Status rhs(double t, const double* y, double* ydot) = 0;
   // Called after every accepted step with the new state; may change y in place (projection onto
-  // the constraint manifold) and then returns true, so that the integrator restarts from the
-  // changed state (drops FSAL derivatives, re-initializes multistep history).
-  virtual bool after_step(double /*t*/, double* /*y*/) { return false; }
+  // the constraint manifold) and then says so, so that the integrator restarts from the changed
+  // state (drops FSAL derivatives, re-initializes multistep history). A non-ok status ends the
+  // run there, as a failed right-hand side does.
+  virtual StepEnd after_step(double /*t*/, double* /*y*/) { return {}; }
 };
 
 enum class IntegratorKind { rk4, dopri5, cvode_bdf, cvode_adams };

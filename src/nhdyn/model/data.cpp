@@ -16,6 +16,8 @@ Data make_data(const Model& model) {
   d.G = Vector::Zero(n);
   d.b = Matrix::Zero(s, n);
   d.b0 = Vector::Zero(s);
+  d.stabilization = Vector::Zero(s);
+  d.b0_model = Vector::Zero(s);
   d.D = Matrix::Zero(k, n);
   d.independent.assign(static_cast<std::size_t>(k), 0);
   d.qdd = Vector::Zero(n);

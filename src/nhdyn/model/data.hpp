@@ -35,6 +35,8 @@ struct Data {
   Vector G;             // n velocity terms
   Matrix b;             // s x n constraint matrix
   Vector b0;            // s
+  Vector stabilization; // s, Baumgarte terms 2 alpha f + beta^2 phi (compute_baumgarte_terms)
+  Vector b0_model;      // s, the model's b0 while a stabilized one is solved (compute_acceleration)
 
   // --- complement D (compute_complement) ---------------------------------------------------------
   Matrix D;             // k x n, D b^T = 0 (2.8)
@@ -56,6 +58,7 @@ struct Data {
   Status status = Status::ok;
   std::string failed_quantity;  // e.g. "A", "q''": preallocated, see make_data
   double failed_t = 0.0;
+  double failed_value = 0.0;    // the residual reached, for Status::projection_failed
 
   // --- counters ------------------------------------------------------------------------------
   long term_evaluations = 0;     // calls of compute_terms

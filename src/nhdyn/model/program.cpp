@@ -315,13 +315,16 @@ ProgramEvaluator::ProgramEvaluator(int n, int s, ModelPrograms programs)
   const std::vector<Output>& outputs = programs_.terms.output_list();
   const int sizes[5] = {n * n, n, n, s * n, s};
   std::size_t j = 0;
-  for (int array = 0; array < 5; ++array)
+  for (int array = 0; array < 5; ++array) {
+    first_entry_[array] = static_cast<std::int32_t>(entries_.size());
     for (int i = 0; i < sizes[array]; ++i, ++j) {
       const Output& o = outputs[j];
       image_.push_back(o.reg < 0 ? o.value : 0.0);
-      if (o.reg >= 0) entries_.push_back(Entry{array, i, o.reg});
+      if (o.reg >= 0) entries_.push_back(Entry{i, o.reg});
     }
-  writer_ = choose_writer(n, s);
+  }
+  first_entry_[5] = static_cast<std::int32_t>(entries_.size());
+  terms_function_ = choose_terms(n, s);
 }
 
 namespace {
@@ -337,11 +340,15 @@ inline void copy_any(const double* from, double* to, std::size_t size) {
 
 }  // namespace
 
-// The image copies are the bulk of the cost of a small model's terms (19 entries for n = 3,
-// s = 1, most of them constant): with the sizes known at compile time they become a few vector
-// moves instead of five short loops.
+// For a small model the fixed cost of the call dominates (19 outputs for n = 3, s = 1, most of
+// them constant): with the sizes known at compile time the input copies and the image copies
+// become a few vector moves instead of loops, and the register outputs are scattered array by
+// array from a base pointer held in a register.
 template <int N, int S>
-void ProgramEvaluator::write_fixed(const ProgramEvaluator& self, const double* registers, const TermsOut& out) {
+void ProgramEvaluator::terms_fixed(const ProgramEvaluator& self, double t, const double* q, const double* v,
+                                   double* scratch, const TermsOut& out) {
+  const Program& p = self.programs_.terms;
+  run_code(p.code_.data(), p.code_.size(), N, p.reads_, t, q, v, scratch);
   const double* image = self.image_.data();
   copy_fixed<N * N>(image, out.A);
   copy_fixed<N>(image + N * N, out.Q);
@@ -349,11 +356,19 @@ void ProgramEvaluator::write_fixed(const ProgramEvaluator& self, const double* r
   copy_fixed<S * N>(image + N * N + 2 * N, out.b);
   copy_fixed<S>(image + N * N + 2 * N + S * N, out.b0);
   double* const arrays[5] = {out.A, out.Q, out.G, out.b, out.b0};
-  for (const Entry& e : self.entries_) arrays[e.array][e.index] = registers[e.reg];
+  const Entry* entries = self.entries_.data();
+  for (int a = 0; a < 5; ++a) {
+    double* to = arrays[a];
+    for (std::int32_t e = self.first_entry_[a]; e < self.first_entry_[a + 1]; ++e)
+      to[entries[e].index] = scratch[entries[e].reg];
+  }
 }
 
-void ProgramEvaluator::write_any(const ProgramEvaluator& self, const double* registers, const TermsOut& out) {
+void ProgramEvaluator::terms_any(const ProgramEvaluator& self, double t, const double* q, const double* v,
+                                 double* scratch, const TermsOut& out) {
+  const Program& p = self.programs_.terms;
   const std::size_t n = static_cast<std::size_t>(self.n_), s = static_cast<std::size_t>(self.s_);
+  run_code(p.code_.data(), p.code_.size(), n, p.reads_, t, q, v, scratch);
   const double* image = self.image_.data();
   copy_any(image, out.A, n * n);
   copy_any(image + n * n, out.Q, n);
@@ -361,30 +376,33 @@ void ProgramEvaluator::write_any(const ProgramEvaluator& self, const double* reg
   copy_any(image + n * n + 2 * n, out.b, s * n);
   copy_any(image + n * n + 2 * n + s * n, out.b0, s);
   double* const arrays[5] = {out.A, out.Q, out.G, out.b, out.b0};
-  for (const Entry& e : self.entries_) arrays[e.array][e.index] = registers[e.reg];
+  const Entry* entries = self.entries_.data();
+  for (int a = 0; a < 5; ++a) {
+    double* to = arrays[a];
+    for (std::int32_t e = self.first_entry_[a]; e < self.first_entry_[a + 1]; ++e)
+      to[entries[e].index] = scratch[entries[e].reg];
+  }
 }
 
-ProgramEvaluator::Writer ProgramEvaluator::choose_writer(int n, int s) {
+ProgramEvaluator::TermsFunction ProgramEvaluator::choose_terms(int n, int s) {
   switch (n * 8 + s) {
-    case 1 * 8 + 0: return &write_fixed<1, 0>;
-    case 2 * 8 + 0: return &write_fixed<2, 0>;
-    case 2 * 8 + 1: return &write_fixed<2, 1>;
-    case 3 * 8 + 0: return &write_fixed<3, 0>;
-    case 3 * 8 + 1: return &write_fixed<3, 1>;
-    case 3 * 8 + 2: return &write_fixed<3, 2>;
-    case 4 * 8 + 0: return &write_fixed<4, 0>;
-    case 4 * 8 + 1: return &write_fixed<4, 1>;
-    case 4 * 8 + 2: return &write_fixed<4, 2>;
-    case 4 * 8 + 3: return &write_fixed<4, 3>;
-    default: return &write_any;
+    case 1 * 8 + 0: return &terms_fixed<1, 0>;
+    case 2 * 8 + 0: return &terms_fixed<2, 0>;
+    case 2 * 8 + 1: return &terms_fixed<2, 1>;
+    case 3 * 8 + 0: return &terms_fixed<3, 0>;
+    case 3 * 8 + 1: return &terms_fixed<3, 1>;
+    case 3 * 8 + 2: return &terms_fixed<3, 2>;
+    case 4 * 8 + 0: return &terms_fixed<4, 0>;
+    case 4 * 8 + 1: return &terms_fixed<4, 1>;
+    case 4 * 8 + 2: return &terms_fixed<4, 2>;
+    case 4 * 8 + 3: return &terms_fixed<4, 3>;
+    default: return &terms_any;
   }
 }
 
 void ProgramEvaluator::terms(double t, const double* q, const double* v, double* scratch,
                              const TermsOut& out) const {
-  const Program& p = programs_.terms;
-  run_code(p.code_.data(), p.code_.size(), static_cast<std::size_t>(n_), p.reads_, t, q, v, scratch);
-  writer_(*this, scratch, out);
+  terms_function_(*this, t, q, v, scratch, out);
 }
 
 void ProgramEvaluator::complement(double t, const double* q, const double* v, double* scratch, double* D) const {

@@ -166,24 +166,28 @@ class ProgramEvaluator final : public Evaluator {
   double energy(double t, const double* q, const double* v, double* scratch) const override;
 
  private:
-  // A register output of the terms: TermsOut array (0 A, 1 Q, 2 G, 3 b, 4 b0), index, register.
+  // A register output of the terms: its index in its TermsOut array and its register.
   struct Entry {
-    std::int32_t array = 0, index = 0, reg = 0;
+    std::int32_t index = 0, reg = 0;
   };
-  // Writes the terms' outputs: the constant image copied whole, then the register entries.
-  using Writer = void (*)(const ProgramEvaluator& self, const double* registers, const TermsOut& out);
+  // The whole terms() call, with the sizes fixed at compile time for n <= 4 (terms_fixed) or not.
+  using TermsFunction = void (*)(const ProgramEvaluator& self, double t, const double* q, const double* v,
+                                 double* scratch, const TermsOut& out);
   template <int N, int S>
-  static void write_fixed(const ProgramEvaluator& self, const double* registers, const TermsOut& out);
-  static void write_any(const ProgramEvaluator& self, const double* registers, const TermsOut& out);
-  static Writer choose_writer(int n, int s);
+  static void terms_fixed(const ProgramEvaluator& self, double t, const double* q, const double* v,
+                          double* scratch, const TermsOut& out);
+  static void terms_any(const ProgramEvaluator& self, double t, const double* q, const double* v,
+                        double* scratch, const TermsOut& out);
+  static TermsFunction choose_terms(int n, int s);
 
   int n_ = 0;
   int s_ = 0;
   ModelPrograms programs_;
   std::size_t scratch_ = 0;
-  std::vector<double> image_;      // every output of the terms, A Q G b b0; 0 where it is a register
-  std::vector<Entry> entries_;     // the register outputs of the terms
-  Writer writer_ = nullptr;        // sizes fixed at compile time for n <= 4, else write_any
+  std::vector<double> image_;       // every output of the terms, A Q G b b0; 0 where it is a register
+  std::vector<Entry> entries_;      // the register outputs of the terms, array by array (A Q G b b0)
+  std::int32_t first_entry_[6] = {};  // the entries of array a are [first_entry_[a], first_entry_[a + 1])
+  TermsFunction terms_function_ = nullptr;
 };
 
 }  // namespace nhdyn

@@ -235,7 +235,10 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
       }
     }
     t = t_new;
-    const bool changed = system.after_step(t, y_data);
+    const StepEnd end = system.after_step(t, y_data);
+    if (end.status != Status::ok)
+      return finish(end.status, fmt::format("{}: after the step to t = {}: {}", method, t, describe(end.status)), mem);
+    const bool changed = end.changed;
     if (next < output_times.size() && output_times[next] == t) {
       if (output(t, y_data) == Status::stopped) return finish(Status::stopped, {}, mem);
       ++next;
