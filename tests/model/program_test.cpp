@@ -1,6 +1,7 @@
 // Straight-line programs: every instruction against the std:: function it stands for, the
-// validation of operands, the sincos companion, ProgramEvaluator's layout of the terms, and a run
-// that allocates nothing (counted at malloc, as in tests/formulation/allocation_test.cpp).
+// validation of operands, the sincos companion, ProgramEvaluator's layout of the terms, its
+// prepared programs against the programs as given (to the bit), and a run that allocates nothing
+// (counted at malloc, as in tests/formulation/allocation_test.cpp).
 #include "nhdyn/model/program.hpp"
 
 #include <gtest/gtest.h>
@@ -8,6 +9,8 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <iterator>
 #include <new>
 #include <stdexcept>
 #include <vector>
@@ -286,6 +289,104 @@ TEST(ProgramEvaluator, RefusesProgramsOfTheWrongShape) {
   ModelPrograms bad_energy = polar_programs(1.0, 1.0);
   bad_energy.energy->add_constant_output(0.0);
   EXPECT_THROW(ProgramEvaluator(2, 1, bad_energy), std::invalid_argument);
+}
+
+// A program for n >= 2 coordinates whose `outputs` outputs cycle through registers of every kind
+// that ProgramEvaluator prepares apart: a parameter-only subexpression (sqrt(2) * 1.3, folded), the
+// instructions with a constant operand that become immediates, a register output twice, one that
+// later instructions read too, a sincos (or, without the math library, a square and a cube), the
+// inputs t and q', a constant output; and an instruction no output needs.
+Program mixed_program(int n, int outputs, bool library) {
+  Program p(n);
+  const int t = Program::time_register(), q0 = p.coordinate_register(0), q1 = p.coordinate_register(1);
+  const int v0 = p.velocity_register(0), v1 = p.velocity_register(1);
+  const int c = p.push_constant(1.3);
+  const int pm = p.push(Op::mul, p.push(Op::sqrt, p.push_constant(2.0)), c);
+  const int x = p.push(Op::mul, q0, pm);
+  const int y = p.push(Op::sub, v0, c);
+  const int z = p.push(Op::div, c, q1);
+  const int w = p.push(Op::muladd, q0, c, v1);
+  const int add = p.push(Op::add, pm, v0);
+  int s = 0, cs = 0;
+  if (library) {
+    s = p.push(Op::sincos, q1);
+    cs = s + 1;
+    p.push(Op::exp, q0);  // no output needs it
+  } else {
+    s = p.push(Op::square, q1);
+    cs = p.push(Op::cube, q1);
+    p.push(Op::neg, q0);  // no output needs it
+  }
+  const int u = p.push(Op::muladd, s, x, y);
+  const int pool[] = {pm, x, y, z, w, add, s, cs, u, x, v1, t, s, -1, u};
+  for (int i = 0; i < outputs; ++i) {
+    const int reg = pool[i % static_cast<int>(std::size(pool))];
+    if (reg < 0)
+      p.add_constant_output(0.5);
+    else
+      p.add_output(reg);
+  }
+  return p;
+}
+
+TEST(ProgramEvaluator, PreparedProgramsGiveTheSameBitsAsTheirPrograms) {
+  for (const int n : {2, 3, 5})  // sizes fixed at compile time (n <= 4) or not
+    for (const bool library : {true, false}) {
+      const int s = 1;
+      ModelPrograms programs{mixed_program(n, n * n + 2 * n + s * n + s, library),
+                             mixed_program(n, (n - s) * n, library), Program(n), Program(n), std::nullopt};
+      programs.velocity_residual = mixed_program(n, 1, library);
+      const ProgramEvaluator evaluator(n, s, programs);
+      const Program& terms = evaluator.programs().terms;
+      std::vector<double> q(static_cast<std::size_t>(n)), v(static_cast<std::size_t>(n));
+      for (const double state : {0.7, -1.3, 0.0}) {
+        for (int i = 0; i < n; ++i) {
+          q[static_cast<std::size_t>(i)] = state * (1.0 + 0.25 * i);
+          v[static_cast<std::size_t>(i)] = state - 0.5 * i;
+        }
+        const double t = 0.25 * state;
+        const std::vector<double> expected = run(terms, t, q, v);
+        std::vector<double> scratch(evaluator.scratch_size());
+        std::vector<double> got(expected.size(), -7.0);
+        double* const out = got.data();
+        evaluator.terms(t, q.data(), v.data(), scratch.data(),
+                        TermsOut{out, out + n * n, out + n * n + n, out + n * n + 2 * n, out + n * n + 3 * n});
+        for (std::size_t i = 0; i < expected.size(); ++i)
+          EXPECT_EQ(std::memcmp(&got[i], &expected[i], sizeof(double)), 0)
+              << "n = " << n << ", output " << i << ": " << got[i] << " != " << expected[i];
+        // The parameter-only subexpression, folded once, is the value computed at run time.
+        EXPECT_EQ(got[0], std::sqrt(2.0) * 1.3);
+
+        const std::vector<double> expected_d = run(*programs.complement, t, q, v);
+        std::vector<double> d(expected_d.size(), -7.0);
+        evaluator.complement(t, q.data(), v.data(), scratch.data(), d.data());
+        EXPECT_EQ(std::memcmp(d.data(), expected_d.data(), d.size() * sizeof(double)), 0) << "n = " << n;
+        double f = -7.0;
+        evaluator.velocity_residual(t, q.data(), v.data(), scratch.data(), &f);
+        EXPECT_EQ(f, run(programs.velocity_residual, t, q, v)[0]);
+      }
+    }
+}
+
+TEST(ProgramEvaluator, ComputesParameterOnlySubexpressionsOnce) {
+  // A(1, 1) = q0 * (sqrt(2) * m) and Q(0) = sqrt(2) * m; everything else constant.
+  const double m = 1.3;
+  ModelPrograms programs{Program(2), std::nullopt, Program(2), Program(2), std::nullopt};
+  Program& p = programs.terms;
+  const int zero = p.push_constant(0.0);
+  const int sm = p.push(Op::mul, p.push(Op::sqrt, p.push_constant(2.0)), p.push_constant(m));
+  const int a11 = p.push(Op::mul, p.coordinate_register(0), sm);
+  for (const int reg : {zero, zero, zero, a11, sm, zero, zero, zero, zero, zero, zero}) p.add_output(reg);
+  const ProgramEvaluator evaluator(2, 1, programs);
+  EXPECT_EQ(evaluator.terms_operations(), 1) << p.describe();  // k * q0, k folded, into A directly
+  const std::vector<double> q{0.7, -0.2}, v{0.3, 0.4};
+  const std::vector<double> expected = run(p, 0.0, q, v);
+  std::vector<double> scratch(evaluator.scratch_size()), got(expected.size(), -7.0);
+  double* const out = got.data();
+  evaluator.terms(0.0, q.data(), v.data(), scratch.data(), TermsOut{out, out + 4, out + 6, out + 8, out + 10});
+  EXPECT_EQ(got, expected);
+  EXPECT_EQ(got[3], q[0] * (std::sqrt(2.0) * m));
+  EXPECT_EQ(got[4], std::sqrt(2.0) * m);
 }
 
 TEST(ProgramEvaluator, RunsWithoutAllocating) {

@@ -1,8 +1,11 @@
 #include "nhdyn/model/program.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -39,65 +42,142 @@ std::string format_double(double x) {
   return buffer;
 }
 
-// The interpreter, inlined into Program::execute and ProgramEvaluator::terms (a call less on the
-// hottest path).
+// Whether the instruction calls the math library (std::sqrt too: it sets errno below zero).
+bool calls_library(Op op) {
+  switch (op) {
+    case Op::pow:
+    case Op::pow_k:
+    case Op::sqrt:
+    case Op::sin:
+    case Op::cos:
+    case Op::sincos:
+    case Op::tan:
+    case Op::exp:
+    case Op::log:
+    case Op::asin:
+    case Op::acos:
+    case Op::atan:
+    case Op::atan2:
+    case Op::sinh:
+    case Op::cosh:
+    case Op::tanh:
+      return true;
+    default:
+      return false;
+  }
+}
+
 #if defined(__GNUC__)
-[[gnu::always_inline]]
+#define NHDYN_ALWAYS_INLINE [[gnu::always_inline]] inline
+#define NHDYN_UNREACHABLE() __builtin_unreachable()
+#else
+#define NHDYN_ALWAYS_INLINE inline
+#define NHDYN_UNREACHABLE() ((void)0)
 #endif
-inline void run_code(const Instruction* code, std::size_t size, std::size_t n, const bool* reads, double t,
-                     const double* q, const double* v, double* registers) {
-  // Only the inputs the program reads are copied in (a position residual has no v, say).
-  if (reads[0]) registers[0] = t;
+
+// Copies in the inputs the program reads (a position residual has no v, say); inlined with n
+// known at compile time where it is.
+NHDYN_ALWAYS_INLINE void load_inputs(const bool* reads, std::size_t n, double t, const double* q, const double* v,
+                                     double* x) {
+  if (reads[0]) x[0] = t;
   if (reads[1])
-    for (std::size_t i = 0; i < n; ++i) registers[1 + i] = q[i];
+    for (std::size_t i = 0; i < n; ++i) x[1 + i] = q[i];
   if (reads[2])
-    for (std::size_t i = 0; i < n; ++i) registers[1 + n + i] = v[i];
-  double* r = registers + 1 + 2 * n;  // r[i]: the register of instruction i
-  const double* x = registers;        // operands, by register number
-  for (std::size_t i = 0; i < size; ++i) {
-    const Instruction& in = code[i];
-    switch (in.op) {
-      case Op::constant: r[i] = in.k; break;
-      case Op::add: r[i] = x[in.a] + x[in.b]; break;
-      case Op::sub: r[i] = x[in.a] - x[in.b]; break;
-      case Op::mul: r[i] = x[in.a] * x[in.b]; break;
-      case Op::div: r[i] = x[in.a] / x[in.b]; break;
-      case Op::neg: r[i] = -x[in.a]; break;
-      case Op::add_k: r[i] = x[in.a] + in.k; break;
-      case Op::mul_k: r[i] = in.k * x[in.a]; break;
-      case Op::mulk: r[i] = in.k * (x[in.a] * x[in.b]); break;
-      case Op::div_k: r[i] = in.k / x[in.a]; break;
-      case Op::muladd: r[i] = x[in.a] * x[in.b] + x[in.c]; break;
-      case Op::mulsub: r[i] = x[in.c] - x[in.a] * x[in.b]; break;
-      case Op::mulk_add: r[i] = in.k * x[in.a] + x[in.b]; break;
-      case Op::mulk_muladd: r[i] = in.k * (x[in.a] * x[in.b]) + x[in.c]; break;
-      case Op::square: r[i] = x[in.a] * x[in.a]; break;
-      case Op::cube: r[i] = x[in.a] * x[in.a] * x[in.a]; break;
-      case Op::powi: r[i] = powi_value(x[in.a], static_cast<int>(in.k)); break;
-      case Op::pow: r[i] = std::pow(x[in.a], x[in.b]); break;
-      case Op::pow_k: r[i] = std::pow(x[in.a], in.k); break;
-      case Op::sqrt: r[i] = std::sqrt(x[in.a]); break;
-      case Op::sin: r[i] = std::sin(x[in.a]); break;
-      case Op::cos: r[i] = std::cos(x[in.a]); break;
-      case Op::sincos: {
-        const double y = x[in.a];
-        r[i] = std::sin(y);
-        r[i + 1] = std::cos(y);
-        ++i;  // skip the companion nop
+    for (std::size_t i = 0; i < n; ++i) x[1 + n + i] = v[i];
+}
+
+// Keeps the compiler from merging the 8-byte stores around it into one 16-byte store, which a core
+// may not forward to a later 8-byte load of its upper half: the load then waits for the store to
+// retire (measured on AMD Zen 5: the sled's terms some 15% slower). Emits no instruction.
+NHDYN_ALWAYS_INLINE void store_fence() { std::atomic_signal_fence(std::memory_order_seq_cst); }
+
+// A step that calls the math library: from the registers x into y.
+NHDYN_ALWAYS_INLINE void run_library_step(const Step* s, const double* x, double* y) {
+  switch (s->op) {
+    case Op::pow: y[s->to] = std::pow(x[s->a], x[s->b]); break;
+    case Op::pow_k: y[s->to] = std::pow(x[s->a], s->k); break;
+    case Op::sqrt: y[s->to] = std::sqrt(x[s->a]); break;
+    case Op::sin: y[s->to] = std::sin(x[s->a]); break;
+    case Op::cos: y[s->to] = std::cos(x[s->a]); break;
+    case Op::sincos: {
+      const double u = x[s->a];
+      y[s->to] = std::sin(u);
+      store_fence();
+      y[s->to + 1] = std::cos(u);
+      break;
+    }
+    case Op::tan: y[s->to] = std::tan(x[s->a]); break;
+    case Op::exp: y[s->to] = std::exp(x[s->a]); break;
+    case Op::log: y[s->to] = std::log(x[s->a]); break;
+    case Op::asin: y[s->to] = std::asin(x[s->a]); break;
+    case Op::acos: y[s->to] = std::acos(x[s->a]); break;
+    case Op::atan: y[s->to] = std::atan(x[s->a]); break;
+    case Op::atan2: y[s->to] = std::atan2(x[s->a], x[s->b]); break;
+    case Op::sinh: y[s->to] = std::sinh(x[s->a]); break;
+    case Op::cosh: y[s->to] = std::cosh(x[s->a]); break;
+    case Op::tanh: y[s->to] = std::tanh(x[s->a]); break;
+    default: NHDYN_UNREACHABLE();
+  }
+}
+
+// The op and destination of a step, read at once: consecutive steps with the same key form a run.
+static_assert(offsetof(Step, op) == 0 && offsetof(Step, dest) == 1 && sizeof(Op) == 1);
+NHDYN_ALWAYS_INLINE unsigned run_key(const Step* s) {
+  std::uint16_t key;
+  std::memcpy(&key, s, sizeof key);
+  return key;
+}
+
+// Runs the run of steps that starts at s, each writing value(step) to its destination; returns the
+// step after the run.
+template <class Value>
+NHDYN_ALWAYS_INLINE const Step* run(const Step* s, double* const* arrays, Value value) {
+  double* const y = arrays[s->dest];
+  const unsigned key = run_key(s);
+  do y[s->to] = value(*s);
+  while (run_key(++s) == key);
+  return s;
+}
+
+// The interpreter: runs steps up to their closing nop. arrays[0] is the registers, which every
+// operand reads; a step writes arrays[dest]. A run of steps of the same op and destination loops
+// inside its case, one dispatch for the run; the nop that ends the list spares a counter and a
+// compare per step. With Calls = false no step calls the math library, and the interpreter, with
+// no call either, saves and restores no registers: a small model's terms are mostly fixed cost.
+template <bool Calls>
+NHDYN_ALWAYS_INLINE void run_steps(const Step* s, double* const* arrays) {
+  const double* x = arrays[0];
+  for (;;) {
+    switch (s->op) {
+      case Op::constant: s = run(s, arrays, [](const Step& i) { return i.k; }); break;
+      case Op::add: s = run(s, arrays, [x](const Step& i) { return x[i.a] + x[i.b]; }); break;
+      case Op::sub: s = run(s, arrays, [x](const Step& i) { return x[i.a] - x[i.b]; }); break;
+      case Op::mul: s = run(s, arrays, [x](const Step& i) { return x[i.a] * x[i.b]; }); break;
+      case Op::div: s = run(s, arrays, [x](const Step& i) { return x[i.a] / x[i.b]; }); break;
+      case Op::neg: s = run(s, arrays, [x](const Step& i) { return -x[i.a]; }); break;
+      case Op::add_k: s = run(s, arrays, [x](const Step& i) { return x[i.a] + i.k; }); break;
+      case Op::mul_k: s = run(s, arrays, [x](const Step& i) { return i.k * x[i.a]; }); break;
+      case Op::mulk: s = run(s, arrays, [x](const Step& i) { return i.k * (x[i.a] * x[i.b]); }); break;
+      case Op::div_k: s = run(s, arrays, [x](const Step& i) { return i.k / x[i.a]; }); break;
+      case Op::muladd: s = run(s, arrays, [x](const Step& i) { return x[i.a] * x[i.b] + x[i.c]; }); break;
+      case Op::mulsub: s = run(s, arrays, [x](const Step& i) { return x[i.c] - x[i.a] * x[i.b]; }); break;
+      case Op::mulk_add: s = run(s, arrays, [x](const Step& i) { return i.k * x[i.a] + x[i.b]; }); break;
+      case Op::mulk_muladd: s = run(s, arrays, [x](const Step& i) { return i.k * (x[i.a] * x[i.b]) + x[i.c]; }); break;
+      case Op::square: s = run(s, arrays, [x](const Step& i) { return x[i.a] * x[i.a]; }); break;
+      case Op::cube: s = run(s, arrays, [x](const Step& i) { return x[i.a] * x[i.a] * x[i.a]; }); break;
+      case Op::powi:
+        s = run(s, arrays, [x](const Step& i) { return powi_value(x[i.a], static_cast<int>(i.k)); });
         break;
-      }
-      case Op::tan: r[i] = std::tan(x[in.a]); break;
-      case Op::exp: r[i] = std::exp(x[in.a]); break;
-      case Op::log: r[i] = std::log(x[in.a]); break;
-      case Op::abs: r[i] = std::abs(x[in.a]); break;
-      case Op::asin: r[i] = std::asin(x[in.a]); break;
-      case Op::acos: r[i] = std::acos(x[in.a]); break;
-      case Op::atan: r[i] = std::atan(x[in.a]); break;
-      case Op::atan2: r[i] = std::atan2(x[in.a], x[in.b]); break;
-      case Op::sinh: r[i] = std::sinh(x[in.a]); break;
-      case Op::cosh: r[i] = std::cosh(x[in.a]); break;
-      case Op::tanh: r[i] = std::tanh(x[in.a]); break;
-      case Op::nop: break;
+      case Op::abs: s = run(s, arrays, [x](const Step& i) { return std::abs(x[i.a]); }); break;
+      case Op::nop:
+        return;
+      default:
+        if constexpr (Calls) {
+          run_library_step(s, x, arrays[s->dest]);
+          ++s;
+        } else {
+          NHDYN_UNREACHABLE();
+        }
     }
   }
 }
@@ -168,7 +248,7 @@ const char* op_name(Op op) {
   return "?";
 }
 
-Program::Program(int coordinates) : n_(coordinates) {
+Program::Program(int coordinates) : n_(coordinates), steps_(1) {
   if (coordinates < 0) throw std::invalid_argument("Program: negative number of coordinates");
 }
 
@@ -212,6 +292,9 @@ int Program::push(Op op, int a, int b, int c, double k) {
   for (int i = 0; i < count; ++i) note_read(operands[i]);
   code_.push_back(in);
   if (op == Op::sincos) code_.push_back(Instruction{Op::nop, next, 0, 0, 0.0});
+  steps_.back() = Step{op, 0, next, in.a, in.b, in.c, in.k};
+  steps_.push_back(Step{});
+  calls_ = calls_ || calls_library(op);
   return next;
 }
 
@@ -231,7 +314,12 @@ int Program::count(Op op) const {
 }
 
 void Program::execute(double t, const double* q, const double* v, double* registers) const {
-  run_code(code_.data(), code_.size(), static_cast<std::size_t>(n_), reads_, t, q, v, registers);
+  load_inputs(reads_, static_cast<std::size_t>(n_), t, q, v, registers);
+  double* const arrays[1] = {registers};
+  if (calls_)
+    run_steps<true>(steps_.data(), arrays);
+  else
+    run_steps<false>(steps_.data(), arrays);
 }
 
 void Program::run(double t, const double* q, const double* v, double* registers, double* outputs) const {
@@ -311,92 +399,247 @@ ProgramEvaluator::ProgramEvaluator(int n, int s, ModelPrograms programs)
   if (programs_.energy) widen(*programs_.energy);
   scratch_ = largest;
 
-  // The terms' outputs as an image of constants plus the registers to scatter over it.
-  const std::vector<Output>& outputs = programs_.terms.output_list();
-  const int sizes[5] = {n * n, n, n, s * n, s};
-  std::size_t j = 0;
-  for (int array = 0; array < 5; ++array) {
-    first_entry_[array] = static_cast<std::int32_t>(entries_.size());
-    for (int i = 0; i < sizes[array]; ++i, ++j) {
-      const Output& o = outputs[j];
-      image_.push_back(o.reg < 0 ? o.value : 0.0);
-      if (o.reg >= 0) entries_.push_back(Entry{i, o.reg});
-    }
-  }
-  first_entry_[5] = static_cast<std::int32_t>(entries_.size());
-  terms_function_ = choose_terms(n, s);
+  terms_ = prepare(programs_.terms, {n * n, n, n, s * n, s});
+  if (programs_.complement) complement_ = prepare(*programs_.complement, {(n - s) * n});
+  position_residual_ = prepare(programs_.position_residual, {programs_.position_residual.outputs()});
+  velocity_residual_ = prepare(programs_.velocity_residual, {programs_.velocity_residual.outputs()});
+  if (programs_.energy) energy_ = prepare(*programs_.energy, {1});
+  terms_function_ = terms_.calls ? choose_terms<true>(n, s) : choose_terms<false>(n, s);
 }
 
 namespace {
 
-template <int N>
-inline void copy_fixed(const double* from, double* to) {
-  for (int i = 0; i < N; ++i) to[i] = from[i];
+// The value of one instruction on constant operands, computed by the interpreter itself.
+double fold(const Instruction& in, double a, double b, double c, double* cosine) {
+  double x[5] = {a, b, c, 0.0, 0.0};
+  const Step once[2] = {Step{in.op, 0, 3, 0, 1, 2, in.k}, Step{}};
+  double* const arrays[1] = {x};
+  run_steps<true>(once, arrays);
+  *cosine = x[4];
+  return x[3];
 }
 
-inline void copy_any(const double* from, double* to, std::size_t size) {
-  for (std::size_t i = 0; i < size; ++i) to[i] = from[i];
+}  // namespace
+
+ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, const std::vector<int>& sizes) {
+  const std::vector<Instruction>& code = program.code();
+  const int inputs = program.inputs();
+  const std::size_t registers = static_cast<std::size_t>(program.registers());
+  const auto at = [](int reg) { return static_cast<std::size_t>(reg); };
+
+  // Constants folded, constant operands made immediates; program order, every step to a register.
+  std::vector<char> known(registers, 0);  // the register holds the constant value[reg]
+  std::vector<double> value(registers, 0.0);
+  std::vector<Step> steps;
+  for (std::size_t i = 0; i < code.size(); ++i) {
+    const Instruction& in = code[i];
+    if (in.op == Op::nop) continue;  // the cosine of a sincos
+    const int to = inputs + static_cast<int>(i);
+    Step step{in.op, 0, to, in.a, in.b, in.c, in.k};
+    const int operands[3] = {in.a, in.b, in.c};
+    const int count = operand_count(in.op);
+    bool constant_operands = in.op != Op::constant;
+    for (int j = 0; j < count; ++j) constant_operands = constant_operands && known[at(operands[j])];
+    if (constant_operands) {
+      double cosine = 0.0;
+      const double result = fold(in, value[at(in.a)], value[at(in.b)], value[at(in.c)], &cosine);
+      if (in.op == Op::sincos) {
+        known[at(to + 1)] = 1;
+        value[at(to + 1)] = cosine;
+        steps.push_back(Step{Op::constant, 0, to + 1, 0, 0, 0, cosine});
+      }
+      step = Step{Op::constant, 0, to, 0, 0, 0, result};
+    }
+    if (step.op == Op::constant) {
+      known[at(to)] = 1;
+      value[at(to)] = step.k;
+      steps.push_back(step);
+      continue;
+    }
+    // A constant operand as the immediate: a + k and k * a commute exactly, a - k is a + (-k),
+    // k / a is div_k and a * k + c is mulk_add, all with the same rounding.
+    const auto is_known = [&](int reg) { return known[at(reg)] != 0; };
+    switch (step.op) {
+      case Op::add:
+      case Op::mul:
+        if (is_known(step.a) || is_known(step.b)) {
+          const bool first = is_known(step.a);
+          step = Step{step.op == Op::add ? Op::add_k : Op::mul_k, 0, to, first ? step.b : step.a, 0, 0,
+                      value[at(first ? step.a : step.b)]};
+        }
+        break;
+      case Op::sub:
+        if (is_known(step.b)) step = Step{Op::add_k, 0, to, step.a, 0, 0, -value[at(step.b)]};
+        break;
+      case Op::div:
+        if (is_known(step.a)) step = Step{Op::div_k, 0, to, step.b, 0, 0, value[at(step.a)]};
+        break;
+      case Op::muladd:
+        if (is_known(step.a) || is_known(step.b)) {
+          const bool first = is_known(step.a);
+          step = Step{Op::mulk_add, 0, to, first ? step.b : step.a, step.c, 0, value[at(first ? step.a : step.b)]};
+        }
+        break;
+      default:
+        break;
+    }
+    steps.push_back(step);
+  }
+
+  // The outputs: constants into the image, the others wanted from their registers.
+  Prepared p;
+  struct Want {
+    int array, index;
+  };
+  std::vector<std::vector<Want>> wants(registers);
+  const std::vector<Output>& outputs = program.output_list();
+  std::size_t j = 0;
+  for (std::size_t array = 0; array < sizes.size(); ++array)
+    for (int i = 0; i < sizes[array]; ++i, ++j) {
+      const Output& o = outputs[j];
+      const bool constant = o.reg < 0 || known[at(o.reg)];
+      p.image.push_back(o.reg < 0 ? o.value : constant ? value[at(o.reg)] : 0.0);
+      if (!constant) wants[at(o.reg)].push_back(Want{static_cast<int>(array) + 1, i});
+    }
+
+  // Only the steps an output needs, found backwards; then who reads each register.
+  std::vector<char> live(registers, 0), keep(steps.size(), 0);
+  std::vector<int> readers(registers, 0);
+  for (std::size_t r = 0; r < registers; ++r) live[r] = !wants[r].empty();
+  for (std::size_t i = steps.size(); i-- > 0;) {
+    const Step& step = steps[i];
+    if (!live[at(step.to)] && !(step.op == Op::sincos && live[at(step.to + 1)])) continue;
+    keep[i] = 1;
+    const int operands[3] = {step.a, step.b, step.c};
+    for (int k = 0; k < operand_count(step.op); ++k) {
+      live[at(operands[k])] = 1;
+      ++readers[at(operands[k])];
+    }
+  }
+
+  // Each step in place: an output computed once for all is written where it goes; a copy (1 * x,
+  // exact) serves an input or a sincos, a clone of its step every further output of a register.
+  const int n = program.coordinates();
+  const auto note_read = [&p, n](int reg) {
+    if (reg == 0)
+      p.reads[0] = true;
+    else if (reg <= n)
+      p.reads[1] = true;
+    else if (reg <= 2 * n)
+      p.reads[2] = true;
+  };
+  const auto place = [&p, &note_read](const Step& step, int dest, int to) {
+    Step x = step;
+    x.dest = static_cast<std::uint8_t>(dest);
+    x.to = to;
+    p.steps.push_back(x);
+    const int operands[3] = {x.a, x.b, x.c};
+    for (int k = 0; k < operand_count(x.op); ++k) note_read(operands[k]);
+    p.calls = p.calls || calls_library(x.op);
+  };
+  const auto copy = [&place](int reg, const Want& w) {
+    place(Step{Op::mul_k, 0, 0, reg, 0, 0, 1.0}, w.array, w.index);
+  };
+  for (int r = 0; r < inputs; ++r)
+    for (const Want& w : wants[at(r)]) copy(r, w);
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    if (!keep[i]) continue;
+    const Step& step = steps[i];
+    const std::vector<Want>& want = wants[at(step.to)];
+    if (step.op == Op::sincos) {
+      place(step, 0, step.to);
+      for (const Want& w : want) copy(step.to, w);
+      for (const Want& w : wants[at(step.to + 1)]) copy(step.to + 1, w);
+      continue;
+    }
+    std::size_t first = 0;
+    if (!want.empty() && readers[at(step.to)] == 0) {
+      place(step, want[0].array, want[0].index);
+      first = 1;
+    } else {
+      place(step, 0, step.to);
+    }
+    for (std::size_t w = first; w < want.size(); ++w) place(step, want[w].array, want[w].index);
+  }
+  p.steps.push_back(Step{});
+  return p;
+}
+
+namespace {
+
+// The arrays a step of the terms may write: the registers, then A, Q, G, b, b0. Written one
+// pointer at a time (store_fence), since every step reads one of them back.
+struct TermsArrays {
+  double* arrays[6];
+  NHDYN_ALWAYS_INLINE TermsArrays(double* registers, const TermsOut& out) {
+    arrays[0] = registers;
+    store_fence();
+    arrays[1] = out.A;
+    store_fence();
+    arrays[2] = out.Q;
+    store_fence();
+    arrays[3] = out.G;
+    store_fence();
+    arrays[4] = out.b;
+    store_fence();
+    arrays[5] = out.b0;
+  }
+};
+
+template <int N>
+NHDYN_ALWAYS_INLINE void copy_fixed(const double* from, double* to) {
+  if constexpr (N > 0) std::memcpy(to, from, N * sizeof(double));
 }
 
 }  // namespace
 
 // For a small model the fixed cost of the call dominates (19 outputs for n = 3, s = 1, most of
 // them constant): with the sizes known at compile time the input copies and the image copies
-// become a few vector moves instead of loops, and the register outputs are scattered array by
-// array from a base pointer held in a register.
-template <int N, int S>
+// become a few vector moves instead of loops.
+template <int N, int S, bool Calls>
 void ProgramEvaluator::terms_fixed(const ProgramEvaluator& self, double t, const double* q, const double* v,
                                    double* scratch, const TermsOut& out) {
-  const Program& p = self.programs_.terms;
-  run_code(p.code_.data(), p.code_.size(), N, p.reads_, t, q, v, scratch);
-  const double* image = self.image_.data();
+  const Prepared& p = self.terms_;
+  load_inputs(p.reads, N, t, q, v, scratch);
+  const double* image = p.image.data();
   copy_fixed<N * N>(image, out.A);
   copy_fixed<N>(image + N * N, out.Q);
   copy_fixed<N>(image + N * N + N, out.G);
   copy_fixed<S * N>(image + N * N + 2 * N, out.b);
   copy_fixed<S>(image + N * N + 2 * N + S * N, out.b0);
-  double* const arrays[5] = {out.A, out.Q, out.G, out.b, out.b0};
-  const Entry* entries = self.entries_.data();
-  for (int a = 0; a < 5; ++a) {
-    double* to = arrays[a];
-    for (std::int32_t e = self.first_entry_[a]; e < self.first_entry_[a + 1]; ++e)
-      to[entries[e].index] = scratch[entries[e].reg];
-  }
+  run_steps<Calls>(p.steps.data(), TermsArrays(scratch, out).arrays);
 }
 
+template <bool Calls>
 void ProgramEvaluator::terms_any(const ProgramEvaluator& self, double t, const double* q, const double* v,
                                  double* scratch, const TermsOut& out) {
-  const Program& p = self.programs_.terms;
+  const Prepared& p = self.terms_;
   const std::size_t n = static_cast<std::size_t>(self.n_), s = static_cast<std::size_t>(self.s_);
-  run_code(p.code_.data(), p.code_.size(), n, p.reads_, t, q, v, scratch);
-  const double* image = self.image_.data();
-  copy_any(image, out.A, n * n);
-  copy_any(image + n * n, out.Q, n);
-  copy_any(image + n * n + n, out.G, n);
-  copy_any(image + n * n + 2 * n, out.b, s * n);
-  copy_any(image + n * n + 2 * n + s * n, out.b0, s);
-  double* const arrays[5] = {out.A, out.Q, out.G, out.b, out.b0};
-  const Entry* entries = self.entries_.data();
+  load_inputs(p.reads, n, t, q, v, scratch);
+  const TermsArrays arrays(scratch, out);
+  const std::size_t sizes[5] = {n * n, n, n, s * n, s};
+  const double* image = p.image.data();
   for (int a = 0; a < 5; ++a) {
-    double* to = arrays[a];
-    for (std::int32_t e = self.first_entry_[a]; e < self.first_entry_[a + 1]; ++e)
-      to[entries[e].index] = scratch[entries[e].reg];
+    for (std::size_t i = 0; i < sizes[a]; ++i) arrays.arrays[a + 1][i] = image[i];
+    image += sizes[a];
   }
+  run_steps<Calls>(p.steps.data(), arrays.arrays);
 }
 
+template <bool Calls>
 ProgramEvaluator::TermsFunction ProgramEvaluator::choose_terms(int n, int s) {
   switch (n * 8 + s) {
-    case 1 * 8 + 0: return &terms_fixed<1, 0>;
-    case 2 * 8 + 0: return &terms_fixed<2, 0>;
-    case 2 * 8 + 1: return &terms_fixed<2, 1>;
-    case 3 * 8 + 0: return &terms_fixed<3, 0>;
-    case 3 * 8 + 1: return &terms_fixed<3, 1>;
-    case 3 * 8 + 2: return &terms_fixed<3, 2>;
-    case 4 * 8 + 0: return &terms_fixed<4, 0>;
-    case 4 * 8 + 1: return &terms_fixed<4, 1>;
-    case 4 * 8 + 2: return &terms_fixed<4, 2>;
-    case 4 * 8 + 3: return &terms_fixed<4, 3>;
-    default: return &terms_any;
+    case 1 * 8 + 0: return &terms_fixed<1, 0, Calls>;
+    case 2 * 8 + 0: return &terms_fixed<2, 0, Calls>;
+    case 2 * 8 + 1: return &terms_fixed<2, 1, Calls>;
+    case 3 * 8 + 0: return &terms_fixed<3, 0, Calls>;
+    case 3 * 8 + 1: return &terms_fixed<3, 1, Calls>;
+    case 3 * 8 + 2: return &terms_fixed<3, 2, Calls>;
+    case 4 * 8 + 0: return &terms_fixed<4, 0, Calls>;
+    case 4 * 8 + 1: return &terms_fixed<4, 1, Calls>;
+    case 4 * 8 + 2: return &terms_fixed<4, 2, Calls>;
+    case 4 * 8 + 3: return &terms_fixed<4, 3, Calls>;
+    default: return &terms_any<Calls>;
   }
 }
 
@@ -405,24 +648,39 @@ void ProgramEvaluator::terms(double t, const double* q, const double* v, double*
   terms_function_(*this, t, q, v, scratch, out);
 }
 
+void ProgramEvaluator::run(const Prepared& p, double t, const double* q, const double* v, double* scratch,
+                           double* out) const {
+  load_inputs(p.reads, static_cast<std::size_t>(n_), t, q, v, scratch);
+  const std::size_t m = p.image.size();
+  for (std::size_t i = 0; i < m; ++i) out[i] = p.image[i];
+  double* arrays[2];
+  arrays[0] = scratch;
+  store_fence();
+  arrays[1] = out;
+  if (p.calls)
+    run_steps<true>(p.steps.data(), arrays);
+  else
+    run_steps<false>(p.steps.data(), arrays);
+}
+
 void ProgramEvaluator::complement(double t, const double* q, const double* v, double* scratch, double* D) const {
   if (!programs_.complement) return;
-  programs_.complement->run(t, q, v, scratch, D);
+  run(complement_, t, q, v, scratch, D);
 }
 
 void ProgramEvaluator::position_residual(double t, const double* q, double* scratch, double* phi) const {
-  programs_.position_residual.run(t, q, nullptr, scratch, phi);
+  run(position_residual_, t, q, nullptr, scratch, phi);
 }
 
 void ProgramEvaluator::velocity_residual(double t, const double* q, const double* v, double* scratch,
                                          double* f) const {
-  programs_.velocity_residual.run(t, q, v, scratch, f);
+  run(velocity_residual_, t, q, v, scratch, f);
 }
 
 double ProgramEvaluator::energy(double t, const double* q, const double* v, double* scratch) const {
   if (!programs_.energy) return 0.0;
   double e = 0.0;
-  programs_.energy->run(t, q, v, scratch, &e);
+  run(energy_, t, q, v, scratch, &e);
   return e;
 }
 

@@ -1,12 +1,16 @@
 // Straight-line programs on doubles: the numeric form of a model compiled from symbols
 // (symbolic/compile.hpp). A Program is a flat array of instructions in single-assignment form with
-// no branches and no allocation when it runs, so its cost is one switch dispatch per instruction
-// plus the arithmetic. Registers: r[0] = t, r[1 + i] = q_i, r[1 + n + i] = q'_i (the inputs, copied
-// in when the program starts), then instruction j writes register inputs() + j and reads only
-// registers below it. Outputs are registers or constants; constant outputs cost no instruction.
+// no branches and no allocation when it runs, so its cost is one switch dispatch per run of
+// instructions of the same op, plus the arithmetic. Registers: r[0] = t, r[1 + i] = q_i,
+// r[1 + n + i] = q'_i (the inputs, copied in when the program starts), then instruction j writes
+// register inputs() + j and reads only registers below it. Outputs are registers or constants;
+// constant outputs cost no instruction.
 // ProgramEvaluator runs such programs as an Evaluator: all the terms A, Q, G, b, b0 in one
 // program (common subexpressions computed once), the complement D, the residuals and the energy
-// in their own. Generated C++ (symbolic/codegen.hpp) prints the same programs as source code.
+// in their own, each in a prepared form: what depends on constants only is computed once when the
+// evaluator is built (the parameters are frozen in the Model), what no output needs is dropped,
+// and results go straight to the output arrays. Generated C++ (symbolic/codegen.hpp) prints the
+// same programs as source code.
 #pragma once
 
 #include <cstddef>
@@ -72,6 +76,20 @@ struct Instruction {
   double k = 0.0;
 };
 
+// An instruction as the interpreter runs it: it writes to[...] of the array `dest` (0: the
+// registers; ProgramEvaluator lets a step write an output array directly) from operand registers
+// a, b, c and immediate k. A sincos is one step; a nop ends a list of steps. Consecutive steps of
+// the same op and dest form a run, which costs one dispatch.
+struct Step {
+  Op op = Op::nop;
+  std::uint8_t dest = 0;  // op and dest are the first two bytes: the interpreter reads them at once
+  std::int32_t to = 0;
+  std::int32_t a = 0;
+  std::int32_t b = 0;
+  std::int32_t c = 0;
+  double k = 0.0;
+};
+
 // An output of a program: register `reg`, or the constant `value` when reg < 0.
 struct Output {
   int reg = -1;
@@ -123,11 +141,12 @@ class Program {
   std::string register_name(int reg) const;
 
  private:
-  friend class ProgramEvaluator;  // runs the terms' code inline
   void note_read(int reg);
 
   int n_ = 0;
   std::vector<Instruction> code_;
+  std::vector<Step> steps_;  // code_ as the interpreter runs it, ended by a nop
+  bool calls_ = false;       // an instruction calls the math library (sin, pow, sqrt...)
   std::vector<Output> outputs_;
   bool reads_[3] = {false, false, false};  // t, q, q'
 };
@@ -142,9 +161,19 @@ struct ModelPrograms {
   std::optional<Program> energy;     // one output: T + V
 };
 
-// An Evaluator that runs straight-line programs. scratch_size() is the largest register count
-// of its programs; outputs go from the registers straight into the caller's arrays (constant
-// entries from a prepared image, the others scattered from their registers).
+// An Evaluator that runs straight-line programs. Each program is prepared once, when the
+// evaluator is built (the parameters are frozen by then):
+// - an instruction whose operands are all constants becomes a constant, computed by the
+//   interpreter itself so to the same bits (a parameter-only subexpression costs nothing per call);
+// - a constant operand of add, sub, mul, div or muladd becomes the immediate of add_k, mul_k,
+//   div_k or mulk_add, which round alike;
+// - constant outputs go to an image copied whole before the instructions run; an instruction
+//   whose result is an output and no operand writes the output array itself (a further output of
+//   the same value costs one more instruction: its clone, or a copy 1 * x of an input or sincos);
+// - instructions that no output needs are left out.
+// Programs that call no math library function run in an interpreter without those calls, whose
+// fixed cost per call is lower. The prepared form computes the same values as the programs, to the
+// bit. scratch_size() is the largest register count of the programs.
 class ProgramEvaluator final : public Evaluator {
  public:
   // Throws std::invalid_argument when a program's output count or coordinate count does not
@@ -153,7 +182,10 @@ class ProgramEvaluator final : public Evaluator {
 
   int n() const { return n_; }
   int s() const { return s_; }
+  // The programs as given (generated code prints these).
   const ModelPrograms& programs() const { return programs_; }
+  // Number of operations the prepared terms run per call (a sincos counts one).
+  int terms_operations() const { return static_cast<int>(terms_.steps.size()) - 1; }
 
   std::size_t scratch_size() const override { return scratch_; }
   // The Evaluator interface; each call runs one program and writes its outputs.
@@ -166,27 +198,37 @@ class ProgramEvaluator final : public Evaluator {
   double energy(double t, const double* q, const double* v, double* scratch) const override;
 
  private:
-  // A register output of the terms: its index in its TermsOut array and its register.
-  struct Entry {
-    std::int32_t index = 0, reg = 0;
+  // A program ready to run: its steps (destination 0 the registers, 1 + i the i-th output array),
+  // ended by a nop, the inputs they read, and every output as an image (constants, 0 where a
+  // step writes) that is copied before the steps run.
+  struct Prepared {
+    std::vector<Step> steps;
+    bool calls = false;                     // a step calls the math library
+    bool reads[3] = {false, false, false};  // t, q, q'
+    std::vector<double> image;
   };
-  // The whole terms() call, with the sizes fixed at compile time for n <= 4 (terms_fixed) or not.
+  // Prepares `program`, whose outputs fill arrays of the given sizes one after the other.
+  static Prepared prepare(const Program& program, const std::vector<int>& sizes);
+
+  // The whole terms() call, with the sizes fixed at compile time for n <= 4 (terms_fixed) or not:
+  // the input copies and the image copies then become a few moves instead of loops.
   using TermsFunction = void (*)(const ProgramEvaluator& self, double t, const double* q, const double* v,
                                  double* scratch, const TermsOut& out);
-  template <int N, int S>
+  template <int N, int S, bool Calls>
   static void terms_fixed(const ProgramEvaluator& self, double t, const double* q, const double* v,
                           double* scratch, const TermsOut& out);
+  template <bool Calls>
   static void terms_any(const ProgramEvaluator& self, double t, const double* q, const double* v,
                         double* scratch, const TermsOut& out);
+  template <bool Calls>
   static TermsFunction choose_terms(int n, int s);
+  void run(const Prepared& p, double t, const double* q, const double* v, double* scratch, double* out) const;
 
   int n_ = 0;
   int s_ = 0;
   ModelPrograms programs_;
   std::size_t scratch_ = 0;
-  std::vector<double> image_;       // every output of the terms, A Q G b b0; 0 where it is a register
-  std::vector<Entry> entries_;      // the register outputs of the terms, array by array (A Q G b b0)
-  std::int32_t first_entry_[6] = {};  // the entries of array a are [first_entry_[a], first_entry_[a + 1])
+  Prepared terms_, complement_, position_residual_, velocity_residual_, energy_;
   TermsFunction terms_function_ = nullptr;
 };
 
