@@ -46,6 +46,8 @@ Data make_data(const Model& model) {
   d.tmp_n2 = Vector::Zero(n);
   d.tmp_s = Vector::Zero(s);
   d.tmp_k = Vector::Zero(k);
+  d.tmp_s2 = Vector::Zero(s);
+  d.projection_scale = Vector::Ones(s);
   d.bWt = Matrix::Zero(n, s);
   d.b_dep = Matrix::Zero(s, s);
   d.b_ind = Matrix::Zero(s, k);

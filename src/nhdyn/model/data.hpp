@@ -86,6 +86,8 @@ struct Data {
   Vector tmp_n2;                 // n
   Vector tmp_s;                  // s
   Vector tmp_k;                  // k
+  Vector tmp_s2;                 // s
+  Vector projection_scale;       // s, ratio of each constraint's gradient to its row of b (compute_projection)
   Matrix bWt;                    // n x s, (b A^(-1/2))^T
   Matrix b_dep;                  // s x s, columns of b of the dependent coordinates
   Matrix b_ind;                  // s x k, columns of b of the independent coordinates
