@@ -40,16 +40,50 @@ Status fail(Data& data, ConstraintLevel level, double t, double residual) {
   return Status::projection_failed;
 }
 
+// A row of b need only be parallel to the gradient of its constraint (the paper writes Appell's
+// as grad f / (2 z')). Along the first Newton step dx, a forward difference of the residual gives
+// grad r_j . dx; against b_j . dx it gives the factor between the two (it may change with the
+// state, so every Newton step measures it anew). Constraints whose row hardly moves along dx
+// keep the factor 1.
+void estimate_scale(const Model& model, Data& data, double t, double* q, double* v, ConstraintLevel level,
+                    double* x, double x_size, double step_size) {
+  const int n = model.n();
+  Vector& r = level == ConstraintLevel::position ? data.phi : data.f;
+  Vector& r0 = data.tmp_s2;
+  Vector& scale = data.projection_scale;
+  const Eigen::Index m = r.size();
+  r0.head(m) = r;
+  const double h = std::min(1.0, 1e-7 * std::max(1.0, x_size) / step_size);
+  for (int i = 0; i < n; ++i) x[i] += h * data.kkt_sol(i);
+  evaluate_residual(model, data, t, q, v, level);
+  for (int i = 0; i < n; ++i) x[i] -= h * data.kkt_sol(i);
+  Eigen::Index j = 0;
+  for (int i = 0; i < model.s(); ++i) {
+    if (!belongs_to(model.constraints[static_cast<std::size_t>(i)].level, level)) continue;
+    const double predicted = data.b.row(i).dot(data.kkt_sol.head(n));
+    const double actual = (r(j) - r0(j)) / h;
+    const double ratio = actual / predicted;
+    const bool measurable = std::abs(predicted) > 1e-8 * data.b.row(i).cwiseAbs().maxCoeff() * step_size &&
+                            std::abs(r(j) - r0(j)) > 1e-6 * std::abs(r0(j));
+    // Within the accuracy of the difference, 1 is 1: rows that are the gradients keep the exact
+    // Newton step (one step for a constraint linear in x).
+    // A difference lost in round-off keeps the factor measured before.
+    if (measurable && std::isfinite(ratio) && ratio != 0.0) scale(j) = std::abs(ratio - 1.0) > 1e-6 ? ratio : 1.0;
+    ++j;
+  }
+  r.head(m) = r0.head(m);
+}
+
 Status project_level(const Model& model, Data& data, double t, double* q, double* v, ConstraintLevel level,
                      const ProjectionOptions& options, int& iterations, double& change, double& residual) {
   const int n = model.n();
   const int s = model.s();
   const Vector& r = level == ConstraintLevel::position ? data.phi : data.f;
   double* x = level == ConstraintLevel::position ? q : v;
-  Vector& r_old = data.tmp_s2;
   Vector& scale = data.projection_scale;
-  Vector& x_old = data.tmp_n;
+  Vector& x_start = data.tmp_n2;
   scale.setOnes();
+  for (int i = 0; i < n; ++i) x_start(i) = x[i];
   iterations = 0;
   change = 0.0;
   residual = evaluate_residual(model, data, t, q, v, level);
@@ -61,14 +95,10 @@ Status project_level(const Model& model, Data& data, double t, double* q, double
     // right-hand side: their multiplier is zero and the matrix keeps the size make_data gave it.
     data.K.setZero();
     data.K.topLeftCorner(n, n) = data.A;
-    data.kkt_rhs.setZero();
-    Eigen::Index j = 0;
     for (int i = 0; i < s; ++i) {
       if (belongs_to(model.constraints[static_cast<std::size_t>(i)].level, level)) {
         data.K.row(n + i).head(n) = data.b.row(i);
         data.K.col(n + i).head(n) = data.b.row(i).transpose();
-        data.kkt_rhs(n + i) = -r(j) / scale(j);
-        ++j;
       } else {
         data.K(n + i, n + i) = 1.0;
       }
@@ -79,39 +109,37 @@ Status project_level(const Model& model, Data& data, double t, double* q, double
       data.failed_t = t;
       return Status::singular_system;
     }
-    data.kkt_sol = data.lu_kkt.solve(data.kkt_rhs);
+    for (int pass = 0; pass < 2; ++pass) {
+      data.kkt_rhs.setZero();
+      Eigen::Index j = 0;
+      for (int i = 0; i < s; ++i)
+        if (belongs_to(model.constraints[static_cast<std::size_t>(i)].level, level)) {
+          data.kkt_rhs(n + i) = -r(j) / scale(j);
+          ++j;
+        }
+      data.kkt_sol = data.lu_kkt.solve(data.kkt_rhs);
+      if (pass == 0) {
+        double step = 0.0, size = 0.0;
+        for (int i = 0; i < n; ++i) {
+          step = std::max(step, std::abs(data.kkt_sol(i)));
+          size = std::max(size, std::abs(x[i]));
+        }
+        if (!(step > 0.0)) break;
+        estimate_scale(model, data, t, q, v, level, x, size, step);
+      }
+    }
     double step = 0.0, size = 0.0;
     for (int i = 0; i < n; ++i) {
-      x_old(i) = x[i];
       x[i] += data.kkt_sol(i);
       step = std::max(step, std::abs(data.kkt_sol(i)));
       size = std::max(size, std::abs(x[i]));
     }
     ++iterations;
-    r_old.head(r.size()) = r;
-    const double previous = residual;
     residual = evaluate_residual(model, data, t, q, v, level);
-    // A row of b need only be parallel to the gradient of its constraint (the paper writes
-    // Appell's as grad f / (2 z')). The step predicted a change of -r_j / scale_j in b_j dx;
-    // the change f_j actually made gives the ratio of the two: a secant estimate of the factor.
     // Steps at the round-off of x cannot lower the residual any further.
-    const bool at_round_off = step <= 8.0 * std::numeric_limits<double>::epsilon() * size;
-    if (!at_round_off)
-      for (Eigen::Index i = 0; i < r.size(); ++i) {
-        const double ratio = (r_old(i) - r(i)) / r_old(i);
-        if (std::abs(r_old(i)) > options.tolerance && std::isfinite(ratio) && ratio != 0.0) scale(i) *= ratio;
-      }
-    if (!(residual < previous)) {
-      // No progress: take the step back, and try again with the corrected factors unless the
-      // step was round-off already.
-      for (int i = 0; i < n; ++i) x[i] = x_old(i);
-      residual = evaluate_residual(model, data, t, q, v, level);
-      if (at_round_off) break;
-      continue;
-    }
-    change = std::max(change, step);
-    if (at_round_off) break;
+    if (step <= 64.0 * std::numeric_limits<double>::epsilon() * size) break;
   }
+  for (int i = 0; i < n; ++i) change = std::max(change, std::abs(x[i] - x_start(i)));
   return Status::ok;
 }
 

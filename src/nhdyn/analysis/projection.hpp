@@ -9,8 +9,8 @@
 // with J the rows of b that belong to the constraints of that level (b = dphi/dq for a position
 // constraint, df/dq' for a position or velocity one, FORMULATION.md §2), so no inverse of A is
 // formed. A row of b need only be parallel to its constraint's gradient (a model may scale it, as
-// the paper does Appell's); the factor is estimated by a secant from the residual each step
-// actually leaves, and a step that does not lower the residual is taken back and redone with it.
+// the paper does Appell's); the factor is estimated at every Newton step by a forward difference
+// of the residual along the step, which is then solved again with it.
 // When the rows are the gradients, constraints linear in the velocities converge in one step.
 #pragma once
 
@@ -24,7 +24,7 @@ struct ProjectionOptions {
   // A level counts as satisfied when every residual is at most this, or when Newton's steps
   // have shrunk to round-off of the coordinates (the residual then is as small as doubles allow).
   double tolerance = 1e-13;
-  int max_iterations = 20;  // Newton steps per level
+  int max_iterations = 10;  // Newton steps per level
 };
 
 struct ProjectionResult {
