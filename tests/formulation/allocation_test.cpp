@@ -7,6 +7,7 @@
 #include <new>
 #include <vector>
 
+#include "nhdyn/analysis/projection.hpp"
 #include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/model/appell.hpp"
@@ -103,6 +104,35 @@ TEST(Allocation, AccelerationSolveAllocatesNothingAfterTheFirstCall) {
         g_counting = false;
         EXPECT_EQ(g_allocations.load(), 0) << model.name << " " << method_name(m) << "/" << complement_name(c);
       }
+  }
+}
+
+TEST(Allocation, StabilizationAllocatesNothing) {
+  // Baumgarte inside the solve, and projection of states that are off the constraints (Appell's
+  // scaled row takes several Newton steps with the forward-difference factor).
+  for (const Model& model : {make_sled_model(), make_appell_model()}) {
+    Data data = make_data(model);
+    FormulationOptions options{Method::sanh, Complement::qr};
+    options.baumgarte.enabled = true;
+    Vector q(3), v(3);
+    q << 0.1, 0.2, 0.3;
+    v << 0.5, 0.6, 0.7;
+    ASSERT_EQ(compute_dynamics(model, data, options, 0.0, q.data(), v.data()), Status::ok);
+    ProjectionResult result;
+    ASSERT_EQ(compute_projection(model, data, 0.0, q.data(), v.data(), ProjectionOptions{}, result), Status::ok);
+    g_allocations = 0;
+    g_counting = true;
+    long iterations = 0;
+    for (int i = 0; i < 10; ++i) {
+      v(0) += 0.01;
+      v(2) += 0.02;
+      compute_dynamics(model, data, options, 0.1 * i, q.data(), v.data());
+      compute_projection(model, data, 0.1 * i, q.data(), v.data(), ProjectionOptions{}, result);
+      iterations += result.velocity_iterations;
+    }
+    g_counting = false;
+    EXPECT_EQ(g_allocations.load(), 0) << model.name;
+    EXPECT_GE(iterations, 10) << model.name << ": the projections had nothing to do";
   }
 }
 
