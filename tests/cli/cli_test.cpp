@@ -24,6 +24,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+
+#include "nhdyn/io/csv.hpp"
 #include <iterator>
 #include <optional>
 #include <regex>
@@ -580,6 +582,33 @@ TEST_P(CliBadInput, LeavesAnExistingOutputFileUntouched) {
 
 const std::string o = "-o", out = "out.csv";
 
+TEST(CliCompare, RunsEveryCaseAndWritesTableAndSeries) {
+  ScratchDir dir;
+  const RunResult r = nhdyn({"compare", "sled", "--t-end", "1", "--methods", "sanh,lagrange", "--integrators",
+                             "dopri5,rk4", "-o", "cmp.csv"},
+                            dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nhdyn::CsvTable series = nhdyn::load_csv(dir / "cmp-series.csv");
+  EXPECT_EQ(series.header.size(), 1u + 4u * 2u);  // t, then error and velocity residual per case
+  EXPECT_EQ(series.rows.size(), 101u);
+  std::ifstream table(dir / "cmp.csv");
+  std::string line;
+  int lines = 0;
+  while (std::getline(table, line)) ++lines;
+  EXPECT_EQ(lines, 5);  // header and four cases
+  EXPECT_TRUE(contains(r.out, "udwadia") == false);
+  EXPECT_TRUE(contains(r.out, "rk4"));
+}
+
+TEST(CliCompare, AnalyticReferenceWithoutAnAnalyticSolutionIsRefused) {
+  ScratchDir dir;
+  const RunResult r = nhdyn({"compare", "appell", "--reference", "analytic", "-o", "cmp.csv"}, dir.path());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(contains(r.err, "no analytic solution")) << r.err;
+  EXPECT_TRUE(contains(r.err, "--reference tight")) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "cmp.csv"));
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Cases, CliBadInput,
     ::testing::Values(
@@ -592,6 +621,13 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"output_step_zero", {"appell", "--output-step", "0", o, out}, {"step 0"}},
         BadInput{"too_many_rows", {"appell", "--t-end", "1e9", "--output-step", "1", o, out}, {"1000000000|1e+09"}},
         BadInput{"rtol_zero", {"appell", "--rtol", "0", o, out}, {"rtol = 0|--rtol 0"}},
+        BadInput{"stabilize_unknown", {"sled", "--stabilize", "magic", o, out}, {"magic", "baumgarte", "projection"}},
+        BadInput{"baumgarte_alpha_negative",
+                 {"sled", "--stabilize", "baumgarte", "--baumgarte-alpha", "-1", o, out}, {"alpha", "-1"}},
+        BadInput{"baumgarte_beta_nan", {"sled", "--stabilize", "baumgarte", "--baumgarte-beta", "nan", o, out},
+                 {"beta"}},
+        BadInput{"projection_tolerance_zero",
+                 {"sled", "--stabilize", "projection", "--projection-tolerance", "0", o, out}, {"tolerance"}},
         BadInput{"rtol_negative", {"appell", "--rtol", "-1e-6", o, out}, {"-1e-06|-1e-6"}},
         BadInput{"rtol_below_double_precision", {"appell", "--rtol", "1e-16", o, out}, {"1e-16"}},
         BadInput{"atol_zero", {"appell", "--atol", "0", o, out}, {"atol = 0|--atol 0"}},

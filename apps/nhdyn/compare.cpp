@@ -1,0 +1,170 @@
+// `nhdyn compare MODEL`: the formulations and integrators side by side on one model, against one
+// reference (analysis/comparison.hpp). Prints a table, writes it as CSV, writes the error and the
+// residuals against time as a second CSV, and plots them on a log scale.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "model_source.hpp"
+#include "nhdyn/analysis/comparison.hpp"
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/io/atomic_file.hpp"
+#include "nhdyn/io/csv.hpp"
+#include "nhdyn/io/plot.hpp"
+
+namespace nhdyn::cli {
+namespace {
+
+struct CompareArgs {
+  std::string model;
+  std::string reference = "tight";
+  std::vector<std::string> methods{"sanh", "lagrange", "udwadia-kalaba", "nullspace"};
+  std::vector<std::string> integrators{"dopri5"};
+  std::string complement = "qr";
+  std::optional<double> t_end;
+  std::optional<double> output_step;
+  double rtol = 1e-8;
+  double atol = 1e-10;
+  std::string stabilize = "none";
+  std::vector<std::string> sets;
+  std::string output;
+  std::string plot;
+  bool quiet = false;
+};
+
+std::string case_name(const ComparisonCase& c) {
+  return fmt::format("{}_{}", method_name(c.method), integrator_name(c.integrator));
+}
+
+int run_compare(const CompareArgs& args) {
+  const ResolvedModel resolved = resolve_model(args.model, args.sets);
+  const Model& model = resolved.model;
+  if (args.reference == "analytic")
+    throw InputError(fmt::format("model '{}' gives no analytic solution, so --reference analytic cannot be used; "
+                                 "use --reference tight (a run at rtol 1e-13)",
+                                 model.name));
+  if (args.reference != "tight")
+    throw InputError(fmt::format("unknown reference '{}'; choose one of: tight, analytic", args.reference));
+
+  ComparisonOptions options;
+  options.run.t_end = args.t_end.value_or(model.defaults.t_end);
+  options.run.output_step = args.output_step.value_or(model.defaults.output_step);
+  options.run.formulation.complement = parse_complement(args.complement);
+  options.run.integrator.rtol = args.rtol;
+  options.run.integrator.atol = args.atol;
+  options.run.stabilization = parse_stabilization(args.stabilize);
+  for (const std::string& m : args.methods)
+    for (const std::string& i : args.integrators) options.cases.push_back({parse_method(m), parse_integrator(i)});
+
+  namespace fs = std::filesystem;
+  const fs::path table_path = args.output.empty() ? fs::path("results") / (model.name + "-compare.csv") : fs::path(args.output);
+  if (args.output.empty()) {
+    std::error_code ec;
+    fs::create_directories(table_path.parent_path(), ec);
+  }
+  fs::path series_path = table_path;
+  series_path.replace_filename(table_path.stem().string() + "-series.csv");
+  if (!args.plot.empty() && !gnuplot_available())
+    throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
+                    "or run without --plot");
+  AtomicFile table(table_path);  // both paths are checked before any run
+  std::vector<std::string> columns{"t"};
+  for (const ComparisonCase& c : options.cases) {
+    columns.push_back("error_" + case_name(c));
+    if (model.position_constraints() > 0) columns.push_back("residual_pos_" + case_name(c));
+    if (model.velocity_constraints() > 0) columns.push_back("residual_vel_" + case_name(c));
+  }
+  CsvWriter series(series_path, columns);
+
+  const Comparison result = compare_formulations(model, options);
+
+  std::string text =
+      "method,integrator,solve_ns,steps,rhs_evaluations,wall_time_s,max_residual_pos,max_residual_vel,"
+      "max_residual_acc,energy_drift,max_error_q,max_error_v,status\n";
+  for (const ComparisonResult& r : result.results) {
+    const SimulationSummary& s = r.summary;
+    text += fmt::format("{},{},{:.4g},{},{},{:.4g},{:.3e},{:.3e},{:.3e},{:.3e},{:.3e},{:.3e},{}\n",
+                        method_name(r.which.method), integrator_name(r.which.integrator), r.solve_ns, s.stats.steps,
+                        s.stats.rhs_evaluations, s.wall_time, s.max_position_residual, s.max_velocity_residual,
+                        s.max_acceleration_residual, s.energy_drift, r.max_error_q, r.max_error_v,
+                        s.status == Status::ok ? "ok" : std::string(describe(s.status)));
+  }
+  table.write(text);
+  std::vector<double> row;
+  for (std::size_t k = 0; k < result.times.size(); ++k) {
+    row.assign(1, result.times[k]);
+    for (const ComparisonResult& r : result.results) {
+      row.push_back(r.error[k]);
+      if (model.position_constraints() > 0) row.push_back(r.position_residual[k]);
+      if (model.velocity_constraints() > 0) row.push_back(r.velocity_residual[k]);
+    }
+    series.write_row(row);
+  }
+  series.commit();
+  table.commit();
+  if (!args.plot.empty()) {
+    PlotRequest request;
+    request.title = fmt::format("{}: error against the reference and constraint residuals", model.name);
+    request.csv = series_path;
+    request.residuals.assign(columns.begin() + 1, columns.end());
+    write_plot(request, args.plot);
+  }
+
+  if (!args.quiet) {
+    fmt::print("nhdyn compare {}: t = {:g} .. {:g} s, D: {}, rtol {:g}, atol {:g}, stabilization {}\n", model.name,
+               model.t0, options.run.t_end, args.complement, args.rtol, args.atol, args.stabilize);
+    fmt::print("reference: sanh, dopri5, rtol 1e-13, atol 1e-15 ({} steps)\n", result.reference.stats.steps);
+    auto level = [](double value, bool defined) { return defined ? fmt::format("{:.2e}", value) : std::string("-"); };
+    fmt::print("{:<15} {:<12} {:>9} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "method", "integrator",
+               "solve ns", "steps", "rhs", "wall ms", "res pos", "res vel", "drift", "err q", "err q'");
+    for (const ComparisonResult& r : result.results) {
+      const SimulationSummary& s = r.summary;
+      fmt::print("{:<15} {:<12} {:>9.1f} {:>8} {:>9} {:>9.3g} {:>9} {:>9} {:>9.2e} {:>9.2e} {:>9.2e}{}\n",
+                 method_name(r.which.method), integrator_name(r.which.integrator), r.solve_ns, s.stats.steps,
+                 s.stats.rhs_evaluations, s.wall_time * 1e3,
+                 level(s.max_position_residual, model.position_constraints() > 0),
+                 level(s.max_velocity_residual, model.velocity_constraints() > 0),
+                 s.energy_drift, r.max_error_q, r.max_error_v,
+                 s.status == Status::ok ? "" : fmt::format("  FAILED at t = {:.4g}: {}", s.t_reached, s.message));
+    }
+    fmt::print("table -> {}\nseries -> {}\n", table_path.string(), series_path.string());
+    if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
+  }
+  for (const ComparisonResult& r : result.results)
+    if (r.summary.status != Status::ok) return 1;
+  return 0;
+}
+
+}  // namespace
+
+std::function<int()> add_compare_command(CLI::App& app) {
+  auto args = std::make_shared<CompareArgs>();
+  CLI::App* cmd = app.add_subcommand("compare", "Run formulations and integrators side by side against a reference");
+  cmd->add_option("MODEL", args->model, "A model file (.toml) or a built-in model (see `nhdyn list`)")->required();
+  cmd->add_option("--reference", args->reference, "tight (a run at rtol 1e-13) | analytic (the model's)")
+      ->capture_default_str();
+  cmd->add_option("--methods", args->methods, "Formulations, comma-separated")->delimiter(',')->capture_default_str();
+  cmd->add_option("--integrators", args->integrators, "Integrators, comma-separated")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--complement", args->complement, "Where D comes from: qr | partition | analytic")
+      ->capture_default_str();
+  cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
+  cmd->add_option("--output-step", args->output_step, "Time between compared outputs [s] (default: the model's)");
+  cmd->add_option("--rtol", args->rtol, "Relative tolerance of every case")->capture_default_str();
+  cmd->add_option("--atol", args->atol, "Absolute tolerance of every case")->capture_default_str();
+  cmd->add_option("--stabilize", args->stabilize, "none | baumgarte | projection")->capture_default_str();
+  cmd->add_option("--set", args->sets, "Override a model file's parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("-o,--output", args->output, "Table CSV (default results/MODEL-compare.csv); the series "
+                                                "goes next to it as ...-series.csv");
+  cmd->add_option("--plot", args->plot, "PNG of the error and the residuals against time");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print no table");
+  return [args] { return run_compare(*args); };
+}
+
+}  // namespace nhdyn::cli

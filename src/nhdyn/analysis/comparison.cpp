@@ -1,0 +1,91 @@
+#include "nhdyn/analysis/comparison.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "nhdyn/core/error.hpp"
+
+namespace nhdyn {
+namespace {
+
+double max_abs(const Vector& v) { return v.size() > 0 ? v.cwiseAbs().maxCoeff() : 0.0; }
+
+double time_one_solve(const Model& model, const FormulationOptions& formulation, int samples) {
+  Data data = make_data(model);
+  if (compute_dynamics(model, data, formulation, model.t0, model.q0.data(), model.v0.data()) != Status::ok)
+    return std::numeric_limits<double>::quiet_NaN();
+  // The best of three batches: a batch that another process interrupted says nothing of the solve.
+  double best = std::numeric_limits<double>::infinity();
+  for (int batch = 0; batch < 3; ++batch) {
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < samples; ++i)
+      compute_dynamics(model, data, formulation, model.t0, model.q0.data(), model.v0.data());
+    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  return best / samples * 1e9;
+}
+
+}  // namespace
+
+Comparison compare_formulations(const Model& model, const ComparisonOptions& options) {
+  if (options.cases.empty()) throw InputError("compare needs at least one method and one integrator");
+  check_simulation_options(model, options.run);
+  Comparison out;
+  out.times = make_output_times(model.t0, options.run.t_end, options.run.output_step);
+  const std::size_t rows = out.times.size();
+  const int n = model.n();
+
+  SimulationOptions tight = options.run;
+  tight.formulation.method = Method::sanh;
+  tight.integrator.kind = IntegratorKind::dopri5;
+  tight.integrator.rtol = 1e-13;
+  tight.integrator.atol = 1e-15;
+  std::vector<double> ref(rows * static_cast<std::size_t>(2 * n), 0.0);
+  std::size_t row = 0;
+  out.reference = simulate(model, tight, [&](const Data& data) {
+    std::copy(data.q.data(), data.q.data() + n, ref.begin() + static_cast<std::ptrdiff_t>(row * 2 * n));
+    std::copy(data.v.data(), data.v.data() + n, ref.begin() + static_cast<std::ptrdiff_t>(row * 2 * n + n));
+    ++row;
+  });
+  if (out.reference.status != Status::ok)
+    throw ModelError(fmt::format("model '{}': the reference run (sanh, dopri5, rtol 1e-13) failed at t = {:.6g}: {}",
+                                 model.name, out.reference.t_reached, out.reference.message));
+
+  for (const ComparisonCase& c : options.cases) {
+    SimulationOptions run = options.run;
+    run.formulation.method = c.method;
+    run.integrator.kind = c.integrator;
+    ComparisonResult r;
+    r.which = c;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    r.error.assign(rows, nan);
+    r.position_residual.assign(rows, nan);
+    r.velocity_residual.assign(rows, nan);
+    FormulationOptions formulation = run.formulation;
+    formulation.baumgarte.enabled = run.stabilization == Stabilization::baumgarte;
+    r.solve_ns = time_one_solve(model, formulation, options.cost_samples);
+    row = 0;
+    r.summary = simulate(model, run, [&](const Data& data) {
+      const double* q_ref = ref.data() + row * 2 * n;
+      double eq = 0.0, ev = 0.0;
+      for (int i = 0; i < n; ++i) {
+        eq = std::max(eq, std::abs(data.q(i) - q_ref[i]));
+        ev = std::max(ev, std::abs(data.v(i) - q_ref[n + i]));
+      }
+      r.max_error_q = std::max(r.max_error_q, eq);
+      r.max_error_v = std::max(r.max_error_v, ev);
+      r.error[row] = std::max(eq, ev);
+      r.position_residual[row] = max_abs(data.phi);
+      r.velocity_residual[row] = max_abs(data.f);
+      ++row;
+    });
+    out.results.push_back(std::move(r));
+  }
+  return out;
+}
+
+}  // namespace nhdyn
