@@ -1,7 +1,7 @@
 // `nhdyn compare`: one model run by several formulations and integrators side by side, each
 // measured against one reference solution. The reference is a run at the tightest tolerances
 // (sanh, dopri5, rtol 1e-13, atol 1e-15); an analytic solution in the model file is the other
-// reference the CLI offers (docs/compare.md says where that stands).
+// reference the CLI offers; no model carries one yet (docs/cli.md, `nhdyn compare`).
 #pragma once
 
 #include <string>
