@@ -49,31 +49,48 @@ struct Solution {
   std::vector<GiNaC::numeric> qdd, R, lambda;
 };
 
+// The terms of one state as numbers: A (n x n, row-major), h = Q + G, b (s x n, row-major), b0.
+struct NumericTerms {
+  int n = 0, s = 0;
+  std::vector<GiNaC::numeric> A, h, b, b0;
+};
+
+NumericTerms evaluate_terms(const Derivation& d, const GiNaC::lst& values) {
+  NumericTerms out;
+  out.n = static_cast<int>(d.A.rows());
+  out.s = static_cast<int>(d.b.rows());
+  for (int i = 0; i < out.n; ++i) {
+    for (int j = 0; j < out.n; ++j) out.A.push_back(evaluate(d.A(i, j), values, fmt::format("A({},{})", i, j)));
+    out.h.push_back(evaluate(d.Q(i, 0), values, fmt::format("Q({})", i)) +
+                    evaluate(d.G(i, 0), values, fmt::format("G({})", i)));
+  }
+  for (int r = 0; r < out.s; ++r) {
+    for (int j = 0; j < out.n; ++j) out.b.push_back(evaluate(d.b(r, j), values, fmt::format("b({},{})", r, j)));
+    out.b0.push_back(evaluate(d.b0(r, 0), values, fmt::format("b0({})", r)));
+  }
+  return out;
+}
+
 // The KKT system at the current Digits, by Gaussian elimination with partial pivoting.
-Solution solve_at_current_digits(const Derivation& d, const GiNaC::lst& values) {
-  const int n = static_cast<int>(d.A.rows());
-  const int s = static_cast<int>(d.b.rows());
+Solution solve_at_current_digits(const NumericTerms& terms) {
+  const int n = terms.n;
+  const int s = terms.s;
   const int m = n + s;
+  const std::vector<GiNaC::numeric>& A = terms.A;
+  const std::vector<GiNaC::numeric>& h = terms.h;
   std::vector<std::vector<GiNaC::numeric>> K(static_cast<std::size_t>(m),
                                              std::vector<GiNaC::numeric>(static_cast<std::size_t>(m + 1), 0));
-  std::vector<GiNaC::numeric> A(static_cast<std::size_t>(n * n), 0), h(static_cast<std::size_t>(n), 0);
   const auto at = [&K](int i, int j) -> GiNaC::numeric& { return K[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]; };
   for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      A[static_cast<std::size_t>(i * n + j)] = evaluate(d.A(i, j), values, fmt::format("A({},{})", i, j));
-      at(i, j) = A[static_cast<std::size_t>(i * n + j)];
-    }
-    h[static_cast<std::size_t>(i)] = evaluate(d.Q(i, 0), values, fmt::format("Q({})", i)) +
-                                     evaluate(d.G(i, 0), values, fmt::format("G({})", i));
+    for (int j = 0; j < n; ++j) at(i, j) = A[static_cast<std::size_t>(i * n + j)];
     at(i, m) = h[static_cast<std::size_t>(i)];
   }
   for (int r = 0; r < s; ++r) {
     for (int j = 0; j < n; ++j) {
-      const GiNaC::numeric bij = evaluate(d.b(r, j), values, fmt::format("b({},{})", r, j));
-      at(n + r, j) = bij;
-      at(j, n + r) = bij;
+      at(n + r, j) = terms.b[static_cast<std::size_t>(r * n + j)];
+      at(j, n + r) = terms.b[static_cast<std::size_t>(r * n + j)];
     }
-    at(n + r, m) = -evaluate(d.b0(r, 0), values, fmt::format("b0({})", r));
+    at(n + r, m) = -terms.b0[static_cast<std::size_t>(r)];
   }
   for (int c = 0; c < m; ++c) {
     int pivot = c;
@@ -153,11 +170,50 @@ PreciseAcceleration calc_precise_acceleration(const Spec& spec, const Derivation
   Solution result, check;
   {
     DigitsScope scope(digits);
-    result = solve_at_current_digits(derivation, values);
+    result = solve_at_current_digits(evaluate_terms(derivation, values));
   }
   {
     DigitsScope scope(digits + 20);
-    check = solve_at_current_digits(derivation, values);
+    check = solve_at_current_digits(evaluate_terms(derivation, values));
+  }
+  PreciseAcceleration out;
+  out.digits = digits;
+  out.estimated_error = std::max(relative_difference(result.qdd, check.qdd), relative_difference(result.R, check.R));
+  out.qdd = std::move(result.qdd);
+  out.R = std::move(result.R);
+  out.lambda = std::move(result.lambda);
+  return out;
+}
+
+PreciseAcceleration calc_precise_solution(const Matrix& A, const Vector& h, const Matrix& b, const Vector& b0,
+                                          int digits) {
+  const int n = static_cast<int>(A.rows());
+  const int s = static_cast<int>(b.rows());
+  if (A.cols() != n || h.size() != n || b.cols() != n || b0.size() != s)
+    throw InputError(fmt::format("terms of inconsistent sizes: A {}x{}, Q + G {}, b {}x{}, b0 {}", A.rows(), A.cols(),
+                                 h.size(), b.rows(), b.cols(), b0.size()));
+  if (digits < 17)
+    throw InputError(fmt::format("{} digits is no more than double precision; ask for 17 or more", digits));
+  // The terms are exact rationals: elimination at either precision rounds only its own steps.
+  NumericTerms terms;
+  terms.n = n;
+  terms.s = s;
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) terms.A.push_back(exact_rational(A(i, j)));
+    terms.h.push_back(exact_rational(h(i)));
+  }
+  for (int r = 0; r < s; ++r) {
+    for (int j = 0; j < n; ++j) terms.b.push_back(exact_rational(b(r, j)));
+    terms.b0.push_back(exact_rational(b0(r)));
+  }
+  Solution result, check;
+  {
+    DigitsScope scope(digits);
+    result = solve_at_current_digits(terms);
+  }
+  {
+    DigitsScope scope(digits + 20);
+    check = solve_at_current_digits(terms);
   }
   PreciseAcceleration out;
   out.digits = digits;

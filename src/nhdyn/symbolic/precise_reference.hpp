@@ -18,6 +18,7 @@
 #include <span>
 #include <vector>
 
+#include "nhdyn/core/types.hpp"
 #include "nhdyn/symbolic/derivation.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 
@@ -49,6 +50,14 @@ struct PreciseAcceleration {
 PreciseAcceleration calc_precise_acceleration(const Spec& spec, const Derivation& derivation, double t,
                                               std::span<const double> q, std::span<const double> v,
                                               int digits = 50);
+
+// The same solve for terms given as doubles (A n x n, h = Q + G of size n, b s x n, b0 of size s),
+// each taken as the exact rational it stands for: the exact solution of the problem exactly as a
+// double-precision evaluation of the terms posed it. Against it, a formulation's error is that of
+// its solve alone; against calc_precise_acceleration, it includes the rounding of the terms.
+// Throws InputError for inconsistent sizes, non-finite terms or digits < 17, ModelError when singular.
+PreciseAcceleration calc_precise_solution(const Matrix& A, const Vector& h, const Matrix& b, const Vector& b0,
+                                          int digits = 50);
 
 // ||x - reference||_2 / ||reference||_2 computed at the precision of `reference` (x exact, as
 // rationals), rounded to double; ||x - reference||_2 when the reference is zero. Sizes must match.

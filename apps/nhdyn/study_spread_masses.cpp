@@ -1,0 +1,188 @@
+// `nhdyn study spread-masses [MODEL]`: the relative error of q'' and R of every formulation against
+// a 50-digit reference as the ratio of the largest to the smallest mass grows from 1 to 1e12
+// (studies/spread_masses.hpp, docs/studies/spread-masses.md). Prints the tables, writes them as
+// one CSV (one row per ratio) and draws the two plots, q'' and R, against the ratio on log-log axes.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model_source.hpp"
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/io/csv.hpp"
+#include "nhdyn/io/plot.hpp"
+#include "nhdyn/io/xy_plot.hpp"
+#include "nhdyn/studies/spread_masses.hpp"
+#include "study.hpp"
+
+namespace nhdyn::cli {
+namespace {
+
+struct SpreadMassesArgs {
+  std::string model = "examples/spread_masses.toml";
+  std::vector<double> ratios = SpreadMassesOptions{}.ratios;
+  int samples = SpreadMassesOptions{}.samples;
+  int digits = SpreadMassesOptions{}.digits;
+  std::string parameter = "ratio";
+  std::vector<std::string> sets;
+  std::string output = "results/spread-masses.csv";
+  std::string plot;
+  bool quiet = false;
+};
+
+// The plot of R goes beside the plot of q'': out.png -> out-reactions.png.
+std::filesystem::path reactions_plot_path(const std::filesystem::path& plot) {
+  std::filesystem::path out = plot;
+  out.replace_filename(plot.stem().string() + "-reactions" + plot.extension().string());
+  return out;
+}
+
+int run_spread_masses(const SpreadMassesArgs& args) {
+  // Options first, so that a bad value is reported before the model file is read.
+  SpreadMassesOptions options;
+  options.ratios = args.ratios;
+  options.samples = args.samples;
+  options.digits = args.digits;
+  options.parameter = args.parameter;
+  for (double ratio : options.ratios)
+    if (!(ratio > 0.0 && std::isfinite(ratio)))
+      throw InputError(fmt::format("--ratios: {} is not a positive number; give ratios such as 1,1e6,1e12", ratio));
+  if (args.samples < 1) throw InputError(fmt::format("--samples {}: give at least 1 state per ratio", args.samples));
+  if (args.digits < 20)
+    throw InputError(fmt::format("--digits {}: the reference needs 20 digits or more (default 50)", args.digits));
+  const symbolic::Spec spec = resolve_spec(args.model, args.sets);
+
+  namespace fs = std::filesystem;
+  const fs::path table_path = args.output;
+  if (table_path.has_parent_path()) {
+    std::error_code ec;
+    fs::create_directories(table_path.parent_path(), ec);
+  }
+  if (!args.plot.empty() && !gnuplot_available())
+    throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
+                    "or run without --plot");
+
+  // Every formulation the model allows, named before the run so that the CSV (its columns) is
+  // opened, and its directory proved writable, before anything is computed.
+  options.formulations = {{Method::sanh, Complement::qr}, {Method::sanh, Complement::partition}};
+  if (!spec.independent.empty() || spec.complement) options.formulations.push_back({Method::sanh, Complement::analytic});
+  for (Method m : {Method::lagrange, Method::udwadia_kalaba, Method::nullspace}) options.formulations.push_back({m, Complement::qr});
+  std::vector<std::string> columns{"ratio", "cond_A", "reference_error"};
+  std::vector<std::string> qdd_columns, R_columns, other_columns;
+  for (const StudyFormulation& f : options.formulations) {
+    const std::string label = formulation_label(f);
+    qdd_columns.push_back("error_qdd_" + label);
+    R_columns.push_back("error_R_" + label);
+  }
+  for (const char* prefix : {"solve_error_qdd_", "solve_error_R_", "residual_acc_"})
+    for (const StudyFormulation& f : options.formulations) other_columns.push_back(prefix + formulation_label(f));
+  columns.insert(columns.end(), qdd_columns.begin(), qdd_columns.end());
+  columns.insert(columns.end(), R_columns.begin(), R_columns.end());
+  columns.insert(columns.end(), other_columns.begin(), other_columns.end());
+  CsvWriter csv(table_path, columns);
+
+  const SpreadMasses study = study_spread_masses(spec, options);
+  std::vector<double> row;
+  for (std::size_t r = 0; r < study.ratios.size(); ++r) {
+    const SpreadMassesRatio& ratio = study.ratios[r];
+    row = {ratio.ratio, ratio.cond_A, ratio.reference_error};
+    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).error_qdd);
+    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).error_R);
+    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).solve_error_qdd);
+    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).solve_error_R);
+    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).residual);
+    csv.write_row(row);
+  }
+  csv.commit();
+
+  if (!args.plot.empty()) {
+    XyPlotRequest request;
+    request.csv = table_path;
+    request.x = "ratio";
+    request.x_label = "mass ratio (largest / smallest)";
+    // No apostrophes in the texts: gnuplot's quoted strings take none (q'' is written qdd).
+    request.title = fmt::format("{}: relative error of the accelerations qdd, {}-digit reference (max over {} states)",
+                                study.model, study.digits, study.states.size());
+    request.y = qdd_columns;
+    request.y_label = "|qdd - qdd_ref| / |qdd_ref|";
+    write_xy_plot(request, args.plot);
+    request.title = fmt::format("{}: relative error of the reactions R, {}-digit reference (max over {} states)",
+                                study.model, study.digits, study.states.size());
+    request.y = R_columns;
+    request.y_label = "|R - R_ref| / |R_ref|";
+    write_xy_plot(request, reactions_plot_path(args.plot));
+  }
+
+  if (!args.quiet) {
+    fmt::print("nhdyn study spread-masses {}: {} states per ratio, reference at {} digits (Lagrange system, "
+               "exact rationals)\n",
+               study.model, study.states.size(), study.digits);
+    const auto block = [&](const char* title, auto value) {
+      fmt::print("\n{}\n{:>8} {:>9}", title, "ratio", "cond(A)");
+      for (const StudyFormulation& f : study.formulations) fmt::print(" {:>14}", formulation_label(f));
+      fmt::print("\n");
+      for (std::size_t r = 0; r < study.ratios.size(); ++r) {
+        fmt::print("{:>8.0e} {:>9.1e}", study.ratios[r].ratio, study.ratios[r].cond_A);
+        for (std::size_t f = 0; f < study.formulations.size(); ++f) {
+          const SpreadMassesPoint& p = study.point(r, f);
+          if (p.failures > 0)
+            fmt::print(" {:>14}", "refused");
+          else
+            fmt::print(" {:>14.2e}", value(p));
+        }
+        fmt::print("\n");
+      }
+    };
+    block("relative error of q'' (max over the states)", [](const SpreadMassesPoint& p) { return p.error_qdd; });
+    block("relative error of R (max over the states)", [](const SpreadMassesPoint& p) { return p.error_R; });
+    block("relative error of q'' of the solve alone (against the exact solution of the rounded terms)",
+          [](const SpreadMassesPoint& p) { return p.solve_error_qdd; });
+    block("relative error of R of the solve alone", [](const SpreadMassesPoint& p) { return p.solve_error_R; });
+    block("acceleration-level residual max |b q'' + b0|", [](const SpreadMassesPoint& p) { return p.residual; });
+    for (std::size_t f = 0; f < study.formulations.size(); ++f)
+      for (std::size_t r = 0; r < study.ratios.size(); ++r)
+        if (study.point(r, f).failures > 0) {
+          fmt::print("\n{} refused {} of {} states from ratio {:g} on, first: {}\n", formulation_label(study.formulations[f]),
+                     study.point(r, f).failures, study.states.size(), study.ratios[r].ratio,
+                     describe(study.point(r, f).failure));
+          break;
+        }
+    double reference_error = 0.0;
+    for (const SpreadMassesRatio& r : study.ratios) reference_error = std::max(reference_error, r.reference_error);
+    fmt::print("\nreference: estimated relative error at most {:.1e} (against {} digits)\n", reference_error,
+               study.digits + 20);
+    fmt::print("table -> {}\n", table_path.string());
+    if (!args.plot.empty())
+      fmt::print("plots -> {}, {}\n", args.plot, reactions_plot_path(args.plot).string());
+  }
+  // A formulation that refuses a badly scaled system is one of the study's findings (printed
+  // and left as NaN in the CSV), not a failure of the command.
+  return 0;
+}
+
+}  // namespace
+
+std::function<int()> add_spread_masses_study(CLI::App& study) {
+  auto args = std::make_shared<SpreadMassesArgs>();
+  CLI::App* cmd = study.add_subcommand(
+      "spread-masses", "Accuracy of q'' and R of every formulation against a 50-digit reference as the masses spread");
+  cmd->add_option("MODEL", args->model, "A model file (.toml) with a parameter that spreads the masses")
+      ->capture_default_str();
+  cmd->add_option("--ratios", args->ratios, "Mass ratios, comma-separated")->delimiter(',')->capture_default_str();
+  cmd->add_option("--samples", args->samples, "States per ratio")->capture_default_str();
+  cmd->add_option("--digits", args->digits, "Decimal digits of the reference")->capture_default_str();
+  cmd->add_option("--parameter", args->parameter, "The model parameter that holds the mass ratio")
+      ->capture_default_str();
+  cmd->add_option("--set", args->sets, "Override a model file's parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("-o,--output", args->output, "Table CSV, one row per ratio")->capture_default_str();
+  cmd->add_option("--plot", args->plot,
+                  "PNG of the error of q'' against the ratio (log-log); that of R goes to NAME-reactions.png");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print no table");
+  return [args] { return run_spread_masses(*args); };
+}
+
+}  // namespace nhdyn::cli
