@@ -159,6 +159,33 @@ TEST(PreciseReference, DoubleFormulationsAgreeToRoundOffOnly) {
   }
 }
 
+TEST(PreciseReference, SolutionOfDoubleTermsIsTheExactOneOfThoseTerms) {
+  // Pendulum terms given as doubles: A = m I, Q + G = (0, -m g), b = 2 (x, y), b0 = 2 |v|^2. Its
+  // exact solution is the closed form above at those rationals (to 1e-30), and it differs from the
+  // reference of the spec only by the rounding of the terms (here exact but for m g and 2 |v|^2).
+  const numeric m = exact_rational(0.3);
+  const double x = 0.7, y = -1.05, vx = 0.9, vy = 0.45;
+  Matrix A = Matrix::Identity(2, 2) * 0.3;
+  Vector h(2);
+  h << 0.0, -0.3 * 9.81;
+  Matrix b(1, 2);
+  b << 2 * x, 2 * y;
+  Vector b0(1);
+  b0 << 2 * (vx * vx + vy * vy);
+  const PreciseAcceleration solution = calc_precise_solution(A, h, b, b0);
+  const numeric gd = exact_rational(-h(1)) / m;  // the g these rounded terms imply
+  const numeric mu = (-exact_rational(b0(0)) / 2 + exact_rational(y) * gd) / (exact_rational(x) * exact_rational(x) +
+                                                                         exact_rational(y) * exact_rational(y));
+  EXPECT_LT(relative(solution.qdd[0], mu * exact_rational(x)), 1e-30);
+  EXPECT_LT(relative(solution.qdd[1], -gd + mu * exact_rational(y)), 1e-30);
+  const Spec spec = pendulum_spec();
+  const PreciseAcceleration ref = calc_precise_acceleration(spec, derive(spec), 0.0, std::vector<double>{x, y},
+                                                            std::vector<double>{vx, vy});
+  EXPECT_LT(relative(solution.qdd[1], ref.qdd[1]), 1e-15);
+  EXPECT_GT(relative(solution.qdd[1], ref.qdd[1]), 1e-30) << "m g rounded in double should show";
+  EXPECT_THROW(calc_precise_solution(A, h, Matrix::Zero(1, 3), b0), InputError);
+}
+
 TEST(PreciseReference, RefusesBadInput) {
   const Spec spec = appell_spec();
   const Derivation derivation = derive(spec);
