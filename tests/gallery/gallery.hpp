@@ -35,18 +35,25 @@ inline Model load_example(const std::string& file, const std::vector<std::pair<s
   return symbolic::compile_model(spec);
 }
 
-// The model of examples/<file> with one piece of its text replaced: the deliberately wrong models
-// that show a test can fail (`from` must occur in the file exactly once).
-inline Model load_altered_example(const std::string& file, const std::string& from, const std::string& to) {
+// The model of examples/<file> with pieces of its text replaced, in order: the deliberately wrong
+// models that show a test can fail (each `from` must occur in the text exactly once).
+inline Model load_altered_example(const std::string& file,
+                                  const std::vector<std::pair<std::string, std::string>>& replacements) {
   std::ifstream in(example_path(file));
   std::stringstream buffer;
   buffer << in.rdbuf();
   std::string text = buffer.str();
-  const std::size_t at = text.find(from);
-  if (at == std::string::npos || text.find(from, at + 1) != std::string::npos)
-    throw std::logic_error("'" + from + "' is not in " + file + " exactly once");
-  text.replace(at, from.size(), to);
+  for (const auto& [from, to] : replacements) {
+    const std::size_t at = text.find(from);
+    if (at == std::string::npos || text.find(from, at + 1) != std::string::npos)
+      throw std::logic_error("'" + from + "' is not in " + file + " exactly once");
+    text.replace(at, from.size(), to);
+  }
   return symbolic::compile_model(load_model_string(text, file + " (altered)"));
+}
+
+inline Model load_altered_example(const std::string& file, const std::string& from, const std::string& to) {
+  return load_altered_example(file, {{from, to}});
 }
 
 // Options for a tight run: dopri5 at rtol 1e-10, atol 1e-12 (the files' own defaults).
