@@ -15,6 +15,7 @@ namespace {
 double max_abs(const Vector& v) { return v.size() > 0 ? v.cwiseAbs().maxCoeff() : 0.0; }
 
 double time_one_solve(const Model& model, const FormulationOptions& formulation, int samples) {
+  if (samples <= 0) return std::numeric_limits<double>::quiet_NaN();
   Data data = make_data(model);
   if (compute_dynamics(model, data, formulation, model.t0, model.q0.data(), model.v0.data()) != Status::ok)
     return std::numeric_limits<double>::quiet_NaN();
@@ -39,21 +40,35 @@ Comparison compare_formulations(const Model& model, const ComparisonOptions& opt
   const std::size_t rows = out.times.size();
   const int n = model.n();
 
-  SimulationOptions tight = options.run;
-  tight.formulation.method = Method::sanh;
-  tight.integrator.kind = IntegratorKind::dopri5;
-  tight.integrator.rtol = 1e-13;
-  tight.integrator.atol = 1e-15;
   std::vector<double> ref(rows * static_cast<std::size_t>(2 * n), 0.0);
   std::size_t row = 0;
-  out.reference = simulate(model, tight, [&](const Data& data) {
-    std::copy(data.q.data(), data.q.data() + n, ref.begin() + static_cast<std::ptrdiff_t>(row * 2 * n));
-    std::copy(data.v.data(), data.v.data() + n, ref.begin() + static_cast<std::ptrdiff_t>(row * 2 * n + n));
-    ++row;
-  });
-  if (out.reference.status != Status::ok)
-    throw ModelError(fmt::format("model '{}': the reference run (sanh, dopri5, rtol 1e-13) failed at t = {:.6g}: {}",
-                                 model.name, out.reference.t_reached, out.reference.message));
+  if (options.reference == Reference::analytic) {
+    if (!model.evaluator->has_solution())
+      throw InputError(fmt::format("model '{}' gives no analytic solution, so --reference analytic cannot be used; "
+                                   "give its exact motion in a [solution] table of the model file "
+                                   "(docs/model-format.md), or use --reference tight (a run at rtol 1e-13)",
+                                   model.name));
+    Data data = make_data(model);
+    std::vector<double> qva(static_cast<std::size_t>(3 * n));
+    for (row = 0; row < rows; ++row) {
+      model.evaluator->solution(out.times[row], data.scratch.data(), qva.data());
+      std::copy(qva.begin(), qva.begin() + 2 * n, ref.begin() + static_cast<std::ptrdiff_t>(row * 2 * n));
+    }
+  } else {
+    SimulationOptions tight = options.run;
+    tight.formulation.method = Method::sanh;
+    tight.integrator.kind = IntegratorKind::dopri5;
+    tight.integrator.rtol = 1e-13;
+    tight.integrator.atol = 1e-15;
+    out.reference = simulate(model, tight, [&](const Data& data) {
+      std::copy(data.q.data(), data.q.data() + n, ref.begin() + static_cast<std::ptrdiff_t>(row * 2 * n));
+      std::copy(data.v.data(), data.v.data() + n, ref.begin() + static_cast<std::ptrdiff_t>(row * 2 * n + n));
+      ++row;
+    });
+    if (out.reference.status != Status::ok)
+      throw ModelError(fmt::format("model '{}': the reference run (sanh, dopri5, rtol 1e-13) failed at t = {:.6g}: {}",
+                                   model.name, out.reference.t_reached, out.reference.message));
+  }
 
   for (const ComparisonCase& c : options.cases) {
     SimulationOptions run = options.run;

@@ -1,7 +1,7 @@
 // `nhdyn compare`: one model run by several formulations and integrators side by side, each
-// measured against one reference solution. The reference is a run at the tightest tolerances
-// (sanh, dopri5, rtol 1e-13, atol 1e-15); an analytic solution in the model file is the other
-// reference the CLI offers; no model carries one yet (docs/cli.md, `nhdyn compare`).
+// measured against one reference solution: a run at the tightest tolerances (sanh, dopri5,
+// rtol 1e-13, atol 1e-15), or the model's exact motion where it has one (Evaluator::solution: the
+// [solution] of a model file, docs/model-format.md; the built-in appell).
 #pragma once
 
 #include <string>
@@ -16,10 +16,16 @@ struct ComparisonCase {
   IntegratorKind integrator = IntegratorKind::dopri5;
 };
 
+enum class Reference {
+  tight,     // a run of sanh with dopri5 at rtol 1e-13, atol 1e-15
+  analytic,  // the model's exact solution
+};
+
 struct ComparisonOptions {
+  Reference reference = Reference::tight;
   SimulationOptions run;                // times, tolerances, complement, stabilization of every case
   std::vector<ComparisonCase> cases;    // each formulation x integrator to run
-  int cost_samples = 20000;             // acceleration solves timed per case
+  int cost_samples = 20000;             // acceleration solves timed per case (0: not timed, NaN)
 };
 
 // The result of one case.
@@ -36,12 +42,13 @@ struct ComparisonResult {
 
 struct Comparison {
   std::vector<double> times;             // the output times
-  SimulationSummary reference;           // the reference run
+  SimulationSummary reference;           // the reference run (empty for an analytic reference)
   std::vector<ComparisonResult> results; // in the order of options.cases
 };
 
-// Runs the reference, then every case. Throws InputError for bad options (as simulate does) and
-// ModelError when the reference run itself fails (naming why). A case that fails keeps its
+// Runs the reference, then every case. Throws InputError for bad options (as simulate does) or
+// an analytic reference for a model without a solution, and ModelError when the reference run
+// itself fails (naming why). A case that fails keeps its
 // summary's status and message; its error columns stop where it stopped (NaN after).
 Comparison compare_formulations(const Model& model, const ComparisonOptions& options);
 

@@ -40,7 +40,7 @@ using symbolic::SpecBuilder;
 const std::vector<std::string> top_level_keys = {
     "name",           "description", "coordinates", "parameters",  "kinetic_energy",
     "potential_energy", "forces",    "constraints", "independent", "complement",
-    "initial",        "simulation",  "plot"};
+    "initial",        "solution",    "simulation",  "plot"};
 const std::vector<std::string> parameter_keys = {"value", "unit"};
 const std::vector<std::string> constraint_keys = {"name", "position", "velocity", "acceleration"};
 const std::vector<std::string> initial_keys = {"t0", "position", "velocity"};
@@ -139,6 +139,7 @@ class Loader {
     if (const toml::node* constraints = root.get("constraints")) load_constraints(*constraints, builder);
     load_complement(root, builder);
     if (const toml::node* initial = root.get("initial")) load_initial(*initial, builder);
+    if (const toml::node* solution = root.get("solution")) load_solution(*solution, builder);
     if (const toml::node* simulation = root.get("simulation")) load_simulation(*simulation, builder);
     if (const toml::node* plot = root.get("plot")) load_plot(*plot, builder);
     return builder.build();
@@ -634,6 +635,18 @@ class Loader {
       if (q0[i].given) located(*q0[i].node, [&] { builder.initial(c, q0[i].text, "0", q0[i].where); });
       if (v0[i].given) located(*v0[i].node, [&] { builder.initial(c, q0[i].text, v0[i].text, v0[i].where); });
       else if (!q0[i].given) builder.initial(c, "0", "0", at(node));
+    }
+  }
+
+  // [solution]: q(t) per coordinate, expressions in t and the parameters.
+  void load_solution(const toml::node& node, SpecBuilder& builder) const {
+    const toml::table& table = table_of(node, "solution", "[solution] followed by x = \"x0 + v0*t\"");
+    for (const Entry& entry : in_file_order(table)) {
+      const std::string coordinate(entry.key->str());
+      coordinate_index(coordinate, at(*entry.key), "in [solution]");
+      const std::string text =
+          number_or_expression(*entry.value, fmt::format("solution.{}", coordinate), "\"x0 + v0*t\"");
+      located(*entry.value, [&] { builder.solution(coordinate, text, content_at(*entry.value)); });
     }
   }
 

@@ -2,6 +2,7 @@
 // target PNG, runs gnuplot on it through posix_spawnp (no shell) with stderr captured, and
 // renames gnuplot's output onto the target only when gnuplot succeeded.
 #include "nhdyn/io/plot.hpp"
+#include "nhdyn/io/xy_plot.hpp"
 
 #include <fcntl.h>
 #include <fmt/format.h>
@@ -16,6 +17,7 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <string_view>
 #include <system_error>
@@ -559,6 +561,57 @@ std::string quoted_stderr(const std::string& text) {
   return tail.empty() ? "(gnuplot wrote nothing on stderr)" : tail;
 }
 
+// The part every plot shares: writes the script that `script(output)` returns next to `png`, runs
+// gnuplot on it, and renames gnuplot's output (a temporary file) onto `target` = absolute `png`
+// only when gnuplot succeeded. `csv` is named in the error messages.
+void render(const fs::path& png, const fs::path& target, const fs::path& csv,
+            const std::function<std::string(const fs::path& output)>& script) {
+  std::error_code ec;
+  if (fs::is_directory(target, ec)) {
+    throw FileError(
+        fmt::format("cannot write the plot to '{}': it is a directory; give a file "
+                    "name such as '{}'",
+                    png.string(), (png / "plot.png").string()));
+  }
+  if (!gnuplot_available()) {
+    throw FileError(
+        fmt::format("cannot plot into '{}': gnuplot is not installed or has no PNG terminal; {}",
+                    png.string(), install_hint));
+  }
+
+  const fs::path directory = target.parent_path();
+  const std::string base = target.filename().string();
+  TempFile output(directory, base, ".tmp");
+  output.close();  // gnuplot opens it by name
+  TempFile script_file(directory, base, ".gp");
+  write_all(script_file.fd(), script(output.path()), script_file.path());
+  script_file.close();
+
+  // -d: ignore the user's ~/.gnuplot, so the picture does not depend on who draws it.
+  const GnuplotRun run = run_gnuplot({"-d", script_file.path().string()});
+  if (!run.exited || run.code != 0) {
+    throw FileError(fmt::format(
+        "gnuplot failed to draw '{}' from '{}' ({} {}); check that the CSV holds numeric rows. "
+        "gnuplot said:\n{}",
+        png.string(), csv.string(), run.exited ? "exit status" : "killed by signal",
+        run.code, quoted_stderr(run.stderr_text)));
+  }
+  if (fs::file_size(output.path(), ec) == 0 || ec) {
+    throw FileError(
+        fmt::format("gnuplot exited normally but wrote no image for '{}'; gnuplot "
+                    "said:\n{}",
+                    png.string(), quoted_stderr(run.stderr_text)));
+  }
+  fs::rename(output.path(), target, ec);
+  if (ec) {
+    throw FileError(
+        fmt::format("cannot move the finished plot onto '{}' ({}); check that it "
+                    "is writable",
+                    png.string(), ec.message()));
+  }
+  output.keep();
+}
+
 }  // namespace
 
 bool gnuplot_available() {
@@ -624,50 +677,74 @@ void write_plot(const PlotRequest& request, const std::filesystem::path& png) {
     in.stride = (head.rows + max_rows_per_curve - 1) / max_rows_per_curve;
   }
 
-  if (fs::is_directory(target, ec)) {
-    throw FileError(
-        fmt::format("cannot write the plot to '{}': it is a directory; give a file "
-                    "name such as '{}'",
-                    png.string(), (png / "plot.png").string()));
-  }
-  if (!gnuplot_available()) {
-    throw FileError(
-        fmt::format("cannot plot into '{}': gnuplot is not installed or has no PNG terminal; {}",
-                    png.string(), install_hint));
-  }
+  render(png, target, request.csv, [&](const fs::path& output) {
+    in.output = output;
+    return make_script(in);
+  });
+}
 
-  const fs::path directory = target.parent_path();
-  const std::string base = target.filename().string();
-  TempFile output(directory, base, ".tmp");
-  output.close();  // gnuplot opens it by name
-  TempFile script(directory, base, ".gp");
-  in.output = output.path();
-  write_all(script.fd(), make_script(in), script.path());
-  script.close();
+}  // namespace nhdyn
 
-  // -d: ignore the user's ~/.gnuplot, so the picture does not depend on who draws it.
-  const GnuplotRun run = run_gnuplot({"-d", script.path().string()});
-  if (!run.exited || run.code != 0) {
-    throw FileError(fmt::format(
-        "gnuplot failed to draw '{}' from '{}' ({} {}); check that the CSV holds numeric rows. "
-        "gnuplot said:\n{}",
-        png.string(), request.csv.string(), run.exited ? "exit status" : "killed by signal",
-        run.code, quoted_stderr(run.stderr_text)));
-  }
-  if (fs::file_size(output.path(), ec) == 0 || ec) {
-    throw FileError(
-        fmt::format("gnuplot exited normally but wrote no image for '{}'; gnuplot "
-                    "said:\n{}",
-                    png.string(), quoted_stderr(run.stderr_text)));
-  }
-  fs::rename(output.path(), target, ec);
-  if (ec) {
-    throw FileError(
-        fmt::format("cannot move the finished plot onto '{}' ({}); check that it "
-                    "is writable",
-                    png.string(), ec.message()));
-  }
-  output.keep();
+namespace nhdyn {
+
+void write_xy_plot(const XyPlotRequest& request, const std::filesystem::path& png) {
+  if (request.y.empty())
+    throw InputError(fmt::format("nothing to plot into '{}': the request names no y column", png.string()));
+  std::error_code ec;
+  const fs::path csv = fs::absolute(request.csv, ec);
+  if (ec) throw FileError(fmt::format("cannot resolve the CSV path '{}' ({})", request.csv.string(), ec.message()));
+  const fs::path target = fs::absolute(png, ec);
+  if (ec) throw FileError(fmt::format("cannot resolve the plot path '{}' ({})", png.string(), ec.message()));
+  const CsvHead head = read_csv_head(request.csv);
+  const int x = column_of(head, request.csv, request.x, "x");
+  std::vector<Column> ys;
+  for (const std::string& name : request.y) ys.push_back(Column{column_of(head, request.csv, name, "y"), name});
+
+  render(png, target, request.csv, [&](const fs::path& output) {
+    // Values without a logarithm become NaN, which gnuplot skips; a first pass (stats) finds
+    // whether anything is left to draw on each logarithmic axis.
+    const auto value = [](int column, bool log) {
+      return log ? fmt::format("(column({0}) > 0 ? column({0}) : NaN)", column) : fmt::format("(column({}))", column);
+    };
+    std::string s;
+    s += "# Written by nhdyn (src/nhdyn/io/plot.cpp, write_xy_plot) for one plot; deleted after the run.\n";
+    s += "set encoding utf8\n";
+    s += "if (strstrt(' '.GPVAL_TERMINALS.' ', ' pngcairo ') > 0) {\n";
+    s += "  set terminal pngcairo size 1000,700 font 'Sans,10' noenhanced\n";
+    s += "} else {\n";
+    s += "  set terminal png size 1000,700 noenhanced\n";
+    s += "}\n";
+    s += "set termoption noenhanced\n";
+    s += fmt::format("csv_file = {}\n", gp_string(csv.string()));
+    s += fmt::format("output_file = {}\n", gp_string(output.string()));
+    s += "set output output_file\n";
+    s += "set datafile separator comma\n";
+    s += "set grid\n";
+    s += "set key outside right top vertical\n";
+    s += fmt::format("set title {}\n", gp_label(request.title));
+    s += fmt::format("set xlabel {}\nset ylabel {}\n", gp_label(request.x_label.empty() ? request.x : request.x_label),
+                     gp_label(request.y_label));
+    const std::string skip = fmt::format(" skip {}", head.header_lines);
+    if (request.log_x) {
+      s += fmt::format("stats csv_file{0} using (largest = 0, largest = (column({1}) > largest ? column({1}) : largest)) "
+                       "nooutput\n", skip, x);
+      s += "if (STATS_max > 0) { set logscale x; set format x '1e%L' }\n";
+    }
+    if (request.log_y) {
+      std::string largest = "largest = 0";
+      for (const Column& c : ys)
+        largest += fmt::format(", largest = (column({0}) > largest ? column({0}) : largest)", c.index);
+      s += fmt::format("stats csv_file{} using ({}, largest) nooutput\n", skip, largest);
+      s += "if (STATS_max > 0) { set logscale y; set format y '1e%L' }\n";
+    }
+    std::vector<std::string> clauses;
+    for (const Column& c : ys)
+      clauses.push_back(plot_clause(skip, fmt::format("{}:{}", value(x, request.log_x), value(c.index, request.log_y)),
+                                    "linespoints", c.name));
+    s += join_clauses(clauses);
+    s += "set output\n";
+    return s;
+  });
 }
 
 }  // namespace nhdyn

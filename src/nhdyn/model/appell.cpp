@@ -7,7 +7,12 @@ namespace {
 
 class AppellEvaluator final : public Evaluator {
  public:
-  explicit AppellEvaluator(const AppellParameters& p) : p_(p) {}
+  AppellEvaluator(const AppellParameters& p, double t0, const Vector& q0, const Vector& v0) : p_(p), t0_(t0) {
+    for (int i = 0; i < 3; ++i) {
+      q0_[i] = q0[i];
+      v0_[i] = v0[i];
+    }
+  }
 
   void terms(double, const double*, const double* v, double*, const TermsOut& out) const override {
     const double m = p_.m;
@@ -46,8 +51,28 @@ class AppellEvaluator final : public Evaluator {
     return 0.5 * p_.m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) - p_.m * p_.g * q[2];
   }
 
+  // docs/derivations/appell.md section 3.1 (falling branch, z' > 0): the horizontal velocity keeps
+  // its direction e and its length grows at c = g a / (1 + a^2); z' = a u throughout.
+  bool has_solution() const override { return true; }
+  void solution(double t, double*, double* qva) const override {
+    const double u0 = std::hypot(v0_[0], v0_[1]);
+    const double c = p_.g * p_.a / (1.0 + p_.a * p_.a);
+    const double e[2] = {v0_[0] / u0, v0_[1] / u0};
+    const double tau = t - t0_;
+    const double s = u0 * tau + 0.5 * c * tau * tau;  // horizontal distance travelled
+    const double u = u0 + c * tau;
+    const double direction[3] = {e[0], e[1], p_.a};
+    for (int i = 0; i < 3; ++i) {
+      qva[i] = q0_[i] + direction[i] * s;
+      qva[3 + i] = direction[i] * u;
+      qva[6 + i] = direction[i] * c;
+    }
+  }
+
  private:
   AppellParameters p_;
+  double t0_;
+  double q0_[3], v0_[3];  // the initial state the solution starts from
 };
 
 }  // namespace
@@ -65,7 +90,7 @@ Model make_appell_model(const AppellParameters& p) {
   model.v0 << 1.0, 0.5, p.a * std::sqrt(1.0 + 0.25);
   model.defaults = {10.0, 0.01};
   model.path = PlanarPath{0, 1};
-  model.evaluator = std::make_shared<AppellEvaluator>(p);
+  model.evaluator = std::make_shared<AppellEvaluator>(p, model.t0, model.q0, model.v0);
   return model;
 }
 

@@ -15,6 +15,7 @@ struct AppellParameters {
 };
 
 // Initial state: at the origin with horizontal velocity (1, 0.5) m/s and z' = a |(x', y')| > 0.
+// The model carries its exact motion from that state (Evaluator::solution).
 Model make_appell_model(const AppellParameters& p = {});
 
 }  // namespace nhdyn

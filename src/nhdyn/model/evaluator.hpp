@@ -1,6 +1,6 @@
 // The numeric face of a mechanical system: at (t, q, q') an Evaluator yields the terms of the
 // equations of motion (A, Q, G, b, b0), optionally an analytic complement D, the residuals of the
-// constraints at the level they were given, and the energy. Built-in C++ models implement it by
+// constraints at the level they were given, the energy, and optionally a known exact solution. Built-in C++ models implement it by
 // hand; model files (through the symbolic compiler) and generated code are other implementations.
 // It is stateless: any workspace it needs is the `scratch` array that Data owns.
 #pragma once
@@ -50,6 +50,12 @@ class Evaluator {
                         double* /*scratch*/) const {
     return 0.0;
   }
+
+  // Whether solution() is defined: the model knows its exact motion from its own initial state
+  // (a closed form), which `nhdyn compare --reference analytic` measures the runs against.
+  virtual bool has_solution() const { return false; }
+  // q(t), q'(t) and q''(t) one after the other in `qva` (3 n values).
+  virtual void solution(double /*t*/, double* /*scratch*/, double* /*qva*/) const {}
 };
 
 }  // namespace nhdyn

@@ -383,6 +383,11 @@ ProgramEvaluator::ProgramEvaluator(int n, int s, ModelPrograms programs)
   check_program(programs_.position_residual, "position residual", n, -1);
   check_program(programs_.velocity_residual, "velocity residual", n, -1);
   if (programs_.energy) check_program(*programs_.energy, "energy", n, 1);
+  if (programs_.solution) {
+    check_program(*programs_.solution, "solution", n, 3 * n);
+    if (programs_.solution->reads_coordinates() || programs_.solution->reads_velocities())
+      throw std::invalid_argument("ProgramEvaluator: the solution program reads the state; it may read only t");
+  }
   if (programs_.position_residual.reads_velocities())
     throw std::invalid_argument("ProgramEvaluator: the position residual program reads velocities");
   if (programs_.position_residual.outputs() > s || programs_.velocity_residual.outputs() > s ||
@@ -397,6 +402,7 @@ ProgramEvaluator::ProgramEvaluator(int n, int s, ModelPrograms programs)
   widen(programs_.position_residual);
   widen(programs_.velocity_residual);
   if (programs_.energy) widen(*programs_.energy);
+  if (programs_.solution) widen(*programs_.solution);
   scratch_ = largest;
 
   terms_ = prepare(programs_.terms, {n * n, n, n, s * n, s});
@@ -404,6 +410,7 @@ ProgramEvaluator::ProgramEvaluator(int n, int s, ModelPrograms programs)
   position_residual_ = prepare(programs_.position_residual, {programs_.position_residual.outputs()});
   velocity_residual_ = prepare(programs_.velocity_residual, {programs_.velocity_residual.outputs()});
   if (programs_.energy) energy_ = prepare(*programs_.energy, {1});
+  if (programs_.solution) solution_ = prepare(*programs_.solution, {3 * n});
   terms_function_ = terms_.calls ? choose_terms<true>(n, s) : choose_terms<false>(n, s);
 }
 
@@ -682,6 +689,11 @@ double ProgramEvaluator::energy(double t, const double* q, const double* v, doub
   double e = 0.0;
   run(energy_, t, q, v, scratch, &e);
   return e;
+}
+
+void ProgramEvaluator::solution(double t, double* scratch, double* qva) const {
+  if (!programs_.solution) return;
+  run(solution_, t, nullptr, nullptr, scratch, qva);
 }
 
 }  // namespace nhdyn

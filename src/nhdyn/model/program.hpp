@@ -159,6 +159,7 @@ struct ModelPrograms {
   Program position_residual;         // outputs: phi (p); reads no velocity
   Program velocity_residual;         // outputs: f (r)
   std::optional<Program> energy;     // one output: T + V
+  std::optional<Program> solution;   // outputs: q (n), q' (n), q'' (n) of the exact motion; reads only t
 };
 
 // An Evaluator that runs straight-line programs. Each program is prepared once, when the
@@ -196,6 +197,8 @@ class ProgramEvaluator final : public Evaluator {
   void velocity_residual(double t, const double* q, const double* v, double* scratch, double* f) const override;
   bool has_energy() const override { return programs_.energy.has_value(); }
   double energy(double t, const double* q, const double* v, double* scratch) const override;
+  bool has_solution() const override { return programs_.solution.has_value(); }
+  void solution(double t, double* scratch, double* qva) const override;
 
  private:
   // A program ready to run: its steps (destination 0 the registers, 1 + i the i-th output array),
@@ -228,7 +231,7 @@ class ProgramEvaluator final : public Evaluator {
   int s_ = 0;
   ModelPrograms programs_;
   std::size_t scratch_ = 0;
-  Prepared terms_, complement_, position_residual_, velocity_residual_, energy_;
+  Prepared terms_, complement_, position_residual_, velocity_residual_, energy_, solution_;
   TermsFunction terms_function_ = nullptr;
 };
 

@@ -87,6 +87,10 @@ struct Spec {
   SourceLocation complement_where;
   double t0 = 0.0;
   std::vector<GiNaC::ex> q0, v0;             // n initial values, expressions in the parameters
+  // Optional exact motion q(t) from the initial state, n expressions in t and the parameters
+  // (empty when the model gives none); compare --reference analytic measures runs against it.
+  std::vector<GiNaC::ex> solution;
+  std::vector<SourceLocation> solution_where;  // where each expression was written
   SimulationDefaults defaults;
   std::string method;                        // default formulation, "" = sanh
   std::string integrator;                    // default integrator, "" = dopri5

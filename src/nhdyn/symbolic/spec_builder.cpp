@@ -588,6 +588,7 @@ SpecBuilder& SpecBuilder::coordinate(const std::string& name, SourceLocation whe
   spec_.q0.resize(spec_.coordinates.size(), GiNaC::ex(0));
   spec_.v0.resize(spec_.coordinates.size(), GiNaC::ex(0));
   initial_given_.resize(spec_.coordinates.size(), false);
+  solution_given_.resize(spec_.coordinates.size(), false);
   return *this;
 }
 
@@ -769,6 +770,26 @@ SpecBuilder& SpecBuilder::initial(const std::string& coordinate, const std::stri
   return *this;
 }
 
+SpecBuilder& SpecBuilder::solution(const std::string& coordinate, const std::string& text, SourceLocation where) {
+  const int i = index_of(spec_.coordinates, coordinate);
+  if (i < 0)
+    fail(where, fmt::format("solution of '{}'", coordinate),
+         fmt::format("'{}' is not a coordinate{}", coordinate, did_you_mean(coordinate, spec_.coordinates)));
+  const Site site{text, where, fmt::format("solution of '{}'", coordinate)};
+  const Parsed parsed = read(spec_, site);
+  for (const Occurrence& o : parsed.symbols)
+    if (o.kind != SymbolKind::parameter && o.kind != SymbolKind::constant && o.kind != SymbolKind::time &&
+        parsed.value.has(o.symbol))
+      site.fail_at(o.position, fmt::format("a solution q(t) may depend on t and the parameters only, not on '{}'",
+                                           o.name));
+  spec_.solution.resize(spec_.coordinates.size(), GiNaC::ex(0));
+  spec_.solution_where.resize(spec_.coordinates.size());
+  spec_.solution[static_cast<std::size_t>(i)] = parsed.value;
+  spec_.solution_where[static_cast<std::size_t>(i)] = std::move(where);
+  solution_given_[static_cast<std::size_t>(i)] = true;
+  return *this;
+}
+
 SpecBuilder& SpecBuilder::initial_time(double t0) {
   if (!std::isfinite(t0)) fail(spec_.where, fmt::format("model '{}'", spec_.name), "the initial time is not finite");
   spec_.t0 = t0;
@@ -841,6 +862,16 @@ Spec SpecBuilder::build() const {
     fail(spec_.where, context,
          fmt::format("initial values are given for some coordinates but not for {}: give all or none "
                      "(none means all zero)",
+                     join(missing)));
+  }
+  const auto solved = static_cast<std::size_t>(std::count(solution_given_.begin(), solution_given_.end(), true));
+  if (solved != 0 && solved != solution_given_.size()) {
+    std::vector<std::string> missing;
+    for (std::size_t i = 0; i < solution_given_.size(); ++i)
+      if (!solution_given_[i]) missing.push_back(spec_.coordinates[i]);
+    fail(spec_.where, context,
+         fmt::format("the solution gives q(t) for some coordinates but not for {}: an exact motion needs "
+                     "every coordinate",
                      join(missing)));
   }
   Spec spec = spec_;

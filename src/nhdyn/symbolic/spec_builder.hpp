@@ -47,6 +47,10 @@ class SpecBuilder {
   SpecBuilder& initial(const std::string& coordinate, const std::string& q0, const std::string& v0,
                        SourceLocation where = {});
   SpecBuilder& initial_time(double t0);
+  // The exact motion of one coordinate, q(t), as an expression in t and the parameters (a closed
+  // form such as docs/derivations/appell.md gives). Velocity and acceleration are its derivatives.
+  // Give it for every coordinate or none; compile_model checks it against the initial state.
+  SpecBuilder& solution(const std::string& coordinate, const std::string& text, SourceLocation where = {});
   SpecBuilder& defaults(const SimulationDefaults& defaults);
   SpecBuilder& method(const std::string& name);
   SpecBuilder& integrator(const std::string& name);
@@ -54,13 +58,15 @@ class SpecBuilder {
   SpecBuilder& path(const std::string& x, const std::string& y);
 
   // Checks completeness (coordinates, a kinetic energy, fewer constraints than coordinates,
-  // names unique, initial values for all or none — none means zero) and returns the Spec.
+  // names unique, initial values for all or none — none means zero — and a solution for all
+  // coordinates or none) and returns the Spec.
   Spec build() const;
 
  private:
   Spec spec_;
   // Bookkeeping for the checks of build(), not part of the Spec.
   std::vector<bool> initial_given_;   // per coordinate: initial() was called for it
+  std::vector<bool> solution_given_;  // per coordinate: solution() was called for it
   SourceLocation independent_where_;  // where independent() was called
 };
 

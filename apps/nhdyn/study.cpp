@@ -1,0 +1,30 @@
+// `nhdyn study NAME`: the command that holds the studies (study.hpp); each study is a subcommand
+// defined in its own file.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "commands.hpp"
+#include "study.hpp"
+
+namespace nhdyn::cli {
+
+std::function<int()> add_study_command(CLI::App& app) {
+  CLI::App* cmd = app.add_subcommand("study", "Reproduce a study of docs/studies/ (table, CSV and plot)");
+  cmd->require_subcommand(1);
+  std::vector<std::pair<CLI::App*, std::function<int()>>> studies;
+  // One line per study: the subcommand it adds is the last one of `cmd`.
+  const auto add = [&](std::function<int()> (*adder)(CLI::App&)) {
+    std::function<int()> run = adder(*cmd);
+    studies.emplace_back(cmd->get_subcommands([](CLI::App*) { return true; }).back(), std::move(run));
+  };
+  add(add_error_relation_study);
+  add(add_spread_masses_study);
+  return [studies] {
+    for (const auto& [sub, run] : studies)
+      if (sub->parsed()) return run();
+    return 2;
+  };
+}
+
+}  // namespace nhdyn::cli

@@ -1,0 +1,17 @@
+// The studies behind docs/studies/: each `nhdyn study NAME` reproduces one published table and
+// plot from a single command. Every study registers itself under the `study` command through one
+// of these functions, defined in its own file (study_<name>.cpp).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace nhdyn::cli {
+
+// `nhdyn study error-relation`: global error against constraint residual (docs/studies/error-relation.md).
+std::function<int()> add_error_relation_study(CLI::App& study);
+// `nhdyn study spread-masses`: accelerations and reactions against a 50-digit reference as the
+// mass ratio grows (docs/studies/spread-masses.md).
+std::function<int()> add_spread_masses_study(CLI::App& study);
+
+}  // namespace nhdyn::cli

@@ -1,0 +1,188 @@
+// `nhdyn study error-relation [MODEL]`: for tolerances from 1e-3 to 1e-12, every formulation and
+// integrator against the model's exact solution — the global error beside the constraint
+// residuals (studies/error_relation.hpp, docs/studies/error-relation.md). Prints the table, writes
+// it as CSV (one row per run), a second CSV with one row per tolerance for the plot, and the plot.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model_source.hpp"
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/io/atomic_file.hpp"
+#include "nhdyn/io/csv.hpp"
+#include "nhdyn/io/plot.hpp"
+#include "nhdyn/io/xy_plot.hpp"
+#include "nhdyn/studies/error_relation.hpp"
+#include "study.hpp"
+
+namespace nhdyn::cli {
+namespace {
+
+struct ErrorRelationArgs {
+  std::string model = "appell";
+  std::vector<double> tolerances{1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12};
+  std::vector<std::string> methods;  // empty: every formulation the model allows
+  std::vector<std::string> integrators{"dopri5", "cvode-bdf", "cvode-adams"};
+  double atol_factor = 1.0;
+  std::optional<double> t_end;
+  std::optional<double> output_step;
+  std::vector<std::string> sets;
+  std::string output = "results/error-relation.csv";
+  std::string plot;
+  bool quiet = false;
+};
+
+StudyFormulation parse_formulation(const std::string& label) {
+  if (label == "sanh" || label == "sanh-qr") return {Method::sanh, Complement::qr};
+  if (label == "sanh-partition") return {Method::sanh, Complement::partition};
+  if (label == "sanh-analytic") return {Method::sanh, Complement::analytic};
+  if (label == "sanh-" || label.starts_with("sanh-"))
+    throw InputError(fmt::format("unknown formulation '{}'; sanh takes its D from qr, partition or analytic: "
+                                 "sanh-qr, sanh-partition, sanh-analytic",
+                                 label));
+  return {parse_method(label), Complement::qr};  // throws naming the valid methods
+}
+
+std::string run_label(const ErrorRelationRun& run) {
+  return fmt::format("{}_{}", formulation_label(run.formulation), integrator_name(run.integrator));
+}
+
+int run_error_relation(const ErrorRelationArgs& args) {
+  const ResolvedModel resolved = resolve_model(args.model, args.sets);
+  const Model& model = resolved.model;
+  ErrorRelationOptions options;
+  options.tolerances = args.tolerances;
+  options.atol_factor = args.atol_factor;
+  for (const std::string& m : args.methods) options.formulations.push_back(parse_formulation(m));
+  options.integrators.clear();
+  for (const std::string& i : args.integrators) options.integrators.push_back(parse_integrator(i));
+  options.t_end = args.t_end.value_or(0.0);
+  options.output_step = args.output_step.value_or(0.0);
+  if (args.t_end && !(*args.t_end > model.t0))
+    throw InputError(fmt::format("--t-end {} must be after the initial time {}", *args.t_end, model.t0));
+  if (args.output_step && !(*args.output_step > 0.0))
+    throw InputError(fmt::format("--output-step {} must be positive", *args.output_step));
+
+  namespace fs = std::filesystem;
+  const fs::path table_path = args.output;
+  fs::path series_path = table_path;
+  series_path.replace_filename(table_path.stem().string() + "-by-tolerance.csv");
+  if (table_path.has_parent_path()) {
+    std::error_code ec;
+    fs::create_directories(table_path.parent_path(), ec);
+  }
+  if (!args.plot.empty() && !gnuplot_available())
+    throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
+                    "or run without --plot");
+  AtomicFile table(table_path);  // both paths are checked before the runs
+
+  const ErrorRelation study = study_error_relation(model, options);
+  const bool pos = model.position_constraints() > 0;
+  const bool vel = model.velocity_constraints() > 0;
+
+  std::vector<std::string> columns{"tolerance"};
+  for (std::size_t f = 0; f < study.formulations.size(); ++f)
+    for (std::size_t i = 0; i < study.integrators.size(); ++i) {
+      const std::string label = run_label(study.run(f, i, 0));
+      columns.push_back("error_" + label);
+      if (vel) columns.push_back("residual_vel_" + label);
+      if (pos) columns.push_back("residual_pos_" + label);
+    }
+  CsvWriter series(series_path, columns);
+  std::vector<double> row;
+  for (std::size_t k = 0; k < study.tolerances.size(); ++k) {
+    row.assign(1, study.tolerances[k]);
+    for (std::size_t f = 0; f < study.formulations.size(); ++f)
+      for (std::size_t i = 0; i < study.integrators.size(); ++i) {
+        const ErrorRelationRun& r = study.run(f, i, k);
+        const bool ok = r.summary.status == Status::ok;
+        const double nan = std::nan("");
+        row.push_back(ok ? std::max(r.max_error_q, r.max_error_v) : nan);
+        if (vel) row.push_back(ok ? r.max_residual_vel : nan);
+        if (pos) row.push_back(ok ? r.max_residual_pos : nan);
+      }
+    series.write_row(row);
+  }
+
+  std::string text = "formulation,integrator,rtol,atol,max_error_q,max_error_v,max_residual_pos,max_residual_vel,"
+                     "steps,rhs_evaluations,status\n";
+  for (const ErrorRelationRun& r : study.runs)
+    text += fmt::format("{},{},{:.3g},{:.3g},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{}\n", formulation_label(r.formulation),
+                        integrator_name(r.integrator), r.tolerance, r.tolerance * args.atol_factor, r.max_error_q,
+                        r.max_error_v, r.max_residual_pos, r.max_residual_vel, r.summary.stats.steps,
+                        r.summary.stats.rhs_evaluations,
+                        r.summary.status == Status::ok ? "ok" : std::string(describe(r.summary.status)));
+  table.write(text);
+  series.commit();
+  table.commit();
+
+  if (!args.plot.empty()) {
+    XyPlotRequest request;
+    request.title = fmt::format("{}: global error against the {} (solid: error, per run: residuals)", model.name,
+                                study.analytic ? "exact solution" : "tight run");
+    request.csv = series_path;
+    request.x = "tolerance";
+    request.y.assign(columns.begin() + 1, columns.end());
+    request.x_label = "rtol";
+    request.y_label = "max over the run";
+    write_xy_plot(request, args.plot);
+  }
+
+  if (!args.quiet) {
+    const double t_end = args.t_end.value_or(model.defaults.t_end);
+    fmt::print("nhdyn study error-relation {}: t = {:g} .. {:g} s, atol = {:g} rtol, reference: {}\n", model.name,
+               model.t0, t_end, args.atol_factor,
+               study.analytic ? "the model's exact solution" : "sanh, dopri5, rtol 1e-13 (no exact solution)");
+    fmt::print("{:<16} {:<12} {:>7} {:>10} {:>10} {:>10} {:>10} {:>8}\n", "formulation", "integrator", "rtol",
+               "err q", "err q'", "res pos", "res vel", "steps");
+    for (const ErrorRelationRun& r : study.runs) {
+      const auto level = [](double value, bool defined) { return defined ? fmt::format("{:.2e}", value) : std::string("-"); };
+      fmt::print("{:<16} {:<12} {:>7.0e} {:>10.2e} {:>10.2e} {:>10} {:>10} {:>8}{}\n", formulation_label(r.formulation),
+                 integrator_name(r.integrator), r.tolerance, r.max_error_q, r.max_error_v, level(r.max_residual_pos, pos),
+                 level(r.max_residual_vel, vel), r.summary.stats.steps,
+                 r.summary.status == Status::ok ? "" : fmt::format("  FAILED at t = {:.4g}: {}", r.summary.t_reached,
+                                                                  r.summary.message));
+    }
+    fmt::print("table -> {}\nby tolerance -> {}\n", table_path.string(), series_path.string());
+    if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
+  }
+  for (const ErrorRelationRun& r : study.runs)
+    if (r.summary.status != Status::ok) return 1;
+  return 0;
+}
+
+}  // namespace
+
+std::function<int()> add_error_relation_study(CLI::App& study) {
+  auto args = std::make_shared<ErrorRelationArgs>();
+  CLI::App* cmd = study.add_subcommand("error-relation",
+                                       "Global error against constraint residual for a range of tolerances");
+  cmd->add_option("MODEL", args->model, "A model file (.toml) or a built-in model; one with an exact solution")
+      ->capture_default_str();
+  cmd->add_option("--tolerances", args->tolerances, "rtol of each run, comma-separated")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--methods", args->methods,
+                  "Formulations, comma-separated: sanh-qr, sanh-partition, sanh-analytic, lagrange, "
+                  "udwadia-kalaba, nullspace (default: all the model allows)")
+      ->delimiter(',');
+  cmd->add_option("--integrators", args->integrators, "Integrators, comma-separated")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--atol-factor", args->atol_factor, "atol of each run = this x rtol")->capture_default_str();
+  cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
+  cmd->add_option("--output-step", args->output_step, "Time between compared outputs [s] (default: the model's)");
+  cmd->add_option("--set", args->sets, "Override a model file's parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("-o,--output", args->output, "Table CSV, one row per run; the by-tolerance CSV goes next to it")
+      ->capture_default_str();
+  cmd->add_option("--plot", args->plot, "PNG of error and residuals against the tolerance (log-log)");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print no table");
+  return [args] { return run_error_relation(*args); };
+}
+
+}  // namespace nhdyn::cli
