@@ -122,14 +122,25 @@ int run_error_relation(const ErrorRelationArgs& args) {
   table.commit();
 
   if (!args.plot.empty()) {
+    // The relation itself: each run is a point (its residual, its error); the points of one
+    // formulation and integrator are joined in the order of the tolerances. On the diagonal the
+    // residual equals the error.
+    const std::string level = vel ? "vel" : "pos";
     XyPlotRequest request;
-    request.title = fmt::format("{}: global error against the {} (solid: error, per run: residuals)", model.name,
-                                study.analytic ? "exact solution" : "tight run");
+    request.title = fmt::format("{}: global error against the {} constraint residual, rtol {:g} .. {:g}", model.name,
+                                vel ? "velocity" : "position", study.tolerances.front(), study.tolerances.back());
     request.csv = series_path;
-    request.x = "tolerance";
-    request.y.assign(columns.begin() + 1, columns.end());
-    request.x_label = "rtol";
-    request.y_label = "max over the run";
+    for (std::size_t f = 0; f < study.formulations.size(); ++f)
+      for (std::size_t i = 0; i < study.integrators.size(); ++i) {
+        const std::string label = run_label(study.run(f, i, 0));
+        request.y.push_back("error_" + label);
+        request.x_of_curve.push_back(fmt::format("residual_{}_{}", level, label));
+        request.titles.push_back(fmt::format("{} {}", formulation_label(study.formulations[f]),
+                                             integrator_name(study.integrators[i])));
+      }
+    request.x_label = fmt::format("max |{} residual| over the run", vel ? "velocity" : "position");
+    request.y_label = study.analytic ? "max |error| against the exact solution" : "max |error| against a tight run";
+    request.diagonal = true;
     write_xy_plot(request, args.plot);
   }
 

@@ -696,9 +696,19 @@ void write_xy_plot(const XyPlotRequest& request, const std::filesystem::path& pn
   const fs::path target = fs::absolute(png, ec);
   if (ec) throw FileError(fmt::format("cannot resolve the plot path '{}' ({})", png.string(), ec.message()));
   const CsvHead head = read_csv_head(request.csv);
-  const int x = column_of(head, request.csv, request.x, "x");
-  std::vector<Column> ys;
-  for (const std::string& name : request.y) ys.push_back(Column{column_of(head, request.csv, name, "y"), name});
+  if (!request.x_of_curve.empty() && request.x_of_curve.size() != request.y.size())
+    throw InputError(fmt::format("plot '{}': {} x columns for {} curves; give one per curve or none", png.string(),
+                                 request.x_of_curve.size(), request.y.size()));
+  if (!request.titles.empty() && request.titles.size() != request.y.size())
+    throw InputError(fmt::format("plot '{}': {} titles for {} curves; give one per curve or none", png.string(),
+                                 request.titles.size(), request.y.size()));
+  std::vector<Column> xs, ys;
+  for (std::size_t i = 0; i < request.y.size(); ++i) {
+    const std::string& x_name = request.x_of_curve.empty() ? request.x : request.x_of_curve[i];
+    xs.push_back(Column{column_of(head, request.csv, x_name, "x"), x_name});
+    ys.push_back(Column{column_of(head, request.csv, request.y[i], "y"),
+                        request.titles.empty() ? request.y[i] : request.titles[i]});
+  }
 
   render(png, target, request.csv, [&](const fs::path& output) {
     // Values without a logarithm become NaN, which gnuplot skips; a first pass (stats) finds
@@ -726,8 +736,10 @@ void write_xy_plot(const XyPlotRequest& request, const std::filesystem::path& pn
                      gp_label(request.y_label));
     const std::string skip = fmt::format(" skip {}", head.header_lines);
     if (request.log_x) {
-      s += fmt::format("stats csv_file{0} using (largest = 0, largest = (column({1}) > largest ? column({1}) : largest)) "
-                       "nooutput\n", skip, x);
+      std::string largest = "largest = 0";
+      for (const Column& c : xs)
+        largest += fmt::format(", largest = (column({0}) > largest ? column({0}) : largest)", c.index);
+      s += fmt::format("stats csv_file{} using ({}, largest) nooutput\n", skip, largest);
       s += "if (STATS_max > 0) { set logscale x; set format x '1e%L' }\n";
     }
     if (request.log_y) {
@@ -738,9 +750,11 @@ void write_xy_plot(const XyPlotRequest& request, const std::filesystem::path& pn
       s += "if (STATS_max > 0) { set logscale y; set format y '1e%L' }\n";
     }
     std::vector<std::string> clauses;
-    for (const Column& c : ys)
-      clauses.push_back(plot_clause(skip, fmt::format("{}:{}", value(x, request.log_x), value(c.index, request.log_y)),
-                                    "linespoints", c.name));
+    for (std::size_t i = 0; i < ys.size(); ++i)
+      clauses.push_back(plot_clause(skip,
+                                    fmt::format("{}:{}", value(xs[i].index, request.log_x), value(ys[i].index, request.log_y)),
+                                    "linespoints", ys[i].name));
+    if (request.diagonal) clauses.push_back("x with lines dashtype 2 linecolor 'gray40' title 'y = x'");
     s += join_clauses(clauses);
     s += "set output\n";
     return s;
