@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -115,6 +116,53 @@ TEST_F(StudyCli, SpreadMassesRefusesBadInput) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("examples/sled.toml"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "bad.csv"));
+}
+
+TEST_F(StudyCli, ErrorRelationWritesTableByToleranceAndPlot) {
+  const Result r = nhdyn({"study", "error-relation", "appell", "--tolerances", "1e-3,1e-6", "--methods",
+                          "sanh-qr,lagrange", "--integrators", "dopri5,cvode-bdf", "-o", "out/er.csv", "--plot",
+                          "out/er.png"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("the model's exact solution"), std::string::npos) << r.out;
+  const std::string table = read(dir_ / "out/er.csv");
+  EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 9);  // header and 2 x 2 x 2 runs
+  EXPECT_EQ(table.rfind("formulation,integrator,rtol,atol,max_error_q", 0), 0u) << table;
+  const nhdyn::CsvTable by_tolerance = nhdyn::load_csv(dir_ / "out/er-by-tolerance.csv");
+  ASSERT_EQ(by_tolerance.rows.size(), 2u);
+  const int bdf = by_tolerance.column("error_sanh-qr_cvode-bdf");
+  const int bdf_residual = by_tolerance.column("residual_vel_sanh-qr_cvode-bdf");
+  ASSERT_GE(bdf, 0);
+  ASSERT_GE(bdf_residual, 0);
+  // The study's finding on Appell (tests/studies/error_relation_test.cpp has the margins).
+  EXPECT_GT(by_tolerance.rows[0][static_cast<std::size_t>(bdf)],
+            1e4 * by_tolerance.rows[0][static_cast<std::size_t>(bdf_residual)]);
+  EXPECT_GT(fs::file_size(dir_ / "out/er.png"), 1000u);
+}
+
+TEST_F(StudyCli, ErrorRelationRefusesBadInput) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string needle;
+  };
+  const std::vector<Case> cases{
+      {{"--tolerances", "1e-3,-1e-6"}, "-1e-06"},
+      {{"--methods", "sanh-svd"}, "sanh-svd"},
+      {{"--methods", "kane"}, "kane"},
+      {{"--integrators", "euler"}, "euler"},
+      {{"--atol-factor", "0"}, "atol factor 0"},
+      {{"--t-end", "-1"}, "--t-end -1"},
+      {{"--methods", "sanh-analytic"}, "no analytic complement"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args{"study", "error-relation", NHDYN_SOURCE_DIR "/examples/knife_edge.toml", "-o",
+                                  "bad.csv"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const Result r = nhdyn(args);
+    EXPECT_EQ(r.exit_code, 2) << c.needle << "\n" << r.out << r.err;
+    EXPECT_NE(r.err.find(c.needle), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "bad.csv")) << c.needle;
+    EXPECT_FALSE(fs::exists(dir_ / "bad-by-tolerance.csv")) << c.needle;
+  }
 }
 
 }  // namespace
