@@ -104,11 +104,10 @@ int run_spread_masses(const SpreadMassesArgs& args) {
     request.csv = table_path;
     request.x = "ratio";
     request.x_label = "mass ratio (largest / smallest)";
-    // No apostrophes in the texts: gnuplot's quoted strings take none (q'' is written qdd).
-    request.title = fmt::format("{}: relative error of the accelerations qdd, {}-digit reference (max over {} states)",
+    request.title = fmt::format("{}: relative error of the accelerations q'', {}-digit reference (max over {} states)",
                                 study.model, study.digits, study.states.size());
     request.y = qdd_columns;
-    request.y_label = "|qdd - qdd_ref| / |qdd_ref|";
+    request.y_label = "|q'' - q''_ref| / |q''_ref|";
     write_xy_plot(request, args.plot);
     request.title = fmt::format("{}: relative error of the reactions R, {}-digit reference (max over {} states)",
                                 study.model, study.digits, study.states.size());

@@ -2,6 +2,7 @@
 // size, names that are not in the CSV header are refused by name, and a failed plot leaves
 // neither a partial image nor a temporary file behind.
 #include "nhdyn/io/plot.hpp"
+#include "nhdyn/io/xy_plot.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -275,4 +276,95 @@ TEST_F(PlotTest, BadRequestsThrowInputError) {
 }
 
 }  // namespace
+
+// ---- write_xy_plot (studies) ------------------------------------------------------------------
+
+class XyPlotTest : public PlotTest {
+ protected:
+  // Errors and residuals of two runs against the tolerance, as `nhdyn study error-relation`
+  // writes them; one residual is 0 (no logarithm) in the last row.
+  void write_study_csv() const {
+    std::ofstream out(csv_);
+    out << "tolerance,error_a,residual_a,error_b,residual_b\n";
+    for (int k = 3; k <= 12; ++k) {
+      const double tol = std::pow(10.0, -k);
+      out << fmt::format("{},{},{},{},{}\n", tol, 5 * tol, tol, 1e-13, k == 12 ? 0.0 : 2e-13);
+    }
+  }
+  static void expect_xy_png(const fs::path& png) {
+    ASSERT_TRUE(fs::exists(png));
+    const std::string bytes = read_bytes(png);
+    ASSERT_GT(bytes.size(), 24u);
+    EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n"));
+    EXPECT_EQ(big_endian_u32(bytes, 16), 1000u);
+    EXPECT_EQ(big_endian_u32(bytes, 20), 700u);
+    EXPECT_GT(bytes.size(), 8000u);
+  }
+};
+
+TEST_F(XyPlotTest, DrawsCurvesAgainstOneColumn) {
+  write_study_csv();
+  XyPlotRequest request;
+  request.title = "q'' and R: it's a test";  // apostrophes reach gnuplot as text
+  request.csv = csv_;
+  request.x = "tolerance";
+  request.y = {"error_a", "residual_a", "error_b", "residual_b"};
+  request.x_label = "rtol";
+  request.y_label = "|q'' - q''_ref|";
+  const fs::path png = dir_ / "study.png";
+  write_xy_plot(request, png);
+  expect_xy_png(png);
+  EXPECT_EQ(entries(dir_), (std::set<std::string>{"sled.csv", "study.png"}));
+}
+
+TEST_F(XyPlotTest, DrawsEachCurveAgainstItsOwnColumnWithADiagonal) {
+  write_study_csv();
+  XyPlotRequest request;
+  request.csv = csv_;
+  request.y = {"error_a", "error_b"};
+  request.x_of_curve = {"residual_a", "residual_b"};
+  request.titles = {"run a", "run b's"};
+  request.diagonal = true;
+  const fs::path png = dir_ / "relation.png";
+  write_xy_plot(request, png);
+  expect_xy_png(png);
+}
+
+TEST_F(XyPlotTest, AllValuesWithoutALogarithmFallBackToALinearAxis) {
+  {
+    std::ofstream out(csv_);
+    out << "x,y\n1,0\n2,0\n3,-1\n";
+  }
+  XyPlotRequest request;
+  request.csv = csv_;
+  request.x = "x";
+  request.y = {"y"};
+  const fs::path png = dir_ / "zero.png";
+  write_xy_plot(request, png);
+  expect_xy_png(png);
+}
+
+TEST_F(XyPlotTest, BadRequestsThrowInputErrorAndLeaveNothing) {
+  write_study_csv();
+  const fs::path png = dir_ / "bad.png";
+  XyPlotRequest request;
+  request.csv = csv_;
+  request.x = "tolerance";
+  EXPECT_THROW(write_xy_plot(request, png), InputError);  // no curve
+  request.y = {"error_c"};
+  try {
+    write_xy_plot(request, png);
+    ADD_FAILURE() << "an unknown column was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'error_c'"), std::string::npos) << e.what();
+  }
+  request.y = {"error_a", "error_b"};
+  request.x_of_curve = {"residual_a"};
+  EXPECT_THROW(write_xy_plot(request, png), InputError);
+  request.x_of_curve.clear();
+  request.titles = {"only one"};
+  EXPECT_THROW(write_xy_plot(request, png), InputError);
+  EXPECT_EQ(entries(dir_), (std::set<std::string>{"sled.csv"}));
+}
+
 }  // namespace nhdyn

@@ -55,17 +55,18 @@ std::string one_line(std::string_view text) {
   return out;
 }
 
-// A gnuplot string expression whose value is exactly `text` (for file names). Single-quoted
-// gnuplot strings take every byte literally: no backslash escapes, no `backquote` command
-// substitution, no @macro expansion; only the quote itself is doubled. A control character,
-// which cannot sit inside a single-quoted string on one script line, is joined in as a
-// double-quoted octal escape ('a'."\012".'b'). Use the result on the right of an assignment.
+// A gnuplot string expression whose value is exactly `text` (for file names and labels).
+// Single-quoted gnuplot strings take every byte literally: no backslash escapes, no `backquote`
+// command substitution, no @macro expansion. The quote itself is joined in as a double-quoted
+// "'" ('it'."'".'s'): gnuplot's doubled quote ('it''s') works for one quote but not for two in a
+// row (q''). A control character, which cannot sit inside a single-quoted string on one script
+// line, is joined in as a double-quoted octal escape ('a'."\012".'b').
 std::string gp_string(std::string_view text) {
   std::string out = "'";
   for (char c : text) {
     const auto byte = static_cast<unsigned char>(c);
     if (c == '\'') {
-      out += "''";
+      out += "'.\"'\".'";
     } else if (byte < 0x20 || byte == 0x7f) {
       out += fmt::format("'.\"\\{:03o}\".'", static_cast<unsigned>(byte));
     } else {
@@ -713,8 +714,10 @@ void write_xy_plot(const XyPlotRequest& request, const std::filesystem::path& pn
   render(png, target, request.csv, [&](const fs::path& output) {
     // Values without a logarithm become NaN, which gnuplot skips; a first pass (stats) finds
     // whether anything is left to draw on each logarithmic axis.
-    const auto value = [](int column, bool log) {
-      return log ? fmt::format("(column({0}) > 0 ? column({0}) : NaN)", column) : fmt::format("(column({}))", column);
+    // `log_x` and `log_y` are set by the script once it knows whether anything is left to draw
+    // on a logarithmic axis (else the axis is linear and every value is drawn).
+    const auto value = [](int column, const char* log) {
+      return fmt::format("(({1} && column({0}) <= 0) ? NaN : column({0}))", column, log);
     };
     std::string s;
     s += "# Written by nhdyn (src/nhdyn/io/plot.cpp, write_xy_plot) for one plot; deleted after the run.\n";
@@ -735,24 +738,27 @@ void write_xy_plot(const XyPlotRequest& request, const std::filesystem::path& pn
     s += fmt::format("set xlabel {}\nset ylabel {}\n", gp_label(request.x_label.empty() ? request.x : request.x_label),
                      gp_label(request.y_label));
     const std::string skip = fmt::format(" skip {}", head.header_lines);
+    s += "log_x = 0\nlog_y = 0\n";
     if (request.log_x) {
       std::string largest = "largest = 0";
       for (const Column& c : xs)
         largest += fmt::format(", largest = (column({0}) > largest ? column({0}) : largest)", c.index);
       s += fmt::format("stats csv_file{} using ({}, largest) nooutput\n", skip, largest);
-      s += "if (STATS_max > 0) { set logscale x; set format x '1e%L' }\n";
+      s += "log_x = STATS_max > 0\n";
+      s += "if (log_x) { set logscale x; set format x '1e%L' }\n";
     }
     if (request.log_y) {
       std::string largest = "largest = 0";
       for (const Column& c : ys)
         largest += fmt::format(", largest = (column({0}) > largest ? column({0}) : largest)", c.index);
       s += fmt::format("stats csv_file{} using ({}, largest) nooutput\n", skip, largest);
-      s += "if (STATS_max > 0) { set logscale y; set format y '1e%L' }\n";
+      s += "log_y = STATS_max > 0\n";
+      s += "if (log_y) { set logscale y; set format y '1e%L' }\n";
     }
     std::vector<std::string> clauses;
     for (std::size_t i = 0; i < ys.size(); ++i)
       clauses.push_back(plot_clause(skip,
-                                    fmt::format("{}:{}", value(xs[i].index, request.log_x), value(ys[i].index, request.log_y)),
+                                    fmt::format("{}:{}", value(xs[i].index, "log_x"), value(ys[i].index, "log_y")),
                                     "linespoints", ys[i].name));
     if (request.diagonal) clauses.push_back("x with lines dashtype 2 linecolor 'gray40' title 'y = x'");
     s += join_clauses(clauses);
