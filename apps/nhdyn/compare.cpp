@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "model_source.hpp"
 #include "nhdyn/analysis/comparison.hpp"
+#include "nhdyn/analysis/exact_solution.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
@@ -49,11 +50,7 @@ int run_compare(const CompareArgs& args) {
 
   ComparisonOptions options;
   options.reference = args.reference == "analytic" ? Reference::analytic : Reference::tight;
-  if (options.reference == Reference::analytic && !model.evaluator->has_solution())
-    throw InputError(fmt::format("model '{}' gives no analytic solution, so --reference analytic cannot be used; "
-                                 "give its exact motion in a [solution] table of the model file "
-                                 "(docs/model-format.md), or use --reference tight (a run at rtol 1e-13)",
-                                 model.name));
+  if (options.reference == Reference::analytic) check_solution(model);  // before any file is opened
   options.run.t_end = args.t_end.value_or(model.defaults.t_end);
   options.run.output_step = args.output_step.value_or(model.defaults.output_step);
   options.run.formulation.complement = parse_complement(args.complement);

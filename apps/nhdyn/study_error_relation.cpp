@@ -48,10 +48,6 @@ StudyFormulation parse_formulation(const std::string& label) {
   return {parse_method(label), Complement::qr};  // throws naming the valid methods
 }
 
-std::string run_label(const ErrorRelationRun& run) {
-  return fmt::format("{}_{}", formulation_label(run.formulation), integrator_name(run.integrator));
-}
-
 int run_error_relation(const ErrorRelationArgs& args) {
   const ResolvedModel resolved = resolve_model(args.model, args.sets);
   const Model& model = resolved.model;
@@ -79,21 +75,24 @@ int run_error_relation(const ErrorRelationArgs& args) {
   if (!args.plot.empty() && !gnuplot_available())
     throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
                     "or run without --plot");
-  AtomicFile table(table_path);  // both paths are checked before the runs
-
-  const ErrorRelation study = study_error_relation(model, options);
+  if (options.formulations.empty()) options.formulations = calc_study_formulations(model);
   const bool pos = model.position_constraints() > 0;
   const bool vel = model.velocity_constraints() > 0;
-
+  const auto label_of = [](const StudyFormulation& f, IntegratorKind i) {
+    return fmt::format("{}_{}", formulation_label(f), integrator_name(i));
+  };
   std::vector<std::string> columns{"tolerance"};
-  for (std::size_t f = 0; f < study.formulations.size(); ++f)
-    for (std::size_t i = 0; i < study.integrators.size(); ++i) {
-      const std::string label = run_label(study.run(f, i, 0));
-      columns.push_back("error_" + label);
-      if (vel) columns.push_back("residual_vel_" + label);
-      if (pos) columns.push_back("residual_pos_" + label);
+  for (const StudyFormulation& f : options.formulations)
+    for (IntegratorKind i : options.integrators) {
+      columns.push_back("error_" + label_of(f, i));
+      if (vel) columns.push_back("residual_vel_" + label_of(f, i));
+      if (pos) columns.push_back("residual_pos_" + label_of(f, i));
     }
+  // Both files are opened (and so checked writable) before the runs; they appear only on commit.
+  AtomicFile table(table_path);
   CsvWriter series(series_path, columns);
+
+  const ErrorRelation study = study_error_relation(model, options);
   std::vector<double> row;
   for (std::size_t k = 0; k < study.tolerances.size(); ++k) {
     row.assign(1, study.tolerances[k]);
@@ -132,7 +131,7 @@ int run_error_relation(const ErrorRelationArgs& args) {
     request.csv = series_path;
     for (std::size_t f = 0; f < study.formulations.size(); ++f)
       for (std::size_t i = 0; i < study.integrators.size(); ++i) {
-        const std::string label = run_label(study.run(f, i, 0));
+        const std::string label = label_of(study.formulations[f], study.integrators[i]);
         request.y.push_back("error_" + label);
         request.x_of_curve.push_back(fmt::format("residual_{}_{}", level, label));
         request.titles.push_back(fmt::format("{} {}", formulation_label(study.formulations[f]),
@@ -191,7 +190,7 @@ std::function<int()> add_error_relation_study(CLI::App& study) {
   cmd->add_option("--set", args->sets, "Override a model file's parameter, NAME=VALUE (repeatable)");
   cmd->add_option("-o,--output", args->output, "Table CSV, one row per run; the by-tolerance CSV goes next to it")
       ->capture_default_str();
-  cmd->add_option("--plot", args->plot, "PNG of error and residuals against the tolerance (log-log)");
+  cmd->add_option("--plot", args->plot, "PNG of the error against the residual, one curve per run series (log-log)");
   cmd->add_flag("-q,--quiet", args->quiet, "Print no table");
   return [args] { return run_error_relation(*args); };
 }

@@ -21,7 +21,10 @@ TEST(GalleryCli, EveryExampleRunsFromTheCommandLine) {
                                                           {"knife_edge", "t,x,y,phi,"},
                                                           {"pendulum_cartesian", "t,x,y,"},
                                                           {"hoop_bead", "t,x,y,z,"},
-                                                          {"double_pendulum", "t,x1,y1,x2,y2,"}};
+                                                          {"double_pendulum", "t,x1,y1,x2,y2,"},
+                                                          {"rolling_disk", "t,x,y,psi,theta,phi,"},
+                                                          {"slider_crank", "t,alpha,beta,x,"},
+                                                          {"diff_drive", "t,x,y,theta,phi_r,phi_l,"}};
   for (const auto& [name, header] : examples) {
     const fs::path csv = dir / (name + ".csv");
     const std::string command = std::string("'") + NHDYN_CLI_PATH + "' simulate '" + NHDYN_SOURCE_DIR +

@@ -45,8 +45,11 @@ TEST(ErrorRelation, KnifeEdgeResidualTracksTheError) {
       // Both error and residual fall with the tolerance (by 1e4 for a 1e4 tighter rtol; asserted 100).
       EXPECT_LT(error_of(study.run(f, i, 1)), error_of(study.run(f, i, 0)) / 100.0);
       EXPECT_LT(study.run(f, i, 1).max_residual_vel, study.run(f, i, 0).max_residual_vel / 100.0);
-      // Every formulation integrates the same equations: same error.
-      EXPECT_NEAR(error_of(study.run(f, i, 0)), error_of(study.run(0, i, 0)), 0.5 * error_of(study.run(0, i, 0)));
+      // Every formulation integrates the same equations: same error, at every tolerance.
+      for (std::size_t k = 0; f > 0 && k < study.tolerances.size(); ++k) {
+        EXPECT_NEAR(error_of(study.run(f, i, k)), error_of(study.run(0, i, k)), 0.5 * error_of(study.run(0, i, k)))
+            << formulation_label(study.formulations[f]) << " " << study.tolerances[k];
+      }
     }
 }
 
@@ -104,7 +107,31 @@ TEST(ErrorRelation, BadOptionsAreRefused) {
   options.atol_factor = 1.0;
   options.integrators.clear();
   EXPECT_THROW(study_error_relation(appell, options), InputError);
+  options.integrators = {IntegratorKind::dopri5, IntegratorKind::rk4};
+  EXPECT_THROW(study_error_relation(appell, options), InputError);  // a fixed step ignores the tolerance
+  options.integrators = {IntegratorKind::dopri5, IntegratorKind::dopri5};
+  EXPECT_THROW(study_error_relation(appell, options), InputError);
   options.integrators = {IntegratorKind::dopri5};
+  options.tolerances = {1e-3, 1e-3};
+  EXPECT_THROW(study_error_relation(appell, options), InputError);
+  options.tolerances = {1e-3};
+  options.formulations = {{Method::lagrange, Complement::qr}, {Method::lagrange, Complement::partition}};
+  EXPECT_THROW(study_error_relation(appell, options), InputError);  // the same formulation: lagrange has no D
+  options.formulations = {{Method::sanh, Complement::qr}};
+  options.t_end = -1.0;
+  EXPECT_THROW(study_error_relation(appell, options), InputError);
+  options.t_end = 0.0;
+  options.output_step = -0.1;
+  EXPECT_THROW(study_error_relation(appell, options), InputError);
+  options.output_step = 0.0;
+  const Model free_fall = symbolic::compile_model(load_model_string(
+      "name = \"fall\"\ncoordinates = [\"z\"]\nkinetic_energy = \"z'^2/2\"\npotential_energy = \"-9.81*z\"\n", "f.toml"));
+  try {
+    study_error_relation(free_fall, options);
+    ADD_FAILURE() << "a model without constraints was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no constraints"), std::string::npos) << e.what();
+  }
   options.formulations = {{Method::sanh, Complement::analytic}};
   const Model knife = symbolic::compile_model(load_model_file(std::filesystem::path(NHDYN_SOURCE_DIR) /
                                                               "examples/knife_edge.toml"));

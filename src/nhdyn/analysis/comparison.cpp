@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "nhdyn/analysis/exact_solution.hpp"
 #include "nhdyn/core/error.hpp"
 
 namespace nhdyn {
@@ -43,15 +44,17 @@ Comparison compare_formulations(const Model& model, const ComparisonOptions& opt
   std::vector<double> ref(rows * static_cast<std::size_t>(2 * n), 0.0);
   std::size_t row = 0;
   if (options.reference == Reference::analytic) {
-    if (!model.evaluator->has_solution())
-      throw InputError(fmt::format("model '{}' gives no analytic solution, so --reference analytic cannot be used; "
-                                   "give its exact motion in a [solution] table of the model file "
-                                   "(docs/model-format.md), or use --reference tight (a run at rtol 1e-13)",
-                                   model.name));
+    check_solution(model);
     Data data = make_data(model);
     std::vector<double> qva(static_cast<std::size_t>(3 * n));
     for (row = 0; row < rows; ++row) {
       model.evaluator->solution(out.times[row], data.scratch.data(), qva.data());
+      for (int i = 0; i < 2 * n; ++i)
+        if (!std::isfinite(qva[static_cast<std::size_t>(i)]))
+          throw ModelError(fmt::format("model '{}': its analytic solution gives {}{} = {} at t = {}; it cannot be a "
+                                       "reference there (shorten --t-end or check [solution])",
+                                       model.name, model.coordinates[static_cast<std::size_t>(i % n)],
+                                       i < n ? "" : "'", qva[static_cast<std::size_t>(i)], out.times[row]));
       std::copy(qva.begin(), qva.begin() + 2 * n, ref.begin() + static_cast<std::ptrdiff_t>(row * 2 * n));
     }
   } else {

@@ -743,16 +743,18 @@ void write_xy_plot(const XyPlotRequest& request, const std::filesystem::path& pn
       std::string largest = "largest = 0";
       for (const Column& c : xs)
         largest += fmt::format(", largest = (column({0}) > largest ? column({0}) : largest)", c.index);
+      s += "undefine STATS_*\n";
       s += fmt::format("stats csv_file{} using ({}, largest) nooutput\n", skip, largest);
-      s += "log_x = STATS_max > 0\n";
+      s += "log_x = exists('STATS_max') && STATS_max > 0\n";
       s += "if (log_x) { set logscale x; set format x '1e%L' }\n";
     }
     if (request.log_y) {
       std::string largest = "largest = 0";
       for (const Column& c : ys)
         largest += fmt::format(", largest = (column({0}) > largest ? column({0}) : largest)", c.index);
+      s += "undefine STATS_*\n";
       s += fmt::format("stats csv_file{} using ({}, largest) nooutput\n", skip, largest);
-      s += "log_y = STATS_max > 0\n";
+      s += "log_y = exists('STATS_max') && STATS_max > 0\n";
       s += "if (log_y) { set logscale y; set format y '1e%L' }\n";
     }
     std::vector<std::string> clauses;

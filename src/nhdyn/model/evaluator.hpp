@@ -1,6 +1,6 @@
 // The numeric face of a mechanical system: at (t, q, q') an Evaluator yields the terms of the
-// equations of motion (A, Q, G, b, b0), optionally an analytic complement D, the residuals of the
-// constraints at the level they were given, the energy, and optionally a known exact solution. Built-in C++ models implement it by
+// equations of motion (A, Q, G, b, b0), optionally an analytic complement D, the residuals of
+// the constraints at the level they were given, the energy, and optionally an exact solution. Built-in C++ models implement it by
 // hand; model files (through the symbolic compiler) and generated code are other implementations.
 // It is stateless: any workspace it needs is the `scratch` array that Data owns.
 #pragma once
@@ -54,7 +54,9 @@ class Evaluator {
   // Whether solution() is defined: the model knows its exact motion from its own initial state
   // (a closed form), which `nhdyn compare --reference analytic` measures the runs against.
   virtual bool has_solution() const { return false; }
-  // q(t), q'(t) and q''(t) one after the other in `qva` (3 n values).
+  // q(t), q'(t) and q''(t) one after the other in `qva` (3 n values); `scratch` has
+  // scratch_size() entries. Only for a model that has_solution(); the default fills nothing, so
+  // callers ask has_solution() first (analysis/exact_solution.hpp checks it).
   virtual void solution(double /*t*/, double* /*scratch*/, double* /*qva*/) const {}
 };
 

@@ -22,14 +22,18 @@ struct StudyFormulation {
 // "sanh-qr", "sanh-partition", "sanh-analytic", "lagrange", ...
 std::string formulation_label(const StudyFormulation& formulation);
 
+// Every formulation `model` allows: sanh with D from qr and partition (and analytic when the
+// model gives D), lagrange, udwadia-kalaba, nullspace.
+std::vector<StudyFormulation> calc_study_formulations(const Model& model);
+
 struct ErrorRelationOptions {
   std::vector<double> tolerances;          // rtol of each run (atol = atol_factor * rtol); > 0
   double atol_factor = 1.0;
   std::vector<StudyFormulation> formulations;  // empty: every formulation the model allows
   std::vector<IntegratorKind> integrators{IntegratorKind::dopri5, IntegratorKind::cvode_bdf,
                                           IntegratorKind::cvode_adams};
-  double t_end = 0.0;        // 0: the model's default
-  double output_step = 0.0;  // 0: the model's default
+  double t_end = 0.0;        // 0: the model's default; else after t0
+  double output_step = 0.0;  // 0: the model's default; else > 0
 };
 
 // One run: a formulation, an integrator and a tolerance.
@@ -40,8 +44,8 @@ struct ErrorRelationRun {
   SimulationSummary summary;
   double max_error_q = 0.0;  // max over outputs of max_i |q_i - q_exact,i|
   double max_error_v = 0.0;  // ... of the velocities
-  double max_residual_pos = 0.0;
-  double max_residual_vel = 0.0;
+  double max_residual_pos = 0.0;  // max over outputs of max |phi| (0 without position constraints)
+  double max_residual_vel = 0.0;  // max over outputs of max |f| (velocity level, FORMULATION.md (2.14))
 };
 
 struct ErrorRelation {
@@ -56,8 +60,13 @@ struct ErrorRelation {
   }
 };
 
-// Throws InputError for an empty or non-positive tolerance list, an analytic complement for a
-// model without one, or bad run options (as simulate does).
+// Throws InputError for a model without constraints (there is no residual to study), an empty,
+// non-positive or repeated tolerance, a repeated formulation or integrator, rk4 (a fixed step: its
+// runs do not depend on the tolerance), an analytic complement for a model without one, a negative
+// t_end or output_step, or bad run options (as simulate does); ModelError for an exact solution
+// that fails analysis/exact_solution.hpp's checks. Each (formulation, tolerance) runs its
+// integrators in one compare_formulations call, so without an exact solution the tight reference is
+// computed once per formulation and tolerance.
 ErrorRelation study_error_relation(const Model& model, const ErrorRelationOptions& options);
 
 }  // namespace nhdyn

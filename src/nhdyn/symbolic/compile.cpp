@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -119,6 +120,9 @@ class ProgramCompiler {
       program_.add_output(emit(numeric_form));
     }
   }
+
+  // An output that is NaN at every call (an expression that cannot be evaluated).
+  void add_nan_output() { program_.add_constant_output(std::numeric_limits<double>::quiet_NaN()); }
 
   // The finished program, with each sin(x), cos(x) pair fused into one sincos.
   Program finish() const { return fuse_sincos(program_); }
@@ -482,32 +486,6 @@ int coordinate_index(const Spec& spec, const std::string& name, const char* what
   return static_cast<int>(it - spec.coordinates.begin());
 }
 
-std::string where_prefix(const SourceLocation& where) {
-  const std::string text = where.describe();
-  return text.empty() ? text : text + ": ";
-}
-
-// A solution that does not start where the run starts is the motion of another initial state:
-// every error measured against it would be wrong, so it is refused here.
-void check_solution_start(const Spec& spec, const Model& model) {
-  const int n = model.n();
-  std::vector<double> scratch(model.evaluator->scratch_size()), qva(static_cast<std::size_t>(3 * n));
-  model.evaluator->solution(model.t0, scratch.data(), qva.data());
-  for (int order = 0; order < 2; ++order)
-    for (int i = 0; i < n; ++i) {
-      const double exact = qva[static_cast<std::size_t>(order * n + i)];
-      const double initial = order == 0 ? model.q0[i] : model.v0[i];
-      if (!(std::abs(exact - initial) <= 1e-9 * (1.0 + std::abs(initial)))) {
-        const std::string name = spec.coordinates[static_cast<std::size_t>(i)] + (order == 0 ? "" : "'");
-        throw ModelError(fmt::format(
-            "{}model '{}': the solution does not start at the initial state: at t0 = {} it gives {} = {:.17g}, "
-            "the initial state has {} = {:.17g}; correct [solution] or [initial] (after --set, both must still agree)",
-            where_prefix(spec.solution_where[static_cast<std::size_t>(i)]), spec.name, model.t0, name, exact, name,
-            initial));
-      }
-    }
-}
-
 }  // namespace
 
 Model compile_model(const Spec& spec, const Derivation& derivation) {
@@ -609,13 +587,20 @@ Model compile_model(const Spec& spec, const Derivation& derivation) {
     }
   }
   if (!spec.solution.empty()) {
-    // q(t), then its first and second derivatives: the exact velocities and accelerations.
+    // q(t), then its first and second derivatives: the exact velocities and accelerations. A
+    // closed form that cannot be evaluated at these parameter values (v0/w with w = 0) must not
+    // stop the model: that output is NaN, which check_solution refuses where the solution is used.
     ProgramCompiler solution(spec);
     const GiNaC::symbol& t = spec.symbols.time();
     for (int order = 0; order < 3; ++order)
-      for (int i = 0; i < n; ++i)
-        solution.add_output(spec.solution[static_cast<std::size_t>(i)].diff(t, order),
-                            fmt::format("solution {}{}", q_name(i), std::string(static_cast<std::size_t>(order), '\'')));
+      for (int i = 0; i < n; ++i) {
+        try {
+          solution.add_output(spec.solution[static_cast<std::size_t>(i)].diff(t, order),
+                              fmt::format("solution {}{}", q_name(i), std::string(static_cast<std::size_t>(order), '\'')));
+        } catch (const ModelError&) {
+          solution.add_nan_output();
+        }
+      }
     programs.solution = solution.finish();
   }
   model.defaults = spec.defaults;
@@ -623,7 +608,6 @@ Model compile_model(const Spec& spec, const Derivation& derivation) {
     model.path = PlanarPath{coordinate_index(spec, spec.path->first, "x"), coordinate_index(spec, spec.path->second, "y")};
   model.evaluator = std::make_shared<ProgramEvaluator>(n, s, std::move(programs));
   check_model_shape(model);
-  if (model.evaluator->has_solution()) check_solution_start(spec, model);
   return model;
 }
 
