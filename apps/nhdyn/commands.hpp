@@ -15,5 +15,6 @@ std::function<int()> add_equations_command(CLI::App& app);
 std::function<int()> add_codegen_command(CLI::App& app);
 std::function<int()> add_compare_command(CLI::App& app);
 std::function<int()> add_study_command(CLI::App& app);
+std::function<int()> add_example_command(CLI::App& app);
 
 }  // namespace nhdyn::cli

@@ -18,12 +18,13 @@ int main(int argc, char** argv) {
   const auto codegen = nhdyn::cli::add_codegen_command(app);
   const auto compare = nhdyn::cli::add_compare_command(app);
   const auto study = nhdyn::cli::add_study_command(app);
+  const auto example = nhdyn::cli::add_example_command(app);
   if (argc > 1 && argv[1][0] != '-') {
     bool known = false;
     for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
       known = known || sub->get_name() == argv[1];
     if (!known) {
-      fmt::print(stderr, "nhdyn: error: unknown command '{}'; the commands are simulate, compare, study, list, equations, codegen "
+      fmt::print(stderr, "nhdyn: error: unknown command '{}'; the commands are simulate, compare, study, list, equations, codegen, example "
                          "(see nhdyn --help)\n", argv[1]);
       return 2;
     }
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("codegen")) return codegen();
     if (app.got_subcommand("compare")) return compare();
     if (app.got_subcommand("study")) return study();
+    if (app.got_subcommand("example")) return example();
   } catch (const nhdyn::Error& e) {
     fmt::print(stderr, "nhdyn: error: {}\n", e.what());
     return 2;

@@ -1,0 +1,111 @@
+// End-to-end runs of `nhdyn example`: the chain's model file, on stdout or with -o, runs with
+// `nhdyn simulate`; the list of examples; bad --bodies, --set and names refused with exit 2, the
+// value and the limit named, and no output file left behind.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int exit_code;
+  std::string out;  // stdout and stderr together
+};
+
+Outcome nhdyn(const std::string& args, const fs::path& dir) {
+  const std::string command = "cd '" + dir.string() + "' && '" + NHDYN_CLI_PATH + "' " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buffer{};
+  while (std::size_t got = std::fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), got);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+class ExampleCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("nhdyn_excli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string read(const std::string& file) {
+    std::ifstream in(dir_ / file);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  fs::path dir_;
+};
+
+TEST_F(ExampleCli, ChainOnStdoutRunsWithSimulate) {
+  const Outcome gen = nhdyn("example chain --bodies 4 > chain4.toml", dir_);
+  ASSERT_EQ(gen.exit_code, 0) << gen.out;
+  const Outcome sim = nhdyn("simulate chain4.toml --t-end 1 --output-step 0.1 -q -o out.csv", dir_);
+  ASSERT_EQ(sim.exit_code, 0) << sim.out;
+  const std::string csv = read("out.csv");
+  EXPECT_EQ(csv.rfind("t,x1,y1,theta1,x2,", 0), 0u) << csv.substr(0, 200);
+  EXPECT_NE(csv.find("theta4"), std::string::npos);
+}
+
+TEST_F(ExampleCli, ChainWithOutputFileAndSetRunsWithSimulate) {
+  const Outcome gen = nhdyn("example chain --bodies 2 --set m=2 --set w0=0.25 -o chain2.toml", dir_);
+  ASSERT_EQ(gen.exit_code, 0) << gen.out;
+  EXPECT_EQ(gen.out, "");
+  const std::string text = read("chain2.toml");
+  EXPECT_NE(text.find("m = { value = 2.0"), std::string::npos);
+  EXPECT_NE(text.find("w0 = { value = 0.25"), std::string::npos);
+  const Outcome sim = nhdyn("simulate chain2.toml --t-end 0.5 -q -o out.csv", dir_);
+  EXPECT_EQ(sim.exit_code, 0) << sim.out;
+  const Outcome shipped =
+      nhdyn("simulate '" + std::string(NHDYN_SOURCE_DIR) + "/examples/chain.toml' --t-end 0.5 -q -o shipped.csv", dir_);
+  EXPECT_EQ(shipped.exit_code, 0) << shipped.out;
+}
+
+TEST_F(ExampleCli, ListsTheExamples) {
+  const Outcome none = nhdyn("example", dir_);
+  EXPECT_EQ(none.exit_code, 0) << none.out;
+  EXPECT_NE(none.out.find("chain"), std::string::npos) << none.out;
+  const Outcome unknown = nhdyn("example trailer", dir_);
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.out;
+  EXPECT_NE(unknown.out.find("unknown example 'trailer'"), std::string::npos) << unknown.out;
+  EXPECT_NE(unknown.out.find("chain"), std::string::npos) << unknown.out;
+}
+
+TEST_F(ExampleCli, RefusesBadBodiesWithTheLimitAndNoFile) {
+  for (const std::string value : {"0", "-3", "=-3", "abc", "1e9", "10001", "99999999999999999999", "2.5"}) {
+    const std::string option = value[0] == '=' ? "--bodies" + value : "--bodies " + value;
+    const Outcome out = nhdyn("example chain " + option + " -o chain.toml", dir_);
+    EXPECT_EQ(out.exit_code, 2) << value << ": " << out.out;
+    const std::string shown = value[0] == '=' ? value.substr(1) : value;
+    EXPECT_NE(out.out.find(shown), std::string::npos) << value << ": " << out.out;
+    EXPECT_NE(out.out.find("from 1 to 10000"), std::string::npos) << value << ": " << out.out;
+    EXPECT_FALSE(fs::exists(dir_ / "chain.toml")) << value;
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator{}), 0) << value;
+  }
+}
+
+TEST_F(ExampleCli, RefusesBadParametersWithNoFile) {
+  const Outcome zero = nhdyn("example chain --set m=0 -o chain.toml", dir_);
+  EXPECT_EQ(zero.exit_code, 2) << zero.out;
+  EXPECT_NE(zero.out.find("mass m = 0"), std::string::npos) << zero.out;
+  const Outcome unknown = nhdyn("example chain --set rho=1 -o chain.toml", dir_);
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.out;
+  EXPECT_NE(unknown.out.find("no parameter 'rho'"), std::string::npos) << unknown.out;
+  const Outcome text = nhdyn("example chain --set f=long -o chain.toml", dir_);
+  EXPECT_EQ(text.exit_code, 2) << text.out;
+  EXPECT_FALSE(fs::exists(dir_ / "chain.toml"));
+}
+
+}  // namespace
