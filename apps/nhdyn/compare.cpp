@@ -11,6 +11,7 @@
 
 #include "commands.hpp"
 #include "model_source.hpp"
+#include "outputs.hpp"
 #include "nhdyn/analysis/comparison.hpp"
 #include "nhdyn/analysis/exact_solution.hpp"
 #include "nhdyn/core/error.hpp"
@@ -62,15 +63,10 @@ int run_compare(const CompareArgs& args) {
 
   namespace fs = std::filesystem;
   const fs::path table_path = args.output.empty() ? fs::path("results") / (model.name + "-compare.csv") : fs::path(args.output);
-  if (args.output.empty()) {
-    std::error_code ec;
-    fs::create_directories(table_path.parent_path(), ec);
-  }
+  if (args.output.empty()) make_parent_directory(table_path);
   fs::path series_path = table_path;
   series_path.replace_filename(table_path.stem().string() + "-series.csv");
-  if (!args.plot.empty() && !gnuplot_available())
-    throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
-                    "or run without --plot");
+  check_plot_possible(args.plot);
   AtomicFile table(table_path);  // both paths are checked before any run
   std::vector<std::string> columns{"t"};
   for (const ComparisonCase& c : options.cases) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "model_source.hpp"
+#include "outputs.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
@@ -68,13 +69,8 @@ int run_error_relation(const ErrorRelationArgs& args) {
   const fs::path table_path = args.output;
   fs::path series_path = table_path;
   series_path.replace_filename(table_path.stem().string() + "-by-tolerance.csv");
-  if (table_path.has_parent_path()) {
-    std::error_code ec;
-    fs::create_directories(table_path.parent_path(), ec);
-  }
-  if (!args.plot.empty() && !gnuplot_available())
-    throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
-                    "or run without --plot");
+  make_parent_directory(table_path);
+  check_plot_possible(args.plot);
   if (options.formulations.empty()) options.formulations = calc_study_formulations(model);
   const bool pos = model.position_constraints() > 0;
   const bool vel = model.velocity_constraints() > 0;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "model_source.hpp"
+#include "outputs.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
@@ -58,13 +59,8 @@ int run_spread_masses(const SpreadMassesArgs& args) {
 
   namespace fs = std::filesystem;
   const fs::path table_path = args.output;
-  if (table_path.has_parent_path()) {
-    std::error_code ec;
-    fs::create_directories(table_path.parent_path(), ec);
-  }
-  if (!args.plot.empty() && !gnuplot_available())
-    throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
-                    "or run without --plot");
+  make_parent_directory(table_path);
+  check_plot_possible(args.plot);
 
   // Every formulation the model allows, named before the run so that the CSV (its columns) is
   // opened, and its directory proved writable, before anything is computed.
