@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/symbolic/occurrence.hpp"
 #include "nhdyn/symbolic/simplify.hpp"
 
 namespace nhdyn::symbolic {
@@ -31,20 +32,55 @@ std::string printed(const GiNaC::ex& e) {
 }
 
 // The total time derivative of an expression in (t, q, q') along the motion, without the terms
-// in q'': sum_i (de/dq_i) q'_i + de/dt. (The q'' terms are sum_i (de/dq'_i) q''_i.)
-GiNaC::ex convective_derivative(const GiNaC::ex& e, const SymbolTable& symbols, int n) {
-  GiNaC::ex out = e.diff(symbols.time());
-  for (int i = 0; i < n; ++i) out += e.diff(symbols.coordinate(i)) * symbols.velocity(i);
+// in q'': sum_i (de/dq_i) q'_i + de/dt. (The q'' terms are sum_i (de/dq'_i) q''_i.) Only the
+// coordinates that e contains are differentiated by.
+GiNaC::ex convective_derivative(const GiNaC::ex& e, const SymbolTable& symbols, const SymbolIndex& index) {
+  const Contained o = index.find(e);
+  GiNaC::ex out = o.time ? e.diff(symbols.time()) : GiNaC::ex(0);
+  for (int i : o.q) out += e.diff(symbols.coordinate(i)) * symbols.velocity(i);
   return out;
 }
 
-// The first symbol of `symbols(i)`, i < n, that `e` contains, or -1.
-template <class Get>
-int first_contained(const GiNaC::ex& e, int n, Get get) {
-  for (int i = 0; i < n; ++i)
-    if (e.has(get(i))) return i;
-  return -1;
+// The terms of a sum (or the expression itself): each is differentiated only by what it contains.
+std::vector<GiNaC::ex> terms_of(const GiNaC::ex& e) {
+  std::vector<GiNaC::ex> out;
+  if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
+    for (std::size_t i = 0; i < e.nops(); ++i) out.push_back(e.op(i));
+  } else if (!e.is_zero()) {
+    out.push_back(e);
+  }
+  return out;
 }
+
+// A sum split into its terms, with the terms that contain each coordinate and each velocity:
+// d/dq_i of the sum is the sum of d/dq_i of those terms alone.
+struct SplitSum {
+  std::vector<GiNaC::ex> terms;
+  std::vector<Contained> occurrences;        // per term
+  std::vector<std::vector<int>> with_q, with_v;  // per coordinate: the terms containing q_i, q'_i
+
+  SplitSum(const GiNaC::ex& e, const SymbolIndex& index, int n)
+      : terms(terms_of(e)), with_q(static_cast<std::size_t>(n)), with_v(static_cast<std::size_t>(n)) {
+    for (std::size_t j = 0; j < terms.size(); ++j) {
+      occurrences.push_back(index.find(terms[j]));
+      for (int i : occurrences.back().q) with_q[static_cast<std::size_t>(i)].push_back(static_cast<int>(j));
+      for (int i : occurrences.back().v) with_v[static_cast<std::size_t>(i)].push_back(static_cast<int>(j));
+    }
+  }
+  // The first index of `kind` (a, v...) that some term contains, or -1.
+  template <class Member>
+  int first(Member member) const {
+    int out = -1;
+    for (const Contained& o : occurrences)
+      if (!(o.*member).empty() && (out < 0 || (o.*member).front() < out)) out = (o.*member).front();
+    return out;
+  }
+  GiNaC::ex diff(const std::vector<std::vector<int>>& with, int i, const GiNaC::symbol& x) const {
+    GiNaC::ex out = 0;
+    for (int j : with[static_cast<std::size_t>(i)]) out += terms[static_cast<std::size_t>(j)].diff(x);
+    return out;
+  }
+};
 
 }  // namespace
 
@@ -93,38 +129,54 @@ Derivation derive(const Spec& spec) {
 
   const GiNaC::ex& T = spec.kinetic_energy;
   const GiNaC::ex& V = spec.potential_energy;
-  if (first_contained(T, n, a) >= 0 || first_contained(V, n, a) >= 0)
+  const SymbolIndex index(symbols);
+  const SplitSum Ts(T, index, n), Vs(V, index, n);
+  if (Ts.first(&Contained::a) >= 0 || Vs.first(&Contained::a) >= 0)
     throw ModelError(model + "the kinetic and potential energies may not contain accelerations");
-  if (const int i = first_contained(V, n, v); i >= 0)
+  if (const int i = Vs.first(&Contained::v); i >= 0)
     throw ModelError(model + fmt::format("the potential energy V contains the velocity {}'", name(i)));
 
   Derivation d;
   // A = d2T/dq'2 (FORMULATION.md (2.4)); T must be quadratic in q' so that A does not depend on q'.
+  // Only the pairs of velocities that occur in a common term of T can give a nonzero entry.
   d.A = GiNaC::matrix(un, un);
   std::vector<GiNaC::ex> Tv(un);
-  for (int i = 0; i < n; ++i) Tv[static_cast<std::size_t>(i)] = T.diff(v(i));
-  for (unsigned i = 0; i < un; ++i)
-    for (unsigned j = i; j < un; ++j) {
-      const GiNaC::ex entry = simplify(Tv[i].diff(v(static_cast<int>(j))));
-      if (const int m = first_contained(entry, n, v); m >= 0)
+  bool moving = false;
+  for (int i = 0; i < n; ++i) {
+    const auto ui = static_cast<unsigned>(i);
+    Tv[ui] = Ts.diff(Ts.with_v, i, v(i));
+    std::vector<int> partners;
+    for (int j : Ts.with_v[ui]) {
+      const std::vector<int>& vs = Ts.occurrences[static_cast<std::size_t>(j)].v;
+      partners.insert(partners.end(), vs.begin(), vs.end());
+    }
+    std::sort(partners.begin(), partners.end());
+    partners.erase(std::unique(partners.begin(), partners.end()), partners.end());
+    for (int jj : partners) {
+      if (jj < i) continue;
+      const auto uj = static_cast<unsigned>(jj);
+      const GiNaC::ex entry = simplify(Tv[ui].diff(v(jj)));
+      if (const Contained o = index.find(entry); !o.v.empty())
         throw ModelError(model + fmt::format("the kinetic energy T is not quadratic in the velocities: "
                                              "A = d2T/dq'2 depends on {}' (entry ({}, {}) is {})",
-                                             name(m), name(static_cast<int>(i)), name(static_cast<int>(j)),
-                                             printed(entry)));
-      d.A(i, j) = d.A(j, i) = entry;
+                                             name(o.v.front()), name(i), name(jj), printed(entry)));
+      d.A(ui, uj) = d.A(uj, ui) = entry;
+      moving = moving || !entry.is_zero();
     }
-  if (d.A.is_zero_matrix()) throw ModelError(model + "the kinetic energy T does not depend on the velocities");
+  }
+  if (!moving) throw ModelError(model + "the kinetic energy T does not depend on the velocities");
 
   // G = dT/dq - (d2T/dq'dq) q' - d2T/dq'dt and Q = -dV/dq + forces (FORMULATION.md section 1).
   d.G = GiNaC::matrix(un, 1);
   d.Q = GiNaC::matrix(un, 1);
   for (int i = 0; i < n; ++i) {
     const auto ui = static_cast<unsigned>(i);
-    d.G(ui, 0) = simplify(T.diff(q(i)) - convective_derivative(Tv[ui], symbols, n));
+    d.G(ui, 0) = simplify(Ts.diff(Ts.with_q, i, q(i)) - convective_derivative(Tv[ui], symbols, index));
     const GiNaC::ex force = ui < spec.forces.size() ? spec.forces[ui] : GiNaC::ex(0);
-    if (const int m = first_contained(force, n, a); m >= 0)
-      throw ModelError(model + fmt::format("the force on '{}' contains the acceleration {}''", name(i), name(m)));
-    d.Q(ui, 0) = simplify(-V.diff(q(i)) + force);
+    if (const Contained o = index.find(force); !o.a.empty())
+      throw ModelError(model + fmt::format("the force on '{}' contains the acceleration {}''", name(i),
+                                           name(o.a.front())));
+    d.Q(ui, 0) = simplify(-Vs.diff(Vs.with_q, i, q(i)) + force);
   }
 
   // Every constraint at acceleration level, b q'' + b0 = 0 (FORMULATION.md (2.5)).
@@ -134,44 +186,46 @@ Derivation derive(const Spec& spec) {
     const SpecConstraint& c = spec.constraints[r];
     const std::string where = fmt::format("{}constraint '{}'", prefix(c.where), c.name);
     const GiNaC::ex& e = c.expression;
+    const Contained o = index.find(e);
     GiNaC::ex b0;
-    std::vector<GiNaC::ex> row(un);
+    std::vector<GiNaC::ex> row(un, GiNaC::ex(0));
     const char* involve = "the velocities";
     switch (c.level) {
       case ConstraintLevel::position: {
-        if (const int m = first_contained(e, n, v); m >= 0)
-          throw ModelError(where + fmt::format(" is given at position level but contains the velocity {}'", name(m)));
-        if (const int m = first_contained(e, n, a); m >= 0)
-          throw ModelError(where +
-                           fmt::format(" is given at position level but contains the acceleration {}''", name(m)));
+        if (!o.v.empty())
+          throw ModelError(where + fmt::format(" is given at position level but contains the velocity {}'",
+                                               name(o.v.front())));
+        if (!o.a.empty())
+          throw ModelError(where + fmt::format(" is given at position level but contains the acceleration {}''",
+                                               name(o.a.front())));
         // phi' = phi_q q' + phi_t; phi'' = b q'' + b0 with b = phi_q and
         // b0 = (d/dq (phi_q q')) q' + 2 phi_qt q' + phi_tt, the q''-free part of d/dt phi'.
-        const GiNaC::ex phidot = convective_derivative(e, symbols, n);
-        for (int j = 0; j < n; ++j) row[static_cast<std::size_t>(j)] = e.diff(q(j));
-        b0 = convective_derivative(phidot, symbols, n);
+        const GiNaC::ex phidot = convective_derivative(e, symbols, index);
+        for (int j : o.q) row[static_cast<std::size_t>(j)] = e.diff(q(j));
+        b0 = convective_derivative(phidot, symbols, index);
         d.phi.push_back(e);
         d.f.push_back(simplify(phidot));
         break;
       }
       case ConstraintLevel::velocity: {
-        if (const int m = first_contained(e, n, a); m >= 0)
-          throw ModelError(where +
-                           fmt::format(" is given at velocity level but contains the acceleration {}''", name(m)));
+        if (!o.a.empty())
+          throw ModelError(where + fmt::format(" is given at velocity level but contains the acceleration {}''",
+                                               name(o.a.front())));
         // f' = (df/dq') q'' + (df/dq) q' + df/dt.
-        for (int j = 0; j < n; ++j) row[static_cast<std::size_t>(j)] = e.diff(v(j));
-        b0 = convective_derivative(e, symbols, n);
+        for (int j : o.v) row[static_cast<std::size_t>(j)] = e.diff(v(j));
+        b0 = convective_derivative(e, symbols, index);
         d.f.push_back(e);
         break;
       }
       case ConstraintLevel::acceleration: {
         involve = "the accelerations";
         GiNaC::lst at_rest;
-        for (int j = 0; j < n; ++j) {
+        for (int j : o.a) {
           row[static_cast<std::size_t>(j)] = e.diff(a(j));
           at_rest.append(a(j) == 0);
         }
-        for (int i = 0; i < n; ++i)
-          for (int j = 0; j < n; ++j)
+        for (int i : o.a)
+          for (int j : o.a)
             if (!symbolic::is_zero(row[static_cast<std::size_t>(i)].diff(a(j))))
               throw ModelError(where + fmt::format(" must be linear in the accelerations, but it is not linear in "
                                                    "{}'' (its derivative by {}'' depends on {}'')",
@@ -182,6 +236,7 @@ Derivation derive(const Spec& spec) {
     }
     bool zero = true;
     for (unsigned j = 0; j < un; ++j) {
+      if (row[j].is_zero()) continue;
       d.b(r, j) = simplify(row[j]);
       zero = zero && d.b(r, j).is_zero();
     }

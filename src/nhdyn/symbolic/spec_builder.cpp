@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/symbolic/occurrence.hpp"
 #include "nhdyn/symbolic/suggest.hpp"
 
 namespace nhdyn::symbolic {
@@ -89,6 +90,8 @@ struct Occurrence {
 struct Parsed {
   GiNaC::ex value;
   std::vector<Occurrence> symbols;  // in the order they appear
+  SymbolSet present;                // the symbols `value` still contains (x' - x' has none)
+  bool contains(const Occurrence& o) const { return present.count(o.symbol) > 0; }
 };
 
 // Where a piece of text sits, to turn byte offsets into file positions.
@@ -280,8 +283,11 @@ class Reader {
       if (next.kind == TokenKind::close) site_.fail_at(next.begin, "syntax error: unmatched ')'");
       unexpected(next);
     }
+    // Only the names the text uses: a table of every symbol per expression would make reading
+    // a model quadratic in its number of coordinates.
     GiNaC::symtab table;
-    for (const auto& [name, value] : spec_.symbols.parser_table()) table[internal_name(name)] = value;
+    for (const Occurrence& o : symbols_)
+      table[internal_name(o.name)] = o.kind == SymbolKind::constant ? GiNaC::ex(GiNaC::Pi) : GiNaC::ex(o.symbol);
     Parsed parsed;
     try {
       GiNaC::parser parser(table, /*strict=*/true);
@@ -290,6 +296,7 @@ class Reader {
       site_.fail_at(tokens_.front().begin, fmt::format("cannot parse the expression: {}", e.what()));
     }
     parsed.symbols = std::move(symbols_);
+    parsed.present = symbols_of(parsed.value);
     return parsed;
   }
 
@@ -524,7 +531,7 @@ Parsed read(const Spec& spec, const Site& site) { return read(spec, site, 0, sit
 // The first occurrence of a symbol of `kind` that the expression still contains (x' - x' does not).
 const Occurrence* first_of(const Parsed& parsed, SymbolKind kind) {
   for (const Occurrence& o : parsed.symbols)
-    if (o.kind == kind && parsed.value.has(o.symbol)) return &o;
+    if (o.kind == kind && parsed.contains(o)) return &o;
   return nullptr;
 }
 
@@ -663,6 +670,7 @@ SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel le
     parsed.value = lhs.value - rhs.value;
     parsed.symbols = std::move(lhs.symbols);
     parsed.symbols.insert(parsed.symbols.end(), rhs.symbols.begin(), rhs.symbols.end());
+    parsed.present = symbols_of(parsed.value);
   }
   const bool velocities = first_of(parsed, SymbolKind::velocity) != nullptr;
   const bool accelerations = first_of(parsed, SymbolKind::acceleration) != nullptr;
@@ -760,7 +768,7 @@ SpecBuilder& SpecBuilder::initial(const std::string& coordinate, const std::stri
     const Site site{text, where, fmt::format("initial {} of '{}'", what, coordinate)};
     const Parsed parsed = read(spec_, site);
     for (const Occurrence& o : parsed.symbols)
-      if (o.kind != SymbolKind::parameter && o.kind != SymbolKind::constant && parsed.value.has(o.symbol))
+      if (o.kind != SymbolKind::parameter && o.kind != SymbolKind::constant && parsed.contains(o))
         site.fail_at(o.position, fmt::format("an initial value may depend on the parameters only, not on '{}'", o.name));
     return parsed.value;
   };
@@ -779,7 +787,7 @@ SpecBuilder& SpecBuilder::solution(const std::string& coordinate, const std::str
   const Parsed parsed = read(spec_, site);
   for (const Occurrence& o : parsed.symbols)
     if (o.kind != SymbolKind::parameter && o.kind != SymbolKind::constant && o.kind != SymbolKind::time &&
-        parsed.value.has(o.symbol))
+        parsed.contains(o))
       site.fail_at(o.position, fmt::format("a solution q(t) may depend on t and the parameters only, not on '{}'",
                                            o.name));
   spec_.solution.resize(spec_.coordinates.size(), GiNaC::ex(0));
