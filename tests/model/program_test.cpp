@@ -207,7 +207,7 @@ TEST(Program, RefusesOperandsNotYetWritten) {
 // one constraint q0' sin(q1) - q1' = 0 at velocity level, given as b = (sin q1, -1),
 // b0 = q0' q1' cos(q1); D = (1, sin q1); energy m/2 (v0^2 + q0^2 v1^2) + k/2 q0^2.
 ModelPrograms polar_programs(double m, double k) {
-  ModelPrograms p{Program(2), std::nullopt, Program(2), Program(2), std::nullopt, std::nullopt};
+  ModelPrograms p{Program(2), std::nullopt, Program(2), Program(2), std::nullopt, std::nullopt, std::nullopt};
   Program& t = p.terms;
   const int q0 = t.coordinate_register(0), q1 = t.coordinate_register(1);
   const int v0 = t.velocity_register(0), v1 = t.velocity_register(1);
@@ -334,7 +334,7 @@ TEST(ProgramEvaluator, PreparedProgramsGiveTheSameBitsAsTheirPrograms) {
     for (const bool library : {true, false}) {
       const int s = 1;
       ModelPrograms programs{mixed_program(n, n * n + 2 * n + s * n + s, library),
-                             mixed_program(n, (n - s) * n, library), Program(n), Program(n), std::nullopt, std::nullopt};
+                             mixed_program(n, (n - s) * n, library), Program(n), Program(n), std::nullopt, std::nullopt, std::nullopt};
       programs.velocity_residual = mixed_program(n, 1, library);
       const ProgramEvaluator evaluator(n, s, programs);
       const Program& terms = evaluator.programs().terms;
@@ -371,7 +371,7 @@ TEST(ProgramEvaluator, PreparedProgramsGiveTheSameBitsAsTheirPrograms) {
 TEST(ProgramEvaluator, ComputesParameterOnlySubexpressionsOnce) {
   // A(1, 1) = q0 * (sqrt(2) * m) and Q(0) = sqrt(2) * m; everything else constant.
   const double m = 1.3;
-  ModelPrograms programs{Program(2), std::nullopt, Program(2), Program(2), std::nullopt, std::nullopt};
+  ModelPrograms programs{Program(2), std::nullopt, Program(2), Program(2), std::nullopt, std::nullopt, std::nullopt};
   Program& p = programs.terms;
   const int zero = p.push_constant(0.0);
   const int sm = p.push(Op::mul, p.push(Op::sqrt, p.push_constant(2.0)), p.push_constant(m));

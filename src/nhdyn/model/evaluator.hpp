@@ -7,6 +7,8 @@
 
 #include <cstddef>
 
+#include "nhdyn/model/sparsity.hpp"
+
 namespace nhdyn {
 
 // Where an Evaluator writes the terms. All matrices are column-major and contiguous, with a
@@ -29,6 +31,14 @@ class Evaluator {
   // Fills every entry of A, Q, G, b and b0.
   virtual void terms(double t, const double* q, const double* v, double* scratch,
                      const TermsOut& out) const = 0;
+
+  // The structural nonzeros of A and b when the evaluator can write only those (a model compiled
+  // sparse, symbolic/compile.hpp); nullptr otherwise.
+  virtual const TermsSparsity* sparsity() const { return nullptr; }
+  // Like terms(), but out.A and out.b receive only the nonzeros, in the order of sparsity()
+  // (compressed columns). Only for an evaluator whose sparsity() is not null.
+  virtual void sparse_terms(double /*t*/, const double* /*q*/, const double* /*v*/, double* /*scratch*/,
+                            const TermsOut& /*out*/) const {}
 
   // Whether complement() is implemented (the model carries an analytic D).
   virtual bool has_complement() const { return false; }

@@ -378,7 +378,19 @@ ProgramEvaluator::ProgramEvaluator(int n, int s, ModelPrograms programs)
   if (n <= 0 || s < 0 || s >= n)
     throw std::invalid_argument("ProgramEvaluator: needs 0 <= s < n, got n = " + std::to_string(n) +
                                 ", s = " + std::to_string(s));
-  check_program(programs_.terms, "terms", n, n * n + 2 * n + s * n + s);
+  std::size_t a_size = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+  std::size_t b_size = static_cast<std::size_t>(s) * static_cast<std::size_t>(n);
+  if (programs_.sparsity) {
+    check_pattern(programs_.sparsity->A, n, n, "A");
+    check_pattern(programs_.sparsity->b, s, n, "b");
+    a_size = static_cast<std::size_t>(programs_.sparsity->A.nonzeros());
+    b_size = static_cast<std::size_t>(programs_.sparsity->b.nonzeros());
+  }
+  terms_sizes_[0] = a_size;
+  terms_sizes_[1] = terms_sizes_[2] = static_cast<std::size_t>(n);
+  terms_sizes_[3] = b_size;
+  terms_sizes_[4] = static_cast<std::size_t>(s);
+  check_program(programs_.terms, "terms", n, static_cast<int>(a_size + b_size) + 2 * n + s);
   if (programs_.complement) check_program(*programs_.complement, "complement", n, (n - s) * n);
   check_program(programs_.position_residual, "position residual", n, -1);
   check_program(programs_.velocity_residual, "velocity residual", n, -1);
@@ -404,14 +416,24 @@ ProgramEvaluator::ProgramEvaluator(int n, int s, ModelPrograms programs)
   if (programs_.energy) widen(*programs_.energy);
   if (programs_.solution) widen(*programs_.solution);
   scratch_ = largest;
+  if (programs_.sparsity) {
+    // The nonzeros of A and b, between the program's run and their scatter into dense matrices.
+    values_offset_ = static_cast<std::size_t>(programs_.terms.registers());
+    scratch_ = std::max(scratch_, values_offset_ + a_size + b_size);
+  }
 
-  terms_ = prepare(programs_.terms, {n * n, n, n, s * n, s});
+  terms_ = prepare(programs_.terms, {static_cast<int>(a_size), n, n, static_cast<int>(b_size), s});
   if (programs_.complement) complement_ = prepare(*programs_.complement, {(n - s) * n});
   position_residual_ = prepare(programs_.position_residual, {programs_.position_residual.outputs()});
   velocity_residual_ = prepare(programs_.velocity_residual, {programs_.velocity_residual.outputs()});
   if (programs_.energy) energy_ = prepare(*programs_.energy, {1});
   if (programs_.solution) solution_ = prepare(*programs_.solution, {3 * n});
-  terms_function_ = terms_.calls ? choose_terms<true>(n, s) : choose_terms<false>(n, s);
+  if (programs_.sparsity) {
+    terms_function_ = terms_.calls ? &terms_scatter<true> : &terms_scatter<false>;
+    sparse_function_ = terms_.calls ? &terms_any<true> : &terms_any<false>;
+  } else {
+    terms_function_ = terms_.calls ? choose_terms<true>(n, s) : choose_terms<false>(n, s);
+  }
 }
 
 namespace {
@@ -621,16 +643,33 @@ template <bool Calls>
 void ProgramEvaluator::terms_any(const ProgramEvaluator& self, double t, const double* q, const double* v,
                                  double* scratch, const TermsOut& out) {
   const Prepared& p = self.terms_;
-  const std::size_t n = static_cast<std::size_t>(self.n_), s = static_cast<std::size_t>(self.s_);
-  load_inputs(p.reads, n, t, q, v, scratch);
+  load_inputs(p.reads, static_cast<std::size_t>(self.n_), t, q, v, scratch);
   const TermsArrays arrays(scratch, out);
-  const std::size_t sizes[5] = {n * n, n, n, s * n, s};
   const double* image = p.image.data();
   for (int a = 0; a < 5; ++a) {
-    for (std::size_t i = 0; i < sizes[a]; ++i) arrays.arrays[a + 1][i] = image[i];
-    image += sizes[a];
+    const std::size_t size = self.terms_sizes_[a];
+    for (std::size_t i = 0; i < size; ++i) arrays.arrays[a + 1][i] = image[i];
+    image += size;
   }
   run_steps<Calls>(p.steps.data(), arrays.arrays);
+}
+
+template <bool Calls>
+void ProgramEvaluator::terms_scatter(const ProgramEvaluator& self, double t, const double* q, const double* v,
+                                     double* scratch, const TermsOut& out) {
+  double* const a_values = scratch + self.values_offset_;
+  double* const b_values = a_values + self.terms_sizes_[0];
+  terms_any<Calls>(self, t, q, v, scratch, TermsOut{a_values, out.Q, out.G, b_values, out.b0});
+  const auto scatter = [](const SparsityPattern& pattern, const double* values, double* dense) {
+    const std::size_t rows = static_cast<std::size_t>(pattern.rows);
+    std::fill(dense, dense + rows * static_cast<std::size_t>(pattern.cols), 0.0);
+    for (int j = 0; j < pattern.cols; ++j)
+      for (int k = pattern.outer[static_cast<std::size_t>(j)]; k < pattern.outer[static_cast<std::size_t>(j) + 1]; ++k)
+        dense[static_cast<std::size_t>(j) * rows + static_cast<std::size_t>(pattern.inner[static_cast<std::size_t>(k)])] =
+            values[k];
+  };
+  scatter(self.programs_.sparsity->A, a_values, out.A);
+  scatter(self.programs_.sparsity->b, b_values, out.b);
 }
 
 template <bool Calls>
@@ -653,6 +692,13 @@ ProgramEvaluator::TermsFunction ProgramEvaluator::choose_terms(int n, int s) {
 void ProgramEvaluator::terms(double t, const double* q, const double* v, double* scratch,
                              const TermsOut& out) const {
   terms_function_(*this, t, q, v, scratch, out);
+}
+
+void ProgramEvaluator::sparse_terms(double t, const double* q, const double* v, double* scratch,
+                                    const TermsOut& out) const {
+  if (sparse_function_ == nullptr)
+    throw std::logic_error("ProgramEvaluator::sparse_terms: this model was compiled dense (sparsity() is null)");
+  sparse_function_(*this, t, q, v, scratch, out);
 }
 
 void ProgramEvaluator::run(const Prepared& p, double t, const double* q, const double* v, double* scratch,

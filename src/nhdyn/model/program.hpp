@@ -154,12 +154,15 @@ class Program {
 // The programs of a compiled model, with the output each must have (n coordinates, s
 // constraints, p of them at position level, r = number at position or velocity level).
 struct ModelPrograms {
-  Program terms;                     // outputs: A (n x n, col-major), Q (n), G (n), b (s x n, col-major), b0 (s)
+  // outputs: A (n x n, col-major), Q (n), G (n), b (s x n, col-major), b0 (s); with a sparsity,
+  // only its nonzeros of A and b (compressed columns) in their places
+  Program terms;
   std::optional<Program> complement;  // outputs: D, k x n col-major (k = n - s)
   Program position_residual;         // outputs: phi (p); reads no velocity
   Program velocity_residual;         // outputs: f (r)
   std::optional<Program> energy;     // one output: T + V
   std::optional<Program> solution;   // outputs: q (n), q' (n), q'' (n) of the exact motion; reads only t
+  std::optional<TermsSparsity> sparsity;  // the nonzeros of A and b that terms writes, if not all
 };
 
 // An Evaluator that runs straight-line programs. Each program is prepared once, when the
@@ -189,8 +192,13 @@ class ProgramEvaluator final : public Evaluator {
   int terms_operations() const { return static_cast<int>(terms_.steps.size()) - 1; }
 
   std::size_t scratch_size() const override { return scratch_; }
-  // The Evaluator interface; each call runs one program and writes its outputs.
+  // The Evaluator interface; each call runs one program and writes its outputs. A sparse terms
+  // program fills a dense A and b by zeroing them and scattering its nonzeros (through scratch).
   void terms(double t, const double* q, const double* v, double* scratch, const TermsOut& out) const override;
+  const TermsSparsity* sparsity() const override {
+    return programs_.sparsity ? &*programs_.sparsity : nullptr;
+  }
+  void sparse_terms(double t, const double* q, const double* v, double* scratch, const TermsOut& out) const override;
   bool has_complement() const override { return programs_.complement.has_value(); }
   void complement(double t, const double* q, const double* v, double* scratch, double* D) const override;
   void position_residual(double t, const double* q, double* scratch, double* phi) const override;
@@ -224,6 +232,9 @@ class ProgramEvaluator final : public Evaluator {
   static void terms_any(const ProgramEvaluator& self, double t, const double* q, const double* v,
                         double* scratch, const TermsOut& out);
   template <bool Calls>
+  static void terms_scatter(const ProgramEvaluator& self, double t, const double* q, const double* v,
+                            double* scratch, const TermsOut& out);
+  template <bool Calls>
   static TermsFunction choose_terms(int n, int s);
   void run(const Prepared& p, double t, const double* q, const double* v, double* scratch, double* out) const;
 
@@ -233,6 +244,9 @@ class ProgramEvaluator final : public Evaluator {
   std::size_t scratch_ = 0;
   Prepared terms_, complement_, position_residual_, velocity_residual_, energy_, solution_;
   TermsFunction terms_function_ = nullptr;
+  std::size_t terms_sizes_[5] = {0, 0, 0, 0, 0};  // outputs of terms: A, Q, G, b, b0 (nonzeros when sparse)
+  std::size_t values_offset_ = 0;  // where terms_scatter keeps the nonzeros in scratch
+  TermsFunction sparse_function_ = nullptr;
 };
 
 }  // namespace nhdyn

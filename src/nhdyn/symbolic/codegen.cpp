@@ -224,7 +224,8 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
     if (namespaces.front() == "std") throw InputError("codegen: the generated code may not go into namespace std");
   }
 
-  const Model model = compile_model(spec, derivation);
+  // The generated code writes every entry of A and b (dense outputs).
+  const Model model = compile_model(spec, derivation, CompileOptions{TermsLayout::dense});
   const auto* evaluator = dynamic_cast<const ProgramEvaluator*>(model.evaluator.get());
   if (evaluator == nullptr) throw std::logic_error("generate_code: compile_model did not make a ProgramEvaluator");
   const ModelPrograms& programs = evaluator->programs();

@@ -104,6 +104,10 @@ class ProgramCompiler {
 
   // Compiles `e` (parameters still symbolic) into the next output; `what` names it in errors.
   void add_output(const GiNaC::ex& e, const std::string& what) {
+    if (e.is_zero()) {
+      program_.add_constant_output(0.0);
+      return;
+    }
     what_ = what;
     original_ = e;
     GiNaC::ex numeric_form;
@@ -486,9 +490,29 @@ int coordinate_index(const Spec& spec, const std::string& name, const char* what
   return static_cast<int>(it - spec.coordinates.begin());
 }
 
+// The entries of m that are not identically zero, in compressed columns.
+SparsityPattern pattern_of(const GiNaC::matrix& m) {
+  SparsityPattern p;
+  p.rows = static_cast<int>(m.rows());
+  p.cols = static_cast<int>(m.cols());
+  p.outer.push_back(0);
+  for (unsigned j = 0; j < m.cols(); ++j) {
+    for (unsigned i = 0; i < m.rows(); ++i)
+      if (!m(i, j).is_zero()) p.inner.push_back(static_cast<int>(i));
+    p.outer.push_back(static_cast<int>(p.inner.size()));
+  }
+  return p;
+}
+
+bool compile_sparse(const TermsSparsity& sparsity, int n, int s, TermsLayout layout) {
+  if (layout != TermsLayout::automatic) return layout == TermsLayout::sparse;
+  const double entries = static_cast<double>(n) * static_cast<double>(n + s);
+  return n >= kSparseFrom && sparsity.A.nonzeros() + sparsity.b.nonzeros() <= 0.25 * entries;
+}
+
 }  // namespace
 
-Model compile_model(const Spec& spec, const Derivation& derivation) {
+Model compile_model(const Spec& spec, const Derivation& derivation, const CompileOptions& options) {
   const int n = spec.n(), s = spec.s();
   if (n == 0) throw ModelError(fmt::format("model '{}' has no coordinates", spec.name));
   if (s >= n)
@@ -524,22 +548,40 @@ Model compile_model(const Spec& spec, const Derivation& derivation) {
 
   ModelPrograms programs;
   {
+    TermsSparsity sparsity{pattern_of(derivation.A), pattern_of(derivation.b)};
+    const bool sparse = compile_sparse(sparsity, n, s, options.layout);
     ProgramCompiler terms(spec);
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        terms.add_output(derivation.A(static_cast<unsigned>(i), static_cast<unsigned>(j)),
-                         fmt::format("A({}, {})", q_name(i), q_name(j)));
+    // Column by column: every entry when dense, the pattern's nonzeros when sparse. Entry names
+    // are formatted only when compiled (a thousand-body chain has 18 million entries).
+    const auto matrix_outputs = [&](const GiNaC::matrix& m, const SparsityPattern& pattern, const char* symbol,
+                                    auto row_name) {
+      for (int j = 0; j < static_cast<int>(m.cols()); ++j) {
+        const auto output = [&](int i) {
+          const GiNaC::ex& e = m(static_cast<unsigned>(i), static_cast<unsigned>(j));
+          if (e.is_zero())
+            terms.add_output(e, "");
+          else
+            terms.add_output(e, fmt::format("{}({}, {})", symbol, row_name(i), q_name(j)));
+        };
+        if (sparse) {
+          for (int k = pattern.outer[static_cast<std::size_t>(j)]; k < pattern.outer[static_cast<std::size_t>(j) + 1];
+               ++k)
+            output(pattern.inner[static_cast<std::size_t>(k)]);
+        } else {
+          for (int i = 0; i < static_cast<int>(m.rows()); ++i) output(i);
+        }
+      }
+    };
+    matrix_outputs(derivation.A, sparsity.A, "A", q_name);
     for (int i = 0; i < n; ++i)
       terms.add_output(derivation.Q(static_cast<unsigned>(i), 0), fmt::format("Q({})", q_name(i)));
     for (int i = 0; i < n; ++i)
       terms.add_output(derivation.G(static_cast<unsigned>(i), 0), fmt::format("G({})", q_name(i)));
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < s; ++i)
-        terms.add_output(derivation.b(static_cast<unsigned>(i), static_cast<unsigned>(j)),
-                         fmt::format("b({}, {})", c_name(i), q_name(j)));
+    matrix_outputs(derivation.b, sparsity.b, "b", c_name);
     for (int i = 0; i < s; ++i)
       terms.add_output(derivation.b0(static_cast<unsigned>(i), 0), fmt::format("b0({})", c_name(i)));
     programs.terms = terms.finish();
+    if (sparse) programs.sparsity = std::move(sparsity);
   }
   if (derivation.D) {
     ProgramCompiler complement(spec);
@@ -611,6 +653,8 @@ Model compile_model(const Spec& spec, const Derivation& derivation) {
   return model;
 }
 
-Model compile_model(const Spec& spec) { return compile_model(spec, derive(spec)); }
+Model compile_model(const Spec& spec, const CompileOptions& options) {
+  return compile_model(spec, derive(spec), options);
+}
 
 }  // namespace nhdyn::symbolic

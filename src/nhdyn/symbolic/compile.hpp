@@ -10,10 +10,22 @@
 
 namespace nhdyn::symbolic {
 
+// How the terms program writes A and b: every entry (dense), or only the entries that are not
+// identically zero (sparse; the evaluator then also offers sparse_terms() for the sparse
+// formulations, formulation/sparse_sanh.hpp). `automatic` compiles sparse from kSparseFrom
+// coordinates on when at most a quarter of the entries of A and b are nonzero: a chain of a
+// thousand bodies would otherwise write 18 million entries per call, nearly all of them zero.
+enum class TermsLayout { automatic, dense, sparse };
+inline constexpr int kSparseFrom = 64;
+
+struct CompileOptions {
+  TermsLayout layout = TermsLayout::automatic;
+};
+
 // Throws ModelError when an initial value or term is not a number once the parameters are set.
-Model compile_model(const Spec& spec, const Derivation& derivation);
+Model compile_model(const Spec& spec, const Derivation& derivation, const CompileOptions& options = {});
 
 // derive() then compile_model().
-Model compile_model(const Spec& spec);
+Model compile_model(const Spec& spec, const CompileOptions& options = {});
 
 }  // namespace nhdyn::symbolic
