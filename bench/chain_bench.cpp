@@ -1,21 +1,27 @@
 // Scaling with the size of the model (issue 5): the N-trailer chain of docs/gallery/chain.md
-// (symbolic/chain.hpp), n = 3N coordinates, s = 3N - 2 constraints, k = 2, with today's dense
-// linear algebra:
-//   chain/derive_and_compile/N        make_chain_spec, derive() and compile_model(): the symbolic
-//                                     front end from nothing to a frozen Model
-//   chain/terms/N                     compute_terms at the initial state (A, Q, G, b, b0; the
-//                                     dense n x n A and s x n b are written whole)
-//   chain/acceleration/<form>/N       compute_dynamics (terms + solve) per formulation
-// N = 1, 3, 10, 30, 100. The sparse path the issue asks for (and N = 1000) is not built yet:
-// with dense matrices one solve is O(n^3) and the terms alone write 9e6 entries at N = 1000.
-// Results and the fitted exponents: docs/performance.md.
+// (symbolic/chain.hpp), n = 3N coordinates, s = 3N - 2 constraints, k = 2.
+//   chain/derive_and_compile/N         make_chain_spec, derive() and compile_model(): the symbolic
+//                                      front end from nothing to a frozen Model (compiled sparse
+//                                      from N = 22 on, TermsLayout::automatic)
+//   chain/terms/dense/N                compute_terms into the dense Data (A and b written whole)
+//   chain/terms/sparse/N               compute_sparse_terms (only the nonzeros of A and b)
+//   chain/solve/dense/<form>/N         one acceleration solve (compute_acceleration) with the
+//                                      terms already computed: sanh/qr, sanh/partition, lagrange
+//   chain/solve/sparse/<form>/N        the same on the sparse path: sanh (block elimination on
+//                                      the partition, formulation/sparse_sanh.hpp) and lagrange
+//                                      (one SparseLU of the KKT matrix), Eigen's SparseLU both
+// Dense for N = 1 .. 100 (one dense solve at N = 1000 takes seconds and its Data a gigabyte);
+// sparse for N = 1 .. 1000. Results, plot and fitted exponents: docs/performance.md.
 #include <benchmark/benchmark.h>
 
 #include <string>
 #include <vector>
 
 #include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/formulation/sparse_lagrange.hpp"
+#include "nhdyn/formulation/sparse_sanh.hpp"
 #include "nhdyn/model/data.hpp"
+#include "nhdyn/model/sparse_data.hpp"
 #include "nhdyn/model/terms.hpp"
 #include "nhdyn/symbolic/chain.hpp"
 #include "nhdyn/symbolic/compile.hpp"
@@ -23,10 +29,10 @@
 namespace nhdyn::bench {
 namespace {
 
-Model make_chain_model(int bodies) {
+Model make_chain_model(int bodies, symbolic::TermsLayout layout = symbolic::TermsLayout::automatic) {
   symbolic::ChainParameters p;
   p.bodies = bodies;
-  return symbolic::compile_model(symbolic::make_chain_spec(p));
+  return symbolic::compile_model(symbolic::make_chain_spec(p), symbolic::CompileOptions{layout});
 }
 
 void bench_derive_and_compile(benchmark::State& state) {
@@ -38,8 +44,8 @@ void bench_derive_and_compile(benchmark::State& state) {
   state.counters["n"] = 3.0 * bodies;
 }
 
-void bench_terms(benchmark::State& state) {
-  const Model model = make_chain_model(static_cast<int>(state.range(0)));
+void bench_dense_terms(benchmark::State& state) {
+  const Model model = make_chain_model(static_cast<int>(state.range(0)), symbolic::TermsLayout::dense);
   Data data = make_data(model);
   for (auto _ : state) {
     compute_terms(model, data, model.t0, model.q0.data(), model.v0.data());
@@ -49,15 +55,26 @@ void bench_terms(benchmark::State& state) {
   state.counters["n"] = model.n();
 }
 
-void bench_acceleration(benchmark::State& state, FormulationOptions options) {
-  const Model model = make_chain_model(static_cast<int>(state.range(0)));
+void bench_sparse_terms(benchmark::State& state) {
+  const Model model = make_chain_model(static_cast<int>(state.range(0)), symbolic::TermsLayout::sparse);
+  SparseData data = make_sparse_data(model);
+  for (auto _ : state) {
+    compute_sparse_terms(model, data, model.t0, model.q0.data(), model.v0.data());
+    benchmark::DoNotOptimize(data.A.valuePtr());
+    benchmark::ClobberMemory();
+  }
+  state.counters["n"] = model.n();
+}
+
+void bench_dense_solve(benchmark::State& state, FormulationOptions options) {
+  const Model model = make_chain_model(static_cast<int>(state.range(0)), symbolic::TermsLayout::dense);
   Data data = make_data(model);
   if (compute_dynamics(model, data, options, model.t0, model.q0.data(), model.v0.data()) != Status::ok) {
     state.SkipWithError("compute_dynamics failed at the chain's initial state");
     return;
   }
   for (auto _ : state) {
-    Status status = compute_dynamics(model, data, options, model.t0, model.q0.data(), model.v0.data());
+    Status status = compute_acceleration(model, data, options);
     benchmark::DoNotOptimize(status);
     benchmark::DoNotOptimize(data.qdd.data());
     benchmark::ClobberMemory();
@@ -65,26 +82,53 @@ void bench_acceleration(benchmark::State& state, FormulationOptions options) {
   state.counters["n"] = model.n();
 }
 
-const std::vector<long> sizes{1, 3, 10, 30, 100};
+using SparseSolve = Status (*)(const Model&, SparseData&);
+
+void bench_sparse_solve(benchmark::State& state, SparseSolve solve) {
+  const Model model = make_chain_model(static_cast<int>(state.range(0)), symbolic::TermsLayout::sparse);
+  SparseData data = make_sparse_data(model);
+  if (compute_sparse_terms(model, data, model.t0, model.q0.data(), model.v0.data()) != Status::ok ||
+      solve(model, data) != Status::ok) {
+    state.SkipWithError("the sparse solve failed at the chain's initial state");
+    return;
+  }
+  for (auto _ : state) {
+    Status status = solve(model, data);
+    benchmark::DoNotOptimize(status);
+    benchmark::DoNotOptimize(data.qdd.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["n"] = model.n();
+}
+
+const std::vector<long> dense_sizes{1, 3, 10, 30, 100};
+const std::vector<long> sparse_sizes{1, 3, 10, 30, 100, 300, 1000};
 
 const bool registered = [] {
   auto* compile = benchmark::RegisterBenchmark("chain/derive_and_compile", bench_derive_and_compile);
-  auto* terms = benchmark::RegisterBenchmark("chain/terms", bench_terms);
-  for (long n : sizes) {
-    compile->Arg(n);
-    terms->Arg(n);
-  }
+  for (long n : sparse_sizes) compile->Arg(n);
   compile->Unit(benchmark::kMillisecond);
-  terms->Unit(benchmark::kMicrosecond);
-  const std::vector<std::pair<std::string, FormulationOptions>> forms{
+  auto* dense_terms = benchmark::RegisterBenchmark("chain/terms/dense", bench_dense_terms);
+  for (long n : dense_sizes) dense_terms->Arg(n);
+  dense_terms->Unit(benchmark::kMicrosecond);
+  auto* sparse_terms = benchmark::RegisterBenchmark("chain/terms/sparse", bench_sparse_terms);
+  for (long n : sparse_sizes) sparse_terms->Arg(n);
+  sparse_terms->Unit(benchmark::kMicrosecond);
+
+  const std::vector<std::pair<std::string, FormulationOptions>> dense{
       {"sanh/qr", {Method::sanh, Complement::qr}},
       {"sanh/partition", {Method::sanh, Complement::partition}},
-      {"lagrange", {Method::lagrange, Complement::qr}},
-      {"udwadia-kalaba", {Method::udwadia_kalaba, Complement::qr}},
-      {"nullspace/qr", {Method::nullspace, Complement::qr}}};
-  for (const auto& [name, options] : forms) {
-    auto* b = benchmark::RegisterBenchmark(("chain/acceleration/" + name).c_str(), bench_acceleration, options);
-    for (long n : sizes) b->Arg(n);
+      {"lagrange", {Method::lagrange, Complement::qr}}};
+  for (const auto& [name, options] : dense) {
+    auto* b = benchmark::RegisterBenchmark(("chain/solve/dense/" + name).c_str(), bench_dense_solve, options);
+    for (long n : dense_sizes) b->Arg(n);
+    b->Unit(benchmark::kMicrosecond);
+  }
+  const std::vector<std::pair<std::string, SparseSolve>> sparse{
+      {"sanh", &compute_sparse_sanh_acceleration}, {"lagrange", &compute_sparse_lagrange_acceleration}};
+  for (const auto& [name, solve] : sparse) {
+    auto* b = benchmark::RegisterBenchmark(("chain/solve/sparse/" + name).c_str(), bench_sparse_solve, solve);
+    for (long n : sparse_sizes) b->Arg(n);
     b->Unit(benchmark::kMicrosecond);
   }
   return true;

@@ -289,7 +289,14 @@ Derivation derive(const Spec& spec) {
   // T + V is conserved when no other force acts and nothing depends on t explicitly.
   bool conservative = symbolic::is_zero(T.diff(t)) && symbolic::is_zero(V.diff(t));
   for (const GiNaC::ex& force : spec.forces) conservative = conservative && symbolic::is_zero(force);
-  if (conservative) d.energy = simplify(T + V);
+  if (conservative) {
+    // Simplifying a sum costs more than linearly in its number of terms (every trigonometric
+    // argument is reduced across all of them): a large model's energy is kept as written, which
+    // computes the same values.
+    const GiNaC::ex energy = T + V;
+    constexpr std::size_t kSimplifiedTerms = 64;
+    d.energy = energy.nops() <= kSimplifiedTerms ? simplify(energy) : energy;
+  }
   return d;
 }
 
