@@ -1,9 +1,45 @@
 #include "nhdyn/model/data.hpp"
 
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cmath>
+
+#include "nhdyn/core/error.hpp"
+
 namespace nhdyn {
+
+double dense_data_bytes(int n, int s) {
+  const double dn = n, ds = s;
+  return 8.0 * (5.0 * dn * dn + 2.0 * (dn + ds) * (dn + ds) + 6.0 * dn * ds + 2.0 * ds * ds);
+}
+
+double physical_memory_bytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES);
+  const long page_size = sysconf(_SC_PAGESIZE);
+  return pages > 0 && page_size > 0 ? static_cast<double>(pages) * static_cast<double>(page_size) : 0.0;
+}
+
+void check_dense_memory(const Model& model, double available) {
+  const int n = model.n(), s = model.s();
+  const double needed = dense_data_bytes(n, s);
+  if (available <= 0.0 || needed <= available) return;
+  // The largest n that fits with the same ratio s / n.
+  const double ratio = static_cast<double>(s) / n;
+  const double per_n2 = dense_data_bytes(1000, static_cast<int>(std::lround(1000 * ratio))) / 1e6;
+  const double largest = std::floor(std::sqrt(available / per_n2));
+  constexpr double GB = 1e9;
+  throw ModelError(fmt::format(
+      "model '{}' is too large for the dense solvers: with n = {} coordinates and s = {} constraints a "
+      "simulation's dense matrices need {:.3g} GB (about 8 (5 n^2 + 2 (n + s)^2 + 6 n s + 2 s^2) bytes), and this "
+      "machine has {:.3g} GB; the limit here is about n = {:.0f} coordinates. Use the sparse path (a model "
+      "compiled sparse with make_sparse_data, docs/performance.md) or a smaller model",
+      model.name, n, s, needed / GB, available / GB, largest));
+}
 
 Data make_data(const Model& model) {
   check_model_shape(model);
+  check_dense_memory(model, physical_memory_bytes());
   const int n = model.n();
   const int s = model.s();
   const int k = model.k();

@@ -105,6 +105,20 @@ struct Data {
 };
 
 // Allocates every field of Data for `model` and sets the state to the model's initial state.
+// Throws ModelError (check_dense_memory) when its dense matrices would not fit in this machine's
+// memory, before allocating anything.
 Data make_data(const Model& model);
+
+// Bytes of the dense matrices of a Data for n coordinates and s constraints: about
+// 8 (5 n^2 + 2 (n + s)^2 + 6 n s + 2 s^2) (A, M, the KKT matrix and the factorizations).
+double dense_data_bytes(int n, int s);
+
+// Throws ModelError when dense_data_bytes(n, s) exceeds `available` bytes, saying how much is
+// needed, how much there is, the largest n that fits, and the way out (the sparse path of
+// docs/performance.md, or a smaller model).
+void check_dense_memory(const Model& model, double available);
+
+// The physical memory of this machine in bytes (0 when the system does not say).
+double physical_memory_bytes();
 
 }  // namespace nhdyn

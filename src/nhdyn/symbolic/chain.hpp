@@ -37,10 +37,10 @@ struct ChainParameters {
 };
 
 // The largest chain the generator builds. The model file grows by about 0.5 kB a body (5 MB at
-// the limit), but a simulation's Data holds dense n x n matrices of 8 n^2 bytes each (n = 3N):
-// 7.2 GB each at N = 10000, more than a machine of today has for several of them; and the symbolic
-// derivation grows about as N^2 (7.6 s at N = 100, docs/gallery/chain.md). Raise the limit with
-// the sparse solvers.
+// the limit) and the derivation about as N^1.3 (2.7 s at N = 1000, docs/performance.md). A
+// simulation with the dense solvers holds n x n matrices (n = 3N): make_data refuses a model whose
+// dense matrices exceed the machine's memory (check_dense_memory), which on a machine of 24 GB is
+// from about N = 4000 on; the sparse path (SparseData) needs megabytes at the limit.
 inline constexpr int kMaxChainBodies = 10000;
 
 // Throws InputError naming the first bad value, its limit and what to do: bodies outside
