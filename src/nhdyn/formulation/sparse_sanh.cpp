@@ -12,7 +12,7 @@ Status compute_sparse_sanh_acceleration(const Model& model, SparseData& data) {
     const double* b_values = data.b.valuePtr();
     double* dep_values = data.b_dep.valuePtr();
     for (std::size_t m = 0; m < data.b_dep_source.size(); ++m) dep_values[m] = b_values[data.b_dep_source[m]];
-    data.b_ind.setZero();
+    data.b_ind.leftCols(k).setZero();
     for (int jj = 0; jj < k; ++jj) {
       const int j = data.independent[static_cast<std::size_t>(jj)];
       for (int m = data.b.outerIndexPtr()[j]; m < data.b.outerIndexPtr()[j + 1]; ++m)
@@ -23,11 +23,11 @@ Status compute_sparse_sanh_acceleration(const Model& model, SparseData& data) {
       data.failed.assign("columns of b of the dependent coordinates (b_dep)");
       return Status::singular_system;
     }
+    data.b_ind.col(k) = data.b0;
     data.X = data.lu_dep->solve(data.b_ind);
-    data.p = data.lu_dep->solve(data.b0);
     for (int jj = 0; jj < s; ++jj) {
       const int j = data.dependent[static_cast<std::size_t>(jj)];
-      data.c[j] = -data.p[jj];
+      data.c[j] = -data.X(jj, k);
       for (int r = 0; r < k; ++r) data.D(r, j) = -data.X(jj, r);
     }
   }

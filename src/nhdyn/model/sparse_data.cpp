@@ -93,9 +93,8 @@ SparseData make_sparse_data(const Model& model) {
     for (int m = 0; m < d.b_dep.nonZeros(); ++m)
       d.b_dep_source[static_cast<std::size_t>(m)] = static_cast<int>(d.b_dep.valuePtr()[m]);
   }
-  d.b_ind = Matrix::Zero(s, k);
-  d.X = Matrix::Zero(s, k);
-  d.p = Vector::Zero(s);
+  d.b_ind = Matrix::Zero(s, k + 1);
+  d.X = Matrix::Zero(s, k + 1);
   d.D = Matrix::Zero(k, n);
   d.AD = Matrix::Zero(n, k);
   d.DAD = Matrix::Zero(k, k);

@@ -50,10 +50,9 @@ struct SparseData {
   // --- sanh scratch ---------------------------------------------------------------------------------
   SparseMatrix b_dep;            // s x s, values gathered from b
   std::vector<int> b_dep_source; // for each value of b_dep, its index among b's values
-  Matrix b_ind;                  // s x k, the columns of b of the independent coordinates
+  Matrix b_ind;                  // s x (k + 1): the columns of b of the independent coordinates, then b0
   std::unique_ptr<SparseLU> lu_dep;  // b_dep, pattern analysed once (SparseLU cannot be moved)
-  Matrix X;                      // s x k, b_dep^-1 b_ind
-  Vector p;                      // s, b_dep^-1 b0
+  Matrix X;                      // s x (k + 1), b_dep^-1 [b_ind, b0] (one solve for both)
   Matrix D;                      // k x n, partitioned complement [I, -X^T] (original column order)
   Matrix AD;                     // n x k, A D^T
   Matrix DAD;                    // k x k, D A D^T
