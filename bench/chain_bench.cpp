@@ -6,7 +6,8 @@
 //   chain/terms/dense/N                compute_terms into the dense Data (A and b written whole)
 //   chain/terms/sparse/N               compute_sparse_terms (only the nonzeros of A and b)
 //   chain/solve/dense/<form>/N         one acceleration solve (compute_acceleration) with the
-//                                      terms already computed: sanh/qr, sanh/partition, lagrange
+//                                      terms already computed: sanh/qr, sanh/partition, lagrange,
+//                                      udwadia-kalaba, nullspace/qr
 //   chain/solve/sparse/<form>/N        the same on the sparse path: sanh (block elimination on
 //                                      the partition, formulation/sparse_sanh.hpp) and lagrange
 //                                      (one SparseLU of the KKT matrix), Eigen's SparseLU both
@@ -118,7 +119,9 @@ const bool registered = [] {
   const std::vector<std::pair<std::string, FormulationOptions>> dense{
       {"sanh/qr", {Method::sanh, Complement::qr}},
       {"sanh/partition", {Method::sanh, Complement::partition}},
-      {"lagrange", {Method::lagrange, Complement::qr}}};
+      {"lagrange", {Method::lagrange, Complement::qr}},
+      {"udwadia-kalaba", {Method::udwadia_kalaba, Complement::qr}},
+      {"nullspace/qr", {Method::nullspace, Complement::qr}}};
   for (const auto& [name, options] : dense) {
     auto* b = benchmark::RegisterBenchmark(("chain/solve/dense/" + name).c_str(), bench_dense_solve, options);
     for (long n : dense_sizes) b->Arg(n);
