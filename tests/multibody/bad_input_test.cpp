@@ -79,9 +79,16 @@ TEST(MultibodyBadInput, TheBriefDiskLoads) {
 }
 
 TEST(MultibodyBadInput, InertiaNotPositiveDefinite) {
-  // 1 + 1 < 3 breaks the triangle inequality of principal moments.
+  expect_error(replaced("inertia = [\"m*r^2/4\", \"m*r^2/2\", \"m*r^2/4\"]", "inertia = [1, -1, 3]"),
+               {"disk.toml:26:", "body 'disk'", "not positive definite", "[[1, 0, 0], [0, -1, 0], [0, 0, 3]]"});
+  // Positive definite, but 1 + 1 < 3 breaks the triangle inequality of a rigid body's moments,
+  // also when the axes are not principal.
   expect_error(replaced("inertia = [\"m*r^2/4\", \"m*r^2/2\", \"m*r^2/4\"]", "inertia = [1, 1, 3]"),
-               {"disk.toml:26:", "body 'disk'", "not positive definite"});
+               {"disk.toml:26:", "body 'disk'", "triangle inequality"});
+  expect_error(replaced("inertia = [\"m*r^2/4\", \"m*r^2/2\", \"m*r^2/4\"]",
+                        "inertia = [[2, 0, 1], [0, 1, 0], [1, 0, 2]]"),  // moments 1, 1, 3
+               {"disk.toml:26:", "triangle inequality"});
+  // The thin disk is on the boundary (Iyy = Ixx + Izz) and is accepted: see TheBriefDiskLoads.
   expect_error(replaced("inertia = [\"m*r^2/4\", \"m*r^2/2\", \"m*r^2/4\"]", "inertia = [0, 1, 1]"),
                {"disk.toml:26:", "not positive definite"});
   expect_error(replaced("inertia = [\"m*r^2/4\", \"m*r^2/2\", \"m*r^2/4\"]", "inertia = [\"-m\", 1, 1]"),

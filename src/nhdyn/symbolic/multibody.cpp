@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <exception>
 #include <sstream>
@@ -67,6 +68,24 @@ std::optional<double> value_of(const GiNaC::ex& e, const Spec& spec, bool at_ref
   } catch (const std::exception&) {
     return std::nullopt;
   }
+}
+
+// The eigenvalues of a symmetric 3 x 3 matrix (the trigonometric closed form).
+std::array<double, 3> principal_moments(const double (&A)[3][3]) {
+  const double p1 = A[0][1] * A[0][1] + A[0][2] * A[0][2] + A[1][2] * A[1][2];
+  if (p1 == 0.0) return {A[0][0], A[1][1], A[2][2]};
+  const double q = (A[0][0] + A[1][1] + A[2][2]) / 3.0;
+  const double p2 = (A[0][0] - q) * (A[0][0] - q) + (A[1][1] - q) * (A[1][1] - q) + (A[2][2] - q) * (A[2][2] - q) + 2.0 * p1;
+  const double p = std::sqrt(p2 / 6.0);
+  double B[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) B[i][j] = (A[i][j] - (i == j ? q : 0.0)) / p;
+  const double r = (B[0][0] * (B[1][1] * B[2][2] - B[1][2] * B[2][1]) - B[0][1] * (B[1][0] * B[2][2] - B[1][2] * B[2][0]) +
+                    B[0][2] * (B[1][0] * B[2][1] - B[1][1] * B[2][0])) / 2.0;
+  const double phi = r <= -1.0 ? std::acos(-1.0) / 3.0 : r >= 1.0 ? 0.0 : std::acos(r) / 3.0;
+  const double e1 = q + 2.0 * p * std::cos(phi);
+  const double e3 = q + 2.0 * p * std::cos(phi + 2.0 * std::acos(-1.0) / 3.0);
+  return {e1, 3.0 * q - e1 - e3, e3};
 }
 
 }  // namespace
@@ -259,6 +278,18 @@ MultibodyBuilder& MultibodyBuilder::body(const std::string& name, const std::str
                      "leading principal minors are {:.6g}, {:.6g}, {:.6g}; all must be positive): every principal "
                      "moment must be positive and each at most the sum of the other two",
                      I[0][0], I[0][1], I[0][2], I[1][0], I[1][1], I[1][2], I[2][0], I[2][1], I[2][2], d1, d2, d3));
+  // A rigid body's principal moments obey the triangle inequality (I1 = integral of y^2 + z^2
+  // <= I2 + I3); equality is a planar lamina such as the thin disk.
+  const std::array<double, 3> moments = principal_moments(I);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double others = moments[(i + 1) % 3] + moments[(i + 2) % 3];
+    if (moments[i] > others + 1e-12 * size)
+      fail(where, context,
+           fmt::format("the inertia tensor's principal moments {:.6g}, {:.6g}, {:.6g} break the triangle inequality "
+                       "({:.6g} > {:.6g} + {:.6g}): no rigid body has this inertia; check the moments and their "
+                       "axes",
+                       moments[0], moments[1], moments[2], moments[i], moments[(i + 1) % 3], moments[(i + 2) % 3]));
+  }
   bodies_.push_back(std::move(b));
   return *this;
 }
