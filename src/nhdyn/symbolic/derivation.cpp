@@ -46,6 +46,9 @@ int first_contained(const GiNaC::ex& e, int n, Get get) {
   return -1;
 }
 
+// Terms of large models are simplified only up to a size (simplify_moderate, simplify.hpp).
+GiNaC::ex tidy(const GiNaC::ex& e) { return simplify_moderate(e); }
+
 }  // namespace
 
 std::optional<GiNaC::matrix> partitioned_complement(const GiNaC::matrix& b, const std::vector<int>& independent) {
@@ -105,7 +108,7 @@ Derivation derive(const Spec& spec) {
   for (int i = 0; i < n; ++i) Tv[static_cast<std::size_t>(i)] = T.diff(v(i));
   for (unsigned i = 0; i < un; ++i)
     for (unsigned j = i; j < un; ++j) {
-      const GiNaC::ex entry = simplify(Tv[i].diff(v(static_cast<int>(j))));
+      const GiNaC::ex entry = tidy(Tv[i].diff(v(static_cast<int>(j))));
       if (const int m = first_contained(entry, n, v); m >= 0)
         throw ModelError(model + fmt::format("the kinetic energy T is not quadratic in the velocities: "
                                              "A = d2T/dq'2 depends on {}' (entry ({}, {}) is {})",
@@ -120,11 +123,11 @@ Derivation derive(const Spec& spec) {
   d.Q = GiNaC::matrix(un, 1);
   for (int i = 0; i < n; ++i) {
     const auto ui = static_cast<unsigned>(i);
-    d.G(ui, 0) = simplify(T.diff(q(i)) - convective_derivative(Tv[ui], symbols, n));
+    d.G(ui, 0) = tidy(T.diff(q(i)) - convective_derivative(Tv[ui], symbols, n));
     const GiNaC::ex force = ui < spec.forces.size() ? spec.forces[ui] : GiNaC::ex(0);
     if (const int m = first_contained(force, n, a); m >= 0)
       throw ModelError(model + fmt::format("the force on '{}' contains the acceleration {}''", name(i), name(m)));
-    d.Q(ui, 0) = simplify(-V.diff(q(i)) + force);
+    d.Q(ui, 0) = tidy(-V.diff(q(i)) + force);
   }
 
   // Every constraint at acceleration level, b q'' + b0 = 0 (FORMULATION.md (2.5)).
@@ -150,7 +153,7 @@ Derivation derive(const Spec& spec) {
         for (int j = 0; j < n; ++j) row[static_cast<std::size_t>(j)] = e.diff(q(j));
         b0 = convective_derivative(phidot, symbols, n);
         d.phi.push_back(e);
-        d.f.push_back(simplify(phidot));
+        d.f.push_back(tidy(phidot));
         break;
       }
       case ConstraintLevel::velocity: {
@@ -182,7 +185,7 @@ Derivation derive(const Spec& spec) {
     }
     bool zero = true;
     for (unsigned j = 0; j < un; ++j) {
-      d.b(r, j) = simplify(row[j]);
+      d.b(r, j) = tidy(row[j]);
       zero = zero && d.b(r, j).is_zero();
     }
     if (zero)
@@ -195,7 +198,7 @@ Derivation derive(const Spec& spec) {
                                            c.level == ConstraintLevel::position   ? "the coordinates"
                                            : c.level == ConstraintLevel::velocity ? "the velocities"
                                                                                   : "the accelerations"));
-    d.b0(r, 0) = simplify(b0);
+    d.b0(r, 0) = tidy(b0);
   }
 
   // D: analytic, or partitioned for the named independent coordinates.
@@ -234,7 +237,7 @@ Derivation derive(const Spec& spec) {
   // T + V is conserved when no other force acts and nothing depends on t explicitly.
   bool conservative = symbolic::is_zero(T.diff(t)) && symbolic::is_zero(V.diff(t));
   for (const GiNaC::ex& force : spec.forces) conservative = conservative && symbolic::is_zero(force);
-  if (conservative) d.energy = simplify(T + V);
+  if (conservative) d.energy = tidy(T + V);
   return d;
 }
 

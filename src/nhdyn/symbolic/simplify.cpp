@@ -258,6 +258,22 @@ GiNaC::matrix simplify(const GiNaC::matrix& m) {
   return out;
 }
 
+namespace {
+
+// Node count of the expression tree, counted no further than `limit`.
+std::size_t capped_size(const ex& e, std::size_t limit) {
+  std::size_t n = 1;
+  for (std::size_t i = 0; i < e.nops() && n <= limit; ++i) n += capped_size(e.op(i), limit - n);
+  return n;
+}
+
+}  // namespace
+
+GiNaC::ex simplify_moderate(const GiNaC::ex& e) {
+  if (capped_size(e, kSimplifyLimit) > kSimplifyLimit) return e;
+  return simplify(e);
+}
+
 bool is_zero(const GiNaC::ex& e) {
   if (e.is_zero()) return true;
   if (GiNaC::is_a<GiNaC::numeric>(e) || GiNaC::is_a<GiNaC::symbol>(e)) return false;
