@@ -27,6 +27,7 @@
 #include <toml++/toml.h>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/symbolic/multibody.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
 #include "nhdyn/symbolic/suggest.hpp"
 
@@ -40,7 +41,16 @@ using symbolic::SpecBuilder;
 const std::vector<std::string> top_level_keys = {
     "name",           "description", "coordinates", "parameters",  "kinetic_energy",
     "potential_energy", "forces",    "constraints", "independent", "complement",
-    "initial",        "solution",    "simulation",  "plot"};
+    "initial",        "solution",    "simulation",  "plot",
+    // The multibody description (docs/multibody.md).
+    "gravity", "frames", "points", "bodies", "wheels", "knife_edges", "surfaces", "curves"};
+const std::vector<std::string> frame_keys = {"name", "parent", "translation", "rotations"};
+const std::vector<std::string> point_keys = {"name", "frame", "position"};
+const std::vector<std::string> body_keys = {"name", "frame", "mass", "com", "inertia"};
+const std::vector<std::string> wheel_keys = {"name", "body", "axis", "radius", "normal"};
+const std::vector<std::string> knife_edge_keys = {"name", "point", "axis", "normal"};
+const std::vector<std::string> surface_keys = {"name", "point", "surface"};
+const std::vector<std::string> curve_keys = {"name", "point", "surfaces"};
 const std::vector<std::string> parameter_keys = {"value", "unit"};
 const std::vector<std::string> constraint_keys = {"name", "position", "velocity", "acceleration"};
 const std::vector<std::string> initial_keys = {"t0", "position", "velocity"};
@@ -123,12 +133,18 @@ class Loader {
     load_coordinates(root, builder);
     if (const toml::node* parameters = root.get("parameters")) load_parameters(*parameters, builder);
 
-    const toml::node* kinetic = required(root, "kinetic_energy",
-                                         "the kinetic energy in the velocities x', e.g. "
-                                         "kinetic_energy = \"m/2 * (x'^2 + y'^2)\"");
-    const std::string kinetic_text =
-        expression_string(*kinetic, "kinetic_energy", "kinetic_energy = \"m/2 * x'^2\"");
-    located(*kinetic, [&] { builder.kinetic_energy(kinetic_text, content_at(*kinetic)); });
+    // With [[bodies]], T comes from them; a kinetic_energy given as well is added to theirs.
+    const toml::node* kinetic = root.get("bodies") != nullptr
+                                    ? root.get("kinetic_energy")
+                                    : required(root, "kinetic_energy",
+                                               "the kinetic energy in the velocities x', e.g. "
+                                               "kinetic_energy = \"m/2 * (x'^2 + y'^2)\" (or [[bodies]], "
+                                               "docs/multibody.md)");
+    if (kinetic != nullptr) {
+      const std::string kinetic_text =
+          expression_string(*kinetic, "kinetic_energy", "kinetic_energy = \"m/2 * x'^2\"");
+      located(*kinetic, [&] { builder.kinetic_energy(kinetic_text, content_at(*kinetic)); });
+    }
     if (const toml::node* potential = root.get("potential_energy")) {
       const std::string potential_text =
           expression_string(*potential, "potential_energy", "potential_energy = \"-m * g * z\"");
@@ -137,6 +153,7 @@ class Loader {
 
     if (const toml::node* forces = root.get("forces")) load_forces(*forces, builder);
     if (const toml::node* constraints = root.get("constraints")) load_constraints(*constraints, builder);
+    load_multibody(root, builder);
     load_complement(root, builder);
     if (const toml::node* initial = root.get("initial")) load_initial(*initial, builder);
     if (const toml::node* solution = root.get("solution")) load_solution(*solution, builder);
@@ -682,6 +699,190 @@ class Loader {
                                          *atol));
     }
     if (rtol || atol) builder.tolerances(rtol, atol);
+  }
+
+  // ---- The multibody description (docs/multibody.md) ------------------------------------------
+
+  // The tables of an array of tables such as [[frames]]; `example` shows one.
+  std::vector<const toml::table*> tables_of(const toml::node& node, const std::string& key,
+                                            const std::vector<std::string>& keys) const {
+    const toml::array& array = array_of(node, key, fmt::format("[[{}]] followed by name = \"...\"", key));
+    std::vector<const toml::table*> out;
+    for (const toml::node& element : array) {
+      const toml::table* table = element.as_table();
+      if (table == nullptr)
+        fail(at(element), fmt::format("each entry of '{}' must be a table (write it as [[{}]]); entry {} is {}", key,
+                                      key, out.size() + 1, type_name(element)));
+      check_keys(*table, keys, fmt::format("in [[{}]] entry {}", key, out.size() + 1));
+      out.push_back(table);
+    }
+    return out;
+  }
+
+  const toml::node& member(const toml::table& table, const std::string& section, std::string_view key,
+                           std::string_view example) const {
+    const toml::node* node = table.get(key);
+    if (node == nullptr)
+      fail(at(table), fmt::format("[[{}]] entry has no '{}': give it, e.g. {}", section, key, example));
+    return *node;
+  }
+
+  std::string name_of(const toml::table& table, const std::string& section) const {
+    return string_of(member(table, section, "name", "name = \"wheel\""), section + ".name", "name = \"wheel\"");
+  }
+
+  // Three numbers or expressions, e.g. translation = ["x", "y", 0].
+  symbolic::Triple triple_of(const toml::node& node, const std::string& what, std::string_view example) const {
+    const toml::array& array = array_of(node, what, example);
+    if (array.size() != 3)
+      fail(at(node), fmt::format("'{}' must have 3 components (x, y, z), e.g. {}; it has {}", what, example,
+                                 array.size()));
+    symbolic::Triple out;
+    for (std::size_t i = 0; i < 3; ++i)
+      out[i] = number_or_expression(*array.get(i), fmt::format("{}[{}]", what, i + 1), example);
+    return out;
+  }
+
+  std::optional<symbolic::Triple> optional_triple(const toml::table& table, std::string_view key,
+                                                  const std::string& what) const {
+    const toml::node* node = table.get(key);
+    if (node == nullptr) return std::nullopt;
+    return triple_of(*node, what, "[0, 0, 1]");
+  }
+
+  void load_multibody(const toml::table& root, SpecBuilder& builder) const {
+    bool any = false;
+    for (const char* key : {"gravity", "frames", "points", "bodies", "wheels", "knife_edges", "surfaces", "curves"})
+      any = any || root.get(key) != nullptr;
+    if (!any) return;
+    symbolic::MultibodyBuilder mb(builder);
+    if (const toml::node* gravity = root.get("gravity"))
+      mb.gravity(triple_of(*gravity, "gravity", "gravity = [0, 0, \"-g\"]"), at(*gravity));
+    if (const toml::node* frames = root.get("frames"))
+      for (const toml::table* table : tables_of(*frames, "frames", frame_keys)) {
+        const std::string name = name_of(*table, "frames");
+        std::string parent = "ground";
+        if (const toml::node* node = table->get("parent"))
+          parent = string_of(*node, fmt::format("frame '{}': parent", name), "parent = \"ground\"");
+        symbolic::Triple translation{"0", "0", "0"};
+        if (const toml::node* node = table->get("translation"))
+          translation = triple_of(*node, fmt::format("frame '{}': translation", name), "translation = [\"x\", \"y\", 0]");
+        std::vector<symbolic::FrameRotation> rotations;
+        if (const toml::node* node = table->get("rotations")) {
+          constexpr std::string_view example = "rotations = [[\"z\", \"psi\"], [\"x\", \"theta\"]]";
+          const toml::array& array = array_of(*node, fmt::format("frame '{}': rotations", name), example);
+          for (const toml::node& element : array) {
+            const std::string what = fmt::format("frame '{}': rotation {}", name, rotations.size() + 1);
+            const toml::array& pair = array_of(element, what, "[\"z\", \"psi\"] (an axis and an angle)");
+            if (pair.size() != 2)
+              fail(at(element), fmt::format("'{}' must be a pair [axis, angle], e.g. [\"z\", \"psi\"]; it has {} "
+                                            "entries",
+                                            what, pair.size()));
+            rotations.push_back({string_of(*pair.get(0), what + " axis", "\"z\""),
+                                 number_or_expression(*pair.get(1), what + " angle", "\"psi\""), at(element)});
+          }
+        }
+        mb.frame(name, parent, translation, rotations, at(*table));
+      }
+    if (const toml::node* points = root.get("points"))
+      for (const toml::table* table : tables_of(*points, "points", point_keys)) {
+        const std::string name = name_of(*table, "points");
+        const std::string frame = string_of(member(*table, "points", "frame", "frame = \"wheel\""),
+                                            fmt::format("point '{}': frame", name), "frame = \"wheel\"");
+        symbolic::Triple position{"0", "0", "0"};
+        if (const toml::node* node = table->get("position"))
+          position = triple_of(*node, fmt::format("point '{}': position", name), "position = [0, 0, \"-l\"]");
+        mb.point(name, frame, position, at(*table));
+      }
+    if (const toml::node* bodies = root.get("bodies"))
+      for (const toml::table* table : tables_of(*bodies, "bodies", body_keys)) {
+        const std::string name = name_of(*table, "bodies");
+        const std::string frame = string_of(member(*table, "bodies", "frame", "frame = \"wheel\""),
+                                            fmt::format("body '{}': frame", name), "frame = \"wheel\"");
+        const std::string mass = number_or_expression(member(*table, "bodies", "mass", "mass = \"m\""),
+                                                      fmt::format("body '{}': mass", name), "mass = \"m\"");
+        symbolic::Triple com{"0", "0", "0"};
+        if (const toml::node* node = table->get("com"))
+          com = triple_of(*node, fmt::format("body '{}': com", name), "com = [0, 0, \"-l/2\"]");
+        const toml::node& inertia_node = member(*table, "bodies", "inertia",
+                                                "inertia = [\"Ixx\", \"Iyy\", \"Izz\"] (principal moments) or a 3 x 3 array");
+        mb.body(name, frame, mass, com, inertia_of(inertia_node, name), at(*table));
+      }
+    if (const toml::node* wheels = root.get("wheels"))
+      for (const toml::table* table : tables_of(*wheels, "wheels", wheel_keys)) {
+        const std::string name = name_of(*table, "wheels");
+        const std::string what = fmt::format("wheel '{}'", name);
+        mb.rolling_wheel(name,
+                         string_of(member(*table, "wheels", "body", "body = \"disk\""), what + ": body", "body = \"disk\""),
+                         string_of(member(*table, "wheels", "axis", "axis = \"y\""), what + ": axis", "axis = \"y\""),
+                         number_or_expression(member(*table, "wheels", "radius", "radius = \"r\""), what + ": radius",
+                                              "radius = \"r\""),
+                         optional_triple(*table, "normal", what + ": normal"), at(*table));
+      }
+    if (const toml::node* knives = root.get("knife_edges"))
+      for (const toml::table* table : tables_of(*knives, "knife_edges", knife_edge_keys)) {
+        const std::string name = name_of(*table, "knife_edges");
+        const std::string what = fmt::format("knife edge '{}'", name);
+        mb.knife_edge(name,
+                      string_of(member(*table, "knife_edges", "point", "point = \"blade\""), what + ": point",
+                                "point = \"blade\""),
+                      string_of(member(*table, "knife_edges", "axis", "axis = \"x\""), what + ": axis", "axis = \"x\""),
+                      optional_triple(*table, "normal", what + ": normal"), at(*table));
+      }
+    if (const toml::node* surfaces = root.get("surfaces"))
+      for (const toml::table* table : tables_of(*surfaces, "surfaces", surface_keys)) {
+        const std::string name = name_of(*table, "surfaces");
+        const std::string what = fmt::format("surface '{}'", name);
+        const toml::node& surface = member(*table, "surfaces", "surface", "surface = \"X^2 + Y^2 - R^2\"");
+        const std::string text = expression_string(surface, what + ": surface", "surface = \"X^2 + Y^2 - R^2\"");
+        mb.point_on_surface(name,
+                            string_of(member(*table, "surfaces", "point", "point = \"bead\""), what + ": point",
+                                      "point = \"bead\""),
+                            text, content_at(surface));
+      }
+    if (const toml::node* curves = root.get("curves"))
+      for (const toml::table* table : tables_of(*curves, "curves", curve_keys)) {
+        const std::string name = name_of(*table, "curves");
+        const std::string what = fmt::format("curve '{}'", name);
+        constexpr std::string_view example = "surfaces = [\"X^2 + Y^2 - R^2\", \"Z\"]";
+        const toml::node& node = member(*table, "curves", "surfaces", example);
+        const toml::array& array = array_of(node, what + ": surfaces", example);
+        if (array.size() != 2)
+          fail(at(node), fmt::format("{}: a curve is the meeting of two surfaces, e.g. {}; {} are given", what, example,
+                                     array.size()));
+        mb.point_on_curve(name,
+                          string_of(member(*table, "curves", "point", "point = \"bead\""), what + ": point",
+                                    "point = \"bead\""),
+                          expression_string(*array.get(0), what + ": surfaces[1]", example),
+                          expression_string(*array.get(1), what + ": surfaces[2]", example), at(node));
+      }
+    mb.apply();
+  }
+
+  // [Ixx, Iyy, Izz] (principal axes along the frame's) or a 3 x 3 array.
+  symbolic::InertiaText inertia_of(const toml::node& node, const std::string& body) const {
+    const std::string what = fmt::format("body '{}': inertia", body);
+    constexpr std::string_view example = "[\"Ixx\", \"Iyy\", \"Izz\"] or [[9.2, 0, 2.4], [0, 11, 0], [2.4, 0, 2.8]]";
+    const toml::array& array = array_of(node, what, example);
+    symbolic::InertiaText I;
+    for (auto& row : I) row = {"0", "0", "0"};
+    if (array.size() == 3 && !array.get(0)->is_array()) {
+      for (std::size_t i = 0; i < 3; ++i)
+        I[i][i] = number_or_expression(*array.get(i), fmt::format("{}[{}]", what, i + 1), example);
+      return I;
+    }
+    if (array.size() != 3)
+      fail(at(node), fmt::format("'{}' must be 3 principal moments or a 3 x 3 array, e.g. {}; it has {} entries", what,
+                                 example, array.size()));
+    for (std::size_t i = 0; i < 3; ++i) {
+      const std::string row_what = fmt::format("{} row {}", what, i + 1);
+      const toml::array& row = array_of(*array.get(i), row_what, "[9.2, 0, 2.4]");
+      if (row.size() != 3)
+        fail(at(*array.get(i)), fmt::format("'{}' must have 3 entries; it has {}", row_what, row.size()));
+      for (std::size_t j = 0; j < 3; ++j)
+        I[i][j] = number_or_expression(*row.get(j), fmt::format("{}[{}]", row_what, j + 1), example);
+    }
+    return I;
   }
 
   std::string one_of(const toml::node& node, std::string_view what, const std::vector<std::string>& names) const {

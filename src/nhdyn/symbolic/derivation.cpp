@@ -82,6 +82,9 @@ struct SplitSum {
   }
 };
 
+// Terms of large models are simplified only up to a size (simplify_moderate, simplify.hpp).
+GiNaC::ex tidy(const GiNaC::ex& e) { return simplify_moderate(e); }
+
 }  // namespace
 
 std::optional<GiNaC::matrix> partitioned_complement(const GiNaC::matrix& b, const std::vector<int>& independent) {
@@ -155,7 +158,7 @@ Derivation derive(const Spec& spec) {
     for (int jj : partners) {
       if (jj < i) continue;
       const auto uj = static_cast<unsigned>(jj);
-      const GiNaC::ex entry = simplify(Tv[ui].diff(v(jj)));
+      const GiNaC::ex entry = tidy(Tv[ui].diff(v(jj)));
       if (const Contained o = index.find(entry); !o.v.empty())
         throw ModelError(model + fmt::format("the kinetic energy T is not quadratic in the velocities: "
                                              "A = d2T/dq'2 depends on {}' (entry ({}, {}) is {})",
@@ -171,12 +174,12 @@ Derivation derive(const Spec& spec) {
   d.Q = GiNaC::matrix(un, 1);
   for (int i = 0; i < n; ++i) {
     const auto ui = static_cast<unsigned>(i);
-    d.G(ui, 0) = simplify(Ts.diff(Ts.with_q, i, q(i)) - convective_derivative(Tv[ui], symbols, index));
+    d.G(ui, 0) = tidy(Ts.diff(Ts.with_q, i, q(i)) - convective_derivative(Tv[ui], symbols, index));
     const GiNaC::ex force = ui < spec.forces.size() ? spec.forces[ui] : GiNaC::ex(0);
     if (const Contained o = index.find(force); !o.a.empty())
       throw ModelError(model + fmt::format("the force on '{}' contains the acceleration {}''", name(i),
                                            name(o.a.front())));
-    d.Q(ui, 0) = simplify(-Vs.diff(Vs.with_q, i, q(i)) + force);
+    d.Q(ui, 0) = tidy(-Vs.diff(Vs.with_q, i, q(i)) + force);
   }
 
   // Every constraint at acceleration level, b q'' + b0 = 0 (FORMULATION.md (2.5)).
@@ -204,7 +207,7 @@ Derivation derive(const Spec& spec) {
         for (int j : o.q) row[static_cast<std::size_t>(j)] = e.diff(q(j));
         b0 = convective_derivative(phidot, symbols, index);
         d.phi.push_back(e);
-        d.f.push_back(simplify(phidot));
+        d.f.push_back(tidy(phidot));
         break;
       }
       case ConstraintLevel::velocity: {
@@ -237,7 +240,7 @@ Derivation derive(const Spec& spec) {
     bool zero = true;
     for (unsigned j = 0; j < un; ++j) {
       if (row[j].is_zero()) continue;
-      d.b(r, j) = simplify(row[j]);
+      d.b(r, j) = tidy(row[j]);
       zero = zero && d.b(r, j).is_zero();
     }
     if (zero)
@@ -250,7 +253,7 @@ Derivation derive(const Spec& spec) {
                                            c.level == ConstraintLevel::position   ? "the coordinates"
                                            : c.level == ConstraintLevel::velocity ? "the velocities"
                                                                                   : "the accelerations"));
-    d.b0(r, 0) = simplify(b0);
+    d.b0(r, 0) = tidy(b0);
   }
 
   // D: analytic, or partitioned for the named independent coordinates.
@@ -295,7 +298,7 @@ Derivation derive(const Spec& spec) {
     // computes the same values.
     const GiNaC::ex energy = T + V;
     constexpr std::size_t kSimplifiedTerms = 64;
-    d.energy = energy.nops() <= kSimplifiedTerms ? simplify(energy) : energy;
+    d.energy = energy.nops() <= kSimplifiedTerms ? tidy(energy) : energy;
   }
   return d;
 }

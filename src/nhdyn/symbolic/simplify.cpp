@@ -105,6 +105,26 @@ void collect_families(const ex& e, std::vector<Family>& out) {
   for (std::size_t i = 0; i < e.nops(); ++i) collect_families(e.op(i), out);
 }
 
+// Replaces every power with a non-integer exponent (a square root, say) by a symbol of its own, so
+// that the reduction below sees a polynomial: GiNaC's degree() refuses sqrt(1 - sin(u)^2) in u.
+// Such powers are left as they are (their inside is not reduced); `back` undoes the replacement.
+struct Freeze : GiNaC::map_function {
+  GiNaC::lst back;
+  std::vector<std::pair<ex, GiNaC::symbol>> seen;
+  ex operator()(const ex& e) override {
+    if (GiNaC::is_a<GiNaC::power>(e) && !e.op(1).info(GiNaC::info_flags::integer)) {
+      for (const auto& [power, symbol] : seen)
+        if (power.is_equal(e)) return symbol;
+      const GiNaC::symbol symbol;
+      seen.emplace_back(e, symbol);
+      back.append(symbol == e);
+      return symbol;
+    }
+    if (GiNaC::is_a<GiNaC::function>(e)) return e;
+    return e.map(*this);
+  }
+};
+
 // Reduces a polynomial modulo the relations of the families: with s, c the two functions of a
 // family, eliminate_first replaces s^2 by 1 - c^2 (sinh^2 by cosh^2 - 1), otherwise c^2 by
 // 1 - s^2 (cosh^2 by 1 + sinh^2). The result has degree at most 1 in the eliminated function.
@@ -120,7 +140,8 @@ ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool elim
     back.append(first[i] == f);
     back.append(second[i] == g);
   }
-  ex q = GiNaC::expand(p.subs(to_symbols));
+  Freeze freeze;
+  ex q = GiNaC::expand(freeze(p).subs(to_symbols));
   for (std::size_t i = 0; i < families.size(); ++i) {
     const GiNaC::symbol& s = first[i];
     const GiNaC::symbol& c = second[i];
@@ -140,7 +161,7 @@ ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool elim
     }
     q = GiNaC::expand(reduced);
   }
-  return q.subs(back);
+  return q.subs(back).subs(freeze.back);
 }
 
 Fraction reduce(const Fraction& start, const std::vector<Family>& families, bool eliminate_first) {
@@ -235,6 +256,22 @@ GiNaC::matrix simplify(const GiNaC::matrix& m) {
   for (unsigned i = 0; i < m.rows(); ++i)
     for (unsigned j = 0; j < m.cols(); ++j) out(i, j) = simplify(m(i, j));
   return out;
+}
+
+namespace {
+
+// Node count of the expression tree, counted no further than `limit`.
+std::size_t capped_size(const ex& e, std::size_t limit) {
+  std::size_t n = 1;
+  for (std::size_t i = 0; i < e.nops() && n <= limit; ++i) n += capped_size(e.op(i), limit - n);
+  return n;
+}
+
+}  // namespace
+
+GiNaC::ex simplify_moderate(const GiNaC::ex& e) {
+  if (capped_size(e, kSimplifyLimit) > kSimplifyLimit) return e;
+  return simplify(e);
 }
 
 bool is_zero(const GiNaC::ex& e) {

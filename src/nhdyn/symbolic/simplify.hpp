@@ -15,6 +15,7 @@
 
 #include <ginac/ginac.h>
 
+#include <cstddef>
 #include <string>
 #include <utility>
 
@@ -23,6 +24,14 @@ namespace nhdyn::symbolic {
 GiNaC::ex simplify(const GiNaC::ex& e);
 // Entry by entry.
 GiNaC::matrix simplify(const GiNaC::matrix& m);
+
+// simplify() for expressions of at most kSimplifyLimit tree nodes; larger ones are returned as
+// they are. normal() and the trigonometric reduction grow steeply with size (the Whipple
+// bicycle's terms, built from a multibody description, took tens of seconds), while the compiler
+// shares the common subexpressions of unsimplified terms anyway. The hand-written models of the
+// gallery stay below the limit. Used by derive() on the terms and by the multibody front end.
+inline constexpr std::size_t kSimplifyLimit = 1000;
+GiNaC::ex simplify_moderate(const GiNaC::ex& e);
 
 // True when simplify(e) is 0; false when it is not or when simplify() cannot tell. Call it as
 // symbolic::is_zero: argument-dependent lookup also finds GiNaC::is_zero, which only tests whether

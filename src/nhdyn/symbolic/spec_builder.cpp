@@ -644,18 +644,53 @@ SpecBuilder& SpecBuilder::force(const std::string& coordinate, const std::string
   return *this;
 }
 
-SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel level, const std::string& text,
-                                     SourceLocation where) {
+namespace {
+
+void check_constraint_name(const Spec& spec, const std::string& name, const SourceLocation& where) {
   const std::string context = fmt::format("constraint '{}'", name);
   if (name.empty() || !std::isalpha(static_cast<unsigned char>(name[0])) ||
       !std::all_of(name.begin(), name.end(), [](char c) { return identifier_char(c) || c == '-'; }))
     fail(where, context, "not a valid constraint name: use letters, digits, '_' and '-', starting with a letter");
-  for (const SpecConstraint& c : spec_.constraints)
+  for (const SpecConstraint& c : spec.constraints)
     if (c.name == name) {
       const std::string at = c.where.describe();
       fail(where, context, fmt::format("duplicated constraint name '{}'{}", name,
                                        at.empty() ? "" : " (first given at " + at + ")"));
     }
+}
+
+}  // namespace
+
+SpecBuilder& SpecBuilder::add_energies(const GiNaC::ex& kinetic, const GiNaC::ex& potential) {
+  spec_.kinetic_energy += kinetic;
+  spec_.potential_energy += potential;
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel level, const GiNaC::ex& expression,
+                                     const std::string& text, SourceLocation where) {
+  check_constraint_name(spec_, name, where);
+  const int n = spec_.n();
+  bool velocities = false, accelerations = false;
+  for (int i = 0; i < n; ++i) {
+    velocities = velocities || expression.has(spec_.symbols.velocity(i));
+    accelerations = accelerations || expression.has(spec_.symbols.acceleration(i));
+  }
+  const bool fits = level == ConstraintLevel::position   ? !velocities && !accelerations
+                    : level == ConstraintLevel::velocity ? velocities && !accelerations
+                                                         : accelerations;
+  if (!fits)
+    fail(where, fmt::format("constraint '{}'", name),
+         "the expression does not match the level it is given at (position: no velocities; velocity: some "
+         "velocity, no acceleration; acceleration: some acceleration)");
+  spec_.constraints.push_back({name, level, expression, text, std::move(where)});
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel level, const std::string& text,
+                                     SourceLocation where) {
+  const std::string context = fmt::format("constraint '{}'", name);
+  check_constraint_name(spec_, name, where);
   const Site site{text, where, context};
   // `lhs = rhs` is read as lhs - rhs = 0.
   Parsed parsed;

@@ -57,6 +57,16 @@ class SpecBuilder {
   SpecBuilder& tolerances(std::optional<double> rtol, std::optional<double> atol);
   SpecBuilder& path(const std::string& x, const std::string& y);
 
+  // For front ends that build expressions themselves (multibody.hpp), from this builder's symbols:
+  // adds to T and V (what kinetic_energy()/potential_energy() set, or zero), and appends a
+  // constraint `expression = 0` whose `text` is shown to users in place of the expression. The
+  // constraint's name and level are checked as for the text form.
+  SpecBuilder& add_energies(const GiNaC::ex& kinetic, const GiNaC::ex& potential);
+  SpecBuilder& constraint(const std::string& name, ConstraintLevel level, const GiNaC::ex& expression,
+                          const std::string& text, SourceLocation where = {});
+  // The spec as built so far: its symbols and parameter values, for such front ends.
+  const Spec& current() const { return spec_; }
+
   // Checks completeness (coordinates, a kinetic energy, fewer constraints than coordinates,
   // names unique, initial values for all or none — none means zero — and a solution for all
   // coordinates or none) and returns the Spec.

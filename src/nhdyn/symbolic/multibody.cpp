@@ -1,0 +1,618 @@
+#include "nhdyn/symbolic/multibody.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <exception>
+#include <sstream>
+#include <utility>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/symbolic/simplify.hpp"
+#include "nhdyn/symbolic/suggest.hpp"
+
+namespace nhdyn::symbolic {
+namespace {
+
+[[noreturn]] void fail(const SourceLocation& where, const std::string& context, const std::string& problem) {
+  const std::string location = where.describe();
+  throw ModelError((location.empty() ? "" : location + ": ") + (context.empty() ? "" : context + ": ") + problem);
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i > 0 ? ", " : "") + items[i];
+  return out;
+}
+
+// "'heding' is not a frame; did you mean 'heading'? (the frames are: ground, heading)"
+std::string unknown(const std::string& name, const char* kind, const std::vector<std::string>& known) {
+  const std::string nearest = nearest_name(name, known);
+  std::string out = fmt::format("'{}' is not a {}", name, kind);
+  if (!nearest.empty()) out += fmt::format("; did you mean '{}'?", nearest);
+  if (known.empty()) return out + fmt::format(" (none is defined yet: define a {} before using it)", kind);
+  return out + fmt::format(" (the {}s defined so far: {})", kind, join(known));
+}
+
+int axis_index(const std::string& axis) {
+  if (axis == "x") return 0;
+  if (axis == "y") return 1;
+  if (axis == "z") return 2;
+  return -1;
+}
+
+std::string printed(const GiNaC::ex& e) {
+  std::ostringstream out;
+  out << e;
+  return out.str();
+}
+
+// Whether simplify_moderate() simplified `e` (it is small enough).
+bool capped_size_below(const GiNaC::ex& e) {
+  std::size_t count = 0;
+  for (GiNaC::const_preorder_iterator it = e.preorder_begin(); it != e.preorder_end(); ++it)
+    if (++count > kSimplifyLimit) return false;
+  return true;
+}
+
+// The value of an expression with the parameters set (and, at the reference configuration, every
+// coordinate and t at 0); nullopt when it is not a finite real number.
+std::optional<double> value_of(const GiNaC::ex& e, const Spec& spec, bool at_reference = false) {
+  try {
+    GiNaC::lst values = spec.parameter_values();
+    if (at_reference) {
+      values.append(spec.symbols.time() == 0);
+      for (int i = 0; i < spec.n(); ++i) values.append(spec.symbols.coordinate(i) == 0);
+    }
+    const GiNaC::ex v = e.subs(values).evalf();
+    if (!GiNaC::is_a<GiNaC::numeric>(v)) return std::nullopt;
+    const GiNaC::numeric number = GiNaC::ex_to<GiNaC::numeric>(v);
+    if (!number.is_real()) return std::nullopt;
+    const double d = number.to_double();
+    if (!std::isfinite(d)) return std::nullopt;
+    return d;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+// The eigenvalues of a symmetric 3 x 3 matrix (the trigonometric closed form).
+std::array<double, 3> principal_moments(const double (&A)[3][3]) {
+  const double p1 = A[0][1] * A[0][1] + A[0][2] * A[0][2] + A[1][2] * A[1][2];
+  if (p1 == 0.0) return {A[0][0], A[1][1], A[2][2]};
+  const double q = (A[0][0] + A[1][1] + A[2][2]) / 3.0;
+  const double p2 = (A[0][0] - q) * (A[0][0] - q) + (A[1][1] - q) * (A[1][1] - q) + (A[2][2] - q) * (A[2][2] - q) + 2.0 * p1;
+  const double p = std::sqrt(p2 / 6.0);
+  double B[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) B[i][j] = (A[i][j] - (i == j ? q : 0.0)) / p;
+  const double r = (B[0][0] * (B[1][1] * B[2][2] - B[1][2] * B[2][1]) - B[0][1] * (B[1][0] * B[2][2] - B[1][2] * B[2][0]) +
+                    B[0][2] * (B[1][0] * B[2][1] - B[1][1] * B[2][0])) / 2.0;
+  const double phi = r <= -1.0 ? std::acos(-1.0) / 3.0 : r >= 1.0 ? 0.0 : std::acos(r) / 3.0;
+  const double e1 = q + 2.0 * p * std::cos(phi);
+  const double e3 = q + 2.0 * p * std::cos(phi + 2.0 * std::acos(-1.0) / 3.0);
+  return {e1, 3.0 * q - e1 - e3, e3};
+}
+
+}  // namespace
+
+MultibodyBuilder::MultibodyBuilder(SpecBuilder& builder) : builder_(builder) {
+  PlacedFrame ground;
+  ground.name = "ground";
+  ground.origin = {0, 0, 0};
+  ground.rotation = GiNaC::matrix{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  ground.omega = {0, 0, 0};
+  ground.omega_local = {0, 0, 0};
+  frames_.push_back(ground);
+}
+
+GiNaC::ex MultibodyBuilder::parse(const std::string& text, const SourceLocation& where, const std::string& context,
+                                  bool coordinates_allowed) const {
+  const GiNaC::ex e = builder_.parse(text, where);
+  const Spec& spec = builder_.current();
+  const SymbolTable& symbols = spec.symbols;
+  for (int i = 0; i < spec.n(); ++i) {
+    const std::string& name = spec.coordinates[static_cast<std::size_t>(i)];
+    if (e.has(symbols.velocity(i)) || e.has(symbols.acceleration(i)))
+      fail(where, context,
+           fmt::format("\"{}\" contains a derivative of '{}'; positions, angles and constants may not contain "
+                       "velocities or accelerations (the front end derives them)",
+                       text, name));
+    if (!coordinates_allowed && e.has(symbols.coordinate(i)))
+      fail(where, context,
+           fmt::format("\"{}\" depends on the coordinate '{}'; this value must be a constant, an expression in the "
+                       "parameters only",
+                       text, name));
+  }
+  if (!coordinates_allowed && e.has(symbols.time()))
+    fail(where, context,
+         fmt::format("\"{}\" depends on the time t; this value must be a constant, an expression in the parameters "
+                     "only",
+                     text));
+  return e;
+}
+
+Vector3 MultibodyBuilder::parse(const Triple& texts, const SourceLocation& where, const std::string& context,
+                                bool coordinates_allowed) const {
+  return {parse(texts[0], where, context, coordinates_allowed), parse(texts[1], where, context, coordinates_allowed),
+          parse(texts[2], where, context, coordinates_allowed)};
+}
+
+int MultibodyBuilder::frame_index(const std::string& name, const SourceLocation& where,
+                                  const std::string& context) const {
+  std::vector<std::string> known;
+  for (std::size_t i = 0; i < frames_.size(); ++i) {
+    if (frames_[i].name == name) return static_cast<int>(i);
+    known.push_back(frames_[i].name);
+  }
+  fail(where, context, unknown(name, "frame", known));
+}
+
+int MultibodyBuilder::point_index(const std::string& name, const SourceLocation& where,
+                                  const std::string& context) const {
+  std::vector<std::string> known;
+  for (std::size_t i = 0; i < points_.size(); ++i) {
+    if (points_[i].name == name) return static_cast<int>(i);
+    known.push_back(points_[i].name);
+  }
+  fail(where, context, unknown(name, "point", known));
+}
+
+int MultibodyBuilder::body_index(const std::string& name, const SourceLocation& where,
+                                 const std::string& context) const {
+  std::vector<std::string> known;
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_[i].name == name) return static_cast<int>(i);
+    known.push_back(bodies_[i].name);
+  }
+  fail(where, context, unknown(name, "body", known));
+}
+
+namespace {
+
+template <class Items>
+void check_new(const Items& items, const std::string& name, const char* kind, const SourceLocation& where) {
+  const std::string context = fmt::format("{} '{}'", kind, name);
+  if (name.empty() || !std::isalpha(static_cast<unsigned char>(name[0])) ||
+      !std::all_of(name.begin(), name.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }))
+    fail(where, context, "not a valid name: use letters, digits and '_', starting with a letter");
+  for (const auto& item : items)
+    if (item.name == name) {
+      const std::string first = item.where.describe();
+      fail(where, context,
+           fmt::format("a {} called '{}' is already defined{}; give each {} its own name", kind, name,
+                       first.empty() ? "" : " (at " + first + ")", kind));
+    }
+}
+
+}  // namespace
+
+MultibodyBuilder& MultibodyBuilder::frame(const std::string& name, const std::string& parent,
+                                          const Triple& translation, const std::vector<FrameRotation>& rotations,
+                                          SourceLocation where) {
+  const std::string context = fmt::format("frame '{}'", name);
+  check_new(frames_, name, "frame", where);
+  const int p = frame_index(parent, where, context + ": parent");
+  const PlacedFrame& up = frames_[static_cast<std::size_t>(p)];
+  const SymbolTable& symbols = builder_.current().symbols;
+
+  PlacedFrame f;
+  f.name = name;
+  f.parent = p;
+  f.where = where;
+  f.origin = add(up.origin, multiply(up.rotation, parse(translation, where, context + ": translation", true)));
+  f.rotation = up.rotation;
+  f.omega = up.omega;
+  f.omega_local = up.omega_local;
+  for (std::size_t j = 0; j < rotations.size(); ++j) {
+    const FrameRotation& r = rotations[j];
+    const SourceLocation& at = r.where.line > 0 || r.where.file.size() > 0 ? r.where : where;
+    const std::string which = fmt::format("{}: rotation {}", context, j + 1);
+    const int axis = axis_index(r.axis);
+    if (axis < 0)
+      fail(at, which,
+           fmt::format("unknown axis '{}'; rotate about \"x\", \"y\" or \"z\" (the axes of the frame produced by the "
+                       "rotations before it)",
+                       r.axis));
+    const GiNaC::ex angle = parse(r.angle, at, which + " (its angle)", true);
+    const GiNaC::ex rate = time_derivative(angle, symbols);
+    // omega_F = omega_P + sum_j a_j' e_j with e_j the axis in world components before rotation j;
+    // in the frame's own axes, omega <- R_j^T omega + a_j' k_j (docs/derivations/rolling-wheel.md).
+    f.omega = add(f.omega, scale(rate, column(f.rotation, axis)));
+    const GiNaC::matrix Rj = rotation_about(axis, angle);
+    f.rotation = f.rotation.mul(Rj);
+    f.omega_local = add(multiply_transposed(Rj, f.omega_local), scale(rate, unit(axis)));
+  }
+  frames_.push_back(std::move(f));
+  return *this;
+}
+
+MultibodyBuilder& MultibodyBuilder::point(const std::string& name, const std::string& frame, const Triple& position,
+                                          SourceLocation where) {
+  const std::string context = fmt::format("point '{}'", name);
+  check_new(points_, name, "point", where);
+  const int f = frame_index(frame, where, context);
+  const PlacedFrame& F = frames_[static_cast<std::size_t>(f)];
+  const Vector3 local = parse(position, where, context + ": position", true);
+  points_.push_back({name, f, add(F.origin, multiply(F.rotation, local)), where});
+  return *this;
+}
+
+MultibodyBuilder& MultibodyBuilder::body(const std::string& name, const std::string& frame, const std::string& mass,
+                                         const Triple& centre_of_mass, const InertiaText& inertia,
+                                         SourceLocation where) {
+  const std::string context = fmt::format("body '{}'", name);
+  check_new(bodies_, name, "body", where);
+  const Spec& spec = builder_.current();
+  Body b;
+  b.name = name;
+  b.where = where;
+  b.frame = frame_index(frame, where, context);
+  b.mass = parse(mass, where, context + ": mass", false);
+  const std::optional<double> m = value_of(b.mass, spec);
+  if (!m || !(*m > 0.0))
+    fail(where, context + ": mass",
+         fmt::format("the mass \"{}\" must be a positive number, but it is {}", mass, m ? fmt::format("{}", *m) : "not a number"));
+  b.com = parse(centre_of_mass, where, context + ": centre of mass", false);
+  b.inertia = GiNaC::matrix(3, 3);
+  double I[3][3];
+  for (unsigned i = 0; i < 3; ++i)
+    for (unsigned j = 0; j < 3; ++j) {
+      b.inertia(i, j) = parse(inertia[i][j], where, fmt::format("{}: inertia entry ({}, {})", context, i + 1, j + 1), false);
+      const std::optional<double> value = value_of(b.inertia(i, j), spec);
+      if (!value)
+        fail(where, context, fmt::format("inertia entry ({}, {}) = \"{}\" is not a finite number", i + 1, j + 1,
+                                         inertia[i][j]));
+      I[i][j] = *value;
+    }
+  for (unsigned i = 0; i < 3; ++i)
+    for (unsigned j = i + 1; j < 3; ++j)
+      if (!symbolic::is_zero(b.inertia(i, j) - b.inertia(j, i)))
+        fail(where, context,
+             fmt::format("the inertia tensor is not symmetric: entry ({}, {}) is {} but entry ({}, {}) is {}; an "
+                         "inertia tensor has I_ij = I_ji",
+                         i + 1, j + 1, inertia[i][j], j + 1, i + 1, inertia[j][i]));
+  // Sylvester's criterion; scale-free so that grams and tonnes are judged alike.
+  const double d1 = I[0][0];
+  const double d2 = I[0][0] * I[1][1] - I[0][1] * I[1][0];
+  const double d3 = I[0][0] * (I[1][1] * I[2][2] - I[1][2] * I[2][1]) - I[0][1] * (I[1][0] * I[2][2] - I[1][2] * I[2][0]) +
+                    I[0][2] * (I[1][0] * I[2][1] - I[1][1] * I[2][0]);
+  const double size = std::max({std::fabs(I[0][0]), std::fabs(I[1][1]), std::fabs(I[2][2]), 1e-300});
+  if (!(d1 > 0.0 && d2 > 1e-14 * size * size && d3 > 1e-14 * size * size * size))
+    fail(where, context,
+         fmt::format("the inertia tensor [[{}, {}, {}], [{}, {}, {}], [{}, {}, {}]] is not positive definite (its "
+                     "leading principal minors are {:.6g}, {:.6g}, {:.6g}; all must be positive): every principal "
+                     "moment must be positive and each at most the sum of the other two",
+                     I[0][0], I[0][1], I[0][2], I[1][0], I[1][1], I[1][2], I[2][0], I[2][1], I[2][2], d1, d2, d3));
+  // A rigid body's principal moments obey the triangle inequality (I1 = integral of y^2 + z^2
+  // <= I2 + I3); equality is a planar lamina such as the thin disk.
+  const std::array<double, 3> moments = principal_moments(I);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double others = moments[(i + 1) % 3] + moments[(i + 2) % 3];
+    if (moments[i] > others + 1e-12 * size)
+      fail(where, context,
+           fmt::format("the inertia tensor's principal moments {:.6g}, {:.6g}, {:.6g} break the triangle inequality "
+                       "({:.6g} > {:.6g} + {:.6g}): no rigid body has this inertia; check the moments and their "
+                       "axes",
+                       moments[0], moments[1], moments[2], moments[i], moments[(i + 1) % 3], moments[(i + 2) % 3]));
+  }
+  bodies_.push_back(std::move(b));
+  return *this;
+}
+
+MultibodyBuilder& MultibodyBuilder::gravity(const Triple& g, SourceLocation where) {
+  if (gravity_)
+    fail(where, "gravity", fmt::format("gravity is given twice (first at {})", gravity_where_.describe()));
+  gravity_ = parse(g, where, "gravity", false);
+  gravity_where_ = std::move(where);
+  return *this;
+}
+
+void MultibodyBuilder::check_helper_name(const std::string& name, const SourceLocation& where) const {
+  check_new(helpers_, name, "constraint helper", where);
+}
+
+MultibodyBuilder& MultibodyBuilder::rolling_wheel(const std::string& name, const std::string& body,
+                                                  const std::string& axis, const std::string& radius,
+                                                  const std::optional<Triple>& normal, SourceLocation where) {
+  const std::string context = fmt::format("wheel '{}'", name);
+  check_helper_name(name, where);
+  Helper h;
+  h.kind = Helper::Kind::wheel;
+  h.name = name;
+  h.where = where;
+  h.index = body_index(body, where, context);
+  h.axis = axis_index(axis);
+  if (h.axis < 0)
+    fail(where, context, fmt::format("unknown axle axis '{}'; the axle is the \"x\", \"y\" or \"z\" axis of the "
+                                     "wheel body's frame",
+                                     axis));
+  h.radius = parse(radius, where, context + ": radius", false);
+  const std::optional<double> r = value_of(h.radius, builder_.current());
+  if (!r || !(*r > 0.0))
+    fail(where, context, fmt::format("the radius \"{}\" must be positive, but it is {}", radius,
+                                     r ? fmt::format("{}", *r) : "not a number"));
+  if (normal) h.normal = parse(*normal, where, context + ": normal", false);
+  helpers_.push_back(std::move(h));
+  if (helpers_.back().normal) plane_normal(helpers_.back(), context);  // a zero normal is refused now
+  return *this;
+}
+
+MultibodyBuilder& MultibodyBuilder::knife_edge(const std::string& name, const std::string& point,
+                                               const std::string& axis, const std::optional<Triple>& normal,
+                                               SourceLocation where) {
+  const std::string context = fmt::format("knife edge '{}'", name);
+  check_helper_name(name, where);
+  Helper h;
+  h.kind = Helper::Kind::knife_edge;
+  h.name = name;
+  h.where = where;
+  h.index = point_index(point, where, context);
+  h.axis = axis_index(axis);
+  if (h.axis < 0)
+    fail(where, context, fmt::format("unknown blade axis '{}'; the blade lies along the \"x\", \"y\" or \"z\" axis "
+                                     "of the point's frame",
+                                     axis));
+  if (normal) h.normal = parse(*normal, where, context + ": normal", false);
+  helpers_.push_back(std::move(h));
+  if (helpers_.back().normal) plane_normal(helpers_.back(), context);
+  return *this;
+}
+
+GiNaC::ex MultibodyBuilder::parse_surface(const std::string& text, const Vector3& at, const SourceLocation& where,
+                                          const std::string& context) const {
+  // X, Y, Z are declared as extra parameters of a copy of the builder, then replaced by the point.
+  SpecBuilder scratch = builder_;
+  for (const char* name : {"X", "Y", "Z"})
+    if (builder_.current().symbols.has(name))
+      fail(where, context,
+           fmt::format("a surface is written in the world coordinates X, Y, Z of the point, but '{}' is already a "
+                       "coordinate or parameter of the model; rename it",
+                       name));
+  scratch.parameter("X", 0.0).parameter("Y", 0.0).parameter("Z", 0.0);
+  const GiNaC::ex f = scratch.parse(text, where);
+  const SymbolTable& symbols = scratch.current().symbols;
+  for (int i = 0; i < scratch.current().n(); ++i)
+    if (f.has(symbols.velocity(i)) || f.has(symbols.acceleration(i)))
+      fail(where, context, fmt::format("the surface \"{}\" may not contain velocities or accelerations", text));
+  return f.subs(GiNaC::lst{symbols.parameter("X") == at[0], symbols.parameter("Y") == at[1],
+                           symbols.parameter("Z") == at[2]});
+}
+
+MultibodyBuilder& MultibodyBuilder::point_on_surface(const std::string& name, const std::string& point,
+                                                     const std::string& surface, SourceLocation where) {
+  const std::string context = fmt::format("surface constraint '{}'", name);
+  check_helper_name(name, where);
+  Helper h;
+  h.kind = Helper::Kind::surface;
+  h.name = name;
+  h.where = where;
+  h.index = point_index(point, where, context);
+  h.surfaces.push_back(parse_surface(surface, points_[static_cast<std::size_t>(h.index)].world, where, context));
+  helpers_.push_back(std::move(h));
+  return *this;
+}
+
+MultibodyBuilder& MultibodyBuilder::point_on_curve(const std::string& name, const std::string& point,
+                                                   const std::string& surface1, const std::string& surface2,
+                                                   SourceLocation where) {
+  const std::string context = fmt::format("curve constraint '{}'", name);
+  check_helper_name(name, where);
+  Helper h;
+  h.kind = Helper::Kind::curve;
+  h.name = name;
+  h.where = where;
+  h.index = point_index(point, where, context);
+  const Vector3& at = points_[static_cast<std::size_t>(h.index)].world;
+  h.surfaces.push_back(parse_surface(surface1, at, where, context + " (first surface)"));
+  h.surfaces.push_back(parse_surface(surface2, at, where, context + " (second surface)"));
+  helpers_.push_back(std::move(h));
+  return *this;
+}
+
+Vector3 MultibodyBuilder::plane_normal(const Helper& helper, const std::string& context) const {
+  Vector3 n;
+  if (helper.normal) {
+    n = *helper.normal;
+  } else if (gravity_) {
+    n = scale(-1, *gravity_);
+  } else {
+    fail(helper.where, context,
+         "no contact plane: give the plane's normal (e.g. normal = [0, 0, 1] for the ground z = 0) or a gravity "
+         "vector, whose opposite is then the normal");
+  }
+  const Spec& spec = builder_.current();
+  std::array<double, 3> value{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::optional<double> v = value_of(n[i], spec);
+    if (!v) fail(helper.where, context, fmt::format("the plane's normal component {} is not a number", i + 1));
+    value[i] = *v;
+  }
+  const double length = std::sqrt(value[0] * value[0] + value[1] * value[1] + value[2] * value[2]);
+  if (!(length > 0.0))
+    fail(helper.where, context,
+         helper.normal ? "the plane's normal is the zero vector; give a nonzero normal, e.g. [0, 0, 1]"
+                       : "the gravity vector is zero, so it defines no contact plane; give the plane's normal, e.g. "
+                         "normal = [0, 0, 1]");
+  // An axis-aligned normal is kept exact (+-x, +-y, +-z); others are normalized symbolically.
+  for (std::size_t i = 0; i < 3; ++i)
+    if (std::fabs(value[i]) == length) return scale(value[i] > 0 ? 1 : -1, unit(static_cast<int>(i)));
+  const GiNaC::ex norm = GiNaC::sqrt(simplify(dot(n, n)));
+  return {n[0] / norm, n[1] / norm, n[2] / norm};
+}
+
+namespace {
+
+// An orthonormal basis t1, t2 of the plane with unit normal n: t1 from the world axis least aligned
+// with n (the first of ties), t2 = n x t1.
+std::pair<Vector3, Vector3> tangents(const Vector3& n, const Spec& spec) {
+  int k = 0;
+  double smallest = 2.0;
+  for (int i = 0; i < 3; ++i) {
+    const double v = std::fabs(value_of(n[static_cast<std::size_t>(i)], spec).value_or(1.0));
+    if (v < smallest - 1e-15) {
+      smallest = v;
+      k = i;
+    }
+  }
+  const GiNaC::ex nk = n[static_cast<std::size_t>(k)];
+  Vector3 t1 = subtract(unit(k), scale(nk, n));
+  const GiNaC::ex length = GiNaC::sqrt(simplify(1 - nk * nk));
+  t1 = {simplify(t1[0] / length), simplify(t1[1] / length), simplify(t1[2] / length)};
+  const Vector3 t2 = cross(n, t1);
+  return {t1, {simplify(t2[0]), simplify(t2[1]), simplify(t2[2])}};
+}
+
+// For an expression too large for simplify(): whether it is zero at a few fixed, generic points
+// (coordinates and t in [-1, 1], the parameters at their values): |e| <= 1e-12 at each.
+bool vanishes_at_sample_points(const GiNaC::ex& e, const Spec& spec) {
+  if (capped_size_below(e)) return false;  // small ones were simplified: not zero
+  for (int sample = 0; sample < 3; ++sample) {
+    GiNaC::lst values = spec.parameter_values();
+    values.append(spec.symbols.time() == 0.1 * (sample + 1));
+    for (int i = 0; i < spec.n(); ++i)
+      values.append(spec.symbols.coordinate(i) == std::sin(1.7 * (i + 1) + 2.3 * sample));
+    const GiNaC::ex v = e.subs(values).evalf();
+    if (!GiNaC::is_a<GiNaC::numeric>(v) || !GiNaC::ex_to<GiNaC::numeric>(v).is_real() ||
+        std::abs(GiNaC::ex_to<GiNaC::numeric>(v).to_double()) > 1e-12)
+      return false;
+  }
+  return true;
+}
+
+bool has_coordinates(const GiNaC::ex& e, const Spec& spec) {
+  if (e.has(spec.symbols.time())) return true;
+  for (int i = 0; i < spec.n(); ++i)
+    if (e.has(spec.symbols.coordinate(i))) return true;
+  return false;
+}
+
+}  // namespace
+
+void MultibodyBuilder::add_wheel(const Helper& h) {
+  const std::string context = fmt::format("wheel '{}'", h.name);
+  const Spec& spec = builder_.current();
+  const Body& body = bodies_[static_cast<std::size_t>(h.index)];
+  const PlacedFrame& F = frames_[static_cast<std::size_t>(body.frame)];
+  const Vector3 n = plane_normal(h, context);
+  const Vector3& C = F.origin;
+  const Vector3 a = column(F.rotation, h.axis);
+  const GiNaC::ex an = dot(a, n);
+  // |a x n| = sqrt(1 - (a.n)^2); a perfect square u^2 gives u with its sign at the reference
+  // configuration (docs/derivations/rolling-wheel.md).
+  const GiNaC::ex squared = simplify(1 - an * an);
+  if (symbolic::is_zero(squared))
+    fail(h.where, context, "the axle is always normal to the plane (the wheel lies flat): it cannot roll");
+  GiNaC::ex length = GiNaC::sqrt(squared);
+  if (GiNaC::is_a<GiNaC::power>(squared) && squared.op(1) == 2) {
+    const std::optional<double> u = value_of(squared.op(0), spec, true);
+    if (u && *u != 0.0) length = *u > 0 ? squared.op(0) : -squared.op(0);
+  }
+  const Vector3 CP = scale(h.radius / length, subtract(scale(an, a), n));  // P - C
+  const Vector3 P = add(C, CP);
+
+  const GiNaC::ex contact = simplify_moderate(dot(n, P));
+  if (!contact.is_zero() && !vanishes_at_sample_points(contact, spec)) {
+    if (!has_coordinates(contact, spec))
+      fail(h.where, context,
+           fmt::format("the wheel can never touch the plane: the height of its lowest point above the plane is the "
+                       "constant {}; place the wheel's frame so that it touches the plane",
+                       printed(contact)));
+    builder_.constraint(h.name + "_contact", ConstraintLevel::position, contact,
+                        fmt::format("wheel '{}': lowest point on the plane, n.P = 0", h.name), h.where);
+  }
+  // The material point at P: v_C + omega x (P - C); its two components along the plane vanish.
+  const Vector3 vP = add(time_derivative(C, spec.symbols), cross(F.omega, CP));
+  const auto [t1, t2] = tangents(n, spec);
+  int k = 0;
+  for (const Vector3& tk : {t1, t2}) {
+    const GiNaC::ex slip = simplify_moderate(dot(tk, vP));
+    ++k;
+    if (slip.is_zero())
+      fail(h.where, context,
+           fmt::format("the contact point's velocity along the plane (direction {}) is zero whatever the "
+                       "velocities: the wheel's frame cannot move, so it has nothing to roll on",
+                       k));
+    builder_.constraint(fmt::format("{}_slip{}", h.name, k), ConstraintLevel::velocity, slip,
+                        fmt::format("wheel '{}': no slip, t{}.v_P = 0", h.name, k), h.where);
+  }
+}
+
+void MultibodyBuilder::add_knife_edge(const Helper& h) {
+  const std::string context = fmt::format("knife edge '{}'", h.name);
+  const Spec& spec = builder_.current();
+  const Point& p = points_[static_cast<std::size_t>(h.index)];
+  const PlacedFrame& F = frames_[static_cast<std::size_t>(p.frame)];
+  const Vector3 n = plane_normal(h, context);
+  const Vector3 across = cross(n, column(F.rotation, h.axis));
+  bool blade_in_plane = false;
+  for (const GiNaC::ex& c : across) blade_in_plane = blade_in_plane || value_of(c, spec, true).value_or(1.0) != 0.0;
+  if (!blade_in_plane)
+    fail(h.where, context,
+         "the blade is normal to the plane at the reference configuration (all coordinates 0): it must lie along the "
+         "plane; choose another axis");
+  const GiNaC::ex constraint = simplify_moderate(dot(across, time_derivative(p.world, spec.symbols)));
+  builder_.constraint(h.name, ConstraintLevel::velocity, constraint,
+                      fmt::format("knife edge '{}': no velocity across the blade", h.name), h.where);
+}
+
+GiNaC::ex MultibodyBuilder::kinetic_energy() const {
+  // Left unexpanded: the nested products of the rotation chain are what GiNaC differentiates
+  // fastest (gathering T as 1/2 M_ij q_i' q_j' with simplified M_ij was slower for the bicycle).
+  const SymbolTable& symbols = builder_.current().symbols;
+  GiNaC::ex T = 0;
+  for (const Body& b : bodies_) {
+    const PlacedFrame& F = frames_[static_cast<std::size_t>(b.frame)];
+    const Vector3 vc = time_derivative(add(F.origin, multiply(F.rotation, b.com)), symbols);
+    Vector3 Iw;
+    for (unsigned i = 0; i < 3; ++i)
+      Iw[i] = b.inertia(i, 0) * F.omega_local[0] + b.inertia(i, 1) * F.omega_local[1] +
+              b.inertia(i, 2) * F.omega_local[2];
+    T += b.mass / 2 * dot(vc, vc) + dot(F.omega_local, Iw) / 2;
+  }
+  return T;
+}
+
+GiNaC::ex MultibodyBuilder::potential_energy() const {
+  if (!gravity_) return 0;
+  GiNaC::ex V = 0;
+  for (const Body& b : bodies_) {
+    const PlacedFrame& F = frames_[static_cast<std::size_t>(b.frame)];
+    V -= b.mass * dot(*gravity_, add(F.origin, multiply(F.rotation, b.com)));
+  }
+  return V;
+}
+
+void MultibodyBuilder::apply() {
+  if (applied_) throw ModelError("MultibodyBuilder::apply() was called twice; call it once, after everything else");
+  applied_ = true;
+  builder_.add_energies(kinetic_energy(), potential_energy());
+  for (const Helper& h : helpers_) {
+    switch (h.kind) {
+      case Helper::Kind::wheel: add_wheel(h); break;
+      case Helper::Kind::knife_edge: add_knife_edge(h); break;
+      case Helper::Kind::surface:
+        builder_.constraint(h.name, ConstraintLevel::position, h.surfaces[0],
+                            fmt::format("point on a surface '{}'", h.name), h.where);
+        break;
+      case Helper::Kind::curve:
+        builder_.constraint(h.name + "_1", ConstraintLevel::position, h.surfaces[0],
+                            fmt::format("point on a curve '{}', first surface", h.name), h.where);
+        builder_.constraint(h.name + "_2", ConstraintLevel::position, h.surfaces[1],
+                            fmt::format("point on a curve '{}', second surface", h.name), h.where);
+        break;
+    }
+  }
+}
+
+const PlacedFrame& MultibodyBuilder::placed_frame(const std::string& name) const {
+  return frames_[static_cast<std::size_t>(frame_index(name, {}, "placed_frame"))];
+}
+
+Vector3 MultibodyBuilder::point_position(const std::string& name) const {
+  return points_[static_cast<std::size_t>(point_index(name, {}, "point_position"))].world;
+}
+
+}  // namespace nhdyn::symbolic

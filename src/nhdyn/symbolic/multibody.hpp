@@ -1,0 +1,153 @@
+// The multibody front end: builds the kinetic energy, the potential of gravity and the constraints
+// of rolling wheels, knife edges and points on surfaces from a description of frames, points and
+// bodies, and hands them to a SpecBuilder — from there on the model is derived and compiled like a
+// hand-written one (spec_builder.hpp -> derive -> compile_model). The model file's [[frames]],
+// [[points]], [[bodies]], gravity, [[wheels]], [[knife_edges]] and [[surfaces]] (io/model_file.cpp)
+// are a thin layer over this class. docs/multibody.md describes it for users;
+// docs/derivations/rolling-wheel.md derives what it writes.
+//
+// Frames: "ground" is the world frame. A frame is placed in its parent by a translation (in the
+// parent's axes) and then a body-fixed sequence of rotations about the x, y or z axis of the frame
+// produced so far, each by an angle (an expression in t, the coordinates and the parameters).
+// Angular velocities come from the rates of these angles, not from differentiating matrices.
+//
+// Every expression is text parsed by the SpecBuilder (its coordinates and parameters must be
+// declared first). Errors are ModelErrors that start with the SourceLocation given.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "nhdyn/symbolic/kinematics.hpp"
+#include "nhdyn/symbolic/spec_builder.hpp"
+
+namespace nhdyn::symbolic {
+
+// One rotation of a frame's sequence: about axis "x", "y" or "z" of the frame produced so far.
+struct FrameRotation {
+  std::string axis;
+  std::string angle;  // expression in t, the coordinates and the parameters
+  SourceLocation where;
+};
+
+using Triple = std::array<std::string, 3>;        // three expressions, a vector's components
+using InertiaText = std::array<Triple, 3>;         // a 3 x 3 tensor, row by row
+
+// A frame once placed: everything in world components except omega_local.
+struct PlacedFrame {
+  std::string name;
+  int parent = -1;            // index among the frames; -1 for ground
+  Vector3 origin;             // position of the origin
+  GiNaC::matrix rotation;     // R: frame components -> world components
+  Vector3 omega;              // angular velocity, world components (linear in q')
+  Vector3 omega_local;        // the same in the frame's own axes
+  SourceLocation where;
+};
+
+class MultibodyBuilder {
+ public:
+  // Coordinates and parameters must already be declared on `builder`, which must outlive this.
+  explicit MultibodyBuilder(SpecBuilder& builder);
+
+  MultibodyBuilder& frame(const std::string& name, const std::string& parent, const Triple& translation,
+                          const std::vector<FrameRotation>& rotations, SourceLocation where = {});
+  // A point fixed in `frame`, at `position` in the frame's axes.
+  MultibodyBuilder& point(const std::string& name, const std::string& frame, const Triple& position,
+                          SourceLocation where = {});
+  // A rigid body moving with `frame`: mass, centre of mass (in the frame's axes) and inertia tensor
+  // about the centre of mass in the frame's axes (symmetric, positive definite; all expressions in
+  // the parameters). Checked with the parameter values given so far.
+  MultibodyBuilder& body(const std::string& name, const std::string& frame, const std::string& mass,
+                         const Triple& centre_of_mass, const InertiaText& inertia, SourceLocation where = {});
+  // The gravitational acceleration vector in world components (parameters only), e.g. {0, 0, -g}.
+  MultibodyBuilder& gravity(const Triple& g, SourceLocation where = {});
+
+  // A thin wheel of `radius` that rolls without slipping: the body's frame origin is its centre,
+  // its axle is the frame's `axis` ("x", "y" or "z"). The plane passes through the world origin
+  // with the normal `normal` (world components, parameters only), or opposite to gravity when no
+  // normal is given. Adds "<name>_contact" (position level, unless it holds identically) and
+  // "<name>_slip1", "<name>_slip2" (velocity level).
+  MultibodyBuilder& rolling_wheel(const std::string& name, const std::string& body, const std::string& axis,
+                                  const std::string& radius, const std::optional<Triple>& normal = std::nullopt,
+                                  SourceLocation where = {});
+  // A knife edge at `point` along its frame's `axis`, on the plane of `normal` (default: opposite
+  // to gravity): the velocity of the point across the blade within the plane vanishes. Adds one
+  // velocity-level constraint called `name`.
+  MultibodyBuilder& knife_edge(const std::string& name, const std::string& point, const std::string& axis,
+                               const std::optional<Triple>& normal = std::nullopt, SourceLocation where = {});
+  // `point` stays on the fixed surface f(X, Y, Z) = 0 (world coordinates X, Y, Z; the expression
+  // may also use t and the parameters). One position-level constraint called `name`.
+  MultibodyBuilder& point_on_surface(const std::string& name, const std::string& point, const std::string& surface,
+                                     SourceLocation where = {});
+  // `point` stays on the curve where two surfaces meet: "<name>_1" and "<name>_2".
+  MultibodyBuilder& point_on_curve(const std::string& name, const std::string& point, const std::string& surface1,
+                                   const std::string& surface2, SourceLocation where = {});
+
+  // T = sum (1/2 m v_c.v_c + 1/2 w.I w) and V = -sum m g.r_c over the bodies.
+  GiNaC::ex kinetic_energy() const;
+  GiNaC::ex potential_energy() const;
+  // Adds T and V to the builder's energies and the helpers' constraints to its constraints, in the
+  // order the helpers were given. Call once, after everything else.
+  void apply();
+
+  // For tests and other front ends.
+  const PlacedFrame& placed_frame(const std::string& name) const;
+  Vector3 point_position(const std::string& name) const;  // world components
+
+ private:
+  struct Point {
+    std::string name;
+    int frame;
+    Vector3 world;
+    SourceLocation where;
+  };
+  struct Body {
+    std::string name;
+    int frame;
+    GiNaC::ex mass;
+    Vector3 com;             // in the frame's axes
+    GiNaC::matrix inertia;   // about the com, in the frame's axes
+    SourceLocation where;
+  };
+  // A helper's constraints, computed in apply() (the plane's default normal needs the gravity,
+  // which may come later).
+  struct Helper {
+    enum class Kind { wheel, knife_edge, surface, curve } kind;
+    std::string name;
+    int index = -1;          // body (wheel) or point
+    int axis = 0;
+    GiNaC::ex radius;
+    std::optional<Vector3> normal;
+    std::vector<GiNaC::ex> surfaces;
+    SourceLocation where;
+  };
+
+  GiNaC::ex parse(const std::string& text, const SourceLocation& where, const std::string& context,
+                  bool coordinates_allowed) const;
+  Vector3 parse(const Triple& texts, const SourceLocation& where, const std::string& context,
+                bool coordinates_allowed) const;
+  int frame_index(const std::string& name, const SourceLocation& where, const std::string& context) const;
+  int point_index(const std::string& name, const SourceLocation& where, const std::string& context) const;
+  int body_index(const std::string& name, const SourceLocation& where, const std::string& context) const;
+  void check_helper_name(const std::string& name, const SourceLocation& where) const;
+  GiNaC::ex parse_surface(const std::string& text, const Vector3& at, const SourceLocation& where,
+                          const std::string& context) const;
+  Vector3 plane_normal(const Helper& helper, const std::string& context) const;
+  void add_wheel(const Helper& helper);
+  void add_knife_edge(const Helper& helper);
+
+  SpecBuilder& builder_;
+  std::vector<PlacedFrame> frames_;  // frames_[0] is ground
+  std::vector<Point> points_;
+  std::vector<Body> bodies_;
+  std::vector<Helper> helpers_;
+  std::optional<Vector3> gravity_;
+  SourceLocation gravity_where_;
+  bool applied_ = false;
+};
+
+}  // namespace nhdyn::symbolic
