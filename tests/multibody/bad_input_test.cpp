@@ -154,6 +154,13 @@ TEST(MultibodyBadInput, WrongTomlTypes) {
   expect_error(replaced("[[wheels]]", "[wheels]"), {"disk.toml:", "'wheels' must be an array"});
   expect_error(replaced("radius = \"r\"", "radius = \"r\"\nrdius = 1"), {"disk.toml:37:", "unknown key 'rdius'", "radius"});
   expect_error(replaced("name = \"disk\"\nframe", "frame"), {"disk.toml:26:", "[[bodies]]", "no 'name'"});
+  expect_error(replaced("gravity = [0, 0, \"-g\"]", "gravity = 9.81"), {"disk.toml:3:", "'gravity' must be an array", "a floating-point number"});
+  expect_error(replaced("inertia = [\"m*r^2/4\", \"m*r^2/2\", \"m*r^2/4\"]", "inertia = [1, 2]"),
+               {"disk.toml:30:", "inertia", "3 principal moments or a 3 x 3 array"});
+  expect_error(replaced("inertia = [\"m*r^2/4\", \"m*r^2/2\", \"m*r^2/4\"]", "inertia = [[1, 0, 0], [0, 1, 0], [0, 0]]"),
+               {"disk.toml:30:", "row 3", "3 entries"});
+  expect_error(replaced("axis = \"y\"", "axis = 2"), {"disk.toml:35:", "axis", "must be a string", "an integer"});
+  expect_error(disk + "\n[[surfaces]]\nname = \"s\"\npoint = \"p\"\nsurface = 3\n", {"disk.toml:41:", "surface", "expression written as a string"});
 }
 
 TEST(MultibodyBadInput, VelocitiesInPlacementsAndCoordinatesInConstants) {

@@ -1,5 +1,6 @@
 // Exams of the multibody front end (symbolic/multibody.hpp) built through the C++ API, against
-// closed forms: a compound pendulum, a free rigid body in gravity (its centre falls with g, its
+// closed forms: a compound pendulum, a heavy symmetric top (Lagrange's theta equation, steady
+// precession), a free rigid body in gravity (its centre falls with g, its
 // rotation obeys Euler's torque-free equations), a particle held on a sphere by point_on_surface
 // (the spherical pendulum: q'' = g_tangential - |v|^2/l u), a knife edge on the ground (the
 // classical constraint -sin(phi) x' + cos(phi) y' = 0), and the angular velocity of a rotation
@@ -43,6 +44,41 @@ TEST(MultibodyClosedForms, CompoundPendulum) {
     EXPECT_NEAR(evaluate(spec, spec.kinetic_energy, q, v), 0.5 * (0.05 + 1.3 * 0.49) * v[0] * v[0], 1e-13);
     EXPECT_NEAR(evaluate(spec, spec.potential_energy, q, v), -1.3 * 9.81 * 0.7 * std::cos(q[0]), 1e-13);
   }
+}
+
+TEST(MultibodyClosedForms, HeavySymmetricTop) {
+  // Euler angles z(psi), x(theta), z(phi) about the fixed tip; centre of mass l up the symmetry
+  // axis. Lagrange's equation for theta, with I1 = I1c + m l^2 and w3 = phi' + psi' cos(theta):
+  //   I1 theta'' = I1 psi'^2 sin(theta) cos(theta) - I3 w3 psi' sin(theta) + m g l sin(theta),
+  // and steady precession (theta' = 0, all q'' = 0) when w3 = (I1 Omega^2 cos(theta) + m g l) / (I3 Omega).
+  const double m = 0.4, g = 9.81, l = 0.05, I1c = 2e-4, I3 = 3e-4, I1 = I1c + m * l * l;
+  SpecBuilder b("top");
+  b.coordinate("psi").coordinate("theta").coordinate("phi");
+  b.parameter("m", m).parameter("g", g).parameter("l", l).parameter("I1c", I1c).parameter("I3", I3);
+  MultibodyBuilder mb(b);
+  mb.frame("top", "ground", {"0", "0", "0"}, {{"z", "psi", {}}, {"x", "theta", {}}, {"z", "phi", {}}})
+      .body("top", "top", "m", {"0", "0", "l"}, {{{"I1c", "0", "0"}, {"0", "I1c", "0"}, {"0", "0", "I3"}}})
+      .gravity({"0", "0", "-g"});
+  mb.apply();
+  const Model model = symbolic::compile_model(b.build());
+  std::mt19937 rng(21);
+  for (int trial = 0; trial < 10; ++trial) {
+    const std::vector<double> q{uniform(rng, -3, 3), uniform(rng, 0.2, 1.4), uniform(rng, -3, 3)};
+    const std::vector<double> v{uniform(rng, -10, 10), uniform(rng, -5, 5), uniform(rng, -100, 100)};
+    const double w3 = v[2] + v[0] * std::cos(q[1]);
+    const double exact = (I1 * v[0] * v[0] * std::sin(q[1]) * std::cos(q[1]) - I3 * w3 * v[0] * std::sin(q[1]) +
+                          m * g * l * std::sin(q[1])) / I1;
+    const Data d = dynamics_at(model, q, v);
+    EXPECT_NEAR(d.qdd(1), exact, 1e-11 * (1 + std::abs(exact))) << trial;
+  }
+  // Steady precession at Omega = 2 rad/s, theta = 0.6.
+  const double theta = 0.6, Omega = 2.0;
+  const double w3 = (I1 * Omega * Omega * std::cos(theta) + m * g * l) / (I3 * Omega);
+  const Data steady = dynamics_at(model, {0.3, theta, 0.0}, {Omega, 0.0, w3 - Omega * std::cos(theta)});
+  EXPECT_LT(steady.qdd.norm(), 1e-10 * w3 * Omega);
+  // Negative control: 10 % more spin and it nods.
+  const Data off = dynamics_at(model, {0.3, theta, 0.0}, {Omega, 0.0, 1.1 * w3 - Omega * std::cos(theta)});
+  EXPECT_GT(std::abs(off.qdd(1)), 1e-2);
 }
 
 TEST(MultibodyClosedForms, FreeRigidBodyFallsWithGAndObeysEulersEquations) {
