@@ -70,11 +70,12 @@ int run_linearize(const LinearizeArgs& args) {
   fmt::print("state matrix S ({} x {}), d/dt x = S x with x = ({}):\n", k, k, join_names(l.state));
   std::size_t width = 8;
   for (const std::string& s : l.state) width = std::max(width, s.size());
-  fmt::print("{:<{}}", "", width + 2);
+  const std::size_t label = width + 5;  // "d/dt " and the longest name
+  fmt::print("{:<{}}", "", label);
   for (const std::string& s : l.state) fmt::print(" {:>20}", s);
   fmt::print("\n");
   for (std::size_t i = 0; i < k; ++i) {
-    fmt::print("{:<{}}", "d/dt " + l.state[i], width + 6 > 0 ? width + 2 : 0);
+    fmt::print("{:<{}}", "d/dt " + l.state[i], label);
     for (std::size_t j = 0; j < k; ++j)
       fmt::print(" {:>20.13g}", l.state_matrix(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)));
     fmt::print("\n");

@@ -4,7 +4,11 @@
 // CSV, and optionally the classical plot of real and imaginary parts against the parameter.
 #include <fmt/format.h>
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <filesystem>
+#include <system_error>
 #include <memory>
 #include <string>
 #include <vector>
@@ -108,23 +112,58 @@ int run_sweep(const SweepArgs& args) {
   crossings_file.commit();
 
   if (!args.plot.empty()) {
+    // The plot draws the real parts and the |imaginary parts| each sorted at every value: the
+    // k-th largest of continuous functions is continuous, so the curves have no jumps where the
+    // CSV's order (by real part) swaps the imaginary parts. Its data go to a temporary file.
+    const fs::path data = fs::temp_directory_path() /
+                          fmt::format(".nhdyn-sweep-{}-{}.csv", ::getpid(), fs::path(args.plot).stem().string());
+    {
+      std::string plot_text = args.param;
+      for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",re_{}", i);
+      for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",absim_{}", i);
+      plot_text += "\n";
+      for (const SweepPoint& p : sweep.points) {
+        std::vector<double> re, im;
+        for (const std::complex<double>& e : p.eigenvalues) {
+          re.push_back(e.real());
+          im.push_back(std::abs(e.imag()));
+        }
+        std::sort(re.rbegin(), re.rend());
+        std::sort(im.rbegin(), im.rend());
+        plot_text += fmt::format("{:.17g}", p.value);
+        for (double x : re) plot_text += fmt::format(",{:.17g}", x);
+        for (double x : im) plot_text += fmt::format(",{:.17g}", x);
+        plot_text += "\n";
+      }
+      AtomicFile plot_data(data);
+      plot_data.write(plot_text);
+      plot_data.commit();
+    }
     XyPlotRequest request;
     request.title = fmt::format("{}: eigenvalues of the linearization against {}", spec.name, args.param);
-    request.csv = table_path;
+    request.csv = data;
     request.x = args.param;
     for (std::size_t i = 1; i <= k; ++i) {
       request.y.push_back(fmt::format("re_{}", i));
-      request.titles.push_back(fmt::format("Re {}", i));
+      request.titles.push_back(fmt::format("Re, {}. largest", i));
     }
     for (std::size_t i = 1; i <= k; ++i) {
-      request.y.push_back(fmt::format("im_{}", i));
-      request.titles.push_back(fmt::format("Im {}", i));
+      request.y.push_back(fmt::format("absim_{}", i));
+      request.titles.push_back(fmt::format("|Im|, {}. largest", i));
     }
     request.x_label = args.param;
-    request.y_label = "eigenvalue [1/s]: real and imaginary parts";
+    request.y_label = "eigenvalues [1/s]: real parts and |imaginary parts|";
     request.log_x = false;
     request.log_y = false;
-    write_xy_plot(request, args.plot);
+    try {
+      write_xy_plot(request, args.plot);
+    } catch (...) {
+      std::error_code ignored;
+      fs::remove(data, ignored);
+      throw;
+    }
+    std::error_code ignored;
+    fs::remove(data, ignored);
   }
 
   if (!args.quiet) {

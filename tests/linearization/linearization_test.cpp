@@ -191,6 +191,29 @@ TEST(Linearization, BenchmarkBicycleEqualsTheIndependentStateMatrix) {
   }
 }
 
+// Meijaard et al. 2007, Table 2: the weave pair at v = 1..10 m/s, and all four at 5 and 10 m/s.
+TEST(Linearization, BenchmarkBicycleMatchesThePublishedTable) {
+  const C weave[10] = {C(3.52696170990070, 0.807740275199300), C(2.68234517512745, 1.68066296590675),
+                       C(1.70675605663975, 2.31582447384325),  C(0.413253315211250, 3.07910818603206),
+                       C(-0.775341882195850, 4.46486771378823), C(-1.52644486584142, 5.87673060598709),
+                       C(-2.13875644258362, 7.19525913329805),  C(-2.69348683581097, 8.46037971396931),
+                       C(-3.21675402252485, 9.69377351531791),  C(-3.72016840437287, 10.9068113947629)};
+  for (int v = 1; v <= 10; ++v) {
+    const Linearization l = linearize(compile_example("bicycle_linear.toml", {{"v", v}}));
+    bool found = false;
+    for (const C& e : l.eigenvalues) found = found || std::abs(e - weave[v - 1]) < 1e-12 * std::abs(weave[v - 1]);
+    EXPECT_TRUE(found) << "v = " << v << ": the weave eigenvalue " << weave[v - 1] << " is not among the computed";
+  }
+  const Linearization five = linearize(compile_example("bicycle_linear.toml", {{"v", 5.0}}));
+  expect_eigenvalues(five.eigenvalues,
+                     {C(-14.07838969279822, 0), C(-0.32286642900409, 0), C(-0.77534188219585, 4.46486771378823),
+                      C(-0.77534188219585, -4.46486771378823)},
+                     1e-12);
+  const Linearization ten = linearize(compile_example("bicycle_linear.toml", {{"v", 10.0}}));
+  EXPECT_NEAR(ten.eigenvalues.front().real(), 0.16105338653172, 1e-12);  // capsize, unstable
+  EXPECT_NEAR(ten.eigenvalues.back().real(), -24.62459635017404, 1e-11);  // castering
+}
+
 // The bicycle's equations by hand, to run the Richardson path (no programs) against the tangent one.
 class BicycleEvaluator final : public Evaluator {
  public:
