@@ -58,7 +58,18 @@ int run_sweep(const SweepArgs& args) {
                                  "its model file instead (examples/)",
                                  args.model, args.param));
   symbolic::Spec spec = resolve_spec(args.model, args.sets);
-  spec.set_parameter(args.param, args.from);  // throws for an unknown name, naming the nearest
+  {
+    std::string names;
+    bool known = false;
+    for (const symbolic::SpecParameter& p : spec.parameters) {
+      names += (names.empty() ? "" : ", ") + p.name;
+      known = known || p.name == args.param;
+    }
+    if (!known)
+      throw InputError(fmt::format("--param {}: model '{}' ({}) has no parameter '{}'; its parameters are: {}",
+                                   args.param, spec.name, args.model, args.param, names.empty() ? "(none)" : names));
+  }
+  spec.set_parameter(args.param, args.from);
   const symbolic::Derivation derivation = symbolic::derive(spec);
   const ModelAtValue model_at = [&](double value) {
     spec.set_parameter(args.param, value);

@@ -126,7 +126,7 @@ TEST_F(CliRun, BadInputIsRefusedWithTheValueNamed) {
     std::vector<std::string> message;
   };
   const std::vector<Case> cases = {
-      {"sweep " + bike + " --param speed --from 0 --to 10", {"speed"}},
+      {"sweep " + bike + " --param speed --from 0 --to 10", {"--param speed", "no parameter 'speed'", "v, g, M_pp"}},
       {"sweep " + bike + " --param v --from 0 --to 10 --steps 1", {"--steps 1"}},
       {"sweep " + bike + " --param v --from 0 --to 10 --steps 0", {"--steps 0"}},
       {"sweep " + bike + " --param v --from 10 --to 0", {"--from 10 --to 0"}},
