@@ -69,17 +69,19 @@ TEST(Linearization, PendulumWithYNamedIndependentAtTheBottomIsRefused) {
   expect_error<InputError>([&] { linearize(model, o); }, {"--independent", "'z'", "x, y"});
 }
 
-TEST(Linearization, PendulumNamedStateGivesTheSameEigenvalues) {
-  // Away from the bottom both coordinates can serve; the eigenvalues do not depend on the choice.
-  const double theta = 0.0;
-  const Model model = compile_example("pendulum_cartesian.toml", {{"theta0", theta}});
-  LinearizationOptions o;
-  o.independent = {"x"};
-  o.speeds = {"x"};
-  const Linearization l = linearize(model, o);
-  EXPECT_EQ(l.state, (std::vector<std::string>{"x", "x'"}));
-  const double w = std::sqrt(9.81 / 1.5);
-  expect_eigenvalues(l.eigenvalues, {C(0, w), C(0, -w)}, 1e-13);
+TEST(Linearization, TheChoiceOfIndependentCoordinateDoesNotChangeTheEigenvalues) {
+  // At theta* both x and z can serve as the independent coordinate on the hoop.
+  const double star = std::acos(9.81 / (0.5 * 36.0));
+  const Model model = compile_example("hoop_bead_rotating.toml", {{"theta0", star}});
+  const double w = 6.0 * std::sin(star);
+  for (const char* name : {"x", "z"}) {
+    LinearizationOptions o;
+    o.independent = {name};
+    o.speeds = {name};
+    const Linearization l = linearize(model, o);
+    EXPECT_EQ(l.state, (std::vector<std::string>{name, std::string(name) + "'"}));
+    expect_eigenvalues(l.eigenvalues, {C(0, w), C(0, -w)}, 1e-12);
+  }
 }
 
 TEST(Linearization, BeadOnTheRotatingHoopHasBothClosedFormEquilibria) {
@@ -173,11 +175,14 @@ TEST(Linearization, UprightRollingDiskMatchesTheClosedForm) {
     const C root = std::sqrt(C(lambda2, 0.0));
     expect_eigenvalues(l.eigenvalues, {root, -root, C(0, 0), C(0, 0)}, 1e-11);
   }
-  // Negative control: without naming psi cyclic it is part of the state (it enters the rolling
-  // constraints), and the answer for the tilt is unchanged.
+  // Without naming psi cyclic it stays in the state (it enters the rolling constraints): the
+  // motion keeps psi = 0, so this linearization is exact too, and gives the same tilt eigenvalues
+  // and one more zero (the heading itself).
   const Linearization full = linearize(compile_example("rolling_disk_upright.toml", {{"w", 6.0}}));
   EXPECT_EQ(full.cyclic, (std::vector<std::string>{"x", "y", "phi"}));
-  EXPECT_EQ(full.state.size(), 5u);
+  EXPECT_EQ(full.state, (std::vector<std::string>{"psi", "theta", "psi'", "theta'", "phi'"}));
+  const C root = std::sqrt(C(0.8 * (g / r - 3.0 * 36.0), 0.0));
+  expect_eigenvalues(full.eigenvalues, {root, -root, C(0, 0), C(0, 0), C(0, 0)}, 1e-11);
 }
 
 TEST(Linearization, BenchmarkBicycleEqualsTheIndependentStateMatrix) {

@@ -63,8 +63,21 @@ TEST(Sweep, BenchmarkBicycleWeaveAndCapsizeSpeeds) {
   EXPECT_FALSE(capsize.oscillatory);
   EXPECT_EQ(capsize.unstable_before, 0);
   EXPECT_EQ(capsize.unstable_after, 1);
-  // Negative control: a crossing 1e-7 away from the published value would fail the tolerance.
-  EXPECT_GT(std::abs(weave.value + 1e-7 - testing::kWeaveSpeed), 1e-9);
+}
+
+// Negative control: the tolerance 1e-9 tells a bicycle whose K2 differs in the seventh digit.
+TEST(Sweep, APerturbedBicycleMissesThePublishedSpeeds) {
+  FileSweep file("bicycle_linear.toml", "v");
+  file.spec.set_parameter("K2_pd", 76.59734589573222 * (1 + 1e-7));
+  SweepOptions o;
+  o.parameter = "v";
+  o.from = 0.0;
+  o.to = 10.0;
+  o.steps = 11;
+  const Sweep sweep = sweep_eigenvalues(file.model_at(), o);
+  ASSERT_EQ(sweep.crossings.size(), 2u);
+  EXPECT_GT(std::abs(sweep.crossings[0].value - testing::kWeaveSpeed), 1e-8);
+  EXPECT_GT(std::abs(sweep.crossings[1].value - testing::kCapsizeSpeed), 1e-8);
 }
 
 TEST(Sweep, UprightRollingDiskThreshold) {
