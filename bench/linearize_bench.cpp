@@ -46,7 +46,7 @@ void linearize_disk(benchmark::State& state, bool richardson) {
   LinearizationOptions options;
   options.cyclic = {"psi"};
   for (auto _ : state) {
-    Linearization l = linearize(model, options);
+    Linearization l = calc_linearization(model, options);
     benchmark::DoNotOptimize(l.eigenvalues.data());
   }
 }
@@ -60,7 +60,7 @@ void sweep_point(benchmark::State& state) {
   for (auto _ : state) {
     spec.set_parameter("v", v);
     v = v < 10.0 ? v + 0.1 : 0.0;
-    Linearization l = linearize(symbolic::compile_model(spec, derivation));
+    Linearization l = calc_linearization(symbolic::compile_model(spec, derivation));
     benchmark::DoNotOptimize(l.eigenvalues.data());
   }
 }

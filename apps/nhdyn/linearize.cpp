@@ -39,7 +39,7 @@ int run_linearize(const LinearizeArgs& args) {
   options.independent = args.independent;
   options.speeds = args.speeds;
   options.steady_tolerance = args.tolerance;
-  const Linearization l = linearize(model, options);
+  const Linearization l = calc_linearization(model, options);
 
   if (!args.output.empty()) {
     make_parent_directory(args.output);

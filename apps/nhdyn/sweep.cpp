@@ -79,7 +79,7 @@ int run_sweep(const SweepArgs& args) {
   // The first point linearized before any file is made: a model that is not steady, or a bad
   // --cyclic or --independent, is refused with nothing written.
   try {
-    linearize(model_at(args.from), options.linearization);
+    calc_linearization(model_at(args.from), options.linearization);
   } catch (const InputError& e) {
     throw InputError(fmt::format("at {} = {:g}: {}", args.param, args.from, e.what()));
   } catch (const ModelError& e) {
@@ -96,7 +96,7 @@ int run_sweep(const SweepArgs& args) {
   AtomicFile table(table_path);  // both files can be written: checked before any work
   AtomicFile crossings_file(crossings_path);
 
-  const Sweep sweep = sweep_eigenvalues(model_at, options);
+  const Sweep sweep = calc_eigenvalue_sweep(model_at, options);
 
   const std::size_t k = sweep.state.size();
   std::vector<std::string> columns{args.param};

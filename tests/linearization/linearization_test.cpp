@@ -48,13 +48,13 @@ void expect_eigenvalues(const std::vector<C>& got, std::vector<C> want, double t
 
 TEST(Linearization, PendulumInCartesianCoordinatesAtTheBottomOscillatesAtSqrtGOverL) {
   const Model model = compile_example("pendulum_cartesian.toml", {{"theta0", 0.0}});
-  const Linearization l = linearize(model);
+  const Linearization l = calc_linearization(model);
   const double w = std::sqrt(9.81 / 1.5);
   EXPECT_EQ(l.derivatives, DerivativeMethod::tangent);
   ASSERT_EQ(l.state, (std::vector<std::string>{"x", "x'"}));  // y is dependent at the bottom (y = -l)
   expect_eigenvalues(l.eigenvalues, {C(0, w), C(0, -w)}, 1e-13);
   // Negative control: at the top the same model is unstable, +-sqrt(g/l).
-  const Linearization top = linearize(compile_example("pendulum_cartesian.toml", {{"theta0", std::numbers::pi}}));
+  const Linearization top = calc_linearization(compile_example("pendulum_cartesian.toml", {{"theta0", std::numbers::pi}}));
   expect_eigenvalues(top.eigenvalues, {C(w, 0), C(-w, 0)}, 1e-12);
 }
 
@@ -62,11 +62,11 @@ TEST(Linearization, PendulumWithYNamedIndependentAtTheBottomIsRefused) {
   const Model model = compile_example("pendulum_cartesian.toml", {{"theta0", 0.0}});
   LinearizationOptions o;
   o.independent = {"y"};  // x' = 0 on the rod at the bottom: x cannot be expressed through y
-  expect_error<InputError>([&] { linearize(model, o); }, {"x", "cannot be expressed", "--independent"});
+  expect_error<InputError>([&] { calc_linearization(model, o); }, {"x", "cannot be expressed", "--independent"});
   o.independent = {"x", "y"};
-  expect_error<InputError>([&] { linearize(model, o); }, {"--independent names 2", "1 independent"});
+  expect_error<InputError>([&] { calc_linearization(model, o); }, {"--independent names 2", "1 independent"});
   o.independent = {"z"};
-  expect_error<InputError>([&] { linearize(model, o); }, {"--independent", "'z'", "x, y"});
+  expect_error<InputError>([&] { calc_linearization(model, o); }, {"--independent", "'z'", "x, y"});
 }
 
 TEST(Linearization, TheChoiceOfIndependentCoordinateDoesNotChangeTheEigenvalues) {
@@ -78,7 +78,7 @@ TEST(Linearization, TheChoiceOfIndependentCoordinateDoesNotChangeTheEigenvalues)
     LinearizationOptions o;
     o.independent = {name};
     o.speeds = {name};
-    const Linearization l = linearize(model, o);
+    const Linearization l = calc_linearization(model, o);
     EXPECT_EQ(l.state, (std::vector<std::string>{name, std::string(name) + "'"}));
     expect_eigenvalues(l.eigenvalues, {C(0, w), C(0, -w)}, 1e-12);
   }
@@ -87,17 +87,17 @@ TEST(Linearization, TheChoiceOfIndependentCoordinateDoesNotChangeTheEigenvalues)
 TEST(Linearization, BeadOnTheRotatingHoopHasBothClosedFormEquilibria) {
   const double g = 9.81, r = 0.5, Omega = 6.0;
   // The bottom: unstable above the critical rate, +-sqrt(Omega^2 - g/r).
-  const Linearization bottom = linearize(compile_example("hoop_bead_rotating.toml", {{"theta0", 0.0}}));
+  const Linearization bottom = calc_linearization(compile_example("hoop_bead_rotating.toml", {{"theta0", 0.0}}));
   const double a = std::sqrt(Omega * Omega - g / r);
   expect_eigenvalues(bottom.eigenvalues, {C(a, 0), C(-a, 0)}, 1e-12);
   // Below the critical rate the bottom is stable: +-i sqrt(g/r - Omega^2).
   const Linearization slow =
-      linearize(compile_example("hoop_bead_rotating.toml", {{"theta0", 0.0}, {"Omega", 3.0}}));
+      calc_linearization(compile_example("hoop_bead_rotating.toml", {{"theta0", 0.0}, {"Omega", 3.0}}));
   const double c = std::sqrt(g / r - 9.0);
   expect_eigenvalues(slow.eigenvalues, {C(0, c), C(0, -c)}, 1e-12);
   // The off-bottom equilibrium theta* = acos(g / (r Omega^2)): +-i Omega sin(theta*).
   const double star = std::acos(g / (r * Omega * Omega));
-  const Linearization side = linearize(compile_example("hoop_bead_rotating.toml", {{"theta0", star}}));
+  const Linearization side = calc_linearization(compile_example("hoop_bead_rotating.toml", {{"theta0", star}}));
   const double w = Omega * std::sin(star);
   expect_eigenvalues(side.eigenvalues, {C(0, w), C(0, -w)}, 1e-12);
 }
@@ -105,7 +105,7 @@ TEST(Linearization, BeadOnTheRotatingHoopHasBothClosedFormEquilibria) {
 TEST(Linearization, NotSteadyNamesTheLargestViolation) {
   // The pendulum at 0.5 rad, at rest: it accelerates, x'' = -g sin(theta) cos(theta) the largest.
   const Model model = compile_example("pendulum_cartesian.toml", {{"theta0", 0.5}});
-  expect_error<ModelError>([&] { linearize(model); },
+  expect_error<ModelError>([&] { calc_linearization(model); },
                            {"not a steady motion", "acceleration", "x''", "tolerance 1e-09"});
   // A non-cyclic coordinate that moves.
   std::string text = R"(name = "moving"
@@ -117,20 +117,20 @@ position = { phi = 0 }
 velocity = { phi = 0.25 }
 )";
   const Model moving = symbolic::compile_model(load_model_string(text, "moving.toml"));
-  expect_error<ModelError>([&] { linearize(moving); }, {"not a steady motion", "velocity phi' = 0.25", "at rest"});
+  expect_error<ModelError>([&] { calc_linearization(moving); }, {"not a steady motion", "velocity phi' = 0.25", "at rest"});
   // The hoop bead just off its equilibrium: the message gives the size.
   const double star = std::acos(9.81 / (0.5 * 36.0));
   const Model off = compile_example("hoop_bead_rotating.toml", {{"theta0", star + 1e-3}});
-  expect_error<ModelError>([&] { linearize(off); }, {"not a steady motion", "acceleration"});
+  expect_error<ModelError>([&] { calc_linearization(off); }, {"not a steady motion", "acceleration"});
   // A looser tolerance accepts a state that is steady within it.
   LinearizationOptions loose;
   loose.steady_tolerance = 1e-1;
-  EXPECT_NO_THROW(linearize(off, loose));
+  EXPECT_NO_THROW(calc_linearization(off, loose));
 }
 
 TEST(Linearization, TimeDependentModelIsRefused) {
   const Model model = compile_example("hoop_bead.toml");
-  expect_error<ModelError>([&] { linearize(model); }, {"depends on time t explicitly", "hoop-bead"});
+  expect_error<ModelError>([&] { calc_linearization(model); }, {"depends on time t explicitly", "hoop-bead"});
 }
 
 TEST(Linearization, InitialStateOffTheConstraintIsRefused) {
@@ -145,20 +145,20 @@ position = "x^2 + y^2 - 1"
 position = { x = 0, y = -1.5 }
 )";
   const Model model = symbolic::compile_model(load_model_string(text, "off.toml"));
-  expect_error<ModelError>([&] { linearize(model); }, {"violates the constraint 'rod'", "position level", "1.250e+00"});
+  expect_error<ModelError>([&] { calc_linearization(model); }, {"violates the constraint 'rod'", "position level", "1.250e+00"});
 }
 
 TEST(Linearization, UnknownCyclicNameIsRefused) {
   const Model model = compile_example("rolling_disk_upright.toml");
   LinearizationOptions o;
   o.cyclic = {"heading"};
-  expect_error<InputError>([&] { linearize(model, o); }, {"--cyclic", "'heading'", "x, y, psi, theta, phi"});
+  expect_error<InputError>([&] { calc_linearization(model, o); }, {"--cyclic", "'heading'", "x, y, psi, theta, phi"});
   o.cyclic = {"psi"};
   o.independent = {"x"};
-  expect_error<InputError>([&] { linearize(model, o); }, {"--independent", "'x' is cyclic"});
+  expect_error<InputError>([&] { calc_linearization(model, o); }, {"--independent", "'x' is cyclic"});
   o.independent.clear();
   o.speeds = {"theta"};
-  expect_error<InputError>([&] { linearize(model, o); }, {"--speeds names 1", "3 independent speed"});
+  expect_error<InputError>([&] { calc_linearization(model, o); }, {"--speeds names 1", "3 independent speed"});
 }
 
 // docs/linearization.md, "The upright rolling disk": theta'' = (4/5) (g/r - 3 w^2) theta, and the
@@ -168,7 +168,7 @@ TEST(Linearization, UprightRollingDiskMatchesTheClosedForm) {
   LinearizationOptions o;
   o.cyclic = {"psi"};
   for (double w : {6.0, 2.0, 4.0}) {
-    const Linearization l = linearize(compile_example("rolling_disk_upright.toml", {{"w", w}}), o);
+    const Linearization l = calc_linearization(compile_example("rolling_disk_upright.toml", {{"w", w}}), o);
     EXPECT_EQ(l.cyclic, (std::vector<std::string>{"x", "y", "psi", "phi"}));
     EXPECT_EQ(l.state, (std::vector<std::string>{"theta", "psi'", "theta'", "phi'"})) << w;
     const double lambda2 = 0.8 * (g / r - 3.0 * w * w);
@@ -178,7 +178,7 @@ TEST(Linearization, UprightRollingDiskMatchesTheClosedForm) {
   // Without naming psi cyclic it stays in the state (it enters the rolling constraints): the
   // motion keeps psi = 0, so this linearization is exact too, and gives the same tilt eigenvalues
   // and one more zero (the heading itself).
-  const Linearization full = linearize(compile_example("rolling_disk_upright.toml", {{"w", 6.0}}));
+  const Linearization full = calc_linearization(compile_example("rolling_disk_upright.toml", {{"w", 6.0}}));
   EXPECT_EQ(full.cyclic, (std::vector<std::string>{"x", "y", "phi"}));
   EXPECT_EQ(full.state, (std::vector<std::string>{"psi", "theta", "psi'", "theta'", "phi'"}));
   const C root = std::sqrt(C(0.8 * (g / r - 3.0 * 36.0), 0.0));
@@ -188,7 +188,7 @@ TEST(Linearization, UprightRollingDiskMatchesTheClosedForm) {
 TEST(Linearization, BenchmarkBicycleEqualsTheIndependentStateMatrix) {
   const testing::BicycleMatrices bike;
   for (double v : {0.0, 1.0, 3.7, testing::kWeaveSpeed, 5.0, testing::kCapsizeSpeed, 8.0, 10.0}) {
-    const Linearization l = linearize(compile_example("bicycle_linear.toml", {{"v", v}}));
+    const Linearization l = calc_linearization(compile_example("bicycle_linear.toml", {{"v", v}}));
     ASSERT_EQ(l.state, (std::vector<std::string>{"phi", "delta", "phi'", "delta'"}));
     const Eigen::Matrix4d S = bike.state_matrix(v);
     EXPECT_LT((l.state_matrix - S).lpNorm<Eigen::Infinity>(), 1e-11 * S.lpNorm<Eigen::Infinity>()) << v;
@@ -204,17 +204,17 @@ TEST(Linearization, BenchmarkBicycleMatchesThePublishedTable) {
                        C(-2.13875644258362, 7.19525913329805),  C(-2.69348683581097, 8.46037971396931),
                        C(-3.21675402252485, 9.69377351531791),  C(-3.72016840437287, 10.9068113947629)};
   for (int v = 1; v <= 10; ++v) {
-    const Linearization l = linearize(compile_example("bicycle_linear.toml", {{"v", v}}));
+    const Linearization l = calc_linearization(compile_example("bicycle_linear.toml", {{"v", v}}));
     bool found = false;
     for (const C& e : l.eigenvalues) found = found || std::abs(e - weave[v - 1]) < 1e-12 * std::abs(weave[v - 1]);
     EXPECT_TRUE(found) << "v = " << v << ": the weave eigenvalue " << weave[v - 1] << " is not among the computed";
   }
-  const Linearization five = linearize(compile_example("bicycle_linear.toml", {{"v", 5.0}}));
+  const Linearization five = calc_linearization(compile_example("bicycle_linear.toml", {{"v", 5.0}}));
   expect_eigenvalues(five.eigenvalues,
                      {C(-14.07838969279822, 0), C(-0.32286642900409, 0), C(-0.77534188219585, 4.46486771378823),
                       C(-0.77534188219585, -4.46486771378823)},
                      1e-12);
-  const Linearization ten = linearize(compile_example("bicycle_linear.toml", {{"v", 10.0}}));
+  const Linearization ten = calc_linearization(compile_example("bicycle_linear.toml", {{"v", 10.0}}));
   EXPECT_NEAR(ten.eigenvalues.front().real(), 0.16105338653172, 1e-12);  // capsize, unstable
   EXPECT_NEAR(ten.eigenvalues.back().real(), -24.62459635017404, 1e-11);  // castering
 }
@@ -242,7 +242,7 @@ TEST(Linearization, HandWrittenModelUsesRichardsonDifferencesAndAgrees) {
   model.q0 = Vector::Zero(2);
   model.v0 = Vector::Zero(2);
   model.evaluator = std::make_shared<BicycleEvaluator>(5.0);
-  const Linearization l = linearize(model);
+  const Linearization l = calc_linearization(model);
   EXPECT_EQ(l.derivatives, DerivativeMethod::richardson);
   const testing::BicycleMatrices bike;
   EXPECT_LT((l.state_matrix - bike.state_matrix(5.0)).lpNorm<Eigen::Infinity>(), 1e-8);

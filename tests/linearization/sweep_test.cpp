@@ -38,7 +38,7 @@ TEST(Sweep, BenchmarkBicycleWeaveAndCapsizeSpeeds) {
   o.from = 0.0;
   o.to = 10.0;
   o.steps = 101;
-  const Sweep sweep = sweep_eigenvalues(file.model_at(), o);
+  const Sweep sweep = calc_eigenvalue_sweep(file.model_at(), o);
   ASSERT_EQ(sweep.points.size(), 101u);
   EXPECT_DOUBLE_EQ(sweep.points[50].value, 5.0);
   EXPECT_EQ(sweep.points.back().value, 10.0);
@@ -74,7 +74,7 @@ TEST(Sweep, APerturbedBicycleMissesThePublishedSpeeds) {
   o.from = 0.0;
   o.to = 10.0;
   o.steps = 11;
-  const Sweep sweep = sweep_eigenvalues(file.model_at(), o);
+  const Sweep sweep = calc_eigenvalue_sweep(file.model_at(), o);
   ASSERT_EQ(sweep.crossings.size(), 2u);
   EXPECT_GT(std::abs(sweep.crossings[0].value - testing::kWeaveSpeed), 1e-8);
   EXPECT_GT(std::abs(sweep.crossings[1].value - testing::kCapsizeSpeed), 1e-8);
@@ -88,7 +88,7 @@ TEST(Sweep, UprightRollingDiskThreshold) {
   o.to = 10.0;
   o.steps = 10;
   o.linearization.cyclic = {"psi"};
-  const Sweep sweep = sweep_eigenvalues(file.model_at(), o);
+  const Sweep sweep = calc_eigenvalue_sweep(file.model_at(), o);
   ASSERT_EQ(sweep.crossings.size(), 1u);
   EXPECT_NEAR(sweep.crossings[0].value, std::sqrt(9.81 / (3 * 0.2)), 1e-9);
   EXPECT_FALSE(sweep.crossings[0].oscillatory);
@@ -141,7 +141,7 @@ TEST(Sweep, AFailingPointNamesTheParameterValue) {
   o.to = 1.0;
   o.steps = 3;
   try {
-    sweep_eigenvalues(file.model_at(), o);
+    calc_eigenvalue_sweep(file.model_at(), o);
     ADD_FAILURE();
   } catch (const ModelError& e) {
     const std::string m = e.what();

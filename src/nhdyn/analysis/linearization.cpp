@@ -235,7 +235,7 @@ void sort_eigenvalues(std::vector<std::complex<double>>& eigenvalues) {
   });
 }
 
-Linearization linearize(const Model& model, const LinearizationOptions& options) {
+Linearization calc_linearization(const Model& model, const LinearizationOptions& options) {
   check_model_shape(model);
   const int n = model.n();
   const int s = model.s();

@@ -58,7 +58,7 @@ struct Linearization {
 // time explicitly, when the state violates a constraint, or when it is not a steady motion (the
 // message names the largest violation: which velocity or acceleration, how large). Cost: 2n
 // tangent (or 8n finite-difference) evaluations of the terms and n^3-size dense algebra.
-Linearization linearize(const Model& model, const LinearizationOptions& options = {});
+Linearization calc_linearization(const Model& model, const LinearizationOptions& options = {});
 
 // Sorted as in Linearization::eigenvalues: decreasing real part, then decreasing imaginary part.
 void sort_eigenvalues(std::vector<std::complex<double>>& eigenvalues);

@@ -49,13 +49,13 @@ void check_sweep_options(const SweepOptions& options) {
                                  options.from, options.to, options.parameter));
 }
 
-Sweep sweep_eigenvalues(const ModelAtValue& model_at, const SweepOptions& options) {
+Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& options) {
   check_sweep_options(options);
   Sweep out;
   LinearizationOptions lin = options.linearization;
   const auto at = [&](double value) -> Linearization {
     try {
-      return linearize(model_at(value), lin);
+      return calc_linearization(model_at(value), lin);
     } catch (const InputError& e) {
       throw InputError(fmt::format("at {} = {:.17g}: {}", options.parameter, value, e.what()));
     } catch (const ModelError& e) {

@@ -54,7 +54,7 @@ using ModelAtValue = std::function<Model(double)>;
 // or from >= to. Linearizes at every grid point with the state chosen at the first one (the
 // independent coordinates and speeds named from it), so that every row has the same columns;
 // a point where the linearization fails rethrows its error with the parameter value in front.
-Sweep sweep_eigenvalues(const ModelAtValue& model_at, const SweepOptions& options);
+Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& options);
 
 // Checks `options` as sweep_eigenvalues does (for callers that must refuse bad input before they
 // open files).
