@@ -148,6 +148,22 @@ position = { x = 0, y = -1.5 }
   expect_error<ModelError>([&] { calc_linearization(model); }, {"violates the constraint 'rod'", "position level", "1.250e+00"});
 }
 
+TEST(Linearization, InitialVelocityOffTheConstraintIsRefused) {
+  // A knife edge pointing along x, moving sideways: the blade forbids it.
+  const std::string text = R"(name = "skid"
+coordinates = ["x", "y", "phi"]
+kinetic_energy = "(x'^2 + y'^2 + phi'^2)/2"
+[[constraints]]
+name = "blade"
+velocity = "-sin(phi)*x' + cos(phi)*y'"
+[initial]
+position = { x = 0, y = 0, phi = 0 }
+velocity = { x = 1, y = 0.5 }
+)";
+  const Model model = symbolic::compile_model(load_model_string(text, "skid.toml"));
+  expect_error<ModelError>([&] { calc_linearization(model); }, {"violates the constraint 'blade'", "velocity level", "5.000e-01"});
+}
+
 TEST(Linearization, UnknownCyclicNameIsRefused) {
   const Model model = compile_example("rolling_disk_upright.toml");
   LinearizationOptions o;
