@@ -60,14 +60,12 @@ class Differentiator {
   // The flat vector at (t, q, v).
   void evaluate(double t, const Vector& q, const Vector& v, Vector& out) {
     out.resize(layout_.size());
-    const int n = layout_.n;
     const TermsOut terms{out.data() + layout_.A(), out.data() + layout_.Q(), out.data() + layout_.G(),
                          out.data() + layout_.b(), out.data() + layout_.b0()};
     model_.evaluator->terms(t, q.data(), v.data(), scratch_.data(), terms);
     if (layout_.p > 0) model_.evaluator->position_residual(t, q.data(), scratch_.data(), out.data() + layout_.phi());
     if (layout_.r > 0)
       model_.evaluator->velocity_residual(t, q.data(), v.data(), scratch_.data(), out.data() + layout_.f());
-    (void)n;
   }
 
   // d(flat)/d(input): exact by the tangent mode, or Richardson-extrapolated central differences
@@ -144,16 +142,14 @@ std::vector<char> find_dependence(const Model& model, const Layout& layout, Diff
   std::vector<char> depends(static_cast<std::size_t>(1 + 2 * n), 0);
   if (const auto* pe = dynamic_cast<const ProgramEvaluator*>(model.evaluator.get())) {
     const ModelPrograms& p = pe->programs();
-    for (const Program* program : {&p.terms, &p.position_residual, &p.velocity_residual}) {
-      const std::vector<char> d = calc_input_dependence(*program);
-      for (std::size_t i = 0; i < depends.size(); ++i) depends[i] = depends[i] || d[i];
-    }
-    // A position residual may depend on a coordinate whose gradient is constant (x - r theta):
-    // what the linearization needs of it, its gradient, is a row of b, which the terms carry.
+    // Time: any program. Coordinates: the terms and the velocity residuals only — a position
+    // residual may depend on a coordinate whose gradient is constant (x - r theta), and what the
+    // linearization needs of it, its gradient, is a row of b, which the terms carry.
     const std::vector<char> terms = calc_input_dependence(p.terms);
-    const std::vector<char> vel = calc_input_dependence(p.velocity_residual);
-    for (int i = 0; i < n; ++i) depends[static_cast<std::size_t>(1 + i)] = terms[static_cast<std::size_t>(1 + i)] ||
-                                                                            vel[static_cast<std::size_t>(1 + i)];
+    const std::vector<char> velocity = calc_input_dependence(p.velocity_residual);
+    const std::vector<char> position = calc_input_dependence(p.position_residual);
+    for (std::size_t i = 0; i < depends.size(); ++i) depends[i] = terms[i] || velocity[i];
+    depends[0] = depends[0] || position[0];
     return depends;
   }
   Vector base, d;
@@ -373,7 +369,7 @@ Linearization calc_linearization(const Model& model, const LinearizationOptions&
     const Eigen::Map<const Vector> dQ(d.data() + layout.Q(), n), dG(d.data() + layout.G(), n);
     const Eigen::Map<const Matrix> db(d.data() + layout.b(), s, n);
     const Eigen::Map<const Vector> db0(d.data() + layout.b0(), s);
-    // K d(q'', mu) = d(rhs) - dK (q'', mu): docs/linearization.md (3).
+    // K d(q'', mu) = d(rhs) - dK (q'', mu): docs/linearization.md (2).
     drhs.head(n) = dQ + dG - dA * out.qdd - db.transpose() * mu;
     drhs.tail(s) = -db0 - db * out.qdd;
     const Vector dsol = kkt.solve(drhs);
