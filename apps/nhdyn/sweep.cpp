@@ -1,0 +1,224 @@
+// `nhdyn sweep MODEL --param P --from A --to B --steps N --eigenvalues`: the eigenvalues of the
+// linearization about the model's steady motion against one parameter (analysis/sweep.hpp) as
+// CSV, the values where a real part crosses zero (found by bisection) on stdout and as a second
+// CSV, and optionally the classical plot of real and imaginary parts against the parameter.
+#include <fmt/format.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <system_error>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "model_source.hpp"
+#include "outputs.hpp"
+#include "nhdyn/analysis/sweep.hpp"
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/io/atomic_file.hpp"
+#include "nhdyn/io/xy_plot.hpp"
+#include "nhdyn/model/builtin.hpp"
+#include "nhdyn/symbolic/compile.hpp"
+#include "nhdyn/symbolic/derivation.hpp"
+
+namespace nhdyn::cli {
+namespace {
+
+struct SweepArgs {
+  std::string model;
+  std::string param;
+  double from = 0.0;
+  double to = 0.0;
+  int steps = 101;
+  bool eigenvalues = false;
+  std::vector<std::string> sets;
+  std::vector<std::string> cyclic, independent, speeds;
+  double tolerance = 1e-9;
+  std::string output;
+  std::string plot;
+  bool quiet = false;
+};
+
+int run_sweep(const SweepArgs& args) {
+  SweepOptions options;
+  options.parameter = args.param;
+  options.from = args.from;
+  options.to = args.to;
+  options.steps = args.steps;
+  options.linearization.cyclic = args.cyclic;
+  options.linearization.independent = args.independent;
+  options.linearization.speeds = args.speeds;
+  options.linearization.steady_tolerance = args.tolerance;
+  check_sweep_options(options);
+  if (is_builtin_model(args.model) && args.model.find('/') == std::string::npos && !args.model.ends_with(".toml"))
+    throw InputError(fmt::format("'{}' is a built-in model with fixed parameters, so --param {} cannot vary; sweep "
+                                 "its model file instead (examples/)",
+                                 args.model, args.param));
+  symbolic::Spec spec = resolve_spec(args.model, args.sets);
+  {
+    std::string names;
+    bool known = false;
+    for (const symbolic::SpecParameter& p : spec.parameters) {
+      names += (names.empty() ? "" : ", ") + p.name;
+      known = known || p.name == args.param;
+    }
+    if (!known)
+      throw InputError(fmt::format("--param {}: model '{}' ({}) has no parameter '{}'; its parameters are: {}",
+                                   args.param, spec.name, args.model, args.param, names.empty() ? "(none)" : names));
+  }
+  spec.set_parameter(args.param, args.from);
+  const symbolic::Derivation derivation = symbolic::derive(spec);
+  const ModelAtValue model_at = [&](double value) {
+    spec.set_parameter(args.param, value);
+    return symbolic::compile_model(spec, derivation);
+  };
+
+  // The first point linearized before any file is made: a model that is not steady, or a bad
+  // --cyclic or --independent, is refused with nothing written.
+  try {
+    calc_linearization(model_at(args.from), options.linearization);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("at {} = {:g}: {}", args.param, args.from, e.what()));
+  } catch (const ModelError& e) {
+    throw ModelError(fmt::format("at {} = {:g}: {}", args.param, args.from, e.what()));
+  }
+
+  namespace fs = std::filesystem;
+  const fs::path table_path =
+      args.output.empty() ? fs::path("results") / (spec.name + "-sweep-" + args.param + ".csv") : fs::path(args.output);
+  make_parent_directory(table_path);
+  fs::path crossings_path = table_path;
+  crossings_path.replace_filename(table_path.stem().string() + "-crossings.csv");
+  check_plot_possible(args.plot);
+  AtomicFile table(table_path);  // both files can be written: checked before any work
+  AtomicFile crossings_file(crossings_path);
+
+  const Sweep sweep = calc_eigenvalue_sweep(model_at, options);
+
+  const std::size_t k = sweep.state.size();
+  std::vector<std::string> columns{args.param};
+  for (std::size_t i = 1; i <= k; ++i) {
+    columns.push_back(fmt::format("re_{}", i));
+    columns.push_back(fmt::format("im_{}", i));
+  }
+  std::string text;
+  for (std::size_t c = 0; c < columns.size(); ++c) text += (c ? "," : "") + columns[c];
+  text += "\n";
+  for (const SweepPoint& p : sweep.points) {
+    text += fmt::format("{:.17g}", p.value);
+    for (const std::complex<double>& e : p.eigenvalues) text += fmt::format(",{:.17g},{:.17g}", e.real(), e.imag());
+    text += "\n";
+  }
+  table.write(text);
+  std::string ctext = "parameter,value,kind,frequency,unstable_before,unstable_after,bracket\n";
+  for (const StabilityCrossing& c : sweep.crossings)
+    ctext += fmt::format("{},{:.17g},{},{:.17g},{},{},{:.3g}\n", args.param, c.value,
+                         c.oscillatory ? "complex-pair" : "real", c.frequency, c.unstable_before, c.unstable_after,
+                         c.bracket);
+  crossings_file.write(ctext);
+  table.commit();
+  crossings_file.commit();
+
+  if (!args.plot.empty()) {
+    // The plot draws the real parts and the |imaginary parts| each sorted at every value: the
+    // k-th largest of continuous functions is continuous, so the curves have no jumps where the
+    // CSV's order (by real part) swaps the imaginary parts. Its data go to a temporary file.
+    const fs::path data = fs::temp_directory_path() /
+                          fmt::format(".nhdyn-sweep-{}-{}.csv", ::getpid(), fs::path(args.plot).stem().string());
+    {
+      std::string plot_text = args.param;
+      for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",re_{}", i);
+      for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",absim_{}", i);
+      plot_text += "\n";
+      for (const SweepPoint& p : sweep.points) {
+        std::vector<double> re, im;
+        for (const std::complex<double>& e : p.eigenvalues) {
+          re.push_back(e.real());
+          im.push_back(std::abs(e.imag()));
+        }
+        std::sort(re.rbegin(), re.rend());
+        std::sort(im.rbegin(), im.rend());
+        plot_text += fmt::format("{:.17g}", p.value);
+        for (double x : re) plot_text += fmt::format(",{:.17g}", x);
+        for (double x : im) plot_text += fmt::format(",{:.17g}", x);
+        plot_text += "\n";
+      }
+      AtomicFile plot_data(data);
+      plot_data.write(plot_text);
+      plot_data.commit();
+    }
+    XyPlotRequest request;
+    request.title = fmt::format("{}: eigenvalues of the linearization against {}", spec.name, args.param);
+    request.csv = data;
+    request.x = args.param;
+    for (std::size_t i = 1; i <= k; ++i) {
+      request.y.push_back(fmt::format("re_{}", i));
+      request.titles.push_back(fmt::format("Re, {}. largest", i));
+    }
+    for (std::size_t i = 1; i <= k; ++i) {
+      request.y.push_back(fmt::format("absim_{}", i));
+      request.titles.push_back(fmt::format("|Im|, {}. largest", i));
+    }
+    request.x_label = args.param;
+    request.y_label = "eigenvalues [1/s]: real parts and |imaginary parts|";
+    request.log_x = false;
+    request.log_y = false;
+    try {
+      write_xy_plot(request, args.plot);
+    } catch (...) {
+      std::error_code ignored;
+      fs::remove(data, ignored);
+      throw;
+    }
+    std::error_code ignored;
+    fs::remove(data, ignored);
+  }
+
+  if (!args.quiet) {
+    std::string state;
+    for (const std::string& s : sweep.state) state += (state.empty() ? "" : ", ") + s;
+    fmt::print("nhdyn sweep {}: eigenvalues of the linearization for {} = {:g} .. {:g} ({} points), state ({})\n",
+               spec.name, args.param, args.from, args.to, args.steps, state);
+    if (sweep.crossings.empty())
+      fmt::print("no real part crosses zero in the range\n");
+    for (const StabilityCrossing& c : sweep.crossings)
+      fmt::print("crossing: {} = {:.15g}  {} ({}), unstable eigenvalues {} -> {}\n", args.param, c.value,
+                 c.oscillatory ? "a complex pair crosses the imaginary axis" : "a real eigenvalue crosses zero",
+                 c.oscillatory ? fmt::format("frequency {:.6g} rad/s", c.frequency) : std::string("divergence"),
+                 c.unstable_before, c.unstable_after);
+    fmt::print("eigenvalues -> {}\ncrossings -> {}\n", table_path.string(), crossings_path.string());
+    if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::function<int()> add_sweep_command(CLI::App& app) {
+  auto args = std::make_shared<SweepArgs>();
+  CLI::App* cmd = app.add_subcommand("sweep", "Eigenvalues of the linearization against a parameter, with the "
+                                              "values where the stability changes");
+  cmd->add_option("MODEL", args->model, "A model file (.toml)")->required();
+  cmd->add_option("--param", args->param, "The parameter to vary")->required();
+  cmd->add_option("--from", args->from, "First value")->required();
+  cmd->add_option("--to", args->to, "Last value")->required();
+  cmd->add_option("--steps", args->steps, "Number of grid points, both ends included")->capture_default_str();
+  cmd->add_flag("--eigenvalues", args->eigenvalues, "Sweep the eigenvalues (the default and, so far, only quantity)");
+  cmd->add_option("--set", args->sets, "Override another parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("--cyclic", args->cyclic, "Coordinates to treat as cyclic besides those found, comma-separated")
+      ->delimiter(',');
+  cmd->add_option("--independent", args->independent, "Independent coordinates, comma-separated")->delimiter(',');
+  cmd->add_option("--speeds", args->speeds, "Coordinates whose velocities are independent speeds, comma-separated")
+      ->delimiter(',');
+  cmd->add_option("--tolerance", args->tolerance, "Tolerance of the steady-motion test (scaled)")->capture_default_str();
+  cmd->add_option("-o,--output", args->output, "Eigenvalue CSV (default results/MODEL-sweep-PARAM.csv); the "
+                                               "crossings go next to it as ...-crossings.csv");
+  cmd->add_option("--plot", args->plot, "PNG of the real and imaginary parts against the parameter");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print nothing");
+  return [args] { return run_sweep(*args); };
+}
+
+}  // namespace nhdyn::cli
