@@ -22,6 +22,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -93,7 +94,9 @@ bool is_reciprocal(const GiNaC::ex& e) {
 class ProgramCompiler {
  public:
   explicit ProgramCompiler(const Spec& spec)
-      : spec_(spec), values_(spec.parameter_values()), program_(spec.n()) {
+      : spec_(spec), program_(spec.n()) {
+    for (const SpecParameter& p : spec.parameters)
+      values_.emplace(spec.symbols.parameter(p.name), GiNaC::numeric(p.value));
     const SymbolTable& symbols = spec.symbols;
     variables_.emplace(symbols.time(), Program::time_register());
     for (int i = 0; i < symbols.coordinates(); ++i) {
@@ -112,7 +115,7 @@ class ProgramCompiler {
     original_ = e;
     GiNaC::ex numeric_form;
     try {
-      numeric_form = e.subs(values_, GiNaC::subs_options::no_pattern).evalf();
+      numeric_form = with_values(e);
     } catch (const std::exception& error) {
       fail(fmt::format("cannot be evaluated once the parameters are set ({})", error.what()));
     }
@@ -123,6 +126,31 @@ class ProgramCompiler {
     } else {
       program_.add_output(emit(numeric_form));
     }
+  }
+
+  // `e` with the parameters replaced by their values and the constants (pi) by theirs, every
+  // distinct node once: derived terms share large subexpressions (a bicycle's entries of A and G),
+  // which GiNaC's subs() and evalf() would walk once per path to them. Numeric operands fold as
+  // GiNaC rebuilds each node (sums, products, powers and functions of floats evaluate).
+  GiNaC::ex with_values(const GiNaC::ex& e) {
+    if (GiNaC::is_a<GiNaC::symbol>(e)) {
+      const auto found = values_.find(e);
+      return found == values_.end() ? e : found->second;
+    }
+    if (GiNaC::is_exactly_a<GiNaC::constant>(e)) return e.evalf();
+    if (e.nops() == 0) return e;
+    const GiNaC::basic* node = &GiNaC::ex_to<GiNaC::basic>(e);
+    const auto found = with_values_memo_.find(node);
+    if (found != with_values_memo_.end()) return found->second.second;
+    struct Children : GiNaC::map_function {
+      ProgramCompiler& self;
+      explicit Children(ProgramCompiler& compiler) : self(compiler) {}
+      GiNaC::ex operator()(const GiNaC::ex& x) override { return self.with_values(x); }
+    } children(*this);
+    GiNaC::ex out = e.map(children);
+    // The node itself is kept in the memo so that its address cannot be reused by another.
+    with_values_memo_.emplace(node, std::make_pair(e, out));
+    return out;
   }
 
   // An output that is NaN at every call (an expression that cannot be evaluated).
@@ -450,7 +478,8 @@ class ProgramCompiler {
   }
 
   const Spec& spec_;
-  GiNaC::lst values_;
+  std::map<GiNaC::ex, GiNaC::ex, GiNaC::ex_is_less> values_;  // parameter symbol -> its value
+  std::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, GiNaC::ex>> with_values_memo_;
   Program program_;
   std::map<GiNaC::ex, int, GiNaC::ex_is_less> variables_;  // t, q, q' -> input register
   std::map<GiNaC::ex, int, GiNaC::ex_is_less> memo_;
