@@ -1,4 +1,5 @@
-// Every gallery example also runs from the command line as its page says:
+// Every gallery example, and the models built from bodies, also run from the command line as
+// their pages say:
 // `nhdyn simulate examples/<name>.toml -o FILE.csv` exits 0 and writes the CSV with the model's
 // coordinates in its header and one row per output time.
 #include <gtest/gtest.h>
@@ -24,7 +25,10 @@ TEST(GalleryCli, EveryExampleRunsFromTheCommandLine) {
                                                           {"double_pendulum", "t,x1,y1,x2,y2,"},
                                                           {"rolling_disk", "t,x,y,psi,theta,phi,"},
                                                           {"slider_crank", "t,alpha,beta,x,"},
-                                                          {"diff_drive", "t,x,y,theta,phi_r,phi_l,"}};
+                                                          {"diff_drive", "t,x,y,theta,phi_r,phi_l,"},
+                                                          // built from bodies (docs/multibody.md)
+                                                          {"rolling_disk_bodies", "t,x,y,psi,theta,phi,"},
+                                                          {"whipple_bicycle", "t,x,y,psi,phi,theta,delta,thetaR,thetaF,"}};
   for (const auto& [name, header] : examples) {
     const fs::path csv = dir / (name + ".csv");
     const std::string command = std::string("'") + NHDYN_CLI_PATH + "' simulate '" + NHDYN_SOURCE_DIR +

@@ -140,34 +140,36 @@ Vector3 MultibodyBuilder::parse(const Triple& texts, const SourceLocation& where
           parse(texts[2], where, context, coordinates_allowed)};
 }
 
+namespace {
+
+// The index of the item called `name` among `items` (frames, points or bodies), or a failure that
+// lists the known names of that kind.
+template <class Items>
+int index_in(const Items& items, const std::string& name, const char* kind, const SourceLocation& where,
+             const std::string& context) {
+  std::vector<std::string> known;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (items[i].name == name) return static_cast<int>(i);
+    known.push_back(items[i].name);
+  }
+  fail(where, context, unknown(name, kind, known));
+}
+
+}  // namespace
+
 int MultibodyBuilder::frame_index(const std::string& name, const SourceLocation& where,
                                   const std::string& context) const {
-  std::vector<std::string> known;
-  for (std::size_t i = 0; i < frames_.size(); ++i) {
-    if (frames_[i].name == name) return static_cast<int>(i);
-    known.push_back(frames_[i].name);
-  }
-  fail(where, context, unknown(name, "frame", known));
+  return index_in(frames_, name, "frame", where, context);
 }
 
 int MultibodyBuilder::point_index(const std::string& name, const SourceLocation& where,
                                   const std::string& context) const {
-  std::vector<std::string> known;
-  for (std::size_t i = 0; i < points_.size(); ++i) {
-    if (points_[i].name == name) return static_cast<int>(i);
-    known.push_back(points_[i].name);
-  }
-  fail(where, context, unknown(name, "point", known));
+  return index_in(points_, name, "point", where, context);
 }
 
 int MultibodyBuilder::body_index(const std::string& name, const SourceLocation& where,
                                  const std::string& context) const {
-  std::vector<std::string> known;
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    if (bodies_[i].name == name) return static_cast<int>(i);
-    known.push_back(bodies_[i].name);
-  }
-  fail(where, context, unknown(name, "body", known));
+  return index_in(bodies_, name, "body", where, context);
 }
 
 namespace {
