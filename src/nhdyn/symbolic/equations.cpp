@@ -446,7 +446,10 @@ struct Content {
   GiNaC::matrix A, Q, G;
   std::vector<ConstraintView> constraints;
   std::optional<GiNaC::matrix> D;
-  enum class Origin { analytic, independent, none_constraints, fallback, unavailable } origin = Origin::unavailable;
+  // too_large: the terms are too large to look for a partition symbolically (entries of more than
+  // kSimplifyLimit nodes; the Whipple bicycle).
+  enum class Origin { analytic, independent, none_constraints, fallback, unavailable, too_large } origin =
+      Origin::unavailable;
   std::vector<std::string> independent;  // names, for independent and fallback
   std::optional<GiNaC::matrix> A0, C;
   std::optional<ex> energy;
@@ -468,18 +471,46 @@ std::optional<std::pair<std::vector<int>, GiNaC::matrix>> first_partition(const 
   return std::nullopt;
 }
 
+// Whether some entry of m has more than kSimplifyLimit nodes (simplify_moderate leaves it as is).
+// The count stops at the limit, so a large entry costs no more than a small one.
+bool has_large_entry(const GiNaC::matrix& m) {
+  for (unsigned i = 0; i < m.rows(); ++i)
+    for (unsigned j = 0; j < m.cols(); ++j) {
+      std::size_t count = 0;
+      std::vector<ex> stack{m(i, j)};
+      while (!stack.empty() && count <= kSimplifyLimit) {
+        const ex e = stack.back();
+        stack.pop_back();
+        ++count;
+        for (std::size_t o = 0; o < e.nops(); ++o) stack.push_back(e.op(o));
+      }
+      if (count > kSimplifyLimit) return true;
+    }
+  return false;
+}
+
 Content make_content(const Spec& spec, const Derivation& d) {
   Content c;
   const int n = spec.n(), s = spec.s(), k = n - s;
-  c.T = simplify(spec.kinetic_energy);
-  c.V = simplify(spec.potential_energy);
-  c.A = simplify(d.A);
-  c.Q = simplify(d.Q);
-  c.G = simplify(d.G);
+  // A large model (the Whipple bicycle) is shown with its large entries as derived: simplifying
+  // them, inverting b_dep symbolically or multiplying out D A would take minutes.
+  const bool large = has_large_entry(d.A) || has_large_entry(d.G) || has_large_entry(d.b) || has_large_entry(d.b0);
+  const auto tidy = [large](const ex& e) { return large ? simplify_moderate(e) : simplify(e); };
+  const auto tidy_matrix = [&](const GiNaC::matrix& m) {
+    GiNaC::matrix out(m.rows(), m.cols());
+    for (unsigned i = 0; i < m.rows(); ++i)
+      for (unsigned j = 0; j < m.cols(); ++j) out(i, j) = tidy(m(i, j));
+    return out;
+  };
+  c.T = tidy(spec.kinetic_energy);
+  c.V = tidy(spec.potential_energy);
+  c.A = tidy_matrix(d.A);
+  c.Q = tidy_matrix(d.Q);
+  c.G = tidy_matrix(d.G);
   for (unsigned r = 0; r < static_cast<unsigned>(s); ++r) {
-    ConstraintView view{spec.constraints[r].name, spec.constraints[r].level, simplify(spec.constraints[r].expression),
-                        {}, simplify(d.b0(r, 0))};
-    for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) view.b.push_back(simplify(d.b(r, j)));
+    ConstraintView view{spec.constraints[r].name, spec.constraints[r].level, tidy(spec.constraints[r].expression),
+                        {}, tidy(d.b0(r, 0))};
+    for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) view.b.push_back(tidy(d.b(r, j)));
     c.constraints.push_back(std::move(view));
   }
   Derivation with_d = d;
@@ -493,17 +524,24 @@ Content make_content(const Spec& spec, const Derivation& d) {
   } else if (s == 0) {
     c.origin = Content::Origin::none_constraints;
     with_d.D = GiNaC::ex_to<GiNaC::matrix>(GiNaC::unit_matrix(static_cast<unsigned>(n)));
+  } else if (large) {
+    c.origin = Content::Origin::too_large;
   } else if (const auto partition = first_partition(d.b, n, k)) {
     c.origin = Content::Origin::fallback;
     for (const int i : partition->first) c.independent.push_back(spec.coordinates[static_cast<std::size_t>(i)]);
     with_d.D = partition->second;
   }
   if (with_d.D) {
-    c.D = simplify(*with_d.D);
-    c.A0 = reduced_inertia(with_d);
-    c.C = reduced_forces(with_d);
+    c.D = tidy_matrix(*with_d.D);
+    if (large) {
+      c.A0 = tidy_matrix(with_d.D->mul(d.A));
+      c.C = tidy_matrix(with_d.D->mul(d.Q.add(d.G)));
+    } else {
+      c.A0 = reduced_inertia(with_d);
+      c.C = reduced_forces(with_d);
+    }
   }
-  if (d.energy) c.energy = simplify(*d.energy);
+  if (d.energy) c.energy = tidy(*d.energy);
   return c;
 }
 
@@ -605,6 +643,12 @@ std::string format_text(const Spec& spec, const Content& c) {
                          "choice of {} independent coordinates gives a regular partition symbolically\n",
                          k);
       break;
+    case Content::Origin::too_large:
+      out += fmt::format("Complement D: the model gives none (no independent coordinates, no analytic D), and its "
+                         "terms are too large (entries of more than {} nodes) to look for a partition "
+                         "symbolically; the solver chooses D numerically at each step\n",
+                         kSimplifyLimit);
+      break;
   }
   if (!c.D || !c.A0 || !c.C) {
     out += fmt::format("Reduced inertia A0 = D A and reduced forces C = D (Q + G): unavailable without D; add "
@@ -694,6 +738,11 @@ std::string format_latex(const Spec& spec, const Content& c) {
       heading = fmt::format("The model gives no complement $D$ and no choice of {} independent coordinates gives a "
                             "regular partition symbolically.",
                             k);
+      break;
+    case Content::Origin::too_large:
+      heading = fmt::format("The model gives no complement $D$, and its terms are too large (entries of more than {} "
+                            "nodes) to look for a partition symbolically.",
+                            kSimplifyLimit);
       break;
   }
   if (!c.D || !c.A0 || !c.C) {
