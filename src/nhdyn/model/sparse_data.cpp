@@ -98,7 +98,9 @@ SparseData make_sparse_data(const Model& model) {
   d.D = Matrix::Zero(k, n);
   d.AD = Matrix::Zero(n, k);
   d.DAD = Matrix::Zero(k, k);
-  d.llt_k = Eigen::LLT<Matrix>(k);
+  // Factor an identity once rather than assign a default-constructed LLT, whose status is
+  // uninitialized (copying or moving it is undefined behaviour); the storage is sized either way.
+  d.llt_k.compute(Matrix::Identity(k, k));
   d.h = Vector::Zero(n);
   d.c = Vector::Zero(n);
   d.tmp_n = Vector::Zero(n);
