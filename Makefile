@@ -52,7 +52,7 @@ SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 
 asan: deps
-	@cmake -S . -B $(SAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DNHDYN_SANITIZE=ON \
+	@cmake -S . -B $(SAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DNHDYN_SANITIZE=ON -DNHDYN_BUILD_TESTS=ON \
 	  -DNHDYN_BUILD_BENCH=OFF "-DNHDYN_SKIP_TEST_MODULES=$(ASAN_SKIP_TESTS)" $(SAN_COMPILER) \
 	  $(if $(HAVE_CLANG),,-DNHDYN_WERROR=ON) >/dev/null
 	@$(SANITIZER_ENV) cmake --build $(SAN_BUILD) -j $(JOBS)
