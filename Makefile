@@ -1,42 +1,67 @@
 # The two commands of the README's Quick start, and a few more for developers.
-#   make run    install what is missing, build (Release), simulate the default example
-#               (examples/sled.toml; MODEL=... NAME=... for another)
-#   make test   install what is missing, build, run every test through ctest
+#   make run    install what is missing, build the nhdyn command (Release) and only it, simulate
+#               the default example (examples/sled.toml; MODEL=... NAME=... for another)
+#   make test   install what is missing, build everything (Release), run every test through ctest
+#   make asan   the tests again under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/)
+#   make fuzz   the model-file fuzzer (needs clang-14; fuzz/run says which packages)
+#   make bench  build and run the benchmarks
 BUILD ?= build
 JOBS ?= $(shell nproc)
 MODEL ?= examples/sled.toml
 NAME ?= sled
 
-.PHONY: run test build deps bench asan clean
+.PHONY: run test build configure deps bench asan fuzz clean
 
 deps:
 	@bash scripts/install-deps
 
-build: deps
+configure: deps
 	@cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release $(if $(CI),-DNHDYN_WERROR=ON) >/dev/null
+
+# Everything: library, CLI, tests, examples, benchmarks.
+build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
-run: build
+# The main job needs the CLI only (about half of the whole build).
+run: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_cli
 	@mkdir -p results
 	$(BUILD)/apps/nhdyn/nhdyn simulate $(MODEL) -o results/$(NAME).csv --plot results/$(NAME).png
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
-bench: build
+bench: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_bench
 	$(BUILD)/bench/nhdyn_bench --benchmark_min_time=0.2
+
+# The sanitizer build (docs/design.md, "Build and CI"): ASan + UBSan at -O1 with line tables only.
+# With clang-14 installed it is also the fuzzer's build (every target instrumented for libFuzzer),
+# so that the instrumented library is compiled once for both; otherwise GCC, without the fuzzer.
+# The test folders that run the same kernels end to end (the CLI in child processes, long
+# simulations of the gallery, studies, sweeps) or check no code (layering) are left out of it:
+# make test runs them; ASAN_SKIP_TESTS= (empty) builds and runs them all under the sanitizers.
+SAN_BUILD ?= build-asan
+ASAN_SKIP_TESTS ?= cli;gallery;studies;linearization;layering
+HAVE_CLANG := $(shell command -v clang++-14 >/dev/null 2>&1 && echo yes)
+SAN_COMPILER = $(if $(HAVE_CLANG),-DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 -DNHDYN_FUZZ=ON)
 
 # GiNaC's number library keeps global tables until exit: suppressed for LeakSanitizer (test
 # discovery runs the executables at build time, so the build needs the same environment).
 SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/scripts/lsan.supp:print_suppressions=0 \
   UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 
-# The tests again under AddressSanitizer and UndefinedBehaviorSanitizer (what CI runs too).
 asan: deps
-	@cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNHDYN_SANITIZE=ON \
-	  -DNHDYN_WERROR=ON -DNHDYN_BUILD_BENCH=OFF >/dev/null
-	@$(SANITIZER_ENV) cmake --build build-asan -j $(JOBS)
-	cd build-asan && $(SANITIZER_ENV) ctest --output-on-failure -j $(JOBS)
+	@cmake -S . -B $(SAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DNHDYN_SANITIZE=ON -DNHDYN_BUILD_TESTS=ON \
+	  -DNHDYN_BUILD_BENCH=OFF "-DNHDYN_SKIP_TEST_MODULES=$(ASAN_SKIP_TESTS)" $(SAN_COMPILER) \
+	  $(if $(HAVE_CLANG),,-DNHDYN_WERROR=ON) >/dev/null
+	@$(SANITIZER_ENV) cmake --build $(SAN_BUILD) -j $(JOBS)
+	cd $(SAN_BUILD) && $(SANITIZER_ENV) ctest --output-on-failure -j $(JOBS)
+
+# Reuses build-asan when it was made with clang-14 (make asan), else configures build-fuzz.
+FUZZ_RUNS ?= 5000
+fuzz:
+	NHDYN_FUZZ_BUILD=$(if $(HAVE_CLANG),$(CURDIR)/$(SAN_BUILD),$(CURDIR)/build-fuzz) sh fuzz/run $(FUZZ_RUNS)
 
 clean:
-	rm -rf $(BUILD) build-asan results
+	rm -rf $(BUILD) $(SAN_BUILD) build-fuzz results
