@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <utility>
 #include <vector>
 
 namespace nhdyn {
@@ -118,7 +119,18 @@ TEST(Tableaus, DormandPrinceHasOrder5WithAnEmbeddedOrder4) {
 TEST(Tableaus, DormandPrince853HasOrder8WithEmbeddedOrders5And3) {
   using T = rk::DormandPrince853;
   constexpr std::size_t S = T::stages;
-  expect_consistent_nodes<T>();
+  // Rows summing to the nodes, up to the round-off of coefficients as large as 43.
+  for (std::size_t i = 0; i < S; ++i) {
+    double row = 0.0, size = 0.0;
+    for (std::size_t j = 0; j < S; ++j) {
+      row += T::a[i][j];
+      size += std::abs(T::a[i][j]);
+      if (j >= i) {
+        EXPECT_EQ(T::a[i][j], 0.0) << i << "," << j;
+      }
+    }
+    EXPECT_NEAR(row, T::c[i], 1e-15 * std::max(1.0, size)) << "row " << i;
+  }
   // The conditions up to order 5 here (order 8 shows in the convergence exams below): 17 trees
   // whose residuals a mistyped digit of a, b or c would spoil.
   for (double r : order_residuals(T::a, T::c, T::b, 5)) EXPECT_NEAR(r, 0.0, 1e-13);
@@ -392,7 +404,7 @@ KeplerRun run_kepler(const IntegratorOptions& options, double t0, const std::vec
 
 double kepler_fixed_step_error(IntegratorKind kind, int steps) {
   const double t_end = 2.0 * std::acos(-1.0);
-  Kepler system(0.5);
+  Kepler system(0.3);
   const KeplerRun run = run_kepler(fixed_step(kind, t_end / steps), 0.0, {t_end}, system);
   EXPECT_EQ(run.result.status, Status::ok) << run.result.message;
   EXPECT_EQ(run.result.stats.steps, steps);
@@ -401,15 +413,16 @@ double kepler_fixed_step_error(IntegratorKind kind, int steps) {
 }
 
 TEST(Dop853, GlobalErrorHasOrder8) {
-  // One orbit of eccentricity 0.5 in N and 2N equal steps: the error falls by 2^8 = 256, where
-  // dopri5's falls by 2^5 = 32.
-  const double coarse = kepler_fixed_step_error(IntegratorKind::dop853, 200);
-  const double fine = kepler_fixed_step_error(IntegratorKind::dop853, 400);
+  // One orbit of eccentricity 0.3 in N and 2N equal steps: the error falls by 2^8 = 256 (200 at
+  // these steps, where the next term still shows; an order of 7 or 9 would give 128 or 512),
+  // while dopri5's falls by 2^5 = 32.
+  const double coarse = kepler_fixed_step_error(IntegratorKind::dop853, 50);
+  const double fine = kepler_fixed_step_error(IntegratorKind::dop853, 100);
   const double ratio = coarse / fine;
-  EXPECT_GT(ratio, 200.0) << coarse << " " << fine;
-  EXPECT_LT(ratio, 320.0) << coarse << " " << fine;
-  const double dopri5_ratio = kepler_fixed_step_error(IntegratorKind::dopri5, 200) /
-                              kepler_fixed_step_error(IntegratorKind::dopri5, 400);
+  EXPECT_GT(ratio, 160.0) << coarse << " " << fine;
+  EXPECT_LT(ratio, 350.0) << coarse << " " << fine;
+  const double dopri5_ratio = kepler_fixed_step_error(IntegratorKind::dopri5, 100) /
+                              kepler_fixed_step_error(IntegratorKind::dopri5, 200);
   EXPECT_GT(dopri5_ratio, 25.0);
   EXPECT_LT(dopri5_ratio, 40.0);
 }
@@ -417,7 +430,7 @@ TEST(Dop853, GlobalErrorHasOrder8) {
 // The largest error of the continuous extension inside one step of size h from the exact state
 // at t0 = 0.2 (near the pericentre, where the solution bends most).
 double one_step_interpolation_error(IntegratorKind kind, double h) {
-  Kepler system(0.5);
+  Kepler system(0.3);
   const double t0 = 0.2;
   std::vector<double> times;
   for (int i = 1; i < 10; ++i) times.push_back(t0 + 0.1 * i * h);
@@ -434,7 +447,7 @@ TEST(Dop853, ContinuousExtensionHasOrder7) {
   const double coarse = one_step_interpolation_error(IntegratorKind::dop853, 0.2);
   const double fine = one_step_interpolation_error(IntegratorKind::dop853, 0.1);
   EXPECT_GT(coarse / fine, 200.0) << coarse << " " << fine;
-  EXPECT_LT(coarse / fine, 330.0) << coarse << " " << fine;
+  EXPECT_LT(coarse / fine, 320.0) << coarse << " " << fine;
   const double dopri5_ratio = one_step_interpolation_error(IntegratorKind::dopri5, 0.2) /
                               one_step_interpolation_error(IntegratorKind::dopri5, 0.1);
   EXPECT_GT(dopri5_ratio, 25.0);
@@ -502,16 +515,19 @@ TEST(Dop853, OutputsComeFromTheContinuousExtensionAndNeverShortenSteps) {
 }
 
 TEST(Dop853, TakesFarFewerRhsThanDopri5AtTightTolerances) {
-  for (double tol : {1e-10, 1e-12}) {
+  // Fewer steps by tol^(1/5 - 1/8) at twice dopri5's cost per step: on this orbit 1.9 times fewer
+  // rhs evaluations at 1e-10, 3.3 times at 1e-12 (and about the same at 1e-6).
+  for (const auto& [tol, factor] : {std::pair{1e-10, 1.5}, std::pair{1e-12, 2.5}}) {
     Kepler a(0.5), b(0.5);
     const KeplerRun dop853 = run_kepler(dop853_options(tol), 0.0, {20.0}, a);
     const KeplerRun dopri5 = run_kepler(dopri5_options(tol), 0.0, {20.0}, b);
     ASSERT_EQ(dop853.result.status, Status::ok);
     ASSERT_EQ(dopri5.result.status, Status::ok);
-    EXPECT_LT(2 * dop853.result.stats.rhs_evaluations, dopri5.result.stats.rhs_evaluations)
+    EXPECT_LT(factor * static_cast<double>(dop853.result.stats.rhs_evaluations),
+              static_cast<double>(dopri5.result.stats.rhs_evaluations))
         << "rtol " << tol;
     // At no loss of accuracy.
-    EXPECT_LT(dop853.max_error, 10.0 * dopri5.max_error + 1e-3 * tol) << "rtol " << tol;
+    EXPECT_LT(dop853.max_error, 2.0 * dopri5.max_error) << "rtol " << tol;
   }
 }
 

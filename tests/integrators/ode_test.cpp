@@ -311,9 +311,10 @@ TEST_P(EveryIntegrator, RenormalizationKeepsTheStateOnTheCircle) {
     // Every output is a step end.
     EXPECT_LT(radius_error, 1e-14);
   } else {
-    // Outputs inside a step follow the flow off the circle for less than a step (growth 0.1 h);
-    // an integrator that did not restart from the renormalized state drifts by up to 0.22.
-    EXPECT_LT(radius_error, 0.02);
+    // Outputs inside a step follow the flow off the circle for less than a step (growth 0.1 h;
+    // dop853's longer steps reach 0.03); an integrator that did not restart from the
+    // renormalized state drifts by up to 0.22.
+    EXPECT_LT(radius_error, GetParam() == IntegratorKind::dop853 ? 0.04 : 0.02);
   }
 }
 
