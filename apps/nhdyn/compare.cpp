@@ -147,7 +147,8 @@ std::function<int()> add_compare_command(CLI::App& app) {
   cmd->add_option("--reference", args->reference, "tight (a run at rtol 1e-13) | analytic (the model's)")
       ->capture_default_str();
   cmd->add_option("--methods", args->methods, "Formulations, comma-separated")->delimiter(',')->capture_default_str();
-  cmd->add_option("--integrators", args->integrators, "Integrators, comma-separated")
+  cmd->add_option("--integrators", args->integrators,
+                  "Integrators, comma-separated: rk4, dopri5, dop853, cvode-bdf, cvode-adams")
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--complement", args->complement, "Where D comes from: qr | partition | analytic")

@@ -186,7 +186,7 @@ std::function<int()> add_simulate_command(CLI::App& app) {
   cmd->add_option("--method", args->method, "Formulation: sanh (default) | lagrange | udwadia-kalaba | nullspace");
   cmd->add_option("--complement", args->complement, "Where D comes from (sanh, nullspace): qr | partition | analytic")
       ->capture_default_str();
-  cmd->add_option("--integrator", args->integrator, "rk4 | dopri5 (default) | cvode-bdf | cvode-adams");
+  cmd->add_option("--integrator", args->integrator, "rk4 | dopri5 (default) | dop853 | cvode-bdf | cvode-adams");
   cmd->add_option("--rtol", args->rtol, "Relative tolerance of the adaptive integrators (default 1e-8)");
   cmd->add_option("--atol", args->atol, "Absolute tolerance of the adaptive integrators (default 1e-10)");
   cmd->add_option("--step", args->step, "rk4: step size [s] (default output step / 10); adaptive: first step");

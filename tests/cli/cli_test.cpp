@@ -452,7 +452,7 @@ INSTANTIATE_TEST_SUITE_P(
     AllMethodsComplementsIntegrators, CliAppellEveryChoice,
     ::testing::Combine(::testing::Values("sanh", "lagrange", "udwadia-kalaba", "nullspace"),
                        ::testing::Values("qr", "partition", "analytic"),
-                       ::testing::Values("rk4", "dopri5", "cvode-bdf", "cvode-adams")),
+                       ::testing::Values("rk4", "dopri5", "dop853", "cvode-bdf", "cvode-adams")),
     [](const ::testing::TestParamInfo<CliAppellEveryChoice::ParamType>& info) {
       std::string name = std::get<0>(info.param) + "_" + std::get<1>(info.param) + "_" + std::get<2>(info.param);
       std::replace(name.begin(), name.end(), '-', '_');
@@ -671,7 +671,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"method_kane", {"appell", "--method", "kane", o, out},
                  {"kane", "sanh", "lagrange", "udwadia-kalaba", "nullspace"}},
         BadInput{"integrator_euler", {"appell", "--integrator", "euler", o, out},
-                 {"euler", "rk4", "dopri5", "cvode-bdf", "cvode-adams"}},
+                 {"euler", "rk4", "dopri5", "dop853", "cvode-bdf", "cvode-adams"}},
         BadInput{"complement_svd", {"appell", "--complement", "svd", o, out}, {"svd", "qr", "partition", "analytic"}},
         BadInput{"output_directory_missing", {"appell", o, "nodir/x.csv"}, {"nodir"}},
         BadInput{"output_is_a_directory", {"appell", o, "existing"}, {"existing", "directory"}},

@@ -37,7 +37,8 @@ namespace nhdyn {
 namespace {
 
 constexpr IntegratorKind all_kinds[] = {IntegratorKind::rk4, IntegratorKind::dopri5,
-                                        IntegratorKind::cvode_bdf, IntegratorKind::cvode_adams};
+                                        IntegratorKind::dop853, IntegratorKind::cvode_bdf,
+                                        IntegratorKind::cvode_adams};
 
 std::vector<double> linspace(double a, double b, int count) {
   std::vector<double> t(static_cast<std::size_t>(count));
@@ -274,7 +275,7 @@ TEST_P(EveryIntegrator, RestartsAfterAfterStepChangedTheState) {
   EXPECT_LT(worst, 1e-7);
   // A derivative kept from before the jump is a first stage off by a factor 2: the error test
   // then rejects step after step until the step is tiny.
-  if (GetParam() == IntegratorKind::dopri5) {
+  if (GetParam() == IntegratorKind::dopri5 || GetParam() == IntegratorKind::dop853) {
     EXPECT_EQ(result.stats.rejected_steps, 0);
   }
 }
@@ -310,9 +311,10 @@ TEST_P(EveryIntegrator, RenormalizationKeepsTheStateOnTheCircle) {
     // Every output is a step end.
     EXPECT_LT(radius_error, 1e-14);
   } else {
-    // Outputs inside a step follow the flow off the circle for less than a step (growth 0.1 h);
-    // an integrator that did not restart from the renormalized state drifts by up to 0.22.
-    EXPECT_LT(radius_error, 0.02);
+    // Outputs inside a step follow the flow off the circle for less than a step (growth 0.1 h;
+    // dop853's longer steps reach 0.03); an integrator that did not restart from the
+    // renormalized state drifts by up to 0.22.
+    EXPECT_LT(radius_error, GetParam() == IntegratorKind::dop853 ? 0.04 : 0.02);
   }
 }
 

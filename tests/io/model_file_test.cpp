@@ -513,7 +513,7 @@ TEST(ModelFileError, UnknownMethodAndIntegrator) {
   expect_error("name = \"m\"\ncoordinates = [\"x\"]\nkinetic_energy = \"x'^2\"\n[simulation]\nmethod = \"sahn\"\n", "5:10",
                {"unknown simulation.method 'sahn'", "did you mean 'sanh'?", "udwadia-kalaba"});
   expect_error("name = \"m\"\ncoordinates = [\"x\"]\nkinetic_energy = \"x'^2\"\n[simulation]\nintegrator = \"euler\"\n",
-               "5:14", {"unknown simulation.integrator 'euler'", "rk4, dopri5, cvode-bdf, cvode-adams"});
+               "5:14", {"unknown simulation.integrator 'euler'", "rk4, dopri5, dop853, cvode-bdf, cvode-adams"});
 }
 
 TEST(ModelFileError, IndependentAndComplementTogether) {

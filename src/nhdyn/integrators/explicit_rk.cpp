@@ -1,8 +1,10 @@
 #include "nhdyn/integrators/explicit_rk.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -30,14 +32,17 @@ class Stepper {
   void reuse_last_stage() { std::swap(k_.front(), k_.back()); }
 
   // Evaluates stages 2..s of a step of size h from (t, y), k(0) holding f(t, y) on entry, and
-  // writes y1 = y + h sum b_i k_i. On a non-ok status, t_fail is where the rhs failed.
+  // writes y1 = y + h sum b_i k_i. With FSAL and evaluate_last false, the last stage f(t + h, y1)
+  // is left for the caller (its error estimate does not need it). On a non-ok status, t_fail is
+  // where the rhs failed.
   Status step(OdeSystem& system, double t, const double* y, double h, double* y1,
-              IntegratorStats& stats, double& t_fail) {
+              IntegratorStats& stats, double& t_fail, bool evaluate_last = true) {
     constexpr int s_count = Tableau::stages;
     for (int s = 1; s < s_count; ++s) {
       // With FSAL the last row of a equals b, so the last stage state is y1 itself.
       double* target = (Tableau::fsal && s == s_count - 1) ? y1 : y_stage_.data();
       combine(Tableau::a[static_cast<std::size_t>(s)], s, y, h, target);
+      if (Tableau::fsal && s == s_count - 1 && !evaluate_last) break;
       const double ts = t + Tableau::c[static_cast<std::size_t>(s)] * h;
       ++stats.rhs_evaluations;
       const Status status = system.rhs(ts, target, k(s));
@@ -149,23 +154,344 @@ Status initial_step(OdeSystem& system, const IntegratorOptions& options, int ord
   return Status::ok;
 }
 
-// Hairer's CONTD5: y(t + theta h) from the stages of the step (t, y) -> (t + h, y1), whose
-// last stage is f(t + h, y1). Order 4, continuous across steps.
-void continuous_extension(const Stepper<rk::DormandPrince54>& stepper, int n, const double* y,
-                          const double* y1, double h, double theta, double* out) {
+// What the adaptive pairs differ in, besides their tableau: the error estimate, whether it needs
+// the FSAL stage (dopri5's does, so that stage is evaluated before the error test; DOP853's does
+// not, so rejected steps skip it) and the continuous extension.
+template <class Tableau>
+constexpr bool error_uses_last_stage = true;
+template <>
+constexpr bool error_uses_last_stage<rk::DormandPrince853> = false;
+
+// The weighted RMS norm of the error estimate of the step (t, y) -> (t + h, y1), weights
+// atol + rtol max(|y|, |y1|); the step is accepted when it is at most 1. Dormand-Prince 5(4):
+// the difference from the embedded 4th-order solution, O(h^5).
+double step_error(const Stepper<rk::DormandPrince54>& stepper, int n, const double* y,
+                  const double* y1, double h, const IntegratorOptions& options) {
   using Tableau = rk::DormandPrince54;
-  const double theta1 = 1.0 - theta;
-  const double* k_first = stepper.k(0);
-  const double* k_last = stepper.k(Tableau::stages - 1);
+  double sum = 0.0;
   for (int i = 0; i < n; ++i) {
-    const double ydiff = y1[i] - y[i];
-    const double bspl = h * k_first[i] - ydiff;
-    const double hermite = ydiff - h * k_last[i] - bspl;
-    double dk = 0.0;
+    double e = 0.0;
     for (int j = 0; j < Tableau::stages; ++j)
-      dk += Tableau::d[static_cast<std::size_t>(j)] * stepper.k(j)[i];
-    out[i] = y[i] + theta * (ydiff + theta1 * (bspl + theta * (hermite + theta1 * h * dk)));
+      e += Tableau::e[static_cast<std::size_t>(j)] * stepper.k(j)[i];
+    const double sk = options.atol + options.rtol * std::max(std::abs(y[i]), std::abs(y1[i]));
+    const double r = h * e / sk;
+    sum += r * r;
   }
+  return std::sqrt(sum / n);
+}
+
+// Weights b - bhh of the 3rd-order error estimate of DOP853.
+constexpr std::array<double, rk::DormandPrince853::stages> dop853_e3 = [] {
+  std::array<double, rk::DormandPrince853::stages> e3{};
+  for (std::size_t j = 0; j < e3.size(); ++j)
+    e3[j] = rk::DormandPrince853::b[j] - rk::DormandPrince853::bhh[j];
+  return e3;
+}();
+
+// Hairer's DOP853 estimate: with E5 and E3 the weighted sums of squares of the 5th- and
+// 3rd-order estimates (each without its factor h), err = h E5 / sqrt(n (E5 + 0.01 E3)). E5 is
+// O(h^10) and E3 O(h^6), so err is O(h^8) where the asymptotics hold, while the 3rd-order term
+// keeps the estimate from vanishing by accident in large steps (Hairer-Norsett-Wanner I, II.10).
+double step_error(const Stepper<rk::DormandPrince853>& stepper, int n, const double* y,
+                  const double* y1, double h, const IntegratorOptions& options) {
+  using Tableau = rk::DormandPrince853;
+  double err5 = 0.0;
+  double err3 = 0.0;
+  for (int i = 0; i < n; ++i) {
+    double e5 = 0.0;
+    double e3 = 0.0;
+    // The last stage (f(t + h, y1), not evaluated yet) has weight 0 in both.
+    for (int j = 0; j + 1 < Tableau::stages; ++j) {
+      const double kj = stepper.k(j)[i];
+      e5 += Tableau::e5[static_cast<std::size_t>(j)] * kj;
+      e3 += dop853_e3[static_cast<std::size_t>(j)] * kj;
+    }
+    const double sk = options.atol + options.rtol * std::max(std::abs(y[i]), std::abs(y1[i]));
+    err5 += (e5 / sk) * (e5 / sk);
+    err3 += (e3 / sk) * (e3 / sk);
+  }
+  double denominator = err5 + 0.01 * err3;
+  if (denominator <= 0.0) denominator = 1.0;
+  return std::abs(h) * err5 / std::sqrt(n * denominator);
+}
+
+// y(t + theta h) inside an accepted step (t, y) -> (t + h, y1), from the step's stages (the last
+// one f(t + h, y1)). prepare() readies one step, evaluate() may then be called for any theta in
+// [0, 1]; continuous across steps, as the ends are y and y1.
+template <class Tableau>
+class ContinuousExtension;
+
+// Hairer's CONTD5, order 4: no extra stages.
+template <>
+class ContinuousExtension<rk::DormandPrince54> {
+ public:
+  using Tableau = rk::DormandPrince54;
+  explicit ContinuousExtension(int n) : n_(n) {}
+
+  Status prepare(OdeSystem& /*system*/, const Stepper<Tableau>& stepper, double /*t*/,
+                 const double* y, const double* y1, double h, IntegratorStats& /*stats*/,
+                 double& /*t_fail*/) {
+    stepper_ = &stepper;
+    y_ = y;
+    y1_ = y1;
+    h_ = h;
+    return Status::ok;
+  }
+
+  void evaluate(double theta, double* out) const {
+    const double theta1 = 1.0 - theta;
+    const double* k_first = stepper_->k(0);
+    const double* k_last = stepper_->k(Tableau::stages - 1);
+    for (int i = 0; i < n_; ++i) {
+      const double ydiff = y1_[i] - y_[i];
+      const double bspl = h_ * k_first[i] - ydiff;
+      const double hermite = ydiff - h_ * k_last[i] - bspl;
+      double dk = 0.0;
+      for (int j = 0; j < Tableau::stages; ++j)
+        dk += Tableau::d[static_cast<std::size_t>(j)] * stepper_->k(j)[i];
+      out[i] = y_[i] + theta * (ydiff + theta1 * (bspl + theta * (hermite + theta1 * h_ * dk)));
+    }
+  }
+
+ private:
+  int n_;
+  const Stepper<Tableau>* stepper_ = nullptr;
+  const double* y_ = nullptr;
+  const double* y1_ = nullptr;
+  double h_ = 0.0;
+};
+
+// Hairer's CONTD8, order 7: three more stages (3 rhs evaluations) give the coefficients of
+//   y + theta (r1 + s (r2 + theta (r3 + s (r4 + theta (r5 + s (r6 + theta r7)))))),  s = 1 - theta,
+// r1..r3 from y, y1, f(t, y), f(t + h, y1) (the cubic Hermite part), r4..r7 = h sum_j d_j k_j.
+template <>
+class ContinuousExtension<rk::DormandPrince853> {
+ public:
+  using Tableau = rk::DormandPrince853;
+  explicit ContinuousExtension(int n) : n_(n), y_stage_(static_cast<std::size_t>(n)) {
+    for (std::vector<double>& k : extra_) k.assign(static_cast<std::size_t>(n), 0.0);
+    for (std::vector<double>& r : r_) r.assign(static_cast<std::size_t>(n), 0.0);
+  }
+
+  Status prepare(OdeSystem& system, const Stepper<Tableau>& stepper, double t, const double* y,
+                 const double* y1, double h, IntegratorStats& stats, double& t_fail) {
+    const auto stage = [&](int j) -> const double* {
+      return j < Tableau::stages ? stepper.k(j)
+                                 : extra_[static_cast<std::size_t>(j - Tableau::stages)].data();
+    };
+    for (int s = 0; s < Tableau::extra_stages; ++s) {
+      const std::array<double, Tableau::all_stages>& w =
+          Tableau::a_extra[static_cast<std::size_t>(s)];
+      std::copy(y, y + n_, y_stage_.begin());
+      for (int j = 0; j < Tableau::stages + s; ++j) {
+        if (w[static_cast<std::size_t>(j)] == 0.0) continue;
+        const double coef = h * w[static_cast<std::size_t>(j)];
+        const double* kj = stage(j);
+        for (int i = 0; i < n_; ++i) y_stage_[static_cast<std::size_t>(i)] += coef * kj[i];
+      }
+      const double ts = t + Tableau::c_extra[static_cast<std::size_t>(s)] * h;
+      ++stats.rhs_evaluations;
+      const Status status =
+          system.rhs(ts, y_stage_.data(), extra_[static_cast<std::size_t>(s)].data());
+      if (status != Status::ok) {
+        t_fail = ts;
+        return status;
+      }
+    }
+    const double* k_first = stepper.k(0);
+    const double* k_last = stepper.k(Tableau::stages - 1);
+    for (int i = 0; i < n_; ++i) {
+      const std::size_t ui = static_cast<std::size_t>(i);
+      const double ydiff = y1[i] - y[i];
+      const double bspl = h * k_first[i] - ydiff;
+      r_[0][ui] = y[i];
+      r_[1][ui] = ydiff;
+      r_[2][ui] = bspl;
+      r_[3][ui] = ydiff - h * k_last[i] - bspl;
+    }
+    for (std::size_t m = 0; m < Tableau::d.size(); ++m) {
+      std::vector<double>& r = r_[4 + m];
+      std::fill(r.begin(), r.end(), 0.0);
+      for (int j = 0; j < Tableau::all_stages; ++j) {
+        const double w = Tableau::d[m][static_cast<std::size_t>(j)];
+        if (w == 0.0) continue;
+        const double* kj = stage(j);
+        for (int i = 0; i < n_; ++i) r[static_cast<std::size_t>(i)] += w * kj[i];
+      }
+      for (double& x : r) x *= h;
+    }
+    return Status::ok;
+  }
+
+  void evaluate(double theta, double* out) const {
+    const double s = 1.0 - theta;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(n_); ++i)
+      out[i] =
+          r_[0][i] +
+          theta *
+              (r_[1][i] +
+               s * (r_[2][i] +
+                    theta * (r_[3][i] +
+                             s * (r_[4][i] +
+                                  theta * (r_[5][i] + s * (r_[6][i] + theta * r_[7][i]))))));
+  }
+
+ private:
+  int n_;
+  std::vector<double> y_stage_;
+  std::array<std::vector<double>, Tableau::extra_stages> extra_;
+  std::array<std::vector<double>, 8> r_;  // r_0 = y, then r1..r7 above
+};
+
+// The driver of the adaptive pairs: Hairer's step-size control with the tableau's constants,
+// outputs inside a step from the continuous extension (never shortening a step), only the last
+// step shortened to end on the last output time, so the rhs is never evaluated beyond it.
+template <class Tableau>
+IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
+                                     const IntegratorOptions& options, double t0, const double* y0,
+                                     std::span<const double> output_times,
+                                     const OutputFn& output) {
+  constexpr double beta = Tableau::beta;
+  constexpr double expo1 = Tableau::exponent;
+  constexpr double fac_min = Tableau::fac_min;
+  constexpr double fac_max = Tableau::fac_max;
+  constexpr double safety = Tableau::safety;
+  constexpr int last_stage = Tableau::stages - 1;
+  static_assert(Tableau::fsal, "the adaptive driver reuses the last stage as the next first one");
+
+  const int n = system.size();
+  IntegrationResult result;
+  result.t_reached = t0;
+  if (output_times.empty()) return result;
+
+  std::vector<double> y(y0, y0 + n);
+  std::vector<double> y1(static_cast<std::size_t>(n));
+  std::vector<double> y_out(static_cast<std::size_t>(n));
+  Stepper<Tableau> stepper(n);
+  ContinuousExtension<Tableau> extension(n);
+  IntegratorStats stats;
+
+  std::size_t next = 0;
+  if (output_times.front() == t0) {
+    if (output(t0, y.data()) == Status::stopped) return stopped_at(t0, stats);
+    ++next;
+  }
+  if (next == output_times.size()) return result;
+  const double t_end = output_times.back();
+  const double hmax = options.max_step > 0.0 ? std::min(options.max_step, t_end - t0) : t_end - t0;
+
+  double t = t0;
+  ++stats.rhs_evaluations;
+  Status status = system.rhs(t, y.data(), stepper.k(0));
+  if (status != Status::ok) return rhs_failure(method, status, t, t, stats);
+  double h = 0.0;
+  if (options.step > 0.0) {
+    h = std::min(options.step, hmax);
+  } else {
+    status = initial_step(system, options, Tableau::order, t, y.data(), stepper.k(0), hmax,
+                          stepper.scratch(), stepper.k(1), stats, h);
+    if (status != Status::ok) return rhs_failure(method, status, t, t, stats);
+  }
+
+  double err_old = 1e-4;  // Hairer's FACOLD: the previous accepted error, floored
+  bool last_rejected = false;
+  bool last_error_finite = true;
+  for (;;) {
+    if (stats.steps + stats.rejected_steps >= options.max_steps)
+      return budget_exhausted(method, options.max_steps, t, stats);
+    if (!(h >= 16.0 * eps * std::max(std::abs(t), std::numeric_limits<double>::min()))) {
+      IntegrationResult failure;
+      failure.status = last_error_finite ? Status::step_size_underflow : Status::non_finite;
+      failure.t_reached = t;
+      failure.stats = stats;
+      failure.message =
+          last_error_finite
+              ? fmt::format("{}: step size underflow at t = {} (h = {}): the solution may be "
+                            "singular there, or the tolerances too tight",
+                            method, t, h)
+              : fmt::format("{}: non-finite states at t = {} for every step size down to h = {}",
+                            method, t, h);
+      return failure;
+    }
+    // Reaching t_end within 1% of a step is done in that step; stretching the last step a little
+    // is cheaper than a sliver of a step after it.
+    const bool last = t + 1.01 * h >= t_end;
+    if (last) h = t_end - t;
+
+    double t_fail = t;
+    status = stepper.step(system, t, y.data(), h, y1.data(), stats, t_fail,
+                          error_uses_last_stage<Tableau>);
+    if (status != Status::ok) return rhs_failure(method, status, t_fail, t, stats);
+
+    const double err = step_error(stepper, n, y.data(), y1.data(), h, options);
+    last_error_finite = std::isfinite(err) && all_finite(y1.data(), n);
+
+    if (!last_error_finite) {
+      // An overflow in a too-long step: retreat as far as the controller ever does.
+      ++stats.rejected_steps;
+      last_rejected = true;
+      h *= fac_min;
+      continue;
+    }
+    const double fac11 = std::pow(err, expo1);
+    if (err > 1.0) {
+      ++stats.rejected_steps;
+      last_rejected = true;
+      h /= std::min(1.0 / fac_min, fac11 / safety);
+      continue;
+    }
+
+    const double fac =
+        std::clamp(fac11 / std::pow(err_old, beta) / safety, 1.0 / fac_max, 1.0 / fac_min);
+    double h_new = h / fac;
+    err_old = std::max(err, 1e-4);
+    // Right after a rejection, growing the step again invites another one.
+    if (last_rejected) h_new = std::min(h_new, h);
+    last_rejected = false;
+    ++stats.steps;
+
+    const double t_new = last ? t_end : t + h;
+    bool last_stage_ready = error_uses_last_stage<Tableau>;
+    // Outputs inside the step follow the step's own solution; after_step acts at the step end,
+    // so an output there sees the state it leaves.
+    if (next < output_times.size() && output_times[next] < t_new) {
+      if (!last_stage_ready) {
+        ++stats.rhs_evaluations;
+        status = system.rhs(t_new, y1.data(), stepper.k(last_stage));
+        if (status != Status::ok) return rhs_failure(method, status, t_new, t, stats);
+        last_stage_ready = true;
+      }
+      status = extension.prepare(system, stepper, t, y.data(), y1.data(), h, stats, t_fail);
+      if (status != Status::ok) return rhs_failure(method, status, t_fail, t, stats);
+      for (; next < output_times.size() && output_times[next] < t_new; ++next) {
+        const double t_out = output_times[next];
+        extension.evaluate((t_out - t) / h, y_out.data());
+        if (output(t_out, y_out.data()) == Status::stopped) return stopped_at(t_out, stats);
+      }
+    }
+    const StepEnd end = system.after_step(t_new, y1.data());
+    if (end.status != Status::ok) return step_end_failure(method, end.status, t_new, stats);
+    // The FSAL stage belongs to the state before a change; evaluated here, it is that of the
+    // state the next step starts from.
+    if (end.changed || !last_stage_ready) {
+      ++stats.rhs_evaluations;
+      status = system.rhs(t_new, y1.data(), stepper.k(last_stage));
+      if (status != Status::ok) return rhs_failure(method, status, t_new, t_new, stats);
+    }
+    if (next < output_times.size() && output_times[next] == t_new) {
+      if (output(t_new, y1.data()) == Status::stopped) return stopped_at(t_new, stats);
+      ++next;
+    }
+
+    std::swap(y, y1);
+    stepper.reuse_last_stage();
+    t = t_new;
+    if (last) break;
+    h = std::min(h_new, hmax);
+  }
+  result.t_reached = t;
+  result.stats = stats;
+  return result;
 }
 
 }  // namespace
@@ -237,147 +563,19 @@ IntegrationResult integrate_rk4(OdeSystem& system, const IntegratorOptions& opti
   return result;
 }
 
+
 IntegrationResult integrate_dopri5(OdeSystem& system, const IntegratorOptions& options, double t0,
                                    const double* y0, std::span<const double> output_times,
                                    const OutputFn& output) {
-  using Tableau = rk::DormandPrince54;
-  constexpr std::string_view method = "dopri5";
-  // Hairer's DOPRI5 defaults: PI control with beta = 0.04, new step within [h/5, 10 h],
-  // safety factor 0.9.
-  constexpr double beta = 0.04;
-  constexpr double expo1 = 1.0 / (Tableau::embedded_order + 1) - 0.75 * beta;
-  constexpr double fac_min = 0.2;
-  constexpr double fac_max = 10.0;
-  constexpr double safety = 0.9;
+  return integrate_adaptive<rk::DormandPrince54>("dopri5", system, options, t0, y0, output_times,
+                                                 output);
+}
 
-  const int n = system.size();
-  IntegrationResult result;
-  result.t_reached = t0;
-  if (output_times.empty()) return result;
-
-  std::vector<double> y(y0, y0 + n);
-  std::vector<double> y1(static_cast<std::size_t>(n));
-  std::vector<double> y_out(static_cast<std::size_t>(n));
-  Stepper<Tableau> stepper(n);
-  IntegratorStats stats;
-
-  std::size_t next = 0;
-  if (output_times.front() == t0) {
-    if (output(t0, y.data()) == Status::stopped) return stopped_at(t0, stats);
-    ++next;
-  }
-  if (next == output_times.size()) return result;
-  const double t_end = output_times.back();
-  const double hmax = options.max_step > 0.0 ? std::min(options.max_step, t_end - t0) : t_end - t0;
-
-  double t = t0;
-  ++stats.rhs_evaluations;
-  Status status = system.rhs(t, y.data(), stepper.k(0));
-  if (status != Status::ok) return rhs_failure(method, status, t, t, stats);
-  double h = 0.0;
-  if (options.step > 0.0) {
-    h = std::min(options.step, hmax);
-  } else {
-    status = initial_step(system, options, Tableau::order, t, y.data(), stepper.k(0), hmax,
-                          stepper.scratch(), stepper.k(1), stats, h);
-    if (status != Status::ok) return rhs_failure(method, status, t, t, stats);
-  }
-
-  double err_old = 1e-4;  // Hairer's FACOLD: the previous accepted error, floored
-  bool last_rejected = false;
-  bool last_error_finite = true;
-  for (;;) {
-    if (stats.steps + stats.rejected_steps >= options.max_steps)
-      return budget_exhausted(method, options.max_steps, t, stats);
-    if (!(h >= 16.0 * eps * std::max(std::abs(t), std::numeric_limits<double>::min()))) {
-      IntegrationResult failure;
-      failure.status = last_error_finite ? Status::step_size_underflow : Status::non_finite;
-      failure.t_reached = t;
-      failure.stats = stats;
-      failure.message =
-          last_error_finite
-              ? fmt::format("{}: step size underflow at t = {} (h = {}): the solution may be "
-                            "singular there, or the tolerances too tight",
-                            method, t, h)
-              : fmt::format("{}: non-finite states at t = {} for every step size down to h = {}",
-                            method, t, h);
-      return failure;
-    }
-    // Reaching t_end within 1% of a step is done in that step; stretching the last step a little
-    // is cheaper than a sliver of a step after it.
-    const bool last = t + 1.01 * h >= t_end;
-    if (last) h = t_end - t;
-
-    double t_fail = t;
-    status = stepper.step(system, t, y.data(), h, y1.data(), stats, t_fail);
-    if (status != Status::ok) return rhs_failure(method, status, t_fail, t, stats);
-
-    double sum = 0.0;
-    for (int i = 0; i < n; ++i) {
-      double e = 0.0;
-      for (int j = 0; j < Tableau::stages; ++j)
-        e += Tableau::e[static_cast<std::size_t>(j)] * stepper.k(j)[i];
-      const double sk = options.atol + options.rtol * std::max(std::abs(y[i]), std::abs(y1[i]));
-      const double r = h * e / sk;
-      sum += r * r;
-    }
-    const double err = std::sqrt(sum / n);
-    last_error_finite = std::isfinite(err);
-
-    if (!last_error_finite) {
-      // An overflow in a too-long step: retreat as far as the controller ever does.
-      ++stats.rejected_steps;
-      last_rejected = true;
-      h *= fac_min;
-      continue;
-    }
-    const double fac11 = std::pow(err, expo1);
-    if (err > 1.0) {
-      ++stats.rejected_steps;
-      last_rejected = true;
-      h /= std::min(1.0 / fac_min, fac11 / safety);
-      continue;
-    }
-
-    const double fac =
-        std::clamp(fac11 / std::pow(err_old, beta) / safety, 1.0 / fac_max, 1.0 / fac_min);
-    double h_new = h / fac;
-    err_old = std::max(err, 1e-4);
-    // Right after a rejection, growing the step again invites another one.
-    if (last_rejected) h_new = std::min(h_new, h);
-    last_rejected = false;
-    ++stats.steps;
-
-    const double t_new = last ? t_end : t + h;
-    // Outputs inside the step follow the step's own solution; after_step acts at the step end,
-    // so an output there sees the state it leaves.
-    for (; next < output_times.size() && output_times[next] < t_new; ++next) {
-      const double t_out = output_times[next];
-      continuous_extension(stepper, n, y.data(), y1.data(), h, (t_out - t) / h, y_out.data());
-      if (output(t_out, y_out.data()) == Status::stopped) return stopped_at(t_out, stats);
-    }
-    const StepEnd end = system.after_step(t_new, y1.data());
-    if (end.status != Status::ok) return step_end_failure(method, end.status, t_new, stats);
-    if (end.changed) {
-      // The FSAL stage belongs to the state before the change.
-      ++stats.rhs_evaluations;
-      status = system.rhs(t_new, y1.data(), stepper.k(Tableau::stages - 1));
-      if (status != Status::ok) return rhs_failure(method, status, t_new, t_new, stats);
-    }
-    if (next < output_times.size() && output_times[next] == t_new) {
-      if (output(t_new, y1.data()) == Status::stopped) return stopped_at(t_new, stats);
-      ++next;
-    }
-
-    std::swap(y, y1);
-    stepper.reuse_last_stage();
-    t = t_new;
-    if (last) break;
-    h = std::min(h_new, hmax);
-  }
-  result.t_reached = t;
-  result.stats = stats;
-  return result;
+IntegrationResult integrate_dop853(OdeSystem& system, const IntegratorOptions& options, double t0,
+                                   const double* y0, std::span<const double> output_times,
+                                   const OutputFn& output) {
+  return integrate_adaptive<rk::DormandPrince853>("dop853", system, options, t0, y0, output_times,
+                                                  output);
 }
 
 }  // namespace nhdyn

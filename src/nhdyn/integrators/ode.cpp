@@ -12,8 +12,8 @@
 namespace nhdyn {
 namespace {
 
-constexpr std::array<IntegratorKind, 4> all_kinds{IntegratorKind::rk4, IntegratorKind::dopri5,
-                                                  IntegratorKind::cvode_bdf,
+constexpr std::array<IntegratorKind, 5> all_kinds{IntegratorKind::rk4, IntegratorKind::dopri5,
+                                                  IntegratorKind::dop853, IntegratorKind::cvode_bdf,
                                                   IntegratorKind::cvode_adams};
 
 bool is_adaptive(IntegratorKind kind) { return kind != IntegratorKind::rk4; }
@@ -72,6 +72,7 @@ std::string_view integrator_name(IntegratorKind kind) {
   switch (kind) {
     case IntegratorKind::rk4: return "rk4";
     case IntegratorKind::dopri5: return "dopri5";
+    case IntegratorKind::dop853: return "dop853";
     case IntegratorKind::cvode_bdf: return "cvode-bdf";
     case IntegratorKind::cvode_adams: return "cvode-adams";
   }
@@ -82,7 +83,7 @@ IntegratorKind parse_integrator(std::string_view name) {
   for (IntegratorKind kind : all_kinds)
     if (integrator_name(kind) == name) return kind;
   throw InputError(fmt::format(
-      "unknown integrator '{}'; valid names are rk4, dopri5, cvode-bdf, cvode-adams", name));
+      "unknown integrator '{}'; valid names are rk4, dopri5, dop853, cvode-bdf, cvode-adams", name));
 }
 
 IntegrationResult integrate(OdeSystem& system, const IntegratorOptions& options, double t0,
@@ -94,6 +95,8 @@ IntegrationResult integrate(OdeSystem& system, const IntegratorOptions& options,
       return integrate_rk4(system, options, t0, y0, output_times, output);
     case IntegratorKind::dopri5:
       return integrate_dopri5(system, options, t0, y0, output_times, output);
+    case IntegratorKind::dop853:
+      return integrate_dop853(system, options, t0, y0, output_times, output);
     case IntegratorKind::cvode_bdf:
     case IntegratorKind::cvode_adams:
       return integrate_cvode(system, options, t0, y0, output_times, output);

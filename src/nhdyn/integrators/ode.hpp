@@ -34,9 +34,9 @@ class OdeSystem {
   virtual StepEnd after_step(double /*t*/, double* /*y*/) { return {}; }
 };
 
-enum class IntegratorKind { rk4, dopri5, cvode_bdf, cvode_adams };
+enum class IntegratorKind { rk4, dopri5, dop853, cvode_bdf, cvode_adams };
 
-// "rk4", "dopri5", "cvode-bdf", "cvode-adams".
+// "rk4", "dopri5", "dop853", "cvode-bdf", "cvode-adams".
 std::string_view integrator_name(IntegratorKind kind);
 // Inverse of integrator_name; throws InputError listing the valid names.
 IntegratorKind parse_integrator(std::string_view name);

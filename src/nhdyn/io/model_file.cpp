@@ -61,7 +61,7 @@ const std::vector<std::string> plot_keys = {"path"};
 // (parse_integrator) accept. io may not depend on those modules, so the lists are repeated here;
 // tests/io/model_file_test.cpp checks that they agree.
 const std::vector<std::string> method_names = {"sanh", "lagrange", "udwadia-kalaba", "nullspace"};
-const std::vector<std::string> integrator_names = {"rk4", "dopri5", "cvode-bdf", "cvode-adams"};
+const std::vector<std::string> integrator_names = {"rk4", "dopri5", "dop853", "cvode-bdf", "cvode-adams"};
 
 std::string join(const std::vector<std::string>& names) {
   std::string out;

@@ -1,0 +1,146 @@
+// Same input, same bytes: the built binary (NHDYN_CLI_PATH) is run several times in separate
+// processes on the same model and options, with address-space layout randomisation as the system
+// has it (on by default: each process then loads GiNaC, whose hashes of sums and products derive
+// from an address, somewhere else), and the files it writes must agree byte for byte.
+// docs/design.md ("Reproducibility") says what orders by address. The DISABLED_ tests still fail
+// (issue 12, item 6 is open): the bicycle's results and code, the double pendulum's code; run them
+// with --gtest_also_run_disabled_tests to see where the runs part.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kRuns = 4;
+
+std::string read(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string example(const std::string& file) {
+  return (fs::path(NHDYN_SOURCE_DIR) / "examples" / file).string();
+}
+
+// Whether the kernel randomises where shared libraries are loaded (the condition under which the
+// differences showed; with it off every process would see the same addresses).
+bool aslr_on() {
+  std::ifstream in("/proc/sys/kernel/randomize_va_space");
+  int level = 0;
+  return (in >> level) && level > 0;
+}
+
+class Reproducible : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           (std::string("nhdyn-repro-") + info->name() + "-" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Runs `nhdyn ARGS` in the test's directory (each argument single-quoted for the shell) and
+  // returns its exit code; stdout and stderr go to out.txt and err.txt there.
+  int nhdyn(const std::vector<std::string>& args) const {
+    std::string command = "cd '" + dir_.string() + "' && '" NHDYN_CLI_PATH "'";
+    for (const std::string& a : args) command += " '" + a + "'";
+    command += " > out.txt 2> err.txt";
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+  // Runs `nhdyn ARGS -o run<i>.EXT` kRuns times and expects every file equal to the first.
+  void expect_same_bytes(std::vector<std::string> args, const std::string& extension) {
+    std::vector<std::string> outputs;
+    for (int i = 0; i < kRuns; ++i) {
+      const std::string file = "run" + std::to_string(i) + "." + extension;
+      std::vector<std::string> run_args = args;
+      run_args.insert(run_args.end(), {"-o", file});
+      ASSERT_EQ(nhdyn(run_args), 0) << read(dir_ / "err.txt");
+      outputs.push_back(read(dir_ / file));
+      ASSERT_FALSE(outputs.back().empty());
+    }
+    for (int i = 1; i < kRuns; ++i) {
+      if (outputs[static_cast<std::size_t>(i)] == outputs[0]) continue;
+      // Name the first line that differs, so that a failure says where the runs part.
+      std::istringstream a(outputs[0]), b(outputs[static_cast<std::size_t>(i)]);
+      std::string line_a, line_b;
+      int line = 0;
+      while (std::getline(a, line_a) && std::getline(b, line_b) && line_a == line_b) ++line;
+      ADD_FAILURE() << "run " << i << " differs from run 0 at line " << line + 1 << ":\n  "
+                    << line_a << "\n  " << line_b;
+    }
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(Reproducible, AslrIsOnForTheseTests) {
+  if (!aslr_on()) GTEST_SKIP() << "address-space randomisation is off: the runs below prove less";
+  SUCCEED();
+}
+
+TEST_F(Reproducible, DISABLED_BicycleSimulation) {
+  expect_same_bytes({"simulate", example("whipple_bicycle.toml"), "--t-end", "3", "-q"}, "csv");
+}
+
+TEST_F(Reproducible, DISABLED_BicycleSimulationWithDop853) {
+  expect_same_bytes({"simulate", example("whipple_bicycle.toml"), "--t-end", "3", "--integrator",
+                     "dop853", "--rtol", "1e-12", "--atol", "1e-14", "-q"},
+                    "csv");
+}
+
+TEST_F(Reproducible, RollingDiskFromBodies) {
+  expect_same_bytes({"simulate", example("rolling_disk_bodies.toml"), "--t-end", "3", "-q"}, "csv");
+}
+
+TEST_F(Reproducible, GeneratedChain) {
+  ASSERT_EQ(nhdyn({"example", "chain", "--bodies", "4", "-o", "chain.toml"}), 0)
+      << read(dir_ / "err.txt");
+  expect_same_bytes({"simulate", "chain.toml", "--t-end", "2", "-q"}, "csv");
+}
+
+TEST_F(Reproducible, ModelFiles) {
+  for (const char* file : {"knife_edge.toml", "chaplygin_sleigh.toml", "double_pendulum.toml",
+                           "slider_crank.toml", "rolling_disk.toml", "diff_drive.toml"}) {
+    SCOPED_TRACE(file);
+    expect_same_bytes({"simulate", example(file), "--t-end", "2", "-q"}, "csv");
+  }
+}
+
+TEST_F(Reproducible, GeneratedCode) {
+  for (const char* file : {"rolling_disk_bodies.toml", "slider_crank.toml", "knife_edge.toml"}) {
+    SCOPED_TRACE(file);
+    expect_same_bytes({"codegen", example(file)}, "hpp");
+  }
+}
+
+// Its CSV agrees (a negated difference under an even or odd function gives the same bits), but the
+// code says q[2] - q[0] in some processes and q[0] - q[2] in others.
+TEST_F(Reproducible, DISABLED_DoublePendulumGeneratedCode) {
+  expect_same_bytes({"codegen", example("double_pendulum.toml")}, "hpp");
+}
+
+TEST_F(Reproducible, DISABLED_BicycleGeneratedCode) {
+  expect_same_bytes({"codegen", example("whipple_bicycle.toml")}, "hpp");
+}
+
+TEST_F(Reproducible, DISABLED_BicycleLinearization) {
+  expect_same_bytes({"linearize", example("whipple_bicycle.toml"), "--cyclic", "thetaR,thetaF"},
+                    "csv");
+}
+
+}  // namespace
