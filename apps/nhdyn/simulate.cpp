@@ -11,6 +11,7 @@
 
 #include "commands.hpp"
 #include "model_source.hpp"
+#include "outputs.hpp"
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/csv.hpp"
@@ -46,6 +47,7 @@ struct SimulateArgs {
 std::string format_residual(double value, bool defined) { return defined ? fmt::format("{:.3g}", value) : "-"; }
 
 int run_simulate(const SimulateArgs& args) {
+  protect_model_file(args.model);
   const ResolvedModel resolved = resolve_model(args.model, args.sets);
   const Model& model = resolved.model;
   const symbolic::Spec* spec = resolved.spec ? &*resolved.spec : nullptr;
@@ -71,7 +73,7 @@ int run_simulate(const SimulateArgs& args) {
 
   namespace fs = std::filesystem;
   const bool default_csv = args.output.empty();
-  const fs::path csv_path = default_csv ? fs::path("results") / (model.name + ".csv") : fs::path(args.output);
+  const fs::path csv_path = default_csv ? fs::path("results") / (make_file_name(model.name) + ".csv") : fs::path(args.output);
   std::optional<AtomicFile> plot_probe;
   if (!args.plot.empty()) {
     std::error_code ec;

@@ -43,6 +43,7 @@ struct SweepArgs {
 };
 
 int run_sweep(const SweepArgs& args) {
+  protect_model_file(args.model);
   SweepOptions options;
   options.parameter = args.param;
   options.from = args.from;
@@ -88,7 +89,7 @@ int run_sweep(const SweepArgs& args) {
 
   namespace fs = std::filesystem;
   const fs::path table_path =
-      args.output.empty() ? fs::path("results") / (spec.name + "-sweep-" + args.param + ".csv") : fs::path(args.output);
+      args.output.empty() ? fs::path("results") / (make_file_name(spec.name + "-sweep-" + args.param) + ".csv") : fs::path(args.output);
   make_parent_directory(table_path);
   fs::path crossings_path = table_path;
   crossings_path.replace_filename(table_path.stem().string() + "-crossings.csv");

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <exception>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -377,6 +379,18 @@ class Reader {
         const std::string exact = exact_number(spelled(token));
         if (exact.empty())
           site_.fail_at(token.begin, fmt::format("the number {} is out of the range of double precision", spelled(token)));
+        // A literal that is not zero but rounds to a subnormal double (or to 0) would reach the
+        // numeric layer as a value without precision (CLN refuses it with "floating point
+        // underflow"); one that rounds to infinity is out of range.
+        const std::string literal(spelled(token));
+        const double rounded = std::strtod(literal.c_str(), nullptr);
+        const bool nonzero = literal.substr(0, literal.find_first_of("eE")).find_first_of("123456789") != std::string::npos;
+        if (nonzero && std::abs(rounded) < std::numeric_limits<double>::min())
+          site_.fail_at(token.begin, fmt::format("the number {} is below the smallest normal double (2.2e-308); "
+                                                 "write 0 or change the units",
+                                                 spelled(token)));
+        if (std::isinf(rounded))
+          site_.fail_at(token.begin, fmt::format("the number {} is out of the range of double precision", spelled(token)));
         out_ += exact;
         return;
       }
@@ -603,6 +617,11 @@ SpecBuilder& SpecBuilder::parameter(const std::string& name, double value, std::
   check_new_name(spec_, name, "parameter", where);
   if (!std::isfinite(value))
     fail(where, fmt::format("parameter '{}'", name), fmt::format("value {} is not a finite number", value));
+  if (value != 0.0 && std::abs(value) < std::numeric_limits<double>::min())
+    fail(where, fmt::format("parameter '{}'", name),
+         fmt::format("value {:g} is below the smallest normal double (2.2e-308), where numbers lose their precision; "
+                     "give 0 or change the units",
+                     value));
   spec_.symbols.add_parameter(name);
   spec_.parameters.push_back({name, value, std::move(unit), std::move(where)});
   return *this;
