@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/SVD>
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -84,6 +86,57 @@ struct SplitSum {
 
 // Terms of large models are simplified only up to a size (simplify_moderate, simplify.hpp).
 GiNaC::ex tidy(const GiNaC::ex& e) { return simplify_moderate(e); }
+
+// An analytic D must satisfy D b^T = 0 and make [D; b] invertible; checked at the initial state
+// with the parameter values (a wrong D otherwise gives a wrong motion with no error). Entries that
+// do not evaluate to finite reals there skip the check (they fail later, with their own message).
+void require_complement_at_initial_state(const Spec& spec, const GiNaC::matrix& b, const GiNaC::matrix& D) {
+  const unsigned k = D.rows(), n = D.cols(), s = b.rows();
+  const GiNaC::lst values = spec.parameter_values();
+  GiNaC::exmap at;
+  at[spec.symbols.time()] = GiNaC::numeric(spec.t0);
+  for (unsigned i = 0; i < n; ++i) {
+    if (i < spec.q0.size()) at[spec.symbols.coordinate(static_cast<int>(i))] = spec.q0[i].subs(values);
+    if (i < spec.v0.size()) at[spec.symbols.velocity(static_cast<int>(i))] = spec.v0[i].subs(values);
+  }
+  const auto value = [&](const GiNaC::ex& e, double& out) {
+    try {
+      const GiNaC::ex x = GiNaC::evalf(e.subs(at).subs(values).subs(values));
+      if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real()) return false;
+      out = GiNaC::ex_to<GiNaC::numeric>(x).to_double();
+      return std::isfinite(out);
+    } catch (const std::exception&) {
+      return false;
+    }
+  };
+  Eigen::MatrixXd stacked(k + s, n);
+  for (unsigned r = 0; r < k + s; ++r)
+    for (unsigned j = 0; j < n; ++j)
+      if (!value(r < k ? D(r, j) : b(r - k, j), stacked(r, j))) return;
+  const Eigen::MatrixXd Dm = stacked.topRows(k), bm = stacked.bottomRows(s);
+  const std::string where = prefix(spec.complement_where);
+  if (s > 0) {
+    const Eigen::MatrixXd residual = Dm * bm.transpose();
+    Eigen::Index row = 0, col = 0;
+    const double worst = residual.cwiseAbs().maxCoeff(&row, &col);
+    const double scale = std::max(Dm.norm() * bm.norm(), 1e-300);
+    if (worst > 1e-9 * scale)
+      throw ModelError(fmt::format(
+          "{}complement D: D b^T is not zero at the initial state: row {} of D against constraint '{}' gives {:.3g} "
+          "(|D| |b| = {:.3g}); the rows of D must span the velocities the constraints allow (D b^T = 0): check D",
+          where, row + 1,
+          static_cast<std::size_t>(col) < spec.constraints.size() ? spec.constraints[static_cast<std::size_t>(col)].name
+                                                                  : fmt::format("{}", col + 1),
+          residual(row, col), scale));
+  }
+  const Eigen::VectorXd sigma = Eigen::JacobiSVD<Eigen::MatrixXd>(stacked).singularValues();
+  if (sigma.size() > 0 && !(sigma(sigma.size() - 1) > 1e-10 * sigma(0)))
+    throw ModelError(fmt::format(
+        "{}complement D: D is rank deficient at the initial state: the stacked matrix [D; b] ({} x {}) has a "
+        "singular value {:.3g} against the largest {:.3g}; the k = {} rows of D must be independent of each other "
+        "and of the constraints: check D",
+        where, k + s, n, sigma(sigma.size() - 1), sigma(0), k));
+}
 
 }  // namespace
 
@@ -262,6 +315,7 @@ Derivation derive(const Spec& spec) {
     if (static_cast<int>(D.rows()) != k || static_cast<int>(D.cols()) != n)
       throw ModelError(fmt::format("{}complement D: D is {} x {} but must be k x n = {} x {}",
                                    prefix(spec.complement_where), D.rows(), D.cols(), k, n));
+    require_complement_at_initial_state(spec, d.b, D);
     d.D = D;
   } else if (!spec.independent.empty()) {
     std::vector<int> independent;
