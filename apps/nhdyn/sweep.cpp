@@ -185,6 +185,13 @@ int run_sweep(const SweepArgs& args) {
                spec.name, args.param, args.from, args.to, args.steps, state);
     if (sweep.crossings.empty())
       fmt::print("no real part crosses zero in the range\n");
+    int undecided = 0;
+    for (const SweepPoint& p : sweep.points) undecided = std::max(undecided, p.undecided);
+    if (undecided > 0)
+      fmt::print("undecided: up to {} eigenvalues per value have a real part within their round-off uncertainty "
+                  "(zero, on the imaginary axis, or a multiple eigenvalue split by round-off); they are never "
+                  "counted unstable\n",
+                  undecided);
     for (const StabilityCrossing& c : sweep.crossings)
       fmt::print("crossing: {} = {:.15g}  {} ({}), unstable eigenvalues {} -> {}\n", args.param, c.value,
                  c.oscillatory ? "a complex pair crosses the imaginary axis" : "a real eigenvalue crosses zero",
