@@ -98,7 +98,7 @@ void make_parent_directory(const std::filesystem::path& file) {
 
 void check_plot_possible(const std::string& plot) {
   if (plot.empty()) return;
-  require_not_input(resolve_links(plot));
+  require_not_input(resolve_links(plot), plot);
   if (!gnuplot_available())
     throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
                     "or run without --plot");

@@ -14,10 +14,10 @@ namespace nhdyn {
 namespace {
 
 std::string sled(const std::string& complement) {
-  return R"(name = "sled"
+  return R"toml(name = "sled"
 coordinates = ["x", "y", "phi"]
 kinetic_energy = "m/2 * (x'^2 + y'^2) + m*a*phi' * (cos(phi)*y' - sin(phi)*x') + m*rho^2/2 * phi'^2"
-complement = )" + complement + R"(
+complement = )toml" + complement + R"toml(
 [parameters]
 m = 1.0
 a = 0.5
@@ -28,7 +28,7 @@ velocity = "-sin(phi)*x' + cos(phi)*y'"
 [initial]
 position = { x = 0, y = 0, phi = 0.3 }
 velocity = { x = "cos(0.3)", y = "sin(0.3)", phi = 1.0 }
-)";
+)toml";
 }
 
 std::string refusal(const std::string& complement) {
@@ -41,19 +41,19 @@ std::string refusal(const std::string& complement) {
 }
 
 TEST(AnalyticComplement, ARightOneIsAccepted) {
-  EXPECT_EQ(refusal(R"([["cos(phi)", "sin(phi)", 0], [0, 0, 1]])"), "");
+  EXPECT_EQ(refusal(R"d([["cos(phi)", "sin(phi)", 0], [0, 0, 1]])d"), "");
 }
 
 TEST(AnalyticComplement, OneNotOrthogonalToBIsRefusedWithItsResidual) {
   // Row 1 = (1, 0, 0): D b^T = -sin(0.3) = -0.2955 against the blade.
-  const std::string m = refusal(R"([[1, 0, 0], [0, 0, 1]])");
+  const std::string m = refusal(R"d([[1, 0, 0], [0, 0, 1]])d");
   EXPECT_NE(m.find("D b^T is not zero"), std::string::npos) << m;
   EXPECT_NE(m.find("'blade'"), std::string::npos) << m;
   EXPECT_NE(m.find("-0.296"), std::string::npos) << m;
 }
 
 TEST(AnalyticComplement, ARankDeficientOneIsRefused) {
-  const std::string m = refusal(R"([["cos(phi)", "sin(phi)", 0], ["2*cos(phi)", "2*sin(phi)", 0]])");
+  const std::string m = refusal(R"d([["cos(phi)", "sin(phi)", 0], ["2*cos(phi)", "2*sin(phi)", 0]])d");
   EXPECT_NE(m.find("rank deficient"), std::string::npos) << m;
 }
 

@@ -181,6 +181,10 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
           if (mid == neg || mid == pos) break;
           const SweepPoint p = at(mid);
           const std::size_t j = nearest(p.eigenvalues, track);
+          // Joined to a cluster (a multiple eigenvalue there), its sign is round-off: the
+          // bracket so far is all the conditioning supports.
+          const double simple = *std::min_element(p.uncertainty.begin(), p.uncertainty.end());
+          if (p.uncertainty[j] > simple) break;
           track = p.eigenvalues[j];
           (track.real() > 0.0 ? pos : neg) = mid;
         }

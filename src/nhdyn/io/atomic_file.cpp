@@ -72,7 +72,7 @@ void protect_input(const fs::path& input) {
   protected_inputs.push_back({st.st_dev, st.st_ino, input.string()});
 }
 
-void require_not_input(const fs::path& output) {
+void require_not_input(const fs::path& output, const fs::path& named) {
   struct stat st{};
   if (::stat(output.c_str(), &st) != 0) return;  // does not exist (or unreachable): not an input
   const std::lock_guard lock(inputs_mutex);
@@ -80,7 +80,7 @@ void require_not_input(const fs::path& output) {
     if (in.device == st.st_dev && in.inode == st.st_ino)
       throw FileError(fmt::format("refusing to write '{}': it is '{}', an input of this run (the model file); "
                                   "give another output path",
-                                  output.string(), in.name));
+                                  (named.empty() ? output : named).string(), in.name));
 }
 
 int register_temporary_file(const fs::path& path) {
@@ -124,7 +124,7 @@ std::string make_file_name(std::string_view name, std::string_view fallback) {
 }
 
 AtomicFile::AtomicFile(const fs::path& target) : target_(target), resolved_(resolve_links(target)) {
-  require_not_input(resolved_);
+  require_not_input(resolved_, target);
   std::error_code ec;
   struct stat st{};
   const bool exists = ::stat(resolved_.c_str(), &st) == 0;

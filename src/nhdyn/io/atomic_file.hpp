@@ -48,7 +48,8 @@ class AtomicFile {
 // A path that does not exist is ignored. For the CLI, which knows its inputs.
 void protect_input(const std::filesystem::path& input);
 // Throws FileError when `output` (links followed) is a protected input, naming both.
-void require_not_input(const std::filesystem::path& output);
+// `named`, when given, is the name the user gave (a link to `output`), for the message.
+void require_not_input(const std::filesystem::path& output, const std::filesystem::path& named = {});
 // `path` with its symbolic links followed (up to 40), the way open() would; a dangling link
 // gives the path it points to. Throws FileError on a loop.
 std::filesystem::path resolve_links(const std::filesystem::path& path);

@@ -576,7 +576,7 @@ void render(const fs::path& png, const fs::path& named_target, const fs::path& c
   std::error_code ec;
   // Through a symbolic link to the file it names (io/atomic_file.hpp); never onto an input.
   const fs::path target = resolve_links(named_target);
-  require_not_input(target);
+  require_not_input(target, png);
   struct stat existing{};
   const bool exists = ::stat(target.c_str(), &existing) == 0;
   if (fs::is_directory(target, ec)) {

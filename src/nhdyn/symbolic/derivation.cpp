@@ -101,7 +101,7 @@ void require_complement_at_initial_state(const Spec& spec, const GiNaC::matrix& 
   }
   const auto value = [&](const GiNaC::ex& e, double& out) {
     try {
-      const GiNaC::ex x = GiNaC::evalf(e.subs(at).subs(values).subs(values));
+      const GiNaC::ex x = e.subs(at).subs(values).subs(values).evalf();
       if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real()) return false;
       out = GiNaC::ex_to<GiNaC::numeric>(x).to_double();
       return std::isfinite(out);
@@ -136,6 +136,50 @@ void require_complement_at_initial_state(const Spec& spec, const GiNaC::matrix& 
         "singular value {:.3g} against the largest {:.3g}; the k = {} rows of D must be independent of each other "
         "and of the constraints: check D",
         where, k + s, n, sigma(sigma.size() - 1), sigma(0), k));
+}
+
+// A kinetic energy of degree above 2 in the velocities is refused before its Hessian is formed:
+// for a power such as (x'^2 + y'^2 + x + y)^40 the Hessian takes minutes to expand. degree() reads
+// the unexpanded expression (a power's degree is its base's times the exponent), and a numeric
+// third difference of T(lambda q') at a rational point confirms it, so that terms that cancel
+// once multiplied out are not refused.
+void require_at_most_quadratic(const Spec& spec, const std::string& model) {
+  const SymbolTable& symbols = spec.symbols;
+  const GiNaC::symbol lambda("velocity_scale");
+  GiNaC::exmap scaled;
+  for (int i = 0; i < spec.n(); ++i) scaled[symbols.velocity(i)] = lambda * symbols.velocity(i);
+  int degree = 0;
+  try {
+    degree = spec.kinetic_energy.subs(scaled).degree(lambda);
+  } catch (const std::exception&) {
+    return;  // not a polynomial in lambda: left to the derivation's own check
+  }
+  if (degree <= 2) return;
+  GiNaC::exmap point;
+  for (int i = 0; i < spec.n(); ++i) {
+    point[symbols.coordinate(i)] = GiNaC::numeric(i % 7 + 1, 11);
+    point[symbols.velocity(i)] = GiNaC::numeric(i % 5 + 2, 13);
+  }
+  point[symbols.time()] = GiNaC::numeric(1, 17);
+  const GiNaC::lst values = spec.parameter_values();
+  std::vector<double> f;
+  try {
+    const GiNaC::ex at = spec.kinetic_energy.subs(scaled).subs(point).subs(values).subs(values);
+    for (int k = 0; k < 4; ++k) {
+      const GiNaC::ex x = at.subs(lambda == k).evalf();
+      if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real()) return;
+      f.push_back(GiNaC::ex_to<GiNaC::numeric>(x).to_double());
+    }
+  } catch (const std::exception&) {
+    return;
+  }
+  const double third = f[3] - 3.0 * f[2] + 3.0 * f[1] - f[0];
+  const double size = std::max({std::abs(f[0]), std::abs(f[1]), std::abs(f[2]), std::abs(f[3])});
+  if (!(std::abs(third) > 1e-8 * size)) return;
+  throw ModelError(model + fmt::format("the kinetic energy T is not quadratic in the velocities: it is a polynomial "
+                                       "of degree {} in them; T must be at most quadratic in q' (A = d2T/dq'2 may "
+                                       "depend on q and t only)",
+                                       degree));
 }
 
 }  // namespace
@@ -191,6 +235,7 @@ Derivation derive(const Spec& spec) {
     throw ModelError(model + "the kinetic and potential energies may not contain accelerations");
   if (const int i = Vs.first(&Contained::v); i >= 0)
     throw ModelError(model + fmt::format("the potential energy V contains the velocity {}'", name(i)));
+  require_at_most_quadratic(spec, model);
 
   Derivation d;
   // A = d2T/dq'2 (FORMULATION.md (2.4)); T must be quadratic in q' so that A does not depend on q'.
