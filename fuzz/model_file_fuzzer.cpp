@@ -1,9 +1,14 @@
 // libFuzzer target for the model-file loader: any bytes go through load_model_string, and a file
 // that loads is compiled (derive + compile_model) and its terms evaluated once at the initial
-// state. Every rejection must be an nhdyn::Error; any other exception, a crash, a leak or
-// undefined behaviour is a bug. Built and run by fuzz/run (see fuzz/CMakeLists.txt).
+// state. Every rejection must be an nhdyn::Error (the CLI's exit 2); any other exception is what
+// the CLI reports as "internal error" with exit 3, and aborts here, as do a crash, a leak and
+// undefined behaviour. An input that takes more than 10 s is a bug too (fuzz/run: -timeout=10).
+// Built and run by fuzz/run (see fuzz/CMakeLists.txt).
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
 #include <string_view>
 #include <vector>
 
@@ -23,6 +28,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                            {A.data(), Q.data(), G.data(), b.data(), b0.data()});
   } catch (const nhdyn::Error&) {
     // A clear rejection: what the loader is for.
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "internal error (the CLI would exit 3): %s\n", e.what());
+    std::abort();
   }
   return 0;
 }

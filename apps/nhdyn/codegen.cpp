@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "model_source.hpp"
+#include "outputs.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/symbolic/codegen.hpp"
 #include "nhdyn/symbolic/derivation.hpp"
@@ -26,6 +27,7 @@ std::function<int()> add_codegen_command(CLI::App& app) {
   cmd->add_option("--namespace", args->namespace_name, "C++ namespace of the generated code")->capture_default_str();
   cmd->add_option("--set", args->sets, "Override a parameter, NAME=VALUE (repeatable)");
   return [args] {
+    protect_model_file(args->model);
     AtomicFile file(args->output);  // refuses an unwritable path before deriving
     const symbolic::Spec spec = resolve_spec(args->model, args->sets);
     symbolic::CodegenOptions options;

@@ -44,6 +44,7 @@ std::string case_name(const ComparisonCase& c) {
 }
 
 int run_compare(const CompareArgs& args) {
+  protect_model_file(args.model);
   const ResolvedModel resolved = resolve_model(args.model, args.sets);
   const Model& model = resolved.model;
   if (args.reference != "tight" && args.reference != "analytic")
@@ -62,7 +63,7 @@ int run_compare(const CompareArgs& args) {
     for (const std::string& i : args.integrators) options.cases.push_back({parse_method(m), parse_integrator(i)});
 
   namespace fs = std::filesystem;
-  const fs::path table_path = args.output.empty() ? fs::path("results") / (model.name + "-compare.csv") : fs::path(args.output);
+  const fs::path table_path = args.output.empty() ? fs::path("results") / (make_file_name(model.name) + "-compare.csv") : fs::path(args.output);
   if (args.output.empty()) make_parent_directory(table_path);
   fs::path series_path = table_path;
   series_path.replace_filename(table_path.stem().string() + "-series.csv");

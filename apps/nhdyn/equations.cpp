@@ -29,6 +29,15 @@ std::function<int()> add_equations_command(CLI::App& app) {
     else if (args->format != "text")
       throw InputError(fmt::format("unknown format '{}'; choose text or latex", args->format));
     const symbolic::Spec spec = resolve_spec(args->model, args->sets);
+    // A, D and D A are printed in full, n^2 entries each: 10000 coordinates made 600 MB of text
+    // from 7 GB of memory. Refused before the derivation, with the way out.
+    constexpr int largest = 1000;
+    if (spec.n() > largest)
+      throw InputError(fmt::format(
+          "'{}' has {} coordinates: `nhdyn equations` prints the matrices A, D and D A in full, about {:.2g} "
+          "entries here; it prints models of up to {} coordinates. For a large model use `nhdyn codegen` "
+          "(straight-line C++) or `nhdyn simulate`",
+          spec.name, spec.n(), 3.0 * spec.n() * spec.n(), largest));
     const symbolic::Derivation derivation = symbolic::derive(spec);
     fmt::print("{}", symbolic::format_equations(spec, derivation, format));
     return 0;

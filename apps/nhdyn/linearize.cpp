@@ -32,6 +32,7 @@ std::string join_names(const std::vector<std::string>& names) {
 }
 
 int run_linearize(const LinearizeArgs& args) {
+  protect_model_file(args.model);
   const ResolvedModel resolved = resolve_model(args.model, args.sets);
   const Model& model = resolved.model;
   LinearizationOptions options;

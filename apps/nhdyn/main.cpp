@@ -8,6 +8,7 @@
 
 #include "commands.hpp"
 #include "nhdyn/core/error.hpp"
+#include "outputs.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"nhdyn: equations of motion of constrained mechanical systems (Do Sanh form)", "nhdyn"};
@@ -36,6 +37,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  nhdyn::cli::install_interrupt_handlers();
   try {
     if (app.got_subcommand("simulate")) return simulate();
     if (app.got_subcommand("list")) return list();

@@ -1,11 +1,94 @@
 #include "outputs.hpp"
 
+#include <signal.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstring>
 #include <system_error>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/plot.hpp"
 
 namespace nhdyn::cli {
+namespace {
+
+std::atomic<double> time_reached{std::nan("")};
+static_assert(std::atomic<double>::is_always_lock_free, "the signal handler reads time_reached");
+
+// Appends `text` to buf[len..] within `size`; for the handler, which may not use fmt or printf.
+void append(char* buf, std::size_t size, std::size_t& len, const char* text) {
+  while (*text && len + 1 < size) buf[len++] = *text++;
+}
+
+// t as "%.6g"-like text with integer arithmetic only (async-signal-safe): sign, integer part,
+// up to six decimals, or an exponent form outside [1e-4, 1e15).
+void append_time(char* buf, std::size_t size, std::size_t& len, double t) {
+  if (!(t == t)) return append(buf, size, len, "?");
+  if (t < 0) {
+    append(buf, size, len, "-");
+    t = -t;
+  }
+  int exponent = 0;
+  if (t != 0.0 && (t < 1e-4 || t >= 1e15)) {
+    while (t >= 10.0) { t /= 10.0; ++exponent; }
+    while (t < 1.0) { t *= 10.0; --exponent; }
+  }
+  auto whole = static_cast<unsigned long long>(t);
+  auto decimals = static_cast<unsigned long long>((t - static_cast<double>(whole)) * 1e6 + 0.5);
+  if (decimals >= 1000000ULL) { ++whole; decimals -= 1000000ULL; }
+  char digits[32];
+  int n = 0;
+  do { digits[n++] = static_cast<char>('0' + whole % 10); whole /= 10; } while (whole && n < 30);
+  char text[48];
+  int k = 0;
+  while (n) text[k++] = digits[--n];
+  if (decimals) {
+    text[k++] = '.';
+    char frac[7];
+    for (int i = 5; i >= 0; --i) { frac[i] = static_cast<char>('0' + decimals % 10); decimals /= 10; }
+    int last = 5;
+    while (frac[last] == '0') --last;
+    for (int i = 0; i <= last; ++i) text[k++] = frac[i];
+  }
+  if (exponent) {
+    text[k++] = 'e';
+    if (exponent < 0) { text[k++] = '-'; exponent = -exponent; }
+    char e[8];
+    int m = 0;
+    do { e[m++] = static_cast<char>('0' + exponent % 10); exponent /= 10; } while (exponent);
+    while (m) text[k++] = e[--m];
+  }
+  text[k] = '\0';
+  append(buf, size, len, text);
+}
+
+extern "C" void on_interrupt(int signal_number) {
+  remove_temporary_files();
+  char message[256];
+  std::size_t len = 0;
+  append(message, sizeof message, len, "\nnhdyn: interrupted by ");
+  append(message, sizeof message, len, signal_number == SIGINT ? "SIGINT" : "SIGTERM");
+  const double t = time_reached.load(std::memory_order_relaxed);
+  if (t == t) {
+    append(message, sizeof message, len, " at t = ");
+    append_time(message, sizeof message, len, t);
+  } else {
+    append(message, sizeof message, len, " before the time integration");
+  }
+  append(message, sizeof message, len, "; its unfinished output files were removed\n");
+  [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, message, len);
+  ::_exit(128 + signal_number);
+}
+
+}  // namespace
+
+void protect_model_file(const std::string& model) {
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(model, ec)) protect_input(model);
+}
 
 void make_parent_directory(const std::filesystem::path& file) {
   if (!file.has_parent_path()) return;
@@ -14,9 +97,21 @@ void make_parent_directory(const std::filesystem::path& file) {
 }
 
 void check_plot_possible(const std::string& plot) {
-  if (!plot.empty() && !gnuplot_available())
+  if (plot.empty()) return;
+  require_not_input(resolve_links(plot), plot);
+  if (!gnuplot_available())
     throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
                     "or run without --plot");
 }
+
+void install_interrupt_handlers() {
+  struct sigaction action{};
+  action.sa_handler = on_interrupt;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGTERM, &action, nullptr);
+}
+
+void note_time(double t) { time_reached.store(t, std::memory_order_relaxed); }
 
 }  // namespace nhdyn::cli

@@ -1,6 +1,8 @@
-// What every command that writes tables and plots checks before it computes anything: that the
-// table's directory exists (made when asked) and that gnuplot is there when a plot is asked for.
-// Shared by compare and the studies, so their messages and behaviour stay the same.
+// What every command that writes files checks and guarantees, so that their messages and
+// behaviour stay the same: the model file of the run is never an output (protect_model_file),
+// the table's directory exists (made when asked), gnuplot is there when a plot is asked for, and
+// an interrupted run (SIGINT, SIGTERM) removes its temporary files, says where it stopped and
+// exits 130 or 143.
 #pragma once
 
 #include <filesystem>
@@ -8,12 +10,23 @@
 
 namespace nhdyn::cli {
 
+// Registers the MODEL argument, when it names a file, as an input no output may replace
+// (io/atomic_file.hpp, protect_input). Call before opening any output.
+void protect_model_file(const std::string& model);
+
 // Makes the directory that will hold `file` (and its parents); errors are left to the writer,
 // which names the path when it cannot open the file.
 void make_parent_directory(const std::filesystem::path& file);
 
 // Throws FileError saying how to install gnuplot when `plot` is not empty and gnuplot with a PNG
-// terminal is missing.
+// terminal is missing, and FileError when `plot` names an input of the run.
 void check_plot_possible(const std::string& plot);
+
+// Installs the SIGINT and SIGTERM handlers: remove the temporary files under way, print
+// "interrupted by SIGINT at t = ..." (the last time passed to note_time, if any) and exit with
+// 128 + the signal's number.
+void install_interrupt_handlers();
+// Records how far the run has come, for the message of an interrupted run. Lock-free.
+void note_time(double t);
 
 }  // namespace nhdyn::cli

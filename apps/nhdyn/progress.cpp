@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <string>
 
+#include "outputs.hpp"
+
 namespace nhdyn::cli {
 
 ProgressBar::ProgressBar(double t0, double t_end)
@@ -15,6 +17,7 @@ ProgressBar::ProgressBar(double t0, double t_end)
 ProgressBar::~ProgressBar() { finish(); }
 
 void ProgressBar::update(double t) {
+  note_time(t);
   if (!enabled_) return;
   // Reading the clock on every row would cost more than writing the row.
   if (++calls_ % 64 != 0) return;

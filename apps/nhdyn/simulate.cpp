@@ -3,6 +3,7 @@
 // paths) happens before the first step, so a bad option never costs a run.
 #include <fmt/format.h>
 
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -11,6 +12,7 @@
 
 #include "commands.hpp"
 #include "model_source.hpp"
+#include "outputs.hpp"
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/csv.hpp"
@@ -45,7 +47,46 @@ struct SimulateArgs {
 
 std::string format_residual(double value, bool defined) { return defined ? fmt::format("{:.3g}", value) : "-"; }
 
+// A constraint written in a form that is singular somewhere on the path (y' - tan(phi) x' as phi
+// crosses pi/2) passes the integrator without complaint and gives a wrong motion: watch the
+// norm of each row of b at the output times and warn, once per constraint, when it has grown or
+// shrunk by two orders of magnitude from its first value (or stopped being finite).
+class ConstraintWatch {
+ public:
+  void update(const Model& model, const Data& data) {
+    const Eigen::Index s = data.b.rows();
+    if (s == 0 || static_cast<std::size_t>(s) != model.constraints.size()) return;
+    if (first_.empty()) {
+      first_.resize(static_cast<std::size_t>(s));
+      warned_.assign(static_cast<std::size_t>(s), false);
+      for (Eigen::Index i = 0; i < s; ++i) first_[static_cast<std::size_t>(i)] = data.b.row(i).norm();
+    }
+    for (Eigen::Index i = 0; i < s; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      const double norm = data.b.row(i).norm();
+      if (warned_[k] || !(first_[k] > 0.0)) continue;
+      const double ratio = norm / first_[k];
+      if (std::isfinite(ratio) && ratio < 1e2 && ratio > 1e-2) continue;
+      warned_[k] = true;
+      warnings_.push_back(fmt::format(
+          "nhdyn: warning: constraint '{}': the norm of its row of b went from {:.3g} to {:.3g} by t = {:.6g}; "
+          "its form is (nearly) singular there (such as tan(phi) at phi = pi/2) and the motion past that point "
+          "may be wrong: write it in a form that stays regular (multiply through by cos(phi))\n",
+          model.constraints[k].name, first_[k], norm, data.t));
+    }
+  }
+  void print() const {
+    for (const std::string& w : warnings_) fmt::print(stderr, "{}", w);
+  }
+
+ private:
+  std::vector<double> first_;
+  std::vector<bool> warned_;
+  std::vector<std::string> warnings_;
+};
+
 int run_simulate(const SimulateArgs& args) {
+  protect_model_file(args.model);
   const ResolvedModel resolved = resolve_model(args.model, args.sets);
   const Model& model = resolved.model;
   const symbolic::Spec* spec = resolved.spec ? &*resolved.spec : nullptr;
@@ -71,7 +112,7 @@ int run_simulate(const SimulateArgs& args) {
 
   namespace fs = std::filesystem;
   const bool default_csv = args.output.empty();
-  const fs::path csv_path = default_csv ? fs::path("results") / (model.name + ".csv") : fs::path(args.output);
+  const fs::path csv_path = default_csv ? fs::path("results") / (make_file_name(model.name) + ".csv") : fs::path(args.output);
   std::optional<AtomicFile> plot_probe;
   if (!args.plot.empty()) {
     std::error_code ec;
@@ -97,12 +138,15 @@ int run_simulate(const SimulateArgs& args) {
   std::vector<double> row;
   row.reserve(columns.all.size());
   ProgressBar progress(model.t0, options.t_end);
+  ConstraintWatch watch;
   const SimulationSummary summary = simulate(model, options, [&](const Data& data) {
     fill_result_row(model, data, row);
     writer.write_row(row);
+    watch.update(model, data);
     progress.update(data.t);
   });
   progress.finish();
+  watch.print();
   if (summary.status != Status::ok) {
     fmt::print(stderr, "nhdyn: simulation of '{}' failed at t = {:.6g}: {}\n", model.name, summary.t_reached,
                summary.message);

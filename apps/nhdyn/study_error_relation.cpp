@@ -50,6 +50,7 @@ StudyFormulation parse_formulation(const std::string& label) {
 }
 
 int run_error_relation(const ErrorRelationArgs& args) {
+  protect_model_file(args.model);
   const ResolvedModel resolved = resolve_model(args.model, args.sets);
   const Model& model = resolved.model;
   ErrorRelationOptions options;

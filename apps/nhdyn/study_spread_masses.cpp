@@ -43,6 +43,7 @@ std::filesystem::path reactions_plot_path(const std::filesystem::path& plot) {
 }
 
 int run_spread_masses(const SpreadMassesArgs& args) {
+  protect_model_file(args.model);
   // Options first, so that a bad value is reported before the model file is read.
   SpreadMassesOptions options;
   options.ratios = args.ratios;

@@ -43,6 +43,7 @@ struct SweepArgs {
 };
 
 int run_sweep(const SweepArgs& args) {
+  protect_model_file(args.model);
   SweepOptions options;
   options.parameter = args.param;
   options.from = args.from;
@@ -88,7 +89,7 @@ int run_sweep(const SweepArgs& args) {
 
   namespace fs = std::filesystem;
   const fs::path table_path =
-      args.output.empty() ? fs::path("results") / (spec.name + "-sweep-" + args.param + ".csv") : fs::path(args.output);
+      args.output.empty() ? fs::path("results") / (make_file_name(spec.name + "-sweep-" + args.param) + ".csv") : fs::path(args.output);
   make_parent_directory(table_path);
   fs::path crossings_path = table_path;
   crossings_path.replace_filename(table_path.stem().string() + "-crossings.csv");
@@ -184,6 +185,13 @@ int run_sweep(const SweepArgs& args) {
                spec.name, args.param, args.from, args.to, args.steps, state);
     if (sweep.crossings.empty())
       fmt::print("no real part crosses zero in the range\n");
+    int undecided = 0;
+    for (const SweepPoint& p : sweep.points) undecided = std::max(undecided, p.undecided);
+    if (undecided > 0)
+      fmt::print("undecided: up to {} eigenvalues per value have a real part within their round-off uncertainty "
+                  "(zero, on the imaginary axis, or a multiple eigenvalue split by round-off); they are never "
+                  "counted unstable\n",
+                  undecided);
     for (const StabilityCrossing& c : sweep.crossings)
       fmt::print("crossing: {} = {:.15g}  {} ({}), unstable eigenvalues {} -> {}\n", args.param, c.value,
                  c.oscillatory ? "a complex pair crosses the imaginary axis" : "a real eigenvalue crosses zero",

@@ -6,37 +6,76 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/SVD>
+
 #include "nhdyn/core/error.hpp"
 
 namespace nhdyn {
 namespace {
 
-// Eigenvalues that are zero at every parameter value (a conserved momentum, a cyclic speed) are
-// left out of the counts: their real parts are round-off of either sign.
-// A real part counts as positive above 64 ulps of the largest eigenvalue, the round-off of the
-// eigenvalue solver: a pair on the imaginary axis (a conservative system) has real parts of that
-// size and either sign. A real eigenvalue crossing zero with slope c is then located to
-// 64 eps |lambda|_max / c.
-int count_unstable(std::vector<std::complex<double>> eigenvalues, int structural_zeros) {
-  std::sort(eigenvalues.begin(), eigenvalues.end(),
-            [](const std::complex<double>& a, const std::complex<double>& b) { return std::abs(a) < std::abs(b); });
-  double scale = 1.0;
-  for (const std::complex<double>& e : eigenvalues) scale = std::max(scale, std::abs(e));
-  int count = 0;
-  for (std::size_t i = static_cast<std::size_t>(structural_zeros); i < eigenvalues.size(); ++i)
-    count += eigenvalues[i].real() > 64.0 * std::numeric_limits<double>::epsilon() * scale ? 1 : 0;
-  return count;
+using Eigenvalues = std::vector<std::complex<double>>;
+
+// Eigenvalues whose real part is positive beyond their uncertainty: the motion is then certainly
+// unstable in that many directions. Those within it (a zero, a pair on the imaginary axis, a
+// multiple eigenvalue split by round-off) are undecided and never counted.
+void classify(SweepPoint& p) {
+  p.unstable = 0;
+  p.undecided = 0;
+  for (std::size_t i = 0; i < p.eigenvalues.size(); ++i) {
+    const double re = p.eigenvalues[i].real();
+    if (re > p.uncertainty[i]) ++p.unstable;
+    else if (re >= -p.uncertainty[i]) ++p.undecided;
+  }
 }
 
-int count_zeros(const std::vector<std::complex<double>>& eigenvalues) {
-  double scale = 1.0;
-  for (const std::complex<double>& e : eigenvalues) scale = std::max(scale, std::abs(e));
-  int zeros = 0;
-  for (const std::complex<double>& e : eigenvalues) zeros += std::abs(e) <= 1e-9 * scale ? 1 : 0;
-  return zeros;
+// The eigenvalue of `e` nearest to `target` (continuation along the parameter).
+std::size_t nearest(const Eigenvalues& e, std::complex<double> target) {
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < e.size(); ++i)
+    if (std::abs(e[i] - target) < std::abs(e[best] - target)) best = i;
+  return best;
 }
 
 }  // namespace
+
+std::vector<double> calc_eigenvalue_uncertainty(const Matrix& state_matrix, const Eigenvalues& eigenvalues) {
+  const std::size_t n = eigenvalues.size();
+  const double s = state_matrix.norm();
+  const double e = 64.0 * std::numeric_limits<double>::epsilon();
+  const auto radius = [&](std::size_t l) { return 8.0 * std::pow(e, 1.0 / static_cast<double>(l)) * s; };
+  std::vector<double> out(n, radius(1));
+  // Largest clusters first: an eigenvalue takes the radius of the largest cluster it belongs to.
+  std::vector<bool> settled(n, false);
+  for (std::size_t m = n; m >= 2; --m) {
+    const double r = radius(m);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (settled[i]) continue;
+      std::vector<std::size_t> cluster;
+      std::complex<double> centre = 0.0;
+      for (std::size_t j = 0; j < n; ++j)
+        if (std::abs(eigenvalues[j] - eigenvalues[i]) <= 2.0 * r) {
+          cluster.push_back(j);
+          centre += eigenvalues[j];
+        }
+      if (cluster.size() < m) continue;
+      centre /= static_cast<double>(cluster.size());
+      // g: the geometric multiplicity the cluster can have; the longest Jordan block is m - g + 1.
+      const Eigen::MatrixXcd shifted =
+          state_matrix.cast<std::complex<double>>() - centre * Eigen::MatrixXcd::Identity(state_matrix.rows(), state_matrix.cols());
+      const Eigen::VectorXd sigma = Eigen::JacobiSVD<Eigen::MatrixXcd>(shifted).singularValues();
+      std::size_t g = 0;
+      for (Eigen::Index k = 0; k < sigma.size(); ++k) g += sigma(k) <= 2.0 * r ? 1 : 0;
+      const std::size_t size = cluster.size();
+      const std::size_t longest = g >= size ? 1 : std::max<std::size_t>(1, size - std::max<std::size_t>(g, 1) + 1);
+      for (std::size_t j : cluster)
+        if (!settled[j]) {
+          out[j] = std::max(out[j], radius(longest));
+          settled[j] = true;
+        }
+    }
+  }
+  return out;
+}
 
 void check_sweep_options(const SweepOptions& options) {
   if (options.steps < 2 || options.steps > 1000000)
@@ -53,9 +92,21 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
   check_sweep_options(options);
   Sweep out;
   LinearizationOptions lin = options.linearization;
-  const auto at = [&](double value) -> Linearization {
+  const auto at = [&](double value) -> SweepPoint {
     try {
-      return calc_linearization(model_at(value), lin);
+      const Linearization l = calc_linearization(model_at(value), lin);
+      SweepPoint p;
+      p.value = value;
+      p.eigenvalues = l.eigenvalues;
+      p.uncertainty = calc_eigenvalue_uncertainty(l.state_matrix, l.eigenvalues);
+      classify(p);
+      if (out.state.empty()) {
+        out.state = l.state;
+        // The same state at every point: the choice made here, named.
+        lin.independent = l.independent;
+        lin.speeds = l.speeds;
+      }
+      return p;
     } catch (const InputError& e) {
       throw InputError(fmt::format("at {} = {:.17g}: {}", options.parameter, value, e.what()));
     } catch (const ModelError& e) {
@@ -66,60 +117,92 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
     const double value = i + 1 == options.steps
                              ? options.to
                              : options.from + (options.to - options.from) * i / (options.steps - 1);
-    const Linearization l = at(value);
-    if (i == 0) {
-      out.state = l.state;
-      // The same state at every point: the choice made here, named.
-      lin.independent = l.independent;
-      lin.speeds = l.speeds;
-    }
-    out.points.push_back({value, l.eigenvalues});
+    out.points.push_back(at(value));
   }
   if (!options.find_crossings) return out;
 
+  const double ulp_scale = 4.0 * std::numeric_limits<double>::epsilon();
   for (std::size_t i = 0; i + 1 < out.points.size(); ++i) {
     const SweepPoint& lo = out.points[i];
     const SweepPoint& hi = out.points[i + 1];
-    const int zeros = std::min(count_zeros(lo.eigenvalues), count_zeros(hi.eigenvalues));
-    const int before = count_unstable(lo.eigenvalues, zeros);
-    const int after = count_unstable(hi.eigenvalues, zeros);
-    if (before == after) continue;
-    // Bisection on the count: it stays right until the crossing eigenvalue's real part is
-    // round-off, so the bracket shrinks to (round-off of the eigenvalue) / (its slope).
+    if (lo.unstable == hi.unstable) continue;
+    // 1. Bisection on the count of certainly unstable eigenvalues: it stops where the crossing
+    // eigenvalue's real part leaves its uncertainty.
     double a = lo.value, b = hi.value;
-    std::vector<std::complex<double>> near = hi.eigenvalues;
-    for (int iter = 0; iter < 200 && b - a > 4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(a));
-         ++iter) {
+    SweepPoint at_a = lo, at_b = hi;
+    for (int iter = 0; iter < 200 && b - a > ulp_scale * std::max(1.0, std::abs(a)); ++iter) {
       const double mid = 0.5 * (a + b);
       if (mid <= a || mid >= b) break;
-      const Linearization l = at(mid);
-      if (count_unstable(l.eigenvalues, zeros) == before) {
+      SweepPoint p = at(mid);
+      if (p.unstable == lo.unstable) {
         a = mid;
+        at_a = std::move(p);
       } else {
         b = mid;
-        near = l.eigenvalues;
+        at_b = std::move(p);
+      }
+    }
+    // The crossing eigenvalue: on the unstable side, the certainly unstable one nearest the axis.
+    const bool rising = hi.unstable > lo.unstable;
+    const SweepPoint& unstable_side = rising ? at_b : at_a;
+    std::size_t k = unstable_side.eigenvalues.size();
+    for (std::size_t j = 0; j < unstable_side.eigenvalues.size(); ++j) {
+      const double re = unstable_side.eigenvalues[j].real();
+      if (re > unstable_side.uncertainty[j] && (k == unstable_side.eigenvalues.size() || re < unstable_side.eigenvalues[k].real()))
+        k = j;
+    }
+    std::complex<double> crossing = k < unstable_side.eigenvalues.size() ? unstable_side.eigenvalues[k] : 0.0;
+    // 2. For a simple eigenvalue, the count's threshold is not the crossing: follow that
+    // eigenvalue to where its real part is certainly negative, then bisect on the sign of its
+    // real part (the capsize speed to round-off, not to r_1 / slope). A real part that never
+    // becomes certainly negative (a pair going onto the imaginary axis) keeps step 1's bracket.
+    if (k < unstable_side.eigenvalues.size()) {
+      const double width = std::max(b - a, ulp_scale * std::max(1.0, std::abs(a)));
+      double stable_end = rising ? a : b;
+      std::complex<double> follow = crossing;
+      bool found = false;
+      for (double step = width; step <= hi.value - lo.value; step *= 2.0) {
+        const double probe = rising ? std::max(lo.value, a - step) : std::min(hi.value, b + step);
+        const SweepPoint p = at(probe);
+        const std::size_t j = nearest(p.eigenvalues, follow);
+        follow = p.eigenvalues[j];
+        if (p.eigenvalues[j].real() < -p.uncertainty[j]) {
+          stable_end = probe;
+          found = true;
+          break;
+        }
+        if (probe == lo.value || probe == hi.value) break;
+      }
+      if (found) {
+        double neg = stable_end, pos = rising ? b : a;
+        std::complex<double> track = crossing;
+        for (int iter = 0; iter < 200 && std::abs(pos - neg) > ulp_scale * std::max(1.0, std::abs(neg)); ++iter) {
+          const double mid = 0.5 * (neg + pos);
+          if (mid == neg || mid == pos) break;
+          const SweepPoint p = at(mid);
+          const std::size_t j = nearest(p.eigenvalues, track);
+          // Joined to a cluster (a multiple eigenvalue there), its sign is round-off: the
+          // bracket so far is all the conditioning supports.
+          const double simple = *std::min_element(p.uncertainty.begin(), p.uncertainty.end());
+          if (p.uncertainty[j] > simple) break;
+          track = p.eigenvalues[j];
+          (track.real() > 0.0 ? pos : neg) = mid;
+        }
+        crossing = track;
+        a = std::min(neg, pos);
+        b = std::max(neg, pos);
       }
     }
     StabilityCrossing c;
     c.value = 0.5 * (a + b);
     c.bracket = b - a;
-    c.unstable_before = before;
-    c.unstable_after = after;
-    // The crossing eigenvalue: of those not structurally zero, the one nearest the imaginary axis.
-    std::vector<std::complex<double>> e = near;
-    std::sort(e.begin(), e.end(),
-              [](const std::complex<double>& x, const std::complex<double>& y) { return std::abs(x) < std::abs(y); });
-    e.erase(e.begin(), e.begin() + zeros);
+    c.unstable_before = lo.unstable;
+    c.unstable_after = hi.unstable;
     double scale = 1.0;
-    for (const std::complex<double>& x : e) scale = std::max(scale, std::abs(x));
-    const auto best = std::min_element(e.begin(), e.end(), [](const std::complex<double>& x, const std::complex<double>& y) {
-      return std::abs(x.real()) < std::abs(y.real());
-    });
-    if (best != e.end()) {
-      c.frequency = std::abs(best->imag());
-      c.oscillatory = c.frequency > 1e-6 * scale;
-      if (!c.oscillatory) c.frequency = 0.0;
-    }
+    for (const std::complex<double>& x : unstable_side.eigenvalues) scale = std::max(scale, std::abs(x));
+    c.frequency = std::abs(crossing.imag());
+    c.oscillatory = c.frequency > 1e-6 * scale;
+    if (!c.oscillatory) c.frequency = 0.0;
     out.crossings.push_back(c);
   }
   return out;

@@ -1,9 +1,12 @@
 // Eigenvalues of the linearization (linearization.hpp) against one parameter, and the values
 // where the motion changes stability: where the real part of an eigenvalue crosses zero — a
 // complex pair (a Hopf crossing, the bicycle's weave speed) or a real eigenvalue (a divergence,
-// the capsize speed). The crossings are bracketed on the grid by a change in the number of
-// eigenvalues with positive real part and then found by bisection on that number to round-off
-// (docs/linearization.md, "Stability crossings"). The model at a parameter value comes from the
+// the capsize speed). Each eigenvalue is known only to an uncertainty that reflects its
+// conditioning (a multiple eigenvalue with a Jordan block of size l only to about eps^(1/l));
+// a real part within it is "undecided", never counted unstable. The crossings are bracketed on the
+// grid by a change in the number of eigenvalues whose real part is positive beyond that
+// uncertainty, narrowed by bisection on that number, and then, for a simple eigenvalue, by
+// bisection on the sign of its real part (docs/linearization.md, "Stability crossings"). The model at a parameter value comes from the
 // caller (the CLI recompiles the model file's derivation with the new value), so that this
 // module needs no symbolic layer.
 #pragma once
@@ -30,6 +33,10 @@ struct SweepOptions {
 struct SweepPoint {
   double value = 0.0;
   std::vector<std::complex<double>> eigenvalues;  // sorted as Linearization::eigenvalues
+  // Per eigenvalue, how far the computed value may be from the exact one (calc_eigenvalue_uncertainty).
+  std::vector<double> uncertainty;
+  int unstable = 0;   // eigenvalues with real part > its uncertainty
+  int undecided = 0;  // eigenvalues with |real part| <= its uncertainty (zero, imaginary, or a split multiple one)
 };
 
 struct StabilityCrossing {
@@ -55,6 +62,15 @@ using ModelAtValue = std::function<Model(double)>;
 // independent coordinates and speeds named from it), so that every row has the same columns;
 // a point where the linearization fails rethrows its error with the parameter value in front.
 Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& options);
+
+// How far each computed eigenvalue of `state_matrix` may be from the exact one: with
+// s = ||state_matrix||_F and e = 64 eps, r_l = 8 e^(1/l) s for an eigenvalue in a cluster of m
+// eigenvalues (within 2 r_m of each other) whose largest Jordan block can be l = m - g + 1 long,
+// g being the number of singular values of (state_matrix - centre I) below 2 r_m. A simple
+// eigenvalue gets r_1 = 512 eps s; a double zero of a Jordan block (a roller racer going straight)
+// about 1e-6 s; a semisimple multiple eigenvalue r_1. docs/linearization.md, "Stability crossings".
+std::vector<double> calc_eigenvalue_uncertainty(const Matrix& state_matrix,
+                                                const std::vector<std::complex<double>>& eigenvalues);
 
 // Checks `options` as sweep_eigenvalues does (for callers that must refuse bad input before they
 // open files).

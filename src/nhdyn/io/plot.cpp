@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -18,11 +19,13 @@
 #include <cstdint>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <random>
 #include <string_view>
 #include <system_error>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/io/atomic_file.hpp"
 
 extern char** environ;
 
@@ -258,6 +261,7 @@ class TempFile {
       if (fd >= 0) {
         fd_.reset(fd);
         path_ = candidate;
+        slot_ = register_temporary_file(path_);  // removed if the run is interrupted
         return;
       }
       const int err = errno;
@@ -280,6 +284,7 @@ class TempFile {
       std::error_code ignored;
       fs::remove(path_, ignored);
     }
+    release_temporary_file(slot_);
   }
   const fs::path& path() const { return path_; }
   int fd() const { return fd_.get(); }
@@ -289,6 +294,7 @@ class TempFile {
  private:
   UniqueFd fd_;
   fs::path path_;
+  int slot_ = -1;
 };
 
 void write_all(int fd, std::string_view text, const fs::path& path) {
@@ -565,9 +571,14 @@ std::string quoted_stderr(const std::string& text) {
 // The part every plot shares: writes the script that `script(output)` returns next to `png`, runs
 // gnuplot on it, and renames gnuplot's output (a temporary file) onto `target` = absolute `png`
 // only when gnuplot succeeded. `csv` is named in the error messages.
-void render(const fs::path& png, const fs::path& target, const fs::path& csv,
+void render(const fs::path& png, const fs::path& named_target, const fs::path& csv,
             const std::function<std::string(const fs::path& output)>& script) {
   std::error_code ec;
+  // Through a symbolic link to the file it names (io/atomic_file.hpp); never onto an input.
+  const fs::path target = resolve_links(named_target);
+  require_not_input(target, png);
+  struct stat existing{};
+  const bool exists = ::stat(target.c_str(), &existing) == 0;
   if (fs::is_directory(target, ec)) {
     throw FileError(
         fmt::format("cannot write the plot to '{}': it is a directory; give a file "
@@ -603,6 +614,17 @@ void render(const fs::path& png, const fs::path& target, const fs::path& csv,
                     "said:\n{}",
                     png.string(), quoted_stderr(run.stderr_text)));
   }
+  if (exists && !S_ISREG(existing.st_mode) && !S_ISDIR(existing.st_mode)) {
+    // A device or pipe: copy the picture into it rather than replace it by a regular file.
+    std::ifstream in(output.path(), std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const UniqueFd fd(::open(target.c_str(), O_WRONLY | O_CLOEXEC));
+    if (fd.get() < 0)
+      throw FileError(fmt::format("cannot write the plot to '{}' ({})", png.string(), errno_text(errno)));
+    write_all(fd.get(), bytes, target);
+    return;
+  }
+  if (exists) ::chmod(output.path().c_str(), existing.st_mode & 07777);  // a replaced file keeps its mode
   fs::rename(output.path(), target, ec);
   if (ec) {
     throw FileError(

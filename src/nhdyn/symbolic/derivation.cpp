@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/SVD>
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -85,6 +87,101 @@ struct SplitSum {
 // Terms of large models are simplified only up to a size (simplify_moderate, simplify.hpp).
 GiNaC::ex tidy(const GiNaC::ex& e) { return simplify_moderate(e); }
 
+// An analytic D must satisfy D b^T = 0 and make [D; b] invertible; checked at the initial state
+// with the parameter values (a wrong D otherwise gives a wrong motion with no error). Entries that
+// do not evaluate to finite reals there skip the check (they fail later, with their own message).
+void require_complement_at_initial_state(const Spec& spec, const GiNaC::matrix& b, const GiNaC::matrix& D) {
+  const unsigned k = D.rows(), n = D.cols(), s = b.rows();
+  const GiNaC::lst values = spec.parameter_values();
+  GiNaC::exmap at;
+  at[spec.symbols.time()] = GiNaC::numeric(spec.t0);
+  for (unsigned i = 0; i < n; ++i) {
+    if (i < spec.q0.size()) at[spec.symbols.coordinate(static_cast<int>(i))] = spec.q0[i].subs(values);
+    if (i < spec.v0.size()) at[spec.symbols.velocity(static_cast<int>(i))] = spec.v0[i].subs(values);
+  }
+  const auto value = [&](const GiNaC::ex& e, double& out) {
+    try {
+      const GiNaC::ex x = e.subs(at).subs(values).subs(values).evalf();
+      if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real()) return false;
+      out = GiNaC::ex_to<GiNaC::numeric>(x).to_double();
+      return std::isfinite(out);
+    } catch (const std::exception&) {
+      return false;
+    }
+  };
+  Eigen::MatrixXd stacked(k + s, n);
+  for (unsigned r = 0; r < k + s; ++r)
+    for (unsigned j = 0; j < n; ++j)
+      if (!value(r < k ? D(r, j) : b(r - k, j), stacked(r, j))) return;
+  const Eigen::MatrixXd Dm = stacked.topRows(k), bm = stacked.bottomRows(s);
+  const std::string where = prefix(spec.complement_where);
+  if (s > 0) {
+    const Eigen::MatrixXd residual = Dm * bm.transpose();
+    Eigen::Index row = 0, col = 0;
+    const double worst = residual.cwiseAbs().maxCoeff(&row, &col);
+    const double scale = std::max(Dm.norm() * bm.norm(), 1e-300);
+    if (worst > 1e-9 * scale)
+      throw ModelError(fmt::format(
+          "{}complement D: D b^T is not zero at the initial state: row {} of D against constraint '{}' gives {:.3g} "
+          "(|D| |b| = {:.3g}); the rows of D must span the velocities the constraints allow (D b^T = 0): check D",
+          where, row + 1,
+          static_cast<std::size_t>(col) < spec.constraints.size() ? spec.constraints[static_cast<std::size_t>(col)].name
+                                                                  : fmt::format("{}", col + 1),
+          residual(row, col), scale));
+  }
+  const Eigen::VectorXd sigma = Eigen::JacobiSVD<Eigen::MatrixXd>(stacked).singularValues();
+  if (sigma.size() > 0 && !(sigma(sigma.size() - 1) > 1e-10 * sigma(0)))
+    throw ModelError(fmt::format(
+        "{}complement D: D is rank deficient at the initial state: the stacked matrix [D; b] ({} x {}) has a "
+        "singular value {:.3g} against the largest {:.3g}; the k = {} rows of D must be independent of each other "
+        "and of the constraints: check D",
+        where, k + s, n, sigma(sigma.size() - 1), sigma(0), k));
+}
+
+// A kinetic energy of degree above 2 in the velocities is refused before its Hessian is formed:
+// for a power such as (x'^2 + y'^2 + x + y)^40 the Hessian takes minutes to expand. degree() reads
+// the unexpanded expression (a power's degree is its base's times the exponent), and a numeric
+// third difference of T(lambda q') at a rational point confirms it, so that terms that cancel
+// once multiplied out are not refused.
+void require_at_most_quadratic(const Spec& spec, const std::string& model) {
+  const SymbolTable& symbols = spec.symbols;
+  const GiNaC::symbol lambda("velocity_scale");
+  GiNaC::exmap scaled;
+  for (int i = 0; i < spec.n(); ++i) scaled[symbols.velocity(i)] = lambda * symbols.velocity(i);
+  int degree = 0;
+  try {
+    degree = spec.kinetic_energy.subs(scaled).degree(lambda);
+  } catch (const std::exception&) {
+    return;  // not a polynomial in lambda: left to the derivation's own check
+  }
+  if (degree <= 2) return;
+  GiNaC::exmap point;
+  for (int i = 0; i < spec.n(); ++i) {
+    point[symbols.coordinate(i)] = GiNaC::numeric(i % 7 + 1, 11);
+    point[symbols.velocity(i)] = GiNaC::numeric(i % 5 + 2, 13);
+  }
+  point[symbols.time()] = GiNaC::numeric(1, 17);
+  const GiNaC::lst values = spec.parameter_values();
+  std::vector<double> f;
+  try {
+    const GiNaC::ex at = spec.kinetic_energy.subs(scaled).subs(point).subs(values).subs(values);
+    for (int k = 0; k < 4; ++k) {
+      const GiNaC::ex x = at.subs(lambda == k).evalf();
+      if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real()) return;
+      f.push_back(GiNaC::ex_to<GiNaC::numeric>(x).to_double());
+    }
+  } catch (const std::exception&) {
+    return;
+  }
+  const double third = f[3] - 3.0 * f[2] + 3.0 * f[1] - f[0];
+  const double size = std::max({std::abs(f[0]), std::abs(f[1]), std::abs(f[2]), std::abs(f[3])});
+  if (!(std::abs(third) > 1e-8 * size)) return;
+  throw ModelError(model + fmt::format("the kinetic energy T is not quadratic in the velocities: it is a polynomial "
+                                       "of degree {} in them; T must be at most quadratic in q' (A = d2T/dq'2 may "
+                                       "depend on q and t only)",
+                                       degree));
+}
+
 }  // namespace
 
 std::optional<GiNaC::matrix> partitioned_complement(const GiNaC::matrix& b, const std::vector<int>& independent) {
@@ -138,6 +235,7 @@ Derivation derive(const Spec& spec) {
     throw ModelError(model + "the kinetic and potential energies may not contain accelerations");
   if (const int i = Vs.first(&Contained::v); i >= 0)
     throw ModelError(model + fmt::format("the potential energy V contains the velocity {}'", name(i)));
+  require_at_most_quadratic(spec, model);
 
   Derivation d;
   // A = d2T/dq'2 (FORMULATION.md (2.4)); T must be quadratic in q' so that A does not depend on q'.
@@ -262,6 +360,7 @@ Derivation derive(const Spec& spec) {
     if (static_cast<int>(D.rows()) != k || static_cast<int>(D.cols()) != n)
       throw ModelError(fmt::format("{}complement D: D is {} x {} but must be k x n = {} x {}",
                                    prefix(spec.complement_where), D.rows(), D.cols(), k, n));
+    require_complement_at_initial_state(spec, d.b, D);
     d.D = D;
   } else if (!spec.independent.empty()) {
     std::vector<int> independent;

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <exception>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -377,6 +379,18 @@ class Reader {
         const std::string exact = exact_number(spelled(token));
         if (exact.empty())
           site_.fail_at(token.begin, fmt::format("the number {} is out of the range of double precision", spelled(token)));
+        // A literal that is not zero but rounds to a subnormal double (or to 0) would reach the
+        // numeric layer as a value without precision (CLN refuses it with "floating point
+        // underflow"); one that rounds to infinity is out of range.
+        const std::string literal(spelled(token));
+        const double rounded = std::strtod(literal.c_str(), nullptr);
+        const bool nonzero = literal.substr(0, literal.find_first_of("eE")).find_first_of("123456789") != std::string::npos;
+        if (nonzero && std::abs(rounded) < std::numeric_limits<double>::min())
+          site_.fail_at(token.begin, fmt::format("the number {} is below the smallest normal double (2.2e-308); "
+                                                 "write 0 or change the units",
+                                                 spelled(token)));
+        if (std::isinf(rounded))
+          site_.fail_at(token.begin, fmt::format("the number {} is out of the range of double precision", spelled(token)));
         out_ += exact;
         return;
       }
@@ -517,12 +531,66 @@ bool has_huge_exponent(const GiNaC::ex& e) {
   return false;
 }
 
+// The number of terms that multiplying out `e` can produce (an upper bound: a sum's terms add, a
+// product's multiply, (t terms)^n gives at most C(n + t - 1, t - 1)); function arguments and the
+// bases of non-integer powers are atoms here and measured on their own by largest_expansion.
+double expanded_terms(const GiNaC::ex& e) {
+  if (GiNaC::is_a<GiNaC::add>(e)) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < e.nops(); ++i) sum += expanded_terms(e.op(i));
+    return sum;
+  }
+  if (GiNaC::is_a<GiNaC::mul>(e)) {
+    double product = 1.0;
+    for (std::size_t i = 0; i < e.nops(); ++i) product *= expanded_terms(e.op(i));
+    return std::min(product, 1e300);
+  }
+  if (GiNaC::is_a<GiNaC::power>(e) && GiNaC::is_a<GiNaC::numeric>(e.op(1)) &&
+      GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_integer()) {
+    const double t = expanded_terms(e.op(0));
+    const double n = std::min(std::abs(GiNaC::ex_to<GiNaC::numeric>(e.op(1)).to_double()), 1e6);
+    if (t <= 1.0) return 1.0;
+    // C(n + t - 1, t - 1) through lgamma, capped: only its order of magnitude matters.
+    const double log_terms = std::lgamma(n + t) - std::lgamma(n + 1.0) - std::lgamma(t);
+    return log_terms > 690.0 ? 1e300 : std::exp(log_terms);
+  }
+  return 1.0;
+}
+
+double largest_expansion(const GiNaC::ex& e) {
+  double largest = expanded_terms(e);
+  const bool atom = GiNaC::is_a<GiNaC::function>(e) ||
+                    (GiNaC::is_a<GiNaC::power>(e) && !(GiNaC::is_a<GiNaC::numeric>(e.op(1)) &&
+                                                       GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_integer()));
+  if (atom || GiNaC::is_a<GiNaC::add>(e) || GiNaC::is_a<GiNaC::mul>(e) || GiNaC::is_a<GiNaC::power>(e))
+    for (std::size_t i = 0; i < e.nops(); ++i) largest = std::max(largest, largest_expansion(e.op(i)));
+  return largest;
+}
+
+std::size_t node_count(const GiNaC::ex& e) {
+  std::size_t n = 1;
+  for (std::size_t i = 0; i < e.nops(); ++i) n += node_count(e.op(i));
+  return n;
+}
+
+// The derivation multiplies expressions out (expand, normal); one that would grow by more terms
+// than this takes minutes and gigabytes (a product of powers of sums), so it is refused where it
+// is read. A long sum as written (the kinetic energy of a 10000-body chain) grows by nothing and
+// is not limited here; the examples' products of sums stay below a tenth of it.
+constexpr double kLargestExpansion = 1e5;
+
 Parsed read(const Spec& spec, const Site& site, std::size_t begin, std::size_t end) {
   Parsed parsed = Reader(site, spec, lex(site, begin, end)).read();
   if (has_huge_exponent(parsed.value))
     site.fail_whole(fmt::format("an exponent larger than {} in magnitude; nhdyn expands powers symbolically, "
                                 "so rewrite the expression (e.g. with exp and log) or use a smaller power",
                                 kLargestExponent));
+  const double terms = largest_expansion(parsed.value);
+  if (terms > kLargestExpansion + 10.0 * static_cast<double>(node_count(parsed.value)))
+    site.fail_whole(fmt::format("multiplied out, this expression could have about {:.2g} terms (the limit is {:g}): "
+                                "nhdyn expands products and powers of sums symbolically, which would take minutes; "
+                                "use smaller powers, or fewer factors that are sums",
+                                terms, kLargestExpansion));
   return parsed;
 }
 
@@ -603,6 +671,11 @@ SpecBuilder& SpecBuilder::parameter(const std::string& name, double value, std::
   check_new_name(spec_, name, "parameter", where);
   if (!std::isfinite(value))
     fail(where, fmt::format("parameter '{}'", name), fmt::format("value {} is not a finite number", value));
+  if (value != 0.0 && std::abs(value) < std::numeric_limits<double>::min())
+    fail(where, fmt::format("parameter '{}'", name),
+         fmt::format("value {:g} is below the smallest normal double (2.2e-308), where numbers lose their precision; "
+                     "give 0 or change the units",
+                     value));
   spec_.symbols.add_parameter(name);
   spec_.parameters.push_back({name, value, std::move(unit), std::move(where)});
   return *this;
