@@ -130,7 +130,8 @@ int run_simulate(const SimulateArgs& args) {
     const bool adaptive = options.integrator.kind != IntegratorKind::rk4;
     fmt::print("nhdyn simulate {}: method {} ({}), integrator {}{}\n", model.name,
                method_name(options.formulation.method),
-               summary.sparse ? std::string("sparse path, D: partition")
+               summary.sparse ? std::string(options.formulation.method == Method::sanh ? "sparse path, D: partition"
+                                                                                        : "sparse path")
                               : fmt::format("D: {}", complement_name(options.formulation.complement)),
                integrator_name(options.integrator.kind),
                adaptive ? fmt::format(" (rtol {:g}, atol {:g})", options.integrator.rtol, options.integrator.atol) : "");
