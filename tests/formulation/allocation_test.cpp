@@ -191,7 +191,9 @@ TEST(Allocation, SparsePathAllocatesOnlyInsideItsSparseFactorizations) {
         }
       });
       EXPECT_EQ(solve, factors) << model.name << " " << method_name(m);
-      if (kCountsMalloc) EXPECT_GT(factors, 0) << "SparseLU no longer allocates: tighten this test to zero";
+      if (kCountsMalloc) {
+        EXPECT_GT(factors, 0) << "SparseLU no longer allocates: tighten this test to zero";
+      }
     }
   }
 }

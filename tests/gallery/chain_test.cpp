@@ -164,7 +164,9 @@ TEST(ChainSparsePath, SparseAndDenseKernelsAgreeAtRandomStates) {
             << sparse.failed_quantity;
         EXPECT_LT(relative(sparse.qdd, dense.qdd), 1e-11) << method_name(m);
         EXPECT_LT(relative(sparse.R, dense.R), 1e-10) << method_name(m);
-        if (m == Method::lagrange) EXPECT_LT(relative(sparse.lambda, dense.lambda), 1e-10);
+        if (m == Method::lagrange) {
+          EXPECT_LT(relative(sparse.lambda, dense.lambda), 1e-10);
+        }
         compute_residuals(model, dense);
         compute_residuals(model, sparse);
         EXPECT_LT((sparse.e - dense.e).norm(), 1e-11 * (1.0 + dense.b.norm() * dense.qdd.norm())) << method_name(m);

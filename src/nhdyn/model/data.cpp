@@ -237,22 +237,20 @@ void check_dense_memory(const Model& model, double available, const DataOptions&
                       : "Use the sparse path (a model compiled sparse, docs/performance.md) or a smaller model"));
 }
 
-Status compute_sparse_partition(const Model& model, Data& data) {
+namespace {
+
+// Makes `dependent` (s ascending coordinate indices) the partition of data: the flags, the
+// independent coordinates, the pattern of b_dep with the source of each value among b's values,
+// and its symbolic analysis.
+void install_partition(const Model& model, Data& data, std::vector<int> dependent) {
   const int n = model.n(), s = model.s();
-  if (!data.sparse || s == 0) return Status::ok;
-  long rank = 0;
-  if (!choose_dependent(data.b_sparse, data.dependent, rank)) {
-    data.status = Status::dependent_constraints;
-    data.failed_quantity.assign("constraint matrix b");
-    data.failed_t = data.t;
-    return Status::dependent_constraints;
-  }
+  std::sort(dependent.begin(), dependent.end());
+  data.dependent = std::move(dependent);
   data.is_dependent.assign(static_cast<std::size_t>(n), 0);
   data.independent.clear();
   for (int j : data.dependent) data.is_dependent[static_cast<std::size_t>(j)] = 1;
   for (int j = 0; j < n; ++j)
     if (!data.is_dependent[static_cast<std::size_t>(j)]) data.independent.push_back(j);
-  // The pattern of b_dep with the source of each value among b's values.
   std::vector<Eigen::Triplet<double, int>> entries;
   for (int jj = 0; jj < s; ++jj) {
     const int j = data.dependent[static_cast<std::size_t>(jj)];
@@ -266,6 +264,55 @@ Status compute_sparse_partition(const Model& model, Data& data) {
     data.b_dep_source[static_cast<std::size_t>(m)] = static_cast<int>(data.b_dep_sparse.valuePtr()[m]);
   data.lu_dep = std::make_unique<SparseLU>();
   data.lu_dep->analyzePattern(data.b_dep_sparse);
+}
+
+// The independent coordinates that keep X = b_dep^-1 b_ind small: the first k pivots of a
+// column-pivoted QR of the basis D = [I, -X^T] of null(b) from a first, merely nonsingular
+// partition. A sparse QR of b chooses its columns for fill-in, not size: on the chain it makes the
+// last body's heading independent, and the lead's then follows from it with a factor (f/r)^(N-1).
+// Returns false (leaving the partition as it is) when the first b_dep is singular.
+bool refine_partition(const Model& model, Data& data) {
+  const int n = model.n(), s = model.s(), k = model.k();
+  if (k == 0) return true;
+  const double* b_values = data.b_sparse.valuePtr();
+  double* dep_values = data.b_dep_sparse.valuePtr();
+  for (std::size_t m = 0; m < data.b_dep_source.size(); ++m) dep_values[m] = b_values[data.b_dep_source[m]];
+  Matrix b_ind = Matrix::Zero(s, k);
+  for (int jj = 0; jj < k; ++jj) {
+    const int j = data.independent[static_cast<std::size_t>(jj)];
+    for (int m = data.b_sparse.outerIndexPtr()[j]; m < data.b_sparse.outerIndexPtr()[j + 1]; ++m)
+      b_ind(data.b_sparse.innerIndexPtr()[m], jj) = b_values[m];
+  }
+  data.lu_dep->factorize(data.b_dep_sparse);
+  if (data.lu_dep->info() != Eigen::Success) return false;
+  const Matrix X = data.lu_dep->solve(b_ind);
+  if (!X.allFinite()) return false;
+  Matrix D = Matrix::Zero(k, n);
+  for (int r = 0; r < k; ++r) {
+    D(r, data.independent[static_cast<std::size_t>(r)]) = 1.0;
+    for (int jj = 0; jj < s; ++jj) D(r, data.dependent[static_cast<std::size_t>(jj)]) = -X(jj, r);
+  }
+  Eigen::ColPivHouseholderQR<Matrix> qr(D);
+  std::vector<int> dependent;
+  for (int i = k; i < n; ++i) dependent.push_back(qr.colsPermutation().indices()(i));
+  install_partition(model, data, std::move(dependent));
+  return true;
+}
+
+}  // namespace
+
+Status compute_sparse_partition(const Model& model, Data& data) {
+  if (!data.sparse || model.s() == 0) return Status::ok;
+  std::vector<int> dependent;
+  long rank = 0;
+  if (!choose_dependent(data.b_sparse, dependent, rank)) {
+    data.status = Status::dependent_constraints;
+    data.failed_quantity.assign("constraint matrix b");
+    data.failed_t = data.t;
+    return Status::dependent_constraints;
+  }
+  install_partition(model, data, std::move(dependent));
+  refine_partition(model, data);
   ++data.partition_changes;
   return Status::ok;
 }
