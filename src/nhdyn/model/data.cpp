@@ -7,6 +7,7 @@
 #include <Eigen/SparseQR>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 
 #include "nhdyn/core/error.hpp"
@@ -267,35 +268,52 @@ void install_partition(const Model& model, Data& data, std::vector<int> dependen
 }
 
 // The independent coordinates that keep X = b_dep^-1 b_ind small: the first k pivots of a
-// column-pivoted QR of the basis D = [I, -X^T] of null(b) from a first, merely nonsingular
-// partition. A sparse QR of b chooses its columns for fill-in, not size: on the chain it makes the
-// last body's heading independent, and the lead's then follows from it with a factor (f/r)^(N-1).
-// Returns false (leaving the partition as it is) when the first b_dep is singular.
-bool refine_partition(const Model& model, Data& data) {
+// column-pivoted QR of a basis Z (n x k) of null(b). A sparse QR of b chooses its columns for
+// fill-in, not size: on the chain it makes the last body's heading independent, and the lead's then
+// follows from it with a factor (f/r)^(N-1), which overflows at N = 1000. Z comes without such
+// factors from k KKT solves, [A b^T; b 0] [z; mu] = [A g; 0]: z is the A-orthogonal projection of g
+// onto null(b), for k fixed pseudo-random g (generated from integers, so the same on every
+// platform). Returns false, leaving the partition as it is, when the KKT matrix is singular.
+bool choose_by_null_space(const Model& model, Data& data) {
   const int n = model.n(), s = model.s(), k = model.k();
   if (k == 0) return true;
+  const double* a_values = data.A_sparse.valuePtr();
   const double* b_values = data.b_sparse.valuePtr();
-  double* dep_values = data.b_dep_sparse.valuePtr();
-  for (std::size_t m = 0; m < data.b_dep_source.size(); ++m) dep_values[m] = b_values[data.b_dep_source[m]];
-  Matrix b_ind = Matrix::Zero(s, k);
-  for (int jj = 0; jj < k; ++jj) {
-    const int j = data.independent[static_cast<std::size_t>(jj)];
-    for (int m = data.b_sparse.outerIndexPtr()[j]; m < data.b_sparse.outerIndexPtr()[j + 1]; ++m)
-      b_ind(data.b_sparse.innerIndexPtr()[m], jj) = b_values[m];
+  double* k_values = data.K_sparse.valuePtr();
+  for (std::size_t m = 0; m < data.K_source.size(); ++m) {
+    const int source = data.K_source[m];
+    k_values[m] = source == kKktDiagonal ? 0.0 : source >= 0 ? a_values[source] : b_values[~source];
   }
-  data.lu_dep->factorize(data.b_dep_sparse);
-  if (data.lu_dep->info() != Eigen::Success) return false;
-  const Matrix X = data.lu_dep->solve(b_ind);
-  if (!X.allFinite()) return false;
-  Matrix D = Matrix::Zero(k, n);
+  data.lu_kkt_sparse->factorize(data.K_sparse);
+  if (data.lu_kkt_sparse->info() != Eigen::Success) return false;
+  Matrix Z(k, n);
+  Vector g(n), rhs = Vector::Zero(n + s);
+  std::uint64_t state = 0x9e3779b97f4a7c15ULL;
   for (int r = 0; r < k; ++r) {
-    D(r, data.independent[static_cast<std::size_t>(r)]) = 1.0;
-    for (int jj = 0; jj < s; ++jj) D(r, data.dependent[static_cast<std::size_t>(jj)]) = -X(jj, r);
+    for (int i = 0; i < n; ++i) {
+      state = state * 6364136223846793005ULL + 1442695040888963407ULL;  // Knuth's MMIX generator
+      g(i) = static_cast<double>(state >> 11) * 0x1.0p-53 - 0.5;
+    }
+    rhs.head(n) = data.A_sparse * g;
+    const Vector sol = data.lu_kkt_sparse->solve(rhs);
+    if (!sol.allFinite()) return false;
+    Z.row(r) = sol.head(n).transpose();
   }
-  Eigen::ColPivHouseholderQR<Matrix> qr(D);
+  Eigen::ColPivHouseholderQR<Matrix> qr(Z);
+  if (qr.rank() < k) return false;
   std::vector<int> dependent;
   for (int i = k; i < n; ++i) dependent.push_back(qr.colsPermutation().indices()(i));
+  std::vector<int> previous = data.dependent;
   install_partition(model, data, std::move(dependent));
+  // The chosen b_dep must be nonsingular (it is, when Z spans null(b)); else back to the first.
+  const double* values = data.b_sparse.valuePtr();
+  double* dep_values = data.b_dep_sparse.valuePtr();
+  for (std::size_t m = 0; m < data.b_dep_source.size(); ++m) dep_values[m] = values[data.b_dep_source[m]];
+  data.lu_dep->factorize(data.b_dep_sparse);
+  if (data.lu_dep->info() != Eigen::Success) {
+    install_partition(model, data, std::move(previous));
+    return false;
+  }
   return true;
 }
 
@@ -312,7 +330,7 @@ Status compute_sparse_partition(const Model& model, Data& data) {
     return Status::dependent_constraints;
   }
   install_partition(model, data, std::move(dependent));
-  refine_partition(model, data);
+  choose_by_null_space(model, data);
   ++data.partition_changes;
   return Status::ok;
 }
