@@ -25,16 +25,17 @@ measure() {
   wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$work/time.txt" |
          awk -F: '{ if (NF == 3) print $1 * 3600 + $2 * 60 + $3; else print $1 * 60 + $2 }')
   rss=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$work/time.txt")
-  echo "$wall $rss"
+  cpu=$(sed -n 's/.*\(User\|System\) time (seconds): //p' "$work/time.txt" | awk '{ t += $1 } END { print t }')
+  echo "$wall $rss $cpu"
 }
 
-printf '%6s %6s | %10s %9s | %10s %9s | %7s | %s\n' N n "nhdyn [s]" "[MB]" "scipy [s]" "[MB]" "ratio" "max |q_nhdyn - q_scipy| at t_end"
+printf '%6s %6s | %9s %8s %7s | %9s %8s %7s | %6s %6s | %s\n' N n "nhdyn [s]" "cpu [s]" "[MB]" "scipy [s]" "cpu [s]" "[MB]" "ratio" "cpu" "max |q_nhdyn - q_scipy| at t_end"
 for N in $sizes; do
   "$nhdyn" example chain --bodies "$N" -o "$work/c.toml" > /dev/null
   set -- $(measure "$nhdyn" simulate "$work/c.toml" --t-end "$t_end" -q -o "$work/nhdyn.csv")
-  t_nhdyn=$1 m_nhdyn=$2
+  t_nhdyn=$1 m_nhdyn=$2 c_nhdyn=$3
   set -- $(measure /usr/bin/python3 "$here/chain_scipy.py" "$work/c.toml" "$work/scipy.csv" --t-end "$t_end")
-  t_scipy=$1 m_scipy=$2
+  t_scipy=$1 m_scipy=$2 c_scipy=$3
   diff=$(/usr/bin/python3 - "$work/nhdyn.csv" "$work/scipy.csv" "$N" <<'PY'
 import sys, numpy as np
 a = np.loadtxt(sys.argv[1], delimiter=",", skiprows=1, max_rows=None)
@@ -43,7 +44,8 @@ n = 3 * int(sys.argv[3])
 print(f"{np.abs(a[-1, 1:1 + n] - b[-1, 1:1 + n]).max():.2e}")
 PY
 )
-  printf '%6s %6s | %10.2f %9.0f | %10.2f %9.0f | %7.2f | %s\n' "$N" $((3 * N)) "$t_nhdyn" "$(echo "$m_nhdyn / 1024" | bc -l)" \
-    "$t_scipy" "$(echo "$m_scipy / 1024" | bc -l)" "$(echo "$t_scipy / $t_nhdyn" | bc -l)" "$diff"
+  printf '%6s %6s | %9.2f %8.2f %7.0f | %9.2f %8.2f %7.0f | %6.2f %6.2f | %s\n' "$N" $((3 * N)) \
+    "$t_nhdyn" "$c_nhdyn" "$(echo "$m_nhdyn / 1024" | bc -l)" "$t_scipy" "$c_scipy" "$(echo "$m_scipy / 1024" | bc -l)" \
+    "$(echo "$t_scipy / $t_nhdyn" | bc -l)" "$(echo "$c_scipy / $c_nhdyn" | bc -l)" "$diff"
 done
-echo "ratio: SciPy's time over nhdyn's (above 1: nhdyn is faster)"
+echo "ratio: SciPy's wall time over nhdyn's, cpu: the same for user + system CPU time (above 1: nhdyn is faster)"
