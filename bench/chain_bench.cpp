@@ -4,13 +4,16 @@
 //                                      front end from nothing to a frozen Model (compiled sparse
 //                                      from N = 22 on, TermsLayout::automatic)
 //   chain/terms/dense/N                compute_terms into the dense Data (A and b written whole)
-//   chain/terms/sparse/N               compute_sparse_terms (only the nonzeros of A and b)
+//   chain/terms/sparse/N               compute_terms on a sparse Data (only the nonzeros of A and b)
 //   chain/solve/dense/<form>/N         one acceleration solve (compute_acceleration) with the
 //                                      terms already computed: sanh/qr, sanh/partition, lagrange,
 //                                      udwadia-kalaba, nullspace/qr
 //   chain/solve/sparse/<form>/N        the same on the sparse path: sanh (block elimination on
 //                                      the partition, formulation/sparse_sanh.hpp) and lagrange
 //                                      (one SparseLU of the KKT matrix), Eigen's SparseLU both
+//   chain/rhs/sparse/<form>/N          one whole right-hand side (compute_dynamics: terms and
+//                                      solve) at the initial state, what an integrator pays per
+//                                      stage; its growth from N = 100 to 1000 is the n^1.1 target
 // Dense for N = 1 .. 100 (one dense solve at N = 1000 takes seconds and its Data a gigabyte);
 // sparse for N = 1 .. 1000. Results, plot and fitted exponents: docs/performance.md.
 #include <benchmark/benchmark.h>
@@ -19,10 +22,7 @@
 #include <vector>
 
 #include "nhdyn/formulation/formulation.hpp"
-#include "nhdyn/formulation/sparse_lagrange.hpp"
-#include "nhdyn/formulation/sparse_sanh.hpp"
 #include "nhdyn/model/data.hpp"
-#include "nhdyn/model/sparse_data.hpp"
 #include "nhdyn/model/terms.hpp"
 #include "nhdyn/symbolic/chain.hpp"
 #include "nhdyn/symbolic/compile.hpp"
@@ -47,7 +47,7 @@ void bench_derive_and_compile(benchmark::State& state) {
 
 void bench_dense_terms(benchmark::State& state) {
   const Model model = make_chain_model(static_cast<int>(state.range(0)), symbolic::TermsLayout::dense);
-  Data data = make_data(model);
+  Data data = make_data(model, DataOptions{Path::dense, Method::sanh, false});
   for (auto _ : state) {
     compute_terms(model, data, model.t0, model.q0.data(), model.v0.data());
     benchmark::DoNotOptimize(data.A.data());
@@ -58,10 +58,10 @@ void bench_dense_terms(benchmark::State& state) {
 
 void bench_sparse_terms(benchmark::State& state) {
   const Model model = make_chain_model(static_cast<int>(state.range(0)), symbolic::TermsLayout::sparse);
-  SparseData data = make_sparse_data(model);
+  Data data = make_data(model, DataOptions{Path::sparse, Method::sanh, false});
   for (auto _ : state) {
-    compute_sparse_terms(model, data, model.t0, model.q0.data(), model.v0.data());
-    benchmark::DoNotOptimize(data.A.valuePtr());
+    compute_terms(model, data, model.t0, model.q0.data(), model.v0.data());
+    benchmark::DoNotOptimize(data.A_sparse.valuePtr());
     benchmark::ClobberMemory();
   }
   state.counters["n"] = model.n();
@@ -69,7 +69,7 @@ void bench_sparse_terms(benchmark::State& state) {
 
 void bench_dense_solve(benchmark::State& state, FormulationOptions options) {
   const Model model = make_chain_model(static_cast<int>(state.range(0)), symbolic::TermsLayout::dense);
-  Data data = make_data(model);
+  Data data = make_data(model, DataOptions{Path::dense, options.method, false});
   if (compute_dynamics(model, data, options, model.t0, model.q0.data(), model.v0.data()) != Status::ok) {
     state.SkipWithError("compute_dynamics failed at the chain's initial state");
     return;
@@ -83,18 +83,27 @@ void bench_dense_solve(benchmark::State& state, FormulationOptions options) {
   state.counters["n"] = model.n();
 }
 
-using SparseSolve = Status (*)(const Model&, SparseData&);
-
-void bench_sparse_solve(benchmark::State& state, SparseSolve solve) {
+void bench_sparse_solve(benchmark::State& state, FormulationOptions options) {
   const Model model = make_chain_model(static_cast<int>(state.range(0)), symbolic::TermsLayout::sparse);
-  SparseData data = make_sparse_data(model);
-  if (compute_sparse_terms(model, data, model.t0, model.q0.data(), model.v0.data()) != Status::ok ||
-      solve(model, data) != Status::ok) {
+  Data data = make_data(model, DataOptions{Path::sparse, options.method, false});
+  if (compute_dynamics(model, data, options, model.t0, model.q0.data(), model.v0.data()) != Status::ok) {
     state.SkipWithError("the sparse solve failed at the chain's initial state");
     return;
   }
   for (auto _ : state) {
-    Status status = solve(model, data);
+    Status status = compute_acceleration(model, data, options);
+    benchmark::DoNotOptimize(status);
+    benchmark::DoNotOptimize(data.qdd.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["n"] = model.n();
+}
+
+void bench_sparse_rhs(benchmark::State& state, FormulationOptions options) {
+  const Model model = make_chain_model(static_cast<int>(state.range(0)), symbolic::TermsLayout::sparse);
+  Data data = make_data(model, DataOptions{Path::sparse, options.method, false});
+  for (auto _ : state) {
+    Status status = compute_dynamics(model, data, options, model.t0, model.q0.data(), model.v0.data());
     benchmark::DoNotOptimize(status);
     benchmark::DoNotOptimize(data.qdd.data());
     benchmark::ClobberMemory();
@@ -127,12 +136,15 @@ const bool registered = [] {
     for (long n : dense_sizes) b->Arg(n);
     b->Unit(benchmark::kMicrosecond);
   }
-  const std::vector<std::pair<std::string, SparseSolve>> sparse{
-      {"sanh", &compute_sparse_sanh_acceleration}, {"lagrange", &compute_sparse_lagrange_acceleration}};
-  for (const auto& [name, solve] : sparse) {
-    auto* b = benchmark::RegisterBenchmark(("chain/solve/sparse/" + name).c_str(), bench_sparse_solve, solve);
+  const std::vector<std::pair<std::string, FormulationOptions>> sparse{{"sanh", FormulationOptions(Method::sanh)},
+                                                                       {"lagrange", FormulationOptions(Method::lagrange)}};
+  for (const auto& [name, options] : sparse) {
+    auto* b = benchmark::RegisterBenchmark(("chain/solve/sparse/" + name).c_str(), bench_sparse_solve, options);
     for (long n : sparse_sizes) b->Arg(n);
     b->Unit(benchmark::kMicrosecond);
+    auto* r = benchmark::RegisterBenchmark(("chain/rhs/sparse/" + name).c_str(), bench_sparse_rhs, options);
+    for (long n : sparse_sizes) r->Arg(n);
+    r->Unit(benchmark::kMicrosecond);
   }
   return true;
 }();

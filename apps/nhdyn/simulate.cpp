@@ -172,8 +172,11 @@ int run_simulate(const SimulateArgs& args) {
 
   if (!args.quiet) {
     const bool adaptive = options.integrator.kind != IntegratorKind::rk4;
-    fmt::print("nhdyn simulate {}: method {} (D: {}), integrator {}{}\n", model.name,
-               method_name(options.formulation.method), complement_name(options.formulation.complement),
+    fmt::print("nhdyn simulate {}: method {} ({}), integrator {}{}\n", model.name,
+               method_name(options.formulation.method),
+               summary.sparse ? std::string(options.formulation.method == Method::sanh ? "sparse path, D: partition"
+                                                                                        : "sparse path")
+                              : fmt::format("D: {}", complement_name(options.formulation.complement)),
                integrator_name(options.integrator.kind),
                adaptive ? fmt::format(" (rtol {:g}, atol {:g})", options.integrator.rtol, options.integrator.atol) : "");
     if (options.stabilization == Stabilization::baumgarte)

@@ -1,5 +1,9 @@
 // The acceleration solve allocates nothing after Data exists: every formulation and every choice
-// of D is run once, then again under a counting global operator new that must stay at zero.
+// of D is run once, then again under a counting global operator new that must stay at zero. On
+// the sparse path (the built-in models' sparse twins, formulation/sparse_twin.hpp) the terms,
+// residuals, energy and Baumgarte's terms allocate nothing, and a solve allocates exactly what its
+// sparse factorizations allocate when run alone on the same matrices (Eigen's SparseLU allocates
+// its factors in every factorize(); docs/design.md).
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -7,8 +11,11 @@
 #include <new>
 #include <vector>
 
+#include "formulation/sparse_twin.hpp"
 #include "nhdyn/analysis/projection.hpp"
 #include "nhdyn/analysis/residuals.hpp"
+#include "nhdyn/formulation/baumgarte.hpp"
+#include "nhdyn/model/terms.hpp"
 #include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/model/appell.hpp"
 #include "nhdyn/model/sled.hpp"
@@ -133,6 +140,61 @@ TEST(Allocation, StabilizationAllocatesNothing) {
     g_counting = false;
     EXPECT_EQ(g_allocations.load(), 0) << model.name;
     EXPECT_GE(iterations, 10) << model.name << ": the projections had nothing to do";
+  }
+}
+
+template <class F>
+long count_allocations(F&& f) {
+  g_allocations = 0;
+  g_counting = true;
+  f();
+  g_counting = false;
+  return g_allocations.load();
+}
+
+TEST(Allocation, SparsePathAllocatesOnlyInsideItsSparseFactorizations) {
+  for (const Model& dense_model : {make_sled_model(), make_sled_model(SledVariant::paper), make_appell_model()}) {
+    const Model model = testing::make_sparse_twin(dense_model);
+    Data data = make_data(model);
+    ASSERT_TRUE(data.sparse);
+    Vector q(3), v(3);
+    q << 0.1, 0.2, 0.3;
+    v << 0.5, 0.6, 0.7;
+    FormulationOptions options{Method::sanh, Complement::qr};
+    options.baumgarte.enabled = true;
+    ASSERT_EQ(compute_dynamics(model, data, options, 0.0, q.data(), v.data()), Status::ok);
+    const long terms = count_allocations([&] {
+      for (int i = 0; i < 10; ++i) {
+        q(2) += 0.01;
+        compute_terms(model, data, 0.1 * i, q.data(), v.data());
+        compute_baumgarte_terms(model, data, options.baumgarte);
+      }
+    });
+    ASSERT_EQ(compute_acceleration(model, data, options), Status::ok);
+    const long side = terms + count_allocations([&] {
+      compute_residuals(model, data);
+      compute_energy(model, data);
+    });
+    EXPECT_EQ(side, 0) << model.name << ": terms, Baumgarte's terms, residuals or energy allocated";
+    for (Method m : {Method::sanh, Method::lagrange}) {
+      const FormulationOptions plain(m);
+      ASSERT_EQ(compute_dynamics(model, data, plain, 0.2, q.data(), v.data()), Status::ok);
+      const long solve = count_allocations([&] { compute_acceleration(model, data, plain); });
+      // The same factorization and solve alone, on the matrices the kernel has just filled.
+      const long factors = count_allocations([&] {
+        if (m == Method::sanh) {
+          data.lu_dep->factorize(data.b_dep_sparse);
+          data.X = data.lu_dep->solve(data.b_ind);
+        } else {
+          data.lu_kkt_sparse->factorize(data.K_sparse);
+          data.kkt_sol = data.lu_kkt_sparse->solve(data.kkt_rhs);
+        }
+      });
+      EXPECT_EQ(solve, factors) << model.name << " " << method_name(m);
+      if (kCountsMalloc) {
+        EXPECT_GT(factors, 0) << "SparseLU no longer allocates: tighten this test to zero";
+      }
+    }
   }
 }
 

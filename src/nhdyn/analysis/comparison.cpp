@@ -17,7 +17,10 @@ double max_abs(const Vector& v) { return v.size() > 0 ? v.cwiseAbs().maxCoeff() 
 
 double time_one_solve(const Model& model, const FormulationOptions& formulation, int samples) {
   if (samples <= 0) return std::numeric_limits<double>::quiet_NaN();
-  Data data = make_data(model);
+  DataOptions data_options;
+  data_options.method = formulation.method;
+  data_options.projection = false;
+  Data data = make_data(model, data_options);
   if (compute_dynamics(model, data, formulation, model.t0, model.q0.data(), model.v0.data()) != Status::ok)
     return std::numeric_limits<double>::quiet_NaN();
   // The best of three batches: a batch that another process interrupted says nothing of the solve.

@@ -84,7 +84,23 @@ class Differentiator {
       else
         dv_(input - 1 - n) = 1.0;
       const ModelPrograms& p = programs_->programs();
-      run_tangent(p.terms, values_[0].data(), dt, dq_.data(), dv_.data(), tangents_.data(), out.data());
+      if (const TermsSparsity* sparsity = programs_->sparsity()) {
+        // A program compiled sparse writes only the nonzeros of A and b (model/sparsity.hpp):
+        // its tangent comes in that layout and is scattered into the dense one of Layout.
+        const int a_nz = sparsity->A.nonzeros(), b_nz = sparsity->b.nonzeros();
+        sparse_tangent_.resize(static_cast<std::size_t>(a_nz + 2 * n + b_nz + layout_.s));
+        run_tangent(p.terms, values_[0].data(), dt, dq_.data(), dv_.data(), tangents_.data(), sparse_tangent_.data());
+        const double* a_values = sparse_tangent_.data();
+        const double* qg_values = a_values + a_nz;
+        const double* b_values = qg_values + 2 * n;
+        const double* b0_values = b_values + b_nz;
+        scatter(sparsity->A, a_values, out.data() + layout_.A());
+        std::copy(qg_values, qg_values + 2 * n, out.data() + layout_.Q());
+        scatter(sparsity->b, b_values, out.data() + layout_.b());
+        std::copy(b0_values, b0_values + layout_.s, out.data() + layout_.b0());
+      } else {
+        run_tangent(p.terms, values_[0].data(), dt, dq_.data(), dv_.data(), tangents_.data(), out.data());
+      }
       if (layout_.p > 0)
         run_tangent(p.position_residual, values_[1].data(), dt, dq_.data(), nullptr, tangents_.data(),
                     out.data() + layout_.phi());
@@ -123,6 +139,15 @@ class Differentiator {
     return (plus - minus) / (2.0 * h);
   }
 
+  // The values of a compressed-column pattern into a dense column-major matrix (zero elsewhere).
+  static void scatter(const SparsityPattern& pattern, const double* values, double* dense) {
+    const Index rows = pattern.rows;
+    std::fill(dense, dense + rows * pattern.cols, 0.0);
+    for (int j = 0; j < pattern.cols; ++j)
+      for (int k = pattern.outer[static_cast<std::size_t>(j)]; k < pattern.outer[static_cast<std::size_t>(j) + 1]; ++k)
+        dense[j * rows + pattern.inner[static_cast<std::size_t>(k)]] = values[k];
+  }
+
   const Model& model_;
   Layout layout_;
   double t_;
@@ -131,6 +156,7 @@ class Differentiator {
   std::vector<double> scratch_;
   std::vector<std::vector<double>> values_;
   std::vector<double> tangents_;
+  std::vector<double> sparse_tangent_;  // the tangent of a terms program compiled sparse
   Vector dq_, dv_;
 };
 

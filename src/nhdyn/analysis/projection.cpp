@@ -4,7 +4,10 @@
 #include <cmath>
 #include <limits>
 
+#include <stdexcept>
+
 #include "nhdyn/formulation/sanh.hpp"
+#include "nhdyn/formulation/sparse_lagrange.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {
@@ -53,6 +56,19 @@ void estimate_scale(const Model& model, Data& data, double t, double* q, double*
   Vector& scale = data.projection_scale;
   const Eigen::Index m = r.size();
   r0.head(m) = r;
+  // b dx (tmp_s) and the largest entry of each row of b (tmp_s3), on either path.
+  Vector& predicted_all = data.tmp_s;
+  Vector& row_scale = data.tmp_s3;
+  if (data.sparse) {
+    predicted_all.noalias() = data.b_sparse * data.kkt_sol.head(n);
+    row_scale.setZero();
+    for (int j = 0; j < n; ++j)
+      for (SparseMatrix::InnerIterator it(data.b_sparse, j); it; ++it)
+        row_scale(it.row()) = std::max(row_scale(it.row()), std::abs(it.value()));
+  } else {
+    predicted_all.noalias() = data.b * data.kkt_sol.head(n);
+    for (int i = 0; i < model.s(); ++i) row_scale(i) = data.b.row(i).cwiseAbs().maxCoeff();
+  }
   const double h = std::min(1.0, 1e-7 * std::max(1.0, x_size) / step_size);
   for (int i = 0; i < n; ++i) x[i] += h * data.kkt_sol(i);
   evaluate_residual(model, data, t, q, v, level);
@@ -60,10 +76,10 @@ void estimate_scale(const Model& model, Data& data, double t, double* q, double*
   Eigen::Index j = 0;
   for (int i = 0; i < model.s(); ++i) {
     if (!belongs_to(model.constraints[static_cast<std::size_t>(i)].level, level)) continue;
-    const double predicted = data.b.row(i).dot(data.kkt_sol.head(n));
+    const double predicted = predicted_all(i);
     const double actual = (r(j) - r0(j)) / h;
     const double ratio = actual / predicted;
-    const bool measurable = std::abs(predicted) > 1e-8 * data.b.row(i).cwiseAbs().maxCoeff() * step_size &&
+    const bool measurable = std::abs(predicted) > 1e-8 * row_scale(i) * step_size &&
                             std::abs(r(j) - r0(j)) > 1e-6 * std::abs(r0(j));
     // Within the accuracy of the difference, 1 is 1: rows that are the gradients keep the exact
     // Newton step (one step for a constraint linear in x).
@@ -93,18 +109,29 @@ Status project_level(const Model& model, Data& data, double t, double* q, double
     if (status != Status::ok) return status;
     // Constraints of other levels keep a row of the KKT matrix with a unit diagonal and a zero
     // right-hand side: their multiplier is zero and the matrix keeps the size make_data gave it.
-    data.K.setZero();
-    data.K.topLeftCorner(n, n) = data.A;
-    for (int i = 0; i < s; ++i) {
-      if (belongs_to(model.constraints[static_cast<std::size_t>(i)].level, level)) {
-        data.K.row(n + i).head(n) = data.b.row(i);
-        data.K.col(n + i).head(n) = data.b.row(i).transpose();
-      } else {
-        data.K(n + i, n + i) = 1.0;
+    bool singular = false;
+    if (data.sparse) {
+      for (int i = 0; i < s; ++i)
+        data.projection_rows[static_cast<std::size_t>(i)] =
+            belongs_to(model.constraints[static_cast<std::size_t>(i)].level, level) ? 1 : 0;
+      fill_sparse_kkt(data, data.projection_rows.data());
+      data.lu_kkt_sparse->factorize(data.K_sparse);
+      singular = data.lu_kkt_sparse->info() != Eigen::Success;
+    } else {
+      data.K.setZero();
+      data.K.topLeftCorner(n, n) = data.A;
+      for (int i = 0; i < s; ++i) {
+        if (belongs_to(model.constraints[static_cast<std::size_t>(i)].level, level)) {
+          data.K.row(n + i).head(n) = data.b.row(i);
+          data.K.col(n + i).head(n) = data.b.row(i).transpose();
+        } else {
+          data.K(n + i, n + i) = 1.0;
+        }
       }
+      data.lu_kkt.compute(data.K);
+      singular = lu_is_singular(data.lu_kkt);
     }
-    data.lu_kkt.compute(data.K);
-    if (lu_is_singular(data.lu_kkt)) {
+    if (singular) {
       record_failure(data, Status::singular_system, "projection's KKT matrix [A J^T; J 0]");
       data.failed_t = t;
       return Status::singular_system;
@@ -117,7 +144,10 @@ Status project_level(const Model& model, Data& data, double t, double* q, double
           data.kkt_rhs(n + i) = -r(j) / scale(j);
           ++j;
         }
-      data.kkt_sol = data.lu_kkt.solve(data.kkt_rhs);
+      if (data.sparse)
+        data.kkt_sol = data.lu_kkt_sparse->solve(data.kkt_rhs);
+      else
+        data.kkt_sol = data.lu_kkt.solve(data.kkt_rhs);
       if (pass == 0) {
         double step = 0.0, size = 0.0;
         for (int i = 0; i < n; ++i) {
@@ -147,6 +177,9 @@ Status project_level(const Model& model, Data& data, double t, double* q, double
 
 Status compute_projection(const Model& model, Data& data, double t, double* q, double* v,
                           const ProjectionOptions& options, ProjectionResult& result) {
+  if (!data.projection_workspace)
+    throw std::logic_error("compute_projection: this Data was made without the projection's workspace "
+                           "(DataOptions::projection)");
   result = ProjectionResult{};
   Status status = project_level(model, data, t, q, v, ConstraintLevel::position, options,
                                 result.position_iterations, result.position_change, result.position_residual);

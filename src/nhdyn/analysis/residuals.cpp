@@ -11,7 +11,10 @@ void compute_residuals(const Model& model, Data& data) {
   if (data.phi.size() > 0) ev.position_residual(data.t, data.q.data(), data.scratch.data(), data.phi.data());
   if (data.f.size() > 0)
     ev.velocity_residual(data.t, data.q.data(), data.v.data(), data.scratch.data(), data.f.data());
-  data.e.noalias() = data.b * data.qdd;
+  if (data.sparse)
+    data.e.noalias() = data.b_sparse * data.qdd;
+  else
+    data.e.noalias() = data.b * data.qdd;
   data.e += data.b0;
 }
 

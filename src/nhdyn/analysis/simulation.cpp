@@ -132,7 +132,12 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
 SimulationSummary simulate(const Model& model, const SimulationOptions& options, const RowFn& row) {
   check_simulation_options(model, options);
   const std::vector<double> times = make_output_times(model.t0, options.t_end, options.output_step);
-  Data data = make_data(model);
+  // The Data of the chosen formulation only, on the path the model takes (model/data.hpp).
+  DataOptions data_options;
+  data_options.path = options.path;
+  data_options.method = options.formulation.method;
+  data_options.projection = options.fix_initial || options.stabilization == Stabilization::projection;
+  Data data = make_data(model, data_options);
   check_state_or_throw(model, data, model.t0, model.q0.data(), model.v0.data());
   SimulationSummary summary;
   Vector q0 = model.q0, v0 = model.v0;
@@ -190,6 +195,8 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.status = output_failure != Status::ok ? output_failure : result.status;
   summary.t_reached = result.t_reached;
+  summary.sparse = data.sparse;
+  summary.partition_changes = data.partition_changes;
   summary.stats = result.stats;
   if (summary.status != Status::ok) {
     // The kernels recorded the details of a failed evaluation in data; prefer those words.

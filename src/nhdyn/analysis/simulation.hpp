@@ -42,6 +42,10 @@ struct SimulationOptions {
   // Baumgarte's gains are formulation.baumgarte.{alpha, beta}; `baumgarte` switches them on.
   Stabilization stabilization = Stabilization::none;
   ProjectionOptions projection;
+  // Dense or sparse kernels (model/data.hpp): `automatic` takes the sparse path for a model
+  // compiled sparse and a formulation with sparse kernels (sanh, lagrange), the dense path
+  // otherwise (udwadia-kalaba and nullspace on a sparse model: dense, if it fits in memory).
+  Path path = Path::automatic;
 };
 
 struct SimulationSummary {
@@ -51,6 +55,8 @@ struct SimulationSummary {
   IntegratorStats stats;
   long outputs = 0;                 // rows handed to the caller
   double wall_time = 0.0;           // [s], integration and output evaluation
+  bool sparse = false;              // whether the run took the sparse kernels (model/data.hpp)
+  long partition_changes = 0;       // sparse sanh: times the dependent coordinates were chosen anew
   double max_position_residual = 0.0;      // max |phi| over outputs and constraints
   double max_velocity_residual = 0.0;      // max |f|
   double max_acceleration_residual = 0.0;  // max |b q'' + b0|

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseQR>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -14,8 +17,80 @@ namespace {
 
 constexpr double kRankTolerance = 1e-12;
 
+// Beyond this many coordinates, or on the sparse path, the checks take sparse factorizations
+// (a sparse QR for the rank of b, a sparse Cholesky factorization for A) instead of the dense SVD
+// and eigenvalues, whose O(n^3) cost took minutes at n = 3000 (docs/performance.md).
+constexpr int kDenseChecksUpTo = 64;
+
+bool sparse_checks(const Model& model, const Data& data) { return data.sparse || model.n() > kDenseChecksUpTo; }
+
+SparseMatrix sparse_a(const Data& data) { return data.sparse ? data.A_sparse : SparseMatrix(data.A.sparseView()); }
+SparseMatrix sparse_b(const Data& data) { return data.sparse ? data.b_sparse : SparseMatrix(data.b.sparseView()); }
+
+// The column-pivoted sparse QR of b^T: its columns are the constraints, so the columns it moves
+// behind the rank are the constraints that depend on the others.
+struct SparseRank {
+  long rank = 0;
+  std::vector<int> dependent_rows;  // constraints beyond the rank, in pivot order
+  double condition = 0.0;           // |R(0,0)| / |R(r-1,r-1)|, a rough estimate
+};
+
+SparseRank calc_sparse_rank(const Data& data) {
+  SparseRank out;
+  const SparseMatrix bt = sparse_b(data).transpose();
+  if (bt.cols() == 0) return out;
+  Eigen::SparseQR<SparseMatrix, Eigen::COLAMDOrdering<int>> qr;
+  // Eigen's default threshold is 20 (rows + cols) eps max|column|: a rank test of the same order
+  // as the dense one (kRankTolerance relative to the largest singular value).
+  qr.compute(bt);
+  if (qr.info() != Eigen::Success) return out;
+  out.rank = qr.rank();
+  for (long j = out.rank; j < bt.cols(); ++j) out.dependent_rows.push_back(qr.colsPermutation().indices()(j));
+  const SparseMatrix R = qr.matrixR();
+  double first = 0.0, last = std::numeric_limits<double>::infinity();
+  for (long j = 0; j < out.rank; ++j) {
+    const double d = std::abs(R.coeff(j, j));
+    first = std::max(first, d);
+    last = std::min(last, d);
+  }
+  out.condition = out.rank > 0 && last > 0.0 ? first / last : std::numeric_limits<double>::infinity();
+  return out;
+}
+
+std::string explain_dependent_constraints_sparse(const Model& model, const Data& data) {
+  const SparseRank r = calc_sparse_rank(data);
+  std::string involved;
+  for (int i : r.dependent_rows)
+    involved += (involved.empty() ? "" : ", ") + ("'" + model.constraints[static_cast<std::size_t>(i)].name + "'");
+  return fmt::format(
+      "the constraints {} depend on the others or conflict with them at t = {:.6g}: the constraint matrix b has "
+      "rank {} below s = {} (a sparse QR with column pivoting; condition estimate of the rest {:.3g}). Remove or "
+      "rewrite a redundant constraint, or check that the state does not sit on a singular configuration of the "
+      "constraints.",
+      involved.empty() ? std::string("(all)") : involved, data.t, r.rank, model.s(), r.condition);
+}
+
+// The smallest and largest pivots of an LDL^T factorization of A: of the signs of the eigenvalues
+// (Sylvester's law of inertia), without the O(n^3) eigenvalue solver.
+std::string explain_inertia_sparse(const Model& model, const Data& data) {
+  const SparseMatrix A = sparse_a(data);
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt(A);
+  double smallest = std::numeric_limits<double>::quiet_NaN(), largest = smallest;
+  if (ldlt.info() == Eigen::Success && ldlt.vectorD().size() > 0) {
+    smallest = ldlt.vectorD().minCoeff();
+    largest = ldlt.vectorD().maxCoeff();
+  }
+  const double asymmetry = (A - SparseMatrix(A.transpose())).norm();
+  return fmt::format(
+      "the inertia matrix A is not positive definite at t = {:.6g} (smallest pivot of its LDL^T factorization "
+      "{:.6g}, largest {:.6g}; asymmetry |A - A^T| = {:.3g}; n = {} coordinates). Check the kinetic energy: every "
+      "coordinate needs a velocity term, and masses and inertias must be positive.",
+      data.t, smallest, largest, asymmetry, model.n());
+}
+
 // Singular values of b and, for each small one, the constraints taking part in the dependency.
 std::string explain_dependent_constraints(const Model& model, const Data& data) {
+  if (sparse_checks(model, data)) return explain_dependent_constraints_sparse(model, data);
   Eigen::JacobiSVD<Matrix> svd(data.b, Eigen::ComputeFullU);
   const Vector& sv = svd.singularValues();
   const double largest = sv.size() > 0 ? sv(0) : 0.0;
@@ -40,6 +115,7 @@ std::string explain_dependent_constraints(const Model& model, const Data& data) 
 }
 
 std::string explain_inertia(const Model& model, const Data& data) {
+  if (sparse_checks(model, data)) return explain_inertia_sparse(model, data);
   Eigen::SelfAdjointEigenSolver<Matrix> eig(data.A, Eigen::EigenvaluesOnly);
   std::string coords;
   for (const std::string& c : model.coordinates) coords += (coords.empty() ? "" : ", ") + c;
@@ -50,14 +126,22 @@ std::string explain_inertia(const Model& model, const Data& data) {
       data.t, eig.eigenvalues()(0), eig.eigenvalues()(eig.eigenvalues().size() - 1), coords);
 }
 
-bool b_is_rank_deficient(const Data& data) {
-  if (data.b.rows() == 0) return false;
+bool b_is_rank_deficient(const Model& model, const Data& data) {
+  if (model.s() == 0) return false;
+  if (sparse_checks(model, data)) return calc_sparse_rank(data).rank < model.s();
   Eigen::JacobiSVD<Matrix> svd(data.b);
   const Vector& sv = svd.singularValues();
   return !(sv(sv.size() - 1) > kRankTolerance * sv(0));
 }
 
-bool a_is_positive_definite(const Data& data) {
+bool a_is_positive_definite(const Model& model, const Data& data) {
+  if (sparse_checks(model, data)) {
+    const SparseMatrix A = sparse_a(data);
+    const double asymmetry = (A - SparseMatrix(A.transpose())).norm();
+    if (!(asymmetry <= 1e-12 * A.norm())) return false;
+    Eigen::SimplicialLLT<SparseMatrix> llt(A);
+    return llt.info() == Eigen::Success;
+  }
   Eigen::LLT<Matrix> llt(data.A);
   return llt.info() == Eigen::Success && data.A.isApprox(data.A.transpose(), 1e-12);
 }
@@ -75,8 +159,8 @@ std::string explain_failure(const Model& model, const Data& data) {
                          "tan(phi) at its singular point)",
                          data.failed_quantity, data.failed_t);
     case Status::singular_system:
-      if (b_is_rank_deficient(data)) return explain_dependent_constraints(model, data);
-      if (!a_is_positive_definite(data)) return explain_inertia(model, data);
+      if (b_is_rank_deficient(model, data)) return explain_dependent_constraints(model, data);
+      if (!a_is_positive_definite(model, data)) return explain_inertia(model, data);
       return fmt::format("the {} is singular at t = {:.6g} although A is positive definite and b has "
                          "full rank; this points to a D that is not a complement of b",
                          data.failed_quantity, data.failed_t);
@@ -91,9 +175,9 @@ std::string explain_failure(const Model& model, const Data& data) {
 }
 
 Status check_terms(const Model& model, Data& data) {
-  if (!a_is_positive_definite(data))
+  if (!a_is_positive_definite(model, data))
     return record_failure(data, Status::inertia_not_positive_definite, "inertia matrix A");
-  if (model.s() > 0 && b_is_rank_deficient(data))
+  if (model.s() > 0 && b_is_rank_deficient(model, data))
     return record_failure(data, Status::dependent_constraints, "constraint matrix b");
   return Status::ok;
 }

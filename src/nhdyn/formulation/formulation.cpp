@@ -8,6 +8,8 @@
 #include "nhdyn/formulation/lagrange.hpp"
 #include "nhdyn/formulation/nullspace.hpp"
 #include "nhdyn/formulation/sanh.hpp"
+#include "nhdyn/formulation/sparse_lagrange.hpp"
+#include "nhdyn/formulation/sparse_sanh.hpp"
 #include "nhdyn/formulation/udwadia_kalaba.hpp"
 #include "nhdyn/model/terms.hpp"
 
@@ -49,6 +51,15 @@ Complement parse_complement(std::string_view name) {
 Status compute_acceleration(const Model& model, Data& data, const FormulationOptions& options) {
   if (data.stage < Stage::terms)
     throw std::logic_error("compute_acceleration: call compute_terms first for the current state");
+  if (data.method && *data.method != options.method)
+    throw std::logic_error("compute_acceleration: this Data was made for the " + std::string(method_name(*data.method)) +
+                           " formulation; make one for " + std::string(method_name(options.method)) +
+                           " (make_data with DataOptions::method)");
+  if (data.sparse && options.method != Method::sanh && options.method != Method::lagrange)
+    throw std::logic_error("compute_acceleration: the " + std::string(method_name(options.method)) +
+                           " formulation has no sparse kernels; use sanh or lagrange on the sparse path, or make "
+                           "the Data with DataOptions::method = " + std::string(method_name(options.method)) +
+                           " (the dense path)");
   data.has_multipliers = false;
   if (options.baumgarte.enabled) {
     compute_baumgarte_terms(model, data, options.baumgarte);
@@ -56,7 +67,10 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
     data.b0 += data.stabilization;
   }
   Status status = Status::ok;
-  switch (options.method) {
+  if (data.sparse)
+    status = options.method == Method::sanh ? compute_sparse_sanh_acceleration(model, data)
+                                            : compute_sparse_lagrange_acceleration(model, data);
+  else switch (options.method) {
     case Method::sanh: status = compute_sanh_acceleration(model, data, options.complement); break;
     case Method::lagrange: status = compute_lagrange_acceleration(model, data); break;
     case Method::udwadia_kalaba: status = compute_udwadia_kalaba_acceleration(model, data); break;

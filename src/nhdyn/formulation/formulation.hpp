@@ -13,7 +13,8 @@
 
 namespace nhdyn {
 
-enum class Method { sanh, lagrange, udwadia_kalaba, nullspace };
+// enum class Method { sanh, lagrange, udwadia_kalaba, nullspace } is declared in model/data.hpp,
+// because make_data sizes the workspace of one formulation.
 
 // Where D comes from (FORMULATION.md section 3): the model's analytic D, coordinate
 // partitioning, or an orthonormal basis of null(b) from a QR factorization (the default).
@@ -38,7 +39,11 @@ Complement parse_complement(std::string_view name);  // throws InputError listin
 
 // Requires compute_terms for the current state (Stage::terms). Writes data.qdd, data.R,
 // data.lambda (when the method has multipliers), data.D (sanh, nullspace) and sets
-// Stage::acceleration. With Baumgarte gains enabled, the formulation solves the stabilized
+// Stage::acceleration. On the sparse path (data.sparse) it runs the sparse kernels of sanh
+// (sparse_sanh.hpp, always with the partitioned D whatever `options.complement` says) or
+// lagrange (sparse_lagrange.hpp). Throws std::logic_error when data was made for another
+// formulation (DataOptions::method) or, on the sparse path, for udwadia-kalaba and nullspace,
+// which have no sparse kernels (make_data with that method takes the dense path instead). With Baumgarte gains enabled, the formulation solves the stabilized
 // constraint (b0 + data.stabilization in place of b0); data.b0 keeps the model's b0 on return.
 // Allocates nothing. On numerical trouble returns a non-ok status, records
 // it in data, and leaves stage at Stage::terms; explain_failure (diagnosis.hpp) gives the words.

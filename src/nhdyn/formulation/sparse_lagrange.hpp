@@ -2,16 +2,23 @@
 // solve: one sparse LU (Eigen's SparseLU, like sparse_sanh.hpp) of
 //     [ A  b^T ] [ q''    ]   [ Q + G ]
 //     [ b   0  ] [ lambda ] = [ -b0   ],   R = -b^T lambda as in formulation/lagrange.hpp,
-// an (n + s)-square matrix whose pattern make_sparse_data analyses once.
+// an (n + s)-square matrix whose pattern make_data analyses once (Data::K_sparse, shared with the
+// projection, which puts ones on the diagonal of the rows it leaves out).
 #pragma once
 
 #include "nhdyn/core/status.hpp"
+#include "nhdyn/model/data.hpp"
 #include "nhdyn/model/model.hpp"
-#include "nhdyn/model/sparse_data.hpp"
 
 namespace nhdyn {
 
-// Requires compute_sparse_terms for the current state. Writes data.qdd, data.lambda, data.R.
-Status compute_sparse_lagrange_acceleration(const Model& model, SparseData& data);
+// Requires compute_terms on a sparse Data (data.sparse). Writes data.qdd, data.lambda, data.R.
+// Status::singular_system when the KKT matrix is singular. Allocates nothing beyond SparseLU's
+// factors.
+Status compute_sparse_lagrange_acceleration(const Model& model, Data& data);
+
+// Fills data.K_sparse from A and b: the rows of b whose flag in `keep` is 1 (all when `keep` is
+// null) with their transposes, a unit diagonal for the others, zero on the kept diagonal.
+void fill_sparse_kkt(Data& data, const char* keep);
 
 }  // namespace nhdyn

@@ -3,6 +3,13 @@
 // One Data per thread is the whole thread-safety story. Each field says its size and which
 // kernel fills it; `stage` records how far the kernels have got for the current state, so that a
 // kernel called out of order says so instead of reading stale values.
+//
+// One Data serves both paths (docs/design.md, "One Data, dense or sparse inside"). The dense path
+// holds A and b as dense matrices; the sparse path, taken for a model compiled sparse
+// (Evaluator::sparsity()), holds them as Eigen sparse matrices on the evaluator's pattern
+// (A_sparse, b_sparse) and leaves the dense n x n fields empty. make_data chooses the path and
+// sizes only the workspace of the path and of the formulation asked for (DataOptions), so that a
+// dense Data made for sanh holds no KKT matrix and a sparse Data holds no n x n matrix at all.
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -10,6 +17,11 @@
 #include <Eigen/LU>
 #include <Eigen/QR>
 #include <Eigen/SVD>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,10 +31,38 @@
 
 namespace nhdyn {
 
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+using SparseLU = Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>>;
+using SparseLLT = Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>;
+
+// The formulations (formulation/formulation.hpp says what each one solves). Declared here because
+// make_data sizes the workspace of the one it is asked for.
+enum class Method { sanh, lagrange, udwadia_kalaba, nullspace };
+
+// Which kernels a Data is made for: `automatic` takes the sparse path for a model compiled sparse
+// (Evaluator::sparsity() not null) and a formulation that has sparse kernels (sanh, lagrange),
+// the dense path otherwise.
+enum class Path { automatic, dense, sparse };
+
+struct DataOptions {
+  Path path = Path::automatic;
+  // The formulation the Data will run. Empty: the workspace of every formulation (dense path),
+  // for tools and tests that switch formulations on one Data.
+  std::optional<Method> method;
+  // The KKT workspace of compute_projection (analysis/projection.hpp): (n + s)^2 on the dense
+  // path. Always there on the sparse path, where it costs O(nonzeros).
+  bool projection = true;
+};
+
 // How far the kernels have got for the state (t, q, v) held in Data.
 enum class Stage { empty = 0, terms = 1, acceleration = 2 };
 
 struct Data {
+  // --- how this Data was made (make_data) ---------------------------------------------------------
+  bool sparse = false;           // the sparse path: A_sparse, b_sparse and the sparse workspace
+  std::optional<Method> method;  // the formulation sized for; empty: every formulation
+  bool projection_workspace = false;  // whether compute_projection may run on this Data
+
   // --- state, set by compute_terms -------------------------------------------------------------
   double t = 0.0;       // time [s]
   Vector q;             // n coordinates
@@ -30,16 +70,18 @@ struct Data {
   Stage stage = Stage::empty;
 
   // --- terms of the equations (compute_terms, FORMULATION.md (2.4), (2.5)) -----------------------
-  Matrix A;             // n x n inertia matrix
+  Matrix A;             // n x n inertia matrix (dense path; 0 x 0 on the sparse path)
   Vector Q;             // n generalized forces
   Vector G;             // n velocity terms
-  Matrix b;             // s x n constraint matrix
+  Matrix b;             // s x n constraint matrix (dense path; 0 x 0 on the sparse path)
   Vector b0;            // s
+  SparseMatrix A_sparse;  // n x n on the evaluator's pattern (sparse path; empty on the dense path)
+  SparseMatrix b_sparse;  // s x n on the evaluator's pattern (sparse path)
   Vector stabilization; // s, Baumgarte terms 2 alpha f + beta^2 phi (compute_baumgarte_terms)
   Vector b0_model;      // s, the model's b0 while a stabilized one is solved (compute_acceleration)
 
-  // --- complement D (compute_complement) ---------------------------------------------------------
-  Matrix D;             // k x n, D b^T = 0 (2.8)
+  // --- complement D (compute_complement; the sparse sanh solve) ----------------------------------
+  Matrix D;             // k x n, D b^T = 0 (2.8); 0 x 0 where the formulation needs none
   std::vector<int> independent;  // k indices of the independent coordinates (partitioned D only)
 
   // --- results (compute_acceleration) ------------------------------------------------------------
@@ -63,23 +105,26 @@ struct Data {
   // --- counters ------------------------------------------------------------------------------
   long term_evaluations = 0;     // calls of compute_terms
   long acceleration_solves = 0;  // successful calls of compute_acceleration
+  long partition_changes = 0;    // sparse path: times the dependent coordinates were chosen anew
 
   // --- scratch (owned by the kernels; sizes fixed by make_data) ---------------------------------
+  // Fields a formulation does not use are left empty (0 x 0) by make_data.
   // Whether the formulations may take their fixed-size path for small n (formulation/
   // small_dense.hpp). Both paths compute the same values; tests clear it to compare them.
   bool small_kernels = true;
   std::vector<double> scratch;   // evaluator workspace, Evaluator::scratch_size()
   Vector h;                      // n, Q + G
-  Matrix M;                      // n x n, stacked sanh matrix [D A; b]
+  Matrix M;                      // n x n, stacked sanh matrix [D A; b] (dense sanh)
   Vector rhs;                    // n, stacked right-hand side [D (Q + G); -b0]
-  Matrix K;                      // (n + s) x (n + s), KKT matrix
+  Matrix K;                      // (n + s) x (n + s), KKT matrix (dense lagrange, projection)
   Vector kkt_rhs;                // n + s
   Vector kkt_sol;                // n + s
-  Matrix bt;                     // n x s, b^T
-  Matrix Q_full;                 // n x n, orthogonal factor of b^T
+  Matrix bt;                     // n x s, b^T (QR complement)
+  Matrix Q_full;                 // n x n, orthogonal factor of b^T (QR complement, udwadia-kalaba)
   Vector hh_work;                // n, Householder workspace
-  Matrix DA;                     // k x n, D A
-  Matrix DAD;                    // k x k, D A D^T
+  Matrix DA;                     // k x n, D A (nullspace)
+  Matrix DAD;                    // k x k, D A D^T (nullspace, sparse sanh)
+  Matrix AD;                     // n x k, A D^T (sparse sanh)
   Vector p;                      // n, particular solution of b p = -b0
   Vector w;                      // k, reduced accelerations
   Vector tmp_n;                  // n
@@ -87,38 +132,69 @@ struct Data {
   Vector tmp_s;                  // s
   Vector tmp_k;                  // k
   Vector tmp_s2;                 // s
+  Vector tmp_s3;                 // s, row scales of b (compute_projection)
+  std::vector<char> projection_rows;  // s flags, the constraints a projection step solves (compute_projection)
   Vector projection_scale;       // s, ratio of each constraint's gradient to its row of b (compute_projection)
-  Matrix bWt;                    // n x s, (b A^(-1/2))^T
-  Matrix b_dep;                  // s x s, columns of b of the dependent coordinates
-  Matrix b_ind;                  // s x k, columns of b of the independent coordinates
-  Matrix X;                      // s x k, b_dep^(-1) b_ind
+  Matrix bWt;                    // n x s, (b A^(-1/2))^T (udwadia-kalaba)
+  Matrix b_dep;                  // s x s, columns of b of the dependent coordinates (partitioned D)
+  Matrix b_ind;                  // s x k, columns of b of the independent coordinates; s x (k + 1)
+                                 // on the sparse path, with -b0 as its last column
+  Matrix X;                      // s x k, b_dep^(-1) b_ind; s x (k + 1) on the sparse path
   std::vector<int> dependent;    // s indices of the dependent coordinates
   std::vector<char> is_dependent;  // n flags
-  Eigen::PartialPivLU<Matrix> lu_n;          // n x n
-  Eigen::PartialPivLU<Matrix> lu_kkt;        // (n + s) x (n + s)
-  Eigen::PartialPivLU<Matrix> lu_s;          // s x s
-  Eigen::ColPivHouseholderQR<Matrix> qr_bt;  // n x s
-  Eigen::ColPivHouseholderQR<Matrix> qr_b;   // s x n
+  Eigen::PartialPivLU<Matrix> lu_n;          // n x n (dense sanh)
+  Eigen::PartialPivLU<Matrix> lu_kkt;        // (n + s) x (n + s) (dense lagrange, projection)
+  Eigen::PartialPivLU<Matrix> lu_s;          // s x s (partitioned D)
+  Eigen::ColPivHouseholderQR<Matrix> qr_bt;  // n x s (QR complement)
+  Eigen::ColPivHouseholderQR<Matrix> qr_b;   // s x n (partitioned D)
   Eigen::LLT<Matrix> llt_k;                  // k x k
-  Eigen::LLT<Matrix> llt_n;                  // n x n
-  Eigen::ColPivHouseholderQR<Matrix> qr_bWt;    // n x s, (b A^(-1/2))^T
+  Eigen::LLT<Matrix> llt_n;                  // n x n (udwadia-kalaba)
+  Eigen::ColPivHouseholderQR<Matrix> qr_bWt;    // n x s, (b A^(-1/2))^T (udwadia-kalaba)
+
+  // --- sparse workspace (sparse path only; make_data analyses every pattern once) ---------------
+  SparseMatrix b_dep_sparse;       // s x s, b(:, dependent), values gathered from b_sparse
+  std::vector<int> b_dep_source;   // for each value of b_dep_sparse, its index among b_sparse's values
+  std::unique_ptr<SparseLU> lu_dep;    // b_dep_sparse (SparseLU cannot be moved: held by pointer)
+  std::unique_ptr<SparseLLT> llt_a;    // A_sparse, for a model without constraints (s = 0)
+  SparseMatrix K_sparse;           // (n + s) x (n + s), [A b^T; b C] with C diagonal (0 for lagrange,
+                                   // 1 on the rows a projection leaves out)
+  std::vector<int> K_source;       // each value of K_sparse: A's index (>= 0), ~b's index, or kKktDiagonal
+  std::unique_ptr<SparseLU> lu_kkt_sparse;  // K_sparse
 };
 
-// Allocates every field of Data for `model` and sets the state to the model's initial state.
-// Throws ModelError (check_dense_memory) when its dense matrices would not fit in this machine's
-// memory, before allocating anything.
-Data make_data(const Model& model);
+// The code in Data::K_source of a diagonal entry of the lower right block of K_sparse.
+inline constexpr int kKktDiagonal = -(1 << 30);
 
-// Bytes of the dense matrices of a Data for n coordinates and s constraints: about
-// 8 (5 n^2 + 2 (n + s)^2 + 6 n s + 2 s^2) (A, M, the KKT matrix and the factorizations).
+// Whether make_data(model, options) takes the sparse path. Throws InputError when options ask
+// for the sparse path of a model not compiled sparse, or of a formulation without sparse kernels.
+bool calc_sparse_path(const Model& model, const DataOptions& options);
+
+// Allocates Data for `model` and the path and formulation of `options`, and sets the state to the
+// model's initial state. On the dense path it throws ModelError (check_dense_memory) when the
+// dense matrices would not fit in this machine's memory, before allocating anything. On the
+// sparse path it evaluates the terms at the initial state and chooses the dependent coordinates
+// there (a sparse QR of b with column pivoting); it throws ModelError when a term is not finite
+// or b has rank below s there.
+Data make_data(const Model& model, const DataOptions& options = {});
+
+// Bytes of the dense matrices of a Data for n coordinates and s constraints with the workspace of
+// every formulation: about 8 (5 n^2 + 2 (n + s)^2 + 6 n s + 2 s^2) (A, M, the KKT matrix and the
+// factorizations).
 double dense_data_bytes(int n, int s);
+// The same for the workspace make_data allocates with `options` on the dense path.
+double dense_data_bytes(int n, int s, const DataOptions& options);
 
-// Throws ModelError when dense_data_bytes(n, s) exceeds `available` bytes, saying how much is
+// Throws ModelError when the dense Data of `options` exceeds `available` bytes, saying how much is
 // needed, how much there is, the largest n that fits, and the way out (the sparse path of
 // docs/performance.md, or a smaller model).
-void check_dense_memory(const Model& model, double available);
+void check_dense_memory(const Model& model, double available, const DataOptions& options = {});
 
 // The physical memory of this machine in bytes (0 when the system does not say).
 double physical_memory_bytes();
+
+// Chooses the dependent coordinates of the sparse path anew at the state held in data (a sparse QR
+// of b_sparse with column pivoting) and analyses the pattern of b_dep once more. Cold path: it
+// allocates. Returns Status::dependent_constraints when b has rank below s there.
+Status compute_sparse_partition(const Model& model, Data& data);
 
 }  // namespace nhdyn

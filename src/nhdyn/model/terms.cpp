@@ -15,11 +15,15 @@ Status record_failure(Data& data, Status status, const char* quantity) {
   return status;
 }
 
+namespace {
+bool all_finite(const SparseMatrix& m) { return Eigen::Map<const Vector>(m.valuePtr(), m.nonZeros()).allFinite(); }
+}  // namespace
+
 const char* find_non_finite_term(const Data& data) {
-  if (!data.A.allFinite()) return "inertia matrix A";
+  if (!data.A.allFinite() || !all_finite(data.A_sparse)) return "inertia matrix A";
   if (!data.Q.allFinite()) return "generalized forces Q";
   if (!data.G.allFinite()) return "velocity terms G";
-  if (!data.b.allFinite()) return "constraint matrix b";
+  if (!data.b.allFinite() || !all_finite(data.b_sparse)) return "constraint matrix b";
   if (!data.b0.allFinite()) return "constraint term b0";
   return nullptr;
 }
@@ -31,8 +35,14 @@ Status compute_terms(const Model& model, Data& data, double t, const double* q, 
   if (q != data.q.data()) std::memcpy(data.q.data(), q, sizeof(double) * static_cast<std::size_t>(n));
   if (v != data.v.data()) std::memcpy(data.v.data(), v, sizeof(double) * static_cast<std::size_t>(n));
   data.stage = Stage::empty;
-  TermsOut out{data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data()};
-  model.evaluator->terms(t, data.q.data(), data.v.data(), data.scratch.data(), out);
+  // The sparse path (model/data.hpp) receives only the nonzeros of A and b.
+  if (data.sparse)
+    model.evaluator->sparse_terms(t, data.q.data(), data.v.data(), data.scratch.data(),
+                                  TermsOut{data.A_sparse.valuePtr(), data.Q.data(), data.G.data(),
+                                           data.b_sparse.valuePtr(), data.b0.data()});
+  else
+    model.evaluator->terms(t, data.q.data(), data.v.data(), data.scratch.data(),
+                           TermsOut{data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data()});
   ++data.term_evaluations;
   double acc = accumulate_non_finite(0.0, data.q);
   acc = accumulate_non_finite(acc, data.v);
@@ -41,6 +51,8 @@ Status compute_terms(const Model& model, Data& data, double t, const double* q, 
   acc = accumulate_non_finite(acc, data.G);
   acc = accumulate_non_finite(acc, data.b);
   acc = accumulate_non_finite(acc, data.b0);
+  acc = accumulate_non_finite(acc, data.A_sparse.valuePtr(), data.A_sparse.nonZeros());
+  acc = accumulate_non_finite(acc, data.b_sparse.valuePtr(), data.b_sparse.nonZeros());
   if (acc != 0.0) {
     if (!data.q.allFinite()) return record_failure(data, Status::non_finite, "coordinates q");
     if (!data.v.allFinite()) return record_failure(data, Status::non_finite, "velocities q'");

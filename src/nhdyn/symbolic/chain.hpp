@@ -40,7 +40,7 @@ struct ChainParameters {
 // the limit) and the derivation about as N^1.3 (2.7 s at N = 1000, docs/performance.md). A
 // simulation with the dense solvers holds n x n matrices (n = 3N): make_data refuses a model whose
 // dense matrices exceed the machine's memory (check_dense_memory), which on a machine of 24 GB is
-// from about N = 4000 on; the sparse path (SparseData) needs megabytes at the limit.
+// from about N = 4000 on; the sparse path (model/data.hpp) needs megabytes at the limit.
 inline constexpr int kMaxChainBodies = 10000;
 
 // Throws InputError naming the first bad value, its limit and what to do: bodies outside
