@@ -30,8 +30,8 @@ struct CompareArgs {
   std::string complement = "qr";
   std::optional<double> t_end;
   std::optional<double> output_step;
-  double rtol = 1e-8;
-  double atol = 1e-10;
+  std::optional<double> rtol;  // default: the model's (its file's [simulation], else RunOptions)
+  std::optional<double> atol;
   std::string stabilize = "none";
   std::vector<std::string> sets;
   std::string output;
@@ -56,8 +56,8 @@ int run_compare(const CompareArgs& args) {
   options.run.t_end = args.t_end.value_or(model.defaults.t_end);
   options.run.output_step = args.output_step.value_or(model.defaults.output_step);
   options.run.formulation.complement = parse_complement(args.complement);
-  options.run.integrator.rtol = args.rtol;
-  options.run.integrator.atol = args.atol;
+  options.run.integrator.rtol = args.rtol.value_or(model.defaults.rtol);
+  options.run.integrator.atol = args.atol.value_or(model.defaults.atol);
   options.run.stabilization = parse_stabilization(args.stabilize);
   for (const std::string& m : args.methods)
     for (const std::string& i : args.integrators) options.cases.push_back({parse_method(m), parse_integrator(i)});
@@ -113,7 +113,7 @@ int run_compare(const CompareArgs& args) {
 
   if (!args.quiet) {
     fmt::print("nhdyn compare {}: t = {:g} .. {:g} s, D: {}, rtol {:g}, atol {:g}, stabilization {}\n", model.name,
-               model.t0, options.run.t_end, args.complement, args.rtol, args.atol, args.stabilize);
+               model.t0, options.run.t_end, args.complement, options.run.integrator.rtol, options.run.integrator.atol, args.stabilize);
     if (options.reference == Reference::analytic)
       fmt::print("reference: the model's exact solution\n");
     else
@@ -156,8 +156,8 @@ std::function<int()> add_compare_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
   cmd->add_option("--output-step", args->output_step, "Time between compared outputs [s] (default: the model's)");
-  cmd->add_option("--rtol", args->rtol, "Relative tolerance of every case")->capture_default_str();
-  cmd->add_option("--atol", args->atol, "Absolute tolerance of every case")->capture_default_str();
+  cmd->add_option("--rtol", args->rtol, "Relative tolerance of every case (default: the model's, else 1e-8)");
+  cmd->add_option("--atol", args->atol, "Absolute tolerance of every case (default: the model's, else 1e-10)");
   cmd->add_option("--stabilize", args->stabilize, "none | baumgarte | projection")->capture_default_str();
   cmd->add_option("--set", args->sets, "Override a model file's parameter, NAME=VALUE (repeatable)");
   cmd->add_option("-o,--output", args->output, "Table CSV (default results/MODEL-compare.csv); the series "

@@ -13,6 +13,7 @@
 #include "commands.hpp"
 #include "model_source.hpp"
 #include "outputs.hpp"
+#include "nhdyn/analysis/run_options.hpp"
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/csv.hpp"
@@ -29,10 +30,10 @@ struct SimulateArgs {
   std::optional<double> t_end;
   std::optional<double> output_step;
   std::optional<std::string> method;      // default: the model file's, else sanh
-  std::string complement = "qr";
-  std::optional<std::string> integrator;  // default: the model file's, else dopri5
-  std::optional<double> rtol;             // default: the model file's, else 1e-8
-  std::optional<double> atol;             // default: the model file's, else 1e-10
+  std::optional<std::string> complement;  // default: the model's (RunOptions)
+  std::optional<std::string> integrator;  // default: the model file's, else RunOptions
+  std::optional<double> rtol;             // default: the model file's, else RunOptions
+  std::optional<double> atol;             // default: the model file's, else RunOptions
   std::vector<std::string> sets;
   bool fix_initial = false;
   std::string stabilize = "none";
@@ -89,19 +90,17 @@ int run_simulate(const SimulateArgs& args) {
   protect_model_file(args.model);
   const ResolvedModel resolved = resolve_model(args.model, args.sets);
   const Model& model = resolved.model;
-  const symbolic::Spec* spec = resolved.spec ? &*resolved.spec : nullptr;
-  auto from_file = [&](const std::string& value, const char* fallback) {
-    return spec && !value.empty() ? value : std::string(fallback);
-  };
-  SimulationOptions options;
-  options.t_end = args.t_end.value_or(model.defaults.t_end);
-  options.output_step = args.output_step.value_or(model.defaults.output_step);
-  options.formulation.method = parse_method(args.method.value_or(from_file(spec ? spec->method : "", "sanh")));
-  options.formulation.complement = parse_complement(args.complement);
-  options.integrator.kind =
-      parse_integrator(args.integrator.value_or(from_file(spec ? spec->integrator : "", "dopri5")));
-  options.integrator.rtol = args.rtol.value_or(spec && spec->rtol ? *spec->rtol : 1e-8);
-  options.integrator.atol = args.atol.value_or(spec && spec->atol ? *spec->atol : 1e-10);
+  // The model's run options (its file's [simulation], else the defaults of RunOptions), then
+  // what the command line overrides.
+  RunOptions run = model.defaults;
+  run.t_end = args.t_end.value_or(run.t_end);
+  run.output_step = args.output_step.value_or(run.output_step);
+  run.method = args.method.value_or(run.method);
+  run.complement = args.complement.value_or(run.complement);
+  run.integrator = args.integrator.value_or(run.integrator);
+  run.rtol = args.rtol.value_or(run.rtol);
+  run.atol = args.atol.value_or(run.atol);
+  SimulationOptions options = make_simulation_options(run);
   options.integrator.step = args.step;
   options.fix_initial = args.fix_initial;
   options.stabilization = parse_stabilization(args.stabilize);
@@ -231,11 +230,10 @@ std::function<int()> add_simulate_command(CLI::App& app) {
   cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
   cmd->add_option("--output-step", args->output_step, "Time between output rows [s] (default: the model's)");
   cmd->add_option("--method", args->method, "Formulation: sanh (default) | lagrange | udwadia-kalaba | nullspace");
-  cmd->add_option("--complement", args->complement, "Where D comes from (sanh, nullspace): qr | partition | analytic")
-      ->capture_default_str();
+  cmd->add_option("--complement", args->complement, "Where D comes from (sanh, nullspace): qr (default) | partition | analytic");
   cmd->add_option("--integrator", args->integrator, "rk4 | dopri5 (default) | dop853 | cvode-bdf | cvode-adams");
-  cmd->add_option("--rtol", args->rtol, "Relative tolerance of the adaptive integrators (default 1e-8)");
-  cmd->add_option("--atol", args->atol, "Absolute tolerance of the adaptive integrators (default 1e-10)");
+  cmd->add_option("--rtol", args->rtol, "Relative tolerance of the adaptive integrators (default: the model's, else 1e-8)");
+  cmd->add_option("--atol", args->atol, "Absolute tolerance of the adaptive integrators (default: the model's, else 1e-10)");
   cmd->add_option("--step", args->step, "rk4: step size [s] (default output step / 10); adaptive: first step");
   cmd->add_option("-o,--output", args->output, "CSV file to write (default results/MODEL.csv)");
   cmd->add_option("--plot", args->plot, "PNG file to draw with gnuplot");

@@ -12,6 +12,7 @@
 
 #include "nhdyn/core/types.hpp"
 #include "nhdyn/model/evaluator.hpp"
+#include "nhdyn/model/run_options.hpp"
 
 namespace nhdyn {
 
@@ -30,11 +31,8 @@ struct Parameter {
   std::string unit;
 };
 
-// What a run of this model does when the user says nothing else.
-struct SimulationDefaults {
-  double t_end = 10.0;
-  double output_step = 0.01;
-};
+// What a run of this model does when the user says nothing else (run_options.hpp).
+using SimulationDefaults = RunOptions;
 
 // A pair of coordinates that a plot may draw as a path y(x) (planar systems).
 struct PlanarPath {

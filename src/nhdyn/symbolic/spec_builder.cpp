@@ -919,11 +919,13 @@ SpecBuilder& SpecBuilder::defaults(const SimulationDefaults& defaults) {
 
 SpecBuilder& SpecBuilder::method(const std::string& name) {
   spec_.method = name;
+  spec_.defaults.method = name.empty() ? RunOptions{}.method : name;
   return *this;
 }
 
 SpecBuilder& SpecBuilder::integrator(const std::string& name) {
   spec_.integrator = name;
+  spec_.defaults.integrator = name.empty() ? RunOptions{}.integrator : name;
   return *this;
 }
 
@@ -937,6 +939,8 @@ SpecBuilder& SpecBuilder::tolerances(std::optional<double> rtol, std::optional<d
   check(atol, "atol");
   spec_.rtol = rtol;
   spec_.atol = atol;
+  spec_.defaults.rtol = rtol.value_or(RunOptions{}.rtol);
+  spec_.defaults.atol = atol.value_or(RunOptions{}.atol);
   return *this;
 }
 

@@ -1,0 +1,293 @@
+// `nhdyn batch MODEL --grid NAME=FROM:TO:COUNT ... | --runs runs.csv`: many runs of one model on a
+// pool of threads (analysis/batch.hpp), one summary row per run (its parameters and initial
+// values, status, final state, largest residuals, message) and optionally every run's CSV.
+// A NAME is a parameter of the model file, or an initial value: x(0) for a coordinate, x'(0) for
+// a velocity. Runs that fail are reported in the summary; the others are kept (exit 1 if any failed).
+#include <fmt/format.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "nhdyn/analysis/batch.hpp"
+#include "nhdyn/analysis/run_options.hpp"
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/io/atomic_file.hpp"
+#include "nhdyn/io/csv.hpp"
+#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/io/results.hpp"
+
+namespace nhdyn::cli {
+namespace {
+
+struct BatchArgs {
+  std::string model;
+  std::vector<std::string> grids;
+  std::string runs_csv;
+  std::vector<std::string> sets;
+  int threads = 0;
+  std::string output = "batch";
+  bool write_runs = false;
+  std::optional<double> t_end, output_step, rtol, atol;
+  std::optional<std::string> method, complement, integrator;
+  bool quiet = false;
+};
+
+// What a column of the batch sets: a parameter, or the initial coordinate / velocity `index`.
+struct Varied {
+  std::string name;
+  enum Kind { parameter, coordinate, velocity } kind = parameter;
+  int index = -1;
+};
+
+Varied classify(const std::string& name, const Model& model) {
+  Varied v{name};
+  const bool velocity = name.ends_with("'(0)");
+  if (velocity || name.ends_with("(0)")) {
+    const std::string coordinate = name.substr(0, name.size() - (velocity ? 4 : 3));
+    for (int i = 0; i < model.n(); ++i)
+      if (model.coordinates[static_cast<std::size_t>(i)] == coordinate) {
+        v.kind = velocity ? Varied::velocity : Varied::coordinate;
+        v.index = i;
+        return v;
+      }
+    std::string names;
+    for (const std::string& c : model.coordinates) names += (names.empty() ? "" : ", ") + c;
+    throw InputError(fmt::format("'{}': '{}' is not a coordinate of model '{}'; its coordinates are {}", name,
+                                 coordinate, model.name, names));
+  }
+  return v;  // a parameter: load_model_variants checks the name
+}
+
+double parse_number(const std::string& text, const std::string& what) {
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(value))
+    throw InputError(fmt::format("{}: '{}' is not a finite number", what, text));
+  return value;
+}
+
+// NAME=FROM:TO:COUNT -> COUNT values, both ends included.
+std::pair<std::string, std::vector<double>> parse_grid(const std::string& grid) {
+  const std::size_t eq = grid.find('=');
+  const std::string hint = "write it as NAME=FROM:TO:COUNT, e.g. --grid v=0:10:101";
+  if (eq == std::string::npos || eq == 0) throw InputError(fmt::format("--grid '{}': {}", grid, hint));
+  const std::string name = grid.substr(0, eq);
+  std::vector<std::string> parts;
+  std::string rest = grid.substr(eq + 1);
+  for (std::size_t at = rest.find(':'); at != std::string::npos; at = rest.find(':')) {
+    parts.push_back(rest.substr(0, at));
+    rest = rest.substr(at + 1);
+  }
+  parts.push_back(rest);
+  if (parts.size() != 3) throw InputError(fmt::format("--grid '{}': {}", grid, hint));
+  const double from = parse_number(parts[0], "--grid " + name + " FROM");
+  const double to = parse_number(parts[1], "--grid " + name + " TO");
+  const double count = parse_number(parts[2], "--grid " + name + " COUNT");
+  if (count < 1 || count > 1e7 || count != std::floor(count))
+    throw InputError(fmt::format("--grid '{}': COUNT = {} must be a whole number from 1 to 10000000", grid, parts[2]));
+  if (count == 1 && from != to)
+    throw InputError(fmt::format("--grid '{}': one value needs FROM = TO", grid));
+  std::vector<double> values(static_cast<std::size_t>(count));
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] = values.size() == 1 ? from
+                                   : from + (to - from) * static_cast<double>(i) / static_cast<double>(values.size() - 1);
+  return {name, values};
+}
+
+std::string csv_text(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"') out += '"';
+    out += c == '\n' ? ' ' : c;
+  }
+  return out + "\"";
+}
+
+int run_batch(const BatchArgs& args) {
+  if (args.grids.empty() == args.runs_csv.empty())
+    throw InputError("give the runs either as --grid NAME=FROM:TO:COUNT (repeatable) or as --runs FILE.csv");
+  if (args.threads < 0) throw InputError(fmt::format("--threads {}: give 0 (every core) or a positive number", args.threads));
+  ParameterOverrides overrides;
+  for (const std::string& set : args.sets) {
+    const std::size_t eq = set.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(fmt::format("--set '{}': write it as NAME=VALUE, e.g. --set a=0.3", set));
+    overrides.emplace_back(set.substr(0, eq), set.substr(eq + 1));
+  }
+  const ModelSource source = read_model_source(args.model);
+  const Model base = load_model(source, overrides);
+
+  // The table of runs: one column per name, one row per run.
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> table;
+  if (!args.grids.empty()) {
+    table.assign(1, {});
+    for (const std::string& grid : args.grids) {
+      auto [name, values] = parse_grid(grid);
+      for (const std::string& known : names)
+        if (known == name) throw InputError(fmt::format("--grid {}: given twice", name));
+      names.push_back(name);
+      std::vector<std::vector<double>> product;  // the first grid varies slowest
+      for (const std::vector<double>& row : table)
+        for (double value : values) {
+          product.push_back(row);
+          product.back().push_back(value);
+        }
+      table = std::move(product);
+      if (table.size() > 10000000) throw InputError("--grid: more than 10000000 runs; use fewer values");
+    }
+  } else {
+    const CsvTable csv = load_csv(args.runs_csv);
+    if (csv.header.empty()) throw InputError(fmt::format("{}: no header naming the columns", args.runs_csv));
+    names = csv.header;
+    table = csv.rows;
+    if (table.empty()) throw InputError(fmt::format("{}: no runs (the file has a header and no rows)", args.runs_csv));
+  }
+  std::vector<Varied> varied;
+  std::vector<std::string> parameter_names;
+  for (const std::string& name : names) {
+    varied.push_back(classify(name, base));
+    if (varied.back().kind == Varied::parameter) parameter_names.push_back(name);
+  }
+  std::vector<std::vector<double>> parameter_values(table.size());
+  for (std::size_t r = 0; r < table.size(); ++r)
+    for (std::size_t j = 0; j < names.size(); ++j)
+      if (varied[j].kind == Varied::parameter) parameter_values[r].push_back(table[r][j]);
+
+  RunOptions run = base.defaults;
+  run.t_end = args.t_end.value_or(run.t_end);
+  run.output_step = args.output_step.value_or(run.output_step);
+  run.method = args.method.value_or(run.method);
+  run.complement = args.complement.value_or(run.complement);
+  run.integrator = args.integrator.value_or(run.integrator);
+  run.rtol = args.rtol.value_or(run.rtol);
+  run.atol = args.atol.value_or(run.atol);
+  BatchOptions options;
+  options.simulation = make_simulation_options(run);
+  options.threads = args.threads;
+  options.keep_trajectories = args.write_runs;
+  check_simulation_options(base, options.simulation);
+
+  namespace fs = std::filesystem;
+  const fs::path dir(args.output);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw FileError(fmt::format("-o {}: cannot create the output directory ({}); give another with -o", args.output,
+                                ec ? ec.message() : "not a directory"));
+  AtomicFile summary(dir / "summary.csv");  // checks the directory is writable before any run
+
+  std::vector<BatchRun> runs(table.size());
+  {
+    // One compiled model per run when parameters vary (until parameters are run-time data);
+    // otherwise every run shares the base model.
+    std::vector<Model> models;
+    if (!parameter_names.empty()) models = load_model_variants(source, overrides, parameter_names, parameter_values);
+    std::shared_ptr<const Model> shared = parameter_names.empty() ? std::make_shared<const Model>(base) : nullptr;
+    for (std::size_t r = 0; r < table.size(); ++r) {
+      runs[r].model = shared ? shared : std::make_shared<const Model>(std::move(models[r]));
+      for (std::size_t j = 0; j < names.size(); ++j) {
+        if (varied[j].kind == Varied::coordinate) {
+          if (!runs[r].q0) runs[r].q0 = runs[r].model->q0;
+          (*runs[r].q0)(varied[j].index) = table[r][j];
+        } else if (varied[j].kind == Varied::velocity) {
+          if (!runs[r].v0) runs[r].v0 = runs[r].model->v0;
+          (*runs[r].v0)(varied[j].index) = table[r][j];
+        }
+      }
+    }
+  }
+  const std::vector<BatchResult> results = simulate_batch(runs, options);
+
+  std::string header = "run";
+  for (const std::string& name : names) header += "," + csv_text(name);
+  header += ",status,t_reached";
+  for (const std::string& c : base.coordinates) header += "," + csv_text(c);
+  for (const std::string& c : base.coordinates) header += "," + csv_text(c + "'");
+  header += ",max_residual_pos,max_residual_vel,max_residual_acc,message\n";
+  summary.write(header);
+  long failed = 0;
+  const int digits = static_cast<int>(std::to_string(std::max<std::size_t>(results.size(), 1) - 1).size());
+  for (std::size_t r = 0; r < results.size(); ++r) {
+    const BatchResult& res = results[r];
+    failed += res.ok ? 0 : 1;
+    std::string line = std::to_string(r);
+    for (double value : table[r]) line += fmt::format(",{}", value);
+    line += res.ok ? ",ok" : ",failed";
+    line += fmt::format(",{}", res.summary.t_reached);
+    for (int i = 0; i < base.n(); ++i) line += res.q_end.size() == base.n() ? fmt::format(",{}", res.q_end(i)) : ",";
+    for (int i = 0; i < base.n(); ++i) line += res.v_end.size() == base.n() ? fmt::format(",{}", res.v_end(i)) : ",";
+    line += fmt::format(",{},{},{},{}\n", res.summary.max_position_residual, res.summary.max_velocity_residual,
+                        res.summary.max_acceleration_residual, csv_text(res.message));
+    summary.write(line);
+    if (args.write_runs && res.trajectory.rows() > 0) {
+      const Model& model = *runs[r].model;
+      CsvWriter writer(dir / fmt::format("run_{:0{}}.csv", r, digits), make_result_columns(model).all);
+      const Trajectory& tr = res.trajectory;
+      std::vector<double> row;
+      const auto n = static_cast<std::size_t>(tr.n);
+      const auto m = static_cast<std::size_t>(tr.residual_columns);
+      for (std::size_t k = 0; k < static_cast<std::size_t>(tr.rows()); ++k) {
+        row.clear();
+        row.push_back(tr.t[k]);
+        for (const std::vector<double>* column : {&tr.q, &tr.v, &tr.qdd, &tr.R})
+          row.insert(row.end(), column->begin() + static_cast<std::ptrdiff_t>(k * n),
+                     column->begin() + static_cast<std::ptrdiff_t>((k + 1) * n));
+        row.insert(row.end(), tr.residuals.begin() + static_cast<std::ptrdiff_t>(k * m),
+                   tr.residuals.begin() + static_cast<std::ptrdiff_t>((k + 1) * m));
+        if (tr.has_energy) row.push_back(tr.energy[k]);
+        writer.write_row(row);
+      }
+      writer.commit();
+    }
+  }
+  summary.commit();
+  if (!args.quiet) {
+    fmt::print("nhdyn batch {}: {} runs on {} threads, {} failed -> {}\n", base.name, results.size(),
+               batch_threads(args.threads, results.size()), failed, (dir / "summary.csv").string());
+    for (std::size_t r = 0; r < results.size() && failed > 0; ++r)
+      if (!results[r].ok) {
+        fmt::print(stderr, "nhdyn: run {} failed: {}\n", r, results[r].message);
+        break;
+      }
+  }
+  return failed > 0 ? 1 : 0;
+}
+
+}  // namespace
+
+std::function<int()> add_batch_command(CLI::App& app) {
+  auto args = std::make_shared<BatchArgs>();
+  CLI::App* cmd = app.add_subcommand("batch", "Run a model for many parameter values or initial states on every core");
+  cmd->add_option("MODEL", args->model, "A model file (.toml) or a built-in model (initial states only)")->required();
+  cmd->add_option("--grid", args->grids,
+                  "NAME=FROM:TO:COUNT, COUNT values from FROM to TO (repeatable: every combination). NAME is a "
+                  "parameter, or x(0) / x'(0) for an initial coordinate / velocity");
+  cmd->add_option("--runs", args->runs_csv, "A CSV file: a header of NAMEs, one row of values per run");
+  cmd->add_option("--set", args->sets, "Override a model file's parameter for every run, NAME=VALUE (repeatable)");
+  cmd->add_option("--threads", args->threads, "Threads (default 0: every core)");
+  cmd->add_option("-o,--output", args->output, "Directory for summary.csv (and run_*.csv)")->capture_default_str();
+  cmd->add_flag("--write-runs", args->write_runs, "Also write every run's results as run_NNN.csv");
+  cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
+  cmd->add_option("--output-step", args->output_step, "Time between output rows [s] (default: the model's)");
+  cmd->add_option("--method", args->method, "Formulation (default: the model's, else sanh)");
+  cmd->add_option("--complement", args->complement, "qr (default) | partition | analytic");
+  cmd->add_option("--integrator", args->integrator, "Integrator (default: the model's, else dopri5)");
+  cmd->add_option("--rtol", args->rtol, "Relative tolerance (default: the model's, else 1e-8)");
+  cmd->add_option("--atol", args->atol, "Absolute tolerance (default: the model's, else 1e-10)");
+  cmd->add_flag("-q,--quiet", args->quiet, "Print no summary");
+  return [args] { return run_batch(*args); };
+}
+
+}  // namespace nhdyn::cli

@@ -1,0 +1,142 @@
+// nhdyn._nhdyn.simulate: one run of a Model with the model's run options and the caller's
+// overrides; the outputs come back as NumPy arrays that take over the C++ vectors (no copy).
+// The GIL is released during the run.
+#include <pybind11/stl.h>
+
+#include <chrono>
+
+#include "bindings.hpp"
+#include "nhdyn/analysis/batch.hpp"
+#include "nhdyn/analysis/run_options.hpp"
+#include "nhdyn/core/error.hpp"
+
+namespace nhdyn::python {
+namespace {
+
+template <typename T>
+std::optional<T> get(const py::dict& kwargs, const char* key) {
+  if (!kwargs.contains(key)) return std::nullopt;
+  const py::object value = kwargs[key];
+  if (value.is_none()) return std::nullopt;
+  try {
+    return value.cast<T>();
+  } catch (const py::cast_error&) {
+    throw InputError(fmt::format("{}={}: wrong type", key, py::repr(value).cast<std::string>()));
+  }
+}
+
+const char* const known_options[] = {"t_end",     "output_step", "method",    "complement",
+                                     "integrator", "rtol",        "atol",      "step",
+                                     "fix_initial", "stabilize",  "q0",        "v0"};
+
+}  // namespace
+
+SimulationOptions make_options(const Model& model, const py::dict& kwargs) {
+  for (const auto& item : kwargs) {
+    const auto key = item.first.cast<std::string>();
+    bool known = false;
+    for (const char* name : known_options) known = known || key == name;
+    if (!known)
+      throw InputError(fmt::format("simulate: unknown option '{}'; the options are t_end, output_step, method, complement, "
+                                   "integrator, rtol, atol, step, fix_initial, stabilize, q0, v0",
+                                   key));
+  }
+  RunOptions run = model.defaults;
+  run.t_end = get<double>(kwargs, "t_end").value_or(run.t_end);
+  run.output_step = get<double>(kwargs, "output_step").value_or(run.output_step);
+  run.method = get<std::string>(kwargs, "method").value_or(run.method);
+  run.complement = get<std::string>(kwargs, "complement").value_or(run.complement);
+  run.integrator = get<std::string>(kwargs, "integrator").value_or(run.integrator);
+  run.rtol = get<double>(kwargs, "rtol").value_or(run.rtol);
+  run.atol = get<double>(kwargs, "atol").value_or(run.atol);
+  SimulationOptions options = make_simulation_options(run);
+  options.integrator.step = get<double>(kwargs, "step").value_or(0.0);
+  options.fix_initial = get<bool>(kwargs, "fix_initial").value_or(false);
+  options.stabilization = parse_stabilization(get<std::string>(kwargs, "stabilize").value_or("none"));
+  check_simulation_options(model, options);
+  return options;
+}
+
+namespace {
+
+std::optional<Vector> state_vector(const py::dict& kwargs, const char* key, int n) {
+  if (!kwargs.contains(key) || py::object(kwargs[key]).is_none()) return std::nullopt;
+  const auto array = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(kwargs[key]);
+  if (!array || array.ndim() != 1 || array.shape(0) != n)
+    throw InputError(fmt::format("{}: expected {} values (one per coordinate), got an array of shape {}", key, n,
+                                 array ? py::str(py::cast(std::vector<py::ssize_t>(array.shape(), array.shape() + array.ndim()))).cast<std::string>()
+                                       : std::string("(not numeric)")));
+  Vector v(n);
+  for (int i = 0; i < n; ++i) v(i) = array.at(i);
+  return v;
+}
+
+}  // namespace
+
+py::dict summary_dict(const SimulationSummary& s) {
+  py::dict d;
+  d["status"] = std::string(describe(s.status));
+  d["message"] = s.message;
+  d["t_reached"] = s.t_reached;
+  d["steps"] = s.stats.steps;
+  d["rejected_steps"] = s.stats.rejected_steps;
+  d["rhs_evaluations"] = s.stats.rhs_evaluations;
+  d["outputs"] = s.outputs;
+  d["wall_time"] = s.wall_time;
+  d["max_position_residual"] = s.max_position_residual;
+  d["max_velocity_residual"] = s.max_velocity_residual;
+  d["max_acceleration_residual"] = s.max_acceleration_residual;
+  d["energy_drift"] = s.has_energy ? py::cast(s.energy_drift) : py::none();
+  return d;
+}
+
+py::dict trajectory_dict(Trajectory&& tr) {
+  const py::ssize_t rows = tr.rows();
+  const py::ssize_t n = tr.n;
+  py::dict d;
+  d["t"] = take_array(std::move(tr.t), {rows});
+  d["q"] = take_array(std::move(tr.q), {rows, n});
+  d["qd"] = take_array(std::move(tr.v), {rows, n});
+  d["qdd"] = take_array(std::move(tr.qdd), {rows, n});
+  d["R"] = take_array(std::move(tr.R), {rows, n});
+  d["residuals"] = take_array(std::move(tr.residuals), {rows, static_cast<py::ssize_t>(tr.residual_columns)});
+  d["energy"] = tr.has_energy ? py::object(take_array(std::move(tr.energy), {rows})) : py::object(py::none());
+  return d;
+}
+
+void bind_simulation(py::module_& m) {
+  m.def(
+      "simulate",
+      [](const ModelPtr& model_ptr, const py::kwargs& kwargs) {
+        const Model* model = model_ptr.get();
+        std::optional<Model> changed;
+        const std::optional<Vector> q0 = state_vector(kwargs, "q0", model->n());
+        const std::optional<Vector> v0 = state_vector(kwargs, "v0", model->n());
+        if (q0 || v0) {
+          changed = *model;
+          if (q0) changed->q0 = *q0;
+          if (v0) changed->v0 = *v0;
+          model = &*changed;
+        }
+        const SimulationOptions options = make_options(*model, kwargs);
+        Trajectory trajectory;
+        SimulationSummary summary;
+        double seconds = 0.0;
+        {
+          py::gil_scoped_release release;
+          const auto start = std::chrono::steady_clock::now();
+          const std::vector<double> times = make_output_times(model->t0, options.t_end, options.output_step);
+          trajectory.reset(*model, static_cast<long>(times.size()));
+          summary = simulate(*model, options, [&](const Data& data) { trajectory.append(data); });
+          seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        }
+        py::dict out = trajectory_dict(std::move(trajectory));
+        out["summary"] = summary_dict(summary);
+        out["ok"] = summary.status == Status::ok;
+        out["cpp_seconds"] = seconds;  // the whole C++ call, for the overhead benchmark
+        return out;
+      },
+      "simulate(model, **options) -> dict of arrays (t, q, qd, qdd, R, residuals, energy) and summary");
+}
+
+}  // namespace nhdyn::python

@@ -1,0 +1,120 @@
+#include "nhdyn/analysis/batch.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <thread>
+
+#include "nhdyn/core/error.hpp"
+
+namespace nhdyn {
+
+void Trajectory::reset(const Model& model, long expected_rows) {
+  n = model.n();
+  residual_columns = model.position_constraints() + model.velocity_constraints() + model.s();
+  has_energy = model.evaluator && model.evaluator->has_energy();
+  for (std::vector<double>* column : {&t, &q, &v, &qdd, &R, &residuals, &energy}) column->clear();
+  const auto rows = static_cast<std::size_t>(std::max(0L, expected_rows));
+  const auto un = static_cast<std::size_t>(n);
+  t.reserve(rows);
+  q.reserve(rows * un);
+  v.reserve(rows * un);
+  qdd.reserve(rows * un);
+  R.reserve(rows * un);
+  residuals.reserve(rows * static_cast<std::size_t>(residual_columns));
+  if (has_energy) energy.reserve(rows);
+}
+
+void Trajectory::append(const Data& data) {
+  t.push_back(data.t);
+  q.insert(q.end(), data.q.data(), data.q.data() + n);
+  v.insert(v.end(), data.v.data(), data.v.data() + n);
+  qdd.insert(qdd.end(), data.qdd.data(), data.qdd.data() + n);
+  R.insert(R.end(), data.R.data(), data.R.data() + n);
+  residuals.insert(residuals.end(), data.phi.data(), data.phi.data() + data.phi.size());
+  residuals.insert(residuals.end(), data.f.data(), data.f.data() + data.f.size());
+  residuals.insert(residuals.end(), data.e.data(), data.e.data() + data.e.size());
+  if (has_energy) energy.push_back(data.energy);
+}
+
+int batch_threads(int threads, std::size_t runs) {
+  int count = threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency());
+  count = std::max(count, 1);
+  return static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(count), std::max<std::size_t>(runs, 1)));
+}
+
+namespace {
+
+void run_one(const BatchRun& run, const BatchOptions& options, BatchResult& result) {
+  try {
+    const Model* model = run.model.get();
+    Model changed;
+    if (run.q0 || run.v0) {  // the run's own copy: Model is cheap to copy (the evaluator is shared)
+      changed = *run.model;
+      if (run.q0) changed.q0 = *run.q0;
+      if (run.v0) changed.v0 = *run.v0;
+      model = &changed;
+    }
+    long expected = 0;
+    if (options.keep_trajectories && options.simulation.output_step > 0.0 && options.simulation.t_end > model->t0)
+      expected = static_cast<long>(std::min(1e7, (options.simulation.t_end - model->t0) / options.simulation.output_step)) + 2;
+    result.trajectory.reset(*model, expected);
+    const int n = model->n();
+    result.q_end.resize(n);
+    result.v_end.resize(n);
+    bool any_row = false;
+    result.summary = simulate(*model, options.simulation, [&](const Data& data) {
+      if (options.keep_trajectories) result.trajectory.append(data);
+      result.q_end = data.q;
+      result.v_end = data.v;
+      any_row = true;
+    });
+    if (!any_row) {
+      result.q_end.resize(0);
+      result.v_end.resize(0);
+    }
+    result.ok = result.summary.status == Status::ok;
+    if (!result.ok)
+      result.message = fmt::format("failed at t = {:.6g}: {}", result.summary.t_reached, result.summary.message);
+  } catch (const std::exception& e) {  // bad initial state, options refused for this model, ...
+    result.ok = false;
+    result.message = e.what();
+    result.q_end.resize(0);
+    result.v_end.resize(0);
+  }
+}
+
+}  // namespace
+
+std::vector<BatchResult> simulate_batch(const std::vector<BatchRun>& runs, const BatchOptions& options) {
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const BatchRun& run = runs[i];
+    if (!run.model) throw InputError(fmt::format("batch run {} has no model", i));
+    const int n = run.model->n();
+    if (run.q0 && run.q0->size() != n)
+      throw InputError(fmt::format("batch run {}: {} initial coordinates for a model with {} ({})", i, run.q0->size(),
+                                   n, run.model->name));
+    if (run.v0 && run.v0->size() != n)
+      throw InputError(fmt::format("batch run {}: {} initial velocities for a model with {} ({})", i, run.v0->size(),
+                                   n, run.model->name));
+  }
+  std::vector<BatchResult> results(runs.size());
+  const int threads = batch_threads(options.threads, runs.size());
+  std::atomic<std::size_t> next{0};
+  const auto work = [&] {
+    for (std::size_t i = next.fetch_add(1); i < runs.size(); i = next.fetch_add(1)) run_one(runs[i], options, results[i]);
+  };
+  if (threads == 1) {
+    work();
+    return results;
+  }
+  std::vector<std::thread> pool;
+  pool.reserve(static_cast<std::size_t>(threads));
+  for (int i = 0; i < threads; ++i) pool.emplace_back(work);
+  for (std::thread& thread : pool) thread.join();
+  return results;
+}
+
+}  // namespace nhdyn

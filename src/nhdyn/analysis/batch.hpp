@@ -1,0 +1,67 @@
+// Batch runs: many simulations of one system (other parameter values, other initial states) on a
+// pool of threads, each run's output kept as a Trajectory (one row per output time). Models are
+// read-only and their evaluators stateless, so runs share them; every run makes its own Data
+// inside simulate(), which is the whole thread-safety story (model/data.hpp). Runs are handed out
+// one at a time from a shared counter, so a slow run does not hold up a fixed share of the others.
+// A run that fails (bad initial state, numerical trouble) reports its status and message in its
+// own result and never stops the others. Used by `nhdyn batch` and nhdyn.simulate_batch (Python).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "nhdyn/analysis/simulation.hpp"
+#include "nhdyn/core/types.hpp"
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn {
+
+// The outputs of one run, each row-major with one row per output time (rows() of them):
+// the same quantities, in the same order, as a results CSV (io/results.hpp).
+struct Trajectory {
+  int n = 0;                        // coordinates
+  int residual_columns = 0;         // position + velocity + acceleration residuals
+  bool has_energy = false;
+  std::vector<double> t;            // rows
+  std::vector<double> q, v, qdd, R; // rows x n each
+  std::vector<double> residuals;    // rows x residual_columns: phi, then f, then e (Data)
+  std::vector<double> energy;       // rows (empty without an energy)
+
+  long rows() const { return static_cast<long>(t.size()); }
+  // Sizes the columns for `model` and drops every row; reserves `expected_rows`.
+  void reset(const Model& model, long expected_rows = 0);
+  // Appends the row of Data after an output (simulate's RowFn): t, q, q', q'', R, residuals, energy.
+  void append(const Data& data);
+};
+
+struct BatchRun {
+  std::shared_ptr<const Model> model;  // this run's model; runs may share one
+  std::optional<Vector> q0, v0;        // n each: initial state replacing the model's
+};
+
+struct BatchOptions {
+  SimulationOptions simulation;  // the same for every run
+  int threads = 0;               // 0: every core (std::thread::hardware_concurrency)
+  bool keep_trajectories = true; // false: keep the summaries only (less memory)
+};
+
+struct BatchResult {
+  bool ok = false;               // the run reached t_end
+  std::string message;           // empty when ok: the error or the numerical trouble, with t
+  SimulationSummary summary;     // steps, residuals, ... (status set when the run started)
+  Trajectory trajectory;         // the rows up to where the run ended
+  Vector q_end, v_end;           // n, the last output's state (empty when no row was made)
+};
+
+// The number of threads a batch of `runs` runs uses for `threads` (0 = every core), at least 1.
+int batch_threads(int threads, std::size_t runs);
+
+// Runs every member; result i belongs to runs[i], whatever the number of threads (the results do
+// not depend on it: each run is the same sequential computation). Throws InputError only for
+// options that no run could use (a run without a model, an initial state of the wrong size);
+// everything specific to a run ends up in its result.
+std::vector<BatchResult> simulate_batch(const std::vector<BatchRun>& runs, const BatchOptions& options);
+
+}  // namespace nhdyn

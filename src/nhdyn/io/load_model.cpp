@@ -1,0 +1,165 @@
+#include "nhdyn/io/load_model.hpp"
+
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/model/builtin.hpp"
+#include "nhdyn/symbolic/compile.hpp"
+#include "nhdyn/symbolic/derivation.hpp"
+#include "nhdyn/symbolic/equations.hpp"
+#include "nhdyn/symbolic/spec.hpp"
+
+namespace nhdyn {
+namespace {
+
+bool looks_like_file(const std::string& source) {
+  return source.find('/') != std::string::npos || source.ends_with(".toml") || std::filesystem::exists(source);
+}
+
+// Until parameters are run-time data (set_parameter), a string override is read as a number, the
+// way the CLI's --set has always read it.
+double override_value(const std::string& name, const ParameterValue& value) {
+  if (const double* number = std::get_if<double>(&value)) {
+    if (!std::isfinite(*number)) throw InputError(fmt::format("parameter {} = {}: not a finite number", name, *number));
+    return *number;
+  }
+  const std::string& text = std::get<std::string>(value);
+  char* end = nullptr;
+  errno = 0;
+  const double number = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(number))
+    throw InputError(fmt::format("parameter {} = '{}': not a finite number", name, text));
+  return number;
+}
+
+void refuse_builtin_overrides(const ModelSource& source, const ParameterOverrides& overrides) {
+  if (overrides.empty()) return;
+  const std::string file = source.builtin == "sled-paper" ? "sled_paper" : source.builtin;
+  throw InputError(fmt::format("'{}' is a built-in model written in C++, with fixed parameters (cannot set '{}'); "
+                               "load its model file instead: examples/{}.toml",
+                               source.builtin, overrides.front().first, file));
+}
+
+symbolic::Spec load_spec(const ModelSource& source, const ParameterOverrides& overrides) {
+  symbolic::Spec spec = load_model_string(source.text, source.file_name);
+  for (const auto& [name, value] : overrides) spec.set_parameter(name, override_value(name, value));
+  return spec;
+}
+
+void require_file(const ModelSource& source, const char* what) {
+  if (source.is_builtin()) {
+    const std::string file = source.builtin == "sled-paper" ? "sled_paper" : source.builtin;
+    throw InputError(fmt::format("'{}' is a built-in model written in C++, with fixed parameters and no symbolic "
+                                 "form, so it has no {}; use its model file instead: examples/{}.toml",
+                                 source.builtin, what, file));
+  }
+}
+
+}  // namespace
+
+ModelSource read_model_source(const std::string& source) {
+  if (is_builtin_model(source) && !looks_like_file(source)) return ModelSource{source, "", source};
+  if (!looks_like_file(source)) make_builtin_model(source);  // throws, listing the built-in models
+  std::error_code ec;
+  if (std::filesystem::is_directory(source, ec))
+    throw FileError(fmt::format("{}: is a directory, not a model file", source));
+  std::ifstream in(source, std::ios::binary);
+  if (!in) throw FileError(fmt::format("{}: cannot read the model file (missing or no permission)", source));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw FileError(fmt::format("{}: cannot read the model file", source));
+  return ModelSource{"", text.str(), source};
+}
+
+ModelSource model_source_from_text(std::string text, std::string file_name) {
+  return ModelSource{"", std::move(text), std::move(file_name)};
+}
+
+Model load_model(const ModelSource& source, const ParameterOverrides& overrides) {
+  if (source.is_builtin()) {
+    refuse_builtin_overrides(source, overrides);
+    return make_builtin_model(source.builtin);
+  }
+  return symbolic::compile_model(load_spec(source, overrides));
+}
+
+Model load_model(const std::string& source, const ParameterOverrides& overrides) {
+  return load_model(read_model_source(source), overrides);
+}
+
+Model load_model_text(std::string_view text, const std::string& file_name, const ParameterOverrides& overrides) {
+  return load_model(model_source_from_text(std::string(text), file_name), overrides);
+}
+
+std::vector<Model> load_model_variants(const ModelSource& source, const ParameterOverrides& overrides,
+                                       const std::vector<std::string>& names,
+                                       const std::vector<std::vector<double>>& values) {
+  std::vector<Model> models;
+  models.reserve(values.size());
+  if (names.empty()) {
+    const Model model = load_model(source, overrides);
+    models.assign(values.size(), model);
+    return models;
+  }
+  if (source.is_builtin()) refuse_builtin_overrides(source, {{names.front(), 0.0}});
+  symbolic::Spec spec = load_spec(source, overrides);
+  for (const std::string& name : names) {
+    bool known = false;
+    for (const symbolic::SpecParameter& p : spec.parameters) known = known || p.name == name;
+    if (!known) spec.set_parameter(name, 0.0);  // throws, naming the nearest parameter
+  }
+  const symbolic::Derivation derivation = symbolic::derive(spec);
+  for (std::size_t row = 0; row < values.size(); ++row) {
+    if (values[row].size() != names.size())
+      throw InputError(fmt::format("run {}: {} parameter values for {} names", row, values[row].size(), names.size()));
+    for (std::size_t j = 0; j < names.size(); ++j) {
+      if (!std::isfinite(values[row][j]))
+        throw InputError(fmt::format("run {}: parameter {} = {} is not a finite number", row, names[j], values[row][j]));
+      spec.set_parameter(names[j], values[row][j]);
+    }
+    models.push_back(symbolic::compile_model(spec, derivation));
+  }
+  return models;
+}
+
+std::vector<std::pair<std::string, double>> model_parameters(const ModelSource& source,
+                                                             const ParameterOverrides& overrides) {
+  std::vector<std::pair<std::string, double>> out;
+  if (source.is_builtin()) return out;
+  const symbolic::Spec spec = load_spec(source, overrides);
+  for (const symbolic::SpecParameter& p : spec.parameters) out.emplace_back(p.name, p.value);
+  return out;
+}
+
+std::string model_equations(const ModelSource& source, const ParameterOverrides& overrides, EquationsFormat format) {
+  require_file(source, "equations to show");
+  const symbolic::Spec spec = load_spec(source, overrides);
+  const symbolic::Derivation derivation = symbolic::derive(spec);
+  return symbolic::format_equations(spec, derivation,
+                                    format == EquationsFormat::latex ? symbolic::EquationFormat::latex
+                                                                     : symbolic::EquationFormat::text);
+}
+
+Sweep sweep_model_parameter(const ModelSource& source, const ParameterOverrides& overrides,
+                            const SweepOptions& options) {
+  require_file(source, "parameter to sweep");
+  check_sweep_options(options);
+  symbolic::Spec spec = load_spec(source, overrides);
+  spec.set_parameter(options.parameter, options.from);  // an unknown name throws, naming the nearest
+  const symbolic::Derivation derivation = symbolic::derive(spec);
+  const ModelAtValue model_at = [&](double value) {
+    spec.set_parameter(options.parameter, value);
+    return symbolic::compile_model(spec, derivation);
+  };
+  return calc_eigenvalue_sweep(model_at, options);
+}
+
+}  // namespace nhdyn

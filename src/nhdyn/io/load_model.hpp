@@ -1,0 +1,78 @@
+// The loading API for C++ users and for the Python package: from the name of a built-in model, the
+// path of a model file or the text of one, to a numeric Model, with parameter overrides. The
+// symbolic front end (Spec, derivation, compilation; GiNaC) stays behind this header: it includes
+// no GiNaC, so a program that only loads and runs models never sees the compiler's types.
+//
+//     "examples/sled.toml" | "sled" | text --load_model--> Model --make_data--> Data
+//
+// Overrides replace a model file's parameter values before compilation. An override given as a
+// string is read as a number for now; when parameters become run-time data (issue 12 item 1,
+// set_parameter in model/), strings become expressions of numbers, constants and parameters.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "nhdyn/analysis/linearization.hpp"
+#include "nhdyn/analysis/sweep.hpp"
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn {
+
+// A parameter's new value: a number, or the text of one ("0.3", "1e-2").
+using ParameterValue = std::variant<double, std::string>;
+// In the order they are applied; a later override of the same name wins.
+using ParameterOverrides = std::vector<std::pair<std::string, ParameterValue>>;
+
+// Where a model comes from, kept so that it can be loaded again (with other overrides, or on
+// another machine: the Python package's Dask workers rebuild models from it).
+struct ModelSource {
+  std::string builtin;    // the name of a built-in model (nhdyn list), or empty
+  std::string text;       // the model file's text (empty for a built-in model)
+  std::string file_name;  // the path it was read from, for messages ("<string>" for text)
+  bool is_builtin() const { return !builtin.empty(); }
+};
+
+// Resolves `source`: a built-in model's name (unless a file of that name exists, or it contains
+// '/' or ends in .toml), else a model file, whose text is read. Throws InputError listing the
+// built-in models when it is neither, FileError when the file cannot be read.
+ModelSource read_model_source(const std::string& source);
+
+// The text of a model file; `file_name` is used in the messages only.
+ModelSource model_source_from_text(std::string text, std::string file_name = "<string>");
+
+// Loads and compiles. Throws ModelError ("file:line:column: ...") for anything wrong in a model
+// file, InputError for an unknown parameter (naming the nearest one) or an override of a built-in
+// model (whose parameters are fixed: use its model file in examples/).
+Model load_model(const ModelSource& source, const ParameterOverrides& overrides = {});
+Model load_model(const std::string& source, const ParameterOverrides& overrides = {});
+Model load_model_text(std::string_view text, const std::string& file_name = "<string>",
+                      const ParameterOverrides& overrides = {});
+
+// One model per row of `values` (each row one value per name in `names`), with `overrides`
+// applied first; the model file is derived once and compiled per row. Used by batch runs over
+// parameters. Throws like load_model, the message naming the row.
+std::vector<Model> load_model_variants(const ModelSource& source, const ParameterOverrides& overrides,
+                                       const std::vector<std::string>& names,
+                                       const std::vector<std::vector<double>>& values);
+
+// The names of the parameters of a model file in file order, with their values after the
+// overrides (empty for a built-in model: its parameters are fixed).
+std::vector<std::pair<std::string, double>> model_parameters(const ModelSource& source,
+                                                             const ParameterOverrides& overrides = {});
+
+enum class EquationsFormat { text, latex };
+
+// The equations of motion as `nhdyn equations` shows them (T, V, A, Q, G, b, b0, D, A0, C); the
+// LaTeX form is one align* environment. A built-in model is refused (no symbolic form).
+std::string model_equations(const ModelSource& source, const ParameterOverrides& overrides, EquationsFormat format);
+
+// The eigenvalue sweep of the model's linearization against one parameter (analysis/sweep.hpp);
+// options.parameter names it. A built-in model is refused (its parameters are fixed).
+Sweep sweep_model_parameter(const ModelSource& source, const ParameterOverrides& overrides,
+                            const SweepOptions& options);
+
+}  // namespace nhdyn
