@@ -74,6 +74,16 @@ std::vector<double> calc_eigenvalue_uncertainty(const Matrix& state_matrix, cons
         }
     }
   }
+  // Near a multiple eigenvalue but split from it by d, an eigenvalue moves by about e s^2 / d
+  // (a pair +-sqrt(x) near a Jordan block: x is known to e s^2): the sharper bound once d is
+  // larger than the Jordan radius, so that a pair leaving zero is decided as soon as it can be.
+  for (std::size_t i = 0; i < n; ++i) {
+    if (out[i] <= radius(1)) continue;
+    double d = std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < n; ++j)
+      if (j != i) d = std::min(d, std::abs(eigenvalues[j] - eigenvalues[i]));
+    if (d > 0.0) out[i] = std::min(out[i], std::max(radius(1), 8.0 * e * s * s / d));
+  }
   return out;
 }
 

@@ -68,7 +68,8 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
 // eigenvalues (within 2 r_m of each other) whose largest Jordan block can be l = m - g + 1 long,
 // g being the number of singular values of (state_matrix - centre I) below 2 r_m. A simple
 // eigenvalue gets r_1 = 512 eps s; a double zero of a Jordan block (a roller racer going straight)
-// about 1e-6 s; a semisimple multiple eigenvalue r_1. docs/linearization.md, "Stability crossings".
+// about 1e-6 s; a semisimple multiple eigenvalue r_1. An eigenvalue split from its nearest
+// neighbour by d gets at most max(r_1, 8 e s^2 / d) (first-order perturbation near a multiple one). docs/linearization.md, "Stability crossings".
 std::vector<double> calc_eigenvalue_uncertainty(const Matrix& state_matrix,
                                                 const std::vector<std::complex<double>>& eigenvalues);
 

@@ -123,10 +123,14 @@ std::string make_file_name(std::string_view name, std::string_view fallback) {
   return out;
 }
 
-AtomicFile::AtomicFile(const fs::path& target) : target_(target), resolved_(resolve_links(target)) {
+AtomicFile::AtomicFile(const fs::path& target) : target_(target) {
+  // A device or pipe reached through the kernel's own links (/dev/stdout -> /proc/self/fd/1 ->
+  // "pipe:[...]") is opened by the name given; only links to regular files are followed by hand.
+  struct stat st{};
+  const bool special = ::stat(target.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode);
+  resolved_ = special ? target : resolve_links(target);
   require_not_input(resolved_, target);
   std::error_code ec;
-  struct stat st{};
   const bool exists = ::stat(resolved_.c_str(), &st) == 0;
   if (exists && S_ISDIR(st.st_mode))
     throw FileError(fmt::format("cannot write '{}': it is a directory; give a file name", target.string()));
