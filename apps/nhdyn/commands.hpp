@@ -18,5 +18,6 @@ std::function<int()> add_study_command(CLI::App& app);
 std::function<int()> add_example_command(CLI::App& app);
 std::function<int()> add_linearize_command(CLI::App& app);
 std::function<int()> add_sweep_command(CLI::App& app);
+std::function<int()> add_report_command(CLI::App& app);
 
 }  // namespace nhdyn::cli

@@ -1,0 +1,160 @@
+"""The HTML report in a real browser (Debian's headless Chromium): no console error, the canvas
+shows the body, two screenshots at different times differ where the body moved, the slider moves
+the scene, the plots and the equations are drawn. Usage: report_test.py NHDYN SOURCE_DIR WORK_DIR.
+Exits 77 (ctest's skip code) with the reason printed when Chromium cannot start; nowhere else."""
+import os
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from browser import Browser, find_chromium, png_pixels  # noqa: E402
+
+NHDYN, SOURCE, WORK = sys.argv[1:4]
+os.makedirs(WORK, exist_ok=True)
+failures = []
+
+
+def check(condition, message):
+    print(("ok   " if condition else "FAIL ") + message, flush=True)
+    if not condition:
+        failures.append(message)
+
+
+def run(*args):
+    result = subprocess.run([NHDYN, *args], capture_output=True, text=True)
+    if result.returncode != 0:
+        raise SystemExit(f"nhdyn {' '.join(args)} failed ({result.returncode}): {result.stderr}")
+    return result
+
+
+def canvas_pixels(browser):
+    rect = browser.evaluate("(() => { const r = document.getElementById('canvas').getBoundingClientRect();"
+                            " return [r.left, r.top, r.width, r.height]; })()")
+    png = browser.screenshot({"x": rect[0], "y": rect[1], "width": rect[2], "height": rect[3]})
+    width, height, rows = png_pixels(png)
+    return rect, rows, png
+
+
+def coloured_near(rows, rect, point, radius):
+    """Pixels within `radius` of `point` (page coordinates) that are clearly coloured: the bodies are
+    drawn in saturated colours, the background white and the grid grey."""
+    x0, y0 = int(point[0] - rect[0]), int(point[1] - rect[1])
+    count = 0
+    for y in range(max(0, y0 - radius), min(len(rows), y0 + radius + 1)):
+        for x in range(max(0, x0 - radius), min(len(rows[0]), x0 + radius + 1)):
+            r, g, b = rows[y][x]
+            if max(r, g, b) - min(r, g, b) > 60:
+                count += 1
+    return count
+
+
+def changed_near(a, b, rect, point, radius):
+    x0, y0 = int(point[0] - rect[0]), int(point[1] - rect[1])
+    count = 0
+    for y in range(max(0, y0 - radius), min(len(a), y0 + radius + 1)):
+        for x in range(max(0, x0 - radius), min(len(a[0]), x0 + radius + 1)):
+            if sum(abs(p - q) for p, q in zip(a[y][x], b[y][x])) > 60:
+                count += 1
+    return count
+
+
+def slider_point(browser, fraction):
+    r = browser.evaluate("(() => { const r = document.getElementById('slider').getBoundingClientRect();"
+                         " return [r.left, r.top, r.width, r.height]; })()")
+    # The thumb's centre travels over the width less the thumb (about 16 px wide).
+    return r[0] + 8 + fraction * (r[2] - 16), r[1] + r[3] / 2
+
+
+def check_report(browser, html, shape, label, screenshots):
+    browser.events.clear()
+    browser.open("file://" + os.path.abspath(html) + "#paused")
+    check(browser.errors() == [], f"{label}: no console error on opening ({browser.errors()[:3]})")
+    check(browser.evaluate("document.getElementById('canvas') !== null"), f"{label}: the page has a WebGL canvas")
+    frames = browser.evaluate("nhdyn.frames")
+    check(browser.evaluate("nhdyn.frame") == 0, f"{label}: paused at the first frame")
+
+    # The slider moves the scene: a click at 15 % and at 80 % of its track.
+    browser.click(*slider_point(browser, 0.15))
+    first = browser.evaluate("nhdyn.frame")
+    check(abs(first - 0.15 * (frames - 1)) <= 0.03 * frames,
+          f"{label}: a click at 15 % of the slider shows frame {first} of {frames}")
+    where_first = browser.evaluate(f"nhdyn.screen({shape})")
+    rect, rows_first, png_first = canvas_pixels(browser)
+    browser.click(*slider_point(browser, 0.8))
+    second = browser.evaluate("nhdyn.frame")
+    check(abs(second - 0.8 * (frames - 1)) <= 0.03 * frames,
+          f"{label}: a click at 80 % of the slider shows frame {second} of {frames}")
+    where_second = browser.evaluate(f"nhdyn.screen({shape})")
+    _, rows_second, png_second = canvas_pixels(browser)
+    for name, png in (("early", png_first), ("late", png_second)):
+        path = os.path.join(WORK, f"{label}-{name}.png")
+        with open(path, "wb") as f:
+            f.write(png)
+        screenshots.append(path)
+
+    # Not blank: the body is drawn where the camera projects it, at both times.
+    check(coloured_near(rows_first, rect, where_first, 6) > 10,
+          f"{label}: the body is drawn at {where_first[0]:.0f}, {where_first[1]:.0f} (early)")
+    check(coloured_near(rows_second, rect, where_second, 6) > 10,
+          f"{label}: the body is drawn at {where_second[0]:.0f}, {where_second[1]:.0f} (late)")
+    moved = ((where_first[0] - where_second[0]) ** 2 + (where_first[1] - where_second[1]) ** 2) ** 0.5
+    check(moved > 15, f"{label}: the body moved {moved:.0f} px on the screen between the two times")
+    # The two screenshots differ where the body was and where it went.
+    check(changed_near(rows_first, rows_second, rect, where_first, 6) > 10,
+          f"{label}: the screenshots differ where the body was")
+    check(changed_near(rows_first, rows_second, rect, where_second, 6) > 10,
+          f"{label}: the screenshots differ where the body went")
+    far = (rect[0] + 3, rect[1] + 3)
+    check(changed_near(rows_first, rows_second, rect, far, 2) == 0,
+          f"{label}: the screenshots agree far from the body (the corner)")
+    plots = browser.evaluate("document.querySelectorAll('canvas.plot').length")
+    check(plots >= 3, f"{label}: {plots} plot panels")
+    check(browser.errors() == [], f"{label}: no console error after moving the slider ({browser.errors()[:3]})")
+
+
+def main():
+    chromium = find_chromium()
+    if chromium is None:
+        print("SKIP: no Chromium on PATH (apt-get install chromium); the report's browser tests did not run")
+        return 77
+    reports = []
+    sled = os.path.join(WORK, "sled.html")
+    run("simulate", os.path.join(SOURCE, "examples/sled.toml"), "--t-end", "4", "-q",
+        "-o", os.path.join(WORK, "sled.csv"), "--html", sled)
+    reports.append((sled, 2, "sled"))  # shape 2: the centre of mass
+    disk = os.path.join(WORK, "rolling_disk_bodies.html")
+    run("simulate", os.path.join(SOURCE, "examples/rolling_disk_bodies.toml"), "--t-end", "3", "-q",
+        "-o", os.path.join(WORK, "disk.csv"), "--html", disk)
+    shape = None
+    reports_disk_shapes = None
+    try:
+        browser = Browser(chromium)
+    except Exception as error:  # noqa: BLE001 - any failure to start is a reason to skip
+        print(f"SKIP: Chromium ({chromium}) cannot start here: {error}")
+        return 77
+    screenshots = []
+    try:
+        shapes = browser  # placeholder for clarity below
+        del shapes
+        for html, shape, label in reports[:1]:
+            check_report(browser, html, shape, label, screenshots)
+        # The disk: follow the shape that is the wheel.
+        browser.open("file://" + os.path.abspath(disk) + "#paused")
+        reports_disk_shapes = browser.evaluate("NHDYN.scene.shapes.map(s => s.kind)")
+        shape = reports_disk_shapes.index("wheel")
+        check_report(browser, disk, shape, "rolling_disk_bodies", screenshots)
+        check(browser.evaluate("document.querySelectorAll('.katex').length") > 0,
+              "rolling_disk_bodies: the equations are rendered by KaTeX")
+        check(browser.evaluate("document.querySelectorAll('.katex-error').length") == 0,
+              "rolling_disk_bodies: KaTeX reports no error in the equations")
+    finally:
+        browser.close()
+    print("screenshots: " + " ".join(screenshots))
+    if failures:
+        print(f"{len(failures)} check(s) failed")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
