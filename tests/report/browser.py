@@ -5,6 +5,7 @@ decodes them with the standard library only."""
 import base64
 import json
 import os
+import select
 import shutil
 import subprocess
 import tempfile
@@ -37,12 +38,15 @@ class Browser:
         self._from_chrome, from_chrome_w = os.pipe()
         # Chromium reads commands on fd 3 and writes replies on fd 4.
         def child():
-            os.dup2(to_chrome_r, 3)
-            os.dup2(from_chrome_w, 4)
+            # Through fresh copies: dup2 onto the same number would keep the close-on-exec flag.
+            read_end, write_end = os.dup(to_chrome_r), os.dup(from_chrome_w)
+            os.dup2(read_end, 3)
+            os.dup2(write_end, 4)
         self.process = subprocess.Popen(
             [executable, *CHROMIUM_FLAGS, "--user-data-dir=" + self.profile, "about:blank"],
             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-            preexec_fn=child, pass_fds=(to_chrome_r, from_chrome_w))
+            # subprocess closes inherited descriptors after preexec_fn: keep them, 3 and 4 included.
+            preexec_fn=child, close_fds=False)
         os.close(to_chrome_r)
         os.close(from_chrome_w)
         self.timeout = timeout
@@ -59,6 +63,9 @@ class Browser:
     def _read_message(self, deadline):
         while b"\0" not in self._buffer:
             if time.time() > deadline:
+                raise TimeoutError("Chromium did not answer in time")
+            ready, _, _ = select.select([self._from_chrome], [], [], max(0.0, deadline - time.time()))
+            if not ready:
                 raise TimeoutError("Chromium did not answer in time")
             chunk = os.read(self._from_chrome, 1 << 20)
             if not chunk:

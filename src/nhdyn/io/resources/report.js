@@ -214,8 +214,9 @@
 
   // Orbit camera: drag to turn about the target, wheel to zoom. z is up (y for a planar scene,
   // seen from +z).
-  const orbit = S.planar ? { azimuth: -Math.PI / 2, elevation: Math.PI / 2 - 1e-3, distance: 2.2 * extent }
-                         : { azimuth: -Math.PI / 3, elevation: 0.45, distance: 2.2 * extent };
+  // The whole motion in view: the field of view is 40 degrees, tan(20 deg) = 0.36.
+  const orbit = S.planar ? { azimuth: -Math.PI / 2, elevation: Math.PI / 2 - 1e-3, distance: 1.6 * extent }
+                         : { azimuth: -Math.PI / 3, elevation: 0.45, distance: 2.0 * extent };
   const target = centre.clone();
   const aim = () => {
     const ce = Math.cos(orbit.elevation);
@@ -304,9 +305,37 @@
   // ---- Equations -------------------------------------------------------------------------------
   const equations = el("div", { id: "equations" }, document.body);
   el("h2", { text: "Equations of motion" }, equations);
+  // `nhdyn equations --format latex` writes one align* environment with \intertext between its
+  // groups and %-comments above it, for a LaTeX document; KaTeX has no \intertext, so each group
+  // becomes an aligned display and each \intertext a paragraph with its $...$ rendered inline.
+  const renderEquations = (latex, box) => {
+    const lines = latex.split("\n");
+    for (const line of lines)
+      if (line.startsWith("%") && !line.includes("usepackage")) el("p", { class: "comment", text: line.replace(/^%\s?/, "") }, box);
+    let rest = lines.filter((line) => !line.startsWith("%")).join("\n")
+      .replace("\\begin{align*}", "").replace("\\end{align*}", "");
+    const options = { throwOnError: false, strict: "ignore" };
+    while (true) {
+      const i = rest.indexOf("\\intertext{");
+      const rows = (i < 0 ? rest : rest.slice(0, i)).replace(/\\\\\s*$/, "");
+      if (rows.trim())
+        katex.render("\\begin{aligned}" + rows + "\\end{aligned}", el("div", {}, box), { ...options, displayMode: true });
+      if (i < 0) break;
+      let j = i + "\\intertext".length, depth = 0;
+      for (; j < rest.length; ++j) {
+        if (rest[j] === "{") ++depth;
+        else if (rest[j] === "}" && --depth === 0) break;
+      }
+      const p = el("p", {}, box);
+      rest.slice(i + "\\intertext{".length, j).split("$").forEach((part, k) => {
+        if (k % 2 === 1) katex.render(part, el("span", {}, p), options);
+        else p.appendChild(document.createTextNode(part.replace(/\\texttt\{([^}]*)\}/g, "$1")));
+      });
+      rest = rest.slice(j + 1);
+    }
+  };
   if (D.equations) {
-    const box = el("div", {}, equations);
-    katex.render(D.equations, box, { displayMode: true, throwOnError: false, trust: false, strict: "ignore" });
+    renderEquations(D.equations, el("div", {}, equations));
   } else {
     el("p", { text: D.equations_note }, equations);
   }
