@@ -273,14 +273,16 @@
     // Ticks: 1-2-5 steps (decades on a log scale).
     const step = p.log ? Math.max(1, Math.round(niceStep((vmax - vmin) / 4))) : niceStep((vmax - vmin) / 4);
     g.fillStyle = "#555";
-    for (let v = Math.ceil(vmin / step) * step; v <= vmax + 1e-9 * step; v += step) {
+    for (let i = Math.ceil(vmin / step); i * step <= vmax + 1e-9 * step; ++i) {
+      const v = i * step;  // a multiple of the step, printed without the float's accumulated error
       g.fillText(p.log ? "1e" + Math.round(v) : Number(v.toPrecision(6)).toString(), 2, ty(v) + 4);
       g.strokeStyle = "#eee";
       g.beginPath(); g.moveTo(x0, ty(v)); g.lineTo(x1, ty(v)); g.stroke();
     }
     const tstep = niceStep((t1 - t0) / 5);
-    for (let t = Math.ceil(t0 / tstep) * tstep; t <= t1 + 1e-9 * tstep; t += tstep)
-      g.fillText(Number(t.toPrecision(6)).toString(), tx(t) - 8, h - 6);
+    for (let i = Math.ceil(t0 / tstep); i * tstep <= t1 + 1e-9 * tstep; ++i)
+      g.fillText(Number((i * tstep).toPrecision(6)).toString(), tx(i * tstep) - 8, h - 6);
+    let legend = x0 + g.measureText(p.title).width + 16;
     shown.forEach((s, k) => {
       g.strokeStyle = "#" + colours[k % colours.length].toString(16).padStart(6, "0");
       g.beginPath();
@@ -292,7 +294,8 @@
       }
       g.stroke();
       g.fillStyle = g.strokeStyle;
-      g.fillText(p.series[k].name, x1 - 8 - 90 * (p.series.length - k), 14);
+      g.fillText(p.series[k].name, legend, 14);  // legends after the title, in a row
+      legend += g.measureText(p.series[k].name).width + 12;
     });
     const background = g.getImageData(0, 0, w, h);
     return { cursor: (t) => {
