@@ -127,6 +127,11 @@ def main():
     disk = os.path.join(WORK, "rolling_disk_bodies.html")
     run("simulate", os.path.join(SOURCE, "examples/rolling_disk_bodies.toml"), "--t-end", "3", "-q",
         "-o", os.path.join(WORK, "disk.csv"), "--html", disk)
+    bicycle = os.path.join(WORK, "whipple_bicycle.html")
+    run("simulate", os.path.join(SOURCE, "examples/whipple_bicycle.toml"), "--t-end", "10", "--output-step", "0.01",
+        "-q", "-o", os.path.join(WORK, "bicycle.csv"), "--html", bicycle)
+    size = os.path.getsize(bicycle)
+    check(size < 5e6, f"whipple_bicycle: a 10 s run at 100 frames/s gives a page of {size / 1e6:.2f} MB (< 5 MB)")
     try:
         browser = Browser(chromium)
     except Exception as error:  # noqa: BLE001 - any failure to start is a reason to skip
@@ -141,6 +146,12 @@ def main():
               "rolling_disk_bodies: the equations are rendered by KaTeX")
         check(browser.evaluate("document.querySelectorAll('.katex-error').length") == 0,
               "rolling_disk_bodies: KaTeX reports no error in the equations")
+        browser.events.clear()
+        browser.open("file://" + os.path.abspath(bicycle) + "#paused")
+        check(browser.evaluate("nhdyn.frames") == 1001, "whipple_bicycle: all 1001 rows shown")
+        check(browser.evaluate("NHDYN.scene.shapes.filter(s => s.kind === 'wheel').length") == 2,
+              "whipple_bicycle: two wheels drawn")
+        check(browser.errors() == [], f"whipple_bicycle: no console error ({browser.errors()[:3]})")
     finally:
         browser.close()
     print("screenshots: " + " ".join(screenshots))

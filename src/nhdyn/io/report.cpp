@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <sstream>
 #include <string_view>
 
 #include "nhdyn/core/error.hpp"
@@ -350,7 +351,17 @@ std::string write_model_report(const Model& model, const symbolic::Spec* spec, c
     input.scene = &*scene;
     input.path = spec->path;
     const symbolic::Derivation derivation = symbolic::derive(*spec);
-    input.equations_latex = symbolic::format_equations(*spec, derivation, symbolic::EquationFormat::latex);
+    // Laying out the equations simplifies every term, which takes a bicycle over a minute for
+    // pages the page would not show: terms whose plain printing already exceeds the limit are
+    // left out before that.
+    std::ostringstream raw;
+    raw << derivation.A << derivation.Q << derivation.G << derivation.b << derivation.b0;
+    if (raw.str().size() > options.max_equations)
+      input.equations_note = fmt::format("The equations of '{}' are too long to lay out here (their terms alone take "
+                                         "{} kB); `nhdyn equations MODEL --format latex` prints them.",
+                                         model.name, raw.str().size() / 1000);
+    else
+      input.equations_latex = symbolic::format_equations(*spec, derivation, symbolic::EquationFormat::latex);
   } else {
     input.equations_note = fmt::format("'{}' is a built-in model written in C++: it has no symbolic equations to "
                                        "show (its model file in examples/ has).",
