@@ -5,7 +5,11 @@
 // --html path that cannot be written, a model with nothing to draw). The page in a browser is
 // tests/report/report_test.py.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -49,16 +53,23 @@ TEST(Visual, SledBladeAndCentreOfMassFollowTheClosedForm) {
   ASSERT_EQ(scene.shapes.size(), 3u);
   EXPECT_TRUE(scene.planar);
   EXPECT_FALSE(scene.ground);
-  EXPECT_EQ(scene.shapes[0].kind, VisualKind::segment);
-  EXPECT_EQ(scene.shapes[2].kind, VisualKind::sphere);
-  EXPECT_DOUBLE_EQ(scene.shapes[2].size[0], 0.08);
+  auto find = [&](const std::string& name) {
+    for (const nhdyn::symbolic::VisualShape& shape : scene.shapes)
+      if (shape.name == name) return shape;
+    ADD_FAILURE() << "no shape " << name;
+    return nhdyn::symbolic::VisualShape{};
+  };
+  const nhdyn::symbolic::VisualShape blade = find("blade"), mass = find("centre of mass");
+  EXPECT_EQ(blade.kind, VisualKind::segment);
+  EXPECT_EQ(mass.kind, VisualKind::sphere);
+  EXPECT_DOUBLE_EQ(mass.size[0], 0.08);
   // phi is an angle (inside cos and sin), x and y are lengths.
   EXPECT_EQ(scene.angles, (std::vector<bool>{false, false, true}));
   const double a = parameter(spec, "a");
   for (const double phi : {0.0, 0.7, -2.1, 3.0}) {
     const double x = 1.3, y = -0.4;
     const std::vector<double> out = run_scene(scene, 0.0, {x, y, phi}, {0.1, 0.2, 0.3});
-    const int b = scene.shapes[0].offset, c = scene.shapes[2].offset;
+    const int b = blade.offset, c = mass.offset;
     EXPECT_NEAR(out[b + 0], x - 0.25 * std::cos(phi), 1e-14);
     EXPECT_NEAR(out[b + 1], y - 0.25 * std::sin(phi), 1e-14);
     EXPECT_EQ(out[b + 2], 0.0);
@@ -118,13 +129,13 @@ TEST(Visual, RollingDiskCentreAndContactPoint) {
   EXPECT_EQ(scene.angles, (std::vector<bool>{false, false, true, true, true}));
 }
 
-const char* const kPlanarModel = R"(
+const char* const kPlanarModel = R"toml(
 name = "dot"
 coordinates = ["x", "y"]
 kinetic_energy = "m/2*(x'^2 + y'^2)"
 [parameters]
 m = 1.0
-)";
+)toml";
 
 TEST(Visual, BadVisualTablesAreRefusedWithTheirPlace) {
   const std::string base = kPlanarModel;

@@ -123,7 +123,7 @@ def main():
     sled = os.path.join(WORK, "sled.html")
     run("simulate", os.path.join(SOURCE, "examples/sled.toml"), "--t-end", "4", "-q",
         "-o", os.path.join(WORK, "sled.csv"), "--html", sled)
-    reports.append((sled, 2, "sled"))  # shape 2: the centre of mass
+    reports.append((sled, "sphere", "sled"))  # the centre of mass
     disk = os.path.join(WORK, "rolling_disk_bodies.html")
     run("simulate", os.path.join(SOURCE, "examples/rolling_disk_bodies.toml"), "--t-end", "3", "-q",
         "-o", os.path.join(WORK, "disk.csv"), "--html", disk)

@@ -7,7 +7,8 @@ execute_process(COMMAND ${CMAKE_COMMAND} -S "${SOURCE}" -B "${WORK}" -DRESOURCES
 if(result EQUAL 0)
   message(FATAL_ERROR "configuring without three.js succeeded; it must stop and name libjs-three")
 endif()
-string(FIND "${err}" "install the Debian package libjs-three" found)
+string(REGEX REPLACE "[ \n]+" " " flat "${err}")  # CMake wraps its messages
+string(FIND "${flat}" "install the Debian package libjs-three" found)
 if(found EQUAL -1)
   message(FATAL_ERROR "the configuration failed without naming libjs-three:\n${err}")
 endif()
