@@ -146,8 +146,7 @@ void check_report_columns(const std::vector<std::string>& header, const ResultCo
                                    "{} columns; give the CSV that `nhdyn simulate` wrote for this model",
                                    csv, model, i + 1, header[i], want.size()));
     throw InputError(fmt::format("{} does not belong to model '{}': its column {} is '{}' where the model expects "
-                                 "'{}'; give the CSV that `nhdyn simulate` wrote for this model (and the same --set "
-                                 "of nothing but parameters)",
+                                 "'{}'; give the CSV that `nhdyn simulate` wrote for this model",
                                  csv, model, i + 1, header[i], want[i]));
   }
 }
