@@ -19,5 +19,6 @@ std::function<int()> add_example_command(CLI::App& app);
 std::function<int()> add_linearize_command(CLI::App& app);
 std::function<int()> add_sweep_command(CLI::App& app);
 std::function<int()> add_batch_command(CLI::App& app);
+std::function<int()> add_report_command(CLI::App& app);
 
 }  // namespace nhdyn::cli

@@ -23,12 +23,13 @@ int main(int argc, char** argv) {
   const auto linearize = nhdyn::cli::add_linearize_command(app);
   const auto sweep = nhdyn::cli::add_sweep_command(app);
   const auto batch = nhdyn::cli::add_batch_command(app);
+  const auto report = nhdyn::cli::add_report_command(app);
   if (argc > 1 && argv[1][0] != '-') {
     bool known = false;
     for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
       known = known || sub->get_name() == argv[1];
     if (!known) {
-      fmt::print(stderr, "nhdyn: error: unknown command '{}'; the commands are simulate, compare, study, linearize, sweep, batch, list, equations, codegen, example "
+      fmt::print(stderr, "nhdyn: error: unknown command '{}'; the commands are simulate, compare, study, linearize, sweep, batch, report, list, equations, codegen, example "
                          "(see nhdyn --help)\n", argv[1]);
       return 2;
     }
@@ -50,6 +51,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("linearize")) return linearize();
     if (app.got_subcommand("sweep")) return sweep();
     if (app.got_subcommand("batch")) return batch();
+    if (app.got_subcommand("report")) return report();
   } catch (const nhdyn::Error& e) {
     fmt::print(stderr, "nhdyn: error: {}\n", e.what());
     return 2;

@@ -18,6 +18,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
+#include "nhdyn/io/report.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 #include "progress.hpp"
@@ -43,6 +44,7 @@ struct SimulateArgs {
   double step = 0.0;
   std::string output;
   std::string plot;
+  std::string html;  // the HTML report (io/report.hpp), written from the CSV after the run
   bool quiet = false;
 };
 
@@ -131,6 +133,14 @@ int run_simulate(const SimulateArgs& args) {
       throw FileError(fmt::format("cannot create the directory '{}' for the results: {}; give another path with -o",
                                   csv_path.parent_path().string(), ec.message()));
   }
+  std::optional<AtomicFile> html_probe;
+  if (!args.html.empty()) {
+    std::error_code ec;
+    if (fs::weakly_canonical(args.html, ec) == fs::weakly_canonical(csv_path, ec))
+      throw InputError(fmt::format("--html {} and the CSV output {} are the same file; give them different names",
+                                   args.html, csv_path.string()));
+    html_probe.emplace(args.html);  // checks the report's directory now; removed unused
+  }
   const ResultColumns columns = make_result_columns(model);
   CsvWriter writer(csv_path, columns.all);  // refuses an unwritable path before any step
 
@@ -168,6 +178,16 @@ int run_simulate(const SimulateArgs& args) {
     if (!columns.energy.empty()) request.energy = columns.energy;
     write_plot(request, args.plot);
   }
+  html_probe.reset();
+  std::string html_notice;
+  if (!args.html.empty())
+    html_notice = write_model_report(model, spec, load_csv(csv_path),
+                       fmt::format("{}: {}, {}", model.name, method_name(options.formulation.method),
+                                   integrator_name(options.integrator.kind)),
+                       {{"steps", fmt::format("{} (rejected {})", summary.stats.steps, summary.stats.rejected_steps)},
+                        {"right-hand sides", fmt::format("{}", summary.stats.rhs_evaluations)},
+                        {"results", csv_path.string()}},
+                       args.html);
 
   if (!args.quiet) {
     const bool adaptive = options.integrator.kind != IntegratorKind::rk4;
@@ -206,6 +226,7 @@ int run_simulate(const SimulateArgs& args) {
     if (summary.has_energy)
       fmt::print("  energy drift: {:.3g} (E0 = {:.10g})\n", summary.energy_drift, summary.energy_initial);
     if (!args.plot.empty()) fmt::print("  plot -> {}\n", args.plot);
+    if (!args.html.empty()) fmt::print("  report -> {}{}\n", args.html, html_notice.empty() ? "" : "\n  note: " + html_notice);
   }
   return 0;
 }
@@ -237,6 +258,7 @@ std::function<int()> add_simulate_command(CLI::App& app) {
   cmd->add_option("--step", args->step, "rk4: step size [s] (default output step / 10); adaptive: first step");
   cmd->add_option("-o,--output", args->output, "CSV file to write (default results/MODEL.csv)");
   cmd->add_option("--plot", args->plot, "PNG file to draw with gnuplot");
+  cmd->add_option("--html", args->html, "HTML report to write: 3-D animation, plots, equations (docs/report.md)");
   cmd->add_flag("-q,--quiet", args->quiet, "Print no summary");
   return [args] { return run_simulate(*args); };
 }

@@ -41,7 +41,7 @@ using symbolic::SpecBuilder;
 const std::vector<std::string> top_level_keys = {
     "name",           "description", "coordinates", "parameters",  "kinetic_energy",
     "potential_energy", "forces",    "constraints", "independent", "complement",
-    "initial",        "solution",    "simulation",  "plot",
+    "initial",        "solution",    "simulation",  "plot",        "visual",
     // The multibody description (docs/multibody.md).
     "gravity", "frames", "points", "bodies", "wheels", "knife_edges", "surfaces", "curves"};
 const std::vector<std::string> frame_keys = {"name", "parent", "translation", "rotations"};
@@ -56,6 +56,9 @@ const std::vector<std::string> constraint_keys = {"name", "position", "velocity"
 const std::vector<std::string> initial_keys = {"t0", "position", "velocity"};
 const std::vector<std::string> simulation_keys = {"t_end", "output_step", "integrator", "method", "rtol", "atol"};
 const std::vector<std::string> plot_keys = {"path"};
+const std::vector<std::string> visual_keys = {"points", "segments"};
+const std::vector<std::string> visual_point_keys = {"name", "position", "radius"};
+const std::vector<std::string> visual_segment_keys = {"name", "from", "to"};
 
 // The names that formulation/formulation.cpp (parse_method) and integrators/ode.cpp
 // (parse_integrator) accept. io may not depend on those modules, so the lists are repeated here;
@@ -153,13 +156,17 @@ class Loader {
 
     if (const toml::node* forces = root.get("forces")) load_forces(*forces, builder);
     if (const toml::node* constraints = root.get("constraints")) load_constraints(*constraints, builder);
-    load_multibody(root, builder);
+    symbolic::SpecVisual visual;
+    load_multibody(root, builder, visual);
+    if (const toml::node* node = root.get("visual")) load_visual(*node, builder, visual);
     load_complement(root, builder);
     if (const toml::node* initial = root.get("initial")) load_initial(*initial, builder);
     if (const toml::node* solution = root.get("solution")) load_solution(*solution, builder);
     if (const toml::node* simulation = root.get("simulation")) load_simulation(*simulation, builder);
     if (const toml::node* plot = root.get("plot")) load_plot(*plot, builder);
-    return builder.build();
+    symbolic::Spec spec = builder.build();
+    spec.visual = std::move(visual);
+    return spec;
   }
 
  private:
@@ -750,12 +757,14 @@ class Loader {
     return triple_of(*node, what, "[0, 0, 1]");
   }
 
-  void load_multibody(const toml::table& root, SpecBuilder& builder) const {
+  void load_multibody(const toml::table& root, SpecBuilder& builder, symbolic::SpecVisual& visual) const {
     bool any = false;
     for (const char* key : {"gravity", "frames", "points", "bodies", "wheels", "knife_edges", "surfaces", "curves"})
       any = any || root.get(key) != nullptr;
     if (!any) return;
     symbolic::MultibodyBuilder mb(builder);
+    visual.ground = true;
+    std::vector<std::pair<std::string, symbolic::PlacedFrame>> body_frames;  // for the wheels' scene
     if (const toml::node* gravity = root.get("gravity"))
       mb.gravity(triple_of(*gravity, "gravity", "gravity = [0, 0, \"-g\"]"), at(*gravity));
     if (const toml::node* frames = root.get("frames"))
@@ -783,6 +792,7 @@ class Loader {
           }
         }
         mb.frame(name, parent, translation, rotations, at(*table));
+        visual.items.push_back(frame_item(mb.placed_frame(name), symbolic::VisualKind::frame, at(*table)));
       }
     if (const toml::node* points = root.get("points"))
       for (const toml::table* table : tables_of(*points, "points", point_keys)) {
@@ -806,18 +816,41 @@ class Loader {
           com = triple_of(*node, fmt::format("body '{}': com", name), "com = [0, 0, \"-l/2\"]");
         const toml::node& inertia_node = member(*table, "bodies", "inertia",
                                                 "inertia = [\"Ixx\", \"Iyy\", \"Izz\"] (principal moments) or a 3 x 3 array");
-        mb.body(name, frame, mass, com, inertia_of(inertia_node, name), at(*table));
+        const symbolic::InertiaText inertia = inertia_of(inertia_node, name);
+        mb.body(name, frame, mass, com, inertia, at(*table));
+        // The scene's ellipsoid of the body: its centre of mass, moving with its frame.
+        symbolic::VisualItem item = frame_item(mb.placed_frame(frame), symbolic::VisualKind::body, at(*table));
+        item.name = name;
+        item.size = builder.parse(mass, at(*table));
+        for (std::size_t i = 0; i < 3; ++i) {
+          for (std::size_t j = 0; j < 3; ++j) {
+            item.at[i] += item.other[3 * i + j] * builder.parse(com[j], at(*table));
+            item.inertia.push_back(builder.parse(inertia[i][j], at(*table)));
+          }
+        }
+        body_frames.emplace_back(name, mb.placed_frame(frame));
+        visual.items.push_back(std::move(item));
       }
     if (const toml::node* wheels = root.get("wheels"))
       for (const toml::table* table : tables_of(*wheels, "wheels", wheel_keys)) {
         const std::string name = name_of(*table, "wheels");
         const std::string what = fmt::format("wheel '{}'", name);
-        mb.rolling_wheel(name,
-                         string_of(member(*table, "wheels", "body", "body = \"disk\""), what + ": body", "body = \"disk\""),
-                         string_of(member(*table, "wheels", "axis", "axis = \"y\""), what + ": axis", "axis = \"y\""),
-                         number_or_expression(member(*table, "wheels", "radius", "radius = \"r\""), what + ": radius",
-                                              "radius = \"r\""),
-                         optional_triple(*table, "normal", what + ": normal"), at(*table));
+        const std::string body =
+            string_of(member(*table, "wheels", "body", "body = \"disk\""), what + ": body", "body = \"disk\"");
+        const std::string axis =
+            string_of(member(*table, "wheels", "axis", "axis = \"y\""), what + ": axis", "axis = \"y\"");
+        const std::string radius = number_or_expression(member(*table, "wheels", "radius", "radius = \"r\""),
+                                                        what + ": radius", "radius = \"r\"");
+        mb.rolling_wheel(name, body, axis, radius, optional_triple(*table, "normal", what + ": normal"), at(*table));
+        // The scene draws the wheel's body as a disk of the wheel's radius about its axle.
+        for (const auto& [body_name, placed] : body_frames)
+          if (body_name == body) {
+            symbolic::VisualItem item = frame_item(placed, symbolic::VisualKind::wheel, at(*table));
+            item.name = name;
+            item.size = builder.parse(radius, at(*table));
+            item.axis = axis == "x" ? 0 : axis == "y" ? 1 : 2;
+            visual.items.push_back(std::move(item));
+          }
       }
     if (const toml::node* knives = root.get("knife_edges"))
       for (const toml::table* table : tables_of(*knives, "knife_edges", knife_edge_keys)) {
@@ -911,6 +944,82 @@ class Loader {
       }
       builder.path(axes[0], axes[1]);
     }
+  }
+
+  // ---- [visual]: what the report's scene draws of a hand-written model (docs/model-format.md) ----
+
+  // A multibody frame's origin and rotation as a scene item.
+  symbolic::VisualItem frame_item(const symbolic::PlacedFrame& frame, symbolic::VisualKind kind,
+                                  const SourceLocation& where) const {
+    symbolic::VisualItem item;
+    item.kind = kind;
+    item.name = frame.name;
+    item.where = where.describe();
+    item.at.assign(frame.origin.begin(), frame.origin.end());
+    for (unsigned i = 0; i < 3; ++i)
+      for (unsigned j = 0; j < 3; ++j) item.other.push_back(frame.rotation(i, j));
+    return item;
+  }
+
+  // A position: two (x, y: a planar scene) or three components, expressions in t, q, q' and the
+  // parameters. `components` is set by the first position met; the others must agree.
+  std::vector<GiNaC::ex> position_of(const toml::node& node, const std::string& what, SpecBuilder& builder,
+                                     std::size_t& components) const {
+    constexpr std::string_view example = "[\"x\", \"y\"] or [\"x\", \"y\", \"z\"]";
+    const toml::array& array = array_of(node, what, example);
+    if (array.size() != 2 && array.size() != 3)
+      fail(at(node), fmt::format("'{}' must have 2 (x, y: a planar scene) or 3 components, e.g. {}; it has {}", what,
+                                 example, array.size()));
+    if (components == 0) components = array.size();
+    if (array.size() != components)
+      fail(at(node), fmt::format("'{}' has {} components but an earlier [visual] position has {}; give every "
+                                 "position the same number (2 for a planar scene, 3 otherwise)",
+                                 what, array.size(), components));
+    std::vector<GiNaC::ex> out;
+    for (std::size_t i = 0; i < array.size(); ++i) {
+      const toml::node& element = *array.get(i);
+      const std::string text = number_or_expression(element, fmt::format("{}[{}]", what, i + 1), example);
+      out.push_back(located(element, [&] { return builder.parse(text, content_at(element)); }));
+    }
+    if (out.size() == 2) out.push_back(0);
+    return out;
+  }
+
+  void load_visual(const toml::node& node, SpecBuilder& builder, symbolic::SpecVisual& visual) const {
+    const toml::table& table =
+        table_of(node, "visual", "[visual] followed by points = [{ name = \"particle\", position = [\"x\", \"y\"] }]");
+    check_keys(table, visual_keys, "in [visual]");
+    std::size_t components = 0;
+    if (const toml::node* points = table.get("points"))
+      for (const toml::table* entry : tables_of(*points, "visual.points", visual_point_keys)) {
+        symbolic::VisualItem item;
+        item.kind = symbolic::VisualKind::sphere;
+        item.name = name_of(*entry, "visual.points");
+        item.where = at(*entry).describe();
+        const std::string what = fmt::format("[visual] point '{}'", item.name);
+        item.at = position_of(member(*entry, "visual.points", "position", "position = [\"x\", \"y\"]"),
+                              what + ": position", builder, components);
+        item.size = 0.05;
+        if (const toml::node* radius = entry->get("radius")) {
+          const std::string text = number_or_expression(*radius, what + ": radius", "radius = 0.05");
+          item.size = located(*radius, [&] { return builder.parse(text, content_at(*radius)); });
+        }
+        visual.items.push_back(std::move(item));
+      }
+    if (const toml::node* segments = table.get("segments"))
+      for (const toml::table* entry : tables_of(*segments, "visual.segments", visual_segment_keys)) {
+        symbolic::VisualItem item;
+        item.kind = symbolic::VisualKind::segment;
+        item.name = name_of(*entry, "visual.segments");
+        item.where = at(*entry).describe();
+        const std::string what = fmt::format("[visual] segment '{}'", item.name);
+        item.at = position_of(member(*entry, "visual.segments", "from", "from = [\"x\", \"y\"]"), what + ": from",
+                              builder, components);
+        item.other = position_of(member(*entry, "visual.segments", "to", "to = [\"x + l*cos(phi)\", \"y\"]"),
+                                 what + ": to", builder, components);
+        visual.items.push_back(std::move(item));
+      }
+    visual.planar = components == 2 && !visual.ground;
   }
 
   std::string_view text_;

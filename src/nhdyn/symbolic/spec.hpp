@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "nhdyn/model/model.hpp"
+#include "nhdyn/symbolic/visual.hpp"
 
 namespace nhdyn::symbolic {
 
@@ -96,6 +97,7 @@ struct Spec {
   std::string integrator;                    // default integrator, "" = dopri5
   std::optional<double> rtol, atol;
   std::optional<std::pair<std::string, std::string>> path;  // coordinates to draw as y(x)
+  SpecVisual visual;  // what a report's 3-D scene draws ([visual], or the bodies): symbolic/visual.hpp
 
   int n() const { return static_cast<int>(coordinates.size()); }
   int s() const { return static_cast<int>(constraints.size()); }

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Writes the HTML report (docs/report.md) of every example with something to draw, and a
+# screenshot of each taken by headless Chromium, into OUT (default build/gallery-reports):
+#     docs/gallery/make_reports.sh [NHDYN] [OUT]
+# The reports are 1.5-3 MB each (the embedded JavaScript libraries), so the repository keeps only
+# the screenshots of docs/gallery/reports/ (copied there by hand from OUT).
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../.." && pwd)
+nhdyn=${1:-$root/build/apps/nhdyn/nhdyn}
+out=${2:-$root/build/gallery-reports}
+mkdir -p "$out"
+# name, end time, time of the screenshot
+runs=(
+  "sled 6 4" "sled_paper 6 4" "chaplygin_sleigh 10 6" "knife_edge 4 3" "appell 2 1.5"
+  "double_pendulum 5 3" "pendulum_cartesian 4 1" "rolling_disk_bodies 6 2" "whipple_bicycle 10 4"
+)
+for run in "${runs[@]}"; do
+  read -r name t_end shot <<<"$run"
+  "$nhdyn" simulate "$root/examples/$name.toml" --t-end "$t_end" -q -o "$out/$name.csv" --html "$out/$name.html"
+  if command -v chromium >/dev/null; then
+    profile=$(mktemp -d)
+    chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking \
+      --disable-component-update --disable-sync --hide-scrollbars --user-data-dir="$profile" \
+      --window-size=1300,760 --virtual-time-budget=5000 --screenshot="$out/$name.png" \
+      "file://$out/$name.html#paused&t=$shot" >/dev/null 2>&1 || echo "no screenshot of $name" >&2
+    rm -rf "$profile"
+  fi
+  echo "$name: $(du -h "$out/$name.html" | cut -f1) -> $out/$name.html"
+done

@@ -1,0 +1,398 @@
+#include "nhdyn/io/report.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <sstream>
+#include <string_view>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/io/atomic_file.hpp"
+#include "nhdyn/symbolic/derivation.hpp"
+#include "nhdyn/symbolic/equations.hpp"
+#include "nhdyn/symbolic/spec.hpp"
+#include "nhdyn/symbolic/visual.hpp"
+
+// Generated at build time from the Debian packages and io/resources/ (io/resources/embed.cmake).
+namespace nhdyn::resources {
+struct FontResource {
+  const char* name;  // e.g. "KaTeX_Main-Regular"
+  const unsigned char* data;
+  std::size_t size;
+};
+extern const std::string_view three_js, katex_js, katex_css, report_js, report_css;
+extern const FontResource katex_fonts[];
+extern const std::size_t katex_font_count;
+}  // namespace nhdyn::resources
+
+namespace nhdyn {
+namespace {
+
+// A JSON string, safe inside a <script> element (no "</" can end it early).
+void append_string(std::string& out, std::string_view text) {
+  out += '"';
+  for (const char c : text) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      case '<': out += "\\u003c"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) out += fmt::format("\\u{:04x}", static_cast<int>(c));
+        else out += c;
+    }
+  }
+  out += '"';
+}
+
+// Six significant digits: a page 0.1 mm off on a metre-sized scene cannot be seen, and the
+// numbers are most of the page. Non-finite values become null (a gap in a curve).
+void append_number(std::string& out, double x) {
+  if (!std::isfinite(x)) {
+    out += "null";
+    return;
+  }
+  if (x == 0.0) x = 0.0;  // no "-0"
+  out += fmt::format("{:.6g}", x);
+}
+
+void append_numbers(std::string& out, const std::vector<double>& values) {
+  out += '[';
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (i > 0) out += ',';
+    append_number(out, values[i]);
+  }
+  out += ']';
+}
+
+std::string base64(const unsigned char* data, std::size_t size) {
+  static constexpr char digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((size + 2) / 3 * 4);
+  for (std::size_t i = 0; i < size; i += 3) {
+    const unsigned a = data[i], b = i + 1 < size ? data[i + 1] : 0u, c = i + 2 < size ? data[i + 2] : 0u;
+    const unsigned triple = (a << 16) | (b << 8) | c;
+    out += digits[(triple >> 18) & 63];
+    out += digits[(triple >> 12) & 63];
+    out += i + 1 < size ? digits[(triple >> 6) & 63] : '=';
+    out += i + 2 < size ? digits[triple & 63] : '=';
+  }
+  return out;
+}
+
+// KaTeX's stylesheet with every font's list of sources replaced by the embedded woff2 file as a
+// data: URL, so that no font is fetched when the page is opened.
+std::string katex_css_with_fonts() {
+  const std::string_view css = resources::katex_css;
+  std::string out;
+  std::size_t p = 0;
+  while (true) {
+    const std::size_t src = css.find("src:", p);
+    if (src == std::string_view::npos) break;
+    const std::size_t end = css.find_first_of(";}", src);
+    if (end == std::string_view::npos) break;
+    const std::string_view sources = css.substr(src, end - src);
+    out.append(css.substr(p, src - p));
+    bool replaced = false;
+    for (std::size_t i = 0; i < resources::katex_font_count && !replaced; ++i) {
+      const resources::FontResource& font = resources::katex_fonts[i];
+      if (sources.find(fmt::format("fonts/{}.woff2", font.name)) == std::string_view::npos) continue;
+      out += "src:url(data:font/woff2;base64,";
+      out += base64(font.data, font.size);
+      out += ") format(\"woff2\")";
+      replaced = true;
+    }
+    if (!replaced) out.append(sources);
+    p = end;
+  }
+  out.append(css.substr(p));
+  return out;
+}
+
+struct PlotGroup {
+  std::string title;
+  bool log = false;
+  bool drift = false;  // drawn as v - v(first row)
+  std::vector<std::string> columns;
+};
+
+}  // namespace
+
+std::vector<std::size_t> report_frames(std::size_t rows, int max_frames) {
+  std::vector<std::size_t> out;
+  if (rows == 0) return out;
+  const std::size_t most = static_cast<std::size_t>(std::max(max_frames, 2));
+  const std::size_t k = rows <= most ? 1 : (rows - 1 + most - 2) / (most - 1);
+  for (std::size_t i = 0; i < rows; i += k) out.push_back(i);
+  if (out.back() != rows - 1) out.push_back(rows - 1);
+  return out;
+}
+
+void check_report_columns(const std::vector<std::string>& header, const ResultColumns& expected,
+                          const std::string& csv, const std::string& model) {
+  const std::vector<std::string>& want = expected.all;
+  for (std::size_t i = 0; i < std::max(header.size(), want.size()); ++i) {
+    if (i < header.size() && i < want.size() && header[i] == want[i]) continue;
+    if (i >= header.size())
+      throw InputError(fmt::format("{} does not belong to model '{}': it ends after column {} where the model "
+                                   "expects column '{}'; give the CSV that `nhdyn simulate` wrote for this model",
+                                   csv, model, i, want[i]));
+    if (i >= want.size())
+      throw InputError(fmt::format("{} does not belong to model '{}': its column {} '{}' is one more than the model's "
+                                   "{} columns; give the CSV that `nhdyn simulate` wrote for this model",
+                                   csv, model, i + 1, header[i], want.size()));
+    throw InputError(fmt::format("{} does not belong to model '{}': its column {} is '{}' where the model expects "
+                                 "'{}'; give the CSV that `nhdyn simulate` wrote for this model",
+                                 csv, model, i + 1, header[i], want[i]));
+  }
+}
+
+std::string make_report_html(const ReportInput& input, const ReportOptions& options, std::string* notice) {
+  const CsvTable& table = input.table;
+  if (table.rows.empty()) throw InputError(fmt::format("the run of '{}' has no row to report", input.model));
+  check_report_columns(table.header, input.columns, "the table", input.model);
+  const std::vector<std::size_t> frames = report_frames(table.rows.size(), options.max_frames);
+  auto column = [&](const std::string& name) {
+    const int c = table.column(name);
+    std::vector<double> values;
+    values.reserve(frames.size());
+    for (const std::size_t f : frames) values.push_back(c < 0 ? std::nan("") : table.rows[f][static_cast<std::size_t>(c)]);
+    return values;
+  };
+
+  // Panels: lengths and angles apart (their scales differ), then reactions, residuals, energy.
+  std::vector<PlotGroup> groups;
+  PlotGroup lengths{"coordinates", false, false, {}}, angles{"angles [rad]", false, false, {}};
+  for (std::size_t i = 0; i < input.coordinates.size(); ++i)
+    (i < input.angles.size() && input.angles[i] ? angles : lengths).columns.push_back(input.coordinates[i]);
+  for (PlotGroup* g : {&lengths, &angles})
+    if (!g->columns.empty()) groups.push_back(*g);
+  if (!input.columns.reactions.empty()) groups.push_back({"reactions R", false, false, input.columns.reactions});
+  if (!input.columns.residuals.empty())
+    groups.push_back({"|constraint residuals| (log scale)", true, false, input.columns.residuals});
+  if (!input.columns.energy.empty())
+    groups.push_back({"energy drift E(t) - E(0)", false, true, {input.columns.energy}});
+
+  std::string data = "{\"title\":";
+  append_string(data, input.title);
+  data += ",\"summary\":[";
+  for (std::size_t i = 0; i < input.summary.size(); ++i) {
+    data += i > 0 ? ",[" : "[";
+    append_string(data, input.summary[i].first);
+    data += ',';
+    append_string(data, input.summary[i].second);
+    data += ']';
+  }
+  data += "],\"t\":";
+  append_numbers(data, column("t"));
+  data += ",\"plots\":[";
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    data += g > 0 ? ",{\"title\":" : "{\"title\":";
+    append_string(data, groups[g].title);
+    data += groups[g].log ? ",\"log\":true,\"series\":[" : ",\"log\":false,\"series\":[";
+    for (std::size_t s = 0; s < groups[g].columns.size(); ++s) {
+      std::vector<double> values = column(groups[g].columns[s]);
+      if (groups[g].drift) {
+        const double first = table.rows.front()[static_cast<std::size_t>(table.column(groups[g].columns[s]))];
+        for (double& v : values) v -= first;
+      }
+      data += s > 0 ? ",{\"name\":" : "{\"name\":";
+      append_string(data, groups[g].columns[s]);
+      data += ",\"v\":";
+      append_numbers(data, values);
+      data += '}';
+    }
+    data += "]}";
+  }
+  data += ']';
+
+  // The scene: the model's shapes, or the path as one moving point.
+  std::string note;
+  const bool has_shapes = input.scene != nullptr && !input.scene->shapes.empty();
+  data += ",\"scene\":{";
+  if (has_shapes) {
+    const symbolic::VisualScene& scene = *input.scene;
+    const Program& program = scene.program;
+    const int n = program.coordinates();
+    if (n != static_cast<int>(input.coordinates.size()))
+      throw InputError(fmt::format("the scene of '{}' has {} coordinates, the run {}", input.model, n,
+                                   input.coordinates.size()));
+    std::vector<int> qc, vc;
+    for (const std::string& q : input.coordinates) {
+      qc.push_back(table.column(q));
+      vc.push_back(table.column(q + "'"));
+    }
+    std::vector<double> q(static_cast<std::size_t>(n)), v(static_cast<std::size_t>(n));
+    std::vector<double> registers(static_cast<std::size_t>(program.registers()));
+    std::vector<double> outputs(static_cast<std::size_t>(program.outputs()));
+    std::vector<double> values;
+    values.reserve(frames.size() * outputs.size());
+    const int tc = table.column("t");
+    for (const std::size_t f : frames) {
+      const std::vector<double>& row = table.rows[f];
+      for (int i = 0; i < n; ++i) {
+        q[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(qc[static_cast<std::size_t>(i)])];
+        v[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(vc[static_cast<std::size_t>(i)])];
+      }
+      program.run(row[static_cast<std::size_t>(tc)], q.data(), v.data(), registers.data(), outputs.data());
+      values.insert(values.end(), outputs.begin(), outputs.end());
+    }
+    data += fmt::format("\"planar\":{},\"ground\":{},\"stride\":{},\"shapes\":[", scene.planar, scene.ground,
+                        outputs.size());
+    for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
+      const symbolic::VisualShape& shape = scene.shapes[s];
+      static constexpr const char* kinds[] = {"sphere", "segment", "wheel", "body", "frame"};
+      data += fmt::format("{}{{\"kind\":\"{}\",\"name\":", s > 0 ? "," : "", kinds[static_cast<int>(shape.kind)]);
+      append_string(data, shape.name);
+      data += fmt::format(",\"offset\":{},\"axis\":{},\"size\":", shape.offset, shape.axis);
+      append_numbers(data, {shape.size[0], shape.size[1], shape.size[2]});
+      data += '}';
+    }
+    data += "],\"values\":";
+    append_numbers(data, values);
+  } else {
+    std::pair<std::string, std::string> path;
+    if (input.path) path = *input.path;
+    else if (input.coordinates.size() >= 2) path = {input.coordinates[0], input.coordinates[1]};
+    else if (!input.coordinates.empty()) path = {"t", input.coordinates[0]};
+    note = fmt::format("The model '{}' names nothing to draw (no [visual] table, no bodies): the scene shows the path "
+                       "({}, {}). docs/model-format.md says how to add a [visual] table.",
+                       input.model, path.first, path.second);
+    const std::vector<double> x = column(path.first), y = column(path.second);
+    std::vector<double> values;
+    values.reserve(3 * frames.size());
+    double size = 0.0;
+    for (std::size_t f = 0; f < frames.size(); ++f) {
+      values.insert(values.end(), {x[f], y[f], 0.0});
+      if (std::isfinite(x[f]) && std::isfinite(y[f])) size = std::max({size, std::abs(x[f] - x[0]), std::abs(y[f] - y[0])});
+    }
+    data += "\"planar\":true,\"ground\":false,\"stride\":3,\"shapes\":[{\"kind\":\"sphere\",\"name\":";
+    append_string(data, path.first + ", " + path.second);
+    data += ",\"offset\":0,\"axis\":0,\"size\":";
+    const double r = size > 0.0 ? 0.02 * size : 0.05;
+    append_numbers(data, {r, r, r});
+    data += "}],\"values\":";
+    append_numbers(data, values);
+  }
+  data += '}';
+  if (frames.size() < table.rows.size())
+    note += fmt::format("{}The page shows {} of the run's {} rows (every {}th, and the last); the CSV has them all.",
+                        note.empty() ? "" : " ", frames.size(), table.rows.size(), frames.size() > 1 ? frames[1] : 1);
+  data += ",\"note\":";
+  append_string(data, note);
+  if (notice != nullptr) *notice = note;
+  data += ",\"equations\":";
+  std::string equations_note = input.equations_note;
+  if (input.equations_latex.size() > options.max_equations) {
+    append_string(data, "");
+    equations_note = fmt::format("The equations of '{}' take {} kB of LaTeX, too many to lay out here; "
+                                 "`nhdyn equations MODEL --format latex` prints them.",
+                                 input.model, input.equations_latex.size() / 1000);
+  } else {
+    append_string(data, input.equations_latex);
+  }
+  data += ",\"equations_note\":";
+  append_string(data, equations_note);
+  data += '}';
+
+  std::string html;
+  html.reserve(data.size() + resources::three_js.size() + resources::katex_js.size() + 600000);
+  html += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>";
+  for (const char c : input.title) {
+    if (c == '<') html += "&lt;";
+    else if (c == '&') html += "&amp;";
+    else html += c;
+  }
+  html += "</title>\n<!-- Written by nhdyn (io/report.hpp). Embedded: three.js (libjs-three, MIT licence), KaTeX and its "
+          "fonts (libjs-katex, MIT licence and SIL Open Font Licence). -->\n<style>\n";
+  html += katex_css_with_fonts();
+  html += "\n</style>\n<style>\n";
+  html += resources::report_css;
+  html += "</style>\n</head>\n<body>\n<script>\n";
+  html += resources::three_js;
+  html += "\n</script>\n<script>\n";
+  html += resources::katex_js;
+  html += "\n</script>\n<script>\nconst NHDYN = ";
+  html += data;
+  html += ";\n</script>\n<script>\n";
+  html += resources::report_js;
+  html += "</script>\n</body>\n</html>\n";
+  return html;
+}
+
+std::string write_report(const ReportInput& input, const std::filesystem::path& path, const ReportOptions& options) {
+  std::string notice;
+  const std::string html = make_report_html(input, options, &notice);
+  AtomicFile file(path);
+  file.write(html);
+  file.commit();
+  return notice;
+}
+
+std::string write_model_report(const Model& model, const symbolic::Spec* spec, const CsvTable& table, const std::string& title,
+                        const std::vector<std::pair<std::string, std::string>>& extra,
+                        const std::filesystem::path& path, const ReportOptions& options) {
+  ReportInput input;
+  input.title = title;
+  input.model = model.name;
+  input.coordinates = model.coordinates;
+  input.columns = make_result_columns(model);
+  check_report_columns(table.header, input.columns, "the results", model.name);
+  input.table = table;
+  std::optional<symbolic::VisualScene> scene;
+  if (spec != nullptr) {
+    scene = symbolic::compile_visual(*spec);
+    input.angles = scene->angles;
+    input.scene = &*scene;
+    input.path = spec->path;
+    const symbolic::Derivation derivation = symbolic::derive(*spec);
+    // Laying out the equations simplifies every term, which takes a bicycle over a minute for
+    // pages the page would not show: terms whose plain printing already exceeds the limit are
+    // left out before that.
+    std::ostringstream raw;
+    raw << derivation.A << derivation.Q << derivation.G << derivation.b << derivation.b0;
+    if (raw.str().size() > options.max_equations)
+      input.equations_note = fmt::format("The equations of '{}' are too long to lay out here (their terms alone take "
+                                         "{} kB); `nhdyn equations MODEL --format latex` prints them.",
+                                         model.name, raw.str().size() / 1000);
+    else
+      input.equations_latex = symbolic::format_equations(*spec, derivation, symbolic::EquationFormat::latex);
+  } else {
+    input.equations_note = fmt::format("'{}' is a built-in model written in C++: it has no symbolic equations to "
+                                       "show (its model file in examples/ has).",
+                                       model.name);
+    if (model.path)
+      input.path = std::make_pair(model.coordinates[static_cast<std::size_t>(model.path->x)],
+                                  model.coordinates[static_cast<std::size_t>(model.path->y)]);
+  }
+  input.summary = extra;
+  const std::vector<double>& first = table.rows.empty() ? std::vector<double>{} : table.rows.front();
+  if (!table.rows.empty()) {
+    input.summary.emplace_back("time", fmt::format("{:g} .. {:g} s, {} rows", first[0], table.rows.back()[0],
+                                                   table.rows.size()));
+    const char* levels[] = {"residual_pos_", "residual_vel_", "residual_acc_"};
+    const char* labels[] = {"max |position residual|", "max |velocity residual|", "max |acceleration residual|"};
+    for (int level = 0; level < 3; ++level) {
+      double largest = -1.0;
+      for (std::size_t c = 0; c < table.header.size(); ++c)
+        if (table.header[c].starts_with(levels[level]))
+          for (const std::vector<double>& row : table.rows) largest = std::max(largest, std::abs(row[c]));
+      if (largest >= 0.0) input.summary.emplace_back(labels[level], fmt::format("{:.3g}", largest));
+    }
+    const int e = input.columns.energy.empty() ? -1 : table.column(input.columns.energy);
+    if (e >= 0) {
+      double drift = 0.0;
+      for (const std::vector<double>& row : table.rows)
+        drift = std::max(drift, std::abs(row[static_cast<std::size_t>(e)] - first[static_cast<std::size_t>(e)]));
+      input.summary.emplace_back("energy drift", fmt::format("{:.3g} (E0 = {:.10g})", drift,
+                                                             first[static_cast<std::size_t>(e)]));
+    }
+  }
+  return write_report(input, path, options);
+}
+
+}  // namespace nhdyn

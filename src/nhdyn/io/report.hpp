@@ -1,0 +1,84 @@
+// The HTML report of a run: one self-contained file (no server, no download when it is opened)
+// with a 3-D animation of the motion, the plots of the run with a cursor at the current time, the
+// summary and the model's equations rendered by KaTeX. Last stage of the pipeline, like the plots
+// (io/plot.hpp): it reads the rows of a finished run (CSV layout of io/results.hpp) and, for the
+// scene, the compiled visual program of the model (symbolic/visual.hpp), which it runs on each
+// row it shows. The JavaScript libraries (Debian's libjs-three and libjs-katex with its fonts) and
+// the page's own template (io/resources/) are embedded in the library at build time; docs/report.md
+// describes what the page shows and how long runs are thinned.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "nhdyn/io/csv.hpp"
+#include "nhdyn/io/results.hpp"
+
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn::symbolic {
+struct Spec;
+struct VisualScene;
+}
+
+namespace nhdyn {
+
+struct ReportInput {
+  std::string title;                                         // e.g. "sled: sanh, dopri5"
+  std::string model;                                         // the model's name
+  std::vector<std::pair<std::string, std::string>> summary;  // label, value: the run's summary
+  std::vector<std::string> coordinates;                      // the model's coordinates, in order
+  std::vector<bool> angles;                                  // per coordinate: an angle (its own panel)
+  ResultColumns columns;                                     // what each column of `table` is
+  CsvTable table;                                            // the run, as written by simulate
+  std::string equations_latex;  // an align* environment (symbolic/equations.hpp); "" when none
+  std::string equations_note;   // shown instead of the equations when there are none, and why
+  // The scene; null or without shapes: the path of `path` (else of the first two coordinates) is
+  // drawn, and the page says the model has nothing to draw.
+  const symbolic::VisualScene* scene = nullptr;
+  std::optional<std::pair<std::string, std::string>> path;
+};
+
+struct ReportOptions {
+  // Most rows shown. A run of N rows shows every k-th row, k = ceil((N - 1) / (max_frames - 1)),
+  // and always the last one; the CSV itself is never thinned. 2000 rows keep a 20 s run at 100
+  // frames per second whole, and a page of any run under a few megabytes.
+  int max_frames = 2000;
+  // Equations longer than this (bytes of LaTeX) are left out with a note: KaTeX would take
+  // seconds to lay out a bicycle's pages of terms, and `nhdyn equations` prints them anyway.
+  std::size_t max_equations = 200000;
+};
+
+// Throws InputError when `header` is not the column layout `expected` (make_result_columns of the
+// model): the message names the first column that differs, its position and what the model
+// expects there, with the CSV's name `csv` and the model's name.
+void check_report_columns(const std::vector<std::string>& header, const ResultColumns& expected,
+                          const std::string& csv, const std::string& model);
+
+// The page as text. Throws InputError when the table has no row or its header is not
+// input.columns.all. Same input -> same bytes. `notice`, when given, receives the note the page
+// shows above the scene (nothing to draw, rows thinned), "" when none.
+std::string make_report_html(const ReportInput& input, const ReportOptions& options = {}, std::string* notice = nullptr);
+
+// make_report_html written through an AtomicFile (FileError when `path` cannot be written).
+// Returns the page's notice ("" when none).
+std::string write_report(const ReportInput& input, const std::filesystem::path& path, const ReportOptions& options = {});
+
+// The report of a model's run, everything taken from the model: the columns it must have, its
+// angles and scene (compile_visual of the spec), its equations (derived again from the spec;
+// none for a built-in model, which has no spec) and a summary computed from the rows (times,
+// largest residual per level, energy drift), after `extra` (the run's own figures). Throws as
+// check_report_columns when `table` is not this model's, InputError/ModelError for a scene that
+// cannot be compiled, FileError when `path` cannot be written. Returns the page's notice for the
+// user ("" when none): the model has nothing to draw, or the rows were thinned.
+std::string write_model_report(const Model& model, const symbolic::Spec* spec, const CsvTable& table, const std::string& title,
+                        const std::vector<std::pair<std::string, std::string>>& extra,
+                        const std::filesystem::path& path, const ReportOptions& options = {});
+
+// The rows a report shows out of `rows` (indices, ascending, first and last included).
+std::vector<std::size_t> report_frames(std::size_t rows, int max_frames);
+
+}  // namespace nhdyn

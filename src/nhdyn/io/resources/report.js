@@ -1,0 +1,414 @@
+// The page of an nhdyn report (io/report.hpp, docs/report.md). NHDYN holds the run: times t, the
+// plots' series and, per shown row, the positions and rotations of the scene's shapes computed by
+// the library (symbolic/visual.hpp), so this script only places shapes and draws curves. THREE
+// (Debian's libjs-three) draws the scene, katex (libjs-katex) the equations.
+(function () {
+  "use strict";
+  const D = NHDYN;
+  const T = D.t;
+  const frames = T.length;
+  const api = { ready: false, frame: 0, frames: frames };
+  window.nhdyn = api;
+
+  // ---- Page ------------------------------------------------------------------------------------
+  const el = (tag, attrs, parent) => {
+    const e = document.createElement(tag);
+    for (const k in attrs || {}) {
+      if (k === "text") e.textContent = attrs[k];
+      else e.setAttribute(k, attrs[k]);
+    }
+    if (parent) parent.appendChild(e);
+    return e;
+  };
+  const header = el("header", {}, document.body);
+  el("h1", { text: D.title }, header);
+  const main = el("div", { id: "main" }, document.body);
+  const left = el("div", { id: "left" }, main);
+  const right = el("div", { id: "right" }, main);
+  const view = el("div", { id: "view" }, left);
+  const controls = el("div", { id: "controls" }, left);
+  const play = el("button", { id: "play", text: "Pause" }, controls);
+  const speed = el("select", { id: "speed", title: "speed" }, controls);
+  for (const s of [0.1, 0.25, 0.5, 1, 2, 4, 10]) {
+    const o = el("option", { value: String(s), text: s + "x" }, speed);
+    if (s === 1) o.selected = true;
+  }
+  const slider = el("input", { id: "slider", type: "range", min: "0", max: String(frames - 1), value: "0", step: "1" },
+                    controls);
+  const timeLabel = el("span", { id: "time" }, controls);
+  const follow = el("select", { id: "follow", title: "camera follows" }, controls);
+  el("option", { value: "-1", text: "fixed camera" }, follow);
+  D.scene.shapes.forEach((s, i) => {
+    if (s.kind !== "frame") el("option", { value: String(i), text: "follow " + s.name }, follow);
+  });
+  if (D.note) el("div", { id: "note", text: D.note }, left);
+  el("h2", { text: "Summary" }, left);
+  const summary = el("table", { class: "summary" }, left);
+  for (const [k, v] of D.summary) {
+    const tr = el("tr", {}, summary);
+    el("td", { text: k }, tr);
+    el("td", { text: v }, tr);
+  }
+
+  // ---- Scene -----------------------------------------------------------------------------------
+  const S = D.scene;
+  const stride = S.stride;
+  const value = (f, i) => S.values[f * stride + i];
+  // Every point a shape passes through, for the bounds of the scene.
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  const grow = (x, y, z, r) => {
+    const p = [x, y, z];
+    for (let k = 0; k < 3; ++k) {
+      if (!isFinite(p[k])) continue;
+      lo[k] = Math.min(lo[k], p[k] - r);
+      hi[k] = Math.max(hi[k], p[k] + r);
+    }
+  };
+  for (const s of S.shapes) {
+    const r = s.kind === "frame" ? 0 : Math.max(s.size[0], s.size[1], s.size[2]);
+    for (let f = 0; f < frames; ++f) {
+      grow(value(f, s.offset), value(f, s.offset + 1), value(f, s.offset + 2), r);
+      if (s.kind === "segment") grow(value(f, s.offset + 3), value(f, s.offset + 4), value(f, s.offset + 5), 0);
+    }
+  }
+  for (let k = 0; k < 3; ++k)
+    if (!(lo[k] <= hi[k])) { lo[k] = -0.5; hi[k] = 0.5; }
+  const extent = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 0.1);
+  const centre = new THREE.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
+
+  const width = 640, height = 480;
+  let renderer = null;
+  try {
+    renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+  } catch (e) {
+    el("div", { id: "nowebgl", text: "This browser offers no WebGL: the 3-D scene cannot be shown; the plots below still work." }, view);
+  }
+  const scene = new THREE.Scene();
+  scene.background = new THREE.Color(0xffffff);
+  const camera = new THREE.PerspectiveCamera(40, width / height, extent / 1000, extent * 100);
+  if (renderer) {
+    renderer.setPixelRatio(1);
+    renderer.setSize(width, height);
+    renderer.domElement.id = "canvas";
+    view.appendChild(renderer.domElement);
+  }
+  scene.add(new THREE.AmbientLight(0xffffff, 0.55));
+  const sun = new THREE.DirectionalLight(0xffffff, 0.7);
+  sun.position.set(1, -2, 3);
+  scene.add(sun);
+
+  // The ground (multibody) or the plane of a planar scene: a grid in z = 0, 1-2-5 spacing.
+  const niceStep = (span) => {
+    const p = Math.pow(10, Math.floor(Math.log10(span)));
+    const m = span / p;
+    return (m < 2 ? 1 : m < 5 ? 2 : 5) * p;
+  };
+  {
+    const step = niceStep(extent / 8);
+    const half = Math.ceil((extent * 0.75) / step) * step;
+    const grid = new THREE.GridHelper(2 * half, Math.round((2 * half) / step), 0x999999, 0xdddddd);
+    grid.rotation.x = Math.PI / 2;  // THREE's grid lies in y = 0; ours in z = 0
+    grid.position.set(Math.round(centre.x / step) * step, Math.round(centre.y / step) * step, S.planar ? -1e-3 * extent : 0);
+    scene.add(grid);
+  }
+
+  const colours = [0x1f77b4, 0xd62728, 0x2ca02c, 0xff7f0e, 0x9467bd, 0x8c564b, 0xe377c2, 0x17becf];
+  const material = (i, opacity) => new THREE.MeshLambertMaterial({
+    color: colours[i % colours.length], transparent: opacity < 1, opacity: opacity });
+  const Sphere = THREE.SphereBufferGeometry || THREE.SphereGeometry;
+  const Cylinder = THREE.CylinderBufferGeometry || THREE.CylinderGeometry;
+  const Torus = THREE.TorusBufferGeometry || THREE.TorusGeometry;
+  const Circle = THREE.CircleBufferGeometry || THREE.CircleGeometry;
+  const setPositions = (geometry, array) => {
+    const attribute = new THREE.BufferAttribute(array, 3);
+    if (geometry.setAttribute) geometry.setAttribute("position", attribute);
+    else geometry.addAttribute("position", attribute);
+  };
+  const trail = (points, colour) => {
+    const geometry = new THREE.BufferGeometry();
+    setPositions(geometry, points);
+    geometry.setDrawRange(0, 1);
+    const line = new THREE.Line(geometry, new THREE.LineBasicMaterial({ color: colour }));
+    scene.add(line);
+    return line;
+  };
+  const thin = extent * 0.006;
+  const objects = S.shapes.map((s, i) => {
+    const o = { shape: s, object: null, trail: null };
+    if (s.kind === "sphere") {
+      o.object = new THREE.Mesh(new Sphere(s.size[0], 24, 16), material(i, 1));
+      const points = new Float32Array(frames * 3);
+      for (let f = 0; f < frames; ++f)
+        for (let k = 0; k < 3; ++k) points[3 * f + k] = value(f, s.offset + k);
+      o.trail = trail(points, 0x999999);
+    } else if (s.kind === "segment") {
+      o.object = new THREE.Mesh(new Cylinder(thin, thin, 1, 8), material(i, 1));
+    } else if (s.kind === "wheel") {
+      // A tyre (torus) and two spokes about the axle, which is the frame's axis s.axis.
+      const r = s.size[0];
+      const group = new THREE.Group();
+      const inner = new THREE.Group();
+      inner.add(new THREE.Mesh(new Torus(r, r * 0.04, 8, 48), material(i, 1)));
+      const disk = new THREE.Mesh(new Circle(r, 48), material(i, 0.25));
+      disk.material.side = THREE.DoubleSide;
+      inner.add(disk);
+      for (const a of [0, Math.PI / 2]) {
+        const spoke = new THREE.Mesh(new Cylinder(r * 0.02, r * 0.02, 2 * r, 6), material(i + 3, 1));
+        spoke.rotation.z = a;
+        inner.add(spoke);
+      }
+      // Torus and circle lie in their xy plane (axle z): turn z onto the frame's axle.
+      if (s.axis === 0) inner.rotation.y = Math.PI / 2;
+      if (s.axis === 1) inner.rotation.x = Math.PI / 2;
+      group.add(inner);
+      o.object = group;
+      const points = new Float32Array(frames * 3);
+      for (let f = 0; f < frames; ++f) {
+        const c = [value(f, s.offset), value(f, s.offset + 1), value(f, s.offset + 2)];
+        const a = [value(f, s.offset + 3 + s.axis), value(f, s.offset + 6 + s.axis), value(f, s.offset + 9 + s.axis)];
+        // The contact point: the lowest point of the rim, c - r d with d the unit vector of the
+        // vertical within the wheel's plane.
+        let d = [-a[2] * a[0], -a[2] * a[1], 1 - a[2] * a[2]];
+        const norm = Math.hypot(d[0], d[1], d[2]) || 1;
+        for (let k = 0; k < 3; ++k) points[3 * f + k] = c[k] - (r * d[k]) / norm;
+      }
+      o.trail = trail(points, 0x444444);
+    } else if (s.kind === "body") {
+      const group = new THREE.Group();
+      const ball = new THREE.Mesh(new Sphere(1, 24, 16), material(i, 0.55));
+      ball.scale.set(s.size[0], s.size[1], s.size[2]);
+      group.add(ball);
+      o.object = group;
+    } else {
+      o.object = new THREE.AxesHelper(extent * 0.08);
+    }
+    if (s.kind !== "sphere" && s.kind !== "segment") o.object.matrixAutoUpdate = false;
+    scene.add(o.object);
+    return o;
+  });
+  const up = new THREE.Vector3(0, 1, 0);
+  const place = (f) => {
+    for (const o of objects) {
+      const s = o.shape, b = s.offset;
+      if (s.kind === "sphere") {
+        o.object.position.set(value(f, b), value(f, b + 1), value(f, b + 2));
+      } else if (s.kind === "segment") {
+        const p = new THREE.Vector3(value(f, b), value(f, b + 1), value(f, b + 2));
+        const q = new THREE.Vector3(value(f, b + 3), value(f, b + 4), value(f, b + 5));
+        const d = q.clone().sub(p);
+        const length = d.length();
+        o.object.position.copy(p).add(q).multiplyScalar(0.5);
+        o.object.scale.set(1, Math.max(length, 1e-9), 1);
+        if (length > 0) o.object.quaternion.setFromUnitVectors(up, d.multiplyScalar(1 / length));
+      } else {
+        const m = o.object.matrix;
+        m.set(value(f, b + 3), value(f, b + 4), value(f, b + 5), value(f, b),
+              value(f, b + 6), value(f, b + 7), value(f, b + 8), value(f, b + 1),
+              value(f, b + 9), value(f, b + 10), value(f, b + 11), value(f, b + 2),
+              0, 0, 0, 1);
+        o.object.matrixWorldNeedsUpdate = true;
+      }
+      if (o.trail) o.trail.geometry.setDrawRange(0, f + 1);
+    }
+  };
+
+  // Orbit camera: drag to turn about the target, wheel to zoom. z is up (y for a planar scene,
+  // seen from +z).
+  // The whole motion in view: the field of view is 40 degrees, tan(20 deg) = 0.36.
+  const orbit = S.planar ? { azimuth: -Math.PI / 2, elevation: Math.PI / 2 - 1e-3, distance: 1.6 * extent }
+                         : { azimuth: -Math.PI / 3, elevation: 0.45, distance: 2.0 * extent };
+  const target = centre.clone();
+  const aim = () => {
+    const ce = Math.cos(orbit.elevation);
+    const offset = new THREE.Vector3(ce * Math.cos(orbit.azimuth), ce * Math.sin(orbit.azimuth), Math.sin(orbit.elevation));
+    // Looking (nearly) straight down, "up" on the screen is away from the camera's side.
+    if (orbit.elevation > 1.55) camera.up.set(-Math.cos(orbit.azimuth), -Math.sin(orbit.azimuth), 0);
+    else camera.up.set(0, 0, 1);
+    camera.position.copy(target).addScaledVector(offset, orbit.distance);
+    camera.lookAt(target);
+  };
+  if (renderer) {
+    let dragging = null;
+    const canvas = renderer.domElement;
+    canvas.addEventListener("mousedown", (e) => { dragging = [e.clientX, e.clientY]; });
+    window.addEventListener("mouseup", () => { dragging = null; });
+    window.addEventListener("mousemove", (e) => {
+      if (!dragging) return;
+      orbit.azimuth -= (e.clientX - dragging[0]) * 0.01;
+      orbit.elevation = Math.max(-1.5, Math.min(1.5707, orbit.elevation + (e.clientY - dragging[1]) * 0.01));
+      dragging = [e.clientX, e.clientY];
+      draw();
+    });
+    canvas.addEventListener("wheel", (e) => {
+      e.preventDefault();
+      orbit.distance *= Math.exp(e.deltaY * 0.001);
+      draw();
+    }, { passive: false });
+  }
+
+  // ---- Plots -----------------------------------------------------------------------------------
+  const plots = D.plots.map((p) => {
+    const canvas = el("canvas", { class: "plot" }, right);
+    const w = 560, h = 170;
+    canvas.width = w;
+    canvas.height = h;
+    const g = canvas.getContext("2d");
+    const x0 = 56, x1 = w - 10, y0 = 22, y1 = h - 22;
+    const t0 = T[0], t1 = T[frames - 1] > T[0] ? T[frames - 1] : T[0] + 1;
+    const tx = (t) => x0 + ((t - t0) / (t1 - t0)) * (x1 - x0);
+    // Values as drawn: log10 |v| on a log scale (zeros left out).
+    const shown = p.series.map((s) => s.v.map((v) => (v === null ? NaN : p.log ? (v === 0 ? NaN : Math.log10(Math.abs(v))) : v)));
+    let vmin = Infinity, vmax = -Infinity;
+    for (const s of shown) for (const v of s) if (isFinite(v)) { vmin = Math.min(vmin, v); vmax = Math.max(vmax, v); }
+    if (!(vmin <= vmax)) { vmin = 0; vmax = 1; }
+    if (vmax - vmin < 1e-12 * Math.max(1, Math.abs(vmax))) { vmin -= 0.5; vmax += 0.5; }
+    const ty = (v) => y1 - ((v - vmin) / (vmax - vmin)) * (y1 - y0);
+    g.fillStyle = "#fff";
+    g.fillRect(0, 0, w, h);
+    g.font = "11px sans-serif";
+    g.fillStyle = "#222";
+    g.fillText(p.title, x0, 14);
+    g.strokeStyle = "#888";
+    g.strokeRect(x0, y0, x1 - x0, y1 - y0);
+    // Ticks: 1-2-5 steps (decades on a log scale).
+    const step = p.log ? Math.max(1, Math.round(niceStep((vmax - vmin) / 4))) : niceStep((vmax - vmin) / 4);
+    g.fillStyle = "#555";
+    for (let i = Math.ceil(vmin / step); i * step <= vmax + 1e-9 * step; ++i) {
+      const v = i * step;  // a multiple of the step, printed without the float's accumulated error
+      g.fillText(p.log ? "1e" + Math.round(v) : Number(v.toPrecision(6)).toString(), 2, ty(v) + 4);
+      g.strokeStyle = "#eee";
+      g.beginPath(); g.moveTo(x0, ty(v)); g.lineTo(x1, ty(v)); g.stroke();
+    }
+    const tstep = niceStep((t1 - t0) / 5);
+    for (let i = Math.ceil(t0 / tstep); i * tstep <= t1 + 1e-9 * tstep; ++i)
+      g.fillText(Number((i * tstep).toPrecision(6)).toString(), tx(i * tstep) - 8, h - 6);
+    let legend = x0 + g.measureText(p.title).width + 16;
+    shown.forEach((s, k) => {
+      g.strokeStyle = "#" + colours[k % colours.length].toString(16).padStart(6, "0");
+      g.beginPath();
+      let pen = false;
+      for (let f = 0; f < frames; ++f) {
+        if (!isFinite(s[f])) { pen = false; continue; }
+        if (pen) g.lineTo(tx(T[f]), ty(s[f])); else g.moveTo(tx(T[f]), ty(s[f]));
+        pen = true;
+      }
+      g.stroke();
+      g.fillStyle = g.strokeStyle;
+      g.fillText(p.series[k].name, legend, 14);  // legends after the title, in a row
+      legend += g.measureText(p.series[k].name).width + 12;
+    });
+    const background = g.getImageData(0, 0, w, h);
+    return { cursor: (t) => {
+      g.putImageData(background, 0, 0);
+      g.strokeStyle = "#c00";
+      g.beginPath(); g.moveTo(tx(t), y0); g.lineTo(tx(t), y1); g.stroke();
+    } };
+  });
+
+  // ---- Equations -------------------------------------------------------------------------------
+  const equations = el("div", { id: "equations" }, document.body);
+  el("h2", { text: "Equations of motion" }, equations);
+  // `nhdyn equations --format latex` writes one align* environment with \intertext between its
+  // groups and %-comments above it, for a LaTeX document; KaTeX has no \intertext, so each group
+  // becomes an aligned display and each \intertext a paragraph with its $...$ rendered inline.
+  const renderEquations = (latex, box) => {
+    const lines = latex.split("\n");
+    for (const line of lines)
+      if (line.startsWith("%") && !line.includes("usepackage")) el("p", { class: "comment", text: line.replace(/^%\s?/, "") }, box);
+    let rest = lines.filter((line) => !line.startsWith("%")).join("\n")
+      .replace("\\begin{align*}", "").replace("\\end{align*}", "");
+    const options = { throwOnError: false, strict: "ignore" };
+    while (true) {
+      const i = rest.indexOf("\\intertext{");
+      const rows = (i < 0 ? rest : rest.slice(0, i)).replace(/\\\\\s*$/, "");
+      if (rows.trim())
+        katex.render("\\begin{aligned}" + rows + "\\end{aligned}", el("div", {}, box), { ...options, displayMode: true });
+      if (i < 0) break;
+      let j = i + "\\intertext".length, depth = 0;
+      for (; j < rest.length; ++j) {
+        if (rest[j] === "{") ++depth;
+        else if (rest[j] === "}" && --depth === 0) break;
+      }
+      const p = el("p", {}, box);
+      rest.slice(i + "\\intertext{".length, j).split("$").forEach((part, k) => {
+        if (k % 2 === 1) katex.render(part, el("span", {}, p), options);
+        else p.appendChild(document.createTextNode(part.replace(/\\texttt\{([^}]*)\}/g, "$1")));
+      });
+      rest = rest.slice(j + 1);
+    }
+  };
+  if (D.equations) {
+    renderEquations(D.equations, el("div", {}, equations));
+  } else {
+    el("p", { text: D.equations_note }, equations);
+  }
+
+  // ---- Time ------------------------------------------------------------------------------------
+  const draw = () => {
+    const f = api.frame;
+    place(f);
+    const chosen = Number(follow.value);
+    if (chosen >= 0) {
+      const b = S.shapes[chosen].offset;
+      target.set(value(f, b), value(f, b + 1), value(f, b + 2));
+    } else {
+      target.copy(centre);
+    }
+    aim();
+    if (renderer) renderer.render(scene, camera);
+    for (const p of plots) p.cursor(T[f]);
+    timeLabel.textContent = "t = " + T[f].toFixed(3) + " s";
+    slider.value = String(f);
+  };
+  // The frame shown at time t: the last one at or before t.
+  const frameAt = (t) => {
+    let a = 0, b = frames - 1;
+    while (a < b) {
+      const m = (a + b + 1) >> 1;
+      if (T[m] <= t) a = m; else b = m - 1;
+    }
+    return a;
+  };
+  let playing = !/paused/.test(location.hash);
+  let clock = T[0];
+  play.textContent = playing ? "Pause" : "Play";
+  play.addEventListener("click", () => {
+    playing = !playing;
+    play.textContent = playing ? "Pause" : "Play";
+    last = null;
+  });
+  const show = (f) => {
+    api.frame = Math.max(0, Math.min(frames - 1, f));
+    clock = T[api.frame];
+    draw();
+  };
+  slider.addEventListener("input", () => show(Number(slider.value)));
+  follow.addEventListener("change", draw);
+  api.setFrame = show;
+  // Where shape i is on the page now, in CSS pixels (for tests: the screenshots differ there).
+  api.screen = (i) => {
+    const b = S.shapes[i].offset, f = api.frame;
+    const p = new THREE.Vector3(value(f, b), value(f, b + 1), value(f, b + 2)).project(camera);
+    const r = renderer ? renderer.domElement.getBoundingClientRect() : { left: 0, top: 0 };
+    return [r.left + ((p.x + 1) / 2) * width, r.top + ((1 - p.y) / 2) * height];
+  };
+  let last = null;
+  const tick = (now) => {
+    if (playing && frames > 1) {
+      if (last !== null) {
+        clock += ((now - last) / 1000) * Number(speed.value);
+        if (clock > T[frames - 1]) clock = T[0];
+        const f = frameAt(clock);
+        if (f !== api.frame) { api.frame = f; draw(); }
+      }
+      last = now;
+    } else {
+      last = null;
+    }
+    requestAnimationFrame(tick);
+  };
+  const start = /[#&]t=([0-9.eE+-]+)/.exec(location.hash);
+  show(start ? frameAt(Number(start[1])) : 0);
+  api.ready = true;
+  requestAnimationFrame(tick);
+})();

@@ -1,0 +1,165 @@
+"""The HTML report in a real browser (Debian's headless Chromium): no console error, the canvas
+shows the body, two screenshots at different times differ where the body moved, the slider moves
+the scene, the plots and the equations are drawn. Usage: report_test.py NHDYN SOURCE_DIR WORK_DIR.
+Exits 77 (ctest's skip code) with the reason printed when Chromium cannot start; nowhere else."""
+import os
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from browser import Browser, find_chromium, png_pixels  # noqa: E402
+
+NHDYN, SOURCE, WORK = sys.argv[1:4]
+os.makedirs(WORK, exist_ok=True)
+failures = []
+
+
+def check(condition, message):
+    print(("ok   " if condition else "FAIL ") + message, flush=True)
+    if not condition:
+        failures.append(message)
+
+
+def run(*args):
+    result = subprocess.run([NHDYN, *args], capture_output=True, text=True)
+    if result.returncode != 0:
+        raise SystemExit(f"nhdyn {' '.join(args)} failed ({result.returncode}): {result.stderr}")
+    return result
+
+
+def canvas_pixels(browser):
+    rect = browser.evaluate("(() => { const r = document.getElementById('canvas').getBoundingClientRect();"
+                            " return [r.left, r.top, r.width, r.height]; })()")
+    png = browser.screenshot({"x": rect[0], "y": rect[1], "width": rect[2], "height": rect[3]})
+    width, height, rows = png_pixels(png)
+    return rect, rows, png
+
+
+def coloured_near(rows, rect, point, radius):
+    """Pixels within `radius` of `point` (page coordinates) that are clearly coloured: the bodies are
+    drawn in saturated colours, the background white and the grid grey."""
+    x0, y0 = int(point[0] - rect[0]), int(point[1] - rect[1])
+    count = 0
+    for y in range(max(0, y0 - radius), min(len(rows), y0 + radius + 1)):
+        for x in range(max(0, x0 - radius), min(len(rows[0]), x0 + radius + 1)):
+            r, g, b = rows[y][x]
+            if max(r, g, b) - min(r, g, b) > 60:
+                count += 1
+    return count
+
+
+def changed_near(a, b, rect, point, radius):
+    x0, y0 = int(point[0] - rect[0]), int(point[1] - rect[1])
+    count = 0
+    for y in range(max(0, y0 - radius), min(len(a), y0 + radius + 1)):
+        for x in range(max(0, x0 - radius), min(len(a[0]), x0 + radius + 1)):
+            if sum(abs(p - q) for p, q in zip(a[y][x], b[y][x])) > 60:
+                count += 1
+    return count
+
+
+def slider_point(browser, fraction):
+    r = browser.evaluate("(() => { const r = document.getElementById('slider').getBoundingClientRect();"
+                         " return [r.left, r.top, r.width, r.height]; })()")
+    # The thumb's centre travels over the width less the thumb (about 16 px wide).
+    return r[0] + 8 + fraction * (r[2] - 16), r[1] + r[3] / 2
+
+
+def check_report(browser, html, shape, label, screenshots):
+    browser.events.clear()
+    browser.open("file://" + os.path.abspath(html) + "#paused")
+    check(browser.errors() == [], f"{label}: no console error on opening ({browser.errors()[:3]})")
+    check(browser.evaluate("document.getElementById('canvas') !== null"), f"{label}: the page has a WebGL canvas")
+    frames = browser.evaluate("nhdyn.frames")
+    check(browser.evaluate("nhdyn.frame") == 0, f"{label}: paused at the first frame")
+    if isinstance(shape, str):  # the first shape of this kind
+        shape = browser.evaluate(f"NHDYN.scene.shapes.findIndex(s => s.kind === '{shape}')")
+
+    # The slider moves the scene: a click at 15 % and at 80 % of its track.
+    browser.click(*slider_point(browser, 0.15))
+    first = browser.evaluate("nhdyn.frame")
+    check(abs(first - 0.15 * (frames - 1)) <= 0.03 * frames,
+          f"{label}: a click at 15 % of the slider shows frame {first} of {frames}")
+    where_first = browser.evaluate(f"nhdyn.screen({shape})")
+    rect, rows_first, png_first = canvas_pixels(browser)
+    browser.click(*slider_point(browser, 0.8))
+    second = browser.evaluate("nhdyn.frame")
+    check(abs(second - 0.8 * (frames - 1)) <= 0.03 * frames,
+          f"{label}: a click at 80 % of the slider shows frame {second} of {frames}")
+    where_second = browser.evaluate(f"nhdyn.screen({shape})")
+    _, rows_second, png_second = canvas_pixels(browser)
+    for name, png in (("early", png_first), ("late", png_second)):
+        path = os.path.join(WORK, f"{label}-{name}.png")
+        with open(path, "wb") as f:
+            f.write(png)
+        screenshots.append(path)
+
+    # Not blank: the body is drawn where the camera projects it, at both times.
+    check(coloured_near(rows_first, rect, where_first, 6) > 10,
+          f"{label}: the body is drawn at {where_first[0]:.0f}, {where_first[1]:.0f} (early)")
+    check(coloured_near(rows_second, rect, where_second, 6) > 10,
+          f"{label}: the body is drawn at {where_second[0]:.0f}, {where_second[1]:.0f} (late)")
+    moved = ((where_first[0] - where_second[0]) ** 2 + (where_first[1] - where_second[1]) ** 2) ** 0.5
+    check(moved > 15, f"{label}: the body moved {moved:.0f} px on the screen between the two times")
+    # The two screenshots differ where the body was and where it went.
+    check(changed_near(rows_first, rows_second, rect, where_first, 6) > 10,
+          f"{label}: the screenshots differ where the body was")
+    check(changed_near(rows_first, rows_second, rect, where_second, 6) > 10,
+          f"{label}: the screenshots differ where the body went")
+    far = (rect[0] + 3, rect[1] + 3)
+    check(changed_near(rows_first, rows_second, rect, far, 2) == 0,
+          f"{label}: the screenshots agree far from the body (the corner)")
+    plots = browser.evaluate("document.querySelectorAll('canvas.plot').length")
+    check(plots >= 3, f"{label}: {plots} plot panels")
+    check(browser.errors() == [], f"{label}: no console error after moving the slider ({browser.errors()[:3]})")
+
+
+def main():
+    chromium = find_chromium()
+    if chromium is None:
+        print("SKIP: no Chromium on PATH (apt-get install chromium); the report's browser tests did not run")
+        return 77
+    reports = []
+    sled = os.path.join(WORK, "sled.html")
+    run("simulate", os.path.join(SOURCE, "examples/sled.toml"), "--t-end", "4", "-q",
+        "-o", os.path.join(WORK, "sled.csv"), "--html", sled)
+    reports.append((sled, "sphere", "sled"))  # the centre of mass
+    disk = os.path.join(WORK, "rolling_disk_bodies.html")
+    run("simulate", os.path.join(SOURCE, "examples/rolling_disk_bodies.toml"), "--t-end", "3", "-q",
+        "-o", os.path.join(WORK, "disk.csv"), "--html", disk)
+    bicycle = os.path.join(WORK, "whipple_bicycle.html")
+    run("simulate", os.path.join(SOURCE, "examples/whipple_bicycle.toml"), "--t-end", "10", "--output-step", "0.01",
+        "-q", "-o", os.path.join(WORK, "bicycle.csv"), "--html", bicycle)
+    size = os.path.getsize(bicycle)
+    check(size < 5e6, f"whipple_bicycle: a 10 s run at 100 frames/s gives a page of {size / 1e6:.2f} MB (< 5 MB)")
+    try:
+        browser = Browser(chromium)
+    except Exception as error:  # noqa: BLE001 - any failure to start is a reason to skip
+        print(f"SKIP: Chromium ({chromium}) cannot start here: {error}")
+        return 77
+    screenshots = []
+    try:
+        for html, shape, label in reports[:1]:
+            check_report(browser, html, shape, label, screenshots)
+        check_report(browser, disk, "wheel", "rolling_disk_bodies", screenshots)
+        check(browser.evaluate("document.querySelectorAll('.katex').length") > 0,
+              "rolling_disk_bodies: the equations are rendered by KaTeX")
+        check(browser.evaluate("document.querySelectorAll('.katex-error').length") == 0,
+              "rolling_disk_bodies: KaTeX reports no error in the equations")
+        browser.events.clear()
+        browser.open("file://" + os.path.abspath(bicycle) + "#paused")
+        check(browser.evaluate("nhdyn.frames") == 1001, "whipple_bicycle: all 1001 rows shown")
+        check(browser.evaluate("NHDYN.scene.shapes.filter(s => s.kind === 'wheel').length") == 2,
+              "whipple_bicycle: two wheels drawn")
+        check(browser.errors() == [], f"whipple_bicycle: no console error ({browser.errors()[:3]})")
+    finally:
+        browser.close()
+    print("screenshots: " + " ".join(screenshots))
+    if failures:
+        print(f"{len(failures)} check(s) failed")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
