@@ -378,7 +378,11 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   // The constructor computes the parameter stage of every program once.
   {
     std::string stage;
-    const auto add_stage = [&stage](const Printer& printer) { stage += printer.statements(true, "    "); };
+    // One block per program: each numbers its registers from its own inputs.
+    const auto add_stage = [&stage](const Printer& printer) {
+      const std::string statements = printer.statements(true, "      ");
+      if (!statements.empty()) stage += "    {\n" + statements + "    }\n";
+    };
     add_stage(terms_printer);
     if (complement_printer) add_stage(*complement_printer);
     add_stage(phi_printer);
