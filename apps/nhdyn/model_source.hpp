@@ -1,6 +1,6 @@
 // Where the MODEL argument of a command comes from: the name of a built-in model, or the path
 // of a model file (TOML, docs/model-format.md). Every command resolves it through this one
-// place, together with the `--set name=value` overrides of a file's parameters.
+// place, together with the `--set NAME=EXPR` overrides of its parameters.
 #pragma once
 
 #include <optional>
@@ -18,7 +18,8 @@ struct ResolvedModel {
 };
 
 // Throws InputError listing the built-in models when `source` is neither one nor a file, and
-// for a --set on a built-in model or an unknown parameter.
+// for a --set of an unknown parameter, a bad expression or a cyclic definition. The --set
+// NAME=EXPR overrides apply to model files and built-in models alike (model/parameters.hpp).
 ResolvedModel resolve_model(const std::string& source, const std::vector<std::string>& sets = {});
 
 // A model file's Spec with the --set overrides applied; a built-in name is refused with the

@@ -20,9 +20,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/xy_plot.hpp"
-#include "nhdyn/model/builtin.hpp"
-#include "nhdyn/symbolic/compile.hpp"
-#include "nhdyn/symbolic/derivation.hpp"
+#include "nhdyn/model/parameters.hpp"
 
 namespace nhdyn::cli {
 namespace {
@@ -54,27 +52,24 @@ int run_sweep(const SweepArgs& args) {
   options.linearization.speeds = args.speeds;
   options.linearization.steady_tolerance = args.tolerance;
   check_sweep_options(options);
-  if (is_builtin_model(args.model) && args.model.find('/') == std::string::npos && !args.model.ends_with(".toml"))
-    throw InputError(fmt::format("'{}' is a built-in model with fixed parameters, so --param {} cannot vary; sweep "
-                                 "its model file instead (examples/)",
-                                 args.model, args.param));
-  symbolic::Spec spec = resolve_spec(args.model, args.sets);
+  // Compiled once: each grid point and bisection step only sets the parameter (parameters as
+  // data, model/parameters.hpp), which re-binds the evaluator without symbolic work.
+  const Model base = resolve_model(args.model, args.sets).model;
   {
     std::string names;
     bool known = false;
-    for (const symbolic::SpecParameter& p : spec.parameters) {
+    for (const Parameter& p : base.parameters) {
       names += (names.empty() ? "" : ", ") + p.name;
       known = known || p.name == args.param;
     }
     if (!known)
       throw InputError(fmt::format("--param {}: model '{}' ({}) has no parameter '{}'; its parameters are: {}",
-                                   args.param, spec.name, args.model, args.param, names.empty() ? "(none)" : names));
+                                   args.param, base.name, args.model, args.param, names.empty() ? "(none)" : names));
   }
-  spec.set_parameter(args.param, args.from);
-  const symbolic::Derivation derivation = symbolic::derive(spec);
   const ModelAtValue model_at = [&](double value) {
-    spec.set_parameter(args.param, value);
-    return symbolic::compile_model(spec, derivation);
+    Model model = base;
+    set_parameter(model, args.param, value);
+    return model;
   };
 
   // The first point linearized before any file is made: a model that is not steady, or a bad
@@ -89,7 +84,7 @@ int run_sweep(const SweepArgs& args) {
 
   namespace fs = std::filesystem;
   const fs::path table_path =
-      args.output.empty() ? fs::path("results") / (make_file_name(spec.name + "-sweep-" + args.param) + ".csv") : fs::path(args.output);
+      args.output.empty() ? fs::path("results") / (make_file_name(base.name + "-sweep-" + args.param) + ".csv") : fs::path(args.output);
   make_parent_directory(table_path);
   fs::path crossings_path = table_path;
   crossings_path.replace_filename(table_path.stem().string() + "-crossings.csv");
@@ -152,7 +147,7 @@ int run_sweep(const SweepArgs& args) {
       plot_data.commit();
     }
     XyPlotRequest request;
-    request.title = fmt::format("{}: eigenvalues of the linearization against {}", spec.name, args.param);
+    request.title = fmt::format("{}: eigenvalues of the linearization against {}", base.name, args.param);
     request.csv = data;
     request.x = args.param;
     for (std::size_t i = 1; i <= k; ++i) {
@@ -182,7 +177,7 @@ int run_sweep(const SweepArgs& args) {
     std::string state;
     for (const std::string& s : sweep.state) state += (state.empty() ? "" : ", ") + s;
     fmt::print("nhdyn sweep {}: eigenvalues of the linearization for {} = {:g} .. {:g} ({} points), state ({})\n",
-               spec.name, args.param, args.from, args.to, args.steps, state);
+               base.name, args.param, args.from, args.to, args.steps, state);
     if (sweep.crossings.empty())
       fmt::print("no real part crosses zero in the range\n");
     int undecided = 0;
@@ -209,13 +204,13 @@ std::function<int()> add_sweep_command(CLI::App& app) {
   auto args = std::make_shared<SweepArgs>();
   CLI::App* cmd = app.add_subcommand("sweep", "Eigenvalues of the linearization against a parameter, with the "
                                               "values where the stability changes");
-  cmd->add_option("MODEL", args->model, "A model file (.toml)")->required();
+  cmd->add_option("MODEL", args->model, "A model file (.toml) or a built-in model")->required();
   cmd->add_option("--param", args->param, "The parameter to vary")->required();
   cmd->add_option("--from", args->from, "First value")->required();
   cmd->add_option("--to", args->to, "Last value")->required();
   cmd->add_option("--steps", args->steps, "Number of grid points, both ends included")->capture_default_str();
   cmd->add_flag("--eigenvalues", args->eigenvalues, "Sweep the eigenvalues (the default and, so far, only quantity)");
-  cmd->add_option("--set", args->sets, "Override another parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("--set", args->sets, "Override another parameter, NAME=EXPR (repeatable)");
   cmd->add_option("--cyclic", args->cyclic, "Coordinates to treat as cyclic besides those found, comma-separated")
       ->delimiter(',');
   cmd->add_option("--independent", args->independent, "Independent coordinates, comma-separated")->delimiter(',');

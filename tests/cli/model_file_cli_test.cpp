@@ -77,10 +77,10 @@ TEST_F(ModelFileCli, SetOverridesAParameterAndRefusesUnknownOnes) {
   EXPECT_NE(typo.out.find("did you mean 'rho'"), std::string::npos) << typo.out;
   const Outcome nan = nhdyn("simulate " + example("sled.toml") + " --set rho=abc", dir_);
   EXPECT_EQ(nan.exit_code, 2);
-  EXPECT_NE(nan.out.find("not a finite number"), std::string::npos) << nan.out;
-  const Outcome builtin = nhdyn("simulate sled --set rho=1", dir_);
-  EXPECT_EQ(builtin.exit_code, 2);
-  EXPECT_NE(builtin.out.find("examples/sled.toml"), std::string::npos) << builtin.out;
+  EXPECT_NE(nan.out.find("'abc'"), std::string::npos) << nan.out;  // --set takes expressions: an unknown name
+  // Built-in models take --set too (parameters are data, docs/cli.md "Parameters").
+  const Outcome builtin = nhdyn("simulate sled --set rho=1 --t-end 1 -o builtin.csv", dir_);
+  EXPECT_EQ(builtin.exit_code, 0) << builtin.out;
 }
 
 TEST_F(ModelFileCli, ViolatedInitialStateIsRefusedOrFixed) {

@@ -242,7 +242,8 @@ TEST(SolutionError, DoesNotStartAtTheInitialState) {
 
 TEST(SolutionError, NotARealNumberOnceTheParametersAreSet) {
   const std::string m = error_of(head + "[solution]\nx = \"t\"\nz = \"sqrt(-g)*t^2\"\n");
-  EXPECT_TRUE(has(m, "z = nan")) << m;
+  // The parameters are read at run time, so the NaN is the one sqrt returns (its sign varies).
+  EXPECT_TRUE(has(m, "z = nan") || has(m, "z = -nan")) << m;
   EXPECT_TRUE(has(m, "cannot be evaluated")) << m;
 }
 

@@ -29,7 +29,10 @@ TEST(Codegen, HeaderImplementsTheEvaluatorAndTheModelMaker) {
   EXPECT_FALSE(contains(code, "ginac")) << code;
   EXPECT_TRUE(contains(code, "namespace nhdyn {\nnamespace generated {\n"));
   EXPECT_TRUE(contains(code, "class SledEvaluator final : public ::nhdyn::Evaluator"));
-  EXPECT_TRUE(contains(code, "inline ::nhdyn::Model make_sled_model()"));
+  EXPECT_TRUE(contains(code, "inline ::nhdyn::Model make_sled_model(const SledParameters& p = {})"));
+  // The parameters are a struct with the values as defaults, read by the evaluator at run time.
+  EXPECT_TRUE(contains(code, "struct SledParameters {\n  double m = 1.0;  // [kg]\n")) << code;
+  EXPECT_TRUE(contains(code, "std::shared_ptr<const ::nhdyn::Evaluator> with_parameters(")) << code;
   EXPECT_TRUE(contains(code, "bool has_complement() const override { return true; }"));
   EXPECT_TRUE(contains(code, "bool has_energy() const override { return true; }"));
   EXPECT_TRUE(contains(code, "model.constraints.push_back({\"blade\", ::nhdyn::ConstraintLevel::velocity, "
@@ -49,8 +52,8 @@ TEST(Codegen, DoublesAreWrittenWithFullPrecision) {
   p.g = 1.0 / 3.0;
   const HandBuilt built = make_hand_built_sled(p);
   const std::string code = generate_code(built.spec, built.derivation);
-  EXPECT_TRUE(contains(code, "{\"m\", 0.10000000000000001, \"kg\"}")) << code;
-  EXPECT_TRUE(contains(code, "{\"g\", 0.33333333333333331, \"m/s^2\"}")) << code;
+  EXPECT_TRUE(contains(code, "double m = 0.10000000000000001;")) << code;
+  EXPECT_TRUE(contains(code, "double g = 0.33333333333333331;")) << code;
   EXPECT_TRUE(contains(code, "model.v0[0] = 1.0;")) << code;
 }
 
@@ -72,14 +75,14 @@ TEST(Codegen, NamespaceAndIdentifierAreConfigurable) {
   options.namespace_name = "lab::models";
   std::string code = generate_code(built.spec, built.derivation, options);
   EXPECT_TRUE(contains(code, "namespace lab {\nnamespace models {\n")) << code;
-  EXPECT_TRUE(contains(code, "make_sled_paper_2_model()")) << code;
+  EXPECT_TRUE(contains(code, "make_sled_paper_2_model(")) << code;
   EXPECT_TRUE(contains(code, "class SledPaper2Evaluator")) << code;
   EXPECT_TRUE(contains(code, "model.name = \"sled-paper 2\";")) << code;
   options.namespace_name = "";
   options.identifier = "my_sled";
   code = generate_code(built.spec, built.derivation, options);
   EXPECT_FALSE(contains(code, "namespace ")) << code;
-  EXPECT_TRUE(contains(code, "make_my_sled_model()")) << code;
+  EXPECT_TRUE(contains(code, "make_my_sled_model(")) << code;
   options.identifier = "2sled";
   EXPECT_THROW(generate_code(built.spec, built.derivation, options), InputError);
   options.identifier = "";

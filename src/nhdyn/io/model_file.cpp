@@ -27,6 +27,7 @@
 #include <toml++/toml.h>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/multibody.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
 #include "nhdyn/symbolic/suggest.hpp"
@@ -166,6 +167,10 @@ class Loader {
     if (const toml::node* plot = root.get("plot")) load_plot(*plot, builder);
     symbolic::Spec spec = builder.build();
     spec.visual = std::move(visual);
+    // The definitions of derived parameters, which a --set of a parameter they use re-evaluates.
+    for (symbolic::SpecParameter& p : spec.parameters)
+      for (const Parameter& loaded : parameter_values_)
+        if (loaded.name == p.name) p.expression = loaded.expression;
     return spec;
   }
 
@@ -460,46 +465,54 @@ class Loader {
         if (const toml::node* unit_node = full->get("unit"))
           unit = string_of(*unit_node, fmt::format("{}.unit", name), "unit = \"m\"");
       }
-      const double number = parameter_value(*value, name, builder);
+      const auto [number, expression] = parameter_value(*value, name);
       builder.parameter(name, number, unit, at(*entry.key));
-      parameter_values_.emplace_back(name, number);
+      parameter_values_.push_back(Parameter{name, number, unit, expression});
     }
   }
 
-  // A number, or a constant expression in pi and the parameters above ("pi/6", "2*a").
-  double parameter_value(const toml::node& node, const std::string& name, const SpecBuilder& builder) const {
-    if (const std::optional<double> number = number_value(node, name)) return *number;
+  // A number, or an expression in numbers, pi, e and the parameters above ("pi/6", "2*a"),
+  // evaluated as --set evaluates one (model/parameters.hpp, no GiNaC), so that a value computed
+  // here and one re-evaluated after a --set agree to the bit. Returns the value and, for an
+  // expression that uses parameters (a derived parameter), its text.
+  std::pair<double, std::string> parameter_value(const toml::node& node, const std::string& name) const {
+    if (const std::optional<double> number = number_value(node, name)) {
+      try {
+        check_parameter_value(name, *number);
+      } catch (const InputError& e) {
+        fail(at(node), e.what());
+      }
+      return {*number, ""};
+    }
     if (!node.is_string())
       fail(at(node), fmt::format("parameter '{}' must be a number, an expression in pi and the parameters above it "
                                  "(e.g. \"pi/6\"), or {{ value = ..., unit = \"...\" }}; it is {}",
                                  name, type_name(node)));
     const std::string& text = node.as_string()->get();
     const SourceLocation where = content_at(node);
-    const GiNaC::ex parsed = located(node, [&] { return builder.parse(text, where); });
+    std::vector<std::string> names;
     try {
-      GiNaC::lst values;
-      for (GiNaC::const_preorder_iterator it = parsed.preorder_begin(); it != parsed.preorder_end(); ++it) {
-        if (!GiNaC::is_a<GiNaC::symbol>(*it)) continue;
-        const std::string symbol = GiNaC::ex_to<GiNaC::symbol>(*it).get_name();
-        const auto known = std::find_if(parameter_values_.begin(), parameter_values_.end(),
-                                        [&](const auto& p) { return p.first == symbol; });
-        if (known == parameter_values_.end())
-          fail(where, fmt::format("the value of parameter '{}' uses '{}'; a parameter's value may use only numbers, "
-                                  "pi and the parameters above it",
-                                  name, symbol));
-        values.append(*it == GiNaC::numeric(known->second));
-      }
-      const GiNaC::ex value = parsed.subs(values).evalf();
-      if (GiNaC::is_a<GiNaC::numeric>(value) && GiNaC::ex_to<GiNaC::numeric>(value).is_real()) {
-        const double number = GiNaC::ex_to<GiNaC::numeric>(value).to_double();
-        if (std::isfinite(number)) return number;
-      }
-    } catch (const Error&) {
-      throw;
-    } catch (const std::exception& e) {
+      names = calc_expression_names(text, parameter_values_);
+    } catch (const InputError& e) {
       fail(where, fmt::format("the value of parameter '{}', \"{}\", cannot be evaluated: {}", name, text, e.what()));
     }
-    fail(where, fmt::format("the value of parameter '{}', \"{}\", is not a finite real number", name, text));
+    bool derived = false;
+    for (const std::string& symbol : names) {
+      const auto known = std::find_if(parameter_values_.begin(), parameter_values_.end(),
+                                      [&](const Parameter& p) { return p.name == symbol; });
+      if (known == parameter_values_.end())
+        fail(where, fmt::format("the value of parameter '{}' uses '{}'; a parameter's value may use only numbers, "
+                                "pi and the parameters above it",
+                                name, symbol));
+      derived = true;
+    }
+    try {
+      const double value = calc_parameter_expression(text, parameter_values_);
+      check_parameter_value(name, value);
+      return {value, derived ? text : std::string()};
+    } catch (const InputError& e) {
+      fail(where, fmt::format("the value of parameter '{}', \"{}\": {}", name, text, e.what()));
+    }
   }
 
   void load_forces(const toml::node& node, SpecBuilder& builder) const {
@@ -1025,7 +1038,7 @@ class Loader {
   std::string_view text_;
   std::string file_;
   std::vector<std::string> coordinates_;
-  std::vector<std::pair<std::string, double>> parameter_values_;
+  std::vector<Parameter> parameter_values_;  // as loaded so far, in file order
   double t0_ = 0.0;
 };
 

@@ -1,9 +1,22 @@
 #include "nhdyn/model/appell.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
+#include <memory>
+
+#include "nhdyn/core/error.hpp"
 
 namespace nhdyn {
 namespace {
+
+// The initial velocity (1, 0.5, z'), z' = a |(x', y')| on the constraint's falling branch.
+void appell_initial_state(const AppellParameters& p, double* q0, double* v0) {
+  q0[0] = q0[1] = q0[2] = 0.0;
+  v0[0] = 1.0;
+  v0[1] = 0.5;
+  v0[2] = p.a * std::sqrt(1.0 + 0.25);
+}
 
 class AppellEvaluator final : public Evaluator {
  public:
@@ -13,6 +26,23 @@ class AppellEvaluator final : public Evaluator {
       v0_[i] = v0[i];
     }
   }
+
+  // The values in the order of Model::parameters: m, g, a. The exact solution starts from the
+  // initial state of these values.
+  std::shared_ptr<const Evaluator> with_parameters(const double* values, std::size_t count) const override {
+    if (count != 3) throw InputError("appell: 3 parameter values expected (m, g, a)");
+    const AppellParameters p{values[0], values[1], values[2]};
+    if (!(p.m > 0.0) || !(p.a > 0.0))
+      throw InputError(fmt::format("appell: the mass must be positive (m = {:g}), or the inertia matrix is not "
+                                   "positive definite, and so must a (a = {:g}): the model follows the falling "
+                                   "branch z' = a |(x', y')| > 0 and divides by z'",
+                                   p.m, p.a));
+    Vector q0(3), v0(3);
+    appell_initial_state(p, q0.data(), v0.data());
+    return std::make_shared<AppellEvaluator>(p, t0_, q0, v0);
+  }
+  bool has_initial_state() const override { return true; }
+  void initial_state(double*, double* q0, double* v0) const override { appell_initial_state(p_, q0, v0); }
 
   void terms(double, const double*, const double* v, double*, const TermsOut& out) const override {
     const double m = p_.m;
@@ -85,9 +115,9 @@ Model make_appell_model(const AppellParameters& p) {
   model.coordinates = {"x", "y", "z"};
   model.constraints = {{"appell", ConstraintLevel::velocity, "z'^2 - a^2 (x'^2 + y'^2) = 0"}};
   model.parameters = {{"m", p.m, "kg"}, {"g", p.g, "m/s^2"}, {"a", p.a, ""}};
-  model.q0 = Vector::Zero(3);
+  model.q0 = Vector(3);
   model.v0 = Vector(3);
-  model.v0 << 1.0, 0.5, p.a * std::sqrt(1.0 + 0.25);
+  appell_initial_state(p, model.q0.data(), model.v0.data());
   model.defaults = {10.0, 0.01};
   model.path = PlanarPath{0, 1};
   model.evaluator = std::make_shared<AppellEvaluator>(p, model.t0, model.q0, model.v0);

@@ -2,10 +2,13 @@
 // equations of motion (A, Q, G, b, b0), optionally an analytic complement D, the residuals of
 // the constraints at the level they were given, the energy, and optionally an exact solution. Built-in C++ models implement it by
 // hand; model files (through the symbolic compiler) and generated code are other implementations.
-// It is stateless: any workspace it needs is the `scratch` array that Data owns.
+// It is stateless: any workspace it needs is the `scratch` array that Data owns. It computes with
+// one set of parameter values (those of Model::parameters, in order) and never changes: new
+// values give a new evaluator (with_parameters), so Model copies on several threads can share one.
 #pragma once
 
 #include <cstddef>
+#include <memory>
 
 #include "nhdyn/model/sparsity.hpp"
 
@@ -24,6 +27,20 @@ struct TermsOut {
 class Evaluator {
  public:
   virtual ~Evaluator() = default;
+
+  // This model's evaluator computing with parameter values `values` (`count` of them, in the
+  // order of Model::parameters): what depends on the parameters only is computed here, once, not
+  // at every call. nullptr when the evaluator's parameters are fixed (the default). Throws
+  // InputError for values the model refuses, naming them. Called by set_parameter
+  // (parameters.hpp), not in the time loop (it allocates).
+  virtual std::shared_ptr<const Evaluator> with_parameters(const double* /*values*/, std::size_t /*count*/) const {
+    return nullptr;
+  }
+  // Whether the model's initial state depends on its parameters: initial_state() then writes q0
+  // and q'0 (n values each) for the values this evaluator computes with; `scratch` has
+  // scratch_size() entries.
+  virtual bool has_initial_state() const { return false; }
+  virtual void initial_state(double* /*scratch*/, double* /*q0*/, double* /*v0*/) const {}
 
   // Number of doubles of workspace every call below needs (0 for hand-written models).
   virtual std::size_t scratch_size() const { return 0; }

@@ -1,7 +1,9 @@
-// Model: a frozen, numeric description of one constrained mechanical system — its coordinates,
-// constraints, parameters, initial state, simulation defaults, and the Evaluator that computes its
-// terms. Built once (by a built-in model's make_* function, and later by the model compiler),
-// then only read. Everything that changes in time lives in Data (data.hpp).
+// Model: a numeric description of one constrained mechanical system — its coordinates,
+// constraints, parameter values, initial state, simulation defaults, and the Evaluator that
+// computes its terms. Built once (by a built-in model's make_* function or the model compiler),
+// then only read while it runs; between runs its parameters may change (parameters.hpp), which
+// re-binds the evaluator without recompiling. Everything that changes in time lives in Data
+// (data.hpp).
 #pragma once
 
 #include <memory>
@@ -25,10 +27,13 @@ struct Constraint {
   std::string expression;  // as a user reads it, e.g. "y' - tan(phi) x' = 0"
 };
 
+// A parameter and its current value. A derived parameter has the expression of its value in the
+// others (k = "4*m"), re-evaluated when they change (parameters.hpp); a base one has none.
 struct Parameter {
   std::string name;
   double value = 0.0;
   std::string unit;
+  std::string expression = {};  // "" for a base parameter (the initializer spares {name, value, unit} a warning)
 };
 
 // What a run of this model does when the user says nothing else (run_options.hpp).
@@ -45,12 +50,15 @@ struct Model {
   std::string description;
   std::vector<std::string> coordinates;  // n names, in the order of q
   std::vector<Constraint> constraints;   // s, in the order of the rows of b
-  std::vector<Parameter> parameters;     // for display; values are baked into the evaluator
+  std::vector<Parameter> parameters;     // the values the evaluator computes with, in its order;
+                                         // change them with set_parameter (parameters.hpp)
   double t0 = 0.0;
   Vector q0;                             // n, initial coordinates
   Vector v0;                             // n, initial velocities
   SimulationDefaults defaults;
   std::optional<PlanarPath> path;
+  // Immutable and bound to the values of `parameters`: Model copies (one per thread) share it
+  // until one of them sets a parameter, which gives that copy a new one.
   std::shared_ptr<const Evaluator> evaluator;
 
   int n() const { return static_cast<int>(coordinates.size()); }

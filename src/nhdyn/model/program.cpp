@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -187,6 +188,7 @@ NHDYN_ALWAYS_INLINE void run_steps(const Step* s, double* const* arrays) {
 int operand_count(Op op) {
   switch (op) {
     case Op::constant:
+    case Op::parameter:
     case Op::nop:
       return 0;
     case Op::add:
@@ -243,13 +245,15 @@ const char* op_name(Op op) {
     case Op::sinh: return "sinh";
     case Op::cosh: return "cosh";
     case Op::tanh: return "tanh";
+    case Op::parameter: return "parameter";
     case Op::nop: return "nop";
   }
   return "?";
 }
 
-Program::Program(int coordinates) : n_(coordinates), steps_(1) {
+Program::Program(int coordinates, int parameters) : n_(coordinates), parameters_(parameters), steps_(1) {
   if (coordinates < 0) throw std::invalid_argument("Program: negative number of coordinates");
+  if (parameters < 0) throw std::invalid_argument("Program: negative number of parameters");
 }
 
 int Program::coordinate_register(int i) const {
@@ -283,8 +287,15 @@ int Program::push(Op op, int a, int b, int c, double k) {
   if (op == Op::powi && !(k != 0.0 && std::abs(k) <= kMaxPowi && k == std::trunc(k)))
     throw std::invalid_argument("Program::push: powi needs a nonzero integer exponent of magnitude at most 2^20, not " +
                                 format_double(k));
+  if (op == Op::parameter && (a < 0 || a >= parameters_))
+    throw std::invalid_argument("Program::push: parameter " + std::to_string(a) + " out of range [0, " +
+                                std::to_string(parameters_) + ")");
   // Unused fields are zeroed so that equal programs compare equal field by field.
   Instruction in{op, 0, 0, 0, 0.0};
+  if (op == Op::parameter) {
+    in.a = a;
+    reads_parameters_ = true;
+  }
   if (count >= 1) in.a = a;
   if (count >= 2) in.b = b;
   if (count >= 3) in.c = c;
@@ -313,7 +324,28 @@ int Program::count(Op op) const {
   return total;
 }
 
+Program Program::bind(const double* values, std::size_t count) const {
+  if (static_cast<std::size_t>(parameters_) > count)
+    throw std::invalid_argument("Program::bind: " + std::to_string(count) + " values for " +
+                                std::to_string(parameters_) + " parameters");
+  if (!reads_parameters_) return *this;
+  Program out(n_, parameters_);
+  for (const Instruction& in : code_) {
+    if (in.op == Op::nop) continue;  // pushed with its sincos
+    if (in.op == Op::parameter)
+      out.push_constant(values[in.a]);
+    else
+      out.push(in.op, in.a, in.b, in.c, in.k);
+  }
+  out.outputs_ = outputs_;
+  for (const Output& o : outputs_)
+    if (o.reg >= 0) out.note_read(o.reg);
+  return out;
+}
+
 void Program::execute(double t, const double* q, const double* v, double* registers) const {
+  if (reads_parameters_)
+    throw std::logic_error("Program::execute: the program reads parameters; run the program bind() returns");
   load_inputs(reads_, static_cast<std::size_t>(n_), t, q, v, registers);
   double* const arrays[1] = {registers};
   if (calls_)
@@ -347,6 +379,7 @@ std::string Program::describe() const {
     out += std::string(" = ") + op_name(in.op);
     const int operands[3] = {in.a, in.b, in.c};
     for (int j = 0; j < operand_count(in.op); ++j) out += " " + register_name(operands[j]);
+    if (in.op == Op::parameter) out += " p" + std::to_string(in.a);
     if (has_immediate(in.op)) out += " " + format_double(in.k);
     out += "\n";
   }
@@ -373,11 +406,60 @@ void check_program(const Program& program, const char* what, int n, int outputs)
 
 }  // namespace
 
-ProgramEvaluator::ProgramEvaluator(int n, int s, ModelPrograms programs)
-    : n_(n), s_(s), programs_(std::move(programs)) {
+namespace {
+
+ModelPrograms bind_programs(const ModelPrograms& parametric, const std::vector<double>& values) {
+  if (values.size() < static_cast<std::size_t>(parametric.parameters))
+    throw std::invalid_argument("ProgramEvaluator: " + std::to_string(values.size()) + " parameter values for " +
+                                std::to_string(parametric.parameters) + " parameters");
+  const auto bound = [&values](const Program& p) {
+    if (p.parameters() > static_cast<int>(values.size()))
+      throw std::invalid_argument("ProgramEvaluator: a program reads more parameters than the model has");
+    return p.bind(values.data(), values.size());
+  };
+  const auto bound_optional = [&bound](const std::optional<Program>& p) -> std::optional<Program> {
+    if (!p) return std::nullopt;
+    return bound(*p);
+  };
+  ModelPrograms out;
+  out.parameters = parametric.parameters;
+  out.terms = bound(parametric.terms);
+  out.complement = bound_optional(parametric.complement);
+  out.position_residual = bound(parametric.position_residual);
+  out.velocity_residual = bound(parametric.velocity_residual);
+  out.energy = bound_optional(parametric.energy);
+  out.solution = bound_optional(parametric.solution);
+  out.initial_state = bound_optional(parametric.initial_state);
+  out.sparsity = parametric.sparsity;
+  return out;
+}
+
+}  // namespace
+
+ProgramEvaluator::ProgramEvaluator(int n, int s, ModelPrograms programs, std::vector<double> parameters)
+    : n_(n), s_(s), parametric_(std::make_shared<const ModelPrograms>(std::move(programs))),
+      parameters_(std::move(parameters)) {
+  build();
+}
+
+ProgramEvaluator::ProgramEvaluator(const ProgramEvaluator& other, std::vector<double> parameters)
+    : n_(other.n_), s_(other.s_), parametric_(other.parametric_), parameters_(std::move(parameters)) {
+  build();
+}
+
+std::shared_ptr<const Evaluator> ProgramEvaluator::with_parameters(const double* values, std::size_t count) const {
+  if (count < static_cast<std::size_t>(parametric_->parameters))
+    throw std::invalid_argument("ProgramEvaluator::with_parameters: " + std::to_string(count) + " values for " +
+                                std::to_string(parameters_.size()) + " parameters");
+  return std::make_shared<ProgramEvaluator>(*this, std::vector<double>(values, values + count));
+}
+
+void ProgramEvaluator::build() {
+  const int n = n_, s = s_;
   if (n <= 0 || s < 0 || s >= n)
     throw std::invalid_argument("ProgramEvaluator: needs 0 <= s < n, got n = " + std::to_string(n) +
                                 ", s = " + std::to_string(s));
+  programs_ = bind_programs(*parametric_, parameters_);
   std::size_t a_size = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
   std::size_t b_size = static_cast<std::size_t>(s) * static_cast<std::size_t>(n);
   if (programs_.sparsity) {
@@ -400,6 +482,12 @@ ProgramEvaluator::ProgramEvaluator(int n, int s, ModelPrograms programs)
     if (programs_.solution->reads_coordinates() || programs_.solution->reads_velocities())
       throw std::invalid_argument("ProgramEvaluator: the solution program reads the state; it may read only t");
   }
+  if (programs_.initial_state) {
+    check_program(*programs_.initial_state, "initial state", n, 2 * n);
+    if (programs_.initial_state->reads_time() || programs_.initial_state->reads_coordinates() ||
+        programs_.initial_state->reads_velocities())
+      throw std::invalid_argument("ProgramEvaluator: the initial state program reads t, q or q'");
+  }
   if (programs_.position_residual.reads_velocities())
     throw std::invalid_argument("ProgramEvaluator: the position residual program reads velocities");
   if (programs_.position_residual.outputs() > s || programs_.velocity_residual.outputs() > s ||
@@ -415,6 +503,7 @@ ProgramEvaluator::ProgramEvaluator(int n, int s, ModelPrograms programs)
   widen(programs_.velocity_residual);
   if (programs_.energy) widen(*programs_.energy);
   if (programs_.solution) widen(*programs_.solution);
+  if (programs_.initial_state) widen(*programs_.initial_state);
   scratch_ = largest;
   if (programs_.sparsity) {
     // The nonzeros of A and b, between the program's run and their scatter into dense matrices.
@@ -428,6 +517,7 @@ ProgramEvaluator::ProgramEvaluator(int n, int s, ModelPrograms programs)
   velocity_residual_ = prepare(programs_.velocity_residual, {programs_.velocity_residual.outputs()});
   if (programs_.energy) energy_ = prepare(*programs_.energy, {1});
   if (programs_.solution) solution_ = prepare(*programs_.solution, {3 * n});
+  if (programs_.initial_state) initial_state_ = prepare(*programs_.initial_state, {2 * n});
   if (programs_.sparsity) {
     terms_function_ = terms_.calls ? &terms_scatter<true> : &terms_scatter<false>;
     sparse_function_ = terms_.calls ? &terms_any<true> : &terms_any<false>;
@@ -740,6 +830,14 @@ double ProgramEvaluator::energy(double t, const double* q, const double* v, doub
 void ProgramEvaluator::solution(double t, double* scratch, double* qva) const {
   if (!programs_.solution) return;
   run(solution_, t, nullptr, nullptr, scratch, qva);
+}
+
+void ProgramEvaluator::initial_state(double* scratch, double* q0, double* v0) const {
+  if (!programs_.initial_state) return;
+  std::vector<double> out(2 * static_cast<std::size_t>(n_));
+  run(initial_state_, 0.0, nullptr, nullptr, scratch, out.data());
+  std::copy(out.begin(), out.begin() + n_, q0);
+  std::copy(out.begin() + n_, out.end(), v0);
 }
 
 }  // namespace nhdyn

@@ -4,17 +4,20 @@
 // instructions of the same op, plus the arithmetic. Registers: r[0] = t, r[1 + i] = q_i,
 // r[1 + n + i] = q'_i (the inputs, copied in when the program starts), then instruction j writes
 // register inputs() + j and reads only registers below it. Outputs are registers or constants;
-// constant outputs cost no instruction.
+// constant outputs cost no instruction. A `parameter` instruction reads the value of a model
+// parameter: the programs as compiled are parametric, and binding them to values (Program::bind)
+// turns those instructions into constants.
 // ProgramEvaluator runs such programs as an Evaluator: all the terms A, Q, G, b, b0 in one
 // program (common subexpressions computed once), the complement D, the residuals and the energy
-// in their own, each in a prepared form: what depends on constants only is computed once when the
-// evaluator is built (the parameters are frozen in the Model), what no output needs is dropped,
-// and results go straight to the output arrays. Generated C++ (symbolic/codegen.hpp) prints the
-// same programs as source code.
+// in their own, each in a prepared form: what depends on constants and parameters only is
+// computed once when the evaluator is bound to parameter values (with_parameters, the "parameter
+// stage"), what no output needs is dropped, and results go straight to the output arrays.
+// Generated C++ (symbolic/codegen.hpp) prints the same programs as source code.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -60,6 +63,7 @@ enum class Op : std::uint8_t {
   sinh,
   cosh,
   tanh,
+  parameter,    // r = the value of model parameter a (an index, not a register); see Program::bind
   nop,          // the cos slot of a sincos; never pushed on its own
 };
 
@@ -98,10 +102,12 @@ struct Output {
 
 class Program {
  public:
-  // A program of a system with `coordinates` coordinates (its inputs are t, q and q').
-  explicit Program(int coordinates = 0);
+  // A program of a system with `coordinates` coordinates (its inputs are t, q and q') and
+  // `parameters` parameters (read by `parameter` instructions).
+  explicit Program(int coordinates = 0, int parameters = 0);
 
   int coordinates() const { return n_; }
+  int parameters() const { return parameters_; }
   // The input registers: t, q_i, q'_i; inputs() = 1 + 2 n of them.
   int inputs() const { return 1 + 2 * n_; }
   static constexpr int time_register() { return 0; }
@@ -114,6 +120,8 @@ class Program {
   // the sine, the cosine is the next one.
   int push(Op op, int a = 0, int b = 0, int c = 0, double k = 0.0);
   int push_constant(double value) { return push(Op::constant, 0, 0, 0, value); }
+  // Appends `r = parameter index`; throws std::invalid_argument out of [0, parameters()).
+  int push_parameter(int index) { return push(Op::parameter, index); }
   // Appends the next output: a register, or a constant (which costs no instruction).
   void add_output(int reg);
   void add_constant_output(double value);
@@ -128,9 +136,15 @@ class Program {
   bool reads_time() const { return reads_[0]; }
   bool reads_coordinates() const { return reads_[1]; }
   bool reads_velocities() const { return reads_[2]; }
+  bool reads_parameters() const { return reads_parameters_; }
+
+  // The program with every `parameter` instruction replaced by the constant values[index]
+  // (`count` values, at least parameters()); register numbers and outputs stay as they are.
+  Program bind(const double* values, std::size_t count) const;
 
   // Runs the program: q and v hold coordinates() values (v may be null when the program reads no
   // velocity), `registers` registers() doubles, `outputs` outputs() doubles. Allocates nothing.
+  // Throws std::logic_error for a program that reads parameters: bind() it first.
   void run(double t, const double* q, const double* v, double* registers, double* outputs) const;
   // The same without writing the outputs: register outputs stay in registers[output_list()[i].reg].
   void execute(double t, const double* q, const double* v, double* registers) const;
@@ -144,6 +158,8 @@ class Program {
   void note_read(int reg);
 
   int n_ = 0;
+  int parameters_ = 0;
+  bool reads_parameters_ = false;
   std::vector<Instruction> code_;
   std::vector<Step> steps_;  // code_ as the interpreter runs it, ended by a nop
   bool calls_ = false;       // an instruction calls the math library (sin, pow, sqrt...)
@@ -152,7 +168,8 @@ class Program {
 };
 
 // The programs of a compiled model, with the output each must have (n coordinates, s
-// constraints, p of them at position level, r = number at position or velocity level).
+// constraints, p of them at position level, r = number at position or velocity level). Each may
+// read the model's parameters (in the order of Model::parameters).
 struct ModelPrograms {
   // outputs: A (n x n, col-major), Q (n), G (n), b (s x n, col-major), b0 (s); with a sparsity,
   // only its nonzeros of A and b (compressed columns) in their places
@@ -163,12 +180,16 @@ struct ModelPrograms {
   std::optional<Program> energy;     // one output: T + V
   std::optional<Program> solution;   // outputs: q (n), q' (n), q'' (n) of the exact motion; reads only t
   std::optional<TermsSparsity> sparsity;  // the nonzeros of A and b that terms writes, if not all
+  std::optional<Program> initial_state = std::nullopt;  // outputs: q0 (n), q'0 (n); reads parameters only
+  int parameters = 0;                // number of parameters the programs may read
 };
 
-// An Evaluator that runs straight-line programs. Each program is prepared once, when the
-// evaluator is built (the parameters are frozen by then):
-// - an instruction whose operands are all constants becomes a constant, computed by the
-//   interpreter itself so to the same bits (a parameter-only subexpression costs nothing per call);
+// An Evaluator that runs straight-line programs. It keeps the parametric programs (shared by every
+// evaluator bound from them) and the values it computes with; each program is bound to those
+// values and prepared once, when the evaluator is built (with_parameters builds another):
+// - an instruction whose operands are all constants or parameters becomes a constant, computed by
+//   the interpreter itself so to the same bits (a parameter-only subexpression costs nothing per
+//   call: this is the parameter stage);
 // - a constant operand of add, sub, mul, div or muladd becomes the immediate of add_k, mul_k,
 //   div_k or mulk_add, which round alike;
 // - constant outputs go to an image copied whole before the instructions run; an instruction
@@ -181,13 +202,24 @@ struct ModelPrograms {
 class ProgramEvaluator final : public Evaluator {
  public:
   // Throws std::invalid_argument when a program's output count or coordinate count does not
-  // match n and s, or the position residual reads velocities.
-  ProgramEvaluator(int n, int s, ModelPrograms programs);
+  // match n and s, the position residual reads velocities, or there are fewer `parameters` than
+  // programs.parameters.
+  ProgramEvaluator(int n, int s, ModelPrograms programs, std::vector<double> parameters = {});
+  // The same programs bound to other values (no copy of the parametric programs).
+  ProgramEvaluator(const ProgramEvaluator& other, std::vector<double> parameters);
 
   int n() const { return n_; }
   int s() const { return s_; }
-  // The programs as given (generated code prints these).
+  // The programs bound to this evaluator's parameter values: `parameter` instructions are
+  // constants (what linearization's tangents and tests run).
   const ModelPrograms& programs() const { return programs_; }
+  // The programs as compiled, reading the parameters (generated code prints these).
+  const ModelPrograms& parametric_programs() const { return *parametric_; }
+  const std::vector<double>& parameter_values() const { return parameters_; }
+
+  std::shared_ptr<const Evaluator> with_parameters(const double* values, std::size_t count) const override;
+  bool has_initial_state() const override { return programs_.initial_state.has_value(); }
+  void initial_state(double* scratch, double* q0, double* v0) const override;
   // Number of operations the prepared terms run per call (a sincos counts one).
   int terms_operations() const { return static_cast<int>(terms_.steps.size()) - 1; }
 
@@ -238,11 +270,15 @@ class ProgramEvaluator final : public Evaluator {
   static TermsFunction choose_terms(int n, int s);
   void run(const Prepared& p, double t, const double* q, const double* v, double* scratch, double* out) const;
 
+  void build();
+
   int n_ = 0;
   int s_ = 0;
-  ModelPrograms programs_;
+  std::shared_ptr<const ModelPrograms> parametric_;
+  std::vector<double> parameters_;
+  ModelPrograms programs_;  // *parametric_ bound to parameters_
   std::size_t scratch_ = 0;
-  Prepared terms_, complement_, position_residual_, velocity_residual_, energy_, solution_;
+  Prepared terms_, complement_, position_residual_, velocity_residual_, energy_, solution_, initial_state_;
   TermsFunction terms_function_ = nullptr;
   std::size_t terms_sizes_[5] = {0, 0, 0, 0, 0};  // outputs of terms: A, Q, G, b, b0 (nonzeros when sparse)
   std::size_t values_offset_ = 0;  // where terms_scatter keeps the nonzeros in scratch

@@ -38,7 +38,8 @@ void run_tangent(const Program& program, const double* x, double dt, const doubl
     const double da = d[in.a], db = d[in.b], dc = d[in.c];
     double value = 0.0;
     switch (in.op) {
-      case Op::constant: value = 0.0; break;
+      case Op::constant:
+      case Op::parameter: value = 0.0; break;
       case Op::add: value = da + db; break;
       case Op::sub: value = da - db; break;
       case Op::mul: value = da * b + a * db; break;

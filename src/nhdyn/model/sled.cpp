@@ -1,17 +1,36 @@
 #include "nhdyn/model/sled.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
+#include <memory>
 
 #include "nhdyn/core/error.hpp"
 
 namespace nhdyn {
 namespace {
 
+void check_sled_parameters(const SledParameters& p) {
+  if (!(p.rho > p.a) || !(p.m > 0.0))
+    throw InputError(fmt::format("sled: the radius of gyration about the contact point must exceed the distance to "
+                                 "the centre of mass (rho > a; here rho = {:g}, a = {:g}) and the mass must be "
+                                 "positive (m = {:g}), or the inertia matrix is not positive definite",
+                                 p.rho, p.a, p.m));
+}
+
 class SledEvaluator final : public Evaluator {
  public:
   // m g sin(alpha) is a constant of the model: computed once, not at every evaluation.
   SledEvaluator(SledVariant variant, const SledParameters& p)
       : variant_(variant), p_(p), mg_sin_alpha_(p.m * p.g * std::sin(p.alpha)) {}
+
+  // The values in the order of Model::parameters: m, a, rho, alpha, g.
+  std::shared_ptr<const Evaluator> with_parameters(const double* values, std::size_t count) const override {
+    if (count != 5) throw InputError("sled: 5 parameter values expected (m, a, rho, alpha, g)");
+    const SledParameters p{values[0], values[1], values[2], values[3], values[4]};
+    check_sled_parameters(p);
+    return std::make_shared<SledEvaluator>(variant_, p);
+  }
 
   void terms(double, const double* q, const double* v, double*, const TermsOut& out) const override {
     const double m = p_.m, a = p_.a;
@@ -80,10 +99,7 @@ class SledEvaluator final : public Evaluator {
 }  // namespace
 
 Model make_sled_model(SledVariant variant, const SledParameters& p) {
-  if (!(p.rho > p.a) || !(p.m > 0.0))
-    throw InputError("sled: the radius of gyration about the contact point must exceed the distance "
-                     "to the centre of mass (rho > a) and the mass must be positive, or the inertia "
-                     "matrix is not positive definite");
+  check_sled_parameters(p);
   const bool paper = variant == SledVariant::paper;
   Model model;
   model.name = paper ? "sled-paper" : "sled";

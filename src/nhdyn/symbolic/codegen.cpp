@@ -2,9 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -95,75 +97,161 @@ std::string comment_text(const std::string& s) {
   return out;
 }
 
-// A register as C++: the inputs by their parameter (t, q[i], v[i]), the others rN.
-std::string reg(const Program& program, int r) {
-  const int n = program.coordinates();
-  if (r == Program::time_register()) return "t";
-  if (r <= n) return fmt::format("q[{}]", r - 1);
-  if (r <= 2 * n) return fmt::format("v[{}]", r - 1 - n);
-  return "r" + std::to_string(r);
-}
+// How one program is printed. Its parameter stage (the instructions that read parameters and
+// constants only) is computed once per parameter change, in the evaluator's constructor, into
+// members named <prefix>rN_; the calls compute the rest. Parameters read as p_.<field>.
+struct Printer {
+  const Program& program;
+  std::string prefix;                          // of the members that hold stage registers
+  const std::vector<std::string>& fields;      // parameter index -> field of the parameter struct
+  std::vector<char> stage;                     // register -> computed in the stage
+  std::vector<char> constant;                  // register -> a constant instruction
+  std::vector<char> read_by_stage, read_by_call;
 
-// The right-hand side of instruction `in` (not a sincos).
-std::string expression(const Program& program, const Instruction& in) {
-  const int count = operand_count(in.op);
-  const std::string a = count >= 1 ? reg(program, in.a) : "", b = count >= 2 ? reg(program, in.b) : "",
-                    c = count >= 3 ? reg(program, in.c) : "";
-  switch (in.op) {
-    case Op::constant: return literal(in.k);
-    case Op::add: return a + " + " + b;
-    case Op::sub: return a + " - " + b;
-    case Op::mul: return a + " * " + b;
-    case Op::div: return a + " / " + b;
-    case Op::neg: return "-" + a;
-    case Op::add_k: return a + " + " + literal(in.k);
-    case Op::mul_k: return literal(in.k) + " * " + a;
-    case Op::mulk: return literal(in.k) + " * (" + a + " * " + b + ")";
-    case Op::div_k: return literal(in.k) + " / " + a;
-    case Op::muladd: return a + " * " + b + " + " + c;
-    case Op::mulsub: return c + " - " + a + " * " + b;
-    case Op::mulk_add: return literal(in.k) + " * " + a + " + " + b;
-    case Op::mulk_muladd: return literal(in.k) + " * (" + a + " * " + b + ") + " + c;
-    case Op::square: return a + " * " + a;
-    case Op::cube: return a + " * " + a + " * " + a;
-    case Op::powi: return fmt::format("powi({}, {})", a, static_cast<int>(in.k));
-    case Op::pow: return "std::pow(" + a + ", " + b + ")";
-    case Op::pow_k: return "std::pow(" + a + ", " + literal(in.k) + ")";
-    case Op::atan2: return "std::atan2(" + a + ", " + b + ")";
-    case Op::sincos:
-    case Op::nop: break;
-    default: return std::string("std::") + op_name(in.op) + "(" + a + ")";
+  // hoist = false: no stage, every instruction in the call (a program that runs once anyway).
+  Printer(const Program& p, std::string member_prefix, const std::vector<std::string>& parameter_fields,
+          bool hoist = true)
+      : program(p), prefix(std::move(member_prefix)), fields(parameter_fields) {
+    const std::size_t registers = static_cast<std::size_t>(p.registers());
+    stage.assign(registers, 0);
+    constant.assign(registers, 0);
+    read_by_stage.assign(registers, 0);
+    read_by_call.assign(registers, 0);
+    const std::vector<Instruction>& code = p.code();
+    const auto at = [](int r) { return static_cast<std::size_t>(r); };
+    for (std::size_t i = 0; i < code.size(); ++i) {
+      const Instruction& in = code[i];
+      const std::size_t r = static_cast<std::size_t>(p.inputs()) + i;
+      if (in.op == Op::nop) {
+        stage[r] = stage[r - 1];
+        continue;
+      }
+      if (in.op == Op::constant) {
+        constant[r] = 1;
+        continue;
+      }
+      const int operands[3] = {in.a, in.b, in.c};
+      const int count = operand_count(in.op);
+      bool only = in.op == Op::parameter || count > 0;
+      bool any = in.op == Op::parameter;
+      for (int k = 0; k < count; ++k) {
+        only = only && (stage[at(operands[k])] || constant[at(operands[k])]);
+        any = any || stage[at(operands[k])];
+      }
+      stage[r] = hoist && only && any;
+    }
+    for (std::size_t i = 0; i < code.size(); ++i) {
+      const Instruction& in = code[i];
+      if (in.op == Op::nop) continue;
+      const std::size_t r = static_cast<std::size_t>(p.inputs()) + i;
+      const int operands[3] = {in.a, in.b, in.c};
+      for (int k = 0; k < operand_count(in.op); ++k) (stage[r] ? read_by_stage : read_by_call)[at(operands[k])] = 1;
+    }
+    for (const Output& o : p.output_list())
+      if (o.reg >= 0) read_by_call[at(o.reg)] = 1;
   }
-  return "";
-}
+
+  bool member(int r) const {
+    return stage[static_cast<std::size_t>(r)] && read_by_call[static_cast<std::size_t>(r)];
+  }
+  std::string member_name(int r) const { return prefix + "r" + std::to_string(r) + "_"; }
+
+  // A register as C++: the inputs by their parameter (t, q[i], v[i]), stage registers in a call by
+  // their member, the others rN.
+  std::string reg(int r, bool in_stage) const {
+    const int n = program.coordinates();
+    if (r == Program::time_register()) return "t";
+    if (r <= n) return fmt::format("q[{}]", r - 1);
+    if (r <= 2 * n) return fmt::format("v[{}]", r - 1 - n);
+    if (!in_stage && stage[static_cast<std::size_t>(r)]) return member_name(r);
+    return "r" + std::to_string(r);
+  }
+
+  // The right-hand side of instruction `in` (not a sincos).
+  std::string expression(const Instruction& in, bool in_stage) const {
+    const int count = operand_count(in.op);
+    const std::string a = count >= 1 ? reg(in.a, in_stage) : "", b = count >= 2 ? reg(in.b, in_stage) : "",
+                      c = count >= 3 ? reg(in.c, in_stage) : "";
+    switch (in.op) {
+      case Op::constant: return literal(in.k);
+      case Op::parameter: return "p_." + fields[static_cast<std::size_t>(in.a)];
+      case Op::add: return a + " + " + b;
+      case Op::sub: return a + " - " + b;
+      case Op::mul: return a + " * " + b;
+      case Op::div: return a + " / " + b;
+      case Op::neg: return "-" + a;
+      case Op::add_k: return a + " + " + literal(in.k);
+      case Op::mul_k: return literal(in.k) + " * " + a;
+      case Op::mulk: return literal(in.k) + " * (" + a + " * " + b + ")";
+      case Op::div_k: return literal(in.k) + " / " + a;
+      case Op::muladd: return a + " * " + b + " + " + c;
+      case Op::mulsub: return c + " - " + a + " * " + b;
+      case Op::mulk_add: return literal(in.k) + " * " + a + " + " + b;
+      case Op::mulk_muladd: return literal(in.k) + " * (" + a + " * " + b + ") + " + c;
+      case Op::square: return a + " * " + a;
+      case Op::cube: return a + " * " + a + " * " + a;
+      case Op::powi: return fmt::format("powi({}, {})", a, static_cast<int>(in.k));
+      case Op::pow: return "std::pow(" + a + ", " + b + ")";
+      case Op::pow_k: return "std::pow(" + a + ", " + literal(in.k) + ")";
+      case Op::atan2: return "std::atan2(" + a + ", " + b + ")";
+      case Op::sincos:
+      case Op::nop: break;
+      default: return std::string("std::") + op_name(in.op) + "(" + a + ")";
+    }
+    return "";
+  }
+
+  // The statements of the stage (in_stage) or of a call, indented by `indent`.
+  std::string statements(bool in_stage, const char* indent) const {
+    std::string out;
+    const std::vector<Instruction>& code = program.code();
+    for (std::size_t i = 0; i < code.size(); ++i) {
+      const Instruction& in = code[i];
+      const int r = program.inputs() + static_cast<int>(i);
+      const std::size_t at = static_cast<std::size_t>(r);
+      if (in.op == Op::nop) continue;
+      const bool wanted = in_stage ? (stage[at] || (constant[at] && read_by_stage[at]))
+                                   : (!stage[at] && (!constant[at] || read_by_call[at]));
+      if (!wanted) continue;
+      if (in.op == Op::sincos) {
+        out += fmt::format("{}const double {} = std::sin({});\n", indent, reg(r, true), reg(in.a, in_stage));
+        out += fmt::format("{}const double {} = std::cos({});\n", indent, reg(r + 1, true), reg(in.a, in_stage));
+      } else {
+        out += fmt::format("{}const double {} = {};\n", indent, reg(r, true), expression(in, in_stage));
+      }
+    }
+    if (in_stage)
+      for (std::size_t r = 0; r < stage.size(); ++r)
+        if (member(static_cast<int>(r)))
+          out += fmt::format("{}{} = r{};\n", indent, member_name(static_cast<int>(r)), r);
+    return out;
+  }
+  // The declarations of the stage's members.
+  std::string members() const {
+    std::string out;
+    for (std::size_t r = 0; r < stage.size(); ++r)
+      if (member(static_cast<int>(r))) out += fmt::format("  double {} = 0.0;\n", member_name(static_cast<int>(r)));
+    return out;
+  }
+};
 
 struct Body {
   std::string code;
   bool reads_t = false, reads_q = false, reads_v = false;
 };
 
-// The statements of a program, then `sink(i, register)` for each output i.
-Body print_body(const Program& program, const std::function<std::string(int, const std::string&)>& sink) {
+// The statements of a program's call, then `sink(i, register)` for each output i.
+Body print_body(const Printer& printer, const std::function<std::string(int, const std::string&)>& sink) {
+  const Program& program = printer.program;
   Body body;
   body.reads_t = program.reads_time();
   body.reads_q = program.reads_coordinates();
   body.reads_v = program.reads_velocities();
-  const std::vector<Instruction>& code = program.code();
-  for (std::size_t i = 0; i < code.size(); ++i) {
-    const Instruction& in = code[i];
-    const int r = program.inputs() + static_cast<int>(i);
-    if (in.op == Op::nop) continue;
-    if (in.op == Op::sincos) {
-      body.code += fmt::format("    const double {} = std::sin({});\n", reg(program, r), reg(program, in.a));
-      body.code += fmt::format("    const double {} = std::cos({});\n", reg(program, r + 1), reg(program, in.a));
-      continue;
-    }
-    body.code += fmt::format("    const double {} = {};\n", reg(program, r), expression(program, in));
-  }
+  body.code = printer.statements(false, "    ");
   const std::vector<Output>& outputs = program.output_list();
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     const Output& o = outputs[i];
-    body.code += sink(static_cast<int>(i), o.reg < 0 ? literal(o.value) : reg(program, o.reg));
+    body.code += sink(static_cast<int>(i), o.reg < 0 ? literal(o.value) : printer.reg(o.reg, false));
   }
   return body;
 }
@@ -184,7 +272,19 @@ std::string level_name(ConstraintLevel level) {
 bool uses_powi(const ModelPrograms& p) {
   const auto in = [](const Program& program) { return program.count(Op::powi) > 0; };
   return in(p.terms) || (p.complement && in(*p.complement)) || in(p.position_residual) ||
-         in(p.velocity_residual) || (p.energy && in(*p.energy));
+         in(p.velocity_residual) || (p.energy && in(*p.energy)) || (p.initial_state && in(*p.initial_state));
+}
+
+// The fields of the parameter struct: each parameter's name as a C++ identifier, made unique.
+std::vector<std::string> parameter_fields(const std::vector<Parameter>& parameters) {
+  std::vector<std::string> fields;
+  for (std::size_t i = 0; i < parameters.size(); ++i) {
+    std::string field = make_identifier(parameters[i].name);
+    if (field == "p_" || std::find(fields.begin(), fields.end(), field) != fields.end())
+      field += "_" + std::to_string(i);
+    fields.push_back(field);
+  }
+  return fields;
 }
 
 }  // namespace
@@ -228,9 +328,22 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   const Model model = compile_model(spec, derivation, CompileOptions{TermsLayout::dense});
   const auto* evaluator = dynamic_cast<const ProgramEvaluator*>(model.evaluator.get());
   if (evaluator == nullptr) throw std::logic_error("generate_code: compile_model did not make a ProgramEvaluator");
-  const ModelPrograms& programs = evaluator->programs();
+  const ModelPrograms& programs = evaluator->parametric_programs();
   const int n = model.n(), s = model.s();
   const std::string cls = camel_case(id) + "Evaluator";
+  const std::string parameters_struct = camel_case(id) + "Parameters";
+  const std::vector<std::string> fields = parameter_fields(model.parameters);
+  const Printer terms_printer(programs.terms, "terms_", fields);
+  const std::optional<Printer> complement_printer =
+      programs.complement ? std::optional<Printer>(std::in_place, *programs.complement, "complement_", fields)
+                          : std::nullopt;
+  const Printer phi_printer(programs.position_residual, "phi_", fields);
+  const Printer f_printer(programs.velocity_residual, "f_", fields);
+  const std::optional<Printer> energy_printer =
+      programs.energy ? std::optional<Printer>(std::in_place, *programs.energy, "energy_", fields) : std::nullopt;
+  const std::optional<Printer> initial_printer =
+      programs.initial_state ? std::optional<Printer>(std::in_place, *programs.initial_state, "initial_", fields, false)
+                             : std::nullopt;
   const auto q_name = [&](int i) { return comment_text(model.coordinates[static_cast<std::size_t>(i)]); };
   const auto c_name = [&](int i) { return comment_text(model.constraints[static_cast<std::size_t>(i)].name); };
 
@@ -243,16 +356,62 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
                      operations(programs.terms), programs.complement ? operations(*programs.complement) : 0,
                      operations(programs.position_residual), operations(programs.velocity_residual),
                      programs.energy ? operations(*programs.energy) : 0);
-  out += "#pragma once\n\n#include <cmath>\n#include <memory>\n\n";
+  out += "#pragma once\n\n#include <cmath>\n#include <cstddef>\n#include <memory>\n\n";
   out += "#include \"nhdyn/model/evaluator.hpp\"\n#include \"nhdyn/model/model.hpp\"\n\n";
   for (const std::string& part : namespaces) out += fmt::format("namespace {} {{\n", part);
   if (!namespaces.empty()) out += "\n";
 
+  // The parameter struct, with the file's values as defaults.
+  out += "// The model's parameters, with the values of its file as defaults. A derived parameter (one\n";
+  out += "// defined by an expression in the others) is a field too: set_parameter on the Model\n";
+  out += "// (nhdyn/model/parameters.hpp) re-evaluates it, a struct filled by hand does not.\n";
+  out += fmt::format("struct {} {{\n", parameters_struct);
+  for (std::size_t i = 0; i < model.parameters.size(); ++i) {
+    const Parameter& p = model.parameters[i];
+    std::string note = p.unit.empty() ? "" : fmt::format("[{}]", comment_text(p.unit));
+    if (!p.expression.empty()) note += fmt::format("{}= {}", note.empty() ? "" : " ", comment_text(p.expression));
+    out += fmt::format("  double {} = {};{}\n", fields[i], literal(p.value), note.empty() ? "" : "  // " + note);
+  }
+  out += "};\n\n";
+
   out += fmt::format("class {} final : public ::nhdyn::Evaluator {{\n public:\n", cls);
+  // The constructor computes the parameter stage of every program once.
+  {
+    std::string stage;
+    // One block per program: each numbers its registers from its own inputs.
+    const auto add_stage = [&stage](const Printer& printer) {
+      const std::string statements = printer.statements(true, "      ");
+      if (!statements.empty()) stage += "    {\n" + statements + "    }\n";
+    };
+    add_stage(terms_printer);
+    if (complement_printer) add_stage(*complement_printer);
+    add_stage(phi_printer);
+    add_stage(f_printer);
+    if (energy_printer) add_stage(*energy_printer);
+    out += fmt::format("  explicit {}(const {}& p = {{}}) : p_(p) {{", cls, parameters_struct);
+    out += stage.empty() ? "}\n" : "\n" + stage + "  }\n";
+  }
+  out += fmt::format("  const {}& parameters() const {{ return p_; }}\n\n", parameters_struct);
+  out += "  std::shared_ptr<const ::nhdyn::Evaluator> with_parameters(const double* values, std::size_t count) const "
+         "override {\n";
+  out += fmt::format("    if (count != {}) return nullptr;\n", model.parameters.size());
+  out += fmt::format("    {} p;\n", parameters_struct);
+  for (std::size_t i = 0; i < fields.size(); ++i) out += fmt::format("    p.{} = values[{}];\n", fields[i], i);
+  if (fields.empty()) out += "    (void)values;\n";
+  out += fmt::format("    return std::make_shared<{}>(p);\n  }}\n", cls);
+  if (initial_printer) {
+    const Body body = print_body(*initial_printer, [&](int i, const std::string& r) {
+      return i < n ? fmt::format("    q0[{}] = {};\n", i, r) : fmt::format("    v0[{}] = {};\n", i - n, r);
+    });
+    out += "  bool has_initial_state() const override { return true; }\n";
+    out += "  void initial_state(double* /*scratch*/, double* q0, double* v0) const override {\n";
+    out += body.code + "  }\n";
+  }
+  out += "\n";
 
   // terms
   {
-    const Body body = print_body(programs.terms, [&](int i, const std::string& r) {
+    const Body body = print_body(terms_printer, [&](int i, const std::string& r) {
       const int nn = n * n;
       if (i < nn) return fmt::format("    out.A[{}] = {};  // A({}, {})\n", i, r, q_name(i % n), q_name(i / n));
       i -= nn;
@@ -272,7 +431,7 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   // complement
   if (programs.complement) {
     const int k = n - s;
-    const Body body = print_body(*programs.complement, [&](int i, const std::string& r) {
+    const Body body = print_body(*complement_printer, [&](int i, const std::string& r) {
       return fmt::format("    D[{}] = {};  // D({}, {})\n", i, r, i % k + 1, q_name(i / k));
     });
     out += "\n  bool has_complement() const override { return true; }\n";
@@ -283,7 +442,7 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   }
   // residuals
   if (programs.position_residual.outputs() > 0) {
-    const Body body = print_body(programs.position_residual, [&](int i, const std::string& r) {
+    const Body body = print_body(phi_printer, [&](int i, const std::string& r) {
       return fmt::format("    phi[{}] = {};\n", i, r);
     });
     out += fmt::format("\n  void position_residual({}, {}, double* /*scratch*/, double* phi) const override {{\n",
@@ -291,7 +450,7 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
     out += body.code + "  }\n";
   }
   if (programs.velocity_residual.outputs() > 0) {
-    const Body body = print_body(programs.velocity_residual, [&](int i, const std::string& r) {
+    const Body body = print_body(f_printer, [&](int i, const std::string& r) {
       return fmt::format("    f[{}] = {};\n", i, r);
     });
     out += fmt::format("\n  void velocity_residual({}, {}, {}, double* /*scratch*/, double* f) const override {{\n",
@@ -301,7 +460,7 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   }
   // energy
   if (programs.energy) {
-    const Body body = print_body(*programs.energy, [&](int, const std::string& r) {
+    const Body body = print_body(*energy_printer, [&](int, const std::string& r) {
       return fmt::format("    return {};\n", r);
     });
     out += "\n  bool has_energy() const override { return true; }\n";
@@ -310,9 +469,14 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
                        parameter(body.reads_v, "const double*", "v"));
     out += body.code + "  }\n";
   }
+  out += "\n private:\n";
+  out += fmt::format("  {} p_;\n", parameters_struct);
+  out += terms_printer.members();
+  if (complement_printer) out += complement_printer->members();
+  out += phi_printer.members() + f_printer.members();
+  if (energy_printer) out += energy_printer->members();
   if (uses_powi(programs)) {
     // The interpreter's algorithm (model/program.cpp), so that both round alike.
-    out += "\n private:\n";
     out += "  // a^n by repeated squaring, n != 0.\n";
     out += "  static double powi(double a, int n) {\n";
     out += "    unsigned m = n < 0 ? 0u - static_cast<unsigned>(n) : static_cast<unsigned>(n);\n";
@@ -323,7 +487,7 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   out += "};\n\n";
 
   // make_<id>_model
-  out += fmt::format("inline ::nhdyn::Model make_{}_model() {{\n", id);
+  out += fmt::format("inline ::nhdyn::Model make_{}_model(const {}& p = {{}}) {{\n", id, parameters_struct);
   out += "  ::nhdyn::Model model;\n";
   out += fmt::format("  model.name = {};\n", quoted(model.name));
   out += fmt::format("  model.description = {};\n", quoted(model.description));
@@ -333,9 +497,11 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   for (const Constraint& c : model.constraints)
     out += fmt::format("  model.constraints.push_back({{{}, ::nhdyn::ConstraintLevel::{}, {}}});\n", quoted(c.name),
                        level_name(c.level), quoted(c.expression));
-  for (const Parameter& p : model.parameters)
-    out += fmt::format("  model.parameters.push_back({{{}, {}, {}}});\n", quoted(p.name), literal(p.value),
-                       quoted(p.unit));
+  for (std::size_t i = 0; i < model.parameters.size(); ++i) {
+    const Parameter& p = model.parameters[i];
+    out += fmt::format("  model.parameters.push_back({{{}, p.{}, {}, {}}});\n", quoted(p.name), fields[i],
+                       quoted(p.unit), quoted(p.expression));
+  }
   out += fmt::format("  model.t0 = {};\n", literal(model.t0));
   out += fmt::format("  model.q0 = ::nhdyn::Vector({});\n  model.v0 = ::nhdyn::Vector({});\n", n, n);
   for (int i = 0; i < n; ++i) out += fmt::format("  model.q0[{}] = {};\n", i, literal(model.q0[i]));
@@ -343,7 +509,9 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   out += fmt::format("  model.defaults = ::nhdyn::SimulationDefaults{{{}, {}}};\n", literal(model.defaults.t_end),
                      literal(model.defaults.output_step));
   if (model.path) out += fmt::format("  model.path = ::nhdyn::PlanarPath{{{}, {}}};\n", model.path->x, model.path->y);
-  out += fmt::format("  model.evaluator = std::make_shared<{}>();\n", cls);
+  out += fmt::format("  const auto evaluator = std::make_shared<{}>(p);\n", cls);
+  if (programs.initial_state) out += "  evaluator->initial_state(nullptr, model.q0.data(), model.v0.data());\n";
+  out += "  model.evaluator = evaluator;\n";
   out += "  return model;\n}\n";
 
   if (!namespaces.empty()) out += "\n";

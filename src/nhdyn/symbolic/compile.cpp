@@ -1,8 +1,10 @@
 // Compilation of GiNaC expressions into straight-line programs (model/program.hpp).
 //
-// Each expression is first made numeric where it can be: the parameter values are substituted and
-// evalf() folds every numeric subexpression (Pi, sqrt(2), products of parameters) into one
-// double, leaving exponents exact. The expression DAG is then walked from the outputs, every
+// Parameters stay symbols: each becomes a `parameter` instruction, which the evaluator binds to
+// the Model's current values (so a parameter changes without recompiling). The constants (pi) are
+// made numeric, and in a product the factors that depend on parameters only are gathered into one
+// subexpression, which the evaluator computes once per parameter change (its parameter stage)
+// instead of at every call. The expression DAG is then walked from the outputs, every
 // subexpression memoized by structural equality, so that a subexpression shared by several terms
 // (sin(phi) in A, G, b, b0) is computed once. The walk never depends on GiNaC's internal term
 // order, which follows symbol serial numbers and addresses: the operands of sums and products are
@@ -27,6 +29,7 @@
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/model/parameters.hpp"
 #include "nhdyn/model/program.hpp"
 
 namespace nhdyn::symbolic {
@@ -94,9 +97,9 @@ bool is_reciprocal(const GiNaC::ex& e) {
 class ProgramCompiler {
  public:
   explicit ProgramCompiler(const Spec& spec)
-      : spec_(spec), program_(spec.n()) {
-    for (const SpecParameter& p : spec.parameters)
-      values_.emplace(spec.symbols.parameter(p.name), GiNaC::numeric(p.value));
+      : spec_(spec), program_(spec.n(), static_cast<int>(spec.parameters.size())) {
+    for (std::size_t i = 0; i < spec.parameters.size(); ++i)
+      parameters_.emplace(spec.symbols.parameter(spec.parameters[i].name), static_cast<int>(i));
     const SymbolTable& symbols = spec.symbols;
     variables_.emplace(symbols.time(), Program::time_register());
     for (int i = 0; i < symbols.coordinates(); ++i) {
@@ -117,7 +120,7 @@ class ProgramCompiler {
     try {
       numeric_form = with_values(e);
     } catch (const std::exception& error) {
-      fail(fmt::format("cannot be evaluated once the parameters are set ({})", error.what()));
+      fail(fmt::format("cannot be evaluated ({})", error.what()));
     }
     if (GiNaC::is_exactly_a<GiNaC::numeric>(numeric_form)) {
       const GiNaC::numeric& x = GiNaC::ex_to<GiNaC::numeric>(numeric_form);
@@ -128,10 +131,10 @@ class ProgramCompiler {
     }
   }
 
-  // `e` with the parameters replaced by their values and the constants (pi) by theirs, every
-  // distinct node once: derived terms share large subexpressions (a bicycle's entries of A and G),
-  // which GiNaC's subs() and evalf() would walk once per path to them. Numeric operands fold as
-  // GiNaC rebuilds each node (sums, products, powers and functions of floats evaluate).
+  // `e` with the constants (pi) replaced by their values, every distinct node once: derived terms
+  // share large subexpressions (a bicycle's entries of A and G), which GiNaC's subs() and evalf()
+  // would walk once per path to them. Numeric operands fold as GiNaC rebuilds each node (sums,
+  // products, powers and functions of floats evaluate).
   GiNaC::ex with_values(const GiNaC::ex& e) {
     if (GiNaC::is_a<GiNaC::symbol>(e)) {
       const auto found = values_.find(e);
@@ -205,6 +208,12 @@ class ProgramCompiler {
   int emit_symbol(const GiNaC::symbol& x) {
     const auto found = variables_.find(x);
     if (found != variables_.end()) return found->second;
+    const auto parameter = parameters_.find(x);
+    if (parameter != parameters_.end()) {
+      const int r = program_.push_parameter(parameter->second);
+      variables_.emplace(x, r);
+      return r;
+    }
     const std::string name = x.get_name();
     for (int i = 0; i < spec_.symbols.coordinates(); ++i)
       if (x.is_equal(spec_.symbols.acceleration(i)))
@@ -280,7 +289,14 @@ class ProgramCompiler {
       factors.push_back(factor);
     }
     sort_canonically(factors, [](const GiNaC::ex& x) -> const GiNaC::ex& { return x; });
+    parameters_first(factors);
     return factors;
+  }
+
+  // The factors of parameters only first (in their order), so that their products come first and
+  // the evaluator's parameter stage computes them once.
+  void parameters_first(std::vector<GiNaC::ex>& factors) {
+    std::stable_partition(factors.begin(), factors.end(), [this](const GiNaC::ex& x) { return parameters_only(x); });
   }
 
   int scaled(int r, double c) {
@@ -293,6 +309,7 @@ class ProgramCompiler {
   // (k (a b), exact for k = -1 too).
   int product(std::vector<GiNaC::ex>& factors, double c = 1.0) {
     sort_canonically(factors, [](const GiNaC::ex& x) -> const GiNaC::ex& { return x; });
+    parameters_first(factors);
     int acc = emit(factors[0]);
     for (std::size_t i = 1; i < factors.size(); ++i) {
       const int next = emit(factors[i]);
@@ -302,7 +319,35 @@ class ProgramCompiler {
     return scaled(acc, c);
   }
 
+  // Whether `e` depends on parameters and numbers only (not on t, q, q' or an unknown symbol).
+  bool parameters_only(const GiNaC::ex& e) {
+    if (GiNaC::is_a<GiNaC::symbol>(e)) return parameters_.count(e) > 0;
+    if (e.nops() == 0) return true;
+    const auto found = parameters_only_.find(e);
+    if (found != parameters_only_.end()) return found->second;
+    bool only = true;
+    for (std::size_t i = 0; i < e.nops() && only; ++i) only = parameters_only(e.op(i));
+    parameters_only_.emplace(e, only);
+    return only;
+  }
+
   int emit_mul(const GiNaC::ex& e) {
+    {
+      // k * s, k the factors of parameters only (the parameter stage computes it once) and s the
+      // others, when the product has both.
+      GiNaC::exvector k, rest;
+      bool has_parameter = false;
+      for (std::size_t i = 0; i < e.nops(); ++i) {
+        const GiNaC::ex factor = e.op(i);
+        const bool only = parameters_only(factor);
+        has_parameter = has_parameter || (only && !GiNaC::is_exactly_a<GiNaC::numeric>(factor));
+        (only ? k : rest).push_back(factor);
+      }
+      if (has_parameter && !rest.empty()) {
+        const int stage = emit(GiNaC::mul(k));
+        return program_.push(Op::mul, stage, emit(GiNaC::mul(rest)));
+      }
+    }
     double c = 1.0;
     std::vector<GiNaC::ex> numerator, denominator;
     for (std::size_t i = 0; i < e.nops(); ++i) {
@@ -444,7 +489,7 @@ class ProgramCompiler {
       partner[static_cast<std::size_t>(i)] = c->second;
       partner[static_cast<std::size_t>(c->second)] = i;
     }
-    Program out(in.coordinates());
+    Program out(in.coordinates(), in.parameters());
     std::vector<int> map(static_cast<std::size_t>(in.registers()), -1);  // old register -> new
     for (int r = 0; r < inputs; ++r) map[static_cast<std::size_t>(r)] = r;
     const auto arg = [&](int reg) { return map[static_cast<std::size_t>(reg)]; };
@@ -464,6 +509,10 @@ class ProgramCompiler {
         map[reg] = map[reg - 1] + 1;
         continue;
       }
+      if (x.op == Op::parameter) {
+        map[reg] = out.push_parameter(x.a);
+        continue;
+      }
       const int operands = operand_count(x.op);
       map[reg] = out.push(x.op, operands >= 1 ? arg(x.a) : 0, operands >= 2 ? arg(x.b) : 0,
                           operands >= 3 ? arg(x.c) : 0, x.k);
@@ -478,7 +527,9 @@ class ProgramCompiler {
   }
 
   const Spec& spec_;
-  std::map<GiNaC::ex, GiNaC::ex, GiNaC::ex_is_less> values_;  // parameter symbol -> its value
+  std::map<GiNaC::ex, GiNaC::ex, GiNaC::ex_is_less> values_;  // symbol -> its value (none so far)
+  std::map<GiNaC::ex, int, GiNaC::ex_is_less> parameters_;   // parameter symbol -> its index
+  std::map<GiNaC::ex, bool, GiNaC::ex_is_less> parameters_only_;
   std::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, GiNaC::ex>> with_values_memo_;
   Program program_;
   std::map<GiNaC::ex, int, GiNaC::ex_is_less> variables_;  // t, q, q' -> input register
@@ -563,7 +614,10 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
   model.description = spec.description;
   model.coordinates = spec.coordinates;
   for (const SpecConstraint& c : spec.constraints) model.constraints.push_back({c.name, c.level, c.text});
-  for (const SpecParameter& p : spec.parameters) model.parameters.push_back({p.name, p.value, p.unit});
+  for (const SpecParameter& p : spec.parameters) model.parameters.push_back({p.name, p.value, p.unit, p.expression});
+  // The derived values by the evaluator the Model uses later (parameters.hpp), so that a model
+  // compiled with a value and one set to it at run time compute with the same bits.
+  update_parameters(model.parameters, spec.name);
   if (static_cast<int>(derivation.phi.size()) != model.position_constraints() ||
       static_cast<int>(derivation.f.size()) != model.velocity_constraints())
     throw ModelError(fmt::format("model '{}': the derivation has {} position and {} velocity residuals for {} "
@@ -576,6 +630,7 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
   const GiNaC::lst values = spec.parameter_values();
 
   ModelPrograms programs;
+  programs.parameters = static_cast<int>(spec.parameters.size());
   {
     TermsSparsity sparsity{pattern_of(derivation.A), pattern_of(derivation.b)};
     const bool sparse = compile_sparse(sparsity, n, s, options.layout);
@@ -652,10 +707,16 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
     if (static_cast<int>(spec.q0.size()) != n || static_cast<int>(spec.v0.size()) != n)
       throw ModelError(fmt::format("model '{}': {} initial coordinates and {} initial velocities for {} coordinates",
                                    spec.name, spec.q0.size(), spec.v0.size(), n));
+    // Checked here, symbolically (an initial value may use the parameters only); its values come
+    // from the initial-state program, which follows the parameters when they change.
     for (int i = 0; i < n; ++i) {
-      model.q0[i] = initial_value(spec, values, spec.q0[static_cast<std::size_t>(i)], q_name(i));
-      model.v0[i] = initial_value(spec, values, spec.v0[static_cast<std::size_t>(i)], q_name(i) + "'");
+      initial_value(spec, values, spec.q0[static_cast<std::size_t>(i)], q_name(i));
+      initial_value(spec, values, spec.v0[static_cast<std::size_t>(i)], q_name(i) + "'");
     }
+    ProgramCompiler initial(spec);
+    for (int i = 0; i < n; ++i) initial.add_output(spec.q0[static_cast<std::size_t>(i)], "initial " + q_name(i));
+    for (int i = 0; i < n; ++i) initial.add_output(spec.v0[static_cast<std::size_t>(i)], "initial " + q_name(i) + "'");
+    programs.initial_state = initial.finish();
   }
   if (!spec.solution.empty()) {
     // q(t), then its first and second derivatives: the exact velocities and accelerations. A
@@ -677,7 +738,13 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
   model.defaults = spec.defaults;
   if (spec.path)
     model.path = PlanarPath{coordinate_index(spec, spec.path->first, "x"), coordinate_index(spec, spec.path->second, "y")};
-  model.evaluator = std::make_shared<ProgramEvaluator>(n, s, std::move(programs));
+  std::vector<double> parameter_values;
+  for (const Parameter& p : model.parameters) parameter_values.push_back(p.value);
+  model.evaluator = std::make_shared<ProgramEvaluator>(n, s, std::move(programs), std::move(parameter_values));
+  if (model.evaluator->has_initial_state()) {
+    std::vector<double> scratch(model.evaluator->scratch_size());
+    model.evaluator->initial_state(scratch.data(), model.q0.data(), model.v0.data());
+  }
   check_model_shape(model);
   return model;
 }

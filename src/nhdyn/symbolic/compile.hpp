@@ -1,7 +1,8 @@
 // From symbols to numbers: compile a Spec and its Derivation into a frozen numeric Model whose
 // Evaluator runs straight-line programs (model/program.hpp) — all the terms A, Q, G, b, b0 in one
 // program with common subexpressions shared, and D, the residuals and the energy in their own —
-// evaluated on doubles without allocation. Parameters are replaced by their values here.
+// evaluated on doubles without allocation. The programs read the parameters, whose values the
+// Model holds: set_parameter (model/parameters.hpp) changes them without recompiling.
 #pragma once
 
 #include "nhdyn/model/model.hpp"
@@ -22,7 +23,9 @@ struct CompileOptions {
   TermsLayout layout = TermsLayout::automatic;
 };
 
-// Throws ModelError when an initial value or term is not a number once the parameters are set.
+// Throws ModelError when an initial value or term cannot be compiled (an unknown symbol, an
+// unsupported function, an initial value that is not a number once the parameters are set), and
+// InputError for a cyclic or unknown definition of a derived parameter.
 Model compile_model(const Spec& spec, const Derivation& derivation, const CompileOptions& options = {});
 
 // derive() then compile_model().

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/suggest.hpp"
 
 namespace nhdyn::symbolic {
@@ -58,17 +59,48 @@ GiNaC::lst Spec::parameter_values() const {
   return values;
 }
 
+namespace {
+
+std::vector<Parameter> model_parameters(const std::vector<SpecParameter>& parameters) {
+  std::vector<Parameter> out;
+  for (const SpecParameter& p : parameters) out.push_back({p.name, p.value, p.unit, p.expression});
+  return out;
+}
+
+void copy_back(const std::vector<Parameter>& from, std::vector<SpecParameter>& to) {
+  for (std::size_t i = 0; i < to.size(); ++i) {
+    to[i].value = from[i].value;
+    to[i].expression = from[i].expression;
+  }
+}
+
+}  // namespace
+
 void Spec::set_parameter(const std::string& name, double value) {
-  for (SpecParameter& p : parameters)
+  std::vector<Parameter> values = model_parameters(parameters);
+  bool found = false;
+  for (Parameter& p : values)
     if (p.name == name) {
+      check_parameter_value(name, value);
       p.value = value;
-      return;
+      p.expression.clear();
+      found = true;
     }
-  std::vector<std::string> names;
-  for (const SpecParameter& p : parameters) names.push_back(p.name);
-  const std::string nearest = nearest_name(name, names);
-  throw InputError(fmt::format("model '{}' has no parameter '{}'{}", this->name, name,
-                               nearest.empty() ? "" : fmt::format("; did you mean '{}'?", nearest)));
+  if (!found) {
+    std::vector<std::string> names;
+    for (const SpecParameter& p : parameters) names.push_back(p.name);
+    const std::string nearest = nearest_name(name, names);
+    throw InputError(fmt::format("model '{}' has no parameter '{}'{}", this->name, name,
+                                 nearest.empty() ? "" : fmt::format("; did you mean '{}'?", nearest)));
+  }
+  update_parameters(values, this->name);
+  copy_back(values, parameters);
+}
+
+void Spec::apply_parameter_sets(const std::vector<std::string>& sets) {
+  std::vector<Parameter> values = model_parameters(parameters);
+  nhdyn::apply_parameter_sets(values, sets, name);
+  copy_back(values, parameters);
 }
 
 }  // namespace nhdyn::symbolic

@@ -59,9 +59,10 @@ class SymbolTable {
 
 struct SpecParameter {
   std::string name;
-  double value = 0.0;
+  double value = 0.0;  // of a derived parameter: its expression's value (update_parameters)
   std::string unit;
   SourceLocation where;
+  std::string expression = {};  // a derived parameter's definition in the others ("4*m"); "" when base
 };
 
 struct SpecConstraint {
@@ -103,9 +104,11 @@ struct Spec {
   int s() const { return static_cast<int>(constraints.size()); }
   // The numeric values of the parameters as a substitution list (parameter symbol == value).
   GiNaC::lst parameter_values() const;
-  // Sets a parameter's value (for `--set name=value`); throws InputError naming the unknown name
-  // and the nearest known one.
+  // Sets a parameter's value (it becomes a base parameter) and re-evaluates the derived ones;
+  // throws InputError naming the unknown name and the nearest known one.
   void set_parameter(const std::string& name, double value);
+  // `--set NAME=EXPR` for each element of `sets` (model/parameters.hpp, apply_parameter_sets).
+  void apply_parameter_sets(const std::vector<std::string>& sets);
 };
 
 }  // namespace nhdyn::symbolic
