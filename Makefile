@@ -39,10 +39,11 @@ bench: configure
 # With clang-14 installed it is also the fuzzer's build (every target instrumented for libFuzzer),
 # so that the instrumented library is compiled once for both; otherwise GCC, without the fuzzer.
 # The test folders that run the same kernels end to end (the CLI in child processes, long
-# simulations of the gallery, studies, sweeps) or check no code (layering) are left out of it:
+# simulations of the gallery, studies, sweeps, the report in a browser) or check no code (layering)
+# are left out of it:
 # make test runs them; ASAN_SKIP_TESTS= (empty) builds and runs them all under the sanitizers.
 SAN_BUILD ?= build-asan
-ASAN_SKIP_TESTS ?= cli;gallery;studies;linearization;layering
+ASAN_SKIP_TESTS ?= cli;gallery;studies;linearization;layering;report
 HAVE_CLANG := $(shell command -v clang++-14 >/dev/null 2>&1 && echo yes)
 SAN_COMPILER = $(if $(HAVE_CLANG),-DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 -DNHDYN_FUZZ=ON)
 

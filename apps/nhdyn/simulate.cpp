@@ -181,7 +181,7 @@ int run_simulate(const SimulateArgs& args) {
   html_probe.reset();
   std::string html_notice;
   if (!args.html.empty())
-    html_notice = write_model_report(model, spec, load_csv(csv_path),
+    html_notice = write_model_report(model, resolved.spec ? &*resolved.spec : nullptr, load_csv(csv_path),
                        fmt::format("{}: {}, {}", model.name, method_name(options.formulation.method),
                                    integrator_name(options.integrator.kind)),
                        {{"steps", fmt::format("{} (rejected {})", summary.stats.steps, summary.stats.rejected_steps)},

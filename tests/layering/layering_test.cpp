@@ -68,6 +68,8 @@ const std::vector<Allowance> kGinacToRemove = {
     {"tests/gallery/", "loads model files through io/model_file.hpp"},
     {"tests/linearization/", "loads model files through io/model_file.hpp"},
     {"tests/studies/", "loads model files through io/model_file.hpp, studies/spread_masses.hpp"},
+    {"tests/report/", "loads model files through io/model_file.hpp"},
+    {"bench/dop853_bench.cpp", "loads model files through io/model_file.hpp"},
 };
 
 bool is_ginac_header(const std::string& include) {

@@ -131,7 +131,7 @@ TEST_F(CliRun, BadInputIsRefusedWithTheValueNamed) {
       {"sweep " + bike + " --param v --from 0 --to 10 --steps 0", {"--steps 0"}},
       {"sweep " + bike + " --param v --from 10 --to 0", {"--from 10 --to 0"}},
       {"sweep " + bike + " --param v --from 0 --to inf", {"inf"}},
-      {"sweep sled --param alpha --from 0 --to 1", {"built-in", "sled"}},
+      {"sweep sled --param alpha --from 0 --to 1", {"not a steady motion", "--cyclic"}},
       {"linearize " + bike + " --cyclic roll", {"--cyclic", "'roll'", "phi, delta"}},
       {"linearize " + bike + " --independent steer", {"--independent", "'steer'"}},
       {"sweep " + bike + " --param v --from 0 --to 1 --cyclic roll", {"--cyclic", "'roll'"}},

@@ -376,16 +376,20 @@ class Reader {
       case TokenKind::number:
       {
         next();
-        const std::string exact = exact_number(spelled(token));
+        const std::string literal(spelled(token));
+        const bool nonzero = literal.substr(0, literal.find_first_of("eE")).find_first_of("123456789") != std::string::npos;
+        if (!nonzero) {  // zero, whatever its exponent (0e-400 included)
+          out_ += "0";
+          return;
+        }
+        const std::string exact = exact_number(literal);
         if (exact.empty())
           site_.fail_at(token.begin, fmt::format("the number {} is out of the range of double precision", spelled(token)));
         // A literal that is not zero but rounds to a subnormal double (or to 0) would reach the
         // numeric layer as a value without precision (CLN refuses it with "floating point
         // underflow"); one that rounds to infinity is out of range.
-        const std::string literal(spelled(token));
         const double rounded = std::strtod(literal.c_str(), nullptr);
-        const bool nonzero = literal.substr(0, literal.find_first_of("eE")).find_first_of("123456789") != std::string::npos;
-        if (nonzero && std::abs(rounded) < std::numeric_limits<double>::min())
+        if (std::abs(rounded) < std::numeric_limits<double>::min())
           site_.fail_at(token.begin, fmt::format("the number {} is below the smallest normal double (2.2e-308); "
                                                  "write 0 or change the units",
                                                  spelled(token)));
