@@ -7,6 +7,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/model/builtin.hpp"
+#include "nhdyn/model/parameters.hpp"
 
 namespace nhdyn::python {
 
@@ -119,6 +120,21 @@ void bind_model(py::module_& m) {
         return std::make_shared<Model>(load_model(source, to_overrides(overrides)));
       },
       py::arg("source"), py::arg("overrides") = py::list());
+  // A copy of `model` with parameters set (numbers, or expressions in the others): no
+  // recompilation, the copy computes what a model loaded with those values computes.
+  m.def(
+      "with_parameters",
+      [](const Model& model, const py::iterable& values) {
+        auto out = std::make_shared<Model>(model);
+        for (const auto& [name, value] : to_overrides(values)) {
+          if (const double* number = std::get_if<double>(&value))
+            set_parameter(*out, name, *number);
+          else
+            set_parameter_expression(*out, name, std::get<std::string>(value));
+        }
+        return out;
+      },
+      py::arg("model"), py::arg("values"));
   m.def(
       "load_variants",
       [](const ModelSource& source, const py::iterable& overrides, const std::vector<std::string>& names,

@@ -3,7 +3,7 @@ linearize it, sweep a parameter and run batches on every core.
 
     import nhdyn
     m = nhdyn.load("examples/sled.toml")          # a model file, a built-in name, or nhdyn.loads(text)
-    m.parameters["m"] = 2.0                       # re-loads the model with the new value
+    m.parameters["m"] = 2.0                       # no recompilation
     r = m.simulate(t_end=5, rtol=1e-10)           # Result: NumPy arrays r.t, r.q, r.qd, ...
     r.to_pandas()                                 # a DataFrame with the CSV's column names
 
@@ -43,8 +43,9 @@ def loads(text, file_name="<string>", **parameters):
 
 
 class Parameters(MutableMapping):
-    """The parameters of a model file by name. Setting one re-loads the model with the new value
-    (parameters become run-time data without recompilation in a later version of the library).
+    """The parameters of a model by name. Setting one (a number, or an expression in the others such
+    as "2*m") changes the value in place, without recompiling: the model then computes what a model
+    loaded with that value computes.
     Unknown names raise nhdyn.InputError naming the nearest parameter."""
 
     def __init__(self, model):
@@ -87,7 +88,8 @@ class Model:
     def _set_parameters(self, values):
         overrides = dict(self.overrides)
         overrides.update(values)
-        cpp = _nhdyn.load(self.source, list(overrides.items()))  # raises before anything changes
+        # A copy with the values set, no recompilation; raises before anything changes.
+        cpp = _nhdyn.with_parameters(self._cpp, list(values.items()))
         self.overrides, self._cpp = overrides, cpp
 
     def copy(self):

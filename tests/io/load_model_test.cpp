@@ -10,6 +10,7 @@
 #include "nhdyn/analysis/batch.hpp"
 #include "nhdyn/analysis/run_options.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/model/parameters.hpp"
 
 namespace nhdyn {
 namespace {
@@ -99,7 +100,9 @@ TEST(LoadModel, ErrorsNameTheFileLineOrParameter) {
     EXPECT_NE(std::string(e.what()).find("'rh'"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("'rho'"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(load_model("sled", {{"a", 0.3}}), InputError);
+  EXPECT_THROW(load_model("sled", {{"aa", 0.3}}), InputError);  // built-in models take parameters, known ones
+  EXPECT_EQ(get_parameter(load_model("sled", {{"a", 0.3}}), "a"), 0.3);
+  EXPECT_EQ(get_parameter(load_model(examples + "sled.toml", {{"a", std::string("rho/2")}}), "a"), 0.35);
   EXPECT_THROW(load_model(examples + "sled.toml", {{"a", std::string("half")}}), InputError);
   EXPECT_THROW(load_model("no-such-model"), InputError);
   EXPECT_THROW(load_model(examples + "missing.toml"), FileError);

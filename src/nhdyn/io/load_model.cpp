@@ -12,6 +12,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/model_file.hpp"
 #include "nhdyn/model/builtin.hpp"
+#include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 #include "nhdyn/symbolic/derivation.hpp"
 #include "nhdyn/symbolic/equations.hpp"
@@ -24,33 +25,23 @@ bool looks_like_file(const std::string& source) {
   return source.find('/') != std::string::npos || source.ends_with(".toml") || std::filesystem::exists(source);
 }
 
-// Until parameters are run-time data (set_parameter), a string override is read as a number, the
-// way the CLI's --set has always read it.
-double override_value(const std::string& name, const ParameterValue& value) {
-  if (const double* number = std::get_if<double>(&value)) {
-    if (!std::isfinite(*number)) throw InputError(fmt::format("parameter {} = {}: not a finite number", name, *number));
-    return *number;
+// The overrides as the command line's --set NAME=EXPR writes them: a number keeps every bit
+// (17 significant digits), a string is an expression in numbers, constants and the other
+// parameters (model/parameters.hpp).
+std::vector<std::string> override_sets(const ParameterOverrides& overrides) {
+  std::vector<std::string> sets;
+  for (const auto& [name, value] : overrides) {
+    if (const double* number = std::get_if<double>(&value))
+      sets.push_back(fmt::format("{}={:.17g}", name, *number));
+    else
+      sets.push_back(fmt::format("{}={}", name, std::get<std::string>(value)));
   }
-  const std::string& text = std::get<std::string>(value);
-  char* end = nullptr;
-  errno = 0;
-  const double number = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(number))
-    throw InputError(fmt::format("parameter {} = '{}': not a finite number", name, text));
-  return number;
-}
-
-void refuse_builtin_overrides(const ModelSource& source, const ParameterOverrides& overrides) {
-  if (overrides.empty()) return;
-  const std::string file = source.builtin == "sled-paper" ? "sled_paper" : source.builtin;
-  throw InputError(fmt::format("'{}' is a built-in model written in C++, with fixed parameters (cannot set '{}'); "
-                               "load its model file instead: examples/{}.toml",
-                               source.builtin, overrides.front().first, file));
+  return sets;
 }
 
 symbolic::Spec load_spec(const ModelSource& source, const ParameterOverrides& overrides) {
   symbolic::Spec spec = load_model_string(source.text, source.file_name);
-  for (const auto& [name, value] : overrides) spec.set_parameter(name, override_value(name, value));
+  spec.apply_parameter_sets(override_sets(overrides));
   return spec;
 }
 
@@ -85,8 +76,9 @@ ModelSource model_source_from_text(std::string text, std::string file_name) {
 
 Model load_model(const ModelSource& source, const ParameterOverrides& overrides) {
   if (source.is_builtin()) {
-    refuse_builtin_overrides(source, overrides);
-    return make_builtin_model(source.builtin);
+    Model model = make_builtin_model(source.builtin);
+    apply_parameter_sets(model, override_sets(overrides));  // parameters are data: no recompilation
+    return model;
   }
   return symbolic::compile_model(load_spec(source, overrides));
 }
@@ -102,30 +94,22 @@ Model load_model_text(std::string_view text, const std::string& file_name, const
 std::vector<Model> load_model_variants(const ModelSource& source, const ParameterOverrides& overrides,
                                        const std::vector<std::string>& names,
                                        const std::vector<std::vector<double>>& values) {
+  // One load (derivation and compilation), then a copy per run with its parameters set: the
+  // parameters are data (model/parameters.hpp), so no run recompiles.
+  const Model base = load_model(source, overrides);
+  for (const std::string& name : names) find_parameter(base, name);  // throws, naming the nearest
   std::vector<Model> models;
   models.reserve(values.size());
-  if (names.empty()) {
-    const Model model = load_model(source, overrides);
-    models.assign(values.size(), model);
-    return models;
-  }
-  if (source.is_builtin()) refuse_builtin_overrides(source, {{names.front(), 0.0}});
-  symbolic::Spec spec = load_spec(source, overrides);
-  for (const std::string& name : names) {
-    bool known = false;
-    for (const symbolic::SpecParameter& p : spec.parameters) known = known || p.name == name;
-    if (!known) spec.set_parameter(name, 0.0);  // throws, naming the nearest parameter
-  }
-  const symbolic::Derivation derivation = symbolic::derive(spec);
   for (std::size_t row = 0; row < values.size(); ++row) {
     if (values[row].size() != names.size())
       throw InputError(fmt::format("run {}: {} parameter values for {} names", row, values[row].size(), names.size()));
+    Model model = base;
     for (std::size_t j = 0; j < names.size(); ++j) {
       if (!std::isfinite(values[row][j]))
         throw InputError(fmt::format("run {}: parameter {} = {} is not a finite number", row, names[j], values[row][j]));
-      spec.set_parameter(names[j], values[row][j]);
+      set_parameter(model, names[j], values[row][j]);
     }
-    models.push_back(symbolic::compile_model(spec, derivation));
+    models.push_back(std::move(model));
   }
   return models;
 }

@@ -45,16 +45,17 @@ ModelSource read_model_source(const std::string& source);
 ModelSource model_source_from_text(std::string text, std::string file_name = "<string>");
 
 // Loads and compiles. Throws ModelError ("file:line:column: ...") for anything wrong in a model
-// file, InputError for an unknown parameter (naming the nearest one) or an override of a built-in
-// model (whose parameters are fixed: use its model file in examples/).
+// file, InputError for an unknown parameter (naming the nearest one) or a value that is not one.
+// An override is a number or an expression in numbers, constants and the other parameters, as
+// `--set NAME=EXPR` on the command line; built-in models take them too.
 Model load_model(const ModelSource& source, const ParameterOverrides& overrides = {});
 Model load_model(const std::string& source, const ParameterOverrides& overrides = {});
 Model load_model_text(std::string_view text, const std::string& file_name = "<string>",
                       const ParameterOverrides& overrides = {});
 
 // One model per row of `values` (each row one value per name in `names`), with `overrides`
-// applied first; the model file is derived once and compiled per row. Used by batch runs over
-// parameters. Throws like load_model, the message naming the row.
+// applied first; the model is loaded once and each row is a copy with its parameters set (no
+// recompilation, model/parameters.hpp). Used by batch runs over parameters. Throws like load_model, the message naming the row.
 std::vector<Model> load_model_variants(const ModelSource& source, const ParameterOverrides& overrides,
                                        const std::vector<std::string>& names,
                                        const std::vector<std::vector<double>>& values);
