@@ -25,7 +25,7 @@ std::function<int()> add_codegen_command(CLI::App& app) {
   cmd->add_option("MODEL", args->model, "A model file (.toml)")->required();
   cmd->add_option("-o,--output", args->output, "Header to write")->required();
   cmd->add_option("--namespace", args->namespace_name, "C++ namespace of the generated code")->capture_default_str();
-  cmd->add_option("--set", args->sets, "Override a parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   return [args] {
     protect_model_file(args->model);
     AtomicFile file(args->output);  // refuses an unwritable path before deriving

@@ -159,7 +159,7 @@ std::function<int()> add_compare_command(CLI::App& app) {
   cmd->add_option("--rtol", args->rtol, "Relative tolerance of every case (default: the model's, else 1e-8)");
   cmd->add_option("--atol", args->atol, "Absolute tolerance of every case (default: the model's, else 1e-10)");
   cmd->add_option("--stabilize", args->stabilize, "none | baumgarte | projection")->capture_default_str();
-  cmd->add_option("--set", args->sets, "Override a model file's parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   cmd->add_option("-o,--output", args->output, "Table CSV (default results/MODEL-compare.csv); the series "
                                                 "goes next to it as ...-series.csv");
   cmd->add_option("--plot", args->plot, "PNG of the error and the residuals against time");

@@ -22,7 +22,7 @@ std::function<int()> add_equations_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("equations", "Derive and print the equations of motion of a model file");
   cmd->add_option("MODEL", args->model, "A model file (.toml)")->required();
   cmd->add_option("--format", args->format, "text | latex")->capture_default_str();
-  cmd->add_option("--set", args->sets, "Override a parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   return [args] {
     symbolic::EquationFormat format = symbolic::EquationFormat::text;
     if (args->format == "latex") format = symbolic::EquationFormat::latex;

@@ -92,7 +92,7 @@ std::function<int()> add_example_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("example", "Write a generated model file (nhdyn example lists them)");
   cmd->add_option("NAME", args->name, "The example to generate: chain");
   cmd->add_option("--bodies", args->bodies, "chain: number of bodies N (1 to 10000)")->capture_default_str();
-  cmd->add_option("--set", args->sets, "Override a parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   cmd->add_option("-o,--output", args->output, "Write the model file here instead of stdout");
   return [args] {
     if (args->name.empty()) {

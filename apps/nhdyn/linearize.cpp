@@ -96,7 +96,7 @@ std::function<int()> add_linearize_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("linearize", "Linearize about the steady motion the model starts on: state "
                                                   "matrix and eigenvalues");
   cmd->add_option("MODEL", args->model, "A model file (.toml) or a built-in model (see `nhdyn list`)")->required();
-  cmd->add_option("--set", args->sets, "Override a model file's parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   cmd->add_option("--cyclic", args->cyclic, "Coordinates to treat as cyclic besides those found, comma-separated")
       ->delimiter(',');
   cmd->add_option("--independent", args->independent, "Independent coordinates of the state, comma-separated "

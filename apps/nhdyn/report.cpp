@@ -30,7 +30,7 @@ std::function<int()> add_report_command(CLI::App& app) {
   cmd->add_option("RESULT", args->csv, "A CSV written by `nhdyn simulate`")->required();
   cmd->add_option("--model", args->model, "The model that made it: a model file (.toml) or a built-in model")
       ->required();
-  cmd->add_option("--set", args->sets, "The parameters set for the run, NAME=VALUE (repeatable)");
+  cmd->add_option("--set", args->sets, "The parameters set for the run, NAME=EXPR (repeatable)");
   cmd->add_option("-o,--output", args->output, "HTML file to write")->required();
   cmd->add_option("--max-frames", args->max_frames, "Most rows shown (longer runs are thinned for display)")
       ->capture_default_str();

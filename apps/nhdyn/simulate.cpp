@@ -237,7 +237,7 @@ std::function<int()> add_simulate_command(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
   CLI::App* cmd = app.add_subcommand("simulate", "Simulate a model and write its results as CSV");
   cmd->add_option("MODEL", args->model, "A model file (.toml) or a built-in model (see `nhdyn list`)")->required();
-  cmd->add_option("--set", args->sets, "Override a model file's parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   cmd->add_flag("--fix-initial", args->fix_initial,
                 "Move the initial state onto the constraints with the smallest inertia-weighted change");
   cmd->add_option("--stabilize", args->stabilize,

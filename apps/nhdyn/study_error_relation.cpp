@@ -185,7 +185,7 @@ std::function<int()> add_error_relation_study(CLI::App& study) {
   cmd->add_option("--atol-factor", args->atol_factor, "atol of each run = this x rtol")->capture_default_str();
   cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
   cmd->add_option("--output-step", args->output_step, "Time between compared outputs [s] (default: the model's)");
-  cmd->add_option("--set", args->sets, "Override a model file's parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   cmd->add_option("-o,--output", args->output, "Table CSV, one row per run; the by-tolerance CSV goes next to it")
       ->capture_default_str();
   cmd->add_option("--plot", args->plot, "PNG of the error against the residual, one curve per run series (log-log)");

@@ -173,7 +173,7 @@ std::function<int()> add_spread_masses_study(CLI::App& study) {
   cmd->add_option("--digits", args->digits, "Decimal digits of the reference")->capture_default_str();
   cmd->add_option("--parameter", args->parameter, "The model parameter that holds the mass ratio")
       ->capture_default_str();
-  cmd->add_option("--set", args->sets, "Override a model file's parameter, NAME=VALUE (repeatable)");
+  cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   cmd->add_option("-o,--output", args->output, "Table CSV, one row per ratio")->capture_default_str();
   cmd->add_option("--plot", args->plot,
                   "PNG of the error of q'' against the ratio (log-log); that of R goes to NAME-reactions.png");
