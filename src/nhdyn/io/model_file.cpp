@@ -30,7 +30,7 @@
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/multibody.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
-#include "nhdyn/symbolic/suggest.hpp"
+#include "nhdyn/core/suggest.hpp"
 
 namespace nhdyn {
 namespace {
@@ -352,7 +352,7 @@ class Loader {
       const std::string key(entry.key->str());
       if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
       if (&allowed != &top_level_keys) check_not_misplaced(*entry.key, context);
-      const std::string nearest = symbolic::nearest_name(key, allowed);
+      const std::string nearest = nearest_name(key, allowed);
       fail(at(*entry.key), nearest.empty()
                                ? fmt::format("unknown key '{}' {}; the keys here are: {}", key, context, join(allowed))
                                : fmt::format("unknown key '{}' {}; did you mean '{}'?", key, context, nearest));
@@ -426,7 +426,7 @@ class Loader {
   int coordinate_index(const std::string& name, const SourceLocation& where, std::string_view context) const {
     for (std::size_t i = 0; i < coordinates_.size(); ++i)
       if (coordinates_[i] == name) return static_cast<int>(i);
-    const std::string nearest = symbolic::nearest_name(name, coordinates_);
+    const std::string nearest = nearest_name(name, coordinates_);
     fail(where, fmt::format("'{}' {} is not a coordinate; {}", name, context,
                             nearest.empty() ? fmt::format("the coordinates are: {}", join(coordinates_))
                                             : fmt::format("did you mean '{}'?", nearest)));
@@ -934,7 +934,7 @@ class Loader {
   std::string one_of(const toml::node& node, std::string_view what, const std::vector<std::string>& names) const {
     const std::string name = string_of(node, what, fmt::format("\"{}\"", names.front()));
     if (std::find(names.begin(), names.end(), name) == names.end()) {
-      const std::string nearest = symbolic::nearest_name(name, names);
+      const std::string nearest = nearest_name(name, names);
       fail(at(node), fmt::format("unknown {} '{}'; {}choose one of: {}", what, name,
                                  nearest.empty() ? "" : fmt::format("did you mean '{}'? ", nearest), join(names)));
     }

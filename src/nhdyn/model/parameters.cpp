@@ -14,37 +14,16 @@
 #include <utility>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/suggest.hpp"
 
 namespace nhdyn {
 namespace {
 
-int edit_distance(std::string_view a, std::string_view b) {
-  std::vector<int> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = static_cast<int>(j);
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    int diagonal = row[0];
-    row[0] = static_cast<int>(i);
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const int above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
-
-// "; did you mean 'm'?" for the known name nearest to `name`, or "" when none is close (the
-// rule of symbolic/suggest.hpp, which this module cannot include).
+// "; did you mean 'm'?" for the known name nearest to `name`, or "" when none is close.
 std::string did_you_mean(std::string_view name, const std::vector<Parameter>& known) {
-  std::string best;
-  int best_distance = std::max(2, static_cast<int>(name.size()) / 3) + 1;
-  for (const Parameter& p : known) {
-    const int d = edit_distance(name, p.name);
-    if (d < best_distance) {
-      best_distance = d;
-      best = p.name;
-    }
-  }
+  std::vector<std::string> names;
+  for (const Parameter& p : known) names.push_back(p.name);
+  const std::string best = nearest_name(std::string(name), names);
   return best.empty() ? std::string() : fmt::format("; did you mean '{}'?", best);
 }
 

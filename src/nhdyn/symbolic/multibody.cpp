@@ -11,7 +11,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/symbolic/simplify.hpp"
-#include "nhdyn/symbolic/suggest.hpp"
+#include "nhdyn/core/suggest.hpp"
 
 namespace nhdyn::symbolic {
 namespace {

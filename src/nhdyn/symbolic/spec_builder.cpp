@@ -14,7 +14,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/symbolic/occurrence.hpp"
-#include "nhdyn/symbolic/suggest.hpp"
+#include "nhdyn/core/suggest.hpp"
 
 namespace nhdyn::symbolic {
 namespace {

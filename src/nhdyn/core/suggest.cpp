@@ -1,8 +1,8 @@
-#include "nhdyn/symbolic/suggest.hpp"
+#include "nhdyn/core/suggest.hpp"
 
 #include <algorithm>
 
-namespace nhdyn::symbolic {
+namespace nhdyn {
 
 int edit_distance(const std::string& a, const std::string& b) {
   std::vector<int> row(b.size() + 1);
@@ -32,4 +32,4 @@ std::string nearest_name(const std::string& name, const std::vector<std::string>
   return best;
 }
 
-}  // namespace nhdyn::symbolic
+}  // namespace nhdyn
