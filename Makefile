@@ -5,12 +5,13 @@
 #   make asan   the tests again under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/)
 #   make fuzz   the model-file fuzzer (needs clang-14; fuzz/run says which packages)
 #   make bench  build and run the benchmarks
+#   make python build the Python package nhdyn only, and say how to import it
 BUILD ?= build
 JOBS ?= $(shell nproc)
 MODEL ?= examples/sled.toml
 NAME ?= sled
 
-.PHONY: run test build configure deps bench asan fuzz clean
+.PHONY: run test build configure deps bench python asan fuzz clean
 
 deps:
 	@bash scripts/install-deps
@@ -30,6 +31,10 @@ run: configure
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+python: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_python
+	@echo "export PYTHONPATH=$(abspath $(BUILD))/python   # then: /usr/bin/python3 -c 'import nhdyn'"
 
 bench: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_bench
