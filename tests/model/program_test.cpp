@@ -27,7 +27,16 @@ void count() {
 }
 }  // namespace
 
+// AddressSanitizer's build: GCC says so with __SANITIZE_ADDRESS__, clang 14 through __has_feature.
 #if defined(__SANITIZE_ADDRESS__)
+#define NHDYN_ADDRESS_SANITIZER 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define NHDYN_ADDRESS_SANITIZER 1
+#endif
+#endif
+
+#if defined(NHDYN_ADDRESS_SANITIZER)
 // AddressSanitizer owns malloc: count at operator new (the release build counts malloc itself).
 // GCC 12 sees gtest's `new T` inlined next to these definitions and reports the free() as a
 // mismatched deallocation: it is not (every operator new here is malloc).
