@@ -73,7 +73,7 @@ def main():
     print("sled, t = 0..5 s, 501 outputs per run, dopri5 / RK45 at rtol 1e-8, atol 1e-10")
     start = time.perf_counter()
     models = nhdyn._batch_models(m, ["a"], values[:, None], args.runs)
-    print("nhdyn: {} models compiled in {:.2f} s (once per parameter value until parameters are run-time data)".format(
+    print("nhdyn: {} models made in {:.2f} s (one load, then a copy per parameter value with the value set)".format(
         args.runs, time.perf_counter() - start))
     results = {}
     for threads in (1, 2):
