@@ -427,5 +427,38 @@ TEST(Simplify, ValueDoesNotDependOnSymbolCreationOrder) {
   EXPECT_EQ(simplify(e1 - moved), 0);
 }
 
+// A kinetic energy written as a parameter times one long sum (m/2 * (x0'^2 + ... + x19'^2) + ...)
+// is split into its terms before differentiation (derivation.cpp, terms_of): the terms must come
+// out as the hand-derived ones, A = diag(m) with the coupling k between neighbours, G = 0 and
+// Q = -dV/dq for V = m g/2 * (x0 + ... + x19)^2 (whose sum is a power, not a factor, and stays).
+TEST(Derivation, AParameterTimesALongSumIsSplitIntoItsTerms) {
+  constexpr int n = 20;
+  SpecBuilder b("long_sum");
+  std::string velocities, positions;
+  for (int i = 0; i < n; ++i) {
+    b.coordinate("x" + std::to_string(i));
+    velocities += (i ? " + " : "") + ("x" + std::to_string(i) + "'^2");
+    positions += (i ? " + " : "") + ("x" + std::to_string(i));
+  }
+  b.parameter("m", 1.5).parameter("k", 0.25).parameter("g", 9.81);
+  b.kinetic_energy("m/2 * (" + velocities + ") + k * x0' * x1'");
+  b.potential_energy("m*g/2 * (" + positions + ")^2");
+  const Spec spec = b.build();
+  const Derivation d = derive(spec);
+  const SymbolTable& S = spec.symbols;
+  const ex m = S.parameter("m"), k = S.parameter("k"), g = S.parameter("g");
+  ex sum = 0;
+  for (int i = 0; i < n; ++i) sum += S.coordinate(i);
+  GiNaC::matrix A(n, n), Q(n, 1);
+  for (int i = 0; i < n; ++i) {
+    A(i, i) = m;
+    Q(i, 0) = -m * g * sum;
+  }
+  A(0, 1) = A(1, 0) = k;
+  expect_zero(d.A.sub(A), "A");
+  expect_zero(d.G, "G");
+  expect_zero(d.Q.sub(Q), "Q");
+}
+
 }  // namespace
 }  // namespace nhdyn::symbolic

@@ -44,13 +44,40 @@ GiNaC::ex convective_derivative(const GiNaC::ex& e, const SymbolTable& symbols, 
 }
 
 // The terms of a sum (or the expression itself): each is differentiated only by what it contains.
+// A product with one long sum among its factors, as a user writes T = m/2 * (x1'^2 + ... + xN'^2),
+// is distributed first: left whole, it would be one term containing every velocity, and each of
+// the n derivatives would walk all of it (n^2). Short sums (under kDistributeFrom terms) stay as
+// written, so small models derive exactly as before.
+constexpr std::size_t kDistributeFrom = 16;
+
+void append_terms(const GiNaC::ex& e, std::vector<GiNaC::ex>& out) {
+  if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
+    for (std::size_t i = 0; i < e.nops(); ++i) append_terms(e.op(i), out);
+    return;
+  }
+  if (GiNaC::is_exactly_a<GiNaC::mul>(e)) {
+    int sum_factor = -1;
+    int sums = 0;
+    for (std::size_t i = 0; i < e.nops(); ++i)
+      if (GiNaC::is_exactly_a<GiNaC::add>(e.op(i))) {
+        ++sums;
+        sum_factor = static_cast<int>(i);
+      }
+    if (sums == 1 && e.op(static_cast<std::size_t>(sum_factor)).nops() >= kDistributeFrom) {
+      GiNaC::ex rest = 1;
+      for (std::size_t i = 0; i < e.nops(); ++i)
+        if (static_cast<int>(i) != sum_factor) rest *= e.op(i);
+      const GiNaC::ex sum = e.op(static_cast<std::size_t>(sum_factor));
+      for (std::size_t i = 0; i < sum.nops(); ++i) append_terms(rest * sum.op(i), out);
+      return;
+    }
+  }
+  if (!e.is_zero()) out.push_back(e);
+}
+
 std::vector<GiNaC::ex> terms_of(const GiNaC::ex& e) {
   std::vector<GiNaC::ex> out;
-  if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
-    for (std::size_t i = 0; i < e.nops(); ++i) out.push_back(e.op(i));
-  } else if (!e.is_zero()) {
-    out.push_back(e);
-  }
+  append_terms(e, out);
   return out;
 }
 
