@@ -32,7 +32,7 @@ inline void add_coordinate(symbolic::Spec& spec, const std::string& name) {
 }
 
 // The sled with the centre-of-mass potential and the regular blade constraint
-// -sin(phi) x' + cos(phi) y' = 0 (FORMULATION.md section 6; docs/derivations/sled.md 1-5).
+// -sin(phi) x' + cos(phi) y' = 0 (docs/notation.md section 6; docs/derivations/sled.md 1-5).
 inline HandBuilt make_hand_built_sled(const SledParameters& p = {}) {
   using GiNaC::ex;
   HandBuilt out;

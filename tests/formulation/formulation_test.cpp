@@ -86,7 +86,7 @@ TEST(SledFormulations, PaperVariantSatisfiesThePapersReducedEquations) {
         if ((method == Method::lagrange || method == Method::udwadia_kalaba) && c != Complement::qr) continue;
         const Solution sol = solve(model, data, {method, c}, q, v);
         const Vector& a_ = sol.qdd;
-        // FORMULATION.md section 6: the paper's equations with the paper's potential.
+        // docs/notation.md section 6: the paper's equations with the paper's potential.
         const double eq1 = m * a_(0) + m * std::tan(phi) * a_(1) - (m * p.g * std::sin(p.alpha) + m * a * w * w / std::cos(phi));
         const double eq2 = -m * a * std::sin(phi) * a_(0) + m * a * std::cos(phi) * a_(1) + m * p.rho * p.rho * a_(2);
         // The constraint y' = tan(phi) x' differentiated once.

@@ -86,7 +86,7 @@ void expect_valid_latex(const std::string& latex) {
 
 TEST(Equations, SledPaperTextShowsThePapersEquations) {
   const std::string text = show(sled_paper(true), EquationFormat::text);
-  // The paper's pair (FORMULATION.md section 6) and the constraint at acceleration level.
+  // The paper's pair (docs/notation.md section 6) and the constraint at acceleration level.
   EXPECT_TRUE(contains(text, "m x'' + m tan(phi) y'' = m a phi'^2/cos(phi) + m g sin(alpha)\n")) << text;
   EXPECT_TRUE(contains(text, "-m a sin(phi) x'' + m a cos(phi) y'' + m rho^2 phi'' = 0\n")) << text;
   EXPECT_TRUE(contains(text, "-tan(phi) x'' + y'' - x' phi'/cos(phi)^2 = 0   (blade)")) << text;

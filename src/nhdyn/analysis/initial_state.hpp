@@ -6,7 +6,7 @@
 // each by Newton's method on the constraint with the minimum-A-norm step
 //     d = -A^-1 J^T (J A^-1 J^T)^-1 r,
 // J the rows of b belonging to those constraints (b = dphi/dq for a position constraint and
-// df/dq' for a velocity one, FORMULATION.md §2). The same projection (projection.hpp) keeps a
+// df/dq' for a velocity one, docs/notation.md §2). The same projection (projection.hpp) keeps a
 // solution on the constraints with --stabilize projection.
 #pragma once
 

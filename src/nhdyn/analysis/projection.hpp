@@ -7,7 +7,7 @@
 //     [ A  J^T ] [ d  ]   [  0 ]
 //     [ J   0  ] [ mu ] = [ -r ]
 // with J the rows of b that belong to the constraints of that level (b = dphi/dq for a position
-// constraint, df/dq' for a position or velocity one, FORMULATION.md §2), so no inverse of A is
+// constraint, df/dq' for a position or velocity one, docs/notation.md §2), so no inverse of A is
 // formed. A row of b need only be parallel to its constraint's gradient (a model may scale it, as
 // the paper does Appell's); the factor is estimated at every Newton step by a forward difference
 // of the residual along the step, which is then solved again with it.

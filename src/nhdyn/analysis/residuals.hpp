@@ -1,7 +1,7 @@
 // The constraint residuals along a solution at the three levels, and the energy. In the Do Sanh
 // form the acceleration-level residual e = b q'' + b0 is round-off by construction; what the
 // solution violates at velocity and position level comes from the integration error alone and
-// measures it (FORMULATION.md §4, (2.14)).
+// measures it (docs/notation.md §4, (2.14)).
 #pragma once
 
 #include "nhdyn/model/data.hpp"

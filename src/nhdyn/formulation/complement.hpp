@@ -1,5 +1,5 @@
 // The complement D of the constraint matrix b: a k x n matrix of rank k with D b^T = 0 (2.8),
-// whose rows span the admissible directions of acceleration. Three choices (FORMULATION.md §3):
+// whose rows span the admissible directions of acceleration. Three choices (docs/notation.md §3):
 // the model's analytic D, coordinate partitioning, and an orthonormal basis of null(b) from a
 // column-pivoted QR factorization of b^T (the default: well conditioned whatever the coordinates).
 #pragma once

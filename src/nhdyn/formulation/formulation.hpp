@@ -1,7 +1,7 @@
 // The four formulations of the equations of motion behind one entry point, chosen at run time:
 // sanh (the stacked Do Sanh system, the default), lagrange (KKT), udwadia-kalaba and nullspace
 // (Maggi). Each fills q'' and the reactions R in Data (and the multipliers where they exist).
-// FORMULATION.md sections 3 and 5.
+// docs/notation.md sections 3 and 5.
 #pragma once
 
 #include <string_view>
@@ -16,7 +16,7 @@ namespace nhdyn {
 // enum class Method { sanh, lagrange, udwadia_kalaba, nullspace } is declared in model/data.hpp,
 // because make_data sizes the workspace of one formulation.
 
-// Where D comes from (FORMULATION.md section 3): the model's analytic D, coordinate
+// Where D comes from (docs/notation.md section 3): the model's analytic D, coordinate
 // partitioning, or an orthonormal basis of null(b) from a QR factorization (the default).
 enum class Complement { qr, partition, analytic };
 

@@ -1,4 +1,4 @@
-// Lagrange multipliers (FORMULATION.md §5): the (n + s) x (n + s) KKT system
+// Lagrange multipliers (docs/notation.md §5): the (n + s) x (n + s) KKT system
 //     [ A  b^T ] [ q''     ]   [ Q + G ]
 //     [ b  0   ] [ -lambda ] = [ -b0   ],      R = b^T lambda,
 // solved by one LU factorization with partial pivoting (the matrix is symmetric indefinite).

@@ -1,4 +1,4 @@
-// The null-space (Maggi / Kane) formulation (FORMULATION.md §5): q'' = p + D^T w, where p is the
+// The null-space (Maggi / Kane) formulation (docs/notation.md §5): q'' = p + D^T w, where p is the
 // minimum-norm solution of b p = -b0 and (D A D^T) w = D (Q + G - A p) is the k x k reduced
 // system, solved by Cholesky. R = A q'' - Q - G.
 #pragma once

@@ -1,4 +1,4 @@
-// The Do Sanh form (FORMULATION.md §3, (2.16), (2.5)): the n x n stacked system
+// The Do Sanh form (docs/notation.md §3, (2.16), (2.5)): the n x n stacked system
 //     [ D A ] q'' = [ D (Q + G) ]
 //     [  b  ]       [   -b0     ]
 // solved by one LU factorization; no inverse of A and no multipliers. R = A q'' - Q - G (2.15).

@@ -1,4 +1,4 @@
-// Udwadia-Kalaba (FORMULATION.md §5): the unconstrained acceleration a = A^-1 (Q + G) corrected by
+// Udwadia-Kalaba (docs/notation.md §5): the unconstrained acceleration a = A^-1 (Q + G) corrected by
 //     q'' = a + A^(-1/2) (b A^(-1/2))^+ (-b0 - b a),
 // with the square root of A^-1 taken from the Cholesky factor of A and the Moore-Penrose inverse
 // of the full-row-rank b A^(-1/2) from a column-pivoted QR factorization. It inverts A, which is what the Do Sanh form avoids; kept for comparison.

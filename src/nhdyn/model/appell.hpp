@@ -1,4 +1,4 @@
-// Appell's particle (FORMULATION.md section 6): a particle whose speed of fall is tied to its
+// Appell's particle (docs/notation.md section 6): a particle whose speed of fall is tied to its
 // horizontal speed by the nonlinear nonholonomic constraint z'^2 = a^2 (x'^2 + y'^2); z points
 // down. Hand-written from the paper, with the paper's acceleration-level constraint and analytic D.
 // The closed-form solution it is tested against is derived in docs/derivations/appell.md.

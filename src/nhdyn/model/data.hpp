@@ -69,7 +69,7 @@ struct Data {
   Vector v;             // n velocities q'
   Stage stage = Stage::empty;
 
-  // --- terms of the equations (compute_terms, FORMULATION.md (2.4), (2.5)) -----------------------
+  // --- terms of the equations (compute_terms, docs/notation.md (2.4), (2.5)) -----------------------
   Matrix A;             // n x n inertia matrix (dense path; 0 x 0 on the sparse path)
   Vector Q;             // n generalized forces
   Vector G;             // n velocity terms

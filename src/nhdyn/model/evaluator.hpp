@@ -17,9 +17,9 @@ namespace nhdyn {
 // Where an Evaluator writes the terms. All matrices are column-major and contiguous, with a
 // leading dimension equal to their number of rows (the layout of Eigen::MatrixXd).
 struct TermsOut {
-  double* A;   // n x n inertia matrix, d2T/dq'2 (FORMULATION.md (2.4))
+  double* A;   // n x n inertia matrix, d2T/dq'2 (docs/notation.md (2.4))
   double* Q;   // n generalized forces, -dV/dq + nonconservative forces
-  double* G;   // n velocity terms of the kinetic energy (FORMULATION.md section 1)
+  double* G;   // n velocity terms of the kinetic energy (docs/notation.md section 1)
   double* b;   // s x n constraint matrix at acceleration level, b q'' + b0 = 0 (2.5)
   double* b0;  // s
 };

@@ -18,7 +18,7 @@
 
 namespace nhdyn {
 
-// The level at which a constraint is given (FORMULATION.md section 2).
+// The level at which a constraint is given (docs/notation.md section 2).
 enum class ConstraintLevel { position, velocity, acceleration };
 
 struct Constraint {

@@ -1,4 +1,4 @@
-// The sled (knife edge) on an inclined plane (Neimark-Fufaev; FORMULATION.md section 6).
+// The sled (knife edge) on an inclined plane (Neimark-Fufaev; docs/notation.md section 6).
 // q = (x, y, phi): contact point and heading; the centre of mass sits at distance a ahead of the
 // contact point. Two variants:
 //  - `sled`: centre-of-mass potential Pi = -m g sin(alpha) (x + a cos phi) and the constraint in

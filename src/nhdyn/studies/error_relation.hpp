@@ -1,4 +1,4 @@
-// The error relation (FORMULATION.md section 4, docs/studies/error-relation.md): does the residual
+// The error relation (docs/notation.md section 4, docs/studies/error-relation.md): does the residual
 // of the velocity and position constraints along a numerical solution measure that solution's
 // global error? For a list of tolerances, every formulation and integrator runs the model and is
 // measured against the model's exact solution (Evaluator::solution); the study reports, per run,
@@ -45,7 +45,7 @@ struct ErrorRelationRun {
   double max_error_q = 0.0;  // max over outputs of max_i |q_i - q_exact,i|
   double max_error_v = 0.0;  // ... of the velocities
   double max_residual_pos = 0.0;  // max over outputs of max |phi| (0 without position constraints)
-  double max_residual_vel = 0.0;  // max over outputs of max |f| (velocity level, FORMULATION.md (2.14))
+  double max_residual_vel = 0.0;  // max over outputs of max |f| (velocity level, docs/notation.md (2.14))
 };
 
 struct ErrorRelation {

@@ -265,7 +265,7 @@ Derivation derive(const Spec& spec) {
   require_at_most_quadratic(spec, model);
 
   Derivation d;
-  // A = d2T/dq'2 (FORMULATION.md (2.4)); T must be quadratic in q' so that A does not depend on q'.
+  // A = d2T/dq'2 (docs/notation.md (2.4)); T must be quadratic in q' so that A does not depend on q'.
   // Only the pairs of velocities that occur in a common term of T can give a nonzero entry.
   d.A = GiNaC::matrix(un, un);
   std::vector<GiNaC::ex> Tv(un);
@@ -294,7 +294,7 @@ Derivation derive(const Spec& spec) {
   }
   if (!moving) throw ModelError(model + "the kinetic energy T does not depend on the velocities");
 
-  // G = dT/dq - (d2T/dq'dq) q' - d2T/dq'dt and Q = -dV/dq + forces (FORMULATION.md section 1).
+  // G = dT/dq - (d2T/dq'dq) q' - d2T/dq'dt and Q = -dV/dq + forces (docs/notation.md section 1).
   d.G = GiNaC::matrix(un, 1);
   d.Q = GiNaC::matrix(un, 1);
   for (int i = 0; i < n; ++i) {
@@ -307,7 +307,7 @@ Derivation derive(const Spec& spec) {
     d.Q(ui, 0) = tidy(-Vs.diff(Vs.with_q, i, q(i)) + force);
   }
 
-  // Every constraint at acceleration level, b q'' + b0 = 0 (FORMULATION.md (2.5)).
+  // Every constraint at acceleration level, b q'' + b0 = 0 (docs/notation.md (2.5)).
   d.b = GiNaC::matrix(us, un);
   d.b0 = GiNaC::matrix(us, 1);
   for (unsigned r = 0; r < us; ++r) {

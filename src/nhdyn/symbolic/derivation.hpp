@@ -1,4 +1,4 @@
-// The derivation of the equations of motion from a Spec (FORMULATION.md sections 1-3), with
+// The derivation of the equations of motion from a Spec (docs/notation.md sections 1-3), with
 // GiNaC: A = d2T/dq'2, G = dT/dq - (d2T/dq'dq) q' - d2T/dq'dt, Q = -dV/dq + forces, and every
 // constraint at acceleration level b q'' + b0 = 0 (position level differentiated twice, velocity
 // level once, explicit time dependence included). D is the user's analytic one, or the
@@ -31,12 +31,12 @@ struct Derivation {
 Derivation derive(const Spec& spec);
 
 // The partitioned complement D = [I_k, (-b_d^-1 b_i)^T] in the original coordinate order
-// (FORMULATION.md section 3, choice 2): rows in the order of `independent` (k indices into q,
+// (docs/notation.md section 3, choice 2): rows in the order of `independent` (k indices into q,
 // ascending), the other s columns dependent. std::nullopt when the s x s block b_d of the dependent
 // columns is singular (its determinant simplifies to 0). Entries simplified (simplify.hpp).
 std::optional<GiNaC::matrix> partitioned_complement(const GiNaC::matrix& b, const std::vector<int>& independent);
 
-// A0 = D A and C = D (Q + G) (FORMULATION.md (2.17)); requires derivation.D.
+// A0 = D A and C = D (Q + G) (docs/notation.md (2.17)); requires derivation.D.
 GiNaC::matrix reduced_inertia(const Derivation& derivation);
 GiNaC::matrix reduced_forces(const Derivation& derivation);
 

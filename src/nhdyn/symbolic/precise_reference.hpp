@@ -1,7 +1,7 @@
 // A high-precision reference for one evaluation of the equations of motion: given a Spec, its
 // Derivation and a state (t, q, q'), the terms A, Q, G, b, b0 are evaluated with GiNaC at a chosen
 // number of decimal digits (50 by default) and the accelerations q'', the multipliers and the
-// reactions R = A q'' - Q - G (FORMULATION.md (2.15)) are solved for at that precision. The
+// reactions R = A q'' - Q - G (docs/notation.md (2.15)) are solved for at that precision. The
 // studies (studies/spread_masses.hpp, docs/studies/spread-masses.md) measure the double-precision
 // formulations against it.
 //
@@ -40,7 +40,7 @@ struct PreciseAcceleration {
 
 // q'' and R at (t, q, v) (q, v of size n) from the Lagrange-multiplier system
 //     [ A  b^T ] [ q''     ]   [ Q + G ]
-//     [ b  0   ] [ -lambda ] = [ -b0   ]          (FORMULATION.md section 5)
+//     [ b  0   ] [ -lambda ] = [ -b0   ]          (docs/notation.md section 5)
 // which has the same unique solution as every other formulation in exact arithmetic; solved by
 // Gaussian elimination with partial pivoting on `digits`-digit floats, twice (at `digits` and at
 // digits + 20, for estimated_error). GiNaC::Digits is restored on return. The parameters take
