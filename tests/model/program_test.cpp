@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/address_sanitizer.hpp"
+
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
@@ -26,15 +28,6 @@ void count() {
   if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
 }
 }  // namespace
-
-// AddressSanitizer's build: GCC says so with __SANITIZE_ADDRESS__, clang 14 through __has_feature.
-#if defined(__SANITIZE_ADDRESS__)
-#define NHDYN_ADDRESS_SANITIZER 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define NHDYN_ADDRESS_SANITIZER 1
-#endif
-#endif
 
 #if defined(NHDYN_ADDRESS_SANITIZER)
 // AddressSanitizer owns malloc: count at operator new (the release build counts malloc itself).
