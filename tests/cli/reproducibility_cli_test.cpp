@@ -2,9 +2,10 @@
 // processes on the same model and options, with address-space layout randomisation as the system
 // has it (on by default: each process then loads GiNaC, whose hashes of sums and products derive
 // from an address, somewhere else), and the files it writes must agree byte for byte.
-// docs/design.md ("Reproducibility") says what orders by address. The DISABLED_ tests still fail
-// (issue 12, item 6 is open): the bicycle's results and code, the double pendulum's code; run them
-// with --gtest_also_run_disabled_tests to see where the runs part.
+// docs/design.md ("Reproducibility") says what ordered by address and how the compiler's
+// canonical form removes it. The bicycle (terms left as derived, GiNaC's signs and term order
+// visible to the compiler) and the double pendulum's generated code are the cases that parted
+// before it.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -93,11 +94,11 @@ TEST_F(Reproducible, AslrIsOnForTheseTests) {
   SUCCEED();
 }
 
-TEST_F(Reproducible, DISABLED_BicycleSimulation) {
+TEST_F(Reproducible, BicycleSimulation) {
   expect_same_bytes({"simulate", example("whipple_bicycle.toml"), "--t-end", "3", "-q"}, "csv");
 }
 
-TEST_F(Reproducible, DISABLED_BicycleSimulationWithDop853) {
+TEST_F(Reproducible, BicycleSimulationWithDop853) {
   expect_same_bytes({"simulate", example("whipple_bicycle.toml"), "--t-end", "3", "--integrator",
                      "dop853", "--rtol", "1e-12", "--atol", "1e-14", "-q"},
                     "csv");
@@ -128,17 +129,17 @@ TEST_F(Reproducible, GeneratedCode) {
   }
 }
 
-// Its CSV agrees (a negated difference under an even or odd function gives the same bits), but the
-// code says q[2] - q[0] in some processes and q[0] - q[2] in others.
-TEST_F(Reproducible, DISABLED_DoublePendulumGeneratedCode) {
+// GiNaC holds q[2] - q[0] in some processes and q[0] - q[2] in others (under cos and sin); the
+// code must say the same in all.
+TEST_F(Reproducible, DoublePendulumGeneratedCode) {
   expect_same_bytes({"codegen", example("double_pendulum.toml")}, "hpp");
 }
 
-TEST_F(Reproducible, DISABLED_BicycleGeneratedCode) {
+TEST_F(Reproducible, BicycleGeneratedCode) {
   expect_same_bytes({"codegen", example("whipple_bicycle.toml")}, "hpp");
 }
 
-TEST_F(Reproducible, DISABLED_BicycleLinearization) {
+TEST_F(Reproducible, BicycleLinearization) {
   expect_same_bytes({"linearize", example("whipple_bicycle.toml"), "--cyclic", "thetaR,thetaF"},
                     "csv");
 }
