@@ -128,6 +128,27 @@ TEST_F(Reproducible, BicycleSimulationCompiledAsInterpreted) {
   EXPECT_EQ(read(dir_ / "interpreted.csv"), read(dir_ / "run0.csv"));
 }
 
+// A batch compiles once and rebinds the object to each run's parameters: the runs agree with the
+// interpreter's to the byte.
+TEST_F(Reproducible, BatchCompiledAsInterpreted) {
+  ::setenv("XDG_CACHE_HOME", (dir_ / "cache").c_str(), 1);
+  const std::vector<std::string> args{"batch", example("double_pendulum.toml"), "--grid", "m2=0.5:1.5:3", "--grid",
+                                      "l2=0.4:0.9:2", "--t-end", "2", "--threads", "2", "-q"};
+  std::vector<std::string> compiled = args;
+  compiled.insert(compiled.end(), {"--evaluator", "compiled", "-o", "compiled"});
+  const int status = nhdyn(compiled);
+  const std::string err = read(dir_ / "err.txt");
+  ::unsetenv("XDG_CACHE_HOME");
+  if (status != 0 && err.find("cannot be run") != std::string::npos) GTEST_SKIP() << "no C++ compiler: " << err;
+  ASSERT_EQ(status, 0) << err;
+  std::vector<std::string> interpreted = args;
+  interpreted.insert(interpreted.end(), {"-o", "interpreted"});
+  ASSERT_EQ(nhdyn(interpreted), 0) << read(dir_ / "err.txt");
+  const std::string summary = read(dir_ / "interpreted" / "summary.csv");
+  EXPECT_FALSE(summary.empty());
+  EXPECT_EQ(read(dir_ / "compiled" / "summary.csv"), summary);
+}
+
 TEST_F(Reproducible, RollingDiskFromBodies) {
   expect_same_bytes({"simulate", example("rolling_disk_bodies.toml"), "--t-end", "3", "-q"}, "csv");
 }
