@@ -20,6 +20,7 @@
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/load_model.hpp"
 #include "nhdyn/io/results.hpp"
+#include "nhdyn/jit/compiled_evaluator.hpp"
 
 namespace nhdyn::cli {
 namespace {
@@ -35,6 +36,7 @@ struct BatchArgs {
   std::optional<double> t_end, output_step, rtol, atol;
   std::optional<std::string> method, complement, integrator;
   bool quiet = false;
+  std::string evaluator = "interpreted";  // interpreted | compiled | auto (jit/compiled_evaluator.hpp)
 };
 
 // What a column of the batch sets: a parameter, or the initial coordinate / velocity `index`.
@@ -194,7 +196,17 @@ int run_batch(const BatchArgs& args) {
     // otherwise every run shares the base model.
     std::vector<Model> models;
     if (!parameter_names.empty()) models = load_model_variants(source, overrides, parameter_names, parameter_values);
-    std::shared_ptr<const Model> shared = parameter_names.empty() ? std::make_shared<const Model>(base) : nullptr;
+    // The compiled evaluator is made once; each variant rebinds it to its parameter values.
+    std::string notice;
+    const Model chosen = jit::with_evaluator(base, jit::parse_evaluator_choice(args.evaluator), &notice);
+    if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
+    if (jit::is_compiled(chosen))
+      for (Model& m : models) {
+        std::vector<double> values;
+        for (const Parameter& p : m.parameters) values.push_back(p.value);
+        m.evaluator = chosen.evaluator->with_parameters(values.data(), values.size());
+      }
+    std::shared_ptr<const Model> shared = parameter_names.empty() ? std::make_shared<const Model>(chosen) : nullptr;
     for (std::size_t r = 0; r < table.size(); ++r) {
       runs[r].model = shared ? shared : std::make_shared<const Model>(std::move(models[r]));
       for (std::size_t j = 0; j < names.size(); ++j) {
@@ -277,6 +289,7 @@ std::function<int()> add_batch_command(CLI::App& app) {
   cmd->add_option("--runs", args->runs_csv, "A CSV file: a header of NAMEs, one row of values per run");
   cmd->add_option("--set", args->sets, "Override a model file's parameter for every run, NAME=VALUE (repeatable)");
   cmd->add_option("--threads", args->threads, "Threads (default 0: every core)");
+  cmd->add_option("--evaluator", args->evaluator, "interpreted (default) | compiled | auto, as for simulate");
   cmd->add_option("-o,--output", args->output, "Directory for summary.csv (and run_*.csv)")->capture_default_str();
   cmd->add_flag("--write-runs", args->write_runs, "Also write every run's results as run_NNN.csv");
   cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");

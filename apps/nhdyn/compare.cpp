@@ -18,6 +18,7 @@
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
+#include "nhdyn/jit/compiled_evaluator.hpp"
 
 namespace nhdyn::cli {
 namespace {
@@ -37,6 +38,7 @@ struct CompareArgs {
   std::string output;
   std::string plot;
   bool quiet = false;
+  std::string evaluator = "interpreted";  // interpreted | compiled | auto (jit/compiled_evaluator.hpp)
 };
 
 std::string case_name(const ComparisonCase& c) {
@@ -46,7 +48,9 @@ std::string case_name(const ComparisonCase& c) {
 int run_compare(const CompareArgs& args) {
   protect_model_file(args.model);
   const ResolvedModel resolved = resolve_model(args.model, args.sets);
-  const Model& model = resolved.model;
+  std::string notice;
+  const Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
+  if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
   if (args.reference != "tight" && args.reference != "analytic")
     throw InputError(fmt::format("unknown reference '{}'; choose one of: tight, analytic", args.reference));
 
@@ -160,6 +164,7 @@ std::function<int()> add_compare_command(CLI::App& app) {
   cmd->add_option("--atol", args->atol, "Absolute tolerance of every case (default: the model's, else 1e-10)");
   cmd->add_option("--stabilize", args->stabilize, "none | baumgarte | projection")->capture_default_str();
   cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
+  cmd->add_option("--evaluator", args->evaluator, "interpreted (default) | compiled | auto, as for simulate");
   cmd->add_option("-o,--output", args->output, "Table CSV (default results/MODEL-compare.csv); the series "
                                                 "goes next to it as ...-series.csv");
   cmd->add_option("--plot", args->plot, "PNG of the error and the residuals against time");

@@ -20,6 +20,7 @@
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/io/report.hpp"
 #include "nhdyn/io/results.hpp"
+#include "nhdyn/jit/compiled_evaluator.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 #include "progress.hpp"
 
@@ -46,6 +47,7 @@ struct SimulateArgs {
   std::string plot;
   std::string html;  // the HTML report (io/report.hpp), written from the CSV after the run
   bool quiet = false;
+  std::string evaluator = "interpreted";  // interpreted | compiled | auto (jit/compiled_evaluator.hpp)
 };
 
 std::string format_residual(double value, bool defined) { return defined ? fmt::format("{:.3g}", value) : "-"; }
@@ -91,7 +93,9 @@ class ConstraintWatch {
 int run_simulate(const SimulateArgs& args) {
   protect_model_file(args.model);
   const ResolvedModel resolved = resolve_model(args.model, args.sets);
-  const Model& model = resolved.model;
+  std::string notice;
+  const Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
+  if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
   // The model's run options (its file's [simulation], else the defaults of RunOptions), then
   // what the command line overrides.
   RunOptions run = model.defaults;
@@ -238,6 +242,8 @@ std::function<int()> add_simulate_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("simulate", "Simulate a model and write its results as CSV");
   cmd->add_option("MODEL", args->model, "A model file (.toml) or a built-in model (see `nhdyn list`)")->required();
   cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
+  cmd->add_option("--evaluator", args->evaluator,
+                  "interpreted (default) | compiled (the terms as machine code, cached; docs/cli.md) | auto");
   cmd->add_flag("--fix-initial", args->fix_initial,
                 "Move the initial state onto the constraints with the smallest inertia-weighted change");
   cmd->add_option("--stabilize", args->stabilize,

@@ -4,12 +4,13 @@
 // the Model's current values (so a parameter changes without recompiling). The constants (pi) are
 // made numeric, and in a product the factors that depend on parameters only are gathered into one
 // subexpression, which the evaluator computes once per parameter change (its parameter stage)
-// instead of at every call. The expression DAG is then walked from the outputs, every
-// subexpression memoized by structural equality, so that a subexpression shared by several terms
-// (sin(phi) in A, G, b, b0) is computed once. The walk never depends on GiNaC's internal term
-// order, which follows symbol serial numbers and addresses: the operands of sums and products are
-// sorted by a structural hash of our own (canonical_key), so the program — and the generated code
-// printed from it — is the same in every process.
+// instead of at every call. Each expression is first translated into a canonical form of our own
+// (below: sorted operands, sums of canonical sign, every distinct subexpression one node), which
+// does not depend on GiNaC's internal term order or sign choices (they follow addresses, which
+// change from process to process); the program is emitted from that form, every subexpression
+// once, so that a subexpression shared by several terms (sin(phi) in A, G, b, b0) is computed
+// once, and the program — its rounding, and the generated code printed from it — is the same in
+// every process (docs/design.md, "Reproducibility").
 #include "nhdyn/symbolic/compile.hpp"
 
 #include <fmt/format.h>
@@ -18,6 +19,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <deque>
 #include <limits>
 #include <map>
 #include <memory>
@@ -70,28 +72,69 @@ std::uint64_t hash_double(double x) {
 
 double numeric_value(const GiNaC::numeric& x) { return x.to_double(); }
 
-// Splits a term of a sum into (rest, coefficient): 3.5*x*y -> (x*y, 3.5), x -> (x, 1).
-std::pair<GiNaC::ex, double> split_coefficient(const GiNaC::ex& term) {
-  if (GiNaC::is_exactly_a<GiNaC::mul>(term)) {
-    const std::size_t n = term.nops();
-    const GiNaC::ex last = term.op(n - 1);
-    if (GiNaC::is_exactly_a<GiNaC::numeric>(last) && GiNaC::ex_to<GiNaC::numeric>(last).is_real()) {
-      GiNaC::exvector factors;
-      factors.reserve(n - 1);
-      for (std::size_t i = 0; i + 1 < n; ++i) factors.push_back(term.op(i));
-      return {GiNaC::mul(factors), numeric_value(GiNaC::ex_to<GiNaC::numeric>(last))};
-    }
+// The canonical form the compiler emits from: a DAG of our own in which every node is unique
+// (hash-consed), the operands of every sum and product are sorted by a structural key of names,
+// values and shape, and every sum has the sign of its first term in that order positive. GiNaC's
+// own form depends on the process: its hashes (and so its term order) derive from addresses, and
+// it makes a sum that is a factor or a base "unit normal" with respect to a term it picks by that
+// order, so one process holds (y' + a)^2 and another (-y' - a)^2, or -x (b - a) for x (a - b).
+// Translated here, both become the same node times the same coefficient: the -1 of a sum moves
+// into the product, power or function that uses it (through an integer power by its parity,
+// through an odd function such as sin out of it, into an even one such as cos not at all), and
+// negation is exact, so the programs — and their rounding — are the same in every process.
+
+// c * node: a node times a coefficient (kOne for a plain number c).
+struct Scaled {
+  double c = 1.0;
+  int id = 0;
+};
+
+enum class Kind : std::uint8_t { one, symbol, add, mul, power, function };
+
+struct Node {
+  Kind kind = Kind::one;
+  std::uint64_t key = 0;          // structural: names, values and shape only
+  bool parameters_only = true;    // depends on parameters and numbers only (not t, q, q')
+  int input = -1;                 // symbol: its input register (t, q, q'), -1 for a parameter
+  int parameter = -1;             // symbol: the parameter's index, -1 for an input
+  Op op = Op::constant;           // function: its instruction
+  std::string name;               // symbol or function
+  std::vector<Scaled> items;      // add: terms, sorted; mul: factors (c = 1), sorted; power: base
+                                  // [, exponent]; function: arguments
+  double offset = 0.0;            // add: its number term
+  double exponent = 0.0;          // power with a number exponent (items has the base only)
+};
+
+constexpr int kOne = 0;
+
+bool same_bits(double x, double y) { return hash_double(x) == hash_double(y); }
+
+// The value of a unary function at a number (a function of a constant folds at compile time).
+double apply(Op op, double x) {
+  switch (op) {
+    case Op::sin: return std::sin(x);
+    case Op::cos: return std::cos(x);
+    case Op::tan: return std::tan(x);
+    case Op::exp: return std::exp(x);
+    case Op::log: return std::log(x);
+    case Op::abs: return std::abs(x);
+    case Op::asin: return std::asin(x);
+    case Op::acos: return std::acos(x);
+    case Op::atan: return std::atan(x);
+    case Op::sinh: return std::sinh(x);
+    case Op::cosh: return std::cosh(x);
+    case Op::tanh: return std::tanh(x);
+    case Op::sqrt: return std::sqrt(x);
+    default: return std::numeric_limits<double>::quiet_NaN();
   }
-  return {term, 1.0};
 }
 
-// A power with a negative real numeric exponent: it belongs to the denominator of a product.
-bool is_reciprocal(const GiNaC::ex& e) {
-  if (!GiNaC::is_exactly_a<GiNaC::power>(e)) return false;
-  const GiNaC::ex exponent = e.op(1);
-  return GiNaC::is_exactly_a<GiNaC::numeric>(exponent) && GiNaC::ex_to<GiNaC::numeric>(exponent).is_real() &&
-         GiNaC::ex_to<GiNaC::numeric>(exponent).is_negative();
+// f(-x) = -f(x), bit for bit in the C library (it computes on |x| and restores the sign).
+bool is_odd(Op op) {
+  return op == Op::sin || op == Op::tan || op == Op::asin || op == Op::atan || op == Op::sinh || op == Op::tanh;
 }
+// f(-x) = f(x).
+bool is_even(Op op) { return op == Op::cos || op == Op::cosh || op == Op::abs; }
 
 // The translation of expressions of one spec into one Program.
 class ProgramCompiler {
@@ -106,6 +149,8 @@ class ProgramCompiler {
       variables_.emplace(symbols.coordinate(i), program_.coordinate_register(i));
       variables_.emplace(symbols.velocity(i), program_.velocity_register(i));
     }
+    nodes_.emplace_back();  // kOne
+    nodes_.back().key = 1;
   }
 
   // Compiles `e` (parameters still symbolic) into the next output; `what` names it in errors.
@@ -116,44 +161,18 @@ class ProgramCompiler {
     }
     what_ = what;
     original_ = e;
-    GiNaC::ex numeric_form;
+    Scaled form;
     try {
-      numeric_form = with_values(e);
+      form = canonical(e);
+    } catch (const Error&) {
+      throw;
     } catch (const std::exception& error) {
       fail(fmt::format("cannot be evaluated ({})", error.what()));
     }
-    if (GiNaC::is_exactly_a<GiNaC::numeric>(numeric_form)) {
-      const GiNaC::numeric& x = GiNaC::ex_to<GiNaC::numeric>(numeric_form);
-      if (!x.is_real()) emit_numeric(x);  // throws
-      program_.add_constant_output(numeric_value(x));
-    } else {
-      program_.add_output(emit(numeric_form));
-    }
-  }
-
-  // `e` with the constants (pi) replaced by their values, every distinct node once: derived terms
-  // share large subexpressions (a bicycle's entries of A and G), which GiNaC's subs() and evalf()
-  // would walk once per path to them. Numeric operands fold as GiNaC rebuilds each node (sums,
-  // products, powers and functions of floats evaluate).
-  GiNaC::ex with_values(const GiNaC::ex& e) {
-    if (GiNaC::is_a<GiNaC::symbol>(e)) {
-      const auto found = values_.find(e);
-      return found == values_.end() ? e : found->second;
-    }
-    if (GiNaC::is_exactly_a<GiNaC::constant>(e)) return e.evalf();
-    if (e.nops() == 0) return e;
-    const GiNaC::basic* node = &GiNaC::ex_to<GiNaC::basic>(e);
-    const auto found = with_values_memo_.find(node);
-    if (found != with_values_memo_.end()) return found->second.second;
-    struct Children : GiNaC::map_function {
-      ProgramCompiler& self;
-      explicit Children(ProgramCompiler& compiler) : self(compiler) {}
-      GiNaC::ex operator()(const GiNaC::ex& x) override { return self.with_values(x); }
-    } children(*this);
-    GiNaC::ex out = e.map(children);
-    // The node itself is kept in the memo so that its address cannot be reused by another.
-    with_values_memo_.emplace(node, std::make_pair(e, out));
-    return out;
+    if (form.id == kOne)
+      program_.add_constant_output(form.c);
+    else
+      program_.add_output(emit(form));
   }
 
   // An output that is NaN at every call (an expression that cannot be evaluated).
@@ -167,34 +186,321 @@ class ProgramCompiler {
     throw ModelError(fmt::format("model '{}': {} = {} {}", spec_.name, what_, to_text(original_), message));
   }
 
-  int emit(const GiNaC::ex& e) {
-    const auto found = memo_.find(e);
-    if (found != memo_.end()) return found->second;
-    const int r = emit_new(e);
-    memo_.emplace(e, r);
-    return r;
+  // ---- The canonical form -------------------------------------------------------------------
+
+  const Node& node(int id) const { return nodes_[static_cast<std::size_t>(id)]; }
+
+  // The node equal to `n` (made once): its key is computed here from its fields.
+  int intern(Node n) {
+    std::uint64_t h = mix(static_cast<std::uint64_t>(n.kind) + 11, hash_string(n.name));
+    h = mix(h, static_cast<std::uint64_t>(n.input + 2));
+    h = mix(h, static_cast<std::uint64_t>(n.parameter + 2));
+    h = mix(h, static_cast<std::uint64_t>(n.op));
+    h = mix(h, hash_double(n.offset));
+    h = mix(h, hash_double(n.exponent));
+    for (const Scaled& item : n.items) h = mix(mix(h, hash_double(item.c)), node(item.id).key);
+    n.key = h;
+    std::vector<int>& candidates = by_key_[h];
+    for (int id : candidates)
+      if (shallow_equal(node(id), n)) return id;
+    nodes_.push_back(std::move(n));
+    const int id = static_cast<int>(nodes_.size()) - 1;
+    candidates.push_back(id);
+    return id;
   }
 
-  int emit_new(const GiNaC::ex& e) {
-    if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) return emit_numeric(GiNaC::ex_to<GiNaC::numeric>(e));
-    if (GiNaC::is_a<GiNaC::symbol>(e)) return emit_symbol(GiNaC::ex_to<GiNaC::symbol>(e));
+  static bool shallow_equal(const Node& x, const Node& y) {
+    if (x.kind != y.kind || x.input != y.input || x.parameter != y.parameter || x.op != y.op || x.name != y.name ||
+        !same_bits(x.offset, y.offset) || !same_bits(x.exponent, y.exponent) || x.items.size() != y.items.size())
+      return false;
+    for (std::size_t i = 0; i < x.items.size(); ++i)
+      if (x.items[i].id != y.items[i].id || !same_bits(x.items[i].c, y.items[i].c)) return false;
+    return true;
+  }
+
+  // A total order on nodes that is the same in every process: by key, and (should two keys ever
+  // collide) by structure.
+  int compare(int a, int b) const {
+    if (a == b) return 0;
+    const Node& x = node(a);
+    const Node& y = node(b);
+    if (x.key != y.key) return x.key < y.key ? -1 : 1;
+    if (x.kind != y.kind) return x.kind < y.kind ? -1 : 1;
+    if (x.name != y.name) return x.name < y.name ? -1 : 1;
+    if (x.input != y.input) return x.input < y.input ? -1 : 1;
+    if (x.parameter != y.parameter) return x.parameter < y.parameter ? -1 : 1;
+    if (x.op != y.op) return x.op < y.op ? -1 : 1;
+    if (!same_bits(x.offset, y.offset)) return x.offset < y.offset ? -1 : 1;
+    if (!same_bits(x.exponent, y.exponent)) return x.exponent < y.exponent ? -1 : 1;
+    if (x.items.size() != y.items.size()) return x.items.size() < y.items.size() ? -1 : 1;
+    for (std::size_t i = 0; i < x.items.size(); ++i) {
+      if (!same_bits(x.items[i].c, y.items[i].c)) return x.items[i].c < y.items[i].c ? -1 : 1;
+      const int c = compare(x.items[i].id, y.items[i].id);
+      if (c != 0) return c;
+    }
+    return 0;
+  }
+  bool less(const Scaled& x, const Scaled& y) const {
+    const int c = compare(x.id, y.id);
+    if (c != 0) return c < 0;
+    return !same_bits(x.c, y.c) && x.c < y.c;
+  }
+  void sort_canonically(std::vector<Scaled>& items) const {
+    std::sort(items.begin(), items.end(), [this](const Scaled& x, const Scaled& y) { return less(x, y); });
+  }
+
+  // The sum of numbers in an order of their own (their values), not GiNaC's.
+  static double sum(std::vector<double> values) {
+    std::sort(values.begin(), values.end());
+    double s = 0.0;
+    for (double x : values) s += x;
+    return s;
+  }
+  static double product_of(std::vector<double> values) {
+    std::sort(values.begin(), values.end());
+    double p = 1.0;
+    for (double x : values) p *= x;
+    return p;
+  }
+
+  // offset + sum of the terms, with like terms merged and the sign made canonical.
+  Scaled make_add(std::vector<Scaled> terms, double offset) {
+    sort_canonically(terms);
+    std::vector<Scaled> merged;
+    for (const Scaled& t : terms) {
+      if (!merged.empty() && merged.back().id == t.id)
+        merged.back().c += t.c;
+      else
+        merged.push_back(t);
+    }
+    merged.erase(std::remove_if(merged.begin(), merged.end(), [](const Scaled& t) { return t.c == 0.0; }),
+                 merged.end());
+    if (merged.empty()) return {offset, kOne};
+    if (merged.size() == 1 && offset == 0.0) return merged[0];
+    const double sign = merged[0].c < 0.0 ? -1.0 : 1.0;
+    Node n;
+    n.kind = Kind::add;
+    for (Scaled& t : merged) {
+      t.c *= sign;
+      n.parameters_only = n.parameters_only && node(t.id).parameters_only;
+    }
+    n.items = std::move(merged);
+    n.offset = sign * offset;
+    return {sign, intern(std::move(n))};
+  }
+
+  // c * the product of the factors (nodes), sorted.
+  Scaled make_mul(std::vector<int> factors, double c) {
+    if (c == 0.0) return {0.0, kOne};
+    std::sort(factors.begin(), factors.end(), [this](int x, int y) { return compare(x, y) < 0; });
+    if (factors.empty()) return {c, kOne};
+    if (factors.size() == 1) return {c, factors[0]};
+    Node n;
+    n.kind = Kind::mul;
+    for (int f : factors) {
+      n.items.push_back({1.0, f});
+      n.parameters_only = n.parameters_only && node(f).parameters_only;
+    }
+    return {c, intern(std::move(n))};
+  }
+
+  // base^p for a number p.
+  Scaled make_power(Scaled base, double p) {
+    if (base.id == kOne) {
+      const double value = p == 0.5 ? std::sqrt(base.c) : std::pow(base.c, p);
+      if (std::isnan(value)) fail(fmt::format("cannot be evaluated ({}^{} is not a real number)", base.c, p));
+      return {value, kOne};
+    }
+    if (p == 1.0) return base;
+    double sign = 1.0;
+    if (p == std::trunc(p) && base.c < 0.0) {
+      // (-x)^n = (-1)^n x^n.
+      base.c = -base.c;
+      if (std::fmod(std::abs(p), 2.0) == 1.0) sign = -1.0;
+    }
+    Node n;
+    n.kind = Kind::power;
+    n.items = {base};
+    n.exponent = p;
+    n.parameters_only = node(base.id).parameters_only;
+    return {sign, intern(std::move(n))};
+  }
+
+  // The canonical form of `e`: every distinct GiNaC node is translated once (derived terms share
+  // large subexpressions, a bicycle's entries of A and G).
+  Scaled canonical(const GiNaC::ex& e) {
+    const GiNaC::basic* key = &GiNaC::ex_to<GiNaC::basic>(e);
+    const auto found = translated_.find(key);
+    if (found != translated_.end()) return found->second.second;
+    const Scaled s = translate(e);
+    // The node itself is kept in the memo so that its address cannot be reused by another.
+    translated_.emplace(key, std::make_pair(e, s));
+    return s;
+  }
+
+  double real_number(const GiNaC::numeric& x) const {
+    if (!x.is_real()) fail(fmt::format("contains the complex number {}; every quantity must be real", to_text(x)));
+    return numeric_value(x);
+  }
+
+  Scaled translate(const GiNaC::ex& e) {
+    if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) return {real_number(GiNaC::ex_to<GiNaC::numeric>(e)), kOne};
+    if (GiNaC::is_a<GiNaC::symbol>(e)) return {1.0, symbol(GiNaC::ex_to<GiNaC::symbol>(e))};
     if (GiNaC::is_exactly_a<GiNaC::constant>(e)) {
       const GiNaC::ex value = e.evalf();
-      if (GiNaC::is_exactly_a<GiNaC::numeric>(value)) return emit_numeric(GiNaC::ex_to<GiNaC::numeric>(value));
+      if (GiNaC::is_exactly_a<GiNaC::numeric>(value)) return {real_number(GiNaC::ex_to<GiNaC::numeric>(value)), kOne};
       fail(fmt::format("contains the constant '{}', which has no numeric value", to_text(e)));
     }
-    if (GiNaC::is_exactly_a<GiNaC::add>(e)) return emit_add(e);
-    if (GiNaC::is_exactly_a<GiNaC::mul>(e)) return emit_mul(e);
-    if (GiNaC::is_exactly_a<GiNaC::power>(e)) return emit_power(e.op(0), e.op(1));
-    if (GiNaC::is_a<GiNaC::function>(e)) return emit_function(e);
+    if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
+      std::vector<Scaled> terms;
+      std::vector<double> numbers;
+      for (std::size_t i = 0; i < e.nops(); ++i) {
+        const Scaled t = canonical(e.op(i));
+        if (t.id == kOne)
+          numbers.push_back(t.c);
+        else
+          terms.push_back(t);
+      }
+      return make_add(std::move(terms), sum(std::move(numbers)));
+    }
+    if (GiNaC::is_exactly_a<GiNaC::mul>(e)) {
+      std::vector<int> factors;
+      std::vector<double> numbers;
+      for (std::size_t i = 0; i < e.nops(); ++i) {
+        const Scaled f = canonical(e.op(i));
+        if (f.c != 1.0) numbers.push_back(f.c);
+        if (f.id == kOne) continue;
+        if (node(f.id).kind == Kind::mul) {
+          for (const Scaled& g : node(f.id).items) factors.push_back(g.id);
+        } else {
+          factors.push_back(f.id);
+        }
+      }
+      return make_mul(std::move(factors), product_of(std::move(numbers)));
+    }
+    if (GiNaC::is_exactly_a<GiNaC::power>(e)) {
+      const Scaled base = canonical(e.op(0));
+      const GiNaC::ex exponent = e.op(1);
+      if (GiNaC::is_exactly_a<GiNaC::numeric>(exponent))
+        return make_power(base, real_number(GiNaC::ex_to<GiNaC::numeric>(exponent)));
+      const Scaled p = canonical(exponent);
+      if (p.id == kOne) return make_power(base, p.c);
+      Node n;
+      n.kind = Kind::power;
+      n.items = {base, p};
+      n.exponent = std::numeric_limits<double>::quiet_NaN();  // not a number exponent
+      n.parameters_only = node(base.id).parameters_only && node(p.id).parameters_only;
+      return {1.0, intern(std::move(n))};
+    }
+    if (GiNaC::is_a<GiNaC::function>(e)) return function(e);
     fail(fmt::format("contains '{}' (a GiNaC {}), which is not a scalar expression the compiler handles",
                      to_text(e), GiNaC::ex_to<GiNaC::basic>(e).class_name()));
   }
 
-  int emit_numeric(const GiNaC::numeric& x) {
-    if (!x.is_real())
-      fail(fmt::format("contains the complex number {}; every quantity must be real", to_text(x)));
-    return constant(numeric_value(x));
+  int symbol(const GiNaC::symbol& x) {
+    Node n;
+    n.kind = Kind::symbol;
+    n.name = x.get_name();
+    const auto variable = variables_.find(x);
+    const auto parameter = parameters_.find(x);
+    if (variable != variables_.end()) {
+      n.input = variable->second;
+      n.parameters_only = false;
+    } else if (parameter != parameters_.end()) {
+      n.parameter = parameter->second;
+    } else {
+      for (int i = 0; i < spec_.symbols.coordinates(); ++i)
+        if (x.is_equal(spec_.symbols.acceleration(i)))
+          fail(fmt::format("contains the acceleration {}; the terms may depend on t, q and q' only", n.name));
+      fail(fmt::format("contains the symbol '{}', which is neither t, a coordinate nor a velocity once the "
+                       "parameter values are set: declare it as a parameter with a value",
+                       n.name));
+    }
+    return intern(std::move(n));
+  }
+
+  Scaled function(const GiNaC::ex& e) {
+    const std::string name = GiNaC::ex_to<GiNaC::function>(e).get_name();
+    static const std::map<std::string, Op> unary{
+        {"sin", Op::sin},   {"cos", Op::cos},   {"tan", Op::tan},   {"exp", Op::exp},   {"log", Op::log},
+        {"abs", Op::abs},   {"asin", Op::asin}, {"acos", Op::acos}, {"atan", Op::atan}, {"sinh", Op::sinh},
+        {"cosh", Op::cosh}, {"tanh", Op::tanh}, {"sqrt", Op::sqrt}};
+    // Every quantity is real, so the conjugate that GiNaC's derivative of abs() brings in
+    // (d|x|/dx = (x + conjugate(x)) / (2 |x|)) is the identity.
+    if ((name == "conjugate" || name == "real_part") && e.nops() == 1) return canonical(e.op(0));
+    if (name == "imag_part" && e.nops() == 1) return {0.0, kOne};
+    const auto op = unary.find(name);
+    Node n;
+    n.kind = Kind::function;
+    n.name = name;
+    double sign = 1.0;
+    if (op != unary.end() && e.nops() == 1) {
+      Scaled x = canonical(e.op(0));
+      if (x.id == kOne) {
+        const double value = apply(op->second, x.c);
+        if (std::isnan(value)) fail(fmt::format("cannot be evaluated ({}({}) is not a real number)", name, x.c));
+        return {value, kOne};
+      }
+      if (x.c < 0.0 && (is_odd(op->second) || is_even(op->second))) {
+        if (is_odd(op->second)) sign = -1.0;
+        x.c = -x.c;
+      }
+      n.op = op->second;
+      n.items = {x};
+    } else if (name == "atan2" && e.nops() == 2) {
+      const Scaled y = canonical(e.op(0));
+      const Scaled x = canonical(e.op(1));
+      if (y.id == kOne && x.id == kOne) return {std::atan2(y.c, x.c), kOne};
+      n.op = Op::atan2;
+      n.items = {y, x};
+    } else {
+      fail(fmt::format("calls the function '{}', which the compiler does not support (supported: {})", name,
+                       kSupportedFunctions));
+    }
+    for (const Scaled& x : n.items) n.parameters_only = n.parameters_only && node(x.id).parameters_only;
+    return {sign, intern(std::move(n))};
+  }
+
+  // ---- Emission -----------------------------------------------------------------------------
+
+  using MemoKey = std::pair<int, std::uint64_t>;  // (node, bits of the coefficient)
+
+  bool emitted(int id) const { return memo_.count({id, hash_double(1.0)}) > 0; }
+
+  int emit(const Scaled& s) {
+    if (s.id == kOne) return constant(s.c);
+    const MemoKey key{s.id, hash_double(s.c)};
+    const auto found = memo_.find(key);
+    if (found != memo_.end()) return found->second;
+    int r;
+    if (node(s.id).kind == Kind::mul)
+      r = emit_mul(s.id, s.c);
+    else if (s.c == 1.0)
+      r = emit_node(s.id);
+    else
+      r = scaled(emit({1.0, s.id}), s.c);
+    memo_.emplace(key, r);
+    return r;
+  }
+
+  int emit_node(int id) {
+    const Node& n = node(id);
+    switch (n.kind) {
+      case Kind::symbol: return n.input >= 0 ? n.input : program_.push_parameter(n.parameter);
+      case Kind::add: return emit_add(id);
+      case Kind::power: return emit_power(id);
+      case Kind::function: {
+        if (n.op == Op::atan2) {
+          const Scaled x = n.items[1];
+          const int y = emit(n.items[0]);
+          return program_.push(Op::atan2, y, emit(x));
+        }
+        const Op op = n.op;
+        return program_.push(op, emit(n.items[0]));
+      }
+      default: break;
+    }
+    fail("could not be compiled (an unexpected node)");
   }
 
   int constant(double value) {
@@ -205,57 +511,36 @@ class ProgramCompiler {
     return r;
   }
 
-  int emit_symbol(const GiNaC::symbol& x) {
-    const auto found = variables_.find(x);
-    if (found != variables_.end()) return found->second;
-    const auto parameter = parameters_.find(x);
-    if (parameter != parameters_.end()) {
-      const int r = program_.push_parameter(parameter->second);
-      variables_.emplace(x, r);
-      return r;
-    }
-    const std::string name = x.get_name();
-    for (int i = 0; i < spec_.symbols.coordinates(); ++i)
-      if (x.is_equal(spec_.symbols.acceleration(i)))
-        fail(fmt::format("contains the acceleration {}; the terms may depend on t, q and q' only", name));
-    fail(fmt::format("contains the symbol '{}', which is neither t, a coordinate nor a velocity once the "
-                     "parameter values are set: declare it as a parameter with a value",
-                     name));
-  }
-
-  int emit_add(const GiNaC::ex& e) {
-    double offset = 0.0;
-    std::vector<std::pair<GiNaC::ex, double>> terms;
-    for (std::size_t i = 0; i < e.nops(); ++i) {
-      const GiNaC::ex term = e.op(i);
-      if (GiNaC::is_exactly_a<GiNaC::numeric>(term)) {
-        const GiNaC::numeric& x = GiNaC::ex_to<GiNaC::numeric>(term);
-        if (!x.is_real()) emit_numeric(x);  // throws
-        offset += numeric_value(x);
-      } else {
-        terms.push_back(split_coefficient(term));
-      }
-    }
-    sort_canonically(terms, [](const auto& term) -> const GiNaC::ex& { return term.first; });
+  int emit_add(int id) {
+    std::vector<Scaled> terms = node(id).items;  // a copy: emission makes nodes
+    const double offset = node(id).offset;
     // Start from a term with coefficient 1 when there is one, to save a negation or a scaling.
-    const auto first = std::find_if(terms.begin(), terms.end(), [](const auto& term) { return term.second == 1.0; });
+    const auto first = std::find_if(terms.begin(), terms.end(), [](const Scaled& t) { return t.c == 1.0; });
     if (first != terms.end()) std::rotate(terms.begin(), first, first + 1);
 
     // The first term with its coefficient folded into its last multiplication; each further term
     // c * h * f folded into one muladd, mulsub or mulk_muladd (h: the product of its other factors),
     // unless the whole product is needed elsewhere anyway.
     int acc;
-    if (auto factors = fusable_factors(terms[0].first)) {
-      acc = product(*factors, terms[0].second);
+    if (auto factors = fusable_factors(terms[0].id)) {
+      acc = product(*factors, terms[0].c);
     } else {
-      acc = scaled(emit(terms[0].first), terms[0].second);
+      acc = scaled(emit({1.0, terms[0].id}), terms[0].c);
     }
     for (std::size_t i = 1; i < terms.size(); ++i) {
-      const auto& [rest, c] = terms[i];
+      const double c = terms[i].c;
+      const int rest = terms[i].id;
       if (auto factors = fusable_factors(rest)) {
-        const GiNaC::ex last = factors->back();
+        const Scaled last = factors->back();
         factors->pop_back();
-        const int h = factors->size() == 1 ? emit(factors->front()) : emit(GiNaC::mul(*factors));
+        int h;
+        if (factors->size() == 1) {
+          h = emit(factors->front());
+        } else {
+          std::vector<int> ids;
+          for (const Scaled& f : *factors) ids.push_back(f.id);
+          h = emit(make_mul(std::move(ids), 1.0));
+        }
         const int f = emit(last);
         if (c == 1.0)
           acc = program_.push(Op::muladd, h, f, acc);
@@ -264,39 +549,42 @@ class ProgramCompiler {
         else
           acc = program_.push(Op::mulk_muladd, h, f, acc, c);
       } else if (c == 1.0 || c == -1.0) {
-        acc = program_.push(c == 1.0 ? Op::add : Op::sub, acc, emit(rest));
+        acc = program_.push(c == 1.0 ? Op::add : Op::sub, acc, emit({1.0, rest}));
       } else {
-        acc = program_.push(Op::mulk_add, emit(rest), acc, 0, c);
+        acc = program_.push(Op::mulk_add, emit({1.0, rest}), acc, 0, c);
       }
     }
     if (offset != 0.0) acc = program_.push(Op::add_k, acc, 0, 0, offset);
     return acc;
   }
 
+  bool is_reciprocal(int id) const {
+    const Node& n = node(id);
+    return n.kind == Kind::power && n.items.size() == 1 && n.exponent < 0.0;
+  }
+
   // The factors of a product (or square) that is not computed yet and has no denominator, in
   // canonical order: a sum folds its last multiplication into the accumulation.
-  std::optional<std::vector<GiNaC::ex>> fusable_factors(const GiNaC::ex& e) {
-    if (memo_.count(e) > 0) return std::nullopt;
-    if (GiNaC::is_exactly_a<GiNaC::power>(e) && e.op(1).is_equal(GiNaC::ex(2))) {
+  std::optional<std::vector<Scaled>> fusable_factors(int id) {
+    if (emitted(id)) return std::nullopt;
+    const Node& n = node(id);
+    if (n.kind == Kind::power && n.items.size() == 1 && n.exponent == 2.0) {
       // x^2 = x * x: the square folds into the sum too.
-      return std::vector<GiNaC::ex>{e.op(0), e.op(0)};
+      return std::vector<Scaled>{n.items[0], n.items[0]};
     }
-    if (!GiNaC::is_exactly_a<GiNaC::mul>(e)) return std::nullopt;
-    std::vector<GiNaC::ex> factors;
-    for (std::size_t i = 0; i < e.nops(); ++i) {
-      const GiNaC::ex factor = e.op(i);
-      if (GiNaC::is_exactly_a<GiNaC::numeric>(factor) || is_reciprocal(factor)) return std::nullopt;
-      factors.push_back(factor);
-    }
-    sort_canonically(factors, [](const GiNaC::ex& x) -> const GiNaC::ex& { return x; });
+    if (n.kind != Kind::mul) return std::nullopt;
+    std::vector<Scaled> factors = n.items;
+    for (const Scaled& f : factors)
+      if (is_reciprocal(f.id)) return std::nullopt;
     parameters_first(factors);
     return factors;
   }
 
   // The factors of parameters only first (in their order), so that their products come first and
   // the evaluator's parameter stage computes them once.
-  void parameters_first(std::vector<GiNaC::ex>& factors) {
-    std::stable_partition(factors.begin(), factors.end(), [this](const GiNaC::ex& x) { return parameters_only(x); });
+  void parameters_first(std::vector<Scaled>& factors) const {
+    std::stable_partition(factors.begin(), factors.end(),
+                          [this](const Scaled& x) { return node(x.id).parameters_only; });
   }
 
   int scaled(int r, double c) {
@@ -307,8 +595,8 @@ class ProgramCompiler {
 
   // c * f1 * f2 * ... as ((f1 f2) ...) with the coefficient folded into the last multiplication
   // (k (a b), exact for k = -1 too).
-  int product(std::vector<GiNaC::ex>& factors, double c = 1.0) {
-    sort_canonically(factors, [](const GiNaC::ex& x) -> const GiNaC::ex& { return x; });
+  int product(std::vector<Scaled>& factors, double c = 1.0) {
+    sort_canonically(factors);
     parameters_first(factors);
     int acc = emit(factors[0]);
     for (std::size_t i = 1; i < factors.size(); ++i) {
@@ -319,50 +607,27 @@ class ProgramCompiler {
     return scaled(acc, c);
   }
 
-  // Whether `e` depends on parameters and numbers only (not on t, q, q' or an unknown symbol).
-  bool parameters_only(const GiNaC::ex& e) {
-    if (GiNaC::is_a<GiNaC::symbol>(e)) return parameters_.count(e) > 0;
-    if (e.nops() == 0) return true;
-    const auto found = parameters_only_.find(e);
-    if (found != parameters_only_.end()) return found->second;
-    bool only = true;
-    for (std::size_t i = 0; i < e.nops() && only; ++i) only = parameters_only(e.op(i));
-    parameters_only_.emplace(e, only);
-    return only;
-  }
-
-  int emit_mul(const GiNaC::ex& e) {
+  int emit_mul(int id, double c) {
+    const std::vector<Scaled> items = node(id).items;  // a copy: emission makes nodes
     {
-      // k * s, k the factors of parameters only (the parameter stage computes it once) and s the
-      // others, when the product has both.
-      GiNaC::exvector k, rest;
-      bool has_parameter = false;
-      for (std::size_t i = 0; i < e.nops(); ++i) {
-        const GiNaC::ex factor = e.op(i);
-        const bool only = parameters_only(factor);
-        has_parameter = has_parameter || (only && !GiNaC::is_exactly_a<GiNaC::numeric>(factor));
-        (only ? k : rest).push_back(factor);
-      }
-      if (has_parameter && !rest.empty()) {
-        const int stage = emit(GiNaC::mul(k));
-        return program_.push(Op::mul, stage, emit(GiNaC::mul(rest)));
+      // k * s, k the factors of parameters only with the coefficient (the parameter stage computes
+      // it once) and s the others, when the product has both.
+      std::vector<int> k, rest;
+      for (const Scaled& f : items) (node(f.id).parameters_only ? k : rest).push_back(f.id);
+      if (!k.empty() && !rest.empty()) {
+        const int stage = emit(make_mul(std::move(k), c));
+        return program_.push(Op::mul, stage, emit(make_mul(std::move(rest), 1.0)));
       }
     }
-    double c = 1.0;
-    std::vector<GiNaC::ex> numerator, denominator;
-    for (std::size_t i = 0; i < e.nops(); ++i) {
-      const GiNaC::ex factor = e.op(i);
-      if (GiNaC::is_exactly_a<GiNaC::numeric>(factor)) {
-        const GiNaC::numeric& x = GiNaC::ex_to<GiNaC::numeric>(factor);
-        if (!x.is_real()) emit_numeric(x);  // throws
-        c *= numeric_value(x);
-      } else if (is_reciprocal(factor)) {
-        denominator.push_back(GiNaC::pow(factor.op(0), -factor.op(1)));
+    std::vector<Scaled> numerator, denominator;
+    for (const Scaled& f : items) {
+      if (is_reciprocal(f.id)) {
+        const Node& p = node(f.id);
+        denominator.push_back(make_power(p.items[0], -p.exponent));
       } else {
-        numerator.push_back(factor);
+        numerator.push_back(f);
       }
     }
-    if (numerator.empty() && denominator.empty()) return constant(c);
     if (numerator.empty()) return program_.push(Op::div_k, product(denominator), 0, 0, c);
     if (denominator.empty()) return product(numerator, c);
     const int r = program_.push(Op::div, product(numerator), product(denominator));
@@ -378,98 +643,36 @@ class ProgramCompiler {
     return program_.push(Op::powi, base, 0, 0, n);
   }
 
-  int emit_power(const GiNaC::ex& base, const GiNaC::ex& exponent) {
-    if (GiNaC::is_exactly_a<GiNaC::numeric>(exponent) && GiNaC::ex_to<GiNaC::numeric>(exponent).is_real()) {
-      const double p = numeric_value(GiNaC::ex_to<GiNaC::numeric>(exponent));
-      constexpr double kLargest = 1 << 20;
-      if (p == std::trunc(p) && std::abs(p) <= kLargest) {
-        const int n = static_cast<int>(p);
-        // x^-n = 1 / x^n, with x^n shared with its other uses.
-        if (n < 0) return program_.push(Op::div_k, emit(GiNaC::pow(base, -n)), 0, 0, 1.0);
-        return integer_power(emit(base), n);
+  int emit_power(int id) {
+    const Node& n = node(id);
+    const Scaled base = n.items[0];
+    if (n.items.size() == 2) {
+      const Scaled exponent = n.items[1];
+      const int b = emit(base);
+      return program_.push(Op::pow, b, emit(exponent));
+    }
+    const double p = n.exponent;
+    constexpr double kLargest = 1 << 20;
+    if (p == std::trunc(p) && std::abs(p) <= kLargest) {
+      const int k = static_cast<int>(p);
+      // x^-n = 1 / x^n, with x^n shared with its other uses.
+      if (k < 0) return program_.push(Op::div_k, emit(make_power(base, -k)), 0, 0, 1.0);
+      return integer_power(emit(base), k);
+    }
+    if (2.0 * p == std::trunc(2.0 * p) && std::abs(p) <= kLargest) {
+      // x^(m/2) = sqrt(x)^m: exact for squares, and shared with sqrt(x).
+      const Scaled root = make_power(base, 0.5);
+      int r;
+      const auto found = memo_.find({root.id, hash_double(1.0)});
+      if (found != memo_.end()) {
+        r = found->second;
+      } else {
+        r = program_.push(Op::sqrt, emit(base));
+        memo_.emplace(MemoKey{root.id, hash_double(1.0)}, r);
       }
-      if (2.0 * p == std::trunc(2.0 * p) && std::abs(p) <= kLargest) {
-        // x^(m/2) = sqrt(x)^m: exact for squares, and shared with sqrt(x).
-        const GiNaC::ex root = GiNaC::pow(base, GiNaC::numeric(1, 2));
-        int r;
-        const auto found = memo_.find(root);
-        if (found != memo_.end()) {
-          r = found->second;
-        } else {
-          r = program_.push(Op::sqrt, emit(base));
-          memo_.emplace(root, r);
-        }
-        return integer_power(r, static_cast<int>(2.0 * p));
-      }
-      return program_.push(Op::pow_k, emit(base), 0, 0, p);
+      return integer_power(r, static_cast<int>(2.0 * p));
     }
-    const int b = emit(base);
-    return program_.push(Op::pow, b, emit(exponent));
-  }
-
-  int emit_function(const GiNaC::ex& e) {
-    const std::string name = GiNaC::ex_to<GiNaC::function>(e).get_name();
-    static const std::map<std::string, Op> unary{
-        {"sin", Op::sin},   {"cos", Op::cos},   {"tan", Op::tan},   {"exp", Op::exp},   {"log", Op::log},
-        {"abs", Op::abs},   {"asin", Op::asin}, {"acos", Op::acos}, {"atan", Op::atan}, {"sinh", Op::sinh},
-        {"cosh", Op::cosh}, {"tanh", Op::tanh}, {"sqrt", Op::sqrt}};
-    const auto op = unary.find(name);
-    if (op != unary.end() && e.nops() == 1) return program_.push(op->second, emit(e.op(0)));
-    if (name == "atan2" && e.nops() == 2) {
-      const int y = emit(e.op(0));
-      return program_.push(Op::atan2, y, emit(e.op(1)));
-    }
-    // Every quantity is real, so the conjugate that GiNaC's derivative of abs() brings in
-    // (d|x|/dx = (x + conjugate(x)) / (2 |x|)) is the identity.
-    if ((name == "conjugate" || name == "real_part") && e.nops() == 1) return emit(e.op(0));
-    if (name == "imag_part" && e.nops() == 1) return constant(0.0);
-    fail(fmt::format("calls the function '{}', which the compiler does not support (supported: {})", name,
-                     kSupportedFunctions));
-  }
-
-  // Sorts items by the canonical key of their expression (ties, if the hash ever collides, by
-  // GiNaC's structural order).
-  template <class T, class Key>
-  void sort_canonically(std::vector<T>& items, Key key) {
-    std::vector<std::pair<std::uint64_t, std::size_t>> order;
-    order.reserve(items.size());
-    for (std::size_t i = 0; i < items.size(); ++i) order.emplace_back(canonical_key(key(items[i])), i);
-    std::stable_sort(order.begin(), order.end(), [&](const auto& x, const auto& y) {
-      if (x.first != y.first) return x.first < y.first;
-      return key(items[x.second]).compare(key(items[y.second])) < 0;
-    });
-    std::vector<T> sorted;
-    sorted.reserve(items.size());
-    for (const auto& [k, i] : order) sorted.push_back(items[i]);
-    items = std::move(sorted);
-  }
-
-  // A structural hash that depends on names, values and shape only (GiNaC's own hashes depend on
-  // symbol serial numbers and on addresses).
-  std::uint64_t canonical_key(const GiNaC::ex& e) {
-    const auto found = keys_.find(e);
-    if (found != keys_.end()) return found->second;
-    std::uint64_t h = 0;
-    if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) {
-      const GiNaC::numeric& x = GiNaC::ex_to<GiNaC::numeric>(e);
-      h = mix(mix(1, hash_double(GiNaC::real(x).to_double())), hash_double(GiNaC::imag(x).to_double()));
-    } else if (GiNaC::is_a<GiNaC::symbol>(e)) {
-      h = mix(2, hash_string(GiNaC::ex_to<GiNaC::symbol>(e).get_name()));
-    } else if (GiNaC::is_exactly_a<GiNaC::add>(e) || GiNaC::is_exactly_a<GiNaC::mul>(e)) {
-      std::vector<std::uint64_t> children;
-      for (std::size_t i = 0; i < e.nops(); ++i) children.push_back(canonical_key(e.op(i)));
-      std::sort(children.begin(), children.end());
-      h = GiNaC::is_exactly_a<GiNaC::add>(e) ? 3 : 4;
-      for (std::uint64_t child : children) h = mix(h, child);
-    } else if (GiNaC::is_a<GiNaC::function>(e)) {
-      h = mix(5, hash_string(GiNaC::ex_to<GiNaC::function>(e).get_name()));
-      for (std::size_t i = 0; i < e.nops(); ++i) h = mix(h, canonical_key(e.op(i)));
-    } else {
-      h = mix(6, hash_string(GiNaC::ex_to<GiNaC::basic>(e).class_name()));
-      for (std::size_t i = 0; i < e.nops(); ++i) h = mix(h, canonical_key(e.op(i)));
-    }
-    keys_.emplace(e, h);
-    return h;
+    return program_.push(Op::pow_k, emit(base), 0, 0, p);
   }
 
   // Rewrites a program so that sin(x) and cos(x) of the same register become one sincos (one
@@ -527,15 +730,14 @@ class ProgramCompiler {
   }
 
   const Spec& spec_;
-  std::map<GiNaC::ex, GiNaC::ex, GiNaC::ex_is_less> values_;  // symbol -> its value (none so far)
-  std::map<GiNaC::ex, int, GiNaC::ex_is_less> parameters_;   // parameter symbol -> its index
-  std::map<GiNaC::ex, bool, GiNaC::ex_is_less> parameters_only_;
-  std::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, GiNaC::ex>> with_values_memo_;
+  std::map<GiNaC::ex, int, GiNaC::ex_is_less> parameters_;  // parameter symbol -> its index
+  std::map<GiNaC::ex, int, GiNaC::ex_is_less> variables_;   // t, q, q' -> input register
+  std::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, Scaled>> translated_;
+  std::deque<Node> nodes_;  // a deque: references stay valid while nodes are added
+  std::unordered_map<std::uint64_t, std::vector<int>> by_key_;
   Program program_;
-  std::map<GiNaC::ex, int, GiNaC::ex_is_less> variables_;  // t, q, q' -> input register
-  std::map<GiNaC::ex, int, GiNaC::ex_is_less> memo_;
+  std::map<MemoKey, int> memo_;
   std::map<std::uint64_t, int> constants_;  // by the bits of the value
-  std::map<GiNaC::ex, std::uint64_t, GiNaC::ex_is_less> keys_;
   std::string what_;
   GiNaC::ex original_;
 };

@@ -1,0 +1,66 @@
+// The compiled evaluator: a model's terms program (the hot path of every right-hand side) turned
+// into machine code by the system's C++ compiler, loaded with dlopen and used in place of the
+// interpreter. This folder is the only place that runs a compiler or calls dlopen.
+//
+// The source (jit/source.hpp) is compiled into a shared object cached under
+// $XDG_CACHE_HOME/nhdyn (else ~/.cache/nhdyn), named by a hash of the source, the compiler (its
+// command and its --version) and the flags, so a second run of the same model loads it without
+// compiling, and a parameter change reuses it (parameters are data: the stage is recomputed).
+// An object is compiled under a temporary name and renamed into place, so a concurrent process
+// never loads a half-written file. The other programs (complement, residuals, energy, solution,
+// initial state) and the parameter handling stay with the interpreter, whose ProgramEvaluator the
+// compiled evaluator wraps; so every formulation, the sparse path and linearization's finite
+// differences work unchanged.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn::jit {
+
+// The compiled evaluator could not be made; the message says why.
+class JitError : public Error {
+ public:
+  using Error::Error;
+};
+
+enum class EvaluatorChoice { interpreted, compiled, automatic };
+
+// "interpreted" | "compiled" | "auto"; throws InputError naming the value otherwise.
+EvaluatorChoice parse_evaluator_choice(const std::string& text);
+
+// `auto` compiles a model whose terms program has at least this many operations (docs/design.md,
+// "Compiled evaluator": below it the compile time is not won back in a typical run).
+inline constexpr int kAutoCompileFrom = 1000;
+
+struct JitOptions {
+  std::string compiler;  // "" = $NHDYN_CXX, else "c++"
+  std::string cache_dir;  // "" = $XDG_CACHE_HOME/nhdyn, else $HOME/.cache/nhdyn
+};
+
+// What make_compiled happened to do.
+struct JitReport {
+  bool compiled = false;       // a compiler ran (false: the cached object was loaded)
+  double compile_seconds = 0;  // its wall time
+  std::string object;          // the shared object's path
+};
+
+// The model with its terms compiled, sharing everything else. Throws JitError naming the reason
+// (no compiler, a failed compile with its first error line, a failed dlopen, a model whose
+// evaluator is not a compiled program, e.g. a hand-written built-in).
+Model make_compiled(const Model& model, const JitOptions& options = {}, JitReport* report = nullptr);
+
+// The model with the evaluator `choice` asks for: interpreted returns it unchanged; compiled
+// compiles it (throws JitError as make_compiled); automatic compiles when the terms program has
+// kAutoCompileFrom operations or more and falls back to the interpreter on any failure, writing a
+// one-line notice to `notice` (not printed: the caller prints).
+Model with_evaluator(const Model& model, EvaluatorChoice choice, std::string* notice = nullptr,
+                     const JitOptions& options = {}, JitReport* report = nullptr);
+
+// Whether the model's evaluator is a compiled one.
+bool is_compiled(const Model& model);
+
+}  // namespace nhdyn::jit

@@ -1,0 +1,31 @@
+// The C++ source of a model's terms program for the compiled evaluator (compiled_evaluator.hpp):
+// the parametric terms program (model/program.hpp) printed as straight-line code behind a C
+// interface, so the shared object needs no header of the library and no C++ ABI across dlopen.
+// What depends on parameters and constants only (the parameter stage) is a function of its own,
+// run once per parameter change; the call reads its results from an array. Operations and their
+// order are the program's, and the source is compiled without contraction into fused
+// multiply-adds, so the compiled terms round as the interpreter's do.
+#pragma once
+
+#include <string>
+
+#include "nhdyn/model/program.hpp"
+
+namespace nhdyn::jit {
+
+// Bumped whenever the interface below changes: a cached object of another version is rebuilt.
+inline constexpr int kInterfaceVersion = 1;
+
+// The functions the source defines (extern "C"):
+//   int    nhdyn_jit_version(void)             kInterfaceVersion
+//   size_t nhdyn_jit_stage_size(void)          number of doubles the stage writes
+//   void   nhdyn_jit_stage(const double* p, double* m)      p: parameter values, m: the stage
+//   void   nhdyn_jit_terms(const double* m, double t, const double* q, const double* v,
+//                          double* A, double* Q, double* G, double* b, double* b0)
+//          A and b as the program writes them (every entry, or the nonzeros of `sparsity`)
+//   void   nhdyn_jit_terms_dense(...)           the same signature, A and b dense (every entry
+//          the caller has zeroed); only for a sparse program
+// n, s: the model's dimensions; `sparsity` null for a dense program.
+std::string make_terms_source(const Program& terms, int n, int s, const TermsSparsity* sparsity);
+
+}  // namespace nhdyn::jit

@@ -1,0 +1,218 @@
+// The compiled evaluator (jit/compiled_evaluator.hpp) against the interpreter it replaces: the
+// same terms and the same q'' to round-off on every example model (dense and sparse), after a
+// parameter change too; the cache reused by a second build; and the failures it must survive (no
+// compiler, a corrupt cache entry) turned into a clear error or, under `auto`, the interpreter.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/jit/compiled_evaluator.hpp"
+#include "nhdyn/model/data.hpp"
+#include "nhdyn/model/parameters.hpp"
+
+namespace nhdyn::jit {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string example(const std::string& file) { return (fs::path(NHDYN_SOURCE_DIR) / "examples" / file).string(); }
+
+// A cache directory of the test's own, removed afterwards.
+class Jit : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / (std::string("nhdyn-jit-") + info->name() + "-" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    options_.cache_dir = dir_.string();
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+  JitOptions options_;
+};
+
+// Every output of the terms of both models at a few states near the initial one.
+void expect_same_terms(const Model& interpreted, const Model& compiled, double tolerance) {
+  const int n = interpreted.n(), s = interpreted.s();
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> d(-0.3, 0.3);
+  for (int trial = 0; trial < 3; ++trial) {
+    std::vector<double> q(static_cast<std::size_t>(n)), v(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      q[static_cast<std::size_t>(i)] = interpreted.q0[i] + d(random);
+      v[static_cast<std::size_t>(i)] = interpreted.v0[i] + d(random);
+    }
+    const double t = 0.3 * trial;
+    std::vector<double> out1(static_cast<std::size_t>(n * n + 2 * n + s * n + s)), out2(out1.size(), -7.0);
+    std::vector<double> scratch1(interpreted.evaluator->scratch_size()), scratch2(compiled.evaluator->scratch_size());
+    const auto out = [&](std::vector<double>& o) {
+      double* p = o.data();
+      return TermsOut{p, p + n * n, p + n * n + n, p + n * n + 2 * n, p + n * n + 2 * n + s * n};
+    };
+    interpreted.evaluator->terms(t, q.data(), v.data(), scratch1.data(), out(out1));
+    compiled.evaluator->terms(t, q.data(), v.data(), scratch2.data(), out(out2));
+    for (std::size_t k = 0; k < out1.size(); ++k)
+      ASSERT_NEAR(out2[k], out1[k], tolerance * (1.0 + std::abs(out1[k]))) << "output " << k << ", trial " << trial;
+  }
+}
+
+// q'' of both models (sanh, D from QR) at their initial state.
+void expect_same_acceleration(const Model& interpreted, const Model& compiled, double tolerance) {
+  Data a = make_data(interpreted), b = make_data(compiled);
+  FormulationOptions options;
+  ASSERT_EQ(compute_dynamics(interpreted, a, options, interpreted.t0, interpreted.q0.data(), interpreted.v0.data()),
+            Status::ok);
+  ASSERT_EQ(compute_dynamics(compiled, b, options, compiled.t0, compiled.q0.data(), compiled.v0.data()), Status::ok);
+  for (int i = 0; i < interpreted.n(); ++i)
+    EXPECT_NEAR(b.qdd[i], a.qdd[i], tolerance * (1.0 + std::abs(a.qdd[i]))) << interpreted.coordinates[static_cast<std::size_t>(i)];
+}
+
+TEST_F(Jit, EveryExampleGivesTheInterpretersTermsAndAccelerations) {
+  for (const char* file : {"knife_edge.toml", "chaplygin_sleigh.toml", "double_pendulum.toml", "slider_crank.toml",
+                           "rolling_disk.toml", "diff_drive.toml", "rolling_disk_bodies.toml", "whipple_bicycle.toml"}) {
+    SCOPED_TRACE(file);
+    const Model interpreted = load_model(example(file));
+    JitReport report;
+    const Model compiled = make_compiled(interpreted, options_, &report);
+    EXPECT_TRUE(is_compiled(compiled));
+    EXPECT_FALSE(is_compiled(interpreted));
+    EXPECT_TRUE(fs::exists(report.object));  // compiled now, or cached: rolling_disk_bodies.toml
+                                             // makes the same program as rolling_disk.toml
+    // The same operations in the same order without fused multiply-adds: equal to the last bit
+    // is expected, round-off is what is asked.
+    expect_same_terms(interpreted, compiled, 1e-14);
+    expect_same_acceleration(interpreted, compiled, 1e-12);
+  }
+}
+
+TEST_F(Jit, ParametersAreDataAfterCompilation) {
+  const Model interpreted = load_model(example("double_pendulum.toml"));
+  const Model compiled = make_compiled(interpreted, options_);
+  Model a = interpreted, b = compiled;
+  set_parameter(a, "m2", 1.7);
+  set_parameter(b, "m2", 1.7);
+  set_parameter(a, "l2", 0.4);
+  set_parameter(b, "l2", 0.4);
+  EXPECT_TRUE(is_compiled(b));
+  expect_same_terms(a, b, 1e-14);
+  // And no second compile: the object is the same for every value.
+  JitReport report;
+  make_compiled(a, options_, &report);
+  EXPECT_FALSE(report.compiled);
+}
+
+TEST_F(Jit, SparseModelsFillTheSparseAndTheDenseTerms) {
+  // A chain of 70 bodies is compiled sparse (symbolic/compile.hpp, kSparseFrom); its model file
+  // comes from the CLI, as a user makes it.
+  fs::create_directories(dir_);
+  const fs::path file = dir_ / "chain.toml";
+  const std::string command = "'" NHDYN_CLI_PATH "' example chain --bodies 70 -o '" + file.string() + "' > /dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  const Model interpreted = load_model(file.string());
+  ASSERT_NE(interpreted.evaluator->sparsity(), nullptr) << "the chain should be compiled sparse";
+  const Model compiled = make_compiled(interpreted, options_);
+  ASSERT_NE(compiled.evaluator->sparsity(), nullptr);
+  expect_same_terms(interpreted, compiled, 1e-14);
+  expect_same_acceleration(interpreted, compiled, 1e-12);
+}
+
+TEST_F(Jit, TheSecondBuildLoadsTheCachedObject) {
+  const Model model = load_model(example("slider_crank.toml"));
+  JitReport first, second;
+  make_compiled(model, options_, &first);
+  make_compiled(model, options_, &second);
+  EXPECT_TRUE(first.compiled);
+  EXPECT_FALSE(second.compiled);
+  EXPECT_EQ(first.object, second.object);
+  EXPECT_TRUE(fs::exists(second.object));
+  // Nothing but the object is left in the cache (no temporaries, sources or logs).
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    ++files;
+    EXPECT_EQ(entry.path().extension(), ".so") << entry.path();
+  }
+  EXPECT_EQ(files, 1);
+}
+
+TEST_F(Jit, ConcurrentBuildsOfOneModelBothGetAWholeObject) {
+  // Each compiles under a name of its own and renames into place: neither loads a partial file.
+  const Model model = load_model(example("rolling_disk.toml"));
+  Model first, second;
+  std::string error;
+  std::thread other([&] {
+    try {
+      second = make_compiled(model, options_);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  });
+  first = make_compiled(model, options_);
+  other.join();
+  EXPECT_TRUE(error.empty()) << error;
+  expect_same_terms(model, first, 1e-14);
+  expect_same_terms(model, second, 1e-14);
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().extension(), ".so") << "left behind: " << entry.path();
+}
+
+TEST_F(Jit, ACorruptCacheEntryIsCompiledAgain) {
+  const Model model = load_model(example("knife_edge.toml"));
+  JitReport first;
+  make_compiled(model, options_, &first);
+  std::ofstream(first.object, std::ios::binary | std::ios::trunc) << "not an object";
+  JitReport second;
+  const Model compiled = make_compiled(model, options_, &second);
+  EXPECT_TRUE(second.compiled);
+  expect_same_terms(model, compiled, 1e-14);
+}
+
+TEST_F(Jit, AMissingCompilerIsAnErrorForCompiledAndTheInterpreterForAuto) {
+  options_.compiler = "/nonexistent/c++";
+  const Model model = load_model(example("whipple_bicycle.toml"));
+  try {
+    make_compiled(model, options_);
+    FAIL() << "no error";
+  } catch (const JitError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/c++"), std::string::npos) << e.what();
+  }
+  std::string notice;
+  const Model fallback = with_evaluator(model, EvaluatorChoice::automatic, &notice, options_);
+  EXPECT_FALSE(is_compiled(fallback));
+  EXPECT_NE(notice.find("interpreter"), std::string::npos) << notice;
+  EXPECT_EQ(notice.find('\n'), std::string::npos) << "one line";
+}
+
+TEST_F(Jit, AutoLeavesSmallModelsToTheInterpreter) {
+  const Model model = load_model(example("knife_edge.toml"));
+  std::string notice;
+  EXPECT_FALSE(is_compiled(with_evaluator(model, EvaluatorChoice::automatic, &notice, options_)));
+  EXPECT_TRUE(notice.empty());
+  EXPECT_FALSE(fs::exists(dir_)) << "nothing compiled";
+}
+
+TEST_F(Jit, HandWrittenModelsHaveNothingToCompile) {
+  const Model model = load_model("sled");
+  EXPECT_THROW(make_compiled(model, options_), JitError);
+  std::string notice;
+  EXPECT_FALSE(is_compiled(with_evaluator(model, EvaluatorChoice::automatic, &notice, options_)));
+}
+
+TEST(EvaluatorChoice, Parses) {
+  EXPECT_EQ(parse_evaluator_choice("interpreted"), EvaluatorChoice::interpreted);
+  EXPECT_EQ(parse_evaluator_choice("compiled"), EvaluatorChoice::compiled);
+  EXPECT_EQ(parse_evaluator_choice("auto"), EvaluatorChoice::automatic);
+  EXPECT_THROW(parse_evaluator_choice("jit"), InputError);
+}
+
+}  // namespace
+}  // namespace nhdyn::jit
