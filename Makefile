@@ -48,7 +48,7 @@ bench: configure
 # are left out of it:
 # make test runs them; ASAN_SKIP_TESTS= (empty) builds and runs them all under the sanitizers.
 SAN_BUILD ?= build-asan
-ASAN_SKIP_TESTS ?= cli;gallery;studies;linearization;layering;report;codegen
+ASAN_SKIP_TESTS ?= cli;gallery;studies;linearization;layering;report;codegen;jit
 HAVE_CLANG := $(shell command -v clang++-14 >/dev/null 2>&1 && echo yes)
 SAN_COMPILER = $(if $(HAVE_CLANG),-DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 -DNHDYN_FUZZ=ON)
 
