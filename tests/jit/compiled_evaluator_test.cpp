@@ -176,7 +176,7 @@ TEST_F(Jit, ACorruptCacheEntryIsCompiledAgain) {
   expect_same_terms(model, compiled, 1e-14);
 }
 
-TEST_F(Jit, AMissingCompilerIsAnErrorForCompiledAndTheInterpreterForAuto) {
+TEST_F(Jit, AMissingCompilerIsAnErrorOfMakeCompiledAndTheInterpreterWithANoticeForARun) {
   options_.compiler = "/nonexistent/c++";
   const Model model = load_model(example("whipple_bicycle.toml"));
   try {
@@ -185,11 +185,14 @@ TEST_F(Jit, AMissingCompilerIsAnErrorForCompiledAndTheInterpreterForAuto) {
   } catch (const JitError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/c++"), std::string::npos) << e.what();
   }
-  std::string notice;
-  const Model fallback = with_evaluator(model, EvaluatorChoice::automatic, &notice, options_);
-  EXPECT_FALSE(is_compiled(fallback));
-  EXPECT_NE(notice.find("interpreter"), std::string::npos) << notice;
-  EXPECT_EQ(notice.find('\n'), std::string::npos) << "one line";
+  for (const EvaluatorChoice choice : {EvaluatorChoice::automatic, EvaluatorChoice::compiled}) {
+    std::string notice;
+    const Model fallback = with_evaluator(model, choice, &notice, options_);
+    EXPECT_FALSE(is_compiled(fallback));
+    EXPECT_NE(notice.find("interpreter"), std::string::npos) << notice;
+    EXPECT_NE(notice.find("/nonexistent/c++"), std::string::npos) << notice;
+    EXPECT_EQ(notice.find('\n'), std::string::npos) << "one line";
+  }
 }
 
 TEST_F(Jit, AutoLeavesSmallModelsToTheInterpreter) {
@@ -205,6 +208,9 @@ TEST_F(Jit, HandWrittenModelsHaveNothingToCompile) {
   EXPECT_THROW(make_compiled(model, options_), JitError);
   std::string notice;
   EXPECT_FALSE(is_compiled(with_evaluator(model, EvaluatorChoice::automatic, &notice, options_)));
+  EXPECT_TRUE(notice.empty()) << notice;
+  EXPECT_FALSE(is_compiled(with_evaluator(model, EvaluatorChoice::compiled, &notice, options_)));
+  EXPECT_NE(notice.find("nothing to compile"), std::string::npos) << notice;
 }
 
 TEST(EvaluatorChoice, Parses) {

@@ -308,10 +308,18 @@ Model make_compiled(const Model& model, const JitOptions& options, JitReport* re
 Model with_evaluator(const Model& model, EvaluatorChoice choice, std::string* notice, const JitOptions& options,
                      JitReport* report) {
   if (choice == EvaluatorChoice::interpreted) return model;
-  if (choice == EvaluatorChoice::compiled) return make_compiled(model, options, report);
   const auto* base = dynamic_cast<const ProgramEvaluator*>(model.evaluator.get());
-  if (base == nullptr || base->parametric_programs().terms.code().size() < static_cast<std::size_t>(kAutoCompileFrom))
+  if (base == nullptr) {
+    if (choice == EvaluatorChoice::compiled && notice)
+      *notice = fmt::format(
+          "nhdyn: notice: model '{}' is a hand-written built-in model, C++ already: nothing to compile", model.name);
     return model;
+  }
+  if (choice == EvaluatorChoice::automatic &&
+      base->parametric_programs().terms.code().size() < static_cast<std::size_t>(kAutoCompileFrom))
+    return model;
+  // Asked for or worth it: compiled where possible, and otherwise the interpreter with a notice —
+  // a missing compiler or a failed compile never fails a run (make_compiled reports it as an error).
   try {
     return make_compiled(model, options, report);
   } catch (const JitError& e) {

@@ -54,9 +54,10 @@ struct JitReport {
 Model make_compiled(const Model& model, const JitOptions& options = {}, JitReport* report = nullptr);
 
 // The model with the evaluator `choice` asks for: interpreted returns it unchanged; compiled
-// compiles it (throws JitError as make_compiled); automatic compiles when the terms program has
-// kAutoCompileFrom operations or more and falls back to the interpreter on any failure, writing a
-// one-line notice to `notice` (not printed: the caller prints).
+// compiles it; automatic compiles when the terms program has kAutoCompileFrom operations or more.
+// A compile that fails (no compiler, a compile error, a failed dlopen, a hand-written model) never
+// fails the run: the interpreter is kept and a one-line notice written to `notice` (not printed:
+// the caller prints). make_compiled is the call that throws.
 Model with_evaluator(const Model& model, EvaluatorChoice choice, std::string* notice = nullptr,
                      const JitOptions& options = {}, JitReport* report = nullptr);
 
