@@ -181,6 +181,7 @@ int run_simulate(const SimulateArgs& args) {
                                    *args.max_steps, IntegratorOptions{}.max_steps));
     options.integrator.max_steps = *args.max_steps;
   }
+  options.events = model.events;  // the file's [[events]], then the command line's
   for (const std::string& condition : args.stop_when)
     options.events.push_back(symbolic::make_stop_condition(model, condition));
   for (const std::string& definition : args.events)
@@ -223,7 +224,7 @@ int run_simulate(const SimulateArgs& args) {
   const fs::path events_path = companion(csv_path, "-events.csv");
   const fs::path partial_path = companion(csv_path, ".partial.csv");
   std::optional<AtomicFile> events_file;
-  if (companions && (!options.events.empty() || !model.events.empty())) events_file.emplace(events_path);
+  if (companions && !options.events.empty()) events_file.emplace(events_path);
 
   std::vector<double> row;
   row.reserve(columns.all.size());

@@ -17,7 +17,7 @@ namespace nhdyn {
 
 // One located crossing: which event, when, and the state there (as written to the results).
 struct EventRecord {
-  int index = 0;             // in the run's list of events (the model's first, then the options')
+  int index = 0;             // in the run's list of events (SimulationOptions::events)
   std::string name;
   double t = 0.0;
   std::vector<double> q, v;  // n values each

@@ -116,8 +116,7 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
   }
   if (io.max_steps < 1)
     throw InputError(fmt::format("the step budget (--max-steps) {} must be at least 1", io.max_steps));
-  const bool has_events = !options.events.empty() || (options.model_events && !model.events.empty());
-  if (has_events && !supports_events(io.kind))
+  if (!options.events.empty() && !supports_events(io.kind))
     throw InputError(fmt::format("events need an integrator that can locate them; {} has no continuous extension: "
                                  "choose dopri5, dop853, cvode-bdf or cvode-adams",
                                  integrator_name(io.kind)));
@@ -197,10 +196,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     return Status::ok;
   };
 
-  // The model's events, then the options'.
   std::vector<const Event*> events;
-  if (options.model_events)
-    for (const Event& e : model.events) events.push_back(&e);
   for (const Event& e : options.events) events.push_back(&e);
   for (const Event* e : events) summary.event_names.push_back(e->name);
   ModelEventFunctions event_functions(model, events, [&](int i, double t, const double* y) -> Status {

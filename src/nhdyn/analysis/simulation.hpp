@@ -47,12 +47,12 @@ struct SimulationOptions {
   // compiled sparse and a formulation with sparse kernels (sanh, lagrange), the dense path
   // otherwise (udwadia-kalaba and nullspace on a sparse model: dense, if it fits in memory).
   Path path = Path::automatic;
-  // Events located during the run (analysis/events.hpp): the model's own (Model::events, unless
-  // model_events is false), then these. Each crossing writes a row at its time (the exact event
-  // state, between the output rows) and is listed in SimulationSummary::events; a stop event ends
-  // the run there with status ok. rk4 cannot locate events: check_simulation_options refuses them.
+  // Events located during the run (analysis/events.hpp; a model file's [[events]] are in
+  // Model::events: copy them here to locate them). Each crossing writes a row at its time (the
+  // exact event state, between the output rows) and is listed in SimulationSummary::events; a stop
+  // event ends the run there with status ok. rk4 cannot locate events: check_simulation_options
+  // refuses them.
   std::vector<Event> events;
-  bool model_events = true;
 };
 
 struct SimulationSummary {
@@ -79,7 +79,7 @@ struct SimulationSummary {
   double max_velocity_correction = 0.0;
   // The crossings located, in time order, and the stop event that ended the run (its index in
   // `event_names`), or -1 when the run reached t_end.
-  std::vector<std::string> event_names;  // the run's events: the model's, then the options'
+  std::vector<std::string> event_names;  // the run's events, those of SimulationOptions::events
   std::vector<EventRecord> events;
   int stopped_by = -1;
 };

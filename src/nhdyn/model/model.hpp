@@ -61,8 +61,8 @@ struct Model {
   // Immutable and bound to the values of `parameters`: Model copies (one per thread) share it
   // until one of them sets a parameter, which gives that copy a new one.
   std::shared_ptr<const Evaluator> evaluator;
-  // The model's own events ([[events]] of its file), which every simulate() locates unless
-  // SimulationOptions::model_events is false (analysis/simulation.hpp).
+  // The model's own events ([[events]] of its file); a run locates those of its options
+  // (SimulationOptions::events, analysis/simulation.hpp), which `nhdyn simulate` starts from these.
   std::vector<Event> events;
 
   int n() const { return static_cast<int>(coordinates.size()); }

@@ -8,6 +8,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/symbolic/compile.hpp"
+#include "nhdyn/symbolic/spec.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
 
 namespace nhdyn::symbolic {

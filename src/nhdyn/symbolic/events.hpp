@@ -11,9 +11,10 @@
 
 #include "nhdyn/model/event.hpp"
 #include "nhdyn/model/model.hpp"
-#include "nhdyn/symbolic/spec.hpp"
 
 namespace nhdyn::symbolic {
+
+struct Spec;  // spec.hpp: this header includes no GiNaC, for the CLI and the Python module
 
 // Appends an Event to model.events for each of spec.events, in order.
 void compile_events(const Spec& spec, Model& model);
