@@ -219,6 +219,18 @@ TEST_F(CliEvents, BicycleFallsAtTwoMetresPerSecondAndNotAtFive) {
   EXPECT_LT(largest, 0.5);  // it never came near falling
 }
 
+TEST_F(CliEvents, TheStopWhenExampleOfTheDocs) {
+  // docs/cli.md, "Events": the pendulum released at theta0 = 2 rad passes the bottom after P/4.
+  const Outcome run = nhdyn("simulate " + examples + "pendulum_cartesian.toml --stop-when \"x < 0\" -o pendulum.csv");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("stopped by event 'x < 0', 83 rows -> pendulum.csv"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("events: 1 located -> pendulum-events.csv\n    x < 0 at t = 0.81625294126\n"),
+            std::string::npos)
+      << run.out;
+  const double quarter = std::sqrt(1.5 / 9.81) * std::comp_ellint_1(std::sin(1.0));
+  EXPECT_NEAR(load_events(dir_ / "pendulum-events.csv").rows.at(0).at(0), quarter, 1e-9);
+}
+
 TEST_F(CliEvents, SameInputSameBytes) {
   const std::string args = "simulate " + examples + "pendulum_cartesian.toml --event bottom=x --t-end 4 -o ";
   ASSERT_EQ(nhdyn(args + "a.csv").exit_code, 0);
@@ -262,8 +274,11 @@ TEST_F(CliEvents, BadInputIsRefusedBeforeTheRun) {
       {"simulate " + pendulum + " --stop-when 'abs(xx) > 1.2'", {"unknown symbol 'xx'", "did you mean 'x'?", "column 5"}},
       {"simulate " + pendulum + " --event 'far=abs(xx)'", {"--event \"far=abs(xx)\"", "did you mean 'x'?"}},
       {"simulate " + pendulum + " --event 'abs(x)'", {"expected NAME=EXPR"}},
-      {"simulate " + sleigh + " --event 'start=x'", {"event 'start'", "already at zero at the start"}},
-      {"simulate " + sleigh + " --stop-when 'phi > -1'", {"already holds at the start"}},
+      {"simulate " + sleigh + " --event 'start=x'", {"--event \"start=x\": event 'start'", "already at zero at the start"}},
+      {"simulate " + sleigh + " --stop-when 'phi > -1'", {"--stop-when \"phi > -1\": ", "already holds at the start"}},
+      {"simulate " + sleigh + " --stop-when 'abs(phii) > 1'",
+       {"--stop-when \"abs(phii) > 1\": unknown symbol 'phii'; did you mean 'phi'? (column 5 of \"abs(phii) > 1\")"}},
+      {"simulate " + sleigh + " --stop-when 'phi > 1 > 2'", {"expected one comparison"}},
       {"simulate " + pendulum + " --max-steps 0", {"--max-steps 0", "at least 1"}},
       {"simulate " + pendulum + " --max-steps=-5", {"--max-steps -5", "at least 1"}},
       {"simulate " + pendulum + " --event bottom=x --integrator rk4", {"rk4", "dopri5, dop853"}},

@@ -68,10 +68,10 @@ void ModelEventFunctions::require_valid_start(double t0, const double* y0) {
                                    "write it in a form defined at the initial state",
                                    where, e.name, e.expression, g_[i], t0));
     if (e.condition && g_[i] >= 0.0)
-      throw InputError(fmt::format("{}the stop condition \"{}\" already holds at the start (t0 = {}, the difference "
-                                   "of its sides is {:.6g}): the run would stop before its first step; give a "
-                                   "condition that becomes true later",
-                                   where, e.expression, t0, g_[i]));
+      throw InputError(fmt::format("{}the stop condition already holds at the start (t0 = {}, the difference of its "
+                                   "sides is {:.6g}): the run would stop before its first step; give a condition "
+                                   "that becomes true later",
+                                   where, t0, g_[i]));
     if (g_[i] == 0.0)
       throw InputError(fmt::format("{}event '{}' ({}) is already at zero at the start (t0 = {}): it would be found "
                                    "at the initial state, not where it crosses zero later; shift its expression or "

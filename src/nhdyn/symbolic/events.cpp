@@ -116,12 +116,12 @@ Event make_stop_condition(const Model& model, const std::string& condition) {
   const GiNaC::ex left = read_option(builder, option, condition, lhs);
   const GiNaC::ex right = read_option(builder, option, condition, rhs);
   try {
-    Event event = finish(builder.current(), greater ? left - right : right - left, condition, condition, option,
-                         EventDirection::rising, EventAction::stop);
+    Event event = finish(builder.current(), greater ? left - right : right - left, condition, condition,
+                         fmt::format("{} \"{}\"", option, condition), EventDirection::rising, EventAction::stop);
     event.condition = true;
     return event;
   } catch (const ModelError& e) {
-    throw InputError(fmt::format("{} \"{}\": {}", option, condition, e.what()));
+    throw InputError(e.what());
   }
 }
 
@@ -145,10 +145,10 @@ Event make_record_event(const Model& model, const std::string& definition) {
   const SpecBuilder builder = names_of(model);
   const GiNaC::ex g = read_option(builder, option, definition, text);
   try {
-    return finish(builder.current(), g, name, definition.substr(eq + 1), option, EventDirection::both,
-                  EventAction::record);
+    return finish(builder.current(), g, name, definition.substr(eq + 1), fmt::format("{} \"{}\"", option, definition),
+                  EventDirection::both, EventAction::record);
   } catch (const ModelError& e) {
-    throw InputError(fmt::format("{} \"{}\": {}", option, definition, e.what()));
+    throw InputError(e.what());
   }
 }
 
