@@ -1,7 +1,8 @@
 // Events through the C++ API: a model file's [[events]] become Model::events, simulate() locates
 // the ones of SimulationOptions::events and returns them in the summary, and a parameter an event
 // reads is data (set_parameter moves the event without recompiling). A particle at constant speed
-// crosses x = L at exactly t = L / v0; the ball thrown up reaches its top at v0 / g.
+// crosses x = L at exactly t = L / u; the ball thrown up at w reaches its top at w / g and lands
+// from the height h at (w + sqrt(w^2 + 2 g h)) / g.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,7 +16,7 @@
 namespace nhdyn {
 namespace {
 
-const std::string ball = R"(
+const std::string ball = R"toml(
 name = "ball"
 coordinates = ["x", "z"]
 kinetic_energy = "m/2 * (x'^2 + z'^2)"
@@ -27,8 +28,10 @@ g = { value = 9.81 }
 u = { value = 2.0 }    # horizontal speed
 w = { value = 4.0 }    # initial vertical speed
 L = { value = 1.5 }
+h = { value = 0.5 }    # initial height
 
 [initial]
+position = { z = "h" }
 velocity = { x = "u", z = "w" }
 
 [[events]]
@@ -45,7 +48,7 @@ name = "landed"
 when = "z"
 direction = "falling"
 action = "stop"
-)";
+)toml";
 
 TEST(Events, ModelFileEventsThroughTheApi) {
   Model model = load_model_text(ball, "ball.toml");
@@ -55,7 +58,7 @@ TEST(Events, ModelFileEventsThroughTheApi) {
   EXPECT_EQ(model.events[0].action, EventAction::record);
   EXPECT_EQ(model.events[1].direction, EventDirection::falling);
   EXPECT_EQ(model.events[2].action, EventAction::stop);
-  EXPECT_EQ(model.events[0].where, "ball.toml:19:9");
+  EXPECT_EQ(model.events[0].where, "ball.toml:21:9");
 
   SimulationOptions options;
   options.t_end = 5.0;
@@ -63,7 +66,7 @@ TEST(Events, ModelFileEventsThroughTheApi) {
   options.events = model.events;
   SimulationSummary summary = simulate(model, options, [](const Data&) {});
   ASSERT_EQ(summary.status, Status::ok) << summary.message;
-  // passed at L/u = 0.75 s, the top at w/g, landed at 2 w/g (= 0.8155 s) which stops the run.
+  // The top at w/g, passed at L/u = 0.75 s, landed at (w + sqrt(w^2 + 2 g h))/g, which stops the run.
   ASSERT_EQ(summary.events.size(), 3u);
   EXPECT_EQ(summary.events[0].name, "top");
   EXPECT_NEAR(summary.events[0].t, 4.0 / 9.81, 1e-12);
@@ -71,7 +74,7 @@ TEST(Events, ModelFileEventsThroughTheApi) {
   EXPECT_NEAR(summary.events[1].t, 0.75, 1e-12);
   EXPECT_NEAR(summary.events[1].q[0], 1.5, 1e-12);
   EXPECT_EQ(summary.events[2].name, "landed");
-  EXPECT_NEAR(summary.events[2].t, 8.0 / 9.81, 1e-12);
+  EXPECT_NEAR(summary.events[2].t, (4.0 + std::sqrt(16.0 + 2.0 * 9.81 * 0.5)) / 9.81, 1e-12);
   EXPECT_EQ(summary.stopped_by, 2);
   EXPECT_EQ(summary.t_reached, summary.events[2].t);
 
@@ -100,11 +103,11 @@ TEST(Events, ModelFileErrorsNameTheirPlace) {
   };
   std::string text = ball;
   text.replace(text.find("when = \"z'\""), 11, "when = \"zz'\"");
-  EXPECT_NE(message(text).find("ball.toml:23:9: "), std::string::npos) << message(text);
+  EXPECT_NE(message(text).find("ball.toml:25:9: "), std::string::npos) << message(text);
   EXPECT_NE(message(text).find("did you mean 'z''?"), std::string::npos) << message(text);
   text = ball;
   text.replace(text.find("when = \"z'\""), 11, "when = \"z''\"");
-  EXPECT_NE(message(text).find("ball.toml:23:9: event 'top' contains the acceleration z''"), std::string::npos)
+  EXPECT_NE(message(text).find("ball.toml:25:9: event 'top' contains the acceleration z''"), std::string::npos)
       << message(text);
   text = ball + "\n[[events]]\nname = \"top\"\nwhen = \"x\"\n";
   EXPECT_NE(message(text).find("event name 'top' is used twice"), std::string::npos) << message(text);
@@ -126,7 +129,7 @@ TEST(Events, Rk4AndAnEventAtZeroAreRefusedBeforeTheRun) {
     simulate(model, options, [](const Data&) {});
     FAIL() << "an event at zero at the start was accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("ball.toml:19:9: event 'passed' (x - L) is already at zero at the start"),
+    EXPECT_NE(std::string(e.what()).find("ball.toml:21:9: event 'passed' (x - L) is already at zero at the start"),
               std::string::npos)
         << e.what();
   }
