@@ -115,9 +115,10 @@ EventsTable load_events(const fs::path& path) {
 TEST_F(CliEvents, PendulumPeriodFromItsEvents) {
   // x crosses zero at the bottom, alternately rising and falling: crossings k and k + 2 are one
   // period apart. examples/pendulum_cartesian.toml: l = 1.5 m, g = 9.81 m/s^2, theta0 = 2 rad.
+  // The second command of docs/cli.md, "Events".
   const Outcome run = nhdyn("simulate " + examples +
-                        "pendulum_cartesian.toml --event bottom=x --integrator dop853 --rtol 1e-13 --atol 1e-15 "
-                        "-o p.csv");
+                            "pendulum_cartesian.toml --event bottom=x --integrator dop853 --rtol 1e-13 --atol 1e-15 "
+                            "-o p.csv");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const EventsTable events = load_events(dir_ / "p-events.csv");
   ASSERT_EQ(events.header.size(), 6u);
