@@ -4,11 +4,15 @@
 #include <pybind11/stl.h>
 
 #include <chrono>
+#include <map>
+#include <string>
+#include <vector>
 
 #include "bindings.hpp"
 #include "nhdyn/analysis/batch.hpp"
 #include "nhdyn/analysis/run_options.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/symbolic/events.hpp"
 
 namespace nhdyn::python {
 namespace {
@@ -27,7 +31,20 @@ std::optional<T> get(const py::dict& kwargs, const char* key) {
 
 const char* const known_options[] = {"t_end",     "output_step", "method",    "complement",
                                      "integrator", "rtol",        "atol",      "step",
-                                     "fix_initial", "stabilize",  "q0",        "v0"};
+                                     "fix_initial", "stabilize",  "q0",        "v0",
+                                     "stop_when",  "events",      "max_steps"};
+
+// A string or a sequence of strings.
+std::vector<std::string> strings(const py::dict& kwargs, const char* key) {
+  if (!kwargs.contains(key) || py::object(kwargs[key]).is_none()) return {};
+  const py::object value = kwargs[key];
+  if (py::isinstance<py::str>(value)) return {value.cast<std::string>()};
+  try {
+    return value.cast<std::vector<std::string>>();
+  } catch (const py::cast_error&) {
+    throw InputError(fmt::format("{}={}: expected a string or a list of strings", key, py::repr(value).cast<std::string>()));
+  }
+}
 
 }  // namespace
 
@@ -38,7 +55,8 @@ SimulationOptions make_options(const Model& model, const py::dict& kwargs) {
     for (const char* name : known_options) known = known || key == name;
     if (!known)
       throw InputError(fmt::format("simulate: unknown option '{}'; the options are t_end, output_step, method, complement, "
-                                   "integrator, rtol, atol, step, fix_initial, stabilize, q0, v0",
+                                   "integrator, rtol, atol, step, fix_initial, stabilize, q0, v0, stop_when, events, "
+                                   "max_steps",
                                    key));
   }
   RunOptions run = model.defaults;
@@ -53,6 +71,24 @@ SimulationOptions make_options(const Model& model, const py::dict& kwargs) {
   options.integrator.step = get<double>(kwargs, "step").value_or(0.0);
   options.fix_initial = get<bool>(kwargs, "fix_initial").value_or(false);
   options.stabilization = parse_stabilization(get<std::string>(kwargs, "stabilize").value_or("none"));
+  if (const std::optional<long> max_steps = get<long>(kwargs, "max_steps")) {
+    if (*max_steps < 1) throw InputError(fmt::format("max_steps={}: the step budget must be at least 1", *max_steps));
+    options.integrator.max_steps = *max_steps;
+  }
+  // The model's [[events]], then stop_when="abs(phi) > 1" (conditions) and events={"name": "expr"}.
+  options.events = model.events;
+  for (const std::string& condition : strings(kwargs, "stop_when"))
+    options.events.push_back(symbolic::make_stop_condition(model, condition));
+  if (kwargs.contains("events") && !py::object(kwargs["events"]).is_none()) {
+    std::map<std::string, std::string> events;
+    try {
+      events = py::object(kwargs["events"]).cast<std::map<std::string, std::string>>();
+    } catch (const py::cast_error&) {
+      throw InputError("events: expected a dict of names to expressions, e.g. events={\"bottom\": \"x\"}");
+    }
+    for (const auto& [name, expression] : events)
+      options.events.push_back(symbolic::make_record_event(model, name + "=" + expression));
+  }
   check_simulation_options(model, options);
   return options;
 }
@@ -87,6 +123,7 @@ py::dict summary_dict(const SimulationSummary& s) {
   d["max_velocity_residual"] = s.max_velocity_residual;
   d["max_acceleration_residual"] = s.max_acceleration_residual;
   d["energy_drift"] = s.has_energy ? py::cast(s.energy_drift) : py::none();
+  d["stopped_by"] = s.stopped_by >= 0 ? py::cast(s.event_names[static_cast<std::size_t>(s.stopped_by)]) : py::none();
   return d;
 }
 
@@ -132,6 +169,17 @@ void bind_simulation(py::module_& m) {
         }
         py::dict out = trajectory_dict(std::move(trajectory));
         out["summary"] = summary_dict(summary);
+        // The located crossings, in time order: name, t, q, qd at each.
+        py::list events;
+        for (const EventRecord& e : summary.events) {
+          py::dict event;
+          event["name"] = e.name;
+          event["t"] = e.t;
+          event["q"] = py::array_t<double>(static_cast<py::ssize_t>(e.q.size()), e.q.data());
+          event["qd"] = py::array_t<double>(static_cast<py::ssize_t>(e.v.size()), e.v.data());
+          events.append(event);
+        }
+        out["events"] = events;
         out["ok"] = summary.status == Status::ok;
         out["cpp_seconds"] = seconds;  // the whole C++ call, for the overhead benchmark
         return out;

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <string>
@@ -21,6 +22,7 @@
 #include "nhdyn/io/report.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
+#include "nhdyn/symbolic/events.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 #include "progress.hpp"
 
@@ -48,6 +50,9 @@ struct SimulateArgs {
   std::string html;  // the HTML report (io/report.hpp), written from the CSV after the run
   bool quiet = false;
   std::string evaluator = "interpreted";  // interpreted | compiled | auto (jit/compiled_evaluator.hpp)
+  std::vector<std::string> stop_when;  // conditions that end the run when they become true
+  std::vector<std::string> events;     // NAME=EXPR: crossings of zero to record
+  std::optional<long> max_steps;       // the integrator's step budget (default IntegratorOptions)
 };
 
 std::string format_residual(double value, bool defined) { return defined ? fmt::format("{:.3g}", value) : "-"; }
@@ -90,6 +95,66 @@ class ConstraintWatch {
   std::vector<std::string> warnings_;
 };
 
+// Where a run's companion files go: FILE.csv -> FILE-events.csv and FILE.partial.csv (the
+// extension .csv, if any, replaced).
+std::filesystem::path companion(const std::filesystem::path& csv, const std::string& suffix) {
+  std::string base = csv.string();
+  if (csv.extension() == ".csv") base.resize(base.size() - 4);
+  return base + suffix;
+}
+
+std::string csv_cell(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string csv_line(const std::vector<std::string>& cells) {
+  std::string line;
+  for (std::size_t i = 0; i < cells.size(); ++i) line += (i ? "," : "") + csv_cell(cells[i]);
+  return line + "\n";
+}
+
+// The rows of a run kept in memory as well as in the CSV's temporary file, so that a failed run
+// can leave them in FILE.partial.csv with the reason first (the CSV itself is never committed).
+// Numbers are printed as CsvWriter prints them: the shortest form that reads back the same.
+std::string format_rows(const std::vector<double>& values, std::size_t columns) {
+  std::string out;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    fmt::format_to(std::back_inserter(out), "{}", values[i]);
+    out += (i + 1) % columns == 0 ? '\n' : ',';
+  }
+  return out;
+}
+
+// FILE-events.csv: one row per located crossing, name, t, q, q'.
+void write_events_file(AtomicFile& file, const Model& model, const SimulationSummary& summary) {
+  std::vector<std::string> header = {"event", "t"};
+  for (const std::string& q : model.coordinates) header.push_back(q);
+  for (const std::string& q : model.coordinates) header.push_back(q + "'");
+  std::string text = csv_line(header);
+  for (const EventRecord& e : summary.events) {
+    text += csv_cell(e.name);
+    fmt::format_to(std::back_inserter(text), ",{}", e.t);
+    for (double x : e.q) fmt::format_to(std::back_inserter(text), ",{}", x);
+    for (double x : e.v) fmt::format_to(std::back_inserter(text), ",{}", x);
+    text += '\n';
+  }
+  file.write(text);
+  file.commit();
+}
+
+// A device or pipe as the CSV (/dev/stdout) has no place beside it for companion files.
+bool is_regular_target(const std::filesystem::path& csv) {
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(csv, ec);
+  return ec || !std::filesystem::exists(status) || std::filesystem::is_regular_file(status);
+}
+
 int run_simulate(const SimulateArgs& args) {
   protect_model_file(args.model);
   const ResolvedModel resolved = resolve_model(args.model, args.sets);
@@ -113,6 +178,18 @@ int run_simulate(const SimulateArgs& args) {
   options.formulation.baumgarte.alpha = args.baumgarte_alpha;
   options.formulation.baumgarte.beta = args.baumgarte_beta;
   options.projection.tolerance = args.projection_tolerance;
+  if (args.max_steps) {
+    if (*args.max_steps < 1)
+      throw InputError(fmt::format("--max-steps {}: the step budget must be at least 1 (accepted + rejected steps "
+                                   "of the whole run; the default is {})",
+                                   *args.max_steps, IntegratorOptions{}.max_steps));
+    options.integrator.max_steps = *args.max_steps;
+  }
+  options.events = model.events;  // the file's [[events]], then the command line's
+  for (const std::string& condition : args.stop_when)
+    options.events.push_back(symbolic::make_stop_condition(model, condition));
+  for (const std::string& definition : args.events)
+    options.events.push_back(symbolic::make_record_event(model, definition));
   check_simulation_options(model, options);
 
   namespace fs = std::filesystem;
@@ -147,14 +224,21 @@ int run_simulate(const SimulateArgs& args) {
   }
   const ResultColumns columns = make_result_columns(model);
   CsvWriter writer(csv_path, columns.all);  // refuses an unwritable path before any step
+  const bool companions = is_regular_target(csv_path);
+  const fs::path events_path = companion(csv_path, "-events.csv");
+  const fs::path partial_path = companion(csv_path, ".partial.csv");
+  std::optional<AtomicFile> events_file;
+  if (companions && !options.events.empty()) events_file.emplace(events_path);
 
   std::vector<double> row;
   row.reserve(columns.all.size());
+  std::vector<double> kept;  // every row, for FILE.partial.csv if the run fails
   ProgressBar progress(model.t0, options.t_end);
   ConstraintWatch watch;
   const SimulationSummary summary = simulate(model, options, [&](const Data& data) {
     fill_result_row(model, data, row);
     writer.write_row(row);
+    if (companions) kept.insert(kept.end(), row.begin(), row.end());
     watch.update(model, data);
     progress.update(data.t);
   });
@@ -163,10 +247,23 @@ int run_simulate(const SimulateArgs& args) {
   if (summary.status != Status::ok) {
     fmt::print(stderr, "nhdyn: simulation of '{}' failed at t = {:.6g}: {}\n", model.name, summary.t_reached,
                summary.message);
-    fmt::print(stderr, "nhdyn: no results written ({} is left as it was)\n", csv_path.string());
+    if (companions) {
+      std::string reason = fmt::format("# nhdyn: simulation of '{}' failed at t = {:.6g}: {}", model.name,
+                                       summary.t_reached, summary.message);
+      for (char& c : reason)
+        if (c == '\n' || c == '\r') c = ' ';
+      AtomicFile partial(partial_path);
+      partial.write(reason + "\n" + csv_line(columns.all) + format_rows(kept, columns.all.size()));
+      partial.commit();
+      fmt::print(stderr, "nhdyn: the {} rows up to the failure are in {} ({} is left as it was)\n",
+                 summary.outputs, partial_path.string(), csv_path.string());
+    } else {
+      fmt::print(stderr, "nhdyn: no results written ({} is left as it was)\n", csv_path.string());
+    }
     return 1;
   }
   writer.commit();
+  if (events_file) write_events_file(*events_file, model, summary);
   plot_probe.reset();
   if (!args.plot.empty()) {
     PlotRequest request;
@@ -210,7 +307,20 @@ int run_simulate(const SimulateArgs& args) {
                  "{:.3g} in a coordinate, {:.3g} in a velocity\n",
                  summary.projections, summary.projection_iterations, summary.max_position_correction,
                  summary.max_velocity_correction);
-    fmt::print("  t = {:g} .. {:g} s, {} rows -> {}\n", model.t0, options.t_end, summary.outputs, csv_path.string());
+    if (summary.stopped_by >= 0)
+      fmt::print("  t = {:g} .. {:.10g} s: stopped by event '{}', {} rows -> {}\n", model.t0, summary.t_reached,
+                 summary.event_names[static_cast<std::size_t>(summary.stopped_by)], summary.outputs,
+                 csv_path.string());
+    else
+      fmt::print("  t = {:g} .. {:g} s, {} rows -> {}\n", model.t0, options.t_end, summary.outputs, csv_path.string());
+    if (!summary.event_names.empty()) {
+      fmt::print("  events: {} located{}\n", summary.events.size(),
+                 events_file ? fmt::format(" -> {}", events_path.string()) : std::string());
+      constexpr std::size_t shown = 10;
+      for (std::size_t i = 0; i < summary.events.size() && i < shown; ++i)
+        fmt::print("    {} at t = {:.12g}\n", summary.events[i].name, summary.events[i].t);
+      if (summary.events.size() > shown) fmt::print("    ... and {} more\n", summary.events.size() - shown);
+    }
     fmt::print("  steps {} (rejected {}), right-hand-side evaluations {}, wall time {:.3g} ms\n",
                summary.stats.steps, summary.stats.rejected_steps, summary.stats.rhs_evaluations,
                summary.wall_time * 1e3);
@@ -265,6 +375,12 @@ std::function<int()> add_simulate_command(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "CSV file to write (default results/MODEL.csv)");
   cmd->add_option("--plot", args->plot, "PNG file to draw with gnuplot");
   cmd->add_option("--html", args->html, "HTML report to write: 3-D animation, plots, equations (docs/report.md)");
+  cmd->add_option("--stop-when", args->stop_when,
+                  "End the run when a condition becomes true, e.g. \"abs(phi) > 1.2\" (located exactly; repeatable)");
+  cmd->add_option("--event", args->events,
+                  "Record the zero crossings of an expression, NAME=EXPR (e.g. upright=phi; repeatable)");
+  cmd->add_option("--max-steps", args->max_steps,
+                  "Step budget of the integrator, accepted + rejected steps (default 50000000)");
   cmd->add_flag("-q,--quiet", args->quiet, "Print no summary");
   return [args] { return run_simulate(*args); };
 }

@@ -150,13 +150,18 @@ class Model:
 
     # --- runs and analyses ---------------------------------------------------------------------
     def simulate(self, t_end=None, *, rtol=None, atol=None, method=None, integrator=None, output_step=None,
-                 complement=None, step=None, fix_initial=None, stabilize=None, q0=None, qd0=None):
+                 complement=None, step=None, fix_initial=None, stabilize=None, q0=None, qd0=None,
+                 stop_when=None, events=None, max_steps=None):
         """One run from the model's initial state (or q0, qd0) with the model's run options, any of
-        them overridden here. Returns a Result; a run that fails numerically raises
-        nhdyn.SimulationError with the library's message."""
+        them overridden here. Events: the model file's [[events]], plus stop_when (a condition such
+        as "abs(phi) > 1", or a list of them: the run ends when one becomes true) and events (a
+        dict of names to expressions whose zero crossings are recorded); they are located exactly
+        and listed in Result.events, each also a row of the outputs. Returns a Result; a run that
+        fails numerically raises nhdyn.SimulationError with the library's message."""
         out = _nhdyn.simulate(self._cpp, t_end=t_end, rtol=rtol, atol=atol, method=method, integrator=integrator,
                               output_step=output_step, complement=complement, step=step, fix_initial=fix_initial,
-                              stabilize=stabilize, q0=q0, v0=qd0)
+                              stabilize=stabilize, q0=q0, v0=qd0, stop_when=stop_when, events=events,
+                              max_steps=max_steps)
         if not out["ok"]:
             summary = out["summary"]
             raise SimulationError("simulation of '{}' failed at t = {:.6g}: {}".format(
@@ -201,6 +206,8 @@ class Result:
         self.t, self.q, self.qd, self.qdd = out["t"], out["q"], out["qd"], out["qdd"]
         self.R, self.residuals, self.energy = out["R"], out["residuals"], out["energy"]
         self.summary = out["summary"]
+        # The located events in time order: dicts with name, t, q and qd at the crossing.
+        self.events = out["events"]
         self.cpp_seconds = out["cpp_seconds"]
         self.columns = model._cpp.columns
 

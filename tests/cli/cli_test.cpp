@@ -692,7 +692,9 @@ INSTANTIATE_TEST_SUITE_P(
 const std::vector<std::string> diverging_sled{"simulate", "sled",          "--integrator", "rk4", "--step", "5",
                                               "--t-end",  "20",            "--output-step", "5"};
 
-TEST(CliFailure, NumericalFailureExitsWith1AndWritesNothing) {
+// A failed run writes no results, only the rows up to the failure in FILE.partial.csv, whose
+// first line gives the reason (tests/cli/events_cli_test.cpp checks its content).
+TEST(CliFailure, NumericalFailureExitsWith1AndKeepsOnlyThePartialRows) {
   ScratchDir dir;
   std::vector<std::string> args = diverging_sled;
   args.insert(args.end(), {"-o", "out.csv"});
@@ -701,7 +703,8 @@ TEST(CliFailure, NumericalFailureExitsWith1AndWritesNothing) {
   EXPECT_TRUE(contains(r.err, "failed")) << r.err;
   EXPECT_TRUE(contains(r.err, "out.csv")) << "says which file was not written: " << r.err;
   EXPECT_EQ(r.out, "");
-  EXPECT_TRUE(entries(dir.path()).empty());
+  EXPECT_EQ(entries(dir.path()), (std::set<std::string>{"out.partial.csv"}));
+  EXPECT_TRUE(read_bytes(dir / "out.partial.csv").starts_with("# nhdyn: simulation of 'sled' failed at t = "));
 }
 
 TEST(CliFailure, NumericalFailureLeavesAnExistingFileUntouched) {
@@ -714,7 +717,7 @@ TEST(CliFailure, NumericalFailureLeavesAnExistingFileUntouched) {
   const RunResult r = nhdyn(args, dir.path());
   EXPECT_EQ(r.exit_code, 1) << context(args, r);
   EXPECT_EQ(read_bytes(dir / "out.csv"), old_bytes);
-  EXPECT_EQ(entries(dir.path()), (std::set<std::string>{"out.csv"})) << "no plot, no temporary";
+  EXPECT_EQ(entries(dir.path()), (std::set<std::string>{"out.csv", "out.partial.csv"})) << "no plot, no temporary";
 }
 
 TEST(CliFailure, NumericalFailureWithTheDefaultOutput) {
@@ -722,7 +725,8 @@ TEST(CliFailure, NumericalFailureWithTheDefaultOutput) {
   const RunResult r = nhdyn(diverging_sled, dir.path());
   EXPECT_EQ(r.exit_code, 1) << context(diverging_sled, r);
   ASSERT_TRUE(fs::is_directory(dir / "results"));
-  EXPECT_TRUE(entries(dir / "results").empty()) << "no results/sled.csv, no temporary";
+  EXPECT_EQ(entries(dir / "results"), (std::set<std::string>{"sled.partial.csv"}))
+      << "no results/sled.csv, no temporary";
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -114,6 +114,12 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
       throw InputError(fmt::format("the relative tolerance rtol = {} is below what double precision can "
                                    "deliver; use 1e-14 or more", io.rtol));
   }
+  if (io.max_steps < 1)
+    throw InputError(fmt::format("the step budget (--max-steps) {} must be at least 1", io.max_steps));
+  if (!options.events.empty() && !supports_events(io.kind))
+    throw InputError(fmt::format("events need an integrator that can locate them; {} has no continuous extension: "
+                                 "choose dopri5, dop853, cvode-bdf or cvode-adams",
+                                 integrator_name(io.kind)));
   if (!std::isfinite(io.step) || io.step < 0.0)
     throw InputError(fmt::format("the step {} must be positive (or 0 for the default)", io.step));
   if (options.stabilization == Stabilization::baumgarte) check_baumgarte_gains(options.formulation.baumgarte);
@@ -190,10 +196,31 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     return Status::ok;
   };
 
+  std::vector<const Event*> events;
+  for (const Event& e : options.events) events.push_back(&e);
+  for (const Event* e : events) summary.event_names.push_back(e->name);
+  ModelEventFunctions event_functions(model, events, [&](int i, double t, const double* y) -> Status {
+    // The row at the crossing, then its record with the state as written (projected, if so).
+    if (output(t, y) == Status::stopped) return output_failure;
+    EventRecord record;
+    record.index = i;
+    record.name = events[static_cast<std::size_t>(i)]->name;
+    record.t = t;
+    record.q.assign(data.q.data(), data.q.data() + n);
+    record.v.assign(data.v.data(), data.v.data() + n);
+    summary.events.push_back(std::move(record));
+    return Status::ok;
+  });
+  event_functions.require_valid_start(model.t0, y0.data());
+
   const auto start = std::chrono::steady_clock::now();
-  const IntegrationResult result = integrate(ode, options.integrator, model.t0, y0.data(), times, output);
+  const IntegrationResult result = integrate(ode, options.integrator, model.t0, y0.data(), times, output,
+                                             events.empty() ? nullptr : &event_functions);
   summary.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.status = output_failure != Status::ok ? output_failure : result.status;
+  summary.stopped_by = event_functions.stopped_by();
+  // A stop event ends the run as planned.
+  if (summary.status == Status::stopped && summary.stopped_by >= 0) summary.status = Status::ok;
   summary.t_reached = result.t_reached;
   summary.sparse = data.sparse;
   summary.partition_changes = data.partition_changes;

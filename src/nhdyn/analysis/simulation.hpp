@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "nhdyn/analysis/events.hpp"
 #include "nhdyn/analysis/initial_state.hpp"
 #include "nhdyn/analysis/projection.hpp"
 #include "nhdyn/formulation/formulation.hpp"
@@ -46,6 +47,12 @@ struct SimulationOptions {
   // compiled sparse and a formulation with sparse kernels (sanh, lagrange), the dense path
   // otherwise (udwadia-kalaba and nullspace on a sparse model: dense, if it fits in memory).
   Path path = Path::automatic;
+  // Events located during the run (analysis/events.hpp; a model file's [[events]] are in
+  // Model::events: copy them here to locate them). Each crossing writes a row at its time (the
+  // exact event state, between the output rows) and is listed in SimulationSummary::events; a stop
+  // event ends the run there with status ok. rk4 cannot locate events: check_simulation_options
+  // refuses them.
+  std::vector<Event> events;
 };
 
 struct SimulationSummary {
@@ -70,21 +77,27 @@ struct SimulationSummary {
   long projection_iterations = 0;
   double max_position_correction = 0.0;
   double max_velocity_correction = 0.0;
+  // The crossings located, in time order, and the stop event that ended the run (its index in
+  // `event_names`), or -1 when the run reached t_end.
+  std::vector<std::string> event_names;  // the run's events, those of SimulationOptions::events
+  std::vector<EventRecord> events;
+  int stopped_by = -1;
 };
 
-// Called at every output time with Data holding t, q, q', q'', R, residuals and energy.
+// Called at every output time, and at every event (its row is the state at the crossing), with
+// Data holding t, q, q', q'', R, residuals and energy.
 using RowFn = std::function<void(const Data&)>;
 
 // The output times t0, t0 + h, ..., ending exactly at t_end. Throws InputError on t_end <= t0
 // or output_step <= 0 (or too many outputs to store), naming the value.
 std::vector<double> make_output_times(double t0, double t_end, double output_step);
 
-// Throws InputError for options that cannot make a run (times, tolerances, analytic D missing),
-// naming the value and what to do.
+// Throws InputError for options that cannot make a run (times, tolerances, step budget, analytic
+// D missing, events with an integrator that cannot locate them), naming the value and what to do.
 void check_simulation_options(const Model& model, const SimulationOptions& options);
 
-// Checks the options and the initial state (throws InputError / ModelError before any step),
-// then integrates. Numerical trouble during the run ends it with summary.status and message set.
+// Checks the options, the initial state and the events at it (throws InputError / ModelError
+// before any step), then integrates. Numerical trouble during the run ends it with summary.status and message set.
 SimulationSummary simulate(const Model& model, const SimulationOptions& options, const RowFn& row);
 
 }  // namespace nhdyn

@@ -1,9 +1,12 @@
 #include "nhdyn/integrators/explicit_rk.hpp"
 
+#include "nhdyn/integrators/events.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -350,7 +353,7 @@ template <class Tableau>
 IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
                                      const IntegratorOptions& options, double t0, const double* y0,
                                      std::span<const double> output_times,
-                                     const OutputFn& output) {
+                                     const OutputFn& output, EventFunctions* events) {
   constexpr double beta = Tableau::beta;
   constexpr double expo1 = Tableau::exponent;
   constexpr double fac_min = Tableau::fac_min;
@@ -381,6 +384,14 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
   const double hmax = options.max_step > 0.0 ? std::min(options.max_step, t_end - t0) : t_end - t0;
 
   double t = t0;
+  std::optional<EventTracker> tracker;
+  std::vector<EventTracker::Crossing> crossings;
+  if (events != nullptr && events->count() > 0) {
+    tracker.emplace(*events, n);
+    crossings.reserve(static_cast<std::size_t>(events->count()));
+    const Status status = tracker->restart(t, y.data());
+    if (status != Status::ok) return rhs_failure(method, status, t, t, stats);
+  }
   ++stats.rhs_evaluations;
   Status status = system.rhs(t, y.data(), stepper.k(0));
   if (status != Status::ok) return rhs_failure(method, status, t, t, stats);
@@ -452,9 +463,16 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
 
     const double t_new = last ? t_end : t + h;
     bool last_stage_ready = error_uses_last_stage<Tableau>;
+    // Events: a change of sign of some g between the step's ends is located on the step's
+    // continuous extension (events.hpp), before after_step moves the end state.
+    bool crossed = false;
+    if (tracker) {
+      status = tracker->check(t_new, y1.data(), crossed);
+      if (status != Status::ok) return rhs_failure(method, status, t_new, t, stats);
+    }
     // Outputs inside the step follow the step's own solution; after_step acts at the step end,
     // so an output there sees the state it leaves.
-    if (next < output_times.size() && output_times[next] < t_new) {
+    if (crossed || (next < output_times.size() && output_times[next] < t_new)) {
       if (!last_stage_ready) {
         ++stats.rhs_evaluations;
         status = system.rhs(t_new, y1.data(), stepper.k(last_stage));
@@ -463,14 +481,36 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
       }
       status = extension.prepare(system, stepper, t, y.data(), y1.data(), h, stats, t_fail);
       if (status != Status::ok) return rhs_failure(method, status, t_fail, t, stats);
+      if (crossed) {
+        status = tracker->locate(
+            t, h, [&](double theta, double* out) { extension.evaluate(theta, out); }, crossings);
+        if (status != Status::ok) return rhs_failure(method, status, t_new, t, stats);
+        for (const EventTracker::Crossing& crossing : crossings) {
+          for (; next < output_times.size() && output_times[next] < crossing.t; ++next) {
+            const double t_out = output_times[next];
+            extension.evaluate((t_out - t) / h, y_out.data());
+            if (output(t_out, y_out.data()) == Status::stopped) return stopped_at(t_out, stats);
+          }
+          if (crossing.theta >= 1.0) std::copy(y1.begin(), y1.end(), y_out.begin());
+          else extension.evaluate(crossing.theta, y_out.data());
+          const Status event_status = events->on_event(crossing.index, crossing.t, y_out.data());
+          if (event_status == Status::stopped) return stopped_at(crossing.t, stats);
+          if (event_status != Status::ok) return step_end_failure(method, event_status, crossing.t, stats);
+        }
+      }
       for (; next < output_times.size() && output_times[next] < t_new; ++next) {
         const double t_out = output_times[next];
         extension.evaluate((t_out - t) / h, y_out.data());
         if (output(t_out, y_out.data()) == Status::stopped) return stopped_at(t_out, stats);
       }
     }
+    if (tracker) tracker->advance();
     const StepEnd end = system.after_step(t_new, y1.data());
     if (end.status != Status::ok) return step_end_failure(method, end.status, t_new, stats);
+    if (tracker && end.changed) {
+      status = tracker->restart(t_new, y1.data());
+      if (status != Status::ok) return rhs_failure(method, status, t_new, t_new, stats);
+    }
     // The FSAL stage belongs to the state before a change; evaluated here, it is that of the
     // state the next step starts from.
     if (end.changed || !last_stage_ready) {
@@ -566,16 +606,16 @@ IntegrationResult integrate_rk4(OdeSystem& system, const IntegratorOptions& opti
 
 IntegrationResult integrate_dopri5(OdeSystem& system, const IntegratorOptions& options, double t0,
                                    const double* y0, std::span<const double> output_times,
-                                   const OutputFn& output) {
+                                   const OutputFn& output, EventFunctions* events) {
   return integrate_adaptive<rk::DormandPrince54>("dopri5", system, options, t0, y0, output_times,
-                                                 output);
+                                                 output, events);
 }
 
 IntegrationResult integrate_dop853(OdeSystem& system, const IntegratorOptions& options, double t0,
                                    const double* y0, std::span<const double> output_times,
-                                   const OutputFn& output) {
+                                   const OutputFn& output, EventFunctions* events) {
   return integrate_adaptive<rk::DormandPrince853>("dop853", system, options, t0, y0, output_times,
-                                                  output);
+                                                  output, events);
 }
 
 }  // namespace nhdyn

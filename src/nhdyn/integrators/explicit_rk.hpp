@@ -208,10 +208,11 @@ IntegrationResult integrate_rk4(OdeSystem& system, const IntegratorOptions& opti
 // after_step changed. Error test on the RMS norm of the error estimate weighted by
 // atol + rtol max(|y0|, |y1|); outputs inside a step come from the continuous extension and never
 // shorten a step; only the last step is shortened to end on the last output time, so the rhs is
-// never evaluated beyond it.
+// never evaluated beyond it. With `events`, a step whose ends differ in the sign of some event
+// function is interpolated (as for an output) and each crossing located on it (events.hpp).
 IntegrationResult integrate_dopri5(OdeSystem& system, const IntegratorOptions& options, double t0,
                                    const double* y0, std::span<const double> output_times,
-                                   const OutputFn& output);
+                                   const OutputFn& output, EventFunctions* events = nullptr);
 
 // Dormand-Prince 8(5,3) as in Hairer's DOP853: 12 rhs evaluations per accepted step (11 for a
 // rejected one, whose FSAL stage is never needed), plus 3 in each step that holds an output time
@@ -220,6 +221,6 @@ IntegrationResult integrate_dopri5(OdeSystem& system, const IntegratorOptions& o
 // last-step rules as dopri5.
 IntegrationResult integrate_dop853(OdeSystem& system, const IntegratorOptions& options, double t0,
                                    const double* y0, std::span<const double> output_times,
-                                   const OutputFn& output);
+                                   const OutputFn& output, EventFunctions* events = nullptr);
 
 }  // namespace nhdyn

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/integrators/events.hpp"
 #include "nhdyn/integrators/explicit_rk.hpp"
 #include "nhdyn/integrators/sundials/cvode.hpp"
 
@@ -79,6 +80,8 @@ std::string_view integrator_name(IntegratorKind kind) {
   return "unknown";
 }
 
+bool supports_events(IntegratorKind kind) { return kind != IntegratorKind::rk4; }
+
 IntegratorKind parse_integrator(std::string_view name) {
   for (IntegratorKind kind : all_kinds)
     if (integrator_name(kind) == name) return kind;
@@ -88,18 +91,24 @@ IntegratorKind parse_integrator(std::string_view name) {
 
 IntegrationResult integrate(OdeSystem& system, const IntegratorOptions& options, double t0,
                             const double* y0, std::span<const double> output_times,
-                            const OutputFn& output) {
+                            const OutputFn& output, EventFunctions* events) {
   require_valid_input(system, options, t0, y0, output_times);
+  if (events != nullptr && events->count() == 0) events = nullptr;
+  if (events != nullptr && !supports_events(options.kind))
+    throw InputError(fmt::format(
+        "events need an integrator with a continuous extension or root finding; {} has neither: "
+        "choose dopri5, dop853, cvode-bdf or cvode-adams",
+        integrator_name(options.kind)));
   switch (options.kind) {
     case IntegratorKind::rk4:
       return integrate_rk4(system, options, t0, y0, output_times, output);
     case IntegratorKind::dopri5:
-      return integrate_dopri5(system, options, t0, y0, output_times, output);
+      return integrate_dopri5(system, options, t0, y0, output_times, output, events);
     case IntegratorKind::dop853:
-      return integrate_dop853(system, options, t0, y0, output_times, output);
+      return integrate_dop853(system, options, t0, y0, output_times, output, events);
     case IntegratorKind::cvode_bdf:
     case IntegratorKind::cvode_adams:
-      return integrate_cvode(system, options, t0, y0, output_times, output);
+      return integrate_cvode(system, options, t0, y0, output_times, output, events);
   }
   throw InputError(fmt::format("invalid integrator kind {}", static_cast<int>(options.kind)));
 }

@@ -40,6 +40,8 @@ enum class IntegratorKind { rk4, dopri5, dop853, cvode_bdf, cvode_adams };
 std::string_view integrator_name(IntegratorKind kind);
 // Inverse of integrator_name; throws InputError listing the valid names.
 IntegratorKind parse_integrator(std::string_view name);
+// Whether the integrator can locate events (events.hpp): all but rk4.
+bool supports_events(IntegratorKind kind);
 
 struct IntegratorOptions {
   IntegratorKind kind = IntegratorKind::dopri5;
@@ -66,10 +68,15 @@ struct IntegrationResult {
 // Called at each output time with the interpolated state; return Status::stopped to end the run.
 using OutputFn = std::function<Status(double t, const double* y)>;
 
+class EventFunctions;  // events.hpp
+
 // Integrates from (t0, y0) and calls `output` at every time of `output_times` (strictly increasing,
 // all >= t0; the first may equal t0). Does not throw on numerical trouble: the result says.
+// `events` (optional) are located during the run and reported through their on_event, in time
+// order among the outputs (events.hpp); rk4, which has no continuous extension, refuses them
+// (InputError).
 IntegrationResult integrate(OdeSystem& system, const IntegratorOptions& options, double t0,
                             const double* y0, std::span<const double> output_times,
-                            const OutputFn& output);
+                            const OutputFn& output, EventFunctions* events = nullptr);
 
 }  // namespace nhdyn

@@ -43,6 +43,7 @@ const std::vector<std::string> top_level_keys = {
     "name",           "description", "coordinates", "parameters",  "kinetic_energy",
     "potential_energy", "forces",    "constraints", "independent", "complement",
     "initial",        "solution",    "simulation",  "plot",        "visual",
+    "events",  // [[events]]: zero crossings located during a run
     // The multibody description (docs/multibody.md).
     "gravity", "frames", "points", "bodies", "wheels", "knife_edges", "surfaces", "curves"};
 const std::vector<std::string> frame_keys = {"name", "parent", "translation", "rotations"};
@@ -57,6 +58,7 @@ const std::vector<std::string> constraint_keys = {"name", "position", "velocity"
 const std::vector<std::string> initial_keys = {"t0", "position", "velocity"};
 const std::vector<std::string> simulation_keys = {"t_end", "output_step", "integrator", "method", "rtol", "atol"};
 const std::vector<std::string> plot_keys = {"path"};
+const std::vector<std::string> event_keys = {"name", "when", "direction", "action"};
 const std::vector<std::string> visual_keys = {"points", "segments"};
 const std::vector<std::string> visual_point_keys = {"name", "position", "radius"};
 const std::vector<std::string> visual_segment_keys = {"name", "from", "to"};
@@ -165,7 +167,10 @@ class Loader {
     if (const toml::node* solution = root.get("solution")) load_solution(*solution, builder);
     if (const toml::node* simulation = root.get("simulation")) load_simulation(*simulation, builder);
     if (const toml::node* plot = root.get("plot")) load_plot(*plot, builder);
+    std::vector<symbolic::SpecEvent> events;
+    if (const toml::node* node = root.get("events")) events = load_events(*node, builder);
     symbolic::Spec spec = builder.build();
+    spec.events = std::move(events);
     spec.visual = std::move(visual);
     // The definitions of derived parameters, which a --set of a parameter they use re-evaluates.
     for (symbolic::SpecParameter& p : spec.parameters)
@@ -581,6 +586,70 @@ class Loader {
                                                  "velocity = \"y' - tan(phi) * x'\"");
       located(*level_node, [&] { builder.constraint(name, level, text, content_at(*level_node)); });
     }
+  }
+
+  // [[events]]: name, when = "g" (crossing zero), direction = rising | falling | both (default
+  // both), action = stop | record (default record). The expression is read against the model's
+  // symbols here, so that its errors carry their file position.
+  std::vector<symbolic::SpecEvent> load_events(const toml::node& node, const SpecBuilder& builder) const {
+    const toml::array& array =
+        array_of(node, "events", "[[events]] followed by name = \"fallen\" and when = \"abs(phi) - 1\"");
+    std::vector<symbolic::SpecEvent> events;
+    int number = 0;
+    for (const toml::node& element : array) {
+      ++number;
+      const std::string context = fmt::format("in event {}", number);
+      const toml::table* table = element.as_table();
+      if (table == nullptr)
+        fail(at(element), fmt::format("event {} must be a table with a name and when = \"...\" (write it as "
+                                      "[[events]]); it is {}",
+                                      number, type_name(element)));
+      check_keys(*table, event_keys, context);
+      symbolic::SpecEvent event;
+      event.name = fmt::format("event{}", number);
+      SourceLocation name_at = at(element);
+      if (const toml::node* name_node = table->get("name")) {
+        event.name = string_of(*name_node, "name", "name = \"fallen\"");
+        name_at = at(*name_node);
+      }
+      for (const symbolic::SpecEvent& other : events)
+        if (other.name == event.name)
+          fail(name_at, fmt::format("event name '{}' is used twice (first at line {}); give each event its own name",
+                                    event.name, other.where.line));
+      const toml::node* when = table->get("when");
+      if (when == nullptr)
+        fail(at(element), fmt::format("event '{}' has no when = \"...\": give the expression whose crossing of zero "
+                                      "is the event, e.g. when = \"abs(phi) - 1\"",
+                                      event.name));
+      event.text = expression_string(*when, "when", "when = \"abs(phi) - 1\"");
+      event.where = content_at(*when);
+      event.expression = located(*when, [&] { return builder.parse(event.text, content_at(*when)); });
+      if (const toml::node* direction = table->get("direction")) {
+        const std::string value = string_of(*direction, "direction", "direction = \"rising\"");
+        if (value == "rising") event.direction = EventDirection::rising;
+        else if (value == "falling") event.direction = EventDirection::falling;
+        else if (value == "both") event.direction = EventDirection::both;
+        else
+          fail(at(*direction), fmt::format("event '{}': direction '{}' is not one of rising, falling, both{}",
+                                           event.name, value,
+                                           nearest_name(value, {"rising", "falling", "both"}).empty()
+                                               ? ""
+                                               : fmt::format("; did you mean '{}'?",
+                                                             nearest_name(value, {"rising", "falling", "both"}))));
+      }
+      if (const toml::node* action = table->get("action")) {
+        const std::string value = string_of(*action, "action", "action = \"stop\"");
+        if (value == "stop") event.action = EventAction::stop;
+        else if (value == "record") event.action = EventAction::record;
+        else
+          fail(at(*action), fmt::format("event '{}': action '{}' is not one of stop, record{}", event.name, value,
+                                        nearest_name(value, {"stop", "record"}).empty()
+                                            ? ""
+                                            : fmt::format("; did you mean '{}'?", nearest_name(value, {"stop", "record"}))));
+      }
+      events.push_back(std::move(event));
+    }
+    return events;
   }
 
   void load_complement(const toml::table& root, SpecBuilder& builder) const {

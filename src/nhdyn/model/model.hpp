@@ -14,6 +14,7 @@
 
 #include "nhdyn/core/types.hpp"
 #include "nhdyn/model/evaluator.hpp"
+#include "nhdyn/model/event.hpp"
 #include "nhdyn/model/run_options.hpp"
 
 namespace nhdyn {
@@ -60,6 +61,9 @@ struct Model {
   // Immutable and bound to the values of `parameters`: Model copies (one per thread) share it
   // until one of them sets a parameter, which gives that copy a new one.
   std::shared_ptr<const Evaluator> evaluator;
+  // The model's own events ([[events]] of its file); a run locates those of its options
+  // (SimulationOptions::events, analysis/simulation.hpp), which `nhdyn simulate` starts from these.
+  std::vector<Event> events;
 
   int n() const { return static_cast<int>(coordinates.size()); }
   int s() const { return static_cast<int>(constraints.size()); }

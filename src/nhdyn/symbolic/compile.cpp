@@ -33,6 +33,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/model/program.hpp"
+#include "nhdyn/symbolic/events.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
@@ -947,8 +948,15 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
     std::vector<double> scratch(model.evaluator->scratch_size());
     model.evaluator->initial_state(scratch.data(), model.q0.data(), model.v0.data());
   }
+  compile_events(spec, model);
   check_model_shape(model);
   return model;
+}
+
+Program compile_expression(const Spec& spec, const GiNaC::ex& expression, const std::string& what) {
+  ProgramCompiler compiler(spec);
+  compiler.add_output(expression, what);
+  return compiler.finish();
 }
 
 Model compile_model(const Spec& spec, const CompileOptions& options) {

@@ -28,6 +28,10 @@ struct CompileOptions {
 // InputError for a cyclic or unknown definition of a derived parameter.
 Model compile_model(const Spec& spec, const Derivation& derivation, const CompileOptions& options = {});
 
+// One expression of t, q, q' and the parameters of `spec` as a program with one output (events,
+// symbolic/events.hpp); `what` names it in errors. Throws ModelError as compile_model does.
+Program compile_expression(const Spec& spec, const GiNaC::ex& expression, const std::string& what);
+
 // derive() then compile_model().
 Model compile_model(const Spec& spec, const CompileOptions& options = {});
 

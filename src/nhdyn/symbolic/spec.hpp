@@ -73,6 +73,16 @@ struct SpecConstraint {
   SourceLocation where;
 };
 
+// An event ([[events]] of a model file): g(t, q, q') crossing zero (model/event.hpp).
+struct SpecEvent {
+  std::string name;
+  GiNaC::ex expression;  // g
+  std::string text;      // as the user wrote it
+  SourceLocation where;
+  EventDirection direction = EventDirection::both;
+  EventAction action = EventAction::record;
+};
+
 struct Spec {
   std::string name;
   std::string description;
@@ -98,6 +108,7 @@ struct Spec {
   std::string integrator;                    // default integrator, "" = dopri5
   std::optional<double> rtol, atol;
   std::optional<std::pair<std::string, std::string>> path;  // coordinates to draw as y(x)
+  std::vector<SpecEvent> events;             // compiled into Model::events (symbolic/events.hpp)
   SpecVisual visual;  // what a report's 3-D scene draws ([visual], or the bodies): symbolic/visual.hpp
 
   int n() const { return static_cast<int>(coordinates.size()); }

@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include <cvode/cvode.h>
 #include <nvector/nvector_serial.h>
@@ -16,6 +17,8 @@
 #include <sunmatrix/sunmatrix_dense.h>
 
 #include <fmt/format.h>
+
+#include "nhdyn/integrators/events.hpp"
 
 namespace nhdyn {
 namespace {
@@ -52,6 +55,7 @@ using CvodePtr = std::unique_ptr<void, CvodeFree>;
 // What the C callbacks report back across CVODE.
 struct CallbackState {
   OdeSystem* system = nullptr;
+  EventFunctions* events = nullptr;
   Status rhs_status = Status::ok;
   double t_fail = 0.0;
   std::exception_ptr exception;
@@ -64,6 +68,20 @@ int cvode_rhs(realtype t, N_Vector y, N_Vector ydot, void* user_data) noexcept {
   CallbackState& state = *static_cast<CallbackState*>(user_data);
   try {
     const Status status = state.system->rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
+    if (status == Status::ok) return 0;
+    state.rhs_status = status;
+    state.t_fail = t;
+  } catch (...) {
+    state.exception = std::current_exception();
+  }
+  return -1;
+}
+
+// The event functions for CVODE's root finding; a failure ends the run like a failed rhs.
+int cvode_roots(realtype t, N_Vector y, realtype* g, void* user_data) noexcept {
+  CallbackState& state = *static_cast<CallbackState*>(user_data);
+  try {
+    const Status status = state.events->evaluate(t, N_VGetArrayPointer(y), g);
     if (status == Status::ok) return 0;
     state.rhs_status = status;
     state.t_fail = t;
@@ -114,7 +132,7 @@ std::string flag_name(int flag) {
 
 IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& options, double t0,
                                   const double* y0, std::span<const double> output_times,
-                                  const OutputFn& output) {
+                                  const OutputFn& output, EventFunctions* events) {
   const std::string_view method = integrator_name(options.kind);
   const int n = system.size();
   IntegrationResult result;
@@ -186,6 +204,17 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
   if (options.step > 0.0 && CVodeSetInitStep(mem, options.step) != CV_SUCCESS)
     return setup_failure("CVodeSetInitStep");
   if (CVodeSetStopTime(mem, t_end) != CV_SUCCESS) return setup_failure("CVodeSetStopTime");
+  // Events: CVODE's own root finding on its interpolating polynomial (CVodeRootInit), which
+  // returns at each root with the state there (CV_ROOT_RETURN) before the step's end.
+  std::vector<int> directions, roots;
+  if (events != nullptr && events->count() > 0) {
+    state.events = events;
+    const int m = events->count();
+    for (int i = 0; i < m; ++i) directions.push_back(static_cast<int>(events->direction(i)));
+    roots.assign(static_cast<std::size_t>(m), 0);
+    if (CVodeRootInit(mem, m, cvode_roots) != CV_SUCCESS) return setup_failure("CVodeRootInit");
+    if (CVodeSetRootDirection(mem, directions.data()) != CV_SUCCESS) return setup_failure("CVodeSetRootDirection");
+  }
 
   for (;;) {
     const Counters current = read_counters(mem);
@@ -216,6 +245,34 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
                     fmt::format("{}: CVODE failed after t = {} ({}, h = {}): {}", method, t,
                                 flag_name(flag), h_next, state.cvode_message),
                     mem);
+    }
+
+    if (flag == CV_ROOT_RETURN) {
+      // t_new is a root inside the step and y the state there; the next call returns the step's
+      // end (CV_ONE_STEP), where after_step acts.
+      for (; next < output_times.size() && output_times[next] < t_new; ++next) {
+        const double t_out = output_times[next];
+        const int dky_flag = CVodeGetDky(mem, t_out, 0, y_dky.get());
+        if (dky_flag != CV_SUCCESS)
+          return finish(Status::integrator_failure,
+                        fmt::format("{}: interpolation at output time {} failed ({}): {}", method,
+                                    t_out, flag_name(dky_flag), state.cvode_message),
+                        mem);
+        if (output(t_out, N_VGetArrayPointer(y_dky.get())) == Status::stopped) {
+          t = t_out;
+          return finish(Status::stopped, {}, mem);
+        }
+      }
+      CVodeGetRootInfo(mem, roots.data());
+      for (std::size_t i = 0; i < roots.size(); ++i) {
+        if (roots[i] == 0) continue;
+        const Status event_status = events->on_event(static_cast<int>(i), t_new, y_data);
+        if (event_status == Status::ok) continue;
+        t = t_new;
+        if (event_status == Status::stopped) return finish(Status::stopped, {}, mem);
+        return finish(event_status, fmt::format("{}: at the event at t = {}: {}", method, t, describe(event_status)), mem);
+      }
+      continue;
     }
 
     // Outputs inside the step come from CVODE's interpolating polynomial, valid until the

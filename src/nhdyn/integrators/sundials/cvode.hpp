@@ -18,9 +18,10 @@ namespace nhdyn {
 // is never evaluated beyond it. Stats sum CVODE's counters over re-initializations; rhs
 // evaluations include those of the difference-quotient Jacobian. Cost per step: one LU of a dense
 // n x n matrix when CVODE updates its Jacobian (n rhs evaluations), O(n^2) per Newton iteration.
-// An exception thrown by OdeSystem::rhs is carried across CVODE and rethrown here.
+// An exception thrown by OdeSystem::rhs is carried across CVODE and rethrown here. `events` are
+// located by CVODE's root finding (CVodeRootInit) and reported at the roots it returns.
 IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& options, double t0,
                                   const double* y0, std::span<const double> output_times,
-                                  const OutputFn& output);
+                                  const OutputFn& output, EventFunctions* events = nullptr);
 
 }  // namespace nhdyn

@@ -1,0 +1,61 @@
+// A model's events as the integrators see them (integrators/events.hpp): the programs g(t, q, q')
+// of model/event.hpp bound to the model's parameter values, evaluated on y = [q; q'], and the
+// check that refuses a run whose events cannot mean anything at its start (an event already at
+// zero, a stop condition already true). simulate() (simulation.hpp) uses them; the located
+// crossings come back in SimulationSummary::events.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "nhdyn/integrators/events.hpp"
+#include "nhdyn/model/event.hpp"
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn {
+
+// One located crossing: which event, when, and the state there (as written to the results).
+struct EventRecord {
+  int index = 0;             // in the run's list of events (SimulationOptions::events)
+  std::string name;
+  double t = 0.0;
+  std::vector<double> q, v;  // n values each
+};
+
+class ModelEventFunctions final : public EventFunctions {
+ public:
+  // What happens at a crossing of event i: the caller writes the row and returns Status::ok (or
+  // the status of a failure); ModelEventFunctions adds Status::stopped for a stop event.
+  using Handler = std::function<Status(int i, double t, const double* y)>;
+
+  // Binds every event's program to the model's current parameter values (allocates; not in the
+  // time loop). `events` must outlive this object.
+  ModelEventFunctions(const Model& model, const std::vector<const Event*>& events, Handler handler);
+
+  int count() const override { return static_cast<int>(events_.size()); }
+  CrossingDirection direction(int i) const override;
+  // Non-finite g: Status::non_finite. Allocates nothing.
+  Status evaluate(double t, const double* y, double* g) override;
+  Status on_event(int i, double t, const double* y) override;
+
+  const Event& event(int i) const { return *events_[static_cast<std::size_t>(i)]; }
+  // The index of the stop event that ended the run, or -1.
+  int stopped_by() const { return stopped_by_; }
+
+  // Throws InputError when an event is exactly zero (or not finite) at (t0, q0, q'0), or a stop
+  // condition (Event::condition) already holds there, naming the event, where it was written and
+  // its value.
+  void require_valid_start(double t0, const double* y0);
+
+ private:
+  int n_;
+  std::vector<const Event*> events_;
+  std::vector<Program> programs_;   // bound to the parameter values
+  std::vector<double> registers_;
+  std::vector<double> g_;
+  Handler handler_;
+  int stopped_by_ = -1;
+};
+
+}  // namespace nhdyn

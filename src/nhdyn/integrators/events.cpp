@@ -1,0 +1,160 @@
+#include "nhdyn/integrators/events.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace nhdyn {
+namespace {
+
+int sign_of(double x) { return x > 0.0 ? 1 : (x < 0.0 ? -1 : 0); }
+
+}  // namespace
+
+Status find_root(const std::function<Status(double x, double& fx)>& f, double a, double fa, double b,
+                 double fb, double& root) {
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  if (fb == 0.0) {
+    root = b;
+    return Status::ok;
+  }
+  if (fa == 0.0) {
+    root = a;
+    return Status::ok;
+  }
+  const int after = sign_of(fb);
+  double c = a, fc = fa;
+  double d = b - a, e = d;
+  // Each iteration at least halves the bracket every few steps; 400 is far beyond what the
+  // resolution of a double in [0, 1] needs and only guards against a non-finite f.
+  for (int iteration = 0; iteration < 400; ++iteration) {
+    if ((fb > 0.0) == (fc > 0.0)) {
+      c = a;
+      fc = fa;
+      d = e = b - a;
+    }
+    if (std::abs(fc) < std::abs(fb)) {
+      a = b;
+      b = c;
+      c = a;
+      fa = fb;
+      fb = fc;
+      fc = fa;
+    }
+    const double tol = 2.0 * eps * std::abs(b) + std::numeric_limits<double>::min();
+    const double m = 0.5 * (c - b);
+    if (std::abs(m) <= tol || fb == 0.0) break;
+    if (std::abs(e) < tol || std::abs(fa) <= std::abs(fb)) {
+      d = e = m;
+    } else {
+      // Inverse quadratic interpolation, or the secant when only two points are distinct.
+      const double s = fb / fa;
+      double p, q;
+      if (a == c) {
+        p = 2.0 * m * s;
+        q = 1.0 - s;
+      } else {
+        const double qa = fa / fc, r = fb / fc;
+        p = s * (2.0 * m * qa * (qa - r) - (b - a) * (r - 1.0));
+        q = (qa - 1.0) * (r - 1.0) * (s - 1.0);
+      }
+      if (p > 0.0) q = -q;
+      else p = -p;
+      if (2.0 * p < std::min(3.0 * m * q - std::abs(tol * q), std::abs(e * q))) {
+        e = d;
+        d = p / q;
+      } else {
+        d = e = m;
+      }
+    }
+    a = b;
+    fa = fb;
+    b += std::abs(d) > tol ? d : (m > 0.0 ? tol : -tol);
+    const Status status = f(b, fb);
+    if (status != Status::ok) return status;
+    if (!std::isfinite(fb)) return Status::non_finite;
+  }
+  // b is the best estimate; report the end of the bracket on the far side of the crossing.
+  root = (fb == 0.0 || sign_of(fb) == after) ? b : c;
+  return Status::ok;
+}
+
+EventTracker::EventTracker(EventFunctions& events, int n)
+    : events_(events),
+      m_(events.count()),
+      sign_(static_cast<std::size_t>(m_), 0),
+      g_end_(static_cast<std::size_t>(m_), 0.0),
+      g_(static_cast<std::size_t>(m_), 0.0),
+      y_(static_cast<std::size_t>(n), 0.0) {
+  crossed_.reserve(static_cast<std::size_t>(m_));
+}
+
+Status EventTracker::restart(double t, const double* y) {
+  const Status status = events_.evaluate(t, y, g_.data());
+  if (status != Status::ok) return status;
+  for (std::size_t i = 0; i < g_.size(); ++i) {
+    const int s = sign_of(g_[i]);
+    if (s != 0) sign_[i] = s;  // a zero keeps the side it was reached from
+  }
+  return Status::ok;
+}
+
+Status EventTracker::check(double t1, const double* y1, bool& crossed) {
+  crossed = false;
+  crossed_.clear();
+  const Status status = events_.evaluate(t1, y1, g_end_.data());
+  if (status != Status::ok) return status;
+  for (int i = 0; i < m_; ++i) {
+    const std::size_t k = static_cast<std::size_t>(i);
+    const int before = sign_[k];
+    const int after = sign_of(g_end_[k]);
+    if (before == 0 || after == before) continue;
+    const CrossingDirection direction = events_.direction(i);
+    const bool rising = before < 0;
+    if (direction == CrossingDirection::rising && !rising) continue;
+    if (direction == CrossingDirection::falling && rising) continue;
+    crossed_.push_back(i);
+  }
+  crossed = !crossed_.empty();
+  return Status::ok;
+}
+
+Status EventTracker::value(int i, double t, double h, double theta, const Interpolant& interpolate, double& g) {
+  interpolate(theta, y_.data());
+  const Status status = events_.evaluate(t + theta * h, y_.data(), g_.data());
+  g = g_[static_cast<std::size_t>(i)];
+  return status;
+}
+
+Status EventTracker::locate(double t, double h, const Interpolant& interpolate, std::vector<Crossing>& out) {
+  out.clear();
+  for (int i : crossed_) {
+    const std::size_t k = static_cast<std::size_t>(i);
+    double g0 = 0.0;
+    Status status = value(i, t, h, 0.0, interpolate, g0);
+    if (status != Status::ok) return status;
+    // The interpolant starts at the step's start state, where g had the sign sign_[k] (or was zero,
+    // reached from that side).
+    if (sign_of(g0) == -sign_[k]) g0 = 0.0;
+    double theta = 1.0;
+    status = find_root([&](double x, double& fx) { return value(i, t, h, x, interpolate, fx); }, 0.0, g0, 1.0,
+                       g_end_[k], theta);
+    if (status != Status::ok) return status;
+    out.push_back({i, theta >= 1.0 ? t + h : t + theta * h, theta});
+  }
+  std::sort(out.begin(), out.end(), [](const Crossing& a, const Crossing& b) {
+    return a.t != b.t ? a.t < b.t : a.index < b.index;
+  });
+  return Status::ok;
+}
+
+void EventTracker::advance() {
+  for (std::size_t i = 0; i < g_end_.size(); ++i) {
+    const int s = sign_of(g_end_[i]);
+    // Landing exactly on zero passes to the other side: the next step starts from there.
+    if (s != 0) sign_[i] = s;
+    else if (sign_[i] != 0) sign_[i] = -sign_[i];
+  }
+}
+
+}  // namespace nhdyn

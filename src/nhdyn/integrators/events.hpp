@@ -1,0 +1,89 @@
+// Events: the times at which functions g_i(t, y) of the state cross zero, found while a run goes
+// on. The integrators with a continuous extension (dopri5, dop853) look for a change of sign of
+// each g_i between the ends of every accepted step and then locate the root on the step's own
+// interpolating polynomial to round-off (Brent's method in the step's fraction theta); CVODE uses
+// its own root finding (CVodeRootInit). Several crossings in one step are reported in time order.
+// rk4 has no continuous extension: integrate() refuses events with it.
+// Like the rest of integrators/, this knows nothing of mechanics: the simulation driver
+// (analysis/simulation.hpp) turns the model's event expressions into an EventFunctions.
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include "nhdyn/core/status.hpp"
+
+namespace nhdyn {
+
+// Which crossings of zero count: g going from negative to positive (rising), from positive to
+// negative (falling) or either. The values are CVODE's root directions.
+enum class CrossingDirection : int { falling = -1, both = 0, rising = 1 };
+
+class EventFunctions {
+ public:
+  virtual ~EventFunctions() = default;
+  // Number of event functions m.
+  virtual int count() const = 0;
+  virtual CrossingDirection direction(int i) const = 0;
+  // g[0..m) = every event function at (t, y). A non-ok status ends the run as a failed
+  // right-hand side does.
+  virtual Status evaluate(double t, const double* y, double* g) = 0;
+  // Called for every located crossing of event i that its direction admits, in time order
+  // (crossings at the same time in index order), with the state y(t) there. Return
+  // Status::stopped to end the run at t, Status::ok to go on; any other status fails the run.
+  virtual Status on_event(int i, double t, const double* y) = 0;
+};
+
+// The sign bookkeeping and root location shared by the explicit integrators: the sign of each g_i
+// at the start of the current step (the last nonzero one, so that a g that lands exactly on zero
+// at a step end and leaves on the other side counts once), the crossings of a step, and Brent's
+// method on an interpolant. Allocates when made, not per step.
+class EventTracker {
+ public:
+  struct Crossing {
+    int index = 0;
+    double t = 0.0;
+    double theta = 0.0;  // (t - step start) / h as found: evaluate the interpolant here, not at t
+  };
+
+  EventTracker(EventFunctions& events, int n);
+
+  // g at the start of the run (or after the state was changed by OdeSystem::after_step).
+  Status restart(double t, const double* y);
+  // Evaluates g at the step end (t1, y1) and says whether some g_i changed sign since the
+  // step's start in a direction its event admits (then locate() is due). Does not update the
+  // signs: call advance() once the step is done.
+  Status check(double t1, const double* y1, bool& crossed);
+  // y(theta) on a step (t, y) -> (t + h, y1), theta in [0, 1]: writes n values.
+  using Interpolant = std::function<void(double theta, double* y)>;
+  // For each crossing found by check(), the time of the root of g_i(t + theta h, y(theta)) for
+  // theta in [0, 1]; sorted by time, then index. Brent's method to the resolution of double
+  // precision in theta (a few dozen evaluations of the interpolant and g per crossing).
+  Status locate(double t, double h, const Interpolant& interpolate, std::vector<Crossing>& out);
+  // The step is taken: the signs at its end become those of the next step's start.
+  void advance();
+
+  EventFunctions& events() { return events_; }
+
+ private:
+  // g_i at time t + theta h on the interpolant.
+  Status value(int i, double t, double h, double theta, const Interpolant& interpolate, double& g);
+
+  EventFunctions& events_;
+  int m_;
+  std::vector<int> sign_;        // sign of g_i at the step's start (last nonzero); 0 if never nonzero
+  std::vector<double> g_end_;    // g at the step's end, from check()
+  std::vector<double> g_;        // scratch for evaluate()
+  std::vector<double> y_;        // scratch state on the interpolant
+  std::vector<int> crossed_;     // indices that crossed in the step
+};
+
+// Brent's method (Brent 1973, "zeroin") for a root of f in [a, b] given fa = f(a), fb = f(b) of
+// opposite signs (or one of them zero), to the resolution of double precision: the final bracket
+// is at most a few ulps wide, and `root` is its end on b's side (where f has the sign of fb), so
+// that the state reported at a crossing is already past it; or an exact zero of f. f writes its
+// value and returns a status; a non-ok one ends the search and is returned.
+Status find_root(const std::function<Status(double x, double& fx)>& f, double a, double fa, double b,
+                 double fb, double& root);
+
+}  // namespace nhdyn

@@ -1,0 +1,155 @@
+#include "nhdyn/symbolic/events.hpp"
+
+#include <fmt/format.h>
+
+#include <cctype>
+#include <optional>
+#include <vector>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/symbolic/compile.hpp"
+#include "nhdyn/symbolic/spec.hpp"
+#include "nhdyn/symbolic/spec_builder.hpp"
+
+namespace nhdyn::symbolic {
+namespace {
+
+// The velocities and accelerations of an event are those of the state: an event reads t, q, q'
+// and the parameters, and q'' (which needs the dynamics) is refused by name.
+void refuse_accelerations(const Spec& spec, const GiNaC::ex& g, const std::string& where, const std::string& name) {
+  for (int i = 0; i < spec.symbols.coordinates(); ++i)
+    if (g.has(spec.symbols.acceleration(i)))
+      throw ModelError(fmt::format("{}event '{}' contains the acceleration {}; an event may depend on t, the "
+                                   "coordinates, their velocities and the parameters only",
+                                   where.empty() ? "" : where + ": ", name,
+                                   spec.symbols.acceleration(i).get_name()));
+}
+
+// A SpecBuilder with the model's names and parameter values: the symbol table to read an event
+// of a model that has no Spec at hand (built-in models, the command line).
+SpecBuilder names_of(const Model& model) {
+  SpecBuilder builder(model.name);
+  for (const std::string& q : model.coordinates) builder.coordinate(q);
+  for (const Parameter& p : model.parameters) builder.parameter(p.name, p.value, p.unit);
+  return builder;
+}
+
+// Reads `text` for the command-line option `option` (quoted in messages as `shown`): a parse error
+// becomes an InputError naming the option and the text as the user wrote it. `text` may be
+// `shown` with parts blanked out (so that columns stay those of `shown`).
+GiNaC::ex read_option(const SpecBuilder& builder, const std::string& option, const std::string& shown,
+                      const std::string& text) {
+  try {
+    return builder.parse(text);
+  } catch (const ModelError& e) {
+    std::string message = e.what();
+    const std::string blanked = fmt::format("\"{}\"", text);
+    const std::size_t at = message.find(blanked);
+    if (at != std::string::npos) message.replace(at, blanked.size(), fmt::format("\"{}\"", shown));
+    throw InputError(fmt::format("{} \"{}\": {}", option, shown, message));
+  }
+}
+
+Event finish(const Spec& spec, const GiNaC::ex& g, std::string name, std::string text, std::string where,
+             EventDirection direction, EventAction action) {
+  refuse_accelerations(spec, g, where, name);
+  Event event;
+  event.g = compile_expression(spec, g, fmt::format("event '{}'", name));
+  event.name = std::move(name);
+  event.expression = std::move(text);
+  event.where = std::move(where);
+  event.direction = direction;
+  event.action = action;
+  return event;
+}
+
+}  // namespace
+
+void compile_events(const Spec& spec, Model& model) {
+  for (const SpecEvent& e : spec.events)
+    model.events.push_back(finish(spec, e.expression, e.name, e.text, e.where.describe(), e.direction, e.action));
+}
+
+Event make_stop_condition(const Model& model, const std::string& condition) {
+  const std::string option = "--stop-when";
+  // The comparison: one '<' or '>' (optionally followed by '=') outside parentheses.
+  std::vector<std::size_t> found;
+  int depth = 0;
+  for (std::size_t i = 0; i < condition.size(); ++i) {
+    const char c = condition[i];
+    if (c == '(') ++depth;
+    if (c == ')') --depth;
+    if ((c == '<' || c == '>') && depth == 0) found.push_back(i);
+    if (c == '=' && !(i > 0 && (condition[i - 1] == '<' || condition[i - 1] == '>')))
+      throw InputError(fmt::format("{} \"{}\": unexpected '=' at column {}; expected a condition that becomes true, "
+                                   "LHS > RHS or LHS < RHS (>= and <= too), e.g. --stop-when \"abs(phi) > 1.2\"",
+                                   option, condition, i + 1));
+  }
+  if (found.empty())
+    throw InputError(fmt::format("{} \"{}\": expected a condition with a comparison, LHS > RHS or LHS < RHS (>= and "
+                                 "<= too), e.g. --stop-when \"abs(phi) > 1.2\"; found no '<' or '>'",
+                                 option, condition));
+  if (found.size() > 1)
+    throw InputError(fmt::format("{} \"{}\": expected one comparison, LHS > RHS or LHS < RHS; found {} (columns {} "
+                                 "and {}): give one --stop-when per condition",
+                                 option, condition, found.size(), found[0] + 1, found[1] + 1));
+  const std::size_t op = found.front();
+  const bool greater = condition[op] == '>';
+  const std::size_t op_end = op + (op + 1 < condition.size() && condition[op + 1] == '=' ? 2 : 1);
+  const auto blank = [&](std::size_t from, std::size_t to) {
+    std::string text = condition;
+    for (std::size_t i = from; i < to && i < text.size(); ++i) text[i] = ' ';
+    return text;
+  };
+  const auto empty = [](const std::string& text) {
+    for (char c : text)
+      if (!std::isspace(static_cast<unsigned char>(c))) return false;
+    return true;
+  };
+  const std::string lhs = blank(op, condition.size());
+  const std::string rhs = blank(0, op_end);
+  if (empty(lhs) || empty(rhs))
+    throw InputError(fmt::format("{} \"{}\": the comparison '{}' needs an expression on each side, e.g. --stop-when "
+                                 "\"abs(phi) > 1.2\"",
+                                 option, condition, condition.substr(op, op_end - op)));
+  const SpecBuilder builder = names_of(model);
+  const GiNaC::ex left = read_option(builder, option, condition, lhs);
+  const GiNaC::ex right = read_option(builder, option, condition, rhs);
+  try {
+    Event event = finish(builder.current(), greater ? left - right : right - left, condition, condition,
+                         fmt::format("{} \"{}\"", option, condition), EventDirection::rising, EventAction::stop);
+    event.condition = true;
+    return event;
+  } catch (const ModelError& e) {
+    throw InputError(e.what());
+  }
+}
+
+Event make_record_event(const Model& model, const std::string& definition) {
+  const std::string option = "--event";
+  const std::size_t eq = definition.find('=');
+  const auto identifier = [](const std::string& name) {
+    if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_')) return false;
+    for (char c : name)
+      if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-')) return false;
+    return true;
+  };
+  if (eq == std::string::npos || !identifier(definition.substr(0, eq)))
+    throw InputError(fmt::format("{} \"{}\": expected NAME=EXPR, a name (letters, digits, _ and -) and the expression "
+                                 "whose zero crossings to record, e.g. --event \"upright=phi\"",
+                                 option, definition));
+  const std::string name = definition.substr(0, eq);
+  // The name and '=' blanked: columns in messages are those of the whole option.
+  std::string text = definition;
+  for (std::size_t i = 0; i <= eq; ++i) text[i] = ' ';
+  const SpecBuilder builder = names_of(model);
+  const GiNaC::ex g = read_option(builder, option, definition, text);
+  try {
+    return finish(builder.current(), g, name, definition.substr(eq + 1), fmt::format("{} \"{}\"", option, definition),
+                  EventDirection::both, EventAction::record);
+  } catch (const ModelError& e) {
+    throw InputError(e.what());
+  }
+}
+
+}  // namespace nhdyn::symbolic
