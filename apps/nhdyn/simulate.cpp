@@ -45,8 +45,39 @@ struct SimulateArgs {
   std::string output;
   std::string plot;
   std::string html;  // the HTML report (io/report.hpp), written from the CSV after the run
+  std::string program_feedback;  // "alpha,beta" (docs/cli.md); empty: no feedback
   bool quiet = false;
 };
+
+// --program-feedback alpha,beta: two non-negative rates [1/s].
+ProgramFeedback parse_program_feedback(const std::string& text) {
+  ProgramFeedback out;
+  if (text.empty()) return out;
+  const std::size_t comma = text.find(',');
+  const auto number = [&](const std::string& part, const char* name) {
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(part, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != part.size())
+      throw InputError(fmt::format("--program-feedback {}: the gain {} '{}' is not a number; give two rates in 1/s "
+                                   "as alpha,beta (e.g. --program-feedback 10,10)",
+                                   text, name, part));
+    return value;
+  };
+  if (comma == std::string::npos || text.find(',', comma + 1) != std::string::npos)
+    throw InputError(fmt::format("--program-feedback {}: give two rates in 1/s as alpha,beta (e.g. "
+                                 "--program-feedback 10,10)",
+                                 text));
+  out.enabled = true;
+  out.alpha = number(text.substr(0, comma), "alpha");
+  out.beta = number(text.substr(comma + 1), "beta");
+  check_program_feedback(out);
+  return out;
+}
 
 std::string format_residual(double value, bool defined) { return defined ? fmt::format("{:.3g}", value) : "-"; }
 
@@ -109,6 +140,7 @@ int run_simulate(const SimulateArgs& args) {
   options.formulation.baumgarte.alpha = args.baumgarte_alpha;
   options.formulation.baumgarte.beta = args.baumgarte_beta;
   options.projection.tolerance = args.projection_tolerance;
+  options.formulation.program_feedback = parse_program_feedback(args.program_feedback);
   check_simulation_options(model, options);
 
   namespace fs = std::filesystem;
@@ -172,6 +204,7 @@ int run_simulate(const SimulateArgs& args) {
     request.coordinates = columns.coordinates;
     request.reactions = columns.reactions;
     request.residuals = columns.residuals;
+    request.actuators = columns.actuators;
     if (model.path)
       request.path = std::make_pair(model.coordinates[static_cast<std::size_t>(model.path->x)],
                                     model.coordinates[static_cast<std::size_t>(model.path->y)]);
@@ -214,6 +247,16 @@ int run_simulate(const SimulateArgs& args) {
                format_residual(summary.max_position_residual, model.position_constraints() > 0),
                format_residual(summary.max_velocity_residual, model.velocity_constraints() > 0),
                format_residual(summary.max_acceleration_residual, model.s() > 0));
+    if (model.m() > 0) {
+      fmt::print("  programs: {}, max residual: position {}, velocity {}, acceleration {}{}\n", model.m(),
+                 format_residual(summary.max_program_position_residual, model.position_programs() > 0),
+                 format_residual(summary.max_program_velocity_residual, model.velocity_programs() > 0),
+                 format_residual(summary.max_program_acceleration_residual, true),
+                 options.formulation.program_feedback.enabled
+                     ? fmt::format(" (feedback alpha {:g} 1/s, beta {:g} 1/s)", options.formulation.program_feedback.alpha,
+                                   options.formulation.program_feedback.beta)
+                     : "");
+    }
     if (summary.initial_fix) {
       const InitialFix& fix = *summary.initial_fix;
       fmt::print("  initial state moved onto the constraints (--fix-initial):\n");
@@ -259,6 +302,8 @@ std::function<int()> add_simulate_command(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "CSV file to write (default results/MODEL.csv)");
   cmd->add_option("--plot", args->plot, "PNG file to draw with gnuplot");
   cmd->add_option("--html", args->html, "HTML report to write: 3-D animation, plots, equations (docs/report.md)");
+  cmd->add_option("--program-feedback", args->program_feedback,
+                  "Programs: PD feedback ALPHA,BETA [1/s] on their residuals (docs/derivations/program-motion.md)");
   cmd->add_flag("-q,--quiet", args->quiet, "Print no summary");
   return [args] { return run_simulate(*args); };
 }
