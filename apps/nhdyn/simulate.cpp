@@ -266,7 +266,10 @@ int run_simulate(const SimulateArgs& args) {
         if (fix.dv(i) != 0.0) fmt::print("    {}' = {:.12g} (changed by {:+.3g})\n", c, fix.v(i), fix.dv(i));
       }
     }
-    if (summary.has_energy)
+    if (summary.has_energy && model.m() > 0)
+      fmt::print("  energy change: {:.3g} (E0 = {:.10g}; the actuators do work, so E is not conserved)\n",
+                 summary.energy_drift, summary.energy_initial);
+    else if (summary.has_energy)
       fmt::print("  energy drift: {:.3g} (E0 = {:.10g})\n", summary.energy_drift, summary.energy_initial);
     if (!args.plot.empty()) fmt::print("  plot -> {}\n", args.plot);
     if (!args.html.empty()) fmt::print("  report -> {}{}\n", args.html, html_notice.empty() ? "" : "\n  note: " + html_notice);
