@@ -91,11 +91,19 @@ TEST_F(ProgramCli, FeedbackIsReportedAndItsGainsChecked) {
 }
 
 TEST_F(ProgramCli, SingularProgramIsRefusedNamingIt) {
-  const Outcome run = nhdyn("simulate " + example("cart_pendulum_program.toml"), dir_);
+  const Outcome run = nhdyn("simulate " + example("cart_pendulum_program.toml") + " --set theta0=pi/2", dir_);
   EXPECT_EQ(run.exit_code, 2) << run.out;
   EXPECT_NE(run.out.find("'swing'"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("S = b_p P B"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("singular"), std::string::npos) << run.out;
+}
+
+TEST_F(ProgramCli, ARunThatReachesASingularStateStopsThere) {
+  // theta = 0.3 + 0.2 t reaches pi/2 at t = (pi/2 - 0.3) / 0.2 = 6.354.
+  const Outcome run = nhdyn("simulate " + example("cart_pendulum_program.toml") + " --t-end 10 -o out.csv", dir_);
+  EXPECT_EQ(run.exit_code, 1) << run.out;
+  EXPECT_NE(run.out.find("failed at t = 6.35"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("'swing'"), std::string::npos) << run.out;
 }
 
 TEST_F(ProgramCli, UnknownActuatorCoordinateIsNamed) {
