@@ -48,12 +48,43 @@ struct SimulateArgs {
   std::string output;
   std::string plot;
   std::string html;  // the HTML report (io/report.hpp), written from the CSV after the run
+  std::string program_feedback;  // "alpha,beta" (docs/cli.md); empty: no feedback
   bool quiet = false;
   std::string evaluator = "interpreted";  // interpreted | compiled | auto (jit/compiled_evaluator.hpp)
   std::vector<std::string> stop_when;  // conditions that end the run when they become true
   std::vector<std::string> events;     // NAME=EXPR: crossings of zero to record
   std::optional<long> max_steps;       // the integrator's step budget (default IntegratorOptions)
 };
+
+// --program-feedback alpha,beta: two non-negative rates [1/s].
+ProgramFeedback parse_program_feedback(const std::string& text) {
+  ProgramFeedback out;
+  if (text.empty()) return out;
+  const std::size_t comma = text.find(',');
+  const auto number = [&](const std::string& part, const char* name) {
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(part, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != part.size())
+      throw InputError(fmt::format("--program-feedback {}: the gain {} '{}' is not a number; give two rates in 1/s "
+                                   "as alpha,beta (e.g. --program-feedback 10,10)",
+                                   text, name, part));
+    return value;
+  };
+  if (comma == std::string::npos || text.find(',', comma + 1) != std::string::npos)
+    throw InputError(fmt::format("--program-feedback {}: give two rates in 1/s as alpha,beta (e.g. "
+                                 "--program-feedback 10,10)",
+                                 text));
+  out.enabled = true;
+  out.alpha = number(text.substr(0, comma), "alpha");
+  out.beta = number(text.substr(comma + 1), "beta");
+  check_program_feedback(out);
+  return out;
+}
 
 std::string format_residual(double value, bool defined) { return defined ? fmt::format("{:.3g}", value) : "-"; }
 
@@ -190,6 +221,7 @@ int run_simulate(const SimulateArgs& args) {
     options.events.push_back(symbolic::make_stop_condition(model, condition));
   for (const std::string& definition : args.events)
     options.events.push_back(symbolic::make_record_event(model, definition));
+  options.formulation.program_feedback = parse_program_feedback(args.program_feedback);
   check_simulation_options(model, options);
 
   namespace fs = std::filesystem;
@@ -273,6 +305,7 @@ int run_simulate(const SimulateArgs& args) {
     request.coordinates = columns.coordinates;
     request.reactions = columns.reactions;
     request.residuals = columns.residuals;
+    request.actuators = columns.actuators;
     if (model.path)
       request.path = std::make_pair(model.coordinates[static_cast<std::size_t>(model.path->x)],
                                     model.coordinates[static_cast<std::size_t>(model.path->y)]);
@@ -328,6 +361,16 @@ int run_simulate(const SimulateArgs& args) {
                format_residual(summary.max_position_residual, model.position_constraints() > 0),
                format_residual(summary.max_velocity_residual, model.velocity_constraints() > 0),
                format_residual(summary.max_acceleration_residual, model.s() > 0));
+    if (model.m() > 0) {
+      fmt::print("  programs: {}, max residual: position {}, velocity {}, acceleration {}{}\n", model.m(),
+                 format_residual(summary.max_program_position_residual, model.position_programs() > 0),
+                 format_residual(summary.max_program_velocity_residual, model.velocity_programs() > 0),
+                 format_residual(summary.max_program_acceleration_residual, true),
+                 options.formulation.program_feedback.enabled
+                     ? fmt::format(" (feedback alpha {:g} 1/s, beta {:g} 1/s)", options.formulation.program_feedback.alpha,
+                                   options.formulation.program_feedback.beta)
+                     : "");
+    }
     if (summary.initial_fix) {
       const InitialFix& fix = *summary.initial_fix;
       fmt::print("  initial state moved onto the constraints (--fix-initial):\n");
@@ -337,7 +380,10 @@ int run_simulate(const SimulateArgs& args) {
         if (fix.dv(i) != 0.0) fmt::print("    {}' = {:.12g} (changed by {:+.3g})\n", c, fix.v(i), fix.dv(i));
       }
     }
-    if (summary.has_energy)
+    if (summary.has_energy && model.m() > 0)
+      fmt::print("  energy change: {:.3g} (E0 = {:.10g}; the actuators do work, so E is not conserved)\n",
+                 summary.energy_drift, summary.energy_initial);
+    else if (summary.has_energy)
       fmt::print("  energy drift: {:.3g} (E0 = {:.10g})\n", summary.energy_drift, summary.energy_initial);
     if (!args.plot.empty()) fmt::print("  plot -> {}\n", args.plot);
     if (!args.html.empty()) fmt::print("  report -> {}{}\n", args.html, html_notice.empty() ? "" : "\n  note: " + html_notice);
@@ -381,6 +427,8 @@ std::function<int()> add_simulate_command(CLI::App& app) {
                   "Record the zero crossings of an expression, NAME=EXPR (e.g. upright=phi; repeatable)");
   cmd->add_option("--max-steps", args->max_steps,
                   "Step budget of the integrator, accepted + rejected steps (default 50000000)");
+  cmd->add_option("--program-feedback", args->program_feedback,
+                  "Programs: PD feedback ALPHA,BETA [1/s] on their residuals (docs/derivations/program-motion.md)");
   cmd->add_flag("-q,--quiet", args->quiet, "Print no summary");
   return [args] { return run_simulate(*args); };
 }

@@ -13,12 +13,14 @@
 #include <new>
 #include <vector>
 
+#include "formulation/sled_heading.hpp"
 #include "formulation/sparse_twin.hpp"
 #include "nhdyn/analysis/projection.hpp"
 #include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/formulation/baumgarte.hpp"
 #include "nhdyn/model/terms.hpp"
 #include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/formulation/program_motion.hpp"
 #include "nhdyn/model/appell.hpp"
 #include "nhdyn/model/sled.hpp"
 
@@ -113,6 +115,28 @@ TEST(Allocation, AccelerationSolveAllocatesNothingAfterTheFirstCall) {
         g_counting = false;
         EXPECT_EQ(g_allocations.load(), 0) << model.name << " " << method_name(m) << "/" << complement_name(c);
       }
+  }
+}
+
+TEST(Allocation, ProgramMotionAllocatesNothingAfterTheFirstCall) {
+  const Model model = testing::make_sled_heading_model();
+  Data data = make_data(model, {Path::automatic, Method::sanh});
+  const double q[3] = {0.1, -0.2, 0.3}, v[3] = {0.9, 0.1, 1.1};
+  for (Complement c : {Complement::qr, Complement::partition, Complement::analytic}) {
+    for (bool feedback : {false, true}) {
+      FormulationOptions options{Method::sanh, c};
+      options.program_feedback = {feedback, 2.0, 3.0};
+      ASSERT_EQ(compute_dynamics(model, data, options, 0.5, q, v), Status::ok);
+      compute_program_residuals(model, data);
+      g_allocations = 0;
+      g_counting = true;
+      const Status status = compute_dynamics(model, data, options, 0.5, q, v);
+      compute_residuals(model, data);
+      compute_program_residuals(model, data);
+      g_counting = false;
+      ASSERT_EQ(status, Status::ok);
+      EXPECT_EQ(g_allocations.load(), 0) << complement_name(c) << (feedback ? " with feedback" : "");
+    }
   }
 }
 

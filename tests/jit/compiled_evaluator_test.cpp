@@ -95,6 +95,27 @@ TEST_F(Jit, EveryExampleGivesTheInterpretersTermsAndAccelerations) {
   }
 }
 
+// A model with programs (docs/derivations/program-motion.md): the compiled terms and the
+// interpreted program rows together give the interpreter's q'' and actuator forces u.
+TEST_F(Jit, ProgramsKeepTheirActuatorForces) {
+  for (const char* file : {"sled_heading_program.toml", "arm_circle_program.toml", "cart_pendulum_program.toml"}) {
+    SCOPED_TRACE(file);
+    const Model interpreted = load_model(example(file));
+    ASSERT_GT(interpreted.m(), 0);
+    const Model compiled = make_compiled(interpreted, options_);
+    expect_same_acceleration(interpreted, compiled, 1e-12);
+    Data a = make_data(interpreted), b = make_data(compiled);
+    ASSERT_EQ(compute_dynamics(interpreted, a, {}, interpreted.t0, interpreted.q0.data(), interpreted.v0.data()),
+              Status::ok);
+    ASSERT_EQ(compute_dynamics(compiled, b, {}, compiled.t0, compiled.q0.data(), compiled.v0.data()), Status::ok);
+    ASSERT_EQ(b.motion.u.size(), interpreted.m());
+    for (int j = 0; j < interpreted.m(); ++j) {
+      EXPECT_NE(a.motion.u(j), 0.0) << "an actuator force that is zero proves nothing";
+      EXPECT_NEAR(b.motion.u(j), a.motion.u(j), 1e-12 * (1.0 + std::abs(a.motion.u(j))));
+    }
+  }
+}
+
 TEST_F(Jit, ParametersAreDataAfterCompilation) {
   const Model interpreted = load_model(example("double_pendulum.toml"));
   const Model compiled = make_compiled(interpreted, options_);

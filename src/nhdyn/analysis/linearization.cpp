@@ -259,6 +259,10 @@ void sort_eigenvalues(std::vector<std::complex<double>>& eigenvalues) {
 
 Linearization calc_linearization(const Model& model, const LinearizationOptions& options) {
   check_model_shape(model);
+  if (model.m() > 0)
+    throw InputError(fmt::format("model '{}' has programs ([[programs]]); linearization does not take their actuator "
+                                 "forces into account: remove the programs to linearize the free system",
+                                 model.name));
   const int n = model.n();
   const int s = model.s();
   Layout layout;

@@ -10,6 +10,7 @@
 #include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
+#include "nhdyn/formulation/program_motion.hpp"
 
 namespace nhdyn {
 namespace {
@@ -131,6 +132,17 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
       throw InputError(fmt::format("the projection needs at least one Newton iteration, not {}",
                                    options.projection.max_iterations));
   }
+  if (model.m() > 0 && options.formulation.method != Method::sanh)
+    throw InputError(fmt::format("model '{}' has programs ([[programs]]), which only the sanh formulation solves "
+                                 "(docs/derivations/program-motion.md); choose --method sanh",
+                                 model.name));
+  if (options.formulation.program_feedback.enabled) {
+    if (model.m() == 0)
+      throw InputError(fmt::format("--program-feedback needs programs, and model '{}' has none ([[programs]] in "
+                                   "docs/model-format.md)",
+                                   model.name));
+    check_program_feedback(options.formulation.program_feedback);
+  }
   if (options.formulation.complement == Complement::analytic && !model.evaluator->has_complement())
     throw InputError(fmt::format("model '{}' has no analytic D; choose --complement qr or partition", model.name));
 }
@@ -155,6 +167,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   } else {
     check_initial_state(model, data, model.t0, q0, v0, options.initial_tolerance);
   }
+  check_programs_at_initial_state(model, data, options.formulation, model.t0, q0, v0, options.initial_tolerance);
 
   const int n = model.n();
   std::vector<double> y0(static_cast<std::size_t>(2 * n));
@@ -189,6 +202,13 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     summary.max_position_residual = std::max(summary.max_position_residual, max_abs(data.phi));
     summary.max_velocity_residual = std::max(summary.max_velocity_residual, max_abs(data.f));
     summary.max_acceleration_residual = std::max(summary.max_acceleration_residual, max_abs(data.e));
+    if (model.m() > 0) {
+      compute_program_residuals(model, data);
+      summary.max_program_position_residual = std::max(summary.max_program_position_residual, max_abs(data.motion.phi));
+      summary.max_program_velocity_residual = std::max(summary.max_program_velocity_residual, max_abs(data.motion.f));
+      summary.max_program_acceleration_residual =
+          std::max(summary.max_program_acceleration_residual, max_abs(data.motion.e));
+    }
     if (summary.has_energy)
       summary.energy_drift = std::max(summary.energy_drift, std::abs(data.energy - summary.energy_initial));
     ++summary.outputs;

@@ -67,6 +67,11 @@ struct SimulationSummary {
   double max_position_residual = 0.0;      // max |phi| over outputs and constraints
   double max_velocity_residual = 0.0;      // max |f|
   double max_acceleration_residual = 0.0;  // max |b q'' + b0|
+  // Program motion (model.m() > 0): the same maxima for the programs' residuals, the tracking
+  // error of the realized motion (docs/derivations/program-motion.md section 5).
+  double max_program_position_residual = 0.0;
+  double max_program_velocity_residual = 0.0;
+  double max_program_acceleration_residual = 0.0;
   bool has_energy = false;
   double energy_initial = 0.0;
   double energy_drift = 0.0;        // max |E(t) - E(t0)| over outputs
@@ -85,7 +90,8 @@ struct SimulationSummary {
 };
 
 // Called at every output time, and at every event (its row is the state at the crossing), with
-// Data holding t, q, q', q'', R, residuals and energy.
+// Data holding t, q, q', q'', R, residuals and energy (and for a model with programs data.motion:
+// the actuator forces u and the programs' residuals).
 using RowFn = std::function<void(const Data&)>;
 
 // The output times t0, t0 + h, ..., ending exactly at t_end. Throws InputError on t_end <= t0

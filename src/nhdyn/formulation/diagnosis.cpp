@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/formulation/program_motion.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {
@@ -159,6 +160,7 @@ std::string explain_failure(const Model& model, const Data& data) {
                          "tan(phi) at its singular point)",
                          data.failed_quantity, data.failed_t);
     case Status::singular_system:
+      if (data.failed_quantity.rfind("program matrix", 0) == 0) return explain_program_failure(model, data);
       if (b_is_rank_deficient(model, data)) return explain_dependent_constraints(model, data);
       if (!a_is_positive_definite(model, data)) return explain_inertia(model, data);
       return fmt::format("the {} is singular at t = {:.6g} although A is positive definite and b has "

@@ -7,6 +7,7 @@
 #include "nhdyn/core/finite.hpp"
 #include "nhdyn/formulation/lagrange.hpp"
 #include "nhdyn/formulation/nullspace.hpp"
+#include "nhdyn/formulation/program_motion.hpp"
 #include "nhdyn/formulation/sanh.hpp"
 #include "nhdyn/formulation/sparse_lagrange.hpp"
 #include "nhdyn/formulation/sparse_sanh.hpp"
@@ -60,6 +61,9 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
                            " formulation has no sparse kernels; use sanh or lagrange on the sparse path, or make "
                            "the Data with DataOptions::method = " + std::string(method_name(options.method)) +
                            " (the dense path)");
+  if (model.m() > 0 && (options.method != Method::sanh || data.sparse))
+    throw InputError("model '" + model.name + "' has programs ([[programs]]), which only the sanh formulation solves, "
+                     "on the dense path (docs/derivations/program-motion.md); choose --method sanh");
   data.has_multipliers = false;
   if (options.baumgarte.enabled) {
     compute_baumgarte_terms(model, data, options.baumgarte);
@@ -71,7 +75,10 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
     status = options.method == Method::sanh ? compute_sparse_sanh_acceleration(model, data)
                                             : compute_sparse_lagrange_acceleration(model, data);
   else switch (options.method) {
-    case Method::sanh: status = compute_sanh_acceleration(model, data, options.complement); break;
+    case Method::sanh:
+      status = model.m() > 0 ? compute_program_motion(model, data, options.complement, options.program_feedback)
+                             : compute_sanh_acceleration(model, data, options.complement);
+      break;
     case Method::lagrange: status = compute_lagrange_acceleration(model, data); break;
     case Method::udwadia_kalaba: status = compute_udwadia_kalaba_acceleration(model, data); break;
     case Method::nullspace: status = compute_nullspace_acceleration(model, data, options.complement); break;

@@ -8,6 +8,7 @@
 
 #include "nhdyn/core/status.hpp"
 #include "nhdyn/formulation/baumgarte.hpp"
+#include "nhdyn/formulation/program_feedback.hpp"
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/model/model.hpp"
 
@@ -28,6 +29,7 @@ struct FormulationOptions {
   Method method = Method::sanh;
   Complement complement = Complement::qr;
   BaumgarteGains baumgarte;  // off unless enabled (baumgarte.hpp)
+  ProgramFeedback program_feedback;  // off unless enabled; only for a model with programs (program_motion.hpp)
 };
 
 // "sanh", "lagrange", "udwadia-kalaba", "nullspace".
@@ -37,7 +39,9 @@ Method parse_method(std::string_view name);  // throws InputError listing valid 
 std::string_view complement_name(Complement complement);
 Complement parse_complement(std::string_view name);  // throws InputError listing valid names
 
-// Requires compute_terms for the current state (Stage::terms). Writes data.qdd, data.R,
+// Requires compute_terms for the current state (Stage::terms). For a model with programs
+// (model.m() > 0) sanh solves program motion (program_motion.hpp), which writes data.motion too;
+// the other formulations refuse such a model with InputError. Writes data.qdd, data.R,
 // data.lambda (when the method has multipliers), data.D (sanh, nullspace) and sets
 // Stage::acceleration. On the sparse path (data.sparse) it runs the sparse kernels of sanh
 // (sparse_sanh.hpp, always with the partitioned D whatever `options.complement` says) or

@@ -41,7 +41,7 @@ using symbolic::SpecBuilder;
 // The keys of each table of the format (docs/model-format.md), in the order the doc lists them.
 const std::vector<std::string> top_level_keys = {
     "name",           "description", "coordinates", "parameters",  "kinetic_energy",
-    "potential_energy", "forces",    "constraints", "independent", "complement",
+    "potential_energy", "forces",    "constraints", "programs", "independent", "complement",
     "initial",        "solution",    "simulation",  "plot",        "visual",
     "events",  // [[events]]: zero crossings located during a run
     // The multibody description (docs/multibody.md).
@@ -55,6 +55,7 @@ const std::vector<std::string> surface_keys = {"name", "point", "surface"};
 const std::vector<std::string> curve_keys = {"name", "point", "surfaces"};
 const std::vector<std::string> parameter_keys = {"value", "unit"};
 const std::vector<std::string> constraint_keys = {"name", "position", "velocity", "acceleration"};
+const std::vector<std::string> program_keys = {"name", "position", "velocity", "acceleration", "actuator"};
 const std::vector<std::string> initial_keys = {"t0", "position", "velocity"};
 const std::vector<std::string> simulation_keys = {"t_end", "output_step", "integrator", "method", "rtol", "atol"};
 const std::vector<std::string> plot_keys = {"path"};
@@ -159,6 +160,7 @@ class Loader {
 
     if (const toml::node* forces = root.get("forces")) load_forces(*forces, builder);
     if (const toml::node* constraints = root.get("constraints")) load_constraints(*constraints, builder);
+    if (const toml::node* programs = root.get("programs")) load_programs(*programs, builder);
     symbolic::SpecVisual visual;
     load_multibody(root, builder, visual);
     if (const toml::node* node = root.get("visual")) load_visual(*node, builder, visual);
@@ -650,6 +652,68 @@ class Loader {
       events.push_back(std::move(event));
     }
     return events;
+  }
+
+  // [[programs]] (docs/model-format.md, docs/derivations/program-motion.md): each a constraint the
+  // motion must follow, with the actuator that realizes it.
+  void load_programs(const toml::node& node, SpecBuilder& builder) const {
+    constexpr std::string_view example = "[[programs]] followed by name = \"heading\", position = \"phi - omega*t\" "
+                                         "and actuator = \"phi\"";
+    const toml::array& array = array_of(node, "programs", example);
+    int number = 0;
+    for (const toml::node& element : array) {
+      ++number;
+      const toml::table* table = element.as_table();
+      if (table == nullptr)
+        fail(at(element), fmt::format("program {} must be a table with a name, one of position, velocity, "
+                                      "acceleration, and an actuator (write it as [[programs]]); it is {}",
+                                      number, type_name(element)));
+      check_keys(*table, program_keys, fmt::format("in program {}", number));
+      std::string name = fmt::format("p{}", number);
+      if (const toml::node* name_node = table->get("name")) name = string_of(*name_node, "name", "name = \"heading\"");
+      const toml::node* level_node = nullptr;
+      std::string level_key;
+      ConstraintLevel level = ConstraintLevel::position;
+      for (const Entry& entry : in_file_order(*table)) {
+        const std::string key(entry.key->str());
+        ConstraintLevel this_level;
+        if (key == "position") this_level = ConstraintLevel::position;
+        else if (key == "velocity") this_level = ConstraintLevel::velocity;
+        else if (key == "acceleration") this_level = ConstraintLevel::acceleration;
+        else continue;
+        if (level_node != nullptr)
+          fail(at(*entry.key), fmt::format("program '{}' is given both as {} and as {}; give exactly one of "
+                                           "position, velocity, acceleration",
+                                           name, level_key, key));
+        level_node = entry.value;
+        level_key = key;
+        level = this_level;
+      }
+      if (level_node == nullptr)
+        fail(at(element), fmt::format("program '{}' has no expression: give exactly one of position = \"...\", "
+                                      "velocity = \"...\" or acceleration = \"...\" (the program is expression = 0)",
+                                      name));
+      const toml::node* actuator = table->get("actuator");
+      if (actuator == nullptr)
+        fail(at(element), fmt::format("program '{}' has no actuator: name the coordinate its force or torque acts "
+                                      "on, actuator = \"{}\", or give a generalized force direction with one entry "
+                                      "per coordinate, actuator = [...]",
+                                      name, coordinates_.empty() ? "x" : coordinates_.back()));
+      const std::string text = expression_string(*level_node, fmt::format("{}.{}", name, level_key),
+                                                 "position = \"phi - omega*t\"");
+      if (actuator->is_string()) {
+        const std::string coordinate = actuator->as_string()->get();
+        located(*level_node, [&] { builder.program(name, level, text, coordinate, content_at(*level_node), at(*actuator)); });
+        continue;
+      }
+      const std::string what = fmt::format("{}.actuator", name);
+      const toml::array& entries = array_of(*actuator, what, "actuator = \"phi\" or actuator = [0, 0, 1]");
+      std::vector<std::string> direction;
+      for (const toml::node& entry : entries)
+        direction.push_back(number_or_expression(entry, what, "\"cos(q1)\" or 0"));
+      located(*level_node,
+              [&] { builder.program(name, level, text, direction, content_at(*level_node), at(*actuator)); });
+    }
   }
 
   void load_complement(const toml::table& root, SpecBuilder& builder) const {

@@ -429,7 +429,7 @@ struct ScriptInput {
   std::string time_name;
   fs::path csv;     // absolute
   fs::path output;  // absolute, the temporary file
-  std::vector<Column> coordinates, reactions, residuals;
+  std::vector<Column> coordinates, reactions, residuals, actuators;
   std::optional<std::pair<Column, Column>> path;
   std::optional<Column> energy;
   double energy0 = 0.0;
@@ -441,7 +441,7 @@ std::string make_script(const ScriptInput& in) {
   const int panels =
       static_cast<int>(!in.coordinates.empty()) + static_cast<int>(!in.reactions.empty()) +
       static_cast<int>(!in.residuals.empty()) + static_cast<int>(in.path.has_value()) +
-      static_cast<int>(in.energy.has_value());
+      static_cast<int>(in.energy.has_value()) + static_cast<int>(!in.actuators.empty());
   const int layout_columns = panels == 1 ? 1 : 2;
   const int layout_rows = (panels + layout_columns - 1) / layout_columns;
   // gnuplot skips the header lines; `every` also thins the rows, `all` takes them all.
@@ -482,6 +482,7 @@ std::string make_script(const ScriptInput& in) {
   };
   time_series("coordinates", in.coordinates);
   time_series("reactions", in.reactions);
+  time_series("actuator forces u", in.actuators);
 
   if (!in.residuals.empty()) {
     // A residual that is exactly zero (at t = 0, or a constraint met to the last bit) has no
@@ -644,7 +645,7 @@ bool gnuplot_available() {
 
 void write_plot(const PlotRequest& request, const std::filesystem::path& png) {
   if (request.coordinates.empty() && request.reactions.empty() && request.residuals.empty() &&
-      !request.path && !request.energy) {
+      request.actuators.empty() && !request.path && !request.energy) {
     throw InputError(fmt::format(
         "nothing to plot into '{}': the request names no coordinate, reaction, residual, path "
         "or energy column",
@@ -675,6 +676,9 @@ void write_plot(const PlotRequest& request, const std::filesystem::path& png) {
   }
   for (const std::string& name : request.residuals) {
     in.residuals.push_back(lookup(name, "residual"));
+  }
+  for (const std::string& name : request.actuators) {
+    in.actuators.push_back(lookup(name, "actuator force"));
   }
   if (request.path) {
     Column x = lookup(request.path->first, "path x");

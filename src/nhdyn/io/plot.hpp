@@ -21,6 +21,7 @@ struct PlotRequest {
   std::vector<std::string> coordinates;  // coordinate columns against time, e.g. "x", "y", "phi"
   std::vector<std::string> reactions;    // reaction columns against time, e.g. "R_x"
   std::vector<std::string> residuals;    // residual columns, |r| against time on a log scale
+  std::vector<std::string> actuators = {};  // actuator force columns against time, e.g. "u_heading"
   // Columns x and y of a planar system, drawn as its path y(x) with equal axis scales.
   std::optional<std::pair<std::string, std::string>> path;
   std::optional<std::string> energy;  // energy column, drawn as its drift E(t) - E(0)

@@ -172,6 +172,8 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
   for (PlotGroup* g : {&lengths, &angles})
     if (!g->columns.empty()) groups.push_back(*g);
   if (!input.columns.reactions.empty()) groups.push_back({"reactions R", false, false, input.columns.reactions});
+  if (!input.columns.actuators.empty())
+    groups.push_back({"actuator forces u ([[programs]])", false, false, input.columns.actuators});
   if (!input.columns.residuals.empty())
     groups.push_back({"|constraint residuals| (log scale)", true, false, input.columns.residuals});
   if (!input.columns.energy.empty())

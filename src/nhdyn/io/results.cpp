@@ -21,6 +21,17 @@ ResultColumns make_result_columns(const Model& model) {
     c.energy = "energy";
     c.all.push_back(c.energy);
   }
+  // Program motion, after everything else so that a model without programs keeps its layout.
+  std::vector<std::string> program_residuals;
+  for (const ProgramConstraint& p : model.program_constraints) c.actuators.push_back("u_" + p.name);
+  for (const ProgramConstraint& p : model.program_constraints)
+    if (p.level == ConstraintLevel::position) program_residuals.push_back("residual_pos_" + p.name);
+  for (const ProgramConstraint& p : model.program_constraints)
+    if (p.level != ConstraintLevel::acceleration) program_residuals.push_back("residual_vel_" + p.name);
+  for (const ProgramConstraint& p : model.program_constraints) program_residuals.push_back("residual_acc_" + p.name);
+  c.all.insert(c.all.end(), c.actuators.begin(), c.actuators.end());
+  c.all.insert(c.all.end(), program_residuals.begin(), program_residuals.end());
+  c.residuals.insert(c.residuals.end(), program_residuals.begin(), program_residuals.end());
   return c;
 }
 
@@ -35,6 +46,12 @@ void fill_result_row(const Model& model, const Data& data, std::vector<double>& 
   for (Eigen::Index i = 0; i < data.f.size(); ++i) row.push_back(data.f(i));
   for (Eigen::Index i = 0; i < data.e.size(); ++i) row.push_back(data.e(i));
   if (model.evaluator->has_energy()) row.push_back(data.energy);
+  if (model.m() == 0) return;
+  const ProgramMotionData& w = data.motion;
+  for (Eigen::Index i = 0; i < w.u.size(); ++i) row.push_back(w.u(i));
+  for (Eigen::Index i = 0; i < w.phi.size(); ++i) row.push_back(w.phi(i));
+  for (Eigen::Index i = 0; i < w.f.size(); ++i) row.push_back(w.f(i));
+  for (Eigen::Index i = 0; i < w.e.size(); ++i) row.push_back(w.e(i));
 }
 
 }  // namespace nhdyn

@@ -2,7 +2,9 @@
 //   t, the coordinates q (by name), their velocities (x'), accelerations (x''), reactions (R_x),
 //   the constraint residuals — position level (residual_pos_<constraint>), velocity level
 //   (residual_vel_<constraint>), acceleration level (residual_acc_<constraint>) — and energy
-//   (when the model defines one).
+//   (when the model defines one); then, for a model with programs (docs/derivations/program-motion.md),
+//   the actuator forces (u_<program>) and the programs' residuals at the three levels, named like
+//   the constraints' (residual_pos_<program>, ...).
 // Shared by the CSV writer and the plots so that both name the columns the same way.
 #pragma once
 
@@ -20,12 +22,14 @@ struct ResultColumns {
   std::vector<std::string> reactions;    // R
   std::vector<std::string> residuals;    // the three levels
   std::string energy;                    // empty when the model defines none
+  std::vector<std::string> actuators;    // u, one per program (empty without programs)
 };
 
 ResultColumns make_result_columns(const Model& model);
 
 // Fills `row` (sized to the column count; no allocation after the first call) from Data after
-// compute_acceleration, compute_residuals and compute_energy.
+// compute_acceleration, compute_residuals and compute_energy (and compute_program_residuals for a
+// model with programs).
 void fill_result_row(const Model& model, const Data& data, std::vector<double>& row);
 
 }  // namespace nhdyn

@@ -194,6 +194,18 @@ class CompiledEvaluator final : public Evaluator {
   void velocity_residual(double t, const double* q, const double* v, double* scratch, double* f) const override {
     base_->velocity_residual(t, q, v, scratch, f);
   }
+  bool has_program_constraints() const override { return base_->has_program_constraints(); }
+  void program_constraint_terms(double t, const double* q, const double* v, double* scratch, double* b_p,
+                                double* b_p0, double* B) const override {
+    base_->program_constraint_terms(t, q, v, scratch, b_p, b_p0, B);
+  }
+  void program_constraint_position_residual(double t, const double* q, double* scratch, double* phi) const override {
+    base_->program_constraint_position_residual(t, q, scratch, phi);
+  }
+  void program_constraint_velocity_residual(double t, const double* q, const double* v, double* scratch,
+                                            double* f) const override {
+    base_->program_constraint_velocity_residual(t, q, v, scratch, f);
+  }
   bool has_energy() const override { return base_->has_energy(); }
   double energy(double t, const double* q, const double* v, double* scratch) const override {
     return base_->energy(t, q, v, scratch);

@@ -179,8 +179,13 @@ bool calc_sparse_path(const Model& model, const DataOptions& options) {
   const bool compiled_sparse = model.evaluator && model.evaluator->sparsity() != nullptr;
   switch (options.path) {
     case Path::dense: return false;
-    case Path::automatic: return compiled_sparse && (!options.method || has_sparse_kernels(*options.method));
+    case Path::automatic:
+      // Program motion has dense kernels only (formulation/program_motion.hpp).
+      return compiled_sparse && model.m() == 0 && (!options.method || has_sparse_kernels(*options.method));
     case Path::sparse:
+      if (model.m() > 0)
+        throw InputError(fmt::format("model '{}' has programs ([[programs]]), which are solved on the dense path only; "
+                                     "take the dense path", model.name));
       if (!compiled_sparse)
         throw InputError(fmt::format("model '{}' was not compiled sparse, so it has no sparse path; compile it with "
                                      "TermsLayout::sparse (symbolic/compile.hpp) or take the dense path",
@@ -377,6 +382,26 @@ Data make_data(const Model& model, const DataOptions& options) {
   d.projection_rows.assign(static_cast<std::size_t>(s), 0);
   d.dependent.assign(static_cast<std::size_t>(s), 0);
   d.is_dependent.assign(static_cast<std::size_t>(n), 0);
+  if (const int m = model.m(); m > 0) {
+    ProgramMotionData& w = d.motion;
+    w.b_p = Matrix::Zero(m, n);
+    w.b_p0 = Vector::Zero(m);
+    w.B = Matrix::Zero(n, m);
+    w.feedback = Vector::Zero(m);
+    w.u = Vector::Zero(m);
+    w.qdd0 = Vector::Zero(n);
+    w.DB = Matrix::Zero(n, m);
+    w.PB = Matrix::Zero(n, m);
+    w.S = Matrix::Zero(m, m);
+    w.S_scaled = Matrix::Zero(m, m);
+    w.row_scale = Vector::Zero(m);
+    w.col_scale = Vector::Zero(m);
+    w.rhs = Vector::Zero(m);
+    w.lu_S = Eigen::PartialPivLU<Matrix>(m);
+    w.phi = Vector::Zero(model.position_programs());
+    w.f = Vector::Zero(model.velocity_programs());
+    w.e = Vector::Zero(m);
+  }
   if (sparse) {
     // The terms at the initial state, and the dependent coordinates chosen there.
     const TermsOut out{d.A_sparse.valuePtr(), d.Q.data(), d.G.data(), d.b_sparse.valuePtr(), d.b0.data()};

@@ -57,6 +57,33 @@ struct DataOptions {
 // How far the kernels have got for the state (t, q, v) held in Data.
 enum class Stage { empty = 0, terms = 1, acceleration = 2 };
 
+// The workspace and results of program motion (formulation/program_motion.hpp,
+// docs/derivations/program-motion.md), m programs on n coordinates. Sized by make_data for a model
+// with programs (empty otherwise); filled by compute_program_motion and
+// compute_program_residuals.
+struct ProgramMotionData {
+  Matrix b_p;          // m x n, the programs at acceleration level, b_p q'' + b_p0 = 0
+  Vector b_p0;         // m, the model's (without feedback)
+  Matrix B;            // n x m, the actuator matrix
+  Vector feedback;     // m, 2 alpha f_p + beta^2 phi_p added to b_p0 (program feedback, (P6))
+  Vector u;            // m, the actuator forces (units of the generalized force of each column of B)
+  Vector qdd0;         // n, q''_0: the motion without actuators, M^-1 [D (Q + G); -b0]
+  Matrix DB;           // n x m, [D B; 0]
+  Matrix PB;           // n x m, P B = M^-1 [D B; 0]
+  Matrix S;            // m x m, b_p P B (P4)
+  Matrix S_scaled;     // m x m, S with rows scaled by 1/|b_p_i| and columns by 1/|P B_j|
+  Vector row_scale;    // m, |b_p_i|
+  Vector col_scale;    // m, |P B_j|
+  Vector rhs;          // m, -(b_p q''_0 + b_p0 + feedback)
+  Eigen::PartialPivLU<Matrix> lu_S;  // m x m
+  int absorbed = -1;   // program whose actuator the constraints absorb (D B_j = 0), -1 if none
+  // Residuals (compute_program_residuals): one per position-level program, one per position- or
+  // velocity-level program, and all m at acceleration level, b_p q'' + b_p0.
+  Vector phi;
+  Vector f;
+  Vector e;
+};
+
 struct Data {
   // --- how this Data was made (make_data) ---------------------------------------------------------
   bool sparse = false;           // the sparse path: A_sparse, b_sparse and the sparse workspace
@@ -95,6 +122,9 @@ struct Data {
   Vector f;             // velocity-level residuals (one per position or velocity constraint)
   Vector e;             // s acceleration-level residuals b q'' + b0 (2.14)
   double energy = 0.0;  // T + V where the model defines it
+
+  // --- program motion (compute_program_motion; empty for a model without programs) -------------
+  ProgramMotionData motion;
 
   // --- failure details (set when a kernel returns a non-ok status) --------------------------------
   Status status = Status::ok;

@@ -71,6 +71,22 @@ class Evaluator {
   virtual void velocity_residual(double /*t*/, const double* /*q*/, const double* /*v*/,
                                  double* /*scratch*/, double* /*f*/) const {}
 
+  // Programs (docs/derivations/program-motion.md), m = Model::m() of them. Whether the terms
+  // below are computed (a model with programs must say yes).
+  virtual bool has_program_constraints() const { return false; }
+  // b_p (m x n, column-major), b_p0 (m): the programs at acceleration level, b_p q'' + b_p0 = 0;
+  // B (n x m, column-major): the actuator matrix, column j the generalized force direction of
+  // program j.
+  virtual void program_constraint_terms(double /*t*/, const double* /*q*/, const double* /*v*/,
+                                        double* /*scratch*/, double* /*b_p*/, double* /*b_p0*/,
+                                        double* /*B*/) const {}
+  // The programs' residuals as for the constraints: one per position-level program, and one per
+  // position- or velocity-level program, in program order.
+  virtual void program_constraint_position_residual(double /*t*/, const double* /*q*/, double* /*scratch*/,
+                                                    double* /*phi*/) const {}
+  virtual void program_constraint_velocity_residual(double /*t*/, const double* /*q*/, const double* /*v*/,
+                                                    double* /*scratch*/, double* /*f*/) const {}
+
   // Whether energy() is defined (T + V of a system whose other forces do no work).
   virtual bool has_energy() const { return false; }
   virtual double energy(double /*t*/, const double* /*q*/, const double* /*v*/,

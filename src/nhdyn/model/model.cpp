@@ -21,6 +21,17 @@ int Model::velocity_constraints() const {
   }));
 }
 
+int Model::position_programs() const {
+  return static_cast<int>(std::count_if(program_constraints.begin(), program_constraints.end(),
+                                        [](const ProgramConstraint& c) { return c.level == ConstraintLevel::position; }));
+}
+
+int Model::velocity_programs() const {
+  return static_cast<int>(std::count_if(program_constraints.begin(), program_constraints.end(), [](const ProgramConstraint& c) {
+    return c.level != ConstraintLevel::acceleration;
+  }));
+}
+
 void check_model_shape(const Model& model) {
   const std::string who = fmt::format("model '{}'", model.name);
   if (model.n() == 0) throw ModelError(who + ": it has no coordinates");
@@ -39,6 +50,16 @@ void check_model_shape(const Model& model) {
     if (!seen.insert(c.name).second)
       throw ModelError(fmt::format("{}: the name '{}' is used twice (constraint names must differ "
                                    "from each other and from coordinate names)", who, c.name));
+  for (const ProgramConstraint& c : model.program_constraints)
+    if (!seen.insert(c.name).second)
+      throw ModelError(fmt::format("{}: the name '{}' is used twice (program names must differ from each other and "
+                                   "from coordinate and constraint names)", who, c.name));
+  if (model.m() > model.k())
+    throw ModelError(fmt::format("{}: {} programs for k = n - s = {} degrees of freedom: at most {} programs are "
+                                 "possible", who, model.m(), model.k(), model.k()));
+  if (model.m() > 0 && !model.evaluator->has_program_constraints())
+    throw ModelError(fmt::format("{}: it has {} programs but its evaluator does not compute their terms", who,
+                                 model.m()));
   if (model.path && (model.path->x >= model.n() || model.path->y >= model.n()))
     throw ModelError(who + ": the planar path names a coordinate that does not exist");
 }

@@ -28,6 +28,16 @@ struct Constraint {
   std::string expression;  // as a user reads it, e.g. "y' - tan(phi) x' = 0"
 };
 
+// A program (docs/derivations/program-motion.md): a constraint the motion must follow that no
+// ideal contact enforces, realized by its actuator, a generalized force along the column B_j of the
+// actuator matrix with an unknown magnitude u_j. (Unrelated to the evaluator's compiled programs.)
+struct ProgramConstraint {
+  std::string name;
+  ConstraintLevel level = ConstraintLevel::position;
+  std::string expression;  // as a user reads it, e.g. "phi - omega*t"
+  std::string actuator;    // as a user reads it: a coordinate name or "[e1, ..., en]"
+};
+
 // A parameter and its current value. A derived parameter has the expression of its value in the
 // others (k = "4*m"), re-evaluated when they change (parameters.hpp); a base one has none.
 struct Parameter {
@@ -51,6 +61,9 @@ struct Model {
   std::string description;
   std::vector<std::string> coordinates;  // n names, in the order of q
   std::vector<Constraint> constraints;   // s, in the order of the rows of b
+  // m programs with their actuators, in the order of the rows of b_p and the columns of B; empty
+  // for a model without programs. Solved by formulation/program_motion.hpp.
+  std::vector<ProgramConstraint> program_constraints;
   std::vector<Parameter> parameters;     // the values the evaluator computes with, in its order;
                                          // change them with set_parameter (parameters.hpp)
   double t0 = 0.0;
@@ -68,9 +81,13 @@ struct Model {
   int n() const { return static_cast<int>(coordinates.size()); }
   int s() const { return static_cast<int>(constraints.size()); }
   int k() const { return n() - s(); }
+  int m() const { return static_cast<int>(program_constraints.size()); }
   // Number of constraints given at position level, and at position or velocity level.
   int position_constraints() const;
   int velocity_constraints() const;
+  // The same for the programs.
+  int position_programs() const;
+  int velocity_programs() const;
 };
 
 // Checks the dimensions and names of a model before use; throws ModelError naming what is wrong.

@@ -431,6 +431,10 @@ ModelPrograms bind_programs(const ModelPrograms& parametric, const std::vector<d
   out.solution = bound_optional(parametric.solution);
   out.initial_state = bound_optional(parametric.initial_state);
   out.sparsity = parametric.sparsity;
+  out.program_constraints = parametric.program_constraints;
+  out.program_constraint_terms = bound_optional(parametric.program_constraint_terms);
+  out.program_constraint_position_residual = bound_optional(parametric.program_constraint_position_residual);
+  out.program_constraint_velocity_residual = bound_optional(parametric.program_constraint_velocity_residual);
   return out;
 }
 
@@ -494,6 +498,23 @@ void ProgramEvaluator::build() {
       programs_.position_residual.outputs() > programs_.velocity_residual.outputs())
     throw std::invalid_argument("ProgramEvaluator: more residuals than constraints");
 
+  const int m = programs_.program_constraints;
+  if (m < 0 || m > n - s || (m > 0) != programs_.program_constraint_terms.has_value() ||
+      (m > 0) != programs_.program_constraint_position_residual.has_value() ||
+      (m > 0) != programs_.program_constraint_velocity_residual.has_value())
+    throw std::invalid_argument("ProgramEvaluator: " + std::to_string(m) +
+                                " programs need their terms and residual programs (and at most n - s of them)");
+  if (m > 0) {
+    check_program(*programs_.program_constraint_terms, "program terms", n, 2 * m * n + m);
+    check_program(*programs_.program_constraint_position_residual, "program position residual", n, -1);
+    check_program(*programs_.program_constraint_velocity_residual, "program velocity residual", n, -1);
+    if (programs_.program_constraint_position_residual->reads_velocities())
+      throw std::invalid_argument("ProgramEvaluator: the program position residual program reads velocities");
+    if (programs_.program_constraint_position_residual->outputs() > m ||
+        programs_.program_constraint_velocity_residual->outputs() > m)
+      throw std::invalid_argument("ProgramEvaluator: more program residuals than programs");
+  }
+
   std::size_t largest = static_cast<std::size_t>(programs_.terms.registers());
   const auto widen = [&largest](const Program& p) {
     largest = std::max(largest, static_cast<std::size_t>(p.registers()));
@@ -504,6 +525,11 @@ void ProgramEvaluator::build() {
   if (programs_.energy) widen(*programs_.energy);
   if (programs_.solution) widen(*programs_.solution);
   if (programs_.initial_state) widen(*programs_.initial_state);
+  if (m > 0) {
+    widen(*programs_.program_constraint_terms);
+    widen(*programs_.program_constraint_position_residual);
+    widen(*programs_.program_constraint_velocity_residual);
+  }
   scratch_ = largest;
   if (programs_.sparsity) {
     // The nonzeros of A and b, between the program's run and their scatter into dense matrices.
@@ -518,6 +544,15 @@ void ProgramEvaluator::build() {
   if (programs_.energy) energy_ = prepare(*programs_.energy, {1});
   if (programs_.solution) solution_ = prepare(*programs_.solution, {3 * n});
   if (programs_.initial_state) initial_state_ = prepare(*programs_.initial_state, {2 * n});
+  if (m > 0) {
+    program_sizes_[0] = program_sizes_[2] = static_cast<std::size_t>(m) * static_cast<std::size_t>(n);
+    program_sizes_[1] = static_cast<std::size_t>(m);
+    program_terms_ = prepare(*programs_.program_constraint_terms, {m * n, m, n * m});
+    program_phi_ = prepare(*programs_.program_constraint_position_residual,
+                           {programs_.program_constraint_position_residual->outputs()});
+    program_f_ = prepare(*programs_.program_constraint_velocity_residual,
+                         {programs_.program_constraint_velocity_residual->outputs()});
+  }
   if (programs_.sparsity) {
     terms_function_ = terms_.calls ? &terms_scatter<true> : &terms_scatter<false>;
     sparse_function_ = terms_.calls ? &terms_any<true> : &terms_any<false>;
@@ -818,6 +853,42 @@ void ProgramEvaluator::position_residual(double t, const double* q, double* scra
 void ProgramEvaluator::velocity_residual(double t, const double* q, const double* v, double* scratch,
                                          double* f) const {
   run(velocity_residual_, t, q, v, scratch, f);
+}
+
+void ProgramEvaluator::program_constraint_terms(double t, const double* q, const double* v, double* scratch,
+                                                double* b_p, double* b_p0, double* B) const {
+  if (!programs_.program_constraint_terms) return;
+  const Prepared& p = program_terms_;
+  load_inputs(p.reads, static_cast<std::size_t>(n_), t, q, v, scratch);
+  double* arrays[4];
+  arrays[0] = scratch;
+  store_fence();
+  arrays[1] = b_p;
+  store_fence();
+  arrays[2] = b_p0;
+  store_fence();
+  arrays[3] = B;
+  const double* image = p.image.data();
+  for (int a = 0; a < 3; ++a) {
+    for (std::size_t i = 0; i < program_sizes_[a]; ++i) arrays[a + 1][i] = image[i];
+    image += program_sizes_[a];
+  }
+  if (p.calls)
+    run_steps<true>(p.steps.data(), arrays);
+  else
+    run_steps<false>(p.steps.data(), arrays);
+}
+
+void ProgramEvaluator::program_constraint_position_residual(double t, const double* q, double* scratch,
+                                                            double* phi) const {
+  if (!programs_.program_constraint_position_residual) return;
+  run(program_phi_, t, q, nullptr, scratch, phi);
+}
+
+void ProgramEvaluator::program_constraint_velocity_residual(double t, const double* q, const double* v,
+                                                            double* scratch, double* f) const {
+  if (!programs_.program_constraint_velocity_residual) return;
+  run(program_f_, t, q, v, scratch, f);
 }
 
 double ProgramEvaluator::energy(double t, const double* q, const double* v, double* scratch) const {

@@ -182,6 +182,13 @@ struct ModelPrograms {
   std::optional<TermsSparsity> sparsity;  // the nonzeros of A and b that terms writes, if not all
   std::optional<Program> initial_state = std::nullopt;  // outputs: q0 (n), q'0 (n); reads parameters only
   int parameters = 0;                // number of parameters the programs may read
+  // Program motion (docs/derivations/program-motion.md), with m programs: outputs b_p (m x n
+  // col-major), b_p0 (m), B (n x m col-major); the programs' position residuals (reading no
+  // velocity) and velocity residuals. Absent when m = 0.
+  int program_constraints = 0;       // m
+  std::optional<Program> program_constraint_terms = std::nullopt;
+  std::optional<Program> program_constraint_position_residual = std::nullopt;
+  std::optional<Program> program_constraint_velocity_residual = std::nullopt;
 };
 
 // An Evaluator that runs straight-line programs. It keeps the parametric programs (shared by every
@@ -237,6 +244,12 @@ class ProgramEvaluator final : public Evaluator {
   void velocity_residual(double t, const double* q, const double* v, double* scratch, double* f) const override;
   bool has_energy() const override { return programs_.energy.has_value(); }
   double energy(double t, const double* q, const double* v, double* scratch) const override;
+  bool has_program_constraints() const override { return programs_.program_constraint_terms.has_value(); }
+  void program_constraint_terms(double t, const double* q, const double* v, double* scratch, double* b_p,
+                                double* b_p0, double* B) const override;
+  void program_constraint_position_residual(double t, const double* q, double* scratch, double* phi) const override;
+  void program_constraint_velocity_residual(double t, const double* q, const double* v, double* scratch,
+                                            double* f) const override;
   bool has_solution() const override { return programs_.solution.has_value(); }
   void solution(double t, double* scratch, double* qva) const override;
 
@@ -279,6 +292,8 @@ class ProgramEvaluator final : public Evaluator {
   ModelPrograms programs_;  // *parametric_ bound to parameters_
   std::size_t scratch_ = 0;
   Prepared terms_, complement_, position_residual_, velocity_residual_, energy_, solution_, initial_state_;
+  Prepared program_terms_, program_phi_, program_f_;  // program motion (empty without programs)
+  std::size_t program_sizes_[3] = {0, 0, 0};          // outputs of program_terms_: b_p, b_p0, B
   TermsFunction terms_function_ = nullptr;
   std::size_t terms_sizes_[5] = {0, 0, 0, 0, 0};  // outputs of terms: A, Q, G, b, b0 (nonzeros when sparse)
   std::size_t values_offset_ = 0;  // where terms_scatter keeps the nonzeros in scratch

@@ -326,6 +326,10 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
 
   // The generated code writes every entry of A and b (dense outputs).
   const Model model = compile_model(spec, derivation, CompileOptions{TermsLayout::dense});
+  if (model.m() > 0)
+    throw InputError(fmt::format("codegen: model '{}' has programs ([[programs]]), which generated code does not "
+                                 "carry yet; run it through the interpreted evaluator (nhdyn simulate)",
+                                 model.name));
   const auto* evaluator = dynamic_cast<const ProgramEvaluator*>(model.evaluator.get());
   if (evaluator == nullptr) throw std::logic_error("generate_code: compile_model did not make a ProgramEvaluator");
   const ModelPrograms& programs = evaluator->parametric_programs();

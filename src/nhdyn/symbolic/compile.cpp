@@ -793,6 +793,55 @@ bool compile_sparse(const TermsSparsity& sparsity, int n, int s, TermsLayout lay
   return n >= kSparseFrom && sparsity.A.nonzeros() + sparsity.b.nonzeros() <= 0.25 * entries;
 }
 
+// The programs of program motion (docs/derivations/program-motion.md): b_p, b_p0 and B in one
+// program (sharing subexpressions), and the programs' residuals in two more, like the constraints'.
+void compile_program_constraints(const Spec& spec, const Derivation& derivation, ModelPrograms& programs,
+                                 Model& model) {
+  const int n = spec.n(), m = spec.m();
+  if (m == 0) return;
+  check_size(spec, "b_p", derivation.b_p, m, n);
+  check_size(spec, "b_p0", derivation.b_p0, m, 1);
+  check_size(spec, "B", derivation.B, n, m);
+  std::vector<int> position, velocity;  // residual i belongs to the i-th program of its level
+  for (int j = 0; j < m; ++j) {
+    const SpecProgram& p = spec.programs[static_cast<std::size_t>(j)];
+    model.program_constraints.push_back({p.constraint.name, p.constraint.level, p.constraint.text, p.actuator_text});
+    if (p.constraint.level == ConstraintLevel::position) position.push_back(j);
+    if (p.constraint.level != ConstraintLevel::acceleration) velocity.push_back(j);
+  }
+  if (derivation.phi_p.size() != position.size() || derivation.f_p.size() != velocity.size())
+    throw ModelError(fmt::format("model '{}': the derivation has {} position and {} velocity program residuals for "
+                                 "{} position and {} position-or-velocity programs",
+                                 spec.name, derivation.phi_p.size(), derivation.f_p.size(), position.size(),
+                                 velocity.size()));
+  const auto q_name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
+  const auto p_name = [&](int j) { return spec.programs[static_cast<std::size_t>(j)].constraint.name; };
+  ProgramCompiler terms(spec);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < m; ++i)
+      terms.add_output(derivation.b_p(static_cast<unsigned>(i), static_cast<unsigned>(j)),
+                       fmt::format("b_p({}, {})", p_name(i), q_name(j)));
+  for (int i = 0; i < m; ++i)
+    terms.add_output(derivation.b_p0(static_cast<unsigned>(i), 0), fmt::format("b_p0({})", p_name(i)));
+  for (int j = 0; j < m; ++j)
+    for (int i = 0; i < n; ++i)
+      terms.add_output(derivation.B(static_cast<unsigned>(i), static_cast<unsigned>(j)),
+                       fmt::format("B({}, {})", q_name(i), p_name(j)));
+  programs.program_constraints = m;
+  programs.program_constraint_terms = terms.finish();
+  ProgramCompiler phi(spec);
+  for (std::size_t i = 0; i < position.size(); ++i)
+    phi.add_output(derivation.phi_p[i], fmt::format("phi({})", p_name(position[i])));
+  programs.program_constraint_position_residual = phi.finish();
+  if (programs.program_constraint_position_residual->reads_velocities())
+    throw ModelError(fmt::format("model '{}': a program's position-level residual depends on the velocities",
+                                 spec.name));
+  ProgramCompiler f(spec);
+  for (std::size_t i = 0; i < velocity.size(); ++i)
+    f.add_output(derivation.f_p[i], fmt::format("f({})", p_name(velocity[i])));
+  programs.program_constraint_velocity_residual = f.finish();
+}
+
 }  // namespace
 
 Model compile_model(const Spec& spec, const Derivation& derivation, const CompileOptions& options) {
@@ -938,6 +987,7 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
       }
     programs.solution = solution.finish();
   }
+  compile_program_constraints(spec, derivation, programs, model);
   model.defaults = spec.defaults;
   if (spec.path)
     model.path = PlanarPath{coordinate_index(spec, spec.path->first, "x"), coordinate_index(spec, spec.path->second, "y")};

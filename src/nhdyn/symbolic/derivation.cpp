@@ -209,6 +209,94 @@ void require_at_most_quadratic(const Spec& spec, const std::string& model) {
                                        degree));
 }
 
+// The rows of b and b0 of `constraints` (b q'' + b0 = 0, docs/notation.md (2.5)), with their
+// position and velocity residuals; `kind` ("constraint" or "program") names them in errors.
+void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constraints, const char* kind,
+                     const SymbolIndex& index, GiNaC::matrix& b, GiNaC::matrix& b0_out, std::vector<GiNaC::ex>& phi,
+                     std::vector<GiNaC::ex>& f) {
+  const SymbolTable& symbols = spec.symbols;
+  const int n = spec.n();
+  const auto un = static_cast<unsigned>(n), us = static_cast<unsigned>(constraints.size());
+  const auto q = [&](int i) { return symbols.coordinate(i); };
+  const auto v = [&](int i) { return symbols.velocity(i); };
+  const auto a = [&](int i) { return symbols.acceleration(i); };
+  const auto name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
+  b = GiNaC::matrix(us, un);
+  b0_out = GiNaC::matrix(us, 1);
+  for (unsigned r = 0; r < us; ++r) {
+    const SpecConstraint& c = constraints[r];
+    const std::string where = fmt::format("{}{} '{}'", prefix(c.where), kind, c.name);
+    const GiNaC::ex& e = c.expression;
+    const Contained o = index.find(e);
+    GiNaC::ex b0;
+    std::vector<GiNaC::ex> row(un, GiNaC::ex(0));
+    const char* involve = "the velocities";
+    switch (c.level) {
+      case ConstraintLevel::position: {
+        if (!o.v.empty())
+          throw ModelError(where + fmt::format(" is given at position level but contains the velocity {}'",
+                                               name(o.v.front())));
+        if (!o.a.empty())
+          throw ModelError(where + fmt::format(" is given at position level but contains the acceleration {}''",
+                                               name(o.a.front())));
+        // phi' = phi_q q' + phi_t; phi'' = b q'' + b0 with b = phi_q and
+        // b0 = (d/dq (phi_q q')) q' + 2 phi_qt q' + phi_tt, the q''-free part of d/dt phi'.
+        const GiNaC::ex phidot = convective_derivative(e, symbols, index);
+        for (int j : o.q) row[static_cast<std::size_t>(j)] = e.diff(q(j));
+        b0 = convective_derivative(phidot, symbols, index);
+        phi.push_back(e);
+        f.push_back(tidy(phidot));
+        break;
+      }
+      case ConstraintLevel::velocity: {
+        if (!o.a.empty())
+          throw ModelError(where + fmt::format(" is given at velocity level but contains the acceleration {}''",
+                                               name(o.a.front())));
+        // f' = (df/dq') q'' + (df/dq) q' + df/dt.
+        for (int j : o.v) row[static_cast<std::size_t>(j)] = e.diff(v(j));
+        b0 = convective_derivative(e, symbols, index);
+        f.push_back(e);
+        break;
+      }
+      case ConstraintLevel::acceleration: {
+        involve = "the accelerations";
+        GiNaC::lst at_rest;
+        for (int j : o.a) {
+          row[static_cast<std::size_t>(j)] = e.diff(a(j));
+          at_rest.append(a(j) == 0);
+        }
+        for (int i : o.a)
+          for (int j : o.a)
+            if (!symbolic::is_zero(row[static_cast<std::size_t>(i)].diff(a(j))))
+              throw ModelError(where + fmt::format(" must be linear in the accelerations, but it is not linear in "
+                                                   "{}'' (its derivative by {}'' depends on {}'')",
+                                                   name(i), name(i), name(j)));
+        b0 = e.subs(at_rest);
+        break;
+      }
+    }
+    bool zero = true;
+    for (unsigned j = 0; j < un; ++j) {
+      if (row[j].is_zero()) continue;
+      b(r, j) = tidy(row[j]);
+      zero = zero && b(r, j).is_zero();
+    }
+    if (zero)
+      throw ModelError(where + fmt::format(" does not involve {} after differentiation: its row of b is zero "
+                                           "(a {}-level {} must depend on {})",
+                                           involve,
+                                           c.level == ConstraintLevel::position   ? "position"
+                                           : c.level == ConstraintLevel::velocity ? "velocity"
+                                                                                  : "acceleration",
+                                           kind,
+                                           c.level == ConstraintLevel::position   ? "the coordinates"
+                                           : c.level == ConstraintLevel::velocity ? "the velocities"
+                                                                                  : "the accelerations"));
+    b0_out(r, 0) = tidy(b0);
+  }
+
+}
+
 }  // namespace
 
 std::optional<GiNaC::matrix> partitioned_complement(const GiNaC::matrix& b, const std::vector<int>& independent) {
@@ -243,7 +331,7 @@ std::optional<GiNaC::matrix> partitioned_complement(const GiNaC::matrix& b, cons
 Derivation derive(const Spec& spec) {
   const SymbolTable& symbols = spec.symbols;
   const int n = spec.n(), s = spec.s(), k = n - s;
-  const auto un = static_cast<unsigned>(n), us = static_cast<unsigned>(s);
+  const auto un = static_cast<unsigned>(n);
   const std::string model = fmt::format("{}model '{}': ", prefix(spec.where), spec.name);
   if (n == 0) throw ModelError(model + "no coordinates");
   if (s >= n)
@@ -251,7 +339,6 @@ Derivation derive(const Spec& spec) {
   const GiNaC::symbol& t = symbols.time();
   const auto q = [&](int i) { return symbols.coordinate(i); };
   const auto v = [&](int i) { return symbols.velocity(i); };
-  const auto a = [&](int i) { return symbols.acceleration(i); };
   const auto name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
 
   const GiNaC::ex& T = spec.kinetic_energy;
@@ -308,77 +395,29 @@ Derivation derive(const Spec& spec) {
   }
 
   // Every constraint at acceleration level, b q'' + b0 = 0 (docs/notation.md (2.5)).
-  d.b = GiNaC::matrix(us, un);
-  d.b0 = GiNaC::matrix(us, 1);
-  for (unsigned r = 0; r < us; ++r) {
-    const SpecConstraint& c = spec.constraints[r];
-    const std::string where = fmt::format("{}constraint '{}'", prefix(c.where), c.name);
-    const GiNaC::ex& e = c.expression;
-    const Contained o = index.find(e);
-    GiNaC::ex b0;
-    std::vector<GiNaC::ex> row(un, GiNaC::ex(0));
-    const char* involve = "the velocities";
-    switch (c.level) {
-      case ConstraintLevel::position: {
-        if (!o.v.empty())
-          throw ModelError(where + fmt::format(" is given at position level but contains the velocity {}'",
-                                               name(o.v.front())));
-        if (!o.a.empty())
-          throw ModelError(where + fmt::format(" is given at position level but contains the acceleration {}''",
-                                               name(o.a.front())));
-        // phi' = phi_q q' + phi_t; phi'' = b q'' + b0 with b = phi_q and
-        // b0 = (d/dq (phi_q q')) q' + 2 phi_qt q' + phi_tt, the q''-free part of d/dt phi'.
-        const GiNaC::ex phidot = convective_derivative(e, symbols, index);
-        for (int j : o.q) row[static_cast<std::size_t>(j)] = e.diff(q(j));
-        b0 = convective_derivative(phidot, symbols, index);
-        d.phi.push_back(e);
-        d.f.push_back(tidy(phidot));
-        break;
+  constraint_rows(spec, spec.constraints, "constraint", index, d.b, d.b0, d.phi, d.f);
+
+  // The programs the same way, b_p q'' + b_p0 = 0, and their actuators' columns of B
+  // (docs/derivations/program-motion.md section 1).
+  {
+    std::vector<SpecConstraint> programs;
+    for (const SpecProgram& p : spec.programs) programs.push_back(p.constraint);
+    constraint_rows(spec, programs, "program", index, d.b_p, d.b_p0, d.phi_p, d.f_p);
+    const auto um = static_cast<unsigned>(spec.m());
+    d.B = GiNaC::matrix(un, um);
+    for (unsigned j = 0; j < um; ++j) {
+      const SpecProgram& p = spec.programs[j];
+      bool zero = true;
+      for (unsigned i = 0; i < un && i < p.actuator.size(); ++i) {
+        d.B(i, j) = tidy(p.actuator[i]);
+        zero = zero && symbolic::is_zero(d.B(i, j));
       }
-      case ConstraintLevel::velocity: {
-        if (!o.a.empty())
-          throw ModelError(where + fmt::format(" is given at velocity level but contains the acceleration {}''",
-                                               name(o.a.front())));
-        // f' = (df/dq') q'' + (df/dq) q' + df/dt.
-        for (int j : o.v) row[static_cast<std::size_t>(j)] = e.diff(v(j));
-        b0 = convective_derivative(e, symbols, index);
-        d.f.push_back(e);
-        break;
-      }
-      case ConstraintLevel::acceleration: {
-        involve = "the accelerations";
-        GiNaC::lst at_rest;
-        for (int j : o.a) {
-          row[static_cast<std::size_t>(j)] = e.diff(a(j));
-          at_rest.append(a(j) == 0);
-        }
-        for (int i : o.a)
-          for (int j : o.a)
-            if (!symbolic::is_zero(row[static_cast<std::size_t>(i)].diff(a(j))))
-              throw ModelError(where + fmt::format(" must be linear in the accelerations, but it is not linear in "
-                                                   "{}'' (its derivative by {}'' depends on {}'')",
-                                                   name(i), name(i), name(j)));
-        b0 = e.subs(at_rest);
-        break;
-      }
+      if (zero)
+        throw ModelError(fmt::format("{}program '{}': its actuator direction ({}) is zero, so it exerts no force; "
+                                     "give the coordinate the actuator acts on or a nonzero direction",
+                                     prefix(p.actuator_where.line > 0 ? p.actuator_where : p.constraint.where),
+                                     p.constraint.name, p.actuator_text));
     }
-    bool zero = true;
-    for (unsigned j = 0; j < un; ++j) {
-      if (row[j].is_zero()) continue;
-      d.b(r, j) = tidy(row[j]);
-      zero = zero && d.b(r, j).is_zero();
-    }
-    if (zero)
-      throw ModelError(where + fmt::format(" does not involve {} after differentiation: its row of b is zero "
-                                           "(a {}-level constraint must depend on {})",
-                                           involve,
-                                           c.level == ConstraintLevel::position   ? "position"
-                                           : c.level == ConstraintLevel::velocity ? "velocity"
-                                                                                  : "acceleration",
-                                           c.level == ConstraintLevel::position   ? "the coordinates"
-                                           : c.level == ConstraintLevel::velocity ? "the velocities"
-                                                                                  : "the accelerations"));
-    d.b0(r, 0) = tidy(b0);
   }
 
   // D: analytic, or partitioned for the named independent coordinates.

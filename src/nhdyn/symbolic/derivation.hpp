@@ -22,6 +22,13 @@ struct Derivation {
   std::optional<GiNaC::matrix> D;   // k x n: analytic (spec.complement) or partitioned (spec.independent)
   std::vector<GiNaC::ex> phi;       // position-level residuals, one per position constraint
   std::vector<GiNaC::ex> f;         // velocity-level residuals, one per position or velocity constraint
+  // Programs (docs/derivations/program-motion.md), m of them: b_p q'' + b_p0 = 0 and the actuator
+  // matrix B whose column j is program j's generalized force direction; residuals as for phi, f.
+  GiNaC::matrix b_p = GiNaC::matrix(0, 0);   // m x n
+  GiNaC::matrix b_p0 = GiNaC::matrix(0, 1);  // m x 1
+  GiNaC::matrix B = GiNaC::matrix(0, 0);     // n x m
+  std::vector<GiNaC::ex> phi_p;              // one per position-level program
+  std::vector<GiNaC::ex> f_p;                // one per position- or velocity-level program
   std::optional<GiNaC::ex> energy;  // T + V when there are no nonconservative forces and T, V do not depend on t
 };
 

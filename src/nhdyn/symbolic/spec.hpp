@@ -83,6 +83,17 @@ struct SpecEvent {
   EventAction action = EventAction::record;
 };
 
+// A program (docs/derivations/program-motion.md): a constraint the motion must follow, given like
+// a SpecConstraint, that no ideal contact enforces: the actuator it names realizes it, with the
+// generalized force `actuator` (n entries, the column B_j of the actuator matrix B) times an
+// unknown magnitude u_j.
+struct SpecProgram {
+  SpecConstraint constraint;        // name, level, expression = 0, text, where
+  std::vector<GiNaC::ex> actuator;  // n entries: a unit column for `actuator = "delta"`
+  std::string actuator_text;        // as the user wrote it: "delta" or "[0, 0, 1]"
+  SourceLocation actuator_where;
+};
+
 struct Spec {
   std::string name;
   std::string description;
@@ -94,6 +105,7 @@ struct Spec {
   GiNaC::ex potential_energy = 0;            // V(t, q)
   std::vector<GiNaC::ex> forces;             // n nonconservative generalized forces (0 if none)
   std::vector<SpecConstraint> constraints;
+  std::vector<SpecProgram> programs;         // m programs with their actuators ([[programs]])
   std::vector<std::string> independent;      // optional: k coordinates kept independent (partitioned D)
   std::optional<GiNaC::matrix> complement;   // optional analytic D, k x n
   SourceLocation complement_where;
@@ -113,6 +125,7 @@ struct Spec {
 
   int n() const { return static_cast<int>(coordinates.size()); }
   int s() const { return static_cast<int>(constraints.size()); }
+  int m() const { return static_cast<int>(programs.size()); }
   // The numeric values of the parameters as a substitution list (parameter symbol == value).
   GiNaC::lst parameter_values() const;
   // Sets a parameter's value (it becomes a base parameter) and re-evaluates the derived ones;

@@ -834,6 +834,73 @@ SpecBuilder& SpecBuilder::constraint(const std::string& name, const std::string&
   return constraint(name, level, text, std::move(where));
 }
 
+namespace {
+
+// A program is checked and parsed like a constraint (the same rules for its level); its errors
+// then name it as a program.
+std::string as_program(std::string message, const std::string& name) {
+  const std::string constraint = "constraint '" + name + "'";
+  const std::size_t at = message.find(constraint);
+  if (at != std::string::npos) message.replace(at, constraint.size(), "program '" + name + "'");
+  return message;
+}
+
+}  // namespace
+
+SpecBuilder& SpecBuilder::program(const std::string& name, ConstraintLevel level, const std::string& text,
+                                  const std::vector<std::string>& actuator_direction, SourceLocation where,
+                                  SourceLocation actuator_where) {
+  const std::string context = fmt::format("program '{}'", name);
+  for (const SpecProgram& p : spec_.programs)
+    if (p.constraint.name == name) {
+      const std::string at = p.constraint.where.describe();
+      fail(where, context,
+           fmt::format("duplicated program name '{}'{}", name, at.empty() ? "" : " (first given at " + at + ")"));
+    }
+  const int n = spec_.n();
+  if (static_cast<int>(actuator_direction.size()) != n)
+    fail(actuator_where, context,
+         fmt::format("the actuator direction has {} entries for {} coordinates ({}); give one generalized force "
+                     "component per coordinate, or name one coordinate (actuator = \"{}\")",
+                     actuator_direction.size(), n, join(spec_.coordinates), spec_.coordinates.front()));
+  SpecProgram program;
+  for (std::size_t i = 0; i < actuator_direction.size(); ++i) {
+    const Site site{actuator_direction[i], actuator_where,
+                    fmt::format("actuator of {} (entry {}, on '{}')", context, i + 1, spec_.coordinates[i])};
+    const Parsed parsed = read(spec_, site);
+    refuse(parsed, site, SymbolKind::acceleration, "an actuator direction may not contain accelerations (found {})");
+    program.actuator.push_back(parsed.value);
+  }
+  // Parsed and checked as a constraint would be, then moved to the programs.
+  try {
+    constraint(name, level, text, where);
+  } catch (const ModelError& error) {
+    throw ModelError(as_program(error.what(), name));
+  }
+  program.constraint = std::move(spec_.constraints.back());
+  spec_.constraints.pop_back();
+  program.actuator_text = "[" + join(actuator_direction) + "]";
+  program.actuator_where = std::move(actuator_where);
+  spec_.programs.push_back(std::move(program));
+  return *this;
+}
+
+SpecBuilder& SpecBuilder::program(const std::string& name, ConstraintLevel level, const std::string& text,
+                                  const std::string& actuator, SourceLocation where, SourceLocation actuator_where) {
+  const int i = index_of(spec_.coordinates, actuator);
+  if (i < 0)
+    fail(actuator_where, fmt::format("program '{}'", name),
+         fmt::format("the actuator '{}' is not a coordinate: name the coordinate the actuator's force or torque "
+                     "acts on (one of {}), or give a direction, actuator = [\"...\", ...] with one entry per "
+                     "coordinate{}",
+                     actuator, join(spec_.coordinates), did_you_mean(actuator, spec_.coordinates)));
+  std::vector<std::string> direction(spec_.coordinates.size(), "0");
+  direction[static_cast<std::size_t>(i)] = "1";
+  program(name, level, text, direction, where, actuator_where);
+  spec_.programs.back().actuator_text = actuator;
+  return *this;
+}
+
 SpecBuilder& SpecBuilder::independent(const std::vector<std::string>& coordinates, SourceLocation where) {
   const std::string context = "independent coordinates";
   for (std::size_t i = 0; i < coordinates.size(); ++i) {
@@ -967,6 +1034,14 @@ Spec SpecBuilder::build() const {
          fmt::format("{} constraints for {} coordinates: there must be fewer constraints than coordinates (s < n)",
                      s, n));
   const int k = n - s;
+  if (spec_.m() > k) {
+    const SpecProgram& extra = spec_.programs[static_cast<std::size_t>(k)];
+    fail(extra.constraint.where, context,
+         fmt::format("{} programs for k = n - s = {} - {} = {} degrees of freedom: at most {} programs are possible "
+                     "(each program takes one degree of freedom; docs/derivations/program-motion.md section 3); "
+                     "remove {} of them, starting with '{}'",
+                     spec_.m(), n, s, k, k, spec_.m() - k, extra.constraint.name));
+  }
   if (!spec_.independent.empty() && static_cast<int>(spec_.independent.size()) != k)
     fail(independent_where_, "independent coordinates",
          fmt::format("{} given ({}), but k = n - s = {} - {} = {} are needed", spec_.independent.size(),

@@ -39,6 +39,15 @@ class SpecBuilder {
                           SourceLocation where = {});
   // The same with the level inferred from the highest derivative present.
   SpecBuilder& constraint(const std::string& name, const std::string& text, SourceLocation where = {});
+  // A program `text = 0` at `level` (docs/derivations/program-motion.md), checked like a
+  // constraint, realized by a generalized force on the coordinate `actuator` (a torque or force
+  // on it), or along `actuator_direction` (n expressions over t, q, q' and the parameters). The
+  // name must differ from every constraint's and program's.
+  SpecBuilder& program(const std::string& name, ConstraintLevel level, const std::string& text,
+                       const std::string& actuator, SourceLocation where = {}, SourceLocation actuator_where = {});
+  SpecBuilder& program(const std::string& name, ConstraintLevel level, const std::string& text,
+                       const std::vector<std::string>& actuator_direction, SourceLocation where = {},
+                       SourceLocation actuator_where = {});
   // k coordinates to keep independent: the partitioned D is then the one for this choice.
   SpecBuilder& independent(const std::vector<std::string>& coordinates, SourceLocation where = {});
   // An analytic D, k rows of n expressions each.

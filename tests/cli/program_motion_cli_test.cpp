@@ -1,0 +1,178 @@
+// End-to-end runs of `nhdyn simulate` on models with [[programs]] (docs/derivations/program-motion.md):
+// the actuator forces and the programs' residuals as CSV columns, --program-feedback, and each
+// refusal of bad input with exit code 2 and a message naming what is at fault.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int exit_code;
+  std::string out;  // stdout and stderr together
+};
+
+Outcome nhdyn(const std::string& args, const fs::path& dir) {
+  const std::string command = "cd '" + dir.string() + "' && '" + NHDYN_CLI_PATH + "' " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buffer{};
+  while (std::size_t got = std::fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), got);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::string example(const std::string& name) { return std::string(NHDYN_SOURCE_DIR) + "/examples/" + name; }
+
+// A point mass in the plane with a program on each coordinate; `extra` goes at the end.
+std::string plane_model(const std::string& programs, const std::string& constraints = "") {
+  return "name = \"plane\"\n"
+         "coordinates = [\"x\", \"y\"]\n"
+         "kinetic_energy = \"m/2 * (x'^2 + y'^2)\"\n"
+         "[parameters]\n"
+         "m = { value = 2.0 }\n" +
+         constraints + programs;
+}
+
+class ProgramCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("nhdyn_progcli_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string read(const std::string& file) {
+    std::ifstream in(dir_ / file);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  void write(const std::string& file, const std::string& text) { std::ofstream(dir_ / file) << text; }
+  fs::path dir_;
+};
+
+TEST_F(ProgramCli, WritesTheActuatorForcesAndProgramResiduals) {
+  const Outcome run = nhdyn("simulate " + example("sled_heading_program.toml") + " --t-end 1 -o out.csv", dir_);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const std::string csv = read("out.csv");
+  const std::string header = csv.substr(0, csv.find('\n'));
+  EXPECT_NE(header.find(",u_heading,residual_pos_heading,residual_vel_heading,residual_acc_heading"),
+            std::string::npos)
+      << header;
+  EXPECT_NE(run.out.find("programs: 1, max residual: position"), std::string::npos) << run.out;
+}
+
+TEST_F(ProgramCli, FeedbackIsReportedAndItsGainsChecked) {
+  const Outcome run = nhdyn("simulate " + example("sled_heading_program.toml") +
+                                " --t-end 1 -o out.csv --program-feedback 10,10",
+                            dir_);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("feedback alpha 10 1/s, beta 10 1/s"), std::string::npos) << run.out;
+  const Outcome bad = nhdyn("simulate " + example("sled_heading_program.toml") + " --program-feedback 10", dir_);
+  EXPECT_EQ(bad.exit_code, 2) << bad.out;
+  EXPECT_NE(bad.out.find("alpha,beta"), std::string::npos) << bad.out;
+  const Outcome negative =
+      nhdyn("simulate " + example("sled_heading_program.toml") + " --program-feedback 10,-1", dir_);
+  EXPECT_EQ(negative.exit_code, 2) << negative.out;
+  EXPECT_NE(negative.out.find("beta = -1"), std::string::npos) << negative.out;
+  const Outcome none = nhdyn("simulate " + example("sled.toml") + " --program-feedback 1,1", dir_);
+  EXPECT_EQ(none.exit_code, 2) << none.out;
+  EXPECT_NE(none.out.find("has none"), std::string::npos) << none.out;
+}
+
+TEST_F(ProgramCli, SingularProgramIsRefusedNamingIt) {
+  const Outcome run = nhdyn("simulate " + example("cart_pendulum_program.toml") + " --set theta0=pi/2", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("'swing'"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("S = b_p P B"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("singular"), std::string::npos) << run.out;
+}
+
+TEST_F(ProgramCli, ARunThatReachesASingularStateStopsThere) {
+  // theta = 0.3 + 0.2 t reaches pi/2 at t = (pi/2 - 0.3) / 0.2 = 6.354.
+  const Outcome run = nhdyn("simulate " + example("cart_pendulum_program.toml") + " --t-end 10 -o out.csv", dir_);
+  EXPECT_EQ(run.exit_code, 1) << run.out;
+  EXPECT_NE(run.out.find("failed at t = 6.35"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("'swing'"), std::string::npos) << run.out;
+}
+
+TEST_F(ProgramCli, UnknownActuatorCoordinateIsNamed) {
+  write("m.toml", plane_model("[[programs]]\nname = \"px\"\nposition = \"x - t\"\nactuator = \"xx\"\n"));
+  const Outcome run = nhdyn("simulate m.toml", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("m.toml:"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("program 'px'"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("the actuator 'xx' is not a coordinate"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("did you mean 'x'"), std::string::npos) << run.out;
+}
+
+TEST_F(ProgramCli, MoreProgramsThanDegreesOfFreedomSaysHowManyArePossible) {
+  write("m.toml", plane_model("[[programs]]\nname = \"p1\"\nposition = \"x - t\"\nactuator = \"x\"\n"
+                              "[[programs]]\nname = \"p2\"\nposition = \"y - t\"\nactuator = \"y\"\n",
+                              "[[constraints]]\nname = \"line\"\nposition = \"y - x\"\n"));
+  const Outcome run = nhdyn("simulate m.toml", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("2 programs for k = n - s = 2 - 1 = 1 degrees of freedom: at most 1 programs are possible"),
+            std::string::npos)
+      << run.out;
+  EXPECT_NE(run.out.find("'p2'"), std::string::npos) << run.out;
+}
+
+TEST_F(ProgramCli, ZeroActuatorDirectionIsRefused) {
+  write("m.toml", plane_model("[[programs]]\nname = \"px\"\nposition = \"x - t\"\nactuator = [0, \"0*m\"]\n"));
+  const Outcome run = nhdyn("simulate m.toml", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("program 'px': its actuator direction ([0, 0*m]) is zero"), std::string::npos) << run.out;
+}
+
+TEST_F(ProgramCli, ActuatorThatTheConstraintsAbsorbIsRefused) {
+  // The constraint y = 0 holds the mass on the x axis; a force along y pushes into it.
+  write("m.toml", plane_model("[[programs]]\nname = \"px\"\nposition = \"x - t\"\nactuator = \"y\"\n"
+                              "[initial]\nposition = { x = 0, y = 0 }\nvelocity = { x = 1, y = 0 }\n",
+                              "[[constraints]]\nname = \"rail\"\nposition = \"y\"\n"));
+  const Outcome run = nhdyn("simulate m.toml", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("the actuator of program 'px' (y) pushes straight into the physical constraints"),
+            std::string::npos)
+      << run.out;
+}
+
+TEST_F(ProgramCli, ProgramsInConflictWithTheConstraintsAreReportedWithTheirResiduals) {
+  // The rail holds y = 0; the program asks for y = 1 + t: violated at the initial state.
+  write("m.toml", plane_model("[[programs]]\nname = \"lift\"\nposition = \"y - 1 - t\"\nactuator = \"y\"\n"
+                              "[initial]\nposition = { x = 0, y = 0 }\nvelocity = { x = 1, y = 0 }\n",
+                              "[[constraints]]\nname = \"rail\"\nposition = \"y\"\n"));
+  const Outcome run = nhdyn("simulate m.toml", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("violates its programs"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("lift (position level): residual -1"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("lift (velocity level): residual -1"), std::string::npos) << run.out;
+}
+
+TEST_F(ProgramCli, ProgramRepeatingAConstraintIsSingular) {
+  // Met at the initial state, but the program asks for what the constraint already enforces.
+  write("m.toml", plane_model("[[programs]]\nname = \"same\"\nposition = \"y\"\nactuator = \"x\"\n"
+                              "[initial]\nposition = { x = 0, y = 0 }\nvelocity = { x = 1, y = 0 }\n",
+                              "[[constraints]]\nname = \"rail\"\nposition = \"y\"\n"));
+  const Outcome run = nhdyn("simulate m.toml", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("Programs involved: 'same'"), std::string::npos) << run.out;
+}
+
+TEST_F(ProgramCli, ProgramsNeedTheSanhFormulation) {
+  const Outcome run = nhdyn("simulate " + example("sled_heading_program.toml") + " --method lagrange", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("only the sanh formulation solves"), std::string::npos) << run.out;
+}
+
+}  // namespace
