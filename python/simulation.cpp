@@ -87,6 +87,15 @@ py::dict summary_dict(const SimulationSummary& s) {
   d["max_velocity_residual"] = s.max_velocity_residual;
   d["max_acceleration_residual"] = s.max_acceleration_residual;
   d["energy_drift"] = s.has_energy ? py::cast(s.energy_drift) : py::none();
+  // docs/derivations/energy-balance.md: the balance error (accuracy), the work by agent and the
+  // change of E (physics).
+  if (s.has_energy_balance) {
+    d["energy_balance_error"] = s.max_balance_error;
+    d["work_forces"] = s.work_forces;
+    d["work_reactions"] = s.work_reactions;
+    d["work_time"] = s.work_time;
+    d["energy_change"] = s.energy_change;
+  }
   return d;
 }
 

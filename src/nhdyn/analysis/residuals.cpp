@@ -20,8 +20,20 @@ void compute_residuals(const Model& model, Data& data) {
 
 void compute_energy(const Model& model, Data& data) {
   if (data.stage < Stage::terms) throw std::logic_error("compute_energy: call compute_terms first for the current state");
-  if (model.evaluator->has_energy())
-    data.energy = model.evaluator->energy(data.t, data.q.data(), data.v.data(), data.scratch.data());
+  const Evaluator& ev = *model.evaluator;
+  if (ev.has_energy()) data.energy = ev.energy(data.t, data.q.data(), data.v.data(), data.scratch.data());
+  if (ev.has_energy_balance())
+    data.energy_function = ev.energy_function(data.t, data.q.data(), data.v.data(), data.scratch.data());
+}
+
+void compute_power(const Model& model, Data& data) {
+  if (data.stage < Stage::acceleration)
+    throw std::logic_error("compute_power: call compute_acceleration first for the current state");
+  double out[2] = {0.0, 0.0};
+  model.evaluator->power(data.t, data.q.data(), data.v.data(), data.scratch.data(), out);
+  data.power_forces = out[0];
+  data.power_time = out[1];
+  data.power_reactions = data.R.dot(data.v);
 }
 
 }  // namespace nhdyn

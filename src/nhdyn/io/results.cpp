@@ -21,6 +21,11 @@ ResultColumns make_result_columns(const Model& model) {
     c.energy = "energy";
     c.all.push_back(c.energy);
   }
+  if (model.evaluator && model.evaluator->has_energy_balance()) {
+    c.energy_balance = {"energy_function", "power", "work_forces", "work_reactions", "work_time", "work",
+                        "balance_error"};
+    c.all.insert(c.all.end(), c.energy_balance.begin(), c.energy_balance.end());
+  }
   return c;
 }
 
@@ -35,6 +40,15 @@ void fill_result_row(const Model& model, const Data& data, std::vector<double>& 
   for (Eigen::Index i = 0; i < data.f.size(); ++i) row.push_back(data.f(i));
   for (Eigen::Index i = 0; i < data.e.size(); ++i) row.push_back(data.e(i));
   if (model.evaluator->has_energy()) row.push_back(data.energy);
+  if (model.evaluator->has_energy_balance()) {
+    row.push_back(data.energy_function);
+    row.push_back(data.power_forces + data.power_reactions + data.power_time);
+    row.push_back(data.work_forces);
+    row.push_back(data.work_reactions);
+    row.push_back(data.work_time);
+    row.push_back(data.work_forces + data.work_reactions + data.work_time);
+    row.push_back(data.balance_error);
+  }
 }
 
 }  // namespace nhdyn

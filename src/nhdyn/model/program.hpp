@@ -182,6 +182,12 @@ struct ModelPrograms {
   std::optional<TermsSparsity> sparsity;  // the nonzeros of A and b that terms writes, if not all
   std::optional<Program> initial_state = std::nullopt;  // outputs: q0 (n), q'0 (n); reads parameters only
   int parameters = 0;                // number of parameters the programs may read
+  // The energy balance (docs/derivations/energy-balance.md), for a model whose energy program is
+  // E = T + V of any system (not only a conservative one): h where it differs from E, and the
+  // power Q_nc . q', -dL/dt|explicit where it is not identically zero.
+  bool energy_balance = false;
+  std::optional<Program> energy_function = std::nullopt;  // one output: h = q' . dT/dq' - T + V
+  std::optional<Program> power = std::nullopt;            // outputs: Q_nc . q', -dL/dt|explicit
 };
 
 // An Evaluator that runs straight-line programs. It keeps the parametric programs (shared by every
@@ -237,6 +243,10 @@ class ProgramEvaluator final : public Evaluator {
   void velocity_residual(double t, const double* q, const double* v, double* scratch, double* f) const override;
   bool has_energy() const override { return programs_.energy.has_value(); }
   double energy(double t, const double* q, const double* v, double* scratch) const override;
+  bool has_energy_balance() const override { return programs_.energy_balance && programs_.energy.has_value(); }
+  bool energy_function_is_energy() const override { return !programs_.energy_function.has_value(); }
+  double energy_function(double t, const double* q, const double* v, double* scratch) const override;
+  void power(double t, const double* q, const double* v, double* scratch, double* out) const override;
   bool has_solution() const override { return programs_.solution.has_value(); }
   void solution(double t, double* scratch, double* qva) const override;
 
@@ -279,6 +289,7 @@ class ProgramEvaluator final : public Evaluator {
   ModelPrograms programs_;  // *parametric_ bound to parameters_
   std::size_t scratch_ = 0;
   Prepared terms_, complement_, position_residual_, velocity_residual_, energy_, solution_, initial_state_;
+  Prepared energy_function_, power_;
   TermsFunction terms_function_ = nullptr;
   std::size_t terms_sizes_[5] = {0, 0, 0, 0, 0};  // outputs of terms: A, Q, G, b, b0 (nonzeros when sparse)
   std::size_t values_offset_ = 0;  // where terms_scatter keeps the nonzeros in scratch
