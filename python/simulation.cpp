@@ -110,6 +110,8 @@ py::dict trajectory_dict(Trajectory&& tr) {
   d["R"] = take_array(std::move(tr.R), {rows, n});
   d["residuals"] = take_array(std::move(tr.residuals), {rows, static_cast<py::ssize_t>(tr.residual_columns)});
   d["energy"] = tr.has_energy ? py::object(take_array(std::move(tr.energy), {rows})) : py::object(py::none());
+  const auto b = static_cast<py::ssize_t>(tr.balance_columns);
+  d["energy_balance"] = b > 0 ? py::object(take_array(std::move(tr.balance), {rows, b})) : py::object(py::none());
   return d;
 }
 

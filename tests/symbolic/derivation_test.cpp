@@ -321,7 +321,6 @@ TEST(Derivation, GeneralKineticEnergyGivesLagrangesEquations) {
   // -dL/dt|explicit, against the parts of T written out by hand.
   const ex x = spec.symbols.coordinate(0), y = spec.symbols.coordinate(1);
   const ex xd = spec.symbols.velocity(0), yd = spec.symbols.velocity(1);
-  const GiNaC::symbol& t = spec.symbols.time();
   const ex m = spec.symbols.parameter("m"), c = spec.symbols.parameter("c");
   const ex T2 = m / 2 * (1 + y * y) * xd * xd + m / 2 * GiNaC::exp(t) * yd * yd;
   const ex T0 = c * x * x * y * y;

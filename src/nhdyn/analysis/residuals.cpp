@@ -26,6 +26,16 @@ void compute_energy(const Model& model, Data& data) {
     data.energy_function = ev.energy_function(data.t, data.q.data(), data.v.data(), data.scratch.data());
 }
 
+void fill_energy_balance(const Data& data, double* out) {
+  out[0] = data.energy_function;
+  out[1] = data.power_forces + data.power_reactions + data.power_time;
+  out[2] = data.work_forces;
+  out[3] = data.work_reactions;
+  out[4] = data.work_time;
+  out[5] = data.work_forces + data.work_reactions + data.work_time;
+  out[6] = data.balance_error;
+}
+
 void compute_power(const Model& model, Data& data) {
   if (data.stage < Stage::acceleration)
     throw std::logic_error("compute_power: call compute_acceleration first for the current state");

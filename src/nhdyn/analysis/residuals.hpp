@@ -24,4 +24,10 @@ void compute_energy(const Model& model, Data& data);
 // model's power program, which a conservative model does not have.
 void compute_power(const Model& model, Data& data);
 
+// The energy balance of an output row, in the order of its CSV columns (io/results.hpp):
+// h, P, W_forces, W_reactions, W_time, W, h - h(t0) - W. Reads what compute_energy,
+// compute_power and simulate wrote into data.
+inline constexpr int kEnergyBalanceColumns = 7;
+void fill_energy_balance(const Data& data, double* out);
+
 }  // namespace nhdyn

@@ -1,5 +1,7 @@
 #include "nhdyn/io/results.hpp"
 
+#include "nhdyn/analysis/residuals.hpp"
+
 namespace nhdyn {
 
 ResultColumns make_result_columns(const Model& model) {
@@ -41,13 +43,9 @@ void fill_result_row(const Model& model, const Data& data, std::vector<double>& 
   for (Eigen::Index i = 0; i < data.e.size(); ++i) row.push_back(data.e(i));
   if (model.evaluator->has_energy()) row.push_back(data.energy);
   if (model.evaluator->has_energy_balance()) {
-    row.push_back(data.energy_function);
-    row.push_back(data.power_forces + data.power_reactions + data.power_time);
-    row.push_back(data.work_forces);
-    row.push_back(data.work_reactions);
-    row.push_back(data.work_time);
-    row.push_back(data.work_forces + data.work_reactions + data.work_time);
-    row.push_back(data.balance_error);
+    double balance[kEnergyBalanceColumns];
+    fill_energy_balance(data, balance);
+    row.insert(row.end(), balance, balance + kEnergyBalanceColumns);
   }
 }
 
