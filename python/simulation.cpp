@@ -124,6 +124,15 @@ py::dict summary_dict(const SimulationSummary& s) {
   d["max_acceleration_residual"] = s.max_acceleration_residual;
   d["energy_drift"] = s.has_energy ? py::cast(s.energy_drift) : py::none();
   d["stopped_by"] = s.stopped_by >= 0 ? py::cast(s.event_names[static_cast<std::size_t>(s.stopped_by)]) : py::none();
+  // docs/derivations/energy-balance.md: the balance error (accuracy), the work by agent and the
+  // change of E (physics).
+  if (s.has_energy_balance) {
+    d["energy_balance_error"] = s.max_balance_error;
+    d["work_forces"] = s.work_forces;
+    d["work_reactions"] = s.work_reactions;
+    d["work_time"] = s.work_time;
+    d["energy_change"] = s.energy_change;
+  }
   return d;
 }
 
@@ -138,6 +147,8 @@ py::dict trajectory_dict(Trajectory&& tr) {
   d["R"] = take_array(std::move(tr.R), {rows, n});
   d["residuals"] = take_array(std::move(tr.residuals), {rows, static_cast<py::ssize_t>(tr.residual_columns)});
   d["energy"] = tr.has_energy ? py::object(take_array(std::move(tr.energy), {rows})) : py::object(py::none());
+  const auto b = static_cast<py::ssize_t>(tr.balance_columns);
+  d["energy_balance"] = b > 0 ? py::object(take_array(std::move(tr.balance), {rows, b})) : py::object(py::none());
   return d;
 }
 

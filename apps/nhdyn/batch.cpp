@@ -259,6 +259,9 @@ int run_batch(const BatchArgs& args) {
         row.insert(row.end(), tr.residuals.begin() + static_cast<std::ptrdiff_t>(k * m),
                    tr.residuals.begin() + static_cast<std::ptrdiff_t>((k + 1) * m));
         if (tr.has_energy) row.push_back(tr.energy[k]);
+        const auto b = static_cast<std::size_t>(tr.balance_columns);
+        row.insert(row.end(), tr.balance.begin() + static_cast<std::ptrdiff_t>(k * b),
+                   tr.balance.begin() + static_cast<std::ptrdiff_t>((k + 1) * b));
         writer.write_row(row);
       }
       writer.commit();

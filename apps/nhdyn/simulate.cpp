@@ -309,7 +309,9 @@ int run_simulate(const SimulateArgs& args) {
     if (model.path)
       request.path = std::make_pair(model.coordinates[static_cast<std::size_t>(model.path->x)],
                                     model.coordinates[static_cast<std::size_t>(model.path->y)]);
-    if (!columns.energy.empty()) request.energy = columns.energy;
+    // With an energy balance the drawn error is h - h(t0) - W (the change of E may be physics).
+    if (!columns.energy.empty())
+      request.energy = columns.energy_balance.empty() ? columns.energy : columns.energy_balance.back();
     write_plot(request, args.plot);
   }
   html_probe.reset();
@@ -380,11 +382,23 @@ int run_simulate(const SimulateArgs& args) {
         if (fix.dv(i) != 0.0) fmt::print("    {}' = {:.12g} (changed by {:+.3g})\n", c, fix.v(i), fix.dv(i));
       }
     }
-    if (summary.has_energy && model.m() > 0)
+    if (summary.has_energy_balance) {
+      // docs/derivations/energy-balance.md section 3: the balance is the error; the work and the
+      // change of the energy are physics.
+      fmt::print("  energy balance error: {:.3g} (max |h - h0 - W|)\n", summary.max_balance_error);
+      fmt::print("  work W: {:.10g} (forces {:.6g}, reactions {:.6g}, explicit time {:.6g})\n",
+                 summary.work_forces + summary.work_reactions + summary.work_time, summary.work_forces,
+                 summary.work_reactions, summary.work_time);
+      fmt::print("  energy change: E - E0 = {:.10g} (E0 = {:.10g})\n", summary.energy_change, summary.energy_initial);
+      if (summary.energy_function_differs)
+        fmt::print("  energy function change: h - h0 = {:.10g} (h0 = {:.10g})\n", summary.energy_function_change,
+                   summary.energy_function_initial);
+    } else if (summary.has_energy && model.m() > 0) {
       fmt::print("  energy change: {:.3g} (E0 = {:.10g}; the actuators do work, so E is not conserved)\n",
                  summary.energy_drift, summary.energy_initial);
-    else if (summary.has_energy)
+    } else if (summary.has_energy) {
       fmt::print("  energy drift: {:.3g} (E0 = {:.10g})\n", summary.energy_drift, summary.energy_initial);
+    }
     if (!args.plot.empty()) fmt::print("  plot -> {}\n", args.plot);
     if (!args.html.empty()) fmt::print("  report -> {}{}\n", args.html, html_notice.empty() ? "" : "\n  note: " + html_notice);
   }

@@ -205,6 +205,8 @@ class Result:
         self.coordinates = model.coordinates
         self.t, self.q, self.qd, self.qdd = out["t"], out["q"], out["qd"], out["qdd"]
         self.R, self.residuals, self.energy = out["R"], out["residuals"], out["energy"]
+        # h, P, W_forces, W_reactions, W_time, W, h - h0 - W (docs/derivations/energy-balance.md), or None
+        self.energy_balance = out.get("energy_balance")
         self.summary = out["summary"]
         # The located events in time order: dicts with name, t, q and qd at the crossing.
         self.events = out["events"]
@@ -216,6 +218,8 @@ class Result:
         parts = [self.t[:, None], self.q, self.qd, self.qdd, self.R, self.residuals]
         if self.energy is not None:
             parts.append(self.energy[:, None])
+        if self.energy_balance is not None:
+            parts.append(self.energy_balance)
         return list(self.columns["all"]), np.hstack(parts)
 
     def to_pandas(self):

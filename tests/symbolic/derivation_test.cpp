@@ -278,7 +278,13 @@ TEST(Derivation, TimeDependentConstraints) {
   const Spec spec = b.build();
   check_time_derivatives(spec);
   const Derivation d = derive(spec);
-  EXPECT_FALSE(d.energy.has_value());  // T depends on t explicitly
+  // T depends on t explicitly: E = T + V is given, and the power of the explicit time dependence,
+  // -dT/dt = -m x' y', is not zero (docs/derivations/energy-balance.md (E3)).
+  ASSERT_TRUE(d.energy.has_value());
+  EXPECT_FALSE(d.conservative);
+  EXPECT_TRUE(symbolic::is_zero(d.power_time + spec.symbols.parameter("m") * spec.symbols.velocity(0) *
+                                                  spec.symbols.velocity(1)));
+  EXPECT_TRUE(symbolic::is_zero(d.power_forces));
   // x - sin(t): b = (1, 0, 0), b0 = sin(t).
   expect_zero(d.b.sub(GiNaC::matrix{{1, 0, 0}, {d.b(1, 0), d.b(1, 1), d.b(1, 2)}}), "b");
   EXPECT_TRUE(symbolic::is_zero(d.b0(0, 0) - GiNaC::sin(spec.symbols.time())));
@@ -311,7 +317,21 @@ TEST(Derivation, GeneralKineticEnergyGivesLagrangesEquations) {
                         along_path(spec, -spec.potential_energy.diff(spec.symbols.coordinate(i)) + spec.forces[ui]);
     EXPECT_TRUE(symbolic::is_zero(along_path(spec, lhs) - lagrange)) << i;
   }
-  EXPECT_FALSE(d.energy.has_value());
+  // The energy balance (docs/derivations/energy-balance.md): h = T2 - T0 + V, Q_nc . q' and
+  // -dL/dt|explicit, against the parts of T written out by hand.
+  const ex x = spec.symbols.coordinate(0), y = spec.symbols.coordinate(1);
+  const ex xd = spec.symbols.velocity(0), yd = spec.symbols.velocity(1);
+  const ex m = spec.symbols.parameter("m"), c = spec.symbols.parameter("c");
+  const ex T2 = m / 2 * (1 + y * y) * xd * xd + m / 2 * GiNaC::exp(t) * yd * yd;
+  const ex T0 = c * x * x * y * y;
+  const ex V = c * GiNaC::cos(x) * y * y;
+  ASSERT_TRUE(d.energy.has_value());
+  ASSERT_TRUE(d.energy_function.has_value());
+  EXPECT_FALSE(d.conservative);
+  EXPECT_TRUE(symbolic::is_zero(*d.energy_function - (T2 - T0 + V)));
+  EXPECT_TRUE(symbolic::is_zero(d.power_forces + c * xd * t * xd));
+  EXPECT_TRUE(symbolic::is_zero(d.power_time + m / 2 * GiNaC::exp(t) * yd * yd + c * x * x * yd));
+  // A T quadratic in the velocities (the rod above) has h = E: no separate program.
 }
 
 template <class F>

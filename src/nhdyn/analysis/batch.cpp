@@ -7,6 +7,7 @@
 #include <exception>
 #include <thread>
 
+#include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/core/error.hpp"
 
 namespace nhdyn {
@@ -15,7 +16,8 @@ void Trajectory::reset(const Model& model, long expected_rows) {
   n = model.n();
   residual_columns = model.position_constraints() + model.velocity_constraints() + model.s();
   has_energy = model.evaluator && model.evaluator->has_energy();
-  for (std::vector<double>* column : {&t, &q, &v, &qdd, &R, &residuals, &energy}) column->clear();
+  balance_columns = model.evaluator && model.evaluator->has_energy_balance() ? kEnergyBalanceColumns : 0;
+  for (std::vector<double>* column : {&t, &q, &v, &qdd, &R, &residuals, &energy, &balance}) column->clear();
   const auto rows = static_cast<std::size_t>(std::max(0L, expected_rows));
   const auto un = static_cast<std::size_t>(n);
   t.reserve(rows);
@@ -25,6 +27,7 @@ void Trajectory::reset(const Model& model, long expected_rows) {
   R.reserve(rows * un);
   residuals.reserve(rows * static_cast<std::size_t>(residual_columns));
   if (has_energy) energy.reserve(rows);
+  balance.reserve(rows * static_cast<std::size_t>(balance_columns));
 }
 
 void Trajectory::append(const Data& data) {
@@ -37,6 +40,11 @@ void Trajectory::append(const Data& data) {
   residuals.insert(residuals.end(), data.f.data(), data.f.data() + data.f.size());
   residuals.insert(residuals.end(), data.e.data(), data.e.data() + data.e.size());
   if (has_energy) energy.push_back(data.energy);
+  if (balance_columns > 0) {
+    double row[kEnergyBalanceColumns];
+    fill_energy_balance(data, row);
+    balance.insert(balance.end(), row, row + kEnergyBalanceColumns);
+  }
 }
 
 int batch_threads(int threads, std::size_t runs) {

@@ -28,11 +28,14 @@ struct Trajectory {
   std::vector<double> q, v, qdd, R; // rows x n each
   std::vector<double> residuals;    // rows x residual_columns: phi, then f, then e (Data)
   std::vector<double> energy;       // rows (empty without an energy)
+  int balance_columns = 0;          // kEnergyBalanceColumns with an energy balance, else 0
+  std::vector<double> balance;      // rows x balance_columns (analysis/residuals.hpp fill_energy_balance)
 
   long rows() const { return static_cast<long>(t.size()); }
   // Sizes the columns for `model` and drops every row; reserves `expected_rows`.
   void reset(const Model& model, long expected_rows = 0);
-  // Appends the row of Data after an output (simulate's RowFn): t, q, q', q'', R, residuals, energy.
+  // Appends the row of Data after an output (simulate's RowFn): t, q, q', q'', R, residuals,
+  // energy, energy balance.
   void append(const Data& data);
 };
 

@@ -20,8 +20,35 @@ void compute_residuals(const Model& model, Data& data) {
 
 void compute_energy(const Model& model, Data& data) {
   if (data.stage < Stage::terms) throw std::logic_error("compute_energy: call compute_terms first for the current state");
-  if (model.evaluator->has_energy())
-    data.energy = model.evaluator->energy(data.t, data.q.data(), data.v.data(), data.scratch.data());
+  const Evaluator& ev = *model.evaluator;
+  if (ev.has_energy()) data.energy = ev.energy(data.t, data.q.data(), data.v.data(), data.scratch.data());
+  if (ev.has_energy_balance())
+    data.energy_function = ev.energy_function(data.t, data.q.data(), data.v.data(), data.scratch.data());
+}
+
+void fill_energy_balance(const Data& data, double* out) {
+  out[0] = data.energy_function;
+  out[1] = data.power_forces + data.power_reactions + data.power_time;
+  out[2] = data.work_forces;
+  out[3] = data.work_reactions;
+  out[4] = data.work_time;
+  out[5] = data.work_forces + data.work_reactions + data.work_time;
+  out[6] = data.balance_error;
+}
+
+void compute_power(const Model& model, Data& data) {
+  if (data.stage < Stage::acceleration)
+    throw std::logic_error("compute_power: call compute_acceleration first for the current state");
+  double out[2] = {0.0, 0.0};
+  model.evaluator->power(data.t, data.q.data(), data.v.data(), data.scratch.data(), out);
+  data.power_forces = out[0];
+  data.power_time = out[1];
+  data.power_reactions = data.R.dot(data.v);
+  // A model with programs: R is the physical reactions, and the actuators' forces B u are applied
+  // forces doing work like Q_nc (docs/derivations/program-motion.md (P3)): booked with the forces.
+  // A loop, not (B u) . v, so that nothing is allocated.
+  if (model.m() > 0)
+    for (int j = 0; j < model.m(); ++j) data.power_forces += data.motion.u(j) * data.motion.B.col(j).dot(data.v);
 }
 
 }  // namespace nhdyn

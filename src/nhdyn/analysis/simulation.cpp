@@ -32,22 +32,33 @@ StepEnd project(const Model& model, Data& data, const ProjectionOptions& options
   return {Status::ok, result.changed()};
 }
 
-// y = [q; q'], y' = [q'; q''].
+// y = [q; q'], y' = [q'; q'']; with an energy balance also the work of the forces, of the
+// reactions and of the explicit time dependence, W' = P (docs/derivations/energy-balance.md
+// section 3), outside the error norm (OdeSystem::error_size).
 class MechanicalOde final : public OdeSystem {
  public:
   MechanicalOde(const Model& model, Data& data, const FormulationOptions& options, const SimulationOptions& run,
                 SimulationSummary& summary)
-      : model_(model), data_(data), options_(options), run_(run), summary_(summary), n_(model.n()) {}
+      : model_(model), data_(data), options_(options), run_(run), summary_(summary), n_(model.n()),
+        balance_(model.evaluator->has_energy_balance()) {}
 
-  int size() const override { return 2 * n_; }
+  int size() const override { return 2 * n_ + (balance_ ? kWorks : 0); }
+  int error_size() const override { return 2 * n_; }
 
   Status rhs(double t, const double* y, double* ydot) override {
     const Status status = compute_dynamics(model_, data_, options_, t, y, y + n_);
     if (status != Status::ok) return status;
     std::memcpy(ydot, y + n_, sizeof(double) * static_cast<std::size_t>(n_));
     std::memcpy(ydot + n_, data_.qdd.data(), sizeof(double) * static_cast<std::size_t>(n_));
+    if (balance_) {
+      compute_power(model_, data_);
+      ydot[2 * n_] = data_.power_forces;
+      ydot[2 * n_ + 1] = data_.power_reactions;
+      ydot[2 * n_ + 2] = data_.power_time;
+    }
     return Status::ok;
   }
+  static constexpr int kWorks = 3;
 
   StepEnd after_step(double t, double* y) override {
     if (run_.stabilization != Stabilization::projection) return {};
@@ -61,9 +72,27 @@ class MechanicalOde final : public OdeSystem {
   const SimulationOptions& run_;
   SimulationSummary& summary_;
   int n_;
+  bool balance_;
 };
 
 double max_abs(const Vector& v) { return v.size() > 0 ? v.cwiseAbs().maxCoeff() : 0.0; }
+
+// At an output, after compute_dynamics and compute_energy: the power, the integrated work (the
+// states past [q; q']) and the balance h - h(t0) - W (docs/derivations/energy-balance.md section 3).
+void record_balance(const Model& model, Data& data, const double* work, SimulationSummary& summary) {
+  compute_power(model, data);
+  data.work_forces = work[0];
+  data.work_reactions = work[1];
+  data.work_time = work[2];
+  const double W = work[0] + work[1] + work[2];
+  data.balance_error = data.energy_function - summary.energy_function_initial - W;
+  summary.max_balance_error = std::max(summary.max_balance_error, std::abs(data.balance_error));
+  summary.work_forces = work[0];
+  summary.work_reactions = work[1];
+  summary.work_time = work[2];
+  summary.energy_change = data.energy - summary.energy_initial;
+  summary.energy_function_change = data.energy_function - summary.energy_function_initial;
+}
 
 
 }  // namespace
@@ -170,20 +199,21 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   check_programs_at_initial_state(model, data, options.formulation, model.t0, q0, v0, options.initial_tolerance);
 
   const int n = model.n();
-  std::vector<double> y0(static_cast<std::size_t>(2 * n));
-  std::copy(q0.data(), q0.data() + n, y0.begin());
-  std::copy(v0.data(), v0.data() + n, y0.begin() + n);
-
   summary.has_energy = model.evaluator->has_energy();
+  summary.has_energy_balance = model.evaluator->has_energy_balance();
   FormulationOptions formulation = options.formulation;
   formulation.baumgarte.enabled = options.stabilization == Stabilization::baumgarte;
   MechanicalOde ode(model, data, formulation, options, summary);
-  std::vector<double> y_out(static_cast<std::size_t>(2 * n));
+  const auto states = static_cast<std::size_t>(ode.size());
+  std::vector<double> y0(states, 0.0);  // the work starts at 0
+  std::copy(q0.data(), q0.data() + n, y0.begin());
+  std::copy(v0.data(), v0.data() + n, y0.begin() + n);
+  std::vector<double> y_out(states);
   Status output_failure = Status::ok;
   const OutputFn output = [&](double t, const double* y) -> Status {
     if (options.stabilization == Stabilization::projection) {
       // Between step ends the integrator interpolates; the solution it reports is the projected one.
-      std::copy(y, y + 2 * n, y_out.begin());
+      std::copy(y, y + states, y_out.begin());
       y = y_out.data();
       const StepEnd end = project(model, data, options.projection, t, y_out.data(), summary);
       if (end.status != Status::ok) {
@@ -198,7 +228,11 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     }
     compute_residuals(model, data);
     compute_energy(model, data);
-    if (summary.outputs == 0) summary.energy_initial = data.energy;
+    if (summary.outputs == 0) {
+      summary.energy_initial = data.energy;
+      summary.energy_function_initial = data.energy_function;
+    }
+    if (summary.has_energy_balance) record_balance(model, data, y + 2 * n, summary);
     summary.max_position_residual = std::max(summary.max_position_residual, max_abs(data.phi));
     summary.max_velocity_residual = std::max(summary.max_velocity_residual, max_abs(data.f));
     summary.max_acceleration_residual = std::max(summary.max_acceleration_residual, max_abs(data.e));
@@ -245,6 +279,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.sparse = data.sparse;
   summary.partition_changes = data.partition_changes;
   summary.stats = result.stats;
+  summary.energy_function_differs = summary.has_energy_balance && !model.evaluator->energy_function_is_energy();
   if (summary.status != Status::ok) {
     // The kernels recorded the details of a failed evaluation in data; prefer those words.
     summary.message = data.status != Status::ok ? explain_failure(model, data) : result.message;

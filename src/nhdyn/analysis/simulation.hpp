@@ -1,7 +1,8 @@
 // The simulation driver: adapts a Model and a formulation to a first-order ODE y = [q; q'],
 // integrates it, and at every output time evaluates the accelerations, reactions, residuals and
 // energy, hands them to the caller (who writes CSV rows), and keeps the summary a user reads:
-// steps, right-hand-side evaluations, wall time, maximum residual per level, energy drift.
+// steps, right-hand-side evaluations, wall time, maximum residual per level, the energy balance
+// (docs/derivations/energy-balance.md: the work W' = P is integrated with the state).
 #pragma once
 
 #include <functional>
@@ -74,7 +75,18 @@ struct SimulationSummary {
   double max_program_acceleration_residual = 0.0;
   bool has_energy = false;
   double energy_initial = 0.0;
-  double energy_drift = 0.0;        // max |E(t) - E(t0)| over outputs
+  double energy_drift = 0.0;        // max |E(t) - E(t0)| over outputs: error only when no agent does work
+  // The energy balance (docs/derivations/energy-balance.md), when the model has one: the largest
+  // |h - h(t0) - W| over outputs (the accuracy figure), and as physics the work W done up to the
+  // last output by each agent and the change of E = T + V and of h (which differs from E when T
+  // has parts of degree 1 or 0 in the velocities).
+  bool has_energy_balance = false;
+  bool energy_function_differs = false;  // h is not E for this model
+  double energy_function_initial = 0.0;
+  double max_balance_error = 0.0;
+  double work_forces = 0.0, work_reactions = 0.0, work_time = 0.0;
+  double energy_change = 0.0;           // E(t_last) - E(t0)
+  double energy_function_change = 0.0;  // h(t_last) - h(t0)
   std::optional<InitialFix> initial_fix;  // set when options.fix_initial moved the initial state
   // Stabilization::projection: projections that changed the state (after steps and at outputs),
   // their Newton iterations, and the largest change of a coordinate and of a velocity.

@@ -139,9 +139,9 @@ double weighted_rms(const double* v, const double* w, int n, double rtol, double
 Status initial_step(OdeSystem& system, const IntegratorOptions& options, int order, double t0,
                     const double* y0, const double* f0, double hmax, double* scratch, double* f1,
                     IntegratorStats& stats, double& h) {
-  const int n = system.size();
-  const double d0 = weighted_rms(y0, y0, n, options.rtol, options.atol);
-  const double d1 = weighted_rms(f0, y0, n, options.rtol, options.atol);
+  const int n = system.size(), weighed = system.error_size();
+  const double d0 = weighted_rms(y0, y0, weighed, options.rtol, options.atol);
+  const double d1 = weighted_rms(f0, y0, weighed, options.rtol, options.atol);
   double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
   h0 = std::min(h0, hmax);
   for (int i = 0; i < n; ++i) scratch[i] = y0[i] + h0 * f0[i];
@@ -149,7 +149,7 @@ Status initial_step(OdeSystem& system, const IntegratorOptions& options, int ord
   const Status status = system.rhs(t0 + h0, scratch, f1);
   if (status != Status::ok) return status;
   for (int i = 0; i < n; ++i) scratch[i] = f1[i] - f0[i];
-  const double d2 = weighted_rms(scratch, y0, n, options.rtol, options.atol) / h0;
+  const double d2 = weighted_rms(scratch, y0, weighed, options.rtol, options.atol) / h0;
   const double dmax = std::max(d1, d2);
   const double h1 =
       dmax <= 1e-15 ? std::max(1e-6, h0 * 1e-3) : std::pow(0.01 / dmax, 1.0 / (order + 1));
@@ -434,7 +434,7 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
                           error_uses_last_stage<Tableau>);
     if (status != Status::ok) return rhs_failure(method, status, t_fail, t, stats);
 
-    const double err = step_error(stepper, n, y.data(), y1.data(), h, options);
+    const double err = step_error(stepper, system.error_size(), y.data(), y1.data(), h, options);
     last_error_finite = std::isfinite(err) && all_finite(y1.data(), n);
 
     if (!last_error_finite) {

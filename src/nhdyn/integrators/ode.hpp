@@ -24,6 +24,12 @@ class OdeSystem {
   virtual ~OdeSystem() = default;
   // Number of states.
   virtual int size() const = 0;
+  // Number of leading states that the adaptive Runge-Kutta pairs' error norm and first-step
+  // heuristic weigh (all by default). The states past it are quadratures no other state depends
+  // on (the work of the forces, docs/derivations/energy-balance.md): integrated by the same method
+  // on the same steps, they do not choose the steps, so the other states are those of a run
+  // without them, to the bit. CVODE weighs every state.
+  virtual int error_size() const { return size(); }
   // ydot = f(t, y). Returns Status::ok or the reason the right-hand side cannot be evaluated;
   // an integrator stops at the first non-ok status and reports it.
   virtual Status rhs(double t, const double* y, double* ydot) = 0;

@@ -550,7 +550,7 @@ std::string make_script(const ScriptInput& in) {
     const Column& e = *in.energy;
     // Exponent form: always a gnuplot float (a bare "1" would be an integer), all 17 digits.
     s += fmt::format("energy0 = {:.16e}\n", in.energy0);
-    s += fmt::format("set title {}\n", gp_label(fmt::format("energy drift{}", thinned)));
+    s += fmt::format("set title {}\n", gp_label(fmt::format("{}{}", e.name == "balance_error" ? "energy balance error h - h0 - W" : "energy drift", thinned)));
     s += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in.time_name));
     s += join_clauses({plot_clause(every, fmt::format("1:(column({}) - energy0)", e.index), "lines",
                                    fmt::format("{0}(t) - {0}(0)", e.name))});

@@ -176,7 +176,9 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
     groups.push_back({"actuator forces u ([[programs]])", false, false, input.columns.actuators});
   if (!input.columns.residuals.empty())
     groups.push_back({"|constraint residuals| (log scale)", true, false, input.columns.residuals});
-  if (!input.columns.energy.empty())
+  if (!input.columns.energy_balance.empty())
+    groups.push_back({"energy balance error h - h(0) - W", false, true, {input.columns.energy_balance.back()}});
+  else if (!input.columns.energy.empty())
     groups.push_back({"energy drift E(t) - E(0)", false, true, {input.columns.energy}});
 
   std::string data = "{\"title\":";
@@ -386,7 +388,18 @@ std::string write_model_report(const Model& model, const symbolic::Spec* spec, c
       if (largest >= 0.0) input.summary.emplace_back(labels[level], fmt::format("{:.3g}", largest));
     }
     const int e = input.columns.energy.empty() ? -1 : table.column(input.columns.energy);
-    if (e >= 0) {
+    const int balance = input.columns.energy_balance.empty() ? -1 : table.column("balance_error");
+    if (e >= 0 && balance >= 0) {
+      // docs/derivations/energy-balance.md: the balance is the error, the change of E is physics.
+      double largest = 0.0;
+      for (const std::vector<double>& row : table.rows)
+        largest = std::max(largest, std::abs(row[static_cast<std::size_t>(balance)]));
+      input.summary.emplace_back("energy balance error", fmt::format("{:.3g}", largest));
+      const auto E = static_cast<std::size_t>(e);
+      input.summary.emplace_back("energy change", fmt::format("{:.6g} (E0 = {:.10g})", table.rows.back()[E] - first[E], first[E]));
+      const int w = table.column("work");
+      if (w >= 0) input.summary.emplace_back("work", fmt::format("{:.6g}", table.rows.back()[static_cast<std::size_t>(w)]));
+    } else if (e >= 0) {
       double drift = 0.0;
       for (const std::vector<double>& row : table.rows)
         drift = std::max(drift, std::abs(row[static_cast<std::size_t>(e)] - first[static_cast<std::size_t>(e)]));

@@ -1,5 +1,7 @@
 #include "nhdyn/io/results.hpp"
 
+#include "nhdyn/analysis/residuals.hpp"
+
 namespace nhdyn {
 
 ResultColumns make_result_columns(const Model& model) {
@@ -20,6 +22,11 @@ ResultColumns make_result_columns(const Model& model) {
   if (model.evaluator && model.evaluator->has_energy()) {
     c.energy = "energy";
     c.all.push_back(c.energy);
+  }
+  if (model.evaluator && model.evaluator->has_energy_balance()) {
+    c.energy_balance = {"energy_function", "power", "work_forces", "work_reactions", "work_time", "work",
+                        "balance_error"};
+    c.all.insert(c.all.end(), c.energy_balance.begin(), c.energy_balance.end());
   }
   // Program motion, after everything else so that a model without programs keeps its layout.
   std::vector<std::string> program_residuals;
@@ -46,6 +53,11 @@ void fill_result_row(const Model& model, const Data& data, std::vector<double>& 
   for (Eigen::Index i = 0; i < data.f.size(); ++i) row.push_back(data.f(i));
   for (Eigen::Index i = 0; i < data.e.size(); ++i) row.push_back(data.e(i));
   if (model.evaluator->has_energy()) row.push_back(data.energy);
+  if (model.evaluator->has_energy_balance()) {
+    double balance[kEnergyBalanceColumns];
+    fill_energy_balance(data, balance);
+    row.insert(row.end(), balance, balance + kEnergyBalanceColumns);
+  }
   if (model.m() == 0) return;
   const ProgramMotionData& w = data.motion;
   for (Eigen::Index i = 0; i < w.u.size(); ++i) row.push_back(w.u(i));

@@ -1,10 +1,13 @@
 // The layout of a simulation's results, one row per output time, in this order:
 //   t, the coordinates q (by name), their velocities (x'), accelerations (x''), reactions (R_x),
 //   the constraint residuals — position level (residual_pos_<constraint>), velocity level
-//   (residual_vel_<constraint>), acceleration level (residual_acc_<constraint>) — and energy
-//   (when the model defines one); then, for a model with programs (docs/derivations/program-motion.md),
-//   the actuator forces (u_<program>) and the programs' residuals at the three levels, named like
-//   the constraints' (residual_pos_<program>, ...).
+//   (residual_vel_<constraint>), acceleration level (residual_acc_<constraint>) — energy
+//   (E = T + V, when the model defines one) and the energy balance (when the model has one,
+//   docs/derivations/energy-balance.md): energy_function (h), power (P), work_forces,
+//   work_reactions, work_time, work (W, their sum) and balance_error (h - h(t0) - W); then, for a
+//   model with programs (docs/derivations/program-motion.md), the actuator forces (u_<program>)
+//   and the programs' residuals at the three levels, named like the constraints'
+//   (residual_pos_<program>, ...).
 // Shared by the CSV writer and the plots so that both name the columns the same way.
 #pragma once
 
@@ -23,13 +26,17 @@ struct ResultColumns {
   std::vector<std::string> residuals;    // the three levels
   std::string energy;                    // empty when the model defines none
   std::vector<std::string> actuators;    // u, one per program (empty without programs)
+  // The energy balance, when the model has one (docs/derivations/energy-balance.md): h, the power
+  // P, the work of each agent and their sum W, and h - h(t0) - W. Empty otherwise.
+  std::vector<std::string> energy_balance;
 };
 
 ResultColumns make_result_columns(const Model& model);
 
 // Fills `row` (sized to the column count; no allocation after the first call) from Data after
 // compute_acceleration, compute_residuals and compute_energy (and compute_program_residuals for a
-// model with programs).
+// model with programs; with an energy balance, compute_power and the work and balance error that
+// simulate sets).
 void fill_result_row(const Model& model, const Data& data, std::vector<double>& row);
 
 }  // namespace nhdyn

@@ -207,6 +207,14 @@ class CompiledEvaluator final : public Evaluator {
     base_->program_constraint_velocity_residual(t, q, v, scratch, f);
   }
   bool has_energy() const override { return base_->has_energy(); }
+  bool has_energy_balance() const override { return base_->has_energy_balance(); }
+  bool energy_function_is_energy() const override { return base_->energy_function_is_energy(); }
+  double energy_function(double t, const double* q, const double* v, double* scratch) const override {
+    return base_->energy_function(t, q, v, scratch);
+  }
+  void power(double t, const double* q, const double* v, double* scratch, double* out) const override {
+    base_->power(t, q, v, scratch, out);
+  }
   double energy(double t, const double* q, const double* v, double* scratch) const override {
     return base_->energy(t, q, v, scratch);
   }

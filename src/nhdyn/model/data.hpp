@@ -122,6 +122,14 @@ struct Data {
   Vector f;             // velocity-level residuals (one per position or velocity constraint)
   Vector e;             // s acceleration-level residuals b q'' + b0 (2.14)
   double energy = 0.0;  // T + V where the model defines it
+  // The energy balance (docs/derivations/energy-balance.md), where the model has one: h (E2)
+  // (compute_energy); the power (E3) [W] of the nonconservative forces Q_nc . q', of the
+  // reactions R . q' and of the explicit time dependence -dL/dt (compute_power); the work W [J]
+  // done by each since t0, integrated along the run (set by simulate at every output).
+  double energy_function = 0.0;
+  double power_forces = 0.0, power_reactions = 0.0, power_time = 0.0;
+  double work_forces = 0.0, work_reactions = 0.0, work_time = 0.0;
+  double balance_error = 0.0;  // h - h(t0) - W, the accuracy figure (set by simulate)
 
   // --- program motion (compute_program_motion; empty for a model without programs) -------------
   ProgramMotionData motion;

@@ -87,11 +87,26 @@ class Evaluator {
   virtual void program_constraint_velocity_residual(double /*t*/, const double* /*q*/, const double* /*v*/,
                                                     double* /*scratch*/, double* /*f*/) const {}
 
-  // Whether energy() is defined (T + V of a system whose other forces do no work).
+  // Whether energy() is defined: E = T + V (of any system when has_energy_balance(); built-in
+  // models define it only where their other forces do no work).
   virtual bool has_energy() const { return false; }
   virtual double energy(double /*t*/, const double* /*q*/, const double* /*v*/,
                         double* /*scratch*/) const {
     return 0.0;
+  }
+  // Whether energy_function() and power() are defined (docs/derivations/energy-balance.md):
+  // h = q' . dT/dq' - T + V (E2), and out[0] = Q_nc . q' (the power of the nonconservative forces),
+  // out[1] = -dL/dt|explicit (of the explicit time dependence of T and V); the power of the
+  // reactions R . q' (E3) is computed from R (analysis/residuals.hpp).
+  virtual bool has_energy_balance() const { return false; }
+  // Whether h = E identically (T quadratic in the velocities, T = T2).
+  virtual bool energy_function_is_energy() const { return true; }
+  virtual double energy_function(double t, const double* q, const double* v, double* scratch) const {
+    return energy(t, q, v, scratch);
+  }
+  virtual void power(double /*t*/, const double* /*q*/, const double* /*v*/, double* /*scratch*/,
+                     double* out) const {
+    out[0] = out[1] = 0.0;
   }
 
   // Whether solution() is defined: the model knows its exact motion from its own initial state

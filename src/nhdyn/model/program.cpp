@@ -430,6 +430,9 @@ ModelPrograms bind_programs(const ModelPrograms& parametric, const std::vector<d
   out.energy = bound_optional(parametric.energy);
   out.solution = bound_optional(parametric.solution);
   out.initial_state = bound_optional(parametric.initial_state);
+  out.energy_balance = parametric.energy_balance;
+  out.energy_function = bound_optional(parametric.energy_function);
+  out.power = bound_optional(parametric.power);
   out.sparsity = parametric.sparsity;
   out.program_constraints = parametric.program_constraints;
   out.program_constraint_terms = bound_optional(parametric.program_constraint_terms);
@@ -481,6 +484,8 @@ void ProgramEvaluator::build() {
   check_program(programs_.position_residual, "position residual", n, -1);
   check_program(programs_.velocity_residual, "velocity residual", n, -1);
   if (programs_.energy) check_program(*programs_.energy, "energy", n, 1);
+  if (programs_.energy_function) check_program(*programs_.energy_function, "energy function", n, 1);
+  if (programs_.power) check_program(*programs_.power, "power", n, 2);
   if (programs_.solution) {
     check_program(*programs_.solution, "solution", n, 3 * n);
     if (programs_.solution->reads_coordinates() || programs_.solution->reads_velocities())
@@ -523,6 +528,8 @@ void ProgramEvaluator::build() {
   widen(programs_.position_residual);
   widen(programs_.velocity_residual);
   if (programs_.energy) widen(*programs_.energy);
+  if (programs_.energy_function) widen(*programs_.energy_function);
+  if (programs_.power) widen(*programs_.power);
   if (programs_.solution) widen(*programs_.solution);
   if (programs_.initial_state) widen(*programs_.initial_state);
   if (m > 0) {
@@ -542,6 +549,8 @@ void ProgramEvaluator::build() {
   position_residual_ = prepare(programs_.position_residual, {programs_.position_residual.outputs()});
   velocity_residual_ = prepare(programs_.velocity_residual, {programs_.velocity_residual.outputs()});
   if (programs_.energy) energy_ = prepare(*programs_.energy, {1});
+  if (programs_.energy_function) energy_function_ = prepare(*programs_.energy_function, {1});
+  if (programs_.power) power_ = prepare(*programs_.power, {2});
   if (programs_.solution) solution_ = prepare(*programs_.solution, {3 * n});
   if (programs_.initial_state) initial_state_ = prepare(*programs_.initial_state, {2 * n});
   if (m > 0) {
@@ -896,6 +905,21 @@ double ProgramEvaluator::energy(double t, const double* q, const double* v, doub
   double e = 0.0;
   run(energy_, t, q, v, scratch, &e);
   return e;
+}
+
+double ProgramEvaluator::energy_function(double t, const double* q, const double* v, double* scratch) const {
+  if (!programs_.energy_function) return energy(t, q, v, scratch);  // T = T2: h = E
+  double h = 0.0;
+  run(energy_function_, t, q, v, scratch, &h);
+  return h;
+}
+
+void ProgramEvaluator::power(double t, const double* q, const double* v, double* scratch, double* out) const {
+  if (!programs_.power) {
+    out[0] = out[1] = 0.0;
+    return;
+  }
+  run(power_, t, q, v, scratch, out);
 }
 
 void ProgramEvaluator::solution(double t, double* scratch, double* qva) const {

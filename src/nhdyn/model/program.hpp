@@ -189,6 +189,12 @@ struct ModelPrograms {
   std::optional<Program> program_constraint_terms = std::nullopt;
   std::optional<Program> program_constraint_position_residual = std::nullopt;
   std::optional<Program> program_constraint_velocity_residual = std::nullopt;
+  // The energy balance (docs/derivations/energy-balance.md), for a model whose energy program is
+  // E = T + V of any system (not only a conservative one): h where it differs from E, and the
+  // power Q_nc . q', -dL/dt|explicit where it is not identically zero.
+  bool energy_balance = false;
+  std::optional<Program> energy_function = std::nullopt;  // one output: h = q' . dT/dq' - T + V
+  std::optional<Program> power = std::nullopt;            // outputs: Q_nc . q', -dL/dt|explicit
 };
 
 // An Evaluator that runs straight-line programs. It keeps the parametric programs (shared by every
@@ -250,6 +256,10 @@ class ProgramEvaluator final : public Evaluator {
   void program_constraint_position_residual(double t, const double* q, double* scratch, double* phi) const override;
   void program_constraint_velocity_residual(double t, const double* q, const double* v, double* scratch,
                                             double* f) const override;
+  bool has_energy_balance() const override { return programs_.energy_balance && programs_.energy.has_value(); }
+  bool energy_function_is_energy() const override { return !programs_.energy_function.has_value(); }
+  double energy_function(double t, const double* q, const double* v, double* scratch) const override;
+  void power(double t, const double* q, const double* v, double* scratch, double* out) const override;
   bool has_solution() const override { return programs_.solution.has_value(); }
   void solution(double t, double* scratch, double* qva) const override;
 
@@ -294,6 +304,7 @@ class ProgramEvaluator final : public Evaluator {
   Prepared terms_, complement_, position_residual_, velocity_residual_, energy_, solution_, initial_state_;
   Prepared program_terms_, program_phi_, program_f_;  // program motion (empty without programs)
   std::size_t program_sizes_[3] = {0, 0, 0};          // outputs of program_terms_: b_p, b_p0, B
+  Prepared energy_function_, power_;
   TermsFunction terms_function_ = nullptr;
   std::size_t terms_sizes_[5] = {0, 0, 0, 0, 0};  // outputs of terms: A, Q, G, b, b0 (nonzeros when sparse)
   std::size_t values_offset_ = 0;  // where terms_scatter keeps the nonzeros in scratch

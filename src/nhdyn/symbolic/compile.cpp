@@ -950,6 +950,21 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
     ProgramCompiler energy(spec);
     energy.add_output(*derivation.energy, "energy");
     programs.energy = energy.finish();
+    // The energy balance (docs/derivations/energy-balance.md): h where it differs from E, and the
+    // symbolic parts of the power where they are not zero (the power program runs at every
+    // right-hand side of a run, so a conservative model has none).
+    programs.energy_balance = true;
+    if (derivation.energy_function) {
+      ProgramCompiler h(spec);
+      h.add_output(*derivation.energy_function, "energy function");
+      programs.energy_function = h.finish();
+    }
+    if (!derivation.conservative) {
+      ProgramCompiler power(spec);
+      power.add_output(derivation.power_forces, "power of the forces");
+      power.add_output(derivation.power_time, "power of the explicit time dependence");
+      programs.power = power.finish();
+    }
   }
 
   model.t0 = spec.t0;

@@ -454,17 +454,38 @@ Derivation derive(const Spec& spec) {
     }
   }
 
-  // T + V is conserved when no other force acts and nothing depends on t explicitly.
-  bool conservative = symbolic::is_zero(T.diff(t)) && symbolic::is_zero(V.diff(t));
-  for (const GiNaC::ex& force : spec.forces) conservative = conservative && symbolic::is_zero(force);
-  if (conservative) {
-    // Simplifying a sum costs more than linearly in its number of terms (every trigonometric
-    // argument is reduced across all of them): a large model's energy is kept as written, which
-    // computes the same values.
-    const GiNaC::ex energy = T + V;
-    constexpr std::size_t kSimplifiedTerms = 64;
-    d.energy = energy.nops() <= kSimplifiedTerms ? tidy(energy) : energy;
+  // The energy balance (docs/derivations/energy-balance.md). Simplifying a sum costs more than
+  // linearly in its number of terms (every trigonometric argument is reduced across all of them):
+  // a large model's expressions are kept as written, which computes the same values.
+  constexpr std::size_t kSimplifiedTerms = 64;
+  const auto kept = [](const GiNaC::ex& e) { return e.nops() <= kSimplifiedTerms ? tidy(e) : e; };
+  const GiNaC::ex energy = T + V;
+  d.energy = kept(energy);
+  // h = q' . dT/dq' - T + V, term by term of T: a term homogeneous of degree 2 in the velocities
+  // (Euler: q' . dterm/dq' = 2 term) contributes itself, as in E; only the others need the sum.
+  GiNaC::ex h = V;
+  bool h_is_energy = true;
+  for (std::size_t j = 0; j < Ts.terms.size(); ++j) {
+    const GiNaC::ex& term = Ts.terms[j];
+    GiNaC::ex rate = 0;
+    for (int i : Ts.occurrences[j].v) rate += v(i) * term.diff(v(i));
+    // Expanding settles the usual term (a polynomial in the velocities) at a small fraction of
+    // the cost of simplifying it, which matters for the thousands of terms of a long chain.
+    const GiNaC::ex euler = (rate - 2 * term).expand();
+    if (!Ts.occurrences[j].v.empty() && (euler.is_zero() || symbolic::is_zero(euler))) {
+      h += term;
+    } else {
+      h += rate - term;
+      h_is_energy = false;
+    }
   }
+  if (!h_is_energy) d.energy_function = kept(h);
+  GiNaC::ex power_forces = 0;
+  for (std::size_t i = 0; i < spec.forces.size(); ++i)
+    if (!symbolic::is_zero(spec.forces[i])) power_forces += spec.forces[i] * v(static_cast<int>(i));
+  d.power_forces = tidy(power_forces);
+  d.power_time = tidy(V.diff(t) - T.diff(t));
+  d.conservative = symbolic::is_zero(d.power_forces) && symbolic::is_zero(d.power_time);
   return d;
 }
 

@@ -29,7 +29,16 @@ struct Derivation {
   GiNaC::matrix B = GiNaC::matrix(0, 0);     // n x m
   std::vector<GiNaC::ex> phi_p;              // one per position-level program
   std::vector<GiNaC::ex> f_p;                // one per position- or velocity-level program
-  std::optional<GiNaC::ex> energy;  // T + V when there are no nonconservative forces and T, V do not depend on t
+  // The energy balance (docs/derivations/energy-balance.md): E = T + V for every model, the energy
+  // function h = q' . dT/dq' - T + V (E2) when it differs from E (T has parts of degree 1 or 0 in
+  // the velocities; otherwise h = E and this is empty), and the two symbolic parts of the power
+  // (E3): Q_nc . q' (the nonconservative forces) and -dL/dt|explicit = -dT/dt + dV/dt (explicit
+  // time). The power of the reactions, R . q', is numeric (analysis/residuals.hpp).
+  std::optional<GiNaC::ex> energy;  // E = T + V
+  std::optional<GiNaC::ex> energy_function;
+  GiNaC::ex power_forces = 0;
+  GiNaC::ex power_time = 0;
+  bool conservative = false;  // no nonconservative forces and T, V free of t: E can change only by R . q'
 };
 
 // Throws ModelError naming the constraint (and its location) that does not involve the
