@@ -562,32 +562,44 @@ class Loader {
                                     name, other_at.line));
       names.emplace_back(name, name_at);
 
-      const toml::node* level_node = nullptr;
-      std::string level_key;
-      ConstraintLevel level = ConstraintLevel::velocity;
-      for (const Entry& entry : in_file_order(*table)) {
-        const std::string key(entry.key->str());
-        ConstraintLevel this_level;
-        if (key == "position") this_level = ConstraintLevel::position;
-        else if (key == "velocity") this_level = ConstraintLevel::velocity;
-        else if (key == "acceleration") this_level = ConstraintLevel::acceleration;
-        else continue;
-        if (level_node != nullptr)
-          fail(at(*entry.key), fmt::format("constraint '{}' is given both as {} and as {}; give exactly one of "
-                                           "position, velocity, acceleration",
-                                           name, level_key, key));
-        level_node = entry.value;
-        level_key = key;
-        level = this_level;
-      }
-      if (level_node == nullptr)
-        fail(at(element), fmt::format("constraint '{}' has no expression: give exactly one of position = \"...\", "
-                                      "velocity = \"...\" or acceleration = \"...\" (the constraint is expression = 0)",
-                                      name));
+      const LevelEntry found = level_of(*table, element, "constraint", name);
+      const toml::node* level_node = found.node;
+      const std::string& level_key = found.key;
+      const ConstraintLevel level = found.level;
       const std::string text = expression_string(*level_node, fmt::format("{}.{}", name, level_key),
                                                  "velocity = \"y' - tan(phi) * x'\"");
       located(*level_node, [&] { builder.constraint(name, level, text, content_at(*level_node)); });
     }
+  }
+
+  // The one level key of a constraint or program table (position, velocity or acceleration, the
+  // expression = 0): its node, the key and the level. `what` names the table in the messages.
+  struct LevelEntry {
+    const toml::node* node;
+    std::string key;
+    ConstraintLevel level;
+  };
+  LevelEntry level_of(const toml::table& table, const toml::node& element, std::string_view what,
+                      const std::string& name) const {
+    LevelEntry out{nullptr, {}, ConstraintLevel::velocity};
+    for (const Entry& entry : in_file_order(table)) {
+      const std::string key(entry.key->str());
+      ConstraintLevel level;
+      if (key == "position") level = ConstraintLevel::position;
+      else if (key == "velocity") level = ConstraintLevel::velocity;
+      else if (key == "acceleration") level = ConstraintLevel::acceleration;
+      else continue;
+      if (out.node != nullptr)
+        fail(at(*entry.key), fmt::format("{} '{}' is given both as {} and as {}; give exactly one of "
+                                         "position, velocity, acceleration",
+                                         what, name, out.key, key));
+      out = {entry.value, key, level};
+    }
+    if (out.node == nullptr)
+      fail(at(element), fmt::format("{} '{}' has no expression: give exactly one of position = \"...\", "
+                                    "velocity = \"...\" or acceleration = \"...\" (the {} is expression = 0)",
+                                    what, name, what));
+    return out;
   }
 
   // [[events]]: name, when = "g" (crossing zero), direction = rising | falling | both (default
@@ -671,28 +683,10 @@ class Loader {
       check_keys(*table, program_keys, fmt::format("in program {}", number));
       std::string name = fmt::format("p{}", number);
       if (const toml::node* name_node = table->get("name")) name = string_of(*name_node, "name", "name = \"heading\"");
-      const toml::node* level_node = nullptr;
-      std::string level_key;
-      ConstraintLevel level = ConstraintLevel::position;
-      for (const Entry& entry : in_file_order(*table)) {
-        const std::string key(entry.key->str());
-        ConstraintLevel this_level;
-        if (key == "position") this_level = ConstraintLevel::position;
-        else if (key == "velocity") this_level = ConstraintLevel::velocity;
-        else if (key == "acceleration") this_level = ConstraintLevel::acceleration;
-        else continue;
-        if (level_node != nullptr)
-          fail(at(*entry.key), fmt::format("program '{}' is given both as {} and as {}; give exactly one of "
-                                           "position, velocity, acceleration",
-                                           name, level_key, key));
-        level_node = entry.value;
-        level_key = key;
-        level = this_level;
-      }
-      if (level_node == nullptr)
-        fail(at(element), fmt::format("program '{}' has no expression: give exactly one of position = \"...\", "
-                                      "velocity = \"...\" or acceleration = \"...\" (the program is expression = 0)",
-                                      name));
+      const LevelEntry found = level_of(*table, element, "program", name);
+      const toml::node* level_node = found.node;
+      const std::string& level_key = found.key;
+      const ConstraintLevel level = found.level;
       const toml::node* actuator = table->get("actuator");
       if (actuator == nullptr)
         fail(at(element), fmt::format("program '{}' has no actuator: name the coordinate its force or torque acts "
