@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "run_overrides.hpp"
 #include "nhdyn/analysis/batch.hpp"
 #include "nhdyn/analysis/run_options.hpp"
 #include "nhdyn/core/error.hpp"
@@ -167,14 +168,7 @@ int run_batch(const BatchArgs& args) {
     for (std::size_t j = 0; j < names.size(); ++j)
       if (varied[j].kind == Varied::parameter) parameter_values[r].push_back(table[r][j]);
 
-  RunOptions run = base.defaults;
-  run.t_end = args.t_end.value_or(run.t_end);
-  run.output_step = args.output_step.value_or(run.output_step);
-  run.method = args.method.value_or(run.method);
-  run.complement = args.complement.value_or(run.complement);
-  run.integrator = args.integrator.value_or(run.integrator);
-  run.rtol = args.rtol.value_or(run.rtol);
-  run.atol = args.atol.value_or(run.atol);
+  const RunOptions run = run_options_with(base, args);
   BatchOptions options;
   options.simulation = make_simulation_options(run);
   options.threads = args.threads;

@@ -25,6 +25,7 @@
 #include "nhdyn/symbolic/events.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 #include "progress.hpp"
+#include "run_overrides.hpp"
 
 namespace nhdyn::cli {
 namespace {
@@ -192,16 +193,7 @@ int run_simulate(const SimulateArgs& args) {
   std::string notice;
   const Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
   if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
-  // The model's run options (its file's [simulation], else the defaults of RunOptions), then
-  // what the command line overrides.
-  RunOptions run = model.defaults;
-  run.t_end = args.t_end.value_or(run.t_end);
-  run.output_step = args.output_step.value_or(run.output_step);
-  run.method = args.method.value_or(run.method);
-  run.complement = args.complement.value_or(run.complement);
-  run.integrator = args.integrator.value_or(run.integrator);
-  run.rtol = args.rtol.value_or(run.rtol);
-  run.atol = args.atol.value_or(run.atol);
+  RunOptions run = run_options_with(model, args);
   SimulationOptions options = make_simulation_options(run);
   options.integrator.step = args.step;
   options.fix_initial = args.fix_initial;
