@@ -109,7 +109,15 @@ void bind_model(py::module_& m) {
         d["all"] = c.all;
         d["coordinates"] = c.coordinates;
         d["reactions"] = c.reactions;
-        d["residuals"] = c.residuals;
+        // The programs' residual columns come last in c.residuals; they are kept apart here, as
+        // Result.residuals and Result.program_residuals are.
+        std::size_t program_residuals = 0;
+        for (const ProgramConstraint& p : model.program_constraints)
+          program_residuals += p.level == ConstraintLevel::position ? 3 : p.level == ConstraintLevel::velocity ? 2 : 1;
+        const auto split = c.residuals.end() - static_cast<std::ptrdiff_t>(program_residuals);
+        d["residuals"] = std::vector<std::string>(c.residuals.begin(), split);
+        d["program_residuals"] = std::vector<std::string>(split, c.residuals.end());
+        d["actuators"] = c.actuators;
         d["energy"] = c.energy;
         return d;
       });

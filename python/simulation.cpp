@@ -32,7 +32,7 @@ std::optional<T> get(const py::dict& kwargs, const char* key) {
 const char* const known_options[] = {"t_end",     "output_step", "method",    "complement",
                                      "integrator", "rtol",        "atol",      "step",
                                      "fix_initial", "stabilize",  "q0",        "v0",
-                                     "stop_when",  "events",      "max_steps"};
+                                     "stop_when",  "events",      "max_steps", "program_feedback"};
 
 // A string or a sequence of strings.
 std::vector<std::string> strings(const py::dict& kwargs, const char* key) {
@@ -56,7 +56,7 @@ SimulationOptions make_options(const Model& model, const py::dict& kwargs) {
     if (!known)
       throw InputError(fmt::format("simulate: unknown option '{}'; the options are t_end, output_step, method, complement, "
                                    "integrator, rtol, atol, step, fix_initial, stabilize, q0, v0, stop_when, events, "
-                                   "max_steps",
+                                   "max_steps, program_feedback",
                                    key));
   }
   RunOptions run = model.defaults;
@@ -74,6 +74,22 @@ SimulationOptions make_options(const Model& model, const py::dict& kwargs) {
   if (const std::optional<long> max_steps = get<long>(kwargs, "max_steps")) {
     if (*max_steps < 1) throw InputError(fmt::format("max_steps={}: the step budget must be at least 1", *max_steps));
     options.integrator.max_steps = *max_steps;
+  }
+  // program_feedback=(alpha, beta): the PD feedback of program motion (docs/derivations/program-motion.md
+  // section 5), as --program-feedback alpha,beta.
+  if (kwargs.contains("program_feedback") && !py::object(kwargs["program_feedback"]).is_none()) {
+    const py::object value = kwargs["program_feedback"];
+    std::vector<double> gains;
+    try {
+      gains = value.cast<std::vector<double>>();
+    } catch (const py::cast_error&) {
+      gains.clear();
+    }
+    if (gains.size() != 2)
+      throw InputError(fmt::format("program_feedback={}: give two rates in 1/s as (alpha, beta), e.g. "
+                                   "program_feedback=(10, 10)",
+                                   py::repr(value).cast<std::string>()));
+    options.formulation.program_feedback = {true, gains[0], gains[1]};
   }
   // The model's [[events]], then stop_when="abs(phi) > 1" (conditions) and events={"name": "expr"}.
   options.events = model.events;
@@ -123,6 +139,9 @@ py::dict summary_dict(const SimulationSummary& s) {
   d["max_velocity_residual"] = s.max_velocity_residual;
   d["max_acceleration_residual"] = s.max_acceleration_residual;
   d["energy_drift"] = s.has_energy ? py::cast(s.energy_drift) : py::none();
+  d["max_program_position_residual"] = s.max_program_position_residual;
+  d["max_program_velocity_residual"] = s.max_program_velocity_residual;
+  d["max_program_acceleration_residual"] = s.max_program_acceleration_residual;
   d["stopped_by"] = s.stopped_by >= 0 ? py::cast(s.event_names[static_cast<std::size_t>(s.stopped_by)]) : py::none();
   // docs/derivations/energy-balance.md: the balance error (accuracy), the work by agent and the
   // change of E (physics).
@@ -149,6 +168,10 @@ py::dict trajectory_dict(Trajectory&& tr) {
   d["energy"] = tr.has_energy ? py::object(take_array(std::move(tr.energy), {rows})) : py::object(py::none());
   const auto b = static_cast<py::ssize_t>(tr.balance_columns);
   d["energy_balance"] = b > 0 ? py::object(take_array(std::move(tr.balance), {rows, b})) : py::object(py::none());
+  // Program motion: the actuator forces and the programs' residuals (rows x 0 without programs).
+  d["u"] = take_array(std::move(tr.u), {rows, static_cast<py::ssize_t>(tr.actuator_columns)});
+  d["program_residuals"] =
+      take_array(std::move(tr.program_residuals), {rows, static_cast<py::ssize_t>(tr.program_residual_columns)});
   return d;
 }
 
@@ -195,7 +218,8 @@ void bind_simulation(py::module_& m) {
         out["cpp_seconds"] = seconds;  // the whole C++ call, for the overhead benchmark
         return out;
       },
-      "simulate(model, **options) -> dict of arrays (t, q, qd, qdd, R, residuals, energy) and summary");
+      "simulate(model, **options) -> dict of arrays (t, q, qd, qdd, R, residuals, energy, u, program_residuals) "
+      "and summary");
 }
 
 }  // namespace nhdyn::python

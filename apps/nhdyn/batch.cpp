@@ -256,6 +256,12 @@ int run_batch(const BatchArgs& args) {
         const auto b = static_cast<std::size_t>(tr.balance_columns);
         row.insert(row.end(), tr.balance.begin() + static_cast<std::ptrdiff_t>(k * b),
                    tr.balance.begin() + static_cast<std::ptrdiff_t>((k + 1) * b));
+        const auto a = static_cast<std::size_t>(tr.actuator_columns);
+        const auto p = static_cast<std::size_t>(tr.program_residual_columns);
+        row.insert(row.end(), tr.u.begin() + static_cast<std::ptrdiff_t>(k * a),
+                   tr.u.begin() + static_cast<std::ptrdiff_t>((k + 1) * a));
+        row.insert(row.end(), tr.program_residuals.begin() + static_cast<std::ptrdiff_t>(k * p),
+                   tr.program_residuals.begin() + static_cast<std::ptrdiff_t>((k + 1) * p));
         writer.write_row(row);
       }
       writer.commit();

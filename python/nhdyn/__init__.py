@@ -151,17 +151,20 @@ class Model:
     # --- runs and analyses ---------------------------------------------------------------------
     def simulate(self, t_end=None, *, rtol=None, atol=None, method=None, integrator=None, output_step=None,
                  complement=None, step=None, fix_initial=None, stabilize=None, q0=None, qd0=None,
-                 stop_when=None, events=None, max_steps=None):
+                 stop_when=None, events=None, max_steps=None, program_feedback=None):
         """One run from the model's initial state (or q0, qd0) with the model's run options, any of
         them overridden here. Events: the model file's [[events]], plus stop_when (a condition such
         as "abs(phi) > 1", or a list of them: the run ends when one becomes true) and events (a
         dict of names to expressions whose zero crossings are recorded); they are located exactly
-        and listed in Result.events, each also a row of the outputs. Returns a Result; a run that
-        fails numerically raises nhdyn.SimulationError with the library's message."""
+        and listed in Result.events, each also a row of the outputs. For a model with programs,
+        program_feedback=(alpha, beta) adds PD feedback on the programs' residuals (rates in 1/s, as
+        `nhdyn simulate --program-feedback alpha,beta`; docs/derivations/program-motion.md section 5).
+        Returns a Result; a run that fails numerically raises nhdyn.SimulationError with the
+        library's message."""
         out = _nhdyn.simulate(self._cpp, t_end=t_end, rtol=rtol, atol=atol, method=method, integrator=integrator,
                               output_step=output_step, complement=complement, step=step, fix_initial=fix_initial,
                               stabilize=stabilize, q0=q0, v0=qd0, stop_when=stop_when, events=events,
-                              max_steps=max_steps)
+                              max_steps=max_steps, program_feedback=program_feedback)
         if not out["ok"]:
             summary = out["summary"]
             raise SimulationError("simulation of '{}' failed at t = {:.6g}: {}".format(
@@ -198,7 +201,9 @@ class Model:
 class Result:
     """The outputs of one run, one row per output time: t (rows), q, qd, qdd, R (rows x n),
     residuals (rows x residual columns: position, velocity, acceleration level) and energy (rows,
-    or None). `columns` holds the names, the same as the CSV written by `nhdyn simulate`."""
+    or None); for a model with programs, u (rows x m, the actuator forces) and program_residuals
+    (rows x the programs' residual columns, position, velocity, acceleration level), both with no
+    columns otherwise. `columns` holds the names, the same as the CSV written by `nhdyn simulate`."""
 
     def __init__(self, model, out):
         self.model_name = model.name
@@ -207,6 +212,8 @@ class Result:
         self.R, self.residuals, self.energy = out["R"], out["residuals"], out["energy"]
         # h, P, W_forces, W_reactions, W_time, W, h - h0 - W (docs/derivations/energy-balance.md), or None
         self.energy_balance = out.get("energy_balance")
+        # Program motion (docs/derivations/program-motion.md): rows x m and rows x residual columns.
+        self.u, self.program_residuals = out["u"], out["program_residuals"]
         self.summary = out["summary"]
         # The located events in time order: dicts with name, t, q and qd at the crossing.
         self.events = out["events"]
@@ -220,6 +227,7 @@ class Result:
             parts.append(self.energy[:, None])
         if self.energy_balance is not None:
             parts.append(self.energy_balance)
+        parts += [self.u, self.program_residuals]
         return list(self.columns["all"]), np.hstack(parts)
 
     def to_pandas(self):

@@ -72,6 +72,19 @@ TEST_F(ProgramCli, WritesTheActuatorForcesAndProgramResiduals) {
   EXPECT_NE(run.out.find("programs: 1, max residual: position"), std::string::npos) << run.out;
 }
 
+TEST_F(ProgramCli, BatchRunFilesCarryTheActuatorForcesAsSimulateDoes) {
+  // A batch of one run (omega = 1, the file's value) writes the same file as simulate.
+  const Outcome batch = nhdyn("batch " + example("sled_heading_program.toml") +
+                                  " --grid omega=1:1:1 --write-runs -o runs --t-end 1 -q",
+                              dir_);
+  ASSERT_EQ(batch.exit_code, 0) << batch.out;
+  const Outcome run = nhdyn("simulate " + example("sled_heading_program.toml") + " --t-end 1 -o out.csv -q", dir_);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const std::string simulated = read("out.csv");
+  ASSERT_NE(simulated.find(",u_heading,"), std::string::npos);
+  EXPECT_EQ(read("runs/run_0.csv"), simulated);
+}
+
 TEST_F(ProgramCli, FeedbackIsReportedAndItsGainsChecked) {
   const Outcome run = nhdyn("simulate " + example("sled_heading_program.toml") +
                                 " --t-end 1 -o out.csv --program-feedback 10,10",

@@ -17,7 +17,12 @@ void Trajectory::reset(const Model& model, long expected_rows) {
   residual_columns = model.position_constraints() + model.velocity_constraints() + model.s();
   has_energy = model.evaluator && model.evaluator->has_energy();
   balance_columns = model.evaluator && model.evaluator->has_energy_balance() ? kEnergyBalanceColumns : 0;
-  for (std::vector<double>* column : {&t, &q, &v, &qdd, &R, &residuals, &energy, &balance}) column->clear();
+  actuator_columns = model.m();
+  program_residual_columns = 0;
+  for (const ProgramConstraint& p : model.program_constraints)
+    program_residual_columns += p.level == ConstraintLevel::position ? 3 : p.level == ConstraintLevel::velocity ? 2 : 1;
+  for (std::vector<double>* column : {&t, &q, &v, &qdd, &R, &residuals, &energy, &balance, &u, &program_residuals})
+    column->clear();
   const auto rows = static_cast<std::size_t>(std::max(0L, expected_rows));
   const auto un = static_cast<std::size_t>(n);
   t.reserve(rows);
@@ -28,6 +33,8 @@ void Trajectory::reset(const Model& model, long expected_rows) {
   residuals.reserve(rows * static_cast<std::size_t>(residual_columns));
   if (has_energy) energy.reserve(rows);
   balance.reserve(rows * static_cast<std::size_t>(balance_columns));
+  u.reserve(rows * static_cast<std::size_t>(actuator_columns));
+  program_residuals.reserve(rows * static_cast<std::size_t>(program_residual_columns));
 }
 
 void Trajectory::append(const Data& data) {
@@ -44,6 +51,12 @@ void Trajectory::append(const Data& data) {
     double row[kEnergyBalanceColumns];
     fill_energy_balance(data, row);
     balance.insert(balance.end(), row, row + kEnergyBalanceColumns);
+  }
+  if (actuator_columns > 0) {
+    const ProgramMotionData& w = data.motion;
+    u.insert(u.end(), w.u.data(), w.u.data() + w.u.size());
+    for (const Vector* level : {&w.phi, &w.f, &w.e})
+      program_residuals.insert(program_residuals.end(), level->data(), level->data() + level->size());
   }
 }
 

@@ -30,12 +30,17 @@ struct Trajectory {
   std::vector<double> energy;       // rows (empty without an energy)
   int balance_columns = 0;          // kEnergyBalanceColumns with an energy balance, else 0
   std::vector<double> balance;      // rows x balance_columns (analysis/residuals.hpp fill_energy_balance)
+  // Program motion (docs/derivations/program-motion.md), empty without programs:
+  int actuator_columns = 0;            // m
+  std::vector<double> u;               // rows x m: the actuator forces (Data::motion.u)
+  int program_residual_columns = 0;    // position + velocity + acceleration level program residuals
+  std::vector<double> program_residuals;  // rows x program_residual_columns: phi_p, then f_p, then e_p
 
   long rows() const { return static_cast<long>(t.size()); }
   // Sizes the columns for `model` and drops every row; reserves `expected_rows`.
   void reset(const Model& model, long expected_rows = 0);
   // Appends the row of Data after an output (simulate's RowFn): t, q, q', q'', R, residuals,
-  // energy, energy balance.
+  // energy, energy balance, actuator forces, program residuals.
   void append(const Data& data);
 };
 
