@@ -441,10 +441,19 @@ struct ConstraintView {
   ex b0;
 };
 
+// A program (docs/derivations/program-motion.md): shown like a constraint, with its actuator.
+struct ProgramView {
+  ConstraintView constraint;
+  std::string actuator_text;  // as written: "delta" or "[0, 0, 1]"
+};
+
 struct Content {
   ex T, V;
   GiNaC::matrix A, Q, G;
   std::vector<ConstraintView> constraints;
+  std::vector<ProgramView> programs;       // m of them
+  GiNaC::matrix B = GiNaC::matrix(0, 0);   // n x m, the actuator matrix
+  std::optional<GiNaC::matrix> DB;         // k x m, D B: how the actuators enter the reduced equations
   std::optional<GiNaC::matrix> D;
   // too_large: the terms are too large to look for a partition symbolically (entries of more than
   // kSimplifyLimit nodes; the Whipple bicycle).
@@ -513,6 +522,16 @@ Content make_content(const Spec& spec, const Derivation& d) {
     for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) view.b.push_back(tidy(d.b(r, j)));
     c.constraints.push_back(std::move(view));
   }
+  const int m = spec.m();
+  for (unsigned r = 0; r < static_cast<unsigned>(m); ++r) {
+    const SpecProgram& program = spec.programs[r];
+    ProgramView view{{program.constraint.name, program.constraint.level, tidy(program.constraint.expression), {},
+                      tidy(d.b_p0(r, 0))},
+                     program.actuator_text};
+    for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) view.constraint.b.push_back(tidy(d.b_p(r, j)));
+    c.programs.push_back(std::move(view));
+  }
+  if (m > 0) c.B = tidy_matrix(d.B);
   Derivation with_d = d;
   if (d.D) {
     c.origin = spec.complement ? Content::Origin::analytic : Content::Origin::independent;
@@ -540,6 +559,7 @@ Content make_content(const Spec& spec, const Derivation& d) {
       c.A0 = reduced_inertia(with_d);
       c.C = reduced_forces(with_d);
     }
+    if (m > 0) c.DB = tidy_matrix(with_d.D->mul(d.B));
   }
   if (d.energy) c.energy = tidy(*d.energy);
   return c;
@@ -624,6 +644,22 @@ std::string format_text(const Spec& spec, const Content& c) {
       out += "    b0 = " + p.expression(v.b0) + "\n";
     }
   }
+  if (!c.programs.empty()) {
+    const int m = static_cast<int>(c.programs.size());
+    out += fmt::format("\nPrograms (m = {}), at acceleration level b_p q'' + b_p0 = 0, each realized by its actuator\n", m);
+    for (const ProgramView& v : c.programs) {
+      out += fmt::format("  {} ({} level, actuator {}): {} = 0\n", v.constraint.name, level_name(v.constraint.level),
+                         v.actuator_text, p.expression(v.constraint.expression));
+      GiNaC::matrix row(1, static_cast<unsigned>(n));
+      for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) row(0, j) = v.constraint.b[j];
+      out += "    b_p  = " + text_matrix(p, row, "");
+      out += "    b_p0 = " + p.expression(v.constraint.b0) + "\n";
+    }
+    std::vector<std::string> columns;
+    for (const ProgramView& v : c.programs) columns.push_back("u_" + v.constraint.name);
+    out += fmt::format("Actuator matrix B ({} x {}): the generalized force B u, u = ({})\n", n, m, join(columns, ", "));
+    out += text_matrix(p, c.B, "  ");
+  }
 
   out += "\n";
   switch (c.origin) {
@@ -660,18 +696,29 @@ std::string format_text(const Spec& spec, const Content& c) {
     std::vector<std::string> rows;
     for (int i = 1; i <= k; ++i) rows.push_back(std::to_string(i));
     out += "Reduced forces C = D (Q + G)\n" + text_vector(p, "C", *c.C, rows);
-    out += "\nEquations of motion A0 q'' = C";
-    out += s > 0 ? ", b q'' + b0 = 0\n" : "\n";
+    const bool programs = !c.programs.empty() && c.DB;
+    if (programs) out += "Reduced actuator matrix D B\n" + text_matrix(p, *c.DB, "  ");
+    out += programs ? "\nEquations of motion A0 q'' - D B u = C" : "\nEquations of motion A0 q'' = C";
+    out += s > 0 ? ", b q'' + b0 = 0" : "";
+    out += programs ? ", b_p q'' + b_p0 = 0 (unknowns q'' and u)\n" : "\n";
     const std::vector<std::string> names = accelerations(spec, p);
     for (unsigned i = 0; i < static_cast<unsigned>(k); ++i) {
       std::vector<std::pair<ex, std::string>> products;
       for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) products.emplace_back((*c.A0)(i, j), names[j]);
+      if (programs)
+        for (unsigned j = 0; j < c.programs.size(); ++j)
+          products.emplace_back(-(*c.DB)(i, j), "u_" + c.programs[j].constraint.name);
       out += "  " + p.combination(products, 0) + " = " + p.expression((*c.C)(i, 0)) + "\n";
     }
     for (const ConstraintView& v : c.constraints) {
       std::vector<std::pair<ex, std::string>> products;
       for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) products.emplace_back(v.b[j], names[j]);
       out += "  " + p.combination(products, v.b0) + " = 0   (" + v.name + ")\n";
+    }
+    for (const ProgramView& v : c.programs) {
+      std::vector<std::pair<ex, std::string>> products;
+      for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) products.emplace_back(v.constraint.b[j], names[j]);
+      out += "  " + p.combination(products, v.constraint.b0) + " = 0   (program " + v.constraint.name + ")\n";
     }
   }
   if (c.energy) out += "\nEnergy E = T + V\n  E = " + p.expression(*c.energy) + "\n";
@@ -719,6 +766,19 @@ std::string format_latex(const Spec& spec, const Content& c) {
     rows.push_back("b_{\\text{" + name + "}} &= " + latex_matrix(p, row) + ", \\qquad b_{0,\\text{" + name +
                    "}} = " + p.expression(v.b0));
   }
+  for (const ProgramView& program : c.programs) {
+    const ConstraintView& v = program.constraint;
+    const std::string name = latex_escape(v.name);
+    rows.push_back(fmt::format("\\intertext{{Program \\texttt{{{}}}, given at {} level, realized by the actuator "
+                               "\\texttt{{{}}}:}}",
+                               name, level_name(v.level), latex_escape(program.actuator_text)) +
+                   p.expression(v.expression) + " &= 0");
+    GiNaC::matrix row(1, static_cast<unsigned>(n));
+    for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) row(0, j) = v.b[j];
+    rows.push_back("b_{p,\\text{" + name + "}} &= " + latex_matrix(p, row) + ", \\qquad b_{p0,\\text{" + name +
+                   "}} = " + p.expression(v.b0));
+  }
+  if (!c.programs.empty()) rows.push_back("\\intertext{Actuator matrix (the generalized force $B u$):}B &= " + latex_matrix(p, c.B));
   std::vector<std::string> independent;
   for (const std::string& name : c.independent)
     independent.push_back(p.symbol(name));
@@ -756,14 +816,20 @@ std::string format_latex(const Spec& spec, const Content& c) {
     rows.push_back("\\intertext{" + heading + "}" + d_row);
     rows.push_back("A_0 &= D A = " + latex_matrix(p, *c.A0));
     rows.push_back("C &= D (Q + G) = " + latex_matrix(p, *c.C));
+    const bool programs = !c.programs.empty() && c.DB;
+    if (programs) rows.push_back("D B &= " + latex_matrix(p, *c.DB));
     const std::vector<std::string> accelerations_ = accelerations(spec, p);
     bool first = true;
     for (unsigned i = 0; i < static_cast<unsigned>(k); ++i) {
       std::vector<std::pair<ex, std::string>> products;
       for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) products.emplace_back((*c.A0)(i, j), accelerations_[j]);
+      if (programs)
+        for (unsigned j = 0; j < c.programs.size(); ++j)
+          products.emplace_back(-(*c.DB)(i, j), "u_{\\text{" + latex_escape(c.programs[j].constraint.name) + "}}");
       std::string row = p.combination(products, 0) + " &= " + p.expression((*c.C)(i, 0));
-      if (first) row = std::string("\\intertext{Equations of motion $A_0 \\ddot{q} = C$") +
-                       (s > 0 ? ", $b \\ddot{q} + b_0 = 0$" : "") + ":}" + row;
+      if (first) row = std::string("\\intertext{Equations of motion $A_0 \\ddot{q}") + (programs ? " - D B u" : "") +
+                       " = C$" + (s > 0 ? ", $b \\ddot{q} + b_0 = 0$" : "") +
+                       (programs ? ", $b_p \\ddot{q} + b_{p0} = 0$ (unknowns $\\ddot{q}$ and $u$)" : "") + ":}" + row;
       first = false;
       rows.push_back(row);
     }
@@ -771,6 +837,12 @@ std::string format_latex(const Spec& spec, const Content& c) {
       std::vector<std::pair<ex, std::string>> products;
       for (unsigned j = 0; j < static_cast<unsigned>(n); ++j) products.emplace_back(v.b[j], accelerations_[j]);
       rows.push_back(p.combination(products, v.b0) + " &= 0");
+    }
+    for (const ProgramView& program : c.programs) {
+      std::vector<std::pair<ex, std::string>> products;
+      for (unsigned j = 0; j < static_cast<unsigned>(n); ++j)
+        products.emplace_back(program.constraint.b[j], accelerations_[j]);
+      rows.push_back(p.combination(products, program.constraint.b0) + " &= 0");
     }
   }
   if (c.energy) rows.push_back("\\intertext{Energy:}E &= T + V = " + p.expression(*c.energy));
