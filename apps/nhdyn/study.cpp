@@ -20,6 +20,7 @@ std::function<int()> add_study_command(CLI::App& app) {
   };
   add(add_error_relation_study);
   add(add_spread_masses_study);
+  add(add_tracking_study);
   return [studies] {
     for (const auto& [sub, run] : studies)
       if (sub->parsed()) return run();

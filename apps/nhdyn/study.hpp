@@ -13,5 +13,8 @@ std::function<int()> add_error_relation_study(CLI::App& study);
 // `nhdyn study spread-masses`: accelerations and reactions against a 50-digit reference as the
 // mass ratio grows (docs/studies/spread-masses.md).
 std::function<int()> add_spread_masses_study(CLI::App& study);
+// `nhdyn study tracking`: the error of program motion against the programs' residual over
+// tolerances and feedback gains (docs/studies/tracking.md).
+std::function<int()> add_tracking_study(CLI::App& study);
 
 }  // namespace nhdyn::cli
