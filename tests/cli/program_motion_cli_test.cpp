@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -83,6 +84,29 @@ TEST_F(ProgramCli, BatchRunFilesCarryTheActuatorForcesAsSimulateDoes) {
   const std::string simulated = read("out.csv");
   ASSERT_NE(simulated.find(",u_heading,"), std::string::npos);
   EXPECT_EQ(read("runs/run_0.csv"), simulated);
+}
+
+TEST_F(ProgramCli, TrackingStudyWritesTableByToleranceAndPlot) {
+  const Outcome run = nhdyn("study tracking " + example("arm_circle_program.toml") +
+                                " --tolerances 1e-5,1e-8 --gains 0,10 -o t.csv --plot t.png",
+                            dir_);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const std::string table = read("t.csv");
+  EXPECT_EQ(table.substr(0, table.find('\n')),
+            "gain,rtol,atol,max_error_q,max_error_v,max_residual_pos,max_residual_vel,max_residual_acc,steps,"
+            "rhs_evaluations,status");
+  EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 5);  // header and 2 gains x 2 tolerances
+  const std::string series = read("t-by-tolerance.csv");
+  EXPECT_EQ(series.substr(0, series.find('\n')), "tolerance,error_gain_none,residual_gain_none,error_gain_10,residual_gain_10");
+  EXPECT_GT(fs::file_size(dir_ / "t.png"), 1000u);
+  // Without programs, or without an exact solution, there is nothing to study: exit 2, no file.
+  const Outcome none = nhdyn("study tracking " + example("sled.toml") + " -o none.csv", dir_);
+  EXPECT_EQ(none.exit_code, 2) << none.out;
+  EXPECT_NE(none.out.find("no programs"), std::string::npos) << none.out;
+  const Outcome unsolved = nhdyn("study tracking " + example("cart_pendulum_program.toml") + " -o none.csv", dir_);
+  EXPECT_EQ(unsolved.exit_code, 2) << unsolved.out;
+  EXPECT_NE(unsolved.out.find("[solution]"), std::string::npos) << unsolved.out;
+  EXPECT_FALSE(fs::exists(dir_ / "none.csv"));
 }
 
 TEST_F(ProgramCli, FeedbackIsReportedAndItsGainsChecked) {

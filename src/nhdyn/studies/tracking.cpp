@@ -48,7 +48,12 @@ Tracking study_tracking(const Model& model, const TrackingOptions& options) {
   if (options.output_step < 0.0 || !std::isfinite(options.output_step))
     throw InputError(fmt::format("output_step {} is not a valid step; give a positive step, or 0 for the model's",
                                  options.output_step));
-  check_solution(model);  // throws saying how to give a [solution] when there is none
+  if (!model.evaluator->has_solution())
+    throw InputError(fmt::format("model '{}' gives no exact solution, and the tracking study measures the error "
+                                 "against it: give the programmed motion in a [solution] table of the model file "
+                                 "(docs/model-format.md)",
+                                 model.name));
+  check_solution(model);  // a [solution] that does not start at [initial] or solve the equations
 
   Tracking out;
   out.gains = options.gains;
