@@ -149,6 +149,10 @@ py::dict trajectory_dict(Trajectory&& tr) {
   d["energy"] = tr.has_energy ? py::object(take_array(std::move(tr.energy), {rows})) : py::object(py::none());
   const auto b = static_cast<py::ssize_t>(tr.balance_columns);
   d["energy_balance"] = b > 0 ? py::object(take_array(std::move(tr.balance), {rows, b})) : py::object(py::none());
+  // The contact forces of a multibody model, columns as model.columns["contact_forces"].
+  const auto c = static_cast<py::ssize_t>(tr.contact_columns);
+  d["contact_forces"] =
+      c > 0 ? py::object(take_array(std::move(tr.contact_forces), {rows, c})) : py::object(py::none());
   return d;
 }
 

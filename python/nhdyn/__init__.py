@@ -207,6 +207,10 @@ class Result:
         self.R, self.residuals, self.energy = out["R"], out["residuals"], out["energy"]
         # h, P, W_forces, W_reactions, W_time, W, h - h0 - W (docs/derivations/energy-balance.md), or None
         self.energy_balance = out.get("energy_balance")
+        # A multibody model's contact forces (docs/multibody.md): rows x columns, named by
+        # columns["contact_forces"] (NAME_Fx ... NAME_Flat per wheel or knife edge, then
+        # contact_residual), or None.
+        self.contact_forces = out.get("contact_forces")
         self.summary = out["summary"]
         # The located events in time order: dicts with name, t, q and qd at the crossing.
         self.events = out["events"]
@@ -220,6 +224,8 @@ class Result:
             parts.append(self.energy[:, None])
         if self.energy_balance is not None:
             parts.append(self.energy_balance)
+        if self.contact_forces is not None:
+            parts.append(self.contact_forces)
         return list(self.columns["all"]), np.hstack(parts)
 
     def to_pandas(self):

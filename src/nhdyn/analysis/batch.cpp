@@ -17,7 +17,9 @@ void Trajectory::reset(const Model& model, long expected_rows) {
   residual_columns = model.position_constraints() + model.velocity_constraints() + model.s();
   has_energy = model.evaluator && model.evaluator->has_energy();
   balance_columns = model.evaluator && model.evaluator->has_energy_balance() ? kEnergyBalanceColumns : 0;
-  for (std::vector<double>* column : {&t, &q, &v, &qdd, &R, &residuals, &energy, &balance}) column->clear();
+  contact_columns = static_cast<int>(contact_force_columns(model).size());
+  for (std::vector<double>* column : {&t, &q, &v, &qdd, &R, &residuals, &energy, &balance, &contact_forces})
+    column->clear();
   const auto rows = static_cast<std::size_t>(std::max(0L, expected_rows));
   const auto un = static_cast<std::size_t>(n);
   t.reserve(rows);
@@ -28,6 +30,7 @@ void Trajectory::reset(const Model& model, long expected_rows) {
   residuals.reserve(rows * static_cast<std::size_t>(residual_columns));
   if (has_energy) energy.reserve(rows);
   balance.reserve(rows * static_cast<std::size_t>(balance_columns));
+  contact_forces.reserve(rows * static_cast<std::size_t>(contact_columns));
 }
 
 void Trajectory::append(const Data& data) {
@@ -44,6 +47,11 @@ void Trajectory::append(const Data& data) {
     double row[kEnergyBalanceColumns];
     fill_energy_balance(data, row);
     balance.insert(balance.end(), row, row + kEnergyBalanceColumns);
+  }
+  if (contact_columns > 0) {
+    const ContactForceData& c = data.contact;
+    contact_forces.insert(contact_forces.end(), c.values.data(), c.values.data() + c.values.size());
+    contact_forces.push_back(c.residual);
   }
 }
 

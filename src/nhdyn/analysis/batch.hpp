@@ -30,12 +30,15 @@ struct Trajectory {
   std::vector<double> energy;       // rows (empty without an energy)
   int balance_columns = 0;          // kEnergyBalanceColumns with an energy balance, else 0
   std::vector<double> balance;      // rows x balance_columns (analysis/residuals.hpp fill_energy_balance)
+  // The contact forces and contact_residual (model/contact_forces.hpp), 0 columns without contacts.
+  int contact_columns = 0;
+  std::vector<double> contact_forces;  // rows x contact_columns
 
   long rows() const { return static_cast<long>(t.size()); }
   // Sizes the columns for `model` and drops every row; reserves `expected_rows`.
   void reset(const Model& model, long expected_rows = 0);
   // Appends the row of Data after an output (simulate's RowFn): t, q, q', q'', R, residuals,
-  // energy, energy balance.
+  // energy, energy balance, contact forces.
   void append(const Data& data);
 };
 
