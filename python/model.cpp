@@ -119,6 +119,7 @@ void bind_model(py::module_& m) {
         d["program_residuals"] = std::vector<std::string>(split, c.residuals.end());
         d["actuators"] = c.actuators;
         d["energy"] = c.energy;
+        d["contact_forces"] = c.contact_forces;
         return d;
       });
 

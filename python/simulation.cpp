@@ -172,6 +172,10 @@ py::dict trajectory_dict(Trajectory&& tr) {
   d["u"] = take_array(std::move(tr.u), {rows, static_cast<py::ssize_t>(tr.actuator_columns)});
   d["program_residuals"] =
       take_array(std::move(tr.program_residuals), {rows, static_cast<py::ssize_t>(tr.program_residual_columns)});
+  // The contact forces of a multibody model, columns as model.columns["contact_forces"].
+  const auto c = static_cast<py::ssize_t>(tr.contact_columns);
+  d["contact_forces"] =
+      c > 0 ? py::object(take_array(std::move(tr.contact_forces), {rows, c})) : py::object(py::none());
   return d;
 }
 

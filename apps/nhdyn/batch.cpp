@@ -262,6 +262,9 @@ int run_batch(const BatchArgs& args) {
                    tr.u.begin() + static_cast<std::ptrdiff_t>((k + 1) * a));
         row.insert(row.end(), tr.program_residuals.begin() + static_cast<std::ptrdiff_t>(k * p),
                    tr.program_residuals.begin() + static_cast<std::ptrdiff_t>((k + 1) * p));
+        const auto c = static_cast<std::size_t>(tr.contact_columns);
+        row.insert(row.end(), tr.contact_forces.begin() + static_cast<std::ptrdiff_t>(k * c),
+                   tr.contact_forces.begin() + static_cast<std::ptrdiff_t>((k + 1) * c));
         writer.write_row(row);
       }
       writer.commit();

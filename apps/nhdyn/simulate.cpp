@@ -22,6 +22,7 @@
 #include "nhdyn/io/report.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
+#include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 #include "progress.hpp"
@@ -193,6 +194,8 @@ int run_simulate(const SimulateArgs& args) {
   std::string notice;
   const Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
   if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
+  if (model.contact_forces)  // what loading found about the contact forces (docs/multibody.md)
+    for (const std::string& note : model.contact_forces->notes) fmt::print(stderr, "note: contact forces: {}\n", note);
   RunOptions run = run_options_with(model, args);
   SimulationOptions options = make_simulation_options(run);
   options.integrator.step = args.step;

@@ -214,6 +214,10 @@ class Result:
         self.energy_balance = out.get("energy_balance")
         # Program motion (docs/derivations/program-motion.md): rows x m and rows x residual columns.
         self.u, self.program_residuals = out["u"], out["program_residuals"]
+        # A multibody model's contact forces (docs/multibody.md): rows x columns, named by
+        # columns["contact_forces"] (NAME_Fx ... NAME_Flat per wheel or knife edge, then
+        # contact_residual), or None.
+        self.contact_forces = out.get("contact_forces")
         self.summary = out["summary"]
         # The located events in time order: dicts with name, t, q and qd at the crossing.
         self.events = out["events"]
@@ -228,6 +232,8 @@ class Result:
         if self.energy_balance is not None:
             parts.append(self.energy_balance)
         parts += [self.u, self.program_residuals]
+        if self.contact_forces is not None:
+            parts.append(self.contact_forces)
         return list(self.columns["all"]), np.hstack(parts)
 
     def to_pandas(self):

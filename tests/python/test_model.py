@@ -166,3 +166,18 @@ def test_bad_input_raises_with_the_library_message(examples, tmp_path):
     with pytest.raises(nhdyn.Error, match="blade"):
         m.simulate(t_end=1, qd0=[1.0, 1.0, 0.0])
     assert issubclass(nhdyn.InputError, ValueError) and issubclass(nhdyn.FileError, OSError)
+
+
+def test_contact_forces_of_a_multibody_model_match_the_cli(examples, cli, tmp_path):
+    # The rolling disk on its steady circle (docs/derivations/contact-forces.md 6.3): N = m g.
+    model = examples / "rolling_disk_bodies.toml"
+    r = nhdyn.load(model).simulate(t_end=1.0)
+    names = r.columns["contact_forces"]
+    assert names == ["disk_Fx", "disk_Fy", "disk_Fz", "disk_N", "disk_Flong", "disk_Flat", "contact_residual"]
+    assert r.contact_forces.shape == (len(r.t), 7)
+    assert np.max(np.abs(r.contact_forces[:, 3] - 0.5 * 9.81)) < 1e-8
+    cli("simulate", model, "--t-end", 1.0, "-q", "-o", tmp_path / "disk.csv")
+    header, table = read_csv(tmp_path / "disk.csv")
+    header_py, values = r.table()
+    assert header == header_py
+    assert np.array_equal(values, table)

@@ -21,7 +21,9 @@ void Trajectory::reset(const Model& model, long expected_rows) {
   program_residual_columns = 0;
   for (const ProgramConstraint& p : model.program_constraints)
     program_residual_columns += p.level == ConstraintLevel::position ? 3 : p.level == ConstraintLevel::velocity ? 2 : 1;
-  for (std::vector<double>* column : {&t, &q, &v, &qdd, &R, &residuals, &energy, &balance, &u, &program_residuals})
+  contact_columns = static_cast<int>(contact_force_columns(model).size());
+  for (std::vector<double>* column :
+       {&t, &q, &v, &qdd, &R, &residuals, &energy, &balance, &u, &program_residuals, &contact_forces})
     column->clear();
   const auto rows = static_cast<std::size_t>(std::max(0L, expected_rows));
   const auto un = static_cast<std::size_t>(n);
@@ -35,6 +37,7 @@ void Trajectory::reset(const Model& model, long expected_rows) {
   balance.reserve(rows * static_cast<std::size_t>(balance_columns));
   u.reserve(rows * static_cast<std::size_t>(actuator_columns));
   program_residuals.reserve(rows * static_cast<std::size_t>(program_residual_columns));
+  contact_forces.reserve(rows * static_cast<std::size_t>(contact_columns));
 }
 
 void Trajectory::append(const Data& data) {
@@ -57,6 +60,11 @@ void Trajectory::append(const Data& data) {
     u.insert(u.end(), w.u.data(), w.u.data() + w.u.size());
     for (const Vector* level : {&w.phi, &w.f, &w.e})
       program_residuals.insert(program_residuals.end(), level->data(), level->data() + level->size());
+  }
+  if (contact_columns > 0) {
+    const ContactForceData& c = data.contact;
+    contact_forces.insert(contact_forces.end(), c.values.data(), c.values.data() + c.values.size());
+    contact_forces.push_back(c.residual);
   }
 }
 

@@ -35,12 +35,15 @@ struct Trajectory {
   std::vector<double> u;               // rows x m: the actuator forces (Data::motion.u)
   int program_residual_columns = 0;    // position + velocity + acceleration level program residuals
   std::vector<double> program_residuals;  // rows x program_residual_columns: phi_p, then f_p, then e_p
+  // The contact forces and contact_residual (model/contact_forces.hpp), 0 columns without contacts.
+  int contact_columns = 0;
+  std::vector<double> contact_forces;  // rows x contact_columns
 
   long rows() const { return static_cast<long>(t.size()); }
   // Sizes the columns for `model` and drops every row; reserves `expected_rows`.
   void reset(const Model& model, long expected_rows = 0);
   // Appends the row of Data after an output (simulate's RowFn): t, q, q', q'', R, residuals,
-  // energy, energy balance, actuator forces, program residuals.
+  // energy, energy balance, actuator forces, program residuals, contact forces.
   void append(const Data& data);
 };
 

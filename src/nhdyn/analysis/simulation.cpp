@@ -228,6 +228,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     }
     compute_residuals(model, data);
     compute_energy(model, data);
+    compute_contact_forces(model, data);  // nothing for a model without contacts
     if (summary.outputs == 0) {
       summary.energy_initial = data.energy;
       summary.energy_function_initial = data.energy_function;

@@ -39,6 +39,8 @@ ResultColumns make_result_columns(const Model& model) {
   c.all.insert(c.all.end(), c.actuators.begin(), c.actuators.end());
   c.all.insert(c.all.end(), program_residuals.begin(), program_residuals.end());
   c.residuals.insert(c.residuals.end(), program_residuals.begin(), program_residuals.end());
+  c.contact_forces = contact_force_columns(model);
+  c.all.insert(c.all.end(), c.contact_forces.begin(), c.contact_forces.end());
   return c;
 }
 
@@ -58,12 +60,14 @@ void fill_result_row(const Model& model, const Data& data, std::vector<double>& 
     fill_energy_balance(data, balance);
     row.insert(row.end(), balance, balance + kEnergyBalanceColumns);
   }
-  if (model.m() == 0) return;
-  const ProgramMotionData& w = data.motion;
-  for (Eigen::Index i = 0; i < w.u.size(); ++i) row.push_back(w.u(i));
-  for (Eigen::Index i = 0; i < w.phi.size(); ++i) row.push_back(w.phi(i));
-  for (Eigen::Index i = 0; i < w.f.size(); ++i) row.push_back(w.f(i));
-  for (Eigen::Index i = 0; i < w.e.size(); ++i) row.push_back(w.e(i));
+  if (model.m() > 0) {
+    const ProgramMotionData& w = data.motion;
+    for (Eigen::Index i = 0; i < w.u.size(); ++i) row.push_back(w.u(i));
+    for (Eigen::Index i = 0; i < w.phi.size(); ++i) row.push_back(w.phi(i));
+    for (Eigen::Index i = 0; i < w.f.size(); ++i) row.push_back(w.f(i));
+    for (Eigen::Index i = 0; i < w.e.size(); ++i) row.push_back(w.e(i));
+  }
+  append_contact_force_values(model, data, row);
 }
 
 }  // namespace nhdyn

@@ -7,7 +7,9 @@
 //   work_reactions, work_time, work (W, their sum) and balance_error (h - h(t0) - W); then, for a
 //   model with programs (docs/derivations/program-motion.md), the actuator forces (u_<program>)
 //   and the programs' residuals at the three levels, named like the constraints'
-//   (residual_pos_<program>, ...).
+//   (residual_pos_<program>, ...); last, for a multibody model with wheels or knife edges, their
+//   contact forces NAME_Fx, NAME_Fy, NAME_Fz, NAME_N, NAME_Flong, NAME_Flat and contact_residual
+//   (model/contact_forces.hpp, docs/multibody.md).
 // Shared by the CSV writer and the plots so that both name the columns the same way.
 #pragma once
 
@@ -29,6 +31,8 @@ struct ResultColumns {
   // The energy balance, when the model has one (docs/derivations/energy-balance.md): h, the power
   // P, the work of each agent and their sum W, and h - h(t0) - W. Empty otherwise.
   std::vector<std::string> energy_balance;
+  // The contact forces and their check column (model/contact_forces.hpp); empty without contacts.
+  std::vector<std::string> contact_forces;
 };
 
 ResultColumns make_result_columns(const Model& model);

@@ -27,6 +27,7 @@
 
 #include "nhdyn/core/status.hpp"
 #include "nhdyn/core/types.hpp"
+#include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/model.hpp"
 
 namespace nhdyn {
@@ -133,6 +134,9 @@ struct Data {
 
   // --- program motion (compute_program_motion; empty for a model without programs) -------------
   ProgramMotionData motion;
+
+  // --- contact forces (compute_contact_forces; inactive for a model without contacts) -----------
+  ContactForceData contact;
 
   // --- failure details (set when a kernel returns a non-ok status) --------------------------------
   Status status = Status::ok;

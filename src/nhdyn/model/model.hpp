@@ -19,6 +19,8 @@
 
 namespace nhdyn {
 
+struct ContactForceModel;  // contact_forces.hpp
+
 // The level at which a constraint is given (docs/notation.md section 2).
 enum class ConstraintLevel { position, velocity, acceleration };
 
@@ -77,6 +79,9 @@ struct Model {
   // The model's own events ([[events]] of its file); a run locates those of its options
   // (SimulationOptions::events, analysis/simulation.hpp), which `nhdyn simulate` starts from these.
   std::vector<Event> events;
+  // The contact forces of a multibody model's wheels and knife edges (contact_forces.hpp,
+  // docs/derivations/contact-forces.md); null for a model without contacts.
+  std::shared_ptr<const ContactForceModel> contact_forces;
 
   int n() const { return static_cast<int>(coordinates.size()); }
   int s() const { return static_cast<int>(constraints.size()); }

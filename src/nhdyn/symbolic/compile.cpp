@@ -33,6 +33,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/model/program.hpp"
+#include "nhdyn/symbolic/contact_forces.hpp"
 #include "nhdyn/symbolic/events.hpp"
 
 namespace nhdyn::symbolic {
@@ -1014,6 +1015,7 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
     model.evaluator->initial_state(scratch.data(), model.q0.data(), model.v0.data());
   }
   compile_events(spec, model);
+  compile_contact_forces(spec, model);
   check_model_shape(model);
   return model;
 }
@@ -1021,6 +1023,12 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
 Program compile_expression(const Spec& spec, const GiNaC::ex& expression, const std::string& what) {
   ProgramCompiler compiler(spec);
   compiler.add_output(expression, what);
+  return compiler.finish();
+}
+
+Program compile_expressions(const Spec& spec, const std::vector<GiNaC::ex>& expressions, const std::string& what) {
+  ProgramCompiler compiler(spec);
+  for (std::size_t i = 0; i < expressions.size(); ++i) compiler.add_output(expressions[i], fmt::format("{} {}", what, i));
   return compiler.finish();
 }
 

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <exception>
+#include <memory>
 #include <sstream>
 #include <utility>
 
@@ -540,6 +541,18 @@ void MultibodyBuilder::add_wheel(const Helper& h) {
     builder_.constraint(fmt::format("{}_slip{}", h.name, k), ConstraintLevel::velocity, slip,
                         fmt::format("wheel '{}': no slip, t{}.v_P = 0", h.name, k), h.where);
   }
+  // The contact force's unknowns are its world components; e_long = (a x n)/|a x n|.
+  ContactPoint point;
+  point.name = h.name;
+  point.kind = ContactKind::wheel;
+  point.point = P;
+  point.velocity = vP;
+  point.directions = {unit(0), unit(1), unit(2)};
+  point.normal = n;
+  point.longitudinal = scale(1 / length, cross(a, n));
+  point.lateral = cross(n, point.longitudinal);
+  point.system = system_of(body.frame);
+  contacts_.push_back(std::move(point));
 }
 
 void MultibodyBuilder::add_knife_edge(const Helper& h) {
@@ -558,6 +571,18 @@ void MultibodyBuilder::add_knife_edge(const Helper& h) {
   const GiNaC::ex constraint = simplify_moderate(dot(across, time_derivative(p.world, spec.symbols)));
   builder_.constraint(h.name, ConstraintLevel::velocity, constraint,
                       fmt::format("knife edge '{}': no velocity across the blade", h.name), h.where);
+  // The ideal blade takes no force along itself: unknowns along n and e_lat = (n x d)/|n x d|.
+  ContactPoint contact;
+  contact.name = h.name;
+  contact.kind = ContactKind::knife_edge;
+  contact.point = p.world;
+  contact.velocity = time_derivative(p.world, spec.symbols);
+  contact.normal = n;
+  contact.lateral = scale(1 / GiNaC::sqrt(simplify(dot(across, across))), across);
+  contact.longitudinal = cross(contact.lateral, n);
+  contact.directions = {n, contact.lateral};
+  contact.system = system_of(p.frame);
+  contacts_.push_back(std::move(contact));
 }
 
 GiNaC::ex MultibodyBuilder::kinetic_energy() const {
@@ -590,6 +615,9 @@ GiNaC::ex MultibodyBuilder::potential_energy() const {
 void MultibodyBuilder::apply() {
   if (applied_) throw ModelError("MultibodyBuilder::apply() was called twice; call it once, after everything else");
   applied_ = true;
+  const bool other_energy =
+      !builder_.current().kinetic_energy.is_zero() || !builder_.current().potential_energy.is_zero();
+  const std::size_t first_generated = builder_.current().constraints.size();
   builder_.add_energies(kinetic_energy(), potential_energy());
   for (const Helper& h : helpers_) {
     switch (h.kind) {
@@ -606,7 +634,67 @@ void MultibodyBuilder::apply() {
                             fmt::format("point on a curve '{}', second surface", h.name), h.where);
         break;
     }
+    if (h.kind == Helper::Kind::surface || h.kind == Helper::Kind::curve) {
+      // Unknowns: the world components (the solve finds them along the surfaces' normals).
+      const Point& p = points_[static_cast<std::size_t>(h.index)];
+      ContactPoint contact;
+      contact.name = h.name;
+      contact.kind = h.kind == Helper::Kind::surface ? ContactKind::surface : ContactKind::curve;
+      contact.point = p.world;
+      contact.velocity = time_derivative(p.world, builder_.current().symbols);
+      contact.directions = {unit(0), unit(1), unit(2)};
+      contact.system = system_of(p.frame);
+      contacts_.push_back(std::move(contact));
+    }
   }
+  auto record = std::make_shared<SpecContactForces>();
+  record->other_energy = other_energy;
+  const std::vector<SpecConstraint>& constraints = builder_.current().constraints;
+  for (std::size_t i = first_generated; i < constraints.size(); ++i) record->generated.push_back(constraints[i].name);
+  record_contact_forces(*record);
+  builder_.contact_forces(std::move(record));
+}
+
+int MultibodyBuilder::system_of(int frame) const {
+  if (frame <= 0) return -1;
+  while (frames_[static_cast<std::size_t>(frame)].parent > 0) frame = frames_[static_cast<std::size_t>(frame)].parent;
+  return frame;  // a frame index for now; record_contact_forces numbers the systems
+}
+
+void MultibodyBuilder::record_contact_forces(SpecContactForces& record) const {
+  // Systems: the frames below ground that bodies or contacts hang from, numbered in frame order.
+  std::vector<int> number(frames_.size(), -1);
+  const auto use = [&](int root) {
+    if (root >= 0) number[static_cast<std::size_t>(root)] = 0;
+  };
+  for (const Body& b : bodies_) use(system_of(b.frame));
+  for (const ContactPoint& c : contacts_) use(c.system);
+  for (std::size_t f = 0; f < frames_.size(); ++f) {
+    if (number[f] < 0) continue;
+    number[f] = static_cast<int>(record.origins.size());
+    record.origins.push_back(frames_[f].origin);
+    record.system_names.push_back(frames_[f].name);
+  }
+  const auto system = [&](int root) { return root >= 0 ? number[static_cast<std::size_t>(root)] : -1; };
+  for (const Body& b : bodies_) {
+    const PlacedFrame& F = frames_[static_cast<std::size_t>(b.frame)];
+    ContactBody body;
+    body.mass = b.mass;
+    body.centre = add(F.origin, multiply(F.rotation, b.com));
+    body.omega = F.omega;
+    body.inertia = F.rotation.mul(b.inertia).mul(F.rotation.transpose());
+    body.system = system(system_of(b.frame));
+    record.bodies.push_back(std::move(body));
+  }
+  for (ContactPoint c : contacts_) {
+    c.system = system(c.system);
+    record.contacts.push_back(std::move(c));
+  }
+  if (gravity_) record.gravity = *gravity_;
+  double largest = 0.0;  // L, the scale of the moment rows: the largest wheel radius
+  for (const Helper& h : helpers_)
+    if (h.kind == Helper::Kind::wheel) largest = std::max(largest, value_of(h.radius, builder_.current()).value_or(0.0));
+  record.length = largest > 0.0 ? largest : 1.0;
 }
 
 const PlacedFrame& MultibodyBuilder::placed_frame(const std::string& name) const {

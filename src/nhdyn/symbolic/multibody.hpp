@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "nhdyn/symbolic/contact_forces.hpp"
 #include "nhdyn/symbolic/kinematics.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
 
@@ -139,12 +140,16 @@ class MultibodyBuilder {
   Vector3 plane_normal(const Helper& helper, const std::string& context) const;
   void add_wheel(const Helper& helper);
   void add_knife_edge(const Helper& helper);
+  // The bodies and contacts for the contact forces (symbolic/contact_forces.hpp), onto the builder.
+  void record_contact_forces(SpecContactForces& record) const;
+  int system_of(int frame) const;  // index of the frame below ground that `frame` hangs from
 
   SpecBuilder& builder_;
   std::vector<PlacedFrame> frames_;  // frames_[0] is ground
   std::vector<Point> points_;
   std::vector<Body> bodies_;
   std::vector<Helper> helpers_;
+  std::vector<ContactPoint> contacts_;  // filled by add_wheel, add_knife_edge and apply()
   std::optional<Vector3> gravity_;
   SourceLocation gravity_where_;
   bool applied_ = false;

@@ -9,6 +9,7 @@
 #include <ginac/ginac.h>
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,6 +18,8 @@
 #include "nhdyn/symbolic/visual.hpp"
 
 namespace nhdyn::symbolic {
+
+struct SpecContactForces;  // contact_forces.hpp
 
 // Where a piece of a spec came from, for error messages: "file.toml:12:7". Empty file for specs
 // built in C++; line and column are 1-based, 0 when unknown.
@@ -122,6 +125,9 @@ struct Spec {
   std::optional<std::pair<std::string, std::string>> path;  // coordinates to draw as y(x)
   std::vector<SpecEvent> events;             // compiled into Model::events (symbolic/events.hpp)
   SpecVisual visual;  // what a report's 3-D scene draws ([visual], or the bodies): symbolic/visual.hpp
+  // The bodies and contacts of a multibody model, for its contact forces (contact_forces.hpp);
+  // null for a hand-written model.
+  std::shared_ptr<const SpecContactForces> contact_forces;
 
   int n() const { return static_cast<int>(coordinates.size()); }
   int s() const { return static_cast<int>(constraints.size()); }

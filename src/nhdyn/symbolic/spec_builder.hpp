@@ -8,6 +8,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "nhdyn/symbolic/spec.hpp"
@@ -73,6 +74,12 @@ class SpecBuilder {
   SpecBuilder& add_energies(const GiNaC::ex& kinetic, const GiNaC::ex& potential);
   SpecBuilder& constraint(const std::string& name, ConstraintLevel level, const GiNaC::ex& expression,
                           const std::string& text, SourceLocation where = {});
+  // What a multibody front end knows about its bodies and contacts, for the contact forces
+  // (contact_forces.hpp; set by MultibodyBuilder::apply()).
+  SpecBuilder& contact_forces(std::shared_ptr<const SpecContactForces> contacts) {
+    spec_.contact_forces = std::move(contacts);
+    return *this;
+  }
   // The spec as built so far: its symbols and parameter values, for such front ends.
   const Spec& current() const { return spec_; }
 

@@ -1,0 +1,287 @@
+#include "nhdyn/model/contact_forces.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/LU>
+#include <Eigen/SVD>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "nhdyn/model/data.hpp"
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// A stacked system whose least-squares residual is above this, relative to its right side, is not
+// consistent: a balance the contacts cannot meet (round-off is near 1e-15 at the check's state).
+constexpr double kConsistent = 1e-8;
+// A null vector of M with a component above this (relative) along an output leaves it undetermined.
+constexpr double kDetermined = 1e-8;
+
+// M and rhs from the program's outputs, q'' and R (docs/derivations/contact-forces.md step 6).
+void assemble(const ContactForceModel& c, const double* o, const double* qdd, const double* R, Matrix& M,
+              Vector& rhs) {
+  const int n = c.n;
+  M.setZero();
+  rhs.setZero();
+  for (int u = 0; u < c.unknowns; ++u) {
+    const double* column = o + c.unknown_offset(u);
+    for (int j = 0; j < n; ++j) M(j, u) = column[j];
+    const int s = c.unknown_system[static_cast<std::size_t>(u)];
+    if (!c.balance_rows[static_cast<std::size_t>(s)]) continue;
+    for (int r = 0; r < 6; ++r) M(n + 6 * s + r, u) = column[n + r];
+  }
+  for (int h = 0; h < c.hand_constraints; ++h) {
+    const double* row = o + c.hand_offset(h);
+    for (int j = 0; j < n; ++j) M(j, c.unknowns + h) = row[j];
+  }
+  for (int j = 0; j < n; ++j) rhs(j) = R[j];
+  for (int s = 0; s < c.systems; ++s) {
+    if (!c.balance_rows[static_cast<std::size_t>(s)]) continue;
+    const double* K = o + c.system_offset(s);
+    for (int r = 0; r < 6; ++r) {
+      double sum = K[6 * n + r];
+      for (int j = 0; j < n; ++j) sum += K[6 * j + r] * qdd[j];
+      rhs(n + 6 * s + r) = sum;
+    }
+  }
+}
+
+// The world force of reported contact `contact` from the unknowns x.
+void force_of(const ContactForceModel& c, const ContactForceContact& contact, const double* o, const double* x,
+              double* F) {
+  F[0] = F[1] = F[2] = 0.0;
+  for (int k = 0; k < contact.unknowns; ++k) {
+    const int u = contact.first_unknown + k;
+    const double* d = o + c.unknown_offset(u) + c.n + 6;
+    for (int i = 0; i < 3; ++i) F[i] += x[u] * d[i];
+  }
+}
+
+// The coefficients over the unknowns of output `component` of a reported contact (`index` among
+// the reported ones): which combination of x the output is.
+void functional(const ContactForceModel& c, const ContactForceContact& contact, int index, const double* o,
+                int component, Vector& coefficients) {
+  coefficients.setZero();
+  const double* basis = o + c.direction_offset(index);  // n, e_long, e_lat
+  for (int k = 0; k < contact.unknowns; ++k) {
+    const int u = contact.first_unknown + k;
+    const double* d = o + c.unknown_offset(u) + c.n + 6;
+    if (component < 3) {
+      coefficients(u) = d[component];
+    } else {
+      const double* e = basis + 3 * (component - 3);
+      coefficients(u) = e[0] * d[0] + e[1] * d[1] + e[2] * d[2];
+    }
+  }
+}
+
+}  // namespace
+
+const char* contact_component_name(int component) {
+  static const char* const names[kContactComponents] = {"Fx", "Fy", "Fz", "N", "Flong", "Flat"};
+  return component >= 0 && component < kContactComponents ? names[component] : "?";
+}
+
+int ContactForceModel::reported() const {
+  int count = 0;
+  for (const ContactForceContact& c : contacts) count += c.reported ? 1 : 0;
+  return count;
+}
+
+ContactForceData make_contact_force_data(const Model& model) {
+  ContactForceData w;
+  if (!model.contact_forces) return w;
+  const ContactForceModel& c = *model.contact_forces;
+  w.active = true;
+  std::vector<double> values;
+  for (const Parameter& p : model.parameters) values.push_back(p.value);
+  w.program = c.program.reads_parameters() ? c.program.bind(values.data(), values.size()) : c.program;
+  w.registers.assign(static_cast<std::size_t>(w.program.registers()), 0.0);
+  w.outputs.assign(static_cast<std::size_t>(w.program.outputs()), 0.0);
+  w.M = Matrix::Zero(c.rows(), c.columns());
+  w.rhs = Vector::Zero(c.rows());
+  w.x = Vector::Zero(c.columns());
+  w.work = Vector::Zero(c.rows());
+  w.misfit = Vector::Zero(c.rows());
+  w.qr = Eigen::ColPivHouseholderQR<Matrix>(c.rows(), c.columns());
+  w.values = Vector::Constant(kContactComponents * c.reported(), kNaN);
+  return w;
+}
+
+void compute_contact_forces(const Model& model, Data& data) {
+  ContactForceData& w = data.contact;
+  if (!w.active || !model.contact_forces) return;
+  if (data.stage != Stage::acceleration)
+    throw std::logic_error("compute_contact_forces needs the accelerations of the current state: call "
+                           "compute_dynamics (or compute_acceleration) first");
+  const ContactForceModel& c = *model.contact_forces;
+  w.program.run(data.t, data.q.data(), data.v.data(), w.registers.data(), w.outputs.data());
+  const double* o = w.outputs.data();
+  assemble(c, o, data.qdd.data(), data.R.data(), w.M, w.rhs);
+  if (c.single_wheel) {
+    // One wheel supports the only system: F = sum_B m_B (a_B - g), its first balance rows.
+    w.x = w.rhs.segment(c.n, 3);
+  } else {
+    w.qr.compute(w.M);
+    const Eigen::Index rank = w.qr.rank();
+    w.work = w.rhs;
+    w.work.applyOnTheLeft(w.qr.householderQ().setLength(w.qr.nonzeroPivots()).adjoint());
+    w.qr.matrixQR().topLeftCorner(rank, rank).triangularView<Eigen::Upper>().solveInPlace(w.work.head(rank));
+    w.x.setZero();
+    for (Eigen::Index i = 0; i < rank; ++i) w.x(w.qr.colsPermutation().indices()(i)) = w.work(i);
+  }
+  w.misfit.noalias() = w.M * w.x;
+  w.misfit -= w.rhs;
+  const double scale = w.rhs.norm();
+  w.residual = scale > 0.0 ? w.misfit.norm() / scale : w.misfit.norm();
+  int index = 0;
+  for (const ContactForceContact& contact : c.contacts) {
+    if (!contact.reported) continue;
+    double F[3];
+    force_of(c, contact, o, w.x.data(), F);
+    const double* basis = o + c.direction_offset(index);
+    double* out = w.values.data() + kContactComponents * index;
+    out[0] = F[0];
+    out[1] = F[1];
+    out[2] = F[2];
+    for (int k = 0; k < 3; ++k) {
+      const double* e = basis + 3 * k;
+      out[3 + k] = e[0] * F[0] + e[1] * F[1] + e[2] * F[2];
+    }
+    for (int k = 0; k < kContactComponents; ++k)
+      if (!c.determined[static_cast<std::size_t>(kContactComponents * index + k)]) out[k] = kNaN;
+    ++index;
+  }
+}
+
+std::vector<std::string> contact_force_columns(const Model& model) {
+  std::vector<std::string> columns;
+  if (!model.contact_forces) return columns;
+  for (const ContactForceContact& c : model.contact_forces->contacts)
+    if (c.reported)
+      for (int k = 0; k < kContactComponents; ++k) columns.push_back(c.name + "_" + contact_component_name(k));
+  columns.push_back("contact_residual");
+  return columns;
+}
+
+void append_contact_force_values(const Model& model, const Data& data, std::vector<double>& row) {
+  if (!model.contact_forces) return;
+  const ContactForceData& w = data.contact;
+  for (Eigen::Index i = 0; i < w.values.size(); ++i) row.push_back(w.values(i));
+  row.push_back(w.residual);
+}
+
+void analyse_contact_forces(const Model& model, ContactForceModel& c) {
+  const int n = model.n();
+  const int s = model.s();
+  c.determined.assign(static_cast<std::size_t>(kContactComponents * c.reported()), 1);
+  // A generic state near the initial one (fixed shifts: the same model gives the same verdict).
+  Vector q = model.q0, v = model.v0;
+  for (int i = 0; i < n; ++i) {
+    q(i) += 0.1 * std::sin(1.3 * i + 0.7);
+    v(i) += 0.3 * std::cos(0.9 * i + 0.2);
+  }
+  const double t = model.t0;
+  Matrix A = Matrix::Zero(n, n), b = Matrix::Zero(s, n);
+  Vector Q = Vector::Zero(n), G = Vector::Zero(n), b0 = Vector::Zero(s);
+  std::vector<double> scratch(model.evaluator->scratch_size());
+  model.evaluator->terms(t, q.data(), v.data(), scratch.data(), TermsOut{A.data(), Q.data(), G.data(), b.data(), b0.data()});
+  // The ideal-constraint dynamics: [A b^T; b 0] [q''; -lambda] = [Q + G; -b0], R = A q'' - Q - G.
+  Matrix K = Matrix::Zero(n + s, n + s);
+  K.topLeftCorner(n, n) = A;
+  K.topRightCorner(n, s) = b.transpose();
+  K.bottomLeftCorner(s, n) = b;
+  Vector k(n + s);
+  k.head(n) = Q + G;
+  k.tail(s) = -b0;
+  const Vector solution = K.fullPivLu().solve(k);
+  const Vector qdd = solution.head(n);
+  const Vector R = A * qdd - Q - G;
+
+  ContactForceModel probe = c;
+  probe.balance_rows.assign(static_cast<std::size_t>(c.systems), 1);
+  probe.determined.assign(c.determined.size(), 1);
+  ContactForceData w;
+  {
+    std::vector<double> values;
+    for (const Parameter& p : model.parameters) values.push_back(p.value);
+    w.program = c.program.reads_parameters() ? c.program.bind(values.data(), values.size()) : c.program;
+    w.registers.assign(static_cast<std::size_t>(w.program.registers()), 0.0);
+    w.outputs.assign(static_cast<std::size_t>(w.program.outputs()), 0.0);
+  }
+  w.program.run(t, q.data(), v.data(), w.registers.data(), w.outputs.data());
+  const double* o = w.outputs.data();
+  bool finite = qdd.allFinite();
+  for (double x : w.outputs) finite = finite && std::isfinite(x);
+  if (!finite) {
+    c.notes.push_back("the contact forces could not be checked at load (a term is not finite at the state "
+                      "checked); they are reported as solved, with the residual column as the check");
+    return;
+  }
+  Matrix M(c.rows(), c.columns());
+  Vector rhs(c.rows());
+  const auto residual_with = [&](const std::vector<char>& rows) {
+    probe.balance_rows = rows;
+    assemble(probe, o, qdd.data(), R.data(), M, rhs);
+    const Eigen::CompleteOrthogonalDecomposition<Matrix> cod(M);
+    const Vector x = cod.solve(rhs);
+    const double scale = rhs.norm();
+    return scale > 0.0 ? (M * x - rhs).norm() / scale : 0.0;
+  };
+  std::vector<char> rows = c.balance_rows;
+  if (residual_with(rows) > kConsistent) {
+    // Keep the balance of the systems consistent with (C1) on their own.
+    for (int sys = 0; sys < c.systems; ++sys) {
+      if (!rows[static_cast<std::size_t>(sys)]) continue;
+      std::vector<char> alone(static_cast<std::size_t>(c.systems), 0);
+      alone[static_cast<std::size_t>(sys)] = 1;
+      if (residual_with(alone) > kConsistent) {
+        rows[static_cast<std::size_t>(sys)] = 0;
+        c.notes.push_back(fmt::format(
+            "the bodies hanging from frame '{}' are held by the coordinates in a direction no contact supports (their "
+            "momentum balance does not close with the contact forces: e.g. a sled kept flat by its frames); the "
+            "contact forces there are those the reactions R alone determine",
+            c.system_names[static_cast<std::size_t>(sys)]));
+      }
+    }
+  }
+  c.balance_rows = rows;
+  probe.balance_rows = rows;
+  assemble(probe, o, qdd.data(), R.data(), M, rhs);
+  // The null space of M: the combinations of unknowns the stacked system does not fix.
+  const Eigen::JacobiSVD<Matrix> svd(M, Eigen::ComputeFullV);
+  const Vector& sigma = svd.singularValues();
+  const double largest = sigma.size() > 0 ? sigma(0) : 0.0;
+  std::vector<int> null_columns;
+  for (int j = 0; j < c.columns(); ++j)
+    if (j >= sigma.size() || sigma(j) <= kDetermined * largest) null_columns.push_back(j);
+  Vector coefficients(c.columns());
+  int index = 0;
+  for (const ContactForceContact& contact : c.contacts) {
+    if (!contact.reported) continue;
+    std::string missing;
+    for (int component = 0; component < kContactComponents; ++component) {
+      functional(c, contact, index, o, component, coefficients);
+      const double size = coefficients.norm();
+      bool determined = true;
+      for (int j : null_columns)
+        if (std::abs(coefficients.dot(svd.matrixV().col(j))) > kDetermined * std::max(size, 1.0)) determined = false;
+      c.determined[static_cast<std::size_t>(kContactComponents * index + component)] = determined ? 1 : 0;
+      if (!determined) missing += fmt::format("{}{}_{}", missing.empty() ? "" : ", ", contact.name, contact_component_name(component));
+    }
+    if (!missing.empty()) {
+      const bool held = !c.balance_rows[static_cast<std::size_t>(contact.system)];
+      c.notes.push_back(fmt::format(
+          "contact '{}': {} not determined by the model, written as NaN ({})", contact.name, missing,
+          held ? "its bodies are also held by their coordinates, which carry an unknown part of the load"
+               : "a statically indeterminate support: the contacts share a load in a way rigid bodies do not fix"));
+    }
+    ++index;
+  }
+}
+
+}  // namespace nhdyn

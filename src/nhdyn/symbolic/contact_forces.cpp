@@ -1,0 +1,163 @@
+#include "nhdyn/symbolic/contact_forces.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <memory>
+#include <utility>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/symbolic/compile.hpp"
+
+namespace nhdyn::symbolic {
+namespace {
+
+void append(std::vector<GiNaC::ex>& out, const Vector3& v) { out.insert(out.end(), v.begin(), v.end()); }
+
+Vector3 times(const GiNaC::matrix& I, const Vector3& w) {
+  Vector3 out;
+  for (unsigned i = 0; i < 3; ++i) out[i] = I(i, 0) * w[0] + I(i, 1) * w[1] + I(i, 2) * w[2];
+  return out;
+}
+
+Vector3 diff(const Vector3& v, const GiNaC::symbol& x) { return {v[0].diff(x), v[1].diff(x), v[2].diff(x)}; }
+
+// d/dt of v(t, q, q') along the motion with q'' = 0: dv/dt + sum_i dv/dq_i q_i' (the part of the
+// acceleration that does not multiply q''; the rest is (dv/dq') q'').
+Vector3 drift(const Vector3& v, const SymbolTable& symbols) {
+  Vector3 out = diff(v, symbols.time());
+  for (int i = 0; i < symbols.coordinates(); ++i) out = add(out, scale(symbols.velocity(i), diff(v, symbols.coordinate(i))));
+  return out;
+}
+
+// The row of b of a constraint (hand-written: an unknown multiplier along it in (C1)).
+std::vector<GiNaC::ex> b_row(const Spec& spec, const SpecConstraint& c) {
+  std::vector<GiNaC::ex> row;
+  for (int j = 0; j < spec.n(); ++j) {
+    switch (c.level) {
+      case ConstraintLevel::position: row.push_back(c.expression.diff(spec.symbols.coordinate(j))); break;
+      case ConstraintLevel::velocity: row.push_back(c.expression.diff(spec.symbols.velocity(j))); break;
+      case ConstraintLevel::acceleration: row.push_back(c.expression.diff(spec.symbols.acceleration(j))); break;
+    }
+  }
+  return row;
+}
+
+}  // namespace
+
+void compile_contact_forces(const Spec& spec, Model& model) {
+  if (!spec.contact_forces || spec.contact_forces->contacts.empty()) return;
+  const SpecContactForces& in = *spec.contact_forces;
+  const SymbolTable& symbols = spec.symbols;
+  const int n = spec.n();
+  auto out = std::make_shared<ContactForceModel>();
+  ContactForceModel& c = *out;
+  c.n = n;
+  c.systems = static_cast<int>(in.origins.size());
+  c.system_names = in.system_names;
+  c.length = in.length;
+  const GiNaC::ex per_length = GiNaC::numeric(1.0 / in.length);
+
+  // Whether the momentum balance (C3) describes every force on the bodies: not when T or V has
+  // hand-written parts, there are generalized forces or programs (actuator forces), or constraints
+  // that no contact helper wrote (forces at points nhdyn does not know).
+  std::vector<const SpecConstraint*> hand;
+  for (const SpecConstraint& con : spec.constraints)
+    if (std::find(in.generated.begin(), in.generated.end(), con.name) == in.generated.end()) hand.push_back(&con);
+  bool forces = false;
+  for (const GiNaC::ex& f : spec.forces) forces = forces || !f.is_zero();
+  std::string why;
+  if (in.other_energy) why = "the kinetic or potential energy has hand-written parts";
+  else if (forces) why = "the model has generalized forces ([forces])";
+  else if (spec.m() > 0) why = "the model has programs, whose actuator forces act on the bodies";
+  else if (!hand.empty()) why = fmt::format("the constraint '{}' is written by hand", hand.front()->name);
+  c.balance_rows.assign(static_cast<std::size_t>(c.systems), why.empty() ? 1 : 0);
+  if (!why.empty())
+    c.notes.push_back(fmt::format("the bodies' momentum balance is not used for the contact forces since {}: only "
+                                  "what the reactions R determine is reported",
+                                  why));
+  c.hand_constraints = static_cast<int>(hand.size());
+
+  std::vector<GiNaC::ex> outputs;
+  // Per contact and unknown: J^T d (n), E d (6), d (3).
+  for (const ContactPoint& p : in.contacts) {
+    ContactForceContact contact;
+    contact.name = p.name;
+    contact.kind = p.kind;
+    contact.reported = p.kind == ContactKind::wheel || p.kind == ContactKind::knife_edge;
+    contact.first_unknown = c.unknowns;
+    contact.unknowns = static_cast<int>(p.directions.size());
+    contact.system = std::max(p.system, 0);
+    const Vector3 arm =
+        p.system >= 0 ? subtract(p.point, in.origins[static_cast<std::size_t>(p.system)]) : Vector3{0, 0, 0};
+    for (const Vector3& d : p.directions) {
+      const GiNaC::ex along = dot(p.velocity, d);
+      for (int j = 0; j < n; ++j) outputs.push_back(along.diff(symbols.velocity(j)));
+      if (p.system >= 0) {
+        append(outputs, d);
+        append(outputs, scale(per_length, cross(arm, d)));
+      } else {
+        for (int r = 0; r < 6; ++r) outputs.push_back(0);
+      }
+      append(outputs, d);
+      c.unknown_system.push_back(contact.system);
+      ++c.unknowns;
+    }
+    c.contacts.push_back(std::move(contact));
+  }
+  if (c.systems == 0) {
+    c.systems = 1;  // contacts on bodies fixed to the ground: one empty system keeps the layout
+    c.system_names.push_back("ground");
+    c.balance_rows.assign(1, 0);
+  }
+  // Per system: K (6 x n, column-major) and k, the balance K q'' + k.
+  for (int s = 0; s < c.systems; ++s) {
+    const Vector3 O = s < static_cast<int>(in.origins.size()) ? in.origins[static_cast<std::size_t>(s)] : Vector3{0, 0, 0};
+    std::vector<GiNaC::ex> K(static_cast<std::size_t>(6 * n), 0);
+    Vector3 force{0, 0, 0}, moment{0, 0, 0};
+    for (const ContactBody& b : in.bodies) {
+      if (b.system != s) continue;
+      const Vector3 arm = subtract(b.centre, O);
+      const Vector3 velocity = time_derivative(b.centre, symbols);
+      for (int j = 0; j < n; ++j) {
+        // m_B dv_B/dq_j' = m_B dr_B/dq_j: the column of q_j'' in m_B a_B.
+        const Vector3 Jv = scale(b.mass, diff(b.centre, symbols.coordinate(j)));
+        const Vector3 Jw = diff(b.omega, symbols.velocity(j));
+        const Vector3 m = add(cross(arm, Jv), times(b.inertia, Jw));
+        for (int r = 0; r < 3; ++r) {
+          K[static_cast<std::size_t>(6 * j + r)] += Jv[static_cast<std::size_t>(r)];
+          K[static_cast<std::size_t>(6 * j + 3 + r)] += per_length * m[static_cast<std::size_t>(r)];
+        }
+      }
+      const Vector3 a0 = subtract(drift(velocity, symbols), in.gravity);  // a_B - g without q''
+      const Vector3 ma = scale(b.mass, a0);
+      force = add(force, ma);
+      const Vector3 Iw = times(b.inertia, b.omega);
+      moment = add(moment, add(add(cross(arm, ma), times(b.inertia, drift(b.omega, symbols))), cross(b.omega, Iw)));
+    }
+    outputs.insert(outputs.end(), K.begin(), K.end());
+    append(outputs, force);
+    append(outputs, scale(per_length, moment));
+  }
+  // Per reported contact: n, e_long, e_lat.
+  for (const ContactPoint& p : in.contacts) {
+    if (p.kind != ContactKind::wheel && p.kind != ContactKind::knife_edge) continue;
+    append(outputs, p.normal);
+    append(outputs, p.longitudinal);
+    append(outputs, p.lateral);
+  }
+  for (const SpecConstraint* con : hand) {
+    const std::vector<GiNaC::ex> row = b_row(spec, *con);
+    outputs.insert(outputs.end(), row.begin(), row.end());
+  }
+  c.single_wheel = c.systems == 1 && c.contacts.size() == 1 && c.contacts.front().kind == ContactKind::wheel &&
+                   c.hand_constraints == 0 && c.balance_rows.front() && in.contacts.front().system == 0;
+  c.program = compile_expressions(spec, outputs, "contact forces: output");
+  if (c.program.outputs() != c.outputs())
+    throw ModelError(fmt::format("model '{}': the contact-force program has {} outputs, expected {} (a bug)",
+                                 spec.name, c.program.outputs(), c.outputs()));
+  analyse_contact_forces(model, c);
+  model.contact_forces = std::move(out);
+}
+
+}  // namespace nhdyn::symbolic

@@ -1,0 +1,59 @@
+// The symbolic half of the contact forces (docs/derivations/contact-forces.md section 4, method
+// (b)): what the multibody front end (multibody.hpp) knows about its bodies and contacts, kept in
+// the Spec, and its compilation at load into the program of model/contact_forces.hpp — the columns
+// J^T d and E d of every unknown, the momentum balance of every connected system as K q'' + k, and
+// the directions n, e_long, e_lat of every wheel and knife edge — followed by the numeric check of
+// step 5 (analyse_contact_forces), which marks what the model does not determine.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <string>
+#include <vector>
+
+#include "nhdyn/model/contact_forces.hpp"
+#include "nhdyn/model/model.hpp"
+#include "nhdyn/symbolic/kinematics.hpp"
+#include "nhdyn/symbolic/spec.hpp"
+
+namespace nhdyn::symbolic {
+
+// A rigid body: mass, centre of mass r_B(t, q) and angular velocity omega_B (linear in q') in world
+// components, inertia about the centre of mass in world components (R I R^T).
+struct ContactBody {
+  GiNaC::ex mass;
+  Vector3 centre;
+  Vector3 omega;
+  GiNaC::matrix inertia = GiNaC::matrix(3, 3);
+  int system = -1;  // -1: fixed to the ground (not in any balance)
+};
+
+// A contact: the material point P (world) with its velocity v_P (linear in q'), the world
+// directions of its unknowns, and (wheels, knife edges) the plane's normal n and e_long, e_lat.
+struct ContactPoint {
+  std::string name;
+  ContactKind kind = ContactKind::wheel;
+  Vector3 point;
+  Vector3 velocity;
+  std::vector<Vector3> directions;
+  Vector3 normal, longitudinal, lateral;
+  int system = -1;
+};
+
+struct SpecContactForces {
+  std::vector<ContactBody> bodies;
+  std::vector<ContactPoint> contacts;
+  std::vector<Vector3> origins;           // per system: the origin of its first frame (the point O)
+  std::vector<std::string> system_names;  // per system: that frame's name
+  Vector3 gravity = {0, 0, 0};
+  std::vector<std::string> generated;     // the constraints the contact helpers wrote
+  bool other_energy = false;              // T or V written by hand besides the bodies'
+  double length = 1.0;                    // L [m], the largest wheel radius (or 1)
+};
+
+// Builds Model::contact_forces from spec.contact_forces (nothing when it is null or has no
+// contact): compiles the program, then checks it at a generic state (analyse_contact_forces).
+// Called by compile_model once the evaluator exists.
+void compile_contact_forces(const Spec& spec, Model& model);
+
+}  // namespace nhdyn::symbolic
