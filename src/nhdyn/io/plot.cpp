@@ -797,9 +797,10 @@ std::string_view base_coordinate(const PlotColumn& c) {
   return name;
 }
 
-// A column whose values vary by no more than this fraction of their magnitude (or of the
-// largest span among the columns of its role) is constant to round-off: a reaction that is zero
-// up to 1e-17 is drawn as the zero it is, not magnified into noise.
+// A column whose values vary by no more than this fraction of the largest magnitude among the
+// columns of its role is constant to round-off: a reaction that is zero up to 1e-17 is drawn as
+// the zero it is, not magnified into noise. Below the tolerance of any run (rtol 1e-8 by
+// default), such a variation is the integrator's error, not the motion.
 constexpr double round_off = 1e-9;
 
 struct ScaleGroup {
@@ -809,14 +810,13 @@ struct ScaleGroup {
 
 // Splits columns of like units into groups of like scale (scale_ratio). Largest spans first,
 // so a group's first member sets its range; each group keeps the columns in their given order,
-// and the groups come in the order of their first column. `role_span` is the largest span among
-// the columns of their role (round_off).
-std::vector<ScaleGroup> split_by_scale(const std::vector<const PlotColumn*>& columns, double role_span) {
+// and the groups come in the order of their first column. `role_scale` is the largest |value|
+// among the columns of their role (round_off).
+std::vector<ScaleGroup> split_by_scale(const std::vector<const PlotColumn*>& columns, double role_scale) {
   const auto span = [&](const PlotColumn* c) {
     const double s = c->max - c->min;
     if (!std::isfinite(s)) return 0.0;
-    const double magnitude = std::max({std::abs(c->min), std::abs(c->max), role_span});
-    return s <= round_off * magnitude ? 0.0 : s;
+    return s <= round_off * role_scale ? 0.0 : s;
   };
   std::vector<std::size_t> order(columns.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -870,7 +870,7 @@ std::vector<ScaleGroup> split_by_scale(const std::vector<const PlotColumn*>& col
     // Constants: a range around them wide enough that round-off does not show, and that holds
     // every level with a margin.
     const double mid = 0.5 * (g.lo + g.hi);
-    double half = std::max({0.6 * (g.hi - g.lo), 0.5 * std::abs(mid), 0.5 * role_span});
+    double half = std::max({0.6 * (g.hi - g.lo), 0.5 * std::abs(mid), 0.1 * role_scale});
     if (!(half > 0.0)) half = 1.0;
     group.y_range.emplace(mid - half, mid + half);
   }
@@ -899,14 +899,14 @@ std::vector<PlotPanel> calc_plot_panels(const std::vector<PlotColumn>& columns,
   const auto lines = [&](PlotRole role, int angles, std::string_view title) {
     // angles: 1 only angle-named, 0 only the others, -1 every column of the role.
     std::vector<const PlotColumn*> chosen;
-    double role_span = 0.0;
+    double role_scale = 0.0;
     for (const PlotColumn& c : columns) {
       if (c.role != role) continue;
-      if (std::isfinite(c.max - c.min)) role_span = std::max(role_span, c.max - c.min);
+      if (std::isfinite(c.max - c.min)) role_scale = std::max({role_scale, std::abs(c.min), std::abs(c.max)});
       if (angles >= 0 && is_angle_name(base_coordinate(c)) != (angles == 1)) continue;
       chosen.push_back(&c);
     }
-    for (ScaleGroup& group : split_by_scale(chosen, role_span)) {
+    for (ScaleGroup& group : split_by_scale(chosen, role_scale)) {
       PlotPanel& p = panels.emplace_back(PlotPanel{std::string(title), PanelKind::lines, std::move(group.names)});
       p.y_range = group.y_range;
       if (p.y_range) p.title += ", constant to round-off";
@@ -919,7 +919,9 @@ std::vector<PlotPanel> calc_plot_panels(const std::vector<PlotColumn>& columns,
   if (path) {
     const double xs = path->first.max - path->first.min;
     const double ys = path->second.max - path->second.min;
-    if (std::isfinite(xs) && std::isfinite(ys) && xs > 0.0 && ys > 0.0) {
+    const double scale = std::max({std::abs(path->first.min), std::abs(path->first.max), std::abs(path->second.min),
+                                   std::abs(path->second.max)});
+    if (std::isfinite(xs) && std::isfinite(ys) && xs > round_off * scale && ys > round_off * scale) {
       const double ratio = ys / xs;
       PlotPanel p{fmt::format("path {}({})", path->second.name, path->first.name), PanelKind::path,
                   {path->first.name, path->second.name}};

@@ -61,12 +61,13 @@ bool is_angle_name(std::string_view coordinate);
 // A group of linear curves is split further by scale: a curve joins a panel only if the panel's
 // range, with it, spans at most `scale_ratio` (10) times the curve's own span, so every curve
 // spans at least a tenth of its panel's height (a constant curve joins a panel whose range it
-// keeps within that bound). A curve that varies by at most 1e-9 of its magnitude, or of the
-// largest span among the columns of its role, counts as constant (round-off is not drawn as a
+// keeps within that bound). A curve that varies by at most 1e-9 of the largest |value| among
+// the columns of its role (below any run's tolerance) counts as constant (round-off is not drawn as a
 // signal); a panel of constants only gets a fixed range around them and says so in its title. The path (x, y) is drawn with equal axes when its span ratio
 // y/x lies in [1/5, 3/2] (the shape of a panel: both sides of the drawn box keep at least a
 // third of the panel), with separate padded scales otherwise, and is left out when either span
-// is zero or not finite (a line or a point says nothing a time series does not).
+// is not finite or at most 1e-9 of the largest |x| or |y| (a line or a point, to round-off, says
+// nothing a time series does not).
 std::vector<PlotPanel> calc_plot_panels(const std::vector<PlotColumn>& columns,
                                         const std::optional<std::pair<PlotColumn, PlotColumn>>& path);
 
