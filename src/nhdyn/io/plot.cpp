@@ -504,11 +504,13 @@ struct ScriptInput {
   std::optional<std::pair<double, double>> log_range;  // shared |value| range of the log panels
   int header_lines = 1;       // lines before the first data row
   std::uintmax_t stride = 1;  // draw every stride-th row
+  int layout_columns = 0;     // 0: from the number of panels
 };
 
 std::string make_script(const ScriptInput& in) {
   const int panels = static_cast<int>(in.panels.size());
-  const int layout_columns = panels == 1 ? 1 : panels <= 4 ? 2 : 3;
+  const int layout_columns =
+      in.layout_columns > 0 ? std::min(in.layout_columns, panels) : panels == 1 ? 1 : panels <= 4 ? 2 : 3;
   const int layout_rows = (panels + layout_columns - 1) / layout_columns;
   const int width = layout_columns == 1 ? 1000 : 620 * layout_columns;
   const int height = 80 + 340 * layout_rows;
@@ -978,11 +980,58 @@ void select_plot_columns(PlotRequest& request, const std::vector<std::string>& a
     }
 }
 
+std::vector<PlotPanel> calc_comparison_panels(const std::vector<std::string>& methods,
+                                              const std::vector<std::string>& integrators,
+                                              const std::vector<std::string>& quantities) {
+  const auto column = [](const std::string& quantity, const std::string& method, const std::string& integrator) {
+    return fmt::format("{}_{}_{}", quantity, method, integrator);
+  };
+  std::vector<PlotPanel> panels;
+  if (integrators.size() == 1 || methods.size() == 1) {
+    const bool by_method = integrators.size() == 1;
+    for (const std::string& outer : by_method ? methods : integrators) {
+      PlotPanel& p = panels.emplace_back();
+      p.kind = PanelKind::log_abs;
+      p.title = by_method ? fmt::format("{} ({})", outer, integrators.front())
+                          : fmt::format("{} ({})", outer, methods.front());
+      for (const std::string& q : quantities) {
+        p.columns.push_back(by_method ? column(q, outer, integrators.front()) : column(q, methods.front(), outer));
+        p.labels.push_back(q);
+      }
+    }
+    return panels;
+  }
+  for (const std::string& q : quantities)
+    for (const std::string& m : methods) {
+      PlotPanel& p = panels.emplace_back();
+      p.kind = PanelKind::log_abs;
+      p.title = fmt::format("{}: {}", q, m);
+      for (const std::string& i : integrators) {
+        p.columns.push_back(column(q, m, i));
+        p.labels.push_back(i);
+      }
+    }
+  return panels;
+}
+
+void select_panel_columns(std::vector<PlotPanel>& panels, const std::vector<std::string>& chosen) {
+  if (chosen.empty()) return;
+  for (PlotPanel& p : panels) {
+    for (std::size_t i = p.columns.size(); i-- > 0;) {
+      if (std::find(chosen.begin(), chosen.end(), p.columns[i]) != chosen.end()) continue;
+      p.columns.erase(p.columns.begin() + static_cast<std::ptrdiff_t>(i));
+      if (i < p.labels.size()) p.labels.erase(p.labels.begin() + static_cast<std::ptrdiff_t>(i));
+    }
+  }
+  std::erase_if(panels, [](const PlotPanel& p) { return p.columns.empty(); });
+}
+
 namespace {
 
 // Resolves the panels' columns, reads what the script needs from the CSV and draws it.
 void draw_panels(const std::string& title, const fs::path& csv, const CsvHead& head, std::vector<PlotPanel> panels,
-                 const std::vector<PlotEvent>& events, bool same_log_range, const fs::path& png) {
+                 const std::vector<PlotEvent>& events, bool same_log_range, int layout_columns,
+                 const fs::path& png) {
   std::error_code ec;
   ScriptInput in;
   in.csv = fs::absolute(csv, ec);
@@ -993,6 +1042,7 @@ void draw_panels(const std::string& title, const fs::path& csv, const CsvHead& h
   in.time_name = head.names.front();
   in.header_lines = head.header_lines;
   in.events = events;
+  in.layout_columns = layout_columns;
   if (head.rows > max_rows_per_curve) in.stride = (head.rows + max_rows_per_curve - 1) / max_rows_per_curve;
   std::vector<int> log_indices;
   for (PlotPanel& p : panels) {
@@ -1093,7 +1143,7 @@ void write_plot(const PlotRequest& request, const std::filesystem::path& png) {
                                  "its columns against time instead",
                                  png.string(), request.path->second, request.path->first, request.csv.string()));
   }
-  draw_panels(request.title, request.csv, head, std::move(panels), request.events, false, png);
+  draw_panels(request.title, request.csv, head, std::move(panels), request.events, false, 0, png);
 }
 
 void write_panel_plot(const PanelPlotRequest& request, const std::filesystem::path& png) {
@@ -1111,7 +1161,8 @@ void write_panel_plot(const PanelPlotRequest& request, const std::filesystem::pa
                                    png.string(), p.title, p.labels.size(), p.columns.size()));
   }
   const CsvHead head = read_csv_head(request.csv);
-  draw_panels(request.title, request.csv, head, request.panels, request.events, request.same_log_range, png);
+  draw_panels(request.title, request.csv, head, request.panels, request.events, request.same_log_range,
+              request.layout_columns, png);
 }
 
 }  // namespace nhdyn

@@ -133,7 +133,22 @@ struct PanelPlotRequest {
   std::vector<PlotPanel> panels;
   std::vector<PlotEvent> events = {};
   bool same_log_range = false;
+  int layout_columns = 0;  // panels per row of the grid; 0: 1 for one panel, 2 up to four, else 3
 };
+
+// The panels of `nhdyn compare`'s figure, whose series CSV names its columns
+// QUANTITY_METHOD_INTEGRATOR (error_sanh_dopri5, residual_vel_lagrange_rk4), all |value| on a log
+// scale: with one integrator, one panel per method (a curve per quantity); with one method, one
+// panel per integrator; with several of both, one panel per quantity and method (a curve per
+// integrator, in the same colour in every panel), quantities in rows and methods in columns of
+// the grid (layout_columns = the number of methods).
+std::vector<PlotPanel> calc_comparison_panels(const std::vector<std::string>& methods,
+                                              const std::vector<std::string>& integrators,
+                                              const std::vector<std::string>& quantities);
+
+// Keeps in each panel only the columns named in `chosen` and drops the panels left empty; an
+// empty `chosen` keeps everything. Names are not checked here (require_plot_columns).
+void select_panel_columns(std::vector<PlotPanel>& panels, const std::vector<std::string>& chosen);
 
 // Draws `request` as write_plot draws its panels; throws as write_plot does.
 void write_panel_plot(const PanelPlotRequest& request, const std::filesystem::path& png);
