@@ -24,6 +24,7 @@
 #include "nhdyn/jit/compiled_evaluator.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "nhdyn/symbolic/spec.hpp"
+#include "nhdyn/symbolic/visual.hpp"
 #include "progress.hpp"
 #include "run_overrides.hpp"
 
@@ -316,6 +317,16 @@ int run_simulate(const SimulateArgs& args) {
       for (std::size_t i = 0; i < model.coordinates.size(); ++i) {
         mark.state.emplace_back(model.coordinates[i], e.q[i]);
         mark.state.emplace_back(model.coordinates[i] + "'", e.v[i]);
+      }
+    }
+    // A model file also tells its angles by use: the coordinates inside sin, cos or tan.
+    if (resolved.spec) {
+      try {
+        const std::vector<bool> angles = symbolic::compile_visual(*resolved.spec).angles;
+        for (std::size_t i = 0; i < angles.size() && i < model.coordinates.size(); ++i)
+          if (angles[i]) request.angles.push_back(model.coordinates[i]);
+      } catch (const Error&) {
+        // A [visual] item that does not compile costs the plot only this hint; the names remain.
       }
     }
     select_plot_columns(request, columns.all, args.plot_columns);

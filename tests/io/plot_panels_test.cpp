@@ -150,6 +150,29 @@ TEST(PlotPanels, ConstantsShareAPanelAtTheirLevels) {
   EXPECT_GT(panels[0].y_range->second, -14.3);
 }
 
+// A model file names its angles by use (inside sin, cos, tan): alpha is one by its name, s by use.
+TEST(PlotPanels, AnglesKnownByUseJoinTheAngles) {
+  const std::vector<PlotColumn> columns = {col("s", PlotRole::coordinate, 0, 3), col("x", PlotRole::coordinate, 0, 2),
+                                           col("alpha", PlotRole::coordinate, 0, 1),
+                                           col("s'", PlotRole::velocity, 0, 1), col("R_s", PlotRole::reaction, 0, 1)};
+  EXPECT_EQ(names_of(calc_plot_panels(columns, std::nullopt, {"s"})),
+            (std::vector<std::vector<std::string>>{{"s", "alpha"}, {"x"}, {"s'"}, {"R_s"}}));
+  const std::vector<PlotPanel> by_name = calc_plot_panels(columns, std::nullopt);
+  EXPECT_EQ(by_name[0].columns, (std::vector<std::string>{"alpha"}));
+  EXPECT_EQ(by_name[1].columns, (std::vector<std::string>{"s", "x"}));
+}
+
+// Without constraints the reactions are round-off; the actuator forces give them their scale.
+TEST(PlotPanels, ReactionsAreMeasuredAgainstTheActuatorForces) {
+  const std::vector<PlotPanel> panels = calc_plot_panels(
+      {col("R_x", PlotRole::reaction, -3e-14, 1.5e-14), col("u_swing", PlotRole::actuator, -90, -8)}, std::nullopt);
+  ASSERT_EQ(panels.size(), 2u);
+  ASSERT_TRUE(panels[0].y_range);
+  EXPECT_LT(panels[0].y_range->first, -1.0);
+  EXPECT_GT(panels[0].y_range->second, 1.0);
+  EXPECT_FALSE(panels[1].y_range);
+}
+
 TEST(PlotPanels, ActuatorsAndOtherColumnsComeBeforeTheResiduals) {
   const std::vector<PlotPanel> panels =
       calc_plot_panels({col("residual_pos_heading", PlotRole::residual, 0, 1e-10),

@@ -896,16 +896,26 @@ bool is_angle_name(std::string_view coordinate) {
 }
 
 std::vector<PlotPanel> calc_plot_panels(const std::vector<PlotColumn>& columns,
-                                        const std::optional<std::pair<PlotColumn, PlotColumn>>& path) {
+                                        const std::optional<std::pair<PlotColumn, PlotColumn>>& path,
+                                        const std::vector<std::string>& angles) {
+  const auto is_angle = [&](std::string_view coordinate) {
+    return is_angle_name(coordinate) || std::find(angles.begin(), angles.end(), coordinate) != angles.end();
+  };
   std::vector<PlotPanel> panels;
-  const auto lines = [&](PlotRole role, int angles, std::string_view title) {
-    // angles: 1 only angle-named, 0 only the others, -1 every column of the role.
+  const auto lines = [&](PlotRole role, int which, std::string_view title) {
+    // which: 1 only the angles, 0 only the others, -1 every column of the role.
     std::vector<const PlotColumn*> chosen;
     double role_scale = 0.0;
+    // Reactions and actuator forces are both generalized forces: one scale for the two roles.
+    const auto same_scale = [&](PlotRole r) {
+      const auto forces = [](PlotRole x) { return x == PlotRole::reaction || x == PlotRole::actuator; };
+      return r == role || (forces(r) && forces(role));
+    };
     for (const PlotColumn& c : columns) {
+      if (same_scale(c.role) && std::isfinite(c.max - c.min))
+        role_scale = std::max({role_scale, std::abs(c.min), std::abs(c.max)});
       if (c.role != role) continue;
-      if (std::isfinite(c.max - c.min)) role_scale = std::max({role_scale, std::abs(c.min), std::abs(c.max)});
-      if (angles >= 0 && is_angle_name(base_coordinate(c)) != (angles == 1)) continue;
+      if (which >= 0 && is_angle(base_coordinate(c)) != (which == 1)) continue;
       chosen.push_back(&c);
     }
     for (ScaleGroup& group : split_by_scale(chosen, role_scale)) {
@@ -1137,7 +1147,7 @@ void write_plot(const PlotRequest& request, const std::filesystem::path& png) {
     path->second.min = ranges[columns.size() + 1].min;
     path->second.max = ranges[columns.size() + 1].max;
   }
-  std::vector<PlotPanel> panels = calc_plot_panels(columns, path);
+  std::vector<PlotPanel> panels = calc_plot_panels(columns, path, request.angles);
   if (panels.empty()) {
     throw InputError(fmt::format("nothing to plot into '{}': the path {}({}) is a line or a point in '{}'; plot "
                                  "its columns against time instead",

@@ -62,14 +62,18 @@ bool is_angle_name(std::string_view coordinate);
 // range, with it, spans at most `scale_ratio` (10) times the curve's own span, so every curve
 // spans at least a tenth of its panel's height (a constant curve joins a panel whose range it
 // keeps within that bound). A curve that varies by at most 1e-9 of the largest |value| among
-// the columns of its role (below any run's tolerance) counts as constant (round-off is not drawn as a
+// the columns of its role (reactions and actuator forces count as one role: both are generalized
+// forces), below any run's tolerance, counts as constant (round-off is not drawn as a
 // signal); a panel of constants only gets a fixed range around them and says so in its title. The path (x, y) is drawn with equal axes when its span ratio
 // y/x lies in [1/5, 3/2] (the shape of a panel: both sides of the drawn box keep at least a
 // third of the panel), with separate padded scales otherwise, and is left out when either span
 // is not finite or at most 1e-9 of the largest |x| or |y| (a line or a point, to round-off, says
 // nothing a time series does not).
+// `angles` names coordinates known to be angles besides those whose names say so (a model file's
+// coordinates that appear inside sin, cos or tan, symbolic::VisualScene::angles).
 std::vector<PlotPanel> calc_plot_panels(const std::vector<PlotColumn>& columns,
-                                        const std::optional<std::pair<PlotColumn, PlotColumn>>& path);
+                                        const std::optional<std::pair<PlotColumn, PlotColumn>>& path,
+                                        const std::vector<std::string>& angles = {});
 
 // An event to mark on the time axes: a dashed vertical line at t, named in the legend, and a
 // point on the path where `state` gives the path's columns.
@@ -94,6 +98,8 @@ struct PlotRequest {
   std::optional<std::pair<std::string, std::string>> path;
   std::optional<std::string> energy;  // energy column, drawn as its drift E(t) - E(0)
   std::vector<PlotEvent> events = {};
+  // Coordinates that are angles besides those named like one (calc_plot_panels).
+  std::vector<std::string> angles = {};
 };
 
 // Keeps in `request` only the columns named in `chosen` (--plot-columns A,B,...): each stays in
