@@ -217,6 +217,12 @@ int run_simulate(const SimulateArgs& args) {
     options.events.push_back(symbolic::make_record_event(model, definition));
   options.formulation.program_feedback = parse_program_feedback(args.program_feedback);
   check_simulation_options(model, options);
+  const ResultColumns columns = make_result_columns(model);
+  if (!args.plot_columns.empty()) {
+    if (args.plot.empty())
+      throw InputError("--plot-columns chooses what --plot draws; give --plot FILE.png too, or leave --plot-columns out");
+    require_plot_columns(columns.all, args.plot_columns);
+  }
 
   namespace fs = std::filesystem;
   const bool default_csv = args.output.empty();
@@ -247,12 +253,6 @@ int run_simulate(const SimulateArgs& args) {
       throw InputError(fmt::format("--html {} and the CSV output {} are the same file; give them different names",
                                    args.html, csv_path.string()));
     html_probe.emplace(args.html);  // checks the report's directory now; removed unused
-  }
-  const ResultColumns columns = make_result_columns(model);
-  if (!args.plot_columns.empty()) {
-    if (args.plot.empty())
-      throw InputError("--plot-columns chooses what --plot draws; give --plot FILE.png too, or leave --plot-columns out");
-    require_plot_columns(columns.all, args.plot_columns);
   }
   CsvWriter writer(csv_path, columns.all);  // refuses an unwritable path before any step
   const bool companions = is_regular_target(csv_path);

@@ -544,6 +544,12 @@ TEST(CliPlot, UnknownPlotColumnIsRefusedWithTheColumns) {
   EXPECT_EQ(r.out, "");
   EXPECT_TRUE(entries(dir.path()).empty()) << "not even the CSV";
 
+  // Nor is the default results/ directory made for a refused run.
+  const std::vector<std::string> default_csv{"simulate", "sled", "--plot", "s.png", "--plot-columns", "nope"};
+  const RunResult d = nhdyn(default_csv, dir.path());
+  EXPECT_EQ(d.exit_code, 2) << context(default_csv, d);
+  EXPECT_TRUE(entries(dir.path()).empty()) << "no results/ either";
+
   // Without --plot there is nothing to choose for.
   const std::vector<std::string> alone{"simulate", "sled", "--t-end", "1", "-o", "s.csv", "--plot-columns", "x"};
   const RunResult a = nhdyn(alone, dir.path());
