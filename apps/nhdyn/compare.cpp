@@ -3,6 +3,7 @@
 // residuals against time as a second CSV, and plots them on a log scale.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -37,6 +38,7 @@ struct CompareArgs {
   std::vector<std::string> sets;
   std::string output;
   std::string plot;
+  std::vector<std::string> plot_columns;  // the series columns --plot draws (empty: all)
   bool quiet = false;
   std::string evaluator = "interpreted";  // interpreted | compiled | auto (jit/compiled_evaluator.hpp)
 };
@@ -83,6 +85,11 @@ int run_compare(const CompareArgs& args) {
     if (model.position_constraints() > 0) columns.push_back("residual_pos_" + case_name(c));
     if (model.velocity_constraints() > 0) columns.push_back("residual_vel_" + case_name(c));
   }
+  if (!args.plot_columns.empty()) {
+    if (args.plot.empty())
+      throw InputError("--plot-columns chooses what --plot draws; give --plot FILE.png too, or leave --plot-columns out");
+    require_plot_columns(columns, args.plot_columns);
+  }
   CsvWriter series(series_path, columns);
 
   const Comparison result = compare_formulations(model, options);
@@ -112,11 +119,22 @@ int run_compare(const CompareArgs& args) {
   series.commit();
   table.commit();
   if (!args.plot.empty()) {
-    PlotRequest request;
-    request.title = fmt::format("{}: error against the reference and constraint residuals", model.name);
+    PanelPlotRequest request;
+    request.title = fmt::format("{}: |error| against the reference and constraint residuals", model.name);
     request.csv = series_path;
-    request.residuals.assign(columns.begin() + 1, columns.end());
-    write_plot(request, args.plot);
+    std::vector<std::string> methods, integrators, quantities{"error"};
+    for (const ComparisonCase& c : options.cases) {
+      const std::string m(method_name(c.method)), i(integrator_name(c.integrator));
+      if (std::find(methods.begin(), methods.end(), m) == methods.end()) methods.push_back(m);
+      if (std::find(integrators.begin(), integrators.end(), i) == integrators.end()) integrators.push_back(i);
+    }
+    if (model.position_constraints() > 0) quantities.push_back("residual_pos");
+    if (model.velocity_constraints() > 0) quantities.push_back("residual_vel");
+    request.panels = calc_comparison_panels(methods, integrators, quantities);
+    if (methods.size() > 1 && integrators.size() > 1) request.layout_columns = static_cast<int>(methods.size());
+    select_panel_columns(request.panels, args.plot_columns);
+    request.same_log_range = true;  // heights compare across panels
+    write_panel_plot(request, args.plot);
   }
 
   if (!args.quiet) {
@@ -171,7 +189,10 @@ std::function<int()> add_compare_command(CLI::App& app) {
   cmd->add_option("--evaluator", args->evaluator, "interpreted (default) | compiled | auto, as for simulate");
   cmd->add_option("-o,--output", args->output, "Table CSV (default results/MODEL-compare.csv); the series "
                                                 "goes next to it as ...-series.csv");
-  cmd->add_option("--plot", args->plot, "PNG of the error and the residuals against time");
+  cmd->add_option("--plot", args->plot,
+                  "PNG of the error and the residuals against time, one panel per method or integrator");
+  cmd->add_option("--plot-columns", args->plot_columns, "The series columns --plot draws, comma-separated (default: all)")
+      ->delimiter(',');
   cmd->add_flag("-q,--quiet", args->quiet, "Print no table");
   return [args] { return run_compare(*args); };
 }

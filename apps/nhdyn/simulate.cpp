@@ -25,6 +25,7 @@
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "nhdyn/symbolic/spec.hpp"
+#include "nhdyn/symbolic/visual.hpp"
 #include "progress.hpp"
 #include "run_overrides.hpp"
 
@@ -49,6 +50,7 @@ struct SimulateArgs {
   double step = 0.0;
   std::string output;
   std::string plot;
+  std::vector<std::string> plot_columns;  // the columns --plot draws (empty: calc_plot_panels' choice)
   std::string html;  // the HTML report (io/report.hpp), written from the CSV after the run
   std::string program_feedback;  // "alpha,beta" (docs/cli.md); empty: no feedback
   bool quiet = false;
@@ -218,6 +220,12 @@ int run_simulate(const SimulateArgs& args) {
     options.events.push_back(symbolic::make_record_event(model, definition));
   options.formulation.program_feedback = parse_program_feedback(args.program_feedback);
   check_simulation_options(model, options);
+  const ResultColumns columns = make_result_columns(model);
+  if (!args.plot_columns.empty()) {
+    if (args.plot.empty())
+      throw InputError("--plot-columns chooses what --plot draws; give --plot FILE.png too, or leave --plot-columns out");
+    require_plot_columns(columns.all, args.plot_columns);
+  }
 
   namespace fs = std::filesystem;
   const bool default_csv = args.output.empty();
@@ -249,7 +257,6 @@ int run_simulate(const SimulateArgs& args) {
                                    args.html, csv_path.string()));
     html_probe.emplace(args.html);  // checks the report's directory now; removed unused
   }
-  const ResultColumns columns = make_result_columns(model);
   CsvWriter writer(csv_path, columns.all);  // refuses an unwritable path before any step
   const bool companions = is_regular_target(csv_path);
   const fs::path events_path = companion(csv_path, "-events.csv");
@@ -298,6 +305,7 @@ int run_simulate(const SimulateArgs& args) {
                                 integrator_name(options.integrator.kind));
     request.csv = csv_path;
     request.coordinates = columns.coordinates;
+    for (const std::string& q : model.coordinates) request.velocities.push_back(q + "'");
     request.reactions = columns.reactions;
     request.residuals = columns.residuals;
     request.actuators = columns.actuators;
@@ -307,6 +315,24 @@ int run_simulate(const SimulateArgs& args) {
     // With an energy balance the drawn error is h - h(t0) - W (the change of E may be physics).
     if (!columns.energy.empty())
       request.energy = columns.energy_balance.empty() ? columns.energy : columns.energy_balance.back();
+    for (const EventRecord& e : summary.events) {
+      PlotEvent& mark = request.events.emplace_back(PlotEvent{e.name, e.t});
+      for (std::size_t i = 0; i < model.coordinates.size(); ++i) {
+        mark.state.emplace_back(model.coordinates[i], e.q[i]);
+        mark.state.emplace_back(model.coordinates[i] + "'", e.v[i]);
+      }
+    }
+    // A model file also tells its angles by use: the coordinates inside sin, cos or tan.
+    if (resolved.spec) {
+      try {
+        const std::vector<bool> angles = symbolic::compile_visual(*resolved.spec).angles;
+        for (std::size_t i = 0; i < angles.size() && i < model.coordinates.size(); ++i)
+          if (angles[i]) request.angles.push_back(model.coordinates[i]);
+      } catch (const Error&) {
+        // A [visual] item that does not compile costs the plot only this hint; the names remain.
+      }
+    }
+    select_plot_columns(request, columns.all, args.plot_columns);
     write_plot(request, args.plot);
   }
   html_probe.reset();
@@ -428,7 +454,11 @@ std::function<int()> add_simulate_command(CLI::App& app) {
   cmd->add_option("--atol", args->atol, "Absolute tolerance of the adaptive integrators (default: the model's, else 1e-10)");
   cmd->add_option("--step", args->step, "rk4: step size [s] (default output step / 10); adaptive: first step");
   cmd->add_option("-o,--output", args->output, "CSV file to write (default results/MODEL.csv)");
-  cmd->add_option("--plot", args->plot, "PNG file to draw with gnuplot");
+  cmd->add_option("--plot", args->plot, "PNG file to draw with gnuplot (panels: docs/cli.md)");
+  cmd->add_option("--plot-columns", args->plot_columns,
+                  "The columns --plot draws, comma-separated (default: coordinates, velocities, path, reactions, "
+                  "residuals, energy balance error)")
+      ->delimiter(',');
   cmd->add_option("--html", args->html, "HTML report to write: 3-D animation, plots, equations (docs/report.md)");
   cmd->add_option("--stop-when", args->stop_when,
                   "End the run when a condition becomes true, e.g. \"abs(phi) > 1.2\" (located exactly; repeatable)");

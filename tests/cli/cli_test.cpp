@@ -510,6 +510,64 @@ TEST(CliPlot, WritesAPngBesideTheCsv) {
   EXPECT_NO_TEMPORARIES(dir.path());
 }
 
+// A run with events draws them (docs/cli.md, "What --plot draws"); --plot-columns chooses the
+// curves, the event file and the picture sit beside the CSV.
+TEST(CliPlot, DrawsARunWithEventsAndChosenColumns) {
+  if (!gnuplot_available()) GTEST_SKIP() << "gnuplot with a PNG terminal is not installed";
+  ScratchDir dir;
+  const std::vector<std::string> args{"simulate", "sled",   "--t-end", "3",     "--output-step", "0.05",
+                                      "--event",  "turn=phi-0.2", "-o",  "s.csv", "--plot",        "s.png",
+                                      "--plot-columns", "x,y,phi,R_x,energy"};
+  const RunResult r = nhdyn(args, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << context(args, r);
+  EXPECT_TRUE(contains(r.out, "turn at t =")) << r.out;
+  EXPECT_EQ(entries(dir.path()), (std::set<std::string>{"s.csv", "s-events.csv", "s.png"}));
+  const std::string png = read_bytes(dir / "s.png");
+  ASSERT_GT(png.size(), 1000u);
+  EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  EXPECT_NO_TEMPORARIES(dir.path());
+}
+
+// An unknown --plot-columns name is refused before the run, with every column listed.
+TEST(CliPlot, UnknownPlotColumnIsRefusedWithTheColumns) {
+  ScratchDir dir;
+  const std::vector<std::string> args{"simulate", "sled", "--t-end", "1", "-o", "s.csv", "--plot", "s.png",
+                                      "--plot-columns", "x,theta"};
+  const RunResult r = nhdyn(args, dir.path());
+  EXPECT_EQ(r.exit_code, 2) << context(args, r);
+  if (gnuplot_available()) {
+    EXPECT_TRUE(contains(r.err, "--plot-columns")) << r.err;
+    EXPECT_TRUE(contains(r.err, "'theta'")) << r.err;
+    for (const char* column : {"t", "x", "y", "phi", "x'", "phi''", "R_x", "R_phi", "residual_vel_blade"})
+      EXPECT_TRUE(contains(r.err, column)) << column << " not listed: " << r.err;
+  }
+  EXPECT_EQ(r.out, "");
+  EXPECT_TRUE(entries(dir.path()).empty()) << "not even the CSV";
+
+  // Nor is the default results/ directory made for a refused run.
+  const std::vector<std::string> default_csv{"simulate", "sled", "--plot", "s.png", "--plot-columns", "nope"};
+  const RunResult d = nhdyn(default_csv, dir.path());
+  EXPECT_EQ(d.exit_code, 2) << context(default_csv, d);
+  EXPECT_TRUE(entries(dir.path()).empty()) << "no results/ either";
+
+  // Without --plot there is nothing to choose for.
+  const std::vector<std::string> alone{"simulate", "sled", "--t-end", "1", "-o", "s.csv", "--plot-columns", "x"};
+  const RunResult a = nhdyn(alone, dir.path());
+  EXPECT_EQ(a.exit_code, 2) << context(alone, a);
+  EXPECT_TRUE(contains(a.err, "--plot")) << a.err;
+  EXPECT_TRUE(entries(dir.path()).empty());
+
+  // The compare command checks its series columns the same way.
+  if (!gnuplot_available()) return;
+  const std::vector<std::string> compare{"compare", "sled", "--t-end", "0.5", "--methods", "sanh,lagrange",
+                                         "-o", "c.csv", "--plot", "c.png", "--plot-columns", "error_sanh"};
+  const RunResult c = nhdyn(compare, dir.path());
+  EXPECT_EQ(c.exit_code, 2) << context(compare, c);
+  EXPECT_TRUE(contains(c.err, "error_sanh_dopri5")) << c.err;
+  EXPECT_TRUE(contains(c.err, "residual_vel_lagrange_dopri5")) << c.err;
+  EXPECT_TRUE(entries(dir.path()).empty());
+}
+
 TEST(CliPlot, PlotIntoAMissingDirectoryIsRefusedBeforeTheRun) {
   if (!gnuplot_available()) GTEST_SKIP() << "gnuplot with a PNG terminal is not installed";
   ScratchDir dir;

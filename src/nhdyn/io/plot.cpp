@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -424,38 +425,120 @@ std::string join_clauses(const std::vector<std::string>& clauses) {
   return out + "\n";
 }
 
+// The range of a column over the drawn rows, for the panel rule and the shared log range.
+struct Range {
+  double min = NAN, max = NAN;     // finite values only
+  double min_abs_positive = NAN;   // smallest nonzero |value|
+  double max_abs = NAN;
+};
+
+// Reads every `stride`-th data row (as gnuplot's `every` does) and returns the range of each
+// 1-based column in `indices`. Fields that are not numbers are skipped (gnuplot skips them too).
+std::vector<Range> read_ranges(const fs::path& csv, int header_lines, const std::vector<int>& indices,
+                               std::uintmax_t stride) {
+  std::vector<Range> out(indices.size());
+  std::ifstream in(csv, std::ios::binary);
+  if (!in) {
+    throw FileError(fmt::format("cannot read the CSV file '{}' to plot ({}); check the path", csv.string(),
+                                errno_text(errno)));
+  }
+  std::string line;
+  for (int i = 0; i < header_lines && std::getline(in, line); ++i) {
+  }
+  int widest = 0;
+  for (int index : indices) widest = std::max(widest, index);
+  std::vector<std::string_view> fields;
+  std::uintmax_t row = 0;
+  while (std::getline(in, line)) {
+    if (row++ % stride != 0) continue;
+    fields.clear();
+    std::string_view rest(line);
+    while (static_cast<int>(fields.size()) < widest) {
+      const std::size_t comma = rest.find(',');
+      fields.push_back(rest.substr(0, comma));
+      if (comma == std::string_view::npos) break;
+      rest.remove_prefix(comma + 1);
+    }
+    for (std::size_t k = 0; k < indices.size(); ++k) {
+      const auto i = static_cast<std::size_t>(indices[k] - 1);
+      if (i >= fields.size()) continue;
+      std::string_view field = fields[i];
+      while (!field.empty() && (field.front() == ' ' || field.front() == '+')) field.remove_prefix(1);
+      while (!field.empty() && (field.back() == ' ' || field.back() == '\r')) field.remove_suffix(1);
+      double value = 0.0;
+      const auto [end, err] = std::from_chars(field.data(), field.data() + field.size(), value);
+      if (err != std::errc{} || end != field.data() + field.size() || !std::isfinite(value)) continue;
+      Range& r = out[k];
+      r.min = std::isnan(r.min) ? value : std::min(r.min, value);
+      r.max = std::isnan(r.max) ? value : std::max(r.max, value);
+      const double a = std::abs(value);
+      r.max_abs = std::isnan(r.max_abs) ? a : std::max(r.max_abs, a);
+      if (a > 0.0) r.min_abs_positive = std::isnan(r.min_abs_positive) ? a : std::min(r.min_abs_positive, a);
+    }
+  }
+  return out;
+}
+
+// Colours of the event lines, one per event name in order of first appearance: dark enough
+// on white, distinct from gnuplot's first curve colours.
+constexpr std::array<std::string_view, 6> event_colours = {"#c00000", "#7030a0", "#c07000",
+                                                           "#006060", "#606060", "#a00060"};
+// With more events than this, the lines carry no text (the legend names them).
+constexpr std::size_t max_labelled_events = 8;
+// Vertical lines drawn at most; a run that records thousands of crossings gets a thinned comb.
+constexpr std::size_t max_drawn_events = 400;
+
+struct ScriptPanel {
+  PlotPanel panel;
+  std::vector<Column> curves;  // resolved columns; for a path {x, y}
+};
+
 struct ScriptInput {
   std::string title;
   std::string time_name;
   fs::path csv;     // absolute
   fs::path output;  // absolute, the temporary file
-  std::vector<Column> coordinates, reactions, residuals, actuators;
-  std::optional<std::pair<Column, Column>> path;
-  std::optional<Column> energy;
-  double energy0 = 0.0;
+  std::vector<ScriptPanel> panels;
+  std::vector<PlotEvent> events;
+  std::vector<double> drift0;  // first value of each drift panel's column, in panel order
+  std::optional<std::pair<double, double>> log_range;  // shared |value| range of the log panels
   int header_lines = 1;       // lines before the first data row
   std::uintmax_t stride = 1;  // draw every stride-th row
+  int layout_columns = 0;     // 0: from the number of panels
 };
 
 std::string make_script(const ScriptInput& in) {
-  const int panels =
-      static_cast<int>(!in.coordinates.empty()) + static_cast<int>(!in.reactions.empty()) +
-      static_cast<int>(!in.residuals.empty()) + static_cast<int>(in.path.has_value()) +
-      static_cast<int>(in.energy.has_value()) + static_cast<int>(!in.actuators.empty());
-  const int layout_columns = panels == 1 ? 1 : 2;
+  const int panels = static_cast<int>(in.panels.size());
+  const int layout_columns =
+      in.layout_columns > 0 ? std::min(in.layout_columns, panels) : panels == 1 ? 1 : panels <= 4 ? 2 : 3;
   const int layout_rows = (panels + layout_columns - 1) / layout_columns;
+  const int width = layout_columns == 1 ? 1000 : 620 * layout_columns;
+  const int height = 80 + 340 * layout_rows;
   // gnuplot skips the header lines; `every` also thins the rows, `all` takes them all.
   const std::string all = fmt::format(" skip {}", in.header_lines);
   const std::string every = in.stride > 1 ? fmt::format("{} every {}", all, in.stride) : all;
   const std::string thinned = in.stride > 1 ? fmt::format(" (1 row in {} drawn)", in.stride) : "";
 
+  // Events: one colour per name; the names in order of first appearance.
+  std::vector<std::string> event_names;
+  for (const PlotEvent& e : in.events)
+    if (std::find(event_names.begin(), event_names.end(), e.name) == event_names.end())
+      event_names.push_back(e.name);
+  const auto colour_of = [&](const std::string& name) {
+    const auto at = std::find(event_names.begin(), event_names.end(), name) - event_names.begin();
+    return event_colours[static_cast<std::size_t>(at) % event_colours.size()];
+  };
+  const std::size_t event_step =
+      in.events.size() > max_drawn_events ? (in.events.size() + max_drawn_events - 1) / max_drawn_events : 1;
+  const bool label_events = in.events.size() <= max_labelled_events;
+
   std::string s;
   s += "# Written by nhdyn (src/nhdyn/io/plot.cpp) for one plot; deleted after the run.\n";
   s += "set encoding utf8\n";
   s += "if (strstrt(' '.GPVAL_TERMINALS.' ', ' pngcairo ') > 0) {\n";
-  s += "  set terminal pngcairo size 1200,900 font 'Sans,10' noenhanced\n";
+  s += fmt::format("  set terminal pngcairo size {},{} font 'Sans,10' noenhanced\n", width, height);
   s += "} else {\n";
-  s += "  set terminal png size 1200,900 noenhanced\n";
+  s += fmt::format("  set terminal png size {},{} noenhanced\n", width, height);
   s += "}\n";
   // Names such as residual_vel_blade or x' are drawn as written, not as enhanced-text markup.
   s += "set termoption noenhanced\n";
@@ -470,90 +553,150 @@ std::string make_script(const ScriptInput& in) {
   s += fmt::format("set multiplot layout {},{} title {} font ',13'\n", layout_rows, layout_columns,
                    gp_label(in.title));
 
-  const auto time_series = [&](std::string_view heading, const std::vector<Column>& columns) {
-    if (columns.empty()) return;
-    s += fmt::format("set title {}\n", gp_label(fmt::format("{}{}", heading, thinned)));
-    s += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in.time_name));
-    std::vector<std::string> clauses;
-    for (const Column& c : columns) {
-      clauses.push_back(plot_clause(every, fmt::format("1:{}", c.index), "lines", c.name));
+  // The events on a time axis: dashed vertical lines (arrows from the bottom to the top of the
+  // graph), their names written along them when there are few, and one legend entry per name.
+  const auto mark_events = [&](std::vector<std::string>& clauses) {
+    if (in.events.empty()) return;
+    int tag = 1;
+    for (std::size_t i = 0; i < in.events.size(); i += event_step) {
+      const PlotEvent& e = in.events[i];
+      s += fmt::format("set arrow {} from {:.17g}, graph 0 to {:.17g}, graph 1 nohead dashtype 2 lw 1.2 "
+                       "linecolor rgb '{}' front\n",
+                       tag, e.t, e.t, colour_of(e.name));
+      if (label_events)
+        s += fmt::format("set label {} {} at {:.17g}, graph 0.97 rotate by 90 right offset character -0.7,0 "
+                         "font ',8' textcolor rgb '{}' front\n",
+                         tag, gp_label(e.name), e.t, colour_of(e.name));
+      ++tag;
     }
-    s += join_clauses(clauses);
+    for (const std::string& name : event_names)
+      clauses.push_back(fmt::format("NaN with lines dashtype 2 lw 1.2 linecolor rgb '{}' title {}", colour_of(name),
+                                    gp_label("event " + name)));
   };
-  time_series("coordinates", in.coordinates);
-  time_series("reactions", in.reactions);
-  time_series("actuator forces u", in.actuators);
+  const auto clear_marks = [&] { s += "unset arrow\nunset label\n"; };
+  const auto title_of = [&](const ScriptPanel& p, std::size_t i) {
+    return p.panel.labels.size() == p.curves.size() ? p.panel.labels[i] : p.curves[i].name;
+  };
 
-  if (!in.residuals.empty()) {
-    // A residual that is exactly zero (at t = 0, or a constraint met to the last bit) has no
-    // logarithm. It is left out (mapped to NaN, which gnuplot skips, leaving a gap in the
-    // line) rather than clamped to a floor such as 1e-300, which would stretch the axis over
-    // 300 empty decades and draw a comb of spikes down to it. If no drawn row has a nonzero
-    // residual, gnuplot would stop on "all points y value undefined": a first pass (stats)
-    // finds the largest |r| over the rows drawn, and when it is 0 the panel shows |r| on a
-    // linear axis instead. Expressions are written inline: calling a user-defined gnuplot
-    // function costs several times more per row.
-    std::string largest = "largest = 0";
-    for (const Column& c : in.residuals) {
-      largest += fmt::format(
-          ", largest = (abs(column({0})) > largest ? abs(column({0})) : largest)", c.index);
+  std::size_t drift_index = 0;
+  for (const ScriptPanel& p : in.panels) {
+    switch (p.panel.kind) {
+      case PanelKind::lines: {
+        s += fmt::format("set title {}\n", gp_label(fmt::format("{}{}", p.panel.title, thinned)));
+        s += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in.time_name));
+        std::vector<std::string> clauses;
+        for (std::size_t i = 0; i < p.curves.size(); ++i)
+          clauses.push_back(plot_clause(every, fmt::format("1:{}", p.curves[i].index), "lines", title_of(p, i)));
+        mark_events(clauses);
+        if (p.panel.y_range)
+          s += fmt::format("set yrange [{:.17g}:{:.17g}]\n", p.panel.y_range->first, p.panel.y_range->second);
+        s += join_clauses(clauses);
+        if (p.panel.y_range) s += "set autoscale y\n";
+        clear_marks();
+        break;
+      }
+      case PanelKind::drift: {
+        const Column& e = p.curves.front();
+        // Exponent form: always a gnuplot float (a bare "1" would be an integer), all 17 digits.
+        s += fmt::format("drift0 = {:.16e}\n", in.drift0[drift_index++]);
+        s += fmt::format("set title {}\n", gp_label(fmt::format("{}{}", p.panel.title, thinned)));
+        s += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in.time_name));
+        std::vector<std::string> clauses{plot_clause(every, fmt::format("1:(column({}) - drift0)", e.index), "lines",
+                                                     in.drift0[drift_index - 1] == 0.0
+                                                         ? title_of(p, 0)
+                                                         : fmt::format("{0}(t) - {0}(t0)", title_of(p, 0)))};
+        mark_events(clauses);
+        s += join_clauses(clauses);
+        clear_marks();
+        break;
+      }
+      case PanelKind::log_abs: {
+        // A value that is exactly zero (at t = 0, or a constraint met to the last bit) has no
+        // logarithm. It is left out (mapped to NaN, which gnuplot skips, leaving a gap in the
+        // line) rather than clamped to a floor such as 1e-300, which would stretch the axis over
+        // 300 empty decades and draw a comb of spikes down to it. If no drawn row has a nonzero
+        // value, gnuplot would stop on "all points y value undefined": a first pass (stats)
+        // finds the largest |r| over the rows drawn, and when it is 0 the panel shows |r| on a
+        // linear axis instead. Expressions are written inline: calling a user-defined gnuplot
+        // function costs several times more per row.
+        std::string largest = "largest = 0";
+        for (const Column& c : p.curves)
+          largest += fmt::format(", largest = (abs(column({0})) > largest ? abs(column({0})) : largest)", c.index);
+        s += fmt::format("stats csv_file{} using ({}, largest) nooutput\n", every, largest);
+        s += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in.time_name));
+        std::vector<std::string> log_clauses;
+        std::vector<std::string> linear_clauses;
+        for (std::size_t i = 0; i < p.curves.size(); ++i) {
+          const Column& c = p.curves[i];
+          log_clauses.push_back(plot_clause(
+              every, fmt::format("1:(column({0}) != 0 ? abs(column({0})) : NaN)", c.index), "lines", title_of(p, i)));
+          linear_clauses.push_back(
+              plot_clause(every, fmt::format("1:(abs(column({})))", c.index), "lines", title_of(p, i)));
+        }
+        mark_events(log_clauses);
+        mark_events(linear_clauses);
+        s += "if (STATS_max > 0) {\n";
+        s += fmt::format("set title {}\n",
+                         gp_label(fmt::format("{}, log scale, exact zeros left out{}", p.panel.title, thinned)));
+        s += "set logscale y\nset format y '1e%L'\n";
+        if (in.log_range)
+          s += fmt::format("set yrange [{:.17g}:{:.17g}]\n", in.log_range->first, in.log_range->second);
+        s += join_clauses(log_clauses);
+        s += "unset logscale y\nset format y '% h'\nset autoscale y\n";
+        s += "} else {\n";
+        s += fmt::format("set title {}\n",
+                         gp_label(fmt::format("{}, every value exactly 0{}", p.panel.title, thinned)));
+        s += join_clauses(linear_clauses);
+        s += "}\n";
+        clear_marks();
+        break;
+      }
+      case PanelKind::path: {
+        const Column& x = p.curves[0];
+        const Column& y = p.curves[1];
+        s += fmt::format("set title {}\n",
+                         gp_label(fmt::format("{}{}{}", p.panel.title,
+                                              p.panel.equal_axes ? ", equal scales" : ", scales not equal", thinned)));
+        s += fmt::format("set xlabel {}\nset ylabel {}\n", gp_label(x.name), gp_label(y.name));
+        if (p.panel.equal_axes) {
+          // Equal scales make the panel narrow: choose an x tic step giving ~4 intervals so the
+          // tic labels do not run into each other.
+          s += fmt::format("stats csv_file{} using {} nooutput\n", every, x.index);
+          s += "if (STATS_max > STATS_min) {\n";
+          s += "  path_step = (STATS_max - STATS_min) / 4.0\n";
+          s += "  path_unit = 10.0**floor(log10(path_step))\n";
+          s += "  path_f = path_step / path_unit\n";
+          s += "  path_tic = (path_f < 1.5 ? 1 : path_f < 3.5 ? 2 : path_f < 7.5 ? 5 : 10) * path_unit\n";
+          s += "  set xtics path_tic\n";  // not "set xtics (...)": that would read as a list of tics
+          s += "}\n";
+          s += "set size ratio -1\n";
+        } else {
+          // Each axis on its own scale, with a margin so the path does not run along the frame.
+          s += "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n";
+        }
+        // The events where the state is known: a circle at (x, y), named when there are few.
+        int tag = 1;
+        for (std::size_t i = 0; i < in.events.size(); i += event_step) {
+          const PlotEvent& e = in.events[i];
+          std::optional<double> ex, ey;
+          for (const auto& [name, value] : e.state) {
+            if (name == x.name) ex = value;
+            if (name == y.name) ey = value;
+          }
+          if (!ex || !ey) continue;
+          s += fmt::format("set label {} {} at {:.17g}, {:.17g} point pointtype 6 pointsize 1.6 linecolor rgb '{}' "
+                           "offset character 0.8,0.8 font ',8' textcolor rgb '{}' front\n",
+                           tag++, gp_label(label_events ? e.name : ""), *ex, *ey, colour_of(e.name),
+                           colour_of(e.name));
+        }
+        s += join_clauses({plot_clause(every, fmt::format("{}:{}", x.index, y.index), "lines", "path"),
+                           fmt::format("csv_file{} every ::0::0 using {}:{} with points pt 7 ps 1.2 title 'start'",
+                                       all, x.index, y.index)});
+        s += "set size noratio\nset xtics autofreq\nset offsets 0, 0, 0, 0\n";
+        clear_marks();
+        break;
+      }
     }
-    s += fmt::format("stats csv_file{} using ({}, largest) nooutput\n", every, largest);
-    s += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in.time_name));
-    std::vector<std::string> log_clauses;
-    std::vector<std::string> linear_clauses;
-    for (const Column& c : in.residuals) {
-      log_clauses.push_back(
-          plot_clause(every, fmt::format("1:(column({0}) != 0 ? abs(column({0})) : NaN)", c.index),
-                      "lines", c.name));
-      linear_clauses.push_back(
-          plot_clause(every, fmt::format("1:(abs(column({})))", c.index), "lines", c.name));
-    }
-    s += "if (STATS_max > 0) {\n";
-    s += fmt::format(
-        "set title {}\n",
-        gp_label(fmt::format("|residual|, log scale, exact zeros left out{}", thinned)));
-    s += "set logscale y\n";
-    s += join_clauses(log_clauses);
-    s += "unset logscale y\n";
-    s += "} else {\n";
-    s += fmt::format("set title {}\n",
-                     gp_label(fmt::format("|residual|, every value exactly 0{}", thinned)));
-    s += join_clauses(linear_clauses);
-    s += "}\n";
-  }
-
-  if (in.path) {
-    const auto& [x, y] = *in.path;
-    // Equal scales (ratio -1) make the panel narrow: choose an x tic step giving ~4 intervals
-    // so the tic labels do not run into each other.
-    s += fmt::format("stats csv_file{} using {} nooutput\n", every, x.index);
-    s += "if (STATS_max > STATS_min) {\n";
-    s += "  path_step = (STATS_max - STATS_min) / 4.0\n";
-    s += "  path_unit = 10.0**floor(log10(path_step))\n";
-    s += "  path_f = path_step / path_unit\n";
-    s += "  path_tic = (path_f < 1.5 ? 1 : path_f < 3.5 ? 2 : path_f < 7.5 ? 5 : 10) * path_unit\n";
-    s += "  set xtics path_tic\n";  // not "set xtics (...)": that would read as a list of tics
-    s += "}\n";
-    s += fmt::format("set title {}\n",
-                     gp_label(fmt::format("path {}({}), equal scales{}", y.name, x.name, thinned)));
-    s += fmt::format("set xlabel {}\nset ylabel {}\n", gp_label(x.name), gp_label(y.name));
-    s += "set size ratio -1\n";
-    s += join_clauses({plot_clause(every, fmt::format("{}:{}", x.index, y.index), "lines", "path"),
-                       fmt::format("csv_file{} every ::0::0 using {}:{} with points pt 7 ps 1.2 "
-                                   "title 'start'",
-                                   all, x.index, y.index)});
-    s += "set size noratio\nset xtics autofreq\n";
-  }
-
-  if (in.energy) {
-    const Column& e = *in.energy;
-    // Exponent form: always a gnuplot float (a bare "1" would be an integer), all 17 digits.
-    s += fmt::format("energy0 = {:.16e}\n", in.energy0);
-    s += fmt::format("set title {}\n", gp_label(fmt::format("{}{}", e.name == "balance_error" ? "energy balance error h - h0 - W" : "energy drift", thinned)));
-    s += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in.time_name));
-    s += join_clauses({plot_clause(every, fmt::format("1:(column({}) - energy0)", e.index), "lines",
-                                   fmt::format("{0}(t) - {0}(0)", e.name))});
   }
 
   s += "unset multiplot\n";
@@ -636,6 +779,322 @@ void render(const fs::path& png, const fs::path& named_target, const fs::path& c
   output.keep();
 }
 
+// ---------------------------------------------------------------------------------------------
+// Which panel a column goes to (pure; docs/cli.md, "What --plot draws").
+
+// A curve joins a panel only if the panel's range, with it, spans at most this many times the
+// curve's own span: every curve then fills at least a tenth of its panel's height.
+constexpr double scale_ratio = 10.0;
+// The path is drawn with equal axes when its span ratio y/x lies in this interval: a panel is
+// about 620 x 300 px, so both sides of the drawn box keep at least a third of the panel.
+constexpr double path_ratio_low = 0.2;
+constexpr double path_ratio_high = 1.5;
+
+// The coordinate a velocity (x') or a reaction (R_x) belongs to.
+std::string_view base_coordinate(const PlotColumn& c) {
+  std::string_view name = c.name;
+  if (c.role == PlotRole::velocity)
+    while (!name.empty() && name.back() == '\'') name.remove_suffix(1);
+  if (c.role == PlotRole::reaction && name.starts_with("R_")) name.remove_prefix(2);
+  return name;
+}
+
+// A column whose values vary by no more than this fraction of the largest magnitude among the
+// columns of its role is constant to round-off: a reaction that is zero up to 1e-17 is drawn as
+// the zero it is, not magnified into noise. Below the tolerance of any run (rtol 1e-8 by
+// default), such a variation is the integrator's error, not the motion.
+constexpr double round_off = 1e-9;
+
+struct ScaleGroup {
+  std::vector<std::string> names;
+  std::optional<std::pair<double, double>> y_range;  // set for a group of constants
+};
+
+// Splits columns of like units into groups of like scale (scale_ratio). Largest spans first,
+// so a group's first member sets its range; each group keeps the columns in their given order,
+// and the groups come in the order of their first column. `role_scale` is the largest |value|
+// among the columns of their role (round_off).
+std::vector<ScaleGroup> split_by_scale(const std::vector<const PlotColumn*>& columns, double role_scale) {
+  const auto span = [&](const PlotColumn* c) {
+    const double s = c->max - c->min;
+    if (!std::isfinite(s)) return 0.0;
+    return s <= round_off * role_scale ? 0.0 : s;
+  };
+  std::vector<std::size_t> order(columns.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return span(columns[a]) > span(columns[b]); });
+  struct Group {
+    double lo = NAN, hi = NAN;
+    double smallest = INFINITY;  // smallest positive span of a member
+    std::vector<std::size_t> members;
+  };
+  std::vector<Group> groups;
+  for (std::size_t i : order) {
+    const PlotColumn* c = columns[i];
+    const bool finite = std::isfinite(c->min) && std::isfinite(c->max);
+    Group* home = nullptr;
+    for (Group& g : groups) {
+      if (!finite || std::isnan(g.lo)) {  // no values to place: any group will do
+        home = &g;
+        break;
+      }
+      const double lo = std::min(g.lo, c->min), hi = std::max(g.hi, c->max);
+      const double smallest = span(c) > 0.0 ? std::min(g.smallest, span(c)) : g.smallest;
+      // A group of constants takes any other constant: flat lines at their levels read well.
+      if (!std::isfinite(smallest) || hi - lo <= scale_ratio * smallest) {
+        home = &g;
+        break;
+      }
+    }
+    if (!home) home = &groups.emplace_back();
+    home->members.push_back(i);
+    if (finite) {
+      home->lo = std::isnan(home->lo) ? c->min : std::min(home->lo, c->min);
+      home->hi = std::isnan(home->hi) ? c->max : std::max(home->hi, c->max);
+      if (span(c) > 0.0) home->smallest = std::min(home->smallest, span(c));
+    }
+  }
+  // Each group's members in their given order; the groups in the order of their first member
+  // (the first member of a group is its smallest index).
+  std::vector<std::pair<std::size_t, std::size_t>> first;  // (first member, group)
+  for (std::size_t k = 0; k < groups.size(); ++k) {
+    std::sort(groups[k].members.begin(), groups[k].members.end());
+    first.emplace_back(groups[k].members.front(), k);
+  }
+  std::sort(first.begin(), first.end());
+  std::vector<ScaleGroup> out;
+  for (const auto& [unused, k] : first) {
+    const Group& g = groups[k];
+    ScaleGroup& group = out.emplace_back();
+    for (std::size_t i : g.members) group.names.push_back(columns[i]->name);
+    if (std::isfinite(g.smallest) || std::isnan(g.lo)) continue;
+    // Constants: a range around them wide enough that round-off does not show, and that holds
+    // every level with a margin.
+    const double mid = 0.5 * (g.lo + g.hi);
+    double half = std::max({0.6 * (g.hi - g.lo), 0.5 * std::abs(mid), 0.1 * role_scale});
+    if (!(half > 0.0)) half = 1.0;
+    group.y_range.emplace(mid - half, mid + half);
+  }
+  return out;
+}
+
+std::string join_names(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t i = 0; i < names.size(); ++i) out += (i == 0 ? "" : ", ") + names[i];
+  return out;
+}
+
+}  // namespace
+
+bool is_angle_name(std::string_view coordinate) {
+  std::string_view stem = coordinate.substr(0, coordinate.find_first_of("_0123456789'"));
+  while (!stem.empty() && stem.back() >= 'A' && stem.back() <= 'Z') stem.remove_suffix(1);
+  static constexpr std::array<std::string_view, 13> angles = {
+      "alpha", "beta", "gamma", "delta", "theta", "vartheta", "th", "phi", "varphi", "chi", "psi", "angle", "ang"};
+  return std::find(angles.begin(), angles.end(), stem) != angles.end();
+}
+
+std::vector<PlotPanel> calc_plot_panels(const std::vector<PlotColumn>& columns,
+                                        const std::optional<std::pair<PlotColumn, PlotColumn>>& path,
+                                        const std::vector<std::string>& angles) {
+  const auto is_angle = [&](std::string_view coordinate) {
+    return is_angle_name(coordinate) || std::find(angles.begin(), angles.end(), coordinate) != angles.end();
+  };
+  std::vector<PlotPanel> panels;
+  const auto lines = [&](PlotRole role, int which, std::string_view title) {
+    // which: 1 only the angles, 0 only the others, -1 every column of the role.
+    std::vector<const PlotColumn*> chosen;
+    double role_scale = 0.0;
+    // Reactions and actuator forces are both generalized forces: one scale for the two roles.
+    const auto same_scale = [&](PlotRole r) {
+      const auto forces = [](PlotRole x) { return x == PlotRole::reaction || x == PlotRole::actuator; };
+      return r == role || (forces(r) && forces(role));
+    };
+    for (const PlotColumn& c : columns) {
+      if (same_scale(c.role) && std::isfinite(c.max - c.min))
+        role_scale = std::max({role_scale, std::abs(c.min), std::abs(c.max)});
+      if (c.role != role) continue;
+      if (which >= 0 && is_angle(base_coordinate(c)) != (which == 1)) continue;
+      chosen.push_back(&c);
+    }
+    for (ScaleGroup& group : split_by_scale(chosen, role_scale)) {
+      PlotPanel& p = panels.emplace_back(PlotPanel{std::string(title), PanelKind::lines, std::move(group.names)});
+      p.y_range = group.y_range;
+      if (p.y_range) p.title += ", constant to round-off";
+    }
+  };
+  lines(PlotRole::coordinate, 1, "angles");
+  lines(PlotRole::coordinate, 0, "coordinates");
+  lines(PlotRole::velocity, 1, "angular velocities");
+  lines(PlotRole::velocity, 0, "velocities");
+  if (path) {
+    const double xs = path->first.max - path->first.min;
+    const double ys = path->second.max - path->second.min;
+    const double scale = std::max({std::abs(path->first.min), std::abs(path->first.max), std::abs(path->second.min),
+                                   std::abs(path->second.max)});
+    if (std::isfinite(xs) && std::isfinite(ys) && xs > round_off * scale && ys > round_off * scale) {
+      const double ratio = ys / xs;
+      PlotPanel p{fmt::format("path {}({})", path->second.name, path->first.name), PanelKind::path,
+                  {path->first.name, path->second.name}};
+      p.equal_axes = ratio >= path_ratio_low && ratio <= path_ratio_high;
+      panels.push_back(std::move(p));
+    }
+  }
+  lines(PlotRole::reaction, 1, "reactions on angles");
+  lines(PlotRole::reaction, 0, "reactions");
+  lines(PlotRole::actuator, -1, "actuator forces u");
+  lines(PlotRole::other, -1, "other columns");
+  std::vector<std::string> residuals;
+  for (const PlotColumn& c : columns)
+    if (c.role == PlotRole::residual) residuals.push_back(c.name);
+  if (!residuals.empty()) panels.push_back(PlotPanel{"|residual|", PanelKind::log_abs, residuals});
+  for (const PlotColumn& c : columns) {
+    if (c.role != PlotRole::energy_error) continue;
+    panels.push_back(PlotPanel{c.name == "balance_error" ? "energy balance error h - h0 - W" : "energy drift",
+                               PanelKind::drift, {c.name}});
+  }
+  return panels;
+}
+
+void require_plot_columns(const std::vector<std::string>& all, const std::vector<std::string>& chosen,
+                          std::string_view option) {
+  for (const std::string& name : chosen) {
+    if (std::find(all.begin(), all.end(), name) != all.end()) continue;
+    throw InputError(fmt::format("{} names the column '{}', which this run does not write; its columns are: {}; "
+                                 "choose among them (comma-separated)",
+                                 option, name, join_names(all)));
+  }
+}
+
+void select_plot_columns(PlotRequest& request, const std::vector<std::string>& all,
+                         const std::vector<std::string>& chosen, std::string_view option) {
+  if (chosen.empty()) return;
+  require_plot_columns(all, chosen, option);
+  const auto is_chosen = [&](const std::string& name) {
+    return std::find(chosen.begin(), chosen.end(), name) != chosen.end();
+  };
+  std::vector<std::string> placed;
+  for (std::vector<std::string>* role : {&request.coordinates, &request.velocities, &request.reactions,
+                                         &request.actuators, &request.residuals, &request.others}) {
+    std::erase_if(*role, [&](const std::string& name) { return !is_chosen(name); });
+    placed.insert(placed.end(), role->begin(), role->end());
+  }
+  if (request.energy && !is_chosen(*request.energy)) request.energy.reset();
+  if (request.energy) placed.push_back(*request.energy);
+  if (request.path && !(is_chosen(request.path->first) && is_chosen(request.path->second))) request.path.reset();
+  for (const std::string& name : chosen)
+    if (std::find(placed.begin(), placed.end(), name) == placed.end()) {
+      request.others.push_back(name);
+      placed.push_back(name);
+    }
+}
+
+std::vector<PlotPanel> calc_comparison_panels(const std::vector<std::string>& methods,
+                                              const std::vector<std::string>& integrators,
+                                              const std::vector<std::string>& quantities) {
+  const auto column = [](const std::string& quantity, const std::string& method, const std::string& integrator) {
+    return fmt::format("{}_{}_{}", quantity, method, integrator);
+  };
+  std::vector<PlotPanel> panels;
+  if (integrators.size() == 1 || methods.size() == 1) {
+    const bool by_method = integrators.size() == 1;
+    for (const std::string& outer : by_method ? methods : integrators) {
+      PlotPanel& p = panels.emplace_back();
+      p.kind = PanelKind::log_abs;
+      p.title = by_method ? fmt::format("{} ({})", outer, integrators.front())
+                          : fmt::format("{} ({})", outer, methods.front());
+      for (const std::string& q : quantities) {
+        p.columns.push_back(by_method ? column(q, outer, integrators.front()) : column(q, methods.front(), outer));
+        p.labels.push_back(q);
+      }
+    }
+    return panels;
+  }
+  for (const std::string& q : quantities)
+    for (const std::string& m : methods) {
+      PlotPanel& p = panels.emplace_back();
+      p.kind = PanelKind::log_abs;
+      p.title = fmt::format("{}: {}", q, m);
+      for (const std::string& i : integrators) {
+        p.columns.push_back(column(q, m, i));
+        p.labels.push_back(i);
+      }
+    }
+  return panels;
+}
+
+void select_panel_columns(std::vector<PlotPanel>& panels, const std::vector<std::string>& chosen) {
+  if (chosen.empty()) return;
+  for (PlotPanel& p : panels) {
+    for (std::size_t i = p.columns.size(); i-- > 0;) {
+      if (std::find(chosen.begin(), chosen.end(), p.columns[i]) != chosen.end()) continue;
+      p.columns.erase(p.columns.begin() + static_cast<std::ptrdiff_t>(i));
+      if (i < p.labels.size()) p.labels.erase(p.labels.begin() + static_cast<std::ptrdiff_t>(i));
+    }
+  }
+  std::erase_if(panels, [](const PlotPanel& p) { return p.columns.empty(); });
+}
+
+namespace {
+
+// Resolves the panels' columns, reads what the script needs from the CSV and draws it.
+void draw_panels(const std::string& title, const fs::path& csv, const CsvHead& head, std::vector<PlotPanel> panels,
+                 const std::vector<PlotEvent>& events, bool same_log_range, int layout_columns,
+                 const fs::path& png) {
+  std::error_code ec;
+  ScriptInput in;
+  in.csv = fs::absolute(csv, ec);
+  if (ec) throw FileError(fmt::format("cannot resolve the CSV path '{}' ({})", csv.string(), ec.message()));
+  const fs::path target = fs::absolute(png, ec);
+  if (ec) throw FileError(fmt::format("cannot resolve the plot path '{}' ({})", png.string(), ec.message()));
+  in.title = title;
+  in.time_name = head.names.front();
+  in.header_lines = head.header_lines;
+  in.events = events;
+  in.layout_columns = layout_columns;
+  if (head.rows > max_rows_per_curve) in.stride = (head.rows + max_rows_per_curve - 1) / max_rows_per_curve;
+  std::vector<int> log_indices;
+  for (PlotPanel& p : panels) {
+    ScriptPanel& sp = in.panels.emplace_back();
+    for (const std::string& name : p.columns) sp.curves.push_back(Column{column_of(head, csv, name, "a"), name});
+    if (p.kind == PanelKind::log_abs)
+      for (const Column& c : sp.curves) log_indices.push_back(c.index);
+    if (p.kind == PanelKind::drift) {
+      const std::string& name = p.columns.front();
+      const std::size_t i = static_cast<std::size_t>(sp.curves.front().index) - 1;
+      const std::string field = i < head.first_row.size() ? head.first_row[i] : "";
+      double first = 0.0;
+      const auto [end, err] = std::from_chars(field.data(), field.data() + field.size(), first);
+      if (err != std::errc{} || end != field.data() + field.size() || !std::isfinite(first)) {
+        throw InputError(fmt::format(
+            "cannot plot the energy drift: the first value '{}' of column '{}' in '{}' is not a "
+            "finite number; check the CSV, or plot without the energy",
+            field, name, csv.string()));
+      }
+      in.drift0.push_back(first);
+    }
+    sp.panel = std::move(p);
+  }
+  if (same_log_range && !log_indices.empty()) {
+    double lo = INFINITY, hi = 0.0;
+    for (const Range& r : read_ranges(csv, head.header_lines, log_indices, in.stride)) {
+      if (std::isfinite(r.min_abs_positive)) lo = std::min(lo, r.min_abs_positive);
+      if (std::isfinite(r.max_abs)) hi = std::max(hi, r.max_abs);
+    }
+    if (std::isfinite(lo) && hi > 0.0) {
+      const double low = std::pow(10.0, std::floor(std::log10(lo)));
+      double high = std::pow(10.0, std::ceil(std::log10(hi)));
+      if (high <= low) high = low * 10.0;
+      in.log_range.emplace(low, high);
+    }
+  }
+  render(png, target, csv, [&](const fs::path& output) {
+    in.output = output;
+    return make_script(in);
+  });
+}
+
 }  // namespace
 
 bool gnuplot_available() {
@@ -645,69 +1104,75 @@ bool gnuplot_available() {
 
 void write_plot(const PlotRequest& request, const std::filesystem::path& png) {
   if (request.coordinates.empty() && request.reactions.empty() && request.residuals.empty() &&
-      request.actuators.empty() && !request.path && !request.energy) {
+      request.actuators.empty() && request.velocities.empty() && request.others.empty() && !request.path &&
+      !request.energy) {
     throw InputError(fmt::format(
-        "nothing to plot into '{}': the request names no coordinate, reaction, residual, path "
-        "or energy column",
+        "nothing to plot into '{}': the request names no coordinate, velocity, reaction, residual, path, "
+        "energy or other column",
         png.string()));
   }
-  std::error_code ec;
-  ScriptInput in;
-  in.csv = fs::absolute(request.csv, ec);
-  if (ec) {
-    throw FileError(
-        fmt::format("cannot resolve the CSV path '{}' ({})", request.csv.string(), ec.message()));
+  const CsvHead head = read_csv_head(request.csv);
+  std::vector<PlotColumn> columns;
+  std::vector<int> indices;
+  const auto add = [&](const std::vector<std::string>& names, PlotRole role, std::string_view what) {
+    for (const std::string& name : names) {
+      indices.push_back(column_of(head, request.csv, name, what));
+      columns.push_back(PlotColumn{name, role});
+    }
+  };
+  add(request.coordinates, PlotRole::coordinate, "coordinate");
+  add(request.velocities, PlotRole::velocity, "velocity");
+  add(request.reactions, PlotRole::reaction, "reaction");
+  add(request.actuators, PlotRole::actuator, "actuator force");
+  add(request.others, PlotRole::other, "a");
+  add(request.residuals, PlotRole::residual, "residual");
+  if (request.energy) add({*request.energy}, PlotRole::energy_error, "energy");
+  std::optional<std::pair<PlotColumn, PlotColumn>> path;
+  if (request.path) {
+    indices.push_back(column_of(head, request.csv, request.path->first, "path x"));
+    indices.push_back(column_of(head, request.csv, request.path->second, "path y"));
+    path.emplace(PlotColumn{request.path->first, PlotRole::coordinate},
+                 PlotColumn{request.path->second, PlotRole::coordinate});
   }
-  const fs::path target = fs::absolute(png, ec);
-  if (ec) {
-    throw FileError(
-        fmt::format("cannot resolve the plot path '{}' ({})", png.string(), ec.message()));
+  const std::uintmax_t stride =
+      head.rows > max_rows_per_curve ? (head.rows + max_rows_per_curve - 1) / max_rows_per_curve : 1;
+  const std::vector<Range> ranges = read_ranges(request.csv, head.header_lines, indices, stride);
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    columns[i].min = ranges[i].min;
+    columns[i].max = ranges[i].max;
+  }
+  if (path) {
+    path->first.min = ranges[columns.size()].min;
+    path->first.max = ranges[columns.size()].max;
+    path->second.min = ranges[columns.size() + 1].min;
+    path->second.max = ranges[columns.size() + 1].max;
+  }
+  std::vector<PlotPanel> panels = calc_plot_panels(columns, path, request.angles);
+  if (panels.empty()) {
+    throw InputError(fmt::format("nothing to plot into '{}': the path {}({}) is a line or a point in '{}'; plot "
+                                 "its columns against time instead",
+                                 png.string(), request.path->second, request.path->first, request.csv.string()));
+  }
+  draw_panels(request.title, request.csv, head, std::move(panels), request.events, false, 0, png);
+}
+
+void write_panel_plot(const PanelPlotRequest& request, const std::filesystem::path& png) {
+  if (request.panels.empty())
+    throw InputError(fmt::format("nothing to plot into '{}': the request has no panel", png.string()));
+  for (const PlotPanel& p : request.panels) {
+    if (p.columns.empty() || (p.kind == PanelKind::path && p.columns.size() != 2) ||
+        (p.kind == PanelKind::drift && p.columns.size() != 1))
+      throw InputError(fmt::format("plot '{}': the panel '{}' has {} columns; a path takes 2, a drift 1, "
+                                   "any other panel at least 1",
+                                   png.string(), p.title, p.columns.size()));
+    if (!p.labels.empty() && p.labels.size() != p.columns.size())
+      throw InputError(fmt::format("plot '{}': the panel '{}' has {} labels for {} columns; give one per column "
+                                   "or none",
+                                   png.string(), p.title, p.labels.size(), p.columns.size()));
   }
   const CsvHead head = read_csv_head(request.csv);
-
-  const auto lookup = [&](const std::string& name, std::string_view role) {
-    return Column{column_of(head, request.csv, name, role), name};
-  };
-  for (const std::string& name : request.coordinates) {
-    in.coordinates.push_back(lookup(name, "coordinate"));
-  }
-  for (const std::string& name : request.reactions) {
-    in.reactions.push_back(lookup(name, "reaction"));
-  }
-  for (const std::string& name : request.residuals) {
-    in.residuals.push_back(lookup(name, "residual"));
-  }
-  for (const std::string& name : request.actuators) {
-    in.actuators.push_back(lookup(name, "actuator force"));
-  }
-  if (request.path) {
-    Column x = lookup(request.path->first, "path x");
-    Column y = lookup(request.path->second, "path y");
-    in.path.emplace(std::move(x), std::move(y));
-  }
-  if (request.energy) {
-    in.energy = lookup(*request.energy, "energy");
-    const std::size_t i = static_cast<std::size_t>(in.energy->index) - 1;
-    const std::string field = i < head.first_row.size() ? head.first_row[i] : "";
-    const auto [end, err] = std::from_chars(field.data(), field.data() + field.size(), in.energy0);
-    if (err != std::errc{} || end != field.data() + field.size() || !std::isfinite(in.energy0)) {
-      throw InputError(fmt::format(
-          "cannot plot the energy drift: the first value '{}' of column '{}' in '{}' is not a "
-          "finite number; check the CSV, or plot without the energy",
-          field, *request.energy, request.csv.string()));
-    }
-  }
-  in.title = request.title;
-  in.time_name = head.names.front();
-  in.header_lines = head.header_lines;
-  if (head.rows > max_rows_per_curve) {
-    in.stride = (head.rows + max_rows_per_curve - 1) / max_rows_per_curve;
-  }
-
-  render(png, target, request.csv, [&](const fs::path& output) {
-    in.output = output;
-    return make_script(in);
-  });
+  draw_panels(request.title, request.csv, head, request.panels, request.events, request.same_log_range,
+              request.layout_columns, png);
 }
 
 }  // namespace nhdyn
