@@ -111,6 +111,7 @@ void bind_model(py::module_& m) {
         d["reactions"] = c.reactions;
         d["residuals"] = c.residuals;
         d["energy"] = c.energy;
+        d["outputs"] = c.outputs;
         return d;
       });
 

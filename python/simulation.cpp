@@ -149,6 +149,8 @@ py::dict trajectory_dict(Trajectory&& tr) {
   d["energy"] = tr.has_energy ? py::object(take_array(std::move(tr.energy), {rows})) : py::object(py::none());
   const auto b = static_cast<py::ssize_t>(tr.balance_columns);
   d["energy_balance"] = b > 0 ? py::object(take_array(std::move(tr.balance), {rows, b})) : py::object(py::none());
+  // The derived outputs ([outputs], multibody points), rows x count in Model::outputs order.
+  d["outputs"] = take_array(std::move(tr.outputs), {rows, static_cast<py::ssize_t>(tr.output_columns)});
   return d;
 }
 

@@ -256,6 +256,9 @@ int run_batch(const BatchArgs& args) {
         const auto b = static_cast<std::size_t>(tr.balance_columns);
         row.insert(row.end(), tr.balance.begin() + static_cast<std::ptrdiff_t>(k * b),
                    tr.balance.begin() + static_cast<std::ptrdiff_t>((k + 1) * b));
+        const auto o = static_cast<std::size_t>(tr.output_columns);
+        row.insert(row.end(), tr.outputs.begin() + static_cast<std::ptrdiff_t>(k * o),
+                   tr.outputs.begin() + static_cast<std::ptrdiff_t>((k + 1) * o));
         writer.write_row(row);
       }
       writer.commit();

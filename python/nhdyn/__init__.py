@@ -198,7 +198,8 @@ class Model:
 class Result:
     """The outputs of one run, one row per output time: t (rows), q, qd, qdd, R (rows x n),
     residuals (rows x residual columns: position, velocity, acceleration level) and energy (rows,
-    or None). `columns` holds the names, the same as the CSV written by `nhdyn simulate`."""
+    or None), outputs (name -> rows, the derived outputs of docs/model-format.md [outputs]).
+    `columns` holds the names, the same as the CSV written by `nhdyn simulate`."""
 
     def __init__(self, model, out):
         self.model_name = model.name
@@ -212,6 +213,9 @@ class Result:
         self.events = out["events"]
         self.cpp_seconds = out["cpp_seconds"]
         self.columns = model._cpp.columns
+        # The derived outputs ([outputs] of the model file, a multibody model's points): name -> rows.
+        values = out.get("outputs")
+        self.outputs = {name: values[:, i] for i, name in enumerate(self.columns["outputs"])}
 
     def table(self):
         """Every column side by side, in the CSV's order: (names, rows x columns array)."""
@@ -220,6 +224,8 @@ class Result:
             parts.append(self.energy[:, None])
         if self.energy_balance is not None:
             parts.append(self.energy_balance)
+        if self.outputs:
+            parts.append(np.column_stack(list(self.outputs.values())))
         return list(self.columns["all"]), np.hstack(parts)
 
     def to_pandas(self):

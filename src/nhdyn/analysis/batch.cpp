@@ -17,7 +17,8 @@ void Trajectory::reset(const Model& model, long expected_rows) {
   residual_columns = model.position_constraints() + model.velocity_constraints() + model.s();
   has_energy = model.evaluator && model.evaluator->has_energy();
   balance_columns = model.evaluator && model.evaluator->has_energy_balance() ? kEnergyBalanceColumns : 0;
-  for (std::vector<double>* column : {&t, &q, &v, &qdd, &R, &residuals, &energy, &balance}) column->clear();
+  output_columns = model.outputs.count();
+  for (std::vector<double>* column : {&t, &q, &v, &qdd, &R, &residuals, &energy, &balance, &outputs}) column->clear();
   const auto rows = static_cast<std::size_t>(std::max(0L, expected_rows));
   const auto un = static_cast<std::size_t>(n);
   t.reserve(rows);
@@ -28,6 +29,7 @@ void Trajectory::reset(const Model& model, long expected_rows) {
   residuals.reserve(rows * static_cast<std::size_t>(residual_columns));
   if (has_energy) energy.reserve(rows);
   balance.reserve(rows * static_cast<std::size_t>(balance_columns));
+  outputs.reserve(rows * static_cast<std::size_t>(output_columns));
 }
 
 void Trajectory::append(const Data& data) {
@@ -45,6 +47,7 @@ void Trajectory::append(const Data& data) {
     fill_energy_balance(data, row);
     balance.insert(balance.end(), row, row + kEnergyBalanceColumns);
   }
+  outputs.insert(outputs.end(), data.outputs.values.data(), data.outputs.values.data() + output_columns);
 }
 
 int batch_threads(int threads, std::size_t runs) {

@@ -30,12 +30,14 @@ struct Trajectory {
   std::vector<double> energy;       // rows (empty without an energy)
   int balance_columns = 0;          // kEnergyBalanceColumns with an energy balance, else 0
   std::vector<double> balance;      // rows x balance_columns (analysis/residuals.hpp fill_energy_balance)
+  int output_columns = 0;           // derived outputs, Model::outputs (model/output.hpp)
+  std::vector<double> outputs;      // rows x output_columns, in Model::outputs.list order
 
   long rows() const { return static_cast<long>(t.size()); }
   // Sizes the columns for `model` and drops every row; reserves `expected_rows`.
   void reset(const Model& model, long expected_rows = 0);
   // Appends the row of Data after an output (simulate's RowFn): t, q, q', q'', R, residuals,
-  // energy, energy balance.
+  // energy, energy balance, derived outputs.
   void append(const Data& data);
 };
 

@@ -1,8 +1,29 @@
 #include "nhdyn/io/results.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
+
 #include "nhdyn/analysis/residuals.hpp"
+#include "nhdyn/core/error.hpp"
 
 namespace nhdyn {
+
+namespace {
+
+// The derived outputs, last (model/output.hpp); an output may not take another column's name.
+void add_output_columns(const Model& model, ResultColumns& c) {
+  for (const DerivedOutput& o : model.outputs.list) {
+    if (std::find(c.all.begin(), c.all.end(), o.name) != c.all.end())
+      throw ModelError(fmt::format("{}output '{}' is named like the results' column '{}'; give it another name "
+                                   "(the columns: docs/model-format.md, [outputs])",
+                                   o.where.empty() ? "" : o.where + ": ", o.name, o.name));
+    c.outputs.push_back(o.name);
+    c.all.push_back(o.name);
+  }
+}
+
+}  // namespace
 
 ResultColumns make_result_columns(const Model& model) {
   ResultColumns c;
@@ -39,6 +60,7 @@ ResultColumns make_result_columns(const Model& model) {
   c.all.insert(c.all.end(), c.actuators.begin(), c.actuators.end());
   c.all.insert(c.all.end(), program_residuals.begin(), program_residuals.end());
   c.residuals.insert(c.residuals.end(), program_residuals.begin(), program_residuals.end());
+  add_output_columns(model, c);
   return c;
 }
 
@@ -58,12 +80,15 @@ void fill_result_row(const Model& model, const Data& data, std::vector<double>& 
     fill_energy_balance(data, balance);
     row.insert(row.end(), balance, balance + kEnergyBalanceColumns);
   }
-  if (model.m() == 0) return;
-  const ProgramMotionData& w = data.motion;
-  for (Eigen::Index i = 0; i < w.u.size(); ++i) row.push_back(w.u(i));
-  for (Eigen::Index i = 0; i < w.phi.size(); ++i) row.push_back(w.phi(i));
-  for (Eigen::Index i = 0; i < w.f.size(); ++i) row.push_back(w.f(i));
-  for (Eigen::Index i = 0; i < w.e.size(); ++i) row.push_back(w.e(i));
+  if (model.m() > 0) {
+    const ProgramMotionData& w = data.motion;
+    for (Eigen::Index i = 0; i < w.u.size(); ++i) row.push_back(w.u(i));
+    for (Eigen::Index i = 0; i < w.phi.size(); ++i) row.push_back(w.phi(i));
+    for (Eigen::Index i = 0; i < w.f.size(); ++i) row.push_back(w.f(i));
+    for (Eigen::Index i = 0; i < w.e.size(); ++i) row.push_back(w.e(i));
+  }
+  const Vector& outputs = data.outputs.values;
+  row.insert(row.end(), outputs.data(), outputs.data() + outputs.size());
 }
 
 }  // namespace nhdyn

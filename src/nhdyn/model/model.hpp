@@ -15,6 +15,7 @@
 #include "nhdyn/core/types.hpp"
 #include "nhdyn/model/evaluator.hpp"
 #include "nhdyn/model/event.hpp"
+#include "nhdyn/model/output.hpp"
 #include "nhdyn/model/run_options.hpp"
 
 namespace nhdyn {
@@ -77,6 +78,8 @@ struct Model {
   // The model's own events ([[events]] of its file); a run locates those of its options
   // (SimulationOptions::events, analysis/simulation.hpp), which `nhdyn simulate` starts from these.
   std::vector<Event> events;
+  // Derived outputs ([outputs], multibody points): extra result columns (model/output.hpp).
+  ModelOutputs outputs;
 
   int n() const { return static_cast<int>(coordinates.size()); }
   int s() const { return static_cast<int>(constraints.size()); }

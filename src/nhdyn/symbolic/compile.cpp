@@ -34,6 +34,7 @@
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/model/program.hpp"
 #include "nhdyn/symbolic/events.hpp"
+#include "nhdyn/symbolic/outputs.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
@@ -1013,6 +1014,7 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
     std::vector<double> scratch(model.evaluator->scratch_size());
     model.evaluator->initial_state(scratch.data(), model.q0.data(), model.v0.data());
   }
+  compile_outputs(spec, model);
   compile_events(spec, model);
   check_model_shape(model);
   return model;
@@ -1021,6 +1023,13 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
 Program compile_expression(const Spec& spec, const GiNaC::ex& expression, const std::string& what) {
   ProgramCompiler compiler(spec);
   compiler.add_output(expression, what);
+  return compiler.finish();
+}
+
+Program compile_expressions(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
+                            const std::vector<std::string>& what) {
+  ProgramCompiler compiler(spec);
+  for (std::size_t i = 0; i < expressions.size(); ++i) compiler.add_output(expressions[i], what.at(i));
   return compiler.finish();
 }
 

@@ -32,6 +32,10 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
 // symbolic/events.hpp); `what` names it in errors. Throws ModelError as compile_model does.
 Program compile_expression(const Spec& spec, const GiNaC::ex& expression, const std::string& what);
 
+// Several expressions as one program, one output each, common subexpressions computed once.
+Program compile_expressions(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
+                            const std::vector<std::string>& what);
+
 // derive() then compile_model().
 Model compile_model(const Spec& spec, const CompileOptions& options = {});
 
