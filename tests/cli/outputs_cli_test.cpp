@@ -117,7 +117,7 @@ TEST_F(CliOutputs, BadOutputsAreRefusedBeforeTheRun) {
     std::vector<std::string> said;
   };
   const std::vector<Case> cases = {
-      {"E = \"m*gg*y\"\n", {"p.toml:", ":12: unknown symbol 'gg'; did you mean 'g'?"}},
+      {"E = \"m*gg*y\"\n", {"p.toml:", ":8: unknown symbol 'gg'; did you mean 'g'?"}},
       {"energy = \"x\"\n", {"output 'energy' is named like the results' column 'energy'"}},
       {"R_y = \"x\"\n", {"output 'R_y'", "reaction on 'y'"}},
       {"E = \"x +\"\n", {"p.toml:", "syntax error"}},
