@@ -120,6 +120,7 @@ void bind_model(py::module_& m) {
         d["actuators"] = c.actuators;
         d["energy"] = c.energy;
         d["contact_forces"] = c.contact_forces;
+        d["outputs"] = c.outputs;
         return d;
       });
 

@@ -176,6 +176,8 @@ py::dict trajectory_dict(Trajectory&& tr) {
   const auto c = static_cast<py::ssize_t>(tr.contact_columns);
   d["contact_forces"] =
       c > 0 ? py::object(take_array(std::move(tr.contact_forces), {rows, c})) : py::object(py::none());
+  // The derived outputs ([outputs], multibody points), rows x count in Model::outputs order.
+  d["outputs"] = take_array(std::move(tr.outputs), {rows, static_cast<py::ssize_t>(tr.output_columns)});
   return d;
 }
 

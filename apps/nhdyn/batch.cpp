@@ -265,6 +265,9 @@ int run_batch(const BatchArgs& args) {
         const auto c = static_cast<std::size_t>(tr.contact_columns);
         row.insert(row.end(), tr.contact_forces.begin() + static_cast<std::ptrdiff_t>(k * c),
                    tr.contact_forces.begin() + static_cast<std::ptrdiff_t>((k + 1) * c));
+        const auto o = static_cast<std::size_t>(tr.output_columns);
+        row.insert(row.end(), tr.outputs.begin() + static_cast<std::ptrdiff_t>(k * o),
+                   tr.outputs.begin() + static_cast<std::ptrdiff_t>((k + 1) * o));
         writer.write_row(row);
       }
       writer.commit();

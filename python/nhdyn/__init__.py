@@ -203,7 +203,8 @@ class Result:
     residuals (rows x residual columns: position, velocity, acceleration level) and energy (rows,
     or None); for a model with programs, u (rows x m, the actuator forces) and program_residuals
     (rows x the programs' residual columns, position, velocity, acceleration level), both with no
-    columns otherwise. `columns` holds the names, the same as the CSV written by `nhdyn simulate`."""
+    columns otherwise; outputs (name -> rows, the derived outputs of docs/model-format.md [outputs]).
+    `columns` holds the names, the same as the CSV written by `nhdyn simulate`."""
 
     def __init__(self, model, out):
         self.model_name = model.name
@@ -223,6 +224,9 @@ class Result:
         self.events = out["events"]
         self.cpp_seconds = out["cpp_seconds"]
         self.columns = model._cpp.columns
+        # The derived outputs ([outputs] of the model file, a multibody model's points): name -> rows.
+        values = out.get("outputs")
+        self.outputs = {name: values[:, i] for i, name in enumerate(self.columns["outputs"])}
 
     def table(self):
         """Every column side by side, in the CSV's order: (names, rows x columns array)."""
@@ -234,6 +238,8 @@ class Result:
         parts += [self.u, self.program_residuals]
         if self.contact_forces is not None:
             parts.append(self.contact_forces)
+        if self.outputs:
+            parts.append(np.column_stack(list(self.outputs.values())))
         return list(self.columns["all"]), np.hstack(parts)
 
     def to_pandas(self):

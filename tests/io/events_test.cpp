@@ -105,10 +105,11 @@ TEST(Events, ModelFileErrorsNameTheirPlace) {
   text.replace(text.find("when = \"z'\""), 11, "when = \"zz'\"");
   EXPECT_NE(message(text).find("ball.toml:25:9: "), std::string::npos) << message(text);
   EXPECT_NE(message(text).find("did you mean 'z''?"), std::string::npos) << message(text);
+  // An event may read q'' (and the reactions R_x): it is then evaluated on the solved dynamics.
   text = ball;
   text.replace(text.find("when = \"z'\""), 11, "when = \"z''\"");
-  EXPECT_NE(message(text).find("ball.toml:25:9: event 'top' contains the acceleration z''"), std::string::npos)
-      << message(text);
+  EXPECT_EQ(message(text), "");
+  EXPECT_TRUE(load_model_text(text, "ball.toml").events.at(1).dynamics);
   text = ball + "\n[[events]]\nname = \"top\"\nwhen = \"x\"\n";
   EXPECT_NE(message(text).find("event name 'top' is used twice"), std::string::npos) << message(text);
   text = ball;

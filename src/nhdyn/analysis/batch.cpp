@@ -22,8 +22,9 @@ void Trajectory::reset(const Model& model, long expected_rows) {
   for (const ProgramConstraint& p : model.program_constraints)
     program_residual_columns += p.level == ConstraintLevel::position ? 3 : p.level == ConstraintLevel::velocity ? 2 : 1;
   contact_columns = static_cast<int>(contact_force_columns(model).size());
+  output_columns = model.outputs.count();
   for (std::vector<double>* column :
-       {&t, &q, &v, &qdd, &R, &residuals, &energy, &balance, &u, &program_residuals, &contact_forces})
+       {&t, &q, &v, &qdd, &R, &residuals, &energy, &balance, &u, &program_residuals, &contact_forces, &outputs})
     column->clear();
   const auto rows = static_cast<std::size_t>(std::max(0L, expected_rows));
   const auto un = static_cast<std::size_t>(n);
@@ -38,6 +39,7 @@ void Trajectory::reset(const Model& model, long expected_rows) {
   u.reserve(rows * static_cast<std::size_t>(actuator_columns));
   program_residuals.reserve(rows * static_cast<std::size_t>(program_residual_columns));
   contact_forces.reserve(rows * static_cast<std::size_t>(contact_columns));
+  outputs.reserve(rows * static_cast<std::size_t>(output_columns));
 }
 
 void Trajectory::append(const Data& data) {
@@ -66,6 +68,7 @@ void Trajectory::append(const Data& data) {
     contact_forces.insert(contact_forces.end(), c.values.data(), c.values.data() + c.values.size());
     contact_forces.push_back(c.residual);
   }
+  outputs.insert(outputs.end(), data.outputs.values.data(), data.outputs.values.data() + output_columns);
 }
 
 int batch_threads(int threads, std::size_t runs) {

@@ -38,12 +38,14 @@ struct Trajectory {
   // The contact forces and contact_residual (model/contact_forces.hpp), 0 columns without contacts.
   int contact_columns = 0;
   std::vector<double> contact_forces;  // rows x contact_columns
+  int output_columns = 0;           // derived outputs, Model::outputs (model/output.hpp)
+  std::vector<double> outputs;      // rows x output_columns, in Model::outputs.list order
 
   long rows() const { return static_cast<long>(t.size()); }
   // Sizes the columns for `model` and drops every row; reserves `expected_rows`.
   void reset(const Model& model, long expected_rows = 0);
   // Appends the row of Data after an output (simulate's RowFn): t, q, q', q'', R, residuals,
-  // energy, energy balance, actuator forces, program residuals, contact forces.
+  // energy, energy balance, actuator forces, program residuals, contact forces, derived outputs.
   void append(const Data& data);
 };
 

@@ -10,23 +10,30 @@
 namespace nhdyn {
 
 ModelEventFunctions::ModelEventFunctions(const Model& model, const std::vector<const Event*>& events,
-                                         Handler handler)
-    : n_(model.n()), events_(events), handler_(std::move(handler)) {
+                                         Handler handler, Dynamics dynamics)
+    : n_(model.n()), events_(events), handler_(std::move(handler)), dynamics_(std::move(dynamics)) {
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
   int registers = 0;
   for (const Event* event : events_) {
-    if (event->g.outputs() != 1 || event->g.coordinates() != n_)
+    if (event->g.outputs() != 1 || event->g.coordinates() != (event->dynamics ? 2 * n_ : n_))
       throw InputError(fmt::format("event '{}' was compiled for another model ({} coordinates, {} outputs); "
                                    "this one has {} coordinates",
                                    event->name, event->g.coordinates(), event->g.outputs(), n_));
     if (event->g.parameters() > static_cast<int>(values.size()))
       throw InputError(fmt::format("event '{}' reads {} parameters; model '{}' has {}", event->name,
                                    event->g.parameters(), model.name, values.size()));
+    if (event->dynamics && !dynamics_)
+      throw InputError(fmt::format("event '{}' reads q'' or the reactions R, which need the dynamics solved at the "
+                                   "state; this caller evaluates events without them",
+                                   event->name));
+    needs_dynamics_ = needs_dynamics_ || event->dynamics;
     programs_.push_back(event->g.reads_parameters() ? event->g.bind(values.data(), values.size()) : event->g);
     registers = std::max(registers, programs_.back().registers());
   }
   registers_.assign(static_cast<std::size_t>(registers), 0.0);
+  x_.assign(static_cast<std::size_t>(2 * n_), 0.0);
+  xd_.assign(static_cast<std::size_t>(2 * n_), 0.0);
   g_.assign(events_.size(), 0.0);
 }
 
@@ -39,11 +46,28 @@ CrossingDirection ModelEventFunctions::direction(int i) const {
   return CrossingDirection::both;
 }
 
-Status ModelEventFunctions::evaluate(double t, const double* y, double* g) {
-  for (std::size_t i = 0; i < programs_.size(); ++i) {
-    programs_[i].run(t, y, y + n_, registers_.data(), g + i);
-    if (!std::isfinite(g[i])) return Status::non_finite;
+Status ModelEventFunctions::run_all(double t, const double* y, double* g) {
+  if (needs_dynamics_) {
+    const double* qdd = nullptr;
+    const double* R = nullptr;
+    const Status status = dynamics_(t, y, &qdd, &R);
+    if (status != Status::ok) return status;
+    pack_dynamics_inputs(n_, y, y + n_, qdd, R, x_.data(), xd_.data());
   }
+  for (std::size_t i = 0; i < programs_.size(); ++i) {
+    if (events_[i]->dynamics)
+      programs_[i].run(t, x_.data(), xd_.data(), registers_.data(), g + i);
+    else
+      programs_[i].run(t, y, y + n_, registers_.data(), g + i);
+  }
+  return Status::ok;
+}
+
+Status ModelEventFunctions::evaluate(double t, const double* y, double* g) {
+  const Status status = run_all(t, y, g);
+  if (status != Status::ok) return status;
+  for (std::size_t i = 0; i < programs_.size(); ++i)
+    if (!std::isfinite(g[i])) return Status::non_finite;
   return Status::ok;
 }
 
@@ -59,7 +83,10 @@ Status ModelEventFunctions::on_event(int i, double t, const double* y) {
 
 void ModelEventFunctions::require_valid_start(double t0, const double* y0) {
   if (programs_.empty()) return;
-  for (std::size_t i = 0; i < programs_.size(); ++i) programs_[i].run(t0, y0, y0 + n_, registers_.data(), &g_[i]);
+  if (run_all(t0, y0, g_.data()) != Status::ok)
+    throw InputError(fmt::format("the events cannot be evaluated at the start (t0 = {}): the dynamics there could "
+                                 "not be solved",
+                                 t0));
   for (std::size_t i = 0; i < programs_.size(); ++i) {
     const Event& e = *events_[i];
     const std::string where = e.where.empty() ? "" : e.where + ": ";

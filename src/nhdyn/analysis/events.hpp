@@ -28,10 +28,17 @@ class ModelEventFunctions final : public EventFunctions {
   // What happens at a crossing of event i: the caller writes the row and returns Status::ok (or
   // the status of a failure); ModelEventFunctions adds Status::stopped for a stop event.
   using Handler = std::function<Status(int i, double t, const double* y)>;
+  // Solves the dynamics at (t, y = [q; q']) and points qdd and R at its q'' and R (n each), for
+  // the events that read them (Event::dynamics: through an output, model/output.hpp). simulate()
+  // passes compute_dynamics with the run's formulation: such an event costs one more solve per
+  // evaluation of the events (once for all of them), at each step and in the root finding.
+  using Dynamics = std::function<Status(double t, const double* y, const double** qdd, const double** R)>;
 
   // Binds every event's program to the model's current parameter values (allocates; not in the
-  // time loop). `events` must outlive this object.
-  ModelEventFunctions(const Model& model, const std::vector<const Event*>& events, Handler handler);
+  // time loop). `events` must outlive this object. Throws InputError when an event reads q'' or R
+  // and no `dynamics` is given.
+  ModelEventFunctions(const Model& model, const std::vector<const Event*>& events, Handler handler,
+                      Dynamics dynamics = {});
 
   int count() const override { return static_cast<int>(events_.size()); }
   CrossingDirection direction(int i) const override;
@@ -55,6 +62,11 @@ class ModelEventFunctions final : public EventFunctions {
   std::vector<double> registers_;
   std::vector<double> g_;
   Handler handler_;
+  Dynamics dynamics_;
+  bool needs_dynamics_ = false;
+  std::vector<double> x_, xd_;  // 2n each: the dynamics layout's inputs [q; q''], [q'; R]
+  // Runs every program at (t, y) into g; solves the dynamics first when an event needs it.
+  Status run_all(double t, const double* y, double* g);
   int stopped_by_ = -1;
 };
 

@@ -94,6 +94,16 @@ void record_balance(const Model& model, Data& data, const double* work, Simulati
   summary.energy_function_change = data.energy_function - summary.energy_function_initial;
 }
 
+// The dynamics that events reading q'' or R need (ModelEventFunctions::Dynamics): the run's own
+// solve, on the run's Data (the right-hand side recomputes what it needs at every call).
+ModelEventFunctions::Dynamics event_dynamics(const Model& model, Data& data, const FormulationOptions& formulation) {
+  return [&model, &data, &formulation](double t, const double* y, const double** qdd, const double** R) {
+    const Status status = compute_dynamics(model, data, formulation, t, y, y + model.n());
+    *qdd = data.qdd.data();
+    *R = data.R.data();
+    return status;
+  };
+}
 
 }  // namespace
 
@@ -229,6 +239,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     compute_residuals(model, data);
     compute_energy(model, data);
     compute_contact_forces(model, data);  // nothing for a model without contacts
+    compute_outputs(model, data);
     if (summary.outputs == 0) {
       summary.energy_initial = data.energy;
       summary.energy_function_initial = data.energy_function;
@@ -265,7 +276,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     record.v.assign(data.v.data(), data.v.data() + n);
     summary.events.push_back(std::move(record));
     return Status::ok;
-  });
+  }, event_dynamics(model, data, formulation));
   event_functions.require_valid_start(model.t0, y0.data());
 
   const auto start = std::chrono::steady_clock::now();

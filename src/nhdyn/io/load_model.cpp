@@ -11,6 +11,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/model_file.hpp"
+#include "nhdyn/io/results.hpp"
 #include "nhdyn/model/builtin.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/compile.hpp"
@@ -80,7 +81,9 @@ Model load_model(const ModelSource& source, const ParameterOverrides& overrides)
     apply_parameter_sets(model, override_sets(overrides));  // parameters are data: no recompilation
     return model;
   }
-  return symbolic::compile_model(load_spec(source, overrides));
+  Model model = symbolic::compile_model(load_spec(source, overrides));
+  make_result_columns(model);  // refuses a derived output named like another column, at load time
+  return model;
 }
 
 Model load_model(const std::string& source, const ParameterOverrides& overrides) {

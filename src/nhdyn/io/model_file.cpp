@@ -29,6 +29,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/multibody.hpp"
+#include "nhdyn/symbolic/outputs.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
 #include "nhdyn/core/suggest.hpp"
 
@@ -44,6 +45,7 @@ const std::vector<std::string> top_level_keys = {
     "potential_energy", "forces",    "constraints", "programs", "independent", "complement",
     "initial",        "solution",    "simulation",  "plot",        "visual",
     "events",  // [[events]]: zero crossings located during a run
+    "outputs",  // [outputs]: derived result columns
     // The multibody description (docs/multibody.md).
     "gravity", "frames", "points", "bodies", "wheels", "knife_edges", "surfaces", "curves"};
 const std::vector<std::string> frame_keys = {"name", "parent", "translation", "rotations"};
@@ -169,6 +171,7 @@ class Loader {
     if (const toml::node* solution = root.get("solution")) load_solution(*solution, builder);
     if (const toml::node* simulation = root.get("simulation")) load_simulation(*simulation, builder);
     if (const toml::node* plot = root.get("plot")) load_plot(*plot, builder);
+    if (const toml::node* node = root.get("outputs")) load_outputs(*node, builder);
     std::vector<symbolic::SpecEvent> events;
     if (const toml::node* node = root.get("events")) events = load_events(*node, builder);
     symbolic::Spec spec = builder.build();
@@ -522,6 +525,21 @@ class Loader {
     }
   }
 
+  // [outputs]: NAME = "expression" in t, q, q', q'', the reactions R_x, the parameters and the
+  // outputs above it; one result column each, in file order (symbolic/outputs.hpp).
+  void load_outputs(const toml::node& node, SpecBuilder& builder) const {
+    const toml::table& table = table_of(node, "outputs", "[outputs] followed by energy = \"m/2*x'^2 + m*g*y\"");
+    for (const Entry& entry : in_file_order(table)) {
+      check_not_misplaced(*entry.key, "in [outputs]");
+      const std::string name(entry.key->str());
+      const std::string text =
+          expression_string(*entry.value, fmt::format("outputs.{}", name), "energy = \"m/2*x'^2 + m*g*y\"");
+      const GiNaC::ex expression =
+          located(*entry.value, [&] { return builder.parse_derived(text, content_at(*entry.value)); });
+      builder.output(name, expression, text, at(*entry.key));
+    }
+  }
+
   void load_forces(const toml::node& node, SpecBuilder& builder) const {
     const toml::table& table = table_of(node, "forces", "[forces] followed by x = \"-c * x'\"");
     for (const Entry& entry : in_file_order(table)) {
@@ -637,7 +655,7 @@ class Loader {
                                       event.name));
       event.text = expression_string(*when, "when", "when = \"abs(phi) - 1\"");
       event.where = content_at(*when);
-      event.expression = located(*when, [&] { return builder.parse(event.text, content_at(*when)); });
+      event.expression = located(*when, [&] { return builder.parse_derived(event.text, content_at(*when)); });
       if (const toml::node* direction = table->get("direction")) {
         const std::string value = string_of(*direction, "direction", "direction = \"rising\"");
         if (value == "rising") event.direction = EventDirection::rising;
@@ -904,6 +922,7 @@ class Loader {
     if (!any) return;
     symbolic::MultibodyBuilder mb(builder);
     visual.ground = true;
+    std::vector<std::string> frame_names, point_names;  // for the automatic outputs
     std::vector<std::pair<std::string, symbolic::PlacedFrame>> body_frames;  // for the wheels' scene
     if (const toml::node* gravity = root.get("gravity"))
       mb.gravity(triple_of(*gravity, "gravity", "gravity = [0, 0, \"-g\"]"), at(*gravity));
@@ -932,6 +951,7 @@ class Loader {
           }
         }
         mb.frame(name, parent, translation, rotations, at(*table));
+        frame_names.push_back(name);
         visual.items.push_back(frame_item(mb.placed_frame(name), symbolic::VisualKind::frame, at(*table)));
       }
     if (const toml::node* points = root.get("points"))
@@ -943,6 +963,7 @@ class Loader {
         if (const toml::node* node = table->get("position"))
           position = triple_of(*node, fmt::format("point '{}': position", name), "position = [0, 0, \"-l\"]");
         mb.point(name, frame, position, at(*table));
+        point_names.push_back(name);
       }
     if (const toml::node* bodies = root.get("bodies"))
       for (const toml::table* table : tables_of(*bodies, "bodies", body_keys)) {
@@ -1030,6 +1051,8 @@ class Loader {
                           expression_string(*array.get(1), what + ": surfaces[2]", example), at(node));
       }
     mb.apply();
+    // Every point's and frame origin's world position and velocity as result columns.
+    symbolic::add_multibody_outputs(builder, mb, frame_names, point_names);
   }
 
   // [Ixx, Iyy, Izz] (principal axes along the frame's) or a 3 x 3 array.

@@ -1,8 +1,29 @@
 #include "nhdyn/io/results.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
+
 #include "nhdyn/analysis/residuals.hpp"
+#include "nhdyn/core/error.hpp"
 
 namespace nhdyn {
+
+namespace {
+
+// The derived outputs, last (model/output.hpp); an output may not take another column's name.
+void add_output_columns(const Model& model, ResultColumns& c) {
+  for (const DerivedOutput& o : model.outputs.list) {
+    if (std::find(c.all.begin(), c.all.end(), o.name) != c.all.end())
+      throw ModelError(fmt::format("{}output '{}' is named like the results' column '{}'; give it another name "
+                                   "(the columns: docs/model-format.md, [outputs])",
+                                   o.where.empty() ? "" : o.where + ": ", o.name, o.name));
+    c.outputs.push_back(o.name);
+    c.all.push_back(o.name);
+  }
+}
+
+}  // namespace
 
 ResultColumns make_result_columns(const Model& model) {
   ResultColumns c;
@@ -41,6 +62,7 @@ ResultColumns make_result_columns(const Model& model) {
   c.residuals.insert(c.residuals.end(), program_residuals.begin(), program_residuals.end());
   c.contact_forces = contact_force_columns(model);
   c.all.insert(c.all.end(), c.contact_forces.begin(), c.contact_forces.end());
+  add_output_columns(model, c);
   return c;
 }
 
@@ -68,6 +90,8 @@ void fill_result_row(const Model& model, const Data& data, std::vector<double>& 
     for (Eigen::Index i = 0; i < w.e.size(); ++i) row.push_back(w.e(i));
   }
   append_contact_force_values(model, data, row);
+  const Vector& outputs = data.outputs.values;
+  row.insert(row.end(), outputs.data(), outputs.data() + outputs.size());
 }
 
 }  // namespace nhdyn

@@ -7,9 +7,10 @@
 //   work_reactions, work_time, work (W, their sum) and balance_error (h - h(t0) - W); then, for a
 //   model with programs (docs/derivations/program-motion.md), the actuator forces (u_<program>)
 //   and the programs' residuals at the three levels, named like the constraints'
-//   (residual_pos_<program>, ...); last, for a multibody model with wheels or knife edges, their
+//   (residual_pos_<program>, ...); for a multibody model with wheels or knife edges, their
 //   contact forces NAME_Fx, NAME_Fy, NAME_Fz, NAME_N, NAME_Flong, NAME_Flat and contact_residual
-//   (model/contact_forces.hpp, docs/multibody.md).
+//   (model/contact_forces.hpp, docs/multibody.md); last the derived outputs (model/output.hpp: a
+//   multibody model's point and frame positions and velocities, then the file's [outputs], by name).
 // Shared by the CSV writer and the plots so that both name the columns the same way.
 #pragma once
 
@@ -33,12 +34,15 @@ struct ResultColumns {
   std::vector<std::string> energy_balance;
   // The contact forces and their check column (model/contact_forces.hpp); empty without contacts.
   std::vector<std::string> contact_forces;
+  std::vector<std::string> outputs;      // the derived outputs, Model::outputs (empty without)
 };
 
+// Throws ModelError when a derived output is named like another column (naming where the output
+// was written and the column), so that no run starts with two columns of one name.
 ResultColumns make_result_columns(const Model& model);
 
 // Fills `row` (sized to the column count; no allocation after the first call) from Data after
-// compute_acceleration, compute_residuals and compute_energy (and compute_program_residuals for a
+// compute_acceleration, compute_residuals, compute_energy and compute_outputs (and compute_program_residuals for a
 // model with programs; with an energy balance, compute_power and the work and balance error that
 // simulate sets).
 void fill_result_row(const Model& model, const Data& data, std::vector<double>& row);

@@ -29,6 +29,7 @@
 #include "nhdyn/core/types.hpp"
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/model.hpp"
+#include "nhdyn/model/output.hpp"
 
 namespace nhdyn {
 
@@ -131,6 +132,8 @@ struct Data {
   double power_forces = 0.0, power_reactions = 0.0, power_time = 0.0;
   double work_forces = 0.0, work_reactions = 0.0, work_time = 0.0;
   double balance_error = 0.0;  // h - h(t0) - W, the accuracy figure (set by simulate)
+  // Derived outputs (model/output.hpp): their values (compute_outputs) and workspace (make_data).
+  OutputData outputs;
 
   // --- program motion (compute_program_motion; empty for a model without programs) -------------
   ProgramMotionData motion;

@@ -30,6 +30,10 @@ struct Event {
   // already satisfies it is refused rather than stopped at once.
   bool condition = false;
   Program g;  // one output, g(t, q, q'); reads the model's parameters (bind before running)
+  // g reads q'' or the reactions R (through an output, model/output.hpp): g is then in the
+  // dynamics layout (2n coordinates, [q; q''] and [q'; R]) and each evaluation solves the dynamics
+  // at the state first (analysis/events.hpp).
+  bool dynamics = false;
 };
 
 }  // namespace nhdyn

@@ -15,6 +15,7 @@
 #include "nhdyn/core/types.hpp"
 #include "nhdyn/model/evaluator.hpp"
 #include "nhdyn/model/event.hpp"
+#include "nhdyn/model/output.hpp"
 #include "nhdyn/model/run_options.hpp"
 
 namespace nhdyn {
@@ -82,6 +83,8 @@ struct Model {
   // The contact forces of a multibody model's wheels and knife edges (contact_forces.hpp,
   // docs/derivations/contact-forces.md); null for a model without contacts.
   std::shared_ptr<const ContactForceModel> contact_forces;
+  // Derived outputs ([outputs], multibody points): extra result columns (model/output.hpp).
+  ModelOutputs outputs;
 
   int n() const { return static_cast<int>(coordinates.size()); }
   int s() const { return static_cast<int>(constraints.size()); }

@@ -35,6 +35,7 @@
 #include "nhdyn/model/program.hpp"
 #include "nhdyn/symbolic/contact_forces.hpp"
 #include "nhdyn/symbolic/events.hpp"
+#include "nhdyn/symbolic/outputs.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
@@ -1014,6 +1015,7 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
     std::vector<double> scratch(model.evaluator->scratch_size());
     model.evaluator->initial_state(scratch.data(), model.q0.data(), model.v0.data());
   }
+  compile_outputs(spec, model);
   compile_events(spec, model);
   compile_contact_forces(spec, model);
   check_model_shape(model);
@@ -1026,9 +1028,10 @@ Program compile_expression(const Spec& spec, const GiNaC::ex& expression, const 
   return compiler.finish();
 }
 
-Program compile_expressions(const Spec& spec, const std::vector<GiNaC::ex>& expressions, const std::string& what) {
+Program compile_expressions(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
+                            const std::vector<std::string>& what) {
   ProgramCompiler compiler(spec);
-  for (std::size_t i = 0; i < expressions.size(); ++i) compiler.add_output(expressions[i], fmt::format("{} {}", what, i));
+  for (std::size_t i = 0; i < expressions.size(); ++i) compiler.add_output(expressions[i], what.at(i));
   return compiler.finish();
 }
 

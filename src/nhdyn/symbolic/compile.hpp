@@ -34,9 +34,10 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
 // One expression of t, q, q' and the parameters of `spec` as a program with one output (events,
 // symbolic/events.hpp); `what` names it in errors. Throws ModelError as compile_model does.
 Program compile_expression(const Spec& spec, const GiNaC::ex& expression, const std::string& what);
-// Several expressions as one program (common subexpressions shared), one output each, in order
-// (contact forces, symbolic/contact_forces.hpp).
-Program compile_expressions(const Spec& spec, const std::vector<GiNaC::ex>& expressions, const std::string& what);
+// Several expressions as one program, one output each, common subexpressions computed once
+// (outputs, contact forces); what[i] names expression i in messages.
+Program compile_expressions(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
+                            const std::vector<std::string>& what);
 
 // derive() then compile_model().
 Model compile_model(const Spec& spec, const CompileOptions& options = {});

@@ -152,7 +152,9 @@ void compile_contact_forces(const Spec& spec, Model& model) {
   }
   c.single_wheel = c.systems == 1 && c.contacts.size() == 1 && c.contacts.front().kind == ContactKind::wheel &&
                    c.hand_constraints == 0 && c.balance_rows.front() && in.contacts.front().system == 0;
-  c.program = compile_expressions(spec, outputs, "contact forces: output");
+  std::vector<std::string> what(outputs.size());
+  for (std::size_t i = 0; i < what.size(); ++i) what[i] = fmt::format("contact forces: output {}", i);
+  c.program = compile_expressions(spec, outputs, what);
   if (c.program.outputs() != c.outputs())
     throw ModelError(fmt::format("model '{}': the contact-force program has {} outputs, expected {} (a bug)",
                                  spec.name, c.program.outputs(), c.outputs()));

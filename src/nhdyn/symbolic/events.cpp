@@ -8,22 +8,12 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/symbolic/compile.hpp"
+#include "nhdyn/symbolic/outputs.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
-
-// The velocities and accelerations of an event are those of the state: an event reads t, q, q'
-// and the parameters, and q'' (which needs the dynamics) is refused by name.
-void refuse_accelerations(const Spec& spec, const GiNaC::ex& g, const std::string& where, const std::string& name) {
-  for (int i = 0; i < spec.symbols.coordinates(); ++i)
-    if (g.has(spec.symbols.acceleration(i)))
-      throw ModelError(fmt::format("{}event '{}' contains the acceleration {}; an event may depend on t, the "
-                                   "coordinates, their velocities and the parameters only",
-                                   where.empty() ? "" : where + ": ", name,
-                                   spec.symbols.acceleration(i).get_name()));
-}
 
 // A SpecBuilder with the model's names and parameter values: the symbol table to read an event
 // of a model that has no Spec at hand (built-in models, the command line).
@@ -31,6 +21,16 @@ SpecBuilder names_of(const Model& model) {
   SpecBuilder builder(model.name);
   for (const std::string& q : model.coordinates) builder.coordinate(q);
   for (const Parameter& p : model.parameters) builder.parameter(p.name, p.value, p.unit);
+  // The model's outputs, read again from their text, so that an event may name them. An
+  // automatic output whose text is not an expression (the multibody points') is left out: an
+  // event naming it is then refused as an unknown symbol.
+  for (const DerivedOutput& o : model.outputs.list) {
+    try {
+      builder.output(o.name, o.expression);
+    } catch (const ModelError&) {
+      if (!o.automatic) throw;
+    }
+  }
   return builder;
 }
 
@@ -40,7 +40,7 @@ SpecBuilder names_of(const Model& model) {
 GiNaC::ex read_option(const SpecBuilder& builder, const std::string& option, const std::string& shown,
                       const std::string& text) {
   try {
-    return builder.parse(text);
+    return builder.parse_derived(text);
   } catch (const ModelError& e) {
     std::string message = e.what();
     const std::string blanked = fmt::format("\"{}\"", text);
@@ -52,9 +52,11 @@ GiNaC::ex read_option(const SpecBuilder& builder, const std::string& option, con
 
 Event finish(const Spec& spec, const GiNaC::ex& g, std::string name, std::string text, std::string where,
              EventDirection direction, EventAction action) {
-  refuse_accelerations(spec, g, where, name);
   Event event;
-  event.g = compile_expression(spec, g, fmt::format("event '{}'", name));
+  // An event that reads q'' or R (through an output) is evaluated on the solved dynamics.
+  event.dynamics = reads_dynamics(spec, g);
+  event.g = event.dynamics ? compile_dynamics_program(spec, {g}, {fmt::format("event '{}'", name)})
+                           : compile_expression(spec, g, fmt::format("event '{}'", name));
   event.name = std::move(name);
   event.expression = std::move(text);
   event.where = std::move(where);

@@ -98,6 +98,7 @@ class MultibodyBuilder {
   // For tests and other front ends.
   const PlacedFrame& placed_frame(const std::string& name) const;
   Vector3 point_position(const std::string& name) const;  // world components
+  const PlacedFrame& placed_frame_at(int index) const { return frames_.at(static_cast<std::size_t>(index)); }
 
  private:
   struct Point {

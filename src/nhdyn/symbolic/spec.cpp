@@ -24,6 +24,7 @@ int SymbolTable::add_coordinate(const std::string& name) {
   q_.emplace_back(name);
   v_.emplace_back(name + "'");
   a_.emplace_back(name + "''");
+  r_.emplace_back("R_" + name);
   by_name_.emplace(name, q_.back());
   by_name_.emplace(name + "'", v_.back());
   by_name_.emplace(name + "''", a_.back());

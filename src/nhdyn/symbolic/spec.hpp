@@ -45,6 +45,9 @@ class SymbolTable {
   const GiNaC::symbol& coordinate(int i) const { return q_[static_cast<std::size_t>(i)]; }
   const GiNaC::symbol& velocity(int i) const { return v_[static_cast<std::size_t>(i)]; }
   const GiNaC::symbol& acceleration(int i) const { return a_[static_cast<std::size_t>(i)]; }
+  // The generalized reaction on coordinate i, "R_x" as the results name it: known only to the
+  // expressions of outputs and events (SpecBuilder::parse_derived), not to T, V or constraints.
+  const GiNaC::symbol& reaction(int i) const { return r_[static_cast<std::size_t>(i)]; }
   const GiNaC::symbol& parameter(const std::string& name) const;  // throws std::out_of_range
   bool has(const std::string& name) const { return by_name_.count(name) > 0; }
   // The symbol called `name`, if any ("t", "x", "x'", "x''", a parameter).
@@ -56,7 +59,7 @@ class SymbolTable {
 
  private:
   GiNaC::symbol t_;
-  std::vector<GiNaC::symbol> q_, v_, a_;
+  std::vector<GiNaC::symbol> q_, v_, a_, r_;
   std::map<std::string, GiNaC::symbol> by_name_;
 };
 
@@ -97,6 +100,18 @@ struct SpecProgram {
   SourceLocation actuator_where;
 };
 
+// A derived output ([outputs] of a model file, or a multibody model's automatic point positions
+// and velocities): a named expression in t, q, q', q'', the reactions R_x and the parameters,
+// written as a column of the results (symbolic/outputs.hpp compiles it).
+struct SpecOutput {
+  std::string name;
+  GiNaC::ex expression;  // in t, q, q', q'', SymbolTable::reaction and the parameters
+  std::string text;      // as the user wrote it (for automatic outputs: how it was made)
+  SourceLocation where;
+  bool automatic = false;  // made by the multibody front end, not written by the user
+  GiNaC::symbol symbol;    // stands for the output in the expressions of later outputs and events
+};
+
 struct Spec {
   std::string name;
   std::string description;
@@ -124,6 +139,7 @@ struct Spec {
   std::optional<double> rtol, atol;
   std::optional<std::pair<std::string, std::string>> path;  // coordinates to draw as y(x)
   std::vector<SpecEvent> events;             // compiled into Model::events (symbolic/events.hpp)
+  std::vector<SpecOutput> outputs;           // compiled into Model::outputs (symbolic/outputs.hpp)
   SpecVisual visual;  // what a report's 3-D scene draws ([visual], or the bodies): symbolic/visual.hpp
   // The bodies and contacts of a multibody model, for its contact forces (contact_forces.hpp);
   // null for a hand-written model.

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <exception>
 #include <limits>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -274,8 +275,11 @@ const char* describe_token(TokenKind kind) {
 // explicit (-1)* for a leading sign. GiNaC's own parser then builds the expression.
 class Reader {
  public:
-  Reader(const Site& site, const Spec& spec, std::vector<Token> tokens)
-      : site_(site), spec_(spec), tokens_(std::move(tokens)) {}
+  // `scope`: names beyond the spec's symbols (the reactions and outputs that outputs and events
+  // may use, SpecBuilder::parse_derived); null for T, V, constraints and the rest.
+  Reader(const Site& site, const Spec& spec, std::vector<Token> tokens,
+         const std::map<std::string, GiNaC::symbol>* scope = nullptr)
+      : site_(site), spec_(spec), tokens_(std::move(tokens)), scope_(scope) {}
 
   Parsed read() {
     if (tokens_.front().kind == TokenKind::end) site_.fail_at(tokens_.front().begin, "empty expression");
@@ -471,11 +475,17 @@ class Reader {
         out_ += internal_name(name);
         return;
       }
-      const std::optional<GiNaC::symbol> symbol = spec_.symbols.find(name);
+      std::optional<GiNaC::symbol> symbol = spec_.symbols.find(name);
+      if (!symbol && scope_ != nullptr) {
+        const auto found = scope_->find(name);
+        if (found != scope_->end()) symbol = found->second;
+      }
       if (!symbol) {
         std::vector<std::string> known = {"t", "pi"};
         for (const std::string& c : spec_.coordinates) known.push_back(c);
         for (const SpecParameter& p : spec_.parameters) known.push_back(p.name);
+        if (scope_ != nullptr)
+          for (const auto& entry : *scope_) known.push_back(entry.first);
         const std::string nearest = nearest_name(name, known);
         site_.fail_at(token.begin, fmt::format("unknown symbol '{}'{}", name,
                                                nearest.empty() ? "" : fmt::format("; did you mean '{}'?", nearest)));
@@ -517,6 +527,7 @@ class Reader {
   std::size_t index_ = 0;
   std::string out_;
   std::vector<Occurrence> symbols_;
+  const std::map<std::string, GiNaC::symbol>* scope_ = nullptr;
 };
 
 // Exponents beyond this make the derivation's expansion explode (a hang, not an answer); no
@@ -583,8 +594,9 @@ std::size_t node_count(const GiNaC::ex& e) {
 // is not limited here; the examples' products of sums stay below a tenth of it.
 constexpr double kLargestExpansion = 1e5;
 
-Parsed read(const Spec& spec, const Site& site, std::size_t begin, std::size_t end) {
-  Parsed parsed = Reader(site, spec, lex(site, begin, end)).read();
+Parsed read(const Spec& spec, const Site& site, std::size_t begin, std::size_t end,
+            const std::map<std::string, GiNaC::symbol>* scope = nullptr) {
+  Parsed parsed = Reader(site, spec, lex(site, begin, end), scope).read();
   if (has_huge_exponent(parsed.value))
     site.fail_whole(fmt::format("an exponent larger than {} in magnitude; nhdyn expands powers symbolically, "
                                 "so rewrite the expression (e.g. with exp and log) or use a smaller power",
@@ -1020,6 +1032,61 @@ SpecBuilder& SpecBuilder::path(const std::string& x, const std::string& y) {
     if (index_of(spec_.coordinates, name) < 0)
       fail(spec_.where, "path", fmt::format("'{}' is not a coordinate{}", name, did_you_mean(name, spec_.coordinates)));
   spec_.path = std::make_pair(x, y);
+  return *this;
+}
+
+namespace {
+
+// The names outputs and events may use beyond the spec's symbols: the reactions R_x (unless a
+// parameter is called so) and the outputs declared so far.
+std::map<std::string, GiNaC::symbol> derived_scope(const Spec& spec) {
+  std::map<std::string, GiNaC::symbol> scope;
+  for (int i = 0; i < spec.n(); ++i)
+    if (!spec.symbols.has("R_" + spec.coordinates[static_cast<std::size_t>(i)]))
+      scope.emplace("R_" + spec.coordinates[static_cast<std::size_t>(i)], spec.symbols.reaction(i));
+  for (const SpecOutput& o : spec.outputs) scope.emplace(o.name, o.symbol);
+  return scope;
+}
+
+}  // namespace
+
+GiNaC::ex SpecBuilder::parse_derived(const std::string& text, const SourceLocation& where) const {
+  const std::map<std::string, GiNaC::symbol> scope = derived_scope(spec_);
+  const GiNaC::ex value = read(spec_, Site{text, where, ""}, 0, text.size(), &scope).value;
+  if (spec_.outputs.empty()) return value;
+  GiNaC::exmap outputs;
+  for (const SpecOutput& o : spec_.outputs) outputs[o.symbol] = o.expression;
+  return value.subs(outputs);
+}
+
+SpecBuilder& SpecBuilder::output(const std::string& name, const std::string& text, SourceLocation where) {
+  const GiNaC::ex expression = parse_derived(text, where);
+  return output(name, expression, text, std::move(where));
+}
+
+SpecBuilder& SpecBuilder::output(const std::string& name, const GiNaC::ex& expression, const std::string& text,
+                                 SourceLocation where, bool automatic) {
+  check_new_name(spec_, name, "output", where);
+  const std::string context = fmt::format("output '{}'", name);
+  for (const SpecOutput& o : spec_.outputs)
+    if (o.name == name) {
+      const std::string at = o.where.describe();
+      fail(where, context,
+           fmt::format("duplicated name: '{}' is already an output{}{}", name,
+                       o.automatic ? " (the multibody model's own, docs/multibody.md)" : "",
+                       at.empty() ? "" : " (declared at " + at + ")"));
+    }
+  for (const std::string& q : spec_.coordinates)
+    if (name == "R_" + q)
+      fail(where, context, fmt::format("'{}' is the column of the reaction on '{}'; choose another name", name, q));
+  SpecOutput output;
+  output.name = name;
+  output.expression = expression;
+  output.text = text;
+  output.where = std::move(where);
+  output.automatic = automatic;
+  output.symbol = GiNaC::symbol(name);
+  spec_.outputs.push_back(std::move(output));
   return *this;
 }
 

@@ -80,6 +80,19 @@ class SpecBuilder {
     spec_.contact_forces = std::move(contacts);
     return *this;
   }
+  // Derived outputs (docs/model-format.md, [outputs]; symbolic/outputs.hpp): a named expression
+  // in t, q, q', q'', the reactions R_x, the parameters and the outputs declared before it, that
+  // becomes a column of the results. Its name must be a new name (not a coordinate, parameter,
+  // reaction or earlier output); collisions with the other result columns are checked when the
+  // columns are made (io/results.hpp). The second form is for front ends that build the
+  // expression themselves (the multibody points' positions); `automatic` marks those.
+  SpecBuilder& output(const std::string& name, const std::string& text, SourceLocation where = {});
+  SpecBuilder& output(const std::string& name, const GiNaC::ex& expression, const std::string& text,
+                      SourceLocation where = {}, bool automatic = false);
+  // Parses `text` as parse() does, with the reactions R_x and the outputs declared so far known
+  // too (each output replaced by its expression): the expressions of outputs and events.
+  GiNaC::ex parse_derived(const std::string& text, const SourceLocation& where = {}) const;
+
   // The spec as built so far: its symbols and parameter values, for such front ends.
   const Spec& current() const { return spec_; }
 

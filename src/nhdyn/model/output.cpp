@@ -1,0 +1,41 @@
+#include "nhdyn/model/output.hpp"
+
+#include <algorithm>
+
+#include "nhdyn/model/data.hpp"
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn {
+
+OutputData make_output_data(const Model& model) {
+  OutputData d;
+  const int n = model.n();
+  d.x.assign(static_cast<std::size_t>(2 * n), 0.0);
+  d.xd.assign(static_cast<std::size_t>(2 * n), 0.0);
+  d.values = Vector::Zero(model.outputs.count());
+  if (model.outputs.list.empty()) return d;
+  std::vector<double> values;
+  for (const Parameter& p : model.parameters) values.push_back(p.value);
+  const Program& program = model.outputs.program;
+  d.program = program.reads_parameters() ? program.bind(values.data(), values.size()) : program;
+  d.registers.assign(static_cast<std::size_t>(d.program.registers()), 0.0);
+  return d;
+}
+
+void pack_dynamics_inputs(int n, const double* q, const double* v, const double* qdd, const double* R, double* x,
+                          double* xd) {
+  std::copy(q, q + n, x);
+  std::copy(qdd, qdd + n, x + n);
+  std::copy(v, v + n, xd);
+  std::copy(R, R + n, xd + n);
+}
+
+void compute_outputs(const Model& model, Data& data) {
+  OutputData& o = data.outputs;
+  if (model.outputs.list.empty()) return;
+  pack_dynamics_inputs(model.n(), data.q.data(), data.v.data(), data.qdd.data(), data.R.data(), o.x.data(),
+                       o.xd.data());
+  o.program.run(data.t, o.x.data(), o.xd.data(), o.registers.data(), o.values.data());
+}
+
+}  // namespace nhdyn
