@@ -36,6 +36,7 @@
 #include <tuple>
 #include <utility>
 #include <vector>
+#include "support/text.hpp"
 
 extern char** environ;
 
@@ -221,7 +222,7 @@ void write_bytes(const fs::path& path, const std::string& bytes) {
   if (!out) throw std::runtime_error("cannot write " + path.string());
 }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using nhdyn::test::contains;
 
 // ---------------------------------------------------------------------------------------------
 // CSV, read independently of the library's reader so that a shared bug cannot hide.

@@ -13,17 +13,13 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "support/text.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> fields;
-  std::stringstream in(line);
-  for (std::string field; std::getline(in, field, ',');) fields.push_back(field);
-  return fields;
-}
+using nhdyn::test::split;
 
 TEST(CliDop853, KnifeEdgeMatchesItsClosedFormWithFewerRhsThanDopri5) {
   const fs::path dir =

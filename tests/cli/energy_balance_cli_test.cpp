@@ -15,24 +15,15 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "support/text.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> fields;
-  std::stringstream in(line);
-  for (std::string field; std::getline(in, field, ',');) fields.push_back(field);
-  return fields;
-}
+using nhdyn::test::split;
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
+using nhdyn::test::read_text;
 
 TEST(CliEnergyBalance, TheSummaryReportsTheBalanceAsErrorAndTheWorkAsPhysics) {
   const fs::path dir = fs::temp_directory_path() / ("nhdyn-energy-cli-" + std::to_string(::getpid()));

@@ -19,22 +19,18 @@
 #include <vector>
 
 #include "nhdyn/io/csv.hpp"
+#include "support/text.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
+struct EventsOutcome {
   int exit_code = -1;
   std::string out, err;
 };
 
-std::string read(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using nhdyn::test::read_text;
 
 class CliEvents : public ::testing::Test {
  protected:
@@ -48,21 +44,21 @@ class CliEvents : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   // Runs `nhdyn ARGS` in the test's directory; ARGS is shell text.
-  Outcome nhdyn(const std::string& args) const {
+  EventsOutcome nhdyn(const std::string& args) const {
     const std::string command =
         "cd '" + dir_.string() + "' && '" NHDYN_CLI_PATH "' " + args + " > out.txt 2> err.txt";
     const int status = std::system(command.c_str());
-    Outcome run;
+    EventsOutcome run;
     run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.out = read(dir_ / "out.txt");
-    run.err = read(dir_ / "err.txt");
+    run.out = read_text(dir_ / "out.txt");
+    run.err = read_text(dir_ / "err.txt");
     return run;
   }
 
   // A copy of an example with `text` appended, or with `from` replaced by `to` first.
   std::string example_copy(const std::string& example, const std::string& append, const std::string& from = "",
                            const std::string& to = "") const {
-    std::string text = read(fs::path(NHDYN_SOURCE_DIR) / "examples" / example);
+    std::string text = read_text(fs::path(NHDYN_SOURCE_DIR) / "examples" / example);
     if (!from.empty()) {
       const std::size_t at = text.find(from);
       EXPECT_NE(at, std::string::npos) << from;
@@ -116,7 +112,7 @@ TEST_F(CliEvents, PendulumPeriodFromItsEvents) {
   // x crosses zero at the bottom, alternately rising and falling: crossings k and k + 2 are one
   // period apart. examples/pendulum_cartesian.toml: l = 1.5 m, g = 9.81 m/s^2, theta0 = 2 rad.
   // The second command of docs/cli.md, "Events".
-  const Outcome run = nhdyn("simulate " + examples +
+  const EventsOutcome run = nhdyn("simulate " + examples +
                             "pendulum_cartesian.toml --event bottom=x --integrator dop853 --rtol 1e-13 --atol 1e-15 "
                             "-o p.csv");
   ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -153,7 +149,7 @@ TEST_F(CliEvents, PendulumPeriodFromItsEvents) {
 }
 
 TEST_F(CliEvents, CvodeLocatesThePendulumCrossingsWithItsRootFinding) {
-  const Outcome run = nhdyn("simulate " + examples +
+  const EventsOutcome run = nhdyn("simulate " + examples +
                         "pendulum_cartesian.toml --event bottom=x --integrator cvode-adams --rtol 1e-12 --atol 1e-14 "
                         "--t-end 5 -o p.csv");
   ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -178,7 +174,7 @@ TEST_F(CliEvents, ChaplyginSleighStopsWhenItHasTurned) {
   // t = -c0 / k (docs/gallery/chaplygin_sleigh.md (2)), with V^2 = v0^2 + rho^2 w0^2,
   // k = a V / rho^2, sinh(c0) = v0 / (rho w0).
   const std::string model = example_copy("chaplygin_sleigh.toml", sleigh_events);
-  const Outcome run = nhdyn("simulate '" + model + "' -o s.csv");
+  const EventsOutcome run = nhdyn("simulate '" + model + "' -o s.csv");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const double a = 0.3, rho = 0.5, v0 = -1.0, w0 = 1.0;
   const double V = std::sqrt(v0 * v0 + rho * rho * w0 * w0);
@@ -199,7 +195,7 @@ TEST_F(CliEvents, BicycleFallsAtTwoMetresPerSecondAndNotAtFive) {
   // speed range (about 4.3 to 6 m/s) the bicycle falls over, inside it it recovers.
   const std::string model = example_copy("whipple_bicycle.toml", "", "velocity = { x = \"v\", ",
                                          "velocity = { x = \"v\", phi = \"0.5\", ");
-  const Outcome slow = nhdyn("simulate '" + model + "' --set v=2 --t-end 10 --stop-when 'abs(phi) > 1' -o slow.csv");
+  const EventsOutcome slow = nhdyn("simulate '" + model + "' --set v=2 --t-end 10 --stop-when 'abs(phi) > 1' -o slow.csv");
   ASSERT_EQ(slow.exit_code, 0) << slow.err;
   const EventsTable fallen = load_events(dir_ / "slow-events.csv");
   ASSERT_EQ(fallen.rows.size(), 1u);
@@ -209,7 +205,7 @@ TEST_F(CliEvents, BicycleFallsAtTwoMetresPerSecondAndNotAtFive) {
   EXPECT_LT(fallen.rows[0][0], 10.0);
   EXPECT_NE(slow.out.find("stopped by event 'abs(phi) > 1'"), std::string::npos) << slow.out;
 
-  const Outcome fast = nhdyn("simulate '" + model + "' --set v=5 --t-end 10 --stop-when 'abs(phi) > 1' -o fast.csv");
+  const EventsOutcome fast = nhdyn("simulate '" + model + "' --set v=5 --t-end 10 --stop-when 'abs(phi) > 1' -o fast.csv");
   ASSERT_EQ(fast.exit_code, 0) << fast.err;
   EXPECT_EQ(load_events(dir_ / "fast-events.csv").rows.size(), 0u);
   const nhdyn::CsvTable rows = nhdyn::load_csv(dir_ / "fast.csv");
@@ -222,7 +218,7 @@ TEST_F(CliEvents, BicycleFallsAtTwoMetresPerSecondAndNotAtFive) {
 
 TEST_F(CliEvents, TheStopWhenExampleOfTheDocs) {
   // docs/cli.md, "Events": the pendulum released at theta0 = 2 rad passes the bottom after P/4.
-  const Outcome run = nhdyn("simulate " + examples + "pendulum_cartesian.toml --stop-when \"x < 0\" -o pendulum.csv");
+  const EventsOutcome run = nhdyn("simulate " + examples + "pendulum_cartesian.toml --stop-when \"x < 0\" -o pendulum.csv");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.out.find("stopped by event 'x < 0', 83 rows -> pendulum.csv"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("events: 1 located -> pendulum-events.csv\n    x < 0 at t = 0.81625294126\n"),
@@ -236,16 +232,16 @@ TEST_F(CliEvents, SameInputSameBytes) {
   const std::string args = "simulate " + examples + "pendulum_cartesian.toml --event bottom=x --t-end 4 -o ";
   ASSERT_EQ(nhdyn(args + "a.csv").exit_code, 0);
   ASSERT_EQ(nhdyn(args + "b.csv").exit_code, 0);
-  EXPECT_EQ(read(dir_ / "a.csv"), read(dir_ / "b.csv"));
-  EXPECT_EQ(read(dir_ / "a-events.csv"), read(dir_ / "b-events.csv"));
+  EXPECT_EQ(read_text(dir_ / "a.csv"), read_text(dir_ / "b.csv"));
+  EXPECT_EQ(read_text(dir_ / "a-events.csv"), read_text(dir_ / "b-events.csv"));
 }
 
 TEST_F(CliEvents, AFailedRunKeepsItsRowsInAPartialFile) {
-  const Outcome run = nhdyn("simulate " + examples + "pendulum_cartesian.toml --max-steps 40 -o p.csv");
+  const EventsOutcome run = nhdyn("simulate " + examples + "pendulum_cartesian.toml --max-steps 40 -o p.csv");
   EXPECT_EQ(run.exit_code, 1) << run.err;
   EXPECT_FALSE(fs::exists(dir_ / "p.csv"));
   ASSERT_TRUE(fs::exists(dir_ / "p.partial.csv")) << run.err;
-  const std::string text = read(dir_ / "p.partial.csv");
+  const std::string text = read_text(dir_ / "p.partial.csv");
   const std::string first = text.substr(0, text.find('\n'));
   EXPECT_EQ(first.rfind("# nhdyn: simulation of 'pendulum-cartesian' failed at t = ", 0), 0u) << first;
   EXPECT_NE(first.find("budget of 40 steps"), std::string::npos) << first;
@@ -286,7 +282,7 @@ TEST_F(CliEvents, BadInputIsRefusedBeforeTheRun) {
       {"simulate " + pendulum + " --event \"up=R_xx\"", {"unknown symbol 'R_xx'", "did you mean 'R_x'?"}},
   };
   for (const Case& c : cases) {
-    const Outcome run = nhdyn(c.args + " -o r.csv");
+    const EventsOutcome run = nhdyn(c.args + " -o r.csv");
     EXPECT_EQ(run.exit_code, 2) << c.args << "\n" << run.err;
     for (const std::string& s : c.said) EXPECT_NE(run.err.find(s), std::string::npos) << c.args << "\n" << run.err;
     EXPECT_FALSE(fs::exists(dir_ / "r.csv")) << c.args;
@@ -298,7 +294,7 @@ TEST_F(CliEvents, BadInputIsRefusedBeforeTheRun) {
 TEST_F(CliEvents, ModelFileEventKeysAreChecked) {
   const std::string bad_direction = example_copy(
       "chaplygin_sleigh.toml", "\n[[events]]\nname = \"turned\"\nwhen = \"phi\"\ndirection = \"raising\"\n");
-  Outcome run = nhdyn("simulate '" + bad_direction + "' -o r.csv");
+  EventsOutcome run = nhdyn("simulate '" + bad_direction + "' -o r.csv");
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("did you mean 'rising'?"), std::string::npos) << run.err;
   const std::string no_when =

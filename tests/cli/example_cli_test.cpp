@@ -11,25 +11,15 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include "support/cli_run.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
-  int exit_code;
-  std::string out;  // stdout and stderr together
-};
+using Outcome = nhdyn::test::CliOutcome;
 
-Outcome nhdyn(const std::string& args, const fs::path& dir) {
-  const std::string command = "cd '" + dir.string() + "' && '" + NHDYN_CLI_PATH + "' " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buffer{};
-  while (std::size_t got = std::fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), got);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using nhdyn::test::run_nhdyn;
 
 class ExampleCli : public ::testing::Test {
  protected:
@@ -51,9 +41,9 @@ class ExampleCli : public ::testing::Test {
 
 TEST_F(ExampleCli, ChainOnStdoutRunsWithSimulate) {
   // stderr kept out of the file (a sanitizer's exit report would land there) and shown after.
-  const Outcome gen = nhdyn("example chain --bodies 4 > chain4.toml 2> gen.err && cat gen.err", dir_);
+  const Outcome gen = run_nhdyn("example chain --bodies 4 > chain4.toml 2> gen.err && cat gen.err", dir_);
   ASSERT_EQ(gen.exit_code, 0) << gen.out;
-  const Outcome sim = nhdyn("simulate chain4.toml --t-end 1 --output-step 0.1 -q -o out.csv", dir_);
+  const Outcome sim = run_nhdyn("simulate chain4.toml --t-end 1 --output-step 0.1 -q -o out.csv", dir_);
   ASSERT_EQ(sim.exit_code, 0) << sim.out;
   const std::string csv = read("out.csv");
   EXPECT_EQ(csv.rfind("t,x1,y1,theta1,x2,", 0), 0u) << csv.substr(0, 200);
@@ -61,24 +51,24 @@ TEST_F(ExampleCli, ChainOnStdoutRunsWithSimulate) {
 }
 
 TEST_F(ExampleCli, ChainWithOutputFileAndSetRunsWithSimulate) {
-  const Outcome gen = nhdyn("example chain --bodies 2 --set m=2 --set w0=0.25 -o chain2.toml", dir_);
+  const Outcome gen = run_nhdyn("example chain --bodies 2 --set m=2 --set w0=0.25 -o chain2.toml", dir_);
   ASSERT_EQ(gen.exit_code, 0) << gen.out;
   EXPECT_EQ(gen.out.find("error"), std::string::npos) << gen.out;  // silent (a sanitizer may report)
   const std::string text = read("chain2.toml");
   EXPECT_NE(text.find("m = { value = 2.0"), std::string::npos);
   EXPECT_NE(text.find("w0 = { value = 0.25"), std::string::npos);
-  const Outcome sim = nhdyn("simulate chain2.toml --t-end 0.5 -q -o out.csv", dir_);
+  const Outcome sim = run_nhdyn("simulate chain2.toml --t-end 0.5 -q -o out.csv", dir_);
   EXPECT_EQ(sim.exit_code, 0) << sim.out;
   const Outcome shipped =
-      nhdyn("simulate '" + std::string(NHDYN_SOURCE_DIR) + "/examples/chain.toml' --t-end 0.5 -q -o shipped.csv", dir_);
+      run_nhdyn("simulate '" + std::string(NHDYN_SOURCE_DIR) + "/examples/chain.toml' --t-end 0.5 -q -o shipped.csv", dir_);
   EXPECT_EQ(shipped.exit_code, 0) << shipped.out;
 }
 
 TEST_F(ExampleCli, ListsTheExamples) {
-  const Outcome none = nhdyn("example", dir_);
+  const Outcome none = run_nhdyn("example", dir_);
   EXPECT_EQ(none.exit_code, 0) << none.out;
   EXPECT_NE(none.out.find("chain"), std::string::npos) << none.out;
-  const Outcome unknown = nhdyn("example trailer", dir_);
+  const Outcome unknown = run_nhdyn("example trailer", dir_);
   EXPECT_EQ(unknown.exit_code, 2) << unknown.out;
   EXPECT_NE(unknown.out.find("unknown example 'trailer'"), std::string::npos) << unknown.out;
   EXPECT_NE(unknown.out.find("chain"), std::string::npos) << unknown.out;
@@ -87,7 +77,7 @@ TEST_F(ExampleCli, ListsTheExamples) {
 TEST_F(ExampleCli, RefusesBadBodiesWithTheLimitAndNoFile) {
   for (const std::string value : {"0", "-3", "=-3", "abc", "1e9", "10001", "99999999999999999999", "2.5"}) {
     const std::string option = value[0] == '=' ? "--bodies" + value : "--bodies " + value;
-    const Outcome out = nhdyn("example chain " + option + " -o chain.toml", dir_);
+    const Outcome out = run_nhdyn("example chain " + option + " -o chain.toml", dir_);
     EXPECT_EQ(out.exit_code, 2) << value << ": " << out.out;
     const std::string shown = value[0] == '=' ? value.substr(1) : value;
     EXPECT_NE(out.out.find(shown), std::string::npos) << value << ": " << out.out;
@@ -98,13 +88,13 @@ TEST_F(ExampleCli, RefusesBadBodiesWithTheLimitAndNoFile) {
 }
 
 TEST_F(ExampleCli, RefusesBadParametersWithNoFile) {
-  const Outcome zero = nhdyn("example chain --set m=0 -o chain.toml", dir_);
+  const Outcome zero = run_nhdyn("example chain --set m=0 -o chain.toml", dir_);
   EXPECT_EQ(zero.exit_code, 2) << zero.out;
   EXPECT_NE(zero.out.find("mass m = 0"), std::string::npos) << zero.out;
-  const Outcome unknown = nhdyn("example chain --set rho=1 -o chain.toml", dir_);
+  const Outcome unknown = run_nhdyn("example chain --set rho=1 -o chain.toml", dir_);
   EXPECT_EQ(unknown.exit_code, 2) << unknown.out;
   EXPECT_NE(unknown.out.find("no parameter 'rho'"), std::string::npos) << unknown.out;
-  const Outcome text = nhdyn("example chain --set f=long -o chain.toml", dir_);
+  const Outcome text = run_nhdyn("example chain --set f=long -o chain.toml", dir_);
   EXPECT_EQ(text.exit_code, 2) << text.out;
   EXPECT_FALSE(fs::exists(dir_ / "chain.toml"));
 }

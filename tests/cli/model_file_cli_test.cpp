@@ -9,27 +9,18 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include "support/cli_run.hpp"
+#include "support/text.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
-  int exit_code;
-  std::string out;  // stdout and stderr together
-};
+using Outcome = nhdyn::test::CliOutcome;
 
-Outcome nhdyn(const std::string& args, const fs::path& dir) {
-  const std::string command = "cd '" + dir.string() + "' && '" + NHDYN_CLI_PATH + "' " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buffer{};
-  while (std::size_t got = std::fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), got);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using nhdyn::test::run_nhdyn;
 
-std::string example(const std::string& name) { return std::string(NHDYN_SOURCE_DIR) + "/examples/" + name; }
+using nhdyn::test::example;
 
 class ModelFileCli : public ::testing::Test {
  protected:
@@ -50,9 +41,9 @@ class ModelFileCli : public ::testing::Test {
 };
 
 TEST_F(ModelFileCli, SimulatesAModelFileLikeTheBuiltInModel) {
-  const Outcome file = nhdyn("simulate " + example("sled.toml") + " --t-end 1 -o file.csv", dir_);
+  const Outcome file = run_nhdyn("simulate " + example("sled.toml") + " --t-end 1 -o file.csv", dir_);
   ASSERT_EQ(file.exit_code, 0) << file.out;
-  const Outcome builtin = nhdyn("simulate sled --t-end 1 -o builtin.csv", dir_);
+  const Outcome builtin = run_nhdyn("simulate sled --t-end 1 -o builtin.csv", dir_);
   ASSERT_EQ(builtin.exit_code, 0) << builtin.out;
   // Same header, and the file model's energy balance after it (docs/derivations/energy-balance.md;
   // built-in models have none); the last rows agree to the integrator's tolerance (the file model
@@ -72,16 +63,16 @@ TEST_F(ModelFileCli, SimulatesAModelFileLikeTheBuiltInModel) {
 }
 
 TEST_F(ModelFileCli, SetOverridesAParameterAndRefusesUnknownOnes) {
-  const Outcome heavy = nhdyn("simulate " + example("sled.toml") + " --set alpha=0 --t-end 1 -o flat.csv", dir_);
+  const Outcome heavy = run_nhdyn("simulate " + example("sled.toml") + " --set alpha=0 --t-end 1 -o flat.csv", dir_);
   ASSERT_EQ(heavy.exit_code, 0) << heavy.out;
-  const Outcome typo = nhdyn("simulate " + example("sled.toml") + " --set rh=1", dir_);
+  const Outcome typo = run_nhdyn("simulate " + example("sled.toml") + " --set rh=1", dir_);
   EXPECT_EQ(typo.exit_code, 2);
   EXPECT_NE(typo.out.find("did you mean 'rho'"), std::string::npos) << typo.out;
-  const Outcome nan = nhdyn("simulate " + example("sled.toml") + " --set rho=abc", dir_);
+  const Outcome nan = run_nhdyn("simulate " + example("sled.toml") + " --set rho=abc", dir_);
   EXPECT_EQ(nan.exit_code, 2);
   EXPECT_NE(nan.out.find("'abc'"), std::string::npos) << nan.out;  // --set takes expressions: an unknown name
   // Built-in models take --set too (parameters are data, docs/cli.md "Parameters").
-  const Outcome builtin = nhdyn("simulate sled --set rho=1 --t-end 1 -o builtin.csv", dir_);
+  const Outcome builtin = run_nhdyn("simulate sled --set rho=1 --t-end 1 -o builtin.csv", dir_);
   EXPECT_EQ(builtin.exit_code, 0) << builtin.out;
 }
 
@@ -96,39 +87,39 @@ TEST_F(ModelFileCli, ViolatedInitialStateIsRefusedOrFixed) {
   ASSERT_NE(at, std::string::npos) << "examples/sled.toml changed its initial velocity";
   toml.replace(at, from.size(), "velocity = { x = 1.0, y = 0.3, phi = 1.0 }");
   std::ofstream(dir_ / "bad.toml") << toml;
-  const Outcome refused = nhdyn("simulate bad.toml --t-end 1 -o out.csv", dir_);
+  const Outcome refused = run_nhdyn("simulate bad.toml --t-end 1 -o out.csv", dir_);
   EXPECT_EQ(refused.exit_code, 2) << refused.out;
   EXPECT_NE(refused.out.find("blade (velocity level): residual 0.3"), std::string::npos) << refused.out;
   EXPECT_FALSE(fs::exists(dir_ / "out.csv"));
-  const Outcome fixed = nhdyn("simulate bad.toml --t-end 1 -o out.csv --fix-initial", dir_);
+  const Outcome fixed = run_nhdyn("simulate bad.toml --t-end 1 -o out.csv --fix-initial", dir_);
   EXPECT_EQ(fixed.exit_code, 0) << fixed.out;
   EXPECT_NE(fixed.out.find("y' = "), std::string::npos) << fixed.out;
 }
 
 TEST_F(ModelFileCli, EquationsInTextAndLatex) {
-  const Outcome text = nhdyn("equations " + example("sled_paper.toml"), dir_);
+  const Outcome text = run_nhdyn("equations " + example("sled_paper.toml"), dir_);
   ASSERT_EQ(text.exit_code, 0) << text.out;
   EXPECT_NE(text.out.find("m x'' + m tan(phi) y''"), std::string::npos) << text.out;
-  const Outcome latex = nhdyn("equations " + example("sled_paper.toml") + " --format latex", dir_);
+  const Outcome latex = run_nhdyn("equations " + example("sled_paper.toml") + " --format latex", dir_);
   ASSERT_EQ(latex.exit_code, 0) << latex.out;
   EXPECT_NE(latex.out.find("\\ddot"), std::string::npos);
-  const Outcome bad = nhdyn("equations " + example("sled.toml") + " --format pdf", dir_);
+  const Outcome bad = run_nhdyn("equations " + example("sled.toml") + " --format pdf", dir_);
   EXPECT_EQ(bad.exit_code, 2);
-  const Outcome builtin = nhdyn("equations appell", dir_);
+  const Outcome builtin = run_nhdyn("equations appell", dir_);
   EXPECT_EQ(builtin.exit_code, 2);
   EXPECT_NE(builtin.out.find("examples/appell.toml"), std::string::npos) << builtin.out;
 }
 
 TEST_F(ModelFileCli, CodegenWritesAHeaderOrNothing) {
-  const Outcome ok = nhdyn("codegen " + example("appell.toml") + " -o appell_model.hpp", dir_);
+  const Outcome ok = run_nhdyn("codegen " + example("appell.toml") + " -o appell_model.hpp", dir_);
   ASSERT_EQ(ok.exit_code, 0) << ok.out;
   const std::string header = read("appell_model.hpp");
   EXPECT_NE(header.find("make_appell_model"), std::string::npos);
   EXPECT_EQ(header.find("ginac"), std::string::npos);
-  const Outcome missing = nhdyn("codegen nosuch.toml -o x.hpp", dir_);
+  const Outcome missing = run_nhdyn("codegen nosuch.toml -o x.hpp", dir_);
   EXPECT_EQ(missing.exit_code, 2) << missing.out;
   EXPECT_FALSE(fs::exists(dir_ / "x.hpp"));
-  const Outcome nodir = nhdyn("codegen " + example("appell.toml") + " -o nodir/x.hpp", dir_);
+  const Outcome nodir = run_nhdyn("codegen " + example("appell.toml") + " -o nodir/x.hpp", dir_);
   EXPECT_EQ(nodir.exit_code, 2) << nodir.out;
 }
 

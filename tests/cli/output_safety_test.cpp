@@ -42,7 +42,7 @@ std::string slurp(const fs::path& p) {
 
 // Runs nhdyn with `args` in `cwd`; stdout and stderr go to files outside `cwd`. With `signal`,
 // sends it `after` into the run. Killed (code -1) after `deadline` seconds.
-CliRun nhdyn(const std::vector<std::string>& args, const fs::path& cwd, int signal = 0,
+CliRun run_cli(const std::vector<std::string>& args, const fs::path& cwd, int signal = 0,
           std::chrono::milliseconds after = std::chrono::milliseconds(0), double deadline = 60.0) {
   static int counter = 0;
   const fs::path logs = fs::temp_directory_path() / ("nhdyn-safety-logs-" + std::to_string(::getpid()));
@@ -129,7 +129,7 @@ TEST_F(OutputSafety, TheModelFileIsNeverAnOutput) {
       {"study", "error-relation", "appell.toml", "-o", "appell.toml"},
   };
   for (const std::vector<std::string>& args : runs) {
-    const CliRun r = nhdyn(args, dir_);
+    const CliRun r = run_cli(args, dir_);
     EXPECT_EQ(r.code, 2) << args[0] << " " << args.back() << ": " << r.err;
     EXPECT_NE(r.err.find("an input of this run"), std::string::npos) << r.err;
     EXPECT_EQ(slurp(dir_ / "appell.toml"), model_) << args[0] << " " << args.back();
@@ -140,7 +140,7 @@ TEST_F(OutputSafety, TheModelFileIsNeverAnOutput) {
 TEST_F(OutputSafety, ASymbolicLinkIsWrittenThrough) {
   fs::create_directories(dir_ / "real");
   fs::create_symlink("real/results.csv", dir_ / "link.csv");  // dangling until written
-  const CliRun r = nhdyn({"simulate", "appell.toml", "-o", "link.csv", "-q"}, dir_);
+  const CliRun r = run_cli({"simulate", "appell.toml", "-o", "link.csv", "-q"}, dir_);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir_ / "link.csv")));
   EXPECT_TRUE(fs::is_regular_file(dir_ / "real/results.csv"));
@@ -151,7 +151,7 @@ TEST_F(OutputSafety, AFifoGetsTheRowsStraight) {
   ASSERT_EQ(::mkfifo((dir_ / "pipe.csv").c_str(), 0644), 0);
   std::string received;
   std::thread reader([&] { received = slurp(dir_ / "pipe.csv"); });
-  const CliRun r = nhdyn({"simulate", "appell.toml", "-o", "pipe.csv", "-q"}, dir_);
+  const CliRun r = run_cli({"simulate", "appell.toml", "-o", "pipe.csv", "-q"}, dir_);
   reader.join();
   ASSERT_EQ(r.code, 0) << r.err;
   struct stat st{};
@@ -170,7 +170,7 @@ TEST_F(OutputSafety, ADefaultNameStaysInsideResults) {
   text.replace(at, end - at + 1, "name = \"../../escape\"");
   std::ofstream(dir_ / "hostile.toml") << text;
   fs::create_directories(dir_ / "work");
-  const CliRun r = nhdyn({"simulate", "../hostile.toml", "-q"}, dir_ / "work");
+  const CliRun r = run_cli({"simulate", "../hostile.toml", "-q"}, dir_ / "work");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::is_regular_file(dir_ / "work/results/_.._escape.csv"));
   EXPECT_FALSE(fs::exists(dir_ / "escape.csv"));
@@ -180,7 +180,7 @@ TEST_F(OutputSafety, ADefaultNameStaysInsideResults) {
 TEST_F(OutputSafety, AReplacedFileKeepsItsMode) {
   std::ofstream(dir_ / "out.csv") << "old\n";
   fs::permissions(dir_ / "out.csv", fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
-  const CliRun r = nhdyn({"simulate", "appell.toml", "-o", "out.csv", "-q"}, dir_);
+  const CliRun r = run_cli({"simulate", "appell.toml", "-o", "out.csv", "-q"}, dir_);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(fs::status(dir_ / "out.csv").permissions() & fs::perms::all,
             fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
@@ -193,7 +193,7 @@ std::vector<std::string> long_run() {
 }
 
 TEST_F(OutputSafety, SigintRemovesTheTemporaryAndSaysWhereItStopped) {
-  const CliRun r = nhdyn(long_run(), dir_, SIGINT, std::chrono::milliseconds(1500));
+  const CliRun r = run_cli(long_run(), dir_, SIGINT, std::chrono::milliseconds(1500));
   EXPECT_EQ(r.code, 130) << r.err;
   EXPECT_NE(r.err.find("interrupted by SIGINT at t = "), std::string::npos) << r.err;
   EXPECT_TRUE(temporaries().empty());
@@ -201,7 +201,7 @@ TEST_F(OutputSafety, SigintRemovesTheTemporaryAndSaysWhereItStopped) {
 }
 
 TEST_F(OutputSafety, SigtermRemovesTheTemporaryAndExits143) {
-  const CliRun r = nhdyn(long_run(), dir_, SIGTERM, std::chrono::milliseconds(1500));
+  const CliRun r = run_cli(long_run(), dir_, SIGTERM, std::chrono::milliseconds(1500));
   EXPECT_EQ(r.code, 143) << r.err;
   EXPECT_NE(r.err.find("interrupted by SIGTERM"), std::string::npos) << r.err;
   EXPECT_TRUE(temporaries().empty());
@@ -214,7 +214,7 @@ TEST(FuzzCorpus, EveryInputAnswersWithinTenSecondsWithoutInternalError) {
   int files = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(NHDYN_SOURCE_DIR) / "fuzz/corpus")) {
     ++files;
-    const CliRun r = nhdyn({"equations", entry.path().string()}, work, 0, {}, 10.0);
+    const CliRun r = run_cli({"equations", entry.path().string()}, work, 0, {}, 10.0);
     EXPECT_NE(r.code, -1) << entry.path() << " took more than 10 s";
     EXPECT_NE(r.code, 3) << entry.path() << ": " << r.err;
     EXPECT_TRUE(r.code == 0 || r.code == 2) << entry.path() << " exit " << r.code << ": " << r.err;
@@ -247,7 +247,7 @@ velocity = "y' - tan(phi)*x'"
 position = { x = 0, y = 0, phi = 0 }
 velocity = { x = 1, y = 0, phi = 1 }
 )";
-  const CliRun r = nhdyn({"simulate", "tan.toml", "--t-end", "3", "--output-step", "0.01", "-o", "out.csv", "-q"}, dir);
+  const CliRun r = run_cli({"simulate", "tan.toml", "--t-end", "3", "--output-step", "0.01", "-o", "out.csv", "-q"}, dir);
   EXPECT_TRUE(r.code == 0 || r.code == 1) << r.err;
   EXPECT_NE(r.err.find("warning: constraint 'blade'"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("by t = 1.57"), std::string::npos) << r.err;

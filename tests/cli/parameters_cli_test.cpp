@@ -12,19 +12,20 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include "support/text.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
+struct ParametersRun {
   int code = -1;
   std::string output;  // stdout and stderr
 };
 
-CliRun run(const std::string& arguments) {
+ParametersRun run(const std::string& arguments) {
   const std::string command = std::string("'") + NHDYN_CLI_PATH + "' " + arguments + " 2>&1";
-  CliRun r;
+  ParametersRun r;
   FILE* pipe = ::popen(command.c_str(), "r");
   if (pipe == nullptr) return r;
   std::array<char, 4096> buffer{};
@@ -35,9 +36,9 @@ CliRun run(const std::string& arguments) {
   return r;
 }
 
-bool has(const CliRun& r, const std::string& part) { return r.output.find(part) != std::string::npos; }
+bool has(const ParametersRun& r, const std::string& part) { return r.output.find(part) != std::string::npos; }
 
-std::string example(const std::string& name) { return std::string(NHDYN_SOURCE_DIR) + "/examples/" + name; }
+using nhdyn::test::example;
 
 fs::path scratch_dir() {
   const fs::path dir = fs::temp_directory_path() / ("nhdyn-parameters-cli-" + std::to_string(::getpid()));
@@ -47,26 +48,26 @@ fs::path scratch_dir() {
 
 TEST(ParametersCli, BuiltinModelsTakeExpressions) {
   const fs::path dir = scratch_dir();
-  const CliRun r = run("simulate sled --set alpha=pi/10 --set m=2*rho --t-end 0.1 -q -o '" + (dir / "s.csv").string() +
+  const ParametersRun r = run("simulate sled --set alpha=pi/10 --set m=2*rho --t-end 0.1 -q -o '" + (dir / "s.csv").string() +
                     "'");
   EXPECT_EQ(r.code, 0) << r.output;
   fs::remove_all(dir);
 }
 
 TEST(ParametersCli, RefusalsSayWhatIsWrong) {
-  const CliRun subnormal = run("simulate sled --set m=1e-320 --t-end 0.1 -q");
+  const ParametersRun subnormal = run("simulate sled --set m=1e-320 --t-end 0.1 -q");
   EXPECT_EQ(subnormal.code, 2) << subnormal.output;
   EXPECT_TRUE(has(subnormal, "subnormal")) << subnormal.output;
-  const CliRun large = run("simulate '" + example("sled.toml") + "' --set m=1e308 --t-end 0.1 -q");
+  const ParametersRun large = run("simulate '" + example("sled.toml") + "' --set m=1e308 --t-end 0.1 -q");
   EXPECT_EQ(large.code, 2) << large.output;
   EXPECT_TRUE(has(large, "too large")) << large.output;
-  const CliRun unknown = run("simulate sled --set rh0=1 --t-end 0.1 -q");
+  const ParametersRun unknown = run("simulate sled --set rh0=1 --t-end 0.1 -q");
   EXPECT_EQ(unknown.code, 2) << unknown.output;
   EXPECT_TRUE(has(unknown, "'rh0'") && has(unknown, "did you mean 'rho'")) << unknown.output;
-  const CliRun cycle = run("simulate sled --set m=2*a --set a=m/4 --t-end 0.1 -q");
+  const ParametersRun cycle = run("simulate sled --set m=2*a --set a=m/4 --t-end 0.1 -q");
   EXPECT_EQ(cycle.code, 2) << cycle.output;
   EXPECT_TRUE(has(cycle, "cycle") && has(cycle, "m = \"2*a\"") && has(cycle, "a = \"m/4\"")) << cycle.output;
-  const CliRun broken = run("simulate sled --set a=0.9 --t-end 0.1 -q");
+  const ParametersRun broken = run("simulate sled --set a=0.9 --t-end 0.1 -q");
   EXPECT_EQ(broken.code, 2) << broken.output;
   EXPECT_TRUE(has(broken, "rho > a")) << broken.output;
 }
@@ -82,7 +83,7 @@ TEST(ParametersCli, DerivedParameterOfAFileFollowsItsBase) {
   // Period 2 pi sqrt(m/k) = pi whatever m: at t = pi/2, half a period, x = -1.
   for (const char* m : {"1", "9"}) {
     const fs::path csv = dir / (std::string("spring-") + m + ".csv");
-    const CliRun r = run("simulate '" + file.string() + "' --set m=" + m + " --t-end 1.5707963267948966 --output-step "
+    const ParametersRun r = run("simulate '" + file.string() + "' --set m=" + m + " --t-end 1.5707963267948966 --output-step "
                       "1.5707963267948966 --rtol 1e-12 --atol 1e-12 -q -o '" + csv.string() + "'");
     ASSERT_EQ(r.code, 0) << r.output;
     std::ifstream in(csv);
@@ -100,7 +101,7 @@ TEST(ParametersCli, DerivedParameterOfAFileFollowsItsBase) {
 
 TEST(ParametersCli, SweepSetsTheParameterInsteadOfRecompiling) {
   const fs::path dir = scratch_dir();
-  const CliRun r = run("sweep '" + example("bicycle_linear.toml") + "' --param v --from 0 --to 10 --steps 21 -q -o '" +
+  const ParametersRun r = run("sweep '" + example("bicycle_linear.toml") + "' --param v --from 0 --to 10 --steps 21 -q -o '" +
                     (dir / "sweep.csv").string() + "'");
   ASSERT_EQ(r.code, 0) << r.output;
   std::ifstream in(dir / "sweep-crossings.csv");

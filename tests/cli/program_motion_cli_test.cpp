@@ -12,27 +12,18 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include "support/cli_run.hpp"
+#include "support/text.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
-  int exit_code;
-  std::string out;  // stdout and stderr together
-};
+using Outcome = nhdyn::test::CliOutcome;
 
-Outcome nhdyn(const std::string& args, const fs::path& dir) {
-  const std::string command = "cd '" + dir.string() + "' && '" + NHDYN_CLI_PATH + "' " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buffer{};
-  while (std::size_t got = std::fread(buffer.data(), 1, buffer.size(), pipe)) out.append(buffer.data(), got);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using nhdyn::test::run_nhdyn;
 
-std::string example(const std::string& name) { return std::string(NHDYN_SOURCE_DIR) + "/examples/" + name; }
+using nhdyn::test::example;
 
 // A point mass in the plane with a program on each coordinate; `extra` goes at the end.
 std::string plane_model(const std::string& programs, const std::string& constraints = "") {
@@ -63,7 +54,7 @@ class ProgramCli : public ::testing::Test {
 };
 
 TEST_F(ProgramCli, WritesTheActuatorForcesAndProgramResiduals) {
-  const Outcome run = nhdyn("simulate " + example("sled_heading_program.toml") + " --t-end 1 -o out.csv", dir_);
+  const Outcome run = run_nhdyn("simulate " + example("sled_heading_program.toml") + " --t-end 1 -o out.csv", dir_);
   ASSERT_EQ(run.exit_code, 0) << run.out;
   const std::string csv = read("out.csv");
   const std::string header = csv.substr(0, csv.find('\n'));
@@ -110,25 +101,25 @@ TEST_F(ProgramCli, TrackingStudyWritesTableByToleranceAndPlot) {
 }
 
 TEST_F(ProgramCli, FeedbackIsReportedAndItsGainsChecked) {
-  const Outcome run = nhdyn("simulate " + example("sled_heading_program.toml") +
+  const Outcome run = run_nhdyn("simulate " + example("sled_heading_program.toml") +
                                 " --t-end 1 -o out.csv --program-feedback 10,10",
                             dir_);
   ASSERT_EQ(run.exit_code, 0) << run.out;
   EXPECT_NE(run.out.find("feedback alpha 10 1/s, beta 10 1/s"), std::string::npos) << run.out;
-  const Outcome bad = nhdyn("simulate " + example("sled_heading_program.toml") + " --program-feedback 10", dir_);
+  const Outcome bad = run_nhdyn("simulate " + example("sled_heading_program.toml") + " --program-feedback 10", dir_);
   EXPECT_EQ(bad.exit_code, 2) << bad.out;
   EXPECT_NE(bad.out.find("alpha,beta"), std::string::npos) << bad.out;
   const Outcome negative =
-      nhdyn("simulate " + example("sled_heading_program.toml") + " --program-feedback 10,-1", dir_);
+      run_nhdyn("simulate " + example("sled_heading_program.toml") + " --program-feedback 10,-1", dir_);
   EXPECT_EQ(negative.exit_code, 2) << negative.out;
   EXPECT_NE(negative.out.find("beta = -1"), std::string::npos) << negative.out;
-  const Outcome none = nhdyn("simulate " + example("sled.toml") + " --program-feedback 1,1", dir_);
+  const Outcome none = run_nhdyn("simulate " + example("sled.toml") + " --program-feedback 1,1", dir_);
   EXPECT_EQ(none.exit_code, 2) << none.out;
   EXPECT_NE(none.out.find("has none"), std::string::npos) << none.out;
 }
 
 TEST_F(ProgramCli, SingularProgramIsRefusedNamingIt) {
-  const Outcome run = nhdyn("simulate " + example("cart_pendulum_program.toml") + " --set theta0=pi/2", dir_);
+  const Outcome run = run_nhdyn("simulate " + example("cart_pendulum_program.toml") + " --set theta0=pi/2", dir_);
   EXPECT_EQ(run.exit_code, 2) << run.out;
   EXPECT_NE(run.out.find("'swing'"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("S = b_p P B"), std::string::npos) << run.out;
@@ -137,7 +128,7 @@ TEST_F(ProgramCli, SingularProgramIsRefusedNamingIt) {
 
 TEST_F(ProgramCli, ARunThatReachesASingularStateStopsThere) {
   // theta = 0.3 + 0.2 t reaches pi/2 at t = (pi/2 - 0.3) / 0.2 = 6.354.
-  const Outcome run = nhdyn("simulate " + example("cart_pendulum_program.toml") + " --t-end 10 -o out.csv", dir_);
+  const Outcome run = run_nhdyn("simulate " + example("cart_pendulum_program.toml") + " --t-end 10 -o out.csv", dir_);
   EXPECT_EQ(run.exit_code, 1) << run.out;
   EXPECT_NE(run.out.find("failed at t = 6.35"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("'swing'"), std::string::npos) << run.out;
@@ -145,7 +136,7 @@ TEST_F(ProgramCli, ARunThatReachesASingularStateStopsThere) {
 
 TEST_F(ProgramCli, UnknownActuatorCoordinateIsNamed) {
   write("m.toml", plane_model("[[programs]]\nname = \"px\"\nposition = \"x - t\"\nactuator = \"xx\"\n"));
-  const Outcome run = nhdyn("simulate m.toml", dir_);
+  const Outcome run = run_nhdyn("simulate m.toml", dir_);
   EXPECT_EQ(run.exit_code, 2) << run.out;
   EXPECT_NE(run.out.find("m.toml:"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("program 'px'"), std::string::npos) << run.out;
@@ -157,7 +148,7 @@ TEST_F(ProgramCli, MoreProgramsThanDegreesOfFreedomSaysHowManyArePossible) {
   write("m.toml", plane_model("[[programs]]\nname = \"p1\"\nposition = \"x - t\"\nactuator = \"x\"\n"
                               "[[programs]]\nname = \"p2\"\nposition = \"y - t\"\nactuator = \"y\"\n",
                               "[[constraints]]\nname = \"line\"\nposition = \"y - x\"\n"));
-  const Outcome run = nhdyn("simulate m.toml", dir_);
+  const Outcome run = run_nhdyn("simulate m.toml", dir_);
   EXPECT_EQ(run.exit_code, 2) << run.out;
   EXPECT_NE(run.out.find("2 programs for k = n - s = 2 - 1 = 1 degrees of freedom: at most 1 programs are possible"),
             std::string::npos)
@@ -167,7 +158,7 @@ TEST_F(ProgramCli, MoreProgramsThanDegreesOfFreedomSaysHowManyArePossible) {
 
 TEST_F(ProgramCli, ZeroActuatorDirectionIsRefused) {
   write("m.toml", plane_model("[[programs]]\nname = \"px\"\nposition = \"x - t\"\nactuator = [0, \"0*m\"]\n"));
-  const Outcome run = nhdyn("simulate m.toml", dir_);
+  const Outcome run = run_nhdyn("simulate m.toml", dir_);
   EXPECT_EQ(run.exit_code, 2) << run.out;
   EXPECT_NE(run.out.find("program 'px': its actuator direction ([0, 0*m]) is zero"), std::string::npos) << run.out;
 }
@@ -177,7 +168,7 @@ TEST_F(ProgramCli, ActuatorThatTheConstraintsAbsorbIsRefused) {
   write("m.toml", plane_model("[[programs]]\nname = \"px\"\nposition = \"x - t\"\nactuator = \"y\"\n"
                               "[initial]\nposition = { x = 0, y = 0 }\nvelocity = { x = 1, y = 0 }\n",
                               "[[constraints]]\nname = \"rail\"\nposition = \"y\"\n"));
-  const Outcome run = nhdyn("simulate m.toml", dir_);
+  const Outcome run = run_nhdyn("simulate m.toml", dir_);
   EXPECT_EQ(run.exit_code, 2) << run.out;
   EXPECT_NE(run.out.find("the actuator of program 'px' (y) pushes straight into the physical constraints"),
             std::string::npos)
@@ -189,7 +180,7 @@ TEST_F(ProgramCli, ProgramsInConflictWithTheConstraintsAreReportedWithTheirResid
   write("m.toml", plane_model("[[programs]]\nname = \"lift\"\nposition = \"y - 1 - t\"\nactuator = \"y\"\n"
                               "[initial]\nposition = { x = 0, y = 0 }\nvelocity = { x = 1, y = 0 }\n",
                               "[[constraints]]\nname = \"rail\"\nposition = \"y\"\n"));
-  const Outcome run = nhdyn("simulate m.toml", dir_);
+  const Outcome run = run_nhdyn("simulate m.toml", dir_);
   EXPECT_EQ(run.exit_code, 2) << run.out;
   EXPECT_NE(run.out.find("violates its programs"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("lift (position level): residual -1"), std::string::npos) << run.out;
@@ -201,13 +192,13 @@ TEST_F(ProgramCli, ProgramRepeatingAConstraintIsSingular) {
   write("m.toml", plane_model("[[programs]]\nname = \"same\"\nposition = \"y\"\nactuator = \"x\"\n"
                               "[initial]\nposition = { x = 0, y = 0 }\nvelocity = { x = 1, y = 0 }\n",
                               "[[constraints]]\nname = \"rail\"\nposition = \"y\"\n"));
-  const Outcome run = nhdyn("simulate m.toml", dir_);
+  const Outcome run = run_nhdyn("simulate m.toml", dir_);
   EXPECT_EQ(run.exit_code, 2) << run.out;
   EXPECT_NE(run.out.find("Programs involved: 'same'"), std::string::npos) << run.out;
 }
 
 TEST_F(ProgramCli, ProgramsNeedTheSanhFormulation) {
-  const Outcome run = nhdyn("simulate " + example("sled_heading_program.toml") + " --method lagrange", dir_);
+  const Outcome run = run_nhdyn("simulate " + example("sled_heading_program.toml") + " --method lagrange", dir_);
   EXPECT_EQ(run.exit_code, 2) << run.out;
   EXPECT_NE(run.out.find("only the sanh formulation solves"), std::string::npos) << run.out;
 }

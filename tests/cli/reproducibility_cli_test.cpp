@@ -17,6 +17,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "support/text.hpp"
 
 namespace {
 
@@ -24,16 +25,9 @@ namespace fs = std::filesystem;
 
 constexpr int kRuns = 4;
 
-std::string read(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using nhdyn::test::read_text;
 
-std::string example(const std::string& file) {
-  return (fs::path(NHDYN_SOURCE_DIR) / "examples" / file).string();
-}
+using nhdyn::test::example;
 
 // Whether the kernel randomises where shared libraries are loaded (the condition under which the
 // differences showed; with it off every process would see the same addresses).
@@ -71,8 +65,8 @@ class Reproducible : public ::testing::Test {
       const std::string file = "run" + std::to_string(i) + "." + extension;
       std::vector<std::string> run_args = args;
       run_args.insert(run_args.end(), {"-o", file});
-      ASSERT_EQ(nhdyn(run_args), 0) << read(dir_ / "err.txt");
-      outputs.push_back(read(dir_ / file));
+      ASSERT_EQ(nhdyn(run_args), 0) << read_text(dir_ / "err.txt");
+      outputs.push_back(read_text(dir_ / file));
       ASSERT_FALSE(outputs.back().empty());
     }
     for (int i = 1; i < kRuns; ++i) {
@@ -114,7 +108,7 @@ TEST_F(Reproducible, BicycleSimulationCompiledAsInterpreted) {
   std::vector<std::string> compiled = args;
   compiled.insert(compiled.end(), {"--evaluator", "compiled", "-o", "probe.csv"});
   if (nhdyn(compiled) != 0) {
-    const std::string err = read(dir_ / "err.txt");
+    const std::string err = read_text(dir_ / "err.txt");
     ::unsetenv("XDG_CACHE_HOME");
     if (err.find("cannot be run") != std::string::npos) GTEST_SKIP() << "no C++ compiler: " << err;
     FAIL() << err;
@@ -123,9 +117,9 @@ TEST_F(Reproducible, BicycleSimulationCompiledAsInterpreted) {
   expect_same_bytes(compiled, "csv");
   std::vector<std::string> interpreted = args;
   interpreted.insert(interpreted.end(), {"-o", "interpreted.csv"});
-  ASSERT_EQ(nhdyn(interpreted), 0) << read(dir_ / "err.txt");
+  ASSERT_EQ(nhdyn(interpreted), 0) << read_text(dir_ / "err.txt");
   ::unsetenv("XDG_CACHE_HOME");
-  EXPECT_EQ(read(dir_ / "interpreted.csv"), read(dir_ / "run0.csv"));
+  EXPECT_EQ(read_text(dir_ / "interpreted.csv"), read_text(dir_ / "run0.csv"));
 }
 
 // A batch compiles once and rebinds the object to each run's parameters: the runs agree with the
@@ -137,16 +131,16 @@ TEST_F(Reproducible, BatchCompiledAsInterpreted) {
   std::vector<std::string> compiled = args;
   compiled.insert(compiled.end(), {"--evaluator", "compiled", "-o", "compiled"});
   const int status = nhdyn(compiled);
-  const std::string err = read(dir_ / "err.txt");
+  const std::string err = read_text(dir_ / "err.txt");
   ::unsetenv("XDG_CACHE_HOME");
   if (status != 0 && err.find("cannot be run") != std::string::npos) GTEST_SKIP() << "no C++ compiler: " << err;
   ASSERT_EQ(status, 0) << err;
   std::vector<std::string> interpreted = args;
   interpreted.insert(interpreted.end(), {"-o", "interpreted"});
-  ASSERT_EQ(nhdyn(interpreted), 0) << read(dir_ / "err.txt");
-  const std::string summary = read(dir_ / "interpreted" / "summary.csv");
+  ASSERT_EQ(nhdyn(interpreted), 0) << read_text(dir_ / "err.txt");
+  const std::string summary = read_text(dir_ / "interpreted" / "summary.csv");
   EXPECT_FALSE(summary.empty());
-  EXPECT_EQ(read(dir_ / "compiled" / "summary.csv"), summary);
+  EXPECT_EQ(read_text(dir_ / "compiled" / "summary.csv"), summary);
 }
 
 TEST_F(Reproducible, RollingDiskFromBodies) {
@@ -155,7 +149,7 @@ TEST_F(Reproducible, RollingDiskFromBodies) {
 
 TEST_F(Reproducible, GeneratedChain) {
   ASSERT_EQ(nhdyn({"example", "chain", "--bodies", "4", "-o", "chain.toml"}), 0)
-      << read(dir_ / "err.txt");
+      << read_text(dir_ / "err.txt");
   expect_same_bytes({"simulate", "chain.toml", "--t-end", "2", "-q"}, "csv");
 }
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "nhdyn/io/csv.hpp"
+#include "support/text.hpp"
 
 namespace {
 
@@ -25,12 +26,7 @@ struct Result {
   std::string out, err;
 };
 
-std::string read(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using nhdyn::test::read_text;
 
 // A fresh directory per test, removed afterwards.
 class StudyCli : public ::testing::Test {
@@ -51,8 +47,8 @@ class StudyCli : public ::testing::Test {
     const int status = std::system(command.c_str());
     Result r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = read(dir_ / "out.txt");
-    r.err = read(dir_ / "err.txt");
+    r.out = read_text(dir_ / "out.txt");
+    r.err = read_text(dir_ / "err.txt");
     return r;
   }
 
@@ -124,7 +120,7 @@ TEST_F(StudyCli, ErrorRelationWritesTableByToleranceAndPlot) {
                           "out/er.png"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("the model's exact solution"), std::string::npos) << r.out;
-  const std::string table = read(dir_ / "out/er.csv");
+  const std::string table = read_text(dir_ / "out/er.csv");
   EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 9);  // header and 2 x 2 x 2 runs
   EXPECT_EQ(table.rfind("formulation,integrator,rtol,atol,max_error_q", 0), 0u) << table;
   const nhdyn::CsvTable by_tolerance = nhdyn::load_csv(dir_ / "out/er-by-tolerance.csv");

@@ -12,13 +12,14 @@
 #include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/model/appell.hpp"
 #include "support/test_models.hpp"
+#include "support/text.hpp"
 
 namespace nhdyn {
 namespace {
 
-const Method kMethods[] = {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace};
+const Method kDiagnosedMethods[] = {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace};
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using nhdyn::test::contains;
 
 TEST(Diagnosis, DependentConstraintsAreNamedWithAConditionEstimate) {
   Matrix b(3, 4);
@@ -26,7 +27,7 @@ TEST(Diagnosis, DependentConstraintsAreNamedWithAConditionEstimate) {
        0, 1, 1, 0,
        2, 0, 0, 0;  // c3 = 2 c1
   const Model model = testing::make_constant_model(Matrix::Identity(4, 4), Vector::Ones(4), b, Vector::Zero(3));
-  for (Method m : kMethods) {
+  for (Method m : kDiagnosedMethods) {
     Data data = make_data(model);
     const Status status = compute_dynamics(model, data, {m, Complement::qr}, 0.0, model.q0.data(), model.v0.data());
     ASSERT_NE(status, Status::ok) << method_name(m);
@@ -73,7 +74,7 @@ TEST(Diagnosis, NonFiniteTermsNameTheQuantityAndTime) {
   Data data = make_data(model);
   Vector q = Vector::Zero(3), v(3);
   v << 1.0, 0.0, 0.0;
-  for (Method m : kMethods) {
+  for (Method m : kDiagnosedMethods) {
     const Status status = compute_dynamics(model, data, {m, Complement::qr}, 2.5, q.data(), v.data());
     ASSERT_EQ(status, Status::non_finite) << method_name(m);
     const std::string message = explain_failure(model, data);

@@ -31,16 +31,16 @@ RandomSystem random_system(int n, int s, std::mt19937& rng) {
   return r;
 }
 
-struct Solution {
+struct SmallSolution {
   Status status;
   Matrix D;
   Vector qdd, R;
 };
 
-Solution solve(const Model& model, bool small, Complement complement, Method method = Method::sanh) {
+SmallSolution solve(const Model& model, bool small, Complement complement, Method method = Method::sanh) {
   Data data = make_data(model);
   data.small_kernels = small;
-  Solution s;
+  SmallSolution s;
   s.status = compute_dynamics(model, data, {method, complement}, 0.0, model.q0.data(), model.v0.data());
   s.D = data.D;
   s.qdd = data.qdd;
@@ -58,8 +58,8 @@ TEST(SmallKernels, SameAccelerationsAsTheDynamicPathForEverySize) {
         const std::string where = "n = " + std::to_string(n) + ", s = " + std::to_string(s);
         for (Method method : {Method::sanh, Method::nullspace}) {
           for (Complement c : {Complement::qr, Complement::partition}) {
-            const Solution fast = solve(model, true, c, method);
-            const Solution slow = solve(model, false, c, method);
+            const SmallSolution fast = solve(model, true, c, method);
+            const SmallSolution slow = solve(model, false, c, method);
             ASSERT_EQ(fast.status, Status::ok) << where;
             ASSERT_EQ(slow.status, Status::ok) << where;
             const double scale = 1.0 + slow.qdd.norm();
@@ -72,7 +72,7 @@ TEST(SmallKernels, SameAccelerationsAsTheDynamicPathForEverySize) {
             EXPECT_LT((fast.D * (sys.A * fast.qdd - sys.Q)).norm(), 1e-10 * scale) << where;
           }
         }
-        const Solution qr = solve(model, true, Complement::qr);
+        const SmallSolution qr = solve(model, true, Complement::qr);
         ASSERT_EQ(qr.D.rows(), n - s);
         if (s > 0) {
           EXPECT_LT((qr.D * sys.b.transpose()).norm(), 1e-12) << where << ": D b^T";

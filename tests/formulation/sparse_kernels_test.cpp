@@ -20,11 +20,12 @@
 #include "nhdyn/model/sled.hpp"
 #include "nhdyn/model/terms.hpp"
 #include "support/test_models.hpp"
+#include "support/text.hpp"
 
 namespace nhdyn {
 namespace {
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using nhdyn::test::contains;
 
 double relative(const Vector& x, const Vector& reference) {
   return (x - reference).norm() / std::max(reference.norm(), 1e-300);

@@ -37,7 +37,7 @@ struct Robot {
   }
 };
 
-Robot parameters_of(const Model& model) {
+Robot robot_of(const Model& model) {
   return {parameter(model, "m"),  parameter(model, "J"), parameter(model, "Jw"),    parameter(model, "rw"),
           parameter(model, "d"),  parameter(model, "c"), parameter(model, "tau_r"), parameter(model, "tau_l")};
 }
@@ -53,8 +53,8 @@ struct RobotErrors {
 
 // The closed forms from the model's initial state (v0, w0 read from it); x, y only in the two
 // special cases (straight: theta0 = 0 and w = 0 throughout; in place: v = 0 throughout).
-RobotErrors measure(const Model& model, double t_end) {
-  const Robot p = parameters_of(model);
+RobotErrors measure_robot(const Model& model, double t_end) {
+  const Robot p = robot_of(model);
   const double th0 = model.q0(2), v0 = std::cos(th0) * model.v0(0) + std::sin(th0) * model.v0(1), w0 = model.v0(2);
   const double vi = p.v_inf(), wi = p.w_inf(), kv = p.kv(), kw = p.kw();
   const double v_scale = std::max({std::abs(vi), std::abs(v0), 1e-3});
@@ -94,7 +94,7 @@ RobotErrors measure(const Model& model, double t_end) {
 }
 
 TEST(DiffDrive, UnequalTorquesMatchTheClosedFormSpeedAndTurningRate) {
-  const RobotErrors err = measure(load_example("diff_drive.toml"), 20.0);
+  const RobotErrors err = measure_robot(load_example("diff_drive.toml"), 20.0);
   EXPECT_LT(err.v, 1e-9);
   EXPECT_LT(err.w, 1e-9);
   EXPECT_LT(err.theta, 1e-9);
@@ -104,7 +104,7 @@ TEST(DiffDrive, UnequalTorquesMatchTheClosedFormSpeedAndTurningRate) {
 }
 
 TEST(DiffDrive, EqualTorquesDriveStraight) {
-  const RobotErrors err = measure(load_example("diff_drive.toml", {{"tau_r", 0.02}, {"tau_l", 0.02}}), 10.0);
+  const RobotErrors err = measure_robot(load_example("diff_drive.toml", {{"tau_r", 0.02}, {"tau_l", 0.02}}), 10.0);
   EXPECT_LT(err.v, 1e-9);
   EXPECT_LT(err.w, 1e-9);
   EXPECT_LT(err.drift, 1e-9);  // x = the closed-form distance, y = 0
@@ -112,7 +112,7 @@ TEST(DiffDrive, EqualTorquesDriveStraight) {
 }
 
 TEST(DiffDrive, OppositeTorquesTurnInPlace) {
-  const RobotErrors err = measure(load_example("diff_drive.toml", {{"tau_r", 0.02}, {"tau_l", -0.02}}), 10.0);
+  const RobotErrors err = measure_robot(load_example("diff_drive.toml", {{"tau_r", 0.02}, {"tau_l", -0.02}}), 10.0);
   EXPECT_LT(err.w, 1e-9);
   EXPECT_LT(err.theta, 1e-9);
   EXPECT_LT(err.drift, 1e-9);  // x = y = 0
@@ -123,11 +123,11 @@ TEST(DiffDrive, OppositeTorquesTurnInPlace) {
 // any initial v0, w0 on the constraints.
 TEST(DiffDrive, ClosedFormsHoldFromAMovingStart) {
   Model model = load_example("diff_drive.toml");
-  const Robot p = parameters_of(model);
+  const Robot p = robot_of(model);
   const double th0 = 0.7, v0 = -0.3, w0 = 2.0;
   model.q0 << 0.5, -0.2, th0, 0.0, 0.0;
   model.v0 << v0 * std::cos(th0), v0 * std::sin(th0), w0, (v0 + p.d * w0) / p.rw, (v0 - p.d * w0) / p.rw;
-  const RobotErrors err = measure(model, 10.0);
+  const RobotErrors err = measure_robot(model, 10.0);
   EXPECT_LT(err.v, 1e-9);
   EXPECT_LT(err.w, 1e-9);
   EXPECT_LT(err.theta, 1e-9);
@@ -137,10 +137,10 @@ TEST(DiffDrive, ClosedFormsHoldFromAMovingStart) {
 // Negative controls: the wheels' inertia doubled in T, or the left wheel's rolling written with the
 // wrong sense of turning, fail the exam by far.
 TEST(DiffDrive, TheExamRejectsWrongModels) {
-  const RobotErrors heavy = measure(load_altered_example("diff_drive.toml", "Jw/2 * (", "Jw * ("), 20.0);
+  const RobotErrors heavy = measure_robot(load_altered_example("diff_drive.toml", "Jw/2 * (", "Jw * ("), 20.0);
   EXPECT_GT(heavy.v, 1e-3);
   EXPECT_GT(heavy.power, 1e-3);
-  const RobotErrors crossed = measure(
+  const RobotErrors crossed = measure_robot(
       load_altered_example("diff_drive.toml", "sin(theta)*y' - d*theta' - rw*phi_l'", "sin(theta)*y' + d*theta' - rw*phi_l'"),
       20.0);
   EXPECT_GT(crossed.w, 1e-2);

@@ -10,15 +10,12 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+#include "support/text.hpp"
 
 namespace nhdyn {
 namespace {
 
-std::vector<double> linspace(double a, double b, int count) {
-  std::vector<double> t(static_cast<std::size_t>(count));
-  for (int i = 0; i < count; ++i) t[static_cast<std::size_t>(i)] = a + (b - a) * i / (count - 1);
-  return t;
-}
+using nhdyn::test::linspace;
 
 IntegratorOptions tolerances(IntegratorKind kind, double rtol, double atol) {
   IntegratorOptions options;

@@ -20,7 +20,7 @@ namespace {
 constexpr double pi = std::numbers::pi;
 
 // x'' = -x, y(0) = (1, 0): x = cos t.
-class Oscillator : public OdeSystem {
+class EventOscillator : public OdeSystem {
  public:
   int size() const override { return 2; }
   Status rhs(double /*t*/, const double* y, double* ydot) override {
@@ -61,7 +61,7 @@ class Events : public EventFunctions {
 };
 
 IntegrationResult run(IntegratorKind kind, Events& events, double t_end, double rtol, double max_step = 0.0) {
-  Oscillator oscillator;
+  EventOscillator oscillator;
   IntegratorOptions options;
   options.kind = kind;
   options.rtol = rtol;

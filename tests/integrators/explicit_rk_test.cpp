@@ -12,6 +12,7 @@
 #include <numeric>
 #include <utility>
 #include <vector>
+#include "support/text.hpp"
 
 namespace nhdyn {
 namespace {
@@ -161,14 +162,10 @@ TEST(Tableaus, DormandPrince853HasOrder8WithEmbeddedOrders5And3) {
 
 // --- Integration exams ------------------------------------------------------------------------
 
-std::vector<double> linspace(double a, double b, int count) {
-  std::vector<double> t(static_cast<std::size_t>(count));
-  for (int i = 0; i < count; ++i) t[static_cast<std::size_t>(i)] = a + (b - a) * i / (count - 1);
-  return t;
-}
+using nhdyn::test::linspace;
 
 // x'' = -x as y = (x, x'); y(0) = (1, 0) gives (cos t, -sin t).
-class Oscillator : public OdeSystem {
+class RkOscillator : public OdeSystem {
  public:
   int size() const override { return 2; }
   Status rhs(double /*t*/, const double* y, double* ydot) override {
@@ -189,9 +186,9 @@ struct Outcome {
 };
 
 Outcome run_oscillator(const IntegratorOptions& options, const std::vector<double>& times,
-                   Oscillator* observed = nullptr) {
-  Oscillator local;
-  Oscillator& system = observed ? *observed : local;
+                   RkOscillator* observed = nullptr) {
+  RkOscillator local;
+  RkOscillator& system = observed ? *observed : local;
   const double y0[2] = {1.0, 0.0};
   Outcome run;
   run.result = integrate(system, options, 0.0, y0, times, [&](double t, const double* y) {
@@ -232,7 +229,7 @@ TEST(Rk4, GlobalErrorHasOrder4) {
 }
 
 TEST(Rk4, SplitsEachOutputIntervalIntoEqualSteps) {
-  Oscillator system;
+  RkOscillator system;
   const std::vector<double> times = {0.3, 1.0};
   const Outcome run = run_oscillator(rk4_options(0.1), times, &system);
   ASSERT_EQ(run.result.status, Status::ok);
@@ -276,14 +273,14 @@ TEST(Dopri5, DenseOutputIsAccurateAndNeverShortensSteps) {
   std::vector<double> times;
   for (int k = 0; k < 1000; ++k) times.push_back(0.00731 + 0.00997 * k);
   times.push_back(10.0);
-  Oscillator dense_system;
+  RkOscillator dense_system;
   const Outcome dense = run_oscillator(dopri5_options(1e-10), times, &dense_system);
   ASSERT_EQ(dense.result.status, Status::ok) << dense.result.message;
   EXPECT_LT(dense.max_error, 1e-8);
   // Most outputs lie strictly inside steps.
   EXPECT_LT(dense.result.stats.steps, 500);
 
-  Oscillator end_system;
+  RkOscillator end_system;
   const Outcome end_only = run_oscillator(dopri5_options(1e-10), {10.0}, &end_system);
   EXPECT_EQ(dense.result.stats.steps, end_only.result.stats.steps);
   EXPECT_EQ(dense_system.step_ends, end_system.step_ends);
@@ -304,7 +301,7 @@ TEST(Dopri5, ErrorIsProportionalToTheTolerance) {
 }
 
 TEST(Dopri5, HonoursMaxStep) {
-  Oscillator system;
+  RkOscillator system;
   IntegratorOptions options = dopri5_options(1e-6);
   options.max_step = 0.05;
   const Outcome run = run_oscillator(options, {10.0}, &system);
@@ -532,7 +529,7 @@ TEST(Dop853, TakesFarFewerRhsThanDopri5AtTightTolerances) {
 }
 
 // y' = y^2, y(0) = 1: y = 1 / (1 - t) blows up at t = 1.
-class BlowUp : public OdeSystem {
+class RkBlowUp : public OdeSystem {
  public:
   int size() const override { return 1; }
   Status rhs(double /*t*/, const double* y, double* ydot) override {
@@ -542,7 +539,7 @@ class BlowUp : public OdeSystem {
 };
 
 TEST(Dopri5, SingularityGivesStepSizeUnderflow) {
-  BlowUp system;
+  RkBlowUp system;
   const double y0[1] = {1.0};
   const std::vector<double> times = {2.0};
   const IntegrationResult result = integrate(system, dopri5_options(1e-8), 0.0, y0, times,
@@ -554,7 +551,7 @@ TEST(Dopri5, SingularityGivesStepSizeUnderflow) {
 }
 
 TEST(Dop853, SingularityGivesStepSizeUnderflow) {
-  BlowUp system;
+  RkBlowUp system;
   const double y0[1] = {1.0};
   const std::vector<double> times = {2.0};
   const IntegrationResult result = integrate(system, dop853_options(1e-8), 0.0, y0, times,

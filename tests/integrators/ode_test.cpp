@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
+#include "support/text.hpp"
 
 // Counts every allocation of the test program, so that a test can show the step loop makes none.
 namespace {
@@ -40,14 +41,10 @@ constexpr IntegratorKind all_kinds[] = {IntegratorKind::rk4, IntegratorKind::dop
                                         IntegratorKind::dop853, IntegratorKind::cvode_bdf,
                                         IntegratorKind::cvode_adams};
 
-std::vector<double> linspace(double a, double b, int count) {
-  std::vector<double> t(static_cast<std::size_t>(count));
-  for (int i = 0; i < count; ++i) t[static_cast<std::size_t>(i)] = a + (b - a) * i / (count - 1);
-  return t;
-}
+using nhdyn::test::linspace;
 
 // x'' = -x as y = (x, x'); y(0) = (1, 0) gives (cos t, -sin t). Counts calls.
-class Oscillator : public OdeSystem {
+class CountingOscillator : public OdeSystem {
  public:
   int size() const override { return 2; }
   Status rhs(double /*t*/, const double* y, double* ydot) override {
@@ -106,12 +103,12 @@ class Jump : public OdeSystem {
 };
 
 // The oscillator, but its rhs reports non_finite from t_bad on.
-class FailsAt : public Oscillator {
+class FailsAt : public CountingOscillator {
  public:
   explicit FailsAt(double t_bad) : t_bad_(t_bad) {}
   Status rhs(double t, const double* y, double* ydot) override {
     if (t >= t_bad_) return Status::non_finite;
-    return Oscillator::rhs(t, y, ydot);
+    return CountingOscillator::rhs(t, y, ydot);
   }
 
  private:
@@ -148,7 +145,7 @@ TEST(IntegratorNames, UnknownNameListsTheValidOnes) {
 // The message of the InputError that integrate throws, or "" when it does not throw.
 std::string input_error(const IntegratorOptions& options, double t0,
                         const std::vector<double>& times, const double* y0 = nullptr) {
-  Oscillator system;
+  CountingOscillator system;
   const double y_default[2] = {1.0, 0.0};
   try {
     integrate(system, options, t0, y0 ? y0 : y_default, times,
@@ -208,7 +205,7 @@ INSTANTIATE_TEST_SUITE_P(Kinds, EveryIntegrator, ::testing::ValuesIn(all_kinds),
                          });
 
 TEST_P(EveryIntegrator, OutputsAtExactlyTheRequestedTimesStartingWithY0) {
-  Oscillator system;
+  CountingOscillator system;
   const std::vector<double> times = {0.0, 0.1, 0.35, 1.0 / 3.0 + 1.0, 2.0, 7.25};
   const double y0[2] = {1.0, 0.0};
   std::vector<double> seen;
@@ -227,7 +224,7 @@ TEST_P(EveryIntegrator, OutputsAtExactlyTheRequestedTimesStartingWithY0) {
 }
 
 TEST_P(EveryIntegrator, CountersMatchTheCallsMade) {
-  Oscillator system;
+  CountingOscillator system;
   const double y0[2] = {1.0, 0.0};
   const std::vector<double> times = linspace(0.0, 10.0, 11);
   const IntegrationResult result = integrate(system, options_for(GetParam(), 1e-8), 0.0, y0, times,
@@ -239,7 +236,7 @@ TEST_P(EveryIntegrator, CountersMatchTheCallsMade) {
 }
 
 TEST_P(EveryIntegrator, OnlyT0GivesOneOutputAndNoStep) {
-  Oscillator system;
+  CountingOscillator system;
   const double y0[2] = {1.0, 0.0};
   int outputs = 0;
   const std::vector<double> times = {3.0};
@@ -339,7 +336,7 @@ TEST_P(EveryIntegrator, NonFiniteRhsStopsTheRunNearWhereItHappened) {
 }
 
 TEST_P(EveryIntegrator, StepBudgetRunsOut) {
-  Oscillator system;
+  CountingOscillator system;
   const double y0[2] = {1.0, 0.0};
   IntegratorOptions options = options_for(GetParam());
   options.max_steps = 10;
@@ -356,7 +353,7 @@ TEST_P(EveryIntegrator, StepBudgetRunsOut) {
 }
 
 TEST_P(EveryIntegrator, StoppedByTheOutputCallback) {
-  Oscillator system;
+  CountingOscillator system;
   const double y0[2] = {1.0, 0.0};
   const std::vector<double> times = linspace(0.0, 10.0, 11);
   int outputs = 0;
@@ -372,12 +369,12 @@ TEST_P(EveryIntegrator, StoppedByTheOutputCallback) {
 }
 
 TEST_P(EveryIntegrator, NoAllocationOnceTheStepLoopRuns) {
-  class Counting : public Oscillator {
+  class Counting : public CountingOscillator {
    public:
     Status rhs(double t, const double* y, double* ydot) override {
       if (calls == 0) at_first_call = allocations.load();
       at_last_call = allocations.load();
-      return Oscillator::rhs(t, y, ydot);
+      return CountingOscillator::rhs(t, y, ydot);
     }
     long at_first_call = 0;
     long at_last_call = 0;

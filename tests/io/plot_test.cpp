@@ -315,8 +315,6 @@ TEST_F(PlotTest, BadRequestsThrowInputError) {
   EXPECT_EQ(entries(dir_), (std::set<std::string>{"sled.csv"}));
 }
 
-}  // namespace
-
 // ---- write_xy_plot (studies) ------------------------------------------------------------------
 
 class XyPlotTest : public PlotTest {
@@ -407,4 +405,5 @@ TEST_F(XyPlotTest, BadRequestsThrowInputErrorAndLeaveNothing) {
   EXPECT_EQ(entries(dir_), (std::set<std::string>{"sled.csv"}));
 }
 
+}  // namespace
 }  // namespace nhdyn

@@ -17,11 +17,12 @@
 #include "nhdyn/io/model_file.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 #include "nhdyn/symbolic/derivation.hpp"
+#include "support/text.hpp"
 
 namespace nhdyn::multibody_test {
 namespace {
 
-std::string example(const std::string& file) { return std::string(NHDYN_SOURCE_DIR) + "/examples/" + file; }
+using nhdyn::test::example;
 
 std::string read_text(const std::string& path) {
   std::ifstream in(path);

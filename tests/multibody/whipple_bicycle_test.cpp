@@ -22,11 +22,12 @@
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/io/model_file.hpp"
 #include "nhdyn/symbolic/compile.hpp"
+#include "support/text.hpp"
 
 namespace nhdyn::multibody_test {
 namespace {
 
-std::string example(const std::string& file) { return std::string(NHDYN_SOURCE_DIR) + "/examples/" + file; }
+using nhdyn::test::example;
 
 // Loaded and compiled once: the derivation is the slow part.
 struct Bicycle {

@@ -10,6 +10,7 @@
 
 #include "codegen/hand_built_specs.hpp"
 #include "nhdyn/core/error.hpp"
+#include "support/text.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
@@ -18,7 +19,7 @@ using testing::HandBuilt;
 using testing::make_hand_built_appell;
 using testing::make_hand_built_sled;
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using nhdyn::test::contains;
 
 TEST(Codegen, HeaderImplementsTheEvaluatorAndTheModelMaker) {
   const HandBuilt built = make_hand_built_sled();

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "nhdyn/symbolic/spec_builder.hpp"
+#include "support/text.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
@@ -48,9 +49,7 @@ Spec appell(bool with_independent) {
 
 std::string show(const Spec& spec, EquationFormat format) { return format_equations(spec, derive(spec), format); }
 
-bool contains(const std::string& haystack, const std::string& needle) {
-  return haystack.find(needle) != std::string::npos;
-}
+using nhdyn::test::contains;
 
 int count(const std::string& haystack, const std::string& needle) {
   int n = 0;

@@ -67,6 +67,21 @@ Status compute_constraint_basis(const Model& model, Data& data) {
   return Status::ok;
 }
 
+double complement_residual(const Data& data) {
+  const Eigen::Index s = data.b.rows();
+  if (s == 0 || data.D.rows() == 0 || data.D.cols() != data.b.cols()) return 0.0;
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < data.D.rows(); ++i) {
+    const double d_norm = data.D.row(i).norm();
+    for (Eigen::Index j = 0; j < s; ++j) {
+      const double scale = d_norm * data.b.row(j).norm();
+      if (!(scale > 0.0)) continue;  // a zero row: the rank checks report it
+      worst = std::max(worst, std::abs(data.D.row(i).dot(data.b.row(j))) / scale);
+    }
+  }
+  return worst;
+}
+
 Status compute_complement(const Model& model, Data& data, Complement complement) {
   if (data.stage < Stage::terms)
     throw std::logic_error("compute_complement: call compute_terms first for the current state");
@@ -101,6 +116,14 @@ Status compute_complement(const Model& model, Data& data, Complement complement)
                          "(partition) instead");
       model.evaluator->complement(data.t, data.q.data(), data.v.data(), data.scratch.data(), data.D.data());
       if (!data.D.allFinite()) return record_failure(data, Status::non_finite, "complement D");
+      // Loading checks the model's D at the initial state only (symbolic/derivation.cpp); one
+      // that stops being a complement along the run would give a wrong motion without a sign.
+      if (data.check_complement) {
+        if (const double residual = complement_residual(data); residual > kComplementTolerance) {
+          data.failed_value = residual;
+          return record_failure(data, Status::singular_system, "complement D");
+        }
+      }
       return Status::ok;
   }
   return Status::ok;

@@ -14,7 +14,16 @@ namespace nhdyn {
 // Requires compute_terms. Writes data.D (and data.independent for partitioning).
 // Returns Status::dependent_constraints when b has rank below s. Throws InputError when the
 // analytic D is asked of a model that has none. Allocates nothing.
+// With data.check_complement (on in debug builds) the analytic D is checked at every evaluation: when
+// complement_residual exceeds kComplementTolerance it returns Status::singular_system with the
+// quantity "complement D" and the residual in data.failed_value (explain_failure words it).
 Status compute_complement(const Model& model, Data& data, Complement complement);
+
+// How far data.D is from a complement of data.b on the dense path: the largest |D_i . b_j| over
+// |D_i| |b_j| (rows D_i of D, b_j of b), 0 for a D with D b^T = 0. 0 when there is nothing to
+// compare (no constraint, or the sparse path). Allocates nothing.
+double complement_residual(const Data& data);
+inline constexpr double kComplementTolerance = 1e-8;
 
 // The column-pivoted QR factorization b^T P = Q [R1; 0] in data.qr_bt and the full orthogonal
 // factor in data.Q_full (n x n): its first s columns span range(b^T), the last k span null(b).

@@ -161,6 +161,11 @@ std::string explain_failure(const Model& model, const Data& data) {
                          data.failed_quantity, data.failed_t);
     case Status::singular_system:
       if (data.failed_quantity.rfind("program matrix", 0) == 0) return explain_program_failure(model, data);
+      if (data.failed_quantity == "complement D")
+        return fmt::format("the model's complement D is not a complement of b at t = {:.6g}: the largest "
+                           "|D_i . b_j| / (|D_i| |b_j|) is {:.3g} (D b^T must be 0); the rows of D must span "
+                           "the velocities the constraints allow there: check D, or use --complement qr",
+                           data.failed_t, data.failed_value);
       if (b_is_rank_deficient(model, data)) return explain_dependent_constraints(model, data);
       if (!a_is_positive_definite(model, data)) return explain_inertia(model, data);
       return fmt::format("the {} is singular at t = {:.6g} although A is positive definite and b has "

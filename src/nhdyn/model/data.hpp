@@ -157,6 +157,13 @@ struct Data {
   // Whether the formulations may take their fixed-size path for small n (formulation/
   // small_dense.hpp). Both paths compute the same values; tests clear it to compare them.
   bool small_kernels = true;
+  // Whether compute_complement checks the model's analytic D against b at every evaluation
+  // (formulation/complement.hpp): on in debug builds; release builds check D once, at loading.
+#ifdef NDEBUG
+  bool check_complement = false;
+#else
+  bool check_complement = true;
+#endif
   std::vector<double> scratch;   // evaluator workspace, Evaluator::scratch_size()
   Vector h;                      // n, Q + G
   Matrix M;                      // n x n, stacked sanh matrix [D A; b] (dense sanh)
