@@ -15,26 +15,17 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "support/text.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> fields;
-  std::stringstream in(line);
-  for (std::string field; std::getline(in, field, ',');) fields.push_back(field);
-  return fields;
-}
+using nhdyn::test::split;
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
+using nhdyn::test::read_text;
 
-struct Csv {
+struct ContactCsv {
   std::vector<std::string> header;
   std::vector<std::vector<double>> rows;
   std::size_t column(const std::string& name) const {
@@ -44,8 +35,8 @@ struct Csv {
   }
 };
 
-Csv read_csv(const fs::path& path) {
-  Csv csv;
+ContactCsv read_contact_csv(const fs::path& path) {
+  ContactCsv csv;
   std::ifstream in(path);
   std::string line;
   if (!std::getline(in, line)) return csv;
@@ -76,7 +67,7 @@ TEST(CliContactForces, RollingDiskColumnsAreTheCentreOfMassBalanceOfEachRow) {
   const std::string model = std::string(NHDYN_SOURCE_DIR) + "/examples/rolling_disk_bodies.toml";
   ASSERT_EQ(run(dir, "simulate '" + model + "' --t-end 1 -o disk.csv"), 0) << read_text(dir / "err.txt");
   EXPECT_EQ(read_text(dir / "err.txt").find("contact forces"), std::string::npos);
-  const Csv csv = read_csv(dir / "disk.csv");
+  const ContactCsv csv = read_contact_csv(dir / "disk.csv");
   ASSERT_EQ(csv.header.back(), "contact_residual");
   const std::size_t Fx = csv.column("disk_Fx"), N = csv.column("disk_N"), Flat = csv.column("disk_Flat");
   ASSERT_EQ(csv.column("disk_Fy"), Fx + 1);
@@ -132,7 +123,7 @@ velocity = { x = 1, theta = 0.5 }
   const std::string err = read_text(dir / "err.txt");
   EXPECT_NE(err.find("note: contact forces: "), std::string::npos) << err;
   EXPECT_NE(err.find("blade_N"), std::string::npos) << err;
-  const Csv csv = read_csv(dir / "sled.csv");
+  const ContactCsv csv = read_contact_csv(dir / "sled.csv");
   ASSERT_FALSE(csv.rows.empty());
   for (const std::vector<double>& row : csv.rows) {
     EXPECT_TRUE(std::isnan(row[csv.column("blade_N")]));

@@ -17,22 +17,18 @@
 #include <vector>
 
 #include "nhdyn/io/csv.hpp"
+#include "support/text.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
+struct OutputsOutcome {
   int exit_code = -1;
   std::string out, err;
 };
 
-std::string read(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using nhdyn::test::read_text;
 
 const std::string examples = std::string(NHDYN_SOURCE_DIR) + "/examples/";
 
@@ -47,21 +43,21 @@ class CliOutputs : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  Outcome nhdyn(const std::string& args) const {
+  OutputsOutcome nhdyn(const std::string& args) const {
     const std::string command =
         "cd '" + dir_.string() + "' && '" NHDYN_CLI_PATH "' " + args + " > out.txt 2> err.txt";
     const int status = std::system(command.c_str());
-    Outcome run;
+    OutputsOutcome run;
     run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.out = read(dir_ / "out.txt");
-    run.err = read(dir_ / "err.txt");
+    run.out = read_text(dir_ / "out.txt");
+    run.err = read_text(dir_ / "err.txt");
     return run;
   }
 
   // examples/pendulum_cartesian.toml with an [outputs] table appended; returns its path.
   std::string pendulum_with(const std::string& outputs) const {
     const fs::path path = dir_ / "p.toml";
-    std::ofstream(path) << read(examples + "pendulum_cartesian.toml") << "\n[outputs]\n" << outputs;
+    std::ofstream(path) << read_text(examples + "pendulum_cartesian.toml") << "\n[outputs]\n" << outputs;
     return path.string();
   }
 
@@ -70,7 +66,7 @@ class CliOutputs : public ::testing::Test {
 
 TEST_F(CliOutputs, ColumnsAfterTheStandardOnesAndParametersAsData) {
   // The first command of examples/pendulum_outputs.toml.
-  Outcome run = nhdyn("simulate " + examples + "pendulum_outputs.toml -q -o r.csv");
+  OutputsOutcome run = nhdyn("simulate " + examples + "pendulum_outputs.toml -q -o r.csv");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const nhdyn::CsvTable table = nhdyn::load_csv(dir_ / "r.csv");
   const std::vector<std::string> outputs = {"total_energy", "tension", "tension_closed_form", "theta", "speed"};
@@ -78,7 +74,7 @@ TEST_F(CliOutputs, ColumnsAfterTheStandardOnesAndParametersAsData) {
   EXPECT_EQ(std::vector<std::string>(table.header.end() - 5, table.header.end()), outputs);
   EXPECT_GE(table.column("balance_error"), 0);  // the standard columns are all there, before
   // The slack event's rows are in the CSV and FILE-events.csv.
-  EXPECT_NE(read(dir_ / "r-events.csv").find("slack,"), std::string::npos);
+  EXPECT_NE(read_text(dir_ / "r-events.csv").find("slack,"), std::string::npos);
   const int E = table.column("total_energy"), N = table.column("tension"), y = table.column("y");
   const double m = 0.5, g = 9.81, l = 1.5, theta0 = 2.0;
   for (const std::vector<double>& row : table.rows) {
@@ -100,7 +96,7 @@ TEST_F(CliOutputs, ColumnsAfterTheStandardOnesAndParametersAsData) {
 }
 
 TEST_F(CliOutputs, MultibodyPointsAreColumns) {
-  const Outcome run = nhdyn("simulate " + examples + "rolling_disk_bodies.toml --t-end 0.5 -q -o d.csv");
+  const OutputsOutcome run = nhdyn("simulate " + examples + "rolling_disk_bodies.toml --t-end 0.5 -q -o d.csv");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const nhdyn::CsvTable table = nhdyn::load_csv(dir_ / "d.csv");
   const int z = table.column("disk_z"), theta = table.column("theta");
@@ -124,13 +120,13 @@ TEST_F(CliOutputs, BadOutputsAreRefusedBeforeTheRun) {
       {"E = \"sin(x\"\n", {"p.toml:", "syntax error"}},
   };
   for (const Case& c : cases) {
-    const Outcome run = nhdyn("simulate " + pendulum_with(c.outputs) + " -o r.csv");
+    const OutputsOutcome run = nhdyn("simulate " + pendulum_with(c.outputs) + " -o r.csv");
     EXPECT_EQ(run.exit_code, 2) << c.outputs << "\n" << run.err;
     for (const std::string& s : c.said) EXPECT_NE(run.err.find(s), std::string::npos) << c.outputs << "\n" << run.err;
     EXPECT_FALSE(fs::exists(dir_ / "r.csv")) << c.outputs;
   }
   // An event or a --stop-when naming an unknown output.
-  const Outcome run = nhdyn("simulate " + examples + "pendulum_outputs.toml --stop-when 'sped > 4' -o r.csv");
+  const OutputsOutcome run = nhdyn("simulate " + examples + "pendulum_outputs.toml --stop-when 'sped > 4' -o r.csv");
   EXPECT_EQ(run.exit_code, 2) << run.err;
   EXPECT_NE(run.err.find("did you mean 'speed'?"), std::string::npos) << run.err;
 }

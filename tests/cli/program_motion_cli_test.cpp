@@ -66,11 +66,11 @@ TEST_F(ProgramCli, WritesTheActuatorForcesAndProgramResiduals) {
 
 TEST_F(ProgramCli, BatchRunFilesCarryTheActuatorForcesAsSimulateDoes) {
   // A batch of one run (omega = 1, the file's value) writes the same file as simulate.
-  const Outcome batch = nhdyn("batch " + example("sled_heading_program.toml") +
+  const Outcome batch = run_nhdyn("batch " + example("sled_heading_program.toml") +
                                   " --grid omega=1:1:1 --write-runs -o runs --t-end 1 -q",
                               dir_);
   ASSERT_EQ(batch.exit_code, 0) << batch.out;
-  const Outcome run = nhdyn("simulate " + example("sled_heading_program.toml") + " --t-end 1 -o out.csv -q", dir_);
+  const Outcome run = run_nhdyn("simulate " + example("sled_heading_program.toml") + " --t-end 1 -o out.csv -q", dir_);
   ASSERT_EQ(run.exit_code, 0) << run.out;
   const std::string simulated = read("out.csv");
   ASSERT_NE(simulated.find(",u_heading,"), std::string::npos);
@@ -78,7 +78,7 @@ TEST_F(ProgramCli, BatchRunFilesCarryTheActuatorForcesAsSimulateDoes) {
 }
 
 TEST_F(ProgramCli, TrackingStudyWritesTableByToleranceAndPlot) {
-  const Outcome run = nhdyn("study tracking " + example("arm_circle_program.toml") +
+  const Outcome run = run_nhdyn("study tracking " + example("arm_circle_program.toml") +
                                 " --tolerances 1e-5,1e-8 --gains 0,10 -o t.csv --plot t.png",
                             dir_);
   ASSERT_EQ(run.exit_code, 0) << run.out;
@@ -91,10 +91,10 @@ TEST_F(ProgramCli, TrackingStudyWritesTableByToleranceAndPlot) {
   EXPECT_EQ(series.substr(0, series.find('\n')), "tolerance,error_gain_none,residual_gain_none,error_gain_10,residual_gain_10");
   EXPECT_GT(fs::file_size(dir_ / "t.png"), 1000u);
   // Without programs, or without an exact solution, there is nothing to study: exit 2, no file.
-  const Outcome none = nhdyn("study tracking " + example("sled.toml") + " -o none.csv", dir_);
+  const Outcome none = run_nhdyn("study tracking " + example("sled.toml") + " -o none.csv", dir_);
   EXPECT_EQ(none.exit_code, 2) << none.out;
   EXPECT_NE(none.out.find("no programs"), std::string::npos) << none.out;
-  const Outcome unsolved = nhdyn("study tracking " + example("cart_pendulum_program.toml") + " -o none.csv", dir_);
+  const Outcome unsolved = run_nhdyn("study tracking " + example("cart_pendulum_program.toml") + " -o none.csv", dir_);
   EXPECT_EQ(unsolved.exit_code, 2) << unsolved.out;
   EXPECT_NE(unsolved.out.find("[solution]"), std::string::npos) << unsolved.out;
   EXPECT_FALSE(fs::exists(dir_ / "none.csv"));

@@ -29,7 +29,7 @@ struct SleighErrors {
 
 double gd(double u) { return std::atan(std::sinh(u)); }  // Gudermann's function
 
-SleighErrors measure(const Model& model, double t_end) {
+SleighErrors measure_sleigh(const Model& model, double t_end) {
   const double m = parameter(model, "m"), a = parameter(model, "a"), rho = parameter(model, "rho");
   const double phi0 = model.q0(2), w0 = model.v0(2);
   const double v0 = std::cos(phi0) * model.v0(0) + std::sin(phi0) * model.v0(1);
@@ -58,7 +58,7 @@ SleighErrors measure(const Model& model, double t_end) {
 
 TEST(ChaplyginSleigh, MatchesTheClosedForm) {
   const Model model = load_example("chaplygin_sleigh.toml");
-  const SleighErrors err = measure(model, 8.0);
+  const SleighErrors err = measure_sleigh(model, 8.0);
   EXPECT_LT(err.w, 1e-7);
   EXPECT_LT(err.v, 1e-9);
   EXPECT_LT(err.phi, 1e-9);
@@ -89,9 +89,9 @@ TEST(ChaplyginSleigh, TendsToStraightMotionWithTheCentreOfMassAhead) {
 TEST(ChaplyginSleigh, TheExamRejectsWrongModels) {
   const Model flipped = load_altered_example("chaplygin_sleigh.toml", "velocity = \"-sin(phi)*x' + cos(phi)*y'\"",
                                              "velocity = \"sin(phi)*x' + cos(phi)*y'\"");
-  EXPECT_GT(measure(flipped, 8.0).w, 1e-2);
+  EXPECT_GT(measure_sleigh(flipped, 8.0).w, 1e-2);
   const Model behind = load_altered_example("chaplygin_sleigh.toml", "+ m*a*phi' *", "- m*a*phi' *");
-  EXPECT_GT(measure(behind, 8.0).w, 1e-2);
+  EXPECT_GT(measure_sleigh(behind, 8.0).w, 1e-2);
 }
 
 }  // namespace

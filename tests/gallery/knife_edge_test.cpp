@@ -29,7 +29,7 @@ struct KnifeErrors {
   double energy = 0.0;    // max |E - E0| / (m g l), l = c / w^2
 };
 
-KnifeErrors measure(const Model& model) {
+KnifeErrors measure_knife(const Model& model) {
   const double m = parameter(model, "m"), rho = parameter(model, "rho"), g = parameter(model, "g");
   const double c = g * std::sin(parameter(model, "alpha"));
   const double v0 = model.v0(0), w = model.v0(2);
@@ -54,7 +54,7 @@ KnifeErrors measure(const Model& model) {
 }
 
 TEST(KnifeEdge, SpinsAtAConstantRateAndMatchesTheClosedForm) {
-  const KnifeErrors err = measure(load_example("knife_edge.toml"));
+  const KnifeErrors err = measure_knife(load_example("knife_edge.toml"));
   EXPECT_LT(err.spin, 1e-12);
   EXPECT_LT(err.phi, 1e-12);
   EXPECT_LT(err.position, 1e-9);
@@ -67,7 +67,7 @@ TEST(KnifeEdge, SpinsAtAConstantRateAndMatchesTheClosedForm) {
 // (v0 = 0: the skate drifts across the slope on cycloid-like arcs).
 TEST(KnifeEdge, MatchesTheClosedFormAtOtherSpinRatesAndSpeeds) {
   for (const auto& [w, v0] : {std::pair{0.7, 0.0}, std::pair{5.0, -2.0}}) {
-    const KnifeErrors err = measure(load_example("knife_edge.toml", {{"w", w}, {"v0", v0}}));
+    const KnifeErrors err = measure_knife(load_example("knife_edge.toml", {{"w", w}, {"v0", v0}}));
     EXPECT_LT(err.spin, 1e-12) << "w = " << w;
     EXPECT_LT(err.position, 1e-9) << "w = " << w;
     EXPECT_LT(err.reaction, 1e-9) << "w = " << w;
@@ -78,9 +78,9 @@ TEST(KnifeEdge, MatchesTheClosedFormAtOtherSpinRatesAndSpeeds) {
 TEST(KnifeEdge, TheExamRejectsWrongModels) {
   const Model flipped = load_altered_example("knife_edge.toml", "velocity = \"-sin(phi)*x' + cos(phi)*y'\"",
                                              "velocity = \"sin(phi)*x' + cos(phi)*y'\"");
-  EXPECT_GT(measure(flipped).position, 1e-2);
+  EXPECT_GT(measure_knife(flipped).position, 1e-2);
   const Model uphill = load_altered_example("knife_edge.toml", "\"-m*g*sin(alpha) * x\"", "\"m*g*sin(alpha) * x\"");
-  EXPECT_GT(measure(uphill).position, 1e-2);
+  EXPECT_GT(measure_knife(uphill).position, 1e-2);
 }
 
 }  // namespace

@@ -27,7 +27,7 @@ double period_exact(double l, double g, double theta0) {
   return 4.0 * std::sqrt(l / g) * std::comp_ellint_1(std::sin(theta0 / 2));
 }
 
-PendulumErrors measure(const Model& model, double theta0, double periods) {
+PendulumErrors measure_pendulum(const Model& model, double theta0, double periods) {
   const double m = parameter(model, "m"), g = parameter(model, "g"), l = parameter(model, "l");
   const double P = period_exact(l, g, theta0);
   // rtol 1e-12: near the top (theta0 = 3) the period is so sensitive to the energy that the drift
@@ -63,7 +63,7 @@ TEST(PendulumCartesian, PeriodIsTheEllipticIntegralsAndTensionComesFromTheReacti
   // Even at 0.2 rad the small-angle period 2 pi sqrt(l/g) is 2.5e-3 too short (theta0^2/16).
   for (const double theta0 : {2.0, 0.2, 3.0}) {
     const Model model = load_example("pendulum_cartesian.toml", {{"theta0", theta0}});
-    const PendulumErrors err = measure(model, theta0, 3.2);
+    const PendulumErrors err = measure_pendulum(model, theta0, 3.2);
     EXPECT_EQ(err.turning_points, 6) << "theta0 = " << theta0;
     EXPECT_LT(err.period, 1e-8) << "theta0 = " << theta0;
     EXPECT_LT(err.tension, 1e-9) << "theta0 = " << theta0;
@@ -76,9 +76,9 @@ TEST(PendulumCartesian, PeriodIsTheEllipticIntegralsAndTensionComesFromTheReacti
 // Negative controls: gravity reversed, or a kinetic energy that weighs y' twice, is caught.
 TEST(PendulumCartesian, TheExamRejectsWrongModels) {
   const Model reversed = load_altered_example("pendulum_cartesian.toml", "\"m*g*y\"", "\"-m*g*y\"");
-  EXPECT_GT(measure(reversed, 2.0, 3.2).period, 1e-3);
+  EXPECT_GT(measure_pendulum(reversed, 2.0, 3.2).period, 1e-3);
   const Model heavy_y = load_altered_example("pendulum_cartesian.toml", "(x'^2 + y'^2)", "(x'^2 + 2*y'^2)");
-  EXPECT_GT(measure(heavy_y, 2.0, 3.2).period, 1e-3);
+  EXPECT_GT(measure_pendulum(heavy_y, 2.0, 3.2).period, 1e-3);
 }
 
 }  // namespace

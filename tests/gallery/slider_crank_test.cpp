@@ -82,7 +82,7 @@ struct MotionErrors {
   double work = 0.0;        // max |R . q'| / (m3 a^2 w0^3): the reactions do no work
 };
 
-MotionErrors measure(const Model& model) {
+MotionErrors measure_crank(const Model& model) {
   const Crank p = parameters_of(model);
   const double w0 = model.v0(0), scale = p.m3 * p.a * w0 * w0;
   const double E0 = 0.5 * inertia(p, model.q0(0)) * w0 * w0 + potential(p, model.q0(0));
@@ -118,7 +118,7 @@ TEST(SliderCrank, AccelerationsAgreeWithTheOneCoordinateEquationEverywhere) {
 }
 
 TEST(SliderCrank, MotionFollowsTheLoopKinematicsAndConservesEnergy) {
-  const MotionErrors err = measure(load_example("slider_crank.toml"));
+  const MotionErrors err = measure_crank(load_example("slider_crank.toml"));
   EXPECT_LT(err.kinematics, 5e-9);
   EXPECT_LT(err.energy, 5e-9);
   EXPECT_LT(err.lambda_x, 1e-10);
@@ -131,7 +131,7 @@ TEST(SliderCrank, MotionFollowsTheLoopKinematicsAndConservesEnergy) {
 TEST(SliderCrank, TheExamRejectsWrongModels) {
   const Model no_rod_inertia = load_altered_example("slider_crank.toml", "+ m2*l^2/24 * beta'^2", "");
   EXPECT_GT(pointwise_error(no_rod_inertia, Method::sanh), 1e-3);
-  EXPECT_GT(measure(no_rod_inertia).energy, 1e-3);
+  EXPECT_GT(measure_crank(no_rod_inertia).energy, 1e-3);
   const Model wrong_potential = load_altered_example("slider_crank.toml", "m2*(a*sin(alpha) - l/2*sin(beta))",
                                                      "m2*(a*sin(alpha) - l*sin(beta))");
   EXPECT_GT(pointwise_error(wrong_potential, Method::sanh), 1e-3);

@@ -41,7 +41,7 @@ int column(const ResultColumns& c, const std::string& name) {
   return static_cast<int>(it - c.all.begin());
 }
 
-double parameter(const Model& model, const std::string& name) {
+double parameter_of(const Model& model, const std::string& name) {
   for (const Parameter& p : model.parameters)
     if (p.name == name) return p.value;
   ADD_FAILURE() << name;
@@ -65,8 +65,8 @@ TEST(Outputs, PendulumEnergyAndTensionAgainstClosedForms) {
   EXPECT_TRUE(std::equal(c.outputs.begin(), c.outputs.end(), c.all.end() - 5));
   EXPECT_FALSE(model.outputs.list[0].dynamics);
   EXPECT_TRUE(model.outputs.list[1].dynamics);  // reads R
-  const double m = parameter(model, "m"), g = parameter(model, "g"), l = parameter(model, "l");
-  const double theta0 = parameter(model, "theta0");
+  const double m = parameter_of(model, "m"), g = parameter_of(model, "g"), l = parameter_of(model, "l");
+  const double theta0 = parameter_of(model, "theta0");
   const double E0 = -m * g * l * std::cos(theta0);
   const int x = column(c, "x"), y = column(c, "y"), vx = column(c, "x'"), vy = column(c, "y'");
   const int E = column(c, "total_energy"), N = column(c, "tension"), Nc = column(c, "tension_closed_form");
@@ -125,7 +125,7 @@ TEST(Outputs, ParametersAreData) {
     first = false;
     fill_result_row(model, d, row);
     // At rest at theta0: N = m g cos(theta0), E = -m g l cos(theta0), with the new m.
-    const double g = parameter(model, "g"), l = parameter(model, "l"), theta0 = parameter(model, "theta0");
+    const double g = parameter_of(model, "g"), l = parameter_of(model, "l"), theta0 = parameter_of(model, "theta0");
     EXPECT_NEAR(row[static_cast<std::size_t>(column(c, "tension"))], 2.0 * g * std::cos(theta0), 1e-9);
     EXPECT_NEAR(row[static_cast<std::size_t>(column(c, "total_energy"))], -2.0 * g * l * std::cos(theta0), 1e-12);
   });
@@ -143,7 +143,7 @@ TEST(Outputs, StopConditionOnAnOutput) {
   ASSERT_EQ(summary.stopped_by, 0);
   EXPECT_NEAR(last[static_cast<std::size_t>(column(c, "speed"))], 4.0, 1e-9);
   // The speed from the energy: v^2 = 2 g (y0 - y).
-  const double g = parameter(model, "g"), l = parameter(model, "l"), theta0 = parameter(model, "theta0");
+  const double g = parameter_of(model, "g"), l = parameter_of(model, "l"), theta0 = parameter_of(model, "theta0");
   EXPECT_NEAR(2.0 * g * (-l * std::cos(theta0) - last[static_cast<std::size_t>(column(c, "y"))]), 16.0, 1e-7);
   // An event reading the reactions through an output is located on the solved dynamics too:
   // released above the horizontal, the rod pushes (N < 0) until 3 cos(theta) = 2 cos(theta0).
@@ -161,7 +161,7 @@ TEST(Outputs, RollingDiskCentreFromBodies) {
   for (const char* name : {"heading_x", "heading_vz", "disk_x", "disk_y", "disk_z", "disk_vx", "disk_vy", "disk_vz"})
     EXPECT_NE(std::find(c.outputs.begin(), c.outputs.end(), name), c.outputs.end()) << name;
   for (const std::string& name : c.outputs) EXPECT_NE(name.rfind("lean_", 0), 0u) << name;
-  const double r = parameter(model, "r");
+  const double r = parameter_of(model, "r");
   SimulationOptions options = tight(2.0);
   std::vector<double> row;
   long rows = 0;

@@ -17,11 +17,12 @@
 #include "nhdyn/io/load_model.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/model/contact_forces.hpp"
+#include "support/text.hpp"
 
 namespace nhdyn::multibody_test {
 namespace {
 
-std::string example(const std::string& file) { return std::string(NHDYN_SOURCE_DIR) + "/examples/" + file; }
+using nhdyn::test::example;
 
 double parameter(const Model& model, const std::string& name) {
   for (const Parameter& p : model.parameters)

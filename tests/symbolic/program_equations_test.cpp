@@ -9,6 +9,7 @@
 
 #include "nhdyn/symbolic/equations.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
+#include "support/text.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
@@ -28,9 +29,7 @@ Spec sled_heading(bool second_program = false) {
   return b.build();
 }
 
-bool contains(const std::string& haystack, const std::string& needle) {
-  return haystack.find(needle) != std::string::npos;
-}
+using nhdyn::test::contains;
 
 TEST(ProgramEquations, TextShowsTheProgramsTheActuatorMatrixAndTheStackedEquations) {
   const Spec spec = sled_heading();
