@@ -309,6 +309,13 @@ int run_simulate(const SimulateArgs& args) {
     request.reactions = columns.reactions;
     request.residuals = columns.residuals;
     request.actuators = columns.actuators;
+    // Drawn without asking: the file's own [outputs] and each contact's normal force (the load,
+    // whose sign says whether the wheel would lift off); the rest of the contact columns and the
+    // multibody points' coordinates through --plot-columns.
+    for (const DerivedOutput& o : model.outputs.list)
+      if (!o.automatic) request.others.push_back(o.name);
+    for (const std::string& c : columns.contact_forces)
+      if (c.size() > 2 && c.compare(c.size() - 2, 2, "_N") == 0) request.others.push_back(c);
     if (model.path)
       request.path = std::make_pair(model.coordinates[static_cast<std::size_t>(model.path->x)],
                                     model.coordinates[static_cast<std::size_t>(model.path->y)]);
