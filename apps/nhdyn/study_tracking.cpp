@@ -50,15 +50,11 @@ int run_tracking(const TrackingArgs& args) {
   options.integrator = parse_integrator(args.integrator);
   options.t_end = args.t_end.value_or(0.0);
   options.output_step = args.output_step.value_or(0.0);
-  if (args.t_end && !(*args.t_end > model.t0))
-    throw InputError(fmt::format("--t-end {} must be after the initial time {}", *args.t_end, model.t0));
-  if (args.output_step && !(*args.output_step > 0.0))
-    throw InputError(fmt::format("--output-step {} must be positive", *args.output_step));
+  check_study_times(model, args.t_end, args.output_step);
 
   namespace fs = std::filesystem;
   const fs::path table_path = args.output;
-  fs::path series_path = table_path;
-  series_path.replace_filename(table_path.stem().string() + "-by-tolerance.csv");
+  const fs::path series_path = by_tolerance_path(table_path);
   make_parent_directory(table_path);
   check_plot_possible(args.plot);
   // The residual the plot and the by-tolerance CSV use: position level when a program has one.
