@@ -49,6 +49,10 @@ bench: configure
 # make test runs them; ASAN_SKIP_TESTS= (empty) builds and runs them all under the sanitizers.
 SAN_BUILD ?= build-asan
 ASAN_SKIP_TESTS ?= cli;gallery;studies;linearization;layering;report;codegen;jit
+# Single tests of the remaining folders left out for the same reason: the bicycle's two 5 s roll
+# kicks are 10^4 right-hand sides of a kernel the shorter bicycle tests run too (a regular
+# expression for ctest -E; empty runs them).
+ASAN_SKIP_NAMES ?= ^WhippleBicycle[.]ARollKick
 HAVE_CLANG := $(shell command -v clang++-14 >/dev/null 2>&1 && echo yes)
 SAN_COMPILER = $(if $(HAVE_CLANG),-DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 -DNHDYN_FUZZ=ON)
 
@@ -62,7 +66,7 @@ asan: deps
 	  -DNHDYN_BUILD_BENCH=OFF -DNHDYN_BUILD_CLI=$(if $(ASAN_SKIP_TESTS),OFF,ON) "-DNHDYN_SKIP_TEST_MODULES=$(ASAN_SKIP_TESTS)" $(SAN_COMPILER) \
 	  $(if $(HAVE_CLANG),,-DNHDYN_WERROR=ON) >/dev/null
 	@$(SANITIZER_ENV) cmake --build $(SAN_BUILD) -j $(JOBS)
-	cd $(SAN_BUILD) && $(SANITIZER_ENV) ctest --output-on-failure -j $(JOBS)
+	cd $(SAN_BUILD) && $(SANITIZER_ENV) ctest --output-on-failure -j $(JOBS) $(if $(ASAN_SKIP_NAMES),-E '$(ASAN_SKIP_NAMES)')
 
 # Reuses build-asan when it was made with clang-14 (make asan), else configures build-fuzz.
 FUZZ_RUNS ?= 5000

@@ -13,8 +13,6 @@
 namespace nhdyn {
 namespace {
 
-double max_abs(const Vector& v) { return v.size() > 0 ? v.cwiseAbs().maxCoeff() : 0.0; }
-
 double time_one_solve(const Model& model, const FormulationOptions& formulation, int samples) {
   if (samples <= 0) return std::numeric_limits<double>::quiet_NaN();
   DataOptions data_options;

@@ -75,8 +75,6 @@ class MechanicalOde final : public OdeSystem {
   bool balance_;
 };
 
-double max_abs(const Vector& v) { return v.size() > 0 ? v.cwiseAbs().maxCoeff() : 0.0; }
-
 // At an output, after compute_dynamics and compute_energy: the power, the integrated work (the
 // states past [q; q']) and the balance h - h(t0) - W (docs/derivations/energy-balance.md section 3).
 void record_balance(const Model& model, Data& data, const double* work, SimulationSummary& summary) {

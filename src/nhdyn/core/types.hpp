@@ -14,4 +14,7 @@ using ConstVectorRef = Eigen::Ref<const Vector>;
 using MatrixRef = Eigen::Ref<Matrix>;
 using ConstMatrixRef = Eigen::Ref<const Matrix>;
 
+// The largest |v_i|; 0 for an empty vector (Eigen's maxCoeff asserts on one).
+inline double max_abs(const Vector& v) { return v.size() > 0 ? v.cwiseAbs().maxCoeff() : 0.0; }
+
 }  // namespace nhdyn

@@ -37,15 +37,6 @@ void program_residuals(const Model& model, Data& data) {
                                                           w.f.data());
 }
 
-std::string level_name(ConstraintLevel level) {
-  switch (level) {
-    case ConstraintLevel::position: return "position";
-    case ConstraintLevel::velocity: return "velocity";
-    case ConstraintLevel::acceleration: return "acceleration";
-  }
-  return "?";
-}
-
 }  // namespace
 
 void check_program_feedback(const ProgramFeedback& feedback) {

@@ -3,6 +3,7 @@
 // shape of each section) and leaves every question about the mechanics to SpecBuilder, passing it
 // the source location of each node. Every toml++ node is reached through a type-checked accessor
 // (as_string, as_table, ...), so no input can make the loader dereference a missing node.
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/io/model_file.hpp"
 
 #include <fmt/format.h>
@@ -71,12 +72,6 @@ const std::vector<std::string> visual_segment_keys = {"name", "from", "to"};
 // tests/io/model_file_test.cpp checks that they agree.
 const std::vector<std::string> method_names = {"sanh", "lagrange", "udwadia-kalaba", "nullspace"};
 const std::vector<std::string> integrator_names = {"rk4", "dopri5", "dop853", "cvode-bdf", "cvode-adams"};
-
-std::string join(const std::vector<std::string>& names) {
-  std::string out;
-  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
-  return out;
-}
 
 std::string_view type_name(const toml::node& node) {
   switch (node.type()) {

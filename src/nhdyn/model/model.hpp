@@ -25,6 +25,16 @@ struct ContactForceModel;  // contact_forces.hpp
 // The level at which a constraint is given (docs/notation.md section 2).
 enum class ConstraintLevel { position, velocity, acceleration };
 
+// "position", "velocity" or "acceleration", as messages and printed equations name the level.
+inline const char* level_name(ConstraintLevel level) {
+  switch (level) {
+    case ConstraintLevel::position: return "position";
+    case ConstraintLevel::velocity: return "velocity";
+    case ConstraintLevel::acceleration: return "acceleration";
+  }
+  return "acceleration";
+}
+
 struct Constraint {
   std::string name;
   ConstraintLevel level = ConstraintLevel::velocity;

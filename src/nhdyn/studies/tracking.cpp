@@ -26,8 +26,6 @@ void check_list(const std::vector<double>& values, const char* what, bool zero_a
   }
 }
 
-double max_abs(const Vector& v) { return v.size() == 0 ? 0.0 : v.cwiseAbs().maxCoeff(); }
-
 }  // namespace
 
 Tracking study_tracking(const Model& model, const TrackingOptions& options) {

@@ -100,7 +100,7 @@ std::string comment_text(const std::string& s) {
 // How one program is printed. Its parameter stage (the instructions that read parameters and
 // constants only) is computed once per parameter change, in the evaluator's constructor, into
 // members named <prefix>rN_; the calls compute the rest. Parameters read as p_.<field>.
-struct Printer {
+struct CodePrinter {
   const Program& program;
   std::string prefix;                          // of the members that hold stage registers
   const std::vector<std::string>& fields;      // parameter index -> field of the parameter struct
@@ -109,7 +109,7 @@ struct Printer {
   std::vector<char> read_by_stage, read_by_call;
 
   // hoist = false: no stage, every instruction in the call (a program that runs once anyway).
-  Printer(const Program& p, std::string member_prefix, const std::vector<std::string>& parameter_fields,
+  CodePrinter(const Program& p, std::string member_prefix, const std::vector<std::string>& parameter_fields,
           bool hoist = true)
       : program(p), prefix(std::move(member_prefix)), fields(parameter_fields) {
     const std::size_t registers = static_cast<std::size_t>(p.registers());
@@ -241,7 +241,7 @@ struct Body {
 };
 
 // The statements of a program's call, then `sink(i, register)` for each output i.
-Body print_body(const Printer& printer, const std::function<std::string(int, const std::string&)>& sink) {
+Body print_body(const CodePrinter& printer, const std::function<std::string(int, const std::string&)>& sink) {
   const Program& program = printer.program;
   Body body;
   body.reads_t = program.reads_time();
@@ -258,15 +258,6 @@ Body print_body(const Printer& printer, const std::function<std::string(int, con
 
 std::string parameter(bool used, const char* declaration, const char* name) {
   return used ? fmt::format("{} {}", declaration, name) : fmt::format("{} /*{}*/", declaration, name);
-}
-
-std::string level_name(ConstraintLevel level) {
-  switch (level) {
-    case ConstraintLevel::position: return "position";
-    case ConstraintLevel::velocity: return "velocity";
-    case ConstraintLevel::acceleration: return "acceleration";
-  }
-  return "velocity";
 }
 
 bool uses_powi(const ModelPrograms& p) {
@@ -337,16 +328,16 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   const std::string cls = camel_case(id) + "Evaluator";
   const std::string parameters_struct = camel_case(id) + "Parameters";
   const std::vector<std::string> fields = parameter_fields(model.parameters);
-  const Printer terms_printer(programs.terms, "terms_", fields);
-  const std::optional<Printer> complement_printer =
-      programs.complement ? std::optional<Printer>(std::in_place, *programs.complement, "complement_", fields)
+  const CodePrinter terms_printer(programs.terms, "terms_", fields);
+  const std::optional<CodePrinter> complement_printer =
+      programs.complement ? std::optional<CodePrinter>(std::in_place, *programs.complement, "complement_", fields)
                           : std::nullopt;
-  const Printer phi_printer(programs.position_residual, "phi_", fields);
-  const Printer f_printer(programs.velocity_residual, "f_", fields);
-  const std::optional<Printer> energy_printer =
-      programs.energy ? std::optional<Printer>(std::in_place, *programs.energy, "energy_", fields) : std::nullopt;
-  const std::optional<Printer> initial_printer =
-      programs.initial_state ? std::optional<Printer>(std::in_place, *programs.initial_state, "initial_", fields, false)
+  const CodePrinter phi_printer(programs.position_residual, "phi_", fields);
+  const CodePrinter f_printer(programs.velocity_residual, "f_", fields);
+  const std::optional<CodePrinter> energy_printer =
+      programs.energy ? std::optional<CodePrinter>(std::in_place, *programs.energy, "energy_", fields) : std::nullopt;
+  const std::optional<CodePrinter> initial_printer =
+      programs.initial_state ? std::optional<CodePrinter>(std::in_place, *programs.initial_state, "initial_", fields, false)
                              : std::nullopt;
   const auto q_name = [&](int i) { return comment_text(model.coordinates[static_cast<std::size_t>(i)]); };
   const auto c_name = [&](int i) { return comment_text(model.constraints[static_cast<std::size_t>(i)].name); };
@@ -383,7 +374,7 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   {
     std::string stage;
     // One block per program: each numbers its registers from its own inputs.
-    const auto add_stage = [&stage](const Printer& printer) {
+    const auto add_stage = [&stage](const CodePrinter& printer) {
       const std::string statements = printer.statements(true, "      ");
       if (!statements.empty()) stage += "    {\n" + statements + "    }\n";
     };

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/symbolic/occurrence.hpp"
 #include "nhdyn/symbolic/simplify.hpp"
 
@@ -19,12 +20,6 @@ namespace {
 std::string prefix(const SourceLocation& where) {
   const std::string location = where.describe();
   return location.empty() ? "" : location + ": ";
-}
-
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (std::size_t i = 0; i < items.size(); ++i) out += (i > 0 ? ", " : "") + items[i];
-  return out;
 }
 
 std::string printed(const GiNaC::ex& e) {

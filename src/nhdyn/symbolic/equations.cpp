@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/symbolic/simplify.hpp"
 
 namespace nhdyn::symbolic {
@@ -70,20 +71,6 @@ std::string latex_name(const std::string& name, int dots = 0) {
   return out;
 }
 
-std::string join(const std::vector<std::string>& items, const std::string& separator) {
-  std::string out;
-  for (std::size_t i = 0; i < items.size(); ++i) out += (i > 0 ? separator : "") + items[i];
-  return out;
-}
-
-const char* level_name(ConstraintLevel level) {
-  switch (level) {
-    case ConstraintLevel::position: return "position";
-    case ConstraintLevel::velocity: return "velocity";
-    default: return "acceleration";
-  }
-}
-
 // ---------------------------------------------------------------------------------------------
 // The printer: terms and factors in an order that depends on names only.
 
@@ -141,9 +128,9 @@ struct Printed {
   bool fraction = false;  // something below the line
 };
 
-class Printer {
+class EquationPrinter {
  public:
-  Printer(const Spec& spec, EquationFormat format) : latex_(format == EquationFormat::latex) {
+  EquationPrinter(const Spec& spec, EquationFormat format) : latex_(format == EquationFormat::latex) {
     for (std::size_t p = 0; p < spec.parameters.size(); ++p) {
       const std::string& name = spec.parameters[p].name;
       symbols_[name] = {0, static_cast<int>(p), name, latex_name(name)};
@@ -566,7 +553,7 @@ Content make_content(const Spec& spec, const Derivation& d) {
 }
 
 // Every acceleration symbol as printed, in the order of q.
-std::vector<std::string> accelerations(const Spec& spec, const Printer& p) {
+std::vector<std::string> accelerations(const Spec& spec, const EquationPrinter& p) {
   std::vector<std::string> out;
   for (const std::string& c : spec.coordinates) out.push_back(p.symbol(c + "''"));
   return out;
@@ -588,7 +575,7 @@ std::string independent_hint(const std::vector<std::string>& names) {
 // ---------------------------------------------------------------------------------------------
 // Text
 
-std::string text_matrix(const Printer& p, const GiNaC::matrix& m, const std::string& indent) {
+std::string text_matrix(const EquationPrinter& p, const GiNaC::matrix& m, const std::string& indent) {
   std::vector<std::vector<std::string>> cells(m.rows());
   std::vector<std::size_t> width(m.cols(), 0);
   for (unsigned i = 0; i < m.rows(); ++i)
@@ -608,7 +595,7 @@ std::string text_matrix(const Printer& p, const GiNaC::matrix& m, const std::str
   return out;
 }
 
-std::string text_vector(const Printer& p, const std::string& name, const GiNaC::matrix& v,
+std::string text_vector(const EquationPrinter& p, const std::string& name, const GiNaC::matrix& v,
                         const std::vector<std::string>& labels) {
   std::size_t width = 0;
   for (const std::string& label : labels) width = std::max(width, label.size());
@@ -621,7 +608,7 @@ std::string text_vector(const Printer& p, const std::string& name, const GiNaC::
 }
 
 std::string format_text(const Spec& spec, const Content& c) {
-  const Printer p(spec, EquationFormat::text);
+  const EquationPrinter p(spec, EquationFormat::text);
   const int n = spec.n(), s = spec.s(), k = n - s;
   std::string out = fmt::format("Model {}{}\n", spec.name, spec.description.empty() ? "" : ": " + spec.description);
   out += fmt::format("  q = ({}); n = {} coordinates, s = {} constraint{}, k = n - s = {}\n",
@@ -728,7 +715,7 @@ std::string format_text(const Spec& spec, const Content& c) {
 // ---------------------------------------------------------------------------------------------
 // LaTeX
 
-std::string latex_matrix(const Printer& p, const GiNaC::matrix& m) {
+std::string latex_matrix(const EquationPrinter& p, const GiNaC::matrix& m) {
   std::vector<std::string> rows;
   for (unsigned i = 0; i < m.rows(); ++i) {
     std::vector<std::string> cells;
@@ -739,7 +726,7 @@ std::string latex_matrix(const Printer& p, const GiNaC::matrix& m) {
 }
 
 std::string format_latex(const Spec& spec, const Content& c) {
-  const Printer p(spec, EquationFormat::latex);
+  const EquationPrinter p(spec, EquationFormat::latex);
   const int n = spec.n(), s = spec.s(), k = n - s;
   std::vector<std::string> names;
   for (const std::string& coordinate : spec.coordinates) names.push_back(p.symbol(coordinate));
@@ -853,7 +840,7 @@ std::string format_latex(const Spec& spec, const Content& c) {
 }  // namespace
 
 std::string format_expression(const Spec& spec, const GiNaC::ex& e, EquationFormat format) {
-  return Printer(spec, format).expression(simplify(e));
+  return EquationPrinter(spec, format).expression(simplify(e));
 }
 
 std::string format_equations(const Spec& spec, const Derivation& derivation, EquationFormat format) {

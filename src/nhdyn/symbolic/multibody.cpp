@@ -11,22 +11,12 @@
 #include <utility>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/symbolic/simplify.hpp"
 #include "nhdyn/core/suggest.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
-
-[[noreturn]] void fail(const SourceLocation& where, const std::string& context, const std::string& problem) {
-  const std::string location = where.describe();
-  throw ModelError((location.empty() ? "" : location + ": ") + (context.empty() ? "" : context + ": ") + problem);
-}
-
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (std::size_t i = 0; i < items.size(); ++i) out += (i > 0 ? ", " : "") + items[i];
-  return out;
-}
 
 // "'heding' is not a frame; did you mean 'heading'? (the frames are: ground, heading)"
 std::string unknown(const std::string& name, const char* kind, const std::vector<std::string>& known) {
@@ -117,18 +107,18 @@ GiNaC::ex MultibodyBuilder::parse(const std::string& text, const SourceLocation&
   for (int i = 0; i < spec.n(); ++i) {
     const std::string& name = spec.coordinates[static_cast<std::size_t>(i)];
     if (e.has(symbols.velocity(i)) || e.has(symbols.acceleration(i)))
-      fail(where, context,
+      throw_model_error(where, context,
            fmt::format("\"{}\" contains a derivative of '{}'; positions, angles and constants may not contain "
                        "velocities or accelerations (the front end derives them)",
                        text, name));
     if (!coordinates_allowed && e.has(symbols.coordinate(i)))
-      fail(where, context,
+      throw_model_error(where, context,
            fmt::format("\"{}\" depends on the coordinate '{}'; this value must be a constant, an expression in the "
                        "parameters only",
                        text, name));
   }
   if (!coordinates_allowed && e.has(symbols.time()))
-    fail(where, context,
+    throw_model_error(where, context,
          fmt::format("\"{}\" depends on the time t; this value must be a constant, an expression in the parameters "
                      "only",
                      text));
@@ -153,7 +143,7 @@ int index_in(const Items& items, const std::string& name, const char* kind, cons
     if (items[i].name == name) return static_cast<int>(i);
     known.push_back(items[i].name);
   }
-  fail(where, context, unknown(name, kind, known));
+  throw_model_error(where, context, unknown(name, kind, known));
 }
 
 }  // namespace
@@ -180,11 +170,11 @@ void check_new(const Items& items, const std::string& name, const char* kind, co
   const std::string context = fmt::format("{} '{}'", kind, name);
   if (name.empty() || !std::isalpha(static_cast<unsigned char>(name[0])) ||
       !std::all_of(name.begin(), name.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }))
-    fail(where, context, "not a valid name: use letters, digits and '_', starting with a letter");
+    throw_model_error(where, context, "not a valid name: use letters, digits and '_', starting with a letter");
   for (const auto& item : items)
     if (item.name == name) {
       const std::string first = item.where.describe();
-      fail(where, context,
+      throw_model_error(where, context,
            fmt::format("a {} called '{}' is already defined{}; give each {} its own name", kind, name,
                        first.empty() ? "" : " (at " + first + ")", kind));
     }
@@ -215,7 +205,7 @@ MultibodyBuilder& MultibodyBuilder::frame(const std::string& name, const std::st
     const std::string which = fmt::format("{}: rotation {}", context, j + 1);
     const int axis = axis_index(r.axis);
     if (axis < 0)
-      fail(at, which,
+      throw_model_error(at, which,
            fmt::format("unknown axis '{}'; rotate about \"x\", \"y\" or \"z\" (the axes of the frame produced by the "
                        "rotations before it)",
                        r.axis));
@@ -256,7 +246,7 @@ MultibodyBuilder& MultibodyBuilder::body(const std::string& name, const std::str
   b.mass = parse(mass, where, context + ": mass", false);
   const std::optional<double> m = value_of(b.mass, spec);
   if (!m || !(*m > 0.0))
-    fail(where, context + ": mass",
+    throw_model_error(where, context + ": mass",
          fmt::format("the mass \"{}\" must be a positive number, but it is {}", mass, m ? fmt::format("{}", *m) : "not a number"));
   b.com = parse(centre_of_mass, where, context + ": centre of mass", false);
   b.inertia = GiNaC::matrix(3, 3);
@@ -266,14 +256,14 @@ MultibodyBuilder& MultibodyBuilder::body(const std::string& name, const std::str
       b.inertia(i, j) = parse(inertia[i][j], where, fmt::format("{}: inertia entry ({}, {})", context, i + 1, j + 1), false);
       const std::optional<double> value = value_of(b.inertia(i, j), spec);
       if (!value)
-        fail(where, context, fmt::format("inertia entry ({}, {}) = \"{}\" is not a finite number", i + 1, j + 1,
+        throw_model_error(where, context, fmt::format("inertia entry ({}, {}) = \"{}\" is not a finite number", i + 1, j + 1,
                                          inertia[i][j]));
       I[i][j] = *value;
     }
   for (unsigned i = 0; i < 3; ++i)
     for (unsigned j = i + 1; j < 3; ++j)
       if (!symbolic::is_zero(b.inertia(i, j) - b.inertia(j, i)))
-        fail(where, context,
+        throw_model_error(where, context,
              fmt::format("the inertia tensor is not symmetric: entry ({}, {}) is {} but entry ({}, {}) is {}; an "
                          "inertia tensor has I_ij = I_ji",
                          i + 1, j + 1, inertia[i][j], j + 1, i + 1, inertia[j][i]));
@@ -284,7 +274,7 @@ MultibodyBuilder& MultibodyBuilder::body(const std::string& name, const std::str
                     I[0][2] * (I[1][0] * I[2][1] - I[1][1] * I[2][0]);
   const double size = std::max({std::fabs(I[0][0]), std::fabs(I[1][1]), std::fabs(I[2][2]), 1e-300});
   if (!(d1 > 0.0 && d2 > 1e-14 * size * size && d3 > 1e-14 * size * size * size))
-    fail(where, context,
+    throw_model_error(where, context,
          fmt::format("the inertia tensor [[{}, {}, {}], [{}, {}, {}], [{}, {}, {}]] is not positive definite (its "
                      "leading principal minors are {:.6g}, {:.6g}, {:.6g}; all must be positive): every principal "
                      "moment must be positive and each at most the sum of the other two",
@@ -295,7 +285,7 @@ MultibodyBuilder& MultibodyBuilder::body(const std::string& name, const std::str
   for (std::size_t i = 0; i < 3; ++i) {
     const double others = moments[(i + 1) % 3] + moments[(i + 2) % 3];
     if (moments[i] > others + 1e-12 * size)
-      fail(where, context,
+      throw_model_error(where, context,
            fmt::format("the inertia tensor's principal moments {:.6g}, {:.6g}, {:.6g} break the triangle inequality "
                        "({:.6g} > {:.6g} + {:.6g}): no rigid body has this inertia; check the moments and their "
                        "axes",
@@ -307,7 +297,7 @@ MultibodyBuilder& MultibodyBuilder::body(const std::string& name, const std::str
 
 MultibodyBuilder& MultibodyBuilder::gravity(const Triple& g, SourceLocation where) {
   if (gravity_)
-    fail(where, "gravity", fmt::format("gravity is given twice (first at {})", gravity_where_.describe()));
+    throw_model_error(where, "gravity", fmt::format("gravity is given twice (first at {})", gravity_where_.describe()));
   gravity_ = parse(g, where, "gravity", false);
   gravity_where_ = std::move(where);
   return *this;
@@ -329,13 +319,13 @@ MultibodyBuilder& MultibodyBuilder::rolling_wheel(const std::string& name, const
   h.index = body_index(body, where, context);
   h.axis = axis_index(axis);
   if (h.axis < 0)
-    fail(where, context, fmt::format("unknown axle axis '{}'; the axle is the \"x\", \"y\" or \"z\" axis of the "
+    throw_model_error(where, context, fmt::format("unknown axle axis '{}'; the axle is the \"x\", \"y\" or \"z\" axis of the "
                                      "wheel body's frame",
                                      axis));
   h.radius = parse(radius, where, context + ": radius", false);
   const std::optional<double> r = value_of(h.radius, builder_.current());
   if (!r || !(*r > 0.0))
-    fail(where, context, fmt::format("the radius \"{}\" must be positive, but it is {}", radius,
+    throw_model_error(where, context, fmt::format("the radius \"{}\" must be positive, but it is {}", radius,
                                      r ? fmt::format("{}", *r) : "not a number"));
   if (normal) h.normal = parse(*normal, where, context + ": normal", false);
   helpers_.push_back(std::move(h));
@@ -355,7 +345,7 @@ MultibodyBuilder& MultibodyBuilder::knife_edge(const std::string& name, const st
   h.index = point_index(point, where, context);
   h.axis = axis_index(axis);
   if (h.axis < 0)
-    fail(where, context, fmt::format("unknown blade axis '{}'; the blade lies along the \"x\", \"y\" or \"z\" axis "
+    throw_model_error(where, context, fmt::format("unknown blade axis '{}'; the blade lies along the \"x\", \"y\" or \"z\" axis "
                                      "of the point's frame",
                                      axis));
   if (normal) h.normal = parse(*normal, where, context + ": normal", false);
@@ -370,7 +360,7 @@ GiNaC::ex MultibodyBuilder::parse_surface(const std::string& text, const Vector3
   SpecBuilder scratch = builder_;
   for (const char* name : {"X", "Y", "Z"})
     if (builder_.current().symbols.has(name))
-      fail(where, context,
+      throw_model_error(where, context,
            fmt::format("a surface is written in the world coordinates X, Y, Z of the point, but '{}' is already a "
                        "coordinate or parameter of the model; rename it",
                        name));
@@ -379,7 +369,7 @@ GiNaC::ex MultibodyBuilder::parse_surface(const std::string& text, const Vector3
   const SymbolTable& symbols = scratch.current().symbols;
   for (int i = 0; i < scratch.current().n(); ++i)
     if (f.has(symbols.velocity(i)) || f.has(symbols.acceleration(i)))
-      fail(where, context, fmt::format("the surface \"{}\" may not contain velocities or accelerations", text));
+      throw_model_error(where, context, fmt::format("the surface \"{}\" may not contain velocities or accelerations", text));
   return f.subs(GiNaC::lst{symbols.parameter("X") == at[0], symbols.parameter("Y") == at[1],
                            symbols.parameter("Z") == at[2]});
 }
@@ -422,7 +412,7 @@ Vector3 MultibodyBuilder::plane_normal(const Helper& helper, const std::string& 
   } else if (gravity_) {
     n = scale(-1, *gravity_);
   } else {
-    fail(helper.where, context,
+    throw_model_error(helper.where, context,
          "no contact plane: give the plane's normal (e.g. normal = [0, 0, 1] for the ground z = 0) or a gravity "
          "vector, whose opposite is then the normal");
   }
@@ -430,12 +420,12 @@ Vector3 MultibodyBuilder::plane_normal(const Helper& helper, const std::string& 
   std::array<double, 3> value{};
   for (std::size_t i = 0; i < 3; ++i) {
     const std::optional<double> v = value_of(n[i], spec);
-    if (!v) fail(helper.where, context, fmt::format("the plane's normal component {} is not a number", i + 1));
+    if (!v) throw_model_error(helper.where, context, fmt::format("the plane's normal component {} is not a number", i + 1));
     value[i] = *v;
   }
   const double length = std::sqrt(value[0] * value[0] + value[1] * value[1] + value[2] * value[2]);
   if (!(length > 0.0))
-    fail(helper.where, context,
+    throw_model_error(helper.where, context,
          helper.normal ? "the plane's normal is the zero vector; give a nonzero normal, e.g. [0, 0, 1]"
                        : "the gravity vector is zero, so it defines no contact plane; give the plane's normal, e.g. "
                          "normal = [0, 0, 1]");
@@ -507,7 +497,7 @@ void MultibodyBuilder::add_wheel(const Helper& h) {
   // configuration (docs/derivations/rolling-wheel.md).
   const GiNaC::ex squared = simplify(1 - an * an);
   if (symbolic::is_zero(squared))
-    fail(h.where, context, "the axle is always normal to the plane (the wheel lies flat): it cannot roll");
+    throw_model_error(h.where, context, "the axle is always normal to the plane (the wheel lies flat): it cannot roll");
   GiNaC::ex length = GiNaC::sqrt(squared);
   if (GiNaC::is_a<GiNaC::power>(squared) && squared.op(1) == 2) {
     const std::optional<double> u = value_of(squared.op(0), spec, true);
@@ -519,7 +509,7 @@ void MultibodyBuilder::add_wheel(const Helper& h) {
   const GiNaC::ex contact = simplify_moderate(dot(n, P));
   if (!contact.is_zero() && !vanishes_at_sample_points(contact, spec)) {
     if (!has_coordinates(contact, spec))
-      fail(h.where, context,
+      throw_model_error(h.where, context,
            fmt::format("the wheel can never touch the plane: the height of its lowest point above the plane is the "
                        "constant {}; place the wheel's frame so that it touches the plane",
                        printed(contact)));
@@ -534,7 +524,7 @@ void MultibodyBuilder::add_wheel(const Helper& h) {
     const GiNaC::ex slip = simplify_moderate(dot(tk, vP));
     ++k;
     if (slip.is_zero())
-      fail(h.where, context,
+      throw_model_error(h.where, context,
            fmt::format("the contact point's velocity along the plane (direction {}) is zero whatever the "
                        "velocities: the wheel's frame cannot move, so it has nothing to roll on",
                        k));
@@ -565,7 +555,7 @@ void MultibodyBuilder::add_knife_edge(const Helper& h) {
   bool blade_in_plane = false;
   for (const GiNaC::ex& c : across) blade_in_plane = blade_in_plane || value_of(c, spec, true).value_or(1.0) != 0.0;
   if (!blade_in_plane)
-    fail(h.where, context,
+    throw_model_error(h.where, context,
          "the blade is normal to the plane at the reference configuration (all coordinates 0): it must lie along the "
          "plane; choose another axis");
   const GiNaC::ex constraint = simplify_moderate(dot(across, time_derivative(p.world, spec.symbols)));

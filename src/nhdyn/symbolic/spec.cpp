@@ -18,6 +18,11 @@ std::string SourceLocation::describe() const {
   return out;
 }
 
+void throw_model_error(const SourceLocation& where, const std::string& context, const std::string& problem) {
+  const std::string location = where.describe();
+  throw ModelError((location.empty() ? "" : location + ": ") + (context.empty() ? "" : context + ": ") + problem);
+}
+
 SymbolTable::SymbolTable() : t_("t") { by_name_.emplace("t", t_); }
 
 int SymbolTable::add_coordinate(const std::string& name) {

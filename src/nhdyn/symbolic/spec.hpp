@@ -31,6 +31,9 @@ struct SourceLocation {
   std::string describe() const;
 };
 
+// Throws ModelError("where: context: problem"), leaving out the parts that are empty.
+[[noreturn]] void throw_model_error(const SourceLocation& where, const std::string& context, const std::string& problem);
+
 // One symbol table per spec owns every symbol: GiNaC tells symbols apart by identity, so every
 // expression of a spec must be built from these. Names: "t"; each coordinate "x", its velocity
 // "x'" and acceleration "x''"; each parameter.

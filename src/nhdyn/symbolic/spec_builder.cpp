@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/symbolic/occurrence.hpp"
 #include "nhdyn/core/suggest.hpp"
 
@@ -40,15 +41,6 @@ std::vector<std::string> function_names() {
   return names;
 }
 
-std::string join(const std::vector<std::string>& items, const char* separator = ", ") {
-  std::string out;
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    if (i > 0) out += separator;
-    out += items[i];
-  }
-  return out;
-}
-
 std::string compose(const SourceLocation& where, const std::string& context, const std::string& problem) {
   std::string out;
   const std::string location = where.describe();
@@ -58,7 +50,7 @@ std::string compose(const SourceLocation& where, const std::string& context, con
 }
 
 [[noreturn]] void fail(const SourceLocation& where, const std::string& context, const std::string& problem) {
-  throw ModelError(compose(where, context, problem));
+  throw_model_error(where, context, problem);
 }
 
 // GiNaC identifiers cannot contain a prime, and a user's name may collide with GiNaC's own
