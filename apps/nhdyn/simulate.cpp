@@ -391,13 +391,13 @@ int run_simulate(const SimulateArgs& args) {
     // The constraint watch: its warnings are on stderr above; here their count and the largest
     // degradation seen, so that a clean run says the watch had nothing to report.
     if (model.s() > 0)
-      fmt::print("  constraint watch: {} (largest change of a row of b: x{:.3g}{})\n",
+      fmt::print("  constraint watch: {}; largest change of a row of b x{:.3g}{}\n",
                  summary.warnings.empty() ? std::string("no warning")
-                                          : fmt::format("{} warning{} (on stderr)", summary.warnings.size(),
+                                          : fmt::format("{} warning{} on stderr", summary.warnings.size(),
                                                         summary.warnings.size() == 1 ? "" : "s"),
                  summary.largest_row_factor,
                  summary.sparse ? std::string()
-                                : fmt::format(", of the conditioning: x{:.3g}", summary.largest_condition_factor));
+                                : fmt::format(", of the conditioning x{:.3g}", summary.largest_condition_factor));
     if (!args.plot.empty()) fmt::print("  plot -> {}\n", args.plot);
     if (!args.html.empty()) fmt::print("  report -> {}{}\n", args.html, html_notice.empty() ? "" : "\n  note: " + html_notice);
   }

@@ -61,10 +61,11 @@ class MechanicalOde final : public OdeSystem {
   static constexpr int kWorks = 3;
 
   StepEnd after_step(double t, double* y) override {
-    // The watch reads the terms Data holds, when they are those of the step's end (an explicit
-    // Runge-Kutta's last stage); b and D depend on t and q only.
+    // The watch reads the terms Data holds, when they are those of the step's end (the last stage
+    // of dopri5, evaluated there); b depends on t, q and, for constraints nonlinear in the
+    // velocities, q'.
     if (watch_ && watch_->started && data_.stage == Stage::acceleration && data_.t == t &&
-        std::equal(y, y + n_, data_.q.data()))
+        std::equal(y, y + n_, data_.q.data()) && std::equal(y + n_, y + 2 * n_, data_.v.data()))
       compute_constraint_watch(model_, data_, *watch_);
     if (run_.stabilization != Stabilization::projection) return {};
     return project(model_, data_, run_.projection, t, y, summary_);
