@@ -106,6 +106,18 @@ TEST_F(ConstraintWatchCli, SimulateWarnsOnStderrAndCountsInTheSummary) {
   EXPECT_FALSE(contains(quiet.out, "constraint watch:")) << quiet.out;
 }
 
+TEST_F(ConstraintWatchCli, CompareAndBatchPassTheWarningsOn) {
+  std::ofstream(dir_ / "tan.toml") << kWatchTurningBlade;
+  const test::CliOutcome compare = run_nhdyn("compare tan.toml --t-end 2 -q -o cmp", dir_);
+  for (const char* method : {"sanh", "lagrange", "udwadia-kalaba", "nullspace"})
+    EXPECT_TRUE(contains(compare.out, fmt::format("nhdyn: warning ({}, dopri5): constraint 'blade'", method)))
+        << compare.out;
+  const test::CliOutcome batch = run_nhdyn("batch tan.toml --grid rho=0.5:0.7:3 --t-end 2 -o runs --threads 1", dir_);
+  EXPECT_EQ(batch.exit_code, 0) << batch.out;
+  EXPECT_TRUE(contains(batch.out, "nhdyn: warning: run 0: constraint 'blade'")) << batch.out;
+  EXPECT_TRUE(contains(batch.out, "nhdyn: warning: 3 of 3 runs had constraint-watch warnings")) << batch.out;
+}
+
 TEST_F(ConstraintWatchCli, SparseChainRunsWatchedAndSilent) {
   // 30 sleighs: n = 90 coordinates, past the size where a model is compiled sparse.
   const test::CliOutcome gen = run_nhdyn("example chain --bodies 30 -o chain.toml", dir_);
