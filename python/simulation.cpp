@@ -142,6 +142,25 @@ py::dict summary_dict(const SimulationSummary& s) {
   d["max_program_position_residual"] = s.max_program_position_residual;
   d["max_program_velocity_residual"] = s.max_program_velocity_residual;
   d["max_program_acceleration_residual"] = s.max_program_acceleration_residual;
+  // The constraint watch (analysis/constraint_watch.hpp): its warnings in words, and each one's
+  // constraint, measure, time and factor; the Python package raises them as ConstraintWarning.
+  py::list warnings;
+  for (const std::string& w : s.warnings) warnings.append(w);
+  d["warnings"] = warnings;
+  py::list watch;
+  for (const ConstraintWarning& w : s.constraint_warnings) {
+    py::dict item;
+    item["constraint"] = w.constraint;
+    item["measure"] = w.measure == WatchMeasure::row_norm ? "row_norm" : "conditioning";
+    item["t"] = w.t;
+    item["initial"] = w.initial;
+    item["value"] = w.value;
+    item["factor"] = w.factor;
+    watch.append(item);
+  }
+  d["constraint_warnings"] = watch;
+  d["largest_row_factor"] = s.largest_row_factor;
+  d["largest_condition_factor"] = s.largest_condition_factor;
   d["stopped_by"] = s.stopped_by >= 0 ? py::cast(s.event_names[static_cast<std::size_t>(s.stopped_by)]) : py::none();
   // docs/derivations/energy-balance.md: the balance error (accuracy), the work by agent and the
   // change of E (physics).

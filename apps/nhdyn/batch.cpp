@@ -274,6 +274,15 @@ int run_batch(const BatchArgs& args) {
     }
   }
   summary.commit();
+  // The constraint watch (analysis/constraint_watch.hpp): the first run's warnings that has any,
+  // and how many runs warned, whatever -q says.
+  std::size_t warned = 0;
+  for (std::size_t r = 0; r < results.size(); ++r) {
+    if (results[r].summary.warnings.empty()) continue;
+    if (warned++ == 0)
+      for (const std::string& w : results[r].summary.warnings) fmt::print(stderr, "nhdyn: warning: run {}: {}\n", r, w);
+  }
+  if (warned > 1) fmt::print(stderr, "nhdyn: warning: {} of {} runs had constraint-watch warnings\n", warned, results.size());
   if (!args.quiet) {
     fmt::print("nhdyn batch {}: {} runs on {} threads, {} failed -> {}\n", base.name, results.size(),
                batch_threads(args.threads, results.size()), failed, (dir / "summary.csv").string());

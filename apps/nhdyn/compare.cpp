@@ -93,6 +93,10 @@ int run_compare(const CompareArgs& args) {
   CsvWriter series(series_path, columns);
 
   const Comparison result = compare_formulations(model, options);
+  // The constraint watch's warnings (analysis/constraint_watch.hpp), per case, whatever -q says.
+  for (const ComparisonResult& r : result.results)
+    for (const std::string& w : r.summary.warnings)
+      fmt::print(stderr, "nhdyn: warning ({}, {}): {}\n", method_name(r.which.method), integrator_name(r.which.integrator), w);
 
   std::string text =
       "method,integrator,solve_ns,steps,rhs_evaluations,wall_time_s,max_residual_pos,max_residual_vel,"

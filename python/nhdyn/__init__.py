@@ -12,6 +12,7 @@ subclasses InputError, ModelError, FileError) with the library's message (file:l
 See docs/python.md.
 """
 
+import warnings
 from collections.abc import MutableMapping
 
 import numpy as np
@@ -20,10 +21,24 @@ from . import _nhdyn
 from ._nhdyn import Error, FileError, InputError, ModelError, SimulationError
 
 __all__ = [
-    "Error", "InputError", "ModelError", "FileError", "SimulationError",
+    "Error", "InputError", "ModelError", "FileError", "SimulationError", "ConstraintWarning",
     "load", "loads", "builtin_models", "Model", "Result", "Equations", "Linearization", "Sweep",
     "BatchResult", "simulate_batch",
 ]
+
+
+class ConstraintWarning(UserWarning):
+    """A constraint whose row of b, or the conditioning of the stacked matrix [D A; b], degraded
+    by three orders of magnitude during a run (a form singular along the path, such as
+    y' - tan(phi) x' at phi = pi/2): the motion past that time may be wrong. The library's
+    constraint watch (docs/cli.md, "Warnings"); Result.summary["constraint_warnings"] has the
+    numbers. Filter with warnings.simplefilter("error", nhdyn.ConstraintWarning) to make it fatal."""
+
+
+def _warn_constraints(model_name, summary, stacklevel, run=None):
+    where = "" if run is None else " (run {})".format(run)
+    for text in summary.get("warnings", []):
+        warnings.warn("nhdyn: {}{}: {}".format(model_name, where, text), ConstraintWarning, stacklevel=stacklevel + 1)
 
 
 def builtin_models():
@@ -165,6 +180,7 @@ class Model:
                               output_step=output_step, complement=complement, step=step, fix_initial=fix_initial,
                               stabilize=stabilize, q0=q0, v0=qd0, stop_when=stop_when, events=events,
                               max_steps=max_steps, program_feedback=program_feedback)
+        _warn_constraints(self.name, out["summary"], stacklevel=2)
         if not out["ok"]:
             summary = out["summary"]
             raise SimulationError("simulation of '{}' failed at t = {:.6g}: {}".format(
@@ -390,4 +406,6 @@ def simulate_batch(model, parameters=None, initial=None, t_end=None, threads=0, 
     models = _batch_models(model, names, values, runs)
     out = _nhdyn.simulate_batch(models, q0=q0, v0=qd0, threads=int(threads), keep_trajectories=keep_trajectories,
                                 t_end=t_end, **options)
+    for run, summary in enumerate(out["summaries"]):
+        _warn_constraints(model.name, summary, stacklevel=2, run=run)
     return BatchResult(out, {name: values[:, j] for j, name in enumerate(names)}, model.coordinates)

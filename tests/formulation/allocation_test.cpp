@@ -15,6 +15,7 @@
 
 #include "formulation/sled_heading.hpp"
 #include "formulation/sparse_twin.hpp"
+#include "nhdyn/analysis/constraint_watch.hpp"
 #include "nhdyn/analysis/projection.hpp"
 #include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/formulation/baumgarte.hpp"
@@ -242,6 +243,31 @@ TEST(Allocation, TheCounterSeesAnAllocation) {
     g_counting = false;
     EXPECT_EQ(v.sum(), 200.0);
     EXPECT_GE(g_allocations.load(), 1) << "an Eigen allocation went uncounted";
+  }
+}
+
+TEST(Allocation, ConstraintWatchAllocatesNothingEvenWhenItWarns) {
+  // The paper's sled (y' - tan(phi) x') turned towards phi = pi/2: the row of b grows past the
+  // watch's factor inside the counted loop, on the dense path (with the stacked matrix's QR) and
+  // on the sparse one.
+  const Model paper = make_sled_model(SledVariant::paper);
+  for (const Model& model : {paper, testing::make_sparse_twin(paper)}) {
+    Data data = make_data(model, DataOptions{Path::automatic, Method::sanh, false});
+    ConstraintWatch watch = make_constraint_watch(model, data, Method::sanh);
+    const FormulationOptions options{Method::sanh, Complement::qr};
+    Vector q(3), v(3);
+    q << 0.0, 0.0, 0.0;
+    v << 1.0, 0.0, 0.0;
+    ASSERT_EQ(compute_dynamics(model, data, options, 0.0, q.data(), v.data()), Status::ok);
+    compute_constraint_watch(model, data, watch);
+    long watched = 0;
+    for (int i = 1; i <= 10; ++i) {
+      q(2) = 1.5707 * i / 10.0;  // 1/cos(1.5707) = 1.0e4
+      ASSERT_EQ(compute_dynamics(model, data, options, 0.1 * i, q.data(), v.data()), Status::ok);
+      watched += count_allocations([&] { compute_constraint_watch(model, data, watch); });
+    }
+    EXPECT_EQ(watched, 0) << model.name << (data.sparse ? " (sparse)" : " (dense)");
+    EXPECT_EQ(watch.warnings.size(), 1u) << model.name;
   }
 }
 

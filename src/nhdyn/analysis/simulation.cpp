@@ -38,8 +38,8 @@ StepEnd project(const Model& model, Data& data, const ProjectionOptions& options
 class MechanicalOde final : public OdeSystem {
  public:
   MechanicalOde(const Model& model, Data& data, const FormulationOptions& options, const SimulationOptions& run,
-                SimulationSummary& summary)
-      : model_(model), data_(data), options_(options), run_(run), summary_(summary), n_(model.n()),
+                SimulationSummary& summary, ConstraintWatch* watch)
+      : model_(model), data_(data), options_(options), run_(run), summary_(summary), watch_(watch), n_(model.n()),
         balance_(model.evaluator->has_energy_balance()) {}
 
   int size() const override { return 2 * n_ + (balance_ ? kWorks : 0); }
@@ -61,6 +61,12 @@ class MechanicalOde final : public OdeSystem {
   static constexpr int kWorks = 3;
 
   StepEnd after_step(double t, double* y) override {
+    // The watch reads the terms Data holds, when they are those of the step's end (the last stage
+    // of dopri5, evaluated there); b depends on t, q and, for constraints nonlinear in the
+    // velocities, q'.
+    if (watch_ && watch_->started && data_.stage == Stage::acceleration && data_.t == t &&
+        std::equal(y, y + n_, data_.q.data()) && std::equal(y + n_, y + 2 * n_, data_.v.data()))
+      compute_constraint_watch(model_, data_, *watch_);
     if (run_.stabilization != Stabilization::projection) return {};
     return project(model_, data_, run_.projection, t, y, summary_);
   }
@@ -71,6 +77,7 @@ class MechanicalOde final : public OdeSystem {
   const FormulationOptions& options_;
   const SimulationOptions& run_;
   SimulationSummary& summary_;
+  ConstraintWatch* watch_;  // null when the run does not watch
   int n_;
   bool balance_;
 };
@@ -180,6 +187,10 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
                                    model.name));
     check_program_feedback(options.formulation.program_feedback);
   }
+  if (options.watch_constraints && (!std::isfinite(options.watch_factor) || !(options.watch_factor > 1.0)))
+    throw InputError(fmt::format("the constraint watch's factor {} must be a finite number above 1 (the default is "
+                                 "{:g}, three orders of magnitude)",
+                                 options.watch_factor, kConstraintWatchFactor));
   if (options.formulation.complement == Complement::analytic && !model.evaluator->has_complement())
     throw InputError(fmt::format("model '{}' has no analytic D; choose --complement qr or partition", model.name));
 }
@@ -211,7 +222,8 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.has_energy_balance = model.evaluator->has_energy_balance();
   FormulationOptions formulation = options.formulation;
   formulation.baumgarte.enabled = options.stabilization == Stabilization::baumgarte;
-  MechanicalOde ode(model, data, formulation, options, summary);
+  ConstraintWatch watch = make_constraint_watch(model, data, options.formulation.method, options.watch_factor);
+  MechanicalOde ode(model, data, formulation, options, summary, options.watch_constraints ? &watch : nullptr);
   const auto states = static_cast<std::size_t>(ode.size());
   std::vector<double> y0(states, 0.0);  // the work starts at 0
   std::copy(q0.data(), q0.data() + n, y0.begin());
@@ -234,6 +246,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
       output_failure = status;
       return Status::stopped;
     }
+    if (options.watch_constraints) compute_constraint_watch(model, data, watch);
     compute_residuals(model, data);
     compute_energy(model, data);
     compute_contact_forces(model, data);  // nothing for a model without contacts
@@ -290,6 +303,11 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.partition_changes = data.partition_changes;
   summary.stats = result.stats;
   summary.energy_function_differs = summary.has_energy_balance && !model.evaluator->energy_function_is_energy();
+  summary.constraint_warnings = watch.warnings;
+  for (const ConstraintWarning& w : watch.warnings) summary.warnings.push_back(format_constraint_warning(model, w));
+  summary.largest_row_factor = watch.largest_row_factor;
+  summary.largest_condition_factor = watch.largest_condition_factor;
+  summary.watched_states = watch.states;
   if (summary.status != Status::ok) {
     // The kernels recorded the details of a failed evaluation in data; prefer those words.
     summary.message = data.status != Status::ok ? explain_failure(model, data) : result.message;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "nhdyn/analysis/constraint_watch.hpp"
 #include "nhdyn/analysis/events.hpp"
 #include "nhdyn/analysis/initial_state.hpp"
 #include "nhdyn/analysis/projection.hpp"
@@ -54,6 +55,11 @@ struct SimulationOptions {
   // event ends the run there with status ok. rk4 cannot locate events: check_simulation_options
   // refuses them.
   std::vector<Event> events;
+  // The constraint watch (analysis/constraint_watch.hpp): warns when a constraint's row of b or the
+  // conditioning of the stacked matrix degrades by watch_factor or more during the run. Checked at
+  // every output and at every accepted step whose end state the right-hand side last evaluated.
+  bool watch_constraints = true;
+  double watch_factor = kConstraintWatchFactor;
 };
 
 struct SimulationSummary {
@@ -99,6 +105,15 @@ struct SimulationSummary {
   std::vector<std::string> event_names;  // the run's events, those of SimulationOptions::events
   std::vector<EventRecord> events;
   int stopped_by = -1;
+  // The constraint watch (SimulationOptions::watch_constraints): at most one warning per
+  // constraint, in time order, and the same in words (format_constraint_warning); the largest
+  // degradation factor of the row norms and of the conditioning seen (1 when nothing changed) and
+  // the number of states watched.
+  std::vector<ConstraintWarning> constraint_warnings;
+  std::vector<std::string> warnings;
+  double largest_row_factor = 1.0;
+  double largest_condition_factor = 1.0;
+  long watched_states = 0;
 };
 
 // Called at every output time, and at every event (its row is the state at the crossing), with

@@ -1,0 +1,164 @@
+#include "nhdyn/analysis/constraint_watch.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace nhdyn {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// The row norms of b into `out` (s), from the dense b or, on the sparse path, from b_sparse's
+// columns: O(nonzeros).
+void row_norms(const Data& data, Vector& out) {
+  if (!data.sparse) {
+    for (Eigen::Index i = 0; i < out.size(); ++i) out(i) = data.b.row(i).norm();
+    return;
+  }
+  out.setZero();
+  const SparseMatrix& b = data.b_sparse;
+  const double* values = b.valuePtr();
+  const int* rows = b.innerIndexPtr();
+  for (Eigen::Index j = 0; j < b.outerSize(); ++j)
+    for (int m = b.outerIndexPtr()[j]; m < b.outerIndexPtr()[j + 1]; ++m) out(rows[m]) += values[m] * values[m];
+  out = out.cwiseSqrt();
+}
+
+// Growth or shrinkage of a positive measure, as a factor >= 1; infinite when it is not finite or
+// has vanished.
+double change_factor(double initial, double value) {
+  if (!std::isfinite(value) || !(value > 0.0)) return kInfinity;
+  return std::max(value / initial, initial / value);
+}
+
+// The conditioning estimate of the row-scaled watched matrix and the index of its last pivot row.
+double stacked_condition(const Model& model, const Data& data, ConstraintWatch& watch, Eigen::Index& last) {
+  const int k = model.k();
+  const int s = model.s();
+  Matrix& rows = watch.rows;
+  if (watch.stacked && k > 0) rows.topRows(k).noalias() = data.D * data.A;
+  rows.bottomRows(s) = data.b;
+  for (Eigen::Index i = 0; i < rows.rows(); ++i) {
+    const double norm = rows.row(i).norm();
+    if (!std::isfinite(norm)) return kInfinity;
+    if (norm > 0.0) rows.row(i) /= norm;
+  }
+  watch.rows_t = rows.transpose();
+  watch.qr.compute(watch.rows_t);
+  const Matrix& R = watch.qr.matrixQR();
+  double largest = 0.0;
+  double smallest = kInfinity;
+  const Eigen::Index m = std::min(R.rows(), R.cols());
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const double d = std::abs(R(i, i));
+    largest = std::max(largest, d);
+    smallest = std::min(smallest, d);
+  }
+  last = watch.qr.colsPermutation().indices()(m - 1);
+  if (!(smallest > 0.0)) return kInfinity;
+  return largest / smallest;
+}
+
+void record(ConstraintWatch& watch, int constraint, int slot, WatchMeasure measure, double t, double initial,
+            double value, double factor) {
+  char& flag = watch.warned[static_cast<std::size_t>(slot)];
+  if (flag) return;
+  flag = 1;
+  ConstraintWarning w;
+  w.constraint = constraint;
+  w.measure = measure;
+  w.t = t;
+  w.initial = initial;
+  w.value = value;
+  w.factor = factor;
+  watch.warnings.push_back(w);  // within the capacity reserved by make_constraint_watch
+}
+
+}  // namespace
+
+ConstraintWatch make_constraint_watch(const Model& model, const Data& data, std::optional<Method> method,
+                                      double threshold) {
+  ConstraintWatch watch;
+  watch.threshold = threshold;
+  const int n = model.n();
+  const int s = model.s();
+  const int k = model.k();
+  watch.initial_norm = Vector::Zero(s);
+  watch.norm = Vector::Zero(s);
+  watch.warned.assign(static_cast<std::size_t>(s) + 1, 0);
+  watch.warnings.reserve(static_cast<std::size_t>(s) + 1);
+  watch.conditioning = !data.sparse && s > 0;
+  if (watch.conditioning) {
+    // D is there, k x n, for the formulations that solve with it (sanh, nullspace).
+    watch.stacked = method && (*method == Method::sanh || *method == Method::nullspace) && data.D.rows() == k &&
+                    data.D.cols() == n;
+    const int watched = watch.stacked ? n : s;
+    watch.rows = Matrix::Zero(watched, n);
+    watch.rows_t = Matrix::Zero(n, watched);
+    watch.qr = Eigen::ColPivHouseholderQR<Matrix>(n, watched);
+  }
+  return watch;
+}
+
+void compute_constraint_watch(const Model& model, const Data& data, ConstraintWatch& watch) {
+  const int s = model.s();
+  if (s == 0) return;
+  ++watch.states;
+  row_norms(data, watch.norm);
+  Eigen::Index last = 0;
+  if (watch.conditioning) watch.condition = stacked_condition(model, data, watch, last);
+  if (!watch.started) {
+    // The reference: a row that is zero or not finite here was refused before the run began.
+    watch.started = true;
+    watch.initial_norm = watch.norm;
+    watch.initial_condition = watch.condition;
+    return;
+  }
+  for (int i = 0; i < s; ++i) {
+    const double initial = watch.initial_norm(i);
+    if (!(initial > 0.0) || !std::isfinite(initial)) continue;
+    const double factor = change_factor(initial, watch.norm(i));
+    watch.largest_row_factor = std::max(watch.largest_row_factor, factor);
+    if (factor >= watch.threshold)
+      record(watch, i, i, WatchMeasure::row_norm, data.t, initial, watch.norm(i), factor);
+  }
+  if (watch.conditioning && watch.initial_condition > 0.0 && std::isfinite(watch.initial_condition)) {
+    // Only growth counts: a matrix better conditioned than at the start is no trouble.
+    const double factor = std::isfinite(watch.condition) ? watch.condition / watch.initial_condition : kInfinity;
+    watch.largest_condition_factor = std::max(watch.largest_condition_factor, factor);
+    if (factor >= watch.threshold) {
+      // The last pivot: a row of b names its constraint; a row of D A (stacked, index < k) does not.
+      const int k = watch.stacked ? model.k() : 0;
+      const int row = static_cast<int>(last);
+      const int constraint = row >= k ? row - k : -1;
+      record(watch, constraint, constraint >= 0 ? constraint : s, WatchMeasure::conditioning, data.t,
+             watch.initial_condition, watch.condition, factor);
+    }
+  }
+}
+
+std::string format_constraint_warning(const Model& model, const ConstraintWarning& w) {
+  const std::string factor = std::isfinite(w.factor) ? fmt::format("{:.3g}", w.factor) : std::string("infinity");
+  if (w.measure == WatchMeasure::row_norm) {
+    const std::string& name = model.constraints[static_cast<std::size_t>(w.constraint)].name;
+    return fmt::format(
+        "constraint '{}': the norm of its row of b went from {:.3g} to {:.3g} (a factor of {}) by t = {:.6g}; its "
+        "form is (nearly) singular there (such as tan(phi) at phi = pi/2) and the motion past that point may be "
+        "wrong: write it in a form that stays regular (multiply through by cos(phi))",
+        name, w.initial, w.value, factor, w.t);
+  }
+  const std::string who =
+      w.constraint >= 0
+          ? fmt::format("constraint '{}'", model.constraints[static_cast<std::size_t>(w.constraint)].name)
+          : std::string("the complement rows D A");
+  return fmt::format(
+      "{}: the stacked matrix [D A; b] (rows scaled to unit norm) lost conditioning by a factor of {} by t = {:.6g} "
+      "(estimate {:.3g}, {:.3g} at the start), this row the most nearly dependent on the others; the constraints "
+      "are becoming dependent or the coordinates singular there, and the motion past that point may be wrong",
+      who, factor, w.t, w.value, w.initial);
+}
+
+}  // namespace nhdyn

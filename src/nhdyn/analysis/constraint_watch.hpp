@@ -1,0 +1,87 @@
+// The constraint watch: a constraint written in a form that becomes singular along the run
+// (y' - tan(phi) x' as phi crosses pi/2) passes the integrator without complaint and gives a wrong
+// motion. The watch follows, at the states a run visits (every output time and every accepted step
+// whose state Data holds), how far each constraint has drifted from its form at the first state:
+//
+//   1. the Euclidean norm of its row of b (the tan(phi) form grows like 1/|cos(phi)|), on the dense
+//      and the sparse path, O(nonzeros of b);
+//   2. on the dense path, a conditioning estimate of the stacked matrix [D A; b] with its rows
+//      scaled to unit norm (so that 1. alone speaks about scale and 2. about directions): the ratio
+//      of the largest to the smallest |R_ii| of a QR with column pivoting of its transpose, the
+//      last pivot naming the row most nearly dependent on the others. O(n^3), in workspace
+//      allocated once. For a formulation without D (lagrange, udwadia-kalaba) the rows of b alone.
+//
+// A measure that has grown (or a row norm that has shrunk) by kConstraintWatchFactor or more from
+// its first value, or that is no longer finite, makes one warning per constraint: which measure,
+// the time, the factor. The simulate driver (analysis/simulation.hpp) keeps them in its summary;
+// docs/cli.md "Warnings" describes them. Called after compute_acceleration; allocates nothing
+// once made (a warning is stored in space reserved for it).
+#pragma once
+
+#include <Eigen/QR>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "nhdyn/core/types.hpp"
+#include "nhdyn/model/data.hpp"
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn {
+
+// Three orders of magnitude: a well-posed model's rows of b and stacked matrix change with the
+// configuration by far less (the sled, the rolling disk and the bicycle stay below 3 over long
+// runs, tests/analysis/constraint_watch_test.cpp), while the tan(phi) form reaches it at
+// |cos(phi)| = 1e-3, 1 ms of rotation before the singularity at 1 rad/s.
+inline constexpr double kConstraintWatchFactor = 1e3;
+
+// Which measure degraded.
+enum class WatchMeasure {
+  row_norm,      // the norm of the constraint's row of b grew or shrank
+  conditioning,  // the (row-scaled) stacked matrix lost conditioning; its last pivot was this row
+};
+
+struct ConstraintWarning {
+  int constraint = -1;  // index in Model::constraints; -1: a row of D A, not a constraint's row
+  WatchMeasure measure = WatchMeasure::row_norm;
+  double t = 0.0;        // time of the first state past the threshold [s]
+  double initial = 0.0;  // the measure at the first state watched
+  double value = 0.0;    // the measure at t
+  double factor = 0.0;   // max(value/initial, initial/value) for row norms, value/initial for
+                         // conditioning; infinite when the value is not finite
+};
+
+struct ConstraintWatch {
+  double threshold = kConstraintWatchFactor;
+  bool started = false;      // whether the first state (the reference) has been seen
+  bool stacked = false;      // conditioning of [D A; b] (a formulation with D), else of b alone
+  bool conditioning = false; // whether measure 2 is followed (dense path, s > 0)
+  Vector initial_norm;       // s, row norms of b at the first state
+  Vector norm;               // s, row norms of b at the last state watched
+  double initial_condition = 0.0;
+  double condition = 0.0;
+  // The largest degradation factor seen so far of each measure (1 when nothing changed).
+  double largest_row_factor = 1.0;
+  double largest_condition_factor = 1.0;
+  std::vector<char> warned;  // s + 1 flags: each constraint, then the rows of D A
+  std::vector<ConstraintWarning> warnings;  // in time order; capacity s + 1, reserved
+  Matrix rows;                              // (rows watched) x n, the row-scaled stacked matrix
+  Matrix rows_t;                            // n x (rows watched), its transpose for the QR
+  Eigen::ColPivHouseholderQR<Matrix> qr;    // of rows_t
+  long states = 0;                          // states watched
+};
+
+// The watch for a run of `model` on `data` (its path, dense or sparse) with the formulation
+// `method`: sizes every workspace. Cold path.
+ConstraintWatch make_constraint_watch(const Model& model, const Data& data, std::optional<Method> method,
+                                      double threshold = kConstraintWatchFactor);
+
+// Watches the state held in data (b, and on the dense path D and A, after compute_acceleration):
+// the first call sets the reference, every later one compares with it and records a warning the
+// first time a constraint's measure passes the threshold. Allocates nothing.
+void compute_constraint_watch(const Model& model, const Data& data, ConstraintWatch& watch);
+
+// One warning in words: the constraint by name, the measure, t, the factor, and what to do.
+std::string format_constraint_warning(const Model& model, const ConstraintWarning& warning);
+
+}  // namespace nhdyn
