@@ -390,6 +390,18 @@ TEST_F(Cli, UnwritableHtmlIsRefusedBeforeSimulating) {
   EXPECT_FALSE(fs::exists(csv)) << "the run went ahead";
 }
 
+// `nhdyn report -o` into a directory that does not exist: refused (exit 2) naming the path, before
+// the model is compiled or the CSV read (the CSV named here does not exist either).
+TEST_F(Cli, UnwritableReportOutputIsRefusedFirst) {
+  const nhdyn::test::CliOutcome run = nhdyn::test::run_nhdyn(
+      "report " + (dir / "none.csv").string() + " --model " + example("sled.toml").string() + " -o " +
+          (dir / "missing" / "r.html").string(),
+      dir);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_TRUE(nhdyn::test::contains(run.out, (dir / "missing").string())) << run.out;
+  EXPECT_FALSE(nhdyn::test::contains(run.out, "none.csv")) << "the CSV was read first: " << run.out;
+}
+
 TEST_F(Cli, ReportOfSimulateIsSelfContainedAndReproducible) {
   std::string out, err;
   const fs::path csv = dir / "sled.csv", a = dir / "a.html", b = dir / "b.html";

@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <string_view>
@@ -247,10 +249,25 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
 
   // Panels: lengths and angles apart (their scales differ), then reactions, residuals, energy.
   std::vector<PlotGroup> groups;
-  PlotGroup lengths{"coordinates", false, false, {}}, angles{"angles [rad]", false, false, {}};
-  for (std::size_t i = 0; i < input.coordinates.size(); ++i)
-    (i < input.angles.size() && input.angles[i] ? angles : lengths).columns.push_back(input.coordinates[i]);
-  for (PlotGroup* g : {&lengths, &angles})
+  // Angles that turn through more than a revolution (a wheel's spin, a heading) get a panel of
+  // their own, so that their hundreds of radians do not flatten a lean or a steer of a few degrees.
+  PlotGroup lengths{"coordinates", false, false, {}}, angles{"angles [rad]", false, false, {}},
+      turns{"angles turning more than once [rad]", false, false, {}};
+  for (std::size_t i = 0; i < input.coordinates.size(); ++i) {
+    const std::string& name = input.coordinates[i];
+    if (!(i < input.angles.size() && input.angles[i])) {
+      lengths.columns.push_back(name);
+      continue;
+    }
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const double x : column(name)) {
+      if (!std::isfinite(x)) continue;
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+    }
+    (hi - lo > 2 * std::numbers::pi ? turns : angles).columns.push_back(name);
+  }
+  for (PlotGroup* g : {&lengths, &angles, &turns})
     if (!g->columns.empty()) groups.push_back(*g);
   if (!input.columns.reactions.empty()) groups.push_back({"reactions R", false, false, input.columns.reactions});
   if (!input.columns.actuators.empty())
