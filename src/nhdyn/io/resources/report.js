@@ -145,6 +145,11 @@
     const m = span / p;
     return (m < 2 ? 1 : m < 5 ? 2 : 5) * p;
   };
+  const setPositions = (geometry, array) => {
+    const attribute = new THREE.BufferAttribute(array, 3);
+    if (geometry.setAttribute) geometry.setAttribute("position", attribute);
+    else geometry.addAttribute("position", attribute);
+  };
   // Two grids: one for the whole motion, a finer one for the view that follows (at most 600 lines
   // each way: a coarser step beyond).
   const makeGrid = (view) => {
@@ -154,10 +159,28 @@
       step = niceStep((2 * reach) / 600);
       if (step < (2 * reach) / 600) step = niceStep(step * 2.6);
     }
-    const divisions = 2 * Math.ceil(reach / step);
-    const grid = new THREE.GridHelper(divisions * step, divisions, 0x999999, 0xdddddd);
-    grid.rotation.x = Math.PI / 2;  // THREE's grid lies in y = 0; ours in z = 0
-    grid.position.set(Math.round(centre.x / step) * step, Math.round(centre.y / step) * step, S.planar ? -1e-3 * near : 0);
+    // Lines x = const and y = const in the plane z = 0, drawn directly (no rotated GridHelper).
+    const count = Math.ceil(reach / step);
+    const cx = Math.round(centre.x / step) * step, cy = Math.round(centre.y / step) * step;
+    const z = S.planar ? -1e-3 * near : 0, span = count * step;
+    const minor = [], major = [];
+    // Each line in pieces: a piece with an end behind the camera (the view that follows looks
+    // along the ground) is not drawn by every WebGL implementation, so the pieces are short.
+    const pieces = Math.min(2 * count, 100), piece = (2 * span) / pieces;
+    for (let i = -count; i <= count; ++i) {  // the axes x = 0 and y = 0 darker
+      const x = cx + i * step, y = cy + i * step;
+      for (let k = 0; k < pieces; ++k) {
+        const a = -span + k * piece, b = a + piece;
+        (Math.abs(x) < step / 2 ? major : minor).push(x, cy + a, z, x, cy + b, z);
+        (Math.abs(y) < step / 2 ? major : minor).push(cx + a, y, z, cx + b, y, z);
+      }
+    }
+    const grid = new THREE.Group();
+    for (const [lines, colour] of [[minor, 0xdddddd], [major, 0x999999]]) {
+      const geometry = new THREE.BufferGeometry();
+      setPositions(geometry, new Float32Array(lines));
+      grid.add(new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ color: colour })));
+    }
     scene.add(grid);
     return grid;
   };
@@ -171,11 +194,7 @@
   const Cylinder = THREE.CylinderBufferGeometry || THREE.CylinderGeometry;
   const Torus = THREE.TorusBufferGeometry || THREE.TorusGeometry;
   const Circle = THREE.CircleBufferGeometry || THREE.CircleGeometry;
-  const setPositions = (geometry, array) => {
-    const attribute = new THREE.BufferAttribute(array, 3);
-    if (geometry.setAttribute) geometry.setAttribute("position", attribute);
-    else geometry.addAttribute("position", attribute);
-  };
+
   const trail = (points, colour) => {
     const geometry = new THREE.BufferGeometry();
     setPositions(geometry, points);
@@ -218,10 +237,10 @@
         const c = [value(f, s.offset), value(f, s.offset + 1), value(f, s.offset + 2)];
         const a = [value(f, s.offset + 3 + s.axis), value(f, s.offset + 6 + s.axis), value(f, s.offset + 9 + s.axis)];
         // The contact point: the lowest point of the rim, c - r d with d the unit vector of the
-        // vertical within the wheel's plane.
+        // vertical (up, +z or -z) within the wheel's plane.
         let d = [-a[2] * a[0], -a[2] * a[1], 1 - a[2] * a[2]];
         const norm = Math.hypot(d[0], d[1], d[2]) || 1;
-        for (let k = 0; k < 3; ++k) points[3 * f + k] = c[k] - (r * d[k]) / norm;
+        for (let k = 0; k < 3; ++k) points[3 * f + k] = c[k] - (upward * r * d[k]) / norm;
       }
       o.trail = trail(points, 0x444444);
     } else if (s.kind === "body") {
