@@ -3,7 +3,8 @@
 # screenshot of each taken by headless Chromium, into OUT (default build/gallery-reports):
 #     docs/gallery/make_reports.sh [NHDYN] [OUT]
 # The reports are 1.5-3 MB each (the embedded JavaScript libraries), so the repository keeps only
-# the screenshots of docs/gallery/reports/ (copied there by hand from OUT).
+# the screenshots, in docs/gallery/reports/ (cp OUT/*.png docs/gallery/reports/), shown in the
+# table of docs/gallery/README.md with the command that writes each report.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)

@@ -23,7 +23,10 @@
 #include "nhdyn/io/model_file.hpp"
 #include "nhdyn/io/report.hpp"
 #include "nhdyn/symbolic/compile.hpp"
+#include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/visual.hpp"
+#include "support/cli_run.hpp"
+#include "support/text.hpp"
 
 namespace {
 
@@ -32,11 +35,22 @@ using nhdyn::symbolic::VisualKind;
 
 fs::path example(const std::string& name) { return fs::path(NHDYN_SOURCE_DIR) / "examples" / name; }
 
-std::vector<double> run_scene(const nhdyn::symbolic::VisualScene& scene, double t, const std::vector<double>& q,
-                              const std::vector<double>& v) {
-  std::vector<double> registers(static_cast<std::size_t>(scene.program.registers()));
-  std::vector<double> out(static_cast<std::size_t>(scene.program.outputs()));
-  scene.program.run(t, q.data(), v.data(), registers.data(), out.data());
+// The spec's parameters as a Model holds them (name, value), in the spec's order.
+std::vector<nhdyn::Parameter> spec_parameters(const nhdyn::symbolic::Spec& spec) {
+  std::vector<nhdyn::Parameter> out;
+  for (const auto& p : spec.parameters) out.push_back({p.name, p.value, p.unit, p.expression});
+  return out;
+}
+
+// The scene's program bound to the spec's parameter values, run at (t, q, v).
+std::vector<double> run_scene(const nhdyn::symbolic::VisualScene& scene, const nhdyn::symbolic::Spec& spec, double t,
+                              const std::vector<double>& q, const std::vector<double>& v) {
+  std::vector<double> values;
+  for (const auto& p : spec.parameters) values.push_back(p.value);
+  const nhdyn::Program program = scene.program.bind(values.data(), values.size());
+  std::vector<double> registers(static_cast<std::size_t>(program.registers()));
+  std::vector<double> out(static_cast<std::size_t>(program.outputs()));
+  program.run(t, q.data(), v.data(), registers.data(), out.data());
   return out;
 }
 
@@ -47,6 +61,47 @@ double parameter(const nhdyn::symbolic::Spec& spec, const std::string& name) {
   return 0.0;
 }
 
+
+// The numbers of the JSON array that follows `key` at or after `from` in a report's page (null, a
+// gap, as NaN); empty when the key is missing.
+std::vector<double> report_array_after(const std::string& page, const std::string& key, std::size_t from = 0) {
+  std::vector<double> out;
+  const std::size_t at = page.find(key, from);
+  if (at == std::string::npos) return out;
+  std::size_t p = page.find('[', at) + 1;
+  const std::size_t end = page.find(']', p);
+  while (p < end) {
+    std::size_t next = page.find(',', p);
+    if (next == std::string::npos || next > end) next = end;
+    const std::string item = page.substr(p, next - p);
+    out.push_back(item == "null" ? std::nan("") : std::stod(item));
+    p = next + 1;
+  }
+  return out;
+}
+
+// One shape of a report's scene as the page has it: its offset in the values and its size.
+struct ReportShape {
+  int offset = -1;
+  std::vector<double> size;
+};
+ReportShape report_shape(const std::string& page, const std::string& kind, const std::string& name) {
+  ReportShape shape;
+  const std::size_t at = page.find("{\"kind\":\"" + kind + "\",\"name\":\"" + name + "\"", page.find("\"scene\":"));
+  if (at == std::string::npos) return shape;
+  shape.offset = std::stoi(page.substr(page.find("\"offset\":", at) + 9));
+  shape.size = report_array_after(page, "\"size\":", at);
+  return shape;
+}
+
+// The scene's values per frame shown (stride numbers each) and the times of the frames.
+std::vector<double> report_scene_values(const std::string& page) {
+  return report_array_after(page, "\"values\":", page.find("\"scene\":"));
+}
+int report_scene_stride(const std::string& page) {
+  return std::stoi(page.substr(page.find("\"stride\":", page.find("\"scene\":")) + 9));
+}
+
 TEST(Visual, SledBladeAndCentreOfMassFollowTheClosedForm) {
   const nhdyn::symbolic::Spec spec = nhdyn::load_model_file(example("sled.toml"));
   const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
@@ -54,21 +109,22 @@ TEST(Visual, SledBladeAndCentreOfMassFollowTheClosedForm) {
   EXPECT_TRUE(scene.planar);
   EXPECT_FALSE(scene.ground);
   auto find = [&](const std::string& name) {
-    for (const nhdyn::symbolic::VisualShape& shape : scene.shapes)
-      if (shape.name == name) return shape;
+    for (std::size_t i = 0; i < scene.shapes.size(); ++i)
+      if (scene.shapes[i].name == name) return i;
     ADD_FAILURE() << "no shape " << name;
-    return nhdyn::symbolic::VisualShape{};
+    return std::size_t{0};
   };
-  const nhdyn::symbolic::VisualShape blade = find("blade"), mass = find("centre of mass");
+  const nhdyn::symbolic::VisualShape blade = scene.shapes[find("blade")], mass = scene.shapes[find("centre of mass")];
   EXPECT_EQ(blade.kind, VisualKind::segment);
   EXPECT_EQ(mass.kind, VisualKind::sphere);
-  EXPECT_DOUBLE_EQ(mass.size[0], 0.08);
+  const std::vector<nhdyn::SceneSize> sizes = nhdyn::calc_scene_sizes(scene, spec_parameters(spec), spec.name);
+  EXPECT_DOUBLE_EQ(sizes[find("centre of mass")].size[0], 0.08);
   // phi is an angle (inside cos and sin), x and y are lengths.
   EXPECT_EQ(scene.angles, (std::vector<bool>{false, false, true}));
   const double a = parameter(spec, "a");
   for (const double phi : {0.0, 0.7, -2.1, 3.0}) {
     const double x = 1.3, y = -0.4;
-    const std::vector<double> out = run_scene(scene, 0.0, {x, y, phi}, {0.1, 0.2, 0.3});
+    const std::vector<double> out = run_scene(scene, spec, 0.0, {x, y, phi}, {0.1, 0.2, 0.3});
     const int b = blade.offset, c = mass.offset;
     EXPECT_NEAR(out[b + 0], x - 0.25 * std::cos(phi), 1e-14);
     EXPECT_NEAR(out[b + 1], y - 0.25 * std::sin(phi), 1e-14);
@@ -96,10 +152,11 @@ TEST(Visual, RollingDiskCentreAndContactPoint) {
   ASSERT_GE(wheel, 0);
   ASSERT_GE(body, 0);
   const double r = parameter(spec, "r");
-  EXPECT_DOUBLE_EQ(scene.shapes[static_cast<std::size_t>(wheel)].size[0], r);
+  const std::vector<nhdyn::SceneSize> sizes = nhdyn::calc_scene_sizes(scene, spec_parameters(spec), spec.name);
+  EXPECT_DOUBLE_EQ(sizes[static_cast<std::size_t>(wheel)].size[0], r);
   EXPECT_EQ(scene.shapes[static_cast<std::size_t>(wheel)].axis, 1);
   const double x = 0.4, y = -1.1, psi = 0.9, theta = 0.35, phi = 2.0;
-  const std::vector<double> out = run_scene(scene, 0.0, {x, y, psi, theta, phi}, {0, 0, 0, 0, 0});
+  const std::vector<double> out = run_scene(scene, spec, 0.0, {x, y, psi, theta, phi}, {0, 0, 0, 0, 0});
   const int o = scene.shapes[static_cast<std::size_t>(wheel)].offset;
   const double c[3] = {out[o], out[o + 1], out[o + 2]};
   EXPECT_NEAR(c[0], x + r * std::sin(theta) * std::sin(psi), 1e-14);
@@ -120,13 +177,110 @@ TEST(Visual, RollingDiskCentreAndContactPoint) {
   EXPECT_NEAR(c[2] - r * d[2] / norm, 0.0, 1e-14);
   // The body's equivalent ellipsoid: I = m r^2 (1/4, 1/2, 1/4) gives semi-axes sqrt(5)/2 r in the
   // disk's plane and none along the axle, shown as a tenth of the others.
-  std::array<double, 3> semi = scene.shapes[static_cast<std::size_t>(body)].size;
+  std::array<double, 3> semi = sizes[static_cast<std::size_t>(body)].size;
   std::sort(semi.begin(), semi.end());
   EXPECT_NEAR(semi[2], std::sqrt(5.0) / 2 * r, 1e-14);
   EXPECT_NEAR(semi[1], std::sqrt(5.0) / 2 * r, 1e-14);
   EXPECT_NEAR(semi[0], 0.1 * std::sqrt(5.0) / 2 * r, 1e-14);
   // psi, theta and phi are angles; x and y lengths.
   EXPECT_EQ(scene.angles, (std::vector<bool>{false, false, true, true, true}));
+}
+
+// Parameters are data: the scene is compiled once with the parameters symbolic, and the report
+// draws the values of the Model it is given. The spec keeps r = 0.2; the Model's r is set to 0.35
+// after compiling, and the page's wheel, body and centre follow 0.35.
+TEST(Visual, SceneFollowsTheModelsParametersWithoutRecompiling) {
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_file(example("rolling_disk_bodies.toml"));
+  nhdyn::Model model = nhdyn::symbolic::compile_model(spec);
+  const double r = 0.35;
+  ASSERT_NE(parameter(spec, "r"), r);
+  nhdyn::set_parameter(model, "r", r);
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  const std::vector<nhdyn::SceneSize> sizes = nhdyn::calc_scene_sizes(scene, model.parameters, model.name);
+  for (std::size_t i = 0; i < scene.shapes.size(); ++i) {
+    if (scene.shapes[i].kind == VisualKind::wheel) {
+      EXPECT_DOUBLE_EQ(sizes[i].size[0], r);
+    }
+    if (scene.shapes[i].kind == VisualKind::body) {
+      std::array<double, 3> semi = sizes[i].size;
+      std::sort(semi.begin(), semi.end());
+      EXPECT_NEAR(semi[2], std::sqrt(5.0) / 2 * r, 1e-14);
+    }
+  }
+
+  // A run of three rows through write_model_report, the function both commands call.
+  nhdyn::CsvTable table;
+  table.header = nhdyn::make_result_columns(model).all;
+  const std::vector<std::array<double, 5>> states = {{0, 0, 0, 0.3, 0}, {0.4, -1.1, 0.9, 0.35, 2.0}, {-2, 1, -2.5, -0.6, 7}};
+  for (std::size_t k = 0; k < states.size(); ++k) {
+    std::vector<double> row(table.header.size(), 0.0);
+    row[0] = 0.5 * static_cast<double>(k);
+    for (int i = 0; i < 5; ++i) row[static_cast<std::size_t>(table.column(model.coordinates[static_cast<std::size_t>(i)]))] = states[k][static_cast<std::size_t>(i)];
+    table.rows.push_back(row);
+  }
+  const fs::path html = fs::temp_directory_path() / ("nhdyn_report_parameters_" + std::to_string(::getpid()) + ".html");
+  nhdyn::write_model_report(model, &spec, table, "disk", {}, html);
+  const std::string page = nhdyn::test::read_text(html);
+  fs::remove(html);
+  const ReportShape wheel = report_shape(page, "wheel", "disk");
+  ASSERT_GE(wheel.offset, 0) << "no wheel in the page";
+  ASSERT_EQ(wheel.size.size(), 3u);
+  EXPECT_NEAR(wheel.size[0], r, 1e-6);
+  const std::vector<double> values = report_scene_values(page);
+  const int stride = report_scene_stride(page);
+  ASSERT_EQ(values.size(), states.size() * static_cast<std::size_t>(stride));
+  for (std::size_t k = 0; k < states.size(); ++k) {
+    const double x = states[k][0], y = states[k][1], psi = states[k][2], theta = states[k][3];
+    const double* c = values.data() + k * static_cast<std::size_t>(stride) + wheel.offset;
+    EXPECT_NEAR(c[0], x + r * std::sin(theta) * std::sin(psi), 1e-5);  // six significant digits in the page
+    EXPECT_NEAR(c[1], y - r * std::sin(theta) * std::cos(psi), 1e-5);  // six significant digits in the page
+    EXPECT_NEAR(c[2], r * std::cos(theta), 1e-5);  // six significant digits in the page
+  }
+}
+
+// A [visual] table in a derived parameter (h = L/2): setting L re-evaluates h, and the point's
+// place and radius follow; a radius the parameters make negative is refused naming the item.
+TEST(Visual, DerivedParametersAndBadSizesFromTheRunsValues) {
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_string(R"toml(
+name = "dot"
+coordinates = ["x", "y"]
+kinetic_energy = "m/2*(x'^2 + y'^2)"
+[parameters]
+m = 1.0
+L = 1.0
+h = "L/2"
+[visual]
+points = [{ name = "p", position = ["x + h", "y - h^2"], radius = "h/10" }]
+)toml",
+                                                              "dot.toml");
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  nhdyn::Model model = nhdyn::symbolic::compile_model(spec);
+  nhdyn::set_parameter(model, "L", 3.0);
+  const double h = 1.5;
+  EXPECT_DOUBLE_EQ(nhdyn::calc_scene_sizes(scene, model.parameters, model.name)[0].size[0], h / 10);
+  std::vector<double> values;
+  for (const nhdyn::Parameter& p : model.parameters) values.push_back(p.value);
+  const nhdyn::Program program = scene.program.bind(values.data(), values.size());
+  std::vector<double> registers(static_cast<std::size_t>(program.registers())), out(3);
+  const double q[2] = {0.25, -0.75}, v[2] = {0, 0};
+  program.run(0.0, q, v, registers.data(), out.data());
+  EXPECT_DOUBLE_EQ(out[0], 0.25 + h);
+  EXPECT_DOUBLE_EQ(out[1], -0.75 - h * h);
+
+  nhdyn::set_parameter(model, "L", -1.0);
+  try {
+    nhdyn::calc_scene_sizes(scene, model.parameters, model.name);
+    ADD_FAILURE() << "a negative radius was drawn";
+  } catch (const nhdyn::InputError& e) {
+    const std::string m = e.what();
+    EXPECT_TRUE(nhdyn::test::contains(m, "dot.toml:10:")) << m;
+    EXPECT_TRUE(nhdyn::test::contains(m, "point 'p'")) << m;
+    EXPECT_TRUE(nhdyn::test::contains(m, "-0.05")) << m;
+  }
+  // Another model's values are refused, naming both lists.
+  std::vector<nhdyn::Parameter> other = model.parameters;
+  other.pop_back();
+  EXPECT_THROW(nhdyn::calc_scene_sizes(scene, other, model.name), nhdyn::InputError);
 }
 
 const char* const kPlanarModel = R"toml(
@@ -236,6 +390,18 @@ TEST_F(Cli, UnwritableHtmlIsRefusedBeforeSimulating) {
   EXPECT_FALSE(fs::exists(csv)) << "the run went ahead";
 }
 
+// `nhdyn report -o` into a directory that does not exist: refused (exit 2) naming the path, before
+// the model is compiled or the CSV read (the CSV named here does not exist either).
+TEST_F(Cli, UnwritableReportOutputIsRefusedFirst) {
+  const nhdyn::test::CliOutcome run = nhdyn::test::run_nhdyn(
+      "report " + (dir / "none.csv").string() + " --model " + example("sled.toml").string() + " -o " +
+          (dir / "missing" / "r.html").string(),
+      dir);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_TRUE(nhdyn::test::contains(run.out, (dir / "missing").string())) << run.out;
+  EXPECT_FALSE(nhdyn::test::contains(run.out, "none.csv")) << "the CSV was read first: " << run.out;
+}
+
 TEST_F(Cli, ReportOfSimulateIsSelfContainedAndReproducible) {
   std::string out, err;
   const fs::path csv = dir / "sled.csv", a = dir / "a.html", b = dir / "b.html";
@@ -270,6 +436,63 @@ TEST_F(Cli, ReportOfSimulateIsSelfContainedAndReproducible) {
   std::stringstream sc;
   sc << fc.rdbuf();
   EXPECT_EQ(sb.str(), sc.str()) << "same input, same bytes";
+}
+
+// `--set` on the command line: the report of simulate and of `nhdyn report` draw the run's values,
+// checked against the closed form of the wheel's centre on every row of the CSV, and the sled's
+// centre of mass at x + a cos(phi) with the a that was set.
+TEST_F(Cli, SetParametersAreDrawnWithTheRunsValues) {
+  const fs::path csv = dir / "disk.csv", a = dir / "a.html", b = dir / "b.html";
+  const double r = 0.35;
+  nhdyn::test::CliOutcome run = nhdyn::test::run_nhdyn(
+      "simulate " + example("rolling_disk_bodies.toml").string() + " --set r=0.35 --t-end 1 -q -o " + csv.string() +
+          " --html " + a.string(),
+      dir);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  run = nhdyn::test::run_nhdyn("report " + csv.string() + " --model " + example("rolling_disk_bodies.toml").string() +
+                                   " --set r=0.35 -q -o " + b.string(),
+                               dir);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const nhdyn::CsvTable table = nhdyn::load_csv(csv);
+  ASSERT_GT(table.rows.size(), 10u);
+  for (const fs::path& html : {a, b}) {
+    const std::string page = nhdyn::test::read_text(html);
+    const ReportShape wheel = report_shape(page, "wheel", "disk");
+    ASSERT_GE(wheel.offset, 0) << html;
+    EXPECT_NEAR(wheel.size.at(0), r, 1e-6) << html;
+    const ReportShape body = report_shape(page, "body", "disk");
+    ASSERT_EQ(body.size.size(), 3u);
+    EXPECT_NEAR(*std::max_element(body.size.begin(), body.size.end()), std::sqrt(5.0) / 2 * r, 1e-6) << html;
+    const std::vector<double> values = report_scene_values(page);
+    const std::size_t stride = static_cast<std::size_t>(report_scene_stride(page));
+    ASSERT_EQ(values.size(), table.rows.size() * stride) << html;
+    for (std::size_t k = 0; k < table.rows.size(); ++k) {
+      const std::vector<double>& row = table.rows[k];
+      const double x = row[1], y = row[2], psi = row[3], theta = row[4];
+      const double* c = values.data() + k * stride + wheel.offset;
+      ASSERT_NEAR(c[0], x + r * std::sin(theta) * std::sin(psi), 1e-5) << html << " row " << k;
+      ASSERT_NEAR(c[1], y - r * std::sin(theta) * std::cos(psi), 1e-5) << html << " row " << k;
+      ASSERT_NEAR(c[2], r * std::cos(theta), 1e-5) << html << " row " << k;
+    }
+  }
+
+  const fs::path sled_csv = dir / "sled.csv", sled = dir / "sled.html";
+  run = nhdyn::test::run_nhdyn("simulate " + example("sled.toml").string() + " --set a=0.3 --t-end 1 -q -o " +
+                                   sled_csv.string() + " --html " + sled.string(),
+                               dir);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const nhdyn::CsvTable sled_table = nhdyn::load_csv(sled_csv);
+  const std::string page = nhdyn::test::read_text(sled);
+  const ReportShape mass = report_shape(page, "sphere", "centre of mass");
+  ASSERT_GE(mass.offset, 0);
+  const std::vector<double> values = report_scene_values(page);
+  const std::size_t stride = static_cast<std::size_t>(report_scene_stride(page));
+  ASSERT_EQ(values.size(), sled_table.rows.size() * stride);
+  for (std::size_t k = 0; k < sled_table.rows.size(); ++k) {
+    const double x = sled_table.rows[k][1], y = sled_table.rows[k][2], phi = sled_table.rows[k][3];
+    ASSERT_NEAR(values[k * stride + mass.offset], x + 0.3 * std::cos(phi), 1e-5) << "row " << k;
+    ASSERT_NEAR(values[k * stride + mass.offset + 1], y + 0.3 * std::sin(phi), 1e-5) << "row " << k;
+  }
 }
 
 TEST_F(Cli, CsvOfAnotherModelNamesTheColumn) {

@@ -65,13 +65,41 @@ def slider_point(browser, fraction):
     return r[0] + 8 + fraction * (r[2] - 16), r[1] + r[3] / 2
 
 
-def check_report(browser, html, shape, label, screenshots):
+def choose_view(browser, value):
+    browser.evaluate(f"(() => {{ const s = document.getElementById('follow'); s.value = '{value}';"
+                     " s.dispatchEvent(new Event('change')); return s.value; })()")
+
+
+def check_follow(browser, label, screenshots):
+    """A system travelling far beyond its size is followed by default: the view is centred on it
+    and the system is drawn there at both times; the grid moves under it."""
+    check(browser.evaluate("document.getElementById('follow').value") == "-2",
+          f"{label}: the view follows the bodies by default (the motion is far larger than the system)")
+    for fraction, name in ((0.15, "follow-early"), (0.8, "follow-late")):
+        browser.click(*slider_point(browser, fraction))
+        rect, rows, png = canvas_pixels(browser)
+        middle = (rect[0] + rect[2] / 2, rect[1] + rect[3] / 2)
+        check(coloured_near(rows, rect, middle, 40) > 40,
+              f"{label}: the followed system is drawn at the middle of the view ({name})")
+        path = os.path.join(WORK, f"{label}-{name}.png")
+        with open(path, "wb") as f:
+            f.write(png)
+        screenshots.append(path)
+
+
+def check_report(browser, html, shape, label, screenshots, follows=False):
     browser.events.clear()
     browser.open("file://" + os.path.abspath(html) + "#paused")
     check(browser.errors() == [], f"{label}: no console error on opening ({browser.errors()[:3]})")
     check(browser.evaluate("document.getElementById('canvas') !== null"), f"{label}: the page has a WebGL canvas")
     frames = browser.evaluate("nhdyn.frames")
     check(browser.evaluate("nhdyn.frame") == 0, f"{label}: paused at the first frame")
+    if follows:
+        check_follow(browser, label, screenshots)
+    else:
+        check(browser.evaluate("document.getElementById('follow').value") == "-1",
+              f"{label}: the whole motion is shown by default")
+    choose_view(browser, "-1")  # the whole motion: the body moves across a still view
     if isinstance(shape, str):  # the first shape of this kind
         shape = browser.evaluate(f"NHDYN.scene.shapes.findIndex(s => s.kind === '{shape}')")
 
@@ -140,7 +168,7 @@ def main():
     screenshots = []
     try:
         for html, shape, label in reports[:1]:
-            check_report(browser, html, shape, label, screenshots)
+            check_report(browser, html, shape, label, screenshots, follows=True)
         check_report(browser, disk, "wheel", "rolling_disk_bodies", screenshots)
         check(browser.evaluate("document.querySelectorAll('.katex').length") > 0,
               "rolling_disk_bodies: the equations are rendered by KaTeX")
@@ -151,6 +179,7 @@ def main():
         check(browser.evaluate("nhdyn.frames") == 1001, "whipple_bicycle: all 1001 rows shown")
         check(browser.evaluate("NHDYN.scene.shapes.filter(s => s.kind === 'wheel').length") == 2,
               "whipple_bicycle: two wheels drawn")
+        check_follow(browser, "whipple_bicycle", screenshots)
         check(browser.errors() == [], f"whipple_bicycle: no console error ({browser.errors()[:3]})")
     finally:
         browser.close()

@@ -1,9 +1,14 @@
 #include "nhdyn/io/report.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <string_view>
@@ -120,7 +125,85 @@ struct PlotGroup {
   std::vector<std::string> columns;
 };
 
+// Semi-axes and principal directions of the uniform solid ellipsoid with the body's mass and
+// inertia: I_1 = m (b^2 + c^2) / 5 and so on, hence a^2 = 5 (I_2 + I_3 - I_1) / (2 m). A body whose
+// moments leave an axis at zero or below (a point mass, a thin rod) gets a tenth of its largest
+// semi-axis there, so that it stays visible.
+SceneSize equivalent_ellipsoid(double mass, const Eigen::Matrix3d& inertia) {
+  SceneSize out;
+  if (!(mass > 0.0)) {  // a massless body: a small ball
+    out.size = {0.05, 0.05, 0.05};
+    return out;
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(inertia);
+  Eigen::Matrix3d axes = solver.eigenvectors();
+  if (axes.determinant() < 0.0) axes.col(2) = -axes.col(2);
+  const Eigen::Vector3d I = solver.eigenvalues();
+  double largest = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const double square = 5.0 * (I((i + 1) % 3) + I((i + 2) % 3) - I(i)) / (2.0 * mass);
+    out.size[static_cast<std::size_t>(i)] = square > 0.0 ? std::sqrt(square) : 0.0;
+    largest = std::max(largest, out.size[static_cast<std::size_t>(i)]);
+  }
+  if (largest == 0.0) largest = 0.05;  // a point mass: a small ball
+  for (double& a : out.size) a = std::max(a, 0.1 * largest);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) out.axes[static_cast<std::size_t>(3 * i + j)] = axes(i, j);
+  return out;
+}
+
+// The run's values in the order the scene's programs read them; refused when the names differ (a
+// scene compiled from another model than the run's).
+std::vector<double> parameter_values_for(const symbolic::VisualScene& scene, const std::vector<Parameter>& parameters,
+                                         const std::string& model) {
+  std::vector<std::string> names;
+  std::vector<double> values;
+  for (const Parameter& p : parameters) {
+    names.push_back(p.name);
+    values.push_back(p.value);
+  }
+  if (names != scene.parameters)
+    throw InputError(fmt::format("the scene of '{}' reads the parameters ({}), the run has ({}): give the run's "
+                                 "model with its parameter values",
+                                 model, fmt::join(scene.parameters, ", "), fmt::join(names, ", ")));
+  return values;
+}
+
 }  // namespace
+
+std::vector<SceneSize> calc_scene_sizes(const symbolic::VisualScene& scene, const std::vector<Parameter>& parameters,
+                                        const std::string& model) {
+  const std::vector<double> values = parameter_values_for(scene, parameters, model);
+  const Program sizes = scene.sizes.bind(values.data(), values.size());
+  std::vector<double> registers(static_cast<std::size_t>(sizes.registers()));
+  std::vector<double> out(static_cast<std::size_t>(sizes.outputs()));
+  sizes.run(0.0, nullptr, nullptr, registers.data(), out.data());
+  std::vector<SceneSize> result;
+  for (const symbolic::VisualShape& shape : scene.shapes) {
+    const double* x = out.data() + shape.size_offset;
+    SceneSize size;
+    if (shape.kind == symbolic::VisualKind::sphere || shape.kind == symbolic::VisualKind::wheel) {
+      if (!(x[0] > 0.0 && std::isfinite(x[0])))
+        throw InputError(fmt::format("{}{}[visual] {} '{}' of '{}': its radius is {} with the run's parameter values; "
+                                     "it must be positive (check the parameters set with --set)",
+                                     shape.where, shape.where.empty() ? "" : ": ",
+                                     shape.kind == symbolic::VisualKind::wheel ? "wheel" : "point", shape.name, model,
+                                     x[0]));
+      size.size = {x[0], x[0], x[0]};
+    } else if (shape.kind == symbolic::VisualKind::body) {
+      Eigen::Matrix3d inertia;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) inertia(i, j) = x[1 + 3 * i + j];
+      if (!inertia.allFinite() || !std::isfinite(x[0]))
+        throw InputError(fmt::format("{}{}[visual] body '{}' of '{}': its mass or inertia is not finite with the run's "
+                                     "parameter values (check the parameters set with --set)",
+                                     shape.where, shape.where.empty() ? "" : ": ", shape.name, model));
+      size = equivalent_ellipsoid(x[0], inertia);
+    }
+    result.push_back(size);
+  }
+  return result;
+}
 
 std::vector<std::size_t> report_frames(std::size_t rows, int max_frames) {
   std::vector<std::size_t> out;
@@ -166,10 +249,25 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
 
   // Panels: lengths and angles apart (their scales differ), then reactions, residuals, energy.
   std::vector<PlotGroup> groups;
-  PlotGroup lengths{"coordinates", false, false, {}}, angles{"angles [rad]", false, false, {}};
-  for (std::size_t i = 0; i < input.coordinates.size(); ++i)
-    (i < input.angles.size() && input.angles[i] ? angles : lengths).columns.push_back(input.coordinates[i]);
-  for (PlotGroup* g : {&lengths, &angles})
+  // Angles that turn through more than a revolution (a wheel's spin, a heading) get a panel of
+  // their own, so that their hundreds of radians do not flatten a lean or a steer of a few degrees.
+  PlotGroup lengths{"coordinates", false, false, {}}, angles{"angles [rad]", false, false, {}},
+      turns{"angles turning more than once [rad]", false, false, {}};
+  for (std::size_t i = 0; i < input.coordinates.size(); ++i) {
+    const std::string& name = input.coordinates[i];
+    if (!(i < input.angles.size() && input.angles[i])) {
+      lengths.columns.push_back(name);
+      continue;
+    }
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const double x : column(name)) {
+      if (!std::isfinite(x)) continue;
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+    }
+    (hi - lo > 2 * std::numbers::pi ? turns : angles).columns.push_back(name);
+  }
+  for (PlotGroup* g : {&lengths, &angles, &turns})
     if (!g->columns.empty()) groups.push_back(*g);
   if (!input.columns.reactions.empty()) groups.push_back({"reactions R", false, false, input.columns.reactions});
   if (!input.columns.actuators.empty())
@@ -220,7 +318,9 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
   data += ",\"scene\":{";
   if (has_shapes) {
     const symbolic::VisualScene& scene = *input.scene;
-    const Program& program = scene.program;
+    const std::vector<SceneSize> sizes = calc_scene_sizes(scene, input.parameters, input.model);
+    const std::vector<double> parameter_values = parameter_values_for(scene, input.parameters, input.model);
+    const Program program = scene.program.bind(parameter_values.data(), parameter_values.size());
     const int n = program.coordinates();
     if (n != static_cast<int>(input.coordinates.size()))
       throw InputError(fmt::format("the scene of '{}' has {} coordinates, the run {}", input.model, n,
@@ -243,6 +343,17 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
         v[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(vc[static_cast<std::size_t>(i)])];
       }
       program.run(row[static_cast<std::size_t>(tc)], q.data(), v.data(), registers.data(), outputs.data());
+      // A body is drawn along its principal axes: R E, E's columns the axes in the frame's components.
+      for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
+        if (scene.shapes[s].kind != symbolic::VisualKind::body) continue;
+        double* R = outputs.data() + scene.shapes[s].offset + 3;
+        const std::array<double, 9>& E = sizes[s].axes;
+        std::array<double, 9> RE{};
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            for (int k = 0; k < 3; ++k) RE[static_cast<std::size_t>(3 * i + j)] += R[3 * i + k] * E[static_cast<std::size_t>(3 * k + j)];
+        std::copy(RE.begin(), RE.end(), R);
+      }
       values.insert(values.end(), outputs.begin(), outputs.end());
     }
     data += fmt::format("\"planar\":{},\"ground\":{},\"stride\":{},\"shapes\":[", scene.planar, scene.ground,
@@ -253,7 +364,7 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
       data += fmt::format("{}{{\"kind\":\"{}\",\"name\":", s > 0 ? "," : "", kinds[static_cast<int>(shape.kind)]);
       append_string(data, shape.name);
       data += fmt::format(",\"offset\":{},\"axis\":{},\"size\":", shape.offset, shape.axis);
-      append_numbers(data, {shape.size[0], shape.size[1], shape.size[2]});
+      append_numbers(data, {sizes[s].size[0], sizes[s].size[1], sizes[s].size[2]});
       data += '}';
     }
     data += "],\"values\":";
@@ -352,6 +463,7 @@ std::string write_model_report(const Model& model, const symbolic::Spec* spec, c
     scene = symbolic::compile_visual(*spec);
     input.angles = scene->angles;
     input.scene = &*scene;
+    input.parameters = model.parameters;
     input.path = spec->path;
     const symbolic::Derivation derivation = symbolic::derive(*spec);
     // Laying out the equations simplifies every term, which takes a bicycle over a minute for

@@ -2,12 +2,14 @@
 // with a 3-D animation of the motion, the plots of the run with a cursor at the current time, the
 // summary and the model's equations rendered by KaTeX. Last stage of the pipeline, like the plots
 // (io/plot.hpp): it reads the rows of a finished run (CSV layout of io/results.hpp) and, for the
-// scene, the compiled visual program of the model (symbolic/visual.hpp), which it runs on each
-// row it shows. The JavaScript libraries (Debian's libjs-three and libjs-katex with its fonts) and
+// scene, the compiled visual programs of the model (symbolic/visual.hpp), which it binds to the
+// run's parameter values (parameters are data: a --set changes the drawn sizes and positions
+// without recompiling anything) and runs on each row it shows. The JavaScript libraries (Debian's libjs-three and libjs-katex with its fonts) and
 // the page's own template (io/resources/) are embedded in the library at build time; docs/report.md
 // describes what the page shows and how long runs are thinned.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -39,6 +41,9 @@ struct ReportInput {
   // The scene; null or without shapes: the path of `path` (else of the first two coordinates) is
   // drawn, and the page says the model has nothing to draw.
   const symbolic::VisualScene* scene = nullptr;
+  // The run's parameter values, in the order of scene->parameters (Model::parameters): the scene's
+  // programs read them. Their names are checked against the scene's.
+  std::vector<Parameter> parameters;
   std::optional<std::pair<std::string, std::string>> path;
 };
 
@@ -59,7 +64,8 @@ void check_report_columns(const std::vector<std::string>& header, const ResultCo
                           const std::string& csv, const std::string& model);
 
 // The page as text. Throws InputError when the table has no row or its header is not
-// input.columns.all. Same input -> same bytes. `notice`, when given, receives the note the page
+// input.columns.all, when input.parameters are not the scene's, or when a size of the scene is not
+// positive with these values (naming the [visual] item, its place and the value). Same input -> same bytes. `notice`, when given, receives the note the page
 // shows above the scene (nothing to draw, rows thinned), "" when none.
 std::string make_report_html(const ReportInput& input, const ReportOptions& options = {}, std::string* notice = nullptr);
 
@@ -68,7 +74,7 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
 std::string write_report(const ReportInput& input, const std::filesystem::path& path, const ReportOptions& options = {});
 
 // The report of a model's run, everything taken from the model: the columns it must have, its
-// angles and scene (compile_visual of the spec), its equations (derived again from the spec;
+// parameter values, its angles and scene (compile_visual of the spec, bound to model.parameters), its equations (derived again from the spec;
 // none for a built-in model, which has no spec) and a summary computed from the rows (times,
 // largest residual per level, energy drift), after `extra` (the run's own figures). Throws as
 // check_report_columns when `table` is not this model's, InputError/ModelError for a scene that
@@ -80,5 +86,18 @@ std::string write_model_report(const Model& model, const symbolic::Spec* spec, c
 
 // The rows a report shows out of `rows` (indices, ascending, first and last included).
 std::vector<std::size_t> report_frames(std::size_t rows, int max_frames);
+
+// The scene's sizes for the given parameter values (in the order of scene.parameters), per shape:
+// sphere and wheel (r, r, r); body the semi-axes of its equivalent ellipsoid of inertia (uniform
+// solid ellipsoid of the same mass and inertia, a_i^2 = 5 (I_j + I_k - I_i) / (2 m), along the
+// columns of `axes`, its principal directions in the body frame's components, 9 numbers row-major);
+// segment and frame (0, 0, 0). Throws InputError as make_report_html for a radius that is not
+// positive or parameters that are not the scene's.
+struct SceneSize {
+  std::array<double, 3> size = {0.0, 0.0, 0.0};
+  std::array<double, 9> axes = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+};
+std::vector<SceneSize> calc_scene_sizes(const symbolic::VisualScene& scene, const std::vector<Parameter>& parameters,
+                                        const std::string& model);
 
 }  // namespace nhdyn

@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -31,21 +30,29 @@ const char* kind_name(VisualKind kind) {
   return "?";
 }
 
-// Expressions of one spec, parameters already replaced by their values, into one Program. The
+// Expressions of one spec into one Program whose `parameter` instructions read the parameters in
+// the order of spec.parameters, so that the program follows the values of the run it draws. The
 // scene's expressions are short (a few positions and rotations), so this translation aims at being
-// plain rather than at the smallest program: a subexpression met twice is computed once.
+// plain rather than at the smallest program: a subexpression met twice is computed once. With
+// `parameters_only` (the sizes) t, the coordinates and the velocities are refused.
 class Emitter {
  public:
-  explicit Emitter(const Spec& spec) : spec_(spec), program_(spec.n()) {
-    registers_.emplace(spec.symbols.time(), Program::time_register());
+  Emitter(const Spec& spec, bool parameters_only)
+      : program_(parameters_only ? 0 : spec.n(), static_cast<int>(spec.parameters.size())),
+        parameters_only_(parameters_only) {
+    for (std::size_t i = 0; i < spec.parameters.size(); ++i)
+      parameters_.emplace(spec.symbols.parameter(spec.parameters[i].name), static_cast<int>(i));
+    variables_.emplace(spec.symbols.time(), parameters_only ? -1 : Program::time_register());
     for (int i = 0; i < spec.n(); ++i) {
-      registers_.emplace(spec.symbols.coordinate(i), program_.coordinate_register(i));
-      registers_.emplace(spec.symbols.velocity(i), program_.velocity_register(i));
+      variables_.emplace(spec.symbols.coordinate(i), parameters_only ? -1 : program_.coordinate_register(i));
+      variables_.emplace(spec.symbols.velocity(i), parameters_only ? -1 : program_.velocity_register(i));
     }
   }
 
-  void output(const GiNaC::ex& e, const VisualItem& item) {
+  // Compiles `e` into the next output; `what` names it in errors ("radius", "position").
+  void output(const GiNaC::ex& e, const VisualItem& item, const char* what) {
     item_ = &item;
+    what_ = what;
     const GiNaC::ex value = numeric_form(e);
     if (GiNaC::is_exactly_a<GiNaC::numeric>(value)) {
       program_.add_constant_output(number(value, e));
@@ -54,21 +61,13 @@ class Emitter {
     program_.add_output(emit(value, e));
   }
 
-  // The value of a size: parameters only.
-  double constant(const GiNaC::ex& e, const VisualItem& item, const char* what) {
-    item_ = &item;
-    const GiNaC::ex value = numeric_form(e);
-    if (!GiNaC::is_exactly_a<GiNaC::numeric>(value))
-      fail(e, fmt::format("its {} must depend on the parameters only", what));
-    return number(value, e);
-  }
-
   Program take() { return std::move(program_); }
 
  private:
+  // Numbers, pi and exact fractions as doubles; the parameters stay symbols.
   GiNaC::ex numeric_form(const GiNaC::ex& e) const {
     try {
-      return e.subs(spec_.parameter_values()).evalf();
+      return e.evalf();
     } catch (const std::exception& error) {
       fail(e, fmt::format("cannot be evaluated ({})", error.what()));
     }
@@ -83,8 +82,8 @@ class Emitter {
   }
 
   [[noreturn]] void fail(const GiNaC::ex& e, const std::string& why) const {
-    throw ModelError(fmt::format("{}{}[visual] {} '{}': '{}' {}", item_->where, item_->where.empty() ? "" : ": ",
-                                 kind_name(item_->kind), item_->name, text_of(e), why));
+    throw ModelError(fmt::format("{}{}[visual] {} '{}': {} '{}' {}", item_->where, item_->where.empty() ? "" : ": ",
+                                 kind_name(item_->kind), item_->name, what_, text_of(e), why));
   }
 
   int emit(const GiNaC::ex& e, const GiNaC::ex& original) {
@@ -98,10 +97,14 @@ class Emitter {
   int emit_new(const GiNaC::ex& e, const GiNaC::ex& original) {
     if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) return program_.push_constant(number(e, original));
     if (GiNaC::is_a<GiNaC::symbol>(e)) {
-      const auto found = registers_.find(e);
-      if (found == registers_.end())
+      const auto parameter = parameters_.find(e);
+      if (parameter != parameters_.end()) return program_.push_parameter(parameter->second);
+      const auto variable = variables_.find(e);
+      if (variable == variables_.end())
         fail(original, fmt::format("uses '{}', which is not t, a coordinate, a velocity or a parameter", text_of(e)));
-      return found->second;
+      if (parameters_only_)
+        fail(original, fmt::format("uses '{}': a {} must depend on the parameters only", text_of(e), what_));
+      return variable->second;
     }
     if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
       int sum = emit(e.op(0), original);
@@ -119,7 +122,7 @@ class Emitter {
       if (GiNaC::is_exactly_a<GiNaC::numeric>(exponent)) {
         const double k = number(exponent, original);
         if (k == 0.5) return program_.push(Op::sqrt, base);
-        if (k == std::round(k) && std::abs(k) <= 64.0) return program_.push(Op::powi, base, 0, 0, k);
+        if (k == std::round(k) && k != 0.0 && std::abs(k) <= 64.0) return program_.push(Op::powi, base, 0, 0, k);
         return program_.push(Op::pow_k, base, 0, 0, k);
       }
       return program_.push(Op::pow, base, emit(exponent, original));
@@ -139,10 +142,12 @@ class Emitter {
     fail(original, fmt::format("contains '{}', which is not a scalar expression", text_of(e)));
   }
 
-  const Spec& spec_;
   Program program_;
+  bool parameters_only_ = false;
   const VisualItem* item_ = nullptr;
-  std::map<GiNaC::ex, int, GiNaC::ex_is_less> registers_;
+  const char* what_ = "";
+  std::map<GiNaC::ex, int, GiNaC::ex_is_less> parameters_;  // parameter symbol -> its index
+  std::map<GiNaC::ex, int, GiNaC::ex_is_less> variables_;   // t, q, q' -> input register (-1 for sizes)
   std::map<GiNaC::ex, int, GiNaC::ex_is_less> memo_;
 };
 
@@ -159,27 +164,6 @@ void mark_angles(const Spec& spec, const GiNaC::ex& e, std::vector<bool>& angles
   for (std::size_t i = 0; i < e.nops(); ++i) mark_angles(spec, e.op(i), angles);
 }
 
-// Semi-axes and principal directions of the uniform solid ellipsoid with the body's mass and
-// inertia: I_1 = m (b^2 + c^2) / 5 and so on, hence a^2 = 5 (I_2 + I_3 - I_1) / (2 m). A body whose
-// moments leave an axis at zero or below (a point mass, a thin rod) gets a tenth of its largest
-// semi-axis there, so that it stays visible.
-std::array<double, 3> equivalent_ellipsoid(double mass, const Eigen::Matrix3d& inertia, Eigen::Matrix3d& axes) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(inertia);
-  axes = solver.eigenvectors();
-  if (axes.determinant() < 0.0) axes.col(2) = -axes.col(2);
-  const Eigen::Vector3d I = solver.eigenvalues();
-  std::array<double, 3> semi{};
-  double largest = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    const double square = 5.0 * (I((i + 1) % 3) + I((i + 2) % 3) - I(i)) / (2.0 * mass);
-    semi[static_cast<std::size_t>(i)] = square > 0.0 ? std::sqrt(square) : 0.0;
-    largest = std::max(largest, semi[static_cast<std::size_t>(i)]);
-  }
-  if (largest == 0.0) largest = 0.05;  // a point mass: a small ball
-  for (double& a : semi) a = std::max(a, 0.1 * largest);
-  return semi;
-}
-
 }  // namespace
 
 int visual_outputs(VisualKind kind) {
@@ -194,14 +178,15 @@ VisualScene compile_visual(const Spec& spec) {
   VisualScene scene;
   scene.planar = spec.visual.planar;
   scene.ground = spec.visual.ground;
+  for (const SpecParameter& p : spec.parameters) scene.parameters.push_back(p.name);
   scene.angles.assign(static_cast<std::size_t>(spec.n()), false);
   mark_angles(spec, spec.kinetic_energy, scene.angles);
   mark_angles(spec, spec.potential_energy, scene.angles);
   for (const GiNaC::ex& f : spec.forces) mark_angles(spec, f, scene.angles);
   for (const SpecConstraint& c : spec.constraints) mark_angles(spec, c.expression, scene.angles);
 
-  Emitter emitter(spec);
-  int offset = 0;
+  Emitter positions(spec, false), sizes(spec, true);
+  int offset = 0, size_offset = 0;
   for (const VisualItem& item : spec.visual.items) {
     for (const GiNaC::ex& e : item.at) mark_angles(spec, e, scene.angles);
     for (const GiNaC::ex& e : item.other) mark_angles(spec, e, scene.angles);
@@ -209,46 +194,31 @@ VisualScene compile_visual(const Spec& spec) {
     shape.kind = item.kind;
     shape.name = item.name;
     shape.offset = offset;
+    shape.size_offset = size_offset;
     shape.axis = item.axis;
-    std::vector<GiNaC::ex> outputs = item.at;
+    shape.where = item.where;
+    const std::size_t expected = static_cast<std::size_t>(visual_outputs(item.kind));
+    if (item.at.size() + item.other.size() != expected ||
+        (item.kind == VisualKind::body && item.inertia.size() != 9))
+      throw ModelError(fmt::format("{}{}[visual] {} '{}': {} values given, {} expected", item.where,
+                                   item.where.empty() ? "" : ": ", kind_name(item.kind), item.name,
+                                   item.at.size() + item.other.size(), expected));
+    for (const GiNaC::ex& e : item.at) positions.output(e, item, "position");
+    for (const GiNaC::ex& e : item.other) positions.output(e, item, item.kind == VisualKind::segment ? "position" : "rotation");
     if (item.kind == VisualKind::sphere || item.kind == VisualKind::wheel) {
-      const double radius = emitter.constant(item.size, item, "radius");
-      if (!(radius > 0.0))
-        throw ModelError(fmt::format("{}{}[visual] {} '{}': the radius must be positive; it is {}", item.where,
-                                     item.where.empty() ? "" : ": ", kind_name(item.kind), item.name, radius));
-      shape.size = {radius, radius, radius};
+      sizes.output(item.size, item, "radius");
+      size_offset += 1;
     }
     if (item.kind == VisualKind::body) {
-      const double mass = emitter.constant(item.size, item, "mass");
-      Eigen::Matrix3d inertia;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          inertia(i, j) = emitter.constant(item.inertia[static_cast<std::size_t>(3 * i + j)], item, "inertia");
-      Eigen::Matrix3d axes;
-      shape.size = mass > 0.0 ? equivalent_ellipsoid(mass, inertia, axes) : std::array<double, 3>{0.05, 0.05, 0.05};
-      if (!(mass > 0.0)) axes.setIdentity();
-      // R E: the ellipsoid's principal axes in world components.
-      std::vector<GiNaC::ex> rotated(9);
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-          GiNaC::ex sum = 0;
-          for (int k = 0; k < 3; ++k)
-            if (axes(k, j) != 0.0) sum += item.other[static_cast<std::size_t>(3 * i + k)] * GiNaC::numeric(axes(k, j));
-          rotated[static_cast<std::size_t>(3 * i + j)] = sum;
-        }
-      outputs.insert(outputs.end(), rotated.begin(), rotated.end());
-    } else {
-      outputs.insert(outputs.end(), item.other.begin(), item.other.end());
+      sizes.output(item.size, item, "mass");
+      for (const GiNaC::ex& e : item.inertia) sizes.output(e, item, "inertia");
+      size_offset += 10;
     }
-    if (static_cast<int>(outputs.size()) != visual_outputs(item.kind))
-      throw ModelError(fmt::format("{}{}[visual] {} '{}': {} values given, {} expected", item.where,
-                                   item.where.empty() ? "" : ": ", kind_name(item.kind), item.name, outputs.size(),
-                                   visual_outputs(item.kind)));
-    for (const GiNaC::ex& e : outputs) emitter.output(e, item);
     offset += visual_outputs(item.kind);
     scene.shapes.push_back(shape);
   }
-  scene.program = emitter.take();
+  scene.program = positions.take();
+  scene.sizes = sizes.take();
   return scene;
 }
 

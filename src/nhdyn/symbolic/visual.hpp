@@ -1,17 +1,19 @@
 // What the 3-D scene of a report draws, and how its positions are computed. A model file's
 // [visual] table (hand-written models: spheres and segments whose ends are expressions in t, the
 // coordinates and the parameters) and its multibody description (bodies, wheels, frames) become
-// VisualItems of the Spec; compile_visual() turns them into one straight-line Program
-// (model/program.hpp) whose outputs, run on a row of results (t, q, q'), are every position and
-// orientation the scene needs, and a list of shapes saying which outputs belong to which shape.
-// io/report.hpp runs that program on the rows it shows; the browser only places the shapes.
+// VisualItems of the Spec; compile_visual() turns them into two straight-line Programs
+// (model/program.hpp) that read the parameters, like the model's own programs: `program`, whose
+// outputs, run on a row of results (t, q, q'), are every position and orientation the scene
+// needs, and `sizes`, which reads the parameters only (radii, masses, inertias). Parameters are
+// data (docs/design.md): io/report.hpp binds both to the values of the run's Model, so a
+// `--set r=0.3` or a set_parameter after compiling draws the wheel of the run, not of the file.
 //
-//     model file [visual] / [[bodies]] --> Spec::visual --compile_visual--> VisualScene --> report
+//     model file [visual] / [[bodies]] --> Spec::visual --compile_visual--> VisualScene
+//         --(bind to the Model's parameter values, io/report.cpp)--> the report's scene
 #pragma once
 
 #include <ginac/ginac.h>
 
-#include <array>
 #include <string>
 #include <vector>
 
@@ -49,28 +51,36 @@ struct SpecVisual {
   bool ground = false;  // a multibody model: the ground plane z = 0 is drawn with a grid
 };
 
-// A shape of the compiled scene. Its outputs start at `offset` in the program's outputs:
-// sphere 3 (centre), segment 6 (both ends), wheel, body and frame 12 (origin, then R row-major).
+// A shape of the compiled scene. Its outputs start at `offset` in the outputs of
+// VisualScene::program: sphere 3 (centre), segment 6 (both ends), wheel, body and frame 12 (origin,
+// then R row-major); its sizes at `size_offset` in those of VisualScene::sizes: sphere and wheel 1
+// (radius), body 10 (mass, then the inertia about the centre of mass in the frame's axes, 9
+// row-major), segment and frame none.
 struct VisualShape {
   VisualKind kind = VisualKind::sphere;
   std::string name;
   int offset = 0;
-  std::array<double, 3> size = {0.0, 0.0, 0.0};  // sphere, wheel: radius; body: semi-axes along R's columns
-  int axis = 1;                                  // wheel: the axle's column of R
+  int size_offset = 0;
+  int axis = 1;       // wheel: the axle's column of R
+  std::string where;  // "file:line:column" of the item, for messages about its values
 };
 
 struct VisualScene {
   std::vector<VisualShape> shapes;
-  Program program;      // inputs t, q, q'; outputs as the shapes say
+  Program program;  // inputs t, q, q'; reads the parameters; outputs as the shapes say
+  Program sizes;    // no coordinate input; reads the parameters only; outputs as the shapes say
+  std::vector<std::string> parameters;  // the names the programs' `parameter` instructions index
   bool planar = false;
   bool ground = false;
   std::vector<bool> angles;  // per coordinate: it appears inside a trigonometric function (an angle)
 };
 
-// Compiles the spec's visual items with the parameters' current values; an empty spec.visual gives
-// a scene without shapes (the report then draws the path). Cost: one pass over the expressions.
-// Throws ModelError naming the item and its place when a size depends on the coordinates or is
-// not a positive number, or an expression cannot be evaluated.
+// Compiles the spec's visual items with the parameters left symbolic, in the order of
+// spec.parameters (that of Model::parameters); an empty spec.visual gives a scene without shapes
+// (the report then draws the path). Cost: one pass over the expressions. Throws ModelError naming
+// the item and its place when a size depends on t, the coordinates or the velocities, or an
+// expression cannot be evaluated. The values of the sizes (a radius must be positive) are checked
+// when they are known, by the report.
 VisualScene compile_visual(const Spec& spec);
 
 // Output count of a shape of this kind.

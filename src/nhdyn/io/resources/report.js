@@ -37,7 +37,8 @@
                     controls);
   const timeLabel = el("span", { id: "time" }, controls);
   const follow = el("select", { id: "follow", title: "camera follows" }, controls);
-  el("option", { value: "-1", text: "fixed camera" }, follow);
+  el("option", { value: "-1", text: "whole motion" }, follow);
+  el("option", { value: "-2", text: "follow the bodies" }, follow);
   D.scene.shapes.forEach((s, i) => {
     if (s.kind !== "frame") el("option", { value: String(i), text: "follow " + s.name }, follow);
   });
@@ -75,6 +76,47 @@
     if (!(lo[k] <= hi[k])) { lo[k] = -0.5; hi[k] = 0.5; }
   const extent = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 0.1);
   const centre = new THREE.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
+  // The size of the system itself: the largest span of its shapes at one time (a sled's blade and
+  // arm, a bicycle's wheels and frame), and where their middle is at frame f (followed below).
+  const points = (f) => {
+    const out = [];
+    for (const s of S.shapes) {
+      if (s.kind === "frame") continue;
+      const r = Math.max(s.size[0], s.size[1], s.size[2]);
+      for (const k of s.kind === "segment" ? [0, 3] : [0]) {
+        const b = s.offset + k;
+        out.push([value(f, b) - r, value(f, b + 1) - r, value(f, b + 2) - r], [value(f, b) + r, value(f, b + 1) + r, value(f, b + 2) + r]);
+      }
+    }
+    return out;
+  };
+  const middle = (f) => {
+    const a = [Infinity, Infinity, Infinity], z = [-Infinity, -Infinity, -Infinity];
+    for (const p of points(f))
+      for (let k = 0; k < 3; ++k)
+        if (isFinite(p[k])) { a[k] = Math.min(a[k], p[k]); z[k] = Math.max(z[k], p[k]); }
+    return { at: [(a[0] + z[0]) / 2, (a[1] + z[1]) / 2, (a[2] + z[2]) / 2], span: Math.max(z[0] - a[0], z[1] - a[1], z[2] - a[2]) };
+  };
+  let size = 0;
+  for (let f = 0; f < frames; f += Math.max(1, Math.floor(frames / 50))) {
+    const m = middle(f);
+    if (isFinite(m.span)) size = Math.max(size, m.span);
+  }
+  if (!(size > 0)) size = extent;
+  // Up is the side of the ground the bodies are on: +z, or -z for a model whose z points down
+  // (gravity +z, as in the Whipple bicycle's convention).
+  let heights = 0;
+  for (let f = 0; f < frames; f += Math.max(1, Math.floor(frames / 50))) {
+    const z = middle(f).at[2];
+    if (isFinite(z)) heights += z;
+  }
+  const upward = S.ground && heights < 0 ? -1 : 1;
+  // A system that travels far beyond its own size (a sled sliding 40 m, a bicycle riding 50 m) is
+  // followed by default, seen at its own scale; points alone (a particle) have no shape to see, so
+  // their whole motion is shown. "whole motion" in the menu shows it for any scene.
+  const travels = extent > 12 * size && S.shapes.some((s) => s.kind !== "sphere");
+  if (travels) follow.value = "-2";
+  const near = Math.min(extent, 3 * size);  // the width of the view that follows
 
   const width = 640, height = 480;
   let renderer = null;
@@ -85,7 +127,7 @@
   }
   const scene = new THREE.Scene();
   scene.background = new THREE.Color(0xffffff);
-  const camera = new THREE.PerspectiveCamera(40, width / height, extent / 1000, extent * 100);
+  const camera = new THREE.PerspectiveCamera(40, width / height, near / 1000, extent * 100);
   if (renderer) {
     renderer.setPixelRatio(1);
     renderer.setSize(width, height);
@@ -94,7 +136,7 @@
   }
   scene.add(new THREE.AmbientLight(0xffffff, 0.55));
   const sun = new THREE.DirectionalLight(0xffffff, 0.7);
-  sun.position.set(1, -2, 3);
+  sun.position.set(1, -2, 3 * upward);
   scene.add(sun);
 
   // The ground (multibody) or the plane of a planar scene: a grid in z = 0, 1-2-5 spacing.
@@ -103,14 +145,47 @@
     const m = span / p;
     return (m < 2 ? 1 : m < 5 ? 2 : 5) * p;
   };
-  {
-    const step = niceStep(extent / 8);
-    const half = Math.ceil((extent * 0.75) / step) * step;
-    const grid = new THREE.GridHelper(2 * half, Math.round((2 * half) / step), 0x999999, 0xdddddd);
-    grid.rotation.x = Math.PI / 2;  // THREE's grid lies in y = 0; ours in z = 0
-    grid.position.set(Math.round(centre.x / step) * step, Math.round(centre.y / step) * step, S.planar ? -1e-3 * extent : 0);
+  const setPositions = (geometry, array) => {
+    const attribute = new THREE.BufferAttribute(array, 3);
+    if (geometry.setAttribute) geometry.setAttribute("position", attribute);
+    else geometry.addAttribute("position", attribute);
+  };
+  // Two grids: one for the whole motion, a finer one for the view that follows (at most 600 lines
+  // each way: a coarser step beyond).
+  const makeGrid = (view) => {
+    const reach = extent * 0.75 + view;
+    let step = niceStep(view / 8);
+    if ((2 * reach) / step > 600) {  // the next 1-2-5 step at or above 2 reach / 600
+      step = niceStep((2 * reach) / 600);
+      if (step < (2 * reach) / 600) step = niceStep(step * 2.6);
+    }
+    // Lines x = const and y = const in the plane z = 0, drawn directly (no rotated GridHelper).
+    const count = Math.ceil(reach / step);
+    const cx = Math.round(centre.x / step) * step, cy = Math.round(centre.y / step) * step;
+    const z = S.planar ? -1e-3 * near : 0, span = count * step;
+    const minor = [], major = [];
+    // Each line in pieces: a piece with an end behind the camera (the view that follows looks
+    // along the ground) is not drawn by every WebGL implementation, so the pieces are short.
+    const pieces = Math.min(2 * count, 100), piece = (2 * span) / pieces;
+    for (let i = -count; i <= count; ++i) {  // the axes x = 0 and y = 0 darker
+      const x = cx + i * step, y = cy + i * step;
+      for (let k = 0; k < pieces; ++k) {
+        const a = -span + k * piece, b = a + piece;
+        (Math.abs(x) < step / 2 ? major : minor).push(x, cy + a, z, x, cy + b, z);
+        (Math.abs(y) < step / 2 ? major : minor).push(cx + a, y, z, cx + b, y, z);
+      }
+    }
+    const grid = new THREE.Group();
+    for (const [lines, colour] of [[minor, 0xdddddd], [major, 0x999999]]) {
+      const geometry = new THREE.BufferGeometry();
+      setPositions(geometry, new Float32Array(lines));
+      grid.add(new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ color: colour })));
+    }
     scene.add(grid);
-  }
+    return grid;
+  };
+  const wideGrid = makeGrid(extent);
+  const nearGrid = near < extent / 3 ? makeGrid(near) : wideGrid;
 
   const colours = [0x1f77b4, 0xd62728, 0x2ca02c, 0xff7f0e, 0x9467bd, 0x8c564b, 0xe377c2, 0x17becf];
   const material = (i, opacity) => new THREE.MeshLambertMaterial({
@@ -119,11 +194,7 @@
   const Cylinder = THREE.CylinderBufferGeometry || THREE.CylinderGeometry;
   const Torus = THREE.TorusBufferGeometry || THREE.TorusGeometry;
   const Circle = THREE.CircleBufferGeometry || THREE.CircleGeometry;
-  const setPositions = (geometry, array) => {
-    const attribute = new THREE.BufferAttribute(array, 3);
-    if (geometry.setAttribute) geometry.setAttribute("position", attribute);
-    else geometry.addAttribute("position", attribute);
-  };
+
   const trail = (points, colour) => {
     const geometry = new THREE.BufferGeometry();
     setPositions(geometry, points);
@@ -132,7 +203,6 @@
     scene.add(line);
     return line;
   };
-  const thin = extent * 0.006;
   const objects = S.shapes.map((s, i) => {
     const o = { shape: s, object: null, trail: null };
     if (s.kind === "sphere") {
@@ -142,7 +212,7 @@
         for (let k = 0; k < 3; ++k) points[3 * f + k] = value(f, s.offset + k);
       o.trail = trail(points, 0x999999);
     } else if (s.kind === "segment") {
-      o.object = new THREE.Mesh(new Cylinder(thin, thin, 1, 8), material(i, 1));
+      o.object = new THREE.Mesh(new Cylinder(1, 1, 1, 8), material(i, 1));
     } else if (s.kind === "wheel") {
       // A tyre (torus) and two spokes about the axle, which is the frame's axis s.axis.
       const r = s.size[0];
@@ -167,10 +237,10 @@
         const c = [value(f, s.offset), value(f, s.offset + 1), value(f, s.offset + 2)];
         const a = [value(f, s.offset + 3 + s.axis), value(f, s.offset + 6 + s.axis), value(f, s.offset + 9 + s.axis)];
         // The contact point: the lowest point of the rim, c - r d with d the unit vector of the
-        // vertical within the wheel's plane.
+        // vertical (up, +z or -z) within the wheel's plane.
         let d = [-a[2] * a[0], -a[2] * a[1], 1 - a[2] * a[2]];
         const norm = Math.hypot(d[0], d[1], d[2]) || 1;
-        for (let k = 0; k < 3; ++k) points[3 * f + k] = c[k] - (r * d[k]) / norm;
+        for (let k = 0; k < 3; ++k) points[3 * f + k] = c[k] - (upward * r * d[k]) / norm;
       }
       o.trail = trail(points, 0x444444);
     } else if (s.kind === "body") {
@@ -180,25 +250,30 @@
       group.add(ball);
       o.object = group;
     } else {
-      o.object = new THREE.AxesHelper(extent * 0.08);
+      o.object = new THREE.AxesHelper(near * 0.08);
     }
     if (s.kind !== "sphere" && s.kind !== "segment") o.object.matrixAutoUpdate = false;
     scene.add(o.object);
     return o;
   });
   const up = new THREE.Vector3(0, 1, 0);
+  // Segments are drawn 0.6 % of the view's width thick, and points no smaller than that, so that
+  // they stay visible in the view of the whole motion as in the view that follows.
+  let viewWidth = extent;
   const place = (f) => {
+    const thin = 0.006 * viewWidth;
     for (const o of objects) {
       const s = o.shape, b = s.offset;
       if (s.kind === "sphere") {
         o.object.position.set(value(f, b), value(f, b + 1), value(f, b + 2));
+        o.object.scale.setScalar(Math.max(1, thin / s.size[0]));
       } else if (s.kind === "segment") {
         const p = new THREE.Vector3(value(f, b), value(f, b + 1), value(f, b + 2));
         const q = new THREE.Vector3(value(f, b + 3), value(f, b + 4), value(f, b + 5));
         const d = q.clone().sub(p);
         const length = d.length();
         o.object.position.copy(p).add(q).multiplyScalar(0.5);
-        o.object.scale.set(1, Math.max(length, 1e-9), 1);
+        o.object.scale.set(thin, Math.max(length, 1e-9), thin);
         if (length > 0) o.object.quaternion.setFromUnitVectors(up, d.multiplyScalar(1 / length));
       } else {
         const m = o.object.matrix;
@@ -215,15 +290,17 @@
   // Orbit camera: drag to turn about the target, wheel to zoom. z is up (y for a planar scene,
   // seen from +z).
   // The whole motion in view: the field of view is 40 degrees, tan(20 deg) = 0.36.
-  const orbit = S.planar ? { azimuth: -Math.PI / 2, elevation: Math.PI / 2 - 1e-3, distance: 1.6 * extent }
-                         : { azimuth: -Math.PI / 3, elevation: 0.45, distance: 2.0 * extent };
+  const distance = (span) => (S.planar ? 1.6 : 2.0) * span;
+  const orbit = S.planar ? { azimuth: -Math.PI / 2, elevation: Math.PI / 2 - 1e-3, distance: distance(extent) }
+                         : { azimuth: -Math.PI / 3, elevation: 0.45, distance: distance(extent) };
+  let zoom = 1;  // the wheel's zoom, kept when the view changes
   const target = centre.clone();
   const aim = () => {
     const ce = Math.cos(orbit.elevation);
-    const offset = new THREE.Vector3(ce * Math.cos(orbit.azimuth), ce * Math.sin(orbit.azimuth), Math.sin(orbit.elevation));
+    const offset = new THREE.Vector3(ce * Math.cos(orbit.azimuth), ce * Math.sin(orbit.azimuth), upward * Math.sin(orbit.elevation));
     // Looking (nearly) straight down, "up" on the screen is away from the camera's side.
     if (orbit.elevation > 1.55) camera.up.set(-Math.cos(orbit.azimuth), -Math.sin(orbit.azimuth), 0);
-    else camera.up.set(0, 0, 1);
+    else camera.up.set(0, 0, upward);
     camera.position.copy(target).addScaledVector(offset, orbit.distance);
     camera.lookAt(target);
   };
@@ -241,7 +318,7 @@
     });
     canvas.addEventListener("wheel", (e) => {
       e.preventDefault();
-      orbit.distance *= Math.exp(e.deltaY * 0.001);
+      zoom *= Math.exp(e.deltaY * 0.001);
       draw();
     }, { passive: false });
   }
@@ -253,7 +330,17 @@
     canvas.width = w;
     canvas.height = h;
     const g = canvas.getContext("2d");
-    const x0 = 56, x1 = w - 10, y0 = 22, y1 = h - 22;
+    g.font = "11px sans-serif";
+    // The legend after the title, in as many rows as it needs; the plot starts below it.
+    const legendAt = [];
+    let lx = 56 + g.measureText(p.title).width + 16, ly = 14;
+    for (const series of p.series) {
+      const wide = g.measureText(series.name).width;
+      if (lx + wide > w - 6 && legendAt.length > 0) { lx = 56; ly += 13; }
+      legendAt.push([lx, ly]);
+      lx += wide + 12;
+    }
+    const x0 = 56, x1 = w - 10, y0 = ly + 8, y1 = h - 22;
     const t0 = T[0], t1 = T[frames - 1] > T[0] ? T[frames - 1] : T[0] + 1;
     const tx = (t) => x0 + ((t - t0) / (t1 - t0)) * (x1 - x0);
     // Values as drawn: log10 |v| on a log scale (zeros left out).
@@ -282,7 +369,6 @@
     const tstep = niceStep((t1 - t0) / 5);
     for (let i = Math.ceil(t0 / tstep); i * tstep <= t1 + 1e-9 * tstep; ++i)
       g.fillText(Number((i * tstep).toPrecision(6)).toString(), tx(i * tstep) - 8, h - 6);
-    let legend = x0 + g.measureText(p.title).width + 16;
     shown.forEach((s, k) => {
       g.strokeStyle = "#" + colours[k % colours.length].toString(16).padStart(6, "0");
       g.beginPath();
@@ -294,8 +380,7 @@
       }
       g.stroke();
       g.fillStyle = g.strokeStyle;
-      g.fillText(p.series[k].name, legend, 14);  // legends after the title, in a row
-      legend += g.measureText(p.series[k].name).width + 12;
+      g.fillText(p.series[k].name, legendAt[k][0], legendAt[k][1]);
     });
     const background = g.getImageData(0, 0, w, h);
     return { cursor: (t) => {
@@ -346,14 +431,20 @@
   // ---- Time ------------------------------------------------------------------------------------
   const draw = () => {
     const f = api.frame;
-    place(f);
     const chosen = Number(follow.value);
+    viewWidth = chosen === -1 ? extent : near;
+    wideGrid.visible = chosen === -1 || wideGrid === nearGrid;
+    nearGrid.visible = chosen !== -1 || wideGrid === nearGrid;
+    orbit.distance = distance(viewWidth) * zoom;
     if (chosen >= 0) {
       const b = S.shapes[chosen].offset;
       target.set(value(f, b), value(f, b + 1), value(f, b + 2));
+    } else if (chosen === -2) {
+      target.fromArray(middle(f).at);
     } else {
       target.copy(centre);
     }
+    place(f);
     aim();
     if (renderer) renderer.render(scene, camera);
     for (const p of plots) p.cursor(T[f]);
