@@ -50,3 +50,33 @@ def test_bad_events_are_refused(examples):
         m.simulate(stop_when="abs(x) 1")
     with pytest.raises(nhdyn.InputError, match="at least 1"):
         m.simulate(max_steps=0)
+
+
+def test_events_on_contact_forces(examples):
+    """The falling disk of docs/derivations/contact-forces.md 6.4 (examples/rolling_disk_liftoff.toml):
+    its normal force disk_N falls through zero at cos(theta) = (2k + sqrt(4k^2 - 3)) / 6,
+    k = cos(0.1); located to the integration's accuracy (100 rtol, rtol = 1e-11)."""
+    m = nhdyn.load(examples / "rolling_disk_liftoff.toml")
+    k = math.cos(0.1)
+    theta_star = math.acos((2 * k + math.sqrt(4 * k * k - 3)) / 6)
+    r = m.simulate()  # the file's [[events]] liftoff: when = "disk_N", falling, stop
+    assert r.summary["stopped_by"] == "liftoff"
+    assert len(r.events) == 1
+    assert abs(r.events[0]["q"][3] - theta_star) < 1e-9
+    # the event's row is the last one, with disk_N zero to round-off
+    n_column = r.columns["contact_forces"].index("disk_N")
+    assert r.t[-1] == r.events[0]["t"]
+    assert abs(r.contact_forces[-1, n_column]) < 1e-11
+    # stop_when and events name the columns too
+    r = m.simulate(stop_when="disk_N < m*g/10")
+    tenth = math.acos((8 * k + math.sqrt(64 * k * k - 24)) / 24)
+    assert abs(r.events[0]["q"][3] - tenth) < 1e-9
+    r = m.simulate(events={"slide": "disk_Flat"})
+    assert [e["name"] for e in r.events] == ["slide", "liftoff"]
+    assert abs(r.events[0]["q"][3] - math.acos(2 * k / 3)) < 1e-9
+
+
+def test_bad_contact_force_events_are_refused(examples):
+    m = nhdyn.load(examples / "pendulum_cartesian.toml")
+    with pytest.raises(nhdyn.InputError, match="has no contact forces"):
+        m.simulate(stop_when="disk_N < 0")

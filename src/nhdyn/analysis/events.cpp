@@ -6,6 +6,8 @@
 #include <cmath>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/model/contact_forces.hpp"
+#include "nhdyn/model/output.hpp"
 
 namespace nhdyn {
 
@@ -15,8 +17,14 @@ ModelEventFunctions::ModelEventFunctions(const Model& model, const std::vector<c
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
   int registers = 0;
+  contact_columns_ = model.contact_forces ? model.contact_forces->reported() * kContactComponents : 0;
   for (const Event* event : events_) {
-    if (event->g.outputs() != 1 || event->g.coordinates() != (event->dynamics ? 2 * n_ : n_))
+    if (event->contact_forces && contact_columns_ == 0)
+      throw InputError(fmt::format("event '{}' reads contact forces, but model '{}' has none (only the wheels and knife "
+                                   "edges of a multibody model have them)",
+                                   event->name, model.name));
+    const int coordinates = event->contact_forces ? 2 * n_ + contact_columns_ : (event->dynamics ? 2 * n_ : n_);
+    if (event->g.outputs() != 1 || event->g.coordinates() != coordinates)
       throw InputError(fmt::format("event '{}' was compiled for another model ({} coordinates, {} outputs); "
                                    "this one has {} coordinates",
                                    event->name, event->g.coordinates(), event->g.outputs(), n_));
@@ -27,13 +35,14 @@ ModelEventFunctions::ModelEventFunctions(const Model& model, const std::vector<c
       throw InputError(fmt::format("event '{}' reads q'' or the reactions R, which need the dynamics solved at the "
                                    "state; this caller evaluates events without them",
                                    event->name));
-    needs_dynamics_ = needs_dynamics_ || event->dynamics;
+    needs_dynamics_ = needs_dynamics_ || event->dynamics || event->contact_forces;
+    needs_contact_forces_ = needs_contact_forces_ || event->contact_forces;
     programs_.push_back(event->g.reads_parameters() ? event->g.bind(values.data(), values.size()) : event->g);
     registers = std::max(registers, programs_.back().registers());
   }
   registers_.assign(static_cast<std::size_t>(registers), 0.0);
-  x_.assign(static_cast<std::size_t>(2 * n_), 0.0);
-  xd_.assign(static_cast<std::size_t>(2 * n_), 0.0);
+  x_.assign(static_cast<std::size_t>(2 * n_ + contact_columns_), 0.0);
+  xd_.assign(static_cast<std::size_t>(2 * n_ + contact_columns_), 0.0);
   g_.assign(events_.size(), 0.0);
 }
 
@@ -50,9 +59,11 @@ Status ModelEventFunctions::run_all(double t, const double* y, double* g) {
   if (needs_dynamics_) {
     const double* qdd = nullptr;
     const double* R = nullptr;
-    const Status status = dynamics_(t, y, &qdd, &R);
+    const double* F = nullptr;
+    const Status status = dynamics_(t, y, &qdd, &R, needs_contact_forces_ ? &F : nullptr);
     if (status != Status::ok) return status;
     pack_dynamics_inputs(n_, y, y + n_, qdd, R, x_.data(), xd_.data());
+    if (needs_contact_forces_) std::copy(F, F + contact_columns_, x_.begin() + 2 * n_);
   }
   for (std::size_t i = 0; i < programs_.size(); ++i) {
     if (events_[i]->dynamics)

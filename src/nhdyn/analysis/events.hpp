@@ -1,5 +1,5 @@
 // A model's events as the integrators see them (integrators/events.hpp): the programs g(t, q, q')
-// of model/event.hpp bound to the model's parameter values, evaluated on y = [q; q'], and the
+// (or of q'', R and the contact forces, solved at each evaluation) of model/event.hpp bound to the model's parameter values, evaluated on y = [q; q'], and the
 // check that refuses a run whose events cannot mean anything at its start (an event already at
 // zero, a stop condition already true). simulate() (simulation.hpp) uses them; the located
 // crossings come back in SimulationSummary::events.
@@ -29,14 +29,18 @@ class ModelEventFunctions final : public EventFunctions {
   // the status of a failure); ModelEventFunctions adds Status::stopped for a stop event.
   using Handler = std::function<Status(int i, double t, const double* y)>;
   // Solves the dynamics at (t, y = [q; q']) and points qdd and R at its q'' and R (n each), for
-  // the events that read them (Event::dynamics: through an output, model/output.hpp). simulate()
-  // passes compute_dynamics with the run's formulation: such an event costs one more solve per
-  // evaluation of the events (once for all of them), at each step and in the root finding.
-  using Dynamics = std::function<Status(double t, const double* y, const double** qdd, const double** R)>;
+  // the events that read them (Event::dynamics: through an output, model/output.hpp); when F is
+  // not null, also computes the contact forces there and points F at their values (6 per wheel
+  // and knife edge, ContactForceData::values), for the events that read them
+  // (Event::contact_forces). simulate() passes compute_dynamics (and compute_contact_forces) with
+  // the run's formulation: such an event costs one more solve per evaluation of the events (once
+  // for all of them), at each step and in the root finding.
+  using Dynamics =
+      std::function<Status(double t, const double* y, const double** qdd, const double** R, const double** F)>;
 
   // Binds every event's program to the model's current parameter values (allocates; not in the
   // time loop). `events` must outlive this object. Throws InputError when an event reads q'' or R
-  // and no `dynamics` is given.
+  // and no `dynamics` is given, or reads contact forces that `model` does not have.
   ModelEventFunctions(const Model& model, const std::vector<const Event*>& events, Handler handler,
                       Dynamics dynamics = {});
 
@@ -64,7 +68,11 @@ class ModelEventFunctions final : public EventFunctions {
   Handler handler_;
   Dynamics dynamics_;
   bool needs_dynamics_ = false;
-  std::vector<double> x_, xd_;  // 2n each: the dynamics layout's inputs [q; q''], [q'; R]
+  bool needs_contact_forces_ = false;
+  int contact_columns_ = 0;     // 6 per wheel and knife edge of the model
+  // 2n (+ contact_columns_) each: the inputs [q; q''; F], [q'; R; 0] of the dynamics layout (and
+  // of the contact layout, whose programs read the forces after them).
+  std::vector<double> x_, xd_;
   // Runs every program at (t, y) into g; solves the dynamics first when an event needs it.
   Status run_all(double t, const double* y, double* g);
   int stopped_by_ = -1;

@@ -99,13 +99,19 @@ void record_balance(const Model& model, Data& data, const double* work, Simulati
   summary.energy_function_change = data.energy_function - summary.energy_function_initial;
 }
 
-// The dynamics that events reading q'' or R need (ModelEventFunctions::Dynamics): the run's own
-// solve, on the run's Data (the right-hand side recomputes what it needs at every call).
+// The dynamics that events reading q'' or R (or the contact forces) need
+// (ModelEventFunctions::Dynamics): the run's own solve, on the run's Data (the right-hand side
+// recomputes what it needs at every call).
 ModelEventFunctions::Dynamics event_dynamics(const Model& model, Data& data, const FormulationOptions& formulation) {
-  return [&model, &data, &formulation](double t, const double* y, const double** qdd, const double** R) {
+  return [&model, &data, &formulation](double t, const double* y, const double** qdd, const double** R,
+                                       const double** F) {
     const Status status = compute_dynamics(model, data, formulation, t, y, y + model.n());
     *qdd = data.qdd.data();
     *R = data.R.data();
+    if (status == Status::ok && F != nullptr) {
+      compute_contact_forces(model, data);
+      *F = data.contact.values.data();
+    }
     return status;
   };
 }

@@ -1,4 +1,4 @@
-// An event of a model: a function g(t, q, q') whose crossings of zero a run locates and reports
+// An event of a model: a function g(t, q, q') (or of q'', R and the contact forces too) whose crossings of zero a run locates and reports
 // (analysis/simulation.hpp), optionally ending the run there. Written in a model file as
 // [[events]] (docs/model-format.md) or on the command line (--stop-when, --event); compiled from
 // its expression by the symbolic layer (symbolic/events.hpp) into a straight-line program that
@@ -34,6 +34,11 @@ struct Event {
   // dynamics layout (2n coordinates, [q; q''] and [q'; R]) and each evaluation solves the dynamics
   // at the state first (analysis/events.hpp).
   bool dynamics = false;
+  // g reads a contact-force column (NAME_N, ...: model/contact_forces.hpp; implies `dynamics`): g
+  // is then in the contact layout, 2n + 6 c coordinates (c the model's wheels and knife edges),
+  // [q; q''; F] and [q'; R; 0] with F the values of ContactForceData::values, and each evaluation
+  // computes the contact forces after the dynamics (analysis/events.hpp).
+  bool contact_forces = false;
 };
 
 }  // namespace nhdyn

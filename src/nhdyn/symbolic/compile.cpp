@@ -1016,8 +1016,9 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
     model.evaluator->initial_state(scratch.data(), model.q0.data(), model.v0.data());
   }
   compile_outputs(spec, model);
-  compile_events(spec, model);
+  // Before the events: an event that reads a contact force needs to know what the model determines.
   compile_contact_forces(spec, model);
+  compile_events(spec, model);
   check_model_shape(model);
   return model;
 }

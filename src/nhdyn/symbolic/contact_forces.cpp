@@ -162,4 +162,47 @@ void compile_contact_forces(const Spec& spec, Model& model) {
   model.contact_forces = std::move(out);
 }
 
+std::vector<ContactForceSymbol> make_contact_force_symbols(const std::vector<std::string>& reported) {
+  std::vector<ContactForceSymbol> columns;
+  for (const std::string& name : reported)
+    for (int k = 0; k < kContactComponents; ++k) {
+      const std::string column = name + "_" + contact_component_name(k);
+      columns.push_back({column, static_cast<int>(columns.size()), GiNaC::symbol(column)});
+    }
+  return columns;
+}
+
+std::vector<int> contact_force_columns_in(const Spec& spec, const GiNaC::ex& e) {
+  std::vector<int> found;
+  if (!spec.contact_forces) return found;
+  for (const ContactForceSymbol& c : spec.contact_forces->columns)
+    if (e.has(c.symbol)) found.push_back(c.column);
+  return found;
+}
+
+void require_determined_contact_forces(const Spec& spec, const Model& model, const GiNaC::ex& e,
+                                       const std::string& where, const std::string& what) {
+  const std::vector<int> columns = contact_force_columns_in(spec, e);
+  if (columns.empty()) return;
+  const std::string at = where.empty() ? "" : where + ": ";
+  const ContactForceModel* c = model.contact_forces.get();
+  if (c == nullptr || static_cast<int>(c->determined.size()) != c->reported() * kContactComponents ||
+      static_cast<int>(spec.contact_forces->columns.size()) != c->reported() * kContactComponents)
+    throw ModelError(fmt::format("{}{} reads the contact force '{}', but model '{}' has no such contact forces",
+                                 at, what, spec.contact_forces->columns[static_cast<std::size_t>(columns.front())].name,
+                                 model.name));
+  for (int column : columns) {
+    if (c->determined[static_cast<std::size_t>(column)]) continue;
+    const std::string& name = spec.contact_forces->columns[static_cast<std::size_t>(column)].name;
+    // The load's note on this contact says why (docs/multibody.md "When a column is NaN").
+    std::string why;
+    for (const std::string& note : c->notes)
+      if (note.find(name) != std::string::npos) why = note;
+    throw ModelError(fmt::format("{}{} reads the contact force '{}', which model '{}' does not determine: its column is "
+                                 "NaN in every row{}, so the event could never cross zero; name a determined "
+                                 "component (docs/multibody.md, \"When a column is NaN\")",
+                                 at, what, name, model.name, why.empty() ? "" : " (" + why + ")"));
+  }
+}
+
 }  // namespace nhdyn::symbolic

@@ -40,6 +40,15 @@ struct ContactPoint {
   int system = -1;
 };
 
+// A contact-force column (NAME_Fx ... NAME_Flat of a wheel or knife edge) as a symbol, so that the
+// expressions of events may name it (symbolic/events.hpp): `column` indexes ContactForceData::values
+// (kContactComponents per reported contact, in the order of the CSV columns).
+struct ContactForceSymbol {
+  std::string name;
+  int column = 0;
+  GiNaC::symbol symbol;
+};
+
 struct SpecContactForces {
   std::vector<ContactBody> bodies;
   std::vector<ContactPoint> contacts;
@@ -49,7 +58,25 @@ struct SpecContactForces {
   std::vector<std::string> generated;     // the constraints the contact helpers wrote
   bool other_energy = false;              // T or V written by hand besides the bodies'
   double length = 1.0;                    // L [m], the largest wheel radius (or 1)
+  // The columns of the reported contacts as symbols (make_contact_force_symbols), for the
+  // expressions of events; outputs may not read them (they are computed before the forces).
+  std::vector<ContactForceSymbol> columns;
 };
+
+// One symbol per column NAME_Fx ... NAME_Flat of each name in `reported` (the wheels and knife
+// edges, in order). MultibodyBuilder::apply() fills SpecContactForces::columns with it; the
+// command line's events make them from a loaded Model's contacts (symbolic/events.cpp).
+std::vector<ContactForceSymbol> make_contact_force_symbols(const std::vector<std::string>& reported);
+
+// The columns (ContactForceSymbol::column) of the contact-force symbols that `e` contains, in
+// increasing order; empty when `spec` has no contact forces or `e` reads none.
+std::vector<int> contact_force_columns_in(const Spec& spec, const GiNaC::ex& e);
+
+// Throws ModelError (prefixed by `where` and naming `what`) when `e` reads a contact-force column
+// that `model` does not determine (NaN in every row, ContactForceModel::determined), naming the
+// column and why (the load's note).
+void require_determined_contact_forces(const Spec& spec, const Model& model, const GiNaC::ex& e,
+                                       const std::string& where, const std::string& what);
 
 // Builds Model::contact_forces from spec.contact_forces (nothing when it is null or has no
 // contact): compiles the program, then checks it at a generic state (analyse_contact_forces).

@@ -3,11 +3,13 @@
 #include <fmt/format.h>
 
 #include <cctype>
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/symbolic/compile.hpp"
+#include "nhdyn/symbolic/contact_forces.hpp"
 #include "nhdyn/symbolic/outputs.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
@@ -31,6 +33,15 @@ SpecBuilder names_of(const Model& model) {
       if (!o.automatic) throw;
     }
   }
+  // The contact-force columns of its wheels and knife edges, which an event may name too.
+  if (model.contact_forces) {
+    auto contact = std::make_shared<SpecContactForces>();
+    std::vector<std::string> reported;
+    for (const ContactForceContact& c : model.contact_forces->contacts)
+      if (c.reported) reported.push_back(c.name);
+    contact->columns = make_contact_force_symbols(reported);
+    builder.contact_forces(std::move(contact));
+  }
   return builder;
 }
 
@@ -50,13 +61,21 @@ GiNaC::ex read_option(const SpecBuilder& builder, const std::string& option, con
   }
 }
 
-Event finish(const Spec& spec, const GiNaC::ex& g, std::string name, std::string text, std::string where,
-             EventDirection direction, EventAction action) {
+Event finish(const Spec& spec, const Model& model, const GiNaC::ex& g, std::string name, std::string text,
+             std::string where, EventDirection direction, EventAction action) {
   Event event;
-  // An event that reads q'' or R (through an output) is evaluated on the solved dynamics.
-  event.dynamics = reads_dynamics(spec, g);
-  event.g = event.dynamics ? compile_dynamics_program(spec, {g}, {fmt::format("event '{}'", name)})
-                           : compile_expression(spec, g, fmt::format("event '{}'", name));
+  const std::string what = fmt::format("event '{}'", name);
+  // An event that reads a contact force is refused before the run when the model does not
+  // determine it (NaN by design); otherwise it is evaluated with the forces of each state.
+  require_determined_contact_forces(spec, model, g, where, what);
+  event.contact_forces = !contact_force_columns_in(spec, g).empty();
+  // An event that reads q'' or R (through an output), or a contact force, is evaluated on the
+  // solved dynamics.
+  event.dynamics = event.contact_forces || reads_dynamics(spec, g);
+  if (event.contact_forces)
+    event.g = compile_dynamics_program(spec, {g}, {what}, spec.contact_forces->columns);
+  else
+    event.g = event.dynamics ? compile_dynamics_program(spec, {g}, {what}) : compile_expression(spec, g, what);
   event.name = std::move(name);
   event.expression = std::move(text);
   event.where = std::move(where);
@@ -69,7 +88,8 @@ Event finish(const Spec& spec, const GiNaC::ex& g, std::string name, std::string
 
 void compile_events(const Spec& spec, Model& model) {
   for (const SpecEvent& e : spec.events)
-    model.events.push_back(finish(spec, e.expression, e.name, e.text, e.where.describe(), e.direction, e.action));
+    model.events.push_back(
+        finish(spec, model, e.expression, e.name, e.text, e.where.describe(), e.direction, e.action));
 }
 
 Event make_stop_condition(const Model& model, const std::string& condition) {
@@ -118,7 +138,7 @@ Event make_stop_condition(const Model& model, const std::string& condition) {
   const GiNaC::ex left = read_option(builder, option, condition, lhs);
   const GiNaC::ex right = read_option(builder, option, condition, rhs);
   try {
-    Event event = finish(builder.current(), greater ? left - right : right - left, condition, condition,
+    Event event = finish(builder.current(), model, greater ? left - right : right - left, condition, condition,
                          fmt::format("{} \"{}\"", option, condition), EventDirection::rising, EventAction::stop);
     event.condition = true;
     return event;
@@ -147,7 +167,7 @@ Event make_record_event(const Model& model, const std::string& definition) {
   const SpecBuilder builder = names_of(model);
   const GiNaC::ex g = read_option(builder, option, definition, text);
   try {
-    return finish(builder.current(), g, name, definition.substr(eq + 1), fmt::format("{} \"{}\"", option, definition),
+    return finish(builder.current(), model, g, name, definition.substr(eq + 1), fmt::format("{} \"{}\"", option, definition),
                   EventDirection::both, EventAction::record);
   } catch (const ModelError& e) {
     throw InputError(e.what());

@@ -1,7 +1,9 @@
 // Events from their expressions: a model file's [[events]] (compile_events, called by
 // compile_model) and the command line's --stop-when CONDITION and --event NAME=EXPR for any model,
 // built-in ones included (their expressions are read against the model's names: t, the
-// coordinates, their velocities x', the parameters). The result is a model/event.hpp Event whose
+// coordinates, their velocities x', the parameters, the outputs and, for a multibody model, the
+// contact-force columns NAME_N ... of its wheels and knife edges; one the model does not determine,
+// NaN by design, is refused here, before any run). The result is a model/event.hpp Event whose
 // program g reads the parameters, so --set applies to it. Errors are ModelError (a model file's,
 // with file:line:column) or InputError (the command line's, naming the option, the column and the
 // nearest known name).

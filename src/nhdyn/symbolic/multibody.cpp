@@ -642,6 +642,10 @@ void MultibodyBuilder::apply() {
   const std::vector<SpecConstraint>& constraints = builder_.current().constraints;
   for (std::size_t i = first_generated; i < constraints.size(); ++i) record->generated.push_back(constraints[i].name);
   record_contact_forces(*record);
+  std::vector<std::string> reported;  // the wheels and knife edges, whose columns events may name
+  for (const ContactPoint& c : record->contacts)
+    if (c.kind == ContactKind::wheel || c.kind == ContactKind::knife_edge) reported.push_back(c.name);
+  record->columns = make_contact_force_symbols(reported);
   builder_.contact_forces(std::move(record));
 }
 

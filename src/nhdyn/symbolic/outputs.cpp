@@ -19,7 +19,7 @@ bool reads_dynamics(const Spec& spec, const GiNaC::ex& e) {
 }
 
 Program compile_dynamics_program(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
-                                 const std::vector<std::string>& what) {
+                                 const std::vector<std::string>& what, const std::vector<ContactForceSymbol>& contact) {
   // A spec of 2n coordinates whose symbols stand for [q; q''] and, as their velocities, [q'; R]:
   // the compiler then maps them to the input registers of the dynamics layout.
   const int n = spec.n();
@@ -40,6 +40,12 @@ Program compile_dynamics_program(const Spec& spec, const std::vector<GiNaC::ex>&
     const int j = layout.symbols.add_coordinate(name);
     map[spec.symbols.acceleration(i)] = layout.symbols.coordinate(j);
     map[spec.symbols.reaction(i)] = layout.symbols.velocity(j);
+  }
+  // The contact layout: one more coordinate per contact-force column (its velocity slot unused).
+  for (const ContactForceSymbol& c : contact) {
+    layout.coordinates.push_back(c.name);
+    const int j = layout.symbols.add_coordinate(c.name);
+    map[c.symbol] = layout.symbols.coordinate(j);
   }
   layout.parameters = spec.parameters;
   for (const SpecParameter& p : spec.parameters) {
@@ -113,6 +119,15 @@ void compile_outputs(const Spec& spec, Model& model) {
   std::vector<GiNaC::ex> expressions;
   std::vector<std::string> what;
   for (const SpecOutput& o : spec.outputs) {
+    const std::vector<int> contact = contact_force_columns_in(spec, o.expression);
+    if (!contact.empty()) {
+      const std::string at = o.where.describe();
+      throw ModelError(fmt::format("{}output '{}' reads the contact force '{}': outputs cannot read the contact "
+                                   "forces (their columns are in the results already); an event may name it "
+                                   "(docs/model-format.md, [[events]])",
+                                   at.empty() ? "" : at + ": ", o.name,
+                                   spec.contact_forces->columns[static_cast<std::size_t>(contact.front())].name));
+    }
     DerivedOutput out;
     out.name = o.name;
     out.expression = o.text;

@@ -4,13 +4,17 @@
 // of 2n coordinates whose coordinate inputs are [q; q''] and velocity inputs [q'; R], so that an
 // expression may read the accelerations and the generalized reactions R_x of a solved state. The
 // parameters stay parameters (--set changes them without recompiling). Events whose expressions
-// read q'' or R (through an output) are compiled the same way (symbolic/events.cpp).
+// read q'' or R (through an output) are compiled the same way (symbolic/events.cpp), and those that
+// read the contact forces in a layout with their columns too. Outputs may not read the contact
+// forces (their program's layout has no slots for them, and their columns are in the results
+// already): compile_outputs refuses them.
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "nhdyn/model/model.hpp"
+#include "nhdyn/symbolic/contact_forces.hpp"
 #include "nhdyn/symbolic/multibody.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
@@ -21,9 +25,13 @@ namespace nhdyn::symbolic {
 bool reads_dynamics(const Spec& spec, const GiNaC::ex& e);
 
 // The expressions (in t, q, q', q'', R and the parameters of `spec`) as one program in the
-// dynamics layout, one output each; `what` names each in errors (ModelError).
+// dynamics layout, one output each; `what` names each in errors (ModelError). With `contact`
+// (the symbols of the contact-force columns, SpecContactForces::columns) the program is in the
+// contact layout (model/event.hpp): 2n + contact.size() coordinates, the values of those columns
+// after [q; q''] (and zeros after [q'; R]), so that an event may read NAME_N.
 Program compile_dynamics_program(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
-                                 const std::vector<std::string>& what);
+                                 const std::vector<std::string>& what,
+                                 const std::vector<ContactForceSymbol>& contact = {});
 
 // A multibody model's automatic outputs (docs/multibody.md, "Positions and velocities"): for each
 // named point, then each frame whose origin is not identically its parent's, the world position

@@ -15,6 +15,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
+#include "nhdyn/symbolic/contact_forces.hpp"
 #include "nhdyn/symbolic/occurrence.hpp"
 #include "nhdyn/core/suggest.hpp"
 
@@ -305,6 +306,20 @@ class Reader {
     return site_.text.substr(token.begin, token.end - token.begin);
   }
 
+  // For a name shaped like a contact-force column (NAME_N, NAME_Fx, ...) in a model without
+  // contact forces: why it is unknown.
+  std::string contact_force_hint(const std::string& name) const {
+    if (spec_.contact_forces && !spec_.contact_forces->columns.empty()) return "";
+    for (int k = 0; k < kContactComponents; ++k) {
+      const std::string suffix = std::string("_") + contact_component_name(k);
+      if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
+        return fmt::format(" ('{}' looks like a contact-force column, but model '{}' has no contact forces: only "
+                           "the [[wheels]] and [[knife_edges]] of a multibody model have them, docs/multibody.md)",
+                           name, spec_.name);
+    }
+    return "";
+  }
+
   [[noreturn]] void unexpected(const Token& token) {
     if (operand_start(token.kind) && index_ > 0)
       site_.fail_at(token.begin, fmt::format("syntax error: missing operator between '{}' and '{}' "
@@ -479,8 +494,9 @@ class Reader {
         if (scope_ != nullptr)
           for (const auto& entry : *scope_) known.push_back(entry.first);
         const std::string nearest = nearest_name(name, known);
-        site_.fail_at(token.begin, fmt::format("unknown symbol '{}'{}", name,
-                                               nearest.empty() ? "" : fmt::format("; did you mean '{}'?", nearest)));
+        site_.fail_at(token.begin, fmt::format("unknown symbol '{}'{}{}", name,
+                                               nearest.empty() ? "" : fmt::format("; did you mean '{}'?", nearest),
+                                               scope_ != nullptr ? contact_force_hint(name) : ""));
       }
       if (name == "t")
         kind = SymbolKind::time;
@@ -1037,6 +1053,10 @@ std::map<std::string, GiNaC::symbol> derived_scope(const Spec& spec) {
     if (!spec.symbols.has("R_" + spec.coordinates[static_cast<std::size_t>(i)]))
       scope.emplace("R_" + spec.coordinates[static_cast<std::size_t>(i)], spec.symbols.reaction(i));
   for (const SpecOutput& o : spec.outputs) scope.emplace(o.name, o.symbol);
+  // The contact-force columns (NAME_N ...): events may name them (symbolic/events.cpp); outputs
+  // that do are refused (symbolic/outputs.cpp).
+  if (spec.contact_forces)
+    for (const ContactForceSymbol& c : spec.contact_forces->columns) scope.emplace(c.name, c.symbol);
   return scope;
 }
 
