@@ -22,6 +22,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -117,7 +118,14 @@ std::string number_text(double value) {
 
 class Loader {
  public:
-  Loader(std::string_view text, std::string file) : text_(text), file_(std::move(file)) {}
+  Loader(std::string_view text, std::string file) : text_(text), file_(std::move(file)) {
+    // Where each line starts, so that a position costs a lookup, not a walk from the top of the
+    // file: a generated model has thousands of expressions, each located once (N-trailer chain,
+    // docs/performance.md).
+    line_starts_.push_back(0);
+    for (std::size_t p = text_.find('\n'); p != std::string_view::npos; p = text_.find('\n', p + 1))
+      line_starts_.push_back(p + 1);
+  }
 
   symbolic::Spec load() {
     toml::table root;
@@ -201,12 +209,8 @@ class Loader {
   // Byte offset in text_ of a 1-based (line, column), toml++ counting columns in code points.
   std::optional<std::size_t> offset_of(const toml::source_position& position) const {
     if (position.line == 0 || position.column == 0) return std::nullopt;
-    std::size_t p = 0;
-    for (toml::source_index line = 1; line < position.line; ++line) {
-      p = text_.find('\n', p);
-      if (p == std::string_view::npos) return std::nullopt;
-      ++p;
-    }
+    if (position.line > line_starts_.size()) return std::nullopt;
+    std::size_t p = line_starts_[position.line - 1];
     for (toml::source_index column = 1; column < position.column; ++column) {
       if (p >= text_.size()) return std::nullopt;
       ++p;
@@ -218,13 +222,10 @@ class Loader {
   // The (line, column) of byte offset p of text_.
   SourceLocation location_of(std::size_t p) const {
     p = std::min(p, text_.size());
-    int line = 1;
-    std::size_t line_start = 0;
-    for (std::size_t i = 0; i < p; ++i)
-      if (text_[i] == '\n') {
-        ++line;
-        line_start = i + 1;
-      }
+    // The last line starting at or before p (a '\n' at p - 1 starts the line at p).
+    const auto next = std::upper_bound(line_starts_.begin(), line_starts_.end(), p);
+    const int line = static_cast<int>(next - line_starts_.begin());
+    const std::size_t line_start = *(next - 1);
     int column = 1;
     for (std::size_t i = line_start; i < p; ++i)
       if ((static_cast<unsigned char>(text_[i]) & 0xC0u) != 0x80u) ++column;
@@ -429,8 +430,7 @@ class Loader {
 
   // A coordinate named by a key or a string; returns its index.
   int coordinate_index(const std::string& name, const SourceLocation& where, std::string_view context) const {
-    for (std::size_t i = 0; i < coordinates_.size(); ++i)
-      if (coordinates_[i] == name) return static_cast<int>(i);
+    if (const auto it = coordinate_by_name_.find(name); it != coordinate_by_name_.end()) return it->second;
     const std::string nearest = nearest_name(name, coordinates_);
     fail(where, fmt::format("'{}' {} is not a coordinate; {}", name, context,
                             nearest.empty() ? fmt::format("the coordinates are: {}", join(coordinates_))
@@ -450,6 +450,7 @@ class Loader {
       const std::string name =
           string_of(element, fmt::format("coordinates[{}]", i + 1), "coordinates = [\"x\", \"y\", \"phi\"]");
       builder.coordinate(name, at(element));
+      coordinate_by_name_.emplace(name, static_cast<int>(coordinates_.size()));
       coordinates_.push_back(name);
     }
   }
@@ -1181,8 +1182,10 @@ class Loader {
   }
 
   std::string_view text_;
+  std::vector<std::size_t> line_starts_;  // byte offset of the start of each line, line 1 first
   std::string file_;
   std::vector<std::string> coordinates_;
+  std::unordered_map<std::string, int> coordinate_by_name_;  // index into coordinates_ (first of a name)
   std::vector<Parameter> parameter_values_;  // as loaded so far, in file order
   double t0_ = 0.0;
 };

@@ -745,7 +745,8 @@ class ProgramCompiler {
   GiNaC::ex original_;
 };
 
-void check_size(const Spec& spec, const char* what, const GiNaC::matrix& m, int rows, int cols) {
+template <class Matrix>
+void check_size(const Spec& spec, const char* what, const Matrix& m, int rows, int cols) {
   if (static_cast<int>(m.rows()) != rows || static_cast<int>(m.cols()) != cols)
     throw ModelError(fmt::format("model '{}': the derivation's {} is {} x {}, expected {} x {}", spec.name, what,
                                  m.rows(), m.cols(), rows, cols));
@@ -776,14 +777,14 @@ int coordinate_index(const Spec& spec, const std::string& name, const char* what
 }
 
 // The entries of m that are not identically zero, in compressed columns.
-SparsityPattern pattern_of(const GiNaC::matrix& m) {
+SparsityPattern pattern_of(const ExMatrix& m) {
   SparsityPattern p;
   p.rows = static_cast<int>(m.rows());
   p.cols = static_cast<int>(m.cols());
   p.outer.push_back(0);
   for (unsigned j = 0; j < m.cols(); ++j) {
-    for (unsigned i = 0; i < m.rows(); ++i)
-      if (!m(i, j).is_zero()) p.inner.push_back(static_cast<int>(i));
+    for (const auto& [i, e] : m.column(j))
+      if (!e.is_zero()) p.inner.push_back(static_cast<int>(i));
     p.outer.push_back(static_cast<int>(p.inner.size()));
   }
   return p;
@@ -891,7 +892,7 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
     ProgramCompiler terms(spec);
     // Column by column: every entry when dense, the pattern's nonzeros when sparse. Entry names
     // are formatted only when compiled (a thousand-body chain has 18 million entries).
-    const auto matrix_outputs = [&](const GiNaC::matrix& m, const SparsityPattern& pattern, const char* symbol,
+    const auto matrix_outputs = [&](const ExMatrix& m, const SparsityPattern& pattern, const char* symbol,
                                     auto row_name) {
       for (int j = 0; j < static_cast<int>(m.cols()); ++j) {
         const auto output = [&](int i) {

@@ -123,7 +123,7 @@ void require_complement_at_initial_state(const Spec& spec, const GiNaC::matrix& 
   }
   const auto value = [&](const GiNaC::ex& e, double& out) {
     try {
-      const GiNaC::ex x = e.subs(at).subs(values).subs(values).evalf();
+      const GiNaC::ex x = e.subs(at, GiNaC::subs_options::no_pattern).subs(values).subs(values).evalf();
       if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real()) return false;
       out = GiNaC::ex_to<GiNaC::numeric>(x).to_double();
       return std::isfinite(out);
@@ -172,7 +172,9 @@ void require_at_most_quadratic(const Spec& spec, const std::string& model) {
   for (int i = 0; i < spec.n(); ++i) scaled[symbols.velocity(i)] = lambda * symbols.velocity(i);
   int degree = 0;
   try {
-    degree = spec.kinetic_energy.subs(scaled).degree(lambda);
+    // no_pattern: the keys are symbols, so a map lookup per node finds them; GiNaC's default tries
+    // every key as a pattern at every node, n times the size of T (minutes for a long chain).
+    degree = spec.kinetic_energy.subs(scaled, GiNaC::subs_options::no_pattern).degree(lambda);
   } catch (const std::exception&) {
     return;  // not a polynomial in lambda: left to the derivation's own check
   }
@@ -186,7 +188,10 @@ void require_at_most_quadratic(const Spec& spec, const std::string& model) {
   const GiNaC::lst values = spec.parameter_values();
   std::vector<double> f;
   try {
-    const GiNaC::ex at = spec.kinetic_energy.subs(scaled).subs(point).subs(values).subs(values);
+    const GiNaC::ex at = spec.kinetic_energy.subs(scaled, GiNaC::subs_options::no_pattern)
+                             .subs(point, GiNaC::subs_options::no_pattern)
+                             .subs(values)
+                             .subs(values);
     for (int k = 0; k < 4; ++k) {
       const GiNaC::ex x = at.subs(lambda == k).evalf();
       if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real()) return;
@@ -207,7 +212,7 @@ void require_at_most_quadratic(const Spec& spec, const std::string& model) {
 // The rows of b and b0 of `constraints` (b q'' + b0 = 0, docs/notation.md (2.5)), with their
 // position and velocity residuals; `kind` ("constraint" or "program") names them in errors.
 void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constraints, const char* kind,
-                     const SymbolIndex& index, GiNaC::matrix& b, GiNaC::matrix& b0_out, std::vector<GiNaC::ex>& phi,
+                     const SymbolIndex& index, ExMatrix& b, GiNaC::matrix& b0_out, std::vector<GiNaC::ex>& phi,
                      std::vector<GiNaC::ex>& f) {
   const SymbolTable& symbols = spec.symbols;
   const int n = spec.n();
@@ -216,7 +221,7 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
   const auto v = [&](int i) { return symbols.velocity(i); };
   const auto a = [&](int i) { return symbols.acceleration(i); };
   const auto name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
-  b = GiNaC::matrix(us, un);
+  b = ExMatrix(us, un);
   b0_out = GiNaC::matrix(us, 1);
   for (unsigned r = 0; r < us; ++r) {
     const SpecConstraint& c = constraints[r];
@@ -224,7 +229,9 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
     const GiNaC::ex& e = c.expression;
     const Contained o = index.find(e);
     GiNaC::ex b0;
-    std::vector<GiNaC::ex> row(un, GiNaC::ex(0));
+    // The nonzero entries of this row: (column, derivative), columns ascending. A dense row per
+    // constraint would cost n s for a model whose rows hold a few entries each.
+    std::vector<std::pair<int, GiNaC::ex>> row;
     const char* involve = "the velocities";
     switch (c.level) {
       case ConstraintLevel::position: {
@@ -237,7 +244,7 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
         // phi' = phi_q q' + phi_t; phi'' = b q'' + b0 with b = phi_q and
         // b0 = (d/dq (phi_q q')) q' + 2 phi_qt q' + phi_tt, the q''-free part of d/dt phi'.
         const GiNaC::ex phidot = convective_derivative(e, symbols, index);
-        for (int j : o.q) row[static_cast<std::size_t>(j)] = e.diff(q(j));
+        for (int j : o.q) row.emplace_back(j, e.diff(q(j)));
         b0 = convective_derivative(phidot, symbols, index);
         phi.push_back(e);
         f.push_back(tidy(phidot));
@@ -248,7 +255,7 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
           throw ModelError(where + fmt::format(" is given at velocity level but contains the acceleration {}''",
                                                name(o.a.front())));
         // f' = (df/dq') q'' + (df/dq) q' + df/dt.
-        for (int j : o.v) row[static_cast<std::size_t>(j)] = e.diff(v(j));
+        for (int j : o.v) row.emplace_back(j, e.diff(v(j)));
         b0 = convective_derivative(e, symbols, index);
         f.push_back(e);
         break;
@@ -257,12 +264,12 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
         involve = "the accelerations";
         GiNaC::lst at_rest;
         for (int j : o.a) {
-          row[static_cast<std::size_t>(j)] = e.diff(a(j));
+          row.emplace_back(j, e.diff(a(j)));
           at_rest.append(a(j) == 0);
         }
-        for (int i : o.a)
+        for (const auto& [i, entry] : row)
           for (int j : o.a)
-            if (!symbolic::is_zero(row[static_cast<std::size_t>(i)].diff(a(j))))
+            if (!symbolic::is_zero(entry.diff(a(j))))
               throw ModelError(where + fmt::format(" must be linear in the accelerations, but it is not linear in "
                                                    "{}'' (its derivative by {}'' depends on {}'')",
                                                    name(i), name(i), name(j)));
@@ -271,10 +278,11 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
       }
     }
     bool zero = true;
-    for (unsigned j = 0; j < un; ++j) {
-      if (row[j].is_zero()) continue;
-      b(r, j) = tidy(row[j]);
-      zero = zero && b(r, j).is_zero();
+    for (const auto& [j, entry] : row) {
+      if (entry.is_zero()) continue;
+      const auto uj = static_cast<unsigned>(j);
+      b(r, uj) = tidy(entry);
+      zero = zero && b(r, uj).is_zero();
     }
     if (zero)
       throw ModelError(where + fmt::format(" does not involve {} after differentiation: its row of b is zero "
@@ -349,7 +357,7 @@ Derivation derive(const Spec& spec) {
   Derivation d;
   // A = d2T/dq'2 (docs/notation.md (2.4)); T must be quadratic in q' so that A does not depend on q'.
   // Only the pairs of velocities that occur in a common term of T can give a nonzero entry.
-  d.A = GiNaC::matrix(un, un);
+  d.A = ExMatrix(un, un);
   std::vector<GiNaC::ex> Tv(un);
   bool moving = false;
   for (int i = 0; i < n; ++i) {
@@ -397,7 +405,9 @@ Derivation derive(const Spec& spec) {
   {
     std::vector<SpecConstraint> programs;
     for (const SpecProgram& p : spec.programs) programs.push_back(p.constraint);
-    constraint_rows(spec, programs, "program", index, d.b_p, d.b_p0, d.phi_p, d.f_p);
+    ExMatrix b_p;
+    constraint_rows(spec, programs, "program", index, b_p, d.b_p0, d.phi_p, d.f_p);
+    d.b_p = b_p.dense();
     const auto um = static_cast<unsigned>(spec.m());
     d.B = GiNaC::matrix(un, um);
     for (unsigned j = 0; j < um; ++j) {
@@ -458,7 +468,9 @@ Derivation derive(const Spec& spec) {
   d.energy = kept(energy);
   // h = q' . dT/dq' - T + V, term by term of T: a term homogeneous of degree 2 in the velocities
   // (Euler: q' . dterm/dq' = 2 term) contributes itself, as in E; only the others need the sum.
-  GiNaC::ex h = V;
+  // Collected and summed once: adding term by term rebuilds the growing sum at every step,
+  // quadratic in the number of terms (30 000 for 10 000 free particles).
+  GiNaC::exvector h_terms{V};
   bool h_is_energy = true;
   for (std::size_t j = 0; j < Ts.terms.size(); ++j) {
     const GiNaC::ex& term = Ts.terms[j];
@@ -468,13 +480,13 @@ Derivation derive(const Spec& spec) {
     // the cost of simplifying it, which matters for the thousands of terms of a long chain.
     const GiNaC::ex euler = (rate - 2 * term).expand();
     if (!Ts.occurrences[j].v.empty() && (euler.is_zero() || symbolic::is_zero(euler))) {
-      h += term;
+      h_terms.push_back(term);
     } else {
-      h += rate - term;
+      h_terms.push_back(rate - term);
       h_is_energy = false;
     }
   }
-  if (!h_is_energy) d.energy_function = kept(h);
+  if (!h_is_energy) d.energy_function = kept(GiNaC::add(h_terms));
   GiNaC::ex power_forces = 0;
   for (std::size_t i = 0; i < spec.forces.size(); ++i)
     if (!symbolic::is_zero(spec.forces[i])) power_forces += spec.forces[i] * v(static_cast<int>(i));

@@ -9,15 +9,16 @@
 #include <optional>
 #include <vector>
 
+#include "nhdyn/symbolic/ex_matrix.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 
 namespace nhdyn::symbolic {
 
 struct Derivation {
-  GiNaC::matrix A;                  // n x n
+  ExMatrix A;                       // n x n, the entries that may be nonzero (ex_matrix.hpp)
   GiNaC::matrix Q;                  // n x 1
   GiNaC::matrix G;                  // n x 1
-  GiNaC::matrix b;                  // s x n
+  ExMatrix b;                       // s x n, likewise
   GiNaC::matrix b0;                 // s x 1
   std::optional<GiNaC::matrix> D;   // k x n: analytic (spec.complement) or partitioned (spec.independent)
   std::vector<GiNaC::ex> phi;       // position-level residuals, one per position constraint

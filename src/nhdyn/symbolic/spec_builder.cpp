@@ -300,6 +300,10 @@ class Reader {
   }
 
  private:
+  // A coordinate has a velocity symbol, name': a lookup in the symbol table instead of a search
+  // of the list of coordinates, once per identifier read (quadratic for 10 000 particles).
+  bool is_coordinate(const std::string& name) const { return spec_.symbols.has(name + "'"); }
+
   const Token& peek() const { return tokens_[index_]; }
   const Token& next() { return tokens_[index_++]; }
   std::string spelled(const Token& token) const {
@@ -500,7 +504,7 @@ class Reader {
       }
       if (name == "t")
         kind = SymbolKind::time;
-      else if (std::find(spec_.coordinates.begin(), spec_.coordinates.end(), name) != spec_.coordinates.end())
+      else if (is_coordinate(name))
         kind = SymbolKind::coordinate;
       symbols_.push_back({kind, name, *symbol, token.begin});
       out_ += internal_name(name);
@@ -508,8 +512,7 @@ class Reader {
     }
 
     const char* what = token.primes == 1 ? "velocity" : "acceleration";
-    const bool coordinate =
-        std::find(spec_.coordinates.begin(), spec_.coordinates.end(), name) != spec_.coordinates.end();
+    const bool coordinate = is_coordinate(name);
     if (!coordinate) {
       std::string why = "which is not a coordinate";
       if (name == "t")
@@ -639,26 +642,21 @@ bool valid_name(const std::string& name) {
   return std::all_of(name.begin(), name.end(), identifier_char);
 }
 
-int index_of(const std::vector<std::string>& names, const std::string& name) {
-  const auto it = std::find(names.begin(), names.end(), name);
-  return it == names.end() ? -1 : static_cast<int>(it - names.begin());
-}
-
 std::string did_you_mean(const std::string& name, const std::vector<std::string>& known) {
   const std::string nearest = nearest_name(name, known);
   return nearest.empty() ? "" : fmt::format("; did you mean '{}'?", nearest);
 }
 
 // Names of coordinates and parameters share one space with t, pi and the functions.
-void check_new_name(const Spec& spec, const std::string& name, const char* what, const SourceLocation& where) {
+void check_new_name(const Spec& spec, bool is_coordinate, const std::string& name, const char* what,
+                    const SourceLocation& where) {
   const std::string context = fmt::format("{} '{}'", what, name);
   if (!valid_name(name))
     fail(where, context, "not a valid name: use letters, digits and single underscores, starting with a letter");
   if (name == "t") fail(where, context, "'t' is the time and cannot be declared");
   if (name == "pi") fail(where, context, "'pi' is the constant pi and cannot be declared");
   if (function_arity(name) >= 0) fail(where, context, fmt::format("'{}' is the name of a function", name));
-  if (index_of(spec.coordinates, name) >= 0)
-    fail(where, context, fmt::format("duplicated name: '{}' is already a coordinate", name));
+  if (is_coordinate) fail(where, context, fmt::format("duplicated name: '{}' is already a coordinate", name));
   for (const SpecParameter& p : spec.parameters)
     if (p.name == name) {
       const std::string at = p.where.describe();
@@ -668,6 +666,11 @@ void check_new_name(const Spec& spec, const std::string& name, const char* what,
 }
 
 }  // namespace
+
+int SpecBuilder::coordinate_of(const std::string& name) const {
+  const auto it = coordinate_by_name_.find(name);
+  return it == coordinate_by_name_.end() ? -1 : it->second;
+}
 
 SpecBuilder::SpecBuilder(std::string name, SourceLocation where) {
   spec_.name = std::move(name);
@@ -680,7 +683,8 @@ SpecBuilder& SpecBuilder::description(std::string text) {
 }
 
 SpecBuilder& SpecBuilder::coordinate(const std::string& name, SourceLocation where) {
-  check_new_name(spec_, name, "coordinate", where);
+  check_new_name(spec_, coordinate_of(name) >= 0, name, "coordinate", where);
+  coordinate_by_name_.emplace(name, static_cast<int>(spec_.coordinates.size()));
   spec_.symbols.add_coordinate(name);
   spec_.coordinates.push_back(name);
   spec_.forces.resize(spec_.coordinates.size(), GiNaC::ex(0));
@@ -692,7 +696,7 @@ SpecBuilder& SpecBuilder::coordinate(const std::string& name, SourceLocation whe
 }
 
 SpecBuilder& SpecBuilder::parameter(const std::string& name, double value, std::string unit, SourceLocation where) {
-  check_new_name(spec_, name, "parameter", where);
+  check_new_name(spec_, coordinate_of(name) >= 0, name, "parameter", where);
   if (!std::isfinite(value))
     fail(where, fmt::format("parameter '{}'", name), fmt::format("value {} is not a finite number", value));
   if (value != 0.0 && std::abs(value) < std::numeric_limits<double>::min())
@@ -729,7 +733,7 @@ SpecBuilder& SpecBuilder::potential_energy(const std::string& text, SourceLocati
 }
 
 SpecBuilder& SpecBuilder::force(const std::string& coordinate, const std::string& text, SourceLocation where) {
-  const int i = index_of(spec_.coordinates, coordinate);
+  const int i = coordinate_of(coordinate);
   if (i < 0)
     fail(where, fmt::format("force on '{}'", coordinate),
          fmt::format("'{}' is not a coordinate{}", coordinate, did_you_mean(coordinate, spec_.coordinates)));
@@ -907,7 +911,7 @@ SpecBuilder& SpecBuilder::program(const std::string& name, ConstraintLevel level
 
 SpecBuilder& SpecBuilder::program(const std::string& name, ConstraintLevel level, const std::string& text,
                                   const std::string& actuator, SourceLocation where, SourceLocation actuator_where) {
-  const int i = index_of(spec_.coordinates, actuator);
+  const int i = coordinate_of(actuator);
   if (i < 0)
     fail(actuator_where, fmt::format("program '{}'", name),
          fmt::format("the actuator '{}' is not a coordinate: name the coordinate the actuator's force or torque "
@@ -925,7 +929,7 @@ SpecBuilder& SpecBuilder::independent(const std::vector<std::string>& coordinate
   const std::string context = "independent coordinates";
   for (std::size_t i = 0; i < coordinates.size(); ++i) {
     const std::string& name = coordinates[i];
-    if (index_of(spec_.coordinates, name) < 0)
+    if (coordinate_of(name) < 0)
       fail(where, context, fmt::format("'{}' is not a coordinate{}", name, did_you_mean(name, spec_.coordinates)));
     if (std::find(coordinates.begin(), coordinates.begin() + static_cast<std::ptrdiff_t>(i), name) !=
         coordinates.begin() + static_cast<std::ptrdiff_t>(i))
@@ -959,7 +963,7 @@ SpecBuilder& SpecBuilder::complement(const std::vector<std::vector<std::string>>
 
 SpecBuilder& SpecBuilder::initial(const std::string& coordinate, const std::string& q0, const std::string& v0,
                                   SourceLocation where) {
-  const int i = index_of(spec_.coordinates, coordinate);
+  const int i = coordinate_of(coordinate);
   if (i < 0)
     fail(where, fmt::format("initial value of '{}'", coordinate),
          fmt::format("'{}' is not a coordinate{}", coordinate, did_you_mean(coordinate, spec_.coordinates)));
@@ -978,7 +982,7 @@ SpecBuilder& SpecBuilder::initial(const std::string& coordinate, const std::stri
 }
 
 SpecBuilder& SpecBuilder::solution(const std::string& coordinate, const std::string& text, SourceLocation where) {
-  const int i = index_of(spec_.coordinates, coordinate);
+  const int i = coordinate_of(coordinate);
   if (i < 0)
     fail(where, fmt::format("solution of '{}'", coordinate),
          fmt::format("'{}' is not a coordinate{}", coordinate, did_you_mean(coordinate, spec_.coordinates)));
@@ -1037,7 +1041,7 @@ SpecBuilder& SpecBuilder::tolerances(std::optional<double> rtol, std::optional<d
 
 SpecBuilder& SpecBuilder::path(const std::string& x, const std::string& y) {
   for (const std::string& name : {x, y})
-    if (index_of(spec_.coordinates, name) < 0)
+    if (coordinate_of(name) < 0)
       fail(spec_.where, "path", fmt::format("'{}' is not a coordinate{}", name, did_you_mean(name, spec_.coordinates)));
   spec_.path = std::make_pair(x, y);
   return *this;
@@ -1078,7 +1082,7 @@ SpecBuilder& SpecBuilder::output(const std::string& name, const std::string& tex
 
 SpecBuilder& SpecBuilder::output(const std::string& name, const GiNaC::ex& expression, const std::string& text,
                                  SourceLocation where, bool automatic) {
-  check_new_name(spec_, name, "output", where);
+  check_new_name(spec_, coordinate_of(name) >= 0, name, "output", where);
   const std::string context = fmt::format("output '{}'", name);
   for (const SpecOutput& o : spec_.outputs)
     if (o.name == name) {

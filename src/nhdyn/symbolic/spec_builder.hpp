@@ -8,6 +8,7 @@
 #pragma once
 
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -107,6 +108,10 @@ class SpecBuilder {
   std::vector<bool> initial_given_;   // per coordinate: initial() was called for it
   std::vector<bool> solution_given_;  // per coordinate: solution() was called for it
   SourceLocation independent_where_;  // where independent() was called
+  // The index of each coordinate by name: a lookup per initial value, force or solution, which a
+  // linear search made quadratic in the number of coordinates (10 000 particles).
+  std::unordered_map<std::string, int> coordinate_by_name_;
+  int coordinate_of(const std::string& name) const;  // -1 when not a coordinate
 };
 
 }  // namespace nhdyn::symbolic
