@@ -18,6 +18,7 @@
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/io/load_model.hpp"
 #include "support/cli_run.hpp"
+#include "support/models.hpp"
 #include "support/text.hpp"
 
 namespace nhdyn {
@@ -27,20 +28,6 @@ namespace fs = std::filesystem;
 using nhdyn::test::contains;
 using nhdyn::test::example;
 using nhdyn::test::run_nhdyn;
-
-constexpr const char* kWatchTurningBlade = R"(name = "turning-blade"
-coordinates = ["x", "y", "phi"]
-kinetic_energy = "m/2 * (x'^2 + y'^2) + m*rho^2/2 * phi'^2"
-[parameters]
-m = 1.0
-rho = 0.5
-[[constraints]]
-name = "blade"
-velocity = "y' - tan(phi)*x'"
-[initial]
-position = { x = 0, y = 0, phi = 0 }
-velocity = { x = 1, y = 0, phi = 1 }
-)";
 
 SimulationSummary run_watched_example(const std::string& file, double t_end) {
   const Model model = load_model(example(file));
@@ -67,7 +54,7 @@ TEST(ConstraintWatchModels, WhippleBicycleAtFiveMetresPerSecondStaysSilent) {
 }
 
 TEST(ConstraintWatchModels, TanFormNamedWithinAMillisecondOfTheSingularity) {
-  const Model model = load_model_text(kWatchTurningBlade, "tan.toml");
+  const Model model = load_model_text(test::kTanBlade, "tan.toml");
   SimulationOptions options = make_simulation_options(model);
   options.t_end = 3.0;
   options.output_step = 1.0;  // the singularity falls between two outputs: the steps see it
@@ -91,7 +78,7 @@ class ConstraintWatchCli : public ::testing::Test {
 };
 
 TEST_F(ConstraintWatchCli, SimulateWarnsOnStderrAndCountsInTheSummary) {
-  std::ofstream(dir_ / "tan.toml") << kWatchTurningBlade;
+  std::ofstream(dir_ / "tan.toml") << test::kTanBlade;
   const test::CliOutcome r = run_nhdyn("simulate tan.toml --t-end 3 --output-step 1 -o out.csv", dir_);
   EXPECT_EQ(r.exit_code, 0) << r.out;
   const std::string& err = r.out;  // stdout and stderr together
@@ -107,7 +94,7 @@ TEST_F(ConstraintWatchCli, SimulateWarnsOnStderrAndCountsInTheSummary) {
 }
 
 TEST_F(ConstraintWatchCli, CompareAndBatchPassTheWarningsOn) {
-  std::ofstream(dir_ / "tan.toml") << kWatchTurningBlade;
+  std::ofstream(dir_ / "tan.toml") << test::kTanBlade;
   const test::CliOutcome compare = run_nhdyn("compare tan.toml --t-end 2 -q -o cmp", dir_);
   for (const char* method : {"sanh", "lagrange", "udwadia-kalaba", "nullspace"})
     EXPECT_TRUE(contains(compare.out, fmt::format("nhdyn: warning ({}, dopri5): constraint 'blade'", method)))

@@ -17,6 +17,7 @@
 
 #include "nhdyn/io/csv.hpp"
 #include "support/cli_run.hpp"
+#include "support/models.hpp"
 #include "support/text.hpp"
 
 namespace {
@@ -135,40 +136,7 @@ TEST_F(CliContactEvents, StopWhenAndEventNameTheColumns) {
 
 TEST_F(CliContactEvents, MissingOrUndeterminedContactForcesAreRefusedBeforeTheRun) {
   // The sled held flat by its frames: blade_N is NaN by design (docs/multibody.md).
-  const std::string sled = R"(name = "flat-sled"
-coordinates = ["x", "y", "theta"]
-gravity = [0, 0, "-g"]
-
-[parameters]
-m = 2.0
-a = 0.3
-g = 9.81
-
-[[frames]]
-name = "sled"
-translation = ["x", "y", 0]
-rotations = [["z", "theta"]]
-
-[[points]]
-name = "blade"
-frame = "sled"
-
-[[bodies]]
-name = "sled"
-frame = "sled"
-mass = "m"
-com = ["a", 0, 0]
-inertia = [0.05, 0.1, 0.1]
-
-[[knife_edges]]
-name = "blade"
-point = "blade"
-axis = "x"
-
-[initial]
-position = { x = 0, y = 0, theta = 0 }
-velocity = { x = 1, theta = 0.5 }
-)";
+  const std::string sled = nhdyn::test::kFlatSledBodies;
   std::ofstream(dir_ / "sled.toml") << sled;
   std::ofstream(dir_ / "sled_event.toml") << sled << "\n[[events]]\nname = \"lift\"\nwhen = \"blade_N\"\n";
   const std::string pendulum = std::string(NHDYN_SOURCE_DIR) + "/examples/pendulum_cartesian.toml";
@@ -178,8 +146,8 @@ velocity = { x = 1, theta = 0.5 }
   };
   const std::vector<Case> cases = {
       {"simulate sled.toml --stop-when 'blade_N < 0'",
-       {"--stop-when \"blade_N < 0\"", "'blade_N', which model 'flat-sled' does not determine", "NaN"}},
-      {"simulate sled.toml --event 'up=blade_Fz'", {"'blade_Fz', which model 'flat-sled' does not determine"}},
+       {"--stop-when \"blade_N < 0\"", "'blade_N', which model 'sled-bodies' does not determine", "NaN"}},
+      {"simulate sled.toml --event 'up=blade_Fz'", {"'blade_Fz', which model 'sled-bodies' does not determine"}},
       {"simulate sled_event.toml", {"sled_event.toml:37:9: event 'lift' reads the contact force 'blade_N'"}},
       {"simulate '" + pendulum + "' --stop-when 'disk_N < 0'",
        {"unknown symbol 'disk_N'", "model 'pendulum-cartesian' has no contact forces"}},

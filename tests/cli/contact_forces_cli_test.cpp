@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include "support/models.hpp"
 #include "support/text.hpp"
 
 namespace {
@@ -94,33 +95,7 @@ TEST(CliContactForces, RollingDiskColumnsAreTheCentreOfMassBalanceOfEachRow) {
 
 TEST(CliContactForces, UndeterminedNormalForceIsNanWithANote) {
   const fs::path dir = fresh_directory("nhdyn-contact-cli-sled");
-  std::ofstream(dir / "sled.toml") << R"(name = "sled-bodies"
-coordinates = ["x", "y", "theta"]
-gravity = [0, 0, "-g"]
-[parameters]
-m = 2.0
-a = 0.3
-g = 9.81
-[[frames]]
-name = "sled"
-translation = ["x", "y", 0]
-rotations = [["z", "theta"]]
-[[points]]
-name = "blade"
-frame = "sled"
-[[bodies]]
-name = "sled"
-frame = "sled"
-mass = "m"
-com = ["a", 0, 0]
-inertia = [0.05, 0.1, 0.1]
-[[knife_edges]]
-name = "blade"
-point = "blade"
-axis = "x"
-[initial]
-velocity = { x = 1, theta = 0.5 }
-)";
+  std::ofstream(dir / "sled.toml") << nhdyn::test::kFlatSledBodies;
   ASSERT_EQ(run(dir, "simulate sled.toml --t-end 0.5 -o sled.csv"), 0) << read_text(dir / "err.txt");
   const std::string err = read_text(dir / "err.txt");
   EXPECT_NE(err.find("note: contact forces: "), std::string::npos) << err;

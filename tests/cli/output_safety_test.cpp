@@ -23,6 +23,8 @@
 #include <thread>
 #include <vector>
 
+#include "support/models.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -234,19 +236,7 @@ namespace {
 TEST(SingularConstraint, ARowOfBThatBlowsUpIsWarnedAbout) {
   const fs::path dir = fs::temp_directory_path() / ("nhdyn-tan-" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  std::ofstream(dir / "tan.toml") << R"(name = "turning-blade"
-coordinates = ["x", "y", "phi"]
-kinetic_energy = "m/2 * (x'^2 + y'^2) + m*rho^2/2 * phi'^2"
-[parameters]
-m = 1.0
-rho = 0.5
-[[constraints]]
-name = "blade"
-velocity = "y' - tan(phi)*x'"
-[initial]
-position = { x = 0, y = 0, phi = 0 }
-velocity = { x = 1, y = 0, phi = 1 }
-)";
+  std::ofstream(dir / "tan.toml") << nhdyn::test::kTanBlade;
   const CliRun r = run_cli({"simulate", "tan.toml", "--t-end", "3", "--output-step", "0.01", "-o", "out.csv", "-q"}, dir);
   EXPECT_TRUE(r.code == 0 || r.code == 1) << r.err;
   EXPECT_NE(r.err.find("warning: constraint 'blade'"), std::string::npos) << r.err;

@@ -18,6 +18,7 @@
 #include "nhdyn/io/load_model.hpp"
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/symbolic/events.hpp"
+#include "support/models.hpp"
 #include "support/text.hpp"
 
 namespace nhdyn::multibody_test {
@@ -123,44 +124,8 @@ TEST(ContactEvents, RecordEventFindsBothRootsAndStopConditionItsThreshold) {
   EXPECT_NEAR(summary.events[0].q[3], theta_tenth, kLiftoffTolerance);
 }
 
-// The sled held flat by its frames (tests/multibody/contact_forces_test.cpp): its blade's N and
-// Fz are NaN by design, its lateral force is determined.
-constexpr const char* kFlatSled = R"(
-name = "sled-bodies"
-coordinates = ["x", "y", "theta"]
-gravity = [0, 0, "-g"]
-
-[parameters]
-m = 2.0
-a = 0.3
-g = 9.81
-
-[[frames]]
-name = "sled"
-translation = ["x", "y", 0]
-rotations = [["z", "theta"]]
-
-[[points]]
-name = "blade"
-frame = "sled"
-
-[[bodies]]
-name = "sled"
-frame = "sled"
-mass = "m"
-com = ["a", 0, 0]
-inertia = [0.05, 0.1, 0.1]
-
-[[knife_edges]]
-name = "blade"
-point = "blade"
-axis = "x"
-
-[initial]
-position = { x = 0, y = 0, theta = 0 }
-velocity = { x = 1, theta = 0.5 }
-)";
-
+// test::kFlatSledBodies, the sled held flat by its frames: its blade's N and Fz are NaN by design,
+// its lateral force is determined.
 template <typename Error, typename F>
 std::string contact_event_error(F&& f) {
   try {
@@ -173,7 +138,7 @@ std::string contact_event_error(F&& f) {
 }
 
 TEST(ContactEvents, UndeterminedOrMissingContactForcesAreRefused) {
-  const Model sled = load_model_text(kFlatSled, "sled.toml");
+  const Model sled = load_model_text(test::kFlatSledBodies, "sled.toml");
   std::string message =
       contact_event_error<InputError>([&] { symbolic::make_stop_condition(sled, "blade_N < 0"); });
   EXPECT_NE(message.find("--stop-when \"blade_N < 0\""), std::string::npos) << message;
@@ -185,9 +150,9 @@ TEST(ContactEvents, UndeterminedOrMissingContactForcesAreRefused) {
 
   // In the model file: refused at load, with the place of `when`.
   message = contact_event_error<ModelError>([&] {
-    load_model_text(std::string(kFlatSled) + "\n[[events]]\nname = \"lift\"\nwhen = \"blade_N\"\n", "sled.toml");
+    load_model_text(std::string(test::kFlatSledBodies) + "\n[[events]]\nname = \"lift\"\nwhen = \"blade_N\"\n", "sled.toml");
   });
-  EXPECT_NE(message.find("sled.toml:38:9: event 'lift' reads the contact force 'blade_N'"), std::string::npos)
+  EXPECT_NE(message.find("sled.toml:37:9: event 'lift' reads the contact force 'blade_N'"), std::string::npos)
       << message;
 
   // A model without contact forces: the name is unknown, and the message says why.
@@ -198,7 +163,7 @@ TEST(ContactEvents, UndeterminedOrMissingContactForcesAreRefused) {
 
   // An output may not read a contact force (its column is in the results already).
   message = contact_event_error<ModelError>([&] {
-    load_model_text(std::string(kFlatSled) + "\n[outputs]\nside = \"2*blade_Flat\"\n", "sled.toml");
+    load_model_text(std::string(test::kFlatSledBodies) + "\n[outputs]\nside = \"2*blade_Flat\"\n", "sled.toml");
   });
   EXPECT_NE(message.find("output 'side' reads the contact force 'blade_Flat'"), std::string::npos) << message;
 }

@@ -17,6 +17,7 @@
 #include "nhdyn/io/load_model.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/model/contact_forces.hpp"
+#include "support/models.hpp"
 #include "support/text.hpp"
 
 namespace nhdyn::multibody_test {
@@ -230,48 +231,12 @@ TEST(ContactForces, BicycleStaticWheelLoads) {
   EXPECT_EQ(rows, 6);
 }
 
-// A Chaplygin sleigh built from frames: x, y, theta keep it flat on the plane, so its frames carry
-// the part of the weight that the one blade cannot (its centre of mass is ahead of the blade). The
-// normal force is not determined: NaN, and a note at load; the horizontal force is, from R, and
-// equals m times the acceleration of the centre of mass.
-constexpr const char* kSled = R"(
-name = "sled-bodies"
-coordinates = ["x", "y", "theta"]
-gravity = [0, 0, "-g"]
-
-[parameters]
-m = 2.0
-a = 0.3
-g = 9.81
-
-[[frames]]
-name = "sled"
-translation = ["x", "y", 0]
-rotations = [["z", "theta"]]
-
-[[points]]
-name = "blade"
-frame = "sled"
-
-[[bodies]]
-name = "sled"
-frame = "sled"
-mass = "m"
-com = ["a", 0, 0]
-inertia = [0.05, 0.1, 0.1]
-
-[[knife_edges]]
-name = "blade"
-point = "blade"
-axis = "x"
-
-[initial]
-position = { x = 0, y = 0, theta = 0 }
-velocity = { x = 1, theta = 0.5 }
-)";
-
+// test::kFlatSledBodies, a Chaplygin sleigh built from frames: x, y, theta keep it flat on the
+// plane, so its frames carry the part of the weight that the one blade cannot (its centre of mass
+// is ahead of the blade). The normal force is not determined: NaN, and a note at load; the
+// horizontal force is, from R, and equals m times the acceleration of the centre of mass.
 TEST(ContactForces, SledHeldFlatByItsFramesHasNoNormalForce) {
-  const Model model = load_model_text(kSled);
+  const Model model = load_model_text(test::kFlatSledBodies);
   ASSERT_TRUE(model.contact_forces);
   const ContactForceModel& c = *model.contact_forces;
   ASSERT_FALSE(c.notes.empty());
