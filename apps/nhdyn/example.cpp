@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "commands.hpp"
@@ -51,22 +52,24 @@ int parse_bodies(const std::string& text, int most) {
   return static_cast<int>(value);
 }
 
-double parse_value(const std::string& name, const std::string& text) {
+// One --set NAME=VALUE of a generator: its name and its finite value.
+std::pair<std::string, double> parse_set(const std::string& set) {
+  const std::size_t eq = set.find('=');
+  if (eq == std::string::npos)
+    throw InputError(fmt::format("--set '{}': write it as NAME=VALUE, e.g. --set m=2", set));
+  const std::string name = set.substr(0, eq);
+  const std::string text = set.substr(eq + 1);
   char* end = nullptr;
   errno = 0;
   const double value = std::strtod(text.c_str(), &end);
   if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(value))
     throw InputError(fmt::format("--set {}: '{}' is not a finite number", name, text));
-  return value;
+  return {name, value};
 }
 
 void apply_chain_sets(symbolic::ChainParameters& p, const std::vector<std::string>& sets) {
   for (const std::string& set : sets) {
-    const std::size_t eq = set.find('=');
-    if (eq == std::string::npos)
-      throw InputError(fmt::format("--set '{}': write it as NAME=VALUE, e.g. --set m=2", set));
-    const std::string name = set.substr(0, eq);
-    const double value = parse_value(name, set.substr(eq + 1));
+    const auto [name, value] = parse_set(set);
     if (name == "m") p.mass = value;
     else if (name == "J") p.inertia = value;
     else if (name == "a") p.com_offset = value;
@@ -91,11 +94,7 @@ struct ParticleParameters {
 
 void apply_particle_sets(ParticleParameters& p, const std::vector<std::string>& sets) {
   for (const std::string& set : sets) {
-    const std::size_t eq = set.find('=');
-    if (eq == std::string::npos)
-      throw InputError(fmt::format("--set '{}': write it as NAME=VALUE, e.g. --set m=2", set));
-    const std::string name = set.substr(0, eq);
-    const double value = parse_value(name, set.substr(eq + 1));
+    const auto [name, value] = parse_set(set);
     if (name == "m") p.mass = value;
     else if (name == "g") p.gravity = value;
     else if (name == "v0") p.speed = value;

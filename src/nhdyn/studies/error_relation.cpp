@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/studies/run_times.hpp"
 
 namespace nhdyn {
 
@@ -32,12 +33,7 @@ ErrorRelation study_error_relation(const Model& model, const ErrorRelationOption
   if (!(options.atol_factor > 0.0 && std::isfinite(options.atol_factor)))
     throw InputError(fmt::format("the atol factor {} is not a positive number", options.atol_factor));
   if (options.integrators.empty()) throw InputError("the error-relation study needs at least one integrator");
-  if (options.t_end < 0.0 || !std::isfinite(options.t_end))
-    throw InputError(fmt::format("t_end {} is not a valid end time; give a time after t0 = {}, or 0 for the model's",
-                                 options.t_end, model.t0));
-  if (options.output_step < 0.0 || !std::isfinite(options.output_step))
-    throw InputError(fmt::format("output_step {} is not a valid step; give a positive step, or 0 for the model's",
-                                 options.output_step));
+  check_study_run_times(model, options.t_end, options.output_step);
   for (std::size_t i = 0; i < options.tolerances.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (options.tolerances[i] == options.tolerances[j])

@@ -9,6 +9,7 @@
 #include "nhdyn/analysis/exact_solution.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/model/data.hpp"
+#include "nhdyn/studies/run_times.hpp"
 
 namespace nhdyn {
 namespace {
@@ -40,12 +41,7 @@ Tracking study_tracking(const Model& model, const TrackingOptions& options) {
   if (options.integrator == IntegratorKind::rk4)
     throw InputError("rk4 takes a fixed step, so its runs do not depend on the tolerance: use dopri5, dop853, "
                      "cvode-bdf or cvode-adams for the tracking study");
-  if (options.t_end < 0.0 || !std::isfinite(options.t_end))
-    throw InputError(fmt::format("t_end {} is not a valid end time; give a time after t0 = {}, or 0 for the model's",
-                                 options.t_end, model.t0));
-  if (options.output_step < 0.0 || !std::isfinite(options.output_step))
-    throw InputError(fmt::format("output_step {} is not a valid step; give a positive step, or 0 for the model's",
-                                 options.output_step));
+  check_study_run_times(model, options.t_end, options.output_step);
   if (!model.evaluator->has_solution())
     throw InputError(fmt::format("model '{}' gives no exact solution, and the tracking study measures the error "
                                  "against it: give the programmed motion in a [solution] table of the model file "
