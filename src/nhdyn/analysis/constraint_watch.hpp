@@ -31,7 +31,7 @@ namespace nhdyn {
 
 // Three orders of magnitude: a well-posed model's rows of b and stacked matrix change with the
 // configuration by far less (the sled, the rolling disk and the bicycle stay below 3 over long
-// runs, tests/analysis/constraint_watch_test.cpp), while the tan(phi) form reaches it at
+// runs, tests/formulation/constraint_watch_test.cpp), while the tan(phi) form reaches it at
 // |cos(phi)| = 1e-3, 1 ms of rotation before the singularity at 1 rad/s.
 inline constexpr double kConstraintWatchFactor = 1e3;
 
