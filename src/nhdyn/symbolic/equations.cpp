@@ -72,24 +72,12 @@ std::string latex_name(const std::string& name, int dots = 0) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The printer: terms and factors in an order that depends on names only.
-
-
-// Whether the first term of a sum (by canonical_key) has a negative coefficient: GiNaC picks the
-// sign of a sum inside a product by its own term order, the printer picks it by this rule.
-bool leads_negative(const ex& sum) {
-  std::string best;
-  bool negative = false;
-  for (std::size_t i = 0; i < sum.nops(); ++i) {
-    const auto [c, rest] = split_coefficient(sum.op(i));
-    const std::string key = canonical_key(rest);
-    if (i == 0 || key < best) {
-      best = key;
-      negative = c.is_negative();
-    }
-  }
-  return negative;
-}
+// The printer: terms and factors in an order that depends on names only, and every sign choice
+// made on printed text. GiNaC's term order follows its hashes, which change from process to
+// process, and with it the sign GiNaC gives a sum inside a product ((a - b) x or -(b - a) x); the
+// printer decides such signs itself, bottom-up: a sum that is a factor or the base of an integer
+// power gets the sign that makes its first printed term positive, so the text is the same in
+// every process (docs/design.md, "Reproducibility").
 
 bool power_of_ten(const GiNaC::numeric& q) {
   std::ostringstream s;
@@ -112,15 +100,20 @@ std::string decimal(const GiNaC::numeric& p, const GiNaC::numeric& q) {
   return digits.substr(0, digits.size() - k) + "." + digits.substr(digits.size() - k);
 }
 
-struct Factor {
-  ex base;
-  ex exponent;  // a positive number, or an expression
+// A term as printed: its coefficient and its factors' texts above and below the line, in order.
+struct TermText {
+  GiNaC::numeric coefficient = 1;
+  std::vector<std::string> up, down;
 };
 
-struct Term {
-  GiNaC::numeric coefficient = 1;
-  std::vector<Factor> numerator, denominator;
-};
+// +1 for an even function (f(-x) = f(x)), -1 for an odd one (f(-x) = -f(x)), 0 otherwise.
+int function_parity(const std::string& name) {
+  if (name == "cos" || name == "cosh" || name == "abs") return 1;
+  if (name == "sin" || name == "tan" || name == "sinh" || name == "tanh" || name == "asin" || name == "atan" ||
+      name == "asinh" || name == "atanh")
+    return -1;
+  return 0;
+}
 
 struct Printed {
   std::string text;       // the magnitude
@@ -156,16 +149,7 @@ class EquationPrinter {
   std::string paren(const std::string& s) const { return latex_ ? "\\left(" + s + "\\right)" : "(" + s + ")"; }
 
   // A whole expression (not simplified here).
-  std::string expression(const ex& e) const {
-    std::vector<Printed> terms;
-    if (GiNaC::is_a<GiNaC::add>(e)) {
-      for (std::size_t i = 0; i < e.nops(); ++i) terms.push_back(term(e.op(i)));
-      sort(terms);
-    } else {
-      terms.push_back(term(e));
-    }
-    return joined(terms);
-  }
+  std::string expression(const ex& e) const { return joined(terms_of(e)); }
 
   // Sum of coefficient * symbol, in the given order, followed by the terms of `rest`.
   std::string combination(const std::vector<std::pair<ex, std::string>>& products, const ex& rest) const {
@@ -185,14 +169,10 @@ class EquationPrinter {
         p.text += " " + name;
       terms.push_back(p);
     }
-    std::vector<Printed> others;
-    if (GiNaC::is_a<GiNaC::add>(rest)) {
-      for (std::size_t i = 0; i < rest.nops(); ++i) others.push_back(term(rest.op(i)));
-      sort(others);
-    } else if (!rest.is_zero()) {
-      others.push_back(term(rest));
+    if (!rest.is_zero()) {
+      const std::vector<Printed> others = terms_of(rest);
+      terms.insert(terms.end(), others.begin(), others.end());
     }
-    terms.insert(terms.end(), others.begin(), others.end());
     return joined(terms);
   }
 
@@ -216,23 +196,45 @@ class EquationPrinter {
     return out;
   }
 
-  std::tuple<int, int, std::string> factor_key(const Factor& f) const {
-    const ex& base = f.base;
-    std::string key = canonical_key(base) + "^" + canonical_key(f.exponent);
+  // The terms of e (one unless e is a sum), printed and sorted. Terms that print alike apart from
+  // their coefficient are merged: GiNaC keeps x (a - b) and x (b - a) apart, the printer does not.
+  std::vector<Printed> terms_of(const ex& e) const {
+    std::vector<Printed> out;
+    if (!GiNaC::is_a<GiNaC::add>(e)) {
+      out.push_back(term(e));
+      return out;
+    }
+    std::map<std::pair<std::vector<std::string>, std::vector<std::string>>, GiNaC::numeric> merged;
+    for (std::size_t i = 0; i < e.nops(); ++i) {
+      TermText t = decompose(e.op(i));
+      auto [it, fresh] = merged.try_emplace({std::move(t.up), std::move(t.down)}, t.coefficient);
+      if (!fresh) it->second += t.coefficient;
+    }
+    for (const auto& [factors, coefficient] : merged)
+      if (!coefficient.is_zero()) out.push_back(render({coefficient, factors.first, factors.second}));
+    sort(out);
+    return out;
+  }
+
+  Printed term(const ex& e) const { return render(decompose(e)); }
+
+  // Where a factor goes among the others: parameters, constants, functions, coordinates, ... by
+  // the table of names, then by its text.
+  std::pair<int, int> factor_rank(const ex& base) const {
     if (GiNaC::is_a<GiNaC::symbol>(base)) {
       const auto it = symbols_.find(GiNaC::ex_to<GiNaC::symbol>(base).get_name());
-      if (it != symbols_.end()) return {it->second.category, it->second.order, key};
-      return {7, 0, key};
+      if (it != symbols_.end()) return {it->second.category, it->second.order};
+      return {7, 0};
     }
-    if (GiNaC::is_a<GiNaC::constant>(base)) return {1, 0, key};
-    if (GiNaC::is_a<GiNaC::function>(base)) return {2, 0, key};
-    if (GiNaC::is_a<GiNaC::add>(base)) return {9, 0, key};
-    return {8, 0, key};
+    if (GiNaC::is_a<GiNaC::constant>(base)) return {1, 0};
+    if (GiNaC::is_a<GiNaC::function>(base)) return {2, 0};
+    if (GiNaC::is_a<GiNaC::add>(base)) return {9, 0};
+    return {8, 0};
   }
 
   // sin(u)^p / cos(u)^r -> tan(u)^min(p, r) ... (and the hyperbolic ones), for display only.
-  static void fold_tangents(std::vector<std::pair<ex, ex>>& factors, const char* s, const char* c,
-                            ex (*tangent)(const ex&)) {
+  void fold_tangents(std::vector<std::pair<ex, ex>>& factors, const char* s, const char* c,
+                     ex (*tangent)(const ex&)) const {
     const auto named = [](const ex& e, const char* name) {
       return GiNaC::is_a<GiNaC::function>(e) && GiNaC::ex_to<GiNaC::function>(e).get_name() == name;
     };
@@ -244,7 +246,8 @@ class EquationPrinter {
       if (!named(up, s) || !integer(p) || !GiNaC::ex_to<GiNaC::numeric>(p).is_positive()) continue;
       for (auto& [down, r] : factors) {
         if (!named(down, c) || !integer(r) || !GiNaC::ex_to<GiNaC::numeric>(r).is_negative()) continue;
-        if (canonical_key(up.op(0)) != canonical_key(down.op(0))) continue;
+        // The same argument as printed: GiNaC may hold one sum in two signs.
+        if (!up.op(0).is_equal(down.op(0)) && expression(up.op(0)) != expression(down.op(0))) continue;
         const GiNaC::numeric m = std::min(GiNaC::ex_to<GiNaC::numeric>(p), -GiNaC::ex_to<GiNaC::numeric>(r));
         added.emplace_back(tangent(up.op(0)), m);
         p = p - m;
@@ -260,8 +263,8 @@ class EquationPrinter {
   static ex make_tan(const ex& u) { return GiNaC::tan(u); }
   static ex make_tanh(const ex& u) { return GiNaC::tanh(u); }
 
-  Term decompose(const ex& e) const {
-    Term t;
+  TermText decompose(const ex& e) const {
+    TermText t;
     std::vector<std::pair<ex, ex>> factors;
     const auto add_factor = [&](const ex& f) {
       if (GiNaC::is_a<GiNaC::numeric>(f))
@@ -275,30 +278,69 @@ class EquationPrinter {
       for (std::size_t i = 0; i < e.nops(); ++i) add_factor(e.op(i));
     else
       add_factor(e);
+    // cos(-x) = cos(x), sin(-x)^n = (-1)^n sin(x)^n: GiNaC keeps the sign of a negated argument
+    // (the bicycle's rotation by -lambda gives cos(-lambda) cos(lambda)).
     for (auto& [base, exponent] : factors) {
-      if (!GiNaC::is_a<GiNaC::add>(base) || !GiNaC::is_a<GiNaC::numeric>(exponent)) continue;
-      const GiNaC::numeric n = GiNaC::ex_to<GiNaC::numeric>(exponent);
-      if (!n.is_integer() || !leads_negative(base)) continue;
-      base = GiNaC::expand(-base);
-      if (n.is_odd()) t.coefficient = -t.coefficient;
+      if (!GiNaC::is_a<GiNaC::function>(base) || base.nops() != 1) continue;
+      const ex& argument = base.op(0);
+      if (GiNaC::is_a<GiNaC::add>(argument) || !split_coefficient(argument).first.is_negative()) continue;
+      const int parity = function_parity(GiNaC::ex_to<GiNaC::function>(base).get_name());
+      const bool integer =
+          GiNaC::is_a<GiNaC::numeric>(exponent) && GiNaC::ex_to<GiNaC::numeric>(exponent).is_integer();
+      if (parity == 0 || (parity < 0 && !integer)) continue;
+      if (parity < 0 && GiNaC::ex_to<GiNaC::numeric>(exponent).is_odd()) t.coefficient = -t.coefficient;
+      base = GiNaC::function(GiNaC::ex_to<GiNaC::function>(base).get_serial(), -argument);
     }
+    // Like factors (cos(lambda) cos(lambda) after the above) become one power.
+    for (std::size_t i = 0; i < factors.size(); ++i) {
+      for (std::size_t j = i + 1; j < factors.size();) {
+        auto& [base, exponent] = factors[i];
+        if (GiNaC::is_a<GiNaC::numeric>(exponent) && GiNaC::is_a<GiNaC::numeric>(factors[j].second) &&
+            base.is_equal(factors[j].first)) {
+          exponent = exponent + factors[j].second;
+          factors.erase(factors.begin() + static_cast<std::ptrdiff_t>(j));
+        } else {
+          ++j;
+        }
+      }
+    }
+    factors.erase(std::remove_if(factors.begin(), factors.end(), [](const auto& f) { return f.second.is_zero(); }),
+                  factors.end());
     // Folding the tangent back is skipped for expressions with an explicit tan left in them.
     fold_tangents(factors, "sin", "cos", &make_tan);
     fold_tangents(factors, "sinh", "cosh", &make_tanh);
+    struct Placed {
+      std::pair<int, int> rank;
+      std::string text;
+      bool operator<(const Placed& o) const { return rank != o.rank ? rank < o.rank : text < o.text; }
+    };
+    std::vector<Placed> up, down;
     for (const auto& [base, exponent] : factors) {
-      if (GiNaC::is_a<GiNaC::numeric>(exponent) && GiNaC::ex_to<GiNaC::numeric>(exponent).is_negative())
-        t.denominator.push_back({base, -exponent});
-      else
-        t.numerator.push_back({base, exponent});
+      const bool below =
+          GiNaC::is_a<GiNaC::numeric>(exponent) && GiNaC::ex_to<GiNaC::numeric>(exponent).is_negative();
+      const ex power = below ? ex(-exponent) : exponent;
+      std::optional<std::string> sum;
+      if (GiNaC::is_a<GiNaC::add>(base) && GiNaC::is_a<GiNaC::numeric>(power) &&
+          GiNaC::ex_to<GiNaC::numeric>(power).is_integer()) {
+        // (b - a)^n = (-1)^n (a - b)^n: the sign whose first printed term is positive.
+        std::vector<Printed> terms = terms_of(base);
+        if (!terms.empty() && terms[0].negative) {
+          for (Printed& p : terms) p.negative = !p.negative;
+          sort(terms);
+          if (GiNaC::ex_to<GiNaC::numeric>(power).is_odd()) t.coefficient = -t.coefficient;
+        }
+        sum = joined(terms);
+      }
+      (below ? down : up).push_back({factor_rank(base), factor(base, power, sum ? &*sum : nullptr)});
     }
-    const auto by_key = [this](const Factor& a, const Factor& b) { return factor_key(a) < factor_key(b); };
-    std::sort(t.numerator.begin(), t.numerator.end(), by_key);
-    std::sort(t.denominator.begin(), t.denominator.end(), by_key);
+    std::sort(up.begin(), up.end());
+    std::sort(down.begin(), down.end());
+    for (Placed& p : up) t.up.push_back(std::move(p.text));
+    for (Placed& p : down) t.down.push_back(std::move(p.text));
     return t;
   }
 
-  Printed term(const ex& e) const {
-    const Term t = decompose(e);
+  Printed render(const TermText& t) const {
     Printed out;
     GiNaC::numeric c = t.coefficient;
     if (c.is_real() && c.is_negative()) {
@@ -317,8 +359,8 @@ class EquationPrinter {
     } else {
       up.push_back(number(c));
     }
-    for (const Factor& f : t.numerator) up.push_back(factor(f));
-    for (const Factor& f : t.denominator) down.push_back(factor(f));
+    up.insert(up.end(), t.up.begin(), t.up.end());
+    down.insert(down.end(), t.down.begin(), t.down.end());
     const std::string top = up.empty() ? "1" : join(up, " ");
     out.fraction = !down.empty();
     if (down.empty())
@@ -334,12 +376,12 @@ class EquationPrinter {
     return GiNaC::is_a<GiNaC::numeric>(e) && GiNaC::ex_to<GiNaC::numeric>(e) == GiNaC::numeric(p, q);
   }
 
-  std::string factor(const Factor& f) const {
-    const ex& base = f.base;
-    const ex& exponent = f.exponent;
-    if (is_number(exponent, 1)) return atom(base);
+  // base^exponent; `sum`, when given, is the base (a sum) already printed.
+  std::string factor(const ex& base, const ex& exponent, const std::string* sum = nullptr) const {
     if (is_number(exponent, 1, 2))
       return latex_ ? "\\sqrt{" + expression(base) + "}" : "sqrt(" + expression(base) + ")";
+    const std::string base_atom = sum ? paren(*sum) : atom(base);
+    if (is_number(exponent, 1)) return base_atom;
     const bool integer =
         GiNaC::is_a<GiNaC::numeric>(exponent) && GiNaC::ex_to<GiNaC::numeric>(exponent).is_pos_integer();
     std::string power;
@@ -357,7 +399,7 @@ class EquationPrinter {
       if (const std::string command = latex_operator(name); !command.empty())
         return command + "^{" + power + "}" + latex_argument(base.op(0));
     }
-    return latex_ ? atom(base) + "^{" + power + "}" : atom(base) + "^" + power;
+    return latex_ ? base_atom + "^{" + power + "}" : base_atom + "^" + power;
   }
 
   // A base or factor: symbols, constants, functions and positive numbers as they are, anything
