@@ -466,9 +466,8 @@ std::string write_model_report(const Model& model, const symbolic::Spec* spec, c
     input.parameters = model.parameters;
     input.path = spec->path;
     const symbolic::Derivation derivation = symbolic::derive(*spec);
-    // Laying out the equations simplifies every term, which takes a bicycle over a minute for
-    // pages the page would not show: terms whose plain printing already exceeds the limit are
-    // left out before that.
+    // Terms whose plain printing already exceeds the limit are left out before they are printed
+    // and simplified for nothing: the page would not show them.
     std::ostringstream raw;
     raw << derivation.A << derivation.Q << derivation.G << derivation.b << derivation.b0;
     if (raw.str().size() > options.max_equations)
