@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
 #include "nhdyn/core/error.hpp"
@@ -34,6 +35,50 @@ std::size_t nearest(const Eigenvalues& e, std::complex<double> target) {
   for (std::size_t i = 1; i < e.size(); ++i)
     if (std::abs(e[i] - target) < std::abs(e[best] - target)) best = i;
   return best;
+}
+
+// One eigenvalue of a state matrix followed along the parameter by its eigenvector: the nearest
+// value is not enough where another eigenvalue lies on the path (the bicycle's forward speed adds
+// an eigenvalue 0 at every speed, which the capsize eigenvalue passes as it crosses zero).
+struct Mode {
+  std::complex<double> value;
+  Eigen::VectorXcd vector;  // unit length
+};
+
+// The eigenpairs of s (eigenvalues as Linearization computes them: the same solver on the same matrix).
+std::vector<Mode> modes_of(const Matrix& s) {
+  const Eigen::EigenSolver<Matrix> eigen(s, true);
+  std::vector<Mode> out;
+  for (Eigen::Index j = 0; j < s.rows(); ++j) out.push_back({eigen.eigenvalues()(j), eigen.eigenvectors().col(j).normalized()});
+  return out;
+}
+
+// The mode of s whose eigenvector is most nearly parallel to `previous`'s. Near a multiple
+// eigenvalue (a Jordan block, where a real pair turns into a complex one) the eigenvectors of the
+// modes involved become parallel and say nothing: when a second mode is nearly as parallel, the
+// nearest value decides. A pair's two members have conjugate eigenvectors, which need not be far
+// apart: a mode off the real axis (beyond `uncertainty`) is followed on its own side of it.
+Mode follow_mode(const Matrix& s, const Mode& previous, double uncertainty) {
+  const std::vector<Mode> modes = modes_of(s);
+  const int side = std::abs(previous.value.imag()) > uncertainty ? (previous.value.imag() > 0.0 ? 1 : -1) : 0;
+  std::size_t best = modes.size(), nearest_value = modes.size();
+  double best_overlap = -1.0, second_overlap = -1.0;
+  for (std::size_t j = 0; j < modes.size(); ++j) {
+    if (side != 0 && modes[j].value.imag() * side < 0.0) continue;
+    if (nearest_value == modes.size() ||
+        std::abs(modes[j].value - previous.value) < std::abs(modes[nearest_value].value - previous.value))
+      nearest_value = j;
+    const double overlap = std::abs(modes[j].vector.dot(previous.vector));
+    if (overlap > best_overlap) {
+      second_overlap = best_overlap;
+      best_overlap = overlap;
+      best = j;
+    } else {
+      second_overlap = std::max(second_overlap, overlap);
+    }
+  }
+  if (best == modes.size()) return previous;
+  return modes[second_overlap > 0.9 * best_overlap ? nearest_value : best];
 }
 
 }  // namespace
@@ -102,9 +147,11 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
   check_sweep_options(options);
   Sweep out;
   LinearizationOptions lin = options.linearization;
-  const auto at = [&](double value) -> SweepPoint {
+  // The point at `value`; its state matrix too when `state_matrix` is given.
+  const auto at = [&](double value, Matrix* state_matrix = nullptr) -> SweepPoint {
     try {
       const Linearization l = calc_linearization(model_at(value), lin);
+      if (state_matrix != nullptr) *state_matrix = l.state_matrix;
       SweepPoint p;
       p.value = value;
       p.eigenvalues = l.eigenvalues;
@@ -163,19 +210,25 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
     }
     std::complex<double> crossing = k < unstable_side.eigenvalues.size() ? unstable_side.eigenvalues[k] : 0.0;
     // 2. For a simple eigenvalue, the count's threshold is not the crossing: follow that
-    // eigenvalue to where its real part is certainly negative, then bisect on the sign of its
-    // real part (the capsize speed to round-off, not to r_1 / slope). A real part that never
-    // becomes certainly negative (a pair going onto the imaginary axis) keeps step 1's bracket.
+    // eigenvalue (by its eigenvector) to where its real part is certainly negative, then bisect
+    // on the sign of its real part (the capsize speed to round-off, not to r_1 / slope). A real
+    // part that never becomes certainly negative (a pair going onto the imaginary axis) keeps
+    // step 1's bracket.
     if (k < unstable_side.eigenvalues.size()) {
+      Matrix s;
+      at(rising ? b : a, &s);
+      Mode start{crossing, {}};
+      for (const Mode& m : modes_of(s))
+        if (start.vector.size() == 0 || std::abs(m.value - crossing) < std::abs(start.value - crossing)) start = m;
       const double width = std::max(b - a, ulp_scale * std::max(1.0, std::abs(a)));
       double stable_end = rising ? a : b;
-      std::complex<double> follow = crossing;
+      Mode follow = start;
       bool found = false;
       for (double step = width; step <= hi.value - lo.value; step *= 2.0) {
         const double probe = rising ? std::max(lo.value, a - step) : std::min(hi.value, b + step);
-        const SweepPoint p = at(probe);
-        const std::size_t j = nearest(p.eigenvalues, follow);
-        follow = p.eigenvalues[j];
+        const SweepPoint p = at(probe, &s);
+        follow = follow_mode(s, follow, unstable_side.uncertainty[k]);
+        const std::size_t j = nearest(p.eigenvalues, follow.value);
         if (p.eigenvalues[j].real() < -p.uncertainty[j]) {
           stable_end = probe;
           found = true;
@@ -185,20 +238,21 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
       }
       if (found) {
         double neg = stable_end, pos = rising ? b : a;
-        std::complex<double> track = crossing;
+        Mode track = start;
         for (int iter = 0; iter < 200 && std::abs(pos - neg) > ulp_scale * std::max(1.0, std::abs(neg)); ++iter) {
           const double mid = 0.5 * (neg + pos);
           if (mid == neg || mid == pos) break;
-          const SweepPoint p = at(mid);
-          const std::size_t j = nearest(p.eigenvalues, track);
+          const SweepPoint p = at(mid, &s);
+          const Mode next = follow_mode(s, track, unstable_side.uncertainty[k]);
+          const std::size_t j = nearest(p.eigenvalues, next.value);
           // Joined to a cluster (a multiple eigenvalue there), its sign is round-off: the
           // bracket so far is all the conditioning supports.
           const double simple = *std::min_element(p.uncertainty.begin(), p.uncertainty.end());
           if (p.uncertainty[j] > simple) break;
-          track = p.eigenvalues[j];
-          (track.real() > 0.0 ? pos : neg) = mid;
+          track = next;
+          (track.value.real() > 0.0 ? pos : neg) = mid;
         }
-        crossing = track;
+        crossing = track.value;
         a = std::min(neg, pos);
         b = std::max(neg, pos);
       }

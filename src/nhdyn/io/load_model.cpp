@@ -49,8 +49,8 @@ symbolic::Spec load_spec(const ModelSource& source, const ParameterOverrides& ov
 void require_file(const ModelSource& source, const char* what) {
   if (source.is_builtin()) {
     const std::string file = source.builtin == "sled-paper" ? "sled_paper" : source.builtin;
-    throw InputError(fmt::format("'{}' is a built-in model written in C++, with fixed parameters and no symbolic "
-                                 "form, so it has no {}; use its model file instead: examples/{}.toml",
+    throw InputError(fmt::format("'{}' is a built-in model written in C++, with no symbolic form, so it has "
+                                 "no {}; use its model file instead: examples/{}.toml",
                                  source.builtin, what, file));
   }
 }
@@ -120,7 +120,10 @@ std::vector<Model> load_model_variants(const ModelSource& source, const Paramete
 std::vector<std::pair<std::string, double>> model_parameters(const ModelSource& source,
                                                              const ParameterOverrides& overrides) {
   std::vector<std::pair<std::string, double>> out;
-  if (source.is_builtin()) return out;
+  if (source.is_builtin()) {
+    for (const Parameter& p : load_model(source, overrides).parameters) out.emplace_back(p.name, p.value);
+    return out;
+  }
   const symbolic::Spec spec = load_spec(source, overrides);
   for (const symbolic::SpecParameter& p : spec.parameters) out.emplace_back(p.name, p.value);
   return out;
@@ -137,14 +140,15 @@ std::string model_equations(const ModelSource& source, const ParameterOverrides&
 
 Sweep sweep_model_parameter(const ModelSource& source, const ParameterOverrides& overrides,
                             const SweepOptions& options) {
-  require_file(source, "parameter to sweep");
   check_sweep_options(options);
-  symbolic::Spec spec = load_spec(source, overrides);
-  spec.set_parameter(options.parameter, options.from);  // an unknown name throws, naming the nearest
-  const symbolic::Derivation derivation = symbolic::derive(spec);
+  // Parameters are data: one model (a file's compiled once, or a built-in one), re-bound at every
+  // point.
+  Model base = load_model(source, overrides);
+  set_parameter(base, options.parameter, options.from);  // an unknown name throws, naming the nearest
   const ModelAtValue model_at = [&](double value) {
-    spec.set_parameter(options.parameter, value);
-    return symbolic::compile_model(spec, derivation);
+    Model model = base;
+    set_parameter(model, options.parameter, value);
+    return model;
   };
   return calc_eigenvalue_sweep(model_at, options);
 }

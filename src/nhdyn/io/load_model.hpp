@@ -60,8 +60,8 @@ std::vector<Model> load_model_variants(const ModelSource& source, const Paramete
                                        const std::vector<std::string>& names,
                                        const std::vector<std::vector<double>>& values);
 
-// The names of the parameters of a model file in file order, with their values after the
-// overrides (empty for a built-in model: its parameters are fixed).
+// The names of the parameters of a model (a model file's in file order), with their values after
+// the overrides.
 std::vector<std::pair<std::string, double>> model_parameters(const ModelSource& source,
                                                              const ParameterOverrides& overrides = {});
 
@@ -72,7 +72,7 @@ enum class EquationsFormat { text, latex };
 std::string model_equations(const ModelSource& source, const ParameterOverrides& overrides, EquationsFormat format);
 
 // The eigenvalue sweep of the model's linearization against one parameter (analysis/sweep.hpp);
-// options.parameter names it. A built-in model is refused (its parameters are fixed).
+// options.parameter names it. The model is loaded once and its parameter set at every point.
 Sweep sweep_model_parameter(const ModelSource& source, const ParameterOverrides& overrides,
                             const SweepOptions& options);
 
