@@ -28,6 +28,7 @@ struct CompareArgs {
   std::string model;
   std::string reference = "tight";
   std::vector<std::string> methods{"sanh", "lagrange", "udwadia-kalaba", "nullspace"};
+  bool methods_given = false;  // --methods on the command line (else the list above)
   std::vector<std::string> integrators{"dopri5"};
   std::string complement = "qr";
   std::optional<double> t_end;
@@ -69,7 +70,23 @@ int run_compare(const CompareArgs& args) {
   options.run.integrator.rtol = args.rtol.value_or(model.defaults.rtol);
   options.run.integrator.atol = args.atol.value_or(model.defaults.atol);
   options.run.stabilization = parse_stabilization(args.stabilize);
-  for (const std::string& m : args.methods)
+  // Programs are solved by sanh alone: by default it is then the one method compared, with a note;
+  // another one asked for by name is refused.
+  std::vector<std::string> methods = args.methods;
+  if (model.m() > 0) {
+    for (const std::string& m : methods)
+      if (args.methods_given && parse_method(m) != Method::sanh)
+        throw InputError(fmt::format("--methods {}: model '{}' has programs ([[programs]]), which only the sanh "
+                                     "formulation solves; give --methods sanh (and --integrators to compare "
+                                     "integrators)",
+                                     m, model.name));
+    if (!args.methods_given) {
+      methods = {"sanh"};
+      fmt::print(stderr, "nhdyn: note: model '{}' has programs, which only sanh solves: comparing sanh alone "
+                         "(--integrators compares integrators)\n", model.name);
+    }
+  }
+  for (const std::string& m : methods)
     for (const std::string& i : args.integrators) options.cases.push_back({parse_method(m), parse_integrator(i)});
 
   namespace fs = std::filesystem;
@@ -177,7 +194,10 @@ std::function<int()> add_compare_command(CLI::App& app) {
   cmd->add_option("MODEL", args->model, "A model file (.toml) or a built-in model (see `nhdyn list`)")->required();
   cmd->add_option("--reference", args->reference, "tight (a run at rtol 1e-13) | analytic (the model's)")
       ->capture_default_str();
-  cmd->add_option("--methods", args->methods, "Formulations, comma-separated")->delimiter(',')->capture_default_str();
+  cmd->add_option("--methods", args->methods, "Formulations, comma-separated (a model with programs: sanh alone)")
+      ->delimiter(',')
+      ->capture_default_str()
+      ->each([args](const std::string&) { args->methods_given = true; });
   cmd->add_option("--integrators", args->integrators,
                   "Integrators, comma-separated: rk4, dopri5, dop853, cvode-bdf, cvode-adams")
       ->delimiter(',')

@@ -12,6 +12,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
+
 #include "support/cli_run.hpp"
 #include "support/text.hpp"
 
@@ -24,6 +26,7 @@ using Outcome = nhdyn::test::CliOutcome;
 using nhdyn::test::run_nhdyn;
 
 using nhdyn::test::example;
+using nhdyn::test::split;
 
 // A point mass in the plane with a program on each coordinate; `extra` goes at the end.
 std::string plane_model(const std::string& programs, const std::string& constraints = "") {
@@ -62,6 +65,38 @@ TEST_F(ProgramCli, WritesTheActuatorForcesAndProgramResiduals) {
             std::string::npos)
       << header;
   EXPECT_NE(run.out.find("programs: 1, max residual: position"), std::string::npos) << run.out;
+}
+
+// compare: programs are solved by sanh alone, so by default it is the one method run (with a
+// note), against the tight reference; another method asked for by name is refused, nothing written.
+TEST_F(ProgramCli, CompareRunsSanhAloneAndRefusesAnotherMethodByName) {
+  const Outcome run = run_nhdyn("compare " + example("sled_heading_program.toml") +
+                                    " --t-end 1 --integrators dopri5,dop853 -q -o table.csv",
+                                dir_);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("comparing sanh alone"), std::string::npos) << run.out;
+  std::istringstream table(read("table.csv"));
+  std::string header, line;
+  std::getline(table, header);
+  const auto columns = split(header);
+  const std::size_t error_q = static_cast<std::size_t>(
+      std::find(columns.begin(), columns.end(), "max_error_q") - columns.begin());
+  ASSERT_LT(error_q, columns.size()) << header;
+  std::vector<std::string> cases;
+  while (std::getline(table, line)) {
+    const auto cells = split(line);
+    cases.push_back(cells[0] + "," + cells[1]);
+    // rtol 1e-8 against the reference at 1e-13.
+    EXPECT_LT(std::stod(cells[error_q]), 1e-6) << line;
+  }
+  EXPECT_EQ(cases, (std::vector<std::string>{"sanh,dopri5", "sanh,dop853"}));
+
+  const Outcome refused =
+      run_nhdyn("compare " + example("sled_heading_program.toml") + " --methods sanh,lagrange -o other.csv", dir_);
+  EXPECT_EQ(refused.exit_code, 2) << refused.out;
+  EXPECT_NE(refused.out.find("--methods lagrange"), std::string::npos) << refused.out;
+  EXPECT_NE(refused.out.find("give --methods sanh"), std::string::npos) << refused.out;
+  EXPECT_FALSE(fs::exists(dir_ / "other.csv"));
 }
 
 TEST_F(ProgramCli, BatchRunFilesCarryTheActuatorForcesAsSimulateDoes) {
