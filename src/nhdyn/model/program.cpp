@@ -643,6 +643,13 @@ ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, con
           step = Step{Op::mulk_add, 0, to, first ? step.b : step.a, step.c, 0, value[at(first ? step.a : step.b)]};
         }
         break;
+      case Op::mulsub:
+        // c - k x = (-k) x + c: the negation is exact, and a - b is a + (-b) in IEEE arithmetic.
+        if (is_known(step.a) || is_known(step.b)) {
+          const bool first = is_known(step.a);
+          step = Step{Op::mulk_add, 0, to, first ? step.b : step.a, step.c, 0, -value[at(first ? step.a : step.b)]};
+        }
+        break;
       default:
         break;
     }
@@ -678,6 +685,28 @@ ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, con
       live[at(operands[k])] = 1;
       ++readers[at(operands[k])];
     }
+  }
+
+  // A product a * b (or a * a) read only by a k * x or k * x + c that follows becomes part of it:
+  // k * (a * b) is mulk, k * (a * b) + c mulk_muladd, which round exactly as the two steps did.
+  // A parameter times a product of the state, c * p * (a * b) with c * p in the parameter stage,
+  // then costs one step, as it did when parameters were numbers in the program.
+  std::vector<int> producer(registers, -1);
+  for (std::size_t i = 0; i < steps.size(); ++i)
+    if (keep[i]) producer[at(steps[i].to)] = static_cast<int>(i);
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    Step& step = steps[i];
+    if (!keep[i] || (step.op != Op::mul_k && step.op != Op::mulk_add)) continue;
+    const int j = producer[at(step.a)];
+    if (j < 0 || readers[at(step.a)] != 1 || !wants[at(step.a)].empty()) continue;
+    const Step& product = steps[static_cast<std::size_t>(j)];
+    if (product.op != Op::mul && product.op != Op::square) continue;
+    const int a = product.a, b = product.op == Op::square ? product.a : product.b;
+    if (step.op == Op::mul_k)
+      step = Step{Op::mulk, 0, step.to, a, b, 0, step.k};
+    else
+      step = Step{Op::mulk_muladd, 0, step.to, a, b, step.b, step.k};
+    keep[static_cast<std::size_t>(j)] = 0;
   }
 
   // Each step in place: an output computed once for all is written where it goes; a copy (1 * x,
