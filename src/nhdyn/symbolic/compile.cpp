@@ -4,7 +4,9 @@
 // the Model's current values (so a parameter changes without recompiling). The constants (pi) are
 // made numeric, and in a product the factors that depend on parameters only are gathered into one
 // subexpression, which the evaluator computes once per parameter change (its parameter stage)
-// instead of at every call. Each expression is first translated into a canonical form of our own
+// instead of at every call; terms of a sum that differ only in such factors are merged into one,
+// (c1 p1 + c2 p2) s, as a computer algebra system merges them once the parameters are numbers, so
+// that a call costs what it cost when parameters were literals. Each expression is first translated into a canonical form of our own
 // (below: sorted operands, sums of canonical sign, every distinct subexpression one node), which
 // does not depend on GiNaC's internal term order or sign choices (they follow addresses, which
 // change from process to process); the program is emitted from that form, every subexpression
