@@ -2,10 +2,13 @@
 // same terms and the same q'' to round-off on every example model (dense and sparse), after a
 // parameter change too; the cache reused by a second build; and the failures it must survive (no
 // compiler, a corrupt cache entry) turned into a clear error or, under `auto`, the interpreter.
+// The reference of both: the interpreter's prepared terms (constants folded, steps fused and
+// reordered, model/program.hpp) equal their program run instruction by instruction, to the bit.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <cstring>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +22,7 @@
 #include "nhdyn/jit/compiled_evaluator.hpp"
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/model/parameters.hpp"
+#include "nhdyn/model/program.hpp"
 
 namespace nhdyn::jit {
 namespace {
@@ -232,6 +236,38 @@ TEST_F(Jit, HandWrittenModelsHaveNothingToCompile) {
   EXPECT_TRUE(notice.empty()) << notice;
   EXPECT_FALSE(is_compiled(with_evaluator(model, EvaluatorChoice::compiled, &notice, options_)));
   EXPECT_NE(notice.find("nothing to compile"), std::string::npos) << notice;
+}
+
+TEST(Interpreter, PreparedTermsOfEveryExampleAreItsProgramToTheBit) {
+  for (const char* file : {"knife_edge.toml", "chaplygin_sleigh.toml", "double_pendulum.toml", "slider_crank.toml",
+                           "rolling_disk.toml", "diff_drive.toml", "whipple_bicycle.toml"}) {
+    SCOPED_TRACE(file);
+    const Model model = load_model(example(file));
+    const auto& evaluator = dynamic_cast<const ProgramEvaluator&>(*model.evaluator);
+    const Program& program = evaluator.programs().terms;  // bound to the parameters
+    ASSERT_FALSE(evaluator.programs().sparsity.has_value());
+    const int n = model.n(), s = model.s();
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> d(-0.5, 0.5);
+    for (int trial = 0; trial < 3; ++trial) {
+      std::vector<double> q(static_cast<std::size_t>(n)), v(static_cast<std::size_t>(n));
+      for (int i = 0; i < n; ++i) {
+        q[static_cast<std::size_t>(i)] = model.q0[i] + d(random);
+        v[static_cast<std::size_t>(i)] = model.v0[i] + d(random);
+      }
+      const double t = 0.7 * trial;
+      std::vector<double> registers(static_cast<std::size_t>(program.registers()));
+      std::vector<double> expected(static_cast<std::size_t>(program.outputs()));
+      program.run(t, q.data(), v.data(), registers.data(), expected.data());
+      std::vector<double> got(expected.size(), -7.0), scratch(evaluator.scratch_size());
+      double* p = got.data();
+      evaluator.terms(t, q.data(), v.data(), scratch.data(),
+                      TermsOut{p, p + n * n, p + n * n + n, p + n * n + 2 * n, p + n * n + 2 * n + s * n});
+      for (std::size_t k = 0; k < got.size(); ++k)
+        ASSERT_EQ(std::memcmp(&got[k], &expected[k], sizeof(double)), 0)
+            << "output " << k << ", trial " << trial << ": " << got[k] << " != " << expected[k];
+    }
+  }
 }
 
 TEST(EvaluatorChoice, Parses) {

@@ -391,6 +391,40 @@ TEST(ProgramEvaluator, ComputesParameterOnlySubexpressionsOnce) {
   EXPECT_EQ(got[4], std::sqrt(2.0) * m);
 }
 
+TEST(ProgramEvaluator, AProductUnderAConstantFactorIsOneStep) {
+  // k = sqrt(2) m, a parameter stage: k (q0 q1), k (q0 v1) + v0, v1 - k q1 and k (q1 q1) + q0
+  // cost one step each (mulk, mulk_muladd, mulk_add, mulk_muladd), rounding as the program does.
+  ModelPrograms programs{Program(2), std::nullopt, Program(2), Program(2), std::nullopt, std::nullopt, std::nullopt};
+  Program& p = programs.terms;
+  const int q0 = p.coordinate_register(0), q1 = p.coordinate_register(1);
+  const int v0 = p.velocity_register(0), v1 = p.velocity_register(1);
+  const int k = p.push(Op::mul, p.push(Op::sqrt, p.push_constant(2.0)), p.push_constant(1.3));
+  const int a = p.push(Op::mul, k, p.push(Op::mul, q0, q1));
+  const int b = p.push(Op::muladd, k, p.push(Op::mul, q0, v1), v0);
+  const int c = p.push(Op::mulsub, q1, k, v1);
+  const int d = p.push(Op::muladd, p.push(Op::square, q1), k, q0);
+  const int shared = p.push(Op::mul, q0, v0);  // read twice: computed once, not fused
+  const int e = p.push(Op::mul, k, shared);
+  const int f = p.push(Op::add, shared, v1);
+  for (const int reg : {a, b, c, d, e, f, a, b, c, d, e}) p.add_output(reg);
+  const ProgramEvaluator evaluator(2, 1, programs);
+  // The four, then q0 v0, k (q0 v0) and q0 v0 + v1, then a clone for each further output (5).
+  EXPECT_EQ(evaluator.terms_operations(), 4 + 3 + 5) << p.describe();
+  std::vector<double> scratch(evaluator.scratch_size());
+  for (const double state : {0.7, -1.9, 3.1e-3}) {
+    const std::vector<double> q{state, 1.0 - state}, v{0.5 * state, -state * state};
+    const std::vector<double> expected = run(p, 0.0, q, v);
+    std::vector<double> got(expected.size(), -7.0);
+    double* const out = got.data();
+    evaluator.terms(0.0, q.data(), v.data(), scratch.data(), TermsOut{out, out + 4, out + 6, out + 8, out + 10});
+    for (std::size_t i = 0; i < expected.size(); ++i)
+      EXPECT_EQ(std::memcmp(&got[i], &expected[i], sizeof(double)), 0) << "output " << i << ": " << got[i];
+    const double K = std::sqrt(2.0) * 1.3;
+    EXPECT_EQ(got[0], K * (q[0] * q[1]));
+    EXPECT_EQ(got[2], v[1] - q[1] * K);
+  }
+}
+
 TEST(ProgramEvaluator, RunsWithoutAllocating) {
   Model model;
   model.name = "polar";

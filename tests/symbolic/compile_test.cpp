@@ -226,9 +226,10 @@ TEST(Compile, CommonSubexpressionsAreComputedOnce) {
   EXPECT_LT(out[1].reg, 0);  // A(y, x) = 0
   EXPECT_EQ(out[1].value, 0.0);
   // What runs per call, the parameters folded: 13 operations when the values were literals in the
-  // program; a parameter coefficient of a product of two state factors now costs one more (no
-  // fused k (a b) + c with a register k), 3 for the sled.
-  EXPECT_LE(programs_of(model).terms_operations(), 16) << terms.describe();
+  // program; a parameter coefficient of a state product, (c p) (a b) + acc, is one mulk_muladd
+  // step as k (a b) + acc was (model/program.hpp), and terms differing only in their parameters
+  // are one term (16 without either).
+  EXPECT_LE(programs_of(model).terms_operations(), 14) << terms.describe();
   // The complement and residuals have their own sin and cos.
   EXPECT_EQ(programs_of(model).programs().complement->count(Op::sincos), 1);
 }
@@ -334,6 +335,61 @@ TEST(Compile, ShapesAndPathAreChecked) {
   built = make_hand_built_sled();
   built.spec.path = std::make_pair(std::string("x"), std::string("w"));
   EXPECT_NE(model_error([&] { compile_model(built.spec, built.derivation); }).find("'w'"), std::string::npos);
+}
+
+// The instructions of `program` that read t, q or q' (directly or through another): what runs at
+// every call once the parameter stage is folded.
+int state_instructions(const Program& program) {
+  std::vector<char> state(static_cast<std::size_t>(program.registers()), 0);
+  for (int r = 0; r < program.inputs(); ++r) state[static_cast<std::size_t>(r)] = 1;
+  int count = 0;
+  const std::vector<Instruction>& code = program.code();
+  for (std::size_t i = 0; i < code.size(); ++i) {
+    const Instruction& in = code[i];
+    const std::size_t reg = static_cast<std::size_t>(program.inputs()) + i;
+    if (in.op == Op::nop) {  // the cosine of a sincos
+      state[reg] = state[reg - 1];
+      continue;
+    }
+    const int operands[3] = {in.a, in.b, in.c};
+    bool reads = false;
+    for (int k = 0; k < operand_count(in.op); ++k) reads = reads || state[static_cast<std::size_t>(operands[k])];
+    state[reg] = reads ? 1 : 0;
+    count += reads ? 1 : 0;
+  }
+  return count;
+}
+
+TEST(Compile, TermsThatDifferOnlyInTheirParametersAreOneTerm) {
+  // m1 s + m2 s + m1 m2 s + r s + 3 s with s = sin(x) cos(x) x' is (m1 + m2 + m1 m2 + r + 3) s: the
+  // coefficient in the parameter stage, s and its product with the coefficient per call (the sum
+  // of the five terms would cost five multiplications and four additions per call).
+  Spec spec;
+  spec.name = "merged";
+  testing::add_coordinate(spec, "x");
+  testing::add_parameter(spec, "m1", 2.0, "");
+  testing::add_parameter(spec, "m2", 3.0, "");
+  testing::add_parameter(spec, "r", 0.25, "");
+  const GiNaC::ex x = spec.symbols.coordinate(0), v = spec.symbols.velocity(0);
+  const GiNaC::ex m1 = spec.symbols.parameter("m1"), m2 = spec.symbols.parameter("m2"), r = spec.symbols.parameter("r");
+  const GiNaC::ex s = GiNaC::sin(x) * GiNaC::cos(x) * v;
+  const GiNaC::ex e = m1 * s + m2 * s + m1 * m2 * s + r * s + 3 * s + m1 * r + m2 + 4 * x;
+  const Program program = compile_expression(spec, e, "merged");
+  // sincos, sin cos, times x', times the coefficient; 4 x plus that; plus m1 r + m2 (one
+  // parameter-stage number).
+  EXPECT_EQ(state_instructions(program), 6) << program.describe();
+  for (const std::vector<double>& values : {std::vector<double>{2.0, 3.0, 0.25}, std::vector<double>{-0.7, 5.5, 1e-3}}) {
+    const Program bound = program.bind(values.data(), values.size());
+    const double M1 = values[0], M2 = values[1], R = values[2];
+    for (const double X : {0.3, -2.1}) {
+      const double V = 1.7 - X;
+      std::vector<double> registers(static_cast<std::size_t>(bound.registers()));
+      double got = 0.0;
+      bound.run(0.0, &X, &V, registers.data(), &got);
+      const double expected = (M1 + M2 + M1 * M2 + R + 3) * std::sin(X) * std::cos(X) * V + M1 * R + M2 + 4 * X;
+      EXPECT_NEAR(got, expected, 1e-14 * (1.0 + std::abs(expected))) << "m1 = " << M1 << ", x = " << X;
+    }
+  }
 }
 
 TEST(Compile, ParameterValuesAreTakenWhenCompiling) {

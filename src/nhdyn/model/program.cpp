@@ -6,7 +6,9 @@
 #include <cstddef>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <memory>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -582,6 +584,57 @@ double fold(const Instruction& in, double a, double b, double c, double* cosine)
   return x[3];
 }
 
+// The steps in an order that makes runs long: each step still comes after the steps whose registers
+// it reads, and among the steps whose operands are ready, one of the op and destination of the
+// previous step comes first (else the earliest in program order). Every step computes what it did,
+// so the values are the same to the bit; only the dispatches, one per run, are fewer (a derived
+// model's sums of products interleave mul, muladd and mulk_add step by step).
+std::vector<Step> schedule(const std::vector<Step>& steps, std::size_t registers) {
+  const std::size_t m = steps.size();
+  std::vector<int> writer(registers, -1);
+  std::vector<int> pending(m, 0);
+  std::vector<std::vector<int>> next(m);
+  for (std::size_t i = 0; i < m; ++i) {
+    const Step& s = steps[i];
+    const int operands[3] = {s.a, s.b, s.c};
+    for (int k = 0; k < operand_count(s.op); ++k) {
+      const int w = writer[static_cast<std::size_t>(operands[k])];
+      if (w < 0) continue;  // an input
+      next[static_cast<std::size_t>(w)].push_back(static_cast<int>(i));
+      ++pending[i];
+    }
+    if (s.dest == 0) {
+      writer[static_cast<std::size_t>(s.to)] = static_cast<int>(i);
+      if (s.op == Op::sincos) writer[static_cast<std::size_t>(s.to) + 1] = static_cast<int>(i);
+    }
+  }
+  std::map<unsigned, std::set<int>> ready_by_key;
+  std::set<int> ready;
+  const auto make_ready = [&](int i) {
+    ready.insert(i);
+    ready_by_key[run_key(&steps[static_cast<std::size_t>(i)])].insert(i);
+  };
+  for (std::size_t i = 0; i < m; ++i)
+    if (pending[i] == 0) make_ready(static_cast<int>(i));
+  std::vector<Step> out;
+  out.reserve(m);
+  unsigned key = ~0u;
+  while (!ready.empty()) {
+    auto same = ready_by_key.find(key);
+    if (same == ready_by_key.end() || same->second.empty()) {
+      key = run_key(&steps[static_cast<std::size_t>(*ready.begin())]);
+      same = ready_by_key.find(key);
+    }
+    const int i = *same->second.begin();
+    same->second.erase(same->second.begin());
+    ready.erase(i);
+    out.push_back(steps[static_cast<std::size_t>(i)]);
+    for (int j : next[static_cast<std::size_t>(i)])
+      if (--pending[static_cast<std::size_t>(j)] == 0) make_ready(j);
+  }
+  return out;
+}
+
 }  // namespace
 
 ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, const std::vector<int>& sizes) {
@@ -643,6 +696,13 @@ ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, con
           step = Step{Op::mulk_add, 0, to, first ? step.b : step.a, step.c, 0, value[at(first ? step.a : step.b)]};
         }
         break;
+      case Op::mulsub:
+        // c - k x = (-k) x + c: the negation is exact, and a - b is a + (-b) in IEEE arithmetic.
+        if (is_known(step.a) || is_known(step.b)) {
+          const bool first = is_known(step.a);
+          step = Step{Op::mulk_add, 0, to, first ? step.b : step.a, step.c, 0, -value[at(first ? step.a : step.b)]};
+        }
+        break;
       default:
         break;
     }
@@ -678,6 +738,28 @@ ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, con
       live[at(operands[k])] = 1;
       ++readers[at(operands[k])];
     }
+  }
+
+  // A product a * b (or a * a) read only by a k * x or k * x + c that follows becomes part of it:
+  // k * (a * b) is mulk, k * (a * b) + c mulk_muladd, which round exactly as the two steps did.
+  // A parameter times a product of the state, c * p * (a * b) with c * p in the parameter stage,
+  // then costs one step, as it did when parameters were numbers in the program.
+  std::vector<int> producer(registers, -1);
+  for (std::size_t i = 0; i < steps.size(); ++i)
+    if (keep[i]) producer[at(steps[i].to)] = static_cast<int>(i);
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    Step& step = steps[i];
+    if (!keep[i] || (step.op != Op::mul_k && step.op != Op::mulk_add)) continue;
+    const int j = producer[at(step.a)];
+    if (j < 0 || readers[at(step.a)] != 1 || !wants[at(step.a)].empty()) continue;
+    const Step& product = steps[static_cast<std::size_t>(j)];
+    if (product.op != Op::mul && product.op != Op::square) continue;
+    const int a = product.a, b = product.op == Op::square ? product.a : product.b;
+    if (step.op == Op::mul_k)
+      step = Step{Op::mulk, 0, step.to, a, b, 0, step.k};
+    else
+      step = Step{Op::mulk_muladd, 0, step.to, a, b, step.b, step.k};
+    keep[static_cast<std::size_t>(j)] = 0;
   }
 
   // Each step in place: an output computed once for all is written where it goes; a copy (1 * x,
@@ -724,6 +806,7 @@ ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, con
     }
     for (std::size_t w = first; w < want.size(); ++w) place(step, want[w].array, want[w].index);
   }
+  p.steps = schedule(p.steps, registers);
   p.steps.push_back(Step{});
   return p;
 }

@@ -203,12 +203,18 @@ struct ModelPrograms {
 // - an instruction whose operands are all constants or parameters becomes a constant, computed by
 //   the interpreter itself so to the same bits (a parameter-only subexpression costs nothing per
 //   call: this is the parameter stage);
-// - a constant operand of add, sub, mul, div or muladd becomes the immediate of add_k, mul_k,
-//   div_k or mulk_add, which round alike;
+// - a constant operand of add, sub, mul, div, muladd or mulsub becomes the immediate of add_k,
+//   mul_k, div_k or mulk_add, which round alike;
+// - a product a * b (or a * a) read only by a k * x or k * x + c becomes part of it, mulk or
+//   mulk_muladd, k * (a * b) [+ c] as before (the compiler emits a parameter coefficient times a
+//   state product as (c p) * s for this);
 // - constant outputs go to an image copied whole before the instructions run; an instruction
 //   whose result is an output and no operand writes the output array itself (a further output of
 //   the same value costs one more instruction: its clone, or a copy 1 * x of an input or sincos);
-// - instructions that no output needs are left out.
+// - instructions that no output needs are left out;
+// - the steps are reordered, each still after the steps it reads, so that steps of one op and
+//   destination follow each other: the interpreter dispatches once per such run (a derived model's
+//   terms interleave mul, muladd and mulk_add step by step; the bicycle's 3963 steps are 215 runs).
 // Programs that call no math library function run in an interpreter without those calls, whose
 // fixed cost per call is lower. The prepared form computes the same values as the programs, to the
 // bit. scratch_size() is the largest register count of the programs.

@@ -4,7 +4,9 @@
 // the Model's current values (so a parameter changes without recompiling). The constants (pi) are
 // made numeric, and in a product the factors that depend on parameters only are gathered into one
 // subexpression, which the evaluator computes once per parameter change (its parameter stage)
-// instead of at every call. Each expression is first translated into a canonical form of our own
+// instead of at every call; terms of a sum that differ only in such factors are merged into one,
+// (c1 p1 + c2 p2) s, as a computer algebra system merges them once the parameters are numbers, so
+// that a call costs what it cost when parameters were literals. Each expression is first translated into a canonical form of our own
 // (below: sorted operands, sums of canonical sign, every distinct subexpression one node), which
 // does not depend on GiNaC's internal term order or sign choices (they follow addresses, which
 // change from process to process); the program is emitted from that form, every subexpression
@@ -266,8 +268,8 @@ class ProgramCompiler {
     return p;
   }
 
-  // offset + sum of the terms, with like terms merged and the sign made canonical.
-  Scaled make_add(std::vector<Scaled> terms, double offset) {
+  // Like terms merged: the same node, coefficients added.
+  std::vector<Scaled> merge_like(std::vector<Scaled> terms) const {
     sort_canonically(terms);
     std::vector<Scaled> merged;
     for (const Scaled& t : terms) {
@@ -278,6 +280,94 @@ class ProgramCompiler {
     }
     merged.erase(std::remove_if(merged.begin(), merged.end(), [](const Scaled& t) { return t.c == 0.0; }),
                  merged.end());
+    return merged;
+  }
+
+  // The terms that differ only in their factors of parameters, c1 p1 s + c2 p2 s, merged into one,
+  // (c1 p1 + c2 p2) s, whose coefficient the parameter stage computes; the terms of parameters only
+  // merged with the offset into one. The program then does per call what it did when parameters were
+  // numbers in the expression (and a computer algebra system merged such terms): a derived inertia
+  // matrix sums each product of sines and cosines over the bodies, each with its own parameters.
+  std::vector<Scaled> merge_parameter_terms(std::vector<Scaled> terms, double& offset) {
+    struct Part {
+      Scaled term;         // as it was
+      Scaled coefficient;  // c p (kOne: no parameter)
+    };
+    std::vector<Scaled> constants;                 // terms of parameters only
+    std::map<int, std::vector<Part>> by_state;     // state part -> its terms
+    std::vector<int> order;                        // state parts in the order of the terms (canonical)
+    bool merges = false;
+    for (const Scaled& t : terms) {
+      const Node& n = node(t.id);
+      if (n.parameters_only) {
+        constants.push_back(t);
+        continue;
+      }
+      Scaled coefficient{t.c, kOne};
+      int state = t.id;
+      if (n.kind == Kind::mul) {
+        std::vector<int> k, rest;
+        for (const Scaled& f : n.items) (node(f.id).parameters_only ? k : rest).push_back(f.id);
+        if (!k.empty()) {
+          coefficient = make_mul(std::move(k), t.c);
+          state = make_mul(std::move(rest), 1.0).id;
+        }
+      }
+      std::vector<Part>& group = by_state[state];
+      if (group.empty())
+        order.push_back(state);
+      else
+        merges = true;
+      group.push_back({t, coefficient});
+    }
+    const bool merge_constants = !constants.empty() && !order.empty() && (constants.size() > 1 || offset != 0.0);
+    if (!merges && !merge_constants) return terms;
+    std::vector<Scaled> out;
+    if (merge_constants) {
+      const Scaled c = make_add(std::move(constants), offset);
+      offset = 0.0;
+      if (c.id == kOne)
+        offset = c.c;
+      else
+        out.push_back(c);
+    } else {
+      out.insert(out.end(), constants.begin(), constants.end());
+    }
+    for (int state : order) {
+      const std::vector<Part>& group = by_state[state];
+      if (group.size() == 1) {
+        out.push_back(group[0].term);
+        continue;
+      }
+      std::vector<Scaled> parametric;
+      std::vector<double> numbers;
+      for (const Part& part : group) {
+        if (part.coefficient.id == kOne)
+          numbers.push_back(part.coefficient.c);
+        else
+          parametric.push_back(part.coefficient);
+      }
+      const Scaled c = make_add(std::move(parametric), sum(std::move(numbers)));
+      if (c.c == 0.0) continue;
+      std::vector<int> factors = c.id == kOne ? std::vector<int>{} : factors_of(c.id);
+      for (int f : factors_of(state)) factors.push_back(f);
+      out.push_back(make_mul(std::move(factors), c.c));
+    }
+    return merge_like(std::move(out));
+  }
+
+  // The factors of a node: its items for a product, itself otherwise.
+  std::vector<int> factors_of(int id) const {
+    const Node& n = node(id);
+    if (n.kind != Kind::mul) return {id};
+    std::vector<int> out;
+    for (const Scaled& f : n.items) out.push_back(f.id);
+    return out;
+  }
+
+  // offset + sum of the terms, with like terms merged and the sign made canonical.
+  Scaled make_add(std::vector<Scaled> terms, double offset) {
+    std::vector<Scaled> merged = merge_parameter_terms(merge_like(std::move(terms)), offset);
     if (merged.empty()) return {offset, kOne};
     if (merged.size() == 1 && offset == 0.0) return merged[0];
     const double sign = merged[0].c < 0.0 ? -1.0 : 1.0;
@@ -525,7 +615,9 @@ class ProgramCompiler {
     // c * h * f folded into one muladd, mulsub or mulk_muladd (h: the product of its other factors),
     // unless the whole product is needed elsewhere anyway.
     int acc;
-    if (auto factors = fusable_factors(terms[0].id)) {
+    if (auto split = parameter_split(terms[0])) {
+      acc = program_.push(Op::mul, emit(split->first), emit(split->second));
+    } else if (auto factors = fusable_factors(terms[0].id)) {
       acc = product(*factors, terms[0].c);
     } else {
       acc = scaled(emit({1.0, terms[0].id}), terms[0].c);
@@ -533,7 +625,11 @@ class ProgramCompiler {
     for (std::size_t i = 1; i < terms.size(); ++i) {
       const double c = terms[i].c;
       const int rest = terms[i].id;
-      if (auto factors = fusable_factors(rest)) {
+      if (auto split = parameter_split(terms[i])) {
+        // (c p) * s + acc: the evaluator makes it k * s + acc, with the last multiplication of s
+        // inside (model/program.hpp), one step as when the parameters were numbers.
+        acc = program_.push(Op::muladd, emit(split->first), emit(split->second), acc);
+      } else if (auto factors = fusable_factors(rest)) {
         const Scaled last = factors->back();
         factors->pop_back();
         int h;
@@ -559,6 +655,16 @@ class ProgramCompiler {
     }
     if (offset != 0.0) acc = program_.push(Op::add_k, acc, 0, 0, offset);
     return acc;
+  }
+
+  // A term c * p * s of a sum, p the factors of parameters only and s the others (both present,
+  // the product not computed yet), as (c p, s): c p is computed in the parameter stage.
+  std::optional<std::pair<Scaled, Scaled>> parameter_split(const Scaled& term) {
+    if (emitted(term.id) || node(term.id).kind != Kind::mul) return std::nullopt;
+    std::vector<int> k, rest;
+    for (const Scaled& f : node(term.id).items) (node(f.id).parameters_only ? k : rest).push_back(f.id);
+    if (k.empty() || rest.empty()) return std::nullopt;
+    return std::make_pair(make_mul(std::move(k), term.c), make_mul(std::move(rest), 1.0));
   }
 
   bool is_reciprocal(int id) const {
