@@ -224,8 +224,12 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
       double stable_end = rising ? a : b;
       Mode follow = start;
       bool found = false;
-      for (double step = width; step <= hi.value - lo.value; step *= 2.0) {
-        const double probe = rising ? std::max(lo.value, a - step) : std::min(hi.value, b + step);
+      // The search may leave the grid cell: the eigenvalue can still be undecided at the cell's
+      // end (a grid point exactly at the crossing, or an uncertainty made large by a stiff mode
+      // elsewhere), and step 1's bracket then holds the count's threshold, not the crossing.
+      const double first = out.points.front().value, last = out.points.back().value;
+      for (double step = width; step <= 2.0 * (last - first); step *= 2.0) {
+        const double probe = rising ? std::max(first, a - step) : std::min(last, b + step);
         const SweepPoint p = at(probe, &s);
         follow = follow_mode(s, follow, unstable_side.uncertainty[k]);
         const std::size_t j = nearest(p.eigenvalues, follow.value);
@@ -234,7 +238,7 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
           found = true;
           break;
         }
-        if (probe == lo.value || probe == hi.value) break;
+        if (probe == first || probe == last) break;
       }
       if (found) {
         double neg = stable_end, pos = rising ? b : a;
