@@ -2,7 +2,8 @@
 // whose eigenvalues are known in closed form, q'' = -C(p) q' - K(p) q written as forces, with the
 // cases that lead a follower astray: an eigenvalue 0 at every p on the crossing's path (as the
 // bicycle's forward speed adds), eigenvectors nearly parallel, a grid point exactly at the
-// crossing, a stiff mode elsewhere that makes every uncertainty large, a double zero.
+// crossing, two crossings in one grid cell, a stiff mode elsewhere that makes every uncertainty
+// large, a double zero.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -84,6 +85,19 @@ TEST(SweepTracking, GridPointsOnTheCrossings) {
   for (const StabilityCrossing& c : sweep.crossings) EXPECT_LT(c.bracket, 1e-13);
 }
 
+// The same eigenvalues on a grid of spacing 0.2: both crossings in the cell [0.9, 1.1], where the
+// count goes from 0 to 2. Each is found in turn (the second was reported as part of the first).
+TEST(SweepTracking, TwoCrossingsInOneCell) {
+  const Sweep sweep = tracking_sweep("-6*x' + (p-1)*(p+5)*x", "(p - 4.05)*y' + 3*(p - 1.05)*y", 0.3, 1.7, 8);
+  ASSERT_EQ(sweep.crossings.size(), 2u);
+  EXPECT_NEAR(sweep.crossings[0].value, 1.0, 1e-13);
+  EXPECT_NEAR(sweep.crossings[1].value, 1.05, 1e-13);
+  EXPECT_EQ(sweep.crossings[0].unstable_before, 0);
+  EXPECT_EQ(sweep.crossings[0].unstable_after, 1);
+  EXPECT_EQ(sweep.crossings[1].unstable_before, 1);
+  EXPECT_EQ(sweep.crossings[1].unstable_after, 2);
+}
+
 // The cases above with a stiff mode added, z'' = -1000 z' - 1e6 z (eigenvalues -500 +- 866 i):
 // the uncertainties grow with the state matrix's norm (about 0.1 near the crossing here), the
 // count changes 0.11 before the crossing, and the crossing eigenvalue is still undecided at the
@@ -111,16 +125,19 @@ TEST(SweepTracking, AStiffModeElsewhereWidensTheBracketAroundTheCrossing) {
 }
 
 // c = -3 (p - 1), k = 2 (p - 1)^2: the eigenvalues p - 1 and 2 (p - 1), a double zero with a
-// Jordan block at p = 1, where both become unstable at once.
+// Jordan block at p = 1, where both become unstable. Known there to about sqrt(eps) s only, they
+// leave the uncertainty one after the other: two divergences, each bracketing p = 1.
 TEST(SweepTracking, ADoubleZero) {
   const Sweep sweep = tracking_sweep("3*(p-1)*x' - 2*(p-1)^2*x", "-y' - y", 0.3, 1.7, 8);
-  ASSERT_EQ(sweep.crossings.size(), 1u);
-  const StabilityCrossing& c = sweep.crossings[0];
-  EXPECT_LE(std::abs(c.value - 1.0), 0.5 * c.bracket + 1e-15) << c.value << " +- " << 0.5 * c.bracket;
-  EXPECT_LT(c.bracket, 1e-5);  // the double zero is known to about sqrt(eps) s
-  EXPECT_FALSE(c.oscillatory);
-  EXPECT_EQ(c.unstable_before, 0);
-  EXPECT_EQ(c.unstable_after, 2);
+  ASSERT_EQ(sweep.crossings.size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    const StabilityCrossing& c = sweep.crossings[static_cast<std::size_t>(i)];
+    EXPECT_LE(std::abs(c.value - 1.0), 0.5 * c.bracket + 1e-15) << c.value << " +- " << 0.5 * c.bracket;
+    EXPECT_LT(c.bracket, 1e-5);
+    EXPECT_FALSE(c.oscillatory);
+    EXPECT_EQ(c.unstable_before, i);
+    EXPECT_EQ(c.unstable_after, i + 1);
+  }
 }
 
 }  // namespace
