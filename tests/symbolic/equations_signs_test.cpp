@@ -252,6 +252,12 @@ std::vector<SignsCase> signs_cases() {
        }},
       {"-2 I x (b - a)", [=](const SpecBuilder& b) { return signs_mul({-2 * GiNaC::I, s(b, "x"), b_minus_a(b)}); }},
       {"I/10 y", [=](const SpecBuilder& b) { return signs_mul({GiNaC::I / 10, s(b, "y")}); }},
+      {"(y - I x)^3 x", [=](const SpecBuilder& b) {
+         return signs_mul({signs_pow(signs_add({s(b, "y"), -GiNaC::I * s(b, "x")}), 3), s(b, "x")});
+       }},
+      {"(a + (1 - I) x)^-1", [=](const SpecBuilder& b) {
+         return signs_pow(signs_add({s(b, "a"), (1 - GiNaC::I) * s(b, "x")}), -1);
+       }},
   };
 }
 
