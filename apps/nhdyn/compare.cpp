@@ -86,6 +86,16 @@ int run_compare(const CompareArgs& args) {
                          "(--integrators compares integrators)\n", model.name);
     }
   }
+  // A name given twice would give two runs of one case and two columns of one name.
+  for (std::size_t j = 0; j < methods.size(); ++j)
+    for (std::size_t i = 0; i < j; ++i)
+      if (parse_method(methods[i]) == parse_method(methods[j]))
+        throw InputError(fmt::format("--methods: '{}' is named twice; name each method once", methods[j]));
+  for (std::size_t j = 0; j < args.integrators.size(); ++j)
+    for (std::size_t i = 0; i < j; ++i)
+      if (parse_integrator(args.integrators[i]) == parse_integrator(args.integrators[j]))
+        throw InputError(fmt::format("--integrators: '{}' is named twice; name each integrator once",
+                                     args.integrators[j]));
   for (const std::string& m : methods)
     for (const std::string& i : args.integrators) options.cases.push_back({parse_method(m), parse_integrator(i)});
 

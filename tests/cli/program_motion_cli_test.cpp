@@ -99,6 +99,20 @@ TEST_F(ProgramCli, CompareRunsSanhAloneAndRefusesAnotherMethodByName) {
   EXPECT_FALSE(fs::exists(dir_ / "other.csv"));
 }
 
+// A method or integrator named twice would run one case twice and write two columns of one
+// name: refused with the name, nothing written (sanh twice on a model with programs too).
+TEST_F(ProgramCli, CompareRefusesANameGivenTwice) {
+  for (const std::string& options : {std::string(" --methods sanh,sanh"), std::string(" --integrators dopri5,rk4,dopri5")}) {
+    const Outcome refused = run_nhdyn("compare " + example("sled_heading_program.toml") + options + " -o twice.csv", dir_);
+    EXPECT_EQ(refused.exit_code, 2) << options << ": " << refused.out;
+    EXPECT_NE(refused.out.find("named twice"), std::string::npos) << refused.out;
+    EXPECT_NE(refused.out.find(options.find("sanh") != std::string::npos ? "'sanh'" : "'dopri5'"), std::string::npos)
+        << refused.out;
+    EXPECT_FALSE(fs::exists(dir_ / "twice.csv"));
+    EXPECT_FALSE(fs::exists(dir_ / "twice-series.csv"));
+  }
+}
+
 TEST_F(ProgramCli, BatchRunFilesCarryTheActuatorForcesAsSimulateDoes) {
   // A batch of one run (omega = 1, the file's value) writes the same file as simulate.
   const Outcome batch = run_nhdyn("batch " + example("sled_heading_program.toml") +

@@ -180,94 +180,103 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
 
   const double ulp_scale = 4.0 * std::numeric_limits<double>::epsilon();
   for (std::size_t i = 0; i + 1 < out.points.size(); ++i) {
-    const SweepPoint& lo = out.points[i];
     const SweepPoint& hi = out.points[i + 1];
-    if (lo.unstable == hi.unstable) continue;
-    // 1. Bisection on the count of certainly unstable eigenvalues: it stops where the crossing
-    // eigenvalue's real part leaves its uncertainty.
-    double a = lo.value, b = hi.value;
-    SweepPoint at_a = lo, at_b = hi;
-    for (int iter = 0; iter < 200 && b - a > ulp_scale * std::max(1.0, std::abs(a)); ++iter) {
-      const double mid = 0.5 * (a + b);
-      if (mid <= a || mid >= b) break;
-      SweepPoint p = at(mid);
-      if (p.unstable == lo.unstable) {
-        a = mid;
-        at_a = std::move(p);
-      } else {
-        b = mid;
-        at_b = std::move(p);
-      }
-    }
-    // The crossing eigenvalue: on the unstable side, the certainly unstable one nearest the axis.
-    const bool rising = hi.unstable > lo.unstable;
-    const SweepPoint& unstable_side = rising ? at_b : at_a;
-    std::size_t k = unstable_side.eigenvalues.size();
-    for (std::size_t j = 0; j < unstable_side.eigenvalues.size(); ++j) {
-      const double re = unstable_side.eigenvalues[j].real();
-      if (re > unstable_side.uncertainty[j] && (k == unstable_side.eigenvalues.size() || re < unstable_side.eigenvalues[k].real()))
-        k = j;
-    }
-    std::complex<double> crossing = k < unstable_side.eigenvalues.size() ? unstable_side.eigenvalues[k] : 0.0;
-    // 2. For a simple eigenvalue, the count's threshold is not the crossing: follow that
-    // eigenvalue (by its eigenvector) to where its real part is certainly negative, then bisect
-    // on the sign of its real part (the capsize speed to round-off, not to r_1 / slope). A real
-    // part that never becomes certainly negative (a pair going onto the imaginary axis) keeps
-    // step 1's bracket.
-    if (k < unstable_side.eigenvalues.size()) {
-      Matrix s;
-      at(rising ? b : a, &s);
-      Mode start{crossing, {}};
-      for (const Mode& m : modes_of(s))
-        if (start.vector.size() == 0 || std::abs(m.value - crossing) < std::abs(start.value - crossing)) start = m;
-      const double width = std::max(b - a, ulp_scale * std::max(1.0, std::abs(a)));
-      double stable_end = rising ? a : b;
-      Mode follow = start;
-      bool found = false;
-      for (double step = width; step <= hi.value - lo.value; step *= 2.0) {
-        const double probe = rising ? std::max(lo.value, a - step) : std::min(hi.value, b + step);
-        const SweepPoint p = at(probe, &s);
-        follow = follow_mode(s, follow, unstable_side.uncertainty[k]);
-        const std::size_t j = nearest(p.eigenvalues, follow.value);
-        if (p.eigenvalues[j].real() < -p.uncertainty[j]) {
-          stable_end = probe;
-          found = true;
-          break;
+    // Each change of the count in the cell in turn (0 -> 1 -> 2 when two eigenvalues cross in
+    // it), from the point just after the last one found.
+    SweepPoint lo = out.points[i];
+    for (std::size_t guard = 0; lo.unstable != hi.unstable && guard <= hi.eigenvalues.size(); ++guard) {
+      // 1. Bisection on the count of certainly unstable eigenvalues: it stops where the crossing
+      // eigenvalue's real part leaves its uncertainty.
+      double a = lo.value, b = hi.value;
+      SweepPoint at_a = lo, at_b = hi;
+      for (int iter = 0; iter < 200 && b - a > ulp_scale * std::max(1.0, std::abs(a)); ++iter) {
+        const double mid = 0.5 * (a + b);
+        if (mid <= a || mid >= b) break;
+        SweepPoint p = at(mid);
+        if (p.unstable == lo.unstable) {
+          a = mid;
+          at_a = std::move(p);
+        } else {
+          b = mid;
+          at_b = std::move(p);
         }
-        if (probe == lo.value || probe == hi.value) break;
       }
-      if (found) {
-        double neg = stable_end, pos = rising ? b : a;
-        Mode track = start;
-        for (int iter = 0; iter < 200 && std::abs(pos - neg) > ulp_scale * std::max(1.0, std::abs(neg)); ++iter) {
-          const double mid = 0.5 * (neg + pos);
-          if (mid == neg || mid == pos) break;
-          const SweepPoint p = at(mid, &s);
-          const Mode next = follow_mode(s, track, unstable_side.uncertainty[k]);
-          const std::size_t j = nearest(p.eigenvalues, next.value);
-          // Joined to a cluster (a multiple eigenvalue there), its sign is round-off: the
-          // bracket so far is all the conditioning supports.
-          const double simple = *std::min_element(p.uncertainty.begin(), p.uncertainty.end());
-          if (p.uncertainty[j] > simple) break;
-          track = next;
-          (track.value.real() > 0.0 ? pos : neg) = mid;
+      // The crossing eigenvalue: on the unstable side, the certainly unstable one nearest the axis.
+      const SweepPoint after = at_b;  // the count just after this crossing
+      const bool rising = after.unstable > lo.unstable;
+      const SweepPoint& unstable_side = rising ? at_b : at_a;
+      std::size_t k = unstable_side.eigenvalues.size();
+      for (std::size_t j = 0; j < unstable_side.eigenvalues.size(); ++j) {
+        const double re = unstable_side.eigenvalues[j].real();
+        if (re > unstable_side.uncertainty[j] && (k == unstable_side.eigenvalues.size() || re < unstable_side.eigenvalues[k].real()))
+          k = j;
+      }
+      std::complex<double> crossing = k < unstable_side.eigenvalues.size() ? unstable_side.eigenvalues[k] : 0.0;
+      // 2. For a simple eigenvalue, the count's threshold is not the crossing: follow that
+      // eigenvalue (by its eigenvector) to where its real part is certainly negative, then bisect
+      // on the sign of its real part (the capsize speed to round-off, not to r_1 / slope). A real
+      // part that never becomes certainly negative (a pair going onto the imaginary axis) keeps
+      // step 1's bracket.
+      if (k < unstable_side.eigenvalues.size()) {
+        Matrix s;
+        at(rising ? b : a, &s);
+        Mode start{crossing, {}};
+        for (const Mode& m : modes_of(s))
+          if (start.vector.size() == 0 || std::abs(m.value - crossing) < std::abs(start.value - crossing)) start = m;
+        const double width = std::max(b - a, ulp_scale * std::max(1.0, std::abs(a)));
+        double stable_end = rising ? a : b;
+        Mode follow = start;
+        bool found = false;
+        // The search may leave the grid cell: the eigenvalue can still be undecided at the cell's
+        // end (a grid point exactly at the crossing, or an uncertainty made large by a stiff mode
+        // elsewhere), and step 1's bracket then holds the count's threshold, not the crossing.
+        const double first = out.points.front().value, last = out.points.back().value;
+        for (double step = width; step <= 2.0 * (last - first); step *= 2.0) {
+          const double probe = rising ? std::max(first, a - step) : std::min(last, b + step);
+          const SweepPoint p = at(probe, &s);
+          follow = follow_mode(s, follow, unstable_side.uncertainty[k]);
+          const std::size_t j = nearest(p.eigenvalues, follow.value);
+          if (p.eigenvalues[j].real() < -p.uncertainty[j]) {
+            stable_end = probe;
+            found = true;
+            break;
+          }
+          if (probe == first || probe == last) break;
         }
-        crossing = track.value;
-        a = std::min(neg, pos);
-        b = std::max(neg, pos);
+        if (found) {
+          double neg = stable_end, pos = rising ? b : a;
+          Mode track = start;
+          for (int iter = 0; iter < 200 && std::abs(pos - neg) > ulp_scale * std::max(1.0, std::abs(neg)); ++iter) {
+            const double mid = 0.5 * (neg + pos);
+            if (mid == neg || mid == pos) break;
+            const SweepPoint p = at(mid, &s);
+            const Mode next = follow_mode(s, track, unstable_side.uncertainty[k]);
+            const std::size_t j = nearest(p.eigenvalues, next.value);
+            // Joined to a cluster (a multiple eigenvalue there), its sign is round-off: the
+            // bracket so far is all the conditioning supports.
+            const double simple = *std::min_element(p.uncertainty.begin(), p.uncertainty.end());
+            if (p.uncertainty[j] > simple) break;
+            track = next;
+            (track.value.real() > 0.0 ? pos : neg) = mid;
+          }
+          crossing = track.value;
+          a = std::min(neg, pos);
+          b = std::max(neg, pos);
+        }
       }
+      StabilityCrossing c;
+      c.value = 0.5 * (a + b);
+      c.bracket = b - a;
+      c.unstable_before = lo.unstable;
+      c.unstable_after = after.unstable;
+      double scale = 1.0;
+      for (const std::complex<double>& x : unstable_side.eigenvalues) scale = std::max(scale, std::abs(x));
+      c.frequency = std::abs(crossing.imag());
+      c.oscillatory = c.frequency > 1e-6 * scale;
+      if (!c.oscillatory) c.frequency = 0.0;
+      out.crossings.push_back(c);
+      lo = after;
     }
-    StabilityCrossing c;
-    c.value = 0.5 * (a + b);
-    c.bracket = b - a;
-    c.unstable_before = lo.unstable;
-    c.unstable_after = hi.unstable;
-    double scale = 1.0;
-    for (const std::complex<double>& x : unstable_side.eigenvalues) scale = std::max(scale, std::abs(x));
-    c.frequency = std::abs(crossing.imag());
-    c.oscillatory = c.frequency > 1e-6 * scale;
-    if (!c.oscillatory) c.frequency = 0.0;
-    out.crossings.push_back(c);
   }
   return out;
 }

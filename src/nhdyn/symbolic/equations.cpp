@@ -157,10 +157,12 @@ class EquationPrinter {
     for (const auto& [coefficient, name] : products) {
       if (coefficient.is_zero()) continue;
       if (GiNaC::is_a<GiNaC::add>(coefficient)) {
-        terms.push_back({paren(expression(coefficient)) + " " + name, false, false});
+        const std::string sum = expression(coefficient);
+        if (sum != "0") terms.push_back({paren(sum) + " " + name, false, false});
         continue;
       }
       Printed p = term(coefficient);
+      if (p.text == "0") continue;
       if (p.text == "1")
         p.text = name;
       else if (p.fraction && !latex_)
@@ -279,26 +281,34 @@ class EquationPrinter {
     else
       add_factor(e);
     // cos(-x) = cos(x), sin(-x)^n = (-1)^n sin(x)^n: GiNaC keeps the sign of a negated argument
-    // (the bicycle's rotation by -lambda gives cos(-lambda) cos(lambda)).
+    // (the bicycle's rotation by -lambda gives cos(-lambda) cos(lambda)). Decided on the printed
+    // argument, like the sign of a sum: GiNaC holds sin(x (a - b)) as sin(-x (b - a)) in some
+    // processes, which prints as sin(x (a - b)) too, while sin(x (b - a)) prints with a '-'.
     for (auto& [base, exponent] : factors) {
       if (!GiNaC::is_a<GiNaC::function>(base) || base.nops() != 1) continue;
-      const ex& argument = base.op(0);
-      if (GiNaC::is_a<GiNaC::add>(argument) || !split_coefficient(argument).first.is_negative()) continue;
       const int parity = function_parity(GiNaC::ex_to<GiNaC::function>(base).get_name());
       const bool integer =
           GiNaC::is_a<GiNaC::numeric>(exponent) && GiNaC::ex_to<GiNaC::numeric>(exponent).is_integer();
       if (parity == 0 || (parity < 0 && !integer)) continue;
+      const ex& argument = base.op(0);
+      if (expression(argument).rfind('-', 0) != 0) continue;
       if (parity < 0 && GiNaC::ex_to<GiNaC::numeric>(exponent).is_odd()) t.coefficient = -t.coefficient;
       base = GiNaC::function(GiNaC::ex_to<GiNaC::function>(base).get_serial(), -argument);
     }
-    // Like factors (cos(lambda) cos(lambda) after the above) become one power.
+    // Like factors (cos(lambda) cos(lambda) after the above) become one power. Functions are alike
+    // when they print alike: cos(x (a - b)) may be held as cos(-x (b - a)) next to cos(x (a - b)).
+    std::vector<std::string> function_text(factors.size());
+    for (std::size_t i = 0; i < factors.size(); ++i)
+      if (GiNaC::is_a<GiNaC::function>(factors[i].first)) function_text[i] = function(factors[i].first);
     for (std::size_t i = 0; i < factors.size(); ++i) {
       for (std::size_t j = i + 1; j < factors.size();) {
         auto& [base, exponent] = factors[i];
-        if (GiNaC::is_a<GiNaC::numeric>(exponent) && GiNaC::is_a<GiNaC::numeric>(factors[j].second) &&
-            base.is_equal(factors[j].first)) {
+        const bool alike = base.is_equal(factors[j].first) ||
+                           (!function_text[i].empty() && function_text[i] == function_text[j]);
+        if (GiNaC::is_a<GiNaC::numeric>(exponent) && GiNaC::is_a<GiNaC::numeric>(factors[j].second) && alike) {
           exponent = exponent + factors[j].second;
           factors.erase(factors.begin() + static_cast<std::ptrdiff_t>(j));
+          function_text.erase(function_text.begin() + static_cast<std::ptrdiff_t>(j));
         } else {
           ++j;
         }
@@ -330,6 +340,8 @@ class EquationPrinter {
           if (GiNaC::ex_to<GiNaC::numeric>(power).is_odd()) t.coefficient = -t.coefficient;
         }
         sum = joined(terms);
+        // A sum whose terms cancel (x (a - b) + x (b - a)) is 0, and so is a term it multiplies.
+        if (terms.empty() && !below) return TermText{0, {}, {}};
       }
       (below ? down : up).push_back({factor_rank(base), factor(base, power, sum ? &*sum : nullptr)});
     }
@@ -348,7 +360,21 @@ class EquationPrinter {
       c = -c;
     }
     std::vector<std::string> up, down;
-    if (c.is_rational()) {
+    if (c.is_zero()) {
+      out.text = "0";
+      return out;
+    }
+    // A complex coefficient (sqrt(-4) = 2 I): an imaginary one as a real one times I, any other
+    // in parentheses (1+2*I x would read 1 + 2 I x).
+    const bool imaginary = !c.is_real() && c.real().is_zero();
+    if (imaginary) {
+      c = c.imag();
+      out.negative = c.is_negative();
+      if (out.negative) c = -c;
+    }
+    if (!c.is_real()) {
+      up.push_back(paren(number_or_print(c)));
+    } else if (c.is_rational()) {
       const GiNaC::numeric p = c.numer(), q = c.denom();
       if (q != 1 && power_of_ten(q)) {
         up.push_back(decimal(p, q));
@@ -359,6 +385,7 @@ class EquationPrinter {
     } else {
       up.push_back(number(c));
     }
+    if (imaginary) up.push_back(latex_ ? "i" : "I");
     up.insert(up.end(), t.up.begin(), t.up.end());
     down.insert(down.end(), t.down.begin(), t.down.end());
     const std::string top = up.empty() ? "1" : join(up, " ");
@@ -380,7 +407,11 @@ class EquationPrinter {
   std::string factor(const ex& base, const ex& exponent, const std::string* sum = nullptr) const {
     if (is_number(exponent, 1, 2))
       return latex_ ? "\\sqrt{" + expression(base) + "}" : "sqrt(" + expression(base) + ")";
-    const std::string base_atom = sum ? paren(*sum) : atom(base);
+    std::string base_atom = sum ? paren(*sum) : atom(base);
+    // e^{x} takes no second superscript: (e^{x})^{2}.
+    if (latex_ && GiNaC::is_a<GiNaC::function>(base) && GiNaC::ex_to<GiNaC::function>(base).get_name() == "exp" &&
+        !is_number(exponent, 1))
+      base_atom = paren(base_atom);
     if (is_number(exponent, 1)) return base_atom;
     const bool integer =
         GiNaC::is_a<GiNaC::numeric>(exponent) && GiNaC::ex_to<GiNaC::numeric>(exponent).is_pos_integer();
