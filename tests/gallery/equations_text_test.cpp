@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "gallery/gallery.hpp"
+#include "support/equation_reader.hpp"
 #include "nhdyn/symbolic/derivation.hpp"
 #include "nhdyn/symbolic/equations.hpp"
 
@@ -21,65 +22,6 @@ namespace nhdyn::gallery {
 namespace {
 
 using GiNaC::ex;
-
-// The printed notation back into GiNaC's: x'' and x' become names of their own, a space between
-// two factors a product.
-class TextReader {
- public:
-  explicit TextReader(const symbolic::Spec& spec) {
-    table_["t"] = spec.symbols.time();
-    table_["pi"] = GiNaC::Pi;
-    for (int i = 0; i < spec.n(); ++i) {
-      const std::string& name = spec.coordinates[static_cast<std::size_t>(i)];
-      table_[name] = spec.symbols.coordinate(i);
-      table_[name + "__v"] = spec.symbols.velocity(i);
-      table_[name + "__a"] = spec.symbols.acceleration(i);
-    }
-    for (const auto& p : spec.parameters) table_[p.name] = spec.symbols.parameter(p.name);
-  }
-
-  ex read(const std::string& text) const {
-    // By hand: std::regex recurses per character and overflows the stack on the bicycle's lines.
-    std::string out;
-    for (std::size_t i = 0; i < text.size(); ++i) {
-      const char c = text[i];
-      if (c == '\'') {
-        const bool two = i + 1 < text.size() && text[i + 1] == '\'';
-        out += two ? "__a" : "__v";
-        i += two ? 1 : 0;
-      } else if (c == ' ' && text.compare(i, 3, " + ") == 0) {
-        out += '+';
-        i += 2;
-      } else if (c == ' ' && text.compare(i, 3, " - ") == 0) {
-        out += '-';
-        i += 2;
-      } else {
-        out += c == ' ' ? '*' : c;
-      }
-    }
-    GiNaC::parser parse(table_, true);
-    return parse(out);
-  }
-
- private:
-  GiNaC::symtab table_;
-};
-
-// The value of e at the spec's parameters and a state where no coordinate, velocity or
-// acceleration is 0, 1 or a multiple of pi/2.
-double value_at(const symbolic::Spec& spec, const ex& e) {
-  GiNaC::lst point;
-  point.append(spec.symbols.time() == 0.7);
-  for (int i = 0; i < spec.n(); ++i) {
-    point.append(spec.symbols.coordinate(i) == 0.31 + 0.173 * i);
-    point.append(spec.symbols.velocity(i) == -0.53 + 0.241 * i);
-    point.append(spec.symbols.acceleration(i) == 0.77 - 0.189 * i);
-  }
-  for (const auto& p : spec.parameters) point.append(spec.symbols.parameter(p.name) == p.value);
-  const ex v = GiNaC::evalf(e.subs(point));
-  if (!GiNaC::is_a<GiNaC::numeric>(v)) throw std::runtime_error("not a number at the point");
-  return GiNaC::ex_to<GiNaC::numeric>(v).to_double();
-}
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> out;
@@ -112,11 +54,11 @@ int expect_text_reads_back(const std::string& file) {
   const symbolic::Spec spec = load_model_file(example_path(file));
   const symbolic::Derivation d = symbolic::derive(spec);
   const std::string text = symbolic::format_equations(spec, d, symbolic::EquationFormat::text);
-  const TextReader reader(spec);
+  const test::EquationReader reader(spec);
   int compared = 0;
   const auto expect_same = [&](const std::string& printed, const ex& derived, const std::string& what) {
-    const double got = value_at(spec, reader.read(printed));
-    const double want = value_at(spec, derived);
+    const double got = test::equation_value_at(spec, reader.read(printed)).real();
+    const double want = test::equation_value_at(spec, derived).real();
     EXPECT_NEAR(got, want, 1e-9 * (1.0 + std::abs(want))) << file << ": " << what << " printed as " << printed;
     ++compared;
   };

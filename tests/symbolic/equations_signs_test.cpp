@@ -19,71 +19,13 @@
 #include "nhdyn/symbolic/equations.hpp"
 #include "nhdyn/symbolic/simplify.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
+#include "support/equation_reader.hpp"
 #include "support/text.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
 
 using GiNaC::ex;
-
-// The printed text notation back into GiNaC's (as tests/gallery/equations_text_test.cpp reads it):
-// x'' and x' become names of their own, a space between two factors is a product.
-class SignsReader {
- public:
-  explicit SignsReader(const Spec& spec) {
-    table_["t"] = spec.symbols.time();
-    table_["pi"] = GiNaC::Pi;
-    table_["I"] = GiNaC::I;
-    for (int i = 0; i < spec.n(); ++i) {
-      const std::string& name = spec.coordinates[static_cast<std::size_t>(i)];
-      table_[name] = spec.symbols.coordinate(i);
-      table_[name + "__v"] = spec.symbols.velocity(i);
-      table_[name + "__a"] = spec.symbols.acceleration(i);
-    }
-    for (const auto& p : spec.parameters) table_[p.name] = spec.symbols.parameter(p.name);
-  }
-
-  ex read(const std::string& text) const {
-    std::string out;
-    for (std::size_t i = 0; i < text.size(); ++i) {
-      const char c = text[i];
-      if (c == '\'') {
-        const bool two = i + 1 < text.size() && text[i + 1] == '\'';
-        out += two ? "__a" : "__v";
-        i += two ? 1 : 0;
-      } else if (c == ' ' && text.compare(i, 3, " + ") == 0) {
-        out += '+';
-        i += 2;
-      } else if (c == ' ' && text.compare(i, 3, " - ") == 0) {
-        out += '-';
-        i += 2;
-      } else {
-        out += c == ' ' ? '*' : c;
-      }
-    }
-    GiNaC::parser parse(table_, true);
-    return parse(out);
-  }
-
- private:
-  GiNaC::symtab table_;
-};
-
-// The value of e at the spec's parameters and a state where nothing is 0, 1 or a multiple of pi/2.
-std::complex<double> signs_value_at(const Spec& spec, const ex& e) {
-  GiNaC::lst point;
-  point.append(spec.symbols.time() == 0.7);
-  for (int i = 0; i < spec.n(); ++i) {
-    point.append(spec.symbols.coordinate(i) == 0.31 + 0.173 * i);
-    point.append(spec.symbols.velocity(i) == -0.53 + 0.241 * i);
-    point.append(spec.symbols.acceleration(i) == 0.77 - 0.189 * i);
-  }
-  for (const auto& p : spec.parameters) point.append(spec.symbols.parameter(p.name) == p.value);
-  const ex v = GiNaC::evalf(e.subs(point));
-  if (!GiNaC::is_a<GiNaC::numeric>(v)) throw std::runtime_error("not a number at the point");
-  const GiNaC::numeric& n = GiNaC::ex_to<GiNaC::numeric>(v);
-  return {n.real().to_double(), n.imag().to_double()};
-}
 
 // The terms of a printed sum at its top level, each with its sign in front ("+ " or "- ").
 std::vector<std::string> signs_terms(const std::string& sum) {
@@ -157,8 +99,8 @@ SignsPrinted signs_print(const std::function<ex(const SpecBuilder&)>& make, int 
 // The case read back equals the case at the generic point.
 void expect_signs_read_back(const std::function<ex(const SpecBuilder&)>& make, const std::string& what) {
   const SignsPrinted printed = signs_print(make);
-  const std::complex<double> got = signs_value_at(printed.spec, SignsReader(printed.spec).read(printed.text));
-  const std::complex<double> want = signs_value_at(printed.spec, printed.e);
+  const std::complex<double> got = nhdyn::test::equation_value_at(printed.spec, nhdyn::test::EquationReader(printed.spec).read(printed.text));
+  const std::complex<double> want = nhdyn::test::equation_value_at(printed.spec, printed.e);
   EXPECT_LT(std::abs(got - want), 1e-12 * (1.0 + std::abs(want)))
       << what << " printed as " << printed.text << ": " << got << " instead of " << want;
 }
@@ -341,8 +283,8 @@ TEST(EquationSigns, ComplexCoefficientsReadBack) {
   for (const char* text : {"sqrt(-4)*x + x", "sqrt(-4)*x", "-sqrt(-9)*x/2 + a", "(1 + sqrt(-1))*x/(a - x)"}) {
     const ex e = b.parse(text);
     const std::string printed = format_expression(spec, e, EquationFormat::text);
-    const std::complex<double> got = signs_value_at(spec, SignsReader(spec).read(printed));
-    const std::complex<double> want = signs_value_at(spec, e);
+    const std::complex<double> got = nhdyn::test::equation_value_at(spec, nhdyn::test::EquationReader(spec).read(printed));
+    const std::complex<double> want = nhdyn::test::equation_value_at(spec, e);
     EXPECT_LT(std::abs(got - want), 1e-12 * (1.0 + std::abs(want))) << text << " printed as " << printed;
     EXPECT_FALSE(nhdyn::test::contains(format_expression(spec, e, EquationFormat::latex), "*"))
         << format_expression(spec, e, EquationFormat::latex);
@@ -363,13 +305,13 @@ TEST(EquationSigns, ARowWithASumCoefficientReadsBack) {
   const std::string row = text.substr(begin, text.find('\n', begin) - begin);
   const std::size_t equals = row.find(" = ");
   ASSERT_NE(equals, std::string::npos) << row;
-  const SignsReader reader(printed.spec);
+  const nhdyn::test::EquationReader reader(printed.spec);
   const ex lhs = reader.read(row.substr(2, equals - 2));
   const ex want = d.A(0, 0) * printed.spec.symbols.acceleration(0) + d.A(0, 1) * printed.spec.symbols.acceleration(1);
-  EXPECT_LT(std::abs(signs_value_at(printed.spec, lhs) - signs_value_at(printed.spec, want)), 1e-12 * 10.0)
+  EXPECT_LT(std::abs(nhdyn::test::equation_value_at(printed.spec, lhs) - nhdyn::test::equation_value_at(printed.spec, want)), 1e-12 * 10.0)
       << row.substr(0, 200);
-  EXPECT_LT(std::abs(signs_value_at(printed.spec, reader.read(row.substr(equals + 3))) -
-                     signs_value_at(printed.spec, d.Q(0, 0) + d.G(0, 0))),
+  EXPECT_LT(std::abs(nhdyn::test::equation_value_at(printed.spec, reader.read(row.substr(equals + 3))) -
+                     nhdyn::test::equation_value_at(printed.spec, d.Q(0, 0) + d.G(0, 0))),
             1e-12 * 10.0);
 }
 
