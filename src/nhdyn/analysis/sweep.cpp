@@ -179,6 +179,59 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
   if (!options.find_crossings) return out;
 
   const double ulp_scale = 4.0 * std::numeric_limits<double>::epsilon();
+  // 2. For a simple eigenvalue, the count's threshold is not the crossing: follow that eigenvalue
+  // (by its eigenvector) to where its real part is certainly negative, then bisect on the sign of
+  // its real part (the capsize speed to round-off, not to r_1 / slope). Narrows [a, b] to it and
+  // sets `crossing`; a real part that never becomes certainly negative (a pair going onto the
+  // imaginary axis) leaves step 1's bracket.
+  const double first = out.points.front().value, last = out.points.back().value;
+  const auto follow_to_the_sign_change = [&](double& a, double& b, bool rising, const SweepPoint& unstable_side,
+                                            std::size_t k, std::complex<double>& crossing) {
+    Matrix s;
+    at(rising ? b : a, &s);
+    Mode start{crossing, {}};
+    for (const Mode& m : modes_of(s))
+      if (start.vector.size() == 0 || std::abs(m.value - crossing) < std::abs(start.value - crossing)) start = m;
+    const double width = std::max(b - a, ulp_scale * std::max(1.0, std::abs(a)));
+    double stable_end = rising ? a : b;
+    Mode follow = start;
+    bool found = false;
+    // The search may leave the grid cell: the eigenvalue can still be undecided at the cell's
+    // end (a grid point exactly at the crossing, or an uncertainty made large by a stiff mode
+    // elsewhere), and step 1's bracket then holds the count's threshold, not the crossing.
+    for (double step = width; step <= 2.0 * (last - first); step *= 2.0) {
+      const double probe = rising ? std::max(first, a - step) : std::min(last, b + step);
+      const SweepPoint p = at(probe, &s);
+      follow = follow_mode(s, follow, unstable_side.uncertainty[k]);
+      const std::size_t j = nearest(p.eigenvalues, follow.value);
+      if (p.eigenvalues[j].real() < -p.uncertainty[j]) {
+        stable_end = probe;
+        found = true;
+        break;
+      }
+      if (probe == first || probe == last) break;
+    }
+    if (!found) return;
+    double neg = stable_end, pos = rising ? b : a;
+    Mode track = start;
+    for (int iter = 0; iter < 200 && std::abs(pos - neg) > ulp_scale * std::max(1.0, std::abs(neg)); ++iter) {
+      const double mid = 0.5 * (neg + pos);
+      if (mid == neg || mid == pos) break;
+      const SweepPoint p = at(mid, &s);
+      const Mode next = follow_mode(s, track, unstable_side.uncertainty[k]);
+      const std::size_t j = nearest(p.eigenvalues, next.value);
+      // Joined to a cluster (a multiple eigenvalue there), its sign is round-off: the
+      // bracket so far is all the conditioning supports.
+      const double simple = *std::min_element(p.uncertainty.begin(), p.uncertainty.end());
+      if (p.uncertainty[j] > simple) break;
+      track = next;
+      (track.value.real() > 0.0 ? pos : neg) = mid;
+    }
+    crossing = track.value;
+    a = std::min(neg, pos);
+    b = std::max(neg, pos);
+  };
+
   for (std::size_t i = 0; i + 1 < out.points.size(); ++i) {
     const SweepPoint& hi = out.points[i + 1];
     // Each change of the count in the cell in turn (0 -> 1 -> 2 when two eigenvalues cross in
@@ -212,58 +265,8 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
           k = j;
       }
       std::complex<double> crossing = k < unstable_side.eigenvalues.size() ? unstable_side.eigenvalues[k] : 0.0;
-      // 2. For a simple eigenvalue, the count's threshold is not the crossing: follow that
-      // eigenvalue (by its eigenvector) to where its real part is certainly negative, then bisect
-      // on the sign of its real part (the capsize speed to round-off, not to r_1 / slope). A real
-      // part that never becomes certainly negative (a pair going onto the imaginary axis) keeps
-      // step 1's bracket.
-      if (k < unstable_side.eigenvalues.size()) {
-        Matrix s;
-        at(rising ? b : a, &s);
-        Mode start{crossing, {}};
-        for (const Mode& m : modes_of(s))
-          if (start.vector.size() == 0 || std::abs(m.value - crossing) < std::abs(start.value - crossing)) start = m;
-        const double width = std::max(b - a, ulp_scale * std::max(1.0, std::abs(a)));
-        double stable_end = rising ? a : b;
-        Mode follow = start;
-        bool found = false;
-        // The search may leave the grid cell: the eigenvalue can still be undecided at the cell's
-        // end (a grid point exactly at the crossing, or an uncertainty made large by a stiff mode
-        // elsewhere), and step 1's bracket then holds the count's threshold, not the crossing.
-        const double first = out.points.front().value, last = out.points.back().value;
-        for (double step = width; step <= 2.0 * (last - first); step *= 2.0) {
-          const double probe = rising ? std::max(first, a - step) : std::min(last, b + step);
-          const SweepPoint p = at(probe, &s);
-          follow = follow_mode(s, follow, unstable_side.uncertainty[k]);
-          const std::size_t j = nearest(p.eigenvalues, follow.value);
-          if (p.eigenvalues[j].real() < -p.uncertainty[j]) {
-            stable_end = probe;
-            found = true;
-            break;
-          }
-          if (probe == first || probe == last) break;
-        }
-        if (found) {
-          double neg = stable_end, pos = rising ? b : a;
-          Mode track = start;
-          for (int iter = 0; iter < 200 && std::abs(pos - neg) > ulp_scale * std::max(1.0, std::abs(neg)); ++iter) {
-            const double mid = 0.5 * (neg + pos);
-            if (mid == neg || mid == pos) break;
-            const SweepPoint p = at(mid, &s);
-            const Mode next = follow_mode(s, track, unstable_side.uncertainty[k]);
-            const std::size_t j = nearest(p.eigenvalues, next.value);
-            // Joined to a cluster (a multiple eigenvalue there), its sign is round-off: the
-            // bracket so far is all the conditioning supports.
-            const double simple = *std::min_element(p.uncertainty.begin(), p.uncertainty.end());
-            if (p.uncertainty[j] > simple) break;
-            track = next;
-            (track.value.real() > 0.0 ? pos : neg) = mid;
-          }
-          crossing = track.value;
-          a = std::min(neg, pos);
-          b = std::max(neg, pos);
-        }
-      }
+      // 2. Step 1 stopped at the count's threshold; the crossing itself, for a simple eigenvalue.
+      if (k < unstable_side.eigenvalues.size()) follow_to_the_sign_change(a, b, rising, unstable_side, k, crossing);
       StabilityCrossing c;
       c.value = 0.5 * (a + b);
       c.bracket = b - a;
