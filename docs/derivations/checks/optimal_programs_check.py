@@ -11,7 +11,9 @@ What it checks, each against a closed form derived in the document:
   2. the double integrator with least control energy: u(t), x(t) and the cost 12 d^2 / T^3;
   3. the Brockett integrator from the origin to (0, 0, a): cost 2 pi a / T, z(t), x^2 + y^2;
   4. the brachistochrone as a knife edge (Chaplygin-sleigh constraint) in least time: the
-     cycloid's time and path.
+     cycloid's time and path;
+  5. final conditions that fix what a constraint fixes: a mass on a circle in Cartesian
+     coordinates, turned from rest to rest (the double integrator in the angle).
 Each problem is transcribed exactly as the document states it (q, q', q'', u at every point, the
 dynamics defect [D A; b] q'' - [D (Q + G + B u); -b0]), and the NLP is solved by Newton's method
 on its optimality conditions (all these optima are interior: no bound is active), with exact
@@ -146,6 +148,33 @@ class Brachistochrone:
 
     def pos_res(self, t, q):
         return np.zeros(0, dtype=q.dtype)
+
+
+class CircleMass:
+    """A unit mass on the unit circle in Cartesian coordinates (holonomic constraint
+    phi = (x^2 + y^2 - 1)/2), turned by a tangential force u along (-y, x); least integral of u^2."""
+    name = "mass on a circle"
+    n, s, m = 2, 1, 1
+
+    def terms(self, t, q, v):
+        P = q.shape[0]
+        A = np.zeros((P, 2, 2), dtype=q.dtype)
+        A[:, 0, 0] = A[:, 1, 1] = 1.0
+        b = q[:, None, :].copy()  # dphi/dq
+        b0 = (v[:, 0] ** 2 + v[:, 1] ** 2)[:, None]
+        return A, np.zeros((P, 2), dtype=q.dtype), b, b0
+
+    def B(self, t, q, v):
+        return np.stack([-q[:, 1], q[:, 0]], axis=1)[:, :, None]
+
+    def L(self, t, q, v, u):
+        return u[:, 0] ** 2
+
+    def vel_res(self, t, q, v):
+        return np.array([q[0] * v[0] + q[1] * v[1]])
+
+    def pos_res(self, t, q):
+        return np.array([(q[0] ** 2 + q[1] ** 2 - 1) / 2])
 
 
 # --------------------------------------------------------------------------------------------
@@ -743,12 +772,63 @@ def brachistochrone():
           f"(more: a saddle, not a minimum, of the discrete problem)", negative > J.shape[0])
 
 
+# --------------------------------------------------------------------------------------------
+# 5. Final conditions that fix what the constraints fix (document, section 5)
+# --------------------------------------------------------------------------------------------
+def final_conditions():
+    print("\n5. Mass on a circle turned by pi/4 from rest to rest: J = 12 theta1^2 / T^3")
+    model = CircleMass()
+    T, th1 = 1.0, np.pi / 4
+    exact = 12 * th1 ** 2 / T ** 3
+
+    def guess(tr):
+        s = tr.tau
+        th = th1 * (3 * s ** 2 - 2 * s ** 3)
+        w = th1 / T * (6 * s - 6 * s ** 2)
+        al = th1 / T ** 2 * (6 - 12 * s)
+        x = np.zeros(tr.nvar())
+        Z = x[:-1].reshape(tr.P, tr.nz)
+        Z[:, 0], Z[:, 1] = np.cos(th), np.sin(th)
+        Z[:, 2], Z[:, 3] = -np.sin(th) * w, np.cos(th) * w
+        Z[:, 4] = -np.cos(th) * w ** 2 - np.sin(th) * al
+        Z[:, 5] = -np.sin(th) * w ** 2 + np.cos(th) * al
+        Z[:, 6] = al
+        x[-1] = T
+        return x
+
+    initial = {("q", 0): 1.0, ("q", 1): 0.0, ("v", 0): 0.0, ("v", 1): 0.0}
+    for method, Ns in (("trapezoidal", [8, 16, 32]), ("hermite-simpson", [4, 8, 16])):
+        errJ, failed, stalls = [], 0, []
+        for N in Ns:
+            regular = Transcription(model, method, N, T, initial, {("q", 0): np.cos(th1), ("v", 0): 0.0})
+            over = Transcription(model, method, N, T, initial, {("q", 0): np.cos(th1), ("q", 1): np.sin(th1),
+                                                               ("v", 0): 0.0, ("v", 1): 0.0})
+            for tr in (regular, over):
+                tr.initial_constraints = False  # the fixed initial state implies them
+            x, _, _ = regular.solve(guess(regular))
+            errJ.append(regular.objective(x) - exact)
+            try:
+                over.solve(guess(over), max_iter=30)
+            except RuntimeError as error:
+                failed += 1
+                stalls.append(str(error).split("KKT ")[1].rstrip(")"))
+        print(f"  {method}: x, x' fixed at the end: J_N - J = " + ", ".join(f"{e:.3e}" for e in errJ)
+              + " (orders " + ", ".join(f"{o:.2f}" for o in order(np.abs(errJ))) + ")")
+        print(f"  {method}: x, y, x', y' fixed at the end: Newton stalls at KKT residuals " + ", ".join(stalls))
+        p = 2 if method == "trapezoidal" else 4
+        check(f"{method}: final x, x' (independent of the constraint): converges with order {p}",
+              abs(order(np.abs(errJ))[-1] - p) < 0.3)
+        check(f"{method}: final x, y, x', y' (two of them fixed by the constraint): no optimum found at "
+              f"{failed} of {len(Ns)} grids", failed == len(Ns))
+
+
 if __name__ == "__main__":
     np.set_printoptions(linewidth=160)
     check_jacobian_identity()
     double_integrator()
     brockett()
     brachistochrone()
+    final_conditions()
     print()
     if FAILURES:
         print(f"{len(FAILURES)} check(s) failed")
