@@ -188,5 +188,23 @@ for mu in (0.1, 0.25):
             sdot = g * (np.sin(alpha) - mu * np.cos(alpha) * (1 + 1 / k))
             check(f"mu = {mu}, alpha = {alpha:.4f}: sliding slip acceleration g (sin - 3 mu cos) > 0", sdot > 0
                   and abs(sdot - g * (np.sin(alpha) - 3 * mu * np.cos(alpha))) < 1e-12)
+# ---------------------------------------------------------------- 10.5 the falling disk's lift-off
+# Rolling about the fixed contact point (contact-forces.md 6.4): theta'' = (4 g / (5 r)) sin(theta);
+# integrate it independently to N = 0 and evaluate the free disk's gap acceleration there.
+m, r, th0 = 0.5, 0.2, 0.1
+def disk_rhs(y, ys=None):
+    return np.array([y[1], 4 * g / (5 * r) * np.sin(y[0])])
+def disk_N(y):   # N = m (g - r cos th th'^2 - r sin th th'') (contact-forces.md (D1), psi' = phi' = 0)
+    return m * (g - r * np.cos(y[0]) * y[1]**2 - r * np.sin(y[0]) * disk_rhs(y)[1])
+tl, yl = integrate_until(disk_rhs, np.array([th0, 0.0]), 1e-4, disk_N, 5.0)
+kk = np.cos(th0)
+cL = (2 * kk + np.sqrt(4 * kk**2 - 3)) / 6
+check("10.5 disk: N = 0 at cos = (2k + sqrt(4k^2 - 3))/6, theta = 1.052986", abs(np.cos(yl[0]) - cL) < 1e-9
+      and abs(yl[0] - 1.052986) < 1e-6)
+Flat = 0.8 * m * g * np.sin(yl[0]) * (2 * kk - 3 * cL)
+gdd_free = -g + r * np.cos(yl[0]) * yl[1]**2        # free: z_C'' = -g, theta'' = 0
+check(f"10.5 disk: F_lat = {Flat:.4f} N != 0 there, and the free gap acceleration -g + r cos th th'^2 = "
+      f"{gdd_free / g:.4f} g < 0 (= -g + (8g/5) c (k - c))", Flat > 0.1 and gdd_free < 0
+      and abs(gdd_free - (-g + 1.6 * g * cL * (kk - cL))) < 1e-8)
 print("closed_forms: %d failure(s)" % failures)
 sys.exit(1 if failures else 0)
