@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/model/builtin.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/compile.hpp"

@@ -4,7 +4,7 @@
 // the source location of each node. Every toml++ node is reached through a type-checked accessor
 // (as_string, as_table, ...), so no input can make the loader dereference a missing node.
 #include "nhdyn/core/join.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 
 #include <fmt/format.h>
 

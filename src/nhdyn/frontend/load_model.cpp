@@ -1,4 +1,4 @@
-#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 
 #include <fmt/format.h>
 
@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/model/builtin.hpp"
 #include "nhdyn/model/parameters.hpp"
