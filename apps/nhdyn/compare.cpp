@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "model_source.hpp"
 #include "outputs.hpp"
 #include "nhdyn/analysis/comparison.hpp"
 #include "nhdyn/analysis/exact_solution.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
@@ -54,7 +54,7 @@ double energy_error(const SimulationSummary& s) { return s.has_energy_balance ? 
 
 int run_compare(const CompareArgs& args) {
   protect_model_file(args.model);
-  const ResolvedModel resolved = resolve_model(args.model, args.sets);
+  const LoadedModel resolved = load_model_argument(args.model, args.sets);
   std::string notice;
   const Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
   if (!notice.empty()) fmt::print(stderr, "{}\n", notice);

@@ -12,11 +12,12 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "model_source.hpp"
 #include "outputs.hpp"
 #include "nhdyn/analysis/run_options.hpp"
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/describe.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/io/report.hpp"
@@ -24,8 +25,6 @@
 #include "nhdyn/jit/compiled_evaluator.hpp"
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/symbolic/events.hpp"
-#include "nhdyn/symbolic/spec.hpp"
-#include "nhdyn/symbolic/visual.hpp"
 #include "progress.hpp"
 #include "run_overrides.hpp"
 
@@ -154,7 +153,7 @@ bool is_regular_target(const std::filesystem::path& csv) {
 
 int run_simulate(const SimulateArgs& args) {
   protect_model_file(args.model);
-  const ResolvedModel resolved = resolve_model(args.model, args.sets);
+  const LoadedModel resolved = load_model_argument(args.model, args.sets);
   std::string notice;
   const Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
   if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
@@ -291,9 +290,9 @@ int run_simulate(const SimulateArgs& args) {
       }
     }
     // A model file also tells its angles by use: the coordinates inside sin, cos or tan.
-    if (resolved.spec) {
+    if (resolved.description) {
       try {
-        const std::vector<bool> angles = symbolic::compile_visual(*resolved.spec).angles;
+        const std::vector<bool>& angles = description_angles(*resolved.description);
         for (std::size_t i = 0; i < angles.size() && i < model.coordinates.size(); ++i)
           if (angles[i]) request.angles.push_back(model.coordinates[i]);
       } catch (const Error&) {
@@ -306,7 +305,7 @@ int run_simulate(const SimulateArgs& args) {
   html_probe.reset();
   std::string html_notice;
   if (!args.html.empty())
-    html_notice = write_model_report(model, resolved.spec ? &*resolved.spec : nullptr, load_csv(csv_path),
+    html_notice = write_model_report(model, resolved.description.get(), load_csv(csv_path),
                        fmt::format("{}: {}, {}", model.name, method_name(options.formulation.method),
                                    integrator_name(options.integrator.kind)),
                        {{"steps", fmt::format("{} (rejected {})", summary.stats.steps, summary.stats.rejected_steps)},

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "model_source.hpp"
 #include "outputs.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
@@ -51,7 +51,7 @@ StudyFormulation parse_formulation(const std::string& label) {
 
 int run_error_relation(const ErrorRelationArgs& args) {
   protect_model_file(args.model);
-  const ResolvedModel resolved = resolve_model(args.model, args.sets);
+  const LoadedModel resolved = load_model_argument(args.model, args.sets);
   const Model& model = resolved.model;
   ErrorRelationOptions options;
   options.tolerances = args.tolerances;

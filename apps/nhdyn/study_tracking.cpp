@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "model_source.hpp"
 #include "outputs.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/xy_plot.hpp"
@@ -41,7 +41,7 @@ std::string gain_label(double gain) { return gain == 0.0 ? std::string("none") :
 
 int run_tracking(const TrackingArgs& args) {
   protect_model_file(args.model);
-  const ResolvedModel resolved = resolve_model(args.model, args.sets);
+  const LoadedModel resolved = load_model_argument(args.model, args.sets);
   const Model& model = resolved.model;
   TrackingOptions options;
   options.tolerances = args.tolerances;

@@ -1196,7 +1196,7 @@ symbolic::Spec load_model_string(std::string_view text, std::string file_name) {
   return Loader(text, std::move(file_name)).load();
 }
 
-symbolic::Spec load_model_file(const std::filesystem::path& path) {
+std::string read_model_text(const std::filesystem::path& path) {
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(path, ec);
   if (!std::filesystem::exists(status))
@@ -1214,7 +1214,11 @@ symbolic::Spec load_model_file(const std::filesystem::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw FileError(fmt::format("{}: cannot read the model file", path.string()));
-  return load_model_string(text.str(), path.string());
+  return text.str();
+}
+
+symbolic::Spec load_model_file(const std::filesystem::path& path) {
+  return load_model_string(read_model_text(path), path.string());
 }
 
 }  // namespace nhdyn
