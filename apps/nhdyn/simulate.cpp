@@ -411,11 +411,12 @@ std::function<int()> add_simulate_command(CLI::App& app) {
   cmd->add_option("MODEL", args->model, "A model file (.toml) or a built-in model (see `nhdyn list`)")->required();
   cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   cmd->add_option("--evaluator", args->evaluator,
-                  "interpreted (default) | compiled (the terms as machine code, cached; docs/cli.md) | auto");
+                  help_choices(jit::kEvaluatorChoices, jit::EvaluatorChoice::interpreted) +
+                      " (compiled: the terms as machine code, cached; docs/cli.md)");
   cmd->add_flag("--fix-initial", args->fix_initial,
                 "Move the initial state onto the constraints with the smallest inertia-weighted change");
   cmd->add_option("--stabilize", args->stabilize,
-                  "Keep the solution on the constraints: none (default) | baumgarte | projection");
+                  "Keep the solution on the constraints: " + help_choices(kStabilizations, Stabilization::none));
   cmd->add_option("--baumgarte-alpha", args->baumgarte_alpha,
                   "Baumgarte: damping rate of the velocity residual [1/s]")->capture_default_str();
   cmd->add_option("--baumgarte-beta", args->baumgarte_beta,
@@ -424,9 +425,9 @@ std::function<int()> add_simulate_command(CLI::App& app) {
                   "Projection: residual at which Newton stops")->capture_default_str();
   cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
   cmd->add_option("--output-step", args->output_step, "Time between output rows [s] (default: the model's)");
-  cmd->add_option("--method", args->method, "Formulation: sanh (default) | lagrange | udwadia-kalaba | nullspace");
-  cmd->add_option("--complement", args->complement, "Where D comes from (sanh, nullspace): qr (default) | partition | analytic");
-  cmd->add_option("--integrator", args->integrator, "rk4 | dopri5 (default) | dop853 | cvode-bdf | cvode-adams");
+  cmd->add_option("--method", args->method, "Formulation: " + help_choices(kFormulations, Method::sanh));
+  cmd->add_option("--complement", args->complement, "Where D comes from (sanh, nullspace): " + help_choices(kComplements, Complement::qr));
+  cmd->add_option("--integrator", args->integrator, help_choices(kIntegrators, IntegratorKind::dopri5));
   cmd->add_option("--rtol", args->rtol, "Relative tolerance of the adaptive integrators (default: the model's, else 1e-8)");
   cmd->add_option("--atol", args->atol, "Absolute tolerance of the adaptive integrators (default: the model's, else 1e-10)");
   cmd->add_option("--step", args->step, "rk4: step size [s] (default output step / 10); adaptive: first step");

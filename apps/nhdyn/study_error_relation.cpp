@@ -175,7 +175,7 @@ std::function<int()> add_error_relation_study(CLI::App& study) {
                   "udwadia-kalaba, nullspace (default: all the model allows)")
       ->delimiter(',');
   cmd->add_option("--integrators", args->integrators,
-                  "Integrators, comma-separated: dopri5, dop853, cvode-bdf, cvode-adams")
+                  "Integrators, comma-separated: " + adaptive_integrator_names(", "))
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--atol-factor", args->atol_factor, "atol of each run = this x rtol")->capture_default_str();

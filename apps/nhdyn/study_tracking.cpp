@@ -151,7 +151,7 @@ std::function<int()> add_tracking_study(CLI::App& study) {
                   "Feedback gains alpha = beta [1/s] of --program-feedback, comma-separated; 0 is no feedback")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--integrator", args->integrator, "dopri5, dop853, cvode-bdf or cvode-adams")->capture_default_str();
+  cmd->add_option("--integrator", args->integrator, adaptive_integrator_names())->capture_default_str();
   cmd->add_option("--atol-factor", args->atol_factor, "atol of each run = this x rtol")->capture_default_str();
   cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
   cmd->add_option("--output-step", args->output_step, "Time between measured outputs [s] (default: the model's)");

@@ -29,6 +29,8 @@
 #include <toml++/toml.h>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/integrators/ode.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/multibody.hpp"
 #include "nhdyn/symbolic/outputs.hpp"
@@ -68,11 +70,9 @@ const std::vector<std::string> visual_keys = {"points", "segments"};
 const std::vector<std::string> visual_point_keys = {"name", "position", "radius"};
 const std::vector<std::string> visual_segment_keys = {"name", "from", "to"};
 
-// The names that formulation/formulation.cpp (parse_method) and integrators/ode.cpp
-// (parse_integrator) accept. io may not depend on those modules, so the lists are repeated here;
-// tests/io/model_file_test.cpp checks that they agree.
-const std::vector<std::string> method_names = {"sanh", "lagrange", "udwadia-kalaba", "nullspace"};
-const std::vector<std::string> integrator_names = {"rk4", "dopri5", "dop853", "cvode-bdf", "cvode-adams"};
+// The names parse_method and parse_integrator accept, from their tables (formulation.hpp, ode.hpp).
+const std::vector<std::string> method_names = names_of(kFormulations);
+const std::vector<std::string> integrator_names = names_of(kIntegrators);
 
 std::string_view type_name(const toml::node& node) {
   switch (node.type()) {
