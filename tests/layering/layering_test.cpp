@@ -9,7 +9,12 @@
 //     src/nhdyn/symbolic and the places listed below with their reason (never the CLI in apps/ nor
 //     the Python module); a listed place that no longer sees GiNaC must be removed from the list
 //     (so each change tightens it);
-//   - SUNDIALS, directly or through headers, is seen only inside src/nhdyn/integrators/sundials.
+//   - SUNDIALS, directly or through headers, is seen only inside src/nhdyn/integrators/sundials;
+//   - the umbrella header src/nhdyn/nhdyn.hpp (the public surface, for applications) may include
+//     every module's headers but sees neither GiNaC nor SUNDIALS, and no module includes it;
+//   - a header marked "// Internal:" in its opening comment is included only by the library and
+//     the tests, never by an application (the CLI, Python, examples, benchmarks, fuzzer) nor by
+//     the umbrella header.
 // The checker itself is tested on small synthetic trees that break each rule once.
 #include <gtest/gtest.h>
 
@@ -293,6 +298,7 @@ struct Include {
 
 struct SourceFile {
   std::vector<Include> includes;
+  bool internal = false;  // "// Internal:" in the opening comment: not part of the public API
 };
 using Tree = std::map<std::string, SourceFile>;  // path relative to the root -> file
 
@@ -307,8 +313,11 @@ Tree scan(const fs::path& root) {
       SourceFile file;
       std::istringstream in(read_text(e.path()));
       int number = 0;
+      bool opening = true;  // still in the header's opening comment
       for (std::string line; std::getline(in, line);) {
         ++number;
+        if (opening && line.rfind("//", 0) != 0) opening = false;
+        if (opening && line.rfind("// Internal:", 0) == 0) file.internal = true;
         std::smatch m;
         if (std::regex_search(line, m, include)) file.includes.push_back({number, m[2].str(), m[1].str() == "\""});
       }
@@ -330,6 +339,9 @@ std::string resolve(const Tree& tree, const std::string& from, const Include& in
   return {};
 }
 
+// The public surface in one header, for applications.
+const std::string kUmbrella = "src/nhdyn/nhdyn.hpp";
+
 // Which files may include which modules.
 struct Owner {
   std::string what;  // for messages: "module analysis", "tests/io (links nhdyn_io ...)", "application"
@@ -339,6 +351,14 @@ struct Owner {
 Owner owner_of(const std::string& path, const Layers& layers,
                const std::map<std::string, std::vector<std::string>>& test_links, Problems& problems,
                std::set<std::string>& reported) {
+  if (path == kUmbrella) {
+    std::set<std::string> visible;
+    for (const auto& [name, layer] : layers) {
+      std::set<std::string> c = public_closure(layers, name);
+      visible.insert(c.begin(), c.end());
+    }
+    return {"the umbrella header", visible};
+  }
   if (starts_with(path, "src/nhdyn/")) {
     const std::string m = module_of(layers, path.substr(10));
     if (m.empty()) {
@@ -398,6 +418,17 @@ void check_includes(const Tree& tree, const Layers& layers,
       if (!starts_with(inc.target, "nhdyn/")) continue;
       const std::string m = module_of(layers, inc.target.substr(6));
       const std::string where = path + ":" + std::to_string(inc.line) + ": ";
+      const bool application = owner.what.rfind("an application", 0) == 0;
+      if ("src/" + inc.target == kUmbrella) {
+        if (!application && !starts_with(path, "tests/"))
+          problems.push_back(where + owner.what + " includes " + inc.target +
+                             ", the umbrella header for applications; include the module headers it needs");
+        continue;
+      }
+      const auto target = tree.find("src/" + inc.target);
+      if (target != tree.end() && target->second.internal && (application || path == kUmbrella))
+        problems.push_back(where + owner.what + " includes " + inc.target +
+                           ", a header marked internal to the library; use the public headers (nhdyn/nhdyn.hpp)");
       if (m.empty())
         problems.push_back(where + "includes " + inc.target + ", which is in no module of the layer table");
       else if (!owner.visible.count(m))
@@ -648,6 +679,28 @@ TEST_F(SyntheticTree, SourcesOnlyAllowanceLeavesHeadersFenced) {
   // sees GiNaC; the source file is allowed.
   ASSERT_EQ(problems.size(), 3U) << join(problems);
   EXPECT_NE(problems[2].find("src/nhdyn/analysis/load.hpp: sees GiNaC"), std::string::npos) << problems[2];
+}
+
+TEST_F(SyntheticTree, UmbrellaHeaderServesApplicationsOnly) {
+  write("src/nhdyn/nhdyn.hpp", "#include \"nhdyn/analysis/s.hpp\"\n#include \"nhdyn/integrators/ode.hpp\"\n");
+  write("apps/cli/run.cpp", "#include \"nhdyn/nhdyn.hpp\"\n");
+  EXPECT_TRUE(check().empty()) << join(check());
+  write("src/nhdyn/analysis/t.cpp", "#include \"nhdyn/nhdyn.hpp\"\n");
+  EXPECT_TRUE(one_problem(check(), {"src/nhdyn/analysis/t.cpp:1", "umbrella header"}));
+}
+
+TEST_F(SyntheticTree, UmbrellaHeaderSeeingGinacIsReported) {
+  write("src/nhdyn/nhdyn.hpp", "#include \"nhdyn/symbolic/spec.hpp\"\n");
+  EXPECT_TRUE(one_problem(check(), {"src/nhdyn/nhdyn.hpp: sees GiNaC"}));
+}
+
+TEST_F(SyntheticTree, InternalHeaderInAnApplicationIsReported) {
+  write("src/nhdyn/model/detail.hpp", "// Kernels' helpers.\n// Internal: not for users.\n#pragma once\n");
+  write("src/nhdyn/model/m.cpp", "#include \"nhdyn/model/detail.hpp\"\n");
+  write("tests/model/detail_test.cpp", "#include \"nhdyn/model/detail.hpp\"\n");
+  EXPECT_TRUE(check().empty()) << join(check());
+  write("apps/cli/peek.cpp", "#include \"nhdyn/model/detail.hpp\"\n");
+  EXPECT_TRUE(one_problem(check(), {"apps/cli/peek.cpp:1", "internal"}));
 }
 
 TEST_F(SyntheticTree, ModuleWithoutLineIsReported) {
