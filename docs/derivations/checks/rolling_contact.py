@@ -85,7 +85,10 @@ class RollingBody:
     """r_c_expr: sympy 3-vector in X, Q, T (and parameter symbols already substituted).
     u_g_expr: function p -> sympy 3-vector (the ground's velocity field), may use T."""
 
-    def __init__(self, m, I_body, r_c_expr, u_g=None, gravity=(0.0, 0.0, -9.81)):
+    def __init__(self, m, I_body, r_c_expr, u_g=None, gravity=(0.0, 0.0, -9.81), no_spin=None):
+        """no_spin = (n, Omega): "rubber" rolling on a plane of constant normal n turning at the
+        constant rate Omega: also n . w = Omega, held by a moment M_s n (a tenth unknown)."""
+        self.no_spin = None if no_spin is None else (np.array(no_spin[0], float), float(no_spin[1]))
         self.m = float(m)
         self.Ib = np.array(I_body, dtype=float)
         self.g = np.array(gravity, dtype=float)
@@ -117,7 +120,8 @@ class RollingBody:
         rc = self.r_c(t, y)
         bias = np.array(self._bias(t, *y), dtype=float)
         S = skew(rc)
-        K = np.zeros((9, 9))
+        N = 9 if self.no_spin is None else 10
+        K = np.zeros((N, N))
         K[0:3, 0:3] = self.m * np.eye(3)
         K[0:3, 6:9] = -np.eye(3)
         K[3:6, 3:6] = Iw
@@ -125,6 +129,11 @@ class RollingBody:
         K[6:9, 0:3] = np.eye(3)
         K[6:9, 3:6] = -S          # alpha x r_c = -r_c x alpha
         rhs = np.concatenate([self.m * self.g, -np.cross(w, Iw @ w), -bias])
+        if self.no_spin is not None:
+            n = self.no_spin[0]
+            K[3:6, 9] = -n            # Euler: I_w alpha + w x I_w w = r_c x L + M_s n
+            K[9, 3:6] = n             # d/dt (n . w) = n . alpha = 0
+            rhs = np.concatenate([rhs, [0.0]])
         sol = np.linalg.solve(K, rhs)
         return sol[0:3], sol[3:6], sol[6:9]
 
