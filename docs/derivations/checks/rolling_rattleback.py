@@ -156,6 +156,19 @@ for spin in (+5.0, -5.0):
     print("      w3 at t = " + ", ".join(f"{tt:g}: {sol.sol(tt)[6]:+.6f}"
                                           for tt in (1, 2, 3, 5, 8, 10, 12)))
     assert np.ptp(E) < 1e-9
+    # coordinate-free state for comparisons: n = the upward vertical in body axes, w in body axes,
+    # and the contact force (world; N its vertical component) from model 1 at that state
+    for tt in (1.0, 5.0, 10.0):
+        yf = sol.sol(tt)
+        qn = yf[:4] / np.linalg.norm(yf[:4])
+        Rn = quat_to_R(qn)
+        yw = np.concatenate([[0, 0, 0], qn, [0, 0, 0], Rn @ yf[4:]])
+        rc = body.r_c(0.0, yw)
+        yw[2], yw[7:10] = -rc[2], -np.cross(yw[10:13], rc)
+        _, _, L = body.solve(0.0, yw)
+        print(f"      t = {tt:4.1f}: n_body = ({Rn[2, 0]:+.9f}, {Rn[2, 1]:+.9f}, {Rn[2, 2]:+.9f}), "
+              f"w_body = ({yf[4]:+.7f}, {yf[5]:+.7f}, {yf[6]:+.7f}), contact force "
+              f"({L[0]:+.6f}, {L[1]:+.6f}, {L[2]:+.6f}) N")
 
 t_pos, t_neg = results[5.0][0], results[-5.0][0]
 assert t_neg is not None and abs(t_neg - 2.3527) < 2e-3
