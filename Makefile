@@ -6,12 +6,16 @@
 #   make fuzz   the model-file fuzzer (needs clang-14; fuzz/run says which packages)
 #   make bench  build and run the benchmarks
 #   make python build the Python package nhdyn only, and say how to import it
+#   make bench-check   the performance guard: a few paired ratios against bench/baselines (fails
+#               when one is more than 1.5x its baseline; about 40 s on 2 busy cores)
+#   make bench-update  the same, and rewrites docs/performance.md's table (BASELINES=1: and
+#               bench/baselines)
 BUILD ?= build
 JOBS ?= $(shell nproc)
 MODEL ?= examples/sled.toml
 NAME ?= sled
 
-.PHONY: run test build configure deps bench python asan fuzz clean
+.PHONY: run test build configure deps bench bench-check bench-update python asan fuzz clean
 
 deps:
 	@bash scripts/install-deps
@@ -39,6 +43,16 @@ python: configure
 bench: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_bench
 	$(BUILD)/bench/nhdyn_bench --benchmark_min_time=0.2
+
+# The performance guard (scripts/bench-check; docs/performance.md, "The guard").
+BENCH_CHECK_TARGETS = nhdyn_cli nhdyn_sled_reference nhdyn_bench_check
+bench-check: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target $(BENCH_CHECK_TARGETS)
+	python3 scripts/bench-check $(BUILD)
+
+bench-update: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target $(BENCH_CHECK_TARGETS)
+	python3 scripts/bench-check $(BUILD) --update-docs $(if $(BASELINES),--update-baselines)
 
 # The sanitizer build (docs/design.md, "Build and CI"): ASan + UBSan at -O1 with line tables only.
 # With clang-14 installed it is also the fuzzer's build (every target instrumented for libFuzzer),
