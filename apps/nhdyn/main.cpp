@@ -8,11 +8,13 @@
 
 #include "commands.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/version.hpp"
 #include "outputs.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"nhdyn: equations of motion of constrained mechanical systems (Do Sanh form)", "nhdyn"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", fmt::format("nhdyn {} (commit {})", NHDYN_VERSION, NHDYN_GIT_COMMIT));
   const auto simulate = nhdyn::cli::add_simulate_command(app);
   const auto list = nhdyn::cli::add_list_command(app);
   const auto equations = nhdyn::cli::add_equations_command(app);
