@@ -6,12 +6,13 @@
 #   make fuzz   the model-file fuzzer (needs clang-14; fuzz/run says which packages)
 #   make bench  build and run the benchmarks
 #   make python build the Python package nhdyn only, and say how to import it
+#   make package  the Debian package build/nhdyn_VERSION_ARCH.deb (CPack; docs/install.md)
 BUILD ?= build
 JOBS ?= $(shell nproc)
 MODEL ?= examples/sled.toml
 NAME ?= sled
 
-.PHONY: run test build configure deps bench python asan fuzz clean
+.PHONY: run test build configure deps bench python package asan fuzz clean
 
 deps:
 	@bash scripts/install-deps
@@ -35,6 +36,9 @@ test: build
 python: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_python
 	@echo "export PYTHONPATH=$(abspath $(BUILD))/python   # then: /usr/bin/python3 -c 'import nhdyn'"
+
+package: build
+	cd $(BUILD) && cpack -G DEB
 
 bench: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_bench

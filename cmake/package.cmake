@@ -9,11 +9,11 @@ set(CPACK_PACKAGE_NAME nhdyn)
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGE_VENDOR "nhdyn")
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "equations of motion of constrained mechanical systems (Do Sanh form)")
-set(CPACK_DEBIAN_PACKAGE_DESCRIPTION "equations of motion of constrained mechanical systems (Do Sanh form)
- nhdyn simulates constrained mechanical systems, holonomic and nonholonomic,
- with the equations of motion in the form of Do Sanh: a command line (nhdyn),
- a C++ library (find_package(nhdyn), pkg-config nhdyn) and a Python package
- (import nhdyn).")
+# The summary above is the description's first line; CPack indents these for the control file.
+set(CPACK_DEBIAN_PACKAGE_DESCRIPTION "nhdyn simulates constrained mechanical systems, holonomic and nonholonomic,
+with the equations of motion in the form of Do Sanh: a command line (nhdyn),
+a C++ library (find_package(nhdyn), pkg-config nhdyn) and a Python package
+(import nhdyn).")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_MAINTAINER "nhdyn maintainers <nhdyn@localhost>")
