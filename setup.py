@@ -40,13 +40,18 @@ def cached(build_dir, name):
     return None
 
 
+def cmake_build_dir():
+    """Where the CMake build goes (see the top of this file)."""
+    python = "python{}.{}".format(*sys.version_info[:2])
+    return pathlib.Path(os.environ.get("NHDYN_PIP_BUILD_DIR") or ROOT / "build-pip" / python).resolve()
+
+
 class CMakeBuild(build_ext):
     """Builds nhdyn._nhdyn with CMake instead of compiling sources itself."""
 
     def build_extension(self, ext):
         python = "{}.{}".format(*sys.version_info[:2])
-        build_dir = pathlib.Path(os.environ.get("NHDYN_PIP_BUILD_DIR") or ROOT / "build-pip" / ("python" + python))
-        build_dir = build_dir.resolve()
+        build_dir = cmake_build_dir()
         print("nhdyn: building the Python package for Python {} ({}, extension suffix {}) in {}".format(
             python, sys.executable, sysconfig.get_config_var("EXT_SUFFIX"), build_dir), flush=True)
         if (build_dir / "CMakeCache.txt").exists() and os.environ.get("NHDYN_PIP_BUILD_DIR"):
@@ -75,13 +80,16 @@ class CMakeBuild(build_ext):
         shutil.copy2(package / "_build_info.py", target.parent / "_build_info.py")
 
 
+cmake_build_dir().mkdir(parents=True, exist_ok=True)  # egg_info wants its base to exist
 setup(
     version=project_version(),
     packages=["nhdyn"],
     package_dir={"nhdyn": "python/nhdyn"},
     ext_modules=[Extension("nhdyn._nhdyn", sources=[])],
     cmdclass={"build_ext": CMakeBuild},
-    # setuptools' own scratch space beside the CMake build, not in build/ (the CMake build of the README).
-    options={"build": {"build_base": "build-pip/setuptools"}, "egg_info": {"egg_base": "build-pip"}},
+    # setuptools' own scratch space inside the CMake build directory: not in the checkout's build/
+    # (unless that is the CMake build), and apart for two builds at once.
+    options={"build": {"build_base": str(cmake_build_dir() / "setuptools")},
+             "egg_info": {"egg_base": str(cmake_build_dir())}},
     zip_safe=False,
 )
