@@ -12,12 +12,13 @@
 #               when one is more than 1.5x its baseline; about 40 s on 2 busy cores)
 #   make bench-update  the same, and rewrites docs/performance.md's table (BASELINES=1: and
 #               bench/baselines)
+#   make package  the Debian package build/nhdyn_VERSION_ARCH.deb (CPack; docs/install.md)
 BUILD ?= build
 JOBS ?= $(shell nproc)
 MODEL ?= examples/sled.toml
 NAME ?= sled
 
-.PHONY: run test build configure configure-run deps deps-run bench bench-check bench-update python asan fuzz clean
+.PHONY: run test build configure configure-run deps deps-run bench bench-check bench-update python package asan fuzz clean
 
 deps:
 	@bash scripts/install-deps
@@ -51,6 +52,9 @@ test: build
 python: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_python
 	@echo "export PYTHONPATH=$(abspath $(BUILD))/python   # then: /usr/bin/python3 -c 'import nhdyn'"
+
+package: build
+	cd $(BUILD) && cpack -G DEB
 
 bench: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_bench
