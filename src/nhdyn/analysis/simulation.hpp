@@ -29,17 +29,10 @@ enum class Stabilization {
   projection,  // after every accepted step, and at every output, onto phi = 0 and then f = 0
 };
 
-// "none", "baumgarte", "projection".
-// The stabilizations, once (core/names.hpp).
-struct StabilizationInfo {
-  Stabilization value;
-  std::string_view name;
-};
-inline constexpr std::array<StabilizationInfo, 3> kStabilizations{{
-    {Stabilization::none, "none"},
-    {Stabilization::baumgarte, "baumgarte"},
-    {Stabilization::projection, "projection"},
-}};
+// The stabilizations, once (core/names.hpp): "none", "baumgarte", "projection".
+using StabilizationInfo = Named<Stabilization>;
+inline constexpr std::array<StabilizationInfo, 3> kStabilizations{
+    {{Stabilization::none, "none"}, {Stabilization::baumgarte, "baumgarte"}, {Stabilization::projection, "projection"}}};
 
 std::string_view stabilization_name(Stabilization stabilization);
 Stabilization parse_stabilization(std::string_view name);  // throws InputError listing valid names

@@ -18,6 +18,13 @@
 
 namespace nhdyn {
 
+// An entry with nothing but its name, for the lists whose values have no properties to record.
+template <class Value>
+struct Named {
+  Value value;
+  std::string_view name;
+};
+
 // The entry for `value`, or null (a value cast from a bad integer).
 template <class Table, class Value>
 constexpr auto find_value(const Table& table, Value value) -> decltype(&table[0]) {

@@ -49,15 +49,9 @@ inline constexpr std::array<FormulationInfo, 4> kFormulations{{
     {Method::nullspace, "nullspace", false},
 }};
 
-struct ComplementInfo {
-  Complement value;
-  std::string_view name;
-};
-inline constexpr std::array<ComplementInfo, 3> kComplements{{
-    {Complement::qr, "qr"},
-    {Complement::partition, "partition"},
-    {Complement::analytic, "analytic"},
-}};
+using ComplementInfo = Named<Complement>;
+inline constexpr std::array<ComplementInfo, 3> kComplements{
+    {{Complement::qr, "qr"}, {Complement::partition, "partition"}, {Complement::analytic, "analytic"}}};
 
 // Its name in kFormulations: "sanh", "lagrange", "udwadia-kalaba", "nullspace".
 std::string_view method_name(Method method);

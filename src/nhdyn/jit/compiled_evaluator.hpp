@@ -32,15 +32,9 @@ class JitError : public Error {
 enum class EvaluatorChoice { interpreted, compiled, automatic };
 
 // The evaluator choices, once (core/names.hpp): `--evaluator NAME`.
-struct EvaluatorChoiceInfo {
-  EvaluatorChoice value;
-  std::string_view name;
-};
-inline constexpr std::array<EvaluatorChoiceInfo, 3> kEvaluatorChoices{{
-    {EvaluatorChoice::interpreted, "interpreted"},
-    {EvaluatorChoice::compiled, "compiled"},
-    {EvaluatorChoice::automatic, "auto"},
-}};
+using EvaluatorChoiceInfo = Named<EvaluatorChoice>;
+inline constexpr std::array<EvaluatorChoiceInfo, 3> kEvaluatorChoices{
+    {{EvaluatorChoice::interpreted, "interpreted"}, {EvaluatorChoice::compiled, "compiled"}, {EvaluatorChoice::automatic, "auto"}}};
 
 // "interpreted" | "compiled" | "auto"; throws InputError naming the value otherwise.
 EvaluatorChoice parse_evaluator_choice(const std::string& text);
