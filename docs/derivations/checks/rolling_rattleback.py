@@ -176,6 +176,74 @@ assert t_pos is not None and abs(t_pos - 11.461) < 2e-2 and min(results[5.0][1][
 print(f"(g) w3(0) = -5 reverses at {t_neg:.4f} s; w3(0) = +5 keeps its sense (w3 > 1 rad/s) "
       f"for 10 s and, with no dissipation, reverses only at {t_pos:.4f} s (see the growth rates)")
 
+# ---- the start of the nhdyn example (examples/rattleback.toml on the rolling branch) ----
+# Frame rotations z(psi), x(theta), y(phi): R = Rz(psi) Rx(theta) Ry(phi); start psi = 0,
+# theta = phi = 0.5 deg (the same orientation as above) but spinning about the WORLD vertical,
+# w = spin e_z (psi' = spin, theta' = phi' = 0), not about the body's c-axis. O, the ellipsoid's
+# centre, at the height sqrt(a^2 s^2 c^2 + b^2 s^2 + c^2 c^4) (s, c of the tilt), and
+# v_O = -w x (P - O).
+
+
+def euler_rates(y):
+    """(psi', theta', phi') of R = Rz(psi) Rx(theta) Ry(phi) for the state (q, w_b) of model 2."""
+    Rn = quat_to_R(y[:4] / np.linalg.norm(y[:4]))
+    w = Rn @ y[4:]
+    psi = np.arctan2(-Rn[0, 1], Rn[1, 1])
+    axes = np.column_stack([[0, 0, 1], [np.cos(psi), np.sin(psi), 0], Rn[:, 1]])
+    return np.linalg.solve(axes, w)
+
+
+tilt = np.radians(0.5)
+st, ct = np.sin(tilt), np.cos(tilt)
+for spin in (-5.0, +5.0):
+    yw = initial_state(0.5, 0.5, 0.0)
+    Rn = quat_to_R(yw[3:7])
+    yw[10:13] = [0, 0, spin]
+    y0 = to_fast(yw)
+    # the example's closed forms for the height of O and v_O against this model
+    nb = Rn[2, :]
+    hO = np.sqrt(nb @ np.diag([a2, b2, c2]) @ nb)
+    assert abs(hO - np.sqrt(a2 * st**2 * ct**2 + b2 * st**2 + c2 * ct**4)) < 1e-15
+    PO = Rn @ (-np.diag([a2, b2, c2]) @ nb / hO)
+    vO = -np.cross([0, 0, spin], PO)
+    vx = spin * st * ct * (a2 * st**2 + c2 * ct**2 - b2) / hO
+    vy = -spin * (a2 - c2) * st * ct**2 / hO
+    assert abs(vO[0] - vx) < 1e-15 and abs(vO[1] - vy) < 1e-15 and abs(vO[2]) < 1e-15
+    assert np.allclose(euler_rates(y0), [spin, 0, 0], atol=1e-14)
+    t_ex = 10.0
+    sol = solve_ivp(fast_rhs, (0, t_ex), y0, method='DOP853', rtol=1e-10, atol=1e-11,
+                    dense_output=True)
+    tt = np.linspace(0, t_ex, 2001)
+    ys = sol.sol(tt)
+    psid = np.array([euler_rates(ys[:, i])[0] for i in range(len(tt))])
+    w3 = ys[6]
+    wz = np.array([(quat_to_R(ys[:4, i] / np.linalg.norm(ys[:4, i])) @ ys[4:, i])[2]
+                   for i in range(len(tt))])
+
+    def first_flip(f, fun):
+        i = np.nonzero(np.sign(f[1:]) != np.sign(f[:-1]))[0]
+        if not len(i):
+            return None
+        return brentq(lambda t: fun(sol.sol(t)), tt[i[0]], tt[i[0] + 1], xtol=1e-12)
+
+    def wz_of(y):
+        return (quat_to_R(y[:4] / np.linalg.norm(y[:4])) @ y[4:])[2]
+    flips = (first_flip(psid, lambda y: euler_rates(y)[0]), first_flip(w3, lambda y: y[6]),
+             first_flip(wz, wz_of))
+    E = [fast_energy(sol.sol(t)) for t in tt[::100]]
+    fmt = lambda t: "none" if t is None else f"{t:.6f} s"
+    print(f"(g) example start, psi'(0) = {spin:+.0f}: first sign change of psi' at {fmt(flips[0])}, "
+          f"of w3 at {fmt(flips[1])}, of the vertical w_z at {fmt(flips[2])}; psi' in "
+          f"[{psid.min():+.4f}, {psid.max():+.4f}] over {t_ex:g} s; E = {E[0]:.9f} J "
+          f"(potential m g z_G), spread {np.ptp(E):.1e}")
+    assert np.ptp(E) < 1e-9
+    if spin < 0:
+        assert abs(flips[0] - 2.3515) < 1e-3 and psid.min() < -5.3 and psid.max() > 5.3
+    else:
+        assert flips == (None, None, None) and psid.min() > 1.2
+    print("      psi' at t = " + ", ".join(f"{t:g}: {psid[int(round(t / t_ex * 2000))]:+.6f}"
+                                          for t in (1, 2, 3, 5, 10)))
+
 # ---- linearised rattleback about upright spin, from the same model ----
 # reduced state (gamma, w_b): gamma = the upward vertical in body axes, w_b in body axes.
 
