@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "nhdyn/jit/source.hpp"
+#include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/program.hpp"
 
 extern char** environ;
@@ -146,6 +147,37 @@ std::shared_ptr<Library> load(const fs::path& path, bool sparse, std::string& er
   return library;
 }
 
+using ProgramStage = void (*)(const double*, double*);
+using ProgramRun = void (*)(const double*, double, const double*, const double*, double*);
+
+// A program of make_program_source in a loaded object (the contact forces', the outputs').
+class CompiledProgram final : public NativeProgram {
+ public:
+  CompiledProgram(std::shared_ptr<const Library> library, StageSize size, ProgramStage stage, ProgramRun run)
+      : library_(std::move(library)), size_(size), stage_(stage), run_(run) {}
+  std::size_t stage_size() const override { return size_(); }
+  void stage(const double* parameters, double* stage) const override { stage_(parameters, stage); }
+  void run(const double* stage, double t, const double* q, const double* v, double* outputs) const override {
+    run_(stage, t, q, v, outputs);
+  }
+
+ private:
+  std::shared_ptr<const Library> library_;  // keeps the object loaded
+  StageSize size_;
+  ProgramStage stage_;
+  ProgramRun run_;
+};
+
+// The program NAME of the loaded object, or null when the object lacks it.
+std::shared_ptr<const NativeProgram> native_program(const std::shared_ptr<const Library>& library,
+                                                    const std::string& name) {
+  const auto size = reinterpret_cast<StageSize>(dlsym(library->handle, ("nhdyn_jit_" + name + "_stage_size").c_str()));
+  const auto stage = reinterpret_cast<ProgramStage>(dlsym(library->handle, ("nhdyn_jit_" + name + "_stage").c_str()));
+  const auto run = reinterpret_cast<ProgramRun>(dlsym(library->handle, ("nhdyn_jit_" + name).c_str()));
+  if (!size || !stage || !run) return nullptr;
+  return std::make_shared<CompiledProgram>(library, size, stage, run);
+}
+
 // The interpreter's evaluator with its terms replaced by the compiled ones.
 class CompiledEvaluator final : public Evaluator {
  public:
@@ -248,8 +280,10 @@ Model make_compiled(const Model& model, const JitOptions& options, JitReport* re
                                "compile",
                                model.name));
   const bool sparse = base->sparsity() != nullptr;
-  const std::string source = make_terms_source(base->parametric_programs().terms, base->n(), base->s(),
-                                               base->sparsity());
+  // The terms, and the programs of the output rows: a compiled model computes its rows compiled too.
+  std::string source = make_terms_source(base->parametric_programs().terms, base->n(), base->s(), base->sparsity());
+  if (model.contact_forces) source += make_program_source("contact", model.contact_forces->program);
+  if (!model.outputs.list.empty()) source += make_program_source("outputs", model.outputs.program);
   std::string compiler = options.compiler.empty() ? env("NHDYN_CXX") : options.compiler;
   if (compiler.empty()) compiler = "c++";
   const fs::path dir = cache_directory(options);
@@ -321,6 +355,16 @@ Model make_compiled(const Model& model, const JitOptions& options, JitReport* re
     if (!library) throw JitError(fmt::format("cannot load the compiled model: {}", error));
   }
   Model out = model;
+  if (model.contact_forces) {
+    auto contact = std::make_shared<ContactForceModel>(*model.contact_forces);
+    contact->native = native_program(library, "contact");
+    if (!contact->native) throw JitError(fmt::format("{} lacks the contact forces' program", object.string()));
+    out.contact_forces = std::move(contact);
+  }
+  if (!model.outputs.list.empty()) {
+    out.outputs.native = native_program(library, "outputs");
+    if (!out.outputs.native) throw JitError(fmt::format("{} lacks the outputs' program", object.string()));
+  }
   out.evaluator = std::make_shared<CompiledEvaluator>(std::move(base), std::move(library));
   return out;
 }
