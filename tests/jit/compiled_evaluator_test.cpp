@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/io/load_model.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
@@ -124,8 +125,8 @@ TEST_F(Jit, ProgramsKeepTheirActuatorForces) {
 }
 
 // The output rows of a compiled model run compiled too (NativeProgram, model/program.hpp): the
-// bicycle's contact forces and its derived outputs (the multibody points), and a file's [outputs],
-// equal the interpreter's, before and after a parameter change (the stage follows the values).
+// bicycle's contact forces, residuals, energy and derived outputs (the multibody points), and a
+// file's [outputs], equal the interpreter's, before and after a parameter change (the stage follows the values).
 TEST_F(Jit, OutputRowsGiveTheInterpretersContactForcesAndOutputs) {
   for (const char* file : {"whipple_bicycle.toml", "pendulum_outputs.toml"}) {
     SCOPED_TRACE(file);
@@ -152,6 +153,14 @@ TEST_F(Jit, OutputRowsGiveTheInterpretersContactForcesAndOutputs) {
       compute_contact_forces(b, db);
       compute_outputs(a, da);
       compute_outputs(b, db);
+      compute_residuals(a, da);
+      compute_residuals(b, db);
+      compute_energy(a, da);
+      compute_energy(b, db);
+      EXPECT_NE(da.energy, 0.0);
+      EXPECT_NEAR(db.energy, da.energy, 1e-12 * (1.0 + std::abs(da.energy)));
+      for (Eigen::Index i = 0; i < da.f.size(); ++i) EXPECT_NEAR(db.f(i), da.f(i), 1e-12);
+      for (Eigen::Index i = 0; i < da.phi.size(); ++i) EXPECT_NEAR(db.phi(i), da.phi(i), 1e-12);
       ASSERT_EQ(db.outputs.values.size(), da.outputs.values.size());
       double largest = 0.0;
       for (Eigen::Index i = 0; i < da.outputs.values.size(); ++i) {
