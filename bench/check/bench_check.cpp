@@ -15,7 +15,8 @@
 //   bicycle_rows_1001_vs_2_compiled      the same with the compiled evaluator
 // The compiled object comes from the compiled evaluator's cache ($XDG_CACHE_HOME/nhdyn), so only
 // the first run on a machine pays the compiler.
-//   nhdyn_bench_check EXAMPLES_DIR [PAIRS]   (PAIRS: pairs per ratio, default 7)
+//   nhdyn_bench_check EXAMPLES_DIR [PAIRS [FILTER]]   (PAIRS: pairs per ratio, default 7; FILTER:
+//                                                   only the ratios whose name contains it)
 #include <time.h>
 #include <unistd.h>
 
@@ -27,13 +28,17 @@
 #include <string>
 #include <vector>
 
+#include "nhdyn/analysis/constraint_watch.hpp"
+#include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
+#include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/data.hpp"
+#include "nhdyn/model/output.hpp"
 
 namespace {
 
@@ -60,7 +65,10 @@ double median(std::vector<double> x) {
 
 // One warm-up pair, then `pairs` pairs A B (the order alternates, so neither side always runs
 // second, after the other has warmed the caches).
+std::string filter;
+
 void pair(const std::string& name, int pairs, const std::function<void()>& a, const std::function<void()>& b) {
+  if (name.find(filter) == std::string::npos) return;
   a();
   b();
   std::vector<double> ta, tb, ratio;
@@ -115,6 +123,36 @@ void run_with_rows(const Model& model, double output_step, const fs::path& csv) 
   writer.commit();
 }
 
+// FILTER "breakdown": what one output row of the bicycle costs, kernel by kernel (CPU time per
+// call, microseconds), the way simulate() computes a row: for finding where the time goes.
+void breakdown(const Model& model, const char* label) {
+  Data data = make_data(model);
+  const FormulationOptions options{Method::sanh, Complement::qr};
+  ConstraintWatch watch = make_constraint_watch(model, data, options.method, kConstraintWatchFactor);
+  const ResultColumns columns = make_result_columns(model);
+  std::vector<double> row(columns.all.size());
+  const fs::path csv = fs::temp_directory_path() / ("nhdyn-bench-check-" + std::to_string(::getpid()) + ".csv");
+  CsvWriter writer(csv, columns.all);
+  const long calls = 2000;
+  auto per_call = [&](const char* what, const std::function<void()>& job) {
+    job();
+    const double t = timed([&] {
+      for (long i = 0; i < calls; ++i) job();
+    });
+    std::printf("%s %-22s %8.2f us\n", label, what, 1e6 * t / calls);
+  };
+  per_call("compute_dynamics", [&] { compute_dynamics(model, data, options, 0.0, model.q0.data(), model.v0.data()); });
+  per_call("constraint_watch", [&] { compute_constraint_watch(model, data, watch); });
+  per_call("residuals", [&] { compute_residuals(model, data); });
+  per_call("energy", [&] { compute_energy(model, data); });
+  per_call("power", [&] { compute_power(model, data); });
+  per_call("contact_forces", [&] { compute_contact_forces(model, data); });
+  per_call("outputs", [&] { compute_outputs(model, data); });
+  per_call("fill_result_row", [&] { fill_result_row(model, data, row); });
+  per_call("csv write_row", [&] { writer.write_row(row); });
+  fs::remove(csv);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -124,6 +162,7 @@ int main(int argc, char** argv) {
   }
   const fs::path examples = argv[1];
   const int pairs = argc > 2 ? std::max(1, std::atoi(argv[2])) : 7;
+  if (argc > 3) filter = argv[3];
   try {
     Model interpreted = load_model((examples / "whipple_bicycle.toml").string());
     const auto phi = std::find(interpreted.coordinates.begin(), interpreted.coordinates.end(), "phi") -
@@ -131,6 +170,11 @@ int main(int argc, char** argv) {
     interpreted.v0[phi] = 0.5;
     const Model compiled = jit::make_compiled(interpreted);
 
+    if (filter == "breakdown") {
+      breakdown(interpreted, "interpreted");
+      breakdown(compiled, "compiled");
+      return 0;
+    }
     Data di = make_data(interpreted), dc = make_data(compiled);
     pair("bicycle_rhs_compiled_vs_interpreted", pairs, [&] { rhs_loop(compiled, dc, 20000); },
          [&] { rhs_loop(interpreted, di, 20000); });

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <cstdlib>
@@ -17,10 +18,13 @@
 #include <thread>
 #include <vector>
 
+#include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
+#include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/data.hpp"
+#include "nhdyn/model/output.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/model/program.hpp"
 
@@ -116,6 +120,66 @@ TEST_F(Jit, ProgramsKeepTheirActuatorForces) {
     for (int j = 0; j < interpreted.m(); ++j) {
       EXPECT_NE(a.motion.u(j), 0.0) << "an actuator force that is zero proves nothing";
       EXPECT_NEAR(b.motion.u(j), a.motion.u(j), 1e-12 * (1.0 + std::abs(a.motion.u(j))));
+    }
+  }
+}
+
+// The output rows of a compiled model run compiled too (NativeProgram, model/program.hpp): the
+// bicycle's contact forces, residuals, energy and derived outputs (the multibody points), and a
+// file's [outputs], equal the interpreter's, before and after a parameter change (the stage follows the values).
+TEST_F(Jit, OutputRowsGiveTheInterpretersContactForcesAndOutputs) {
+  for (const char* file : {"whipple_bicycle.toml", "pendulum_outputs.toml"}) {
+    SCOPED_TRACE(file);
+    const Model interpreted = load_model(example(file));
+    const Model compiled = make_compiled(interpreted, options_);
+    ASSERT_GT(compiled.outputs.count(), 0);
+    EXPECT_TRUE(compiled.outputs.native != nullptr);
+    EXPECT_EQ(compiled.contact_forces != nullptr, interpreted.contact_forces != nullptr);
+    if (compiled.contact_forces) {
+      EXPECT_TRUE(compiled.contact_forces->native != nullptr);
+    }
+    for (const bool changed : {false, true}) {
+      Model a = interpreted, b = compiled;
+      if (changed) {
+        const std::string name = a.parameters.front().name;
+        const double value = 1.1 * a.parameters.front().value + 0.01;
+        set_parameter(a, name, value);
+        set_parameter(b, name, value);
+      }
+      Data da = make_data(a), db = make_data(b);
+      ASSERT_EQ(compute_dynamics(a, da, {}, a.t0, a.q0.data(), a.v0.data()), Status::ok);
+      ASSERT_EQ(compute_dynamics(b, db, {}, b.t0, b.q0.data(), b.v0.data()), Status::ok);
+      compute_contact_forces(a, da);
+      compute_contact_forces(b, db);
+      compute_outputs(a, da);
+      compute_outputs(b, db);
+      compute_residuals(a, da);
+      compute_residuals(b, db);
+      compute_energy(a, da);
+      compute_energy(b, db);
+      EXPECT_NE(da.energy, 0.0);
+      EXPECT_NEAR(db.energy, da.energy, 1e-12 * (1.0 + std::abs(da.energy)));
+      for (Eigen::Index i = 0; i < da.f.size(); ++i) EXPECT_NEAR(db.f(i), da.f(i), 1e-12);
+      for (Eigen::Index i = 0; i < da.phi.size(); ++i) EXPECT_NEAR(db.phi(i), da.phi(i), 1e-12);
+      ASSERT_EQ(db.outputs.values.size(), da.outputs.values.size());
+      double largest = 0.0;
+      for (Eigen::Index i = 0; i < da.outputs.values.size(); ++i) {
+        largest = std::max(largest, std::abs(da.outputs.values(i)));
+        EXPECT_NEAR(db.outputs.values(i), da.outputs.values(i), 1e-12 * (1.0 + std::abs(da.outputs.values(i))));
+      }
+      EXPECT_GT(largest, 0.0) << "outputs that are all zero prove nothing";
+      ASSERT_EQ(db.contact.values.size(), da.contact.values.size());
+      for (Eigen::Index i = 0; i < da.contact.values.size(); ++i) {
+        if (std::isnan(da.contact.values(i))) {
+          EXPECT_TRUE(std::isnan(db.contact.values(i)));
+          continue;
+        }
+        EXPECT_NEAR(db.contact.values(i), da.contact.values(i), 1e-10 * (1.0 + std::abs(da.contact.values(i))));
+      }
+      if (interpreted.contact_forces) {
+        // The normal force of the rear wheel carries weight: a contact force that is zero proves nothing.
+        EXPECT_GT(std::abs(da.contact.values(3)), 1.0);
+      }
     }
   }
 }

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "nhdyn/jit/source.hpp"
+#include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/program.hpp"
 
 extern char** environ;
@@ -146,20 +148,75 @@ std::shared_ptr<Library> load(const fs::path& path, bool sparse, std::string& er
   return library;
 }
 
-// The interpreter's evaluator with its terms replaced by the compiled ones.
+using ProgramStage = void (*)(const double*, double*);
+using ProgramRun = void (*)(const double*, double, const double*, const double*, double*);
+
+// A program of make_program_source in a loaded object (the contact forces', the outputs').
+class CompiledProgram final : public NativeProgram {
+ public:
+  CompiledProgram(std::shared_ptr<const Library> library, StageSize size, ProgramStage stage, ProgramRun run)
+      : library_(std::move(library)), size_(size), stage_(stage), run_(run) {}
+  std::size_t stage_size() const override { return size_(); }
+  void stage(const double* parameters, double* stage) const override { stage_(parameters, stage); }
+  void run(const double* stage, double t, const double* q, const double* v, double* outputs) const override {
+    run_(stage, t, q, v, outputs);
+  }
+
+ private:
+  std::shared_ptr<const Library> library_;  // keeps the object loaded
+  StageSize size_;
+  ProgramStage stage_;
+  ProgramRun run_;
+};
+
+// The program NAME of the loaded object, or null when the object lacks it.
+std::shared_ptr<const NativeProgram> native_program(const std::shared_ptr<const Library>& library,
+                                                    const std::string& name) {
+  const auto size = reinterpret_cast<StageSize>(dlsym(library->handle, ("nhdyn_jit_" + name + "_stage_size").c_str()));
+  const auto stage = reinterpret_cast<ProgramStage>(dlsym(library->handle, ("nhdyn_jit_" + name + "_stage").c_str()));
+  const auto run = reinterpret_cast<ProgramRun>(dlsym(library->handle, ("nhdyn_jit_" + name).c_str()));
+  if (!size || !stage || !run) return nullptr;
+  return std::make_shared<CompiledProgram>(library, size, stage, run);
+}
+
+// The programs of an output row that the evaluator runs (the residuals, the energy, h and the
+// power), compiled when the model has them; null: the interpreter's.
+enum RowProgram { kPositionResidual, kVelocityResidual, kEnergy, kEnergyFunction, kPower, kRowPrograms };
+const char* const kRowProgramNames[kRowPrograms] = {"position_residual", "velocity_residual", "energy",
+                                                    "energy_function", "power"};
+const Program* row_program(const ModelPrograms& p, int which) {
+  switch (which) {
+    case kPositionResidual: return &p.position_residual;
+    case kVelocityResidual: return &p.velocity_residual;
+    case kEnergy: return p.energy ? &*p.energy : nullptr;
+    case kEnergyFunction: return p.energy_function ? &*p.energy_function : nullptr;
+    case kPower: return p.power ? &*p.power : nullptr;
+    default: return nullptr;
+  }
+}
+using RowPrograms = std::array<std::shared_ptr<const NativeProgram>, kRowPrograms>;
+
+// The interpreter's evaluator with its terms, and the programs of a row, replaced by compiled ones.
 class CompiledEvaluator final : public Evaluator {
  public:
-  CompiledEvaluator(std::shared_ptr<const ProgramEvaluator> base, std::shared_ptr<const Library> library)
-      : base_(std::move(base)), library_(std::move(library)), sparse_(base_->sparsity() != nullptr) {
+  CompiledEvaluator(std::shared_ptr<const ProgramEvaluator> base, std::shared_ptr<const Library> library,
+                    RowPrograms rows)
+      : base_(std::move(base)), library_(std::move(library)), sparse_(base_->sparsity() != nullptr),
+        rows_(std::move(rows)) {
     const std::vector<double>& p = base_->parameter_values();
     stage_.assign(library_->stage_size() + 1, 0.0);
     library_->stage(p.data(), stage_.data());
+    for (int i = 0; i < kRowPrograms; ++i) {
+      if (!rows_[i]) continue;
+      row_stages_[i].assign(rows_[i]->stage_size() + 1, 0.0);  // + 1: data() of an empty stage
+      rows_[i]->stage(p.data(), row_stages_[i].data());
+    }
   }
 
   std::shared_ptr<const Evaluator> with_parameters(const double* values, std::size_t count) const override {
     auto rebound = std::dynamic_pointer_cast<const ProgramEvaluator>(base_->with_parameters(values, count));
     if (!rebound) return nullptr;
-    return std::make_shared<CompiledEvaluator>(std::move(rebound), library_);
+    return std::make_shared<CompiledEvaluator>(std::move(rebound), library_, rows_);
   }
   bool has_initial_state() const override { return base_->has_initial_state(); }
   void initial_state(double* scratch, double* q0, double* v0) const override {
@@ -189,10 +246,16 @@ class CompiledEvaluator final : public Evaluator {
     base_->complement(t, q, v, scratch, D);
   }
   void position_residual(double t, const double* q, double* scratch, double* phi) const override {
-    base_->position_residual(t, q, scratch, phi);
+    if (rows_[kPositionResidual])
+      rows_[kPositionResidual]->run(row_stages_[kPositionResidual].data(), t, q, nullptr, phi);
+    else
+      base_->position_residual(t, q, scratch, phi);
   }
   void velocity_residual(double t, const double* q, const double* v, double* scratch, double* f) const override {
-    base_->velocity_residual(t, q, v, scratch, f);
+    if (rows_[kVelocityResidual])
+      rows_[kVelocityResidual]->run(row_stages_[kVelocityResidual].data(), t, q, v, f);
+    else
+      base_->velocity_residual(t, q, v, scratch, f);
   }
   bool has_program_constraints() const override { return base_->has_program_constraints(); }
   void program_constraint_terms(double t, const double* q, const double* v, double* scratch, double* b_p,
@@ -210,13 +273,22 @@ class CompiledEvaluator final : public Evaluator {
   bool has_energy_balance() const override { return base_->has_energy_balance(); }
   bool energy_function_is_energy() const override { return base_->energy_function_is_energy(); }
   double energy_function(double t, const double* q, const double* v, double* scratch) const override {
-    return base_->energy_function(t, q, v, scratch);
+    if (!rows_[kEnergyFunction]) return base_->energy_function(t, q, v, scratch);
+    double h = 0.0;
+    rows_[kEnergyFunction]->run(row_stages_[kEnergyFunction].data(), t, q, v, &h);
+    return h;
   }
   void power(double t, const double* q, const double* v, double* scratch, double* out) const override {
-    base_->power(t, q, v, scratch, out);
+    if (rows_[kPower])
+      rows_[kPower]->run(row_stages_[kPower].data(), t, q, v, out);
+    else
+      base_->power(t, q, v, scratch, out);
   }
   double energy(double t, const double* q, const double* v, double* scratch) const override {
-    return base_->energy(t, q, v, scratch);
+    if (!rows_[kEnergy]) return base_->energy(t, q, v, scratch);
+    double e = 0.0;
+    rows_[kEnergy]->run(row_stages_[kEnergy].data(), t, q, v, &e);
+    return e;
   }
   bool has_solution() const override { return base_->has_solution(); }
   void solution(double t, double* scratch, double* qva) const override { base_->solution(t, scratch, qva); }
@@ -226,6 +298,8 @@ class CompiledEvaluator final : public Evaluator {
   std::shared_ptr<const Library> library_;
   bool sparse_ = false;
   std::vector<double> stage_;  // what the terms read of the parameter stage (one spare entry)
+  RowPrograms rows_;
+  std::array<std::vector<double>, kRowPrograms> row_stages_;  // their parameter stages
 };
 
 }  // namespace
@@ -247,8 +321,13 @@ Model make_compiled(const Model& model, const JitOptions& options, JitReport* re
                                "compile",
                                model.name));
   const bool sparse = base->sparsity() != nullptr;
-  const std::string source = make_terms_source(base->parametric_programs().terms, base->n(), base->s(),
-                                               base->sparsity());
+  // The terms, and the programs of the output rows: a compiled model computes its rows compiled too.
+  std::string source = make_terms_source(base->parametric_programs().terms, base->n(), base->s(), base->sparsity());
+  for (int i = 0; i < kRowPrograms; ++i)
+    if (const Program* program = row_program(base->parametric_programs(), i))
+      source += make_program_source(kRowProgramNames[i], *program);
+  if (model.contact_forces) source += make_program_source("contact", model.contact_forces->program);
+  if (!model.outputs.list.empty()) source += make_program_source("outputs", model.outputs.program);
   std::string compiler = options.compiler.empty() ? env("NHDYN_CXX") : options.compiler;
   if (compiler.empty()) compiler = "c++";
   const fs::path dir = cache_directory(options);
@@ -320,7 +399,24 @@ Model make_compiled(const Model& model, const JitOptions& options, JitReport* re
     if (!library) throw JitError(fmt::format("cannot load the compiled model: {}", error));
   }
   Model out = model;
-  out.evaluator = std::make_shared<CompiledEvaluator>(std::move(base), std::move(library));
+  if (model.contact_forces) {
+    auto contact = std::make_shared<ContactForceModel>(*model.contact_forces);
+    contact->native = native_program(library, "contact");
+    if (!contact->native) throw JitError(fmt::format("{} lacks the contact forces' program", object.string()));
+    out.contact_forces = std::move(contact);
+  }
+  if (!model.outputs.list.empty()) {
+    out.outputs.native = native_program(library, "outputs");
+    if (!out.outputs.native) throw JitError(fmt::format("{} lacks the outputs' program", object.string()));
+  }
+  RowPrograms rows;
+  for (int i = 0; i < kRowPrograms; ++i) {
+    if (!row_program(base->parametric_programs(), i)) continue;
+    rows[static_cast<std::size_t>(i)] = native_program(library, kRowProgramNames[i]);
+    if (!rows[static_cast<std::size_t>(i)])
+      throw JitError(fmt::format("{} lacks the program {}", object.string(), kRowProgramNames[i]));
+  }
+  out.evaluator = std::make_shared<CompiledEvaluator>(std::move(base), std::move(library), std::move(rows));
   return out;
 }
 

@@ -7,10 +7,13 @@
 // command and its --version) and the flags, so a second run of the same model loads it without
 // compiling, and a parameter change reuses it (parameters are data: the stage is recomputed).
 // An object is compiled under a temporary name and renamed into place, so a concurrent process
-// never loads a half-written file. The other programs (complement, residuals, energy, solution,
-// initial state) and the parameter handling stay with the interpreter, whose ProgramEvaluator the
-// compiled evaluator wraps; so every formulation, the sparse path and linearization's finite
-// differences work unchanged.
+// never loads a half-written file. The programs of an output row go into the same object, so a
+// compiled model computes its rows compiled too: the residuals, the energy, h and the power (the
+// evaluator's), the contact forces' and the derived outputs' programs (NativeProgram, set on the
+// Model's ContactForceModel and ModelOutputs). The other programs (complement, solution, initial
+// state, program constraints) and the parameter handling stay with the interpreter, whose
+// ProgramEvaluator the compiled evaluator wraps; so every formulation, the sparse path and
+// linearization's finite differences work unchanged.
 #pragma once
 
 #include <array>

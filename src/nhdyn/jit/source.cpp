@@ -206,4 +206,18 @@ std::string make_terms_source(const Program& terms, int n, int s, const TermsSpa
   return out;
 }
 
+std::string make_program_source(const std::string& name, const Program& program) {
+  const Printer printer(program);
+  std::string out = fmt::format("\n// The program '{}'.\nextern \"C\" {{\n", name);
+  out += fmt::format("std::size_t nhdyn_jit_{}_stage_size(void) {{ return {}; }}\n", name, printer.stage_size());
+  out += fmt::format("void nhdyn_jit_{}_stage([[maybe_unused]] const double* p, [[maybe_unused]] double* m) {{\n", name);
+  out += printer.stage_body() + "}\n";
+  out += fmt::format("void nhdyn_jit_{}([[maybe_unused]] const double* m, [[maybe_unused]] double t, "
+                     "[[maybe_unused]] const double* q, [[maybe_unused]] const double* v, double* out) {{\n  (void)out;\n",
+                     name);
+  out += printer.call_body([](int j) { return fmt::format("out[{}]", j); }) + "}\n";
+  out += "}  // extern \"C\"\n";
+  return out;
+}
+
 }  // namespace nhdyn::jit

@@ -14,7 +14,7 @@
 namespace nhdyn::jit {
 
 // Bumped whenever the interface below changes: a cached object of another version is rebuilt.
-inline constexpr int kInterfaceVersion = 1;
+inline constexpr int kInterfaceVersion = 2;
 
 // The functions the source defines (extern "C"):
 //   int    nhdyn_jit_version(void)             kInterfaceVersion
@@ -27,5 +27,14 @@ inline constexpr int kInterfaceVersion = 1;
 //          the caller has zeroed); only for a sparse program
 // n, s: the model's dimensions; `sparsity` null for a dense program.
 std::string make_terms_source(const Program& terms, int n, int s, const TermsSparsity* sparsity);
+
+// Another program of the model (the contact forces', the derived outputs') to append to the terms'
+// source, so that a model's output rows run compiled as its terms do (NativeProgram in
+// model/program.hpp). It defines, for NAME:
+//   size_t nhdyn_jit_NAME_stage_size(void)
+//   void   nhdyn_jit_NAME_stage(const double* p, double* m)
+//   void   nhdyn_jit_NAME(const double* m, double t, const double* q, const double* v, double* out)
+//          out: the program's outputs in order (Program::run's)
+std::string make_program_source(const std::string& name, const Program& program);
 
 }  // namespace nhdyn::jit

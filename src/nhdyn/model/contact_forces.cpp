@@ -102,6 +102,10 @@ ContactForceData make_contact_force_data(const Model& model) {
   w.program = c.program.reads_parameters() ? c.program.bind(values.data(), values.size()) : c.program;
   w.registers.assign(static_cast<std::size_t>(w.program.registers()), 0.0);
   w.outputs.assign(static_cast<std::size_t>(w.program.outputs()), 0.0);
+  if (c.native) {
+    w.stage.assign(c.native->stage_size() + 1, 0.0);  // + 1: data() of an empty stage
+    c.native->stage(values.data(), w.stage.data());
+  }
   w.M = Matrix::Zero(c.rows(), c.columns());
   w.rhs = Vector::Zero(c.rows());
   w.x = Vector::Zero(c.columns());
@@ -119,7 +123,10 @@ void compute_contact_forces(const Model& model, Data& data) {
     throw std::logic_error("compute_contact_forces needs the accelerations of the current state: call "
                            "compute_dynamics (or compute_acceleration) first");
   const ContactForceModel& c = *model.contact_forces;
-  w.program.run(data.t, data.q.data(), data.v.data(), w.registers.data(), w.outputs.data());
+  if (c.native)
+    c.native->run(w.stage.data(), data.t, data.q.data(), data.v.data(), w.outputs.data());
+  else
+    w.program.run(data.t, data.q.data(), data.v.data(), w.registers.data(), w.outputs.data());
   const double* o = w.outputs.data();
   assemble(c, o, data.qdd.data(), data.R.data(), w.M, w.rhs);
   if (c.single_wheel) {

@@ -75,6 +75,8 @@ struct ContactForceModel {
   // flags: whether the model determines that component (else it is NaN).
   std::vector<char> determined;
   Program program;             // parametric: reads the model's parameters (bound by make_data)
+  // `program` compiled (jit::make_compiled), run in its place when set; null for the interpreter.
+  std::shared_ptr<const NativeProgram> native;
   // What loading found about the forces not determined, one line each (empty when all are).
   std::vector<std::string> notes;
 
@@ -93,6 +95,7 @@ struct ContactForceModel {
 // calls it; empty for a model without contacts).
 struct ContactForceData {
   bool active = false;       // the model has contact forces
+  std::vector<double> stage; // ContactForceModel::native's parameter stage (empty without it)
   Program program;           // ContactForceModel::program bound to the model's parameter values
   std::vector<double> registers;
   std::vector<double> outputs;

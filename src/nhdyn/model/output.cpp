@@ -19,6 +19,10 @@ OutputData make_output_data(const Model& model) {
   const Program& program = model.outputs.program;
   d.program = program.reads_parameters() ? program.bind(values.data(), values.size()) : program;
   d.registers.assign(static_cast<std::size_t>(d.program.registers()), 0.0);
+  if (model.outputs.native) {
+    d.stage.assign(model.outputs.native->stage_size() + 1, 0.0);  // + 1: data() of an empty stage
+    model.outputs.native->stage(values.data(), d.stage.data());
+  }
   return d;
 }
 
@@ -35,7 +39,10 @@ void compute_outputs(const Model& model, Data& data) {
   if (model.outputs.list.empty()) return;
   pack_dynamics_inputs(model.n(), data.q.data(), data.v.data(), data.qdd.data(), data.R.data(), o.x.data(),
                        o.xd.data());
-  o.program.run(data.t, o.x.data(), o.xd.data(), o.registers.data(), o.values.data());
+  if (model.outputs.native)
+    model.outputs.native->run(o.stage.data(), data.t, o.x.data(), o.xd.data(), o.values.data());
+  else
+    o.program.run(data.t, o.x.data(), o.xd.data(), o.registers.data(), o.values.data());
 }
 
 }  // namespace nhdyn

@@ -37,6 +37,8 @@ struct ModelOutputs {
   // One output per entry of `list`, in the dynamics layout (2n coordinates: [q; q''], [q'; R]);
   // reads the model's parameters (bind before running). Empty program when `list` is.
   Program program = Program();
+  // `program` compiled (jit::make_compiled), run in its place when set; null for the interpreter.
+  std::shared_ptr<const NativeProgram> native;
   int count() const { return static_cast<int>(list.size()); }
 };
 
@@ -45,6 +47,7 @@ struct OutputData {
   Program program = Program();    // ModelOutputs::program bound to the parameter values
   std::vector<double> x, xd;       // 2n each: [q; q''] and [q'; R] (pack_dynamics_inputs)
   std::vector<double> registers;   // program.registers()
+  std::vector<double> stage;       // ModelOutputs::native's parameter stage (empty without it)
   Vector values;                   // one per output (compute_outputs)
 };
 

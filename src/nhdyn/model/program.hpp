@@ -317,4 +317,19 @@ class ProgramEvaluator final : public Evaluator {
   TermsFunction sparse_function_ = nullptr;
 };
 
+// A Program turned into machine code by the compiled evaluator (jit/compiled_evaluator.hpp): the
+// same outputs as Program::run with the same parameter values, in the same order of operations, so
+// the same rounding. model/ only calls it (the contact forces, the derived outputs: the rows of a
+// compiled model go through compiled code, as its terms do); jit::make_compiled makes it.
+class NativeProgram {
+ public:
+  virtual ~NativeProgram() = default;
+  // What depends on the parameters alone, computed once per parameter change into stage_size()
+  // doubles; `parameters` in the model's order (Program::bind's).
+  virtual std::size_t stage_size() const = 0;
+  virtual void stage(const double* parameters, double* stage) const = 0;
+  // One call: Program::run's inputs and outputs, with the stage in place of the registers.
+  virtual void run(const double* stage, double t, const double* q, const double* v, double* outputs) const = 0;
+};
+
 }  // namespace nhdyn
