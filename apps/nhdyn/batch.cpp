@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "commands.hpp"
@@ -121,6 +122,9 @@ int run_batch(const BatchArgs& args) {
   if (args.grids.empty() == args.runs_csv.empty())
     throw InputError("give the runs either as --grid NAME=FROM:TO:COUNT (repeatable) or as --runs FILE.csv");
   if (args.threads < 0) throw InputError(fmt::format("--threads {}: give 0 (every core) or a positive number", args.threads));
+  if (args.threads > max_batch_threads())
+    fmt::print(stderr, "nhdyn: note: --threads {}: this machine has {} cores; using at most {} threads\n", args.threads,
+               std::max(1U, std::thread::hardware_concurrency()), max_batch_threads());
   ParameterOverrides overrides;
   for (const std::string& set : args.sets) {
     const std::size_t eq = set.find('=');
