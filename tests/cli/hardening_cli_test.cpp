@@ -2,7 +2,11 @@
 // test tries one bad input a tester found and checks that it is a clear error (exit 2 naming the
 // value at fault) or a correct answer, never a crash, a destroyed input or a silent wrong answer.
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/stat.h>
+
+#include <algorithm>
+#include <chrono>
 
 #include <filesystem>
 #include <fstream>
@@ -79,6 +83,86 @@ TEST_F(Hardening, HugeThreadCountIsCapped) {
   EXPECT_TRUE(fs::exists(dir_ / "runs" / "summary.csv"));
   for (const auto& entry : fs::directory_iterator(dir_ / "runs"))
     EXPECT_FALSE(contains(entry.path().filename().string(), ".tmp")) << entry.path();
+}
+
+// The shared objects (and their check files) in a cache directory, by extension.
+std::vector<fs::path> cache_entries(const fs::path& cache, const std::string& extension) {
+  std::vector<fs::path> out;
+  if (!fs::exists(cache)) return out;
+  for (const auto& entry : fs::directory_iterator(cache))
+    if (entry.path().extension() == extension) out.push_back(entry.path());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// A truncated object ended every later run in SIGBUS; one copied over another model's name gave
+// that model's motion. Each entry is verified before dlopen, and a bad one compiled again.
+TEST_F(Hardening, DamagedCompiledModelCacheIsRebuilt) {
+  ProcessOptions cached, elsewhere;
+  cached.env = {{"XDG_CACHE_HOME", (dir_ / "cache").string()}};
+  elsewhere.env = {{"XDG_CACHE_HOME", (dir_ / "other-cache").string()}};
+  const fs::path cache = dir_ / "cache" / "nhdyn";
+  ASSERT_EQ(nhdyn({"simulate", "sled.toml", "--evaluator", "compiled", "-q", "-o", "sled.csv"}, cached).code, 0);
+  ASSERT_EQ(nhdyn({"simulate", "appell.toml", "--evaluator", "compiled", "-q", "-o", "a.csv"}, elsewhere).code, 0);
+  const std::string sled = read_whole(dir_ / "sled.csv");
+  ASSERT_EQ(cache_entries(cache, ".so").size(), 1u);
+  ASSERT_EQ(cache_entries(dir_ / "other-cache" / "nhdyn", ".so").size(), 1u);
+  const fs::path sled_object = cache_entries(cache, ".so").front();
+  const fs::path other = cache_entries(dir_ / "other-cache" / "nhdyn", ".so").front();
+  const ProcessRun again = nhdyn({"simulate", "sled.toml", "--evaluator", "compiled", "-q", "-o", "x.csv"}, cached);
+  ASSERT_EQ(again.code, 0);
+  EXPECT_EQ(again.err, "") << "a sound entry is loaded without a note";
+  const auto damaged_run = [&](const std::string& what) {
+    const ProcessRun r = nhdyn({"simulate", "sled.toml", "--evaluator", "compiled", "-q", "-o", "sled2.csv"}, cached);
+    EXPECT_EQ(r.code, 0) << what << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, "unusable")) << what << ": " << r.err;
+    EXPECT_EQ(read_whole(dir_ / "sled2.csv"), sled) << what;
+    EXPECT_TRUE(fs::exists(sled_object));
+  };
+  // Truncated.
+  fs::resize_file(sled_object, 1000);
+  damaged_run("truncated");
+  // Another model's object under this one's name.
+  fs::copy_file(other, sled_object, fs::copy_options::overwrite_existing);
+  damaged_run("another model's object");
+  // And with its check file too.
+  fs::copy_file(other, sled_object, fs::copy_options::overwrite_existing);
+  fs::copy_file(fs::path(other.string() + ".check"), fs::path(sled_object.string() + ".check"),
+                fs::copy_options::overwrite_existing);
+  damaged_run("another model's object and check file");
+  // No temporary, source or log is left.
+  for (const auto& entry : fs::directory_iterator(cache)) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_TRUE(name.ends_with(".so") || name.ends_with(".so.check")) << name;
+  }
+}
+
+// An interrupted compile left its source and log, and the compiler ran on; now the compiler's
+// process group is ended and nothing is left in the cache.
+TEST_F(Hardening, InterruptedCompileLeavesNothing) {
+  const fs::path slow = dir_ / "slow-compiler";
+  std::ofstream(slow) << "#!/bin/sh\nif [ \"$1\" = --version ]; then exec c++ \"$@\"; fi\nsleep 60\nexec c++ \"$@\"\n";
+  fs::permissions(slow, fs::perms::owner_all);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGUSR1}) {
+    ProcessOptions options;
+    options.env = {{"XDG_CACHE_HOME", (dir_ / "cache").string()}, {"NHDYN_CXX", slow.string()}};
+    options.signal = sig;
+    options.after = std::chrono::milliseconds(1500);
+    options.deadline = 30;
+    const ProcessRun r = nhdyn({"simulate", "sled.toml", "--evaluator", "compiled", "-o", "out.csv"}, options);
+    EXPECT_EQ(r.code, 128 + sig) << r.err;
+    EXPECT_TRUE(cache_entries(dir_ / "cache" / "nhdyn", ".cpp").empty());
+    EXPECT_TRUE(cache_entries(dir_ / "cache" / "nhdyn", ".log").empty());
+    if (fs::exists(dir_ / "cache" / "nhdyn")) {
+      EXPECT_TRUE(fs::is_empty(dir_ / "cache" / "nhdyn")) << "signal " << sig;
+    }
+    EXPECT_FALSE(fs::exists(dir_ / "out.csv"));
+    // No process still runs the slow compiler (its path is unique to this test).
+    for (const auto& entry : fs::directory_iterator("/proc")) {
+      const std::string cmdline = read_whole(entry.path() / "cmdline");
+      EXPECT_FALSE(contains(cmdline, slow.string())) << entry.path() << " still runs the compiler";
+    }
+  }
 }
 
 }  // namespace

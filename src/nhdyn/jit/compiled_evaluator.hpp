@@ -7,7 +7,12 @@
 // command and its --version) and the flags, so a second run of the same model loads it without
 // compiling, and a parameter change reuses it (parameters are data: the stage is recomputed).
 // An object is compiled under a temporary name and renamed into place, so a concurrent process
-// never loads a half-written file. The other programs (complement, residuals, energy, solution,
+// never loads a half-written file. Beside it, NAME.so.check holds the key, the size and a hash of
+// the object, checked before every dlopen, and the object itself returns its key: a truncated,
+// altered or misplaced entry is removed and compiled again with a note (JitReport::note), never
+// loaded. An interrupted compile (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2) stops the
+// compiler's whole process group, removes its source, log and temporary object, and then lets the
+// signal take its course. The other programs (complement, residuals, energy, solution,
 // initial state) and the parameter handling stay with the interpreter, whose ProgramEvaluator the
 // compiled evaluator wraps; so every formulation, the sparse path and linearization's finite
 // differences work unchanged.
@@ -46,6 +51,7 @@ struct JitReport {
   bool compiled = false;       // a compiler ran (false: the cached object was loaded)
   double compile_seconds = 0;  // its wall time
   std::string object;          // the shared object's path
+  std::string note;            // a cached object found damaged and compiled again, for the user
 };
 
 // The model with its terms compiled, sharing everything else. Throws JitError naming the reason
