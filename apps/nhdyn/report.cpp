@@ -2,6 +2,7 @@
 // written earlier by `nhdyn simulate`; the CSV must have the model's columns.
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -13,6 +14,7 @@
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/report.hpp"
+#include "nhdyn/io/run_paths.hpp"
 
 namespace nhdyn::cli {
 
@@ -38,6 +40,14 @@ std::function<int()> add_report_command(CLI::App& app) {
   return [args] {
     if (args->max_frames < 2)
       throw InputError(fmt::format("--max-frames {}: give at least 2", args->max_frames));
+    {
+      // Every file of the run, checked together before any work (io/run_paths.hpp).
+      RunPaths paths;
+      paths.input(args->csv, "the result CSV");
+      if (std::filesystem::is_regular_file(args->model)) paths.input(args->model, "the model file");
+      paths.output(args->output, "-o");
+      paths.check();
+    }
     std::optional<AtomicFile> probe(args->output);  // an unwritable path is refused before any work
     const ResolvedModel resolved = resolve_model(args->model, args->sets);
     const CsvTable table = load_csv(args->csv);

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include <filesystem>
 #include <fstream>
@@ -42,6 +43,18 @@ class Hardening : public ::testing::Test {
   }
   fs::path dir_;
 };
+
+constexpr const char* kOscillator = R"(name = "oscillator"
+coordinates = ["x"]
+kinetic_energy = "m/2 * x'^2"
+potential_energy = "k/2 * x^2"
+[parameters]
+m = 1.0
+k = 1.0
+[initial]
+position = { x = 1 }
+velocity = { x = 0 }
+)";
 
 std::string repeat(const std::string& part, int times) {
   std::string out;
@@ -161,6 +174,107 @@ TEST_F(Hardening, InterruptedCompileLeavesNothing) {
     for (const auto& entry : fs::directory_iterator("/proc")) {
       const std::string cmdline = read_whole(entry.path() / "cmdline");
       EXPECT_FALSE(contains(cmdline, slow.string())) << entry.path() << " still runs the compiler";
+    }
+  }
+}
+
+// Outputs replaced inputs: `report R.csv -o R.csv` (also ./R.csv and a link), `-o MODEL`; outputs
+// of one run replaced each other. One rule now: every path listed and checked before any work.
+TEST_F(Hardening, NoOutputReplacesAnInputOrAnotherOutput) {
+  ASSERT_EQ(nhdyn({"simulate", "sled.toml", "--t-end", "0.5", "-q", "-o", "r.csv"}).code, 0);
+  const std::string result = read_whole(dir_ / "r.csv"), model = read_whole(dir_ / "sled.toml");
+  fs::create_symlink("r.csv", dir_ / "link.csv");
+  fs::create_hard_link(dir_ / "r.csv", dir_ / "hard.csv");
+  for (const char* out : {"r.csv", "./r.csv", "link.csv", "hard.csv", "sled.toml"}) {
+    const ProcessRun r = nhdyn({"report", "r.csv", "--model", "sled.toml", "-o", out});
+    EXPECT_EQ(r.code, 2) << out << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, "an input of this run")) << r.err;
+  }
+  EXPECT_EQ(read_whole(dir_ / "r.csv"), result);
+  EXPECT_EQ(read_whole(dir_ / "sled.toml"), model);
+  // Two outputs of one run on one file.
+  const ProcessRun same = nhdyn({"simulate", "sled.toml", "-q", "-o", "s.csv", "--html", "x.png", "--plot", "./x.png"});
+  EXPECT_EQ(same.code, 2);
+  EXPECT_TRUE(contains(same.err, "are the same file")) << same.err;
+  const ProcessRun events =
+      nhdyn({"simulate", "sled.toml", "-q", "-o", "s.csv", "--event", "turn=phi-1", "--html", "s-events.csv"});
+  EXPECT_EQ(events.code, 2);
+  EXPECT_TRUE(contains(events.err, "the events file")) << events.err;
+  EXPECT_FALSE(fs::exists(dir_ / "s.csv"));
+  // batch: its model or its --runs table inside the output folder under an output's name.
+  fs::create_directories(dir_ / "out");
+  fs::copy_file(dir_ / "sled.toml", dir_ / "out" / "run_0.csv");
+  const ProcessRun over_model =
+      nhdyn({"batch", "out/run_0.csv", "--grid", "a=0.1:0.2:2", "--t-end", "0.2", "--write-runs", "-o", "out"});
+  EXPECT_EQ(over_model.code, 2) << over_model.err;
+  EXPECT_EQ(read_whole(dir_ / "out" / "run_0.csv"), model);
+  write("out/summary.csv", "a\n0.3\n0.4\n");
+  const ProcessRun over_runs = nhdyn({"batch", "sled.toml", "--runs", "out/summary.csv", "--t-end", "0.2", "-o", "out"});
+  EXPECT_EQ(over_runs.code, 2) << over_runs.err;
+  EXPECT_EQ(read_whole(dir_ / "out" / "summary.csv"), "a\n0.3\n0.4\n");
+}
+
+// -o '', --html '', --plot '' were read as "not given".
+TEST_F(Hardening, EmptyOptionValuesAreRefused) {
+  for (const char* option : {"-o", "--html", "--plot"}) {
+    const ProcessRun r = nhdyn({"simulate", "sled.toml", "--t-end", "0.1", option, ""});
+    EXPECT_EQ(r.code, 2) << option;
+    EXPECT_TRUE(contains(r.err, "the value is empty")) << r.err;
+  }
+}
+
+// The CLI's batch ignored the model file's [[events]]; a stop event now ends each run where the
+// closed form says: x = cos(sqrt(k) t) falls through zero at pi / (2 sqrt(k)).
+TEST_F(Hardening, BatchHonoursTheModelFilesEvents) {
+  write("osc.toml", std::string(kOscillator) + "[[events]]\nname = \"down\"\nwhen = \"x\"\ndirection = \"falling\"\n"
+                                               "action = \"stop\"\n");
+  const ProcessRun r = nhdyn({"batch", "osc.toml", "--grid", "k=1:4:2", "--t-end", "5", "--rtol", "1e-10", "-o", "out"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(dir_ / "out" / "summary.csv");
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> header = nhdyn::test::split(line);
+  const auto at = static_cast<std::size_t>(std::find(header.begin(), header.end(), "t_reached") - header.begin());
+  ASSERT_LT(at, header.size());
+  for (double k : {1.0, 4.0}) {
+    ASSERT_TRUE(std::getline(in, line));
+    const double t = std::stod(nhdyn::test::split(line)[at]);
+    EXPECT_NEAR(t, 3.14159265358979 / (2 * std::sqrt(k)), 1e-7) << line;
+  }
+}
+
+// A --runs table with a column twice was accepted (the last won); a grid product past the limit
+// was found only after every combination was built (out of memory).
+TEST_F(Hardening, BatchTablesAreCheckedFirst) {
+  write("runs.csv", "a,a\n0.1,0.2\n");
+  const ProcessRun twice = nhdyn({"batch", "sled.toml", "--runs", "runs.csv", "-o", "out"});
+  EXPECT_EQ(twice.code, 2);
+  EXPECT_TRUE(contains(twice.err, "given twice")) << twice.err;
+  ProcessOptions quick;
+  quick.deadline = 20;
+  const ProcessRun huge = nhdyn({"batch", "sled.toml", "--grid", "a=0.1:0.2:10000000", "--grid", "rho=0.7:0.8:10000000",
+                                 "-o", "out"},
+                                quick);
+  EXPECT_EQ(huge.code, 2) << huge.err;
+  EXPECT_TRUE(contains(huge.err, "more than 10000000 runs")) << huge.err;
+}
+
+// SIGINT during batch --write-runs left hundreds of run files and no summary; SIGHUP and SIGUSR1
+// left temporaries. A batch's outputs are written whole or not at all.
+TEST_F(Hardening, InterruptedBatchLeavesNothing) {
+  write("osc.toml", kOscillator);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGUSR1}) {
+    ProcessOptions options;
+    options.signal = sig;
+    options.after = std::chrono::milliseconds(1200);
+    options.deadline = 60;
+    const ProcessRun r = nhdyn({"batch", "osc.toml", "--grid", "k=1:2:4000", "--t-end", "200", "--write-runs",
+                                "--threads", "2", "-o", "out"},
+                               options);
+    EXPECT_EQ(r.code, 128 + sig) << r.err;
+    EXPECT_TRUE(contains(r.err, "nothing was written")) << r.err;
+    if (fs::exists(dir_ / "out")) {
+      EXPECT_TRUE(fs::is_empty(dir_ / "out")) << "signal " << sig;
     }
   }
 }
