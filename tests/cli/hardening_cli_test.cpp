@@ -279,4 +279,36 @@ TEST_F(Hardening, InterruptedBatchLeavesNothing) {
   }
 }
 
+// rk4 stepped across the singular S of a program (theta = 0.3 + 0.2 t reaches pi/2 at 6.354):
+// the sign of det S is watched, and the run fails between the two solves that bracket it.
+TEST_F(Hardening, Rk4DoesNotStepAcrossASingularProgramMatrix) {
+  const ProcessRun r = nhdyn({"simulate", fs::path(NHDYN_SOURCE_DIR) / "examples" / "cart_pendulum_program.toml",
+                              "--t-end", "10", "--integrator", "rk4", "-o", "out.csv"});
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_TRUE(contains(r.err, "changed sign")) << r.err;
+  const std::size_t at = r.err.find("between t = ");
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const double from = std::stod(r.err.substr(at + 12));
+  const double to = std::stod(r.err.substr(r.err.find(" and t = ", at) + 9));
+  const double singular = (3.14159265358979 / 2 - 0.3) / 0.2;
+  EXPECT_LE(from, singular);
+  EXPECT_GE(to, singular);
+  EXPECT_LT(to - from, 0.011);
+}
+
+// --event z=1/x reported a crossing at the pole, and atan2's wrap-around counted as one: a sign
+// change by a jump of g is not a crossing. x = cos t crosses zero at pi/2 (the event z = x).
+TEST_F(Hardening, PolesAndWrapAroundsAreNotCrossings) {
+  write("osc.toml", kOscillator);
+  const ProcessRun r = nhdyn({"simulate", "osc.toml", "--t-end", "3", "--event", "p=1/x", "--event", "z=x", "--event",
+                              "w=atan2(x, -1)", "-q", "-o", "e.csv"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string events = read_whole(dir_ / "e-events.csv");
+  EXPECT_FALSE(contains(events, "\np,")) << events;
+  EXPECT_FALSE(contains(events, "\nw,")) << events;
+  const std::size_t at = events.find("\nz,");
+  ASSERT_NE(at, std::string::npos) << events;
+  EXPECT_NEAR(std::stod(events.substr(at + 3)), 3.14159265358979 / 2, 1e-7);
+}
+
 }  // namespace

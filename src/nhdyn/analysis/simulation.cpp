@@ -210,6 +210,8 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   data_options.method = options.formulation.method;
   data_options.projection = options.fix_initial || options.stabilization == Stabilization::projection;
   Data data = make_data(model, data_options);
+  // rk4 takes no smaller step near a singular S, and could step across it (model/data.hpp).
+  data.motion.watch_sign = options.integrator.kind == IntegratorKind::rk4;
   check_state_or_throw(model, data, model.t0, model.q0.data(), model.v0.data());
   SimulationSummary summary;
   Vector q0 = model.q0, v0 = model.v0;
