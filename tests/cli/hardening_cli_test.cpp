@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -309,6 +310,38 @@ TEST_F(Hardening, PolesAndWrapAroundsAreNotCrossings) {
   const std::size_t at = events.find("\nz,");
   ASSERT_NE(at, std::string::npos) << events;
   EXPECT_NEAR(std::stod(events.substr(at + 3)), 3.14159265358979 / 2, 1e-7);
+}
+
+// report could not read nhdyn's own FILE.partial.csv (its reason line), refused a byte-order mark
+// with an invisible character in the message, and accepted NaN or decreasing times.
+TEST_F(Hardening, ReportReadsItsOwnPartialFilesAndChecksTimes) {
+  const fs::path model = fs::path(NHDYN_SOURCE_DIR) / "examples" / "cart_pendulum_program.toml";
+  ASSERT_EQ(nhdyn({"simulate", model.string(), "--t-end", "7", "-q", "-o", "cp.csv"}).code, 1);
+  ASSERT_TRUE(fs::exists(dir_ / "cp.partial.csv"));
+  const ProcessRun partial = nhdyn({"report", "cp.partial.csv", "--model", model.string(), "-q", "-o", "cp.html"});
+  EXPECT_EQ(partial.code, 0) << partial.err;
+  ASSERT_EQ(nhdyn({"simulate", "sled.toml", "--t-end", "0.3", "-q", "-o", "r.csv"}).code, 0);
+  const std::string csv = read_whole(dir_ / "r.csv");
+  write("bom.csv", "\xEF\xBB\xBF" + csv);
+  EXPECT_EQ(nhdyn({"report", "bom.csv", "--model", "sled.toml", "-q", "-o", "bom.html"}).code, 0);
+  // Rows 2 and 3 swapped: t decreases.
+  std::vector<std::string> lines;
+  std::stringstream in(csv);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  std::swap(lines[2], lines[3]);
+  std::string swapped;
+  for (const std::string& line : lines) swapped += line + "\n";
+  write("back.csv", swapped);
+  const ProcessRun back = nhdyn({"report", "back.csv", "--model", "sled.toml", "-q", "-o", "back.html"});
+  EXPECT_EQ(back.code, 2);
+  EXPECT_TRUE(contains(back.err, "never decrease")) << back.err;
+  lines[1].replace(0, lines[1].find(','), "nan");
+  std::string with_nan;
+  for (const std::string& line : lines) with_nan += line + "\n";
+  write("nan.csv", with_nan);
+  const ProcessRun nan = nhdyn({"report", "nan.csv", "--model", "sled.toml", "-q", "-o", "nan.html"});
+  EXPECT_EQ(nan.code, 2);
+  EXPECT_TRUE(contains(nan.err, "not finite")) << nan.err;
 }
 
 }  // namespace
