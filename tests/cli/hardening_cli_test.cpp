@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 
 #include <filesystem>
 #include <fstream>
@@ -342,6 +343,23 @@ TEST_F(Hardening, ReportReadsItsOwnPartialFilesAndChecksTimes) {
   const ProcessRun nan = nhdyn({"report", "nan.csv", "--model", "sled.toml", "-q", "-o", "nan.html"});
   EXPECT_EQ(nan.code, 2);
   EXPECT_TRUE(contains(nan.err, "not finite")) << nan.err;
+}
+
+// codegen emitted parameters named INFINITY, EOF, errno, NULL as identifiers: the preprocessor
+// replaced them and the header did not compile. They get a trailing underscore, as keywords do.
+TEST_F(Hardening, CodegenAvoidsStandardMacros) {
+  std::string model = kOscillator;
+  model.replace(model.find("k = 1.0"), 7, "k = 1.0\nINFINITY = 2.0\nEOF = 1.0\nerrno = 1.0\nNULL = 1.0");
+  model.replace(model.find("k/2 * x^2"), 9, "k/2 * x^2 + INFINITY*EOF*errno*NULL*x");
+  write("macro.toml", model);
+  const ProcessRun r = nhdyn({"codegen", "macro.toml", "-o", "macro.hpp"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(read_whole(dir_ / "macro.hpp"), "INFINITY_"));
+  write("use.cpp", "#include <cerrno>\n#include <cmath>\n#include <cstddef>\n#include <cstdio>\n#include \"macro.hpp\"\n"
+                   "int main() {}\n");
+  const std::string compile = "cd '" + dir_.string() + "' && c++ -std=c++20 -fsyntax-only -I'" NHDYN_SOURCE_DIR
+                              "/src' -I/usr/include/eigen3 use.cpp 2> compile.log";
+  EXPECT_EQ(std::system(compile.c_str()), 0) << read_whole(dir_ / "compile.log");
 }
 
 }  // namespace
