@@ -362,4 +362,15 @@ TEST_F(Hardening, CodegenAvoidsStandardMacros) {
   EXPECT_EQ(std::system(compile.c_str()), 0) << read_whole(dir_ / "compile.log");
 }
 
+// Duplicate event names (file and command line, or the command line twice) were accepted.
+TEST_F(Hardening, DuplicateEventNamesAreRefused) {
+  write("osc.toml", std::string(kOscillator) + "[[events]]\nname = \"z\"\nwhen = \"x\"\n");
+  const ProcessRun twice = nhdyn({"simulate", "osc.toml", "--event", "y=x'", "--event", "y=x", "-q", "-o", "a.csv"});
+  EXPECT_EQ(twice.code, 2);
+  EXPECT_TRUE(contains(twice.err, "two events are named 'y'")) << twice.err;
+  const ProcessRun file = nhdyn({"simulate", "osc.toml", "--event", "z=x'", "-q", "-o", "a.csv"});
+  EXPECT_EQ(file.code, 2);
+  EXPECT_TRUE(contains(file.err, "two events are named 'z'")) << file.err;
+}
+
 }  // namespace

@@ -174,6 +174,19 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
       throw InputError(fmt::format("the projection needs at least one Newton iteration, not {}",
                                    options.projection.max_iterations));
   }
+  // Events are told apart by name in the CSV, FILE-events.csv and the summary.
+  for (std::size_t i = 0; i < options.events.size(); ++i) {
+    const Event& e = options.events[i];
+    if (e.name.empty())
+      throw InputError(fmt::format("the event {} ({}) has an empty name; give it one (--event NAME=EXPR)", i + 1,
+                                   e.where.empty() ? e.expression : e.where));
+    for (std::size_t j = 0; j < i; ++j)
+      if (options.events[j].name == e.name)
+        throw InputError(fmt::format("two events are named '{}' ({} and {}); give each its own name", e.name,
+                                     options.events[j].where.empty() ? options.events[j].expression
+                                                                      : options.events[j].where,
+                                     e.where.empty() ? e.expression : e.where));
+  }
   if (model.m() > 0 && options.formulation.method != Method::sanh)
     throw InputError(fmt::format("model '{}' has programs ([[programs]]), which only the sanh formulation solves "
                                  "(docs/derivations/program-motion.md); choose --method sanh",
