@@ -34,19 +34,32 @@ std::vector<std::optional<Vector>> initial_states(const py::object& value, const
   return out;
 }
 
-// Stacks one quantity of every run into (runs, rows, width), NaN after a run's last row.
+// Stacks one quantity of every run into (runs, rows, width), NaN after a run's last row; a
+// quantity with one value per row (`per_row`: t, energy) into (runs, rows). A model with one
+// coordinate still gets (runs, rows, 1) for q: the shape does not depend on n.
 py::array_t<double> stack(const std::vector<BatchResult>& results, std::size_t rows, std::size_t width,
-                          const std::vector<double> Trajectory::*column) {
+                          const std::vector<double> Trajectory::*column, bool per_row = false) {
   std::vector<double> out(results.size() * rows * width, std::numeric_limits<double>::quiet_NaN());
   for (std::size_t r = 0; r < results.size(); ++r) {
     const std::vector<double>& values = results[r].trajectory.*column;
     std::copy(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(std::min(values.size(), rows * width)),
               out.begin() + static_cast<std::ptrdiff_t>(r * rows * width));
   }
-  if (width == 1)
+  if (per_row)
     return take_array(std::move(out), {static_cast<py::ssize_t>(results.size()), static_cast<py::ssize_t>(rows)});
   return take_array(std::move(out), {static_cast<py::ssize_t>(results.size()), static_cast<py::ssize_t>(rows),
                                      static_cast<py::ssize_t>(width)});
+}
+
+// threads=: a non-negative int (not a bool, a float or a string), at most what a C int holds.
+int thread_count(const py::object& value) {
+  if (!py::isinstance<py::int_>(value) || py::isinstance<py::bool_>(value))
+    throw InputError(fmt::format("threads = {}: give a whole number (0: every core)", std::string(py::repr(value))));
+  const auto big = value.cast<py::int_>();
+  if (big < py::int_(0)) throw InputError(fmt::format("threads = {}: give 0 (every core) or a positive number",
+                                                       std::string(py::str(value))));
+  if (big > py::int_(1 << 20)) return 1 << 20;  // capped by batch_threads anyway
+  return big.cast<int>();
 }
 
 }  // namespace
@@ -54,13 +67,13 @@ py::array_t<double> stack(const std::vector<BatchResult>& results, std::size_t r
 void bind_batch(py::module_& m) {
   m.def(
       "simulate_batch",
-      [](const std::vector<ModelPtr>& models, const py::object& q0, const py::object& v0, int threads,
+      [](const std::vector<ModelPtr>& models, const py::object& q0, const py::object& v0, const py::object& threads_arg,
          bool keep_trajectories, const py::kwargs& kwargs) {
+        const int threads = thread_count(threads_arg);
         if (models.empty()) throw InputError("simulate_batch: no runs (give at least one parameter value or initial state)");
         const int n = models.front()->n();
         for (const ModelPtr& model : models)
           if (!model || model->n() != n) throw InputError("simulate_batch: every run needs a model with the same coordinates");
-        if (threads < 0) throw InputError(fmt::format("threads = {}: give 0 (every core) or a positive number", threads));
         BatchOptions options;
         options.simulation = make_options(*models.front(), kwargs);
         options.threads = threads;
@@ -71,12 +84,22 @@ void bind_batch(py::module_& m) {
         for (std::size_t i = 0; i < runs.size(); ++i) runs[i] = BatchRun{models[i], q[i], v[i]};
         std::vector<BatchResult> results;
         double seconds = 0.0;
+        // Ctrl-C: the calling thread polls Python's signals between the workers' runs and stops
+        // the batch (the running runs finish), then KeyboardInterrupt is raised.
+        bool interrupted = false;
+        options.keep_going = [&interrupted] {
+          py::gil_scoped_acquire acquire;
+          if (PyErr_CheckSignals() == 0) return true;
+          interrupted = true;
+          return false;
+        };
         {
           py::gil_scoped_release release;
           const auto start = std::chrono::steady_clock::now();
           results = simulate_batch(runs, options);
           seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         }
+        if (interrupted) throw py::error_already_set();
         std::size_t longest = 0;
         std::size_t best = 0;
         for (std::size_t r = 0; r < results.size(); ++r)
@@ -87,7 +110,13 @@ void bind_batch(py::module_& m) {
         const Trajectory& shape = results[best].trajectory;
         const auto un = static_cast<std::size_t>(n);
         py::dict out;
-        out["t"] = take_array(std::vector<double>(shape.t), {static_cast<py::ssize_t>(longest)});
+        // One time vector when every run has the same times (each run's rows a prefix of the
+        // longest's); with events or a stop condition the runs' rows differ, and t is per run.
+        bool shared_times = true;
+        for (const BatchResult& res : results)
+          if (!std::equal(res.trajectory.t.begin(), res.trajectory.t.end(), shape.t.begin())) shared_times = false;
+        out["t"] = shared_times ? take_array(std::vector<double>(shape.t), {static_cast<py::ssize_t>(longest)})
+                                : stack(results, longest, 1, &Trajectory::t, true);
         out["q"] = stack(results, longest, un, &Trajectory::q);
         out["qd"] = stack(results, longest, un, &Trajectory::v);
         out["qdd"] = stack(results, longest, un, &Trajectory::qdd);
@@ -96,12 +125,12 @@ void bind_batch(py::module_& m) {
                                                                              models.front()->velocity_constraints() +
                                                                              models.front()->s()),
                                  &Trajectory::residuals);
-        out["energy"] = models.front()->evaluator->has_energy() ? py::object(stack(results, longest, 1, &Trajectory::energy))
+        out["energy"] = models.front()->evaluator->has_energy() ? py::object(stack(results, longest, 1, &Trajectory::energy, true))
                                                                 : py::object(py::none());
         std::vector<double> q_end(results.size() * un, std::numeric_limits<double>::quiet_NaN());
         std::vector<double> v_end(results.size() * un, std::numeric_limits<double>::quiet_NaN());
         std::vector<double> max_residual(results.size(), std::numeric_limits<double>::quiet_NaN());
-        py::list ok, messages, summaries;
+        py::list ok, messages, summaries, events;
         for (std::size_t r = 0; r < results.size(); ++r) {
           const BatchResult& res = results[r];
           if (res.q_end.size() == n) {
@@ -112,6 +141,16 @@ void bind_batch(py::module_& m) {
           }
           ok.append(res.ok);
           messages.append(res.message);
+          py::list run_events;
+          for (const EventRecord& e : res.summary.events) {
+            py::dict event;
+            event["name"] = e.name;
+            event["t"] = e.t;
+            event["q"] = py::array_t<double>(static_cast<py::ssize_t>(e.q.size()), e.q.data());
+            event["qd"] = py::array_t<double>(static_cast<py::ssize_t>(e.v.size()), e.v.data());
+            run_events.append(event);
+          }
+          events.append(run_events);
           summaries.append(summary_dict(res.summary));
         }
         out["q_end"] = take_array(std::move(q_end), {static_cast<py::ssize_t>(results.size()), n});
@@ -120,6 +159,7 @@ void bind_batch(py::module_& m) {
         out["ok"] = ok;
         out["messages"] = messages;
         out["summaries"] = summaries;
+        out["events"] = events;
         out["threads"] = batch_threads(threads, results.size());
         out["cpp_seconds"] = seconds;
         return out;

@@ -4,12 +4,20 @@
 // A NAME is a parameter of the model file, or an initial value: x(0) for a coordinate, x'(0) for
 // a velocity. Runs that fail are reported in the summary; the others are kept (exit 1 if any failed).
 #include <fmt/format.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <unistd.h>
 
+#include <atomic>
+#include <cerrno>
 #include <cmath>
+#include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "commands.hpp"
@@ -21,6 +29,7 @@
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/results.hpp"
+#include "nhdyn/io/run_paths.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
 
 namespace nhdyn::cli {
@@ -117,163 +126,8 @@ std::string csv_text(const std::string& text) {
   return out + "\"";
 }
 
-int run_batch(const BatchArgs& args) {
-  if (args.grids.empty() == args.runs_csv.empty())
-    throw InputError("give the runs either as --grid NAME=FROM:TO:COUNT (repeatable) or as --runs FILE.csv");
-  if (args.threads < 0) throw InputError(fmt::format("--threads {}: give 0 (every core) or a positive number", args.threads));
-  ParameterOverrides overrides;
-  for (const std::string& set : args.sets) {
-    const std::size_t eq = set.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError(fmt::format("--set '{}': write it as NAME=VALUE, e.g. --set a=0.3", set));
-    overrides.emplace_back(set.substr(0, eq), set.substr(eq + 1));
-  }
-  const ModelSource source = read_model_source(args.model);
-  const Model base = load_model(source, overrides);
-
-  // The table of runs: one column per name, one row per run.
-  std::vector<std::string> names;
-  std::vector<std::vector<double>> table;
-  if (!args.grids.empty()) {
-    table.assign(1, {});
-    for (const std::string& grid : args.grids) {
-      auto [name, values] = parse_grid(grid);
-      for (const std::string& known : names)
-        if (known == name) throw InputError(fmt::format("--grid {}: given twice", name));
-      names.push_back(name);
-      std::vector<std::vector<double>> product;  // the first grid varies slowest
-      for (const std::vector<double>& row : table)
-        for (double value : values) {
-          product.push_back(row);
-          product.back().push_back(value);
-        }
-      table = std::move(product);
-      if (table.size() > 10000000) throw InputError("--grid: more than 10000000 runs; use fewer values");
-    }
-  } else {
-    const CsvTable csv = load_csv(args.runs_csv);
-    if (csv.header.empty()) throw InputError(fmt::format("{}: no header naming the columns", args.runs_csv));
-    names = csv.header;
-    table = csv.rows;
-    if (table.empty()) throw InputError(fmt::format("{}: no runs (the file has a header and no rows)", args.runs_csv));
-  }
-  std::vector<Varied> varied;
-  std::vector<std::string> parameter_names;
-  for (const std::string& name : names) {
-    varied.push_back(classify(name, base));
-    if (varied.back().kind == Varied::parameter) parameter_names.push_back(name);
-  }
-  std::vector<std::vector<double>> parameter_values(table.size());
-  for (std::size_t r = 0; r < table.size(); ++r)
-    for (std::size_t j = 0; j < names.size(); ++j)
-      if (varied[j].kind == Varied::parameter) parameter_values[r].push_back(table[r][j]);
-
-  const RunOptions run = run_options_with(base, args);
-  BatchOptions options;
-  options.simulation = make_simulation_options(run);
-  options.threads = args.threads;
-  options.keep_trajectories = args.write_runs;
-  check_simulation_options(base, options.simulation);
-
-  namespace fs = std::filesystem;
-  const fs::path dir(args.output);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir))
-    throw FileError(fmt::format("-o {}: cannot create the output directory ({}); give another with -o", args.output,
-                                ec ? ec.message() : "not a directory"));
-  AtomicFile summary(dir / "summary.csv");  // checks the directory is writable before any run
-
-  std::vector<BatchRun> runs(table.size());
-  {
-    // One compiled model per run when parameters vary (until parameters are run-time data);
-    // otherwise every run shares the base model.
-    std::vector<Model> models;
-    if (!parameter_names.empty()) models = load_model_variants(source, overrides, parameter_names, parameter_values);
-    // The compiled evaluator is made once; each variant rebinds it to its parameter values.
-    std::string notice;
-    const Model chosen = jit::with_evaluator(base, jit::parse_evaluator_choice(args.evaluator), &notice);
-    if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
-    if (jit::is_compiled(chosen))
-      for (Model& m : models) {
-        std::vector<double> values;
-        for (const Parameter& p : m.parameters) values.push_back(p.value);
-        m.evaluator = chosen.evaluator->with_parameters(values.data(), values.size());
-      }
-    std::shared_ptr<const Model> shared = parameter_names.empty() ? std::make_shared<const Model>(chosen) : nullptr;
-    for (std::size_t r = 0; r < table.size(); ++r) {
-      runs[r].model = shared ? shared : std::make_shared<const Model>(std::move(models[r]));
-      for (std::size_t j = 0; j < names.size(); ++j) {
-        if (varied[j].kind == Varied::coordinate) {
-          if (!runs[r].q0) runs[r].q0 = runs[r].model->q0;
-          (*runs[r].q0)(varied[j].index) = table[r][j];
-        } else if (varied[j].kind == Varied::velocity) {
-          if (!runs[r].v0) runs[r].v0 = runs[r].model->v0;
-          (*runs[r].v0)(varied[j].index) = table[r][j];
-        }
-      }
-    }
-  }
-  const std::vector<BatchResult> results = simulate_batch(runs, options);
-
-  std::string header = "run";
-  for (const std::string& name : names) header += "," + csv_text(name);
-  header += ",status,t_reached";
-  for (const std::string& c : base.coordinates) header += "," + csv_text(c);
-  for (const std::string& c : base.coordinates) header += "," + csv_text(c + "'");
-  header += ",max_residual_pos,max_residual_vel,max_residual_acc,message\n";
-  summary.write(header);
-  long failed = 0;
-  const int digits = static_cast<int>(std::to_string(std::max<std::size_t>(results.size(), 1) - 1).size());
-  for (std::size_t r = 0; r < results.size(); ++r) {
-    const BatchResult& res = results[r];
-    failed += res.ok ? 0 : 1;
-    std::string line = std::to_string(r);
-    for (double value : table[r]) line += fmt::format(",{}", value);
-    line += res.ok ? ",ok" : ",failed";
-    line += fmt::format(",{}", res.summary.t_reached);
-    for (int i = 0; i < base.n(); ++i) line += res.q_end.size() == base.n() ? fmt::format(",{}", res.q_end(i)) : ",";
-    for (int i = 0; i < base.n(); ++i) line += res.v_end.size() == base.n() ? fmt::format(",{}", res.v_end(i)) : ",";
-    line += fmt::format(",{},{},{},{}\n", res.summary.max_position_residual, res.summary.max_velocity_residual,
-                        res.summary.max_acceleration_residual, csv_text(res.message));
-    summary.write(line);
-    if (args.write_runs && res.trajectory.rows() > 0) {
-      const Model& model = *runs[r].model;
-      CsvWriter writer(dir / fmt::format("run_{:0{}}.csv", r, digits), make_result_columns(model).all);
-      const Trajectory& tr = res.trajectory;
-      std::vector<double> row;
-      const auto n = static_cast<std::size_t>(tr.n);
-      const auto m = static_cast<std::size_t>(tr.residual_columns);
-      for (std::size_t k = 0; k < static_cast<std::size_t>(tr.rows()); ++k) {
-        row.clear();
-        row.push_back(tr.t[k]);
-        for (const std::vector<double>* column : {&tr.q, &tr.v, &tr.qdd, &tr.R})
-          row.insert(row.end(), column->begin() + static_cast<std::ptrdiff_t>(k * n),
-                     column->begin() + static_cast<std::ptrdiff_t>((k + 1) * n));
-        row.insert(row.end(), tr.residuals.begin() + static_cast<std::ptrdiff_t>(k * m),
-                   tr.residuals.begin() + static_cast<std::ptrdiff_t>((k + 1) * m));
-        if (tr.has_energy) row.push_back(tr.energy[k]);
-        const auto b = static_cast<std::size_t>(tr.balance_columns);
-        row.insert(row.end(), tr.balance.begin() + static_cast<std::ptrdiff_t>(k * b),
-                   tr.balance.begin() + static_cast<std::ptrdiff_t>((k + 1) * b));
-        const auto a = static_cast<std::size_t>(tr.actuator_columns);
-        const auto p = static_cast<std::size_t>(tr.program_residual_columns);
-        row.insert(row.end(), tr.u.begin() + static_cast<std::ptrdiff_t>(k * a),
-                   tr.u.begin() + static_cast<std::ptrdiff_t>((k + 1) * a));
-        row.insert(row.end(), tr.program_residuals.begin() + static_cast<std::ptrdiff_t>(k * p),
-                   tr.program_residuals.begin() + static_cast<std::ptrdiff_t>((k + 1) * p));
-        const auto c = static_cast<std::size_t>(tr.contact_columns);
-        row.insert(row.end(), tr.contact_forces.begin() + static_cast<std::ptrdiff_t>(k * c),
-                   tr.contact_forces.begin() + static_cast<std::ptrdiff_t>((k + 1) * c));
-        const auto o = static_cast<std::size_t>(tr.output_columns);
-        row.insert(row.end(), tr.outputs.begin() + static_cast<std::ptrdiff_t>(k * o),
-                   tr.outputs.begin() + static_cast<std::ptrdiff_t>((k + 1) * o));
-        writer.write_row(row);
-      }
-      writer.commit();
-    }
-  }
-  summary.commit();
+void print_batch_outcome(const BatchArgs& args, const Model& base, const std::vector<BatchResult>& results, long failed,
+                         const std::filesystem::path& dir) {
   // The constraint watch (analysis/constraint_watch.hpp): the first run's warnings that has any,
   // and how many runs warned, whatever -q says.
   std::size_t warned = 0;
@@ -292,6 +146,279 @@ int run_batch(const BatchArgs& args) {
         break;
       }
   }
+}
+
+// The table of runs: one column per name, one row per run, from the grids (every combination, the
+// first grid varying slowest) or the --runs CSV.
+void make_run_table(const BatchArgs& args, std::vector<std::string>& names, std::vector<std::vector<double>>& table) {
+  if (!args.grids.empty()) {
+    std::vector<std::vector<double>> grids;
+    double product = 1.0;  // checked before any combination is built
+    for (const std::string& grid : args.grids) {
+      auto [name, values] = parse_grid(grid);
+      for (const std::string& known : names)
+        if (known == name) throw InputError(fmt::format("--grid {}: given twice", name));
+      names.push_back(name);
+      product *= static_cast<double>(values.size());
+      if (product > 1e7)
+        throw InputError(fmt::format("--grid: the grids make more than 10000000 runs ({:.3g} so far, at --grid {}); "
+                                     "use fewer values",
+                                     product, name));
+      grids.push_back(std::move(values));
+    }
+    table.assign(1, {});
+    for (const std::vector<double>& values : grids) {
+      std::vector<std::vector<double>> next;
+      next.reserve(table.size() * values.size());
+      for (const std::vector<double>& row : table)
+        for (double value : values) {
+          next.push_back(row);
+          next.back().push_back(value);
+        }
+      table = std::move(next);
+    }
+    return;
+  }
+  const CsvTable csv = load_csv(args.runs_csv);
+  if (csv.header.empty()) throw InputError(fmt::format("{}: no header naming the columns", args.runs_csv));
+  for (std::size_t j = 0; j < csv.header.size(); ++j)
+    for (std::size_t k = 0; k < j; ++k)
+      if (csv.header[j] == csv.header[k])
+        throw InputError(fmt::format("{}: the column '{}' is given twice (columns {} and {}); keep one", args.runs_csv,
+                                     csv.header[j], k + 1, j + 1));
+  names = csv.header;
+  table = csv.rows;
+  if (table.empty()) throw InputError(fmt::format("{}: no runs (the file has a header and no rows)", args.runs_csv));
+}
+
+// One run's rows as CSV, in the columns of `nhdyn simulate`.
+void write_run_file(const std::filesystem::path& path, const Model& model, const Trajectory& tr) {
+  CsvWriter writer(path, make_result_columns(model).all);
+  std::vector<double> row;
+  const auto slice = [&row](const std::vector<double>& column, std::size_t k, std::size_t width) {
+    row.insert(row.end(), column.begin() + static_cast<std::ptrdiff_t>(k * width),
+               column.begin() + static_cast<std::ptrdiff_t>((k + 1) * width));
+  };
+  const auto n = static_cast<std::size_t>(tr.n);
+  for (std::size_t k = 0; k < static_cast<std::size_t>(tr.rows()); ++k) {
+    row.clear();
+    row.push_back(tr.t[k]);
+    for (const std::vector<double>* column : {&tr.q, &tr.v, &tr.qdd, &tr.R}) slice(*column, k, n);
+    slice(tr.residuals, k, static_cast<std::size_t>(tr.residual_columns));
+    if (tr.has_energy) row.push_back(tr.energy[k]);
+    slice(tr.balance, k, static_cast<std::size_t>(tr.balance_columns));
+    slice(tr.u, k, static_cast<std::size_t>(tr.actuator_columns));
+    slice(tr.program_residuals, k, static_cast<std::size_t>(tr.program_residual_columns));
+    slice(tr.contact_forces, k, static_cast<std::size_t>(tr.contact_columns));
+    slice(tr.outputs, k, static_cast<std::size_t>(tr.output_columns));
+    writer.write_row(row);
+  }
+  writer.commit();
+}
+
+// The batch's signals: a stopping signal only sets a flag, so that the batch stops handing out
+// runs, the staging directory is removed whole and the process then exits 128 + the signal.
+std::atomic<int> batch_signal{0};
+extern "C" void on_batch_signal(int sig) { batch_signal.store(sig); }
+constexpr int kBatchSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2};
+
+void install_batch_signal_handlers() {
+  struct sigaction action{};
+  action.sa_handler = on_batch_signal;
+  sigemptyset(&action.sa_mask);
+  for (int sig : kBatchSignals) ::sigaction(sig, &action, nullptr);
+}
+
+const char* signal_name(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    case SIGQUIT: return "SIGQUIT";
+    case SIGUSR1: return "SIGUSR1";
+    default: return "SIGUSR2";
+  }
+}
+
+// A directory inside the output directory where the run files are written while the batch runs;
+// moved into place at the end, removed whole on failure or interruption.
+struct StagingDirectory {
+  std::filesystem::path path;
+  explicit StagingDirectory(const std::filesystem::path& dir) {
+    std::string pattern = (dir / ".nhdyn-batch-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr)
+      throw FileError(fmt::format("-o {}: cannot create a working directory there ({}); check its permissions",
+                                  dir.string(), std::strerror(errno)));
+    path = pattern;
+  }
+  ~StagingDirectory() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+};
+
+std::string summary_line(std::size_t r, const std::vector<double>& values, const BatchResult& res, const Model& base) {
+  std::string line = std::to_string(r);
+  for (double value : values) line += fmt::format(",{}", value);
+  line += res.ok ? ",ok" : ",failed";
+  line += fmt::format(",{}", res.summary.t_reached);
+  for (int i = 0; i < base.n(); ++i) line += res.q_end.size() == base.n() ? fmt::format(",{}", res.q_end(i)) : ",";
+  for (int i = 0; i < base.n(); ++i) line += res.v_end.size() == base.n() ? fmt::format(",{}", res.v_end(i)) : ",";
+  line += fmt::format(",{},{},{},{}\n", res.summary.max_position_residual, res.summary.max_velocity_residual,
+                      res.summary.max_acceleration_residual, csv_text(res.message));
+  return line;
+}
+
+// The runs' models: one per run when parameters vary, else the base shared; initial values set.
+std::vector<BatchRun> make_runs(const BatchArgs& args, const ModelSource& source, const ParameterOverrides& overrides,
+                                const Model& base, const std::vector<std::string>& names,
+                                const std::vector<std::vector<double>>& table) {
+  std::vector<Varied> varied;
+  std::vector<std::string> parameter_names;
+  for (const std::string& name : names) {
+    varied.push_back(classify(name, base));
+    if (varied.back().kind == Varied::parameter) parameter_names.push_back(name);
+  }
+  std::vector<std::vector<double>> parameter_values(table.size());
+  for (std::size_t r = 0; r < table.size(); ++r)
+    for (std::size_t j = 0; j < names.size(); ++j)
+      if (varied[j].kind == Varied::parameter) parameter_values[r].push_back(table[r][j]);
+  std::vector<BatchRun> runs(table.size());
+  std::vector<Model> models;
+  if (!parameter_names.empty()) models = load_model_variants(source, overrides, parameter_names, parameter_values);
+  // The compiled evaluator is made once; each variant rebinds it to its parameter values.
+  std::string notice;
+  const Model chosen = jit::with_evaluator(base, jit::parse_evaluator_choice(args.evaluator), &notice);
+  if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
+  if (jit::is_compiled(chosen))
+    for (Model& m : models) {
+      std::vector<double> values;
+      for (const Parameter& p : m.parameters) values.push_back(p.value);
+      m.evaluator = chosen.evaluator->with_parameters(values.data(), values.size());
+    }
+  std::shared_ptr<const Model> shared = parameter_names.empty() ? std::make_shared<const Model>(chosen) : nullptr;
+  for (std::size_t r = 0; r < table.size(); ++r) {
+    runs[r].model = shared ? shared : std::make_shared<const Model>(std::move(models[r]));
+    for (std::size_t j = 0; j < names.size(); ++j) {
+      if (varied[j].kind == Varied::coordinate) {
+        if (!runs[r].q0) runs[r].q0 = runs[r].model->q0;
+        (*runs[r].q0)(varied[j].index) = table[r][j];
+      } else if (varied[j].kind == Varied::velocity) {
+        if (!runs[r].v0) runs[r].v0 = runs[r].model->v0;
+        (*runs[r].v0)(varied[j].index) = table[r][j];
+      }
+    }
+  }
+  return runs;
+}
+
+// Every input (the model file, the --runs table) checked against every output the batch may write
+// (summary.csv, run_N.csv), by name, link or inode, before any run (io/run_paths.hpp).
+void check_batch_paths(const BatchArgs& args, const std::filesystem::path& dir, std::size_t runs, int digits) {
+  namespace fs = std::filesystem;
+  RunPaths paths;
+  if (fs::is_regular_file(args.model)) paths.input(args.model, "the model file");
+  if (!args.runs_csv.empty()) paths.input(args.runs_csv, "--runs");
+  paths.output(dir / "summary.csv", "the summary");
+  paths.check();
+  if (!args.write_runs) return;
+  for (std::size_t r = 0; r < runs; ++r) {
+    const fs::path run = dir / fmt::format("run_{:0{}}.csv", r, digits);
+    for (const std::string& input : {args.model, args.runs_csv}) {
+      if (input.empty() || !fs::exists(input)) continue;
+      std::error_code ec;
+      if (fs::equivalent(input, run, ec) ||
+          (!fs::exists(run) && fs::weakly_canonical(fs::absolute(input)) == fs::weakly_canonical(fs::absolute(run))))
+        throw FileError(fmt::format("refusing to write '{}' (--write-runs): it is '{}', an input of this run; give "
+                                    "another output directory with -o",
+                                    run.string(), input));
+    }
+  }
+}
+
+int run_batch(const BatchArgs& args) {
+  if (args.grids.empty() == args.runs_csv.empty())
+    throw InputError("give the runs either as --grid NAME=FROM:TO:COUNT (repeatable) or as --runs FILE.csv");
+  if (args.threads < 0) throw InputError(fmt::format("--threads {}: give 0 (every core) or a positive number", args.threads));
+  if (args.threads > max_batch_threads())
+    fmt::print(stderr, "nhdyn: note: --threads {}: this machine has {} cores; using at most {} threads\n", args.threads,
+               std::max(1U, std::thread::hardware_concurrency()), max_batch_threads());
+  ParameterOverrides overrides;
+  for (const std::string& set : args.sets) {
+    const std::size_t eq = set.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(fmt::format("--set '{}': write it as NAME=VALUE, e.g. --set a=0.3", set));
+    overrides.emplace_back(set.substr(0, eq), set.substr(eq + 1));
+  }
+  const ModelSource source = read_model_source(args.model);
+  const Model base = load_model(source, overrides);
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> table;
+  make_run_table(args, names, table);
+
+  const RunOptions run = run_options_with(base, args);
+  BatchOptions options;
+  options.simulation = make_simulation_options(run);
+  options.simulation.events = base.events;  // the file's [[events]], as simulate and Python's batch honour them
+  options.threads = args.threads;
+  options.keep_trajectories = args.write_runs;
+  check_simulation_options(base, options.simulation);
+
+  namespace fs = std::filesystem;
+  const fs::path dir(args.output);
+  const int digits = static_cast<int>(std::to_string(std::max<std::size_t>(table.size(), 1) - 1).size());
+  check_batch_paths(args, dir, table.size(), digits);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw FileError(fmt::format("-o {}: cannot create the output directory ({}); give another with -o", args.output,
+                                ec ? ec.message() : "not a directory"));
+  AtomicFile summary(dir / "summary.csv");  // checks the directory is writable before any run
+  const std::vector<BatchRun> runs = make_runs(args, source, overrides, base, names, table);
+
+  // Each run's file is written as soon as the run ends (not kept in memory), into a staging
+  // directory; the files are moved into place when every run has ended and been written.
+  std::optional<StagingDirectory> staging;
+  if (args.write_runs) {
+    staging.emplace(dir);
+    options.on_result = [&](std::size_t r, BatchResult& result) {
+      if (result.trajectory.rows() > 0)
+        write_run_file(staging->path / fmt::format("run_{:0{}}.csv", r, digits), *runs[r].model, result.trajectory);
+      result.trajectory = Trajectory{};
+    };
+  }
+  install_batch_signal_handlers();
+  options.keep_going = [] { return batch_signal.load() == 0; };
+  const std::vector<BatchResult> results = simulate_batch(runs, options);
+  if (const int sig = batch_signal.load()) {
+    staging.reset();
+    remove_temporary_files();  // the summary's temporary (_exit runs no destructor)
+    fmt::print(stderr, "\nnhdyn: batch interrupted by {}; nothing was written (no summary, no run files)\n",
+               signal_name(sig));
+    std::signal(sig, SIG_DFL);
+    ::_exit(128 + sig);
+  }
+
+  std::string header = "run";
+  for (const std::string& name : names) header += "," + csv_text(name);
+  header += ",status,t_reached";
+  for (const std::string& c : base.coordinates) header += "," + csv_text(c);
+  for (const std::string& c : base.coordinates) header += "," + csv_text(c + "'");
+  header += ",max_residual_pos,max_residual_vel,max_residual_acc,message\n";
+  summary.write(header);
+  long failed = 0;
+  for (std::size_t r = 0; r < results.size(); ++r) {
+    failed += results[r].ok ? 0 : 1;
+    summary.write(summary_line(r, table[r], results[r], base));
+  }
+  if (staging)
+    for (const auto& entry : fs::directory_iterator(staging->path)) {
+      fs::rename(entry.path(), dir / entry.path().filename(), ec);
+      if (ec)
+        throw FileError(fmt::format("cannot move {} into {}: {}", entry.path().string(), dir.string(), ec.message()));
+    }
+  summary.commit();
+  print_batch_outcome(args, base, results, failed, dir);
   return failed > 0 ? 1 : 0;
 }
 

@@ -67,6 +67,12 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  // An empty value (-o '', --html '', --plot '') would otherwise read as "not given" and be
+  // ignored silently: every option that takes a value needs a non-empty one.
+  if (const std::string empty = nhdyn::cli::first_empty_value(app); !empty.empty()) {
+    fmt::print(stderr, "nhdyn: error: {} '': the value is empty; give one (or leave the option out)\n", empty);
+    return 2;
+  }
   nhdyn::cli::install_interrupt_handlers();
   try {
     for (std::size_t i = 0; i < runs.size(); ++i)

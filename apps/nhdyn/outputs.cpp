@@ -3,6 +3,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -110,6 +111,19 @@ void install_interrupt_handlers() {
   sigemptyset(&action.sa_mask);
   ::sigaction(SIGINT, &action, nullptr);
   ::sigaction(SIGTERM, &action, nullptr);
+}
+
+std::string first_empty_value(const CLI::App& app) {
+  for (const CLI::Option* option : app.get_options()) {
+    if (option->count() == 0 || option->get_expected_min() == 0) continue;  // not given, or a flag
+    for (const std::string& value : option->results())
+      if (value.empty()) return option->get_name();
+  }
+  for (const CLI::App* sub : app.get_subcommands()) {
+    const std::string found = first_empty_value(*sub);
+    if (!found.empty()) return found;
+  }
+  return "";
 }
 
 void note_time(double t) { time_reached.store(t, std::memory_order_relaxed); }

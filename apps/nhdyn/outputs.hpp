@@ -8,6 +8,10 @@
 #include <filesystem>
 #include <string>
 
+namespace CLI {
+class App;
+}
+
 namespace nhdyn::cli {
 
 // Registers the MODEL argument, when it names a file, as an input no output may replace
@@ -26,6 +30,10 @@ void check_plot_possible(const std::string& plot);
 // "interrupted by SIGINT at t = ..." (the last time passed to note_time, if any) and exit with
 // 128 + the signal's number.
 void install_interrupt_handlers();
+// The name of the first option given with an empty value in the parsed command line (searched
+// through the subcommands that were given), or "" when none.
+std::string first_empty_value(const CLI::App& app);
+
 // Records how far the run has come, for the message of an interrupted run. Lock-free.
 void note_time(double t);
 

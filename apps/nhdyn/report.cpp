@@ -2,6 +2,8 @@
 // written earlier by `nhdyn simulate`; the CSV must have the model's columns.
 #include <fmt/format.h>
 
+#include <cmath>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -13,6 +15,7 @@
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/report.hpp"
+#include "nhdyn/io/run_paths.hpp"
 
 namespace nhdyn::cli {
 
@@ -38,10 +41,26 @@ std::function<int()> add_report_command(CLI::App& app) {
   return [args] {
     if (args->max_frames < 2)
       throw InputError(fmt::format("--max-frames {}: give at least 2", args->max_frames));
+    {
+      // Every file of the run, checked together before any work (io/run_paths.hpp).
+      RunPaths paths;
+      paths.input(args->csv, "the result CSV");
+      if (std::filesystem::is_regular_file(args->model)) paths.input(args->model, "the model file");
+      paths.output(args->output, "-o");
+      paths.check();
+    }
     std::optional<AtomicFile> probe(args->output);  // an unwritable path is refused before any work
     const LoadedModel resolved = load_model_argument(args->model, args->sets);
     const CsvTable table = load_csv(args->csv);
     check_report_columns(table.header, make_result_columns(resolved.model), args->csv, resolved.model.name);
+    // The time column must be a time: finite and never decreasing (an event row may share a time).
+    if (const int t = table.column("t"); t >= 0)
+      for (std::size_t r = 0; r < table.rows.size(); ++r) {
+        const double value = table.rows[r][static_cast<std::size_t>(t)];
+        if (!std::isfinite(value) || (r > 0 && value < table.rows[r - 1][static_cast<std::size_t>(t)]))
+          throw InputError(fmt::format("{}: row {}: t = {} {}; a result's times are finite and never decrease",
+                                       args->csv, r + 1, value, std::isfinite(value) ? "is before the row above" : "is not finite"));
+      }
     probe.reset();
     ReportOptions options;
     options.max_frames = args->max_frames;

@@ -20,6 +20,7 @@
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
+#include "nhdyn/io/run_paths.hpp"
 #include "nhdyn/io/report.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
@@ -191,12 +192,24 @@ int run_simulate(const SimulateArgs& args) {
   namespace fs = std::filesystem;
   const bool default_csv = args.output.empty();
   const fs::path csv_path = default_csv ? fs::path("results") / (make_file_name(model.name) + ".csv") : fs::path(args.output);
+  const fs::path events_path = companion(csv_path, "-events.csv");
+  const fs::path partial_path = companion(csv_path, ".partial.csv");
+  const bool companions = is_regular_target(csv_path);
+  {
+    // Every file of the run, checked together before any work (io/run_paths.hpp).
+    RunPaths paths;
+    if (fs::is_regular_file(args.model)) paths.input(args.model, "the model file");
+    paths.output(csv_path, "the CSV output");
+    if (companions) {
+      if (!options.events.empty()) paths.output(events_path, "the events file");
+      paths.output(partial_path, "the partial-results file");
+    }
+    if (!args.plot.empty()) paths.output(args.plot, "--plot");
+    if (!args.html.empty()) paths.output(args.html, "--html");
+    paths.check();
+  }
   std::optional<AtomicFile> plot_probe;
   if (!args.plot.empty()) {
-    std::error_code ec;
-    if (fs::weakly_canonical(args.plot, ec) == fs::weakly_canonical(csv_path, ec))
-      throw InputError(fmt::format("--plot {} and the CSV output {} are the same file; give them different names",
-                                   args.plot, csv_path.string()));
     if (!gnuplot_available())
       throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
                       "or run without --plot");
@@ -212,16 +225,9 @@ int run_simulate(const SimulateArgs& args) {
   }
   std::optional<AtomicFile> html_probe;
   if (!args.html.empty()) {
-    std::error_code ec;
-    if (fs::weakly_canonical(args.html, ec) == fs::weakly_canonical(csv_path, ec))
-      throw InputError(fmt::format("--html {} and the CSV output {} are the same file; give them different names",
-                                   args.html, csv_path.string()));
     html_probe.emplace(args.html);  // checks the report's directory now; removed unused
   }
   CsvWriter writer(csv_path, columns.all);  // refuses an unwritable path before any step
-  const bool companions = is_regular_target(csv_path);
-  const fs::path events_path = companion(csv_path, "-events.csv");
-  const fs::path partial_path = companion(csv_path, ".partial.csv");
   std::optional<AtomicFile> events_file;
   if (companions && !options.events.empty()) events_file.emplace(events_path);
 

@@ -347,10 +347,13 @@ class Sweep:
 
 
 class BatchResult:
-    """The runs of simulate_batch stacked: t (rows), q, qd, qdd, R (runs x rows x n), residuals
-    (runs x rows x columns), energy (runs x rows or None), q_end, qd_end (runs x n), max_residual
-    (runs), ok (runs, bool), messages (runs: empty, or why the run failed), parameters (name ->
-    runs values). Rows after a failed run's end are NaN."""
+    """The runs of simulate_batch stacked: t (rows), q, qd, qdd, R (runs x rows x n, also for
+    n = 1), residuals (runs x rows x columns), energy (runs x rows or None), q_end, qd_end
+    (runs x n), max_residual (runs), ok (runs, bool), messages (runs: empty, or why the run
+    failed), events (runs lists of {name, t, q, qd}), parameters (name -> runs values). Rows after
+    a failed run's end are NaN. t is one vector when every run has the same output times; with
+    events or a stop condition each run has its own rows, and t is runs x rows (NaN after a
+    run's last row)."""
 
     def __init__(self, out, parameters, coordinates):
         self.t, self.q, self.qd, self.qdd = out["t"], out["q"], out["qd"], out["qdd"]
@@ -359,6 +362,7 @@ class BatchResult:
         self.ok = np.asarray(out["ok"], dtype=bool)
         self.messages = list(out["messages"])
         self.summaries = out["summaries"]
+        self.events = out.get("events", [[] for _ in out["ok"]])
         self.threads = out["threads"]
         self.cpp_seconds = out["cpp_seconds"]
         self.parameters = parameters
@@ -399,7 +403,11 @@ def _batch_runs(model, parameters, initial):
     columns = []
     runs = None
     for name in names:
-        values = np.asarray(parameters[name], dtype=float)
+        raw = np.asarray(parameters[name])
+        if raw.dtype == bool or raw.dtype.kind not in "iuf":
+            raise InputError("parameters[{!r}]: expected numbers, got {} values (dtype {}); booleans and text are not "
+                             "parameter values".format(name, raw.size, raw.dtype))
+        values = raw.astype(float)
         if values.ndim != 1:
             raise InputError("parameters[{!r}]: expected a 1-D array of values, got shape {}".format(
                 name, values.shape))
@@ -441,7 +449,7 @@ def simulate_batch(model, parameters=None, initial=None, t_end=None, threads=0, 
     """
     names, values, q0, qd0, runs = _batch_runs(model, parameters, initial)
     models = _batch_models(model, names, values, runs)
-    out = _nhdyn.simulate_batch(models, q0=q0, v0=qd0, threads=int(threads), keep_trajectories=keep_trajectories,
+    out = _nhdyn.simulate_batch(models, q0=q0, v0=qd0, threads=threads, keep_trajectories=keep_trajectories,
                                 t_end=t_end, **options)
     for run, summary in enumerate(out["summaries"]):
         _warn_constraints(model.name, summary, stacklevel=2, run=run)

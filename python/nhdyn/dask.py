@@ -47,7 +47,8 @@ def _run_chunk(source, overrides, names, values, q0, qd0, threads, options):
                              **options)
     return {"t": r.t, "q": r.q, "qd": r.qd, "qdd": r.qdd, "R": r.R, "residuals": r.residuals, "energy": r.energy,
             "q_end": r.q_end, "qd_end": r.qd_end, "max_residual": r.max_residual, "ok": list(r.ok),
-            "messages": r.messages, "summaries": r.summaries, "threads": r.threads, "cpp_seconds": r.cpp_seconds}
+            "messages": r.messages, "summaries": r.summaries, "events": r.events, "threads": r.threads,
+            "cpp_seconds": r.cpp_seconds}
 
 
 def _pad(array, rows):
@@ -67,6 +68,8 @@ def simulate_batch(client, model, parameters=None, initial=None, chunk_size=None
     on `threads` threads of its worker (threads=0: every core of the worker). Returns a
     nhdyn.BatchResult in run order."""
     names, values, q0, qd0, runs = nhdyn._batch_runs(model, parameters, initial)
+    if runs == 0:
+        raise nhdyn.InputError("simulate_batch: no runs (give at least one parameter value or initial state)")
     if chunk_size is None:
         workers = max(1, len(client.scheduler_info().get("workers", {})))
         chunk_size = max(1, math.ceil(runs / (4 * workers)))
@@ -85,15 +88,21 @@ def simulate_batch(client, model, parameters=None, initial=None, chunk_size=None
             None if q0 is None else q0[start:stop], None if qd0 is None else qd0[start:stop], threads, options,
             pure=False))
     parts = client.gather(futures)
-    rows = max(len(p["t"]) for p in parts)
-    t = next(p["t"] for p in parts if len(p["t"]) == rows)
+    rows = max(np.shape(p["t"])[-1] for p in parts)
+    longest = next(p["t"] for p in parts if np.ndim(p["t"]) == 1 and len(p["t"]) == rows) if all(
+        np.ndim(p["t"]) == 1 for p in parts) else None
+    if longest is not None and all(np.array_equal(p["t"], longest[: len(p["t"])]) for p in parts):
+        t = longest
+    else:  # the runs have their own times (events, a stop condition): t is per run, as in nhdyn.simulate_batch
+        t = np.concatenate([_pad(p["t"] if np.ndim(p["t"]) == 2 else np.tile(p["t"], (len(p["ok"]), 1)), rows)
+                            for p in parts])
     out = {"t": t}
     for key in ("q", "qd", "qdd", "R", "residuals"):
         out[key] = np.concatenate([_pad(p[key], rows) for p in parts])
     out["energy"] = None if parts[0]["energy"] is None else np.concatenate([_pad(p["energy"], rows) for p in parts])
     for key in ("q_end", "qd_end", "max_residual"):
         out[key] = np.concatenate([p[key] for p in parts])
-    for key in ("ok", "messages", "summaries"):
+    for key in ("ok", "messages", "summaries", "events"):
         out[key] = [x for p in parts for x in p[key]]
     out["threads"] = max(p["threads"] for p in parts)
     out["cpp_seconds"] = sum(p["cpp_seconds"] for p in parts)

@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <exception>
+#include <mutex>
+#include <system_error>
 #include <thread>
 
 #include "nhdyn/analysis/residuals.hpp"
@@ -71,8 +74,13 @@ void Trajectory::append(const Data& data) {
   outputs.insert(outputs.end(), data.outputs.values.data(), data.outputs.values.data() + output_columns);
 }
 
+int max_batch_threads() {
+  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  return std::max(8, 4 * std::max(cores, 1));
+}
+
 int batch_threads(int threads, std::size_t runs) {
-  int count = threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency());
+  int count = threads > 0 ? std::min(threads, max_batch_threads()) : static_cast<int>(std::thread::hardware_concurrency());
   count = std::max(count, 1);
   return static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(count), std::max<std::size_t>(runs, 1)));
 }
@@ -133,19 +141,57 @@ std::vector<BatchResult> simulate_batch(const std::vector<BatchRun>& runs, const
                                    n, run.model->name));
   }
   std::vector<BatchResult> results(runs.size());
+  for (BatchResult& result : results) result.interrupted = true;  // until its run starts
   const int threads = batch_threads(options.threads, runs.size());
   std::atomic<std::size_t> next{0};
+  std::atomic<bool> stop{false};
+  std::atomic<int> working{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
   const auto work = [&] {
-    for (std::size_t i = next.fetch_add(1); i < runs.size(); i = next.fetch_add(1)) run_one(runs[i], options, results[i]);
+    for (std::size_t i = next.fetch_add(1); i < runs.size() && !stop.load(); i = next.fetch_add(1)) {
+      results[i].interrupted = false;
+      run_one(runs[i], options, results[i]);
+      if (!options.on_result) continue;
+      try {
+        options.on_result(i, results[i]);
+      } catch (...) {
+        const std::lock_guard lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+        stop = true;
+      }
+    }
+    working.fetch_sub(1);
   };
-  if (threads == 1) {
-    work();
-    return results;
-  }
+  // The calling thread is one of the workers unless it must poll keep_going; a thread the system
+  // refuses to create (limits on processes or memory) leaves fewer workers, never an abandoned
+  // joinable thread (std::terminate).
+  const bool poll = static_cast<bool>(options.keep_going);
   std::vector<std::thread> pool;
-  pool.reserve(static_cast<std::size_t>(threads));
-  for (int i = 0; i < threads; ++i) pool.emplace_back(work);
+  const int spawn = poll ? threads : threads - 1;
+  pool.reserve(static_cast<std::size_t>(std::max(spawn, 0)));
+  for (int i = 0; i < spawn; ++i) {
+    working.fetch_add(1);
+    try {
+      pool.emplace_back(work);
+    } catch (const std::system_error&) {
+      working.fetch_sub(1);
+      break;
+    }
+  }
+  if (!poll || pool.empty()) {
+    working.fetch_add(1);
+    work();
+  } else {
+    while (working.load() > 0) {
+      if (!stop.load() && !options.keep_going()) stop = true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
   for (std::thread& thread : pool) thread.join();
+  for (BatchResult& result : results)
+    if (result.interrupted) result.message = "not run: the batch was interrupted";
+  if (failure) std::rethrow_exception(failure);
   return results;
 }
 

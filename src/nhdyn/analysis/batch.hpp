@@ -7,6 +7,7 @@
 // own result and never stops the others. Used by `nhdyn batch` and nhdyn.simulate_batch (Python).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -54,10 +55,21 @@ struct BatchRun {
   std::optional<Vector> q0, v0;        // n each: initial state replacing the model's
 };
 
+struct BatchResult;
+
 struct BatchOptions {
   SimulationOptions simulation;  // the same for every run
   int threads = 0;               // 0: every core (std::thread::hardware_concurrency)
   bool keep_trajectories = true; // false: keep the summaries only (less memory)
+  // Called by the calling thread about every 20 ms while the workers run (the calling thread then
+  // runs none itself); false stops the batch: no further run starts, the running ones finish, and
+  // simulate_batch returns with `interrupted` set in every result not run. For Ctrl-C in Python
+  // and the CLI's signals. Empty: the calling thread is one of the workers.
+  std::function<bool()> keep_going;
+  // Called in the worker thread as soon as run i has finished (from several threads at once: the
+  // callee synchronizes). It may take the trajectory away (the CLI streams runs to disk with it);
+  // an exception it throws stops the batch as keep_going does and is rethrown by simulate_batch.
+  std::function<void(std::size_t, BatchResult&)> on_result;
 };
 
 struct BatchResult {
@@ -66,9 +78,14 @@ struct BatchResult {
   SimulationSummary summary;     // steps, residuals, ... (status set when the run started)
   Trajectory trajectory;         // the rows up to where the run ended
   Vector q_end, v_end;           // n, the last output's state (empty when no row was made)
+  bool interrupted = false;      // not run: the batch was stopped first (BatchOptions::keep_going)
 };
 
-// The number of threads a batch of `runs` runs uses for `threads` (0 = every core), at least 1.
+// The most threads a batch uses: four per core (at least 8). A CPU-bound run gains nothing from
+// more, and tens of thousands of threads exhaust the system's limits.
+int max_batch_threads();
+// The number of threads a batch of `runs` runs uses for `threads` (0 = every core), at least 1,
+// at most max_batch_threads() and `runs`. Fewer run when the system refuses to create a thread.
 int batch_threads(int threads, std::size_t runs);
 
 // Runs every member; result i belongs to runs[i], whatever the number of threads (the results do

@@ -174,6 +174,19 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
       throw InputError(fmt::format("the projection needs at least one Newton iteration, not {}",
                                    options.projection.max_iterations));
   }
+  // Events are told apart by name in the CSV, FILE-events.csv and the summary.
+  for (std::size_t i = 0; i < options.events.size(); ++i) {
+    const Event& e = options.events[i];
+    if (e.name.empty())
+      throw InputError(fmt::format("the event {} ({}) has an empty name; give it one (--event NAME=EXPR)", i + 1,
+                                   e.where.empty() ? e.expression : e.where));
+    for (std::size_t j = 0; j < i; ++j)
+      if (options.events[j].name == e.name)
+        throw InputError(fmt::format("two events are named '{}' ({} and {}); give each its own name", e.name,
+                                     options.events[j].where.empty() ? options.events[j].expression
+                                                                      : options.events[j].where,
+                                     e.where.empty() ? e.expression : e.where));
+  }
   if (model.m() > 0 && options.formulation.method != Method::sanh)
     throw InputError(fmt::format("model '{}' has programs ([[programs]]), which only the sanh formulation solves "
                                  "(docs/derivations/program-motion.md); choose --method sanh",
@@ -202,6 +215,8 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   data_options.method = options.formulation.method;
   data_options.projection = options.fix_initial || options.stabilization == Stabilization::projection;
   Data data = make_data(model, data_options);
+  // rk4 takes no smaller step near a singular S, and could step across it (model/data.hpp).
+  data.motion.watch_sign = options.integrator.kind == IntegratorKind::rk4;
   check_state_or_throw(model, data, model.t0, model.q0.data(), model.v0.data());
   SimulationSummary summary;
   Vector q0 = model.q0, v0 = model.v0;

@@ -105,6 +105,16 @@ Status compute_program_motion(const Model& model, Data& data, Complement complem
   const Matrix& LU = w.lu_S.matrixLU();
   for (int i = 0; i < m; ++i) smallest = std::min(smallest, std::abs(LU(i, i)));
   if (!(smallest > kSingularPivot)) return record_failure(data, Status::singular_system, kProgramMatrix);
+  if (w.watch_sign) {
+    int sign = static_cast<int>(w.lu_S.permutationP().determinant());
+    for (int i = 0; i < m; ++i) sign *= LU(i, i) < 0.0 ? -1 : 1;
+    if (w.sign != 0 && sign != w.sign && data.t != w.last_t) {
+      w.crossed = true;
+      return record_failure(data, Status::singular_system, kProgramMatrix);
+    }
+    w.sign = sign;
+    w.last_t = data.t;
+  }
 
   // S u = -(b_p q''_0 + b_p0 + feedback) (P5), solved as S_scaled (C u) = R^-1 rhs.
   w.rhs.noalias() = w.b_p * w.qdd0;
@@ -143,6 +153,13 @@ std::string explain_program_failure(const Model& model, const Data& data) {
         "(docs/derivations/program-motion.md section 3). Give the program an actuator that acts along a motion the "
         "constraints allow",
         name(w.absorbed), model.program_constraints[static_cast<std::size_t>(w.absorbed)].actuator, data.failed_t);
+  if (w.crossed)
+    return fmt::format(
+        "the programs cannot be realized between t = {:.6g} and t = {:.6g}: the determinant of the matrix S = b_p P B, "
+        "which maps the actuator forces to the program accelerations, changed sign there, so S passed through a "
+        "singular state that the fixed step stepped across (an actuator that stops acting on its program); the "
+        "motion past it would be meaningless (docs/derivations/program-motion.md section 3)",
+        w.last_t, data.failed_t);
   // The programs involved: the largest entries of the left singular vector of the smallest
   // singular value (the rows of S are the programs).
   const Eigen::JacobiSVD<Matrix> svd(w.S_scaled, Eigen::ComputeFullU);

@@ -9,6 +9,9 @@ namespace {
 
 int sign_of(double x) { return x > 0.0 ? 1 : (x < 0.0 ? -1 : 0); }
 
+// |g| at a located root above this fraction of its size at the step's ends: a jump, not a zero.
+constexpr double kJumpFraction = 1e-3;
+
 }  // namespace
 
 Status find_root(const std::function<Status(double x, double& fx)>& f, double a, double fa, double b,
@@ -123,6 +126,8 @@ Status EventTracker::value(int i, double t, double h, double theta, const Interp
   interpolate(theta, y_.data());
   const Status status = events_.evaluate(t + theta * h, y_.data(), g_.data());
   g = g_[static_cast<std::size_t>(i)];
+  // Locating one event near another's pole (z = x near p = 1/x): only g_i matters here.
+  if (status == Status::non_finite && std::isfinite(g)) return Status::ok;
   return status;
 }
 
@@ -137,10 +142,33 @@ Status EventTracker::locate(double t, double h, const Interpolant& interpolate, 
     // reached from that side).
     if (sign_of(g0) == -sign_[k]) g0 = 0.0;
     double theta = 1.0;
-    status = find_root([&](double x, double& fx) { return value(i, t, h, x, interpolate, fx); }, 0.0, g0, 1.0,
-                       g_end_[k], theta);
+    double last = 0.0;
+    status = find_root(
+        [&](double x, double& fx) {
+          const Status s = value(i, t, h, x, interpolate, fx);
+          last = fx;
+          return s;
+        },
+        0.0, g0, 1.0, g_end_[k], theta);
+    if (status == Status::non_finite && std::isinf(last)) {  // the search met the pole itself
+      ++jumps_;
+      if (jumps_ == 1) first_jump_t_ = t + theta * h;
+      continue;
+    }
     if (status != Status::ok) return status;
-    out.push_back({i, theta >= 1.0 ? t + h : t + theta * h, theta});
+    // A sign change is a crossing only where g is continuous: at a pole (1/x) or a wrap-around
+    // (atan2) g changes sign by a jump, and the bracket closes on the jump with |g| as large as at
+    // the step's ends. At a true root |g| there is round-off, orders of magnitude below.
+    double g_root = 0.0;
+    status = value(i, t, h, theta, interpolate, g_root);
+    if (status != Status::ok) return status;
+    const double scale = std::max(std::abs(g0), std::abs(g_end_[k]));
+    if (std::isfinite(g_root) && !(std::abs(g_root) > kJumpFraction * scale)) {
+      out.push_back({i, theta >= 1.0 ? t + h : t + theta * h, theta});
+    } else {
+      ++jumps_;
+      if (jumps_ == 1) first_jump_t_ = t + theta * h;
+    }
   }
   std::sort(out.begin(), out.end(), [](const Crossing& a, const Crossing& b) {
     return a.t != b.t ? a.t < b.t : a.index < b.index;

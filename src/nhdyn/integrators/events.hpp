@@ -58,12 +58,18 @@ class EventTracker {
   using Interpolant = std::function<void(double theta, double* y)>;
   // For each crossing found by check(), the time of the root of g_i(t + theta h, y(theta)) for
   // theta in [0, 1]; sorted by time, then index. Brent's method to the resolution of double
-  // precision in theta (a few dozen evaluations of the interpolant and g per crossing).
+  // precision in theta (a few dozen evaluations of the interpolant and g per crossing). A sign
+  // change by a jump of g (|g| at the located point above 1e-3 of its size at the ends: a pole,
+  // a wrap-around) is not a crossing: it is counted in jumps() and left out.
   Status locate(double t, double h, const Interpolant& interpolate, std::vector<Crossing>& out);
   // The step is taken: the signs at its end become those of the next step's start.
   void advance();
 
   EventFunctions& events() { return events_; }
+  // Sign changes that locate() found to be jumps of g (a pole such as 1/x, the wrap-around of
+  // atan2), not zeros, and did not report; and the time of the first.
+  int jumps() const { return jumps_; }
+  double first_jump_t() const { return first_jump_t_; }
 
  private:
   // g_i at time t + theta h on the interpolant.
@@ -76,6 +82,8 @@ class EventTracker {
   std::vector<double> g_;        // scratch for evaluate()
   std::vector<double> y_;        // scratch state on the interpolant
   std::vector<int> crossed_;     // indices that crossed in the step
+  int jumps_ = 0;
+  double first_jump_t_ = 0.0;
 };
 
 // Brent's method (Brent 1973, "zeroin") for a root of f in [a, b] given fa = f(a), fb = f(b) of

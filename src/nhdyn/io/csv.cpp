@@ -93,9 +93,19 @@ CsvTable load_csv(const std::filesystem::path& path) {
   if (!in) throw FileError(fmt::format("cannot read '{}'", path.string()));
   CsvTable table;
   std::string line;
-  if (!std::getline(in, line)) throw FileError(fmt::format("'{}' is empty; expected a header row", path.string()));
+  long line_number = 0;
+  // Comment lines before the header (the reason line of nhdyn's own FILE.partial.csv) are skipped,
+  // and a UTF-8 byte-order mark (spreadsheet exports) is not part of the first name.
+  bool header = false;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line_number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
+    if (!line.empty() && line[0] == '#') continue;
+    header = true;
+    break;
+  }
+  if (!header) throw FileError(fmt::format("'{}' is empty; expected a header row", path.string()));
   table.header = split_header(line);
-  long line_number = 1;
   while (std::getline(in, line)) {
     ++line_number;
     if (line.empty()) continue;
@@ -111,7 +121,13 @@ CsvTable load_csv(const std::filesystem::path& path) {
       p = end;
       if (*p == ',') ++p;
       else if (*p == '\r') ++p;
-      else if (*p) throw FileError(fmt::format("{}:{}: unexpected character '{}'", path.string(), line_number, *p));
+      else if (*p) {
+        const auto byte = static_cast<unsigned char>(*p);
+        throw FileError(byte >= 0x20 && byte < 0x7f
+                            ? fmt::format("{}:{}: unexpected character '{}'", path.string(), line_number, *p)
+                            : fmt::format("{}:{}: unexpected byte 0x{:02X} (an invisible character)", path.string(),
+                                          line_number, byte));
+      }
     }
     if (row.size() != table.header.size())
       throw FileError(fmt::format("{}:{}: {} values for {} columns", path.string(), line_number, row.size(),

@@ -2,6 +2,8 @@
 
 #include <dlfcn.h>
 #include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -56,9 +58,43 @@ std::string read_file(const fs::path& path) {
   return s.str();
 }
 
-// Runs argv (searched in PATH) with stdout and stderr to `log`; returns its exit code, or -1
-// with errno's text in `error` when it cannot start.
-int run(const std::vector<std::string>& argv, const fs::path& log, std::string& error) {
+// The catchable signals that end a process by default and that a user sends to stop a run: while
+// the compiler runs they are held, so that an interrupted compile can stop the compiler and
+// remove its files before the signal takes its course (docs/design.md, "Compiled evaluator").
+sigset_t stopping_signals() {
+  sigset_t set;
+  sigemptyset(&set);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2}) sigaddset(&set, sig);
+  return set;
+}
+
+// Holds the stopping signals in this thread for its lifetime; release() lets them through again
+// and re-raises the one that was caught, so that the process's own disposition (exit, a handler,
+// Python's KeyboardInterrupt) applies once the files are gone.
+class HeldSignals {
+ public:
+  HeldSignals() {
+    const sigset_t set = stopping_signals();
+    pthread_sigmask(SIG_BLOCK, &set, &old_);
+  }
+  ~HeldSignals() { pthread_sigmask(SIG_SETMASK, &old_, nullptr); }
+  HeldSignals(const HeldSignals&) = delete;
+  HeldSignals& operator=(const HeldSignals&) = delete;
+  void release_and_raise(int sig) {
+    pthread_sigmask(SIG_SETMASK, &old_, nullptr);
+    ::raise(sig);
+  }
+
+ private:
+  sigset_t old_{};
+};
+
+// Runs argv (searched in PATH) with stdout and stderr to `log`, in its own process group; returns
+// its exit code, or -1 with errno's text in `error` when it cannot start. A stopping signal sent
+// to this process meanwhile (HeldSignals must be in force) ends the whole group (the compiler
+// driver and its cc1plus, as, ld), waits for it and returns -2 with the signal in `caught`.
+int run(const std::vector<std::string>& argv, const fs::path& log, std::string& error, int& caught) {
+  caught = 0;
   std::vector<char*> args;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
@@ -67,19 +103,43 @@ int run(const std::vector<std::string>& argv, const fs::path& log, std::string& 
   posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_adddup2(&actions, 1, 2);
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t none;
+  sigemptyset(&none);
+  const sigset_t held = stopping_signals();
+  posix_spawnattr_setsigmask(&attributes, &none);
+  posix_spawnattr_setsigdefault(&attributes, &held);
+  posix_spawnattr_setpgroup(&attributes, 0);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETPGROUP);
   pid_t pid = 0;
-  const int spawned = posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
+  const int spawned = posix_spawnp(&pid, args[0], &actions, &attributes, args.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
   if (spawned != 0) {
     error = std::strerror(spawned);
     return -1;
   }
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) {
+  for (;;) {
+    const pid_t done = waitpid(pid, &status, WNOHANG);
+    if (done == pid) break;
+    if (done < 0 && errno != EINTR) {
       error = std::strerror(errno);
       return -1;
     }
+    const timespec wait{0, 20'000'000};
+    const int sig = sigtimedwait(&held, nullptr, &wait);
+    if (sig > 0) {
+      caught = sig;
+      ::kill(-pid, SIGTERM);  // the driver removes its own temporaries on SIGTERM
+      for (int i = 0; i < 250 && waitpid(pid, &status, WNOHANG) == 0; ++i) ::usleep(20'000);
+      ::kill(-pid, SIGKILL);  // whatever is left of the group after 5 s
+      while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+      }
+      return -2;
+    }
+  }
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
 }
 
@@ -121,6 +181,7 @@ struct Library {
   Stage stage = nullptr;
   Terms terms = nullptr;
   Terms terms_dense = nullptr;
+  const char* (*key)() = nullptr;  // the cache key the object was compiled under
   ~Library() {
     if (handle) dlclose(handle);
   }
@@ -140,6 +201,7 @@ std::shared_ptr<Library> load(const fs::path& path, bool sparse, std::string& er
   library->stage = reinterpret_cast<Stage>(dlsym(library->handle, "nhdyn_jit_stage"));
   library->terms = reinterpret_cast<Terms>(dlsym(library->handle, "nhdyn_jit_terms"));
   library->terms_dense = reinterpret_cast<Terms>(dlsym(library->handle, "nhdyn_jit_terms_dense"));
+  library->key = reinterpret_cast<const char* (*)()>(dlsym(library->handle, "nhdyn_jit_key"));
   if (!version || version() != kInterfaceVersion || !library->stage_size || !library->stage || !library->terms ||
       (sparse && !library->terms_dense)) {
     error = fmt::format("{} is not an nhdyn object of interface version {}", path.string(), kInterfaceVersion);
@@ -147,6 +209,24 @@ std::shared_ptr<Library> load(const fs::path& path, bool sparse, std::string& er
   }
   return library;
 }
+
+// The check file beside a cached object: its key, size and two hashes of its bytes.
+std::string entry_check(const std::string& key, const std::string& bytes) {
+  return fmt::format("nhdyn compiled model\nkey {}\nsize {}\nhash {:016x}{:016x}\n", key, bytes.size(),
+                     fnv1a(bytes, 0xcbf29ce484222325ULL), fnv1a(bytes, 0x84222325cbf29ce4ULL));
+}
+
+// "" when `object` is whole and belongs to `key` by its check file; else what is wrong.
+std::string verify_entry(const fs::path& object, const fs::path& check, const std::string& key) {
+  std::error_code ec;
+  if (!fs::exists(object, ec)) return "the object is missing";
+  if (!fs::exists(check, ec)) return "its check file is missing";
+  const std::string expected = read_file(check);
+  if (expected.find(fmt::format("key {}\n", key)) == std::string::npos) return "its check file names another model";
+  if (entry_check(key, read_file(object)) != expected) return "the object is truncated or altered";
+  return "";
+}
+
 
 using ProgramStage = void (*)(const double*, double*);
 using ProgramRun = void (*)(const double*, double, const double*, const double*, double*);
@@ -339,7 +419,17 @@ Model make_compiled(const Model& model, const JitOptions& options, JitReport* re
   const std::string suffix = unique_suffix();
   const fs::path version_log = dir / ("version-" + suffix + ".log");
   std::string error;
-  const int version_status = run({compiler, "--version"}, version_log, error);
+  int caught = 0;
+  int version_status = 0;
+  {
+    HeldSignals held;
+    version_status = run({compiler, "--version"}, version_log, error, caught);
+    if (caught) {
+      fs::remove(version_log, ec);
+      held.release_and_raise(caught);
+      throw JitError("interrupted while asking the C++ compiler for its version");
+    }
+  }
   const std::string version = read_file(version_log);
   fs::remove(version_log, ec);
   if (version_status != 0)
@@ -354,42 +444,84 @@ Model make_compiled(const Model& model, const JitOptions& options, JitReport* re
   const std::uint64_t h2 = fnv1a(identity, fnv1a(source, 0x84222325cbf29ce4ULL));
   const std::string key = fmt::format("{:016x}{:016x}", h1, h2);
   const fs::path object = dir / (key + ".so");
+  const fs::path check = dir / (key + ".so.check");
   if (report) report->object = object.string();
 
   std::shared_ptr<Library> library;
-  if (fs::exists(object)) {
-    library = load(object, sparse, error);
-    if (!library) fs::remove(object, ec);  // a corrupt entry: compile it again
+  if (fs::exists(object, ec) || fs::exists(check, ec)) {
+    // Verified before dlopen: a truncated object would end the process in SIGBUS, and an object
+    // copied over another model's name would give that model's motion.
+    std::string damage = verify_entry(object, check, key);
+    if (damage.empty()) {
+      library = load(object, sparse, error);
+      if (!library)
+        damage = error;
+      else if (!library->key || key != library->key())
+        damage = "it was compiled for another model";
+    }
+    if (!damage.empty()) {
+      library.reset();
+      fs::remove(object, ec);
+      fs::remove(check, ec);
+      if (report)
+        report->note = fmt::format("nhdyn: note: the cached compiled model {} was unusable ({}); compiling it again",
+                                   object.string(), damage);
+    }
   }
   if (!library) {
     const fs::path source_file = dir / (key + "-" + suffix + ".cpp");
     const fs::path temporary = dir / (key + ".so.tmp-" + suffix);
+    const fs::path check_temporary = dir / (key + ".so.check.tmp-" + suffix);
     const fs::path log = dir / (key + "-" + suffix + ".log");
+    const auto remove_all = [&] {
+      for (const fs::path* p : {&source_file, &temporary, &check_temporary, &log}) fs::remove(*p, ec);
+    };
+    HeldSignals held;
     {
       std::ofstream out(source_file, std::ios::binary);
-      out << source;
-      if (!out) throw JitError(fmt::format("cannot write {}", source_file.string()));
+      // The key inside the object: a file renamed or copied to another model's name is caught.
+      out << source << fmt::format("\nextern \"C\" const char* nhdyn_jit_key() {{ return \"{}\"; }}\n", key);
+      if (!out) {
+        remove_all();
+        throw JitError(fmt::format("cannot write {}", source_file.string()));
+      }
     }
     std::vector<std::string> argv = {compiler};
     argv.insert(argv.end(), kFlags.begin(), kFlags.end());
     argv.insert(argv.end(), {"-o", temporary.string(), source_file.string()});
     const auto start = std::chrono::steady_clock::now();
-    const int status = run(argv, log, error);
+    const int status = run(argv, log, error, caught);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const std::string output = read_file(log);
-    fs::remove(source_file, ec);
-    fs::remove(log, ec);
+    const std::string output = status == -2 ? std::string() : read_file(log);
     if (status != 0) {
-      fs::remove(temporary, ec);
+      remove_all();
+      if (caught) {
+        held.release_and_raise(caught);
+        throw JitError("the compile was interrupted");
+      }
       throw JitError(status < 0 ? fmt::format("the C++ compiler '{}' cannot be run ({})", compiler, error)
                                 : fmt::format("the C++ compiler '{}' failed on model '{}': {}", compiler, model.name,
                                               first_error(output)));
     }
-    // Atomic: a concurrent process sees no file or the whole one.
-    fs::rename(temporary, object, ec);
+    fs::remove(source_file, ec);
+    fs::remove(log, ec);
+    // The check file first, then the object: whoever sees the object finds its check. Each is
+    // renamed into place whole, so a concurrent process sees no file or the whole one.
+    const std::string bytes = read_file(temporary);
+    {
+      std::ofstream out(check_temporary, std::ios::binary);
+      out << entry_check(key, bytes);
+      if (!out) {
+        remove_all();
+        throw JitError(fmt::format("cannot write {}", check_temporary.string()));
+      }
+    }
+    fs::rename(check_temporary, check, ec);
+    if (!ec) fs::rename(temporary, object, ec);
     if (ec) {
-      fs::remove(temporary, ec);
-      throw JitError(fmt::format("cannot move the compiled model into {}: {}", object.string(), ec.message()));
+      const std::string reason = ec.message();
+      remove_all();
+      throw JitError(fmt::format("cannot move the compiled model into {}: {}", object.string(), reason));
     }
     if (report) {
       report->compiled = true;
@@ -436,7 +568,11 @@ Model with_evaluator(const Model& model, EvaluatorChoice choice, std::string* no
   // Asked for or worth it: compiled where possible, and otherwise the interpreter with a notice —
   // a missing compiler or a failed compile never fails a run (make_compiled reports it as an error).
   try {
-    return make_compiled(model, options, report);
+    JitReport local;
+    JitReport* made = report ? report : &local;
+    Model compiled = make_compiled(model, options, made);
+    if (!made->note.empty() && notice) *notice = made->note;
+    return compiled;
   } catch (const JitError& e) {
     if (notice) *notice = fmt::format("nhdyn: notice: using the interpreter ({})", e.what());
     return model;

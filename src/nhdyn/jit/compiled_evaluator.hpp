@@ -7,8 +7,13 @@
 // command and its --version) and the flags, so a second run of the same model loads it without
 // compiling, and a parameter change reuses it (parameters are data: the stage is recomputed).
 // An object is compiled under a temporary name and renamed into place, so a concurrent process
-// never loads a half-written file. The programs of an output row go into the same object, so a
-// compiled model computes its rows compiled too: the residuals, the energy, h and the power (the
+// never loads a half-written file. Beside it, NAME.so.check holds the key, the size and a hash of
+// the object, checked before every dlopen, and the object itself returns its key: a truncated,
+// altered or misplaced entry is removed and compiled again with a note (JitReport::note), never
+// loaded. An interrupted compile (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2) stops the
+// compiler's whole process group, removes its source, log and temporary object, and then lets the
+// signal take its course. The programs of an output row go into the same object, so a compiled
+// model computes its rows compiled too: the residuals, the energy, h and the power (the
 // evaluator's), the contact forces' and the derived outputs' programs (NativeProgram, set on the
 // Model's ContactForceModel and ModelOutputs). The other programs (complement, solution, initial
 // state, program constraints) and the parameter handling stay with the interpreter, whose
@@ -56,6 +61,7 @@ struct JitReport {
   bool compiled = false;       // a compiler ran (false: the cached object was loaded)
   double compile_seconds = 0;  // its wall time
   std::string object;          // the shared object's path
+  std::string note;            // a cached object found damaged and compiled again, for the user
 };
 
 // The model with its terms compiled, sharing everything else. Throws JitError naming the reason

@@ -79,6 +79,13 @@ struct ProgramMotionData {
   Vector rhs;          // m, -(b_p q''_0 + b_p0 + feedback)
   Eigen::PartialPivLU<Matrix> lu_S;  // m x m
   int absorbed = -1;   // program whose actuator the constraints absorb (D B_j = 0), -1 if none
+  // A fixed-step integrator (rk4) may step across a state where S is singular without landing
+  // near it: with watch_sign set (by simulate, for rk4), the sign of det S is kept from solve to
+  // solve and a change of sign is a singular S crossed between last_t and the failing time.
+  bool watch_sign = false;
+  int sign = 0;         // sign of det S at the last solve (0: none yet)
+  double last_t = 0.0;  // its time
+  bool crossed = false; // the failure was a change of sign (explain_program_failure)
   // Residuals (compute_program_residuals): one per position-level program, one per position- or
   // velocity-level program, and all m at acceleration level, b_p q'' + b_p0.
   Vector phi;

@@ -27,6 +27,12 @@ std::string did_you_mean(std::string_view name, const std::vector<Parameter>& kn
   return best.empty() ? std::string() : fmt::format("; did you mean '{}'?", best);
 }
 
+// A hostile text may be megabytes long: messages quote its start only.
+std::string shorten(std::string_view text) {
+  if (text.size() <= 80) return std::string(text);
+  return fmt::format("{}... ({} characters)", text.substr(0, 60), text.size());
+}
+
 std::string list_names(const std::vector<Parameter>& known) {
   std::string names;
   for (const Parameter& p : known) names += (names.empty() ? "" : ", ") + p.name;
@@ -51,9 +57,10 @@ class ExpressionParser {
 
  private:
   [[noreturn]] void fail(const std::string& what) const {
+    const std::string shown = shorten(text_);
     throw InputError(fmt::format("'{}' is not a valid expression: {} (column {}); write numbers, + - * / ^, "
                                  "parentheses, functions such as sin(x) or sqrt(x), pi, e and other parameters",
-                                 text_, what, pos_ + 1));
+                                 shown, what, pos_ + 1));
   }
   void skip_space() {
     while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
@@ -89,7 +96,16 @@ class ExpressionParser {
         return value;
     }
   }
+  // Every level of nesting (a parenthesis, a call, a sign, an exponent) passes through here: the
+  // same limit as the model file's other expressions (spec_builder.cpp), so that 20 000 nested
+  // sqrt( or a run of minus signs is refused instead of overflowing the stack.
   double unary() {
+    static constexpr int kMaxNesting = 256;
+    struct Level {
+      int& depth;
+      ~Level() { --depth; }
+    } level{++depth_};
+    if (depth_ > kMaxNesting) fail(fmt::format("expression nested deeper than {} levels", kMaxNesting));
     if (accept("-")) return -unary();
     if (accept("+")) return unary();
     return power();
@@ -148,7 +164,7 @@ class ExpressionParser {
       pos_ = start + word.size();
       return 0.0;
     }
-    throw InputError(fmt::format("'{}' uses '{}', which is neither a parameter ({}) nor a constant (pi, e){}", text_,
+    throw InputError(fmt::format("'{}' uses '{}', which is neither a parameter ({}) nor a constant (pi, e){}", shorten(text_),
                                  word, list_names(known_), did_you_mean(word, known_)));
   }
   double call(const std::string& function) {
@@ -183,6 +199,7 @@ class ExpressionParser {
   const std::vector<Parameter>& known_;
   bool evaluate_;
   std::size_t pos_ = 0;
+  int depth_ = 0;
   std::vector<std::string> names_;
 };
 
@@ -308,7 +325,7 @@ std::pair<std::string, std::string> split_parameter_set(std::string_view set) {
   if (eq == std::string::npos || eq == 0)
     throw InputError(fmt::format("--set '{}': write it as NAME=VALUE or NAME=EXPRESSION, e.g. --set a=0.3 or "
                                  "--set alpha=pi/6",
-                                 set));
+                                 shorten(set)));
   return {std::string(set.substr(0, eq)), std::string(set.substr(eq + 1))};
 }
 
@@ -320,7 +337,7 @@ void apply_parameter_sets(std::vector<Parameter>& parameters, const std::vector<
     try {
       set_parameter_expression(parameters, name, expression, model);
     } catch (const InputError& e) {
-      throw InputError(fmt::format("--set {}: {}", set, e.what()));
+      throw InputError(fmt::format("--set {}: {}", shorten(set), e.what()));
     }
   }
 }

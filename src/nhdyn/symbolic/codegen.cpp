@@ -33,8 +33,21 @@ constexpr const char* kKeywords[] = {
     "using",     "virtual",      "void",         "volatile",    "wchar_t",    "while",        "xor",
     "xor_eq"};
 
+// Macros (and errno) of the standard headers a generated header includes or is included beside
+// (<cmath>, <cstdio>, <cerrno>, <cstddef>, <climits>, <cassert>, POSIX's M_PI): a field so named
+// would be replaced by the preprocessor and the header would not compile.
+const char* const kMacros[] = {
+    "INFINITY", "NAN", "HUGE_VAL", "HUGE_VALF", "HUGE_VALL", "EOF", "errno", "NULL", "assert", "EDOM", "ERANGE",
+    "EILSEQ", "FP_NAN", "FP_INFINITE", "FP_ZERO", "FP_SUBNORMAL", "FP_NORMAL", "FP_ILOGB0", "FP_ILOGBNAN",
+    "FP_FAST_FMA", "MATH_ERRNO", "MATH_ERREXCEPT", "math_errhandling", "stdin", "stdout", "stderr", "BUFSIZ",
+    "FILENAME_MAX", "SEEK_SET", "SEEK_CUR", "SEEK_END", "offsetof", "CHAR_BIT", "INT_MAX", "INT_MIN", "LONG_MAX",
+    "LONG_MIN", "UINT_MAX", "M_PI", "M_E", "M_SQRT2", "M_LN2", "EXIT_SUCCESS", "EXIT_FAILURE", "RAND_MAX",
+    "TRUE", "FALSE", "DBL_MAX", "DBL_MIN", "DBL_EPSILON", "unix", "linux"};
+
 bool is_keyword(const std::string& s) {
   for (const char* k : kKeywords)
+    if (s == k) return true;
+  for (const char* k : kMacros)
     if (s == k) return true;
   return false;
 }

@@ -1,0 +1,376 @@
+// Hostile input against the newest paths of the command (docs/cli.md, "What bad input gets"): each
+// test tries one bad input a tester found and checks that it is a clear error (exit 2 naming the
+// value at fault) or a correct answer, never a crash, a destroyed input or a silent wrong answer.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "support/cli_process.hpp"
+#include "support/text.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nhdyn::test::contains;
+using nhdyn::test::ProcessOptions;
+using nhdyn::test::ProcessRun;
+using nhdyn::test::read_whole;
+using nhdyn::test::run_process;
+
+class Hardening : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("nhdyn-hardening-" + std::to_string(::getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    for (const char* name : {"sled.toml", "appell.toml"})
+      fs::copy_file(fs::path(NHDYN_SOURCE_DIR) / "examples" / name, dir_ / name);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  void write(const std::string& name, const std::string& text) const { std::ofstream(dir_ / name) << text; }
+  ProcessRun nhdyn(const std::vector<std::string>& args, const ProcessOptions& options = {}) const {
+    return run_process(args, dir_, options);
+  }
+  fs::path dir_;
+};
+
+constexpr const char* kOscillator = R"(name = "oscillator"
+coordinates = ["x"]
+kinetic_energy = "m/2 * x'^2"
+potential_energy = "k/2 * x^2"
+[parameters]
+m = 1.0
+k = 1.0
+[initial]
+position = { x = 1 }
+velocity = { x = 0 }
+)";
+
+std::string repeat(const std::string& part, int times) {
+  std::string out;
+  for (int i = 0; i < times; ++i) out += part;
+  return out;
+}
+
+// 20 000 nested sqrt( and 100 000 minus signs overflowed the stack of the parameter evaluator.
+TEST_F(Hardening, DeeplyNestedParameterExpressionsAreRefused) {
+  const std::string nested = repeat("sqrt(", 20000) + "2" + repeat(")", 20000);
+  const std::string minus = repeat("-", 100000) + "1";
+  for (const std::string& value : {nested, minus}) {
+    const ProcessRun set = nhdyn({"simulate", "sled.toml", "--set", "a=" + value, "--t-end", "0.1", "-o", "out.csv"});
+    EXPECT_EQ(set.code, 2) << set.err.substr(0, 400);
+    EXPECT_TRUE(contains(set.err, "nested deeper than 256 levels")) << set.err.substr(0, 400);
+    EXPECT_LT(set.err.size(), 2000u) << "the message quotes the start of the expression only";
+  }
+  std::string model = read_whole(dir_ / "sled.toml");
+  const std::size_t at = model.find("[parameters]");
+  ASSERT_NE(at, std::string::npos);
+  model.insert(at + 13, "deep = \"" + nested + "\"\n");
+  write("deep.toml", model);
+  const ProcessRun file = nhdyn({"simulate", "deep.toml", "--t-end", "0.1", "-o", "out.csv"});
+  EXPECT_EQ(file.code, 2) << file.err.substr(0, 400);
+  EXPECT_TRUE(contains(file.err, "nested deeper than 256 levels")) << file.err.substr(0, 400);
+  // 256 levels are still fine.
+  const ProcessRun fine =
+      nhdyn({"simulate", "sled.toml", "--set", "a=" + repeat("(", 200) + "0.1" + repeat(")", 200), "--t-end", "0.1",
+             "-o", "out.csv"});
+  EXPECT_EQ(fine.code, 0) << fine.err;
+}
+
+// --threads 40000 aborted in std::thread; it is capped at what the machine runs, with a note.
+TEST_F(Hardening, HugeThreadCountIsCapped) {
+  const ProcessRun r = nhdyn({"batch", "sled.toml", "--grid", "a=0.1:0.2:3", "--t-end", "0.5", "--threads", "40000",
+                              "-o", "runs"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "using at most")) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "runs" / "summary.csv"));
+  for (const auto& entry : fs::directory_iterator(dir_ / "runs"))
+    EXPECT_FALSE(contains(entry.path().filename().string(), ".tmp")) << entry.path();
+}
+
+// The shared objects (and their check files) in a cache directory, by extension.
+std::vector<fs::path> cache_entries(const fs::path& cache, const std::string& extension) {
+  std::vector<fs::path> out;
+  if (!fs::exists(cache)) return out;
+  for (const auto& entry : fs::directory_iterator(cache))
+    if (entry.path().extension() == extension) out.push_back(entry.path());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// A truncated object ended every later run in SIGBUS; one copied over another model's name gave
+// that model's motion. Each entry is verified before dlopen, and a bad one compiled again.
+TEST_F(Hardening, DamagedCompiledModelCacheIsRebuilt) {
+  ProcessOptions cached, elsewhere;
+  cached.env = {{"XDG_CACHE_HOME", (dir_ / "cache").string()}};
+  elsewhere.env = {{"XDG_CACHE_HOME", (dir_ / "other-cache").string()}};
+  const fs::path cache = dir_ / "cache" / "nhdyn";
+  ASSERT_EQ(nhdyn({"simulate", "sled.toml", "--evaluator", "compiled", "-q", "-o", "sled.csv"}, cached).code, 0);
+  ASSERT_EQ(nhdyn({"simulate", "appell.toml", "--evaluator", "compiled", "-q", "-o", "a.csv"}, elsewhere).code, 0);
+  const std::string sled = read_whole(dir_ / "sled.csv");
+  ASSERT_EQ(cache_entries(cache, ".so").size(), 1u);
+  ASSERT_EQ(cache_entries(dir_ / "other-cache" / "nhdyn", ".so").size(), 1u);
+  const fs::path sled_object = cache_entries(cache, ".so").front();
+  const fs::path other = cache_entries(dir_ / "other-cache" / "nhdyn", ".so").front();
+  const ProcessRun again = nhdyn({"simulate", "sled.toml", "--evaluator", "compiled", "-q", "-o", "x.csv"}, cached);
+  ASSERT_EQ(again.code, 0);
+  EXPECT_EQ(again.err, "") << "a sound entry is loaded without a note";
+  const auto damaged_run = [&](const std::string& what) {
+    const ProcessRun r = nhdyn({"simulate", "sled.toml", "--evaluator", "compiled", "-q", "-o", "sled2.csv"}, cached);
+    EXPECT_EQ(r.code, 0) << what << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, "unusable")) << what << ": " << r.err;
+    EXPECT_EQ(read_whole(dir_ / "sled2.csv"), sled) << what;
+    EXPECT_TRUE(fs::exists(sled_object));
+  };
+  // Truncated.
+  fs::resize_file(sled_object, 1000);
+  damaged_run("truncated");
+  // Another model's object under this one's name.
+  fs::copy_file(other, sled_object, fs::copy_options::overwrite_existing);
+  damaged_run("another model's object");
+  // And with its check file too.
+  fs::copy_file(other, sled_object, fs::copy_options::overwrite_existing);
+  fs::copy_file(fs::path(other.string() + ".check"), fs::path(sled_object.string() + ".check"),
+                fs::copy_options::overwrite_existing);
+  damaged_run("another model's object and check file");
+  // No temporary, source or log is left.
+  for (const auto& entry : fs::directory_iterator(cache)) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_TRUE(name.ends_with(".so") || name.ends_with(".so.check")) << name;
+  }
+}
+
+// An interrupted compile left its source and log, and the compiler ran on; now the compiler's
+// process group is ended and nothing is left in the cache.
+TEST_F(Hardening, InterruptedCompileLeavesNothing) {
+  const fs::path slow = dir_ / "slow-compiler";
+  std::ofstream(slow) << "#!/bin/sh\nif [ \"$1\" = --version ]; then exec c++ \"$@\"; fi\nsleep 60\nexec c++ \"$@\"\n";
+  fs::permissions(slow, fs::perms::owner_all);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGUSR1}) {
+    ProcessOptions options;
+    options.env = {{"XDG_CACHE_HOME", (dir_ / "cache").string()}, {"NHDYN_CXX", slow.string()}};
+    options.signal = sig;
+    options.after = std::chrono::milliseconds(1500);
+    options.deadline = 30;
+    const ProcessRun r = nhdyn({"simulate", "sled.toml", "--evaluator", "compiled", "-o", "out.csv"}, options);
+    EXPECT_EQ(r.code, 128 + sig) << r.err;
+    EXPECT_TRUE(cache_entries(dir_ / "cache" / "nhdyn", ".cpp").empty());
+    EXPECT_TRUE(cache_entries(dir_ / "cache" / "nhdyn", ".log").empty());
+    if (fs::exists(dir_ / "cache" / "nhdyn")) {
+      EXPECT_TRUE(fs::is_empty(dir_ / "cache" / "nhdyn")) << "signal " << sig;
+    }
+    EXPECT_FALSE(fs::exists(dir_ / "out.csv"));
+    // No process still runs the slow compiler (its path is unique to this test).
+    for (const auto& entry : fs::directory_iterator("/proc")) {
+      const std::string cmdline = read_whole(entry.path() / "cmdline");
+      EXPECT_FALSE(contains(cmdline, slow.string())) << entry.path() << " still runs the compiler";
+    }
+  }
+}
+
+// Outputs replaced inputs: `report R.csv -o R.csv` (also ./R.csv and a link), `-o MODEL`; outputs
+// of one run replaced each other. One rule now: every path listed and checked before any work.
+TEST_F(Hardening, NoOutputReplacesAnInputOrAnotherOutput) {
+  ASSERT_EQ(nhdyn({"simulate", "sled.toml", "--t-end", "0.5", "-q", "-o", "r.csv"}).code, 0);
+  const std::string result = read_whole(dir_ / "r.csv"), model = read_whole(dir_ / "sled.toml");
+  fs::create_symlink("r.csv", dir_ / "link.csv");
+  fs::create_hard_link(dir_ / "r.csv", dir_ / "hard.csv");
+  for (const char* out : {"r.csv", "./r.csv", "link.csv", "hard.csv", "sled.toml"}) {
+    const ProcessRun r = nhdyn({"report", "r.csv", "--model", "sled.toml", "-o", out});
+    EXPECT_EQ(r.code, 2) << out << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, "an input of this run")) << r.err;
+  }
+  EXPECT_EQ(read_whole(dir_ / "r.csv"), result);
+  EXPECT_EQ(read_whole(dir_ / "sled.toml"), model);
+  // Two outputs of one run on one file.
+  const ProcessRun same = nhdyn({"simulate", "sled.toml", "-q", "-o", "s.csv", "--html", "x.png", "--plot", "./x.png"});
+  EXPECT_EQ(same.code, 2);
+  EXPECT_TRUE(contains(same.err, "are the same file")) << same.err;
+  const ProcessRun events =
+      nhdyn({"simulate", "sled.toml", "-q", "-o", "s.csv", "--event", "turn=phi-1", "--html", "s-events.csv"});
+  EXPECT_EQ(events.code, 2);
+  EXPECT_TRUE(contains(events.err, "the events file")) << events.err;
+  EXPECT_FALSE(fs::exists(dir_ / "s.csv"));
+  // batch: its model or its --runs table inside the output folder under an output's name.
+  fs::create_directories(dir_ / "out");
+  fs::copy_file(dir_ / "sled.toml", dir_ / "out" / "run_0.csv");
+  const ProcessRun over_model =
+      nhdyn({"batch", "out/run_0.csv", "--grid", "a=0.1:0.2:2", "--t-end", "0.2", "--write-runs", "-o", "out"});
+  EXPECT_EQ(over_model.code, 2) << over_model.err;
+  EXPECT_EQ(read_whole(dir_ / "out" / "run_0.csv"), model);
+  write("out/summary.csv", "a\n0.3\n0.4\n");
+  const ProcessRun over_runs = nhdyn({"batch", "sled.toml", "--runs", "out/summary.csv", "--t-end", "0.2", "-o", "out"});
+  EXPECT_EQ(over_runs.code, 2) << over_runs.err;
+  EXPECT_EQ(read_whole(dir_ / "out" / "summary.csv"), "a\n0.3\n0.4\n");
+}
+
+// -o '', --html '', --plot '' were read as "not given".
+TEST_F(Hardening, EmptyOptionValuesAreRefused) {
+  for (const char* option : {"-o", "--html", "--plot"}) {
+    const ProcessRun r = nhdyn({"simulate", "sled.toml", "--t-end", "0.1", option, ""});
+    EXPECT_EQ(r.code, 2) << option;
+    EXPECT_TRUE(contains(r.err, "the value is empty")) << r.err;
+  }
+}
+
+// The CLI's batch ignored the model file's [[events]]; a stop event now ends each run where the
+// closed form says: x = cos(sqrt(k) t) falls through zero at pi / (2 sqrt(k)).
+TEST_F(Hardening, BatchHonoursTheModelFilesEvents) {
+  write("osc.toml", std::string(kOscillator) + "[[events]]\nname = \"down\"\nwhen = \"x\"\ndirection = \"falling\"\n"
+                                               "action = \"stop\"\n");
+  const ProcessRun r = nhdyn({"batch", "osc.toml", "--grid", "k=1:4:2", "--t-end", "5", "--rtol", "1e-10", "-o", "out"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(dir_ / "out" / "summary.csv");
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> header = nhdyn::test::split(line);
+  const auto at = static_cast<std::size_t>(std::find(header.begin(), header.end(), "t_reached") - header.begin());
+  ASSERT_LT(at, header.size());
+  for (double k : {1.0, 4.0}) {
+    ASSERT_TRUE(std::getline(in, line));
+    const double t = std::stod(nhdyn::test::split(line)[at]);
+    EXPECT_NEAR(t, 3.14159265358979 / (2 * std::sqrt(k)), 1e-7) << line;
+  }
+}
+
+// A --runs table with a column twice was accepted (the last won); a grid product past the limit
+// was found only after every combination was built (out of memory).
+TEST_F(Hardening, BatchTablesAreCheckedFirst) {
+  write("runs.csv", "a,a\n0.1,0.2\n");
+  const ProcessRun twice = nhdyn({"batch", "sled.toml", "--runs", "runs.csv", "-o", "out"});
+  EXPECT_EQ(twice.code, 2);
+  EXPECT_TRUE(contains(twice.err, "given twice")) << twice.err;
+  ProcessOptions quick;
+  quick.deadline = 20;
+  const ProcessRun huge = nhdyn({"batch", "sled.toml", "--grid", "a=0.1:0.2:10000000", "--grid", "rho=0.7:0.8:10000000",
+                                 "-o", "out"},
+                                quick);
+  EXPECT_EQ(huge.code, 2) << huge.err;
+  EXPECT_TRUE(contains(huge.err, "more than 10000000 runs")) << huge.err;
+}
+
+// SIGINT during batch --write-runs left hundreds of run files and no summary; SIGHUP and SIGUSR1
+// left temporaries. A batch's outputs are written whole or not at all.
+TEST_F(Hardening, InterruptedBatchLeavesNothing) {
+  write("osc.toml", kOscillator);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGUSR1}) {
+    ProcessOptions options;
+    options.signal = sig;
+    options.after = std::chrono::milliseconds(1200);
+    options.deadline = 60;
+    const ProcessRun r = nhdyn({"batch", "osc.toml", "--grid", "k=1:2:4000", "--t-end", "200", "--write-runs",
+                                "--threads", "2", "-o", "out"},
+                               options);
+    EXPECT_EQ(r.code, 128 + sig) << r.err;
+    EXPECT_TRUE(contains(r.err, "nothing was written")) << r.err;
+    if (fs::exists(dir_ / "out")) {
+      EXPECT_TRUE(fs::is_empty(dir_ / "out")) << "signal " << sig;
+    }
+  }
+}
+
+// rk4 stepped across the singular S of a program (theta = 0.3 + 0.2 t reaches pi/2 at 6.354):
+// the sign of det S is watched, and the run fails between the two solves that bracket it.
+TEST_F(Hardening, Rk4DoesNotStepAcrossASingularProgramMatrix) {
+  const ProcessRun r = nhdyn({"simulate", fs::path(NHDYN_SOURCE_DIR) / "examples" / "cart_pendulum_program.toml",
+                              "--t-end", "10", "--integrator", "rk4", "-o", "out.csv"});
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_TRUE(contains(r.err, "changed sign")) << r.err;
+  const std::size_t at = r.err.find("between t = ");
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const double from = std::stod(r.err.substr(at + 12));
+  const double to = std::stod(r.err.substr(r.err.find(" and t = ", at) + 9));
+  const double singular = (3.14159265358979 / 2 - 0.3) / 0.2;
+  EXPECT_LE(from, singular);
+  EXPECT_GE(to, singular);
+  EXPECT_LT(to - from, 0.011);
+}
+
+// --event z=1/x reported a crossing at the pole, and atan2's wrap-around counted as one: a sign
+// change by a jump of g is not a crossing. x = cos t crosses zero at pi/2 (the event z = x).
+TEST_F(Hardening, PolesAndWrapAroundsAreNotCrossings) {
+  write("osc.toml", kOscillator);
+  const ProcessRun r = nhdyn({"simulate", "osc.toml", "--t-end", "3", "--event", "p=1/x", "--event", "z=x", "--event",
+                              "w=atan2(x, -1)", "-q", "-o", "e.csv"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string events = read_whole(dir_ / "e-events.csv");
+  EXPECT_FALSE(contains(events, "\np,")) << events;
+  EXPECT_FALSE(contains(events, "\nw,")) << events;
+  const std::size_t at = events.find("\nz,");
+  ASSERT_NE(at, std::string::npos) << events;
+  EXPECT_NEAR(std::stod(events.substr(at + 3)), 3.14159265358979 / 2, 1e-7);
+}
+
+// report could not read nhdyn's own FILE.partial.csv (its reason line), refused a byte-order mark
+// with an invisible character in the message, and accepted NaN or decreasing times.
+TEST_F(Hardening, ReportReadsItsOwnPartialFilesAndChecksTimes) {
+  const fs::path model = fs::path(NHDYN_SOURCE_DIR) / "examples" / "cart_pendulum_program.toml";
+  ASSERT_EQ(nhdyn({"simulate", model.string(), "--t-end", "7", "-q", "-o", "cp.csv"}).code, 1);
+  ASSERT_TRUE(fs::exists(dir_ / "cp.partial.csv"));
+  const ProcessRun partial = nhdyn({"report", "cp.partial.csv", "--model", model.string(), "-q", "-o", "cp.html"});
+  EXPECT_EQ(partial.code, 0) << partial.err;
+  ASSERT_EQ(nhdyn({"simulate", "sled.toml", "--t-end", "0.3", "-q", "-o", "r.csv"}).code, 0);
+  const std::string csv = read_whole(dir_ / "r.csv");
+  write("bom.csv", "\xEF\xBB\xBF" + csv);
+  EXPECT_EQ(nhdyn({"report", "bom.csv", "--model", "sled.toml", "-q", "-o", "bom.html"}).code, 0);
+  // Rows 2 and 3 swapped: t decreases.
+  std::vector<std::string> lines;
+  std::stringstream in(csv);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  std::swap(lines[2], lines[3]);
+  std::string swapped;
+  for (const std::string& line : lines) swapped += line + "\n";
+  write("back.csv", swapped);
+  const ProcessRun back = nhdyn({"report", "back.csv", "--model", "sled.toml", "-q", "-o", "back.html"});
+  EXPECT_EQ(back.code, 2);
+  EXPECT_TRUE(contains(back.err, "never decrease")) << back.err;
+  lines[1].replace(0, lines[1].find(','), "nan");
+  std::string with_nan;
+  for (const std::string& line : lines) with_nan += line + "\n";
+  write("nan.csv", with_nan);
+  const ProcessRun nan = nhdyn({"report", "nan.csv", "--model", "sled.toml", "-q", "-o", "nan.html"});
+  EXPECT_EQ(nan.code, 2);
+  EXPECT_TRUE(contains(nan.err, "not finite")) << nan.err;
+}
+
+// codegen emitted parameters named INFINITY, EOF, errno, NULL as identifiers: the preprocessor
+// replaced them and the header did not compile. They get a trailing underscore, as keywords do.
+TEST_F(Hardening, CodegenAvoidsStandardMacros) {
+  std::string model = kOscillator;
+  model.replace(model.find("k = 1.0"), 7, "k = 1.0\nINFINITY = 2.0\nEOF = 1.0\nerrno = 1.0\nNULL = 1.0");
+  model.replace(model.find("k/2 * x^2"), 9, "k/2 * x^2 + INFINITY*EOF*errno*NULL*x");
+  write("macro.toml", model);
+  const ProcessRun r = nhdyn({"codegen", "macro.toml", "-o", "macro.hpp"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(read_whole(dir_ / "macro.hpp"), "INFINITY_"));
+  write("use.cpp", "#include <cerrno>\n#include <cmath>\n#include <cstddef>\n#include <cstdio>\n#include \"macro.hpp\"\n"
+                   "int main() {}\n");
+  const std::string compile = "cd '" + dir_.string() + "' && c++ -std=c++20 -fsyntax-only -I'" NHDYN_SOURCE_DIR
+                              "/src' -I/usr/include/eigen3 use.cpp 2> compile.log";
+  EXPECT_EQ(std::system(compile.c_str()), 0) << read_whole(dir_ / "compile.log");
+}
+
+// Duplicate event names (file and command line, or the command line twice) were accepted.
+TEST_F(Hardening, DuplicateEventNamesAreRefused) {
+  write("osc.toml", std::string(kOscillator) + "[[events]]\nname = \"z\"\nwhen = \"x\"\n");
+  const ProcessRun twice = nhdyn({"simulate", "osc.toml", "--event", "y=x'", "--event", "y=x", "-q", "-o", "a.csv"});
+  EXPECT_EQ(twice.code, 2);
+  EXPECT_TRUE(contains(twice.err, "two events are named 'y'")) << twice.err;
+  const ProcessRun file = nhdyn({"simulate", "osc.toml", "--event", "z=x'", "-q", "-o", "a.csv"});
+  EXPECT_EQ(file.code, 2);
+  EXPECT_TRUE(contains(file.err, "two events are named 'z'")) << file.err;
+}
+
+}  // namespace

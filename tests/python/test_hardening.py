@@ -1,0 +1,110 @@
+"""Hostile input against the Python package (docs/cli.md, "What bad input gets"): deeply nested
+parameter expressions are refused like the model file's, thread counts must be whole numbers and
+are capped, batch arrays keep their documented shapes for one coordinate, a batch with events
+gives each run its own times and events (the same as one run), and Ctrl-C stops a batch promptly."""
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import numpy as np
+import pytest
+
+import nhdyn
+
+OSCILLATOR = """name = "oscillator"
+coordinates = ["x"]
+kinetic_energy = "m/2 * x'^2"
+potential_energy = "k/2 * x^2"
+[parameters]
+m = 1.0
+k = 1.0
+[initial]
+position = { x = 1 }
+velocity = { x = 0 }
+"""
+
+
+@pytest.fixture
+def oscillator(tmp_path):
+    path = tmp_path / "oscillator.toml"
+    path.write_text(OSCILLATOR)
+    return nhdyn.load(path)
+
+
+def test_deeply_nested_parameter_expression_is_refused(oscillator):
+    for text in ("sqrt(" * 20000 + "2" + ")" * 20000, "-" * 100000 + "1"):
+        with pytest.raises(nhdyn.InputError, match="nested deeper than 256 levels"):
+            oscillator.parameters["k"] = text
+    assert oscillator.parameters["k"] == 1.0
+    oscillator.parameters["k"] = "(" * 100 + "4" + ")" * 100
+    assert oscillator.parameters["k"] == 4.0
+
+
+@pytest.mark.parametrize("bad", [2.5, "2", True, None])
+def test_threads_must_be_a_whole_number(oscillator, bad):
+    with pytest.raises(nhdyn.InputError, match="threads"):
+        nhdyn.simulate_batch(oscillator, parameters={"k": [1.0]}, t_end=0.1, threads=bad)
+
+
+def test_huge_thread_counts_are_capped(oscillator):
+    for threads in (40000, 10**20):
+        b = nhdyn.simulate_batch(oscillator, parameters={"k": [1.0, 2.0, 3.0]}, t_end=0.1, threads=threads)
+        assert b.ok.all() and 1 <= b.threads <= 3
+
+
+def test_boolean_parameter_values_are_refused(oscillator):
+    with pytest.raises(nhdyn.InputError, match="booleans"):
+        nhdyn.simulate_batch(oscillator, parameters={"k": [True, False]}, t_end=0.1)
+
+
+def test_one_coordinate_keeps_the_documented_shapes(oscillator):
+    b = nhdyn.simulate_batch(oscillator, parameters={"k": [1.0, 4.0]}, t_end=1.0)
+    rows = len(b.t)
+    assert b.q.shape == (2, rows, 1) and b.qd.shape == (2, rows, 1) and b.R.shape == (2, rows, 1)
+    assert b.energy.shape == (2, rows) and b.q_end.shape == (2, 1)
+    # x = cos(sqrt(k) t): a closed form the columns must meet
+    assert np.max(np.abs(b.q[1, :, 0] - np.cos(2.0 * b.t))) < 1e-5
+
+
+def test_batch_with_events_gives_each_run_its_times_and_events(oscillator):
+    b = nhdyn.simulate_batch(oscillator, parameters={"k": [1.0, 4.0]}, t_end=3.0, events={"zero": "x"})
+    assert b.t.ndim == 2 and b.t.shape[0] == 2
+    for i, k in enumerate((1.0, 4.0)):
+        m = oscillator.copy()
+        m.parameters["k"] = k
+        run = m.simulate(t_end=3.0, events={"zero": "x"})
+        rows = len(run.t)
+        assert np.array_equal(b.t[i, :rows], run.t) and np.isnan(b.t[i, rows:]).all()
+        assert np.array_equal(b.q[i, :rows], run.q)
+        # x = cos(sqrt(k) t) crosses zero at (2j+1) pi / (2 sqrt(k))
+        expected = [(2 * j + 1) * np.pi / (2 * np.sqrt(k)) for j in range(3) if (2 * j + 1) * np.pi / (2 * np.sqrt(k)) < 3]
+        got = [e["t"] for e in b.events[i]]
+        assert len(got) == len(expected) and np.max(np.abs(np.array(got) - expected)) < 1e-6
+        for e in b.events[i]:  # the event's row is at its own time, with x = 0 there
+            row = int(np.flatnonzero(b.t[i] == e["t"])[0])
+            assert abs(b.q[i, row, 0]) < 1e-9
+
+
+def test_ctrl_c_stops_a_batch_promptly(tmp_path):
+    (tmp_path / "oscillator.toml").write_text(OSCILLATOR)
+    script = textwrap.dedent("""
+        import os, signal, sys, threading, time
+        import nhdyn
+        m = nhdyn.load(sys.argv[1])
+        threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+        start = time.monotonic()
+        try:
+            nhdyn.simulate_batch(m, parameters={"k": [1.0 + i for i in range(4000)]}, t_end=200.0, threads=2,
+                                 keep_trajectories=False)
+            print("finished", time.monotonic() - start)
+        except KeyboardInterrupt:
+            print("interrupted", time.monotonic() - start)
+    """)
+    out = subprocess.run([sys.executable, "-c", script, str(tmp_path / "oscillator.toml")], capture_output=True,
+                         text=True, timeout=300, env=dict(os.environ))
+    assert out.stdout.startswith("interrupted"), out.stdout + out.stderr
+    assert float(out.stdout.split()[1]) < 10.0
