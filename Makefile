@@ -6,12 +6,13 @@
 #   make fuzz   the model-file fuzzer (needs clang-14; fuzz/run says which packages)
 #   make bench  build and run the benchmarks
 #   make python build the Python package nhdyn only, and say how to import it
+#   make docs-update  rewrite the quoted outputs of README.md and docs/ from real runs
 BUILD ?= build
 JOBS ?= $(shell nproc)
 MODEL ?= examples/sled.toml
 NAME ?= sled
 
-.PHONY: run test build configure deps bench python asan fuzz clean
+.PHONY: run test build configure deps bench python asan fuzz clean docs-update
 
 deps:
 	@bash scripts/install-deps
@@ -35,6 +36,12 @@ test: build
 python: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_python
 	@echo "export PYTHONPATH=$(abspath $(BUILD))/python   # then: /usr/bin/python3 -c 'import nhdyn'"
+
+# The fenced blocks after a `<!-- check: COMMAND -->` line show what COMMAND prints: this rewrites
+# those that differ from a real run; ctest checks them (tests/docs/check_docs.py, label docs).
+docs-update: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_cli
+	python3 tests/docs/check_docs.py --nhdyn $(BUILD)/apps/nhdyn/nhdyn --update
 
 bench: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_bench
