@@ -1,31 +1,47 @@
 # The two commands of the README's Quick start, and a few more for developers.
-#   make run    install what is missing, build the nhdyn command (Release) and only it, simulate
-#               the default example (examples/sled.toml; MODEL=... NAME=... for another)
-#   make test   install what is missing, build everything (Release), run every test through ctest
+#   make run    install what the command needs (scripts/install-deps run), build the nhdyn command
+#               (Release) and only it, simulate the default example (examples/sled.toml;
+#               MODEL=... NAME=... for another)
+#   make test   install everything else (test libraries, Python, Jupyter, Chromium...), build
+#               everything (Release), run every test through ctest
 #   make asan   the tests again under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/)
 #   make fuzz   the model-file fuzzer (needs clang-14; fuzz/run says which packages)
 #   make bench  build and run the benchmarks
 #   make python build the Python package nhdyn only, and say how to import it
+#   make bench-check   the performance guard: a few paired ratios against bench/baselines (fails
+#               when one is more than 1.5x its baseline; about 40 s on 2 busy cores)
+#   make bench-update  the same, and rewrites docs/performance.md's table (BASELINES=1: and
+#               bench/baselines)
 #   make docs-update  rewrite the quoted outputs of README.md and docs/ from real runs
 BUILD ?= build
 JOBS ?= $(shell nproc)
 MODEL ?= examples/sled.toml
 NAME ?= sled
 
-.PHONY: run test build configure deps bench python asan fuzz clean docs-update
+.PHONY: run test build configure configure-run deps deps-run bench bench-check bench-update python asan fuzz clean docs-update
 
 deps:
 	@bash scripts/install-deps
 
+deps-run:
+	@bash scripts/install-deps run
+
+CONFIGURE = cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release $(if $(CI),-DNHDYN_WERROR=ON)
+# Everything on (the options are cached: a build configured by `make run` turns them back on).
 configure: deps
-	@cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release $(if $(CI),-DNHDYN_WERROR=ON) >/dev/null
+	@$(CONFIGURE) -DNHDYN_BUILD_TESTS=ON -DNHDYN_BUILD_BENCH=ON -DNHDYN_BUILD_PYTHON=ON >/dev/null
+
+# The CLI alone: no test, benchmark or Python package, so none of their packages is needed. The
+# same build folder, so that `make test` afterwards reuses every object.
+configure-run: deps-run
+	@$(CONFIGURE) -DNHDYN_BUILD_TESTS=OFF -DNHDYN_BUILD_BENCH=OFF -DNHDYN_BUILD_PYTHON=OFF >/dev/null
 
 # Everything: library, CLI, tests, examples, benchmarks.
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
 # The main job needs the CLI only (about half of the whole build).
-run: configure
+run: configure-run
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_cli
 	@mkdir -p results
 	$(BUILD)/apps/nhdyn/nhdyn simulate $(MODEL) -o results/$(NAME).csv --plot results/$(NAME).png
@@ -46,6 +62,16 @@ docs-update: configure
 bench: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_bench
 	$(BUILD)/bench/nhdyn_bench --benchmark_min_time=0.2
+
+# The performance guard (scripts/bench-check; docs/performance.md, "The guard").
+BENCH_CHECK_TARGETS = nhdyn_cli nhdyn_sled_reference nhdyn_bench_check
+bench-check: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target $(BENCH_CHECK_TARGETS)
+	python3 scripts/bench-check $(BUILD)
+
+bench-update: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target $(BENCH_CHECK_TARGETS)
+	python3 scripts/bench-check $(BUILD) --update-docs $(if $(BASELINES),--update-baselines)
 
 # The sanitizer build (docs/design.md, "Build and CI"): ASan + UBSan at -O1 with line tables only.
 # With clang-14 installed it is also the fuzzer's build (every target instrumented for libFuzzer),

@@ -17,7 +17,7 @@
 
 #include "bench_cases.hpp"
 #include "nhdyn/analysis/simulation.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 
 namespace nhdyn::bench {

@@ -20,7 +20,7 @@
 
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/formulation/formulation.hpp"
-#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/model/parameters.hpp"

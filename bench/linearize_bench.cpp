@@ -12,7 +12,7 @@
 #include <string>
 
 #include "nhdyn/analysis/linearization.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 #include "nhdyn/symbolic/derivation.hpp"
 

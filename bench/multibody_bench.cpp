@@ -16,7 +16,7 @@
 #include <string>
 
 #include "nhdyn/analysis/simulation.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 #include "nhdyn/symbolic/derivation.hpp"
 

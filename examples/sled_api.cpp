@@ -5,9 +5,8 @@
 
 #include <cstdio>
 
-#include "nhdyn/analysis/simulation.hpp"
-#include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/model/sled.hpp"
+#include "nhdyn/nhdyn.hpp"
 
 int main() {
   using namespace nhdyn;

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/model/model.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 

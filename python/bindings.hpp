@@ -15,7 +15,7 @@
 
 #include "nhdyn/analysis/batch.hpp"
 #include "nhdyn/analysis/simulation.hpp"
-#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/model/model.hpp"
 
 namespace nhdyn::python {

@@ -5,11 +5,9 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "model_source.hpp"
 #include "outputs.hpp"
 #include "nhdyn/io/atomic_file.hpp"
-#include "nhdyn/symbolic/codegen.hpp"
-#include "nhdyn/symbolic/derivation.hpp"
+#include "nhdyn/frontend/describe.hpp"
 
 namespace nhdyn::cli {
 
@@ -29,13 +27,11 @@ std::function<int()> add_codegen_command(CLI::App& app) {
   return [args] {
     protect_model_file(args->model);
     AtomicFile file(args->output);  // refuses an unwritable path before deriving
-    const symbolic::Spec spec = resolve_spec(args->model, args->sets);
-    symbolic::CodegenOptions options;
-    options.namespace_name = args->namespace_name;
-    file.write(symbolic::generate_code(spec, symbolic::derive(spec), options));
+    const auto description = load_description(read_model_source(args->model), parse_parameter_sets(args->sets));
+    file.write(generate_model_code(*description, args->namespace_name));
     file.commit();
-    fmt::print("nhdyn codegen {}: wrote {} (make_{}_model())\n", spec.name, args->output,
-               symbolic::make_identifier(spec.name));
+    fmt::print("nhdyn codegen {}: wrote {} (make_{}_model())\n", description_name(*description), args->output,
+               model_code_identifier(*description));
     return 0;
   };
 }

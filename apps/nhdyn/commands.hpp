@@ -8,17 +8,8 @@
 
 namespace nhdyn::cli {
 
-// Each returns the function that runs the subcommand once the command line is parsed.
-std::function<int()> add_simulate_command(CLI::App& app);
-std::function<int()> add_list_command(CLI::App& app);
-std::function<int()> add_equations_command(CLI::App& app);
-std::function<int()> add_codegen_command(CLI::App& app);
-std::function<int()> add_compare_command(CLI::App& app);
-std::function<int()> add_study_command(CLI::App& app);
-std::function<int()> add_example_command(CLI::App& app);
-std::function<int()> add_linearize_command(CLI::App& app);
-std::function<int()> add_sweep_command(CLI::App& app);
-std::function<int()> add_batch_command(CLI::App& app);
-std::function<int()> add_report_command(CLI::App& app);
+// Each subcommand's file defines `std::function<int()> add_<name>_command(CLI::App& app)`, which
+// registers its options and returns the function that runs it once the command line is parsed;
+// main.cpp declares them and lists them in its one table (kSubcommands).
 
 }  // namespace nhdyn::cli

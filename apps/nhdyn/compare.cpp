@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "model_source.hpp"
 #include "outputs.hpp"
 #include "nhdyn/analysis/comparison.hpp"
 #include "nhdyn/analysis/exact_solution.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
@@ -27,7 +27,7 @@ namespace {
 struct CompareArgs {
   std::string model;
   std::string reference = "tight";
-  std::vector<std::string> methods{"sanh", "lagrange", "udwadia-kalaba", "nullspace"};
+  std::vector<std::string> methods = names_of(kFormulations);
   bool methods_given = false;  // --methods on the command line (else the list above)
   std::vector<std::string> integrators{"dopri5"};
   std::string complement = "qr";
@@ -54,7 +54,7 @@ double energy_error(const SimulationSummary& s) { return s.has_energy_balance ? 
 
 int run_compare(const CompareArgs& args) {
   protect_model_file(args.model);
-  const ResolvedModel resolved = resolve_model(args.model, args.sets);
+  const LoadedModel resolved = load_model_argument(args.model, args.sets);
   std::string notice;
   const Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
   if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
@@ -209,18 +209,18 @@ std::function<int()> add_compare_command(CLI::App& app) {
       ->capture_default_str()
       ->each([args](const std::string&) { args->methods_given = true; });
   cmd->add_option("--integrators", args->integrators,
-                  "Integrators, comma-separated: rk4, dopri5, dop853, cvode-bdf, cvode-adams")
+                  "Integrators, comma-separated: " + list_names(kIntegrators))
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--complement", args->complement, "Where D comes from: qr | partition | analytic")
+  cmd->add_option("--complement", args->complement, "Where D comes from: " + list_names(kComplements, " | "))
       ->capture_default_str();
   cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
   cmd->add_option("--output-step", args->output_step, "Time between compared outputs [s] (default: the model's)");
   cmd->add_option("--rtol", args->rtol, "Relative tolerance of every case (default: the model's, else 1e-8)");
   cmd->add_option("--atol", args->atol, "Absolute tolerance of every case (default: the model's, else 1e-10)");
-  cmd->add_option("--stabilize", args->stabilize, "none | baumgarte | projection")->capture_default_str();
+  cmd->add_option("--stabilize", args->stabilize, list_names(kStabilizations, " | "))->capture_default_str();
   cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
-  cmd->add_option("--evaluator", args->evaluator, "interpreted (default) | compiled | auto, as for simulate");
+  cmd->add_option("--evaluator", args->evaluator, help_choices(jit::kEvaluatorChoices, jit::EvaluatorChoice::interpreted) + ", as for simulate");
   cmd->add_option("-o,--output", args->output, "Table CSV (default results/MODEL-compare.csv); the series "
                                                 "goes next to it as ...-series.csv");
   cmd->add_option("--plot", args->plot,

@@ -5,10 +5,8 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "model_source.hpp"
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/symbolic/derivation.hpp"
-#include "nhdyn/symbolic/equations.hpp"
+#include "nhdyn/frontend/describe.hpp"
 
 namespace nhdyn::cli {
 
@@ -24,22 +22,22 @@ std::function<int()> add_equations_command(CLI::App& app) {
   cmd->add_option("--format", args->format, "text | latex")->capture_default_str();
   cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   return [args] {
-    symbolic::EquationFormat format = symbolic::EquationFormat::text;
-    if (args->format == "latex") format = symbolic::EquationFormat::latex;
+    EquationsFormat format = EquationsFormat::text;
+    if (args->format == "latex") format = EquationsFormat::latex;
     else if (args->format != "text")
       throw InputError(fmt::format("unknown format '{}'; choose text or latex", args->format));
-    const symbolic::Spec spec = resolve_spec(args->model, args->sets);
+    const auto description = load_description(read_model_source(args->model), parse_parameter_sets(args->sets));
+    const int n = description_coordinates(*description);
     // A, D and D A are printed in full, n^2 entries each: 10000 coordinates made 600 MB of text
     // from 7 GB of memory. Refused before the derivation, with the way out.
     constexpr int largest = 1000;
-    if (spec.n() > largest)
+    if (n > largest)
       throw InputError(fmt::format(
           "'{}' has {} coordinates: `nhdyn equations` prints the matrices A, D and D A in full, about {:.2g} "
           "entries here; it prints models of up to {} coordinates. For a large model use `nhdyn codegen` "
           "(straight-line C++) or `nhdyn simulate`",
-          spec.name, spec.n(), 3.0 * spec.n() * spec.n(), largest));
-    const symbolic::Derivation derivation = symbolic::derive(spec);
-    fmt::print("{}", symbolic::format_equations(spec, derivation, format));
+          description_name(*description), n, 3.0 * n * n, largest));
+    fmt::print("{}", format_model_equations(*description, format));
     return 0;
   };
 }

@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "model_source.hpp"
 #include "outputs.hpp"
 #include "nhdyn/analysis/linearization.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 
 namespace nhdyn::cli {
@@ -33,7 +33,7 @@ std::string join_names(const std::vector<std::string>& names) {
 
 int run_linearize(const LinearizeArgs& args) {
   protect_model_file(args.model);
-  const ResolvedModel resolved = resolve_model(args.model, args.sets);
+  const LoadedModel resolved = load_model_argument(args.model, args.sets);
   const Model& model = resolved.model;
   LinearizationOptions options;
   options.cyclic = args.cyclic;

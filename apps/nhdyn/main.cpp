@@ -5,32 +5,58 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <functional>
+#include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "nhdyn/core/error.hpp"
 #include "outputs.hpp"
 
+namespace nhdyn::cli {
+
+// The subcommands, once: each is its own file defining add_<name>_command, declared and listed
+// here. The table's order is that of `nhdyn --help` and of the unknown-command message.
+std::function<int()> add_simulate_command(CLI::App& app);
+std::function<int()> add_compare_command(CLI::App& app);
+std::function<int()> add_study_command(CLI::App& app);
+std::function<int()> add_linearize_command(CLI::App& app);
+std::function<int()> add_sweep_command(CLI::App& app);
+std::function<int()> add_batch_command(CLI::App& app);
+std::function<int()> add_report_command(CLI::App& app);
+std::function<int()> add_list_command(CLI::App& app);
+std::function<int()> add_equations_command(CLI::App& app);
+std::function<int()> add_codegen_command(CLI::App& app);
+std::function<int()> add_example_command(CLI::App& app);
+
+struct Subcommand {
+  const char* name;
+  std::function<int()> (*add)(CLI::App& app);
+};
+constexpr Subcommand kSubcommands[] = {
+    {"simulate", add_simulate_command}, {"compare", add_compare_command},   {"study", add_study_command},
+    {"linearize", add_linearize_command}, {"sweep", add_sweep_command},     {"batch", add_batch_command},
+    {"report", add_report_command},     {"list", add_list_command},         {"equations", add_equations_command},
+    {"codegen", add_codegen_command},   {"example", add_example_command},
+};
+
+}  // namespace nhdyn::cli
+
 int main(int argc, char** argv) {
   CLI::App app{"nhdyn: equations of motion of constrained mechanical systems (Do Sanh form)", "nhdyn"};
   app.require_subcommand(1);
-  const auto simulate = nhdyn::cli::add_simulate_command(app);
-  const auto list = nhdyn::cli::add_list_command(app);
-  const auto equations = nhdyn::cli::add_equations_command(app);
-  const auto codegen = nhdyn::cli::add_codegen_command(app);
-  const auto compare = nhdyn::cli::add_compare_command(app);
-  const auto study = nhdyn::cli::add_study_command(app);
-  const auto example = nhdyn::cli::add_example_command(app);
-  const auto linearize = nhdyn::cli::add_linearize_command(app);
-  const auto sweep = nhdyn::cli::add_sweep_command(app);
-  const auto batch = nhdyn::cli::add_batch_command(app);
-  const auto report = nhdyn::cli::add_report_command(app);
+  std::vector<std::function<int()>> runs;
+  std::string names;
+  for (const nhdyn::cli::Subcommand& command : nhdyn::cli::kSubcommands) {
+    runs.push_back(command.add(app));
+    names += (names.empty() ? "" : ", ") + std::string(command.name);
+  }
   if (argc > 1 && argv[1][0] != '-') {
     bool known = false;
     for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
       known = known || sub->get_name() == argv[1];
     if (!known) {
-      fmt::print(stderr, "nhdyn: error: unknown command '{}'; the commands are simulate, compare, study, linearize, sweep, batch, report, list, equations, codegen, example "
-                         "(see nhdyn --help)\n", argv[1]);
+      fmt::print(stderr, "nhdyn: error: unknown command '{}'; the commands are {} (see nhdyn --help)\n", argv[1], names);
       return 2;
     }
   }
@@ -41,17 +67,8 @@ int main(int argc, char** argv) {
   }
   nhdyn::cli::install_interrupt_handlers();
   try {
-    if (app.got_subcommand("simulate")) return simulate();
-    if (app.got_subcommand("list")) return list();
-    if (app.got_subcommand("equations")) return equations();
-    if (app.got_subcommand("codegen")) return codegen();
-    if (app.got_subcommand("compare")) return compare();
-    if (app.got_subcommand("study")) return study();
-    if (app.got_subcommand("example")) return example();
-    if (app.got_subcommand("linearize")) return linearize();
-    if (app.got_subcommand("sweep")) return sweep();
-    if (app.got_subcommand("batch")) return batch();
-    if (app.got_subcommand("report")) return report();
+    for (std::size_t i = 0; i < runs.size(); ++i)
+      if (app.got_subcommand(nhdyn::cli::kSubcommands[i].name)) return runs[i]();
   } catch (const nhdyn::Error& e) {
     fmt::print(stderr, "nhdyn: error: {}\n", e.what());
     return 2;

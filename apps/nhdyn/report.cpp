@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "model_source.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/report.hpp"
@@ -39,13 +39,13 @@ std::function<int()> add_report_command(CLI::App& app) {
     if (args->max_frames < 2)
       throw InputError(fmt::format("--max-frames {}: give at least 2", args->max_frames));
     std::optional<AtomicFile> probe(args->output);  // an unwritable path is refused before any work
-    const ResolvedModel resolved = resolve_model(args->model, args->sets);
+    const LoadedModel resolved = load_model_argument(args->model, args->sets);
     const CsvTable table = load_csv(args->csv);
     check_report_columns(table.header, make_result_columns(resolved.model), args->csv, resolved.model.name);
     probe.reset();
     ReportOptions options;
     options.max_frames = args->max_frames;
-    const std::string notice = write_model_report(resolved.model, resolved.spec ? &*resolved.spec : nullptr, table,
+    const std::string notice = write_model_report(resolved.model, resolved.description.get(), table,
                        fmt::format("{}: {}", resolved.model.name, args->csv), {{"results", args->csv}}, args->output,
                        options);
     if (!args->quiet) {

@@ -12,11 +12,12 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "model_source.hpp"
 #include "outputs.hpp"
 #include "nhdyn/analysis/run_options.hpp"
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/describe.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/io/report.hpp"
@@ -24,8 +25,6 @@
 #include "nhdyn/jit/compiled_evaluator.hpp"
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/symbolic/events.hpp"
-#include "nhdyn/symbolic/spec.hpp"
-#include "nhdyn/symbolic/visual.hpp"
 #include "progress.hpp"
 #include "run_overrides.hpp"
 
@@ -154,7 +153,7 @@ bool is_regular_target(const std::filesystem::path& csv) {
 
 int run_simulate(const SimulateArgs& args) {
   protect_model_file(args.model);
-  const ResolvedModel resolved = resolve_model(args.model, args.sets);
+  const LoadedModel resolved = load_model_argument(args.model, args.sets);
   std::string notice;
   const Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
   if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
@@ -291,9 +290,9 @@ int run_simulate(const SimulateArgs& args) {
       }
     }
     // A model file also tells its angles by use: the coordinates inside sin, cos or tan.
-    if (resolved.spec) {
+    if (resolved.description) {
       try {
-        const std::vector<bool> angles = symbolic::compile_visual(*resolved.spec).angles;
+        const std::vector<bool>& angles = description_angles(*resolved.description);
         for (std::size_t i = 0; i < angles.size() && i < model.coordinates.size(); ++i)
           if (angles[i]) request.angles.push_back(model.coordinates[i]);
       } catch (const Error&) {
@@ -306,7 +305,7 @@ int run_simulate(const SimulateArgs& args) {
   html_probe.reset();
   std::string html_notice;
   if (!args.html.empty())
-    html_notice = write_model_report(model, resolved.spec ? &*resolved.spec : nullptr, load_csv(csv_path),
+    html_notice = write_model_report(model, resolved.description.get(), load_csv(csv_path),
                        fmt::format("{}: {}, {}", model.name, method_name(options.formulation.method),
                                    integrator_name(options.integrator.kind)),
                        {{"steps", fmt::format("{} (rejected {})", summary.stats.steps, summary.stats.rejected_steps)},
@@ -412,11 +411,12 @@ std::function<int()> add_simulate_command(CLI::App& app) {
   cmd->add_option("MODEL", args->model, "A model file (.toml) or a built-in model (see `nhdyn list`)")->required();
   cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   cmd->add_option("--evaluator", args->evaluator,
-                  "interpreted (default) | compiled (the terms as machine code, cached; docs/cli.md) | auto");
+                  help_choices(jit::kEvaluatorChoices, jit::EvaluatorChoice::interpreted) +
+                      " (compiled: the terms as machine code, cached; docs/cli.md)");
   cmd->add_flag("--fix-initial", args->fix_initial,
                 "Move the initial state onto the constraints with the smallest inertia-weighted change");
   cmd->add_option("--stabilize", args->stabilize,
-                  "Keep the solution on the constraints: none (default) | baumgarte | projection");
+                  "Keep the solution on the constraints: " + help_choices(kStabilizations, Stabilization::none));
   cmd->add_option("--baumgarte-alpha", args->baumgarte_alpha,
                   "Baumgarte: damping rate of the velocity residual [1/s]")->capture_default_str();
   cmd->add_option("--baumgarte-beta", args->baumgarte_beta,
@@ -425,9 +425,9 @@ std::function<int()> add_simulate_command(CLI::App& app) {
                   "Projection: residual at which Newton stops")->capture_default_str();
   cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
   cmd->add_option("--output-step", args->output_step, "Time between output rows [s] (default: the model's)");
-  cmd->add_option("--method", args->method, "Formulation: sanh (default) | lagrange | udwadia-kalaba | nullspace");
-  cmd->add_option("--complement", args->complement, "Where D comes from (sanh, nullspace): qr (default) | partition | analytic");
-  cmd->add_option("--integrator", args->integrator, "rk4 | dopri5 (default) | dop853 | cvode-bdf | cvode-adams");
+  cmd->add_option("--method", args->method, "Formulation: " + help_choices(kFormulations, Method::sanh));
+  cmd->add_option("--complement", args->complement, "Where D comes from (sanh, nullspace): " + help_choices(kComplements, Complement::qr));
+  cmd->add_option("--integrator", args->integrator, help_choices(kIntegrators, IntegratorKind::dopri5));
   cmd->add_option("--rtol", args->rtol, "Relative tolerance of the adaptive integrators (default: the model's, else 1e-8)");
   cmd->add_option("--atol", args->atol, "Absolute tolerance of the adaptive integrators (default: the model's, else 1e-10)");
   cmd->add_option("--step", args->step, "rk4: step size [s] (default output step / 10); adaptive: first step");

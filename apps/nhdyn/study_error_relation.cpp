@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "model_source.hpp"
 #include "outputs.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
@@ -51,7 +51,7 @@ StudyFormulation parse_formulation(const std::string& label) {
 
 int run_error_relation(const ErrorRelationArgs& args) {
   protect_model_file(args.model);
-  const ResolvedModel resolved = resolve_model(args.model, args.sets);
+  const LoadedModel resolved = load_model_argument(args.model, args.sets);
   const Model& model = resolved.model;
   ErrorRelationOptions options;
   options.tolerances = args.tolerances;
@@ -175,7 +175,7 @@ std::function<int()> add_error_relation_study(CLI::App& study) {
                   "udwadia-kalaba, nullspace (default: all the model allows)")
       ->delimiter(',');
   cmd->add_option("--integrators", args->integrators,
-                  "Integrators, comma-separated: dopri5, dop853, cvode-bdf, cvode-adams")
+                  "Integrators, comma-separated: " + adaptive_integrator_names(", "))
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--atol-factor", args->atol_factor, "atol of each run = this x rtol")->capture_default_str();

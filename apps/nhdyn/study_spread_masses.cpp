@@ -11,9 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "model_source.hpp"
 #include "outputs.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/describe.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/io/xy_plot.hpp"
@@ -56,7 +57,7 @@ int run_spread_masses(const SpreadMassesArgs& args) {
   if (args.samples < 1) throw InputError(fmt::format("--samples {}: give at least 1 state per ratio", args.samples));
   if (args.digits < 20)
     throw InputError(fmt::format("--digits {}: the reference needs 20 digits or more (default 50)", args.digits));
-  const symbolic::Spec spec = resolve_spec(args.model, args.sets);
+  const auto description = load_description(read_model_source(args.model), parse_parameter_sets(args.sets));
 
   namespace fs = std::filesystem;
   const fs::path table_path = args.output;
@@ -66,7 +67,7 @@ int run_spread_masses(const SpreadMassesArgs& args) {
   // Every formulation the model allows, named before the run so that the CSV (its columns) is
   // opened, and its directory proved writable, before anything is computed.
   options.formulations = {{Method::sanh, Complement::qr}, {Method::sanh, Complement::partition}};
-  if (!spec.independent.empty() || spec.complement) options.formulations.push_back({Method::sanh, Complement::analytic});
+  if (description_gives_complement(*description)) options.formulations.push_back({Method::sanh, Complement::analytic});
   for (Method m : {Method::lagrange, Method::udwadia_kalaba, Method::nullspace}) options.formulations.push_back({m, Complement::qr});
   std::vector<std::string> columns{"ratio", "cond_A", "reference_error"};
   std::vector<std::string> qdd_columns, R_columns, other_columns;
@@ -82,7 +83,7 @@ int run_spread_masses(const SpreadMassesArgs& args) {
   columns.insert(columns.end(), other_columns.begin(), other_columns.end());
   CsvWriter csv(table_path, columns);
 
-  const SpreadMasses study = study_spread_masses(spec, options);
+  const SpreadMasses study = study_spread_masses(description_spec(*description), options);
   std::vector<double> row;
   for (std::size_t r = 0; r < study.ratios.size(); ++r) {
     const SpreadMassesRatio& ratio = study.ratios[r];

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "model_source.hpp"
 #include "outputs.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/xy_plot.hpp"
@@ -41,7 +41,7 @@ std::string gain_label(double gain) { return gain == 0.0 ? std::string("none") :
 
 int run_tracking(const TrackingArgs& args) {
   protect_model_file(args.model);
-  const ResolvedModel resolved = resolve_model(args.model, args.sets);
+  const LoadedModel resolved = load_model_argument(args.model, args.sets);
   const Model& model = resolved.model;
   TrackingOptions options;
   options.tolerances = args.tolerances;
@@ -151,7 +151,7 @@ std::function<int()> add_tracking_study(CLI::App& study) {
                   "Feedback gains alpha = beta [1/s] of --program-feedback, comma-separated; 0 is no feedback")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--integrator", args->integrator, "dopri5, dop853, cvode-bdf or cvode-adams")->capture_default_str();
+  cmd->add_option("--integrator", args->integrator, adaptive_integrator_names())->capture_default_str();
   cmd->add_option("--atol-factor", args->atol_factor, "atol of each run = this x rtol")->capture_default_str();
   cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
   cmd->add_option("--output-step", args->output_step, "Time between measured outputs [s] (default: the model's)");

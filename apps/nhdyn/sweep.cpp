@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "model_source.hpp"
 #include "outputs.hpp"
 #include "nhdyn/analysis/sweep.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/xy_plot.hpp"
 #include "nhdyn/model/parameters.hpp"
@@ -54,7 +54,7 @@ int run_sweep(const SweepArgs& args) {
   check_sweep_options(options);
   // Compiled once: each grid point and bisection step only sets the parameter (parameters as
   // data, model/parameters.hpp), which re-binds the evaluator without symbolic work.
-  const Model base = resolve_model(args.model, args.sets).model;
+  const Model base = load_model_argument(args.model, args.sets).model;
   {
     std::string names;
     bool known = false;
@@ -66,11 +66,7 @@ int run_sweep(const SweepArgs& args) {
       throw InputError(fmt::format("--param {}: model '{}' ({}) has no parameter '{}'; its parameters are: {}",
                                    args.param, base.name, args.model, args.param, names.empty() ? "(none)" : names));
   }
-  const ModelAtValue model_at = [&](double value) {
-    Model model = base;
-    set_parameter(model, args.param, value);
-    return model;
-  };
+  const ModelAtValue model_at = make_model_at_value(base, args.param);
 
   // The first point linearized before any file is made: a model that is not steady, or a bad
   // --cyclic or --independent, is refused with nothing written.

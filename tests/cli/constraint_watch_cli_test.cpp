@@ -16,7 +16,7 @@
 
 #include "nhdyn/analysis/run_options.hpp"
 #include "nhdyn/analysis/simulation.hpp"
-#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "support/cli_run.hpp"
 #include "support/models.hpp"
 #include "support/text.hpp"

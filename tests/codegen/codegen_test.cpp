@@ -16,7 +16,7 @@
 #include "from_file_appell.hpp"
 #include "from_file_sled.hpp"
 #include "from_file_sled_paper.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 
 namespace nhdyn {
 namespace {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "nhdyn/analysis/simulation.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 
 namespace nhdyn::gallery {

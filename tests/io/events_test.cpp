@@ -10,7 +10,7 @@
 
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/model/parameters.hpp"
 
 namespace nhdyn {

@@ -8,7 +8,7 @@
 
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/formulation/formulation.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/model/appell.hpp"
 #include "nhdyn/model/sled.hpp"
 #include "nhdyn/symbolic/compile.hpp"

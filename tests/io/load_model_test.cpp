@@ -1,7 +1,7 @@
-// The GiNaC-free loading API (io/load_model.hpp): sources, overrides, run options from
+// The GiNaC-free loading API (frontend/load_model.hpp): sources, overrides, run options from
 // [simulation] with the defaults of RunOptions, errors with file and line, and the variants of a
 // batch equal to models loaded one by one. This file includes no GiNaC header, like a C++ user.
-#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
-// Model files (io/model_file.hpp, docs/model-format.md). Exams: the shipped examples and every
+// Model files (frontend/model_file.hpp, docs/model-format.md). Exams: the shipped examples and every
 // complete example of the format's documentation load, and compiled they give the same A, Q, G,
 // b, b0, residuals, energy, D and initial state as the hand-written built-in models, at random
 // states. Then one test per kind of bad input, each checking the error's type, its words and the
 // file:line:column it points at (lines and columns as an editor counts them, from 1).
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

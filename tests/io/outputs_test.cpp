@@ -18,7 +18,7 @@
 
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/events.hpp"

@@ -15,7 +15,7 @@
 #include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/formulation/formulation.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/model/terms.hpp"

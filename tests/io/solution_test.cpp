@@ -15,7 +15,7 @@
 #include "nhdyn/analysis/exact_solution.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/formulation/formulation.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/model/appell.hpp"
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/symbolic/compile.hpp"

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "nhdyn/formulation/formulation.hpp"
-#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/model/parameters.hpp"

@@ -6,10 +6,15 @@
 //     the fuzzer and the Python bindings goes down the table (tests may see what their executable
 //     links, per the link_<folder> lines of tests/CMakeLists.txt);
 //   - GiNaC (or CLN), included directly or through any project header, is seen only inside
-//     src/nhdyn/symbolic and the places listed below with their reason; the known exceptions are
-//     listed too, and one that no longer sees GiNaC must be removed from the list (so each change
-//     tightens it);
-//   - SUNDIALS, directly or through headers, is seen only inside src/nhdyn/integrators/sundials.
+//     src/nhdyn/symbolic and the places listed below with their reason (never the CLI in apps/ nor
+//     the Python module); a listed place that no longer sees GiNaC must be removed from the list
+//     (so each change tightens it);
+//   - SUNDIALS, directly or through headers, is seen only inside src/nhdyn/integrators/sundials;
+//   - the umbrella header src/nhdyn/nhdyn.hpp (the public surface, for applications) may include
+//     every module's headers but sees neither GiNaC nor SUNDIALS, and no module includes it;
+//   - a header marked "// Internal:" in its opening comment is included only by the library and
+//     the tests, never by an application (the CLI, Python, examples, benchmarks, fuzzer) nor by
+//     the umbrella header.
 // The checker itself is tested on small synthetic trees that break each rule once.
 #include <gtest/gtest.h>
 
@@ -46,7 +51,8 @@ bool allows(const Allowance& a, const std::string& path) {
 // Places that see GiNaC by design (besides src/nhdyn/symbolic/, its home).
 const std::vector<Allowance> kGinacByDesign = {
     {"src/nhdyn/studies/", "studies compute exact or 50-digit references with GiNaC (studies links symbolic)"},
-    {"src/nhdyn/io/", "io's sources compile model files through symbolic (io links it); its headers stay GiNaC-free", true},
+    {"src/nhdyn/io/", "io's sources read the symbolic scene and equations for the report (io links symbolic); its headers stay GiNaC-free", true},
+    {"src/nhdyn/frontend/", "frontend's sources translate model files into Specs and compile them (frontend links symbolic); its headers stay GiNaC-free", true},
     {"tests/symbolic/", "tests of the symbolic front end"},
     {"tests/codegen/", "hand-built Specs (GiNaC expressions) turned into C++"},
     {"tests/multibody/", "hand-built multibody Specs, tests of symbolic/multibody"},
@@ -54,24 +60,24 @@ const std::vector<Allowance> kGinacByDesign = {
     {"examples/appell_builder.cpp", "the C++ model-building API: a Spec is made of GiNaC expressions"},
     {"bench/compile_bench.cpp", "times the symbolic compiler on hand-built Specs"},
     {"bench/chain_bench.cpp", "times the making of the chain's Spec (symbolic/chain)"},
+    {"src/nhdyn/frontend/model_file.hpp", "the model-file parser's interface: it returns the Spec that load_model compiles "
+                                          "and the parser's tests inspect; the CLI and Python include load_model.hpp only"},
+    {"fuzz/model_file_fuzzer.cpp", "fuzzes the model-file parser, whose output is a Spec"},
+    {"tests/io/", "tests of the model-file parser: they inspect the Spec it makes (locations, parameters, events)"},
+    {"tests/gallery/", "models built with SpecBuilder or symbolic/chain next to their model files, and their equations"},
+    {"tests/linearization/", "sweeps that recompile a kept Spec and derivation at each point, against set_parameter"},
+    {"tests/studies/", "the spread-masses study takes a Spec (its 50-digit reference is symbolic)"},
+    {"tests/report/", "compiles the Specs' [visual] scenes and checks them against the drawn page"},
+    {"bench/linearize_bench.cpp", "times compile_model and linearization on a kept derivation"},
+    {"bench/multibody_bench.cpp", "times derive() and compile_model() of multibody Specs"},
+    {"bench/dop853_bench.cpp", "changes the bicycle's initial speed in its Spec before compiling"},
 };
 
-// Known exceptions, to be removed: each sees GiNaC only because io/model_file.hpp (or the CLI's
-// model_source.hpp) hands out a Spec. A GiNaC-free load_model(path or text, overrides) -> Model
-// removes them; delete each line as soon as the test says it is stale.
-const std::vector<Allowance> kGinacToRemove = {
-    {"src/nhdyn/io/model_file.hpp", "returns a Spec"},
-    {"apps/nhdyn/", "the CLI builds Specs (model_source.hpp, example.cpp)"},
-    {"bench/linearize_bench.cpp", "loads model files through io/model_file.hpp"},
-    {"bench/multibody_bench.cpp", "loads model files through io/model_file.hpp"},
-    {"fuzz/model_file_fuzzer.cpp", "loads model files through io/model_file.hpp"},
-    {"tests/io/", "loads model files through io/model_file.hpp"},
-    {"tests/gallery/", "loads model files through io/model_file.hpp"},
-    {"tests/linearization/", "loads model files through io/model_file.hpp"},
-    {"tests/studies/", "loads model files through io/model_file.hpp, studies/spread_masses.hpp"},
-    {"tests/report/", "loads model files through io/model_file.hpp"},
-    {"bench/dop853_bench.cpp", "loads model files through io/model_file.hpp"},
-};
+// Known exceptions, to be removed: a place that sees GiNaC only because it has not yet moved to
+// load_model (frontend/load_model.hpp, no GiNaC). Empty now: the CLI, the Python module and every
+// loader of model files go through the front door; delete each line as soon as the test says it
+// is stale, and add none.
+const std::vector<Allowance> kGinacToRemove = {};
 
 bool is_ginac_header(const std::string& include) {
   return include.rfind("ginac/", 0) == 0 || include.rfind("cln/", 0) == 0;
@@ -292,6 +298,7 @@ struct Include {
 
 struct SourceFile {
   std::vector<Include> includes;
+  bool internal = false;  // "// Internal:" in the opening comment: not part of the public API
 };
 using Tree = std::map<std::string, SourceFile>;  // path relative to the root -> file
 
@@ -306,8 +313,11 @@ Tree scan(const fs::path& root) {
       SourceFile file;
       std::istringstream in(read_text(e.path()));
       int number = 0;
+      bool opening = true;  // still in the header's opening comment
       for (std::string line; std::getline(in, line);) {
         ++number;
+        if (opening && line.rfind("//", 0) != 0) opening = false;
+        if (opening && line.rfind("// Internal:", 0) == 0) file.internal = true;
         std::smatch m;
         if (std::regex_search(line, m, include)) file.includes.push_back({number, m[2].str(), m[1].str() == "\""});
       }
@@ -329,6 +339,9 @@ std::string resolve(const Tree& tree, const std::string& from, const Include& in
   return {};
 }
 
+// The public surface in one header, for applications.
+const std::string kUmbrella = "src/nhdyn/nhdyn.hpp";
+
 // Which files may include which modules.
 struct Owner {
   std::string what;  // for messages: "module analysis", "tests/io (links nhdyn_io ...)", "application"
@@ -338,6 +351,14 @@ struct Owner {
 Owner owner_of(const std::string& path, const Layers& layers,
                const std::map<std::string, std::vector<std::string>>& test_links, Problems& problems,
                std::set<std::string>& reported) {
+  if (path == kUmbrella) {
+    std::set<std::string> visible;
+    for (const auto& [name, layer] : layers) {
+      std::set<std::string> c = public_closure(layers, name);
+      visible.insert(c.begin(), c.end());
+    }
+    return {"the umbrella header", visible};
+  }
   if (starts_with(path, "src/nhdyn/")) {
     const std::string m = module_of(layers, path.substr(10));
     if (m.empty()) {
@@ -397,6 +418,17 @@ void check_includes(const Tree& tree, const Layers& layers,
       if (!starts_with(inc.target, "nhdyn/")) continue;
       const std::string m = module_of(layers, inc.target.substr(6));
       const std::string where = path + ":" + std::to_string(inc.line) + ": ";
+      const bool application = owner.what.rfind("an application", 0) == 0;
+      if ("src/" + inc.target == kUmbrella) {
+        if (!application && !starts_with(path, "tests/"))
+          problems.push_back(where + owner.what + " includes " + inc.target +
+                             ", the umbrella header for applications; include the module headers it needs");
+        continue;
+      }
+      const auto target = tree.find("src/" + inc.target);
+      if (target != tree.end() && target->second.internal && (application || path == kUmbrella))
+        problems.push_back(where + owner.what + " includes " + inc.target +
+                           ", a header marked internal to the library; use the public headers (nhdyn/nhdyn.hpp)");
       if (m.empty())
         problems.push_back(where + "includes " + inc.target + ", which is in no module of the layer table");
       else if (!owner.visible.count(m))
@@ -647,6 +679,28 @@ TEST_F(SyntheticTree, SourcesOnlyAllowanceLeavesHeadersFenced) {
   // sees GiNaC; the source file is allowed.
   ASSERT_EQ(problems.size(), 3U) << join(problems);
   EXPECT_NE(problems[2].find("src/nhdyn/analysis/load.hpp: sees GiNaC"), std::string::npos) << problems[2];
+}
+
+TEST_F(SyntheticTree, UmbrellaHeaderServesApplicationsOnly) {
+  write("src/nhdyn/nhdyn.hpp", "#include \"nhdyn/analysis/s.hpp\"\n#include \"nhdyn/integrators/ode.hpp\"\n");
+  write("apps/cli/run.cpp", "#include \"nhdyn/nhdyn.hpp\"\n");
+  EXPECT_TRUE(check().empty()) << join(check());
+  write("src/nhdyn/analysis/t.cpp", "#include \"nhdyn/nhdyn.hpp\"\n");
+  EXPECT_TRUE(one_problem(check(), {"src/nhdyn/analysis/t.cpp:1", "umbrella header"}));
+}
+
+TEST_F(SyntheticTree, UmbrellaHeaderSeeingGinacIsReported) {
+  write("src/nhdyn/nhdyn.hpp", "#include \"nhdyn/symbolic/spec.hpp\"\n");
+  EXPECT_TRUE(one_problem(check(), {"src/nhdyn/nhdyn.hpp: sees GiNaC"}));
+}
+
+TEST_F(SyntheticTree, InternalHeaderInAnApplicationIsReported) {
+  write("src/nhdyn/model/detail.hpp", "// Kernels' helpers.\n// Internal: not for users.\n#pragma once\n");
+  write("src/nhdyn/model/m.cpp", "#include \"nhdyn/model/detail.hpp\"\n");
+  write("tests/model/detail_test.cpp", "#include \"nhdyn/model/detail.hpp\"\n");
+  EXPECT_TRUE(check().empty()) << join(check());
+  write("apps/cli/peek.cpp", "#include \"nhdyn/model/detail.hpp\"\n");
+  EXPECT_TRUE(one_problem(check(), {"apps/cli/peek.cpp:1", "internal"}));
 }
 
 TEST_F(SyntheticTree, ModuleWithoutLineIsReported) {

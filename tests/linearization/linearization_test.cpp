@@ -17,7 +17,7 @@
 #include "linearization/support.hpp"
 #include "nhdyn/analysis/linearization.hpp"
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 
 namespace nhdyn {

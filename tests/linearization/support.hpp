@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "nhdyn/analysis/linearization.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 
 namespace nhdyn::testing {

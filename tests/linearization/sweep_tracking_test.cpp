@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "nhdyn/analysis/sweep.hpp"
-#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 
 namespace nhdyn {
 namespace {

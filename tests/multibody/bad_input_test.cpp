@@ -5,7 +5,7 @@
 #include <string>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 
 namespace nhdyn {
 namespace {

@@ -15,7 +15,7 @@
 
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "support/models.hpp"

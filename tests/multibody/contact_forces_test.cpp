@@ -14,7 +14,7 @@
 
 #include "multibody/multibody_support.hpp"
 #include "nhdyn/analysis/simulation.hpp"
-#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/model/contact_forces.hpp"
 #include "support/models.hpp"

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "multibody/multibody_support.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 
 namespace nhdyn::multibody_test {

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "multibody/multibody_support.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 #include "nhdyn/symbolic/derivation.hpp"
 #include "support/text.hpp"

@@ -20,7 +20,7 @@
 
 #include "multibody/multibody_support.hpp"
 #include "nhdyn/analysis/simulation.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 #include "support/text.hpp"
 

@@ -20,7 +20,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/csv.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/io/report.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 #include "nhdyn/model/parameters.hpp"

@@ -13,7 +13,7 @@
 #include <filesystem>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/model/appell.hpp"
 #include "nhdyn/model/sled.hpp"
 #include "nhdyn/studies/error_relation.hpp"

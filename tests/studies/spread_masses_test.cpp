@@ -15,7 +15,7 @@
 
 #include "nhdyn/analysis/initial_state.hpp"
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 

@@ -13,7 +13,7 @@
 #include <string>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/model/sled.hpp"
 #include "nhdyn/studies/tracking.hpp"
 #include "nhdyn/symbolic/compile.hpp"

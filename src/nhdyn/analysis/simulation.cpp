@@ -118,19 +118,11 @@ ModelEventFunctions::Dynamics event_dynamics(const Model& model, Data& data, con
 
 }  // namespace
 
-std::string_view stabilization_name(Stabilization stabilization) {
-  switch (stabilization) {
-    case Stabilization::none: return "none";
-    case Stabilization::baumgarte: return "baumgarte";
-    case Stabilization::projection: return "projection";
-  }
-  return "?";
-}
+std::string_view stabilization_name(Stabilization stabilization) { return name_of(kStabilizations, stabilization); }
 
 Stabilization parse_stabilization(std::string_view name) {
-  for (Stabilization s : {Stabilization::none, Stabilization::baumgarte, Stabilization::projection})
-    if (name == stabilization_name(s)) return s;
-  throw InputError("unknown stabilization '" + std::string(name) + "'; choose one of: none, baumgarte, projection");
+  if (const StabilizationInfo* info = find_named(kStabilizations, name)) return info->value;
+  throw InputError("unknown stabilization '" + std::string(name) + "'; choose one of: " + list_names(kStabilizations));
 }
 
 std::vector<double> make_output_times(double t0, double t_end, double output_step) {

@@ -5,6 +5,7 @@
 // (docs/derivations/energy-balance.md: the work W' = P is integrated with the state).
 #pragma once
 
+#include <array>
 #include <functional>
 #include <optional>
 #include <string>
@@ -29,6 +30,17 @@ enum class Stabilization {
 };
 
 // "none", "baumgarte", "projection".
+// The stabilizations, once (core/names.hpp).
+struct StabilizationInfo {
+  Stabilization value;
+  std::string_view name;
+};
+inline constexpr std::array<StabilizationInfo, 3> kStabilizations{{
+    {Stabilization::none, "none"},
+    {Stabilization::baumgarte, "baumgarte"},
+    {Stabilization::projection, "projection"},
+}};
+
 std::string_view stabilization_name(Stabilization stabilization);
 Stabilization parse_stabilization(std::string_view name);  // throws InputError listing valid names
 

@@ -10,6 +10,7 @@
 #include <Eigen/SVD>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/model/parameters.hpp"
 
 namespace nhdyn {
 namespace {
@@ -282,6 +283,21 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
     }
   }
   return out;
+}
+
+ModelAtValue make_model_at_value(const Model& base, const std::string& parameter) {
+  return [base, parameter](double value) {
+    Model model = base;
+    set_parameter(model, parameter, value);
+    return model;
+  };
+}
+
+Sweep calc_parameter_sweep(const Model& base, const SweepOptions& options) {
+  check_sweep_options(options);
+  Model at_from = base;
+  set_parameter(at_from, options.parameter, options.from);  // an unknown name throws, naming the nearest
+  return calc_eigenvalue_sweep(make_model_at_value(at_from, options.parameter), options);
 }
 
 }  // namespace nhdyn

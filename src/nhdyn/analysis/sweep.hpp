@@ -6,9 +6,9 @@
 // a real part within it is "undecided", never counted unstable. The crossings are bracketed on the
 // grid by a change in the number of eigenvalues whose real part is positive beyond that
 // uncertainty, narrowed by bisection on that number, and then, for a simple eigenvalue, by
-// bisection on the sign of its real part (docs/linearization.md, "Stability crossings"). The model at a parameter value comes from the
-// caller (the CLI recompiles the model file's derivation with the new value), so that this
-// module needs no symbolic layer.
+// bisection on the sign of its real part (docs/linearization.md, "Stability crossings"). The model at
+// a parameter value is a copy of one loaded model with the parameter set (parameters are data,
+// model/parameters.hpp: nothing is recompiled), so that this module needs no symbolic layer.
 #pragma once
 
 #include <complex>
@@ -62,6 +62,16 @@ using ModelAtValue = std::function<Model(double)>;
 // independent coordinates and speeds named from it), so that every row has the same columns;
 // a point where the linearization fails rethrows its error with the parameter value in front.
 Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& options);
+
+// `base` with parameter `parameter` set to the value asked (set_parameter on a copy); the returned
+// function keeps its own copy of `base`. Throws InputError, naming the nearest parameter, when
+// called with a name `base` does not have.
+ModelAtValue make_model_at_value(const Model& base, const std::string& parameter);
+
+// The sweep of options.parameter on `base`: checks the options, then sets the parameter to
+// options.from (InputError naming the nearest for an unknown name), then calc_eigenvalue_sweep
+// over make_model_at_value.
+Sweep calc_parameter_sweep(const Model& base, const SweepOptions& options);
 
 // How far each computed eigenvalue of `state_matrix` may be from the exact one: with
 // s = ||state_matrix||_F and e = 64 eps, r_l = 8 e^(1/l) s for an eigenvalue in a cluster of m

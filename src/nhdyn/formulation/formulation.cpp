@@ -16,37 +16,18 @@
 
 namespace nhdyn {
 
-std::string_view method_name(Method method) {
-  switch (method) {
-    case Method::sanh: return "sanh";
-    case Method::lagrange: return "lagrange";
-    case Method::udwadia_kalaba: return "udwadia-kalaba";
-    case Method::nullspace: return "nullspace";
-  }
-  return "?";
-}
+std::string_view method_name(Method method) { return name_of(kFormulations, method); }
 
 Method parse_method(std::string_view name) {
-  for (Method m : {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace})
-    if (name == method_name(m)) return m;
-  throw InputError("unknown method '" + std::string(name) +
-                   "'; choose one of: sanh, lagrange, udwadia-kalaba, nullspace");
+  if (const FormulationInfo* info = find_named(kFormulations, name)) return info->value;
+  throw InputError("unknown method '" + std::string(name) + "'; choose one of: " + list_names(kFormulations));
 }
 
-std::string_view complement_name(Complement complement) {
-  switch (complement) {
-    case Complement::qr: return "qr";
-    case Complement::partition: return "partition";
-    case Complement::analytic: return "analytic";
-  }
-  return "?";
-}
+std::string_view complement_name(Complement complement) { return name_of(kComplements, complement); }
 
 Complement parse_complement(std::string_view name) {
-  for (Complement c : {Complement::qr, Complement::partition, Complement::analytic})
-    if (name == complement_name(c)) return c;
-  throw InputError("unknown choice of D '" + std::string(name) +
-                   "'; choose one of: qr, partition, analytic");
+  if (const ComplementInfo* info = find_named(kComplements, name)) return info->value;
+  throw InputError("unknown choice of D '" + std::string(name) + "'; choose one of: " + list_names(kComplements));
 }
 
 Status compute_acceleration(const Model& model, Data& data, const FormulationOptions& options) {
@@ -56,7 +37,7 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
     throw std::logic_error("compute_acceleration: this Data was made for the " + std::string(method_name(*data.method)) +
                            " formulation; make one for " + std::string(method_name(options.method)) +
                            " (make_data with DataOptions::method)");
-  if (data.sparse && options.method != Method::sanh && options.method != Method::lagrange)
+  if (data.sparse && !find_value(kFormulations, options.method)->sparse)
     throw std::logic_error("compute_acceleration: the " + std::string(method_name(options.method)) +
                            " formulation has no sparse kernels; use sanh or lagrange on the sparse path, or make "
                            "the Data with DataOptions::method = " + std::string(method_name(options.method)) +

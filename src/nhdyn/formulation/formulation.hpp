@@ -4,8 +4,10 @@
 // docs/notation.md sections 3 and 5.
 #pragma once
 
+#include <array>
 #include <string_view>
 
+#include "nhdyn/core/names.hpp"
 #include "nhdyn/core/status.hpp"
 #include "nhdyn/formulation/baumgarte.hpp"
 #include "nhdyn/formulation/program_feedback.hpp"
@@ -32,10 +34,35 @@ struct FormulationOptions {
   ProgramFeedback program_feedback;  // off unless enabled; only for a model with programs (program_motion.hpp)
 };
 
-// "sanh", "lagrange", "udwadia-kalaba", "nullspace".
+// The formulations and the choices of D, once (core/names.hpp): their names in the CLI, model
+// files and Python, and what each formulation can do. A new formulation adds its Method
+// (model/data.hpp), its line here and its case in compute_acceleration.
+struct FormulationInfo {
+  Method value;
+  std::string_view name;
+  bool sparse;  // has sparse kernels (sparse_sanh.hpp, sparse_lagrange.hpp)
+};
+inline constexpr std::array<FormulationInfo, 4> kFormulations{{
+    {Method::sanh, "sanh", true},
+    {Method::lagrange, "lagrange", true},
+    {Method::udwadia_kalaba, "udwadia-kalaba", false},
+    {Method::nullspace, "nullspace", false},
+}};
+
+struct ComplementInfo {
+  Complement value;
+  std::string_view name;
+};
+inline constexpr std::array<ComplementInfo, 3> kComplements{{
+    {Complement::qr, "qr"},
+    {Complement::partition, "partition"},
+    {Complement::analytic, "analytic"},
+}};
+
+// Its name in kFormulations: "sanh", "lagrange", "udwadia-kalaba", "nullspace".
 std::string_view method_name(Method method);
 Method parse_method(std::string_view name);  // throws InputError listing valid names
-// "qr", "partition", "analytic".
+// Its name in kComplements: "qr", "partition", "analytic".
 std::string_view complement_name(Complement complement);
 Complement parse_complement(std::string_view name);  // throws InputError listing valid names
 

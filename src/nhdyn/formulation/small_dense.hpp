@@ -2,7 +2,8 @@
 // known at compile time. At n = 3 a dynamic-size Eigen call costs more in dispatch than in
 // arithmetic (docs/performance.md); these loops let the compiler unroll everything. They compute
 // the same quantities as the dynamic path, with the same rank and singularity tests, so that the
-// choice between them changes nothing but the time. Internal to the formulation module.
+// choice between them changes nothing but the time.
+// Internal: the formulation module's own kernels, not part of the public API (nhdyn/nhdyn.hpp).
 //
 // Storage is column-major as in Eigen: A(i, j) = A[i + n j], b(i, j) = b[i + s j],
 // D(i, j) = D[i + k j].

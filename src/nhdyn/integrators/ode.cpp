@@ -13,11 +13,10 @@
 namespace nhdyn {
 namespace {
 
-constexpr std::array<IntegratorKind, 5> all_kinds{IntegratorKind::rk4, IntegratorKind::dopri5,
-                                                  IntegratorKind::dop853, IntegratorKind::cvode_bdf,
-                                                  IntegratorKind::cvode_adams};
-
-bool is_adaptive(IntegratorKind kind) { return kind != IntegratorKind::rk4; }
+bool is_adaptive(IntegratorKind kind) {
+  const IntegratorInfo* info = find_value(kIntegrators, kind);
+  return info && info->adaptive;
+}
 
 // Everything the integrators rely on without checking again: bad values here are the user's
 // (a model file, a command line), so they throw rather than return a status.
@@ -69,24 +68,20 @@ void require_valid_input(const OdeSystem& system, const IntegratorOptions& optio
 
 }  // namespace
 
-std::string_view integrator_name(IntegratorKind kind) {
-  switch (kind) {
-    case IntegratorKind::rk4: return "rk4";
-    case IntegratorKind::dopri5: return "dopri5";
-    case IntegratorKind::dop853: return "dop853";
-    case IntegratorKind::cvode_bdf: return "cvode-bdf";
-    case IntegratorKind::cvode_adams: return "cvode-adams";
-  }
-  return "unknown";
+std::string_view integrator_name(IntegratorKind kind) { return name_of(kIntegrators, kind); }
+
+bool supports_events(IntegratorKind kind) {
+  const IntegratorInfo* info = find_value(kIntegrators, kind);
+  return info && info->events;
 }
 
-bool supports_events(IntegratorKind kind) { return kind != IntegratorKind::rk4; }
+std::string adaptive_integrator_names(std::string_view last) {
+  return list_names_if(kIntegrators, [](const IntegratorInfo& i) { return i.adaptive; }, ", ", last);
+}
 
 IntegratorKind parse_integrator(std::string_view name) {
-  for (IntegratorKind kind : all_kinds)
-    if (integrator_name(kind) == name) return kind;
-  throw InputError(fmt::format(
-      "unknown integrator '{}'; valid names are rk4, dopri5, dop853, cvode-bdf, cvode-adams", name));
+  if (const IntegratorInfo* info = find_named(kIntegrators, name)) return info->value;
+  throw InputError(fmt::format("unknown integrator '{}'; valid names are {}", name, list_names(kIntegrators)));
 }
 
 IntegrationResult integrate(OdeSystem& system, const IntegratorOptions& options, double t0,
@@ -97,8 +92,9 @@ IntegrationResult integrate(OdeSystem& system, const IntegratorOptions& options,
   if (events != nullptr && !supports_events(options.kind))
     throw InputError(fmt::format(
         "events need an integrator with a continuous extension or root finding; {} has neither: "
-        "choose dopri5, dop853, cvode-bdf or cvode-adams",
-        integrator_name(options.kind)));
+        "choose {}",
+        integrator_name(options.kind),
+        list_names_if(kIntegrators, [](const IntegratorInfo& i) { return i.events; }, ", ", " or ")));
   switch (options.kind) {
     case IntegratorKind::rk4:
       return integrate_rk4(system, options, t0, y0, output_times, output);

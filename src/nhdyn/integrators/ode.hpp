@@ -4,11 +4,13 @@
 // of mechanics; the simulation driver (analysis/simulation.hpp) adapts a Model to OdeSystem.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <span>
 #include <string_view>
 #include <string>
 
+#include "nhdyn/core/names.hpp"
 #include "nhdyn/core/status.hpp"
 
 namespace nhdyn {
@@ -42,12 +44,32 @@ class OdeSystem {
 
 enum class IntegratorKind { rk4, dopri5, dop853, cvode_bdf, cvode_adams };
 
-// "rk4", "dopri5", "dop853", "cvode-bdf", "cvode-adams".
+// The integrators, once (core/names.hpp): their names in the CLI, model files and Python, and
+// what each can do. A new integrator adds its kind above, its line here and its case in
+// integrate().
+struct IntegratorInfo {
+  IntegratorKind value;
+  std::string_view name;
+  bool events;    // locates events (events.hpp): a continuous extension or root finding
+  bool adaptive;  // chooses its steps to meet rtol and atol
+};
+inline constexpr std::array<IntegratorInfo, 5> kIntegrators{{
+    {IntegratorKind::rk4, "rk4", false, false},
+    {IntegratorKind::dopri5, "dopri5", true, true},
+    {IntegratorKind::dop853, "dop853", true, true},
+    {IntegratorKind::cvode_bdf, "cvode-bdf", true, true},
+    {IntegratorKind::cvode_adams, "cvode-adams", true, true},
+}};
+
+// Its name in kIntegrators: "rk4", "dopri5", "dop853", "cvode-bdf", "cvode-adams".
 std::string_view integrator_name(IntegratorKind kind);
 // Inverse of integrator_name; throws InputError listing the valid names.
 IntegratorKind parse_integrator(std::string_view name);
 // Whether the integrator can locate events (events.hpp): all but rk4.
 bool supports_events(IntegratorKind kind);
+// The adaptive integrators' names, "dopri5, dop853, cvode-bdf or cvode-adams" (`last` between the
+// last two), for the messages of the studies that vary the tolerance.
+std::string adaptive_integrator_names(std::string_view last = " or ");
 
 struct IntegratorOptions {
   IntegratorKind kind = IntegratorKind::dopri5;

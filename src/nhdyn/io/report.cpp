@@ -16,6 +16,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/symbolic/derivation.hpp"
+#include "nhdyn/symbolic/description.hpp"
 #include "nhdyn/symbolic/equations.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 #include "nhdyn/symbolic/visual.hpp"
@@ -203,6 +204,14 @@ std::vector<SceneSize> calc_scene_sizes(const symbolic::VisualScene& scene, cons
     result.push_back(size);
   }
   return result;
+}
+
+std::string write_model_report(const Model& model, const symbolic::Spec* spec, const CsvTable& table,
+                               const std::string& title, const std::vector<std::pair<std::string, std::string>>& extra,
+                               const std::filesystem::path& path, const ReportOptions& options) {
+  if (spec == nullptr) return write_model_report(model, static_cast<const symbolic::ModelDescription*>(nullptr), table, title, extra, path, options);
+  const symbolic::ModelDescription description(*spec);
+  return write_model_report(model, &description, table, title, extra, path, options);
 }
 
 std::vector<std::size_t> report_frames(std::size_t rows, int max_frames) {
@@ -448,7 +457,7 @@ std::string write_report(const ReportInput& input, const std::filesystem::path& 
   return notice;
 }
 
-std::string write_model_report(const Model& model, const symbolic::Spec* spec, const CsvTable& table, const std::string& title,
+std::string write_model_report(const Model& model, const symbolic::ModelDescription* description, const CsvTable& table, const std::string& title,
                         const std::vector<std::pair<std::string, std::string>>& extra,
                         const std::filesystem::path& path, const ReportOptions& options) {
   ReportInput input;
@@ -458,14 +467,14 @@ std::string write_model_report(const Model& model, const symbolic::Spec* spec, c
   input.columns = make_result_columns(model);
   check_report_columns(table.header, input.columns, "the results", model.name);
   input.table = table;
-  std::optional<symbolic::VisualScene> scene;
-  if (spec != nullptr) {
-    scene = symbolic::compile_visual(*spec);
-    input.angles = scene->angles;
-    input.scene = &*scene;
+  if (description != nullptr) {
+    const symbolic::Spec& spec = description->spec();
+    const symbolic::VisualScene& scene = description->scene();
+    input.angles = scene.angles;
+    input.scene = &scene;
     input.parameters = model.parameters;
-    input.path = spec->path;
-    const symbolic::Derivation derivation = symbolic::derive(*spec);
+    input.path = spec.path;
+    const symbolic::Derivation& derivation = description->derivation();
     // Terms whose plain printing already exceeds the limit are left out before they are printed
     // and simplified for nothing: the page would not show them.
     std::ostringstream raw;
@@ -475,7 +484,7 @@ std::string write_model_report(const Model& model, const symbolic::Spec* spec, c
                                          "{} kB); `nhdyn equations MODEL --format latex` prints them.",
                                          model.name, raw.str().size() / 1000);
     else
-      input.equations_latex = symbolic::format_equations(*spec, derivation, symbolic::EquationFormat::latex);
+      input.equations_latex = symbolic::format_equations(spec, derivation, symbolic::EquationFormat::latex);
   } else {
     input.equations_note = fmt::format("'{}' is a built-in model written in C++: it has no symbolic equations to "
                                        "show (its model file in examples/ has).",

@@ -23,6 +23,7 @@
 
 namespace nhdyn::symbolic {
 struct Spec;
+class ModelDescription;  // symbolic/description.hpp (GiNaC), kept by frontend/load_model.hpp
 struct VisualScene;
 }
 
@@ -74,15 +75,22 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
 std::string write_report(const ReportInput& input, const std::filesystem::path& path, const ReportOptions& options = {});
 
 // The report of a model's run, everything taken from the model: the columns it must have, its
-// parameter values, its angles and scene (compile_visual of the spec, bound to model.parameters), its equations (derived again from the spec;
-// none for a built-in model, which has no spec) and a summary computed from the rows (times,
+// parameter values, its angles and scene (the description's, bound to model.parameters), its
+// equations (from the description's derivation, the one the model was compiled from; none for a
+// built-in model, whose description is null) and a summary computed from the rows (times,
 // largest residual per level, energy drift), after `extra` (the run's own figures). Throws as
 // check_report_columns when `table` is not this model's, InputError/ModelError for a scene that
 // cannot be compiled, FileError when `path` cannot be written. Returns the page's notice for the
 // user ("" when none): the model has nothing to draw, or the rows were thinned.
-std::string write_model_report(const Model& model, const symbolic::Spec* spec, const CsvTable& table, const std::string& title,
+std::string write_model_report(const Model& model, const symbolic::ModelDescription* description, const CsvTable& table, const std::string& title,
                         const std::vector<std::pair<std::string, std::string>>& extra,
                         const std::filesystem::path& path, const ReportOptions& options = {});
+
+// The same for a Spec built in C++ (symbolic/spec_builder.hpp) with no description kept: the
+// description is made here, so the equations are derived and the scene compiled for this page.
+std::string write_model_report(const Model& model, const symbolic::Spec* spec, const CsvTable& table,
+                               const std::string& title, const std::vector<std::pair<std::string, std::string>>& extra,
+                               const std::filesystem::path& path, const ReportOptions& options = {});
 
 // The rows a report shows out of `rows` (indices, ascending, first and last included).
 std::vector<std::size_t> report_frames(std::size_t rows, int max_frames);

@@ -231,10 +231,9 @@ class CompiledEvaluator final : public Evaluator {
 }  // namespace
 
 EvaluatorChoice parse_evaluator_choice(const std::string& text) {
-  if (text == "interpreted") return EvaluatorChoice::interpreted;
-  if (text == "compiled") return EvaluatorChoice::compiled;
-  if (text == "auto") return EvaluatorChoice::automatic;
-  throw InputError(fmt::format("--evaluator: '{}' is not an evaluator; use interpreted, compiled or auto", text));
+  if (const EvaluatorChoiceInfo* info = find_named(kEvaluatorChoices, text)) return info->value;
+  throw InputError(fmt::format("--evaluator: '{}' is not an evaluator; use {}", text,
+                               list_names(kEvaluatorChoices, ", ", " or ")));
 }
 
 bool is_compiled(const Model& model) {

@@ -13,10 +13,12 @@
 // differences work unchanged.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/names.hpp"
 #include "nhdyn/model/model.hpp"
 
 namespace nhdyn::jit {
@@ -28,6 +30,17 @@ class JitError : public Error {
 };
 
 enum class EvaluatorChoice { interpreted, compiled, automatic };
+
+// The evaluator choices, once (core/names.hpp): `--evaluator NAME`.
+struct EvaluatorChoiceInfo {
+  EvaluatorChoice value;
+  std::string_view name;
+};
+inline constexpr std::array<EvaluatorChoiceInfo, 3> kEvaluatorChoices{{
+    {EvaluatorChoice::interpreted, "interpreted"},
+    {EvaluatorChoice::compiled, "compiled"},
+    {EvaluatorChoice::automatic, "auto"},
+}};
 
 // "interpreted" | "compiled" | "auto"; throws InputError naming the value otherwise.
 EvaluatorChoice parse_evaluator_choice(const std::string& text);

@@ -303,18 +303,22 @@ void set_parameter_expression(std::vector<Parameter>& parameters, std::string_vi
   parameters = std::move(changed);
 }
 
+std::pair<std::string, std::string> split_parameter_set(std::string_view set) {
+  const std::size_t eq = set.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError(fmt::format("--set '{}': write it as NAME=VALUE or NAME=EXPRESSION, e.g. --set a=0.3 or "
+                                 "--set alpha=pi/6",
+                                 set));
+  return {std::string(set.substr(0, eq)), std::string(set.substr(eq + 1))};
+}
+
 void apply_parameter_sets(std::vector<Parameter>& parameters, const std::vector<std::string>& sets,
                           std::string_view model) {
   for (const std::string& set : sets) {
-    const std::size_t eq = set.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError(fmt::format("--set '{}': write it as NAME=VALUE or NAME=EXPRESSION, e.g. --set a=0.3 or "
-                                   "--set alpha=pi/6",
-                                   set));
-    std::string name = set.substr(0, eq);
+    auto [name, expression] = split_parameter_set(set);
     while (!name.empty() && std::isspace(static_cast<unsigned char>(name.back()))) name.pop_back();
     try {
-      set_parameter_expression(parameters, name, std::string_view(set).substr(eq + 1), model);
+      set_parameter_expression(parameters, name, expression, model);
     } catch (const InputError& e) {
       throw InputError(fmt::format("--set {}: {}", set, e.what()));
     }

@@ -11,6 +11,7 @@
 
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "nhdyn/model/model.hpp"
@@ -46,6 +47,9 @@ void update_parameters(std::vector<Parameter>& parameters, std::string_view mode
 // NAME (with the nearest known one), an expression that does not evaluate, or a cycle.
 void set_parameter_expression(std::vector<Parameter>& parameters, std::string_view name, std::string_view expression,
                               std::string_view model);
+// "NAME=EXPR" split at its first '=' into NAME and EXPR, both as written (NAME + "=" + EXPR is
+// `set` again); throws InputError saying how to write it when there is no '=' or no NAME.
+std::pair<std::string, std::string> split_parameter_set(std::string_view set);
 // Each "NAME=EXPR" of `sets` in turn, as set_parameter_expression.
 void apply_parameter_sets(std::vector<Parameter>& parameters, const std::vector<std::string>& sets,
                           std::string_view model);

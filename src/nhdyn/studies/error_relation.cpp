@@ -41,7 +41,7 @@ ErrorRelation study_error_relation(const Model& model, const ErrorRelationOption
   for (std::size_t i = 0; i < options.integrators.size(); ++i) {
     if (options.integrators[i] == IntegratorKind::rk4)
       throw InputError("rk4 takes a fixed step, so its runs do not depend on the tolerance: leave it out of the "
-                       "error-relation study (dopri5, dop853, cvode-bdf, cvode-adams adapt their step)");
+                       "error-relation study (" + adaptive_integrator_names(", ") + " adapt their step)");
     for (std::size_t j = 0; j < i; ++j)
       if (options.integrators[i] == options.integrators[j])
         throw InputError(fmt::format("integrator {} is given twice; give each once", integrator_name(options.integrators[i])));

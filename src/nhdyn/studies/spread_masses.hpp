@@ -14,7 +14,10 @@
 #include "nhdyn/core/status.hpp"
 #include "nhdyn/core/types.hpp"
 #include "nhdyn/studies/error_relation.hpp"
-#include "nhdyn/symbolic/spec.hpp"
+
+namespace nhdyn::symbolic {
+struct Spec;  // symbolic/spec.hpp: taken by reference, so that this header includes no GiNaC
+}
 
 namespace nhdyn {
 

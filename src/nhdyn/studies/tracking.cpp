@@ -39,8 +39,8 @@ Tracking study_tracking(const Model& model, const TrackingOptions& options) {
   if (!(options.atol_factor > 0.0 && std::isfinite(options.atol_factor)))
     throw InputError(fmt::format("the atol factor {} is not a positive number", options.atol_factor));
   if (options.integrator == IntegratorKind::rk4)
-    throw InputError("rk4 takes a fixed step, so its runs do not depend on the tolerance: use dopri5, dop853, "
-                     "cvode-bdf or cvode-adams for the tracking study");
+    throw InputError("rk4 takes a fixed step, so its runs do not depend on the tolerance: use " +
+                     adaptive_integrator_names() + " for the tracking study");
   check_study_run_times(model, options.t_end, options.output_step);
   if (!model.evaluator->has_solution())
     throw InputError(fmt::format("model '{}' gives no exact solution, and the tracking study measures the error "

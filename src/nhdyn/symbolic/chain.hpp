@@ -19,9 +19,9 @@
 
 #include <string>
 
-#include "nhdyn/symbolic/spec.hpp"
-
 namespace nhdyn::symbolic {
+
+struct Spec;  // spec.hpp: declared only, so that `nhdyn example chain` (write_chain_toml) sees no GiNaC
 
 // Parameters shared by all bodies; the file's parameter names in brackets.
 struct ChainParameters {

@@ -2,7 +2,7 @@
 // of rolling wheels, knife edges and points on surfaces from a description of frames, points and
 // bodies, and hands them to a SpecBuilder — from there on the model is derived and compiled like a
 // hand-written one (spec_builder.hpp -> derive -> compile_model). The model file's [[frames]],
-// [[points]], [[bodies]], gravity, [[wheels]], [[knife_edges]] and [[surfaces]] (io/model_file.cpp)
+// [[points]], [[bodies]], gravity, [[wheels]], [[knife_edges]] and [[surfaces]] (frontend/model_file.cpp)
 // are a thin layer over this class. docs/multibody.md describes it for users;
 // docs/derivations/rolling-wheel.md derives what it writes.
 //

@@ -2,6 +2,7 @@
 // large model (a chain of a thousand bodies) must differentiate each term only by the symbols it
 // contains: asking GiNaC's has() once per coordinate is a walk per coordinate, quadratic in the
 // size of the model.
+// Internal: a helper of the derivation, not part of the public API (nhdyn/nhdyn.hpp).
 #pragma once
 
 #include <ginac/ginac.h>

@@ -1,6 +1,7 @@
 // Deterministic simplification of the expressions of mechanics, used by derive() on every term it
 // returns, by `nhdyn equations` for display, and by the tests to decide that two expressions agree
-// (STYLE.md: compare by simplifying the difference to zero, never by printed strings).
+// (docs/design.md, "Rules the code follows": compare by simplifying the difference to zero, never by
+// printed strings).
 //
 // simplify() rewrites tan and tanh through sin/cos and sinh/cosh, brings the expression to one
 // fraction with expanded, coprime numerator and denominator (GiNaC's normal()), and reduces

@@ -1,5 +1,5 @@
 // The C++ model-building API: builds a Spec the way a model stands in a paper, from names and
-// expressions written as text. The model-file loader (io/model_file.hpp) is a thin layer over it.
+// expressions written as text. The model-file loader (frontend/model_file.hpp) is a thin layer over it.
 //
 // Expressions use GiNaC's syntax (+ - * / ^, parentheses, sin cos tan exp log sqrt abs asin acos
 // atan atan2 sinh cosh tanh, the constant pi), the time t, the coordinates by name, velocities

@@ -4,7 +4,7 @@
 // the source location of each node. Every toml++ node is reached through a type-checked accessor
 // (as_string, as_table, ...), so no input can make the loader dereference a missing node.
 #include "nhdyn/core/join.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 
 #include <fmt/format.h>
 
@@ -29,6 +29,8 @@
 #include <toml++/toml.h>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/integrators/ode.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/multibody.hpp"
 #include "nhdyn/symbolic/outputs.hpp"
@@ -68,11 +70,9 @@ const std::vector<std::string> visual_keys = {"points", "segments"};
 const std::vector<std::string> visual_point_keys = {"name", "position", "radius"};
 const std::vector<std::string> visual_segment_keys = {"name", "from", "to"};
 
-// The names that formulation/formulation.cpp (parse_method) and integrators/ode.cpp
-// (parse_integrator) accept. io may not depend on those modules, so the lists are repeated here;
-// tests/io/model_file_test.cpp checks that they agree.
-const std::vector<std::string> method_names = {"sanh", "lagrange", "udwadia-kalaba", "nullspace"};
-const std::vector<std::string> integrator_names = {"rk4", "dopri5", "dop853", "cvode-bdf", "cvode-adams"};
+// The names parse_method and parse_integrator accept, from their tables (formulation.hpp, ode.hpp).
+const std::vector<std::string> method_names = names_of(kFormulations);
+const std::vector<std::string> integrator_names = names_of(kIntegrators);
 
 std::string_view type_name(const toml::node& node) {
   switch (node.type()) {
@@ -1196,7 +1196,7 @@ symbolic::Spec load_model_string(std::string_view text, std::string file_name) {
   return Loader(text, std::move(file_name)).load();
 }
 
-symbolic::Spec load_model_file(const std::filesystem::path& path) {
+std::string read_model_text(const std::filesystem::path& path) {
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(path, ec);
   if (!std::filesystem::exists(status))
@@ -1214,7 +1214,11 @@ symbolic::Spec load_model_file(const std::filesystem::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw FileError(fmt::format("{}: cannot read the model file", path.string()));
-  return load_model_string(text.str(), path.string());
+  return text.str();
+}
+
+symbolic::Spec load_model_file(const std::filesystem::path& path) {
+  return load_model_string(read_model_text(path), path.string());
 }
 
 }  // namespace nhdyn

@@ -22,6 +22,9 @@ namespace nhdyn {
 // valid key.
 symbolic::Spec load_model_file(const std::filesystem::path& path);
 
+// The text of a model file, with the FileErrors of load_model_file.
+std::string read_model_text(const std::filesystem::path& path);
+
 // The same for the text of a model file; `file_name` is used in the messages only.
 symbolic::Spec load_model_string(std::string_view text, std::string file_name);
 

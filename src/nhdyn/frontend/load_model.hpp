@@ -1,24 +1,35 @@
-// The loading API for C++ users and for the Python package: from the name of a built-in model, the
-// path of a model file or the text of one, to a numeric Model, with parameter overrides. The
-// symbolic front end (Spec, derivation, compilation; GiNaC) stays behind this header: it includes
-// no GiNaC, so a program that only loads and runs models never sees the compiler's types.
+// The front door: the one way from a source (the name of a built-in model, the path of a model
+// file or the text of one) to a numeric Model, with parameter overrides, for the CLI, the Python
+// package, the benchmarks, the fuzzer and the tests. The symbolic front end (Spec, derivation,
+// compilation; GiNaC) stays behind this header: it includes no GiNaC, so a program that only loads
+// and runs models never sees the compiler's types.
 //
 //     "examples/sled.toml" | "sled" | text --load_model--> Model --make_data--> Data
+//                                         \--load_model_described--> Model + ModelDescription
 //
-// Overrides replace a model file's parameter values before compilation. An override given as a
-// string is read as a number for now; when parameters become run-time data (issue 12 item 1,
-// set_parameter in model/), strings become expressions of numbers, constants and parameters.
+// What the compile of a model file produced (its Spec, derivation and scene) is kept, once, in a
+// shared immutable symbolic::ModelDescription beside the Model (LoadedModel); the commands that
+// show the equations, generate code or draw the report read it (frontend/describe.hpp) instead
+// of deriving again.
+//
+// Overrides replace a model file's parameter values before compilation (a built-in model's are
+// set on the Model: parameters are data, model/parameters.hpp). An override given as a string is
+// an expression in numbers, constants and the other parameters, as `--set NAME=EXPR`.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <variant>
 #include <vector>
 
-#include "nhdyn/analysis/linearization.hpp"
 #include "nhdyn/analysis/sweep.hpp"
 #include "nhdyn/model/model.hpp"
+
+namespace nhdyn::symbolic {
+class ModelDescription;  // symbolic/description.hpp (GiNaC): read through frontend/describe.hpp
+}
 
 namespace nhdyn {
 
@@ -26,6 +37,10 @@ namespace nhdyn {
 using ParameterValue = std::variant<double, std::string>;
 // In the order they are applied; a later override of the same name wins.
 using ParameterOverrides = std::vector<std::pair<std::string, ParameterValue>>;
+
+// The command line's `--set NAME=EXPR`, each as an override whose value is the text of EXPR;
+// throws InputError for one without '=' (model/parameters.hpp, split_parameter_set).
+ParameterOverrides parse_parameter_sets(const std::vector<std::string>& sets);
 
 // Where a model comes from, kept so that it can be loaded again (with other overrides, or on
 // another machine: the Python package's Dask workers rebuild models from it).
@@ -53,6 +68,29 @@ Model load_model(const std::string& source, const ParameterOverrides& overrides 
 Model load_model_text(std::string_view text, const std::string& file_name = "<string>",
                       const ParameterOverrides& overrides = {});
 
+// A model and what its compile produced.
+struct LoadedModel {
+  Model model;
+  // The Spec, derivation and scene of a model file, shared and immutable (symbolic/
+  // description.hpp, read through frontend/describe.hpp); null for a built-in model, which is
+  // written in C++ and has no symbolic form.
+  std::shared_ptr<const symbolic::ModelDescription> description;
+};
+
+// load_model, keeping the description: the derivation made for the compile is the one the
+// equations, the generated code and the report read. Throws like load_model.
+LoadedModel load_model_described(const ModelSource& source, const ParameterOverrides& overrides = {});
+
+// A command's MODEL argument with its `--set NAME=EXPR` options: read_model_source,
+// parse_parameter_sets, load_model_described.
+LoadedModel load_model_argument(const std::string& source, const std::vector<std::string>& sets);
+
+// The description of a model file alone, parsed with the overrides applied, nothing derived or
+// compiled yet (for commands that need only the equations). A built-in model is refused with the
+// path of its model file in examples/ (InputError).
+std::shared_ptr<const symbolic::ModelDescription> load_description(const ModelSource& source,
+                                                                   const ParameterOverrides& overrides = {});
+
 // One model per row of `values` (each row one value per name in `names`), with `overrides`
 // applied first; the model is loaded once and each row is a copy with its parameters set (no
 // recompilation, model/parameters.hpp). Used by batch runs over parameters. Throws like load_model, the message naming the row.
@@ -71,8 +109,8 @@ enum class EquationsFormat { text, latex };
 // LaTeX form is one align* environment. A built-in model is refused (no symbolic form).
 std::string model_equations(const ModelSource& source, const ParameterOverrides& overrides, EquationsFormat format);
 
-// The eigenvalue sweep of the model's linearization against one parameter (analysis/sweep.hpp);
-// options.parameter names it. The model is loaded once and its parameter set at every point.
+// calc_parameter_sweep (analysis/sweep.hpp) of the model loaded once: the options are checked
+// before the model is loaded.
 Sweep sweep_model_parameter(const ModelSource& source, const ParameterOverrides& overrides,
                             const SweepOptions& options);
 

@@ -1,4 +1,4 @@
-#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 
 #include <fmt/format.h>
 
@@ -10,13 +10,12 @@
 #include <sstream>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/model_file.hpp"
+#include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/model/builtin.hpp"
 #include "nhdyn/model/parameters.hpp"
-#include "nhdyn/symbolic/compile.hpp"
-#include "nhdyn/symbolic/derivation.hpp"
-#include "nhdyn/symbolic/equations.hpp"
+#include "nhdyn/frontend/describe.hpp"
+#include "nhdyn/symbolic/description.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 
 namespace nhdyn {
@@ -46,44 +45,62 @@ symbolic::Spec load_spec(const ModelSource& source, const ParameterOverrides& ov
   return spec;
 }
 
-void require_file(const ModelSource& source, const char* what) {
+// A built-in model has no Spec: refused with the path of its model file (and, when `what` is
+// given, what it therefore lacks).
+void require_file(const ModelSource& source, const char* what = nullptr) {
   if (source.is_builtin()) {
     const std::string file = source.builtin == "sled-paper" ? "sled_paper" : source.builtin;
-    throw InputError(fmt::format("'{}' is a built-in model written in C++, with no symbolic form, so it has "
-                                 "no {}; use its model file instead: examples/{}.toml",
-                                 source.builtin, what, file));
+    throw InputError(fmt::format("'{}' is a built-in model written in C++, with no symbolic form{}; use its model "
+                                 "file instead: examples/{}.toml",
+                                 source.builtin, what ? fmt::format(", so it has no {}", what) : "", file));
   }
 }
 
 }  // namespace
 
+ParameterOverrides parse_parameter_sets(const std::vector<std::string>& sets) {
+  ParameterOverrides overrides;
+  for (const std::string& set : sets) {
+    auto [name, expression] = split_parameter_set(set);
+    overrides.emplace_back(std::move(name), std::move(expression));
+  }
+  return overrides;
+}
+
 ModelSource read_model_source(const std::string& source) {
   if (is_builtin_model(source) && !looks_like_file(source)) return ModelSource{source, "", source};
   if (!looks_like_file(source)) make_builtin_model(source);  // throws, listing the built-in models
-  std::error_code ec;
-  if (std::filesystem::is_directory(source, ec))
-    throw FileError(fmt::format("{}: is a directory, not a model file", source));
-  std::ifstream in(source, std::ios::binary);
-  if (!in) throw FileError(fmt::format("{}: cannot read the model file (missing or no permission)", source));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw FileError(fmt::format("{}: cannot read the model file", source));
-  return ModelSource{"", text.str(), source};
+  return ModelSource{"", read_model_text(source), source};
 }
 
 ModelSource model_source_from_text(std::string text, std::string file_name) {
   return ModelSource{"", std::move(text), std::move(file_name)};
 }
 
-Model load_model(const ModelSource& source, const ParameterOverrides& overrides) {
+LoadedModel load_model_described(const ModelSource& source, const ParameterOverrides& overrides) {
   if (source.is_builtin()) {
     Model model = make_builtin_model(source.builtin);
     apply_parameter_sets(model, override_sets(overrides));  // parameters are data: no recompilation
-    return model;
+    return {std::move(model), nullptr};
   }
-  Model model = symbolic::compile_model(load_spec(source, overrides));
+  auto description = std::make_shared<const symbolic::ModelDescription>(load_spec(source, overrides));
+  Model model = description->compile();
   make_result_columns(model);  // refuses a derived output named like another column, at load time
-  return model;
+  return {std::move(model), std::move(description)};
+}
+
+LoadedModel load_model_argument(const std::string& source, const std::vector<std::string>& sets) {
+  return load_model_described(read_model_source(source), parse_parameter_sets(sets));
+}
+
+std::shared_ptr<const symbolic::ModelDescription> load_description(const ModelSource& source,
+                                                                   const ParameterOverrides& overrides) {
+  require_file(source);
+  return std::make_shared<const symbolic::ModelDescription>(load_spec(source, overrides));
+}
+
+Model load_model(const ModelSource& source, const ParameterOverrides& overrides) {
+  return load_model_described(source, overrides).model;
 }
 
 Model load_model(const std::string& source, const ParameterOverrides& overrides) {
@@ -131,26 +148,13 @@ std::vector<std::pair<std::string, double>> model_parameters(const ModelSource& 
 
 std::string model_equations(const ModelSource& source, const ParameterOverrides& overrides, EquationsFormat format) {
   require_file(source, "equations to show");
-  const symbolic::Spec spec = load_spec(source, overrides);
-  const symbolic::Derivation derivation = symbolic::derive(spec);
-  return symbolic::format_equations(spec, derivation,
-                                    format == EquationsFormat::latex ? symbolic::EquationFormat::latex
-                                                                     : symbolic::EquationFormat::text);
+  return format_model_equations(*load_description(source, overrides), format);
 }
 
 Sweep sweep_model_parameter(const ModelSource& source, const ParameterOverrides& overrides,
                             const SweepOptions& options) {
   check_sweep_options(options);
-  // Parameters are data: one model (a file's compiled once, or a built-in one), re-bound at every
-  // point.
-  Model base = load_model(source, overrides);
-  set_parameter(base, options.parameter, options.from);  // an unknown name throws, naming the nearest
-  const ModelAtValue model_at = [&](double value) {
-    Model model = base;
-    set_parameter(model, options.parameter, value);
-    return model;
-  };
-  return calc_eigenvalue_sweep(model_at, options);
+  return calc_parameter_sweep(load_model(source, overrides), options);
 }
 
 }  // namespace nhdyn

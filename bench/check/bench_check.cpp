@@ -1,0 +1,151 @@
+// The in-process half of `make bench-check` (scripts/bench-check runs it and the whole-process
+// pairs): paired ratios of two jobs measured in one process, A B A B ..., each pair's ratio
+// taken from CPU time of this thread, so that the machine's speed (shared, noisy) divides out.
+// Prints one line per ratio:
+//   NAME median min max A_median_seconds B_median_seconds
+// The ratios (the names are those of bench/baselines):
+//   bicycle_rhs_compiled_vs_interpreted  one right-hand side of examples/whipple_bicycle.toml
+//                                        (compute_dynamics: terms, then sanh with D from QR),
+//                                        compiled evaluator over interpreter
+//   bicycle_rows_1001_vs_2               simulate() 10 s of the bicycle (dopri5 at rtol 1e-10,
+//                                        atol 1e-12, a roll-rate kick of 0.5 rad/s) with every
+//                                        row filled and written as CSV (fill_result_row,
+//                                        CsvWriter): 1001 rows (output step 0.01 s) over 2 rows,
+//                                        interpreted
+//   bicycle_rows_1001_vs_2_compiled      the same with the compiled evaluator
+// The compiled object comes from the compiled evaluator's cache ($XDG_CACHE_HOME/nhdyn), so only
+// the first run on a machine pays the compiler.
+//   nhdyn_bench_check EXAMPLES_DIR [PAIRS]   (PAIRS: pairs per ratio, default 7)
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "nhdyn/analysis/simulation.hpp"
+#include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/io/csv.hpp"
+#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/io/results.hpp"
+#include "nhdyn/jit/compiled_evaluator.hpp"
+#include "nhdyn/model/data.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace nhdyn;
+
+double cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+double timed(const std::function<void()>& job) {
+  const double t0 = cpu_seconds();
+  job();
+  return cpu_seconds() - t0;
+}
+
+double median(std::vector<double> x) {
+  std::sort(x.begin(), x.end());
+  const std::size_t k = x.size() / 2;
+  return x.size() % 2 ? x[k] : 0.5 * (x[k - 1] + x[k]);
+}
+
+// One warm-up pair, then `pairs` pairs A B (the order alternates, so neither side always runs
+// second, after the other has warmed the caches).
+void pair(const std::string& name, int pairs, const std::function<void()>& a, const std::function<void()>& b) {
+  a();
+  b();
+  std::vector<double> ta, tb, ratio;
+  for (int i = 0; i < pairs; ++i) {
+    double x = 0, y = 0;
+    if (i % 2 == 0) {
+      x = timed(a);
+      y = timed(b);
+    } else {
+      y = timed(b);
+      x = timed(a);
+    }
+    ta.push_back(x);
+    tb.push_back(y);
+    ratio.push_back(x / y);
+  }
+  std::printf("%s %.4g %.4g %.4g %.4g %.4g\n", name.c_str(), median(ratio),
+              *std::min_element(ratio.begin(), ratio.end()), *std::max_element(ratio.begin(), ratio.end()),
+              median(ta), median(tb));
+  std::fflush(stdout);
+}
+
+void rhs_loop(const Model& model, Data& data, long calls) {
+  const FormulationOptions options{Method::sanh, Complement::qr};
+  for (long i = 0; i < calls; ++i) {
+    if (compute_dynamics(model, data, options, 0.0, model.q0.data(), model.v0.data()) != Status::ok) {
+      std::fprintf(stderr, "bench-check: compute_dynamics failed on the bicycle\n");
+      std::exit(1);
+    }
+  }
+}
+
+void run_with_rows(const Model& model, double output_step, const fs::path& csv) {
+  SimulationOptions options;
+  options.t_end = 10.0;
+  options.output_step = output_step;
+  options.formulation = {Method::sanh, Complement::qr};
+  options.integrator.kind = IntegratorKind::dopri5;
+  options.integrator.rtol = 1e-10;
+  options.integrator.atol = 1e-12;
+  const ResultColumns columns = make_result_columns(model);
+  CsvWriter writer(csv, columns.all);
+  std::vector<double> row(columns.all.size());
+  const SimulationSummary summary = simulate(model, options, [&](const Data& data) {
+    fill_result_row(model, data, row);
+    writer.write_row(row);
+  });
+  if (summary.status != Status::ok) {
+    std::fprintf(stderr, "bench-check: the bicycle run failed: %s\n", summary.message.c_str());
+    std::exit(1);
+  }
+  writer.commit();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: nhdyn_bench_check EXAMPLES_DIR [PAIRS]\n");
+    return 2;
+  }
+  const fs::path examples = argv[1];
+  const int pairs = argc > 2 ? std::max(1, std::atoi(argv[2])) : 7;
+  try {
+    Model interpreted = load_model((examples / "whipple_bicycle.toml").string());
+    const auto phi = std::find(interpreted.coordinates.begin(), interpreted.coordinates.end(), "phi") -
+                     interpreted.coordinates.begin();
+    interpreted.v0[phi] = 0.5;
+    const Model compiled = jit::make_compiled(interpreted);
+
+    Data di = make_data(interpreted), dc = make_data(compiled);
+    pair("bicycle_rhs_compiled_vs_interpreted", pairs, [&] { rhs_loop(compiled, dc, 20000); },
+         [&] { rhs_loop(interpreted, di, 20000); });
+
+    const fs::path dir = fs::temp_directory_path() / ("nhdyn-bench-check-" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path csv = dir / "rows.csv";
+    pair("bicycle_rows_1001_vs_2", pairs, [&] { run_with_rows(interpreted, 0.01, csv); },
+         [&] { run_with_rows(interpreted, 10.0, csv); });
+    pair("bicycle_rows_1001_vs_2_compiled", pairs, [&] { run_with_rows(compiled, 0.01, csv); },
+         [&] { run_with_rows(compiled, 10.0, csv); });
+    fs::remove_all(dir);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench-check: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
