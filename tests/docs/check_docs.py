@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Keeps the docs true to the program: quoted outputs are checked against real runs, and the
-README's example commands are run.
+example commands of the README and docs/ are run.
 
 Quoted outputs. A fenced block that shows what a command prints is preceded by a marker naming
 the command, on the line right before the fence (indented like it):
@@ -26,15 +26,19 @@ Nothing else varies: the runs are deterministic, so every other figure, path and
 compared as written. Commands that take long (more than about a second on a loaded 2-core
 machine) are not marked: the whole check must stay well under a minute of CPU.
 
-Example commands. With --examples, every line of the README's indented code blocks that starts
-with `build/apps/nhdyn/nhdyn ` (run as `nhdyn ...`) or `mkdir ` is run in order, in one empty
-temporary directory per block (with `examples` linked as above), and must exit with 0. Lines with
---plot are skipped when gnuplot is not installed.
+Example commands. With --examples, the example commands of the README and docs/ run in order, in
+one empty temporary directory per README block or docs page (with `examples` linked as above),
+and must exit with 0: the README's lines `build/apps/nhdyn/nhdyn ...` (run as `nhdyn ...`) and
+`mkdir ...` of its indented blocks; in docs/, the lines `nhdyn ...` and `mkdir ...` of indented
+blocks and of ```text blocks that hold commands only (see docs_examples). Left out: synopsis lines
+(MODEL, FILE, [--option], <name>, ...), commands writing into the source tree's docs/ (the
+figures), the ```sh blocks of docs/cli.md (tests/cli runs those, with their exit codes), and
+lines with --plot when gnuplot is not installed.
 
 Usage:
     check_docs.py --nhdyn build/apps/nhdyn/nhdyn              # check the quoted outputs
     check_docs.py --nhdyn build/apps/nhdyn/nhdyn --update     # rewrite them from real runs
-    check_docs.py --nhdyn build/apps/nhdyn/nhdyn --examples   # run the README's examples
+    check_docs.py --nhdyn build/apps/nhdyn/nhdyn --examples   # run the example commands
 `make docs-update` runs the second; ctest runs the first and the third (label `docs`).
 """
 
@@ -166,6 +170,11 @@ def check_outputs(source, nhdyn, update):
     return count, failures
 
 
+# A synopsis line, not a command: placeholders (MODEL, FILE.csv, [--opt], <name>, ...) or a line
+# continued on the next. And commands that write into the source tree's docs/ (the figures).
+SYNOPSIS = re.compile(r"\[|<[A-Za-z]|\.\.\.|\b(MODEL|FILE|NAME|N|R|A,A)\b|my_model|\\$|docs/")
+
+
 def readme_examples(source):
     """The README's example commands: [(line, command)] per indented code block."""
     blocks, current = [], []
@@ -188,10 +197,42 @@ def readme_examples(source):
     return blocks
 
 
+def docs_examples(path):
+    """The commands of a page of docs/: the lines `nhdyn ...` and `mkdir ...` of its indented code
+    blocks and of its ```text blocks that hold commands only (not the quoted outputs after a check
+    marker), synopsis lines left out. The ```sh blocks of docs/cli.md are run by the test
+    CliDocs.EveryExampleInCliMdRunsAsDocumented (tests/cli/cli_test.cpp), with their exit codes."""
+    lines = path.read_text(encoding="utf-8").split("\n")
+    commands, i = [], 0
+    while i < len(lines):
+        text = lines[i]
+        if text.strip().startswith("```"):
+            end = i + 1
+            while end < len(lines) and lines[end].strip() != "```":
+                end += 1
+            body = [(n + 1, lines[n]) for n in range(i + 1, min(end, len(lines))) if lines[n].strip()]
+            marked = i > 0 and MARKER.match(lines[i - 1])
+            if (text.strip() == "```text" and not marked and body and
+                    all(l.startswith(("nhdyn ", "mkdir ")) for _, l in body)):
+                commands += [(n, l) for n, l in body if not SYNOPSIS.search(l)]
+            i = end + 1
+            continue
+        command = text[4:] if text.startswith("    ") else ""
+        if command.startswith(("nhdyn ", "mkdir ")) and not SYNOPSIS.search(command):
+            commands.append((i + 1, command))
+        i += 1
+    return commands
+
+
 def check_examples(source, nhdyn):
     failures, count = [], 0
     have_gnuplot = shutil.which("gnuplot") is not None
-    for block in readme_examples(source):
+    blocks = [("README.md", block) for block in readme_examples(source)]
+    for path in sorted((source / "docs").rglob("*.md")):
+        commands = docs_examples(path)
+        if any(c.startswith("nhdyn ") for _, c in commands):
+            blocks.append((str(path.relative_to(source)), commands))
+    for name, block in blocks:
         workdir = fresh_directory(source)
         try:
             for line, command in block:
@@ -200,7 +241,7 @@ def check_examples(source, nhdyn):
                 count += 1
                 code, out = run(command, workdir, nhdyn)
                 if code != 0:
-                    failures.append(f"README.md:{line}: {command}\n  exit code {code}; it printed:\n{out}")
+                    failures.append(f"{name}:{line}: {command}\n  exit code {code}; it printed:\n{out}")
         finally:
             shutil.rmtree(workdir, ignore_errors=True)
     return count, failures
@@ -212,7 +253,7 @@ def main():
     parser.add_argument("--source", default=str(Path(__file__).resolve().parents[2]),
                         help="the source tree (default: the one holding this script)")
     parser.add_argument("--update", action="store_true", help="rewrite the quoted outputs that differ")
-    parser.add_argument("--examples", action="store_true", help="run the README's example commands")
+    parser.add_argument("--examples", action="store_true", help="run the example commands of the README and docs/")
     args = parser.parse_args()
     source = Path(args.source).resolve()
     if not Path(args.nhdyn).is_file():
@@ -221,7 +262,7 @@ def main():
         return 2
     if args.examples:
         count, failures = check_examples(source, args.nhdyn)
-        what = "README example commands"
+        what = "example commands"
     else:
         count, failures = check_outputs(source, args.nhdyn, args.update)
         what = "quoted outputs"
