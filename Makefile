@@ -12,13 +12,14 @@
 #               when one is more than 1.5x its baseline; about 40 s on 2 busy cores)
 #   make bench-update  the same, and rewrites docs/performance.md's table (BASELINES=1: and
 #               bench/baselines)
+#   make package  the Debian package build/nhdyn_VERSION_ARCH.deb (CPack; docs/install.md)
 #   make docs-update  rewrite the quoted outputs of README.md and docs/ from real runs
 BUILD ?= build
 JOBS ?= $(shell nproc)
 MODEL ?= examples/sled.toml
 NAME ?= sled
 
-.PHONY: run test build configure configure-run deps deps-run bench bench-check bench-update python asan fuzz clean docs-update
+.PHONY: run test build configure configure-run deps deps-run bench bench-check bench-update python package asan fuzz clean docs-update
 
 deps:
 	@bash scripts/install-deps
@@ -58,6 +59,9 @@ python: configure
 docs-update: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_cli
 	python3 tests/docs/check_docs.py --nhdyn $(BUILD)/apps/nhdyn/nhdyn --update
+
+package: build
+	cd $(BUILD) && cpack -G DEB
 
 bench: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_bench

@@ -3,11 +3,14 @@
 
 #include "bindings.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/version.hpp"
 
 namespace py = pybind11;
 
 PYBIND11_MODULE(_nhdyn, m) {
   m.doc() = "nhdyn: equations of motion of constrained mechanical systems (C++ core; use the package nhdyn)";
+  m.attr("__version__") = NHDYN_VERSION;
+  m.attr("__git_commit__") = NHDYN_GIT_COMMIT;
   // nhdyn::Error and its subclasses keep their C++ names and messages; InputError and ModelError
   // are also ValueErrors and FileError an OSError, so generic Python handlers catch them.
   static py::exception<nhdyn::Error> error(m, "Error", PyExc_Exception);

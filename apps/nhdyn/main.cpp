@@ -11,6 +11,7 @@
 
 #include "commands.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/version.hpp"
 #include "outputs.hpp"
 
 namespace nhdyn::cli {
@@ -45,6 +46,7 @@ constexpr Subcommand kSubcommands[] = {
 int main(int argc, char** argv) {
   CLI::App app{"nhdyn: equations of motion of constrained mechanical systems (Do Sanh form)", "nhdyn"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", fmt::format("nhdyn {} (commit {})", NHDYN_VERSION, NHDYN_GIT_COMMIT));
   std::vector<std::function<int()>> runs;
   std::string names;
   for (const nhdyn::cli::Subcommand& command : nhdyn::cli::kSubcommands) {

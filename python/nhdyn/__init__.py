@@ -12,16 +12,53 @@ subclasses InputError, ModelError, FileError) with the library's message (file:l
 See docs/python.md.
 """
 
+import os
+import sys
+import sysconfig
 import warnings
 from collections.abc import MutableMapping
 
-import numpy as np
+from . import _build_info
 
-from . import _nhdyn
+
+def _wrong_interpreter(reason):
+    """The ImportError for an interpreter other than the one nhdyn was built for: which one it was
+    built for, which one this is, and the two ways out."""
+    here = "Python {}.{} ({}, extension suffix {})".format(
+        sys.version_info[0], sys.version_info[1], sys.executable, sysconfig.get_config_var("EXT_SUFFIX"))
+    return ImportError(
+        "nhdyn {v} was built for Python {bv} ({bexe}, extension suffix {bs}) but is imported by {here}: {reason}. "
+        "Run it with {bexe} (or a venv made from it with --system-site-packages), or build nhdyn for this "
+        "interpreter (pip install . with it, or cmake -DPYTHON_EXECUTABLE={exe}); docs/python.md".format(
+            v=_build_info.version, bv=_build_info.python_version, bexe=_build_info.python_executable,
+            bs=_build_info.extension_suffix, here=here, reason=reason, exe=sys.executable))
+
+
+def _is_built_for_interpreter():
+    """This is the very interpreter nhdyn was built for (not a venv or a pyenv beside it)."""
+    built = os.path.realpath(_build_info.python_executable)
+    return os.path.realpath(sys.executable) == built and sys.prefix == sys.base_prefix
+
+
+if sysconfig.get_config_var("EXT_SUFFIX") != _build_info.extension_suffix:
+    raise _wrong_interpreter("its compiled module nhdyn/_nhdyn{} cannot be loaded by this interpreter".format(
+        _build_info.extension_suffix))
+try:
+    import numpy as np
+
+    from . import _nhdyn
+except ImportError as error:
+    if _is_built_for_interpreter():
+        raise
+    # The same ABI but another installation (a pyenv or a venv without the system's packages):
+    # the missing piece is usually NumPy, which Debian installs for its own interpreter only.
+    raise _wrong_interpreter(str(error)) from error
 from ._nhdyn import Error, FileError, InputError, ModelError, SimulationError
 
+__version__ = _nhdyn.__version__
+
 __all__ = [
-    "Error", "InputError", "ModelError", "FileError", "SimulationError", "ConstraintWarning",
+    "__version__", "Error", "InputError", "ModelError", "FileError", "SimulationError", "ConstraintWarning",
     "load", "loads", "builtin_models", "Model", "Result", "Equations", "Linearization", "Sweep",
     "BatchResult", "simulate_batch",
 ]
