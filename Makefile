@@ -13,12 +13,13 @@
 #   make bench-update  the same, and rewrites docs/performance.md's table (BASELINES=1: and
 #               bench/baselines)
 #   make package  the Debian package build/nhdyn_VERSION_ARCH.deb (CPack; docs/install.md)
+#   make docs-update  rewrite the quoted outputs of README.md and docs/ from real runs
 BUILD ?= build
 JOBS ?= $(shell nproc)
 MODEL ?= examples/sled.toml
 NAME ?= sled
 
-.PHONY: run test build configure configure-run deps deps-run bench bench-check bench-update python package asan fuzz clean
+.PHONY: run test build configure configure-run deps deps-run bench bench-check bench-update python package asan fuzz clean docs-update
 
 deps:
 	@bash scripts/install-deps
@@ -52,6 +53,12 @@ test: build
 python: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_python
 	@echo "export PYTHONPATH=$(abspath $(BUILD))/python   # then: /usr/bin/python3 -c 'import nhdyn'"
+
+# The fenced blocks after a `<!-- check: COMMAND -->` line show what COMMAND prints: this rewrites
+# those that differ from a real run; ctest checks them (tests/docs/check_docs.py, label docs).
+docs-update: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_cli
+	python3 tests/docs/check_docs.py --nhdyn $(BUILD)/apps/nhdyn/nhdyn --update
 
 package: build
 	cd $(BUILD) && cpack -G DEB
