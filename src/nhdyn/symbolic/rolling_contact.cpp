@@ -339,7 +339,9 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
                                     "place the body's frame so that it touches the ground",
                                     contact_printed(gap)));
     out.constraints.push_back({c.name + "_contact", ConstraintLevel::position, gap,
-                               fmt::format("contact '{}': the gap between the body and the ground = 0", c.name)});
+                               fmt::format("contact '{}': the gap between the body and the ground = 0 (its position residual is the "
+                                           "gap, in length units; --fix-initial moves the body onto the ground)",
+                                           c.name)});
   }
   // Rolling: the material point of the body at P has the ground's velocity there (section 4.2).
   const Vector3 vP = add(time_derivative(F.origin, spec.symbols), cross(F.omega, subtract(touch.point, F.origin)));
