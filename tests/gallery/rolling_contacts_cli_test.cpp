@@ -66,7 +66,7 @@ TEST(RollingContactsCli, NotTouchingAtTheStartGivesTheGap) {
   // -0.00999758 m.
   const nhdyn::test::CliOutcome outcome =
       simulate_altered("gap", "z = \"Rb - sqrt((Rb - r)^2 - x0^2)\"", "z = \"Rb - sqrt((Rb - r)^2 - x0^2) - 0.01\"");
-  expect_refused(outcome, {"ball_contact (position level, bowl.toml:35:1): residual -0.00999758",
+  expect_refused(outcome, {"ball_contact (position level): residual -0.00999758 (bowl.toml:35:1)",
                            "the gap between the body and the ground", "--fix-initial"});
   // --fix-initial moves it onto the wall.
   const fs::path dir = fs::temp_directory_path() / "nhdyn_rolling_gap";

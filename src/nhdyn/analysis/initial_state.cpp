@@ -88,11 +88,11 @@ void check_initial_state(const Model& model, Data& data, double t, const Vector&
     std::string where, says;
     for (const Constraint& c : model.constraints)
       if (c.name == r.constraint) {
-        if (!c.where.empty()) where = ", " + c.where;
+        if (!c.where.empty()) where = " (" + c.where + ")";
         if (c.expression.rfind("contact '", 0) == 0) says = ": " + c.expression;
       }
-    report += fmt::format("\n  {} ({} level{}): residual {:.6g}{}", r.constraint,
-                          r.level == ConstraintLevel::position ? "position" : "velocity", where, r.value, says);
+    report += fmt::format("\n  {} ({} level): residual {:.6g}{}{}", r.constraint,
+                          r.level == ConstraintLevel::position ? "position" : "velocity", r.value, where, says);
   }
   if (!report.empty())
     throw ModelError(fmt::format("model '{}': the initial state violates its constraints (tolerance {:g}):{}\n"

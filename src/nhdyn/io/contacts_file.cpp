@@ -10,7 +10,9 @@
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/core/suggest.hpp"
 #include "nhdyn/symbolic/contact_shapes.hpp"
+#include "nhdyn/symbolic/multibody.hpp"
 #include "nhdyn/symbolic/rolling_contact.hpp"
+#include "nhdyn/symbolic/visual.hpp"
 
 namespace nhdyn {
 namespace {

@@ -12,8 +12,13 @@
 
 #include <toml++/toml.h>
 
-#include "nhdyn/symbolic/multibody.hpp"
-#include "nhdyn/symbolic/visual.hpp"
+// Declared only: this header stays free of GiNaC (tests/layering).
+namespace nhdyn::symbolic {
+class MultibodyBuilder;
+struct PlacedFrame;
+struct SourceLocation;
+struct SpecVisual;
+}  // namespace nhdyn::symbolic
 
 namespace nhdyn {
 
