@@ -17,7 +17,7 @@ ModelEventFunctions::ModelEventFunctions(const Model& model, const std::vector<c
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
   int registers = 0;
-  contact_columns_ = model.contact_forces ? model.contact_forces->reported() * kContactComponents : 0;
+  contact_columns_ = model.contact_forces ? model.contact_forces->values() : 0;
   for (const Event* event : events_) {
     if (event->contact_forces && contact_columns_ == 0)
       throw InputError(fmt::format("event '{}' reads contact forces, but model '{}' has none (only the wheels and knife "

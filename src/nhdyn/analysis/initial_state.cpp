@@ -82,10 +82,18 @@ InitialFix fix_initial_state(const Model& model, Data& data, double t, const Vec
 void check_initial_state(const Model& model, Data& data, double t, const Vector& q, const Vector& v,
                          double tolerance) {
   std::string report;
-  for (const ConstraintResidual& r : calc_initial_residuals(model, data, t, q, v))
-    if (!(std::abs(r.value) <= tolerance))
-      report += fmt::format("\n  {} ({} level): residual {:.6g}", r.constraint,
-                            r.level == ConstraintLevel::position ? "position" : "velocity", r.value);
+  for (const ConstraintResidual& r : calc_initial_residuals(model, data, t, q, v)) {
+    if (std::abs(r.value) <= tolerance) continue;
+    // Where it was written, and what it says when that is more than its name (a contact's gap).
+    std::string where, says;
+    for (const Constraint& c : model.constraints)
+      if (c.name == r.constraint) {
+        if (!c.where.empty()) where = " (" + c.where + ")";
+        if (c.expression.rfind("contact '", 0) == 0) says = ": " + c.expression;
+      }
+    report += fmt::format("\n  {} ({} level): residual {:.6g}{}{}", r.constraint,
+                          r.level == ConstraintLevel::position ? "position" : "velocity", r.value, where, says);
+  }
   if (!report.empty())
     throw ModelError(fmt::format("model '{}': the initial state violates its constraints (tolerance {:g}):{}\n"
                                  "Correct the initial values, or run with --fix-initial to move them onto the "

@@ -30,6 +30,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/frontend/contacts_file.hpp"
 #include "nhdyn/integrators/ode.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/multibody.hpp"
@@ -51,7 +52,7 @@ const std::vector<std::string> top_level_keys = {
     "events",  // [[events]]: zero crossings located during a run
     "outputs",  // [outputs]: derived result columns
     // The multibody description (docs/multibody.md).
-    "gravity", "frames", "points", "bodies", "wheels", "knife_edges", "surfaces", "curves"};
+    "gravity", "frames", "points", "bodies", "wheels", "knife_edges", "surfaces", "curves", "contacts"};
 const std::vector<std::string> frame_keys = {"name", "parent", "translation", "rotations"};
 const std::vector<std::string> point_keys = {"name", "frame", "position"};
 const std::vector<std::string> body_keys = {"name", "frame", "mass", "com", "inertia"};
@@ -913,7 +914,7 @@ class Loader {
 
   void load_multibody(const toml::table& root, SpecBuilder& builder, symbolic::SpecVisual& visual) const {
     bool any = false;
-    for (const char* key : {"gravity", "frames", "points", "bodies", "wheels", "knife_edges", "surfaces", "curves"})
+    for (const char* key : {"gravity", "frames", "points", "bodies", "wheels", "knife_edges", "surfaces", "curves", "contacts"})
       any = any || root.get(key) != nullptr;
     if (!any) return;
     symbolic::MultibodyBuilder mb(builder);
@@ -1046,6 +1047,8 @@ class Loader {
                           expression_string(*array.get(0), what + ": surfaces[1]", example),
                           expression_string(*array.get(1), what + ": surfaces[2]", example), at(node));
       }
+    if (const toml::node* contacts = root.get("contacts"))
+      load_contacts(*contacts, mb, visual, body_frames, [this](const toml::node& node) { return at(node); });
     mb.apply();
     // Every point's and frame origin's world position and velocity as result columns.
     symbolic::add_multibody_outputs(builder, mb, frame_names, point_names);

@@ -64,16 +64,19 @@ void force_of(const ContactForceModel& c, const ContactForceContact& contact, co
 // The coefficients over the unknowns of output `component` of a reported contact (`index` among
 // the reported ones): which combination of x the output is.
 void functional(const ContactForceModel& c, const ContactForceContact& contact, int index, const double* o,
-                int component, Vector& coefficients) {
+                ContactComponent component, Vector& coefficients) {
   coefficients.setZero();
   const double* basis = o + c.direction_offset(index);  // n, e_long, e_lat
   for (int k = 0; k < contact.unknowns; ++k) {
     const int u = contact.first_unknown + k;
     const double* d = o + c.unknown_offset(u) + c.n + 6;
-    if (component < 3) {
-      coefficients(u) = d[component];
+    const int which = static_cast<int>(component);
+    if (component == ContactComponent::Mspin) {
+      coefficients(u) = u == contact.spin_unknown ? 1.0 : 0.0;
+    } else if (which < 3) {
+      coefficients(u) = d[which];
     } else {
-      const double* e = basis + 3 * (component - 3);
+      const double* e = basis + 3 * (which - 3);
       coefficients(u) = e[0] * d[0] + e[1] * d[1] + e[2] * d[2];
     }
   }
@@ -81,14 +84,31 @@ void functional(const ContactForceModel& c, const ContactForceContact& contact, 
 
 }  // namespace
 
-const char* contact_component_name(int component) {
-  static const char* const names[kContactComponents] = {"Fx", "Fy", "Fz", "N", "Flong", "Flat"};
-  return component >= 0 && component < kContactComponents ? names[component] : "?";
+const char* contact_component_name(ContactComponent component) {
+  static const char* const names[kContactComponentKinds] = {"Fx", "Fy", "Fz", "N", "Flong", "Flat", "Mspin"};
+  const int k = static_cast<int>(component);
+  return k >= 0 && k < kContactComponentKinds ? names[k] : "?";
+}
+
+std::vector<ContactComponent> contact_components(ContactKind kind, bool spin) {
+  using C = ContactComponent;
+  if (kind == ContactKind::rolling) {
+    std::vector<C> out = {C::Fx, C::Fy, C::Fz, C::N};
+    if (spin) out.push_back(C::Mspin);
+    return out;
+  }
+  return {C::Fx, C::Fy, C::Fz, C::N, C::Flong, C::Flat};
 }
 
 int ContactForceModel::reported() const {
   int count = 0;
   for (const ContactForceContact& c : contacts) count += c.reported ? 1 : 0;
+  return count;
+}
+
+int ContactForceModel::values() const {
+  int count = 0;
+  for (const ContactForceContact& c : contacts) count += c.reported ? static_cast<int>(c.components.size()) : 0;
   return count;
 }
 
@@ -112,7 +132,7 @@ ContactForceData make_contact_force_data(const Model& model) {
   w.work = Vector::Zero(c.rows());
   w.misfit = Vector::Zero(c.rows());
   w.qr = Eigen::ColPivHouseholderQR<Matrix>(c.rows(), c.columns());
-  w.values = Vector::Constant(kContactComponents * c.reported(), kNaN);
+  w.values = Vector::Constant(c.values(), kNaN);
   return w;
 }
 
@@ -151,16 +171,19 @@ void compute_contact_forces(const Model& model, Data& data) {
     double F[3];
     force_of(c, contact, o, w.x.data(), F);
     const double* basis = o + c.direction_offset(index);
-    double* out = w.values.data() + kContactComponents * index;
-    out[0] = F[0];
-    out[1] = F[1];
-    out[2] = F[2];
-    for (int k = 0; k < 3; ++k) {
-      const double* e = basis + 3 * k;
-      out[3 + k] = e[0] * F[0] + e[1] * F[1] + e[2] * F[2];
+    double* out = w.values.data() + contact.first_value;
+    for (std::size_t j = 0; j < contact.components.size(); ++j) {
+      const int k = static_cast<int>(contact.components[j]);
+      if (contact.components[j] == ContactComponent::Mspin) {
+        out[j] = w.x(contact.spin_unknown);
+      } else if (k < 3) {
+        out[j] = F[k];
+      } else {
+        const double* e = basis + 3 * (k - 3);
+        out[j] = e[0] * F[0] + e[1] * F[1] + e[2] * F[2];
+      }
+      if (!c.determined[static_cast<std::size_t>(contact.first_value) + j]) out[j] = kNaN;
     }
-    for (int k = 0; k < kContactComponents; ++k)
-      if (!c.determined[static_cast<std::size_t>(kContactComponents * index + k)]) out[k] = kNaN;
     ++index;
   }
 }
@@ -170,7 +193,7 @@ std::vector<std::string> contact_force_columns(const Model& model) {
   if (!model.contact_forces) return columns;
   for (const ContactForceContact& c : model.contact_forces->contacts)
     if (c.reported)
-      for (int k = 0; k < kContactComponents; ++k) columns.push_back(c.name + "_" + contact_component_name(k));
+      for (ContactComponent k : c.components) columns.push_back(c.name + "_" + contact_component_name(k));
   columns.push_back("contact_residual");
   return columns;
 }
@@ -185,7 +208,7 @@ void append_contact_force_values(const Model& model, const Data& data, std::vect
 void analyse_contact_forces(const Model& model, ContactForceModel& c) {
   const int n = model.n();
   const int s = model.s();
-  c.determined.assign(static_cast<std::size_t>(kContactComponents * c.reported()), 1);
+  c.determined.assign(static_cast<std::size_t>(c.values()), 1);
   // A generic state near the initial one (fixed shifts: the same model gives the same verdict).
   Vector q = model.q0, v = model.v0;
   for (int i = 0; i < n; ++i) {
@@ -271,13 +294,14 @@ void analyse_contact_forces(const Model& model, ContactForceModel& c) {
   for (const ContactForceContact& contact : c.contacts) {
     if (!contact.reported) continue;
     std::string missing;
-    for (int component = 0; component < kContactComponents; ++component) {
+    for (std::size_t j = 0; j < contact.components.size(); ++j) {
+      const ContactComponent component = contact.components[j];
       functional(c, contact, index, o, component, coefficients);
       const double size = coefficients.norm();
       bool determined = true;
       for (int j : null_columns)
         if (std::abs(coefficients.dot(svd.matrixV().col(j))) > kDetermined * std::max(size, 1.0)) determined = false;
-      c.determined[static_cast<std::size_t>(kContactComponents * index + component)] = determined ? 1 : 0;
+      c.determined[static_cast<std::size_t>(contact.first_value) + j] = determined ? 1 : 0;
       if (!determined) missing += fmt::format("{}{}_{}", missing.empty() ? "" : ", ", contact.name, contact_component_name(component));
     }
     if (!missing.empty()) {

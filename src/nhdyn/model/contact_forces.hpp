@@ -29,11 +29,17 @@ namespace nhdyn {
 struct Model;
 struct Data;
 
-enum class ContactKind { wheel, knife_edge, surface, curve };
+// rolling: a convex body of [[contacts]] (docs/derivations/rolling-bodies.md).
+enum class ContactKind { wheel, knife_edge, surface, curve, rolling };
 
-// The output components of a reported contact, in the order of its CSV columns.
-inline constexpr int kContactComponents = 6;  // Fx, Fy, Fz (world), N, Flong, Flat
-const char* contact_component_name(int component);  // "Fx", ..., "Flat"
+// An output component of a reported contact: the world force, its parts along the ground's normal
+// n and (wheels, knife edges) e_long, e_lat, and the spin moment about n of rubber rolling.
+enum class ContactComponent { Fx, Fy, Fz, N, Flong, Flat, Mspin };
+inline constexpr int kContactComponentKinds = 7;
+const char* contact_component_name(ContactComponent component);  // "Fx", ..., "Mspin"
+// The columns of a contact, in order: a wheel or knife edge Fx, Fy, Fz, N, Flong, Flat; a rolling
+// body Fx, Fy, Fz, N, and Mspin with `spin` (rubber rolling).
+std::vector<ContactComponent> contact_components(ContactKind kind, bool spin);
 
 // One contact of the stacked system: its unknowns are the magnitudes along `unknowns` world
 // directions (3 for a wheel, a point on a surface or curve: the force's world components; 2 for a
@@ -45,6 +51,11 @@ struct ContactForceContact {
   int first_unknown = 0;  // index of its first unknown among all unknowns
   int unknowns = 3;
   int system = 0;         // the connected system it supports
+  // The unknown that is a moment about n (rubber rolling's spin moment: its direction entries are
+  // zero, it is no force), or -1.
+  int spin_unknown = -1;
+  std::vector<ContactComponent> components;  // its columns when reported
+  int first_value = 0;    // index of its first column in ContactForceData::values
 };
 
 // Frozen at load. The program's outputs, in this order:
@@ -71,8 +82,8 @@ struct ContactForceModel {
   // consistent with (C1) (a body held by its coordinates) or the model has forces or energies the
   // bodies do not describe.
   std::vector<char> balance_rows;
-  // Per reported contact (in the order of `contacts` that are reported), kContactComponents
-  // flags: whether the model determines that component (else it is NaN).
+  // Per reported contact (in the order of `contacts` that are reported), one flag per component
+  // (at its first_value): whether the model determines that component (else it is NaN).
   std::vector<char> determined;
   Program program;             // parametric: reads the model's parameters (bound by make_data)
   // `program` compiled (jit::make_compiled), run in its place when set; null for the interpreter.
@@ -83,6 +94,7 @@ struct ContactForceModel {
   int rows() const { return n + 6 * systems; }
   int columns() const { return unknowns + hand_constraints; }
   int reported() const;
+  int values() const;  // the number of result columns of the reported contacts
   // Offsets of the program's outputs.
   int unknown_offset(int u) const { return u * (n + 9); }
   int system_offset(int s) const { return unknowns * (n + 9) + s * (6 * n + 6); }
@@ -105,8 +117,8 @@ struct ContactForceData {
   Vector work;               // rows(), Q^T rhs
   Vector misfit;             // rows(), M F - rhs
   Eigen::ColPivHouseholderQR<Matrix> qr;
-  // Results: per reported contact, Fx, Fy, Fz [N] (world), N, Flong, Flat [N]; NaN where not
-  // determined (ContactForceModel::determined).
+  // Results: per reported contact, its components (Fx, Fy, Fz [N] world, N, Flong, Flat [N],
+  // Mspin [N m]); NaN where not determined (ContactForceModel::determined).
   Vector values;
   double residual = 0.0;     // |M F - rhs| / |rhs|: round-off when the model determines the forces
 };
@@ -119,8 +131,8 @@ ContactForceData make_contact_force_data(const Model& model);
 // system's momentum balance). Throws std::logic_error when called before the accelerations.
 void compute_contact_forces(const Model& model, Data& data);
 
-// The CSV columns: NAME_Fx, NAME_Fy, NAME_Fz, NAME_N, NAME_Flong, NAME_Flat per reported contact,
-// then contact_residual. Empty for a model without contact forces.
+// The CSV columns: NAME_Fx, NAME_Fy, NAME_Fz, NAME_N, NAME_Flong, NAME_Flat per reported wheel or
+// knife edge, NAME_Fx ... NAME_N (NAME_Mspin) per rolling body, then contact_residual. Empty for a model without contact forces.
 std::vector<std::string> contact_force_columns(const Model& model);
 // Appends the values of those columns (after compute_contact_forces).
 void append_contact_force_values(const Model& model, const Data& data, std::vector<double>& row);

@@ -39,6 +39,7 @@ struct Constraint {
   std::string name;
   ConstraintLevel level = ConstraintLevel::velocity;
   std::string expression;  // as a user reads it, e.g. "y' - tan(phi) x' = 0"
+  std::string where = {};  // "file:line:column" where it was written (model files), else ""
 };
 
 // A program (docs/derivations/program-motion.md): a constraint the motion must follow that no

@@ -974,7 +974,7 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
   model.name = spec.name;
   model.description = spec.description;
   model.coordinates = spec.coordinates;
-  for (const SpecConstraint& c : spec.constraints) model.constraints.push_back({c.name, c.level, c.text});
+  for (const SpecConstraint& c : spec.constraints) model.constraints.push_back({c.name, c.level, c.text, c.where.describe()});
   for (const SpecParameter& p : spec.parameters) model.parameters.push_back({p.name, p.value, p.unit, p.expression});
   // The derived values by the evaluator the Model uses later (parameters.hpp), so that a model
   // compiled with a value and one set to it at run time compute with the same bits.

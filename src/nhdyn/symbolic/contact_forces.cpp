@@ -79,15 +79,21 @@ void compile_contact_forces(const Spec& spec, Model& model) {
   c.hand_constraints = static_cast<int>(hand.size());
 
   std::vector<GiNaC::ex> outputs;
+  int values = 0;  // result columns so far
   // Per contact and unknown: J^T d (n), E d (6), d (3).
   for (const ContactPoint& p : in.contacts) {
     ContactForceContact contact;
     contact.name = p.name;
     contact.kind = p.kind;
-    contact.reported = p.kind == ContactKind::wheel || p.kind == ContactKind::knife_edge;
+    contact.reported = p.kind == ContactKind::wheel || p.kind == ContactKind::knife_edge || p.kind == ContactKind::rolling;
     contact.first_unknown = c.unknowns;
-    contact.unknowns = static_cast<int>(p.directions.size());
+    contact.unknowns = static_cast<int>(p.directions.size()) + (p.spin ? 1 : 0);
     contact.system = std::max(p.system, 0);
+    if (contact.reported) {
+      contact.components = contact_components(p.kind, p.spin);
+      contact.first_value = values;
+      values += static_cast<int>(contact.components.size());
+    }
     const Vector3 arm =
         p.system >= 0 ? subtract(p.point, in.origins[static_cast<std::size_t>(p.system)]) : Vector3{0, 0, 0};
     for (const Vector3& d : p.directions) {
@@ -100,6 +106,18 @@ void compile_contact_forces(const Spec& spec, Model& model) {
         for (int r = 0; r < 6; ++r) outputs.push_back(0);
       }
       append(outputs, d);
+      c.unknown_system.push_back(contact.system);
+      ++c.unknowns;
+    }
+    if (p.spin) {
+      // A pure moment M n: its column (d omega/d q')^T n in (C1), [0; n / L] in (C3), no force.
+      const GiNaC::ex about = dot(p.omega, p.normal);
+      for (int j = 0; j < n; ++j) outputs.push_back(about.diff(symbols.velocity(j)));
+      for (int r = 0; r < 3; ++r) outputs.push_back(0);
+      if (p.system >= 0) append(outputs, scale(per_length, p.normal));
+      else append(outputs, Vector3{0, 0, 0});
+      append(outputs, Vector3{0, 0, 0});
+      contact.spin_unknown = c.unknowns;
       c.unknown_system.push_back(contact.system);
       ++c.unknowns;
     }
@@ -141,7 +159,7 @@ void compile_contact_forces(const Spec& spec, Model& model) {
   }
   // Per reported contact: n, e_long, e_lat.
   for (const ContactPoint& p : in.contacts) {
-    if (p.kind != ContactKind::wheel && p.kind != ContactKind::knife_edge) continue;
+    if (p.kind != ContactKind::wheel && p.kind != ContactKind::knife_edge && p.kind != ContactKind::rolling) continue;
     append(outputs, p.normal);
     append(outputs, p.longitudinal);
     append(outputs, p.lateral);
@@ -162,10 +180,10 @@ void compile_contact_forces(const Spec& spec, Model& model) {
   model.contact_forces = std::move(out);
 }
 
-std::vector<ContactForceSymbol> make_contact_force_symbols(const std::vector<std::string>& reported) {
+std::vector<ContactForceSymbol> make_contact_force_symbols(const std::vector<ReportedContact>& reported) {
   std::vector<ContactForceSymbol> columns;
-  for (const std::string& name : reported)
-    for (int k = 0; k < kContactComponents; ++k) {
+  for (const auto& [name, components] : reported)
+    for (ContactComponent k : components) {
       const std::string column = name + "_" + contact_component_name(k);
       columns.push_back({column, static_cast<int>(columns.size()), GiNaC::symbol(column)});
     }
@@ -186,8 +204,8 @@ void require_determined_contact_forces(const Spec& spec, const Model& model, con
   if (columns.empty()) return;
   const std::string at = where.empty() ? "" : where + ": ";
   const ContactForceModel* c = model.contact_forces.get();
-  if (c == nullptr || static_cast<int>(c->determined.size()) != c->reported() * kContactComponents ||
-      static_cast<int>(spec.contact_forces->columns.size()) != c->reported() * kContactComponents)
+  if (c == nullptr || static_cast<int>(c->determined.size()) != c->values() ||
+      static_cast<int>(spec.contact_forces->columns.size()) != c->values())
     throw ModelError(fmt::format("{}{} reads the contact force '{}', but model '{}' has no such contact forces",
                                  at, what, spec.contact_forces->columns[static_cast<std::size_t>(columns.front())].name,
                                  model.name));

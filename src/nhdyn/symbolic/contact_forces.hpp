@@ -9,6 +9,7 @@
 #include <ginac/ginac.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "nhdyn/model/contact_forces.hpp"
@@ -38,11 +39,16 @@ struct ContactPoint {
   std::vector<Vector3> directions;
   Vector3 normal, longitudinal, lateral;
   int system = -1;
+  // Rubber rolling (docs/derivations/rolling-bodies.md section 5): one more unknown, the moment of
+  // the ground about n, whose column in (C1) is (d omega / d q')^T n with omega the body's angular
+  // velocity (world).
+  bool spin = false;
+  Vector3 omega = {0, 0, 0};
 };
 
-// A contact-force column (NAME_Fx ... NAME_Flat of a wheel or knife edge) as a symbol, so that the
-// expressions of events may name it (symbolic/events.hpp): `column` indexes ContactForceData::values
-// (kContactComponents per reported contact, in the order of the CSV columns).
+// A contact-force column (NAME_Fx ... NAME_Flat of a wheel or knife edge, NAME_Fx ... NAME_Mspin of
+// a rolling body) as a symbol, so that the expressions of events may name it (symbolic/events.hpp):
+// `column` indexes ContactForceData::values (in the order of the CSV columns).
 struct ContactForceSymbol {
   std::string name;
   int column = 0;
@@ -63,10 +69,11 @@ struct SpecContactForces {
   std::vector<ContactForceSymbol> columns;
 };
 
-// One symbol per column NAME_Fx ... NAME_Flat of each name in `reported` (the wheels and knife
-// edges, in order). MultibodyBuilder::apply() fills SpecContactForces::columns with it; the
-// command line's events make them from a loaded Model's contacts (symbolic/events.cpp).
-std::vector<ContactForceSymbol> make_contact_force_symbols(const std::vector<std::string>& reported);
+// One symbol per column of each reported contact (its name and components, in order).
+// MultibodyBuilder::apply() fills SpecContactForces::columns with it; the command line's events
+// make them from a loaded Model's contacts (symbolic/events.cpp).
+using ReportedContact = std::pair<std::string, std::vector<ContactComponent>>;
+std::vector<ContactForceSymbol> make_contact_force_symbols(const std::vector<ReportedContact>& reported);
 
 // The columns (ContactForceSymbol::column) of the contact-force symbols that `e` contains, in
 // increasing order; empty when `spec` has no contact forces or `e` reads none.

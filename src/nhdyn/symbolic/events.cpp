@@ -36,9 +36,9 @@ SpecBuilder names_of(const Model& model) {
   // The contact-force columns of its wheels and knife edges, which an event may name too.
   if (model.contact_forces) {
     auto contact = std::make_shared<SpecContactForces>();
-    std::vector<std::string> reported;
+    std::vector<ReportedContact> reported;
     for (const ContactForceContact& c : model.contact_forces->contacts)
-      if (c.reported) reported.push_back(c.name);
+      if (c.reported) reported.emplace_back(c.name, c.components);
     contact->columns = make_contact_force_symbols(reported);
     builder.contact_forces(std::move(contact));
   }

@@ -575,6 +575,63 @@ void MultibodyBuilder::add_knife_edge(const Helper& h) {
   contacts_.push_back(std::move(contact));
 }
 
+MultibodyBuilder& MultibodyBuilder::contact(const ContactText& text) {
+  check_helper_name(text.name, text.where);
+  ContactParsers parsers;
+  parsers.spec = &builder_.current();
+  parsers.constant = [this](const std::string& t, const SourceLocation& where, const std::string& context) {
+    return parse(t, where, context, false);
+  };
+  parsers.of_time = [this](const std::string& t, const SourceLocation& where, const std::string& context) {
+    const GiNaC::ex e = parse(t, where, context, true);
+    const Spec& spec = builder_.current();
+    for (int i = 0; i < spec.n(); ++i)
+      if (e.has(spec.symbols.coordinate(i)))
+        throw_model_error(where, context,
+                          fmt::format("\"{}\" depends on the coordinate '{}'; this value may use t and the parameters "
+                                      "only",
+                                      t, spec.coordinates[static_cast<std::size_t>(i)]));
+    return e;
+  };
+  parsers.surface = [this](const std::string& t, const Vector3& at, const SourceLocation& where,
+                           const std::string& context) { return parse_surface(t, at, where, context); };
+  parsers.body = [this](const std::string& name, const SourceLocation& where, const std::string& context) {
+    return body_index(name, where, context);
+  };
+  Helper h;
+  h.kind = Helper::Kind::contact;
+  h.name = text.name;
+  h.where = text.where;
+  h.contact = std::make_shared<const ParsedContact>(parse_contact(text, parsers));
+  h.index = h.contact->body;
+  helpers_.push_back(std::move(h));
+  return *this;
+}
+
+const ParsedContact* MultibodyBuilder::parsed_contact(const std::string& name) const {
+  for (const Helper& h : helpers_)
+    if (h.kind == Helper::Kind::contact && h.name == name) return h.contact.get();
+  return nullptr;
+}
+
+void MultibodyBuilder::add_contact(const Helper& h) {
+  const Body& body = bodies_[static_cast<std::size_t>(h.index)];
+  const PlacedFrame& F = frames_[static_cast<std::size_t>(body.frame)];
+  RollingContact contact = make_rolling_contact(*h.contact, F, builder_.current(), gravity_);
+  for (const RollingContact::Row& row : contact.constraints)
+    builder_.constraint(row.name, row.level, row.expression, row.text, h.where);
+  static const char* const suffix[3] = {"_X", "_Y", "_Z"};
+  for (std::size_t i = 0; i < 3; ++i) {
+    try {
+      builder_.output(h.name + suffix[i], contact.point[i], printed(contact.point[i]), h.where, /*automatic=*/true);
+    } catch (const ModelError&) {
+      // The name is taken (a coordinate, a parameter, an earlier output): left out.
+    }
+  }
+  contact.force.system = system_of(body.frame);
+  contacts_.push_back(std::move(contact.force));
+}
+
 GiNaC::ex MultibodyBuilder::kinetic_energy() const {
   // Left unexpanded: the nested products of the rotation chain are what GiNaC differentiates
   // fastest (gathering T as 1/2 M_ij q_i' q_j' with simplified M_ij was slower for the bicycle).
@@ -613,6 +670,7 @@ void MultibodyBuilder::apply() {
     switch (h.kind) {
       case Helper::Kind::wheel: add_wheel(h); break;
       case Helper::Kind::knife_edge: add_knife_edge(h); break;
+      case Helper::Kind::contact: add_contact(h); break;
       case Helper::Kind::surface:
         builder_.constraint(h.name, ConstraintLevel::position, h.surfaces[0],
                             fmt::format("point on a surface '{}'", h.name), h.where);
@@ -642,9 +700,10 @@ void MultibodyBuilder::apply() {
   const std::vector<SpecConstraint>& constraints = builder_.current().constraints;
   for (std::size_t i = first_generated; i < constraints.size(); ++i) record->generated.push_back(constraints[i].name);
   record_contact_forces(*record);
-  std::vector<std::string> reported;  // the wheels and knife edges, whose columns events may name
+  std::vector<ReportedContact> reported;  // the wheels, knife edges and rolling bodies, whose columns events may name
   for (const ContactPoint& c : record->contacts)
-    if (c.kind == ContactKind::wheel || c.kind == ContactKind::knife_edge) reported.push_back(c.name);
+    if (c.kind == ContactKind::wheel || c.kind == ContactKind::knife_edge || c.kind == ContactKind::rolling)
+      reported.emplace_back(c.name, contact_components(c.kind, c.spin));
   record->columns = make_contact_force_symbols(reported);
   builder_.contact_forces(std::move(record));
 }
@@ -686,8 +745,11 @@ void MultibodyBuilder::record_contact_forces(SpecContactForces& record) const {
   }
   if (gravity_) record.gravity = *gravity_;
   double largest = 0.0;  // L, the scale of the moment rows: the largest wheel radius
-  for (const Helper& h : helpers_)
+  for (const Helper& h : helpers_) {
     if (h.kind == Helper::Kind::wheel) largest = std::max(largest, value_of(h.radius, builder_.current()).value_or(0.0));
+    if (h.kind == Helper::Kind::contact)
+      largest = std::max(largest, value_of(h.contact->shape->length(h.contact->values), builder_.current()).value_or(0.0));
+  }
   record.length = largest > 0.0 ? largest : 1.0;
 }
 

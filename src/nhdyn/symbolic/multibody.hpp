@@ -18,12 +18,14 @@
 #include <ginac/ginac.h>
 
 #include <array>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "nhdyn/symbolic/contact_forces.hpp"
 #include "nhdyn/symbolic/kinematics.hpp"
+#include "nhdyn/symbolic/rolling_contact.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
 
 namespace nhdyn::symbolic {
@@ -80,6 +82,13 @@ class MultibodyBuilder {
   // velocity-level constraint called `name`.
   MultibodyBuilder& knife_edge(const std::string& name, const std::string& point, const std::string& axis,
                                const std::optional<Triple>& normal = std::nullopt, SourceLocation where = {});
+  // A convex body rolling on a ground ([[contacts]], docs/derivations/rolling-bodies.md): adds
+  // "<name>_contact" (position level, the gap, unless it holds identically), "<name>_roll1",
+  // "<name>_roll2" (velocity level) and, for rubber rolling, "<name>_spin"; the contact point's
+  // world position as the outputs <name>_X, <name>_Y, <name>_Z; its contact force.
+  MultibodyBuilder& contact(const ContactText& text);
+  // The shape and body of a contact given so far, for the scene (nullptr when unknown).
+  const ParsedContact* parsed_contact(const std::string& name) const;
   // `point` stays on the fixed surface f(X, Y, Z) = 0 (world coordinates X, Y, Z; the expression
   // may also use t and the parameters). One position-level constraint called `name`.
   MultibodyBuilder& point_on_surface(const std::string& name, const std::string& point, const std::string& surface,
@@ -118,13 +127,14 @@ class MultibodyBuilder {
   // A helper's constraints, computed in apply() (the plane's default normal needs the gravity,
   // which may come later).
   struct Helper {
-    enum class Kind { wheel, knife_edge, surface, curve } kind;
+    enum class Kind { wheel, knife_edge, surface, curve, contact } kind;
     std::string name;
     int index = -1;          // body (wheel) or point
     int axis = 0;
     GiNaC::ex radius;
     std::optional<Vector3> normal;
     std::vector<GiNaC::ex> surfaces;
+    std::shared_ptr<const ParsedContact> contact;  // a rolling body
     SourceLocation where;
   };
 
@@ -141,6 +151,7 @@ class MultibodyBuilder {
   Vector3 plane_normal(const Helper& helper, const std::string& context) const;
   void add_wheel(const Helper& helper);
   void add_knife_edge(const Helper& helper);
+  void add_contact(const Helper& helper);
   // The bodies and contacts for the contact forces (symbolic/contact_forces.hpp), onto the builder.
   void record_contact_forces(SpecContactForces& record) const;
   int system_of(int frame) const;  // index of the frame below ground that `frame` hangs from

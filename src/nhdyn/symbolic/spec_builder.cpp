@@ -314,11 +314,11 @@ class Reader {
   // contact forces: why it is unknown.
   std::string contact_force_hint(const std::string& name) const {
     if (spec_.contact_forces && !spec_.contact_forces->columns.empty()) return "";
-    for (int k = 0; k < kContactComponents; ++k) {
-      const std::string suffix = std::string("_") + contact_component_name(k);
+    for (int k = 0; k < kContactComponentKinds; ++k) {
+      const std::string suffix = std::string("_") + contact_component_name(static_cast<ContactComponent>(k));
       if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
         return fmt::format(" ('{}' looks like a contact-force column, but model '{}' has no contact forces: only "
-                           "the [[wheels]] and [[knife_edges]] of a multibody model have them, docs/multibody.md)",
+                           "the [[wheels]], [[knife_edges]] and [[contacts]] of a multibody model have them, docs/multibody.md)",
                            name, spec_.name);
     }
     return "";

@@ -1,0 +1,103 @@
+#include "nhdyn/symbolic/contact_shapes.hpp"
+
+#include "nhdyn/core/join.hpp"
+
+namespace nhdyn::symbolic {
+namespace {
+
+// y . e e - nu over |e x nu|: the unit direction in the plane normal to e closest to -nu
+// (the rim point of a disk, docs/derivations/rolling-wheel.md); with |e x nu| = sqrt(1 - (e.nu)^2).
+Vector3 rim_direction(const Vector3& nu, int axis, GiNaC::ex& length) {
+  const Vector3 e = unit(axis);
+  const GiNaC::ex en = nu[static_cast<std::size_t>(axis)];
+  length = GiNaC::sqrt(1 - en * en);
+  return scale(1 / length, subtract(scale(en, e), nu));
+}
+
+class Sphere final : public ContactShape {
+ public:
+  std::string key() const override { return "sphere"; }
+  int size_count() const override { return 1; }
+  std::vector<std::string> size_names() const override { return {"r"}; }
+  std::string example() const override { return "shape = { sphere = \"r\" }"; }
+  ShapeSupport support(const ShapeValues& v, const Vector3& nu) const override {
+    return {scale(-v.sizes[0], nu), v.sizes[0]};
+  }
+  std::optional<GiNaC::ex> ball_radius(const ShapeValues& v) const override { return v.sizes[0]; }
+  std::optional<VisualKind> drawing() const override { return VisualKind::sphere; }
+};
+
+// x^T M x = 1, M = diag(1/a^2, 1/b^2, 1/c^2): y* = -M^{-1} nu / sqrt(nu^T M^{-1} nu).
+class Ellipsoid final : public ContactShape {
+ public:
+  std::string key() const override { return "ellipsoid"; }
+  int size_count() const override { return 3; }
+  std::vector<std::string> size_names() const override { return {"a", "b", "c"}; }
+  std::string example() const override { return "shape = { ellipsoid = [\"a\", \"b\", \"c\"] }"; }
+  ShapeSupport support(const ShapeValues& v, const Vector3& nu) const override {
+    const Vector3 Minv_nu = {v.sizes[0] * v.sizes[0] * nu[0], v.sizes[1] * v.sizes[1] * nu[1],
+                             v.sizes[2] * v.sizes[2] * nu[2]};
+    const GiNaC::ex reach = GiNaC::sqrt(dot(nu, Minv_nu));
+    return {scale(-1 / reach, Minv_nu), reach};
+  }
+  GiNaC::ex length(const ShapeValues& v) const override { return v.sizes[0]; }
+};
+
+// A thin disk of radius r normal to its axis.
+class Disk final : public ContactShape {
+ public:
+  std::string key() const override { return "disk"; }
+  int size_count() const override { return 1; }
+  std::vector<std::string> size_names() const override { return {"r"}; }
+  std::vector<std::string> options() const override { return {"axis"}; }
+  std::string example() const override { return "shape = { disk = \"r\", axis = \"y\" }"; }
+  ShapeSupport support(const ShapeValues& v, const Vector3& nu) const override {
+    GiNaC::ex length;
+    const Vector3 d = rim_direction(nu, v.axis, length);
+    return {scale(v.sizes[0], d), v.sizes[0] * length};
+  }
+  std::optional<VisualKind> drawing() const override { return VisualKind::wheel; }
+};
+
+// The round tyre: the rim circle of radius R swept by a ball of radius r (its convex hull touches
+// a plane where the torus does): support points add over the Minkowski sum.
+class Torus final : public ContactShape {
+ public:
+  std::string key() const override { return "torus"; }
+  int size_count() const override { return 2; }
+  std::vector<std::string> size_names() const override { return {"R", "r"}; }
+  std::vector<std::string> options() const override { return {"axis"}; }
+  std::string example() const override { return "shape = { torus = [\"R\", \"r\"], axis = \"y\" }"; }
+  ShapeSupport support(const ShapeValues& v, const Vector3& nu) const override {
+    GiNaC::ex length;
+    const Vector3 d = rim_direction(nu, v.axis, length);
+    return {subtract(scale(v.sizes[0], d), scale(v.sizes[1], nu)), v.sizes[0] * length + v.sizes[1]};
+  }
+  GiNaC::ex length(const ShapeValues& v) const override { return v.sizes[0] + v.sizes[1]; }
+  std::optional<VisualKind> drawing() const override { return VisualKind::wheel; }
+};
+
+}  // namespace
+
+const std::vector<const ContactShape*>& contact_shapes() {
+  static const Sphere sphere;
+  static const Ellipsoid ellipsoid;
+  static const Disk disk;
+  static const Torus torus;
+  static const std::vector<const ContactShape*> table = {&sphere, &ellipsoid, &disk, &torus};
+  return table;
+}
+
+const ContactShape* find_contact_shape(const std::string& key) {
+  for (const ContactShape* shape : contact_shapes())
+    if (shape->key() == key) return shape;
+  return nullptr;
+}
+
+std::string contact_shape_keys() {
+  std::vector<std::string> keys;
+  for (const ContactShape* shape : contact_shapes()) keys.push_back(shape->key());
+  return join(keys);
+}
+
+}  // namespace nhdyn::symbolic

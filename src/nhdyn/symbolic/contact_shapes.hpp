@@ -1,0 +1,65 @@
+// The shapes a rolling body may have ([[contacts]] of a model file, docs/multibody.md): one type
+// per shape, registered once in the table of contact_shapes.cpp. A shape knows the key that names
+// it in `shape = { KEY = ... }`, how many sizes that key takes and which further keys it has, and
+// its geometry: the support mapping y*(nu), the point of the shape lowest along a unit direction
+// nu (body axes), and the reach rho(nu) = -nu . y*(nu) (docs/derivations/rolling-bodies.md
+// section 2). The rolling-contact builder (rolling_contact.hpp), the loader and the scene go
+// through this table; none of them lists shapes.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "nhdyn/symbolic/kinematics.hpp"
+#include "nhdyn/symbolic/visual.hpp"
+
+namespace nhdyn::symbolic {
+
+// A shape's sizes once parsed (expressions in the parameters) and its axis where it has one.
+struct ShapeValues {
+  std::vector<GiNaC::ex> sizes;  // sphere: r; ellipsoid: a, b, c; disk: r; torus: R, r
+  int axis = -1;                 // disk, torus: 0, 1, 2 for the body's x, y, z
+};
+
+// The support mapping at the unit direction nu (body axes): the shape's point lowest along nu,
+// relative to the shape's centre, and its reach rho = -nu . point (> 0).
+struct ShapeSupport {
+  Vector3 point;
+  GiNaC::ex reach;
+};
+
+class ContactShape {
+ public:
+  virtual ~ContactShape() = default;
+  // The key naming the shape: shape = { sphere = "r" }.
+  virtual std::string key() const = 0;
+  // How many sizes the key takes: 1 is a single value, more a list of that many.
+  virtual int size_count() const = 0;
+  // The names of the sizes, for messages ("r"; "a", "b", "c").
+  virtual std::vector<std::string> size_names() const = 0;
+  // The further keys of the shape's table (an axle: "axis").
+  virtual std::vector<std::string> options() const { return {}; }
+  // An example of the table, for messages.
+  virtual std::string example() const = 0;
+  // y*(nu) and rho(nu) for a unit nu in body axes (docs/derivations/rolling-bodies.md section 2).
+  virtual ShapeSupport support(const ShapeValues& values, const Vector3& nu) const = 0;
+  // The radius when the shape is a ball (the only shape offered on curved grounds so far).
+  virtual std::optional<GiNaC::ex> ball_radius(const ShapeValues&) const { return std::nullopt; }
+  // The size of the shape for the moment rows of the contact-force solve (a length).
+  virtual GiNaC::ex length(const ShapeValues& values) const { return values.sizes.front(); }
+  // How the scene draws it (a ball of its radius, a wheel about its axis), or nothing yet (the
+  // body's ellipsoid of inertia is drawn in any case).
+  virtual std::optional<VisualKind> drawing() const { return std::nullopt; }
+};
+
+// The registered shapes, in the order the docs list them.
+const std::vector<const ContactShape*>& contact_shapes();
+// The shape called `key`, or nullptr.
+const ContactShape* find_contact_shape(const std::string& key);
+// "sphere, ellipsoid, disk, torus".
+std::string contact_shape_keys();
+
+}  // namespace nhdyn::symbolic

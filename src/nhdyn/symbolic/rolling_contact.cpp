@@ -1,0 +1,384 @@
+#include "nhdyn/symbolic/rolling_contact.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <sstream>
+
+#include "nhdyn/core/join.hpp"
+#include "nhdyn/core/suggest.hpp"
+#include "nhdyn/symbolic/multibody.hpp"
+#include "nhdyn/symbolic/simplify.hpp"
+
+namespace nhdyn::symbolic {
+namespace {
+
+// The value once the parameters are set (t and the coordinates at 0 with `at_reference`);
+// nullopt when it is not a finite real number.
+std::optional<double> contact_number_of(const GiNaC::ex& e, const Spec& spec, bool at_reference = false) {
+  try {
+    GiNaC::lst values = spec.parameter_values();
+    if (at_reference) {
+      values.append(spec.symbols.time() == 0);
+      for (int i = 0; i < spec.n(); ++i) values.append(spec.symbols.coordinate(i) == 0);
+    }
+    const GiNaC::ex v = e.subs(values).evalf();
+    if (!GiNaC::is_a<GiNaC::numeric>(v) || !GiNaC::ex_to<GiNaC::numeric>(v).is_real()) return std::nullopt;
+    const double d = GiNaC::ex_to<GiNaC::numeric>(v).to_double();
+    if (!std::isfinite(d)) return std::nullopt;
+    return d;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+std::string contact_printed(const GiNaC::ex& e) {
+  std::ostringstream out;
+  out << e;
+  return out.str();
+}
+
+bool contact_has_coordinates(const GiNaC::ex& e, const Spec& spec) {
+  if (e.has(spec.symbols.time())) return true;
+  for (int i = 0; i < spec.n(); ++i)
+    if (e.has(spec.symbols.coordinate(i))) return true;
+  return false;
+}
+
+std::string contact_option_of(const KeyTexts& options, const std::string& key, const std::string& fallback) {
+  for (const auto& [k, v] : options)
+    if (k == key) return v;
+  return fallback;
+}
+
+// The index of the world axis least aligned with `direction` (the first of ties).
+int contact_least_aligned_axis(const Vector3& direction, const Spec& spec) {
+  int k = 0;
+  double smallest = HUGE_VAL;
+  for (int i = 0; i < 3; ++i) {
+    const double v = std::fabs(contact_number_of(direction[static_cast<std::size_t>(i)], spec).value_or(1.0));
+    if (v < smallest - 1e-15) {
+      smallest = v;
+      k = i;
+    }
+  }
+  return k;
+}
+
+// The unit normal of a plane ground: the given one, else opposite to gravity.
+Vector3 ground_plane_normal(const ParsedGround& ground, const Spec& spec, const std::optional<Vector3>& gravity,
+                     const std::string& context) {
+  Vector3 n;
+  if (ground.normal) n = *ground.normal;
+  else if (gravity) n = scale(-1, *gravity);
+  else
+    throw_model_error(ground.where, context,
+                      "no ground plane: give its normal, ground = { plane = [0, 0, 1] }, or a gravity vector, whose "
+                      "opposite is then the normal");
+  std::array<double, 3> value{};
+  for (std::size_t i = 0; i < 3; ++i) value[i] = contact_number_of(n[i], spec).value_or(0.0);
+  const double length = std::sqrt(value[0] * value[0] + value[1] * value[1] + value[2] * value[2]);
+  if (!(length > 0.0))
+    throw_model_error(ground.where, context,
+                      ground.normal ? "the plane's normal is the zero vector; give a nonzero normal, e.g. [0, 0, 1]"
+                                    : "the gravity vector is zero, so it defines no ground plane; give its normal, "
+                                      "ground = { plane = [0, 0, 1] }");
+  for (std::size_t i = 0; i < 3; ++i)
+    if (std::fabs(value[i]) == length) return scale(value[i] > 0 ? 1 : -1, unit(static_cast<int>(i)));
+  const GiNaC::ex norm = GiNaC::sqrt(simplify(dot(n, n)));
+  return {n[0] / norm, n[1] / norm, n[2] / norm};
+}
+
+// ---- Grounds --------------------------------------------------------------------------------
+
+// The plane through the origin, fixed or turning about its normal (a turntable).
+class PlaneGround final : public ContactGround {
+ public:
+  std::string key() const override { return "plane"; }
+  std::vector<std::string> options() const override { return {"angular_velocity"}; }
+  std::string example() const override { return "ground = { plane = [0, 0, 1], angular_velocity = \"Omega\" }"; }
+  void parse(const GroundText& text, const ContactParsers& p, const std::string& context,
+             ParsedGround& out) const override {
+    if (text.value.size() == 3)
+      out.normal = Vector3{p.constant(text.value[0], text.where, context + ": plane normal"),
+                           p.constant(text.value[1], text.where, context + ": plane normal"),
+                           p.constant(text.value[2], text.where, context + ": plane normal")};
+    const std::string rate = contact_option_of(text.options, "angular_velocity", "");
+    if (!rate.empty()) out.angular_velocity = p.of_time(rate, text.where, context + ": angular_velocity");
+  }
+  void check(const ParsedContact&, const Spec&, const std::string&) const override {}
+  Touch touch(const ParsedContact& c, const PlacedFrame& F, const Spec& spec, const std::optional<Vector3>& gravity,
+              const std::string& context) const override {
+    Touch out;
+    const Vector3 n = ground_plane_normal(c.ground, spec, gravity, context);
+    const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
+    // nu = R^T n, the normal in the body's axes; the support point lowest along it.
+    const Vector3 nu = multiply_transposed(F.rotation, n);
+    const Vector3 nu_s = {simplify_moderate(nu[0]), simplify_moderate(nu[1]), simplify_moderate(nu[2])};
+    const ShapeSupport s = c.shape->support(c.values, nu_s);
+    out.point = add(C, multiply(F.rotation, s.point));
+    out.normal = n;
+    out.gap = dot(n, C) - s.reach;
+    out.ground_omega = scale(c.ground.angular_velocity, n);
+    out.ground_velocity = cross(out.ground_omega, out.point);
+    const int k = contact_least_aligned_axis(n, spec);
+    const GiNaC::ex nk = n[static_cast<std::size_t>(k)];
+    out.tangent1 = scale(1 / GiNaC::sqrt(simplify(1 - nk * nk)), subtract(unit(k), scale(nk, n)));
+    for (GiNaC::ex& e : out.tangent1) e = simplify(e);
+    out.tangent2 = cross(n, out.tangent1);
+    for (GiNaC::ex& e : out.tangent2) e = simplify(e);
+    return out;
+  }
+};
+
+// A fixed surface g(X, Y, Z) = 0; so far a sphere (a quadratic whose Hessian is a positive or
+// negative multiple of the identity), on which a ball rolls inside or outside.
+class SurfaceGround final : public ContactGround {
+ public:
+  std::string key() const override { return "surface"; }
+  std::vector<std::string> options() const override { return {"side"}; }
+  std::string example() const override {
+    return "ground = { surface = \"X^2 + Y^2 + (Z - R)^2 - R^2\", side = \"inside\" }";
+  }
+  void parse(const GroundText& text, const ContactParsers& p, const std::string& context,
+             ParsedGround& out) const override {
+    const GiNaC::symbol X("X"), Y("Y"), Z("Z");
+    const GiNaC::ex g = p.surface(text.value.at(0), Vector3{X, Y, Z}, text.where, context + ": surface").expand();
+    const std::string side = contact_option_of(text.options, "side", "");
+    if (side != "inside" && side != "outside")
+      throw_model_error(text.where, context,
+                        side.empty() ? "a surface ground needs side = \"inside\" (the body is where g < 0, e.g. in a "
+                                       "bowl) or side = \"outside\" (where g > 0)"
+                                     : fmt::format("unknown side '{}'; choose \"inside\" (the body is where g < 0) or "
+                                                   "\"outside\" (where g > 0)",
+                                                   side));
+    // g = alpha |X - K|^2 - alpha R^2: equal square terms, no products, degree 2.
+    const GiNaC::ex alpha = g.coeff(X, 2);
+    bool sphere = g.degree(X) == 2 && g.degree(Y) == 2 && g.degree(Z) == 2 && symbolic::is_zero(g.coeff(Y, 2) - alpha) &&
+                  symbolic::is_zero(g.coeff(Z, 2) - alpha) && !symbolic::is_zero(alpha);
+    for (const GiNaC::ex& cross_term : {g.coeff(X, 1).coeff(Y, 1), g.coeff(X, 1).coeff(Z, 1), g.coeff(Y, 1).coeff(Z, 1)})
+      sphere = sphere && symbolic::is_zero(cross_term);
+    const std::optional<double> a = sphere ? contact_number_of(alpha, *p.spec) : std::nullopt;
+    if (!sphere || !a || *a == 0.0)
+      throw_model_error(text.where, context,
+                        fmt::format("the surface \"{}\" is not a sphere; so far a body rolls on a plane or a sphere "
+                                    "(written as a*(X - X0)^2 + a*(Y - Y0)^2 + a*(Z - Z0)^2 - a*R^2); other surfaces "
+                                    "and terrain are not yet supported",
+                                    text.value.at(0)));
+    const GiNaC::ex zero = g.subs(GiNaC::lst{X == 0, Y == 0, Z == 0});
+    out.centre_x = simplify(-g.coeff(X, 1).subs(GiNaC::lst{Y == 0, Z == 0}) / (2 * alpha));
+    out.centre_y = simplify(-g.coeff(Y, 1).subs(GiNaC::lst{X == 0, Z == 0}) / (2 * alpha));
+    out.centre_z = simplify(-g.coeff(Z, 1).subs(GiNaC::lst{X == 0, Y == 0}) / (2 * alpha));
+    const GiNaC::ex squared = simplify(out.centre_x * out.centre_x + out.centre_y * out.centre_y +
+                                       out.centre_z * out.centre_z - zero / alpha);
+    const std::optional<double> r2 = contact_number_of(squared, *p.spec);
+    if (!r2 || !(*r2 > 0.0))
+      throw_model_error(text.where, context,
+                        fmt::format("the sphere \"{}\" has no points (its radius squared is {}); check its radius",
+                                    text.value.at(0), r2 ? fmt::format("{:.6g}", *r2) : "not a number"));
+    // A perfect square R^2 gives R (positive at the parameter values).
+    GiNaC::ex radius = GiNaC::sqrt(squared);
+    if (GiNaC::is_a<GiNaC::power>(squared) && squared.op(1) == 2) {
+      const std::optional<double> base = contact_number_of(squared.op(0), *p.spec);
+      if (base) radius = *base > 0 ? squared.op(0) : -squared.op(0);
+    }
+    out.radius = radius;
+    // g < 0 is inside the sphere when alpha > 0.
+    out.inside = (side == "inside") == (*a > 0.0);
+  }
+  void check(const ParsedContact& c, const Spec& spec, const std::string& context) const override {
+    const std::optional<GiNaC::ex> r = c.shape->ball_radius(c.values);
+    if (!r)
+      throw_model_error(c.where, context,
+                        fmt::format("a {} on a curved surface is not yet supported (its contact point has no closed "
+                                    "form there); on a sphere only a ball rolls so far: shape = {{ sphere = \"r\" }}",
+                                    c.shape->key()));
+    const double ball = contact_number_of(*r, spec).value_or(0.0);
+    const double sphere = contact_number_of(c.ground.radius, spec).value_or(0.0);
+    if (c.ground.inside && !(ball < sphere))
+      throw_model_error(c.where, context,
+                        fmt::format("the ball (radius {:.6g}) is not smaller than the bowl (radius {:.6g}): it cannot "
+                                    "roll inside it with a single contact point; the ball's radius must be less than "
+                                    "the bowl's",
+                                    ball, sphere));
+  }
+  Touch touch(const ParsedContact& c, const PlacedFrame& F, const Spec& spec, const std::optional<Vector3>& gravity,
+              const std::string&) const override {
+    Touch out;
+    const GiNaC::ex r = *c.shape->ball_radius(c.values);
+    const Vector3 K = {c.ground.centre_x, c.ground.centre_y, c.ground.centre_z};
+    const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
+    const Vector3 KC = subtract(C, K);
+    const GiNaC::ex distance = GiNaC::sqrt(dot(KC, KC));
+    // Inside, the normal out of the wall points to the sphere's centre; outside, away from it.
+    out.normal = scale((c.ground.inside ? -1 : 1) / distance, KC);
+    out.point = subtract(C, scale(r, out.normal));
+    out.gap = c.ground.inside ? c.ground.radius - r - distance : distance - c.ground.radius - r;
+    // Tangent rows e x (C - K) and (C - K) x (e x (C - K)), e the world axis least aligned with
+    // gravity (docs/derivations/rolling-bodies.md section 4.2).
+    const Vector3 e = unit(contact_least_aligned_axis(gravity ? *gravity : unit(2), spec));
+    out.tangent1 = cross(e, KC);
+    out.tangent2 = cross(KC, out.tangent1);
+    return out;
+  }
+};
+
+}  // namespace
+
+const std::vector<const ContactGround*>& contact_grounds() {
+  static const PlaneGround plane;
+  static const SurfaceGround surface;
+  static const std::vector<const ContactGround*> table = {&plane, &surface};
+  return table;
+}
+
+const ContactGround* find_contact_ground(const std::string& key) {
+  for (const ContactGround* ground : contact_grounds())
+    if (ground->key() == key) return ground;
+  return nullptr;
+}
+
+namespace {
+
+std::string contact_unknown_key(const std::string& what, const std::string& key, const std::vector<std::string>& known) {
+  const std::string nearest = nearest_name(key, known);
+  return fmt::format("unknown {} '{}'; {}choose one of: {}", what, key,
+                     nearest.empty() ? "" : fmt::format("did you mean '{}'? ", nearest), join(known));
+}
+
+}  // namespace
+
+ParsedContact parse_contact(const ContactText& text, const ContactParsers& p) {
+  const std::string context = fmt::format("contact '{}'", text.name);
+  ParsedContact out;
+  out.name = text.name;
+  out.where = text.where;
+  out.body = p.body(text.body, text.where, context + ": body");
+
+  std::vector<std::string> shape_keys;
+  for (const ContactShape* shape : contact_shapes()) shape_keys.push_back(shape->key());
+  out.shape = find_contact_shape(text.shape);
+  if (out.shape == nullptr) throw_model_error(text.shape_where, context, contact_unknown_key("shape", text.shape, shape_keys));
+  const ContactShape& shape = *out.shape;
+  const std::vector<std::string> names = shape.size_names();
+  if (static_cast<int>(text.sizes.size()) != shape.size_count())
+    throw_model_error(text.shape_where, context,
+                      fmt::format("a {} takes {} ({}), e.g. {}; {} given", shape.key(),
+                                  shape.size_count() == 1 ? "one size" : fmt::format("{} sizes", shape.size_count()),
+                                  join(names), shape.example(), text.sizes.size()));
+  for (std::size_t i = 0; i < text.sizes.size(); ++i) {
+    const std::string what = fmt::format("{}: {} {}", context, shape.key(), names[i]);
+    const GiNaC::ex size = p.constant(text.sizes[i], text.shape_where, what);
+    const std::optional<double> v = contact_number_of(size, *p.spec);
+    if (!v || !(*v > 0.0))
+      throw_model_error(text.shape_where, what,
+                        fmt::format("\"{}\" must be positive, but it is {}", text.sizes[i],
+                                    v ? fmt::format("{}", *v) : "not a number"));
+    out.values.sizes.push_back(size);
+  }
+  const std::vector<std::string> options = shape.options();
+  for (const auto& [key, value] : text.shape_options) {
+    if (std::find(options.begin(), options.end(), key) == options.end())
+      throw_model_error(text.shape_where, context,
+                        options.empty() ? fmt::format("a {} has no key '{}' (e.g. {})", shape.key(), key, shape.example())
+                                        : contact_unknown_key(fmt::format("key of a {}", shape.key()), key, options));
+    if (key == "axis") {
+      out.values.axis = value == "x" ? 0 : value == "y" ? 1 : value == "z" ? 2 : -1;
+      if (out.values.axis < 0)
+        throw_model_error(text.shape_where, context,
+                          fmt::format("unknown axis '{}'; the axle is the \"x\", \"y\" or \"z\" axis of the body's frame",
+                                      value));
+    }
+  }
+  if (std::find(options.begin(), options.end(), "axis") != options.end() && out.values.axis < 0)
+    throw_model_error(text.shape_where, context,
+                      fmt::format("a {} needs its axle, e.g. {}", shape.key(), shape.example()));
+  if (text.centre)
+    for (std::size_t i = 0; i < 3; ++i) out.centre[i] = p.constant((*text.centre)[i], text.where, context + ": centre");
+
+  std::vector<std::string> ground_keys;
+  for (const ContactGround* ground : contact_grounds()) ground_keys.push_back(ground->key());
+  const ContactGround* ground = find_contact_ground(text.ground.key);
+  if (ground == nullptr)
+    throw_model_error(text.ground.where, context, contact_unknown_key("ground", text.ground.key, ground_keys));
+  const std::vector<std::string> ground_options = ground->options();
+  for (const auto& option : text.ground.options)
+    if (std::find(ground_options.begin(), ground_options.end(), option.first) == ground_options.end())
+      throw_model_error(text.ground.where, context,
+                        contact_unknown_key(fmt::format("key of a {} ground", ground->key()), option.first, ground_options));
+  out.ground.type = ground;
+  out.ground.where = text.ground.where;
+  ground->parse(text.ground, p, context + ": ground", out.ground);
+
+  if (text.rolling != "rolling" && text.rolling != "rubber")
+    throw_model_error(text.where, context,
+                      fmt::format("unknown rolling '{}'; choose \"rolling\" (no slip) or \"rubber\" (no slip and no "
+                                  "spin about the normal)",
+                                  text.rolling));
+  out.rubber = text.rolling == "rubber";
+  ground->check(out, *p.spec, context);
+  return out;
+}
+
+RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F, const Spec& spec,
+                                    const std::optional<Vector3>& gravity) {
+  const std::string context = fmt::format("contact '{}'", c.name);
+  const ContactGround::Touch touch = c.ground.type->touch(c, F, spec, gravity, context);
+  RollingContact out;
+  out.point = touch.point;
+  out.length = c.shape->length(c.values);
+
+  // The contact condition: the gap, zero when touching (rolling-bodies.md section 4.1).
+  const GiNaC::ex gap = simplify_moderate(touch.gap);
+  if (!gap.is_zero()) {
+    if (!contact_has_coordinates(gap, spec))
+      throw_model_error(c.where, context,
+                        fmt::format("the body can never touch the ground: the gap between them is the constant {}; "
+                                    "place the body's frame so that it touches the ground",
+                                    contact_printed(gap)));
+    out.constraints.push_back({c.name + "_contact", ConstraintLevel::position, gap,
+                               fmt::format("contact '{}': the gap between the body and the ground = 0 (its position residual is the "
+                                           "gap, in length units; --fix-initial moves the body onto the ground)",
+                                           c.name)});
+  }
+  // Rolling: the material point of the body at P has the ground's velocity there (section 4.2).
+  const Vector3 vP = add(time_derivative(F.origin, spec.symbols), cross(F.omega, subtract(touch.point, F.origin)));
+  const Vector3 relative = subtract(vP, touch.ground_velocity);
+  int k = 0;
+  for (const Vector3& t : {touch.tangent1, touch.tangent2}) {
+    ++k;
+    const GiNaC::ex row = simplify_moderate(dot(t, relative));
+    if (row.is_zero())
+      throw_model_error(c.where, context,
+                        fmt::format("the contact point's velocity along the ground (direction {}) is zero whatever "
+                                    "the velocities: the body's frame cannot move there, so it has nothing to roll on",
+                                    k));
+    out.constraints.push_back({fmt::format("{}_roll{}", c.name, k), ConstraintLevel::velocity, row,
+                               fmt::format("contact '{}': no slip, t{}.(v_P - v_ground) = 0", c.name, k)});
+  }
+  if (c.rubber) {
+    const GiNaC::ex spin = simplify_moderate(dot(touch.normal, subtract(F.omega, touch.ground_omega)));
+    if (spin.is_zero())
+      throw_model_error(c.where, context,
+                        "the body cannot spin about the contact normal in these coordinates, so rubber rolling adds "
+                        "nothing: write rolling = \"rolling\"");
+    out.constraints.push_back({c.name + "_spin", ConstraintLevel::velocity, spin,
+                               fmt::format("contact '{}': no spin about the normal, n.(omega - omega_ground) = 0", c.name)});
+  }
+  ContactPoint& f = out.force;
+  f.name = c.name;
+  f.kind = ContactKind::rolling;
+  f.point = touch.point;
+  f.velocity = vP;
+  f.directions = {unit(0), unit(1), unit(2)};
+  f.normal = touch.normal;
+  f.longitudinal = {0, 0, 0};
+  f.lateral = {0, 0, 0};
+  f.omega = F.omega;
+  f.spin = c.rubber;
+  return out;
+}
+
+}  // namespace nhdyn::symbolic

@@ -1,0 +1,147 @@
+// A convex body rolling on a ground ([[contacts]] of a model file, docs/multibody.md): the
+// description as the user wrote it (ContactText), the grounds (one type each, registered once in
+// rolling_contact.cpp, as the shapes are in contact_shapes.cpp), and what the multibody builder
+// adds for one contact: the contact condition (the gap), the rolling constraints, the no-spin
+// constraint of rubber rolling, the contact point, and the contact-force description.
+// docs/derivations/rolling-bodies.md derives every expression here.
+//
+//     model file [[contacts]] -> ContactText -> parse_contact -> ParsedContact
+//         -> (MultibodyBuilder::apply) make_rolling_contact -> constraints, ContactPoint, outputs
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <array>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "nhdyn/symbolic/contact_forces.hpp"
+#include "nhdyn/symbolic/contact_shapes.hpp"
+#include "nhdyn/symbolic/kinematics.hpp"
+#include "nhdyn/symbolic/spec.hpp"
+
+namespace nhdyn::symbolic {
+
+struct PlacedFrame;
+
+using KeyTexts = std::vector<std::pair<std::string, std::string>>;  // further keys of a table, as text
+
+// The ground as written: ground = "plane", or a table whose identifying key is `key`.
+struct GroundText {
+  std::string key = "plane";
+  std::vector<std::string> value;  // plane: the normal (3 expressions) or none; surface: g (one)
+  KeyTexts options;                // angular_velocity = "Omega", side = "inside"
+  SourceLocation where;
+};
+
+// One [[contacts]] entry as written (every value an expression in quotes or a number as text).
+struct ContactText {
+  std::string name;
+  std::string body;
+  std::string shape;                // the key naming the shape: "sphere", "ellipsoid", ...
+  std::vector<std::string> sizes;   // its value(s)
+  KeyTexts shape_options;           // axis = "y"
+  std::optional<std::array<std::string, 3>> centre;
+  GroundText ground;
+  std::string rolling = "rolling";  // "rolling" or "rubber"
+  SourceLocation where, shape_where, ground_where;
+};
+
+class ContactGround;
+
+// A ground once parsed.
+struct ParsedGround {
+  const ContactGround* type = nullptr;
+  std::optional<Vector3> normal;    // plane: given (not yet normalized), else opposite to gravity
+  GiNaC::ex angular_velocity = 0;   // plane: the turntable's rate Omega(t) about its normal
+  GiNaC::ex centre_x = 0, centre_y = 0, centre_z = 0;  // surface (a sphere): its centre K
+  GiNaC::ex radius = 0;             // surface: its radius R_g
+  bool inside = false;              // surface: the body is inside the sphere (a bowl)
+  SourceLocation where;
+};
+
+// A contact once parsed: the body's index among the builder's bodies, the shape and its values.
+struct ParsedContact {
+  std::string name;
+  int body = -1;
+  const ContactShape* shape = nullptr;
+  ShapeValues values;
+  Vector3 centre = {0, 0, 0};  // the shape's centre in the body frame's axes
+  ParsedGround ground;
+  bool rubber = false;
+  SourceLocation where;
+};
+
+// What parse_contact needs from the multibody builder. Every function throws ModelError naming
+// `where` and `context`.
+struct ContactParsers {
+  const Spec* spec = nullptr;
+  // A constant: parameters only.
+  std::function<GiNaC::ex(const std::string& text, const SourceLocation& where, const std::string& context)> constant;
+  // An expression in t and the parameters (no coordinates): a turntable's rate.
+  std::function<GiNaC::ex(const std::string& text, const SourceLocation& where, const std::string& context)> of_time;
+  // A surface g(X, Y, Z) with X, Y, Z replaced by `at`.
+  std::function<GiNaC::ex(const std::string& text, const Vector3& at, const SourceLocation& where,
+                          const std::string& context)>
+      surface;
+  // The index of a body, or a failure listing the bodies.
+  std::function<int(const std::string& name, const SourceLocation& where, const std::string& context)> body;
+};
+
+// What one contact adds to the model.
+struct RollingContact {
+  struct Row {
+    std::string name;
+    ConstraintLevel level;
+    GiNaC::ex expression;
+    std::string text;
+  };
+  std::vector<Row> constraints;   // NAME_contact (the gap; left out when it holds identically),
+                                  // NAME_roll1, NAME_roll2, and NAME_spin for rubber
+  ContactPoint force;             // for the contact forces (system left for the builder to set)
+  Vector3 point;                  // the contact point P, world
+  GiNaC::ex length;               // a length of the shape, for the moment rows
+};
+
+// A ground type: its key, the further keys of its table, and where a shape touches it.
+class ContactGround {
+ public:
+  virtual ~ContactGround() = default;
+  virtual std::string key() const = 0;
+  virtual std::vector<std::string> options() const = 0;
+  virtual std::string example() const = 0;
+  // Reads the ground's value and options into `out` (out.type is set already).
+  virtual void parse(const GroundText& text, const ContactParsers& parsers, const std::string& context,
+                     ParsedGround& out) const = 0;
+  // Checks that `contact`'s shape may roll on this ground (a ball smaller than a bowl).
+  virtual void check(const ParsedContact& contact, const Spec& spec, const std::string& context) const = 0;
+  // The contact of the shape of `contact`, whose body moves with `frame`, on this ground
+  // (docs/derivations/rolling-bodies.md sections 2 to 4): fills point, normal, gap, the ground's
+  // velocity and angular velocity there, and two tangent directions.
+  struct Touch {
+    Vector3 point, normal;
+    GiNaC::ex gap;
+    Vector3 ground_velocity = {0, 0, 0}, ground_omega = {0, 0, 0};
+    Vector3 tangent1, tangent2;
+  };
+  virtual Touch touch(const ParsedContact& contact, const PlacedFrame& frame, const Spec& spec,
+                      const std::optional<Vector3>& gravity, const std::string& context) const = 0;
+};
+
+const std::vector<const ContactGround*>& contact_grounds();
+const ContactGround* find_contact_ground(const std::string& key);
+
+// Checks the text against the registered shapes and grounds and parses its expressions.
+ParsedContact parse_contact(const ContactText& text, const ContactParsers& parsers);
+
+// The constraints, contact point and force description of one contact whose body moves with
+// `frame` (docs/derivations/rolling-bodies.md). Throws ModelError when the body can never touch the
+// ground (the gap is a nonzero constant) or cannot move along it.
+RollingContact make_rolling_contact(const ParsedContact& contact, const PlacedFrame& frame, const Spec& spec,
+                                    const std::optional<Vector3>& gravity);
+
+}  // namespace nhdyn::symbolic
