@@ -12,7 +12,7 @@
 
 #include "nhdyn/analysis/linearization.hpp"
 #include "nhdyn/analysis/simulation.hpp"
-#include "nhdyn/io/load_model.hpp"
+#include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/results.hpp"
 #include "support/text.hpp"
 
