@@ -1,5 +1,6 @@
 // `nhdyn report RESULT.csv --model MODEL -o report.html`: the HTML report (io/report.hpp) of a run
-// written earlier by `nhdyn simulate`; the CSV must have the model's columns.
+// written earlier by `nhdyn simulate`; the CSV must have the model's columns, and when it carries
+// its provenance (io/provenance.hpp), the model's hash, whose parameters are then the run's.
 #include <fmt/format.h>
 
 #include <cmath>
@@ -12,6 +13,7 @@
 #include "commands.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/report.hpp"
@@ -33,7 +35,9 @@ std::function<int()> add_report_command(CLI::App& app) {
   cmd->add_option("RESULT", args->csv, "A CSV written by `nhdyn simulate`")->required();
   cmd->add_option("--model", args->model, "The model that made it: a model file (.toml) or a built-in model")
       ->required();
-  cmd->add_option("--set", args->sets, "The parameters set for the run, NAME=EXPR (repeatable)");
+  cmd->add_option("--set", args->sets,
+                  "Set a parameter, NAME=EXPR, after the run's own values read from the CSV's provenance header "
+                  "(repeatable; needed only for a CSV without one)");
   cmd->add_option("-o,--output", args->output, "HTML file to write")->required();
   cmd->add_option("--max-frames", args->max_frames, "Most rows shown (longer runs are thinned for display)")
       ->capture_default_str();
@@ -50,8 +54,15 @@ std::function<int()> add_report_command(CLI::App& app) {
       paths.check();
     }
     std::optional<AtomicFile> probe(args->output);  // an unwritable path is refused before any work
-    const LoadedModel resolved = load_model_argument(args->model, args->sets);
     const CsvTable table = load_csv(args->csv);
+    // A CSV with its provenance (io/provenance.hpp) names its model's hash and its parameters as
+    // run: the model must be that one, and the run's values are applied before any --set.
+    const ModelSource source = read_model_source(args->model);
+    ParameterOverrides overrides;
+    if (const std::optional<Provenance> provenance = parse_provenance(table.comments, args->csv))
+      overrides = check_provenance(*provenance, source, args->csv);
+    for (auto& set : parse_parameter_sets(args->sets)) overrides.push_back(std::move(set));
+    const LoadedModel resolved = load_model_described(source, overrides);
     check_report_columns(table.header, make_result_columns(resolved.model), args->csv, resolved.model.name);
     // The time column must be a time: finite and never decreasing (an event row may share a time).
     if (const int t = table.column("t"); t >= 0)

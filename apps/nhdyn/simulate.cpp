@@ -18,6 +18,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/frontend/describe.hpp"
 #include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/io/run_paths.hpp"
@@ -128,12 +129,13 @@ std::string format_rows(const std::vector<double>& values, std::size_t columns) 
   return out;
 }
 
-// FILE-events.csv: one row per located crossing, name, t, q, q'.
-void write_events_file(AtomicFile& file, const Model& model, const SimulationSummary& summary) {
+// FILE-events.csv: the run's provenance, then one row per located crossing, name, t, q, q'.
+void write_events_file(AtomicFile& file, const Model& model, const SimulationSummary& summary,
+                       const std::string& provenance) {
   std::vector<std::string> header = {"event", "t"};
   for (const std::string& q : model.coordinates) header.push_back(q);
   for (const std::string& q : model.coordinates) header.push_back(q + "'");
-  std::string text = csv_line(header);
+  std::string text = provenance + csv_line(header);
   for (const EventRecord& e : summary.events) {
     text += csv_cell(e.name);
     fmt::format_to(std::back_inserter(text), ",{}", e.t);
@@ -154,7 +156,8 @@ bool is_regular_target(const std::filesystem::path& csv) {
 
 int run_simulate(const SimulateArgs& args) {
   protect_model_file(args.model);
-  const LoadedModel resolved = load_model_argument(args.model, args.sets);
+  const ModelSource source = read_model_source(args.model);
+  const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
   std::string notice;
   const Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
   if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
@@ -183,6 +186,8 @@ int run_simulate(const SimulateArgs& args) {
   options.formulation.program_feedback = parse_program_feedback(args.program_feedback);
   check_simulation_options(model, options);
   const ResultColumns columns = make_result_columns(model);
+  // Every file of the run says where it came from (io/provenance.hpp).
+  const std::string provenance = format_provenance(make_provenance(model, source, options, args.evaluator));
   if (!args.plot_columns.empty()) {
     if (args.plot.empty())
       throw InputError("--plot-columns chooses what --plot draws; give --plot FILE.png too, or leave --plot-columns out");
@@ -227,7 +232,7 @@ int run_simulate(const SimulateArgs& args) {
   if (!args.html.empty()) {
     html_probe.emplace(args.html);  // checks the report's directory now; removed unused
   }
-  CsvWriter writer(csv_path, columns.all);  // refuses an unwritable path before any step
+  CsvWriter writer(csv_path, columns.all, provenance);  // refuses an unwritable path before any step
   std::optional<AtomicFile> events_file;
   if (companions && !options.events.empty()) events_file.emplace(events_path);
 
@@ -253,7 +258,7 @@ int run_simulate(const SimulateArgs& args) {
       for (char& c : reason)
         if (c == '\n' || c == '\r') c = ' ';
       AtomicFile partial(partial_path);
-      partial.write(reason + "\n" + csv_line(columns.all) + format_rows(kept, columns.all.size()));
+      partial.write(reason + "\n" + provenance + csv_line(columns.all) + format_rows(kept, columns.all.size()));
       partial.commit();
       fmt::print(stderr, "nhdyn: the {} rows up to the failure are in {} ({} is left as it was)\n",
                  summary.outputs, partial_path.string(), csv_path.string());
@@ -263,7 +268,7 @@ int run_simulate(const SimulateArgs& args) {
     return 1;
   }
   writer.commit();
-  if (events_file) write_events_file(*events_file, model, summary);
+  if (events_file) write_events_file(*events_file, model, summary, provenance);
   plot_probe.reset();
   if (!args.plot.empty()) {
     PlotRequest request;

@@ -46,9 +46,10 @@ std::vector<std::string> split_header(const std::string& line) {
 
 }  // namespace
 
-CsvWriter::CsvWriter(const std::filesystem::path& target, const std::vector<std::string>& columns)
+CsvWriter::CsvWriter(const std::filesystem::path& target, const std::vector<std::string>& columns,
+                     const std::string& preamble)
     : file_(target), columns_(columns.size()) {
-  std::string header;
+  std::string header = preamble;
   for (std::size_t i = 0; i < columns.size(); ++i) {
     if (i) header += ',';
     header += quote_if_needed(columns[i]);
@@ -100,7 +101,10 @@ CsvTable load_csv(const std::filesystem::path& path) {
   while (std::getline(in, line)) {
     ++line_number;
     if (line_number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
-    if (!line.empty() && line[0] == '#') continue;
+    if (!line.empty() && line[0] == '#') {
+      table.comments.push_back(line.substr(1));
+      continue;
+    }
     header = true;
     break;
   }

@@ -15,8 +15,10 @@ namespace nhdyn {
 class CsvWriter {
  public:
   // Opens the temporary file at once (FileError if the target cannot be written) and writes the
-  // header. Names containing a comma or a quote are quoted.
-  CsvWriter(const std::filesystem::path& target, const std::vector<std::string>& columns);
+  // header, after `preamble` (comment lines, each starting with '#' and ending in '\n': the
+  // provenance header of io/provenance.hpp). Names containing a comma or a quote are quoted.
+  CsvWriter(const std::filesystem::path& target, const std::vector<std::string>& columns,
+            const std::string& preamble = {});
 
   void write_row(std::span<const double> values);  // values.size() must equal the column count
   void commit();                                  // the file appears whole, or FileError
@@ -32,6 +34,9 @@ class CsvWriter {
 struct CsvTable {
   std::vector<std::string> header;
   std::vector<std::vector<double>> rows;
+  // The comment lines before the header, without their '#' (the provenance of io/provenance.hpp,
+  // the reason line of a FILE.partial.csv).
+  std::vector<std::string> comments;
   int column(const std::string& name) const;  // index, or -1
 };
 CsvTable load_csv(const std::filesystem::path& path);  // throws FileError naming file and line

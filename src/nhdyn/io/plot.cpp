@@ -183,7 +183,11 @@ CsvHead read_csv_head(const fs::path& csv) {
   }
   std::string header;
   std::string row;
-  if (!read_csv_record(in, header) || trim(header).empty()) {
+  // Comment lines before the header (the provenance of io/provenance.hpp) are skipped here and,
+  // counted in header_lines, by gnuplot's `skip`.
+  int comment_lines = 0;
+  while (read_csv_record(in, header) && header.starts_with('#')) ++comment_lines;
+  if (!in || trim(header).empty() || header.starts_with('#')) {
     throw InputError(fmt::format(
         "the CSV file '{}' has no header row; expected column names on its first line, as "
         "nhdyn writes them",
@@ -199,7 +203,7 @@ CsvHead read_csv_head(const fs::path& csv) {
   if (header.starts_with("\xEF\xBB\xBF")) header.erase(0, 3);  // UTF-8 byte order mark
 
   CsvHead head;
-  head.header_lines = 1 + static_cast<int>(std::count(header.begin(), header.end(), '\n'));
+  head.header_lines = comment_lines + 1 + static_cast<int>(std::count(header.begin(), header.end(), '\n'));
   head.names = split_csv_record(header);
   head.first_row = split_csv_record(row);
   for (std::string& field : head.first_row) field = trim(field);

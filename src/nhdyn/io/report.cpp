@@ -425,7 +425,19 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
 
   std::string html;
   html.reserve(data.size() + resources::three_js.size() + resources::katex_js.size() + 600000);
-  html += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>";
+  html += "<!DOCTYPE html>\n";
+  if (!input.table.comments.empty()) {
+    // The run's provenance (io/provenance.hpp) as the CSV has it, one "# key: value" per line; an
+    // HTML comment may not hold "--", which a negative value after '=' could bring.
+    html += "<!--\n";
+    for (const std::string& line : input.table.comments) {
+      std::string text = "#" + line;
+      for (std::size_t at = text.find("--"); at != std::string::npos; at = text.find("--", at)) text.replace(at, 2, "- -");
+      html += text + "\n";
+    }
+    html += "-->\n";
+  }
+  html += "<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>";
   for (const char c : input.title) {
     if (c == '<') html += "&lt;";
     else if (c == '&') html += "&amp;";
