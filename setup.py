@@ -85,6 +85,7 @@ setup(
     version=project_version(),
     packages=["nhdyn"],
     package_dir={"nhdyn": "python/nhdyn"},
+    package_data={"nhdyn": ["py.typed", "*.pyi"]},  # type stubs of the compiled module (PEP 561)
     ext_modules=[Extension("nhdyn._nhdyn", sources=[])],
     cmdclass={"build_ext": CMakeBuild},
     # setuptools' own scratch space inside the CMake build directory: not in the checkout's build/

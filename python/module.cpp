@@ -47,4 +47,5 @@ PYBIND11_MODULE(_nhdyn, m) {
   nhdyn::python::bind_simulation(m);
   nhdyn::python::bind_batch(m);
   nhdyn::python::bind_analysis(m);
+  nhdyn::python::bind_report(m);
 }

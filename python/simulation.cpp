@@ -32,7 +32,8 @@ std::optional<T> get(const py::dict& kwargs, const char* key) {
 const char* const known_options[] = {"t_end",     "output_step", "method",    "complement",
                                      "integrator", "rtol",        "atol",      "step",
                                      "fix_initial", "stabilize",  "q0",        "v0",
-                                     "stop_when",  "events",      "max_steps", "program_feedback"};
+                                     "stop_when",  "events",      "max_steps", "program_feedback",
+                                     "t_eval"};
 
 // A string or a sequence of strings.
 std::vector<std::string> strings(const py::dict& kwargs, const char* key) {
@@ -56,10 +57,22 @@ SimulationOptions make_options(const Model& model, const py::dict& kwargs) {
     if (!known)
       throw InputError(fmt::format("simulate: unknown option '{}'; the options are t_end, output_step, method, complement, "
                                    "integrator, rtol, atol, step, fix_initial, stabilize, q0, v0, stop_when, events, "
-                                   "max_steps, program_feedback",
+                                   "max_steps, program_feedback, t_eval",
                                    key));
   }
   RunOptions run = model.defaults;
+  // t_eval: the output times (nhdyn/__init__.py has checked them: 1-D, finite, increasing); the
+  // run ends at the last one unless t_end says otherwise.
+  std::vector<double> t_eval;
+  if (kwargs.contains("t_eval") && !py::object(kwargs["t_eval"]).is_none()) {
+    try {
+      t_eval = py::object(kwargs["t_eval"]).cast<std::vector<double>>();
+    } catch (const py::cast_error&) {
+      throw InputError("t_eval: expected a 1-D array of times");
+    }
+    if (t_eval.empty()) throw InputError("t_eval: give at least one time");
+    run.t_end = t_eval.back();
+  }
   run.t_end = get<double>(kwargs, "t_end").value_or(run.t_end);
   run.output_step = get<double>(kwargs, "output_step").value_or(run.output_step);
   run.method = get<std::string>(kwargs, "method").value_or(run.method);
@@ -68,6 +81,7 @@ SimulationOptions make_options(const Model& model, const py::dict& kwargs) {
   run.rtol = get<double>(kwargs, "rtol").value_or(run.rtol);
   run.atol = get<double>(kwargs, "atol").value_or(run.atol);
   SimulationOptions options = make_simulation_options(run);
+  options.output_times = std::move(t_eval);
   options.integrator.step = get<double>(kwargs, "step").value_or(0.0);
   options.fix_initial = get<bool>(kwargs, "fix_initial").value_or(false);
   options.stabilization = parse_stabilization(get<std::string>(kwargs, "stabilize").value_or("none"));
@@ -164,6 +178,20 @@ py::dict summary_dict(const SimulationSummary& s) {
   d["stopped_by"] = s.stopped_by >= 0 ? py::cast(s.event_names[static_cast<std::size_t>(s.stopped_by)]) : py::none();
   // docs/derivations/energy-balance.md: the balance error (accuracy), the work by agent and the
   // change of E (physics).
+  // fix_initial=True: where the initial state was moved, and by how much (coordinate order).
+  if (s.initial_fix) {
+    py::dict fix;
+    const auto array = [](const Vector& v) {
+      return take_array(std::vector<double>(v.data(), v.data() + v.size()), {v.size()});
+    };
+    fix["q"] = array(s.initial_fix->q);
+    fix["qd"] = array(s.initial_fix->v);
+    fix["dq"] = array(s.initial_fix->dq);
+    fix["dqd"] = array(s.initial_fix->dv);
+    d["initial_fix"] = fix;
+  } else {
+    d["initial_fix"] = py::none();
+  }
   if (s.has_energy_balance) {
     d["energy_balance_error"] = s.max_balance_error;
     d["work_forces"] = s.work_forces;
@@ -221,8 +249,10 @@ void bind_simulation(py::module_& m) {
         {
           py::gil_scoped_release release;
           const auto start = std::chrono::steady_clock::now();
-          const std::vector<double> times = make_output_times(model->t0, options.t_end, options.output_step);
-          trajectory.reset(*model, static_cast<long>(times.size()));
+          const std::size_t rows = options.output_times.empty()
+                                       ? make_output_times(model->t0, options.t_end, options.output_step).size()
+                                       : options.output_times.size();
+          trajectory.reset(*model, static_cast<long>(rows));
           summary = simulate(*model, options, [&](const Data& data) { trajectory.append(data); });
           seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         }

@@ -26,6 +26,7 @@
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
 #include "nhdyn/model/contact_forces.hpp"
+#include "nhdyn/model/initial_values.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "progress.hpp"
 #include "run_overrides.hpp"
@@ -43,6 +44,7 @@ struct SimulateArgs {
   std::optional<double> rtol;             // default: the model file's, else RunOptions
   std::optional<double> atol;             // default: the model file's, else RunOptions
   std::vector<std::string> sets;
+  std::vector<std::string> initial;  // NAME=EXPR: initial values replacing the model's (model/initial_values.hpp)
   bool fix_initial = false;
   std::string stabilize = "none";
   double baumgarte_alpha = BaumgarteGains{}.alpha;
@@ -159,7 +161,8 @@ int run_simulate(const SimulateArgs& args) {
   const ModelSource source = read_model_source(args.model);
   const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
   std::string notice;
-  const Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
+  Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
+  apply_initial_values(model, args.initial);
   if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
   if (model.contact_forces)  // what loading found about the contact forces (docs/multibody.md)
     for (const std::string& note : model.contact_forces->notes) fmt::print(stderr, "note: contact forces: {}\n", note);
@@ -424,6 +427,9 @@ std::function<int()> add_simulate_command(CLI::App& app) {
   cmd->add_option("--evaluator", args->evaluator,
                   help_choices(jit::kEvaluatorChoices, jit::EvaluatorChoice::interpreted) +
                       " (compiled: the terms as machine code, cached; docs/cli.md)");
+  cmd->add_option("--initial", args->initial,
+                  "Set an initial value, NAME=EXPR: a coordinate (x=0.1) or a velocity (\"phi'=0.5\"); EXPR as for "
+                  "--set, in numbers and the parameters (repeatable)");
   cmd->add_flag("--fix-initial", args->fix_initial,
                 "Move the initial state onto the constraints with the smallest inertia-weighted change");
   cmd->add_option("--stabilize", args->stabilize,

@@ -5,7 +5,9 @@ linearize it, sweep a parameter and run batches on every core.
     m = nhdyn.load("examples/sled.toml")          # a model file, a built-in name, or nhdyn.loads(text)
     m.parameters["m"] = 2.0                       # no recompilation
     r = m.simulate(t_end=5, rtol=1e-10)           # Result: NumPy arrays r.t, r.q, r.qd, ...
-    r.to_pandas()                                 # a DataFrame with the CSV's column names
+    r["x"], r["phi'"]                             # a column by its CSV name
+    r.to_pandas(index="t")                        # a DataFrame with the CSV's column names
+    m.report(r, "run.html"); r.plot()             # the HTML report; matplotlib panels
 
 The numbers come from the C++ library (nhdyn._nhdyn); its errors arrive as nhdyn.Error (and the
 subclasses InputError, ModelError, FileError) with the library's message (file:line: ...).
@@ -13,6 +15,7 @@ See docs/python.md.
 """
 
 import os
+import re
 import sys
 import sysconfig
 import warnings
@@ -56,6 +59,51 @@ except ImportError as error:
 from ._nhdyn import Error, FileError, InputError, ModelError, SimulationError
 
 __version__ = _nhdyn.__version__
+
+# What the library's messages call a command-line option, in Python's terms (the keyword of
+# Model.simulate): a Python user gets "fix_initial=True", not "--fix-initial".
+_PYTHON_TERMS = {
+    "--fix-initial": "fix_initial=True", "--t-end": "t_end", "--output-step": "output_step", "--rtol": "rtol",
+    "--atol": "atol", "--step": "step", "--method": "method", "--integrator": "integrator",
+    "--complement": "complement", "--stabilize": "stabilize", "--max-steps": "max_steps",
+    "--stop-when": "stop_when", "--event": "events", "--program-feedback": "program_feedback",
+    "--set": "m.parameters[NAME] =", "--initial": "q0/qd0",
+}
+_OPTION = re.compile(r"--[a-z][a-z-]*[a-z]")
+
+
+def _python_text(text):
+    """`text` with the command line's options named as Python keywords."""
+    return _OPTION.sub(lambda m: _PYTHON_TERMS.get(m.group(0), m.group(0)), text)
+
+
+def _in_python_terms(error):
+    """The same exception (its type kept) with the command line's options named as Python keywords."""
+    text = str(error)
+    translated = _python_text(text)
+    return error if translated == text else type(error)(translated)
+
+
+def _check_t_eval(t_eval, t0, t_end):
+    """t_eval as a 1-D float array of finite, strictly increasing times in [t0, t_end], or InputError."""
+    times = np.asarray(t_eval, dtype=float)
+    if times.ndim != 1 or times.size == 0:
+        raise InputError("t_eval: expected a non-empty 1-D array of times, got shape {}".format(times.shape))
+    if not np.all(np.isfinite(times)):
+        raise InputError("t_eval: time t_eval[{}] = {} is not finite".format(
+            int(np.argmin(np.isfinite(times))), times[np.argmin(np.isfinite(times))]))
+    steps = np.diff(times)
+    if np.any(steps <= 0):
+        i = int(np.argmax(steps <= 0)) + 1
+        raise InputError("t_eval: the times must increase strictly; t_eval[{}] = {} follows {}".format(
+            i, times[i], times[i - 1]))
+    if times[0] < t0:
+        raise InputError("t_eval: t_eval[0] = {} is before the model's start time t0 = {}".format(times[0], t0))
+    if t_end is not None and times[-1] > t_end:
+        raise InputError("t_eval: t_eval[-1] = {} is after t_end = {}; leave t_end out (the run ends at the last "
+                         "time) or give a later one".format(times[-1], t_end))
+    return times
+
 
 __all__ = [
     "__version__", "Error", "InputError", "ModelError", "FileError", "SimulationError", "ConstraintWarning",
@@ -203,7 +251,7 @@ class Model:
     # --- runs and analyses ---------------------------------------------------------------------
     def simulate(self, t_end=None, *, rtol=None, atol=None, method=None, integrator=None, output_step=None,
                  complement=None, step=None, fix_initial=None, stabilize=None, q0=None, qd0=None,
-                 stop_when=None, events=None, max_steps=None, program_feedback=None):
+                 stop_when=None, events=None, max_steps=None, program_feedback=None, t_eval=None):
         """One run from the model's initial state (or q0, qd0) with the model's run options, any of
         them overridden here. Events: the model file's [[events]], plus stop_when (a condition such
         as "abs(phi) > 1", or a list of them: the run ends when one becomes true) and events (a
@@ -211,18 +259,58 @@ class Model:
         and listed in Result.events, each also a row of the outputs. For a model with programs,
         program_feedback=(alpha, beta) adds PD feedback on the programs' residuals (rates in 1/s, as
         `nhdyn simulate --program-feedback alpha,beta`; docs/derivations/program-motion.md section 5).
+        t_eval (increasing times from t0 on, as SciPy's solve_ivp takes them) gives the output
+        times instead of output_step's grid: the rows are at exactly those times (the integrator's
+        dense output), plus the events' rows; the run ends at the last one.
         Returns a Result; a run that fails numerically raises nhdyn.SimulationError with the
-        library's message."""
-        out = _nhdyn.simulate(self._cpp, t_end=t_end, rtol=rtol, atol=atol, method=method, integrator=integrator,
-                              output_step=output_step, complement=complement, step=step, fix_initial=fix_initial,
-                              stabilize=stabilize, q0=q0, v0=qd0, stop_when=stop_when, events=events,
-                              max_steps=max_steps, program_feedback=program_feedback)
+        library's message, its time `t` and the rows up to the failure in `result`. With
+        fix_initial=True, Result.summary["initial_fix"] says where the initial state was moved
+        (q, qd and the changes dq, dqd)."""
+        if t_eval is not None:
+            t_eval = _check_t_eval(t_eval, self.t0, t_end)
+        options = dict(t_end=t_end, rtol=rtol, atol=atol, method=method, integrator=integrator,
+                       output_step=output_step, complement=complement, step=step, fix_initial=fix_initial,
+                       stabilize=stabilize, q0=q0, v0=qd0, stop_when=stop_when, events=events,
+                       max_steps=max_steps, program_feedback=program_feedback, t_eval=t_eval)
+        try:
+            out = _nhdyn.simulate(self._cpp, **options)
+        except Error as error:
+            raise _in_python_terms(error) from None
         _warn_constraints(self.name, out["summary"], stacklevel=2)
+        # The provenance header is made when asked for (Result.provenance), from the compiled model
+        # as it ran (a later parameter change makes a new one) and the same options.
+        cpp, source = self._cpp, self.source
+        result = Result(self, out, lambda: _nhdyn.provenance(cpp, source, **options))
         if not out["ok"]:
             summary = out["summary"]
-            raise SimulationError("simulation of '{}' failed at t = {:.6g}: {}".format(
-                self.name, summary["t_reached"], summary["message"]))
-        return Result(self, out)
+            error = SimulationError("simulation of '{}' failed at t = {:.6g}: {}".format(
+                self.name, summary["t_reached"], _python_text(summary["message"])))
+            error.t = summary["t_reached"]  # where it failed
+            error.result = result           # the rows up to the failure
+            raise error
+        return result
+
+    def report(self, result, path, max_frames=2000):
+        """Writes the HTML report of `result` (a run of this model) to `path`: the page `nhdyn
+        simulate --html` writes (3-D animation, plots, equations; docs/report.md), with the run's
+        provenance at its top. Returns the page's note ("" when none: nothing to draw, rows
+        thinned)."""
+        if not isinstance(result, Result):
+            raise InputError("report: expected a Result of Model.simulate, got {}".format(type(result).__name__))
+        if result._source.is_builtin != self.source.is_builtin or result._source.text != self.source.text or \
+                result._source.builtin != self.source.builtin:
+            raise InputError("report: the result is a run of model '{}' from {}, not of this model '{}' ({}); call "
+                             "report on the model that made it".format(
+                                 result.model_name, result._source.file_name or result._source.builtin, self.name,
+                                 self.source.file_name or self.source.builtin))
+        names, rows = result.table()
+        comments = [line[1:] for line in result.provenance.splitlines()]
+        title = "{}: {}".format(result.model_name, os.fspath(path))
+        summary = result.summary
+        extra = [("steps", "{} (rejected {})".format(summary["steps"], summary["rejected_steps"])),
+                 ("right-hand sides", str(summary["rhs_evaluations"]))]
+        return _nhdyn.write_report(self.source, list(result._overrides.items()), names, rows, comments,
+                                   os.fspath(path), title, extra, max_frames)
 
     def equations(self, format="latex"):
         """The equations of motion (T, V, A, Q, G, b, b0, D, A0 = D A, C = D (Q + G)) as
@@ -259,8 +347,10 @@ class Result:
     columns otherwise; outputs (name -> rows, the derived outputs of docs/model-format.md [outputs]).
     `columns` holds the names, the same as the CSV written by `nhdyn simulate`."""
 
-    def __init__(self, model, out):
+    def __init__(self, model, out, provenance=None):
         self.model_name = model.name
+        self._provenance = provenance  # a function that makes the text, or None
+        self._source, self._overrides = model.source, dict(model.overrides)
         self.coordinates = model.coordinates
         self.t, self.q, self.qd, self.qdd = out["t"], out["q"], out["qd"], out["qdd"]
         self.R, self.residuals, self.energy = out["R"], out["residuals"], out["energy"]
@@ -295,12 +385,107 @@ class Result:
             parts.append(np.column_stack(list(self.outputs.values())))
         return list(self.columns["all"]), np.hstack(parts)
 
-    def to_pandas(self):
-        """A pandas DataFrame with the CSV's column names (needs pandas)."""
+    @property
+    def provenance(self):
+        """The run's provenance header, "# key: value" lines (nhdyn version, model name, file and
+        hash, parameters, initial state, options; docs/cli.md "The CSV"), as to_csv writes it and
+        `nhdyn report` reads it."""
+        if callable(self._provenance):
+            self._provenance = self._provenance()
+        return self._provenance or ""
+
+    def __getitem__(self, name):
+        """One column by its CSV name: r["x"], r["phi'"], r["R_x"], r["energy"], an output's name."""
+        if not hasattr(self, "_index"):
+            self._names, self._values = self.table()
+            self._index = {column: i for i, column in enumerate(self._names)}
+        i = self._index.get(name)
+        if i is None:
+            import difflib
+
+            near = difflib.get_close_matches(str(name), self._names, n=1)
+            raise KeyError("{!r} is not a column of this result{}; the columns are {}".format(
+                name, " (did you mean {!r}?)".format(near[0]) if near else "", ", ".join(self._names)))
+        return self._values[:, i]
+
+    def __contains__(self, name):
+        return name in self.columns["all"]
+
+    def keys(self):
+        """The column names, in the CSV's order."""
+        return list(self.columns["all"])
+
+    def to_pandas(self, index=None):
+        """A pandas DataFrame with the CSV's column names (needs pandas); index="t" (or another
+        column's name) makes that column the index."""
         import pandas as pd
 
         names, values = self.table()
-        return pd.DataFrame(values, columns=names)
+        frame = pd.DataFrame(values, columns=names)
+        if index is not None:
+            if index not in names:
+                raise KeyError("index={!r}: not a column of this result; the columns are {}".format(
+                    index, ", ".join(names)))
+            frame = frame.set_index(index)
+        return frame
+
+    def to_csv(self, path):
+        """Writes the result as `nhdyn simulate` writes its CSV: the provenance header, the column
+        names, one row per output time (numbers in the shortest form that reads back the same)."""
+        names, values = self.table()
+        with open(path, "w") as f:
+            f.write(self.provenance)
+            f.write(",".join(names) + "\n")
+            for row in values:
+                f.write(",".join(repr(float(x)) if np.isfinite(x) else ("nan" if np.isnan(x) else
+                                                                       ("inf" if x > 0 else "-inf")) for x in row))
+                f.write("\n")
+
+    def plot(self, columns=None, path=None):
+        """The run's panels with matplotlib: the coordinates, the velocities, the constraint
+        residuals (|value|, logarithmic) and the energy (or its balance error), or the named
+        `columns`, one panel each. Returns the Figure; `path` also saves it (PNG, PDF, SVG)."""
+        import matplotlib
+
+        if path is not None and "matplotlib.pyplot" not in sys.modules and not os.environ.get("MPLBACKEND"):
+            matplotlib.use("Agg")  # saving needs no window
+        import matplotlib.pyplot as plt
+
+        if columns is not None:
+            panels = [(str(c), [str(c)], False) for c in ([columns] if isinstance(columns, str) else columns)]
+            for _, names, _ in panels:
+                self[names[0]]  # KeyError naming the columns
+        else:
+            panels = [("coordinates", list(self.coordinates), False),
+                      ("velocities", [c + "'" for c in self.coordinates], False)]
+            if self.columns["residuals"]:
+                panels.append(("|constraint residuals|", list(self.columns["residuals"]), True))
+            if "balance_error" in self.columns["all"]:
+                panels.append(("energy balance error h - h0 - W", ["balance_error"], False))
+            elif self.columns["energy"]:
+                panels.append(("energy E - E0", [self.columns["energy"]], False))
+        figure, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(8, 2.4 * len(panels)), squeeze=False)
+        for ax, (title, names, logarithmic) in zip(axes[:, 0], panels):
+            for name in names:
+                values = self[name]
+                if title.startswith("energy E"):
+                    values = values - values[0]
+                if logarithmic:
+                    values = np.abs(values)
+                    values = np.where(values > 0, values, np.nan)  # log scale: an exact 0 is a gap
+                ax.plot(self.t, values, label=name)
+            if logarithmic:
+                ax.set_yscale("log")
+            ax.set_title(title, fontsize=10)
+            if len(names) > 1:
+                ax.legend(fontsize=8, loc="best")
+            ax.grid(True, alpha=0.3)
+        axes[-1, 0].set_xlabel("t [s]")
+        figure.suptitle(self.model_name)
+        figure.tight_layout()
+        if path is not None:
+            figure.savefig(os.fspath(path))
+        return figure
 
     def __repr__(self):
         return "<nhdyn.Result {!r}: {} rows, t = {:g} .. {:g}>".format(

@@ -242,7 +242,9 @@ struct Csv {
 Csv read_csv(const fs::path& path) {
   std::istringstream in(read_bytes(path));
   Csv csv;
-  if (!std::getline(in, csv.header_line)) throw std::runtime_error(path.string() + " is empty");
+  while (std::getline(in, csv.header_line) && csv.header_line.starts_with('#')) {
+  }  // the provenance header (io/provenance.hpp)
+  if (csv.header_line.empty()) throw std::runtime_error(path.string() + " is empty");
   std::stringstream names(csv.header_line);
   for (std::string name; std::getline(names, name, ',');) csv.header.push_back(name);
   std::string line;

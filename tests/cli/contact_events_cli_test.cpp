@@ -70,7 +70,9 @@ ContactEventsTable load_contact_events(const fs::path& path) {
   ContactEventsTable table;
   std::ifstream in(path);
   std::string line;
-  if (!std::getline(in, line)) return table;
+  while (std::getline(in, line) && line.starts_with('#')) {
+  }  // the provenance header (io/provenance.hpp)
+  if (line.empty()) return table;
   table.header = split(line);
   while (std::getline(in, line)) {
     const std::vector<std::string> cells = split(line);

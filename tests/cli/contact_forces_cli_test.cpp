@@ -40,7 +40,9 @@ ContactCsv read_contact_csv(const fs::path& path) {
   ContactCsv csv;
   std::ifstream in(path);
   std::string line;
-  if (!std::getline(in, line)) return csv;
+  while (std::getline(in, line) && line.starts_with('#')) {
+  }  // the provenance header (io/provenance.hpp)
+  if (line.empty()) return csv;
   csv.header = split(line);
   while (std::getline(in, line)) {
     std::vector<double> row;

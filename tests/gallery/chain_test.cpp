@@ -255,7 +255,8 @@ TEST(ChainSparsePath, CommandLineSimulatesA30BodyChainOnTheSparsePath) {
   ASSERT_NE(model.evaluator->sparsity(), nullptr);  // 90 coordinates: compiled sparse
   std::ifstream in(csv);
   std::string line, last;
-  std::getline(in, line);
+  while (std::getline(in, line) && line.starts_with('#')) {
+  }  // the provenance header (io/provenance.hpp), then the column names
   int rows = 0;
   while (std::getline(in, line)) {
     last = line;

@@ -34,7 +34,8 @@ def cli():
 
 
 def read_csv(path):
-    """(header, rows x columns array) of a CSV written by nhdyn."""
+    """(header, rows x columns array) of a CSV written by nhdyn, after its provenance comment lines."""
     with open(path) as f:
-        header = f.readline().rstrip("\n").split(",")
-    return header, np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+        lines = [line for line in f if not line.startswith("#")]
+    header = lines[0].rstrip("\n").split(",")
+    return header, np.loadtxt(lines[1:], delimiter=",", ndmin=2)

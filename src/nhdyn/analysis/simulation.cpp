@@ -145,8 +145,35 @@ std::vector<double> make_output_times(double t0, double t_end, double output_ste
   return times;
 }
 
+namespace {
+
+// The times the integrator reports at: output_step's grid, or the given output times with t0 in
+// front (the run's start state is computed there, for E0 and h0, and not handed on as a row).
+std::vector<double> calc_run_times(const Model& model, const SimulationOptions& options) {
+  if (options.output_times.empty()) return make_output_times(model.t0, options.t_end, options.output_step);
+  std::vector<double> times;
+  times.reserve(options.output_times.size() + 1);
+  if (options.output_times.front() != model.t0) times.push_back(model.t0);
+  for (std::size_t i = 0; i < options.output_times.size(); ++i) {
+    const double t = options.output_times[i];
+    if (!std::isfinite(t) || t < model.t0 || t > options.t_end)
+      throw InputError(fmt::format("the output time {} (index {}) is {}; output times lie in [t0, t_end] = [{}, {}]",
+                                   t, i, std::isfinite(t) ? "outside the run" : "not finite", model.t0, options.t_end));
+    if (i > 0 && !(t > options.output_times[i - 1]))
+      throw InputError(fmt::format("the output times must increase: {} (index {}) follows {}", t, i,
+                                   options.output_times[i - 1]));
+    times.push_back(t);
+  }
+  if (options.output_times.size() > static_cast<std::size_t>(kMaxOutputs))
+    throw InputError(fmt::format("{} output times, more than the limit of {:.0g}", options.output_times.size(),
+                                 kMaxOutputs));
+  return times;
+}
+
+}  // namespace
+
 void check_simulation_options(const Model& model, const SimulationOptions& options) {
-  make_output_times(model.t0, options.t_end, options.output_step);
+  calc_run_times(model, options);
   const IntegratorOptions& io = options.integrator;
   if (io.kind != IntegratorKind::rk4) {
     if (!std::isfinite(io.rtol) || !(io.rtol > 0.0))
@@ -208,7 +235,10 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
 
 SimulationSummary simulate(const Model& model, const SimulationOptions& options, const RowFn& row) {
   check_simulation_options(model, options);
-  const std::vector<double> times = make_output_times(model.t0, options.t_end, options.output_step);
+  const std::vector<double> times = calc_run_times(model, options);
+  // With given output times that do not start at t0, the start is computed but not a row.
+  bool hide_start = !options.output_times.empty() && options.output_times.front() != model.t0;
+  bool first_output = true;
   // The Data of the chosen formulation only, on the path the model takes (model/data.hpp).
   DataOptions data_options;
   data_options.path = options.path;
@@ -264,9 +294,10 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     compute_energy(model, data);
     compute_contact_forces(model, data);  // nothing for a model without contacts
     compute_outputs(model, data);
-    if (summary.outputs == 0) {
+    if (first_output) {
       summary.energy_initial = data.energy;
       summary.energy_function_initial = data.energy_function;
+      first_output = false;
     }
     if (summary.has_energy_balance) record_balance(model, data, y + 2 * n, summary);
     summary.max_position_residual = std::max(summary.max_position_residual, max_abs(data.phi));
@@ -281,6 +312,10 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     }
     if (summary.has_energy)
       summary.energy_drift = std::max(summary.energy_drift, std::abs(data.energy - summary.energy_initial));
+    if (hide_start) {
+      hide_start = false;
+      return Status::ok;
+    }
     ++summary.outputs;
     row(data);
     return Status::ok;

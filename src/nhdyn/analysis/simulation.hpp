@@ -40,6 +40,10 @@ Stabilization parse_stabilization(std::string_view name);  // throws InputError 
 struct SimulationOptions {
   double t_end = 10.0;        // end time [s], > t0
   double output_step = 0.01;  // spacing of output times [s], > 0
+  // When not empty, the output times instead of output_step's grid (Python's t_eval): finite,
+  // strictly increasing, within [t0, t_end]; the run ends at the last one. The rows are at these
+  // times exactly (the integrator's dense output; rk4 steps to each), plus the events' rows.
+  std::vector<double> output_times;
   FormulationOptions formulation;
   IntegratorOptions integrator;
   // The initial state must satisfy the position and velocity constraints to this tolerance, or
