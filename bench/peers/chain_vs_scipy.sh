@@ -38,7 +38,7 @@ for N in $sizes; do
   t_scipy=$1 m_scipy=$2 c_scipy=$3
   diff=$(/usr/bin/python3 - "$work/nhdyn.csv" "$work/scipy.csv" "$N" <<'PY'
 import sys, numpy as np
-a = np.loadtxt(sys.argv[1], delimiter=",", skiprows=1, max_rows=None)
+a = np.loadtxt([l for l in open(sys.argv[1]) if not l.startswith("#")][1:], delimiter=",")  # after the provenance and the names
 b = np.loadtxt(sys.argv[2], delimiter=",")
 n = 3 * int(sys.argv[3])
 print(f"{np.abs(a[-1, 1:1 + n] - b[-1, 1:1 + n]).max():.2e}")

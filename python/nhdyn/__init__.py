@@ -57,6 +57,7 @@ except ImportError as error:
     # the missing piece is usually NumPy, which Debian installs for its own interpreter only.
     raise _wrong_interpreter(str(error)) from error
 from ._nhdyn import Error, FileError, InputError, ModelError, SimulationError
+from ._from_sympy import from_sympy
 
 __version__ = _nhdyn.__version__
 
@@ -108,7 +109,7 @@ def _check_t_eval(t_eval, t0, t_end):
 __all__ = [
     "__version__", "Error", "InputError", "ModelError", "FileError", "SimulationError", "ConstraintWarning",
     "load", "loads", "builtin_models", "Model", "Result", "Equations", "Linearization", "Sweep",
-    "BatchResult", "simulate_batch",
+    "BatchResult", "simulate_batch", "from_sympy",
 ]
 
 

@@ -110,9 +110,13 @@ void ModelEventFunctions::require_valid_start(double t0, const double* y0) {
                                    "sides is {:.6g}): the run would stop before its first step; give a condition "
                                    "that becomes true later",
                                    where, t0, g_[i]));
-    if (g_[i] == 0.0)
+    // With a direction the start is not a crossing: the sign g takes after t0 decides, so that
+    // "back on the start line" (g = 0 at t0, rising) is found where it comes back. Without one, a
+    // zero at t0 is refused: which side the run starts on is then ambiguous to the reader.
+    if (g_[i] == 0.0 && e.direction == EventDirection::both)
       throw InputError(fmt::format("{}event '{}' ({}) is already at zero at the start (t0 = {}): it would be found "
-                                   "at the initial state, not where it crosses zero later; shift its expression or "
+                                   "at the initial state, not where it crosses zero later; give it a direction "
+                                   "(\"rising\" or \"falling\", which skips the start), or shift its expression or "
                                    "the initial state",
                                    where, e.name, e.expression, t0));
   }

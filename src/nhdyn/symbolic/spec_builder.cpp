@@ -193,9 +193,13 @@ std::vector<Token> lex(const Site& site, std::size_t begin, std::size_t end) {
         case '+': token.kind = TokenKind::plus; break;
         case '-': token.kind = TokenKind::minus; break;
         case '*':
-          if (i + 1 < end && s[i + 1] == '*')
-            site.fail_at(i, "'**' is not an operator: write ^ for a power, as in x^2");
-          token.kind = TokenKind::times;
+          // ** is a power as in Python and SymPy (whose printed expressions then read as they are).
+          if (i + 1 < end && s[i + 1] == '*') {
+            token.kind = TokenKind::power;
+            token.end = i + 2;
+          } else {
+            token.kind = TokenKind::times;
+          }
           break;
         case '/': token.kind = TokenKind::divide; break;
         case '^': token.kind = TokenKind::power; break;
