@@ -338,6 +338,43 @@ TEST(Report, LongRunsAreThinnedByAFixedRule) {
   }
 }
 
+// The PNG panels' rules in the page: an angle known by its name (phi, not used in sin or cos
+// here) gets the angles' panel, and a column constant to round-off beside others of its role is
+// drawn flat at its level and labelled so, not magnified into noise.
+TEST(Report, AnglesByNameAndRoundOffDrawnFlat) {
+  const nhdyn::Model model = nhdyn::symbolic::compile_model(nhdyn::load_model_string(
+      "name = \"spinner\"\ncoordinates = [\"x\", \"phi\"]\nkinetic_energy = \"x'^2/2 + phi'^2/2\"\n", "spinner.toml"));
+  nhdyn::CsvTable table;
+  table.header = nhdyn::make_result_columns(model).all;
+  for (int r = 0; r < 11; ++r) {
+    std::vector<double>& row = table.rows.emplace_back(table.header.size(), 0.0);
+    row[0] = 0.1 * r;                                // t
+    row[1] = 2.0 * row[0];                           // x: the motion
+    row[2] = 1e-12 * std::sin(7.0 * r);              // phi: noise of 1e-12 about 0
+  }
+  const fs::path html = fs::temp_directory_path() / "nhdyn_report_rules.html";
+  nhdyn::write_model_report(model, static_cast<const nhdyn::symbolic::ModelDescription*>(nullptr), table, "spinner",
+                            {}, html);
+  std::ifstream in(html);
+  std::stringstream page;
+  page << in.rdbuf();
+  fs::remove(html);
+  const std::string text = page.str();
+  EXPECT_NE(text.find("{\"title\":\"coordinates\",\"log\":false,\"series\":[{\"name\":\"x\","), std::string::npos);
+  const std::size_t angles = text.find("{\"title\":\"angles [rad]\",\"log\":false,\"series\":[{\"name\":\"phi "
+                                       "(constant to round-off, ");
+  ASSERT_NE(angles, std::string::npos) << text.substr(text.find("\"plots\""), 600);
+  // Drawn at one level: every value of the series is the same number.
+  const std::size_t v = text.find("\"v\":[", angles) + 5;
+  const std::string values = text.substr(v, text.find(']', v) - v);
+  const std::string first = values.substr(0, values.find(','));
+  EXPECT_EQ(values, [&] {
+    std::string same = first;
+    for (int r = 1; r < 11; ++r) same += "," + first;
+    return same;
+  }());
+}
+
 TEST(Report, ColumnsOfAnotherModelAreNamed) {
   nhdyn::ResultColumns columns;
   columns.all = {"t", "x", "y", "x'", "y'"};

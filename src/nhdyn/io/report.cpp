@@ -15,6 +15,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/atomic_file.hpp"
+#include "nhdyn/io/plot.hpp"
 #include "nhdyn/symbolic/derivation.hpp"
 #include "nhdyn/symbolic/description.hpp"
 #include "nhdyn/symbolic/equations.hpp"
@@ -124,7 +125,14 @@ struct PlotGroup {
   bool log = false;
   bool drift = false;  // drawn as v - v(first row)
   std::vector<std::string> columns;
+  int role = 0;  // groups of one role (0 coordinates, 1 reactions, 2 actuators) share a scale
 };
+
+// The PNG panels' rule (io/plot.cpp): a column whose values vary by no more than this fraction of
+// the largest magnitude among the columns of its role is constant to round-off, and is drawn as
+// the constant it is (flat, labelled so) rather than magnified into noise: the upright bicycle's
+// lean of 1e-12 rad beside wheels spinning through hundreds of radians.
+constexpr double kReportRoundOff = 1e-9;
 
 // Semi-axes and principal directions of the uniform solid ellipsoid with the body's mass and
 // inertia: I_1 = m (b^2 + c^2) / 5 and so on, hence a^2 = 5 (I_2 + I_3 - I_1) / (2 m). A body whose
@@ -264,7 +272,8 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
       turns{"angles turning more than once [rad]", false, false, {}};
   for (std::size_t i = 0; i < input.coordinates.size(); ++i) {
     const std::string& name = input.coordinates[i];
-    if (!(i < input.angles.size() && input.angles[i])) {
+    // An angle by use in the scene, or by its name (phi, theta_1, psiR: io/plot.hpp), as the PNG has it.
+    if (!((i < input.angles.size() && input.angles[i]) || is_angle_name(name))) {
       lengths.columns.push_back(name);
       continue;
     }
@@ -278,9 +287,16 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
   }
   for (PlotGroup* g : {&lengths, &angles, &turns})
     if (!g->columns.empty()) groups.push_back(*g);
-  if (!input.columns.reactions.empty()) groups.push_back({"reactions R", false, false, input.columns.reactions});
+  if (!input.columns.reactions.empty()) groups.push_back({"reactions R", false, false, input.columns.reactions, 1});
   if (!input.columns.actuators.empty())
-    groups.push_back({"actuator forces u ([[programs]])", false, false, input.columns.actuators});
+    groups.push_back({"actuator forces u ([[programs]])", false, false, input.columns.actuators, 2});
+  // The largest |value| of each role over the rows shown, for the round-off rule.
+  double role_scale[3] = {0.0, 0.0, 0.0};
+  for (const PlotGroup& g : groups)
+    if (!g.log && !g.drift)
+      for (const std::string& c : g.columns)
+        for (const double x : column(c))
+          if (std::isfinite(x)) role_scale[g.role] = std::max(role_scale[g.role], std::abs(x));
   if (!input.columns.residuals.empty())
     groups.push_back({"|constraint residuals| (log scale)", true, false, input.columns.residuals});
   if (!input.columns.energy_balance.empty())
@@ -311,8 +327,26 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
         const double first = table.rows.front()[static_cast<std::size_t>(table.column(groups[g].columns[s]))];
         for (double& v : values) v -= first;
       }
+      std::string label = groups[g].columns[s];
+      if (!groups[g].log && !groups[g].drift && role_scale[groups[g].role] > 0.0) {
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo, sum = 0.0;
+        std::size_t finite = 0;
+        for (const double x : values)
+          if (std::isfinite(x)) {
+            lo = std::min(lo, x);
+            hi = std::max(hi, x);
+            sum += x;
+            ++finite;
+          }
+        if (finite > 0 && hi > lo && hi - lo <= kReportRoundOff * role_scale[groups[g].role]) {
+          const double level = sum / static_cast<double>(finite);
+          for (double& x : values)
+            if (std::isfinite(x)) x = level;
+          label += fmt::format(" (constant to round-off, {:.3g})", level);
+        }
+      }
       data += s > 0 ? ",{\"name\":" : "{\"name\":";
-      append_string(data, groups[g].columns[s]);
+      append_string(data, label);
       data += ",\"v\":";
       append_numbers(data, values);
       data += '}';
