@@ -174,6 +174,9 @@ def main():
               "rolling_disk_bodies: the equations are rendered by KaTeX")
         check(browser.evaluate("document.querySelectorAll('.katex-error').length") == 0,
               "rolling_disk_bodies: KaTeX reports no error in the equations")
+        text = browser.evaluate("[...document.querySelectorAll('#equations p')].map(p => p.textContent).join(' ')")
+        check("Constraint disk_slip1, given at velocity level" in text and "\\" not in text,
+              f"rolling_disk_bodies: a constraint's name reads as written, without TeX escapes ({text[:120]!r})")
         browser.events.clear()
         browser.open("file://" + os.path.abspath(bicycle) + "#paused")
         check(browser.evaluate("nhdyn.frames") == 1001, "whipple_bicycle: all 1001 rows shown")

@@ -417,7 +417,9 @@
       const p = el("p", {}, box);
       rest.slice(i + "\\intertext{".length, j).split("$").forEach((part, k) => {
         if (k % 2 === 1) katex.render(part, el("span", {}, p), options);
-        else p.appendChild(document.createTextNode(part.replace(/\\texttt\{([^}]*)\}/g, "$1")));
+        // Plain text: \texttt{...} loses its command, and LaTeX's escapes (roll\_x) their backslash.
+        else p.appendChild(document.createTextNode(part.replace(/\\texttt\{((?:\\.|[^}\\])*)\}/g, "$1")
+          .replace(/\\([_&%#{}$])/g, "$1")));
       });
       rest = rest.slice(j + 1);
     }
