@@ -100,6 +100,8 @@ def _check_t_eval(t_eval, t0, t_end):
             i, times[i], times[i - 1]))
     if times[0] < t0:
         raise InputError("t_eval: t_eval[0] = {} is before the model's start time t0 = {}".format(times[0], t0))
+    if times[-1] <= t0:
+        raise InputError("t_eval: the last time {} must be after the model's start time t0 = {}".format(times[-1], t0))
     if t_end is not None and times[-1] > t_end:
         raise InputError("t_eval: t_eval[-1] = {} is after t_end = {}; leave t_end out (the run ends at the last "
                          "time) or give a later one".format(times[-1], t_end))

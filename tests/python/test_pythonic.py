@@ -74,6 +74,7 @@ def test_t_eval_gives_rows_at_exactly_those_times(examples):
     ([-1.0, 1.0], r"t_eval\[0\] = -1.0 is before the model's start time t0 = 0"),
     ([[0.1, 0.2]], r"expected a non-empty 1-D array"),
     ([], r"expected a non-empty 1-D array"),
+    ([0.0], r"the last time 0.0 must be after the model's start time t0 = 0"),
 ])
 def test_bad_t_eval_is_refused_in_python_terms(examples, t_eval, message):
     with pytest.raises(nhdyn.InputError, match=message):
