@@ -542,6 +542,21 @@ TEST_F(Cli, CsvOfAnotherModelNamesTheColumn) {
                     (dir / "r.html").string(),
                 out, err, dir),
             2);
+  // The provenance header names the run's model first (io/provenance.hpp) ...
+  EXPECT_NE(err.find("was written by a run of 'appell' from "), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir / "r.html"));
+  // ... and a CSV without one is told by its columns.
+  std::string rows;
+  {
+    std::ifstream in(csv);
+    for (std::string line; std::getline(in, line);)
+      if (!line.starts_with("#")) rows += line + "\n";
+  }
+  std::ofstream(csv) << rows;
+  EXPECT_EQ(run("report " + csv.string() + " --model " + example("sled.toml").string() + " -o " +
+                    (dir / "r.html").string(),
+                out, err, dir),
+            2);
   EXPECT_NE(err.find("does not belong to model 'sled'"), std::string::npos) << err;
   EXPECT_NE(err.find("column 4 is 'z' where the model expects 'phi'"), std::string::npos) << err;
   EXPECT_FALSE(fs::exists(dir / "r.html"));

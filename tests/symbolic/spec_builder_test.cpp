@@ -139,7 +139,7 @@ TEST(SpecBuilderErrors, SyntaxErrorsPointAtTheColumn) {
   // ** is a power too (SymPy's and Python's spelling), with ^'s rules.
   EXPECT_TRUE((b.parse("x**2*phi**(1/2)", at) - b.parse("x^2*phi^(1/2)", at)).is_zero());
   expect_error([&] { b.parse("x**2**3", at); }, {"m.toml:5:14: ", "ambiguous"});
-  expect_error([&] { b.parse("x**-1", at); }, {"m.toml:5:13: ", "a sign directly after '^' needs parentheses"});
+  expect_error([&] { b.parse("x**-1", at); }, {"m.toml:5:13: ", "a sign directly after '**' needs parentheses"});
   expect_error([&] { b.parse("  ", at); }, {"m.toml:5:", "empty expression"});
   expect_error([&] { b.parse("x ' + y", at); }, {"m.toml:5:12: ", "prime must follow"});
   expect_error([&] { b.parse("x = y", at); }, {"m.toml:5:12: ", "unexpected '='"});
