@@ -9,8 +9,9 @@ bool nlp_solver_available() { return false; }
 NlpResult solve_nlp(Nlp& /*nlp*/, const NlpOptions& /*options*/) {
   NlpResult result;
   result.status = NlpStatus::unavailable;
-  result.message = "nhdyn was built without IPOPT: install coinor-libipopt-dev (scripts/install-deps run) and "
-                   "rebuild (cmake picks it up with pkg-config; NHDYN_WITH_IPOPT=AUTO)";
+  result.message = "nhdyn was built without IPOPT: install it (sudo apt-get install coinor-libipopt-dev, or "
+                   "scripts/install-deps, which installs it with the test packages) and rebuild: CMake finds it "
+                   "with pkg-config (NHDYN_WITH_IPOPT=AUTO)";
   return result;
 }
 
