@@ -196,6 +196,29 @@ TEST(OptimizeSection, WarnsOfAControlThatCostsNothing) {
   EXPECT_NE(p.warnings[0].find("'G' costs nothing"), std::string::npos);
 }
 
+TEST(Transcription, RefusesAControlTheConstraintsAbsorb) {
+  // A point on the line y = x (a position constraint) pushed across it, along (1, -1).
+  const std::string model = R"(name = "rail"
+coordinates = ["x", "y"]
+kinetic_energy = "(x'^2 + y'^2)/2"
+[[constraints]]
+name = "rail"
+position = "y - x"
+[optimize]
+controls = [{ name = "F", actuator = [1, -1] }]
+objective = "F^2"
+t_end = 1
+nodes = 5
+)";
+  const OptimalControlProblem p = problem_of(model_source_from_text(model, "rail.toml"));
+  try {
+    Transcription nlp(p);
+    FAIL() << "accepted a control the constraint absorbs";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'F' does not act on the system"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Transcription, RefusesInitialValuesOffTheConstraintsAndBoundaryValuesOutsideBounds) {
   // The blade at rest with x' fixed sideways: the constraint cannot hold.
   const std::string model = R"(name = "blade"

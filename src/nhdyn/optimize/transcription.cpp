@@ -103,6 +103,28 @@ Transcription::Transcription(const OptimalControlProblem& problem) : problem_(pr
   path_row0_ = initial_row0_ + static_cast<int>(initial_rows_.size());
   rows_ = path_row0_ + points_ * path_count_;
   build_pattern();
+  check_controls_act();
+}
+
+// A control whose force the constraints absorb (D B_j = 0: it pushes along a constrained
+// direction) does not act on the system: refuse it, at the first point of the starting point.
+void Transcription::check_controls_act() {
+  if (m_ == 0 || !evaluate_point(0, start_.data())) return;
+  std::vector<double> zero_n(static_cast<std::size_t>(n_), 0.0), e_m(static_cast<std::size_t>(m_), 0.0),
+      column(static_cast<std::size_t>(n_), 0.0), dynamics(static_cast<std::size_t>(n_));
+  dynamics_values(0, start_.data(), dynamics.data());
+  for (int j = 0; j < m_; ++j) {
+    std::fill(e_m.begin(), e_m.end(), 0.0);
+    e_m[static_cast<std::size_t>(j)] = 1.0;
+    dynamics_direction(0, start_.data(), 0.0, zero_n.data(), zero_n.data(), e_m.data(), column.data());
+    double force = 0.0, acting = 0.0;
+    for (int i = 0; i < n_; ++i) force = std::max(force, std::abs(dforce_[static_cast<std::size_t>(i)]));
+    for (int l = 0; l < k_; ++l) acting = std::max(acting, std::abs(column[static_cast<std::size_t>(l)]));
+    if (force > 0.0 && acting <= 1e-12 * force)
+      throw InputError(fmt::format("the control '{}' does not act on the system: the constraints absorb its force "
+                                   "(D B = 0 at t = {}); give its actuator a direction the constraints leave free",
+                                   problem_.controls[static_cast<std::size_t>(j)].name, problem_.t0));
+  }
 }
 
 double Transcription::tau(int p) const {

@@ -29,8 +29,8 @@ namespace nhdyn {
 
 class Transcription final : public Nlp {
  public:
-  // Throws InputError when the model is compiled sparse, when fixed boundary values lie outside
-  // the bounds, when the fixed initial values violate a constraint (naming it and its residual),
+  // Throws InputError when the model is compiled sparse, when a control's force is absorbed by the
+  // constraints (D B_j = 0 at the start), when fixed boundary values lie outside the bounds, when the fixed initial values violate a constraint (naming it and its residual),
   // or when the constraints are dependent at the starting point.
   explicit Transcription(const OptimalControlProblem& problem);
 
@@ -78,6 +78,7 @@ class Transcription final : public Nlp {
   void build_pattern();
   void choose_splits_and_initial_rows();
   void make_start();
+  void check_controls_act();
   // The terms, B u, the split's factorization and r at point p of x (fills the work arrays).
   bool evaluate_point(int p, const double* x);
   // The dynamics rows of the point last evaluated into `out` (n values).
