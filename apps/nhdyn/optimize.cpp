@@ -78,11 +78,10 @@ int run_optimize(const OptimizeArgs& args) {
   if (!args.output.empty()) make_parent_directory(args.output);
   if (!args.plot.empty()) make_parent_directory(args.plot);
   const OptimizeResult result = solve_optimal_control(problem, options);
+  // A build without IPOPT: bad input is still reported as such (the transcription checks it
+  // before the solver is called), then the command says how to get IPOPT.
+  if (result.solver.status == NlpStatus::unavailable) throw InputError(result.solver.message);
   fmt::print("{}", format_optimize_summary(problem, result));
-  if (result.solver.status == NlpStatus::unavailable) {
-    fmt::print(stderr, "nhdyn: error: {}\n", result.solver.message);
-    return 2;
-  }
   const std::string table = format_table(optimize_columns(problem), optimize_rows(problem, result));
   if (!result.converged()) {
     if (!args.output.empty()) {
