@@ -222,6 +222,38 @@ TEST_F(OptimizeCli, BrachistochroneFollowsTheCycloid) {
   }
 }
 
+TEST_F(OptimizeCli, FinalValuesTheConstraintsDetermineAreReleased) {
+  // A knife edge brought to rest: x' = y' = 0 at t_end fixes the sideways speed twice (the blade
+  // constraint already does), which the discrete motion meets only up to its drift. The rank rule
+  // releases y' and says so; the blade's residual there is the drift, small.
+  write("blade.toml", R"toml(name = "blade"
+coordinates = ["x", "y", "theta"]
+kinetic_energy = "m/2 * (x'^2 + y'^2) + J/2 * theta'^2"
+[parameters]
+m = 1.0
+J = 1.0
+[[constraints]]
+name = "blade"
+velocity = "-sin(theta)*x' + cos(theta)*y'"
+[optimize]
+controls = [{ name = "F", actuator = ["cos(theta)", "sin(theta)", 0] }, { name = "T", actuator = "theta" }]
+objective = "F^2 + T^2"
+t_end = 2
+nodes = 11
+initial = { position = { x = 0, y = 0, theta = 0 }, velocity = { x = 0, y = 0, theta = 0 } }
+final = { position = { x = 1, y = 0.1, theta = 0.2 }, velocity = { x = 0, y = 0, theta = 0 } }
+)toml");
+  const Outcome run = optimize("blade.toml -o blade.csv");
+  SKIP_WITHOUT_IPOPT(run);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("note: the final y' is determined by the constraints (blade)"), std::string::npos) << run.out;
+  EXPECT_LT(summary_value(run.out, "replay difference"), 1e-3) << run.out;
+  const Table t = read_csv(dir_ / "blade.csv");
+  EXPECT_DOUBLE_EQ(t.column("x'").back(), 0.0);
+  EXPECT_LT(std::abs(t.column("y'").back()), 1e-3);
+  EXPECT_GT(std::abs(t.column("y'").back()), 0.0);  // left free: the drift, not pinned
+}
+
 TEST_F(OptimizeCli, InfeasibleProblemIsSaidPlainlyAndItsLastIterateKept) {
   // |F| <= 0.1 moves the mass at most 0.1 T^2/4 = 0.1 from rest to rest in T = 2, not d = 1.
   write_variant("double_integrator.toml", "weak.toml", {{"final =", "bounds = { F = [-0.1, 0.1] }\nfinal ="}});

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/model/program_tangent.hpp"
 
 namespace nhdyn {
@@ -95,6 +96,7 @@ Transcription::Transcription(const OptimalControlProblem& problem) : problem_(pr
   }
 
   make_start();
+  release_determined_final_values();
   choose_splits_and_initial_rows();
   build_collocation();
   collocation_rows_ = static_cast<int>(collocation_.size());
@@ -258,6 +260,80 @@ void Transcription::choose_splits_and_initial_rows() {
     notes_.push_back(fmt::format("the constraint {} holds at the first node by the fixed initial values: not imposed "
                                  "there again",
                                  names[static_cast<std::size_t>(c)]));
+  }
+}
+
+// The rank rule at t_end (docs/derivations/optimal-programs.md, section 5, item 1): a combination
+// of the constraints (position and velocity level, linearized at the final state of the starting
+// point) that involves only final values the user fixed is a relation among them which the exact
+// motion meets for free but the discrete one only up to its drift. Such final values are released
+// (one per relation, the pivots of a column-pivoted QR of the relations), and the summary says so.
+void Transcription::release_determined_final_values() {
+  const Model& model = problem_.model;
+  const int pcount = model.position_constraints(), rcount = model.velocity_constraints();
+  const int rows = pcount + rcount;
+  if (rows == 0 || problem_.final.empty()) return;
+  const int last = points_ - 1;
+  const double* x = start_.data();
+  // The starting point's final state with the fixed values in it.
+  std::vector<double> q(x + q_index(last, 0), x + q_index(last, 0) + n_), v(x + v_index(last, 0), x + v_index(last, 0) + n_);
+  for (const BoundaryValue& b : problem_.final) (b.velocity ? v : q)[static_cast<std::size_t>(b.index)] = b.value;
+  const double t = problem_.t_end;
+  std::vector<double> values(static_cast<std::size_t>(rows)), d(static_cast<std::size_t>(rows)),
+      dq(static_cast<std::size_t>(n_)), dv(static_cast<std::size_t>(n_));
+  std::vector<double> position_registers(static_cast<std::size_t>(position_residual_->registers()));
+  if (pcount > 0) position_residual_->run(t, q.data(), v.data(), position_registers.data(), values.data());
+  if (rcount > 0) velocity_residual_->run(t, q.data(), v.data(), velocity_registers_.data(), values.data() + pcount);
+  Eigen::MatrixXd C(rows, 2 * n_);
+  for (int c = 0; c < 2 * n_; ++c) {
+    std::fill(dq.begin(), dq.end(), 0.0);
+    std::fill(dv.begin(), dv.end(), 0.0);
+    (c < n_ ? dq[static_cast<std::size_t>(c)] : dv[static_cast<std::size_t>(c - n_)]) = 1.0;
+    if (pcount > 0) run_tangent(*position_residual_, position_registers.data(), 0.0, dq.data(), nullptr, tangents_.data(), d.data());
+    if (rcount > 0)
+      run_tangent(*velocity_residual_, velocity_registers_.data(), 0.0, dq.data(), dv.data(), tangents_.data(), d.data() + pcount);
+    for (int r = 0; r < rows; ++r) C(r, c) = d[static_cast<std::size_t>(r)];
+  }
+  std::vector<int> fixed_columns, free_columns;
+  for (int c = 0; c < 2 * n_; ++c) {
+    const bool fixed = std::any_of(problem_.final.begin(), problem_.final.end(), [&](const BoundaryValue& b) {
+      return b.index + (b.velocity ? n_ : 0) == c;
+    });
+    (fixed ? fixed_columns : free_columns).push_back(c);
+  }
+  Eigen::MatrixXd Cfree(rows, static_cast<Eigen::Index>(free_columns.size())), Cfixed(rows, static_cast<Eigen::Index>(fixed_columns.size()));
+  for (std::size_t c = 0; c < free_columns.size(); ++c) Cfree.col(static_cast<Eigen::Index>(c)) = C.col(free_columns[c]);
+  for (std::size_t c = 0; c < fixed_columns.size(); ++c) Cfixed.col(static_cast<Eigen::Index>(c)) = C.col(fixed_columns[c]);
+  // The combinations z of the constraint rows with z^T Cfree = 0: a basis of the left null space.
+  Eigen::MatrixXd Z;
+  if (Cfree.cols() == 0) {
+    Z = Eigen::MatrixXd::Identity(rows, rows);
+  } else {
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Cfree, Eigen::ComputeFullU);
+    const double tol = 1e-9 * std::max(1.0, svd.singularValues().size() ? svd.singularValues()(0) : 0.0);
+    int rank = 0;
+    for (Eigen::Index i = 0; i < svd.singularValues().size(); ++i) rank += svd.singularValues()(i) > tol ? 1 : 0;
+    Z = svd.matrixU().rightCols(rows - rank);
+  }
+  if (Z.cols() == 0) return;
+  const Eigen::MatrixXd relations = Z.transpose() * Cfixed;  // relations among the fixed final values
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(relations);
+  const double tol = 1e-9 * std::max(1.0, relations.cwiseAbs().maxCoeff());
+  int count = 0;
+  for (Eigen::Index i = 0; i < std::min(relations.rows(), relations.cols()); ++i)
+    count += std::abs(qr.matrixR()(i, i)) > tol ? 1 : 0;
+  std::vector<std::string> names;
+  for (const Constraint& c : model.constraints)
+    if (c.level != ConstraintLevel::acceleration) names.push_back(c.name);
+  for (int i = 0; i < count; ++i) {
+    const int column = fixed_columns[static_cast<std::size_t>(qr.colsPermutation().indices()(i))];
+    const std::size_t at = static_cast<std::size_t>(column < n_ ? q_index(last, column) : v_index(last, column - n_));
+    const std::string name = model.coordinates[static_cast<std::size_t>(column % n_)] + (column < n_ ? "" : "'");
+    x_lower_[at] = nlp_bound(problem_.state_lower[static_cast<std::size_t>(column)]);
+    x_upper_[at] = nlp_bound(problem_.state_upper[static_cast<std::size_t>(column)]);
+    notes_.push_back(fmt::format("the final {} is determined by the constraints ({}) with the other final values: "
+                                 "left free, it meets its value up to the discretization's drift",
+                                 name, join(names)));
   }
 }
 

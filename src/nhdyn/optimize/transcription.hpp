@@ -11,7 +11,8 @@
 //   the constraints at their own level at the first node (phi, and f or d phi/dt), leaving out
 //     those the fixed initial values already determine (the rank rule of section 5);
 //   the path constraints at each point.
-// Boundary values and bounds are bounds on the variables. The objective is the quadrature (O8) of
+// Boundary values and bounds are bounds on the variables; a fixed final value that the constraints
+// determine from the other fixed final values is released (the rank rule of section 5, item 1). The objective is the quadrature (O8) of
 // the integrand plus the final term (or T for minimum time). Every derivative is exact: the
 // tangent mode of the compiled programs (model/program_tangent.hpp), contracted as in (O5), (O7),
 // so that no derivative of D is needed. Plain C++, no solver types.
@@ -79,6 +80,7 @@ class Transcription final : public Nlp {
   void choose_splits_and_initial_rows();
   void make_start();
   void check_controls_act();
+  void release_determined_final_values();
   // The terms, B u, the split's factorization and r at point p of x (fills the work arrays).
   bool evaluate_point(int p, const double* x);
   // The dynamics rows of the point last evaluated into `out` (n values).
