@@ -1,3 +1,5 @@
+// The collocation NLP of transcription.hpp: layout, bounds, starting point, rank rules, and the
+// values and exact derivatives of the objective and constraints.
 #include "nhdyn/optimize/transcription.hpp"
 
 #include <fmt/format.h>
