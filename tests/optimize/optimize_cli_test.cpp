@@ -123,6 +123,10 @@ TEST_F(OptimizeCli, DoubleIntegratorHermiteSimpsonIsExact) {
     EXPECT_NEAR(u[i], 1.5 * (1 - 2 * s), 1e-6) << "t = " << time[i];
     EXPECT_NEAR(x[i], 3 * s * s - 2 * s * s * s, 1e-8) << "t = " << time[i];
   }
+  // --set reaches the numbers of [optimize]: final x = d = 2, t_end = duration = 1: J = 12 * 4 / 1.
+  const Outcome set = optimize(example("double_integrator.toml") + " --set d=2 --set duration=1");
+  ASSERT_EQ(set.exit_code, 0) << set.out;
+  EXPECT_NEAR(summary_value(set.out, "objective"), 48.0, 1e-7) << set.out;
 }
 
 TEST_F(OptimizeCli, DoubleIntegratorTrapezoidalMeetsItsDiscreteClosedForm) {
