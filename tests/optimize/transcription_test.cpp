@@ -187,6 +187,14 @@ TEST(OptimizeSection, ReadsFlatAndNestedBoundaryStatesAndParameterExpressions) {
   ASSERT_EQ(p.warnings.size(), 0U);
 }
 
+TEST(OptimizeSection, FinalAsAStringIsTheTermAtTheFinalTime) {
+  const std::string base = "controls = [{ name = \"F\", actuator = \"x\" }]\nt_end = 1\nnodes = 5\nobjective = \"F^2\"\n";
+  const OptimalControlProblem p = problem_of(model_source_from_text(plane_problem(base + "final = \"(x - 1)^2\"\n"), "plane.toml"));
+  EXPECT_TRUE(p.final_term.has_value());
+  EXPECT_TRUE(p.final.empty());
+  EXPECT_NE(error_of(base + "final = \"x^2\"\nobjective_final = \"y^2\"\n").find("keep one"), std::string::npos);
+}
+
 TEST(OptimizeSection, WarnsOfAControlThatCostsNothing) {
   const OptimalControlProblem p = problem_of(model_source_from_text(
       plane_problem("controls = [{ name = \"F\", actuator = \"x\" }, { name = \"G\", actuator = \"y\" }]\n"

@@ -78,7 +78,9 @@ class SectionReader {
     p.state_upper.assign(static_cast<std::size_t>(2 * n), kNoBound);
     if (const toml::node* b = section->get("bounds")) read_bounds(*b, p);
     if (const toml::node* v = section->get("initial")) p.initial = read_state(*v, "initial");
-    if (const toml::node* v = section->get("final")) p.final = read_state(*v, "final");
+    // final = { ... } is the final state; final = "..." (the spelling of the Mayer term) is
+    // the same as objective_final = "...".
+    if (const toml::node* v = section->get("final"); v != nullptr && !v->is_string()) p.final = read_state(*v, "final");
     read_objective(*section, p);
     if (const toml::node* v = section->get("path")) read_path(*v, p);
     compile_force(p);
@@ -381,7 +383,14 @@ class SectionReader {
       objective_ = parse(*node, "the objective", true, true);
       p.integrand = compile({objective_}, {"objective"});
     }
-    if (const toml::node* f = section.get("objective_final")) {
+    const toml::node* f = section.get("objective_final");
+    if (const toml::node* mayer = section.get("final"); mayer != nullptr && mayer->is_string()) {
+      if (f != nullptr)
+        fail(*mayer, "final = \"...\" and objective_final both give the term at t_end: keep one (and write the final "
+                     "state as final = { position = {...}, velocity = {...} })");
+      f = mayer;
+    }
+    if (f != nullptr) {
       const GiNaC::ex e = parse(*f, "objective_final", true, false);
       p.final_term = compile({e}, {"objective_final"});
       objective_ += e;
