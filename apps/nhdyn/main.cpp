@@ -29,6 +29,7 @@ std::function<int()> add_list_command(CLI::App& app);
 std::function<int()> add_equations_command(CLI::App& app);
 std::function<int()> add_codegen_command(CLI::App& app);
 std::function<int()> add_example_command(CLI::App& app);
+std::function<int()> add_optimize_command(CLI::App& app);
 
 struct Subcommand {
   const char* name;
@@ -38,7 +39,7 @@ constexpr Subcommand kSubcommands[] = {
     {"simulate", add_simulate_command}, {"compare", add_compare_command},   {"study", add_study_command},
     {"linearize", add_linearize_command}, {"sweep", add_sweep_command},     {"batch", add_batch_command},
     {"report", add_report_command},     {"list", add_list_command},         {"equations", add_equations_command},
-    {"codegen", add_codegen_command},   {"example", add_example_command},
+    {"codegen", add_codegen_command},   {"example", add_example_command},   {"optimize", add_optimize_command},
 };
 
 }  // namespace nhdyn::cli

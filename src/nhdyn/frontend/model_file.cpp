@@ -51,6 +51,7 @@ const std::vector<std::string> top_level_keys = {
     "initial",        "solution",    "simulation",  "plot",        "visual",
     "events",  // [[events]]: zero crossings located during a run
     "outputs",  // [outputs]: derived result columns
+    "optimize",  // [optimize]: an optimal control problem, read by `nhdyn optimize` (frontend/optimize_problem.hpp)
     // The multibody description (docs/multibody.md).
     "gravity", "frames", "points", "bodies", "wheels", "knife_edges", "surfaces", "curves", "contacts"};
 const std::vector<std::string> frame_keys = {"name", "parent", "translation", "rotations"};

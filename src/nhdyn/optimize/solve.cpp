@@ -1,0 +1,156 @@
+#include "nhdyn/optimize/solve.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/io/csv.hpp"
+#include "nhdyn/optimize/replay.hpp"
+#include "nhdyn/optimize/transcription.hpp"
+
+namespace nhdyn {
+
+const char* nlp_status_name(NlpStatus status) {
+  switch (status) {
+    case NlpStatus::solved: return "solved";
+    case NlpStatus::solved_acceptable: return "solved to acceptable level";
+    case NlpStatus::infeasible: return "infeasible";
+    case NlpStatus::iteration_limit: return "iteration limit";
+    case NlpStatus::failed: return "failed";
+    case NlpStatus::unavailable: return "unavailable";
+  }
+  return "failed";
+}
+
+namespace {
+
+// The guess CSV interpolated linearly at each point's time (columns found by name).
+void apply_guess(const Transcription& nlp, const std::filesystem::path& path, std::vector<double>& x) {
+  const OptimalControlProblem& problem = nlp.problem();
+  const CsvTable table = load_csv(path);
+  const auto column = [&](const std::string& name) -> int {
+    return table.column(name);
+  };
+  const int t_column = column("t");
+  if (t_column < 0 || table.rows.size() < 2)
+    throw InputError(fmt::format("{}: a guess needs a column t and at least two rows", path.string()));
+  const auto value = [&](int c, double t) {
+    const std::size_t rows = table.rows.size();
+    std::size_t hi = 1;
+    while (hi + 1 < rows && table.rows[hi][static_cast<std::size_t>(t_column)] < t) ++hi;
+    const double t0 = table.rows[hi - 1][static_cast<std::size_t>(t_column)], t1 = table.rows[hi][static_cast<std::size_t>(t_column)];
+    const double s = t1 > t0 ? std::clamp((t - t0) / (t1 - t0), 0.0, 1.0) : 0.0;
+    return (1 - s) * table.rows[hi - 1][static_cast<std::size_t>(c)] + s * table.rows[hi][static_cast<std::size_t>(c)];
+  };
+  const int n = problem.n(), m = problem.m();
+  std::vector<std::pair<int, int>> map;  // (variable offset in a point, csv column)
+  for (int i = 0; i < n; ++i) {
+    const std::string& name = problem.model.coordinates[static_cast<std::size_t>(i)];
+    for (int level = 0; level < 3; ++level) {
+      const int c = column(name + std::string(static_cast<std::size_t>(level), '\''));
+      if (c < 0 && level < 2)
+        throw InputError(fmt::format("{}: the guess has no column '{}{}': give t, the coordinates and their velocities "
+                                     "(and optionally x'' and u_NAME) as nhdyn optimize writes them",
+                                     path.string(), name, level == 1 ? "'" : ""));
+      if (c >= 0) map.emplace_back(level * n + i, c);
+    }
+  }
+  for (int j = 0; j < m; ++j) {
+    const int c = column("u_" + problem.controls[static_cast<std::size_t>(j)].name);
+    if (c >= 0) map.emplace_back(3 * n + j, c);
+  }
+  for (int p = 0; p < nlp.points(); ++p) {
+    const double t = nlp.time(p, x.data());
+    for (const auto& [offset, c] : map) x[static_cast<std::size_t>(p * nlp.width() + offset)] = value(c, t);
+  }
+}
+
+}  // namespace
+
+OptimizeResult solve_optimal_control(const OptimalControlProblem& problem, const OptimizeOptions& options) {
+  Transcription nlp(problem);
+  OptimizeResult result;
+  result.notes = problem.warnings;
+  for (const std::string& note : nlp.notes()) result.notes.push_back(note);
+  if (!options.guess.empty()) {
+    std::vector<double> x = nlp.start();
+    apply_guess(nlp, options.guess, x);
+    nlp.set_start(std::move(x));
+    result.notes.push_back("first guess: " + options.guess.string());
+  }
+  result.solver = solve_nlp(nlp, options.nlp);
+  if (result.solver.status == NlpStatus::unavailable) return result;
+  std::vector<double> x = result.solver.x.empty() ? nlp.start() : result.solver.x;
+  const int n = problem.n(), m = problem.m(), P = nlp.points();
+  nlp.objective(x.data(), result.objective);
+  result.constraint_violation = nlp.constraint_violation(x.data());
+  result.points = P;
+  result.t_end = problem.t0 + nlp.duration(x.data());
+  for (int p = 0; p < P; ++p) {
+    result.times.push_back(nlp.time(p, x.data()));
+    for (int i = 0; i < n; ++i) {
+      result.q.push_back(x[static_cast<std::size_t>(nlp.q_index(p, i))]);
+      result.v.push_back(x[static_cast<std::size_t>(nlp.v_index(p, i))]);
+      result.a.push_back(x[static_cast<std::size_t>(nlp.a_index(p, i))]);
+    }
+    for (int j = 0; j < m; ++j) result.u.push_back(x[static_cast<std::size_t>(nlp.u_index(p, j))]);
+  }
+  const std::vector<double> v0(result.v.begin(), result.v.begin() + n);
+  const ReplayResult replay = calc_replay(problem, result.times, result.q, v0, result.u);
+  result.replayed = replay.ok;
+  result.replay_difference = replay.difference;
+  result.replay_message = replay.message;
+  if (!result.converged() && options.guess.empty())
+    result.notes.push_back("IPOPT did not converge from the straight line between the boundary states, which can be a "
+                           "stationary point of the constraints' violation (as for the Brockett integrator): give a "
+                           "first guess, --guess FILE.csv (docs/optimize.md)");
+  return result;
+}
+
+std::vector<std::string> optimize_columns(const OptimalControlProblem& problem) {
+  std::vector<std::string> columns{"t"};
+  for (const char* suffix : {"", "'", "''"})
+    for (const std::string& c : problem.model.coordinates) columns.push_back(c + suffix);
+  for (const OptimizeControl& c : problem.controls) columns.push_back("u_" + c.name);
+  return columns;
+}
+
+std::vector<std::vector<double>> optimize_rows(const OptimalControlProblem& problem, const OptimizeResult& result) {
+  const std::size_t n = static_cast<std::size_t>(problem.n()), m = static_cast<std::size_t>(problem.m());
+  std::vector<std::vector<double>> rows;
+  for (std::size_t p = 0; p < static_cast<std::size_t>(result.points); ++p) {
+    std::vector<double> row{result.times[p]};
+    for (const std::vector<double>* block : {&result.q, &result.v, &result.a})
+      row.insert(row.end(), block->begin() + static_cast<std::ptrdiff_t>(p * n), block->begin() + static_cast<std::ptrdiff_t>((p + 1) * n));
+    row.insert(row.end(), result.u.begin() + static_cast<std::ptrdiff_t>(p * m), result.u.begin() + static_cast<std::ptrdiff_t>((p + 1) * m));
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+std::string format_optimize_summary(const OptimalControlProblem& problem, const OptimizeResult& result) {
+  std::string controls;
+  for (const OptimizeControl& c : problem.controls) controls += (controls.empty() ? "" : ", ") + c.name;
+  std::string out = fmt::format("nhdyn optimize {}: {} nodes, {}, controls {}, objective {}\n", problem.model.name,
+                                problem.nodes, collocation_method_name(problem.method), controls,
+                                problem.minimum_time ? "time" : "\"" + problem.objective_text + "\"");
+  out += fmt::format("status: {} ({})\n", nlp_status_name(result.solver.status), result.solver.message);
+  if (result.solver.status == NlpStatus::unavailable) return out;
+  out += fmt::format("iterations: {}\n", result.solver.iterations);
+  out += fmt::format("objective: {:.10g}\n", result.objective);
+  if (problem.free_time) out += fmt::format("t_end: {:.10g}\n", result.t_end);
+  out += fmt::format("constraint violation: {:.3e}\n", result.constraint_violation);
+  if (result.replayed)
+    out += fmt::format("replay difference: {:.3e} (largest |q - q_replayed| at the nodes; dop853, rtol 1e-11)\n",
+                       result.replay_difference);
+  else
+    out += fmt::format("replay difference: none ({})\n", result.replay_message);
+  for (const std::string& note : result.notes) out += "note: " + note + "\n";
+  return out;
+}
+
+}  // namespace nhdyn
