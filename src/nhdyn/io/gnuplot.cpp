@@ -40,13 +40,6 @@ constexpr std::string_view install_hint =
 
 std::string errno_text(int err) { return std::error_code(err, std::generic_category()).message(); }
 
-std::string trim(std::string_view s) {
-  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
-  while (!s.empty() && blank(s.front())) s.remove_prefix(1);
-  while (!s.empty() && blank(s.back())) s.remove_suffix(1);
-  return std::string(s);
-}
-
 // Closes a file descriptor when it goes out of scope.
 class UniqueFd {
  public:
@@ -218,7 +211,9 @@ bool probe_gnuplot() {
 }
 
 std::string quoted_stderr(const std::string& text) {
-  std::string tail = trim(text);
+  constexpr std::string_view blank = " \t\r\n";
+  const std::size_t first = text.find_first_not_of(blank);
+  std::string tail = first == std::string::npos ? "" : text.substr(first, text.find_last_not_of(blank) - first + 1);
   if (tail.size() > max_quoted_stderr) {
     tail = "...\n" + tail.substr(tail.size() - max_quoted_stderr);
   }
