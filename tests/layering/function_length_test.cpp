@@ -284,48 +284,37 @@ std::string body(int lines) {
   return out;
 }
 
+// "name@first_line+lines " for each function of `source`: a whole answer in one comparison.
+std::string functions_of(const std::string& source) {
+  std::string out;
+  for (const Function& f : find_functions(source))
+    out += f.name + "@" + std::to_string(f.first_line) + "+" + std::to_string(f.lines) + " ";
+  return out;
+}
+
 TEST(FunctionLength, CountsFromSignatureToClosingBrace) {
   const std::string source = "namespace a {\nint f(int x,\n      int y) {\n" + body(5) + "}\n}  // namespace a\n";
-  const std::vector<Function> found = find_functions(source);
-  ASSERT_EQ(found.size(), 1u);
-  EXPECT_EQ(found[0].name, "f");
-  EXPECT_EQ(found[0].first_line, 2);
-  EXPECT_EQ(found[0].lines, 2 + 5 + 1);
+  EXPECT_EQ(functions_of(source), "f@2+8 ");  // the two lines of the signature, 5 of body, the brace
 }
 
 TEST(FunctionLength, NestedBracesAndLambdasBelongToTheirFunction) {
-  const std::string source = "void g() {\n  auto h = [&](int i) {\n    if (i) { return; }\n  };\n"
-                             "  for (;;) {\n  }\n}\n";
-  const std::vector<Function> found = find_functions(source);
-  ASSERT_EQ(found.size(), 1u);
-  EXPECT_EQ(found[0].name, "g");
-  EXPECT_EQ(found[0].lines, 7);
+  EXPECT_EQ(functions_of("void g() {\n  auto h = [&](int i) {\n    if (i) { return; }\n  };\n"
+                         "  for (;;) {\n  }\n}\n"),
+            "g@1+7 ");
 }
 
 TEST(FunctionLength, ClassMembersAreFunctionsAndInitializersAreNot) {
-  const std::string source =
-      "struct S : Base {\n  int m() const { return 1; }\n};\n"
-      "const std::array<int, 2> table = {1, 2};\nstd::vector<int> v{3};\n"
-      "int S::n(const char* s) {\n  return 0;\n}\n"
-      "S::S(int x) : a_{x}, b_(x) {\n  if (x) {\n    x = 0;\n  }\n}\n";
-  const std::vector<Function> found = find_functions(source);
-  ASSERT_EQ(found.size(), 3u);
-  EXPECT_EQ(found[0].name, "m");
-  EXPECT_EQ(found[0].lines, 1);
-  EXPECT_EQ(found[1].name, "S::n");
-  EXPECT_EQ(found[1].lines, 3);
-  EXPECT_EQ(found[2].name, "S::S");
-  EXPECT_EQ(found[2].lines, 5);
+  EXPECT_EQ(functions_of("struct S : Base {\n  int m() const { return 1; }\n};\n"
+                         "const std::array<int, 2> table = {1, 2};\nstd::vector<int> v{3};\n"
+                         "int S::n(const char* s) {\n  return 0;\n}\n"
+                         "S::S(int x) : a_{x}, b_(x) {\n  if (x) {\n    x = 0;\n  }\n}\n"),
+            "m@2+1 S::n@6+3 S::S@9+5 ");
 }
 
 TEST(FunctionLength, BracesInCommentsStringsAndMacrosAreNotCode) {
-  const std::string source = "// void x() {\n/* { */\n#define OPEN {\nconst char* s = \"{\";\nchar c = '}';\n"
-                             "auto r = R\"js(function() { )js\";\nint f() {\n  return 1'000;\n}\n";
-  const std::vector<Function> found = find_functions(source);
-  ASSERT_EQ(found.size(), 1u);
-  EXPECT_EQ(found[0].name, "f");
-  EXPECT_EQ(found[0].first_line, 7);
-  EXPECT_EQ(found[0].lines, 3);
+  EXPECT_EQ(functions_of("// void x() {\n/* { */\n#define OPEN {\nconst char* s = \"{\";\nchar c = '}';\n"
+                         "auto r = R\"js(function() { )js\";\nint f() {\n  return 1'000;\n}\n"),
+            "f@7+3 ");
 }
 
 }  // namespace function_length
