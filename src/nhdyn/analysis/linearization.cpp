@@ -257,34 +257,17 @@ void sort_eigenvalues(std::vector<std::complex<double>>& eigenvalues) {
   });
 }
 
-Linearization calc_linearization(const Model& model, const LinearizationOptions& options) {
-  check_model_shape(model);
-  if (model.m() > 0)
-    throw InputError(fmt::format("model '{}' has programs ([[programs]]); linearization does not take their actuator "
-                                 "forces into account: remove the programs to linearize the free system",
-                                 model.name));
-  const int n = model.n();
-  const int s = model.s();
-  Layout layout;
-  layout.n = n;
-  layout.s = s;
-  layout.p = model.position_constraints();
-  layout.r = model.velocity_constraints();
-  if (!(options.steady_tolerance > 0.0) || !std::isfinite(options.steady_tolerance))
-    throw InputError(fmt::format("the steady-motion tolerance must be a positive number, not {}", options.steady_tolerance));
-  const double t = model.t0;
-  const Vector& q = model.q0;
-  const Vector& v = model.v0;
-  const auto name = [&](int i) { return model.coordinates[static_cast<std::size_t>(i)]; };
+namespace {
 
-  Differentiator diff(model, layout, t, q, v);
-  Linearization out;
-  out.derivatives = diff.method();
-
-  // --- cyclic coordinates, named and found; explicit time dependence ---------------------------
+// --- cyclic coordinates, named and found; explicit time dependence ---------------------------
+// Marks the cyclic coordinates (named, and found when options.detect_cyclic), names them in
+// out.cyclic and returns the flags; throws when the model reads t explicitly.
+std::vector<char> find_cyclic(const Model& model, const Layout& layout, Differentiator& diff,
+                              const LinearizationOptions& options, Linearization& out) {
+  const int n = layout.n;
   std::vector<char> cyclic(static_cast<std::size_t>(n), 0);
   for (const std::string& c : options.cyclic) cyclic[static_cast<std::size_t>(find_coordinate(model, c, "--cyclic"))] = 1;
-  const std::vector<char> depends = find_dependence(model, layout, diff, q, v);
+  const std::vector<char> depends = find_dependence(model, layout, diff, model.q0, model.v0);
   if (depends[0])
     throw ModelError(fmt::format("model '{}' depends on time t explicitly (its terms or constraints read t), so a "
                                  "motion of it has no constant linearization; describe it in coordinates in which "
@@ -293,42 +276,45 @@ Linearization calc_linearization(const Model& model, const LinearizationOptions&
   if (options.detect_cyclic)
     for (int i = 0; i < n; ++i)
       if (!depends[static_cast<std::size_t>(1 + i)]) cyclic[static_cast<std::size_t>(i)] = 1;
-  std::vector<int> nc;  // the non-cyclic coordinates
-  for (int i = 0; i < n; ++i) {
-    if (cyclic[static_cast<std::size_t>(i)])
-      out.cyclic.push_back(name(i));
-    else
-      nc.push_back(i);
-  }
-  const int m = static_cast<int>(nc.size());
+  for (int i = 0; i < n; ++i)
+    if (cyclic[static_cast<std::size_t>(i)]) out.cyclic.push_back(model.coordinates[static_cast<std::size_t>(i)]);
+  return cyclic;
+}
 
-  // --- the state: constraints, then q'' and the multipliers from the KKT form ----------------
-  Vector base;
-  diff.evaluate(t, q, v, base);
-  if (!base.allFinite())
-    throw ModelError(fmt::format("model '{}': a term or residual is not finite at the initial state", model.name));
-  {
-    const double tol = options.steady_tolerance;
-    int pos = 0, vel = 0;
-    for (int i = 0; i < s; ++i) {
-      const Constraint& c = model.constraints[static_cast<std::size_t>(i)];
-      if (c.level == ConstraintLevel::acceleration) continue;
-      if (c.level == ConstraintLevel::position) {
-        const double r = base(layout.phi() + pos++);
-        if (!(std::abs(r) <= tol))
-          throw ModelError(fmt::format("the initial state violates the constraint '{}' at position level by {:.3e} "
-                                       "(tolerance {:g}); a steady motion must satisfy the constraints: correct the "
-                                       "initial state (or simulate with --fix-initial to see the nearest one)",
-                                       c.name, r, tol));
-      }
-      const double r = base(layout.f() + vel++);
-      if (!(std::abs(r) <= tol * std::max(1.0, v.lpNorm<Eigen::Infinity>())))
-        throw ModelError(fmt::format("the initial state violates the constraint '{}' at velocity level by {:.3e} "
+// --- the state: constraints, then q'' and the multipliers from the KKT form ----------------
+// Throws when the terms and residuals `base` at the initial state show a violated constraint.
+void require_constraints_met(const Model& model, const Layout& layout, const Vector& base, double tol) {
+  const Vector& v = model.v0;
+  int pos = 0, vel = 0;
+  for (int i = 0; i < layout.s; ++i) {
+    const Constraint& c = model.constraints[static_cast<std::size_t>(i)];
+    if (c.level == ConstraintLevel::acceleration) continue;
+    if (c.level == ConstraintLevel::position) {
+      const double r = base(layout.phi() + pos++);
+      if (!(std::abs(r) <= tol))
+        throw ModelError(fmt::format("the initial state violates the constraint '{}' at position level by {:.3e} "
                                      "(tolerance {:g}); a steady motion must satisfy the constraints: correct the "
-                                     "initial velocities",
+                                     "initial state (or simulate with --fix-initial to see the nearest one)",
                                      c.name, r, tol));
     }
+    const double r = base(layout.f() + vel++);
+    if (!(std::abs(r) <= tol * std::max(1.0, v.lpNorm<Eigen::Infinity>())))
+      throw ModelError(fmt::format("the initial state violates the constraint '{}' at velocity level by {:.3e} "
+                                   "(tolerance {:g}); a steady motion must satisfy the constraints: correct the "
+                                   "initial velocities",
+                                   c.name, r, tol));
   }
+}
+
+// The KKT form [A b^T; b 0] (q'', mu) = (Q + G, -b0) at the initial state, factored once: its
+// solution gives q'' (into out.qdd) and the multipliers mu; its factors serve the derivatives.
+struct KktSolution {
+  Eigen::FullPivLU<Matrix> kkt;
+  Vector mu;  // s, A q'' + b^T mu = Q + G
+};
+
+KktSolution solve_kkt(const Model& model, const Layout& layout, const Vector& base, Linearization& out) {
+  const int n = layout.n, s = layout.s;
   const Eigen::Map<const Matrix> A(base.data() + layout.A(), n, n);
   const Eigen::Map<const Vector> Q(base.data() + layout.Q(), n), G(base.data() + layout.G(), n);
   const Eigen::Map<const Matrix> b(base.data() + layout.b(), s, n);
@@ -337,61 +323,78 @@ Linearization calc_linearization(const Model& model, const LinearizationOptions&
   K.topLeftCorner(n, n) = A;
   K.topRightCorner(n, s) = b.transpose();
   K.bottomLeftCorner(s, n) = b;
-  Eigen::FullPivLU<Matrix> kkt(K);
-  if (!kkt.isInvertible())
+  KktSolution out_kkt{Eigen::FullPivLU<Matrix>(K), Vector()};
+  if (!out_kkt.kkt.isInvertible())
     throw ModelError(fmt::format("model '{}': the KKT matrix [A b^T; b 0] is singular at the initial state (A not "
                                  "positive definite on the constraints, or dependent constraints)",
                                  model.name));
   Vector rhs(n + s);
   rhs.head(n) = Q + G;
   rhs.tail(s) = -b0;
-  const Vector sol = kkt.solve(rhs);
+  const Vector sol = out_kkt.kkt.solve(rhs);
   out.qdd = sol.head(n);
-  const Vector mu = sol.tail(s);  // A q'' + b^T mu = Q + G
+  out_kkt.mu = sol.tail(s);
+  return out_kkt;
+}
 
-  // --- steady? every non-cyclic velocity and every acceleration zero -----------------------------
-  {
-    double accel_scale = 1.0;
-    for (int i = 0; i < n; ++i)
-      if (A(i, i) > 0.0) accel_scale = std::max(accel_scale, std::abs(Q(i) + G(i)) / A(i, i));
-    const double vel_scale = std::max(1.0, v.lpNorm<Eigen::Infinity>());
-    struct Violation {
-      std::string what;
-      double value, ratio;
-    };
-    std::vector<Violation> bad;
-    for (int i : nc) {
-      const double ratio = std::abs(v(i)) / vel_scale;
-      out.steady_residual = std::max(out.steady_residual, ratio);
-      if (ratio > options.steady_tolerance)
-        bad.push_back({fmt::format("velocity {}' = {:.6g} (a non-cyclic coordinate must be at rest)", name(i), v(i)),
-                       v(i), ratio});
-    }
-    for (int i = 0; i < n; ++i) {
-      const double ratio = std::abs(out.qdd(i)) / accel_scale;
-      out.steady_residual = std::max(out.steady_residual, ratio);
-      if (ratio > options.steady_tolerance)
-        bad.push_back({fmt::format("acceleration {}'' = {:.6g}", name(i), out.qdd(i)), out.qdd(i), ratio});
-    }
-    if (!bad.empty()) {
-      std::stable_sort(bad.begin(), bad.end(), [](const Violation& a, const Violation& b) { return a.ratio > b.ratio; });
-      std::string list;
-      for (const Violation& x : bad) list += "; " + x.what;
-      throw ModelError(fmt::format(
-          "the initial state of model '{}' is not a steady motion: the largest violation is {} (tolerance {:g} x "
-          "scale {:.3g}){}. A steady motion keeps every non-cyclic coordinate at rest and every velocity constant "
-          "(cyclic coordinates: {}); set the initial state to one (--set), or name the coordinates that may move "
-          "steadily with --cyclic",
-          model.name, bad.front().what, options.steady_tolerance,
-          bad.front().what.starts_with("velocity") ? vel_scale : accel_scale,
-          bad.size() > 1 ? " (all violations: " + list.substr(2) + ")" : std::string(), join(out.cyclic)));
-    }
+// --- steady? every non-cyclic velocity and every acceleration zero -----------------------------
+// Sets out.steady_residual; throws naming the largest violation when it is over the tolerance.
+void require_steady(const Model& model, const Layout& layout, const Vector& base, const std::vector<int>& nc,
+                    const LinearizationOptions& options, Linearization& out) {
+  const int n = layout.n;
+  const Vector& v = model.v0;
+  const auto name = [&](int i) { return model.coordinates[static_cast<std::size_t>(i)]; };
+  const Eigen::Map<const Matrix> A(base.data() + layout.A(), n, n);
+  const Eigen::Map<const Vector> Q(base.data() + layout.Q(), n), G(base.data() + layout.G(), n);
+  double accel_scale = 1.0;
+  for (int i = 0; i < n; ++i)
+    if (A(i, i) > 0.0) accel_scale = std::max(accel_scale, std::abs(Q(i) + G(i)) / A(i, i));
+  const double vel_scale = std::max(1.0, v.lpNorm<Eigen::Infinity>());
+  struct Violation {
+    std::string what;
+    double value, ratio;
+  };
+  std::vector<Violation> bad;
+  for (int i : nc) {
+    const double ratio = std::abs(v(i)) / vel_scale;
+    out.steady_residual = std::max(out.steady_residual, ratio);
+    if (ratio > options.steady_tolerance)
+      bad.push_back({fmt::format("velocity {}' = {:.6g} (a non-cyclic coordinate must be at rest)", name(i), v(i)),
+                     v(i), ratio});
   }
+  for (int i = 0; i < n; ++i) {
+    const double ratio = std::abs(out.qdd(i)) / accel_scale;
+    out.steady_residual = std::max(out.steady_residual, ratio);
+    if (ratio > options.steady_tolerance)
+      bad.push_back({fmt::format("acceleration {}'' = {:.6g}", name(i), out.qdd(i)), out.qdd(i), ratio});
+  }
+  if (bad.empty()) return;
+  std::stable_sort(bad.begin(), bad.end(), [](const Violation& a, const Violation& b) { return a.ratio > b.ratio; });
+  std::string list;
+  for (const Violation& x : bad) list += "; " + x.what;
+  throw ModelError(fmt::format(
+      "the initial state of model '{}' is not a steady motion: the largest violation is {} (tolerance {:g} x "
+      "scale {:.3g}){}. A steady motion keeps every non-cyclic coordinate at rest and every velocity constant "
+      "(cyclic coordinates: {}); set the initial state to one (--set), or name the coordinates that may move "
+      "steadily with --cyclic",
+      model.name, bad.front().what, options.steady_tolerance,
+      bad.front().what.starts_with("velocity") ? vel_scale : accel_scale,
+      bad.size() > 1 ? " (all violations: " + list.substr(2) + ")" : std::string(), join(out.cyclic)));
+}
 
-  // --- derivatives: dq''/dq, dq''/dq' and the constraint Jacobians --------------------------------
+// --- derivatives: dq''/dq, dq''/dq' and the constraint Jacobians --------------------------------
+// The Jacobians of the position residuals (p x n) and of the velocity residuals (r x n, by q and
+// by q'); dq''/dq and dq''/dq' go into out.Fq and out.Fv.
+struct ConstraintJacobians {
+  Matrix Jphi, Cq, Cv;
+};
+
+ConstraintJacobians differentiate(const Model& model, const Layout& layout, Differentiator& diff,
+                                  const KktSolution& solved, Linearization& out) {
+  const int n = layout.n, s = layout.s;
   out.Fq.setZero(n, n);
   out.Fv.setZero(n, n);
-  Matrix Jphi = Matrix::Zero(layout.p, n), Cq = Matrix::Zero(layout.r, n), Cv = Matrix::Zero(layout.r, n);
+  ConstraintJacobians jac{Matrix::Zero(layout.p, n), Matrix::Zero(layout.r, n), Matrix::Zero(layout.r, n)};
   Vector d, drhs(n + s);
   for (int input = 1; input <= 2 * n; ++input) {
     diff.derivative(input, d);
@@ -400,41 +403,28 @@ Linearization calc_linearization(const Model& model, const LinearizationOptions&
     const Eigen::Map<const Matrix> db(d.data() + layout.b(), s, n);
     const Eigen::Map<const Vector> db0(d.data() + layout.b0(), s);
     // K d(q'', mu) = d(rhs) - dK (q'', mu): docs/linearization.md (2).
-    drhs.head(n) = dQ + dG - dA * out.qdd - db.transpose() * mu;
+    drhs.head(n) = dQ + dG - dA * out.qdd - db.transpose() * solved.mu;
     drhs.tail(s) = -db0 - db * out.qdd;
-    const Vector dsol = kkt.solve(drhs);
+    const Vector dsol = solved.kkt.solve(drhs);
     const bool coordinate = input <= n;
     const int j = coordinate ? input - 1 : input - 1 - n;
     (coordinate ? out.Fq : out.Fv).col(j) = dsol.head(n);
-    if (coordinate && layout.p > 0) Jphi.col(j) = d.segment(layout.phi(), layout.p);
-    if (layout.r > 0) (coordinate ? Cq : Cv).col(j) = d.segment(layout.f(), layout.r);
+    if (coordinate && layout.p > 0) jac.Jphi.col(j) = d.segment(layout.phi(), layout.p);
+    if (layout.r > 0) (coordinate ? jac.Cq : jac.Cv).col(j) = d.segment(layout.f(), layout.r);
   }
   if (!out.Fq.allFinite() || !out.Fv.allFinite())
     throw ModelError(fmt::format("model '{}': the derivatives of q'' are not finite at the initial state", model.name));
+  return jac;
+}
 
-  // --- perturbations y = (dq_nc, dv) on the linearized constraints C y = 0 ----------------------
-  const int N = m + n;
-  const int rows = layout.p + layout.r;
-  Matrix C = Matrix::Zero(rows, N);
-  for (int a = 0; a < m; ++a) {
-    if (layout.p > 0) C.block(0, a, layout.p, 1) = Jphi.col(nc[static_cast<std::size_t>(a)]);
-    if (layout.r > 0) C.block(layout.p, a, layout.r, 1) = Cq.col(nc[static_cast<std::size_t>(a)]);
-  }
-  if (layout.r > 0) C.block(layout.p, m, layout.r, n) = Cv;
-  Matrix J = Matrix::Zero(N, N);
-  for (int a = 0; a < m; ++a) {
-    J(a, m + nc[static_cast<std::size_t>(a)]) = 1.0;
-    J.block(m, a, n, 1) = out.Fq.col(nc[static_cast<std::size_t>(a)]);
-  }
-  J.block(m, m, n, n) = out.Fv;
-
-  // Dependent coordinates (indices into nc) and speeds (coordinate indices).
-  Matrix Jp = Matrix::Zero(layout.p, m);
-  for (int a = 0; a < m; ++a)
-    if (layout.p > 0) Jp.col(a) = Jphi.col(nc[static_cast<std::size_t>(a)]);
-  const int rank_p = rank_of(Jp);
-  const int rank_v = rank_of(Cv);
-  std::vector<char> dep_coord(static_cast<std::size_t>(m), 0), dep_speed(static_cast<std::size_t>(n), 0);
+// --- perturbations y = (dq_nc, dv) on the linearized constraints C y = 0 ----------------------
+// Which non-cyclic coordinates (flags indexed into nc) are dependent: those not named by
+// --independent, else the first rank_p columns of Jp in pivoted-QR order.
+std::vector<char> choose_dependent_coordinates(const Model& model, const LinearizationOptions& options,
+                                               const std::vector<int>& nc, const Matrix& Jp, int rank_p,
+                                               const Linearization& out) {
+  const int m = static_cast<int>(nc.size());
+  std::vector<char> dep_coord(static_cast<std::size_t>(m), 0);
   if (!options.independent.empty()) {
     std::vector<char> named(static_cast<std::size_t>(m), 0);
     for (const std::string& x : options.independent) {
@@ -457,6 +447,15 @@ Linearization calc_linearization(const Model& model, const LinearizationOptions&
     const std::vector<int> order = pivot_order(Jp);
     for (int k = 0; k < rank_p; ++k) dep_coord[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])] = 1;
   }
+  return dep_coord;
+}
+
+// Which speeds (flags indexed by coordinate) are dependent: those not named by --speeds, else
+// rank_v of them chosen greedily.
+std::vector<char> choose_dependent_speeds(const Model& model, const LinearizationOptions& options,
+                                          const std::vector<char>& cyclic, const Matrix& Cv, int rank_v) {
+  const int n = model.n();
+  std::vector<char> dep_speed(static_cast<std::size_t>(n), 0);
   if (!options.speeds.empty()) {
     std::vector<char> named(static_cast<std::size_t>(n), 0);
     for (const std::string& x : options.speeds) {
@@ -487,6 +486,60 @@ Linearization calc_linearization(const Model& model, const LinearizationOptions&
     }
     for (int c : chosen) dep_speed[static_cast<std::size_t>(c)] = 1;
   }
+  return dep_speed;
+}
+
+// T with y_dep = T y_ind on C y = 0 (C's columns split into CD, dependent, and CI); `names` are the
+// dependent entries' names, for the messages.
+Matrix express_dependent(const Matrix& CD, const Matrix& CI, const std::vector<std::string>& names) {
+  Eigen::ColPivHouseholderQR<Matrix> qr(CD);
+  qr.setThreshold(1e-10);
+  if (qr.rank() < CD.cols())
+    throw InputError(fmt::format("the dependent coordinates and speeds ({}) cannot be expressed through the "
+                                 "independent ones: the constraints do not fix them; name other independent "
+                                 "coordinates (--independent) or speeds (--speeds)",
+                                 join(names)));
+  Matrix T = qr.solve(Matrix(-CI));
+  const double defect = (CD * T + CI).lpNorm<Eigen::Infinity>();
+  if (!(defect <= 1e-8 * std::max(1.0, CI.lpNorm<Eigen::Infinity>())))
+    throw InputError(fmt::format("the linearized constraints cannot be satisfied with the dependent coordinates "
+                                 "and speeds ({}) alone (defect {:.3e}); name other independent coordinates or "
+                                 "speeds",
+                                 join(names), defect));
+  return T;
+}
+
+// The state matrix of the independent perturbations, their names and its eigenvalues (into
+// out), from dq''/dq and dq''/dq' (out.Fq, out.Fv) and the constraint Jacobians.
+void reduce_to_independent(const Model& model, const LinearizationOptions& options, const std::vector<char>& cyclic,
+                           const std::vector<int>& nc, const ConstraintJacobians& jac, Linearization& out) {
+  const int n = model.n();
+  const int p = static_cast<int>(jac.Jphi.rows()), r = static_cast<int>(jac.Cv.rows());
+  const auto name = [&](int i) { return model.coordinates[static_cast<std::size_t>(i)]; };
+  const int m = static_cast<int>(nc.size());
+  const int N = m + n;
+  const int rows = p + r;
+  Matrix C = Matrix::Zero(rows, N);
+  for (int a = 0; a < m; ++a) {
+    if (p > 0) C.block(0, a, p, 1) = jac.Jphi.col(nc[static_cast<std::size_t>(a)]);
+    if (r > 0) C.block(p, a, r, 1) = jac.Cq.col(nc[static_cast<std::size_t>(a)]);
+  }
+  if (r > 0) C.block(p, m, r, n) = jac.Cv;
+  Matrix J = Matrix::Zero(N, N);
+  for (int a = 0; a < m; ++a) {
+    J(a, m + nc[static_cast<std::size_t>(a)]) = 1.0;
+    J.block(m, a, n, 1) = out.Fq.col(nc[static_cast<std::size_t>(a)]);
+  }
+  J.block(m, m, n, n) = out.Fv;
+
+  // Dependent coordinates (indices into nc) and speeds (coordinate indices).
+  Matrix Jp = Matrix::Zero(p, m);
+  for (int a = 0; a < m; ++a)
+    if (p > 0) Jp.col(a) = jac.Jphi.col(nc[static_cast<std::size_t>(a)]);
+  const int rank_p = rank_of(Jp);
+  const int rank_v = rank_of(jac.Cv);
+  const std::vector<char> dep_coord = choose_dependent_coordinates(model, options, nc, Jp, rank_p, out);
+  const std::vector<char> dep_speed = choose_dependent_speeds(model, options, cyclic, jac.Cv, rank_v);
 
   std::vector<int> ind, dep;  // into y
   for (int a = 0; a < m; ++a) (dep_coord[static_cast<std::size_t>(a)] ? dep : ind).push_back(a);
@@ -494,29 +547,16 @@ Linearization calc_linearization(const Model& model, const LinearizationOptions&
   const Matrix CD = columns(C, dep), CI = columns(C, ind);
   Matrix T = Matrix::Zero(static_cast<Index>(dep.size()), static_cast<Index>(ind.size()));
   if (!dep.empty()) {
-    Eigen::ColPivHouseholderQR<Matrix> qr(CD);
-    qr.setThreshold(1e-10);
     std::vector<std::string> names;
     for (int y : dep) names.push_back(y < m ? name(nc[static_cast<std::size_t>(y)]) : name(y - m) + "'");
-    if (qr.rank() < static_cast<Index>(dep.size()))
-      throw InputError(fmt::format("the dependent coordinates and speeds ({}) cannot be expressed through the "
-                                   "independent ones: the constraints do not fix them; name other independent "
-                                   "coordinates (--independent) or speeds (--speeds)",
-                                   join(names)));
-    T = qr.solve(Matrix(-CI));
-    const double defect = (CD * T + CI).lpNorm<Eigen::Infinity>();
-    if (!(defect <= 1e-8 * std::max(1.0, CI.lpNorm<Eigen::Infinity>())))
-      throw InputError(fmt::format("the linearized constraints cannot be satisfied with the dependent coordinates "
-                                   "and speeds ({}) alone (defect {:.3e}); name other independent coordinates or "
-                                   "speeds",
-                                   join(names), defect));
+    T = express_dependent(CD, CI, names);
   } else if (rows > 0 && rank_of(C) > 0) {
     throw InputError("the linearized constraints leave no dependent coordinate or speed; name fewer independent ones");
   }
   const Index k = static_cast<Index>(ind.size());
   Matrix E = Matrix::Zero(N, k);
   for (Index j = 0; j < k; ++j) E(ind[static_cast<std::size_t>(j)], j) = 1.0;
-  for (std::size_t r = 0; r < dep.size(); ++r) E.row(dep[r]) = T.row(static_cast<Index>(r));
+  for (std::size_t row = 0; row < dep.size(); ++row) E.row(dep[row]) = T.row(static_cast<Index>(row));
   Matrix JE = J * E;
   out.state_matrix.resize(k, k);
   for (Index j = 0; j < k; ++j) out.state_matrix.row(j) = JE.row(ind[static_cast<std::size_t>(j)]);
@@ -536,6 +576,42 @@ Linearization calc_linearization(const Model& model, const LinearizationOptions&
     for (Index j = 0; j < k; ++j) out.eigenvalues.push_back(eigen.eigenvalues()(j));
     sort_eigenvalues(out.eigenvalues);
   }
+}
+
+}  // namespace
+
+Linearization calc_linearization(const Model& model, const LinearizationOptions& options) {
+  check_model_shape(model);
+  if (model.m() > 0)
+    throw InputError(fmt::format("model '{}' has programs ([[programs]]); linearization does not take their actuator "
+                                 "forces into account: remove the programs to linearize the free system",
+                                 model.name));
+  const int n = model.n();
+  Layout layout;
+  layout.n = n;
+  layout.s = model.s();
+  layout.p = model.position_constraints();
+  layout.r = model.velocity_constraints();
+  if (!(options.steady_tolerance > 0.0) || !std::isfinite(options.steady_tolerance))
+    throw InputError(fmt::format("the steady-motion tolerance must be a positive number, not {}", options.steady_tolerance));
+
+  Differentiator diff(model, layout, model.t0, model.q0, model.v0);
+  Linearization out;
+  out.derivatives = diff.method();
+  const std::vector<char> cyclic = find_cyclic(model, layout, diff, options, out);
+  std::vector<int> nc;  // the non-cyclic coordinates
+  for (int i = 0; i < n; ++i)
+    if (!cyclic[static_cast<std::size_t>(i)]) nc.push_back(i);
+
+  Vector base;
+  diff.evaluate(model.t0, model.q0, model.v0, base);
+  if (!base.allFinite())
+    throw ModelError(fmt::format("model '{}': a term or residual is not finite at the initial state", model.name));
+  require_constraints_met(model, layout, base, options.steady_tolerance);
+  const KktSolution solved = solve_kkt(model, layout, base, out);
+  require_steady(model, layout, base, nc, options, out);
+  const ConstraintJacobians jac = differentiate(model, layout, diff, solved, out);
+  reduce_to_independent(model, options, cyclic, nc, jac, out);
   return out;
 }
 

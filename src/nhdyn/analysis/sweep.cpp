@@ -144,50 +144,64 @@ void check_sweep_options(const SweepOptions& options) {
                                  options.from, options.to, options.parameter));
 }
 
-Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& options) {
-  check_sweep_options(options);
-  Sweep out;
-  LinearizationOptions lin = options.linearization;
+namespace {
+
+// A sweep under way: the linearization options (the first point fixes the state's choice of
+// independent coordinates and speeds for all) and the result so far.
+class Sweeper {
+ public:
+  Sweeper(const ModelAtValue& model_at, const SweepOptions& options)
+      : model_at_(model_at), options_(options), lin_(options.linearization) {}
+
+  Sweep run() {
+    for (int i = 0; i < options_.steps; ++i) {
+      const double value = i + 1 == options_.steps
+                               ? options_.to
+                               : options_.from + (options_.to - options_.from) * i / (options_.steps - 1);
+      out_.points.push_back(at(value));
+    }
+    if (!options_.find_crossings) return out_;
+    first_ = out_.points.front().value;
+    last_ = out_.points.back().value;
+    for (std::size_t i = 0; i + 1 < out_.points.size(); ++i) find_crossings_in(i);
+    return out_;
+  }
+
+ private:
+  static constexpr double ulp_scale = 4.0 * std::numeric_limits<double>::epsilon();
+
   // The point at `value`; its state matrix too when `state_matrix` is given.
-  const auto at = [&](double value, Matrix* state_matrix = nullptr) -> SweepPoint {
+  SweepPoint at(double value, Matrix* state_matrix = nullptr) {
     try {
-      const Linearization l = calc_linearization(model_at(value), lin);
+      const Linearization l = calc_linearization(model_at_(value), lin_);
       if (state_matrix != nullptr) *state_matrix = l.state_matrix;
       SweepPoint p;
       p.value = value;
       p.eigenvalues = l.eigenvalues;
       p.uncertainty = calc_eigenvalue_uncertainty(l.state_matrix, l.eigenvalues);
       classify(p);
-      if (out.state.empty()) {
-        out.state = l.state;
+      if (out_.state.empty()) {
+        out_.state = l.state;
         // The same state at every point: the choice made here, named.
-        lin.independent = l.independent;
-        lin.speeds = l.speeds;
+        lin_.independent = l.independent;
+        lin_.speeds = l.speeds;
       }
       return p;
     } catch (const InputError& e) {
-      throw InputError(fmt::format("at {} = {:.17g}: {}", options.parameter, value, e.what()));
+      throw InputError(fmt::format("at {} = {:.17g}: {}", options_.parameter, value, e.what()));
     } catch (const ModelError& e) {
-      throw ModelError(fmt::format("at {} = {:.17g}: {}", options.parameter, value, e.what()));
+      throw ModelError(fmt::format("at {} = {:.17g}: {}", options_.parameter, value, e.what()));
     }
-  };
-  for (int i = 0; i < options.steps; ++i) {
-    const double value = i + 1 == options.steps
-                             ? options.to
-                             : options.from + (options.to - options.from) * i / (options.steps - 1);
-    out.points.push_back(at(value));
   }
-  if (!options.find_crossings) return out;
 
-  const double ulp_scale = 4.0 * std::numeric_limits<double>::epsilon();
   // 2. For a simple eigenvalue, the count's threshold is not the crossing: follow that eigenvalue
   // (by its eigenvector) to where its real part is certainly negative, then bisect on the sign of
   // its real part (the capsize speed to round-off, not to r_1 / slope). Narrows [a, b] to it and
   // sets `crossing`; a real part that never becomes certainly negative (a pair going onto the
   // imaginary axis) leaves step 1's bracket.
-  const double first = out.points.front().value, last = out.points.back().value;
-  const auto follow_to_the_sign_change = [&](double& a, double& b, bool rising, const SweepPoint& unstable_side,
-                                            std::size_t k, std::complex<double>& crossing) {
+  void follow_to_the_sign_change(double& a, double& b, bool rising, const SweepPoint& unstable_side, std::size_t k,
+                                 std::complex<double>& crossing) {
+    const double first = first_, last = last_;
     Matrix s;
     at(rising ? b : a, &s);
     Mode start{crossing, {}};
@@ -231,13 +245,15 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
     crossing = track.value;
     a = std::min(neg, pos);
     b = std::max(neg, pos);
-  };
+  }
 
-  for (std::size_t i = 0; i + 1 < out.points.size(); ++i) {
-    const SweepPoint& hi = out.points[i + 1];
+  // Each change of the count of certainly unstable eigenvalues between grid points i and i + 1,
+  // located and appended to the crossings.
+  void find_crossings_in(std::size_t i) {
+    const SweepPoint& hi = out_.points[i + 1];
     // Each change of the count in the cell in turn (0 -> 1 -> 2 when two eigenvalues cross in
     // it), from the point just after the last one found.
-    SweepPoint lo = out.points[i];
+    SweepPoint lo = out_.points[i];
     for (std::size_t guard = 0; lo.unstable != hi.unstable && guard <= hi.eigenvalues.size(); ++guard) {
       // 1. Bisection on the count of certainly unstable eigenvalues: it stops where the crossing
       // eigenvalue's real part leaves its uncertainty.
@@ -278,11 +294,23 @@ Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& op
       c.frequency = std::abs(crossing.imag());
       c.oscillatory = c.frequency > 1e-6 * scale;
       if (!c.oscillatory) c.frequency = 0.0;
-      out.crossings.push_back(c);
+      out_.crossings.push_back(c);
       lo = after;
     }
   }
-  return out;
+
+  const ModelAtValue& model_at_;
+  const SweepOptions& options_;
+  LinearizationOptions lin_;
+  Sweep out_;
+  double first_ = 0.0, last_ = 0.0;  // the ends of the grid
+};
+
+}  // namespace
+
+Sweep calc_eigenvalue_sweep(const ModelAtValue& model_at, const SweepOptions& options) {
+  check_sweep_options(options);
+  return Sweeper(model_at, options).run();
 }
 
 ModelAtValue make_model_at_value(const Model& base, const std::string& parameter) {

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -19,29 +20,6 @@ std::string quote_if_needed(const std::string& name) {
     out += c;
   }
   return out + "\"";
-}
-
-std::vector<std::string> split_header(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cell;
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') cell += line[++i];
-      else if (c == '"') quoted = false;
-      else cell += c;
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      out.push_back(cell);
-      cell.clear();
-    } else if (c != '\r') {
-      cell += c;
-    }
-  }
-  out.push_back(cell);
-  return out;
 }
 
 }  // namespace
@@ -109,7 +87,7 @@ CsvTable load_csv(const std::filesystem::path& path) {
     break;
   }
   if (!header) throw FileError(fmt::format("'{}' is empty; expected a header row", path.string()));
-  table.header = split_header(line);
+  table.header = split_csv_record(line);
   while (std::getline(in, line)) {
     ++line_number;
     if (line.empty()) continue;
@@ -139,6 +117,44 @@ CsvTable load_csv(const std::filesystem::path& path) {
     table.rows.push_back(std::move(row));
   }
   return table;
+}
+
+std::vector<std::string> split_csv_record(std::string_view record) {
+  std::vector<std::string> fields;
+  std::string field;
+  bool quoted = false;
+  for (std::size_t i = 0; i < record.size(); ++i) {
+    const char c = record[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < record.size() && record[i + 1] == '"') {
+        field += record[++i];
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        field += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      fields.push_back(std::move(field));
+      field.clear();
+    } else if (c != '\r') {
+      field += c;
+    }
+  }
+  fields.push_back(std::move(field));
+  return fields;
+}
+
+// Reads one CSV record: a line, continued over newlines that sit inside double quotes.
+bool read_csv_record(std::istream& in, std::string& record) {
+  if (!std::getline(in, record)) return false;
+  std::string more;
+  while (std::count(record.begin(), record.end(), '"') % 2 == 1 && std::getline(in, more)) {
+    record += '\n';
+    record += more;
+  }
+  return true;
 }
 
 }  // namespace nhdyn

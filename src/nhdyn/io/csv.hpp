@@ -4,8 +4,10 @@
 #pragma once
 
 #include <filesystem>
+#include <istream>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "nhdyn/io/atomic_file.hpp"
@@ -40,5 +42,12 @@ struct CsvTable {
   int column(const std::string& name) const;  // index, or -1
 };
 CsvTable load_csv(const std::filesystem::path& path);  // throws FileError naming file and line
+
+// Splits a CSV record on commas, as CsvWriter quotes it: a field in double quotes may hold
+// commas, newlines and doubled quotes ("" -> "). Carriage returns outside quotes are dropped.
+std::vector<std::string> split_csv_record(std::string_view record);
+// Reads one CSV record into `record`: a line, continued over newlines that sit inside double
+// quotes (a quoted column name may hold one). False at the end of the input.
+bool read_csv_record(std::istream& in, std::string& record);
 
 }  // namespace nhdyn

@@ -1,34 +1,23 @@
-// write_plot: reads the CSV header (and first data row), writes a gnuplot script next to the
-// target PNG, runs gnuplot on it through posix_spawnp (no shell) with stderr captured, and
-// renames gnuplot's output onto the target only when gnuplot succeeded.
+// The script writer of the plots (plot.hpp, xy_plot.hpp): from a request to the gnuplot script of
+// its figure. write_plot and write_panel_plot resolve the panels' columns against the CSV
+// (plot_csv.hpp), lay them out (plot_panels.hpp) and write one multiplot script; write_xy_plot
+// writes its single panel; gnuplot.hpp runs the script and puts the picture in place.
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/io/xy_plot.hpp"
 
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
-#include <functional>
-#include <iterator>
-#include <random>
 #include <string_view>
 #include <system_error>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/atomic_file.hpp"
-
-extern char** environ;
+#include "nhdyn/io/gnuplot.hpp"
+#include "nhdyn/io/plot_csv.hpp"
 
 namespace nhdyn {
 namespace {
@@ -38,13 +27,6 @@ namespace fs = std::filesystem;
 // A time-series panel is ~550 px wide; 50 000 points per curve is ~90 per pixel column, enough
 // for any curve that the picture can resolve, and keeps gnuplot well under 1 s per curve.
 constexpr std::uintmax_t max_rows_per_curve = 50000;
-// Tail of gnuplot's stderr quoted in an error message (its error comes last, after warnings).
-constexpr std::size_t max_quoted_stderr = 4000;
-
-constexpr std::string_view install_hint =
-    "install gnuplot, e.g. `apt-get install gnuplot-nox`, or run without --plot";
-
-std::string errno_text(int err) { return std::error_code(err, std::generic_category()).message(); }
 
 // ---------------------------------------------------------------------------------------------
 // Quoting for gnuplot.
@@ -85,328 +67,6 @@ std::string gp_string(std::string_view text) {
 std::string gp_label(std::string_view text) { return gp_string(one_line(text)); }
 
 // ---------------------------------------------------------------------------------------------
-// The CSV: header names, the first data row, and the number of data rows (for thinning).
-
-struct CsvHead {
-  std::vector<std::string> names;      // header row, in column order (column 1 = time)
-  std::vector<std::string> first_row;  // fields of the first data row
-  std::uintmax_t rows = 0;             // estimated number of data rows
-  int header_lines = 1;                // lines taken by the header (a quoted name may hold \n)
-};
-
-std::string trim(std::string_view s) {
-  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
-  while (!s.empty() && blank(s.front())) s.remove_prefix(1);
-  while (!s.empty() && blank(s.back())) s.remove_suffix(1);
-  return std::string(s);
-}
-
-// Splits a CSV record on commas, as CsvWriter quotes it: a field in double quotes may hold
-// commas, newlines and doubled quotes ("" -> "). Carriage returns outside quotes are dropped.
-std::vector<std::string> split_csv_record(std::string_view record) {
-  std::vector<std::string> fields;
-  std::string field;
-  bool quoted = false;
-  for (std::size_t i = 0; i < record.size(); ++i) {
-    const char c = record[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < record.size() && record[i + 1] == '"') {
-        field += record[++i];
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        field += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      fields.push_back(std::move(field));
-      field.clear();
-    } else if (c != '\r') {
-      field += c;
-    }
-  }
-  fields.push_back(std::move(field));
-  return fields;
-}
-
-// Reads one CSV record: a line, continued over newlines that sit inside double quotes.
-bool read_csv_record(std::istream& in, std::string& record) {
-  if (!std::getline(in, record)) return false;
-  std::string more;
-  while (std::count(record.begin(), record.end(), '"') % 2 == 1 && std::getline(in, more)) {
-    record += '\n';
-    record += more;
-  }
-  return true;
-}
-
-// Number of data rows after byte `data_start` of a file of `size` bytes: counted in a small
-// file, estimated in a large one from the mean length of the rows in three 64 KiB windows (at
-// 1/4, 1/2 and 3/4 of the rows), as reading a million rows only to count them would cost
-// more than the thinning saves. Not from the first rows alone: they are short ("0,1,0,...")
-// and would overestimate the count tenfold.
-std::uintmax_t count_rows(std::istream& in, std::uintmax_t data_start, std::uintmax_t size) {
-  constexpr std::uintmax_t window = 1 << 16;
-  std::vector<char> buffer(window);
-  const auto newlines_in = [&](std::uintmax_t from, std::uintmax_t length) {
-    in.clear();
-    in.seekg(static_cast<std::streamoff>(from));
-    std::uintmax_t newlines = 0;
-    while (length > 0 && in) {
-      in.read(buffer.data(), static_cast<std::streamsize>(std::min(length, window)));
-      const auto got = static_cast<std::uintmax_t>(in.gcount());
-      if (got == 0) break;
-      newlines += static_cast<std::uintmax_t>(
-          std::count(buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(got), '\n'));
-      length -= got;
-    }
-    return newlines;
-  };
-  if (size <= data_start) return 1;
-  const std::uintmax_t body = size - data_start;
-  if (body <= 4 * window) return std::max<std::uintmax_t>(1, newlines_in(data_start, body));
-  std::uintmax_t sampled = 0;
-  for (std::uintmax_t quarter = 1; quarter <= 3; ++quarter) {
-    sampled += newlines_in(data_start + body / 4 * quarter, window);
-  }
-  return std::max<std::uintmax_t>(1, body / (3 * window) * sampled);
-}
-
-CsvHead read_csv_head(const fs::path& csv) {
-  errno = 0;
-  std::ifstream in(csv, std::ios::binary);
-  if (!in) {
-    const int err = errno;
-    throw FileError(fmt::format("cannot read the CSV file '{}' to plot ({}); check the path",
-                                csv.string(), err != 0 ? errno_text(err) : "open failed"));
-  }
-  std::string header;
-  std::string row;
-  // Comment lines before the header (the provenance of io/provenance.hpp) are skipped here and,
-  // counted in header_lines, by gnuplot's `skip`.
-  int comment_lines = 0;
-  while (read_csv_record(in, header) && header.starts_with('#')) ++comment_lines;
-  if (!in || trim(header).empty() || header.starts_with('#')) {
-    throw InputError(fmt::format(
-        "the CSV file '{}' has no header row; expected column names on its first line, as "
-        "nhdyn writes them",
-        csv.string()));
-  }
-  const std::streamoff data_start = in.tellg();
-  if (!read_csv_record(in, row) || trim(row).empty()) {
-    throw InputError(fmt::format(
-        "the CSV file '{}' has a header but no data rows; there is nothing to plot (did the "
-        "run stop before its first output?)",
-        csv.string()));
-  }
-  if (header.starts_with("\xEF\xBB\xBF")) header.erase(0, 3);  // UTF-8 byte order mark
-
-  CsvHead head;
-  head.header_lines = comment_lines + 1 + static_cast<int>(std::count(header.begin(), header.end(), '\n'));
-  head.names = split_csv_record(header);
-  head.first_row = split_csv_record(row);
-  for (std::string& field : head.first_row) field = trim(field);
-  std::error_code ec;
-  const std::uintmax_t size = fs::file_size(csv, ec);
-  head.rows =
-      ec || data_start < 0 ? 1 : count_rows(in, static_cast<std::uintmax_t>(data_start), size);
-  return head;
-}
-
-// 1-based gnuplot column index of `name`; `role` says which list of the request named it.
-int column_of(const CsvHead& head, const fs::path& csv, const std::string& name,
-              std::string_view role) {
-  for (std::size_t i = 0; i < head.names.size(); ++i) {
-    if (head.names[i] == name) return static_cast<int>(i) + 1;
-  }
-  constexpr std::size_t shown = 40;
-  std::string known;
-  for (std::size_t i = 0; i < head.names.size() && i < shown; ++i) {
-    known += (i == 0 ? "" : ", ") + head.names[i];
-  }
-  if (head.names.size() > shown) known += fmt::format(", ... ({} in all)", head.names.size());
-  throw InputError(fmt::format(
-      "cannot plot {} column '{}': the CSV file '{}' has no column of that name; its columns "
-      "are {}; use one of these names",
-      role, name, csv.string(), known));
-}
-
-// ---------------------------------------------------------------------------------------------
-// Files and processes.
-
-// Closes a file descriptor when it goes out of scope.
-class UniqueFd {
- public:
-  explicit UniqueFd(int fd = -1) : fd_(fd) {}
-  UniqueFd(const UniqueFd&) = delete;
-  UniqueFd& operator=(const UniqueFd&) = delete;
-  ~UniqueFd() { reset(); }
-  int get() const { return fd_; }
-  void reset(int fd = -1) {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = fd;
-  }
-
- private:
-  int fd_;
-};
-
-// A new file, created exclusively under a fresh random name ".<base>.<random><suffix>" in
-// `dir`, and removed when this object goes away unless keep() was called. Created with mode
-// 0666 so that the umask, not this code, decides who may read the final picture.
-class TempFile {
- public:
-  TempFile(const fs::path& dir, const std::string& base, std::string_view suffix) {
-    thread_local std::mt19937_64 random{std::random_device{}()};
-    for (int attempt = 0; attempt < 100; ++attempt) {
-      const fs::path candidate =
-          dir / fmt::format(".{}.{:016x}{}", base, static_cast<std::uint64_t>(random()), suffix);
-      const int fd = ::open(candidate.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-      if (fd >= 0) {
-        fd_.reset(fd);
-        path_ = candidate;
-        slot_ = register_temporary_file(path_);  // removed if the run is interrupted
-        return;
-      }
-      const int err = errno;
-      if (err != EEXIST) {
-        throw FileError(fmt::format(
-            "cannot write the plot into the directory '{}' ({}); create it, make it writable, "
-            "or choose another path for the plot",
-            dir.string(), errno_text(err)));
-      }
-    }
-    throw FileError(fmt::format(
-        "cannot create a temporary file in '{}' (100 names taken); remove stale '.{}.*' files",
-        dir.string(), base));
-  }
-  TempFile(const TempFile&) = delete;
-  TempFile& operator=(const TempFile&) = delete;
-  ~TempFile() {
-    fd_.reset();
-    if (!path_.empty()) {
-      std::error_code ignored;
-      fs::remove(path_, ignored);
-    }
-    release_temporary_file(slot_);
-  }
-  const fs::path& path() const { return path_; }
-  int fd() const { return fd_.get(); }
-  void close() { fd_.reset(); }
-  void keep() { path_.clear(); }
-
- private:
-  UniqueFd fd_;
-  fs::path path_;
-  int slot_ = -1;
-};
-
-void write_all(int fd, std::string_view text, const fs::path& path) {
-  while (!text.empty()) {
-    const ssize_t n = ::write(fd, text.data(), text.size());
-    if (n < 0) {
-      const int err = errno;
-      if (err == EINTR) continue;
-      throw FileError(
-          fmt::format("cannot write the gnuplot script '{}' ({}); free some space "
-                      "or choose another directory for the plot",
-                      path.string(), errno_text(err)));
-    }
-    text.remove_prefix(static_cast<std::size_t>(n));
-  }
-}
-
-struct GnuplotRun {
-  bool exited = false;  // exited normally (else killed by signal `code`)
-  int code = 0;         // exit status, or the signal number
-  std::string stderr_text;
-};
-
-// Runs `gnuplot args...` found on PATH, without a shell: stdin and stdout on /dev/null, stderr
-// captured. Throws FileError with the install hint if there is no gnuplot.
-GnuplotRun run_gnuplot(const std::vector<std::string>& args) {
-  int pipe_fds[2];
-  if (::pipe2(pipe_fds, O_CLOEXEC) != 0) {
-    throw FileError(
-        fmt::format("cannot start gnuplot: no pipe for its messages ({})", errno_text(errno)));
-  }
-  UniqueFd read_end(pipe_fds[0]);
-  UniqueFd write_end(pipe_fds[1]);
-
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_adddup2(&actions, write_end.get(), 2);
-  // The child starts with no blocked signals and SIGPIPE at its default, whatever the caller
-  // did to its own.
-  posix_spawnattr_t attributes;
-  posix_spawnattr_init(&attributes);
-  sigset_t signals;
-  sigemptyset(&signals);
-  posix_spawnattr_setsigmask(&attributes, &signals);
-  sigaddset(&signals, SIGPIPE);
-  posix_spawnattr_setsigdefault(&attributes, &signals);
-  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
-
-  std::vector<std::string> argv_storage{"gnuplot"};
-  argv_storage.insert(argv_storage.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (std::string& arg : argv_storage) argv.push_back(arg.data());
-  argv.push_back(nullptr);
-
-  pid_t pid = 0;
-  const int spawn_error =
-      posix_spawnp(&pid, "gnuplot", &actions, &attributes, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  posix_spawnattr_destroy(&attributes);
-  write_end.reset();  // else the read below never sees end-of-file
-  if (spawn_error == ENOENT) {
-    throw FileError(fmt::format("cannot plot: gnuplot is not on PATH; {}", install_hint));
-  }
-  if (spawn_error != 0) {
-    throw FileError(
-        fmt::format("cannot start gnuplot ({}); check its installation, or run "
-                    "without --plot",
-                    errno_text(spawn_error)));
-  }
-
-  GnuplotRun run;
-  char buffer[4096];
-  while (true) {
-    const ssize_t n = ::read(read_end.get(), buffer, sizeof buffer);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    run.stderr_text.append(buffer, static_cast<std::size_t>(n));
-    // Keep memory bounded if gnuplot warns on every row; only the tail is ever quoted.
-    if (run.stderr_text.size() > (1u << 20)) run.stderr_text.erase(0, 1u << 19);
-  }
-  int status = 0;
-  pid_t waited = 0;
-  do {
-    waited = ::waitpid(pid, &status, 0);
-  } while (waited < 0 && errno == EINTR);
-  if (waited < 0) {
-    throw FileError(fmt::format("lost track of gnuplot (waitpid: {})", errno_text(errno)));
-  }
-  run.exited = WIFEXITED(status);
-  run.code = run.exited ? WEXITSTATUS(status) : WTERMSIG(status);
-  return run;
-}
-
-bool probe_gnuplot() {
-  try {
-    // -d: ignore the user's ~/.gnuplot. Exits 3 if this gnuplot has neither png terminal.
-    const GnuplotRun run = run_gnuplot(
-        {"-d", "-e", "if (strstrt(' '.GPVAL_TERMINALS.' ', ' png') == 0) { exit status 3 }"});
-    return run.exited && run.code == 0;
-  } catch (const FileError&) {
-    return false;
-  }
-}
-
-// ---------------------------------------------------------------------------------------------
 // The script.
 
 struct Column {
@@ -427,60 +87,6 @@ std::string join_clauses(const std::vector<std::string>& clauses) {
     out += (i == 0 ? "" : ", \\\n     ") + clauses[i];
   }
   return out + "\n";
-}
-
-// The range of a column over the drawn rows, for the panel rule and the shared log range.
-struct Range {
-  double min = NAN, max = NAN;     // finite values only
-  double min_abs_positive = NAN;   // smallest nonzero |value|
-  double max_abs = NAN;
-};
-
-// Reads every `stride`-th data row (as gnuplot's `every` does) and returns the range of each
-// 1-based column in `indices`. Fields that are not numbers are skipped (gnuplot skips them too).
-std::vector<Range> read_ranges(const fs::path& csv, int header_lines, const std::vector<int>& indices,
-                               std::uintmax_t stride) {
-  std::vector<Range> out(indices.size());
-  std::ifstream in(csv, std::ios::binary);
-  if (!in) {
-    throw FileError(fmt::format("cannot read the CSV file '{}' to plot ({}); check the path", csv.string(),
-                                errno_text(errno)));
-  }
-  std::string line;
-  for (int i = 0; i < header_lines && std::getline(in, line); ++i) {
-  }
-  int widest = 0;
-  for (int index : indices) widest = std::max(widest, index);
-  std::vector<std::string_view> fields;
-  std::uintmax_t row = 0;
-  while (std::getline(in, line)) {
-    if (row++ % stride != 0) continue;
-    fields.clear();
-    std::string_view rest(line);
-    while (static_cast<int>(fields.size()) < widest) {
-      const std::size_t comma = rest.find(',');
-      fields.push_back(rest.substr(0, comma));
-      if (comma == std::string_view::npos) break;
-      rest.remove_prefix(comma + 1);
-    }
-    for (std::size_t k = 0; k < indices.size(); ++k) {
-      const auto i = static_cast<std::size_t>(indices[k] - 1);
-      if (i >= fields.size()) continue;
-      std::string_view field = fields[i];
-      while (!field.empty() && (field.front() == ' ' || field.front() == '+')) field.remove_prefix(1);
-      while (!field.empty() && (field.back() == ' ' || field.back() == '\r')) field.remove_suffix(1);
-      double value = 0.0;
-      const auto [end, err] = std::from_chars(field.data(), field.data() + field.size(), value);
-      if (err != std::errc{} || end != field.data() + field.size() || !std::isfinite(value)) continue;
-      Range& r = out[k];
-      r.min = std::isnan(r.min) ? value : std::min(r.min, value);
-      r.max = std::isnan(r.max) ? value : std::max(r.max, value);
-      const double a = std::abs(value);
-      r.max_abs = std::isnan(r.max_abs) ? a : std::max(r.max_abs, a);
-      if (a > 0.0) r.min_abs_positive = std::isnan(r.min_abs_positive) ? a : std::min(r.min_abs_positive, a);
-    }
-  }
-  return out;
 }
 
 // Colours of the event lines, one per event name in order of first appearance: dark enough
@@ -511,377 +117,238 @@ struct ScriptInput {
   int layout_columns = 0;     // 0: from the number of panels
 };
 
-std::string make_script(const ScriptInput& in) {
-  const int panels = static_cast<int>(in.panels.size());
-  const int layout_columns =
-      in.layout_columns > 0 ? std::min(in.layout_columns, panels) : panels == 1 ? 1 : panels <= 4 ? 2 : 3;
-  const int layout_rows = (panels + layout_columns - 1) / layout_columns;
-  const int width = layout_columns == 1 ? 1000 : 620 * layout_columns;
-  const int height = 80 + 340 * layout_rows;
-  // gnuplot skips the header lines; `every` also thins the rows, `all` takes them all.
-  const std::string all = fmt::format(" skip {}", in.header_lines);
-  const std::string every = in.stride > 1 ? fmt::format("{} every {}", all, in.stride) : all;
-  const std::string thinned = in.stride > 1 ? fmt::format(" (1 row in {} drawn)", in.stride) : "";
+// Writes the script of a figure, one method per kind of panel; they share the rows drawn, the
+// event marks and the script text `s`.
+class ScriptWriter {
+ public:
+  explicit ScriptWriter(const ScriptInput& in)
+      : in_(in),
+        // gnuplot skips the header lines; `every` also thins the rows, `all` takes them all.
+        all_(fmt::format(" skip {}", in.header_lines)),
+        every_(in.stride > 1 ? fmt::format("{} every {}", all_, in.stride) : all_),
+        thinned_(in.stride > 1 ? fmt::format(" (1 row in {} drawn)", in.stride) : ""),
+        event_step_(in.events.size() > max_drawn_events
+                        ? (in.events.size() + max_drawn_events - 1) / max_drawn_events
+                        : 1),
+        label_events_(in.events.size() <= max_labelled_events) {
+    // Events: one colour per name; the names in order of first appearance.
+    for (const PlotEvent& e : in.events)
+      if (std::find(event_names_.begin(), event_names_.end(), e.name) == event_names_.end())
+        event_names_.push_back(e.name);
+  }
 
-  // Events: one colour per name; the names in order of first appearance.
-  std::vector<std::string> event_names;
-  for (const PlotEvent& e : in.events)
-    if (std::find(event_names.begin(), event_names.end(), e.name) == event_names.end())
-      event_names.push_back(e.name);
-  const auto colour_of = [&](const std::string& name) {
-    const auto at = std::find(event_names.begin(), event_names.end(), name) - event_names.begin();
+  std::string write() {
+    write_header();
+    std::size_t drift_index = 0;
+    for (const ScriptPanel& p : in_.panels) {
+      switch (p.panel.kind) {
+        case PanelKind::lines:
+          write_lines(p);
+          break;
+        case PanelKind::drift:
+          write_drift(p, in_.drift0[drift_index++]);
+          break;
+        case PanelKind::log_abs:
+          write_log_abs(p);
+          break;
+        case PanelKind::path:
+          write_path(p);
+          break;
+      }
+    }
+    s_ += "unset multiplot\n";
+    s_ += "set output\n";  // closes and flushes the PNG
+    return s_;
+  }
+
+ private:
+  void write_header() {
+    const int panels = static_cast<int>(in_.panels.size());
+    const int layout_columns = in_.layout_columns > 0 ? std::min(in_.layout_columns, panels)
+                               : panels == 1          ? 1
+                               : panels <= 4          ? 2
+                                                      : 3;
+    const int layout_rows = (panels + layout_columns - 1) / layout_columns;
+    const int width = layout_columns == 1 ? 1000 : 620 * layout_columns;
+    const int height = 80 + 340 * layout_rows;
+    s_ += "# Written by nhdyn (src/nhdyn/io/plot.cpp) for one plot; deleted after the run.\n";
+    s_ += "set encoding utf8\n";
+    s_ += "if (strstrt(' '.GPVAL_TERMINALS.' ', ' pngcairo ') > 0) {\n";
+    s_ += fmt::format("  set terminal pngcairo size {},{} font 'Sans,10' noenhanced\n", width, height);
+    s_ += "} else {\n";
+    s_ += fmt::format("  set terminal png size {},{} noenhanced\n", width, height);
+    s_ += "}\n";
+    // Names such as residual_vel_blade or x' are drawn as written, not as enhanced-text markup.
+    s_ += "set termoption noenhanced\n";
+    // Absolute paths, so no file name can read as one of gnuplot's special files
+    // ('-', '+', '<command', '~/...').
+    s_ += fmt::format("csv_file = {}\n", gp_string(in_.csv.string()));
+    s_ += fmt::format("output_file = {}\n", gp_string(in_.output.string()));
+    s_ += "set output output_file\n";
+    s_ += "set datafile separator comma\n";
+    s_ += "set grid\n";
+    s_ += "set key below horizontal height 1\n";  // a little air between x label and legend
+    s_ += fmt::format("set multiplot layout {},{} title {} font ',13'\n", layout_rows, layout_columns,
+                      gp_label(in_.title));
+  }
+
+  std::string_view colour_of(const std::string& name) const {
+    const auto at = std::find(event_names_.begin(), event_names_.end(), name) - event_names_.begin();
     return event_colours[static_cast<std::size_t>(at) % event_colours.size()];
-  };
-  const std::size_t event_step =
-      in.events.size() > max_drawn_events ? (in.events.size() + max_drawn_events - 1) / max_drawn_events : 1;
-  const bool label_events = in.events.size() <= max_labelled_events;
-
-  std::string s;
-  s += "# Written by nhdyn (src/nhdyn/io/plot.cpp) for one plot; deleted after the run.\n";
-  s += "set encoding utf8\n";
-  s += "if (strstrt(' '.GPVAL_TERMINALS.' ', ' pngcairo ') > 0) {\n";
-  s += fmt::format("  set terminal pngcairo size {},{} font 'Sans,10' noenhanced\n", width, height);
-  s += "} else {\n";
-  s += fmt::format("  set terminal png size {},{} noenhanced\n", width, height);
-  s += "}\n";
-  // Names such as residual_vel_blade or x' are drawn as written, not as enhanced-text markup.
-  s += "set termoption noenhanced\n";
-  // Absolute paths, so no file name can read as one of gnuplot's special files
-  // ('-', '+', '<command', '~/...').
-  s += fmt::format("csv_file = {}\n", gp_string(in.csv.string()));
-  s += fmt::format("output_file = {}\n", gp_string(in.output.string()));
-  s += "set output output_file\n";
-  s += "set datafile separator comma\n";
-  s += "set grid\n";
-  s += "set key below horizontal height 1\n";  // a little air between x label and legend
-  s += fmt::format("set multiplot layout {},{} title {} font ',13'\n", layout_rows, layout_columns,
-                   gp_label(in.title));
+  }
 
   // The events on a time axis: dashed vertical lines (arrows from the bottom to the top of the
   // graph), their names written along them when there are few, and one legend entry per name.
-  const auto mark_events = [&](std::vector<std::string>& clauses) {
-    if (in.events.empty()) return;
+  void mark_events(std::vector<std::string>& clauses) {
+    if (in_.events.empty()) return;
     int tag = 1;
-    for (std::size_t i = 0; i < in.events.size(); i += event_step) {
-      const PlotEvent& e = in.events[i];
-      s += fmt::format("set arrow {} from {:.17g}, graph 0 to {:.17g}, graph 1 nohead dashtype 2 lw 1.2 "
-                       "linecolor rgb '{}' front\n",
-                       tag, e.t, e.t, colour_of(e.name));
-      if (label_events)
-        s += fmt::format("set label {} {} at {:.17g}, graph 0.97 rotate by 90 right offset character -0.7,0 "
-                         "font ',8' textcolor rgb '{}' front\n",
-                         tag, gp_label(e.name), e.t, colour_of(e.name));
+    for (std::size_t i = 0; i < in_.events.size(); i += event_step_) {
+      const PlotEvent& e = in_.events[i];
+      s_ += fmt::format("set arrow {} from {:.17g}, graph 0 to {:.17g}, graph 1 nohead dashtype 2 lw 1.2 "
+                        "linecolor rgb '{}' front\n",
+                        tag, e.t, e.t, colour_of(e.name));
+      if (label_events_)
+        s_ += fmt::format("set label {} {} at {:.17g}, graph 0.97 rotate by 90 right offset character -0.7,0 "
+                          "font ',8' textcolor rgb '{}' front\n",
+                          tag, gp_label(e.name), e.t, colour_of(e.name));
       ++tag;
     }
-    for (const std::string& name : event_names)
+    for (const std::string& name : event_names_)
       clauses.push_back(fmt::format("NaN with lines dashtype 2 lw 1.2 linecolor rgb '{}' title {}", colour_of(name),
                                     gp_label("event " + name)));
-  };
-  const auto clear_marks = [&] { s += "unset arrow\nunset label\n"; };
-  const auto title_of = [&](const ScriptPanel& p, std::size_t i) {
+  }
+
+  void clear_marks() { s_ += "unset arrow\nunset label\n"; }
+
+  static const std::string& title_of(const ScriptPanel& p, std::size_t i) {
     return p.panel.labels.size() == p.curves.size() ? p.panel.labels[i] : p.curves[i].name;
-  };
+  }
 
-  std::size_t drift_index = 0;
-  for (const ScriptPanel& p : in.panels) {
-    switch (p.panel.kind) {
-      case PanelKind::lines: {
-        s += fmt::format("set title {}\n", gp_label(fmt::format("{}{}", p.panel.title, thinned)));
-        s += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in.time_name));
-        std::vector<std::string> clauses;
-        for (std::size_t i = 0; i < p.curves.size(); ++i)
-          clauses.push_back(plot_clause(every, fmt::format("1:{}", p.curves[i].index), "lines", title_of(p, i)));
-        mark_events(clauses);
-        if (p.panel.y_range)
-          s += fmt::format("set yrange [{:.17g}:{:.17g}]\n", p.panel.y_range->first, p.panel.y_range->second);
-        s += join_clauses(clauses);
-        if (p.panel.y_range) s += "set autoscale y\n";
-        clear_marks();
-        break;
-      }
-      case PanelKind::drift: {
-        const Column& e = p.curves.front();
-        // Exponent form: always a gnuplot float (a bare "1" would be an integer), all 17 digits.
-        s += fmt::format("drift0 = {:.16e}\n", in.drift0[drift_index++]);
-        s += fmt::format("set title {}\n", gp_label(fmt::format("{}{}", p.panel.title, thinned)));
-        s += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in.time_name));
-        std::vector<std::string> clauses{plot_clause(every, fmt::format("1:(column({}) - drift0)", e.index), "lines",
-                                                     in.drift0[drift_index - 1] == 0.0
-                                                         ? title_of(p, 0)
-                                                         : fmt::format("{0}(t) - {0}(t0)", title_of(p, 0)))};
-        mark_events(clauses);
-        s += join_clauses(clauses);
-        clear_marks();
-        break;
-      }
-      case PanelKind::log_abs: {
-        // A value that is exactly zero (at t = 0, or a constraint met to the last bit) has no
-        // logarithm. It is left out (mapped to NaN, which gnuplot skips, leaving a gap in the
-        // line) rather than clamped to a floor such as 1e-300, which would stretch the axis over
-        // 300 empty decades and draw a comb of spikes down to it. If no drawn row has a nonzero
-        // value, gnuplot would stop on "all points y value undefined": a first pass (stats)
-        // finds the largest |r| over the rows drawn, and when it is 0 the panel shows |r| on a
-        // linear axis instead. Expressions are written inline: calling a user-defined gnuplot
-        // function costs several times more per row.
-        std::string largest = "largest = 0";
-        for (const Column& c : p.curves)
-          largest += fmt::format(", largest = (abs(column({0})) > largest ? abs(column({0})) : largest)", c.index);
-        s += fmt::format("stats csv_file{} using ({}, largest) nooutput\n", every, largest);
-        s += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in.time_name));
-        std::vector<std::string> log_clauses;
-        std::vector<std::string> linear_clauses;
-        for (std::size_t i = 0; i < p.curves.size(); ++i) {
-          const Column& c = p.curves[i];
-          log_clauses.push_back(plot_clause(
-              every, fmt::format("1:(column({0}) != 0 ? abs(column({0})) : NaN)", c.index), "lines", title_of(p, i)));
-          linear_clauses.push_back(
-              plot_clause(every, fmt::format("1:(abs(column({})))", c.index), "lines", title_of(p, i)));
-        }
-        mark_events(log_clauses);
-        mark_events(linear_clauses);
-        s += "if (STATS_max > 0) {\n";
-        s += fmt::format("set title {}\n",
-                         gp_label(fmt::format("{}, log scale, exact zeros left out{}", p.panel.title, thinned)));
-        s += "set logscale y\nset format y '1e%L'\n";
-        if (in.log_range)
-          s += fmt::format("set yrange [{:.17g}:{:.17g}]\n", in.log_range->first, in.log_range->second);
-        s += join_clauses(log_clauses);
-        s += "unset logscale y\nset format y '% h'\nset autoscale y\n";
-        s += "} else {\n";
-        s += fmt::format("set title {}\n",
-                         gp_label(fmt::format("{}, every value exactly 0{}", p.panel.title, thinned)));
-        s += join_clauses(linear_clauses);
-        s += "}\n";
-        clear_marks();
-        break;
-      }
-      case PanelKind::path: {
-        const Column& x = p.curves[0];
-        const Column& y = p.curves[1];
-        s += fmt::format("set title {}\n",
-                         gp_label(fmt::format("{}{}{}", p.panel.title,
-                                              p.panel.equal_axes ? ", equal scales" : ", scales not equal", thinned)));
-        s += fmt::format("set xlabel {}\nset ylabel {}\n", gp_label(x.name), gp_label(y.name));
-        if (p.panel.equal_axes) {
-          // Equal scales make the panel narrow: choose an x tic step giving ~4 intervals so the
-          // tic labels do not run into each other.
-          s += fmt::format("stats csv_file{} using {} nooutput\n", every, x.index);
-          s += "if (STATS_max > STATS_min) {\n";
-          s += "  path_step = (STATS_max - STATS_min) / 4.0\n";
-          s += "  path_unit = 10.0**floor(log10(path_step))\n";
-          s += "  path_f = path_step / path_unit\n";
-          s += "  path_tic = (path_f < 1.5 ? 1 : path_f < 3.5 ? 2 : path_f < 7.5 ? 5 : 10) * path_unit\n";
-          s += "  set xtics path_tic\n";  // not "set xtics (...)": that would read as a list of tics
-          s += "}\n";
-          s += "set size ratio -1\n";
-        } else {
-          // Each axis on its own scale, with a margin so the path does not run along the frame.
-          s += "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n";
-        }
-        // The events where the state is known: a circle at (x, y), named when there are few.
-        int tag = 1;
-        for (std::size_t i = 0; i < in.events.size(); i += event_step) {
-          const PlotEvent& e = in.events[i];
-          std::optional<double> ex, ey;
-          for (const auto& [name, value] : e.state) {
-            if (name == x.name) ex = value;
-            if (name == y.name) ey = value;
-          }
-          if (!ex || !ey) continue;
-          s += fmt::format("set label {} {} at {:.17g}, {:.17g} point pointtype 6 pointsize 1.6 linecolor rgb '{}' "
-                           "offset character 0.8,0.8 font ',8' textcolor rgb '{}' front\n",
-                           tag++, gp_label(label_events ? e.name : ""), *ex, *ey, colour_of(e.name),
-                           colour_of(e.name));
-        }
-        s += join_clauses({plot_clause(every, fmt::format("{}:{}", x.index, y.index), "lines", "path"),
-                           fmt::format("csv_file{} every ::0::0 using {}:{} with points pt 7 ps 1.2 title 'start'",
-                                       all, x.index, y.index)});
-        s += "set size noratio\nset xtics autofreq\nset offsets 0, 0, 0, 0\n";
-        clear_marks();
-        break;
-      }
+  void write_lines(const ScriptPanel& p) {
+    s_ += fmt::format("set title {}\n", gp_label(fmt::format("{}{}", p.panel.title, thinned_)));
+    s_ += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in_.time_name));
+    std::vector<std::string> clauses;
+    for (std::size_t i = 0; i < p.curves.size(); ++i)
+      clauses.push_back(plot_clause(every_, fmt::format("1:{}", p.curves[i].index), "lines", title_of(p, i)));
+    mark_events(clauses);
+    if (p.panel.y_range)
+      s_ += fmt::format("set yrange [{:.17g}:{:.17g}]\n", p.panel.y_range->first, p.panel.y_range->second);
+    s_ += join_clauses(clauses);
+    if (p.panel.y_range) s_ += "set autoscale y\n";
+    clear_marks();
+  }
+
+  void write_drift(const ScriptPanel& p, double drift0) {
+    const Column& e = p.curves.front();
+    // Exponent form: always a gnuplot float (a bare "1" would be an integer), all 17 digits.
+    s_ += fmt::format("drift0 = {:.16e}\n", drift0);
+    s_ += fmt::format("set title {}\n", gp_label(fmt::format("{}{}", p.panel.title, thinned_)));
+    s_ += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in_.time_name));
+    std::vector<std::string> clauses{plot_clause(every_, fmt::format("1:(column({}) - drift0)", e.index), "lines",
+                                                 drift0 == 0.0 ? title_of(p, 0)
+                                                               : fmt::format("{0}(t) - {0}(t0)", title_of(p, 0)))};
+    mark_events(clauses);
+    s_ += join_clauses(clauses);
+    clear_marks();
+  }
+
+  void write_log_abs(const ScriptPanel& p) {
+    // A value that is exactly zero (at t = 0, or a constraint met to the last bit) has no
+    // logarithm. It is left out (mapped to NaN, which gnuplot skips, leaving a gap in the
+    // line) rather than clamped to a floor such as 1e-300, which would stretch the axis over
+    // 300 empty decades and draw a comb of spikes down to it. If no drawn row has a nonzero
+    // value, gnuplot would stop on "all points y value undefined": a first pass (stats)
+    // finds the largest |r| over the rows drawn, and when it is 0 the panel shows |r| on a
+    // linear axis instead. Expressions are written inline: calling a user-defined gnuplot
+    // function costs several times more per row.
+    std::string largest = "largest = 0";
+    for (const Column& c : p.curves)
+      largest += fmt::format(", largest = (abs(column({0})) > largest ? abs(column({0})) : largest)", c.index);
+    s_ += fmt::format("stats csv_file{} using ({}, largest) nooutput\n", every_, largest);
+    s_ += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in_.time_name));
+    std::vector<std::string> log_clauses;
+    std::vector<std::string> linear_clauses;
+    for (std::size_t i = 0; i < p.curves.size(); ++i) {
+      const Column& c = p.curves[i];
+      log_clauses.push_back(plot_clause(
+          every_, fmt::format("1:(column({0}) != 0 ? abs(column({0})) : NaN)", c.index), "lines", title_of(p, i)));
+      linear_clauses.push_back(
+          plot_clause(every_, fmt::format("1:(abs(column({})))", c.index), "lines", title_of(p, i)));
     }
+    mark_events(log_clauses);
+    mark_events(linear_clauses);
+    s_ += "if (STATS_max > 0) {\n";
+    s_ += fmt::format("set title {}\n",
+                      gp_label(fmt::format("{}, log scale, exact zeros left out{}", p.panel.title, thinned_)));
+    s_ += "set logscale y\nset format y '1e%L'\n";
+    if (in_.log_range)
+      s_ += fmt::format("set yrange [{:.17g}:{:.17g}]\n", in_.log_range->first, in_.log_range->second);
+    s_ += join_clauses(log_clauses);
+    s_ += "unset logscale y\nset format y '% h'\nset autoscale y\n";
+    s_ += "} else {\n";
+    s_ += fmt::format("set title {}\n",
+                      gp_label(fmt::format("{}, every value exactly 0{}", p.panel.title, thinned_)));
+    s_ += join_clauses(linear_clauses);
+    s_ += "}\n";
+    clear_marks();
   }
 
-  s += "unset multiplot\n";
-  s += "set output\n";  // closes and flushes the PNG
-  return s;
-}
-
-std::string quoted_stderr(const std::string& text) {
-  std::string tail = trim(text);
-  if (tail.size() > max_quoted_stderr) {
-    tail = "...\n" + tail.substr(tail.size() - max_quoted_stderr);
+  void write_path(const ScriptPanel& p) {
+    const Column& x = p.curves[0];
+    const Column& y = p.curves[1];
+    s_ += fmt::format("set title {}\n",
+                      gp_label(fmt::format("{}{}{}", p.panel.title,
+                                           p.panel.equal_axes ? ", equal scales" : ", scales not equal", thinned_)));
+    s_ += fmt::format("set xlabel {}\nset ylabel {}\n", gp_label(x.name), gp_label(y.name));
+    if (p.panel.equal_axes) {
+      // Equal scales make the panel narrow: choose an x tic step giving ~4 intervals so the
+      // tic labels do not run into each other.
+      s_ += fmt::format("stats csv_file{} using {} nooutput\n", every_, x.index);
+      s_ += "if (STATS_max > STATS_min) {\n";
+      s_ += "  path_step = (STATS_max - STATS_min) / 4.0\n";
+      s_ += "  path_unit = 10.0**floor(log10(path_step))\n";
+      s_ += "  path_f = path_step / path_unit\n";
+      s_ += "  path_tic = (path_f < 1.5 ? 1 : path_f < 3.5 ? 2 : path_f < 7.5 ? 5 : 10) * path_unit\n";
+      s_ += "  set xtics path_tic\n";  // not "set xtics (...)": that would read as a list of tics
+      s_ += "}\n";
+      s_ += "set size ratio -1\n";
+    } else {
+      // Each axis on its own scale, with a margin so the path does not run along the frame.
+      s_ += "set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05\n";
+    }
+    // The events where the state is known: a circle at (x, y), named when there are few.
+    int tag = 1;
+    for (std::size_t i = 0; i < in_.events.size(); i += event_step_) {
+      const PlotEvent& e = in_.events[i];
+      std::optional<double> ex, ey;
+      for (const auto& [name, value] : e.state) {
+        if (name == x.name) ex = value;
+        if (name == y.name) ey = value;
+      }
+      if (!ex || !ey) continue;
+      s_ += fmt::format("set label {} {} at {:.17g}, {:.17g} point pointtype 6 pointsize 1.6 linecolor rgb '{}' "
+                        "offset character 0.8,0.8 font ',8' textcolor rgb '{}' front\n",
+                        tag++, gp_label(label_events_ ? e.name : ""), *ex, *ey, colour_of(e.name),
+                        colour_of(e.name));
+    }
+    s_ += join_clauses({plot_clause(every_, fmt::format("{}:{}", x.index, y.index), "lines", "path"),
+                        fmt::format("csv_file{} every ::0::0 using {}:{} with points pt 7 ps 1.2 title 'start'",
+                                    all_, x.index, y.index)});
+    s_ += "set size noratio\nset xtics autofreq\nset offsets 0, 0, 0, 0\n";
+    clear_marks();
   }
-  return tail.empty() ? "(gnuplot wrote nothing on stderr)" : tail;
-}
 
-// The part every plot shares: writes the script that `script(output)` returns next to `png`, runs
-// gnuplot on it, and renames gnuplot's output (a temporary file) onto `target` = absolute `png`
-// only when gnuplot succeeded. `csv` is named in the error messages.
-void render(const fs::path& png, const fs::path& named_target, const fs::path& csv,
-            const std::function<std::string(const fs::path& output)>& script) {
-  std::error_code ec;
-  // Through a symbolic link to the file it names (io/atomic_file.hpp); never onto an input.
-  const fs::path target = resolve_links(named_target);
-  require_not_input(target, png);
-  struct stat existing{};
-  const bool exists = ::stat(target.c_str(), &existing) == 0;
-  if (fs::is_directory(target, ec)) {
-    throw FileError(
-        fmt::format("cannot write the plot to '{}': it is a directory; give a file "
-                    "name such as '{}'",
-                    png.string(), (png / "plot.png").string()));
-  }
-  if (!gnuplot_available()) {
-    throw FileError(
-        fmt::format("cannot plot into '{}': gnuplot is not installed or has no PNG terminal; {}",
-                    png.string(), install_hint));
-  }
-
-  const fs::path directory = target.parent_path();
-  const std::string base = target.filename().string();
-  TempFile output(directory, base, ".tmp");
-  output.close();  // gnuplot opens it by name
-  TempFile script_file(directory, base, ".gp");
-  write_all(script_file.fd(), script(output.path()), script_file.path());
-  script_file.close();
-
-  // -d: ignore the user's ~/.gnuplot, so the picture does not depend on who draws it.
-  const GnuplotRun run = run_gnuplot({"-d", script_file.path().string()});
-  if (!run.exited || run.code != 0) {
-    throw FileError(fmt::format(
-        "gnuplot failed to draw '{}' from '{}' ({} {}); check that the CSV holds numeric rows. "
-        "gnuplot said:\n{}",
-        png.string(), csv.string(), run.exited ? "exit status" : "killed by signal",
-        run.code, quoted_stderr(run.stderr_text)));
-  }
-  if (fs::file_size(output.path(), ec) == 0 || ec) {
-    throw FileError(
-        fmt::format("gnuplot exited normally but wrote no image for '{}'; gnuplot "
-                    "said:\n{}",
-                    png.string(), quoted_stderr(run.stderr_text)));
-  }
-  if (exists && !S_ISREG(existing.st_mode) && !S_ISDIR(existing.st_mode)) {
-    // A device or pipe: copy the picture into it rather than replace it by a regular file.
-    std::ifstream in(output.path(), std::ios::binary);
-    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const UniqueFd fd(::open(target.c_str(), O_WRONLY | O_CLOEXEC));
-    if (fd.get() < 0)
-      throw FileError(fmt::format("cannot write the plot to '{}' ({})", png.string(), errno_text(errno)));
-    write_all(fd.get(), bytes, target);
-    return;
-  }
-  if (exists) ::chmod(output.path().c_str(), existing.st_mode & 07777);  // a replaced file keeps its mode
-  fs::rename(output.path(), target, ec);
-  if (ec) {
-    throw FileError(
-        fmt::format("cannot move the finished plot onto '{}' ({}); check that it "
-                    "is writable",
-                    png.string(), ec.message()));
-  }
-  output.keep();
-}
-
-// ---------------------------------------------------------------------------------------------
-// Which panel a column goes to (pure; docs/cli.md, "What --plot draws").
-
-// A curve joins a panel only if the panel's range, with it, spans at most this many times the
-// curve's own span: every curve then fills at least a tenth of its panel's height.
-constexpr double scale_ratio = 10.0;
-// The path is drawn with equal axes when its span ratio y/x lies in this interval: a panel is
-// about 620 x 300 px, so both sides of the drawn box keep at least a third of the panel.
-constexpr double path_ratio_low = 0.2;
-constexpr double path_ratio_high = 1.5;
-
-// The coordinate a velocity (x') or a reaction (R_x) belongs to.
-std::string_view base_coordinate(const PlotColumn& c) {
-  std::string_view name = c.name;
-  if (c.role == PlotRole::velocity)
-    while (!name.empty() && name.back() == '\'') name.remove_suffix(1);
-  if (c.role == PlotRole::reaction && name.starts_with("R_")) name.remove_prefix(2);
-  return name;
-}
-
-// A column whose values vary by no more than this fraction of the largest magnitude among the
-// columns of its role is constant to round-off: a reaction that is zero up to 1e-17 is drawn as
-// the zero it is, not magnified into noise. Below the tolerance of any run (rtol 1e-8 by
-// default), such a variation is the integrator's error, not the motion.
-constexpr double round_off = 1e-9;
-
-struct ScaleGroup {
-  std::vector<std::string> names;
-  std::optional<std::pair<double, double>> y_range;  // set for a group of constants
+  const ScriptInput& in_;
+  const std::string all_;      // every data row
+  const std::string every_;    // the drawn rows
+  const std::string thinned_;  // said in the titles when rows are thinned
+  const std::size_t event_step_;
+  const bool label_events_;
+  std::vector<std::string> event_names_;
+  std::string s_;
 };
 
-// Splits columns of like units into groups of like scale (scale_ratio). Largest spans first,
-// so a group's first member sets its range; each group keeps the columns in their given order,
-// and the groups come in the order of their first column. `role_scale` is the largest |value|
-// among the columns of their role (round_off).
-std::vector<ScaleGroup> split_by_scale(const std::vector<const PlotColumn*>& columns, double role_scale) {
-  const auto span = [&](const PlotColumn* c) {
-    const double s = c->max - c->min;
-    if (!std::isfinite(s)) return 0.0;
-    return s <= round_off * role_scale ? 0.0 : s;
-  };
-  std::vector<std::size_t> order(columns.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return span(columns[a]) > span(columns[b]); });
-  struct Group {
-    double lo = NAN, hi = NAN;
-    double smallest = INFINITY;  // smallest positive span of a member
-    std::vector<std::size_t> members;
-  };
-  std::vector<Group> groups;
-  for (std::size_t i : order) {
-    const PlotColumn* c = columns[i];
-    const bool finite = std::isfinite(c->min) && std::isfinite(c->max);
-    Group* home = nullptr;
-    for (Group& g : groups) {
-      if (!finite || std::isnan(g.lo)) {  // no values to place: any group will do
-        home = &g;
-        break;
-      }
-      const double lo = std::min(g.lo, c->min), hi = std::max(g.hi, c->max);
-      const double smallest = span(c) > 0.0 ? std::min(g.smallest, span(c)) : g.smallest;
-      // A group of constants takes any other constant: flat lines at their levels read well.
-      if (!std::isfinite(smallest) || hi - lo <= scale_ratio * smallest) {
-        home = &g;
-        break;
-      }
-    }
-    if (!home) home = &groups.emplace_back();
-    home->members.push_back(i);
-    if (finite) {
-      home->lo = std::isnan(home->lo) ? c->min : std::min(home->lo, c->min);
-      home->hi = std::isnan(home->hi) ? c->max : std::max(home->hi, c->max);
-      if (span(c) > 0.0) home->smallest = std::min(home->smallest, span(c));
-    }
-  }
-  // Each group's members in their given order; the groups in the order of their first member
-  // (the first member of a group is its smallest index).
-  std::vector<std::pair<std::size_t, std::size_t>> first;  // (first member, group)
-  for (std::size_t k = 0; k < groups.size(); ++k) {
-    std::sort(groups[k].members.begin(), groups[k].members.end());
-    first.emplace_back(groups[k].members.front(), k);
-  }
-  std::sort(first.begin(), first.end());
-  std::vector<ScaleGroup> out;
-  for (const auto& [unused, k] : first) {
-    const Group& g = groups[k];
-    ScaleGroup& group = out.emplace_back();
-    for (std::size_t i : g.members) group.names.push_back(columns[i]->name);
-    if (std::isfinite(g.smallest) || std::isnan(g.lo)) continue;
-    // Constants: a range around them wide enough that round-off does not show, and that holds
-    // every level with a margin.
-    const double mid = 0.5 * (g.lo + g.hi);
-    double half = std::max({0.6 * (g.hi - g.lo), 0.5 * std::abs(mid), 0.1 * role_scale});
-    if (!(half > 0.0)) half = 1.0;
-    group.y_range.emplace(mid - half, mid + half);
-  }
-  return out;
-}
+std::string make_script(const ScriptInput& in) { return ScriptWriter(in).write(); }
 
 std::string join_names(const std::vector<std::string>& names) {
   std::string out;
@@ -890,76 +357,6 @@ std::string join_names(const std::vector<std::string>& names) {
 }
 
 }  // namespace
-
-bool is_angle_name(std::string_view coordinate) {
-  std::string_view stem = coordinate.substr(0, coordinate.find_first_of("_0123456789'"));
-  while (!stem.empty() && stem.back() >= 'A' && stem.back() <= 'Z') stem.remove_suffix(1);
-  static constexpr std::array<std::string_view, 13> angles = {
-      "alpha", "beta", "gamma", "delta", "theta", "vartheta", "th", "phi", "varphi", "chi", "psi", "angle", "ang"};
-  return std::find(angles.begin(), angles.end(), stem) != angles.end();
-}
-
-std::vector<PlotPanel> calc_plot_panels(const std::vector<PlotColumn>& columns,
-                                        const std::optional<std::pair<PlotColumn, PlotColumn>>& path,
-                                        const std::vector<std::string>& angles) {
-  const auto is_angle = [&](std::string_view coordinate) {
-    return is_angle_name(coordinate) || std::find(angles.begin(), angles.end(), coordinate) != angles.end();
-  };
-  std::vector<PlotPanel> panels;
-  const auto lines = [&](PlotRole role, int which, std::string_view title) {
-    // which: 1 only the angles, 0 only the others, -1 every column of the role.
-    std::vector<const PlotColumn*> chosen;
-    double role_scale = 0.0;
-    // Reactions and actuator forces are both generalized forces: one scale for the two roles.
-    const auto same_scale = [&](PlotRole r) {
-      const auto forces = [](PlotRole x) { return x == PlotRole::reaction || x == PlotRole::actuator; };
-      return r == role || (forces(r) && forces(role));
-    };
-    for (const PlotColumn& c : columns) {
-      if (same_scale(c.role) && std::isfinite(c.max - c.min))
-        role_scale = std::max({role_scale, std::abs(c.min), std::abs(c.max)});
-      if (c.role != role) continue;
-      if (which >= 0 && is_angle(base_coordinate(c)) != (which == 1)) continue;
-      chosen.push_back(&c);
-    }
-    for (ScaleGroup& group : split_by_scale(chosen, role_scale)) {
-      PlotPanel& p = panels.emplace_back(PlotPanel{std::string(title), PanelKind::lines, std::move(group.names)});
-      p.y_range = group.y_range;
-      if (p.y_range) p.title += ", constant to round-off";
-    }
-  };
-  lines(PlotRole::coordinate, 1, "angles");
-  lines(PlotRole::coordinate, 0, "coordinates");
-  lines(PlotRole::velocity, 1, "angular velocities");
-  lines(PlotRole::velocity, 0, "velocities");
-  if (path) {
-    const double xs = path->first.max - path->first.min;
-    const double ys = path->second.max - path->second.min;
-    const double scale = std::max({std::abs(path->first.min), std::abs(path->first.max), std::abs(path->second.min),
-                                   std::abs(path->second.max)});
-    if (std::isfinite(xs) && std::isfinite(ys) && xs > round_off * scale && ys > round_off * scale) {
-      const double ratio = ys / xs;
-      PlotPanel p{fmt::format("path {}({})", path->second.name, path->first.name), PanelKind::path,
-                  {path->first.name, path->second.name}};
-      p.equal_axes = ratio >= path_ratio_low && ratio <= path_ratio_high;
-      panels.push_back(std::move(p));
-    }
-  }
-  lines(PlotRole::reaction, 1, "reactions on angles");
-  lines(PlotRole::reaction, 0, "reactions");
-  lines(PlotRole::actuator, -1, "actuator forces u");
-  lines(PlotRole::other, -1, "other columns");
-  std::vector<std::string> residuals;
-  for (const PlotColumn& c : columns)
-    if (c.role == PlotRole::residual) residuals.push_back(c.name);
-  if (!residuals.empty()) panels.push_back(PlotPanel{"|residual|", PanelKind::log_abs, residuals});
-  for (const PlotColumn& c : columns) {
-    if (c.role != PlotRole::energy_error) continue;
-    panels.push_back(PlotPanel{c.name == "balance_error" ? "energy balance error h - h0 - W" : "energy drift",
-                               PanelKind::drift, {c.name}});
-  }
-  return panels;
-}
 
 void require_plot_columns(const std::vector<std::string>& all, const std::vector<std::string>& chosen,
                           std::string_view option) {
@@ -992,52 +389,6 @@ void select_plot_columns(PlotRequest& request, const std::vector<std::string>& a
       request.others.push_back(name);
       placed.push_back(name);
     }
-}
-
-std::vector<PlotPanel> calc_comparison_panels(const std::vector<std::string>& methods,
-                                              const std::vector<std::string>& integrators,
-                                              const std::vector<std::string>& quantities) {
-  const auto column = [](const std::string& quantity, const std::string& method, const std::string& integrator) {
-    return fmt::format("{}_{}_{}", quantity, method, integrator);
-  };
-  std::vector<PlotPanel> panels;
-  if (integrators.size() == 1 || methods.size() == 1) {
-    const bool by_method = integrators.size() == 1;
-    for (const std::string& outer : by_method ? methods : integrators) {
-      PlotPanel& p = panels.emplace_back();
-      p.kind = PanelKind::log_abs;
-      p.title = by_method ? fmt::format("{} ({})", outer, integrators.front())
-                          : fmt::format("{} ({})", outer, methods.front());
-      for (const std::string& q : quantities) {
-        p.columns.push_back(by_method ? column(q, outer, integrators.front()) : column(q, methods.front(), outer));
-        p.labels.push_back(q);
-      }
-    }
-    return panels;
-  }
-  for (const std::string& q : quantities)
-    for (const std::string& m : methods) {
-      PlotPanel& p = panels.emplace_back();
-      p.kind = PanelKind::log_abs;
-      p.title = fmt::format("{}: {}", q, m);
-      for (const std::string& i : integrators) {
-        p.columns.push_back(column(q, m, i));
-        p.labels.push_back(i);
-      }
-    }
-  return panels;
-}
-
-void select_panel_columns(std::vector<PlotPanel>& panels, const std::vector<std::string>& chosen) {
-  if (chosen.empty()) return;
-  for (PlotPanel& p : panels) {
-    for (std::size_t i = p.columns.size(); i-- > 0;) {
-      if (std::find(chosen.begin(), chosen.end(), p.columns[i]) != chosen.end()) continue;
-      p.columns.erase(p.columns.begin() + static_cast<std::ptrdiff_t>(i));
-      if (i < p.labels.size()) p.labels.erase(p.labels.begin() + static_cast<std::ptrdiff_t>(i));
-    }
-  }
-  std::erase_if(panels, [](const PlotPanel& p) { return p.columns.empty(); });
 }
 
 namespace {
@@ -1082,7 +433,7 @@ void draw_panels(const std::string& title, const fs::path& csv, const CsvHead& h
   }
   if (same_log_range && !log_indices.empty()) {
     double lo = INFINITY, hi = 0.0;
-    for (const Range& r : read_ranges(csv, head.header_lines, log_indices, in.stride)) {
+    for (const ColumnRange& r : read_column_ranges(csv, head.header_lines, log_indices, in.stride)) {
       if (std::isfinite(r.min_abs_positive)) lo = std::min(lo, r.min_abs_positive);
       if (std::isfinite(r.max_abs)) hi = std::max(hi, r.max_abs);
     }
@@ -1093,18 +444,13 @@ void draw_panels(const std::string& title, const fs::path& csv, const CsvHead& h
       in.log_range.emplace(low, high);
     }
   }
-  render(png, target, csv, [&](const fs::path& output) {
+  render_with_gnuplot(png, target, csv, [&](const fs::path& output) {
     in.output = output;
     return make_script(in);
   });
 }
 
 }  // namespace
-
-bool gnuplot_available() {
-  static const bool available = probe_gnuplot();
-  return available;
-}
 
 void write_plot(const PlotRequest& request, const std::filesystem::path& png) {
   if (request.coordinates.empty() && request.reactions.empty() && request.residuals.empty() &&
@@ -1140,7 +486,7 @@ void write_plot(const PlotRequest& request, const std::filesystem::path& png) {
   }
   const std::uintmax_t stride =
       head.rows > max_rows_per_curve ? (head.rows + max_rows_per_curve - 1) / max_rows_per_curve : 1;
-  const std::vector<Range> ranges = read_ranges(request.csv, head.header_lines, indices, stride);
+  const std::vector<ColumnRange> ranges = read_column_ranges(request.csv, head.header_lines, indices, stride);
   for (std::size_t i = 0; i < columns.size(); ++i) {
     columns[i].min = ranges[i].min;
     columns[i].max = ranges[i].max;
@@ -1179,10 +525,6 @@ void write_panel_plot(const PanelPlotRequest& request, const std::filesystem::pa
               request.layout_columns, png);
 }
 
-}  // namespace nhdyn
-
-namespace nhdyn {
-
 void write_xy_plot(const XyPlotRequest& request, const std::filesystem::path& png) {
   if (request.y.empty())
     throw InputError(fmt::format("nothing to plot into '{}': the request names no y column", png.string()));
@@ -1206,7 +548,7 @@ void write_xy_plot(const XyPlotRequest& request, const std::filesystem::path& pn
                         request.titles.empty() ? request.y[i] : request.titles[i]});
   }
 
-  render(png, target, request.csv, [&](const fs::path& output) {
+  render_with_gnuplot(png, target, request.csv, [&](const fs::path& output) {
     // Values without a logarithm become NaN, which gnuplot skips; a first pass (stats) finds
     // whether anything is left to draw on each logarithmic axis.
     // `log_x` and `log_y` are set by the script once it knows whether anything is left to draw

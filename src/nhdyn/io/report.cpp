@@ -251,20 +251,23 @@ void check_report_columns(const std::vector<std::string>& header, const ResultCo
   }
 }
 
-std::string make_report_html(const ReportInput& input, const ReportOptions& options, std::string* notice) {
-  const CsvTable& table = input.table;
-  if (table.rows.empty()) throw InputError(fmt::format("the run of '{}' has no row to report", input.model));
-  check_report_columns(table.header, input.columns, "the table", input.model);
-  const std::vector<std::size_t> frames = report_frames(table.rows.size(), options.max_frames);
-  auto column = [&](const std::string& name) {
+namespace {
+
+// The values of a column at the frames drawn (NaN for a column the table does not have).
+struct FrameColumns {
+  const CsvTable& table;
+  const std::vector<std::size_t>& frames;
+  std::vector<double> operator()(const std::string& name) const {
     const int c = table.column(name);
     std::vector<double> values;
     values.reserve(frames.size());
     for (const std::size_t f : frames) values.push_back(c < 0 ? std::nan("") : table.rows[f][static_cast<std::size_t>(c)]);
     return values;
-  };
+  }
+};
 
-  // Panels: lengths and angles apart (their scales differ), then reactions, residuals, energy.
+// Panels: lengths and angles apart (their scales differ), then reactions, residuals, energy.
+std::vector<PlotGroup> report_plot_groups(const ReportInput& input, const FrameColumns& column) {
   std::vector<PlotGroup> groups;
   // Angles that turn through more than a revolution (a wheel's spin, a heading) get a panel of
   // their own, so that their hundreds of radians do not flatten a lean or a steer of a few degrees.
@@ -303,20 +306,12 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
     groups.push_back({"energy balance error h - h(0) - W", false, true, {input.columns.energy_balance.back()}});
   else if (!input.columns.energy.empty())
     groups.push_back({"energy drift E(t) - E(0)", false, true, {input.columns.energy}});
+  return groups;
+}
 
-  std::string data = "{\"title\":";
-  append_string(data, input.title);
-  data += ",\"summary\":[";
-  for (std::size_t i = 0; i < input.summary.size(); ++i) {
-    data += i > 0 ? ",[" : "[";
-    append_string(data, input.summary[i].first);
-    data += ',';
-    append_string(data, input.summary[i].second);
-    data += ']';
-  }
-  data += "],\"t\":";
-  append_numbers(data, column("t"));
-  data += ",\"plots\":[";
+// The "plots" member of the page's data: each group's series at the frames drawn.
+void append_plots(std::string& data, const CsvTable& table, const std::vector<PlotGroup>& groups,
+                  const FrameColumns& column) {
   for (std::size_t g = 0; g < groups.size(); ++g) {
     data += g > 0 ? ",{\"title\":" : "{\"title\":";
     append_string(data, groups[g].title);
@@ -353,89 +348,171 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
     }
     data += "]}";
   }
+}
+
+// The scene of a model with shapes: each shape's kind, size and place at every frame drawn (a
+// body along its principal axes).
+void append_scene_shapes(std::string& data, const ReportInput& input, const FrameColumns& column) {
+  const CsvTable& table = column.table;
+  const std::vector<std::size_t>& frames = column.frames;
+  const symbolic::VisualScene& scene = *input.scene;
+  const std::vector<SceneSize> sizes = calc_scene_sizes(scene, input.parameters, input.model);
+  const std::vector<double> parameter_values = parameter_values_for(scene, input.parameters, input.model);
+  const Program program = scene.program.bind(parameter_values.data(), parameter_values.size());
+  const int n = program.coordinates();
+  if (n != static_cast<int>(input.coordinates.size()))
+    throw InputError(fmt::format("the scene of '{}' has {} coordinates, the run {}", input.model, n,
+                                 input.coordinates.size()));
+  std::vector<int> qc, vc;
+  for (const std::string& q : input.coordinates) {
+    qc.push_back(table.column(q));
+    vc.push_back(table.column(q + "'"));
+  }
+  std::vector<double> q(static_cast<std::size_t>(n)), v(static_cast<std::size_t>(n));
+  std::vector<double> registers(static_cast<std::size_t>(program.registers()));
+  std::vector<double> outputs(static_cast<std::size_t>(program.outputs()));
+  std::vector<double> values;
+  values.reserve(frames.size() * outputs.size());
+  const int tc = table.column("t");
+  for (const std::size_t f : frames) {
+    const std::vector<double>& row = table.rows[f];
+    for (int i = 0; i < n; ++i) {
+      q[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(qc[static_cast<std::size_t>(i)])];
+      v[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(vc[static_cast<std::size_t>(i)])];
+    }
+    program.run(row[static_cast<std::size_t>(tc)], q.data(), v.data(), registers.data(), outputs.data());
+    // A body is drawn along its principal axes: R E, E's columns the axes in the frame's components.
+    for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
+      if (scene.shapes[s].kind != symbolic::VisualKind::body) continue;
+      double* R = outputs.data() + scene.shapes[s].offset + 3;
+      const std::array<double, 9>& E = sizes[s].axes;
+      std::array<double, 9> RE{};
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          for (int k = 0; k < 3; ++k) RE[static_cast<std::size_t>(3 * i + j)] += R[3 * i + k] * E[static_cast<std::size_t>(3 * k + j)];
+      std::copy(RE.begin(), RE.end(), R);
+    }
+    values.insert(values.end(), outputs.begin(), outputs.end());
+  }
+  data += fmt::format("\"planar\":{},\"ground\":{},\"stride\":{},\"shapes\":[", scene.planar, scene.ground,
+                      outputs.size());
+  for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
+    const symbolic::VisualShape& shape = scene.shapes[s];
+    static constexpr const char* kinds[] = {"sphere", "segment", "wheel", "body", "frame"};
+    data += fmt::format("{}{{\"kind\":\"{}\",\"name\":", s > 0 ? "," : "", kinds[static_cast<int>(shape.kind)]);
+    append_string(data, shape.name);
+    data += fmt::format(",\"offset\":{},\"axis\":{},\"size\":", shape.offset, shape.axis);
+    append_numbers(data, {sizes[s].size[0], sizes[s].size[1], sizes[s].size[2]});
+    data += '}';
+  }
+  data += "],\"values\":";
+  append_numbers(data, values);
+}
+
+// The scene of a model with nothing to draw: its path as one moving point. Returns the page's
+// note that says so.
+std::string append_scene_path(std::string& data, const ReportInput& input, const FrameColumns& column) {
+  const std::vector<std::size_t>& frames = column.frames;
+  std::pair<std::string, std::string> path;
+  if (input.path) path = *input.path;
+  else if (input.coordinates.size() >= 2) path = {input.coordinates[0], input.coordinates[1]};
+  else if (!input.coordinates.empty()) path = {"t", input.coordinates[0]};
+  const std::string note =
+      fmt::format("The model '{}' names nothing to draw (no [visual] table, no bodies): the scene shows the path "
+                  "({}, {}). docs/model-format.md says how to add a [visual] table.",
+                  input.model, path.first, path.second);
+  const std::vector<double> x = column(path.first), y = column(path.second);
+  std::vector<double> values;
+  values.reserve(3 * frames.size());
+  double size = 0.0;
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    values.insert(values.end(), {x[f], y[f], 0.0});
+    if (std::isfinite(x[f]) && std::isfinite(y[f])) size = std::max({size, std::abs(x[f] - x[0]), std::abs(y[f] - y[0])});
+  }
+  data += "\"planar\":true,\"ground\":false,\"stride\":3,\"shapes\":[{\"kind\":\"sphere\",\"name\":";
+  append_string(data, path.first + ", " + path.second);
+  data += ",\"offset\":0,\"axis\":0,\"size\":";
+  const double r = size > 0.0 ? 0.02 * size : 0.05;
+  append_numbers(data, {r, r, r});
+  data += "}],\"values\":";
+  append_numbers(data, values);
+  return note;
+}
+
+// The page: the embedded styles and scripts around the data.
+std::string make_report_page(const std::string& title, const std::vector<std::string>& provenance,
+                             const std::string& data) {
+  std::string html;
+  html.reserve(data.size() + resources::three_js.size() + resources::katex_js.size() + 600000);
+  html += "<!DOCTYPE html>\n";
+  if (!provenance.empty()) {
+    // The run's provenance (io/provenance.hpp) as the CSV has it, one "# key: value" per line; an
+    // HTML comment may not hold "--", which a negative value after '=' could bring.
+    html += "<!--\n";
+    for (const std::string& line : provenance) {
+      std::string text = "#" + line;
+      for (std::size_t at = text.find("--"); at != std::string::npos; at = text.find("--", at)) text.replace(at, 2, "- -");
+      html += text + "\n";
+    }
+    html += "-->\n";
+  }
+  html += "<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>";
+  for (const char c : title) {
+    if (c == '<') html += "&lt;";
+    else if (c == '&') html += "&amp;";
+    else html += c;
+  }
+  html += "</title>\n<!-- Written by nhdyn (io/report.hpp). Embedded: three.js (libjs-three, MIT licence), KaTeX and its "
+          "fonts (libjs-katex, MIT licence and SIL Open Font Licence). -->\n<style>\n";
+  html += katex_css_with_fonts();
+  html += "\n</style>\n<style>\n";
+  html += resources::report_css;
+  html += "</style>\n</head>\n<body>\n<script>\n";
+  html += resources::three_js;
+  html += "\n</script>\n<script>\n";
+  html += resources::katex_js;
+  html += "\n</script>\n<script>\nconst NHDYN = ";
+  html += data;
+  html += ";\n</script>\n<script>\n";
+  html += resources::report_js;
+  html += "</script>\n</body>\n</html>\n";
+  return html;
+}
+
+}  // namespace
+
+std::string make_report_html(const ReportInput& input, const ReportOptions& options, std::string* notice) {
+  const CsvTable& table = input.table;
+  if (table.rows.empty()) throw InputError(fmt::format("the run of '{}' has no row to report", input.model));
+  check_report_columns(table.header, input.columns, "the table", input.model);
+  const std::vector<std::size_t> frames = report_frames(table.rows.size(), options.max_frames);
+  const FrameColumns column{table, frames};
+  const std::vector<PlotGroup> groups = report_plot_groups(input, column);
+
+  std::string data = "{\"title\":";
+  append_string(data, input.title);
+  data += ",\"summary\":[";
+  for (std::size_t i = 0; i < input.summary.size(); ++i) {
+    data += i > 0 ? ",[" : "[";
+    append_string(data, input.summary[i].first);
+    data += ',';
+    append_string(data, input.summary[i].second);
+    data += ']';
+  }
+  data += "],\"t\":";
+  append_numbers(data, column("t"));
+  data += ",\"plots\":[";
+  append_plots(data, table, groups, column);
   data += ']';
 
   // The scene: the model's shapes, or the path as one moving point.
   std::string note;
   const bool has_shapes = input.scene != nullptr && !input.scene->shapes.empty();
   data += ",\"scene\":{";
-  if (has_shapes) {
-    const symbolic::VisualScene& scene = *input.scene;
-    const std::vector<SceneSize> sizes = calc_scene_sizes(scene, input.parameters, input.model);
-    const std::vector<double> parameter_values = parameter_values_for(scene, input.parameters, input.model);
-    const Program program = scene.program.bind(parameter_values.data(), parameter_values.size());
-    const int n = program.coordinates();
-    if (n != static_cast<int>(input.coordinates.size()))
-      throw InputError(fmt::format("the scene of '{}' has {} coordinates, the run {}", input.model, n,
-                                   input.coordinates.size()));
-    std::vector<int> qc, vc;
-    for (const std::string& q : input.coordinates) {
-      qc.push_back(table.column(q));
-      vc.push_back(table.column(q + "'"));
-    }
-    std::vector<double> q(static_cast<std::size_t>(n)), v(static_cast<std::size_t>(n));
-    std::vector<double> registers(static_cast<std::size_t>(program.registers()));
-    std::vector<double> outputs(static_cast<std::size_t>(program.outputs()));
-    std::vector<double> values;
-    values.reserve(frames.size() * outputs.size());
-    const int tc = table.column("t");
-    for (const std::size_t f : frames) {
-      const std::vector<double>& row = table.rows[f];
-      for (int i = 0; i < n; ++i) {
-        q[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(qc[static_cast<std::size_t>(i)])];
-        v[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(vc[static_cast<std::size_t>(i)])];
-      }
-      program.run(row[static_cast<std::size_t>(tc)], q.data(), v.data(), registers.data(), outputs.data());
-      // A body is drawn along its principal axes: R E, E's columns the axes in the frame's components.
-      for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
-        if (scene.shapes[s].kind != symbolic::VisualKind::body) continue;
-        double* R = outputs.data() + scene.shapes[s].offset + 3;
-        const std::array<double, 9>& E = sizes[s].axes;
-        std::array<double, 9> RE{};
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j)
-            for (int k = 0; k < 3; ++k) RE[static_cast<std::size_t>(3 * i + j)] += R[3 * i + k] * E[static_cast<std::size_t>(3 * k + j)];
-        std::copy(RE.begin(), RE.end(), R);
-      }
-      values.insert(values.end(), outputs.begin(), outputs.end());
-    }
-    data += fmt::format("\"planar\":{},\"ground\":{},\"stride\":{},\"shapes\":[", scene.planar, scene.ground,
-                        outputs.size());
-    for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
-      const symbolic::VisualShape& shape = scene.shapes[s];
-      static constexpr const char* kinds[] = {"sphere", "segment", "wheel", "body", "frame"};
-      data += fmt::format("{}{{\"kind\":\"{}\",\"name\":", s > 0 ? "," : "", kinds[static_cast<int>(shape.kind)]);
-      append_string(data, shape.name);
-      data += fmt::format(",\"offset\":{},\"axis\":{},\"size\":", shape.offset, shape.axis);
-      append_numbers(data, {sizes[s].size[0], sizes[s].size[1], sizes[s].size[2]});
-      data += '}';
-    }
-    data += "],\"values\":";
-    append_numbers(data, values);
-  } else {
-    std::pair<std::string, std::string> path;
-    if (input.path) path = *input.path;
-    else if (input.coordinates.size() >= 2) path = {input.coordinates[0], input.coordinates[1]};
-    else if (!input.coordinates.empty()) path = {"t", input.coordinates[0]};
-    note = fmt::format("The model '{}' names nothing to draw (no [visual] table, no bodies): the scene shows the path "
-                       "({}, {}). docs/model-format.md says how to add a [visual] table.",
-                       input.model, path.first, path.second);
-    const std::vector<double> x = column(path.first), y = column(path.second);
-    std::vector<double> values;
-    values.reserve(3 * frames.size());
-    double size = 0.0;
-    for (std::size_t f = 0; f < frames.size(); ++f) {
-      values.insert(values.end(), {x[f], y[f], 0.0});
-      if (std::isfinite(x[f]) && std::isfinite(y[f])) size = std::max({size, std::abs(x[f] - x[0]), std::abs(y[f] - y[0])});
-    }
-    data += "\"planar\":true,\"ground\":false,\"stride\":3,\"shapes\":[{\"kind\":\"sphere\",\"name\":";
-    append_string(data, path.first + ", " + path.second);
-    data += ",\"offset\":0,\"axis\":0,\"size\":";
-    const double r = size > 0.0 ? 0.02 * size : 0.05;
-    append_numbers(data, {r, r, r});
-    data += "}],\"values\":";
-    append_numbers(data, values);
-  }
+  if (has_shapes)
+    append_scene_shapes(data, input, column);
+  else
+    note = append_scene_path(data, input, column);
   data += '}';
   if (frames.size() < table.rows.size())
     note += fmt::format("{}The page shows {} of the run's {} rows (every {}th, and the last); the CSV has them all.",
@@ -457,41 +534,7 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
   append_string(data, equations_note);
   data += '}';
 
-  std::string html;
-  html.reserve(data.size() + resources::three_js.size() + resources::katex_js.size() + 600000);
-  html += "<!DOCTYPE html>\n";
-  if (!input.table.comments.empty()) {
-    // The run's provenance (io/provenance.hpp) as the CSV has it, one "# key: value" per line; an
-    // HTML comment may not hold "--", which a negative value after '=' could bring.
-    html += "<!--\n";
-    for (const std::string& line : input.table.comments) {
-      std::string text = "#" + line;
-      for (std::size_t at = text.find("--"); at != std::string::npos; at = text.find("--", at)) text.replace(at, 2, "- -");
-      html += text + "\n";
-    }
-    html += "-->\n";
-  }
-  html += "<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>";
-  for (const char c : input.title) {
-    if (c == '<') html += "&lt;";
-    else if (c == '&') html += "&amp;";
-    else html += c;
-  }
-  html += "</title>\n<!-- Written by nhdyn (io/report.hpp). Embedded: three.js (libjs-three, MIT licence), KaTeX and its "
-          "fonts (libjs-katex, MIT licence and SIL Open Font Licence). -->\n<style>\n";
-  html += katex_css_with_fonts();
-  html += "\n</style>\n<style>\n";
-  html += resources::report_css;
-  html += "</style>\n</head>\n<body>\n<script>\n";
-  html += resources::three_js;
-  html += "\n</script>\n<script>\n";
-  html += resources::katex_js;
-  html += "\n</script>\n<script>\nconst NHDYN = ";
-  html += data;
-  html += ";\n</script>\n<script>\n";
-  html += resources::report_js;
-  html += "</script>\n</body>\n</html>\n";
-  return html;
+  return make_report_page(input.title, input.table.comments, data);
 }
 
 std::string write_report(const ReportInput& input, const std::filesystem::path& path, const ReportOptions& options) {

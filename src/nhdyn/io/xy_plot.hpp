@@ -1,7 +1,7 @@
 // Plots of a study: one panel of curves y_i(x) read from a CSV, on logarithmic axes by default —
 // error against tolerance, relative error against mass ratio. The studies of docs/studies/ draw
-// their figures with it. It shares gnuplot's running, the atomic rename and the error messages
-// with the plots of a run (plot.hpp), so it is implemented in plot.cpp.
+// their figures with it. Its script is written in plot.cpp beside those of the plots of a run
+// (plot.hpp), sharing the quoting of strings; gnuplot.hpp runs it.
 #pragma once
 
 #include <filesystem>

@@ -310,10 +310,11 @@ std::string make_identifier(const std::string& name) {
   return out;
 }
 
-std::string generate_code(const Spec& spec, const Derivation& derivation, const CodegenOptions& options) {
-  const std::string id = options.identifier.empty() ? make_identifier(spec.name) : options.identifier;
-  if (!is_identifier(id))
-    throw InputError(fmt::format("codegen: '{}' is not a valid C++ identifier for the generated names", id));
+namespace {
+
+// The namespaces of options.namespace_name, outermost first ("a::b" -> {"a", "b"}); InputError for
+// a name that is not '::'-separated identifiers, or std.
+std::vector<std::string> split_namespace(const CodegenOptions& options) {
   std::vector<std::string> namespaces;
   if (!options.namespace_name.empty()) {
     std::string rest = options.namespace_name;
@@ -327,34 +328,52 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
                                      options.namespace_name));
     if (namespaces.front() == "std") throw InputError("codegen: the generated code may not go into namespace std");
   }
+  return namespaces;
+}
 
-  // The generated code writes every entry of A and b (dense outputs).
-  const Model model = compile_model(spec, derivation, CompileOptions{TermsLayout::dense});
-  if (model.m() > 0)
-    throw InputError(fmt::format("codegen: model '{}' has programs ([[programs]]), which generated code does not "
-                                 "carry yet; run it through the interpreted evaluator (nhdyn simulate)",
-                                 model.name));
-  const auto* evaluator = dynamic_cast<const ProgramEvaluator*>(model.evaluator.get());
-  if (evaluator == nullptr) throw std::logic_error("generate_code: compile_model did not make a ProgramEvaluator");
-  const ModelPrograms& programs = evaluator->parametric_programs();
-  const int n = model.n(), s = model.s();
-  const std::string cls = camel_case(id) + "Evaluator";
-  const std::string parameters_struct = camel_case(id) + "Parameters";
-  const std::vector<std::string> fields = parameter_fields(model.parameters);
-  const CodePrinter terms_printer(programs.terms, "terms_", fields);
-  const std::optional<CodePrinter> complement_printer =
-      programs.complement ? std::optional<CodePrinter>(std::in_place, *programs.complement, "complement_", fields)
-                          : std::nullopt;
-  const CodePrinter phi_printer(programs.position_residual, "phi_", fields);
-  const CodePrinter f_printer(programs.velocity_residual, "f_", fields);
-  const std::optional<CodePrinter> energy_printer =
-      programs.energy ? std::optional<CodePrinter>(std::in_place, *programs.energy, "energy_", fields) : std::nullopt;
-  const std::optional<CodePrinter> initial_printer =
-      programs.initial_state ? std::optional<CodePrinter>(std::in_place, *programs.initial_state, "initial_", fields, false)
-                             : std::nullopt;
-  const auto q_name = [&](int i) { return comment_text(model.coordinates[static_cast<std::size_t>(i)]); };
-  const auto c_name = [&](int i) { return comment_text(model.constraints[static_cast<std::size_t>(i)].name); };
+// The names the generated code gives its model's parts, and the printers of its programs.
+struct Generated {
+  Generated(const Model& model_, const ModelPrograms& programs_, const std::string& id_)
+      : model(model_),
+        programs(programs_),
+        id(id_),
+        cls(camel_case(id_) + "Evaluator"),
+        parameters_struct(camel_case(id_) + "Parameters"),
+        fields(parameter_fields(model_.parameters)),
+        terms_printer(programs_.terms, "terms_", fields),
+        complement_printer(programs_.complement ? std::optional<CodePrinter>(std::in_place, *programs_.complement,
+                                                                             "complement_", fields)
+                                                : std::nullopt),
+        phi_printer(programs_.position_residual, "phi_", fields),
+        f_printer(programs_.velocity_residual, "f_", fields),
+        energy_printer(programs_.energy
+                           ? std::optional<CodePrinter>(std::in_place, *programs_.energy, "energy_", fields)
+                           : std::nullopt),
+        initial_printer(programs_.initial_state ? std::optional<CodePrinter>(std::in_place, *programs_.initial_state,
+                                                                             "initial_", fields, false)
+                                                : std::nullopt) {}
 
+  std::string q_name(int i) const { return comment_text(model.coordinates[static_cast<std::size_t>(i)]); }
+  std::string c_name(int i) const { return comment_text(model.constraints[static_cast<std::size_t>(i)].name); }
+
+  const Model& model;
+  const ModelPrograms& programs;
+  const std::string id;
+  const std::string cls;
+  const std::string parameters_struct;
+  const std::vector<std::string> fields;
+  const CodePrinter terms_printer;
+  const std::optional<CodePrinter> complement_printer;
+  const CodePrinter phi_printer;
+  const CodePrinter f_printer;
+  const std::optional<CodePrinter> energy_printer;
+  const std::optional<CodePrinter> initial_printer;
+};
+
+// The file's opening comment (what it was made from, its operation counts) and its includes.
+std::string file_head(const Generated& g) {
+  const Model& model = g.model;
+  const ModelPrograms& programs = g.programs;
   std::string out;
   out += fmt::format("// Generated by nhdyn (symbolic/codegen.hpp) from the model '{}'. Do not edit: regenerate.\n",
                      comment_text(model.name));
@@ -366,23 +385,33 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
                      programs.energy ? operations(*programs.energy) : 0);
   out += "#pragma once\n\n#include <cmath>\n#include <cstddef>\n#include <memory>\n\n";
   out += "#include \"nhdyn/model/evaluator.hpp\"\n#include \"nhdyn/model/model.hpp\"\n\n";
-  for (const std::string& part : namespaces) out += fmt::format("namespace {} {{\n", part);
-  if (!namespaces.empty()) out += "\n";
+  return out;
+}
 
-  // The parameter struct, with the file's values as defaults.
+// The parameter struct, with the file's values as defaults.
+std::string parameters_struct_code(const Generated& g) {
+  const Model& model = g.model;
+  std::string out;
   out += "// The model's parameters, with the values of its file as defaults. A derived parameter (one\n";
   out += "// defined by an expression in the others) is a field too: set_parameter on the Model\n";
   out += "// (nhdyn/model/parameters.hpp) re-evaluates it, a struct filled by hand does not.\n";
-  out += fmt::format("struct {} {{\n", parameters_struct);
+  out += fmt::format("struct {} {{\n", g.parameters_struct);
   for (std::size_t i = 0; i < model.parameters.size(); ++i) {
     const Parameter& p = model.parameters[i];
     std::string note = p.unit.empty() ? "" : fmt::format("[{}]", comment_text(p.unit));
     if (!p.expression.empty()) note += fmt::format("{}= {}", note.empty() ? "" : " ", comment_text(p.expression));
-    out += fmt::format("  double {} = {};{}\n", fields[i], literal(p.value), note.empty() ? "" : "  // " + note);
+    out += fmt::format("  double {} = {};{}\n", g.fields[i], literal(p.value), note.empty() ? "" : "  // " + note);
   }
   out += "};\n\n";
+  return out;
+}
 
-  out += fmt::format("class {} final : public ::nhdyn::Evaluator {{\n public:\n", cls);
+// The evaluator class up to its kernels: the constructor, the parameters, the initial state.
+std::string evaluator_head_code(const Generated& g) {
+  const Model& model = g.model;
+  const int n = model.n();
+  std::string out;
+  out += fmt::format("class {} final : public ::nhdyn::Evaluator {{\n public:\n", g.cls);
   // The constructor computes the parameter stage of every program once.
   {
     std::string stage;
@@ -391,24 +420,24 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
       const std::string statements = printer.statements(true, "      ");
       if (!statements.empty()) stage += "    {\n" + statements + "    }\n";
     };
-    add_stage(terms_printer);
-    if (complement_printer) add_stage(*complement_printer);
-    add_stage(phi_printer);
-    add_stage(f_printer);
-    if (energy_printer) add_stage(*energy_printer);
-    out += fmt::format("  explicit {}(const {}& p = {{}}) : p_(p) {{", cls, parameters_struct);
+    add_stage(g.terms_printer);
+    if (g.complement_printer) add_stage(*g.complement_printer);
+    add_stage(g.phi_printer);
+    add_stage(g.f_printer);
+    if (g.energy_printer) add_stage(*g.energy_printer);
+    out += fmt::format("  explicit {}(const {}& p = {{}}) : p_(p) {{", g.cls, g.parameters_struct);
     out += stage.empty() ? "}\n" : "\n" + stage + "  }\n";
   }
-  out += fmt::format("  const {}& parameters() const {{ return p_; }}\n\n", parameters_struct);
+  out += fmt::format("  const {}& parameters() const {{ return p_; }}\n\n", g.parameters_struct);
   out += "  std::shared_ptr<const ::nhdyn::Evaluator> with_parameters(const double* values, std::size_t count) const "
          "override {\n";
   out += fmt::format("    if (count != {}) return nullptr;\n", model.parameters.size());
-  out += fmt::format("    {} p;\n", parameters_struct);
-  for (std::size_t i = 0; i < fields.size(); ++i) out += fmt::format("    p.{} = values[{}];\n", fields[i], i);
-  if (fields.empty()) out += "    (void)values;\n";
-  out += fmt::format("    return std::make_shared<{}>(p);\n  }}\n", cls);
-  if (initial_printer) {
-    const Body body = print_body(*initial_printer, [&](int i, const std::string& r) {
+  out += fmt::format("    {} p;\n", g.parameters_struct);
+  for (std::size_t i = 0; i < g.fields.size(); ++i) out += fmt::format("    p.{} = values[{}];\n", g.fields[i], i);
+  if (g.fields.empty()) out += "    (void)values;\n";
+  out += fmt::format("    return std::make_shared<{}>(p);\n  }}\n", g.cls);
+  if (g.initial_printer) {
+    const Body body = print_body(*g.initial_printer, [&](int i, const std::string& r) {
       return i < n ? fmt::format("    q0[{}] = {};\n", i, r) : fmt::format("    v0[{}] = {};\n", i - n, r);
     });
     out += "  bool has_initial_state() const override { return true; }\n";
@@ -416,10 +445,20 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
     out += body.code + "  }\n";
   }
   out += "\n";
+  return out;
+}
 
+// The evaluator's kernels: terms, complement, residuals, energy.
+std::string evaluator_kernels_code(const Generated& g) {
+  const Model& model = g.model;
+  const ModelPrograms& programs = g.programs;
+  const int n = model.n(), s = model.s();
+  const auto q_name = [&](int i) { return g.q_name(i); };
+  const auto c_name = [&](int i) { return g.c_name(i); };
+  std::string out;
   // terms
   {
-    const Body body = print_body(terms_printer, [&](int i, const std::string& r) {
+    const Body body = print_body(g.terms_printer, [&](int i, const std::string& r) {
       const int nn = n * n;
       if (i < nn) return fmt::format("    out.A[{}] = {};  // A({}, {})\n", i, r, q_name(i % n), q_name(i / n));
       i -= nn;
@@ -439,7 +478,7 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   // complement
   if (programs.complement) {
     const int k = n - s;
-    const Body body = print_body(*complement_printer, [&](int i, const std::string& r) {
+    const Body body = print_body(*g.complement_printer, [&](int i, const std::string& r) {
       return fmt::format("    D[{}] = {};  // D({}, {})\n", i, r, i % k + 1, q_name(i / k));
     });
     out += "\n  bool has_complement() const override { return true; }\n";
@@ -450,7 +489,7 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   }
   // residuals
   if (programs.position_residual.outputs() > 0) {
-    const Body body = print_body(phi_printer, [&](int i, const std::string& r) {
+    const Body body = print_body(g.phi_printer, [&](int i, const std::string& r) {
       return fmt::format("    phi[{}] = {};\n", i, r);
     });
     out += fmt::format("\n  void position_residual({}, {}, double* /*scratch*/, double* phi) const override {{\n",
@@ -458,7 +497,7 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
     out += body.code + "  }\n";
   }
   if (programs.velocity_residual.outputs() > 0) {
-    const Body body = print_body(f_printer, [&](int i, const std::string& r) {
+    const Body body = print_body(g.f_printer, [&](int i, const std::string& r) {
       return fmt::format("    f[{}] = {};\n", i, r);
     });
     out += fmt::format("\n  void velocity_residual({}, {}, {}, double* /*scratch*/, double* f) const override {{\n",
@@ -468,7 +507,7 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   }
   // energy
   if (programs.energy) {
-    const Body body = print_body(*energy_printer, [&](int, const std::string& r) {
+    const Body body = print_body(*g.energy_printer, [&](int, const std::string& r) {
       return fmt::format("    return {};\n", r);
     });
     out += "\n  bool has_energy() const override { return true; }\n";
@@ -477,12 +516,19 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
                        parameter(body.reads_v, "const double*", "v"));
     out += body.code + "  }\n";
   }
+  return out;
+}
+
+// The evaluator's members: the parameters, each program's parameter stage, powi if used.
+std::string evaluator_members_code(const Generated& g) {
+  const ModelPrograms& programs = g.programs;
+  std::string out;
   out += "\n private:\n";
-  out += fmt::format("  {} p_;\n", parameters_struct);
-  out += terms_printer.members();
-  if (complement_printer) out += complement_printer->members();
-  out += phi_printer.members() + f_printer.members();
-  if (energy_printer) out += energy_printer->members();
+  out += fmt::format("  {} p_;\n", g.parameters_struct);
+  out += g.terms_printer.members();
+  if (g.complement_printer) out += g.complement_printer->members();
+  out += g.phi_printer.members() + g.f_printer.members();
+  if (g.energy_printer) out += g.energy_printer->members();
   if (uses_powi(programs)) {
     // The interpreter's algorithm (model/program.cpp), so that both round alike.
     out += "  // a^n by repeated squaring, n != 0.\n";
@@ -493,9 +539,17 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
     out += "      base *= base;\n    }\n    return n < 0 ? 1.0 / result : result;\n  }\n";
   }
   out += "};\n\n";
+  return out;
+}
 
-  // make_<id>_model
-  out += fmt::format("inline ::nhdyn::Model make_{}_model(const {}& p = {{}}) {{\n", id, parameters_struct);
+// make_<id>_model: the Model with the generated evaluator.
+std::string make_model_code(const Generated& g) {
+  const Model& model = g.model;
+  const ModelPrograms& programs = g.programs;
+  const int n = model.n();
+  const std::string& id = g.id;
+  std::string out;
+  out += fmt::format("inline ::nhdyn::Model make_{}_model(const {}& p = {{}}) {{\n", id, g.parameters_struct);
   out += "  ::nhdyn::Model model;\n";
   out += fmt::format("  model.name = {};\n", quoted(model.name));
   out += fmt::format("  model.description = {};\n", quoted(model.description));
@@ -507,7 +561,7 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
                        level_name(c.level), quoted(c.expression));
   for (std::size_t i = 0; i < model.parameters.size(); ++i) {
     const Parameter& p = model.parameters[i];
-    out += fmt::format("  model.parameters.push_back({{{}, p.{}, {}, {}}});\n", quoted(p.name), fields[i],
+    out += fmt::format("  model.parameters.push_back({{{}, p.{}, {}, {}}});\n", quoted(p.name), g.fields[i],
                        quoted(p.unit), quoted(p.expression));
   }
   out += fmt::format("  model.t0 = {};\n", literal(model.t0));
@@ -517,11 +571,39 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
   out += fmt::format("  model.defaults = ::nhdyn::SimulationDefaults{{{}, {}}};\n", literal(model.defaults.t_end),
                      literal(model.defaults.output_step));
   if (model.path) out += fmt::format("  model.path = ::nhdyn::PlanarPath{{{}, {}}};\n", model.path->x, model.path->y);
-  out += fmt::format("  const auto evaluator = std::make_shared<{}>(p);\n", cls);
+  out += fmt::format("  const auto evaluator = std::make_shared<{}>(p);\n", g.cls);
   if (programs.initial_state) out += "  evaluator->initial_state(nullptr, model.q0.data(), model.v0.data());\n";
   out += "  model.evaluator = evaluator;\n";
   out += "  return model;\n}\n";
+  return out;
+}
 
+}  // namespace
+
+std::string generate_code(const Spec& spec, const Derivation& derivation, const CodegenOptions& options) {
+  const std::string id = options.identifier.empty() ? make_identifier(spec.name) : options.identifier;
+  if (!is_identifier(id))
+    throw InputError(fmt::format("codegen: '{}' is not a valid C++ identifier for the generated names", id));
+  const std::vector<std::string> namespaces = split_namespace(options);
+
+  // The generated code writes every entry of A and b (dense outputs).
+  const Model model = compile_model(spec, derivation, CompileOptions{TermsLayout::dense});
+  if (model.m() > 0)
+    throw InputError(fmt::format("codegen: model '{}' has programs ([[programs]]), which generated code does not "
+                                 "carry yet; run it through the interpreted evaluator (nhdyn simulate)",
+                                 model.name));
+  const auto* evaluator = dynamic_cast<const ProgramEvaluator*>(model.evaluator.get());
+  if (evaluator == nullptr) throw std::logic_error("generate_code: compile_model did not make a ProgramEvaluator");
+  const Generated g(model, evaluator->parametric_programs(), id);
+
+  std::string out = file_head(g);
+  for (const std::string& part : namespaces) out += fmt::format("namespace {} {{\n", part);
+  if (!namespaces.empty()) out += "\n";
+  out += parameters_struct_code(g);
+  out += evaluator_head_code(g);
+  out += evaluator_kernels_code(g);
+  out += evaluator_members_code(g);
+  out += make_model_code(g);
   if (!namespaces.empty()) out += "\n";
   for (auto it = namespaces.rbegin(); it != namespaces.rend(); ++it) out += fmt::format("}}  // namespace {}\n", *it);
   return out;

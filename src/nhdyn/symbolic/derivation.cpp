@@ -331,34 +331,20 @@ std::optional<GiNaC::matrix> partitioned_complement(const GiNaC::matrix& b, cons
   return D;
 }
 
-Derivation derive(const Spec& spec) {
+namespace {
+
+// A = d2T/dq'2 (docs/notation.md (2.4)); T must be quadratic in q' so that A does not depend on q'.
+// Only the pairs of velocities that occur in a common term of T can give a nonzero entry. Tv
+// receives dT/dq'_i, which G needs too.
+void derive_inertia(const Spec& spec, const SplitSum& Ts, const SymbolIndex& index, const std::string& model,
+                    Derivation& d, std::vector<GiNaC::ex>& Tv) {
   const SymbolTable& symbols = spec.symbols;
-  const int n = spec.n(), s = spec.s(), k = n - s;
+  const int n = spec.n();
   const auto un = static_cast<unsigned>(n);
-  const std::string model = fmt::format("{}model '{}': ", prefix(spec.where), spec.name);
-  if (n == 0) throw ModelError(model + "no coordinates");
-  if (s >= n)
-    throw ModelError(model + fmt::format("{} constraints for {} coordinates: there must be fewer (s < n)", s, n));
-  const GiNaC::symbol& t = symbols.time();
-  const auto q = [&](int i) { return symbols.coordinate(i); };
   const auto v = [&](int i) { return symbols.velocity(i); };
   const auto name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
-
-  const GiNaC::ex& T = spec.kinetic_energy;
-  const GiNaC::ex& V = spec.potential_energy;
-  const SymbolIndex index(symbols);
-  const SplitSum Ts(T, index, n), Vs(V, index, n);
-  if (Ts.first(&Contained::a) >= 0 || Vs.first(&Contained::a) >= 0)
-    throw ModelError(model + "the kinetic and potential energies may not contain accelerations");
-  if (const int i = Vs.first(&Contained::v); i >= 0)
-    throw ModelError(model + fmt::format("the potential energy V contains the velocity {}'", name(i)));
-  require_at_most_quadratic(spec, model);
-
-  Derivation d;
-  // A = d2T/dq'2 (docs/notation.md (2.4)); T must be quadratic in q' so that A does not depend on q'.
-  // Only the pairs of velocities that occur in a common term of T can give a nonzero entry.
   d.A = ExMatrix(un, un);
-  std::vector<GiNaC::ex> Tv(un);
+  Tv.assign(un, GiNaC::ex());
   bool moving = false;
   for (int i = 0; i < n; ++i) {
     const auto ui = static_cast<unsigned>(i);
@@ -383,8 +369,16 @@ Derivation derive(const Spec& spec) {
     }
   }
   if (!moving) throw ModelError(model + "the kinetic energy T does not depend on the velocities");
+}
 
-  // G = dT/dq - (d2T/dq'dq) q' - d2T/dq'dt and Q = -dV/dq + forces (docs/notation.md section 1).
+// G = dT/dq - (d2T/dq'dq) q' - d2T/dq'dt and Q = -dV/dq + forces (docs/notation.md section 1).
+void derive_forces(const Spec& spec, const SplitSum& Ts, const SplitSum& Vs, const std::vector<GiNaC::ex>& Tv,
+                   const SymbolIndex& index, const std::string& model, Derivation& d) {
+  const SymbolTable& symbols = spec.symbols;
+  const int n = spec.n();
+  const auto un = static_cast<unsigned>(n);
+  const auto q = [&](int i) { return symbols.coordinate(i); };
+  const auto name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
   d.G = GiNaC::matrix(un, 1);
   d.Q = GiNaC::matrix(un, 1);
   for (int i = 0; i < n; ++i) {
@@ -396,36 +390,38 @@ Derivation derive(const Spec& spec) {
                                            name(o.a.front())));
     d.Q(ui, 0) = tidy(-Vs.diff(Vs.with_q, i, q(i)) + force);
   }
+}
 
-  // Every constraint at acceleration level, b q'' + b0 = 0 (docs/notation.md (2.5)).
-  constraint_rows(spec, spec.constraints, "constraint", index, d.b, d.b0, d.phi, d.f);
-
-  // The programs the same way, b_p q'' + b_p0 = 0, and their actuators' columns of B
-  // (docs/derivations/program-motion.md section 1).
-  {
-    std::vector<SpecConstraint> programs;
-    for (const SpecProgram& p : spec.programs) programs.push_back(p.constraint);
-    ExMatrix b_p;
-    constraint_rows(spec, programs, "program", index, b_p, d.b_p0, d.phi_p, d.f_p);
-    d.b_p = b_p.dense();
-    const auto um = static_cast<unsigned>(spec.m());
-    d.B = GiNaC::matrix(un, um);
-    for (unsigned j = 0; j < um; ++j) {
-      const SpecProgram& p = spec.programs[j];
-      bool zero = true;
-      for (unsigned i = 0; i < un && i < p.actuator.size(); ++i) {
-        d.B(i, j) = tidy(p.actuator[i]);
-        zero = zero && symbolic::is_zero(d.B(i, j));
-      }
-      if (zero)
-        throw ModelError(fmt::format("{}program '{}': its actuator direction ({}) is zero, so it exerts no force; "
-                                     "give the coordinate the actuator acts on or a nonzero direction",
-                                     prefix(p.actuator_where.line > 0 ? p.actuator_where : p.constraint.where),
-                                     p.constraint.name, p.actuator_text));
+// The programs as the constraints, b_p q'' + b_p0 = 0, and their actuators' columns of B
+// (docs/derivations/program-motion.md section 1).
+void derive_programs(const Spec& spec, const SymbolIndex& index, Derivation& d) {
+  const auto un = static_cast<unsigned>(spec.n());
+  std::vector<SpecConstraint> programs;
+  for (const SpecProgram& p : spec.programs) programs.push_back(p.constraint);
+  ExMatrix b_p;
+  constraint_rows(spec, programs, "program", index, b_p, d.b_p0, d.phi_p, d.f_p);
+  d.b_p = b_p.dense();
+  const auto um = static_cast<unsigned>(spec.m());
+  d.B = GiNaC::matrix(un, um);
+  for (unsigned j = 0; j < um; ++j) {
+    const SpecProgram& p = spec.programs[j];
+    bool zero = true;
+    for (unsigned i = 0; i < un && i < p.actuator.size(); ++i) {
+      d.B(i, j) = tidy(p.actuator[i]);
+      zero = zero && symbolic::is_zero(d.B(i, j));
     }
+    if (zero)
+      throw ModelError(fmt::format("{}program '{}': its actuator direction ({}) is zero, so it exerts no force; "
+                                   "give the coordinate the actuator acts on or a nonzero direction",
+                                   prefix(p.actuator_where.line > 0 ? p.actuator_where : p.constraint.where),
+                                   p.constraint.name, p.actuator_text));
   }
+}
 
-  // D: analytic, or partitioned for the named independent coordinates.
+// D: analytic, or partitioned for the named independent coordinates.
+void derive_complement(const Spec& spec, const std::string& model, Derivation& d) {
+  const int n = spec.n(), s = spec.s(), k = n - s;
+  const auto name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
   if (spec.complement) {
     const GiNaC::matrix& D = *spec.complement;
     if (static_cast<int>(D.rows()) != k || static_cast<int>(D.cols()) != n)
@@ -458,10 +454,17 @@ Derivation derive(const Spec& spec) {
                                            join(spec.independent), join(dependent)));
     }
   }
+}
 
-  // The energy balance (docs/derivations/energy-balance.md). Simplifying a sum costs more than
-  // linearly in its number of terms (every trigonometric argument is reduced across all of them):
-  // a large model's expressions are kept as written, which computes the same values.
+// The energy balance (docs/derivations/energy-balance.md). Simplifying a sum costs more than
+// linearly in its number of terms (every trigonometric argument is reduced across all of them):
+// a large model's expressions are kept as written, which computes the same values.
+void derive_energy_balance(const Spec& spec, const SplitSum& Ts, Derivation& d) {
+  const SymbolTable& symbols = spec.symbols;
+  const GiNaC::symbol& t = symbols.time();
+  const auto v = [&](int i) { return symbols.velocity(i); };
+  const GiNaC::ex& T = spec.kinetic_energy;
+  const GiNaC::ex& V = spec.potential_energy;
   constexpr std::size_t kSimplifiedTerms = 64;
   const auto kept = [](const GiNaC::ex& e) { return e.nops() <= kSimplifiedTerms ? tidy(e) : e; };
   const GiNaC::ex energy = T + V;
@@ -493,6 +496,37 @@ Derivation derive(const Spec& spec) {
   d.power_forces = tidy(power_forces);
   d.power_time = tidy(V.diff(t) - T.diff(t));
   d.conservative = symbolic::is_zero(d.power_forces) && symbolic::is_zero(d.power_time);
+}
+
+}  // namespace
+
+Derivation derive(const Spec& spec) {
+  const int n = spec.n(), s = spec.s();
+  const std::string model = fmt::format("{}model '{}': ", prefix(spec.where), spec.name);
+  if (n == 0) throw ModelError(model + "no coordinates");
+  if (s >= n)
+    throw ModelError(model + fmt::format("{} constraints for {} coordinates: there must be fewer (s < n)", s, n));
+  const auto name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
+
+  const GiNaC::ex& T = spec.kinetic_energy;
+  const GiNaC::ex& V = spec.potential_energy;
+  const SymbolIndex index(spec.symbols);
+  const SplitSum Ts(T, index, n), Vs(V, index, n);
+  if (Ts.first(&Contained::a) >= 0 || Vs.first(&Contained::a) >= 0)
+    throw ModelError(model + "the kinetic and potential energies may not contain accelerations");
+  if (const int i = Vs.first(&Contained::v); i >= 0)
+    throw ModelError(model + fmt::format("the potential energy V contains the velocity {}'", name(i)));
+  require_at_most_quadratic(spec, model);
+
+  Derivation d;
+  std::vector<GiNaC::ex> Tv;
+  derive_inertia(spec, Ts, index, model, d, Tv);
+  derive_forces(spec, Ts, Vs, Tv, index, model, d);
+  // Every constraint at acceleration level, b q'' + b0 = 0 (docs/notation.md (2.5)).
+  constraint_rows(spec, spec.constraints, "constraint", index, d.b, d.b0, d.phi, d.f);
+  derive_programs(spec, index, d);
+  derive_complement(spec, model, d);
+  derive_energy_balance(spec, Ts, d);
   return d;
 }
 
