@@ -169,6 +169,109 @@ TEST(ContactModes, DiskAndHoopThrownSlidingStickAtTheirClosedFormTimes) {
   }
 }
 
+// A solid cylinder released at rest on an incline of angle alpha (gravity tilted, the plane
+// z = 0): it slides from the start iff tan(alpha) > 3 mu (section 10.3), with x'' = g (sin(alpha) -
+// mu cos(alpha)) and never sticks; below that it rolls at x'' = 2 g sin(alpha) / 3.
+std::string incline_model(double alpha) {
+  return R"toml(
+name = "cylinder-on-incline"
+coordinates = ["x", "y", "z", "b"]
+gravity = ["g*sin(alpha)", 0, "-g*cos(alpha)"]
+[parameters]
+m = 2.0
+r = 0.1
+g = 9.81
+mu = 0.2
+alpha = )toml" + std::to_string(alpha) + R"toml(
+[[frames]]
+name = "cylinder"
+translation = ["x", "y", "z"]
+rotations = [["y", "b"]]
+[[bodies]]
+name = "cylinder"
+frame = "cylinder"
+mass = "m"
+inertia = ["m*r^2/4", "m*r^2/2", "m*r^2/4"]
+[[contacts]]
+name = "rim"
+body = "cylinder"
+shape = { disk = "r", axis = "y" }
+ground = { plane = [0, 0, 1] }
+friction = "mu"
+[initial]
+position = { x = 0, y = 0, z = "r", b = 0 }
+)toml";
+}
+
+TEST(ContactModes, CylinderOnASteepInclineSlidesFromTheStartAndRollsBelowTheBound) {
+  const double g = 9.81, mu = 0.2;
+  for (const double alpha : {0.7, 0.4}) {
+    SCOPED_TRACE(alpha);
+    const bool steep = std::tan(alpha) > 3 * mu;
+    const Model model = load_model_text(incline_model(alpha), "incline.toml");
+    const ModeRun r = run_modes(model, 1.0);
+    EXPECT_TRUE(r.summary.events.empty());
+    const std::size_t last = r.rows.size() - 1;
+    EXPECT_EQ(r.at(0, "rim_mode"), steep ? 1.0 : 0.0);
+    EXPECT_EQ(r.at(last, "rim_mode"), steep ? 1.0 : 0.0);
+    const double a = steep ? g * (std::sin(alpha) - mu * std::cos(alpha)) : 2 * g * std::sin(alpha) / 3;
+    EXPECT_NEAR(r.at(last, "x'"), a * 1.0, 1e-10);
+    if (steep) {
+      // The slip grows at g (sin(alpha) - 3 mu cos(alpha)); the friction is mu N up the slope.
+      EXPECT_NEAR(r.at(last, "rim_slip_speed"), g * (std::sin(alpha) - 3 * mu * std::cos(alpha)), 1e-10);
+      EXPECT_NEAR(r.at(last, "rim_Fx"), -mu * 2.0 * g * std::cos(alpha), 1e-10);
+    } else {
+      EXPECT_LT(r.summary.max_velocity_residual, 1e-10);
+    }
+    EXPECT_LT(r.summary.max_balance_error, 1e-10);
+  }
+}
+
+// Section 10.2, a ball released at theta0 = 1e-3 from the top of a fixed sphere. Without a
+// friction limit it rolls until N = 0 at cos(theta) = 2 cos(theta0) / (3 + k) and lifts off; with
+// mu = 0.3 it slips at (R3) and lifts off while sliding, at the root of (R4).
+double sphere_angle(const EventRecord& e) { return std::atan2(e.q[0], e.q[2]); }
+
+TEST(ContactModes, BallOnASphereLiftsOffAtTenSeventeenthsOrSlipsFirst) {
+  const double k = 0.4, theta0 = 1e-3;
+  {
+    const Model model = load_model(example("ball_on_sphere.toml"));
+    const ModeRun r = run_modes(model, 3.2);
+    ASSERT_EQ(r.summary.events.size(), 1u);
+    EXPECT_EQ(r.summary.events[0].name, "ball_liftoff");
+    EXPECT_NEAR(std::cos(sphere_angle(r.summary.events[0])), 2 * std::cos(theta0) / (3 + k), 1e-9);
+    const std::size_t last = r.rows.size() - 1;
+    EXPECT_EQ(r.at(last, "ball_mode"), 2.0);
+    EXPECT_GT(r.at(last, "ball_gap"), 0.05);  // flying away from the sphere
+    EXPECT_NEAR(r.at(last, "ball_N"), 0.0, 1e-12);
+    EXPECT_LT(r.summary.max_balance_error, 1e-9);
+  }
+  std::string text = test::read_text(example("ball_on_sphere.toml"));
+  text.replace(text.find("unilateral = true\n"), 18, "unilateral = true\nfriction = 0.3\n");
+  const Model model = load_model_text(text, "sphere.toml");
+  const ModeRun r = run_modes(model, 3.1);
+  ASSERT_EQ(r.summary.events.size(), 2u);
+  EXPECT_EQ(r.summary.events[0].name, "ball_slip");
+  EXPECT_EQ(r.summary.events[1].name, "ball_liftoff");
+  const double mu = 0.3;
+  const double theta_s = std::atan2((3 + k) * mu, k) -
+                         std::asin(2 * mu * std::cos(theta0) / std::sqrt(k * k + (3 + k) * (3 + k) * mu * mu));
+  EXPECT_NEAR(sphere_angle(r.summary.events[0]), theta_s, 1e-8);
+  // (R4): rho u = rho theta'^2 while sliding, from theta_s; lift-off where rho u = g cos(theta).
+  const double rho_u_s = 2 * 9.81 * (std::cos(theta0) - std::cos(theta_s)) / (1 + k);
+  const auto p = [&](double x) { return (2 * mu * mu - 1) * std::cos(x) - 3 * mu * std::sin(x); };
+  const auto excess = [&](double x) {
+    const double E = std::exp(2 * mu * (x - theta_s));
+    return rho_u_s * E + 2 * 9.81 / (1 + 4 * mu * mu) * (p(x) - E * p(theta_s)) - 9.81 * std::cos(x);
+  };
+  double lo = theta_s + 1e-6, hi = 1.5;
+  for (int i = 0; i < 200; ++i) ((excess(0.5 * (lo + hi)) < 0) ? lo : hi) = 0.5 * (lo + hi);
+  EXPECT_NEAR(hi * 180 / M_PI, 52.12, 0.01);  // the derivation's figure
+  EXPECT_NEAR(sphere_angle(r.summary.events[1]), hi, 1e-7);
+  EXPECT_LT(r.at(r.rows.size() - 1, "work_friction"), 0.0);
+  EXPECT_LT(r.summary.max_balance_error, 1e-9);
+}
+
 std::string thrown_ball_with(const std::string& keys) {
   std::string text = test::read_text(example("ball_thrown_sliding.toml"));
   const std::string old = "friction = \"mu\"\nmode = \"sliding\"\n";

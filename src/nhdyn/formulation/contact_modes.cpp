@@ -107,9 +107,14 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
           (w.mu_k[i] * w.sliding_direction[i][a] / lengths[i][a]) * data.b.row(c.roll[a]).transpose();
   }
 
-  // D: the last n - r columns of the orthogonal factor of B~^T (D B~^T = 0), then (S4).
-  w.qr.compute(w.reaction_rows);
-  if (w.qr.rank() < r) {
+  // D: the last n - r columns of the orthogonal factor of B~^T (D B~^T = 0), then (S4). With no
+  // row kept (a free body and nothing else) D is the identity: A q'' = Q + G.
+  const int k = n - r;
+  data.Q_full.resize(n, n);
+  data.hh_work.resize(n);
+  if (r == 0) data.Q_full.setIdentity();
+  else w.qr.compute(w.reaction_rows);
+  if (r > 0 && w.qr.rank() < r) {
     for (std::size_t i = 0; i < cm.contacts.size(); ++i)
       if (w.mode[i] == ContactMode::sliding)
         return fail(data, cm, static_cast<int>(i),
@@ -117,10 +122,7 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
                     "the span of the other constraints)");
     return record_failure(data, Status::dependent_constraints, "b");
   }
-  const int k = n - r;
-  data.Q_full.resize(n, n);
-  data.hh_work.resize(n);
-  w.qr.householderQ().evalTo(data.Q_full, data.hh_work);
+  if (r > 0) w.qr.householderQ().evalTo(data.Q_full, data.hh_work);
   w.M.topRows(k).noalias() = data.Q_full.rightCols(k).transpose() * data.A;
   w.rhs.head(k).noalias() = data.Q_full.rightCols(k).transpose() * (data.Q + data.G);
   for (int j = 0; j < r; ++j) {
@@ -146,10 +148,12 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
   data.R -= data.G;
 
   // The multipliers, R = B~^T lambda (least squares through the same QR): N and F_t.
-  data.tmp_n = data.R;
-  data.tmp_n.applyOnTheLeft(w.qr.householderQ().adjoint());
-  w.qr.matrixQR().topLeftCorner(r, r).triangularView<Eigen::Upper>().solveInPlace(data.tmp_n.head(r));
-  for (int j = 0; j < r; ++j) w.multipliers(w.qr.colsPermutation().indices()(j)) = data.tmp_n(j);
+  if (r > 0) {
+    data.tmp_n = data.R;
+    data.tmp_n.applyOnTheLeft(w.qr.householderQ().adjoint());
+    w.qr.matrixQR().topLeftCorner(r, r).triangularView<Eigen::Upper>().solveInPlace(data.tmp_n.head(r));
+    for (int j = 0; j < r; ++j) w.multipliers(w.qr.colsPermutation().indices()(j)) = data.tmp_n(j);
+  }
   w.power_friction = 0.0;
   for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
     const ContactModeContact& c = cm.contacts[i];
