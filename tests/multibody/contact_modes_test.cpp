@@ -172,7 +172,7 @@ TEST(ContactModes, DiskAndHoopThrownSlidingStickAtTheirClosedFormTimes) {
 // A solid cylinder released at rest on an incline of angle alpha (gravity tilted, the plane
 // z = 0): it slides from the start iff tan(alpha) > 3 mu (section 10.3), with x'' = g (sin(alpha) -
 // mu cos(alpha)) and never sticks; below that it rolls at x'' = 2 g sin(alpha) / 3.
-std::string incline_model(double alpha) {
+std::string incline_model(double alpha, const std::string& friction = "\"mu\"") {
   return R"toml(
 name = "cylinder-on-incline"
 coordinates = ["x", "y", "z", "b"]
@@ -197,7 +197,7 @@ name = "rim"
 body = "cylinder"
 shape = { disk = "r", axis = "y" }
 ground = { plane = [0, 0, 1] }
-friction = "mu"
+friction = )toml" + friction + R"toml(
 [initial]
 position = { x = 0, y = 0, z = "r", b = 0 }
 )toml";
@@ -224,6 +224,31 @@ TEST(ContactModes, CylinderOnASteepInclineSlidesFromTheStartAndRollsBelowTheBoun
       EXPECT_LT(r.summary.max_velocity_residual, 1e-10);
     }
     EXPECT_LT(r.summary.max_balance_error, 1e-10);
+  }
+  // friction = [mu_s, mu_k]: between 3 mu_k and 3 mu_s the static friction holds it from rest.
+  const Model held = load_model_text(incline_model(0.7, "[0.3, 0.2]"), "incline.toml");
+  const ModeRun r = run_modes(held, 1.0);
+  EXPECT_TRUE(r.summary.events.empty());
+  EXPECT_EQ(r.at(r.rows.size() - 1, "rim_mode"), 0.0);
+  EXPECT_NEAR(r.at(r.rows.size() - 1, "x'"), 2 * g * std::sin(0.7) / 3, 1e-10);
+}
+
+// A unilateral contact that would pull at t0 (gravity away from the ground) is refused before
+// the run, with N and the mode to start in.
+TEST(ContactModes, UnilateralContactPullingAtTheStartIsRefused) {
+  std::string text = test::read_text(example("ball_on_sphere.toml"));
+  text.replace(text.find("gravity = [0, 0, \"-g\"]"), 22, "gravity = [0, 0, \"g\"]");
+  const Model model = load_model_text(text, "sphere.toml");
+  SimulationOptions options;
+  options.t_end = 0.1;
+  try {
+    simulate(model, options, [](const Data&) {});
+    ADD_FAILURE() << "accepted";
+  } catch (const ModelError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("contact 'ball' is unilateral"), std::string::npos) << message;
+    EXPECT_NE(message.find("N = -"), std::string::npos) << message;
+    EXPECT_NE(message.find("mode = \"free\""), std::string::npos) << message;
   }
 }
 
@@ -269,6 +294,64 @@ TEST(ContactModes, BallOnASphereLiftsOffAtTenSeventeenthsOrSlipsFirst) {
   EXPECT_NEAR(hi * 180 / M_PI, 52.12, 0.01);  // the derivation's figure
   EXPECT_NEAR(sphere_angle(r.summary.events[1]), hi, 1e-7);
   EXPECT_LT(r.at(r.rows.size() - 1, "work_friction"), 0.0);
+  EXPECT_LT(r.summary.max_balance_error, 1e-9);
+}
+
+// A ball dropped from h0 onto the plane (unilateral, Newton's restitution e, no friction limit:
+// a sticking impulse): it touches down at sqrt(2 h0 / g), bounces at e times its speed, and the
+// touchdowns accumulate at t1 (1 + 2 e / (1 - e)) (Zeno), which ends the run with a message and
+// its rows; plastic (e = 0) it stays on the ground, rolling, N = m g. The impacts' energy is
+// booked with the reactions' work, so h - h0 - W does not jump.
+std::string dropped_ball(double e) {
+  std::string text = test::read_text(example("ball_thrown_sliding.toml"));
+  const std::string keys = "friction = \"mu\"\nmode = \"sliding\"\n";
+  text.replace(text.find(keys), keys.size(),
+               "unilateral = true\nrestitution = " + std::to_string(e) + "\n");
+  text.replace(text.find("z = \"r\""), 7, "z = \"r + 0.2\"");
+  return text;
+}
+
+TEST(ContactModes, DroppedBallBouncesWithNewtonsLawUntilTheTouchdownsAccumulate) {
+  const double g = 9.81, h0 = 0.2, e = 0.5;
+  const double t1 = std::sqrt(2 * h0 / g), v1 = std::sqrt(2 * g * h0);
+  {
+    const Model model = load_model_text(dropped_ball(e), "drop.toml");
+    ModeRun r;
+    r.columns = make_result_columns(model);
+    SimulationOptions options;
+    options.t_end = 2.0;
+    options.output_step = 0.01;
+    options.integrator.rtol = 1e-10;
+    options.integrator.atol = 1e-12;
+    r.summary = simulate(model, options, [&](const Data& data) {
+      std::vector<double> row;
+      fill_result_row(model, data, row);
+      r.rows.push_back(std::move(row));
+    });
+    EXPECT_NE(r.summary.status, Status::ok);
+    EXPECT_NE(r.summary.message.find("Zeno"), std::string::npos) << r.summary.message;
+    ASSERT_GE(r.summary.events.size(), 4u);
+    double t = t1, v = v1;
+    for (std::size_t k = 0; k < 4; ++k) {
+      EXPECT_EQ(r.summary.events[k].name, "ball_touchdown");
+      EXPECT_NEAR(r.summary.events[k].t, t, 1e-9) << k;
+      EXPECT_NEAR(r.summary.events[k].v[2], e * v, 1e-8) << k;  // the row carries the velocity after
+      v *= e;
+      t += 2 * v / g;
+    }
+    const double t_inf = t1 * (1 + 2 * e / (1 - e));
+    EXPECT_LT(r.summary.t_reached, t_inf + 1e-6);
+    EXPECT_GT(r.summary.t_reached, t_inf - 1e-3);
+    EXPECT_LT(r.summary.max_balance_error, 1e-9);
+  }
+  const Model plastic = load_model_text(dropped_ball(0.0), "drop.toml");
+  const ModeRun r = run_modes(plastic, 0.5);
+  ASSERT_EQ(r.summary.events.size(), 1u);
+  EXPECT_NEAR(r.summary.events[0].t, t1, 1e-9);
+  const std::size_t last = r.rows.size() - 1;
+  EXPECT_EQ(r.at(last, "ball_mode"), 0.0);
+  EXPECT_NEAR(r.at(last, "z'"), 0.0, 1e-12);
+  EXPECT_NEAR(r.at(last, "ball_N"), 0.1 * g, 1e-10);
   EXPECT_LT(r.summary.max_balance_error, 1e-9);
 }
 

@@ -8,6 +8,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
+#include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {
 namespace {
@@ -88,7 +89,12 @@ ContactSwitches::ContactSwitches(const Model& model, Data& data, const Formulati
                                  int state_size, EventFunctions* user, Handler handler)
     : model_(model), data_(data), formulation_(formulation), user_(user), handler_(std::move(handler)),
       user_count_(user ? user->count() : 0), size_(state_size),
-      switch_y_(static_cast<std::size_t>(state_size), 0.0) {}
+      switch_y_(static_cast<std::size_t>(state_size), 0.0) {
+  const std::size_t m = model.contact_modes ? model.contact_modes->contacts.size() : 0;
+  last_touchdown_.assign(m, -HUGE_VAL);
+  previous_touchdown_.assign(m, -HUGE_VAL);
+  touchdowns_.assign(m, 0);
+}
 
 int ContactSwitches::count() const {
   return user_count_ + kSlots * static_cast<int>(model_.contact_modes ? model_.contact_modes->contacts.size() : 0);
@@ -126,6 +132,15 @@ Status ContactSwitches::evaluate(double t, const double* y, double* g) {
         break;
       case ContactMode::free: gi[0] = data_.phi(c.gap_position); break;
     }
+    // At the start of a segment a switch has just set the slip (sliding) or the gap (free) to 0,
+    // from where it rises: that zero is not a crossing, and the sign it starts with is the one it
+    // leaves with, so that a flight or a slide shorter than the integrator's first step is still
+    // seen to end (section 4: "the touchdown event must ignore the zero it starts on").
+    if (t == start_t_) {
+      if (w.mode[i] == ContactMode::free && w.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)] >= 0.0)
+        gi[0] = std::max(gi[0], std::numeric_limits<double>::min());
+      if (w.mode[i] == ContactMode::sliding) gi[1] = std::max(gi[1], std::numeric_limits<double>::min());
+    }
   }
   return Status::ok;
 }
@@ -139,12 +154,7 @@ std::string ContactSwitches::switch_contact(int contact, int slot, double t, con
     w.mode[i] = ContactMode::free;
     return c.name + "_liftoff";
   }
-  if (slot == 0) {
-    accumulation_ = fmt::format("contact '{}' touches down at t = {:.9g}: touchdowns (impacts) are not implemented "
-                                "yet; the run ends here with its results so far",
-                                c.name, t);
-    return "";
-  }
+  if (slot == 0) return touchdown(contact, t);
   if (before == ContactMode::rolling) {
     // Slip starts: the friction that rolling needs leaves the cone; it slides opposite to it.
     if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
@@ -191,6 +201,7 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
                                 switch_count_, t, name);
     return Status::integrator_failure;
   }
+  std::copy(y, y + size_, switch_y_.begin());  // a touchdown changes its velocities
   const std::string event = switch_contact(contact, slot, t, y);
   if (event.empty()) {
     if (accumulation_.empty())
@@ -198,11 +209,108 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
                                   name, t, data_.status != Status::ok ? explain_failure(model_, data_) : "");
     return Status::integrator_failure;
   }
-  std::copy(y, y + size_, switch_y_.begin());
   switch_t_ = t;
+  start_t_ = t;
   switched_ = true;
-  const Status status = handler_(event, t, y);
+  const Status status = handler_(event, t, switch_y_.data());
   return status == Status::ok ? Status::stopped : status;
+}
+
+std::string ContactSwitches::touchdown(int contact, double t) {
+  const auto i = static_cast<std::size_t>(contact);
+  const ContactModeModel& cm = *model_.contact_modes;
+  const ContactModeContact& c = cm.contacts[i];
+  ContactModeData& w = data_.modes;
+  const int n = model_.n();
+  const int s = model_.s();
+  // Zeno (section 9): touchdowns 1e-7 s apart (relative to t) accumulate: bounces of a height
+  // 1e-14 m, a few orders above what the event location resolves, so none is missed.
+  const double interval = t - last_touchdown_[i];
+  const double previous = last_touchdown_[i] - previous_touchdown_[i];
+  ++touchdowns_[i];
+  previous_touchdown_[i] = last_touchdown_[i];
+  last_touchdown_[i] = t;
+  if (interval < 1e-7 * std::max(1.0, std::abs(t))) {
+    const double rho = previous > 0.0 ? interval / previous : 0.0;
+    accumulation_ = fmt::format("contact '{}' touched down {} times, the last two {:.3g} s apart (ratio {:.3g} to the "
+                                "interval before): an accumulation of impacts (Zeno) near t = {:.9g}; the run ends "
+                                "here at t = {:.9g} with its results so far",
+                                c.name, touchdowns_[i], interval, rho,
+                                rho > 0.0 && rho < 1.0 ? t + interval * rho / (1.0 - rho) : t, t);
+    return "";
+  }
+  double* q = switch_y_.data();
+  double* v = q + n;
+  if (compute_terms(model_, data_, t, q, v) != Status::ok) return "";
+  std::vector<double> f(static_cast<std::size_t>(model_.velocity_constraints()));
+  model_.evaluator->velocity_residual(t, q, v, data_.scratch.data(), f.data());
+  const double e = w.restitution[i];
+  const double vn = f[static_cast<std::size_t>(c.gap_velocity)];  // the gap's rate before, < 0
+  // (I1)-(I2) with a sticking impulse: the rows kept after the impact hold their velocity
+  // residuals, the gap's rate becomes -e times what it was, the slip becomes 0.
+  w.mode[i] = ContactMode::rolling;
+  std::vector<int> rows;
+  std::vector<double> target;
+  int velocity_index = 0;
+  const Eigen::Map<const Vector> v_before(v, n);
+  for (int row = 0; row < s; ++row) {
+    const bool has_velocity = model_.constraints[static_cast<std::size_t>(row)].level != ConstraintLevel::acceleration;
+    bool keep = true;
+    for (std::size_t j = 0; j < cm.contacts.size() && keep; ++j) {
+      const ContactModeContact& o = cm.contacts[j];
+      if (w.mode[j] == ContactMode::rolling) continue;
+      keep = row != o.roll[0] && row != o.roll[1] && row != o.spin && !(w.mode[j] == ContactMode::free && row == o.gap);
+    }
+    if (keep) {
+      double delta = 0.0;
+      if (row == c.gap) delta = -(1.0 + e) * vn;
+      else if (row == c.roll[0] || row == c.roll[1] || row == c.spin) delta = -f[static_cast<std::size_t>(velocity_index)];
+      rows.push_back(row);
+      target.push_back(data_.b.row(row).dot(v_before) + delta);
+    }
+    if (has_velocity) ++velocity_index;
+  }
+  const int r = static_cast<int>(rows.size());
+  Matrix Bt(n, r);
+  for (int j = 0; j < r; ++j) Bt.col(j) = data_.b.row(rows[static_cast<std::size_t>(j)]).transpose();
+  Eigen::ColPivHouseholderQR<Matrix> qr(Bt);
+  if (qr.rank() < r) {
+    accumulation_ = fmt::format("contact '{}' touches down at t = {:.9g} where the constraints after the impact are "
+                                "dependent; the run ends here with its results so far",
+                                c.name, t);
+    return "";
+  }
+  const Matrix Qf = qr.householderQ();
+  const Matrix D = Qf.rightCols(n - r).transpose();
+  Matrix M(n, n);
+  Vector rhs(n);
+  M.topRows(n - r) = D * data_.A;
+  rhs.head(n - r) = D * (data_.A * v_before);
+  for (int j = 0; j < r; ++j) {
+    M.row(n - r + j) = data_.b.row(rows[static_cast<std::size_t>(j)]);
+    rhs(n - r + j) = target[static_cast<std::size_t>(j)];
+  }
+  const Vector v_after = M.partialPivLu().solve(rhs);
+  const Evaluator& ev = *model_.evaluator;
+  const bool balance = ev.has_energy_balance() && size_ > 2 * n;
+  const double h_before = balance ? ev.energy_function(t, q, v, data_.scratch.data()) : 0.0;
+  std::copy(v_after.data(), v_after.data() + n, v);
+  // The impulsive reactions' work, h+ - h- (section 8), booked with the reactions' work so that
+  // h - h0 - W does not jump.
+  if (balance) switch_y_[static_cast<std::size_t>(2 * n + 1)] += ev.energy_function(t, q, v, data_.scratch.data()) - h_before;
+  const std::string name = c.name + "_touchdown";
+  if (e > 0.0 && -e * vn > slip_floor(data_)) {
+    w.mode[i] = c.unilateral ? ContactMode::free : ContactMode::rolling;
+    return name;
+  }
+  // The contact stays closed: the mode as at the start (section 7, "After the impact").
+  if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return "";
+  if (c.unilateral && w.normal_force[i] < 0.0) w.mode[i] = ContactMode::free;
+  else if (c.friction && norm2(w.friction[i]) > w.mu_s[i] * std::abs(w.normal_force[i])) {
+    w.direction[i] = onset_direction(w, i);
+    w.mode[i] = ContactMode::sliding;
+  }
+  return name;
 }
 
 IntegrationResult integrate_contact_modes(OdeSystem& ode, const IntegratorOptions& options, double t0,

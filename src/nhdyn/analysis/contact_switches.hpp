@@ -2,13 +2,15 @@
 // docs/derivations/contact-modes.md section 6): the mode each contact starts in, the event
 // functions each mode watches (its normal force, its friction cone, its slip along the carried
 // direction, its gap), located to round-off like any event, and what happens at a crossing: the
-// new mode (a stick, a slip, a lift-off), the row written there, and a restart of the integration
-// from that state. simulate() (simulation.hpp) runs through them with integrate_contact_modes.
+// new mode (a stick, a slip, a lift-off, a touchdown with its impact), the row written there, and a
+// restart of the integration from that state (with the velocities after an impact). simulate()
+// (simulation.hpp) runs through them with integrate_contact_modes.
 //
 //     simulate -> choose_initial_contact_modes -> integrate_contact_modes
 //         -> integrate (one segment per mode set) -> ContactSwitches::on_event -> new modes
 #pragma once
 
+#include <cmath>
 #include <functional>
 #include <span>
 #include <string>
@@ -59,6 +61,8 @@ class ContactSwitches final : public EventFunctions {
 
  private:
   std::string switch_contact(int contact, int slot, double t, const double* y);
+  // The impact of a touchdown (section 7): the velocities of switch_y_ after it, and the mode.
+  std::string touchdown(int contact, double t);
 
   const Model& model_;
   Data& data_;
@@ -74,6 +78,10 @@ class ContactSwitches final : public EventFunctions {
   long switch_count_ = 0;
   int same_time_ = 0;       // successive switches without progress in t
   double last_switch_t_ = 0.0;
+  double start_t_ = -HUGE_VAL;  // the time the current segment started at (the last switch)
+  std::vector<double> last_touchdown_;  // per contact: the times of its last two touchdowns
+  std::vector<double> previous_touchdown_;
+  std::vector<long> touchdowns_;
 };
 
 // Integrates as integrate() does, through any number of switches: each switch ends a segment,

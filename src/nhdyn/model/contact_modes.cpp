@@ -61,9 +61,13 @@ std::vector<std::string> contact_mode_columns(const Model& model) {
 }
 
 void append_contact_mode_values(const Model& model, const Data& data, std::vector<double>& row) {
-  if (!model.contact_modes) return;
+  if (model.contact_modes) append_contact_mode_values(data, row);
+}
+
+void append_contact_mode_values(const Data& data, std::vector<double>& row) {
   const ContactModeData& w = data.modes;
-  for (std::size_t i = 0; i < model.contact_modes->contacts.size(); ++i) {
+  if (!w.active) return;
+  for (std::size_t i = 0; i < w.mode.size(); ++i) {
     row.push_back(static_cast<double>(static_cast<int>(w.mode[i])));
     const auto& s = w.slip_world[i];
     row.push_back(w.mode[i] == ContactMode::free ? 0.0 : std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]));

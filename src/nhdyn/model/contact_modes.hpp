@@ -106,6 +106,8 @@ std::vector<std::string> contact_mode_columns(const Model& model);
 // Appends their values (after compute_mode_acceleration and record_contact_gaps); `work_friction`
 // is Data::work_friction.
 void append_contact_mode_values(const Model& model, const Data& data, std::vector<double>& row);
+// The same from a Data made for a model with contact modes (nothing for another).
+void append_contact_mode_values(const Data& data, std::vector<double>& row);
 
 // After compute_residuals: keeps each contact's gap (its position residual) in data.modes.gap, and
 // sets to 0 the residuals of the rows its mode drops (the slip of a sliding contact, the gap and
