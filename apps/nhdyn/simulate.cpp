@@ -209,7 +209,7 @@ int run_simulate(const SimulateArgs& args) {
     if (fs::is_regular_file(args.model)) paths.input(args.model, "the model file");
     paths.output(csv_path, "the CSV output");
     if (companions) {
-      if (!options.events.empty()) paths.output(events_path, "the events file");
+      if (!options.events.empty() || model.contact_modes) paths.output(events_path, "the events file");
       paths.output(partial_path, "the partial-results file");
     }
     if (!args.plot.empty()) paths.output(args.plot, "--plot");
@@ -237,7 +237,8 @@ int run_simulate(const SimulateArgs& args) {
   }
   CsvWriter writer(csv_path, columns.all, provenance);  // refuses an unwritable path before any step
   std::optional<AtomicFile> events_file;
-  if (companions && !options.events.empty()) events_file.emplace(events_path);
+  // Contacts with modes write their switches there too (docs/contact-modes.md).
+  if (companions && (!options.events.empty() || model.contact_modes)) events_file.emplace(events_path);
 
   std::vector<double> row;
   row.reserve(columns.all.size());
@@ -388,9 +389,14 @@ int run_simulate(const SimulateArgs& args) {
       // docs/derivations/energy-balance.md section 3: the balance is the error; the work and the
       // change of the energy are physics.
       fmt::print("  energy balance error: {:.3g} (max |h - h0 - W|)\n", summary.max_balance_error);
-      fmt::print("  work W: {:.10g} (forces {:.6g}, reactions {:.6g}, explicit time {:.6g})\n",
-                 summary.work_forces + summary.work_reactions + summary.work_time, summary.work_forces,
-                 summary.work_reactions, summary.work_time);
+      if (model.contact_modes)  // contacts that slide (docs/contact-modes.md)
+        fmt::print("  work W: {:.10g} (forces {:.6g}, reactions {:.6g}, explicit time {:.6g}, friction {:.6g})\n",
+                   summary.work_forces + summary.work_reactions + summary.work_time + summary.work_friction,
+                   summary.work_forces, summary.work_reactions, summary.work_time, summary.work_friction);
+      else
+        fmt::print("  work W: {:.10g} (forces {:.6g}, reactions {:.6g}, explicit time {:.6g})\n",
+                   summary.work_forces + summary.work_reactions + summary.work_time, summary.work_forces,
+                   summary.work_reactions, summary.work_time);
       fmt::print("  energy change: E - E0 = {:.10g} (E0 = {:.10g})\n", summary.energy_change, summary.energy_initial);
       if (summary.energy_function_differs)
         fmt::print("  energy function change: h - h0 = {:.10g} (h0 = {:.10g})\n", summary.energy_function_change,

@@ -70,6 +70,7 @@ void Trajectory::append(const Data& data) {
     const ContactForceData& c = data.contact;
     contact_forces.insert(contact_forces.end(), c.values.data(), c.values.data() + c.values.size());
     contact_forces.push_back(c.residual);
+    append_contact_mode_values(data, contact_forces);  // model/contact_modes.hpp: after the forces
   }
   outputs.insert(outputs.end(), data.outputs.values.data(), data.outputs.values.data() + output_columns);
 }

@@ -28,11 +28,11 @@ void compute_energy(const Model& model, Data& data) {
 
 void fill_energy_balance(const Data& data, double* out) {
   out[0] = data.energy_function;
-  out[1] = data.power_forces + data.power_reactions + data.power_time;
+  out[1] = data.power_forces + data.power_reactions + data.power_time + data.power_friction;
   out[2] = data.work_forces;
   out[3] = data.work_reactions;
   out[4] = data.work_time;
-  out[5] = data.work_forces + data.work_reactions + data.work_time;
+  out[5] = data.work_forces + data.work_reactions + data.work_time + data.work_friction;
   out[6] = data.balance_error;
 }
 
@@ -43,7 +43,8 @@ void compute_power(const Model& model, Data& data) {
   model.evaluator->power(data.t, data.q.data(), data.v.data(), data.scratch.data(), out);
   data.power_forces = out[0];
   data.power_time = out[1];
-  data.power_reactions = data.R.dot(data.v);
+  // A sliding contact's friction is booked apart (power_friction, contact_modes.hpp; 0 without).
+  data.power_reactions = data.R.dot(data.v) - data.power_friction;
   // A model with programs: R is the physical reactions, and the actuators' forces B u are applied
   // forces doing work like Q_nc (docs/derivations/program-motion.md (P3)): booked with the forces.
   // A loop, not (B u) . v, so that nothing is allocated.

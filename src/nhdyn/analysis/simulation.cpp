@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "nhdyn/analysis/contact_switches.hpp"
 #include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
@@ -40,9 +41,11 @@ class MechanicalOde final : public OdeSystem {
   MechanicalOde(const Model& model, Data& data, const FormulationOptions& options, const SimulationOptions& run,
                 SimulationSummary& summary, ConstraintWatch* watch)
       : model_(model), data_(data), options_(options), run_(run), summary_(summary), watch_(watch), n_(model.n()),
-        balance_(model.evaluator->has_energy_balance()) {}
+        balance_(model.evaluator->has_energy_balance()), friction_(balance_ && model.contact_modes != nullptr) {}
 
-  int size() const override { return 2 * n_ + (balance_ ? kWorks : 0); }
+  // The works: of the forces, the reactions, the explicit time dependence, and with contact modes
+  // the friction's (model/contact_modes.hpp).
+  int size() const override { return 2 * n_ + (balance_ ? kWorks : 0) + (friction_ ? 1 : 0); }
   int error_size() const override { return 2 * n_; }
 
   Status rhs(double t, const double* y, double* ydot) override {
@@ -55,6 +58,7 @@ class MechanicalOde final : public OdeSystem {
       ydot[2 * n_] = data_.power_forces;
       ydot[2 * n_ + 1] = data_.power_reactions;
       ydot[2 * n_ + 2] = data_.power_time;
+      if (friction_) ydot[2 * n_ + 3] = data_.power_friction;
     }
     return Status::ok;
   }
@@ -67,6 +71,11 @@ class MechanicalOde final : public OdeSystem {
     if (watch_ && watch_->started && data_.stage == Stage::acceleration && data_.t == t &&
         std::equal(y, y + n_, data_.q.data()) && std::equal(y + n_, y + 2 * n_, data_.v.data()))
       compute_constraint_watch(model_, data_, *watch_);
+    // A sliding contact carries its slip direction from step to step (formulation/contact_modes.hpp).
+    if (data_.modes.active && data_.stage == Stage::acceleration && data_.t == t &&
+        std::equal(y, y + n_, data_.q.data()) && std::equal(y + n_, y + 2 * n_, data_.v.data()))
+      for (std::size_t i = 0; i < data_.modes.mode.size(); ++i)
+        if (data_.modes.mode[i] == ContactMode::sliding) data_.modes.direction[i] = data_.modes.sliding_direction[i];
     if (run_.stabilization != Stabilization::projection) return {};
     return project(model_, data_, run_.projection, t, y, summary_);
   }
@@ -80,6 +89,7 @@ class MechanicalOde final : public OdeSystem {
   ConstraintWatch* watch_;  // null when the run does not watch
   int n_;
   bool balance_;
+  bool friction_;
 };
 
 // At an output, after compute_dynamics and compute_energy: the power, the integrated work (the
@@ -89,12 +99,14 @@ void record_balance(const Model& model, Data& data, const double* work, Simulati
   data.work_forces = work[0];
   data.work_reactions = work[1];
   data.work_time = work[2];
-  const double W = work[0] + work[1] + work[2];
+  data.work_friction = model.contact_modes ? work[3] : 0.0;
+  const double W = work[0] + work[1] + work[2] + data.work_friction;
   data.balance_error = data.energy_function - summary.energy_function_initial - W;
   summary.max_balance_error = std::max(summary.max_balance_error, std::abs(data.balance_error));
   summary.work_forces = work[0];
   summary.work_reactions = work[1];
   summary.work_time = work[2];
+  summary.work_friction = data.work_friction;
   summary.energy_change = data.energy - summary.energy_initial;
   summary.energy_function_change = data.energy_function - summary.energy_function_initial;
 }
@@ -229,6 +241,19 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
     throw InputError(fmt::format("the constraint watch's factor {} must be a finite number above 1 (the default is "
                                  "{:g}, three orders of magnitude)",
                                  options.watch_factor, kConstraintWatchFactor));
+  if (model.contact_modes) {
+    // The modes are solved by their own sanh kernel (formulation/contact_modes.hpp) and switch at events.
+    const char* why = options.formulation.method != Method::sanh ? "the sanh formulation (--method sanh)"
+                      : options.stabilization == Stabilization::projection
+                          ? "no projection (the projection would hold a sliding contact's slip at zero)"
+                      : !supports_events(io.kind) ? "an integrator that locates events (dopri5, dop853, cvode-bdf, cvode-adams)"
+                      : options.path == Path::sparse ? "the dense path"
+                                                     : nullptr;
+    if (why)
+      throw InputError(fmt::format("model '{}' has contacts that may slide or lift off (friction or unilateral, "
+                                   "docs/contact-modes.md); they need {}",
+                                   model.name, why));
+  }
   if (options.formulation.complement == Complement::analytic && !model.evaluator->has_complement())
     throw InputError(fmt::format("model '{}' has no analytic D; choose --complement qr or partition", model.name));
 }
@@ -255,9 +280,10 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     q0 = summary.initial_fix->q;
     v0 = summary.initial_fix->v;
     check_state_or_throw(model, data, model.t0, q0.data(), v0.data());
-  } else {
-    check_initial_state(model, data, model.t0, q0, v0, options.initial_tolerance);
   }
+  // The mode each contact starts in, before the check: a sliding contact's slip is no violation.
+  choose_initial_contact_modes(model, data, options.formulation, model.t0, q0, v0);
+  if (!options.fix_initial) check_initial_state(model, data, model.t0, q0, v0, options.initial_tolerance);
   check_programs_at_initial_state(model, data, options.formulation, model.t0, q0, v0, options.initial_tolerance);
 
   const int n = model.n();
@@ -291,6 +317,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     }
     if (options.watch_constraints) compute_constraint_watch(model, data, watch);
     compute_residuals(model, data);
+    record_contact_gaps(model, data);  // nothing without contact modes
     compute_energy(model, data);
     compute_contact_forces(model, data);  // nothing for a model without contacts
     compute_outputs(model, data);
@@ -339,8 +366,25 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   event_functions.require_valid_start(model.t0, y0.data());
 
   const auto start = std::chrono::steady_clock::now();
-  const IntegrationResult result = integrate(ode, options.integrator, model.t0, y0.data(), times, output,
-                                             events.empty() ? nullptr : &event_functions);
+  // Contacts that may slide or lift off: the run goes on through their switches (contact_switches.hpp).
+  ContactSwitches switches(model, data, formulation, static_cast<int>(states), events.empty() ? nullptr : &event_functions,
+                           [&](const std::string& name, double t, const double* y) -> Status {
+                             if (output(t, y) == Status::stopped) return output_failure;
+                             auto at = std::find(summary.event_names.begin(), summary.event_names.end(), name);
+                             if (at == summary.event_names.end()) at = summary.event_names.insert(at, name);
+                             EventRecord record;
+                             record.index = static_cast<int>(at - summary.event_names.begin());
+                             record.name = name;
+                             record.t = t;
+                             record.q.assign(data.q.data(), data.q.data() + n);
+                             record.v.assign(data.v.data(), data.v.data() + n);
+                             summary.events.push_back(std::move(record));
+                             return Status::ok;
+                           });
+  const IntegrationResult result =
+      model.contact_modes ? integrate_contact_modes(ode, options.integrator, model.t0, y0.data(), times, output, switches)
+                          : integrate(ode, options.integrator, model.t0, y0.data(), times, output,
+                                      events.empty() ? nullptr : &event_functions);
   summary.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.status = output_failure != Status::ok ? output_failure : result.status;
   summary.stopped_by = event_functions.stopped_by();

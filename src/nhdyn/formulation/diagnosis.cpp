@@ -161,6 +161,8 @@ std::string explain_failure(const Model& model, const Data& data) {
                          data.failed_quantity, data.failed_t);
     case Status::singular_system:
       if (data.failed_quantity.rfind("program matrix", 0) == 0) return explain_program_failure(model, data);
+      if (data.failed_quantity.rfind("contact '", 0) == 0)  // formulation/contact_modes.cpp
+        return fmt::format("{} at t = {:.6g}", data.failed_quantity, data.failed_t);
       if (data.failed_quantity == "complement D")
         return fmt::format("the model's complement D is not a complement of b at t = {:.6g}: the largest "
                            "|D_i . b_j| / (|D_i| |b_j|) is {:.3g} (D b^T must be 0); the rows of D must span "

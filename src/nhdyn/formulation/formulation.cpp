@@ -5,6 +5,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/finite.hpp"
+#include "nhdyn/formulation/contact_modes.hpp"
 #include "nhdyn/formulation/lagrange.hpp"
 #include "nhdyn/formulation/nullspace.hpp"
 #include "nhdyn/formulation/program_motion.hpp"
@@ -52,7 +53,9 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
     data.b0 += data.stabilization;
   }
   Status status = Status::ok;
-  if (data.sparse)
+  if (data.modes.active && !data.sparse)
+    status = compute_mode_acceleration(model, data);  // contacts that may slide or lift off (contact_modes.hpp)
+  else if (data.sparse)
     status = options.method == Method::sanh ? compute_sparse_sanh_acceleration(model, data)
                                             : compute_sparse_lagrange_acceleration(model, data);
   else switch (options.method) {

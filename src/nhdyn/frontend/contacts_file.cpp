@@ -92,10 +92,37 @@ class ContactReader {
     else text.ground.where = text.where;
     if (const toml::node* rolling = table.get("rolling"))
       text.rolling = string_of(*rolling, what + ": rolling", "rolling = \"rolling\"");
+    read_modes(table, what, text);
     return text;
   }
 
  private:
+  // friction = mu or ["mu_s", "mu_k"], unilateral, restitution, mode (docs/contact-modes.md), as
+  // texts for symbolic::parse_contact_mode.
+  void read_modes(const toml::table& table, const std::string& what, symbolic::ContactText& text) const {
+    if (const toml::node* friction = table.get("friction")) {
+      if (const toml::array* pair = friction->as_array()) {
+        if (pair->size() != 2)
+          fail(*friction, fmt::format("{}: friction must be one coefficient or two, [\"mu_s\", \"mu_k\"] (static, "
+                                      "kinetic); {} are given",
+                                      what, pair->size()));
+        text.modes.emplace_back("mu_s", text_of(*pair->get(0), what + ": friction[1]", "0.4"));
+        text.modes.emplace_back("mu_k", text_of(*pair->get(1), what + ": friction[2]", "0.3"));
+      } else {
+        text.modes.emplace_back("friction", text_of(*friction, what + ": friction", "friction = 0.3"));
+      }
+    }
+    if (const toml::node* unilateral = table.get("unilateral")) {
+      const auto* flag = unilateral->as_boolean();
+      if (flag == nullptr) fail(*unilateral, fmt::format("{}: unilateral must be true or false", what));
+      text.modes.emplace_back("unilateral", flag->get() ? "true" : "false");
+    }
+    if (const toml::node* restitution = table.get("restitution"))
+      text.modes.emplace_back("restitution", text_of(*restitution, what + ": restitution", "restitution = 0.5"));
+    if (const toml::node* mode = table.get("mode"))
+      text.modes.emplace_back("mode", string_of(*mode, what + ": mode", "mode = \"sliding\""));
+  }
+
   // shape = { sphere = "r" }: the one key that names a registered shape, and that shape's options.
   void read_shape(const toml::node& node, const std::string& what, symbolic::ContactText& text) const {
     const std::string example = "shape = { sphere = \"r\" } or { ellipsoid = [\"a\", \"b\", \"c\"] }";
@@ -171,7 +198,8 @@ class ContactReader {
 }  // namespace
 
 const std::vector<std::string>& contact_keys() {
-  static const std::vector<std::string> keys = {"name", "body", "shape", "centre", "ground", "rolling"};
+  static const std::vector<std::string> keys = {"name",     "body",       "shape",       "centre", "ground",
+                                                "rolling",  "friction",   "unilateral",  "restitution", "mode"};
   return keys;
 }
 

@@ -195,6 +195,8 @@ std::vector<std::string> contact_force_columns(const Model& model) {
     if (c.reported)
       for (ContactComponent k : c.components) columns.push_back(c.name + "_" + contact_component_name(k));
   columns.push_back("contact_residual");
+  const std::vector<std::string> modes = contact_mode_columns(model);  // contact_modes.hpp
+  columns.insert(columns.end(), modes.begin(), modes.end());
   return columns;
 }
 
@@ -203,6 +205,7 @@ void append_contact_force_values(const Model& model, const Data& data, std::vect
   const ContactForceData& w = data.contact;
   for (Eigen::Index i = 0; i < w.values.size(); ++i) row.push_back(w.values(i));
   row.push_back(w.residual);
+  append_contact_mode_values(model, data, row);
 }
 
 void analyse_contact_forces(const Model& model, ContactForceModel& c) {

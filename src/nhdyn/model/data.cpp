@@ -384,6 +384,7 @@ Data make_data(const Model& model, const DataOptions& options) {
   d.dependent.assign(static_cast<std::size_t>(s), 0);
   d.is_dependent.assign(static_cast<std::size_t>(n), 0);
   d.contact = make_contact_force_data(model);
+  d.modes = make_contact_mode_data(model);
   if (const int m = model.m(); m > 0) {
     ProgramMotionData& w = d.motion;
     w.b_p = Matrix::Zero(m, n);

@@ -28,6 +28,7 @@
 #include "nhdyn/core/status.hpp"
 #include "nhdyn/core/types.hpp"
 #include "nhdyn/model/contact_forces.hpp"
+#include "nhdyn/model/contact_modes.hpp"
 #include "nhdyn/model/model.hpp"
 #include "nhdyn/model/output.hpp"
 
@@ -138,6 +139,9 @@ struct Data {
   double energy_function = 0.0;
   double power_forces = 0.0, power_reactions = 0.0, power_time = 0.0;
   double work_forces = 0.0, work_reactions = 0.0, work_time = 0.0;
+  // Contacts that slide (contact_modes.hpp): the friction's power -mu_k N |s| (booked apart from
+  // power_reactions, which keeps the rest of R . q') and its work since t0 (set by simulate).
+  double power_friction = 0.0, work_friction = 0.0;
   double balance_error = 0.0;  // h - h(t0) - W, the accuracy figure (set by simulate)
   // Derived outputs (model/output.hpp): their values (compute_outputs) and workspace (make_data).
   OutputData outputs;
@@ -147,6 +151,9 @@ struct Data {
 
   // --- contact forces (compute_contact_forces; inactive for a model without contacts) -----------
   ContactForceData contact;
+
+  // --- contact modes (compute_mode_acceleration; inactive for a model without them) -------------
+  ContactModeData modes;
 
   // --- failure details (set when a kernel returns a non-ok status) --------------------------------
   Status status = Status::ok;

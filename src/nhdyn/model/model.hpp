@@ -21,6 +21,7 @@
 namespace nhdyn {
 
 struct ContactForceModel;  // contact_forces.hpp
+struct ContactModeModel;   // contact_modes.hpp
 
 // The level at which a constraint is given (docs/notation.md section 2).
 enum class ConstraintLevel { position, velocity, acceleration };
@@ -94,6 +95,9 @@ struct Model {
   // The contact forces of a multibody model's wheels and knife edges (contact_forces.hpp,
   // docs/derivations/contact-forces.md); null for a model without contacts.
   std::shared_ptr<const ContactForceModel> contact_forces;
+  // The contacts that may slide or lift off (contact_modes.hpp, docs/contact-modes.md); null when
+  // no contact has `friction` or `unilateral`.
+  std::shared_ptr<const ContactModeModel> contact_modes;
   // Derived outputs ([outputs], multibody points): extra result columns (model/output.hpp).
   ModelOutputs outputs;
 

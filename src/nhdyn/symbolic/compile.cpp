@@ -36,6 +36,7 @@
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/model/program.hpp"
 #include "nhdyn/symbolic/contact_forces.hpp"
+#include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "nhdyn/symbolic/outputs.hpp"
 
@@ -1125,6 +1126,7 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
   compile_outputs(spec, model);
   // Before the events: an event that reads a contact force needs to know what the model determines.
   compile_contact_forces(spec, model);
+  compile_contact_modes(spec, model);
   compile_events(spec, model);
   check_model_shape(model);
   return model;

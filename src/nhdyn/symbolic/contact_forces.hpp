@@ -14,6 +14,7 @@
 
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/model.hpp"
+#include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/kinematics.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 
@@ -67,6 +68,8 @@ struct SpecContactForces {
   // The columns of the reported contacts as symbols (make_contact_force_symbols), for the
   // expressions of events; outputs may not read them (they are computed before the forces).
   std::vector<ContactForceSymbol> columns;
+  // The contacts that may slide or lift off (contact_modes.hpp), in the order of [[contacts]].
+  std::vector<SpecContactMode> modes;
 };
 
 // One symbol per column of each reported contact (its name and components, in order).

@@ -603,6 +603,8 @@ MultibodyBuilder& MultibodyBuilder::contact(const ContactText& text) {
   h.name = text.name;
   h.where = text.where;
   h.contact = std::make_shared<const ParsedContact>(parse_contact(text, parsers));
+  if (std::optional<SpecContactMode> mode = parse_contact_mode(text, parsers))
+    h.mode = std::make_shared<const SpecContactMode>(std::move(*mode));
   h.index = h.contact->body;
   helpers_.push_back(std::move(h));
   return *this;
@@ -630,6 +632,13 @@ void MultibodyBuilder::add_contact(const Helper& h) {
   }
   contact.force.system = system_of(body.frame);
   contacts_.push_back(std::move(contact.force));
+  if (h.mode) {
+    SpecContactMode mode = *h.mode;
+    mode.normal = contact.normal;
+    mode.tangent1 = contact.tangent1;
+    mode.tangent2 = contact.tangent2;
+    modes_.push_back(std::move(mode));
+  }
 }
 
 GiNaC::ex MultibodyBuilder::kinetic_energy() const {
@@ -705,6 +714,7 @@ void MultibodyBuilder::apply() {
     if (c.kind == ContactKind::wheel || c.kind == ContactKind::knife_edge || c.kind == ContactKind::rolling)
       reported.emplace_back(c.name, contact_components(c.kind, c.spin));
   record->columns = make_contact_force_symbols(reported);
+  record->modes = modes_;
   builder_.contact_forces(std::move(record));
 }
 

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "nhdyn/symbolic/contact_forces.hpp"
+#include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/kinematics.hpp"
 #include "nhdyn/symbolic/rolling_contact.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
@@ -135,6 +136,7 @@ class MultibodyBuilder {
     std::optional<Vector3> normal;
     std::vector<GiNaC::ex> surfaces;
     std::shared_ptr<const ParsedContact> contact;  // a rolling body
+    std::shared_ptr<const SpecContactMode> mode;   // its friction and lift-off (contact_modes.hpp), or null
     SourceLocation where;
   };
 
@@ -162,6 +164,7 @@ class MultibodyBuilder {
   std::vector<Body> bodies_;
   std::vector<Helper> helpers_;
   std::vector<ContactPoint> contacts_;  // filled by add_wheel, add_knife_edge and apply()
+  std::vector<SpecContactMode> modes_;  // the contacts with modes, filled by add_contact
   std::optional<Vector3> gravity_;
   SourceLocation gravity_where_;
   bool applied_ = false;

@@ -329,6 +329,9 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
   RollingContact out;
   out.point = touch.point;
   out.length = c.shape->length(c.values);
+  out.normal = touch.normal;
+  out.tangent1 = touch.tangent1;
+  out.tangent2 = touch.tangent2;
 
   // The contact condition: the gap, zero when touching (rolling-bodies.md section 4.1).
   const GiNaC::ex gap = simplify_moderate(touch.gap);

@@ -48,6 +48,7 @@ struct ContactText {
   std::optional<std::array<std::string, 3>> centre;
   GroundText ground;
   std::string rolling = "rolling";  // "rolling" or "rubber"
+  KeyTexts modes;                   // friction (or mu_s, mu_k), unilateral, restitution, mode (contact_modes.hpp)
   SourceLocation where, shape_where, ground_where;
 };
 
@@ -105,6 +106,7 @@ struct RollingContact {
   ContactPoint force;             // for the contact forces (system left for the builder to set)
   Vector3 point;                  // the contact point P, world
   GiNaC::ex length;               // a length of the shape, for the moment rows
+  Vector3 normal, tangent1, tangent2;  // world: the ground's normal and the no-slip rows' directions
 };
 
 // A ground type: its key, the further keys of its table, and where a shape touches it.

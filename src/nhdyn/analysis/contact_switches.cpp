@@ -1,0 +1,346 @@
+#include "nhdyn/analysis/contact_switches.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/formulation/diagnosis.hpp"
+#include "nhdyn/model/terms.hpp"
+
+namespace nhdyn {
+namespace {
+
+constexpr int kSlots = 3;               // event functions per contact
+constexpr long kMaxSwitches = 10000;    // switches of a run before it is called an accumulation
+constexpr int kMaxSameTime = 8;         // successive switches without progress in t
+
+// The slip below which a contact is taken not to slip (the integration error of its velocity
+// constraint, not a motion): as in formulation/contact_modes.cpp.
+double slip_floor(const Data& data) { return 1e-10 * (1.0 + data.v.lpNorm<Eigen::Infinity>()); }
+
+double norm2(const std::array<double, 2>& x) { return std::hypot(x[0], x[1]); }
+
+// The direction of the friction at the onset of slip (docs/derivations/contact-modes.md (O2)):
+// opposite to the friction that rolling needs, F_roll, read from data.modes after a solve with
+// the contact rolling. For an isotropic contact (a ball, a body whose contact point responds alike
+// to every tangential push) this is exact; (O1) and (O3) for the others are not implemented yet.
+std::array<double, 2> onset_direction(const ContactModeData& w, std::size_t i) {
+  const double size = norm2(w.friction[i]);
+  if (!(size > 0.0)) return w.direction[i];
+  return {-w.friction[i][0] / size, -w.friction[i][1] / size};
+}
+
+void throw_at_start(const Model& model, const Data& data) {
+  throw ModelError(fmt::format("model '{}': at the initial state: {}", model.name, explain_failure(model, data)));
+}
+
+}  // namespace
+
+void choose_initial_contact_modes(const Model& model, Data& data, const FormulationOptions& formulation, double t0,
+                                  const Vector& q0, const Vector& v0) {
+  if (!data.modes.active || !model.contact_modes) return;
+  const ContactModeModel& cm = *model.contact_modes;
+  ContactModeData& w = data.modes;
+  std::fill(w.mode.begin(), w.mode.end(), ContactMode::rolling);
+  if (compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok) throw_at_start(model, data);
+  if (model.position_constraints() > 0)
+    model.evaluator->position_residual(t0, q0.data(), data.scratch.data(), data.phi.data());
+  const double floor = slip_floor(data);
+  const ContactModeData rolling = w;  // the rolling forces and slips of every contact
+  for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
+    const ContactModeContact& c = cm.contacts[i];
+    const double gap = data.phi(c.gap_position);
+    const double slip = norm2(rolling.slip[i]);
+    const bool cone_violated = c.friction && norm2(rolling.friction[i]) > rolling.mu_s[i] * std::abs(rolling.normal_force[i]);
+    ContactMode mode = ContactMode::rolling;
+    if (c.initial >= 0) mode = static_cast<ContactMode>(c.initial);
+    else if (c.unilateral && gap > 1e-9) mode = ContactMode::free;
+    else if (c.friction && (slip > floor || cone_violated)) mode = ContactMode::sliding;
+    if (mode == ContactMode::sliding) {
+      if (slip > floor) {
+        w.direction[i] = {rolling.slip[i][0] / slip, rolling.slip[i][1] / slip};
+      } else if (norm2(rolling.friction[i]) > 0.0) {
+        w.direction[i] = onset_direction(rolling, i);
+      } else {
+        throw ModelError(fmt::format("{}: contact '{}' is given mode = \"sliding\", but at t0 it does not slip and "
+                                     "rolling needs no friction there, so no direction of sliding is defined; "
+                                     "start it rolling (mode = \"rolling\", or leave the key out)",
+                                     c.where, c.name));
+      }
+    }
+    w.mode[i] = mode;
+  }
+  if (compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok) throw_at_start(model, data);
+  for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
+    const ContactModeContact& c = cm.contacts[i];
+    if (!c.unilateral || w.mode[i] == ContactMode::free || !(w.normal_force[i] < 0.0)) continue;
+    throw ModelError(fmt::format("{}: contact '{}' is unilateral, but at t0 its normal force in the {} mode is N = "
+                                 "{:.6g} N < 0: the ground would have to pull the body. Start it free (mode = "
+                                 "\"free\"): the body leaves the ground at once; or make the contact bilateral "
+                                 "(unilateral = false)",
+                                 c.where, c.name, contact_mode_name(w.mode[i]), w.normal_force[i]));
+  }
+}
+
+ContactSwitches::ContactSwitches(const Model& model, Data& data, const FormulationOptions& formulation,
+                                 int state_size, EventFunctions* user, Handler handler)
+    : model_(model), data_(data), formulation_(formulation), user_(user), handler_(std::move(handler)),
+      user_count_(user ? user->count() : 0), size_(state_size),
+      switch_y_(static_cast<std::size_t>(state_size), 0.0) {
+  const std::size_t m = model.contact_modes ? model.contact_modes->contacts.size() : 0;
+  last_touchdown_.assign(m, -HUGE_VAL);
+  previous_touchdown_.assign(m, -HUGE_VAL);
+  touchdowns_.assign(m, 0);
+}
+
+int ContactSwitches::count() const {
+  return user_count_ + kSlots * static_cast<int>(model_.contact_modes ? model_.contact_modes->contacts.size() : 0);
+}
+
+CrossingDirection ContactSwitches::direction(int i) const {
+  return i < user_count_ ? user_->direction(i) : CrossingDirection::falling;
+}
+
+Status ContactSwitches::evaluate(double t, const double* y, double* g) {
+  if (user_) {
+    const Status status = user_->evaluate(t, y, g);
+    if (status != Status::ok) return status;
+  }
+  const int n = model_.n();
+  const Status status = compute_dynamics(model_, data_, formulation_, t, y, y + n);
+  if (status != Status::ok) return status;
+  const ContactModeModel& cm = *model_.contact_modes;
+  ContactModeData& w = data_.modes;
+  const bool any_free = std::find(w.mode.begin(), w.mode.end(), ContactMode::free) != w.mode.end();
+  if (any_free) model_.evaluator->position_residual(t, y, data_.scratch.data(), data_.phi.data());
+  for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
+    const ContactModeContact& c = cm.contacts[i];
+    double* gi = g + user_count_ + kSlots * static_cast<int>(i);
+    gi[0] = gi[1] = gi[2] = 1.0;
+    const double N = w.normal_force[i];
+    switch (w.mode[i]) {
+      case ContactMode::rolling:
+        if (c.unilateral) gi[0] = N;
+        if (c.friction) gi[1] = w.mu_s[i] * (c.unilateral ? N : std::abs(N)) - norm2(w.friction[i]);
+        break;
+      case ContactMode::sliding:
+        if (c.unilateral) gi[0] = N;
+        gi[1] = w.slip[i][0] * w.direction[i][0] + w.slip[i][1] * w.direction[i][1];
+        break;
+      case ContactMode::free: gi[0] = data_.phi(c.gap_position); break;
+    }
+    // At the start of a segment a switch has just set the slip (sliding) or the gap (free) to 0,
+    // from where it rises: that zero is not a crossing, and the sign it starts with is the one it
+    // leaves with, so that a flight or a slide shorter than the integrator's first step is still
+    // seen to end (section 4: "the touchdown event must ignore the zero it starts on").
+    if (t == start_t_) {
+      if (w.mode[i] == ContactMode::free && w.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)] >= 0.0)
+        gi[0] = std::max(gi[0], std::numeric_limits<double>::min());
+      if (w.mode[i] == ContactMode::sliding) gi[1] = std::max(gi[1], std::numeric_limits<double>::min());
+    }
+  }
+  return Status::ok;
+}
+
+std::string ContactSwitches::switch_contact(int contact, int slot, double t, const double* y) {
+  const auto i = static_cast<std::size_t>(contact);
+  const ContactModeContact& c = model_.contact_modes->contacts[i];
+  ContactModeData& w = data_.modes;
+  const ContactMode before = w.mode[i];
+  if (slot == 0 && before != ContactMode::free) {
+    w.mode[i] = ContactMode::free;
+    return c.name + "_liftoff";
+  }
+  if (slot == 0) return touchdown(contact, t);
+  if (before == ContactMode::rolling) {
+    // Slip starts: the friction that rolling needs leaves the cone; it slides opposite to it.
+    if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
+    w.direction[i] = onset_direction(w, i);
+    w.mode[i] = ContactMode::sliding;
+    return c.name + "_slip";
+  }
+  // The slip reached 0: stick if rolling is consistent and inside the cone, else lift off or slide
+  // on in the onset direction (section 6, "Stick or slide on").
+  w.mode[i] = ContactMode::rolling;
+  if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
+  const double N = w.normal_force[i];
+  if (c.unilateral && !(N > 0.0)) {
+    w.mode[i] = ContactMode::free;
+    return c.name + "_liftoff";
+  }
+  if (norm2(w.friction[i]) <= w.mu_s[i] * std::abs(N)) return c.name + "_stick";
+  w.direction[i] = onset_direction(w, i);
+  w.mode[i] = ContactMode::sliding;
+  return c.name + "_slip";
+}
+
+Status ContactSwitches::on_event(int i, double t, const double* y) {
+  if (i < user_count_) return user_->on_event(i, t, y);
+  const int contact = (i - user_count_) / kSlots;
+  const int slot = (i - user_count_) % kSlots;
+  ++switch_count_;
+  same_time_ = switch_count_ > 1 && std::abs(t - last_switch_t_) <= 64 * std::numeric_limits<double>::epsilon() *
+                                                                          std::max(1.0, std::abs(t))
+                   ? same_time_ + 1
+                   : 0;
+  last_switch_t_ = t;
+  const std::string& name = model_.contact_modes->contacts[static_cast<std::size_t>(contact)].name;
+  if (same_time_ > kMaxSameTime) {
+    accumulation_ = fmt::format("no consistent mode for contact '{}' at t = {:.9g}: it switched {} times at that "
+                                "instant (the modes tried each call for another at once); the run ends here with its "
+                                "results so far",
+                                name, t, same_time_);
+    return Status::integrator_failure;
+  }
+  if (switch_count_ > kMaxSwitches) {
+    accumulation_ = fmt::format("the contacts switched {} times by t = {:.9g} (the last: '{}'), an accumulation of "
+                                "switches (Zeno or chattering); the run ends here with its results so far",
+                                switch_count_, t, name);
+    return Status::integrator_failure;
+  }
+  std::copy(y, y + size_, switch_y_.begin());  // a touchdown changes its velocities
+  const std::string event = switch_contact(contact, slot, t, y);
+  if (event.empty()) {
+    if (accumulation_.empty())
+      accumulation_ = fmt::format("contact '{}': the equations could not be solved at the switch at t = {:.9g}: {}",
+                                  name, t, data_.status != Status::ok ? explain_failure(model_, data_) : "");
+    return Status::integrator_failure;
+  }
+  switch_t_ = t;
+  start_t_ = t;
+  switched_ = true;
+  const Status status = handler_(event, t, switch_y_.data());
+  return status == Status::ok ? Status::stopped : status;
+}
+
+std::string ContactSwitches::touchdown(int contact, double t) {
+  const auto i = static_cast<std::size_t>(contact);
+  const ContactModeModel& cm = *model_.contact_modes;
+  const ContactModeContact& c = cm.contacts[i];
+  ContactModeData& w = data_.modes;
+  const int n = model_.n();
+  const int s = model_.s();
+  // Zeno (section 9): touchdowns 1e-7 s apart (relative to t) accumulate: bounces of a height
+  // 1e-14 m, a few orders above what the event location resolves, so none is missed.
+  const double interval = t - last_touchdown_[i];
+  const double previous = last_touchdown_[i] - previous_touchdown_[i];
+  ++touchdowns_[i];
+  previous_touchdown_[i] = last_touchdown_[i];
+  last_touchdown_[i] = t;
+  if (interval < 1e-7 * std::max(1.0, std::abs(t))) {
+    const double rho = previous > 0.0 ? interval / previous : 0.0;
+    accumulation_ = fmt::format("contact '{}' touched down {} times, the last two {:.3g} s apart (ratio {:.3g} to the "
+                                "interval before): an accumulation of impacts (Zeno) near t = {:.9g}; the run ends "
+                                "here at t = {:.9g} with its results so far",
+                                c.name, touchdowns_[i], interval, rho,
+                                rho > 0.0 && rho < 1.0 ? t + interval * rho / (1.0 - rho) : t, t);
+    return "";
+  }
+  double* q = switch_y_.data();
+  double* v = q + n;
+  if (compute_terms(model_, data_, t, q, v) != Status::ok) return "";
+  std::vector<double> f(static_cast<std::size_t>(model_.velocity_constraints()));
+  model_.evaluator->velocity_residual(t, q, v, data_.scratch.data(), f.data());
+  const double e = w.restitution[i];
+  const double vn = f[static_cast<std::size_t>(c.gap_velocity)];  // the gap's rate before, < 0
+  // (I1)-(I2) with a sticking impulse: the rows kept after the impact hold their velocity
+  // residuals, the gap's rate becomes -e times what it was, the slip becomes 0.
+  w.mode[i] = ContactMode::rolling;
+  std::vector<int> rows;
+  std::vector<double> target;
+  int velocity_index = 0;
+  const Eigen::Map<const Vector> v_before(v, n);
+  for (int row = 0; row < s; ++row) {
+    const bool has_velocity = model_.constraints[static_cast<std::size_t>(row)].level != ConstraintLevel::acceleration;
+    bool keep = true;
+    for (std::size_t j = 0; j < cm.contacts.size() && keep; ++j) {
+      const ContactModeContact& o = cm.contacts[j];
+      if (w.mode[j] == ContactMode::rolling) continue;
+      keep = row != o.roll[0] && row != o.roll[1] && row != o.spin && !(w.mode[j] == ContactMode::free && row == o.gap);
+    }
+    if (keep) {
+      double delta = 0.0;
+      if (row == c.gap) delta = -(1.0 + e) * vn;
+      else if (row == c.roll[0] || row == c.roll[1] || row == c.spin) delta = -f[static_cast<std::size_t>(velocity_index)];
+      rows.push_back(row);
+      target.push_back(data_.b.row(row).dot(v_before) + delta);
+    }
+    if (has_velocity) ++velocity_index;
+  }
+  const int r = static_cast<int>(rows.size());
+  Matrix Bt(n, r);
+  for (int j = 0; j < r; ++j) Bt.col(j) = data_.b.row(rows[static_cast<std::size_t>(j)]).transpose();
+  Eigen::ColPivHouseholderQR<Matrix> qr(Bt);
+  if (qr.rank() < r) {
+    accumulation_ = fmt::format("contact '{}' touches down at t = {:.9g} where the constraints after the impact are "
+                                "dependent; the run ends here with its results so far",
+                                c.name, t);
+    return "";
+  }
+  const Matrix Qf = qr.householderQ();
+  const Matrix D = Qf.rightCols(n - r).transpose();
+  Matrix M(n, n);
+  Vector rhs(n);
+  M.topRows(n - r) = D * data_.A;
+  rhs.head(n - r) = D * (data_.A * v_before);
+  for (int j = 0; j < r; ++j) {
+    M.row(n - r + j) = data_.b.row(rows[static_cast<std::size_t>(j)]);
+    rhs(n - r + j) = target[static_cast<std::size_t>(j)];
+  }
+  const Vector v_after = M.partialPivLu().solve(rhs);
+  const Evaluator& ev = *model_.evaluator;
+  const bool balance = ev.has_energy_balance() && size_ > 2 * n;
+  const double h_before = balance ? ev.energy_function(t, q, v, data_.scratch.data()) : 0.0;
+  std::copy(v_after.data(), v_after.data() + n, v);
+  // The impulsive reactions' work, h+ - h- (section 8), booked with the reactions' work so that
+  // h - h0 - W does not jump.
+  if (balance) switch_y_[static_cast<std::size_t>(2 * n + 1)] += ev.energy_function(t, q, v, data_.scratch.data()) - h_before;
+  const std::string name = c.name + "_touchdown";
+  if (e > 0.0 && -e * vn > slip_floor(data_)) {
+    w.mode[i] = c.unilateral ? ContactMode::free : ContactMode::rolling;
+    return name;
+  }
+  // The contact stays closed: the mode as at the start (section 7, "After the impact").
+  if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return "";
+  if (c.unilateral && w.normal_force[i] < 0.0) w.mode[i] = ContactMode::free;
+  else if (c.friction && norm2(w.friction[i]) > w.mu_s[i] * std::abs(w.normal_force[i])) {
+    w.direction[i] = onset_direction(w, i);
+    w.mode[i] = ContactMode::sliding;
+  }
+  return name;
+}
+
+IntegrationResult integrate_contact_modes(OdeSystem& ode, const IntegratorOptions& options, double t0,
+                                          const double* y0, std::span<const double> output_times,
+                                          const OutputFn& output, ContactSwitches& switches) {
+  std::vector<double> y(y0, y0 + ode.size());
+  double t = t0;
+  std::size_t next = 0;
+  IntegratorStats total;
+  IntegratorOptions segment = options;
+  while (true) {
+    IntegrationResult result = integrate(ode, segment, t, y.data(), output_times.subspan(next), output, &switches);
+    total.steps += result.stats.steps;
+    total.rejected_steps += result.stats.rejected_steps;
+    total.rhs_evaluations += result.stats.rhs_evaluations;
+    result.stats = total;
+    if (result.status == Status::stopped && switches.switched()) {
+      switches.clear();
+      t = switches.switch_t();
+      y = switches.switch_y();
+      while (next < output_times.size() && output_times[next] <= t) ++next;
+      segment.max_steps = options.max_steps - total.steps - total.rejected_steps;
+      if (next < output_times.size() && segment.max_steps > 0) continue;
+      result.status = next < output_times.size() ? Status::too_many_steps : Status::ok;
+      result.t_reached = t;
+      return result;
+    }
+    if (!switches.accumulation().empty() && result.status != Status::ok) result.message = switches.accumulation();
+    return result;
+  }
+}
+
+}  // namespace nhdyn

@@ -1,0 +1,95 @@
+// The switches of contacts that slide and lift off (docs/contact-modes.md; derived in
+// docs/derivations/contact-modes.md section 6): the mode each contact starts in, the event
+// functions each mode watches (its normal force, its friction cone, its slip along the carried
+// direction, its gap), located to round-off like any event, and what happens at a crossing: the
+// new mode (a stick, a slip, a lift-off, a touchdown with its impact), the row written there, and a
+// restart of the integration from that state (with the velocities after an impact). simulate()
+// (simulation.hpp) runs through them with integrate_contact_modes.
+//
+//     simulate -> choose_initial_contact_modes -> integrate_contact_modes
+//         -> integrate (one segment per mode set) -> ContactSwitches::on_event -> new modes
+#pragma once
+
+#include <cmath>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/integrators/events.hpp"
+#include "nhdyn/integrators/ode.hpp"
+#include "nhdyn/model/data.hpp"
+#include "nhdyn/model/model.hpp"
+
+namespace nhdyn {
+
+// Chooses each contact's mode at (t0, q0, v0) into data.modes: the one its `mode` key gives, else
+// free when its gap is open (unilateral), sliding when it slips (or when rolling would need more
+// friction than mu_s N: the onset direction of section 5), rolling otherwise. Throws ModelError
+// naming the contact when a unilateral contact would pull (N < 0) in its starting mode, with the
+// mode to start in instead, or when mode = "sliding" is given with no slip and no friction needed.
+void choose_initial_contact_modes(const Model& model, Data& data, const FormulationOptions& formulation, double t0,
+                                  const Vector& q0, const Vector& v0);
+
+// The mode events of every contact (3 per contact) after the run's own events (`user`, may be
+// null): located on the integrator's dense output; a crossing changes data.modes and ends the
+// current segment (Status::stopped), which integrate_contact_modes restarts from the state there.
+class ContactSwitches final : public EventFunctions {
+ public:
+  // Writes the row of a switch (the mode after it) and records it as an event named NAME_stick,
+  // NAME_slip, NAME_liftoff or NAME_touchdown; returns its status.
+  using Handler = std::function<Status(const std::string& name, double t, const double* y)>;
+
+  // `state_size`: the size of the integrated state y (q, q' and the works).
+  ContactSwitches(const Model& model, Data& data, const FormulationOptions& formulation, int state_size,
+                  EventFunctions* user, Handler handler);
+
+  int count() const override;
+  CrossingDirection direction(int i) const override;
+  Status evaluate(double t, const double* y, double* g) override;
+  Status on_event(int i, double t, const double* y) override;
+
+  // After integrate() returned Status::stopped: whether a switch ended the segment, and where.
+  bool switched() const { return switched_; }
+  double switch_t() const { return switch_t_; }
+  const std::vector<double>& switch_y() const { return switch_y_; }
+  void clear() { switched_ = false; }
+  // Set when the switches accumulate (Zeno or no consistent mode): the message ending the run.
+  const std::string& accumulation() const { return accumulation_; }
+  long switches() const { return switch_count_; }
+
+ private:
+  std::string switch_contact(int contact, int slot, double t, const double* y);
+  // The impact of a touchdown (section 7): the velocities of switch_y_ after it, and the mode.
+  std::string touchdown(int contact, double t);
+
+  const Model& model_;
+  Data& data_;
+  const FormulationOptions& formulation_;
+  EventFunctions* user_;
+  Handler handler_;
+  int user_count_ = 0;
+  int size_ = 0;  // the state's size (y holds q, q' and the works)
+  bool switched_ = false;
+  double switch_t_ = 0.0;
+  std::vector<double> switch_y_;
+  std::string accumulation_;
+  long switch_count_ = 0;
+  int same_time_ = 0;       // successive switches without progress in t
+  double last_switch_t_ = 0.0;
+  double start_t_ = -HUGE_VAL;  // the time the current segment started at (the last switch)
+  std::vector<double> last_touchdown_;  // per contact: the times of its last two touchdowns
+  std::vector<double> previous_touchdown_;
+  std::vector<long> touchdowns_;
+};
+
+// Integrates as integrate() does, through any number of switches: each switch ends a segment,
+// whose state (after the row of the switch) starts the next one with the outputs still due. An
+// accumulation of switches ends the run with Status::integrator_failure and the message of
+// ContactSwitches::accumulation(), with the rows up to there written.
+IntegrationResult integrate_contact_modes(OdeSystem& ode, const IntegratorOptions& options, double t0,
+                                          const double* y0, std::span<const double> output_times,
+                                          const OutputFn& output, ContactSwitches& switches);
+
+}  // namespace nhdyn

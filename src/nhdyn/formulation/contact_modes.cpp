@@ -1,0 +1,185 @@
+#include "nhdyn/formulation/contact_modes.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "nhdyn/model/terms.hpp"
+
+namespace nhdyn {
+namespace {
+
+// The slip below which its direction is taken from the carried one (the onset direction, or the
+// direction of the last step): the slip a rolling contact leaves is the integration error of its
+// velocity constraint, not a direction (docs/derivations/contact-modes.md section 5, "In the
+// sliding mode near s = 0").
+double slip_floor(const Data& data) { return 1e-10 * (1.0 + data.v.lpNorm<Eigen::Infinity>()); }
+
+bool dropped(const ContactModeContact& c, ContactMode mode, int row) {
+  if (mode == ContactMode::rolling) return false;
+  if (row == c.roll[0] || row == c.roll[1] || row == c.spin) return true;
+  return mode == ContactMode::free && row == c.gap;
+}
+
+// Per contact: mu, the unit tangents' lengths, the slip, and for a sliding contact e_s.
+void contact_kinematics(const ContactModeModel& cm, Data& data, std::vector<std::array<double, 2>>& lengths) {
+  ContactModeData& w = data.modes;
+  const double floor = slip_floor(data);
+  for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
+    const ContactModeContact& c = cm.contacts[i];
+    const double* o = w.outputs.data() + ContactModeModel::kOutputs * i;
+    w.mu_s[i] = o[0];
+    w.mu_k[i] = o[1];
+    w.restitution[i] = o[2];
+    const double* t[2] = {o + 6, o + 9};
+    std::array<double, 3> world{0.0, 0.0, 0.0};
+    for (std::size_t a = 0; a < 2; ++a) {
+      const double length = std::sqrt(t[a][0] * t[a][0] + t[a][1] * t[a][1] + t[a][2] * t[a][2]);
+      lengths[i][a] = length > 0.0 ? length : 1.0;
+      w.slip[i][a] = w.velocity_residuals[static_cast<std::size_t>(c.roll_velocity[a])] / lengths[i][a];
+      for (std::size_t k = 0; k < 3; ++k) world[k] += w.slip[i][a] * t[a][k] / lengths[i][a];
+    }
+    w.slip_world[i] = world;
+    const double speed = std::hypot(w.slip[i][0], w.slip[i][1]);
+    std::array<double, 2> e = w.direction[i];
+    if (speed > floor) {
+      e = {w.slip[i][0] / speed, w.slip[i][1] / speed};
+      // Continued through zero: oriented like the carried direction (section 6), so that the
+      // friction stays smooth within the step that holds the stick and s . e_s falls through 0.
+      if (e[0] * w.direction[i][0] + e[1] * w.direction[i][1] < 0.0) e = {-e[0], -e[1]};
+    }
+    w.sliding_direction[i] = e;
+  }
+}
+
+Status fail(Data& data, const ContactModeModel& cm, int contact, const std::string& why) {
+  data.modes.failed_contact = contact;
+  record_failure(data, Status::singular_system, "");
+  data.failed_quantity = contact >= 0 ? fmt::format("contact '{}': {}", cm.contacts[static_cast<std::size_t>(contact)].name, why)
+                                      : why;
+  return Status::singular_system;
+}
+
+}  // namespace
+
+Status compute_mode_acceleration(const Model& model, Data& data) {
+  if (data.stage < Stage::terms)
+    throw std::logic_error("compute_mode_acceleration: call compute_terms first for the current state");
+  if (data.sparse || !model.contact_modes)
+    throw std::logic_error("compute_mode_acceleration: contact modes are solved on the dense path of a model that has them");
+  const ContactModeModel& cm = *model.contact_modes;
+  ContactModeData& w = data.modes;
+  const int n = model.n();
+  const int s = model.s();
+  w.failed_contact = -1;
+  w.program.run(data.t, data.q.data(), data.v.data(), w.registers.data(), w.outputs.data());
+  if (!w.velocity_residuals.empty())
+    model.evaluator->velocity_residual(data.t, data.q.data(), data.v.data(), data.scratch.data(),
+                                       w.velocity_residuals.data());
+  std::vector<std::array<double, 2>>& lengths = w.tangent_length;
+  contact_kinematics(cm, data, lengths);
+
+  // The kept rows, then the reaction directions: a sliding contact's gap row gets -mu_k w_s.
+  w.kept.clear();
+  for (int row = 0; row < s; ++row) {
+    bool keep = true;
+    for (std::size_t i = 0; i < cm.contacts.size() && keep; ++i) keep = !dropped(cm.contacts[i], w.mode[i], row);
+    if (keep) w.kept.push_back(row);
+  }
+  const int r = static_cast<int>(w.kept.size());
+  if (w.reaction_rows.cols() != r) {
+    w.reaction_rows.resize(n, r);
+    w.multipliers.resize(r);
+    w.qr = Eigen::ColPivHouseholderQR<Matrix>(n, r);
+  }
+  for (int j = 0; j < r; ++j) w.reaction_rows.col(j) = data.b.row(w.kept[static_cast<std::size_t>(j)]).transpose();
+  std::vector<int>& gap_column = w.gap_column;
+  for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
+    const ContactModeContact& c = cm.contacts[i];
+    gap_column[i] = -1;
+    for (int j = 0; j < r; ++j)
+      if (w.kept[static_cast<std::size_t>(j)] == c.gap) gap_column[i] = j;
+    if (w.mode[i] != ContactMode::sliding || gap_column[i] < 0) continue;
+    for (std::size_t a = 0; a < 2; ++a)
+      w.reaction_rows.col(gap_column[i]) -=
+          (w.mu_k[i] * w.sliding_direction[i][a] / lengths[i][a]) * data.b.row(c.roll[a]).transpose();
+  }
+
+  // D: the last n - r columns of the orthogonal factor of B~^T (D B~^T = 0), then (S4). With no
+  // row kept (a free body and nothing else) D is the identity: A q'' = Q + G.
+  const int k = n - r;
+  data.Q_full.resize(n, n);
+  data.hh_work.resize(n);
+  if (r == 0) data.Q_full.setIdentity();
+  else w.qr.compute(w.reaction_rows);
+  if (r > 0 && w.qr.rank() < r) {
+    for (std::size_t i = 0; i < cm.contacts.size(); ++i)
+      if (w.mode[i] == ContactMode::sliding)
+        return fail(data, cm, static_cast<int>(i),
+                    "the reaction directions of the sliding contact are dependent (its friction direction lies in "
+                    "the span of the other constraints)");
+    return record_failure(data, Status::dependent_constraints, "b");
+  }
+  if (r > 0) w.qr.householderQ().evalTo(data.Q_full, data.hh_work);
+  w.M.topRows(k).noalias() = data.Q_full.rightCols(k).transpose() * data.A;
+  w.rhs.head(k).noalias() = data.Q_full.rightCols(k).transpose() * (data.Q + data.G);
+  for (int j = 0; j < r; ++j) {
+    const int row = w.kept[static_cast<std::size_t>(j)];
+    w.M.row(k + j) = data.b.row(row);
+    w.rhs(k + j) = -data.b0(row);
+  }
+  w.lu.compute(w.M);
+  const double rcond = w.lu.rcond();
+  if (!(rcond > 1e-14)) {
+    for (std::size_t i = 0; i < cm.contacts.size(); ++i)
+      if (w.mode[i] == ContactMode::sliding)
+        return fail(data, cm, static_cast<int>(i),
+                    fmt::format("the equations of its sliding are singular (Painleve's paradox: with mu_k = {:.6g} "
+                                "its normal force no longer decides its normal acceleration, "
+                                "docs/contact-modes.md); lower the friction coefficient",
+                                w.mu_k[i]));
+    return record_failure(data, Status::singular_system, "stacked matrix [D A; b] of the contact modes");
+  }
+  data.qdd = w.lu.solve(w.rhs);
+  data.R.noalias() = data.A * data.qdd;
+  data.R -= data.Q;
+  data.R -= data.G;
+
+  // The multipliers, R = B~^T lambda (least squares through the same QR): N and F_t.
+  if (r > 0) {
+    data.tmp_n = data.R;
+    data.tmp_n.applyOnTheLeft(w.qr.householderQ().adjoint());
+    w.qr.matrixQR().topLeftCorner(r, r).triangularView<Eigen::Upper>().solveInPlace(data.tmp_n.head(r));
+    for (int j = 0; j < r; ++j) w.multipliers(w.qr.colsPermutation().indices()(j)) = data.tmp_n(j);
+  }
+  w.power_friction = 0.0;
+  for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
+    const ContactModeContact& c = cm.contacts[i];
+    w.friction_power[i] = 0.0;
+    if (w.mode[i] == ContactMode::free || gap_column[i] < 0) {
+      w.normal_force[i] = 0.0;
+      w.friction[i] = {0.0, 0.0};
+      continue;
+    }
+    const double N = w.multipliers(gap_column[i]);
+    w.normal_force[i] = N;
+    if (w.mode[i] == ContactMode::sliding) {
+      for (std::size_t a = 0; a < 2; ++a) w.friction[i][a] = -w.mu_k[i] * N * w.sliding_direction[i][a];
+      // -mu_k |N| |s| = F_t . s, the dissipation (section 8).
+      w.friction_power[i] = w.friction[i][0] * w.slip[i][0] + w.friction[i][1] * w.slip[i][1];
+      w.power_friction += w.friction_power[i];
+      continue;
+    }
+    for (std::size_t a = 0; a < 2; ++a) {
+      w.friction[i][a] = 0.0;
+      for (int j = 0; j < r; ++j)
+        if (w.kept[static_cast<std::size_t>(j)] == c.roll[a]) w.friction[i][a] = w.multipliers(j) * lengths[i][a];
+    }
+  }
+  data.power_friction = w.power_friction;
+  return Status::ok;
+}
+
+}  // namespace nhdyn

@@ -1,0 +1,390 @@
+// Contacts that slide and stick ([[contacts]] with friction, docs/contact-modes.md): bodies thrown
+// sliding on a plane against the closed forms of docs/derivations/contact-modes.md section 10.1
+// (the time they start rolling, their final speed, the friction's work), the energy balance
+// through the switch, and the keys' bad values.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "nhdyn/analysis/simulation.hpp"
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/io/results.hpp"
+#include "support/text.hpp"
+
+namespace nhdyn {
+namespace {
+
+using nhdyn::test::example;
+
+double mode_parameter(const Model& model, const std::string& name) {
+  for (const Parameter& p : model.parameters)
+    if (p.name == name) return p.value;
+  ADD_FAILURE() << "no parameter " << name;
+  return 0.0;
+}
+
+int mode_column(const ResultColumns& columns, const std::string& name) {
+  for (std::size_t i = 0; i < columns.all.size(); ++i)
+    if (columns.all[i] == name) return static_cast<int>(i);
+  ADD_FAILURE() << "no column " << name;
+  return 0;
+}
+
+struct ModeRun {
+  SimulationSummary summary;
+  ResultColumns columns;
+  std::vector<std::vector<double>> rows;
+  double at(std::size_t row, const std::string& name) const {
+    return rows.at(row).at(static_cast<std::size_t>(mode_column(columns, name)));
+  }
+};
+
+ModeRun run_modes(const Model& model, double t_end) {
+  ModeRun out;
+  out.columns = make_result_columns(model);
+  SimulationOptions options;
+  options.t_end = t_end;
+  options.output_step = 0.01;
+  options.integrator.rtol = 1e-10;
+  options.integrator.atol = 1e-12;
+  out.summary = simulate(model, options, [&](const Data& data) {
+    std::vector<double> row;
+    fill_result_row(model, data, row);
+    out.rows.push_back(std::move(row));
+  });
+  EXPECT_EQ(out.summary.status, Status::ok) << out.summary.message;
+  return out;
+}
+
+// The row written at the only switch (an event row).
+std::size_t mode_switch_row(const ModeRun& r, double t) {
+  for (std::size_t i = 0; i < r.rows.size(); ++i)
+    if (r.rows[i][0] == t) return i;
+  ADD_FAILURE() << "no row at the switch t = " << t;
+  return 0;
+}
+
+// Section 10.1, a solid ball thrown without spin: t* = 2 v0 / (7 mu g), then it rolls at 5 v0 / 7;
+// the friction's work is -m v0^2 / 7, all the kinetic energy lost.
+TEST(ContactModes, BallThrownSlidingSticksAtTheClosedFormTimeAndRollsAtFiveSevenths) {
+  const Model model = load_model(example("ball_thrown_sliding.toml"));
+  const double m = mode_parameter(model, "m"), g = mode_parameter(model, "g"), mu = mode_parameter(model, "mu");
+  const double v0 = mode_parameter(model, "v0");
+  const ModeRun r = run_modes(model, 1.0);
+  ASSERT_EQ(r.summary.events.size(), 1u);
+  EXPECT_EQ(r.summary.events[0].name, "ball_stick");
+  const double t_star = 2 * v0 / (7 * mu * g);
+  EXPECT_NEAR(t_star, 0.3495, 1e-4);  // the derivation's test value
+  EXPECT_NEAR(r.summary.events[0].t, t_star, 1e-12);
+  // Until t* the centre decelerates at mu g: x(t*) = v0 t* - mu g t*^2 / 2.
+  EXPECT_NEAR(r.summary.events[0].q[0], v0 * t_star - mu * g * t_star * t_star / 2, 1e-11);
+  const std::size_t s = mode_switch_row(r, r.summary.events[0].t);
+  EXPECT_EQ(r.at(s, "ball_mode"), 0.0);  // a switch row carries the mode after it
+  EXPECT_EQ(r.at(s - 1, "ball_mode"), 1.0);
+  EXPECT_EQ(r.at(0, "ball_mode"), 1.0);
+  EXPECT_NEAR(r.at(0, "ball_slip_speed"), v0, 1e-12);
+  EXPECT_NEAR(r.at(0, "ball_slip_x"), v0, 1e-12);
+  EXPECT_NEAR(r.at(0, "ball_N"), m * g, 1e-12);
+  EXPECT_NEAR(r.at(0, "ball_Fx"), -mu * m * g, 1e-12);
+  EXPECT_NEAR(r.at(s, "ball_slip_speed"), 0.0, 1e-12);
+  const std::size_t last = r.rows.size() - 1;
+  EXPECT_NEAR(r.at(last, "x'"), 5 * v0 / 7, 1e-12);
+  EXPECT_NEAR(r.at(last, "ball_Fx"), 0.0, 1e-12);
+  EXPECT_NEAR(r.at(last, "work_friction"), -m * v0 * v0 / 7, 1e-12);
+  // Rolling after the stick: its no-slip rows hold to round-off, the friction does no more work.
+  EXPECT_LT(r.summary.max_velocity_residual, 1e-12);
+  EXPECT_LT(r.summary.max_balance_error, 1e-12);
+  EXPECT_NEAR(r.summary.energy_change, -m * v0 * v0 / 7, 1e-12);
+}
+
+// With backspin r W > 5 v0 / 2 the ball comes back: it sticks at t* = k (v0 + r W) / (mu g (1 + k))
+// and rolls on at (v0 - k r W) / (1 + k) < 0.
+TEST(ContactModes, BallWithBackspinComesBack) {
+  const Model model = load_model(example("ball_thrown_sliding.toml"), {{"w0", -500.0}});
+  const double g = mode_parameter(model, "g"), mu = mode_parameter(model, "mu"), v0 = mode_parameter(model, "v0");
+  const double r_ball = mode_parameter(model, "r"), W = 500.0, k = 0.4;
+  const ModeRun r = run_modes(model, 2.0);
+  ASSERT_EQ(r.summary.events.size(), 1u);
+  EXPECT_EQ(r.summary.events[0].name, "ball_stick");
+  EXPECT_NEAR(r.summary.events[0].t, k * (v0 + r_ball * W) / (mu * g * (1 + k)), 1e-11);
+  const double back = (v0 - k * r_ball * W) / (1 + k);
+  EXPECT_LT(back, 0.0);
+  EXPECT_NEAR(r.at(r.rows.size() - 1, "x'"), back, 1e-11);
+  EXPECT_LT(r.summary.max_balance_error, 1e-11);
+}
+
+// A thin disk (k = 1/2) or a hoop (k = 1) thrown along its plane: t* = v0 / (3 mu g) and
+// v0 / (2 mu g), final speeds 2 v0 / 3 and v0 / 2.
+std::string thrown_wheel_model(const std::string& inertia) {
+  return R"(
+name = "wheel-thrown"
+coordinates = ["x", "y", "z", "b"]
+gravity = [0, 0, "-g"]
+[parameters]
+m = 0.5
+r = 0.3
+g = 9.81
+mu = 0.2
+v0 = 2.0
+[[frames]]
+name = "wheel"
+translation = ["x", "y", "z"]
+rotations = [["y", "b"]]
+[[bodies]]
+name = "wheel"
+frame = "wheel"
+mass = "m"
+inertia = )" + inertia + R"(
+[[contacts]]
+name = "rim"
+body = "wheel"
+shape = { disk = "r", axis = "y" }
+friction = "mu"
+[initial]
+position = { x = 0, y = 0, z = "r", b = 0 }
+velocity = { x = "v0", y = 0, z = 0, b = 0 }
+)";
+}
+
+TEST(ContactModes, DiskAndHoopThrownSlidingStickAtTheirClosedFormTimes) {
+  struct Case {
+    const char* inertia;
+    double k;
+  };
+  for (const Case& c : {Case{"[\"m*r^2/4\", \"m*r^2/2\", \"m*r^2/4\"]", 0.5}, Case{"[\"m*r^2/2\", \"m*r^2\", \"m*r^2/2\"]", 1.0}}) {
+    SCOPED_TRACE(c.inertia);
+    // No mode given: it slips at t0, so it starts sliding.
+    const Model model = load_model_text(thrown_wheel_model(c.inertia), "wheel.toml");
+    const double g = 9.81, mu = 0.2, v0 = 2.0;
+    const ModeRun r = run_modes(model, 2.0);
+    ASSERT_EQ(r.summary.events.size(), 1u);
+    EXPECT_EQ(r.summary.events[0].name, "rim_stick");
+    EXPECT_NEAR(r.summary.events[0].t, c.k * v0 / (mu * g * (1 + c.k)), 1e-11);
+    EXPECT_NEAR(r.at(r.rows.size() - 1, "x'"), v0 / (1 + c.k), 1e-11);
+    EXPECT_NEAR(r.at(r.rows.size() - 1, "work_friction"), -0.5 * 0.5 * v0 * v0 * c.k / (1 + c.k), 1e-11);
+    EXPECT_LT(r.summary.max_balance_error, 1e-11);
+  }
+}
+
+// A solid cylinder released at rest on an incline of angle alpha (gravity tilted, the plane
+// z = 0): it slides from the start iff tan(alpha) > 3 mu (section 10.3), with x'' = g (sin(alpha) -
+// mu cos(alpha)) and never sticks; below that it rolls at x'' = 2 g sin(alpha) / 3.
+std::string incline_model(double alpha, const std::string& friction = "\"mu\"") {
+  return R"toml(
+name = "cylinder-on-incline"
+coordinates = ["x", "y", "z", "b"]
+gravity = ["g*sin(alpha)", 0, "-g*cos(alpha)"]
+[parameters]
+m = 2.0
+r = 0.1
+g = 9.81
+mu = 0.2
+alpha = )toml" + std::to_string(alpha) + R"toml(
+[[frames]]
+name = "cylinder"
+translation = ["x", "y", "z"]
+rotations = [["y", "b"]]
+[[bodies]]
+name = "cylinder"
+frame = "cylinder"
+mass = "m"
+inertia = ["m*r^2/4", "m*r^2/2", "m*r^2/4"]
+[[contacts]]
+name = "rim"
+body = "cylinder"
+shape = { disk = "r", axis = "y" }
+ground = { plane = [0, 0, 1] }
+friction = )toml" + friction + R"toml(
+[initial]
+position = { x = 0, y = 0, z = "r", b = 0 }
+)toml";
+}
+
+TEST(ContactModes, CylinderOnASteepInclineSlidesFromTheStartAndRollsBelowTheBound) {
+  const double g = 9.81, mu = 0.2;
+  for (const double alpha : {0.7, 0.4}) {
+    SCOPED_TRACE(alpha);
+    const bool steep = std::tan(alpha) > 3 * mu;
+    const Model model = load_model_text(incline_model(alpha), "incline.toml");
+    const ModeRun r = run_modes(model, 1.0);
+    EXPECT_TRUE(r.summary.events.empty());
+    const std::size_t last = r.rows.size() - 1;
+    EXPECT_EQ(r.at(0, "rim_mode"), steep ? 1.0 : 0.0);
+    EXPECT_EQ(r.at(last, "rim_mode"), steep ? 1.0 : 0.0);
+    const double a = steep ? g * (std::sin(alpha) - mu * std::cos(alpha)) : 2 * g * std::sin(alpha) / 3;
+    EXPECT_NEAR(r.at(last, "x'"), a * 1.0, 1e-10);
+    if (steep) {
+      // The slip grows at g (sin(alpha) - 3 mu cos(alpha)); the friction is mu N up the slope.
+      EXPECT_NEAR(r.at(last, "rim_slip_speed"), g * (std::sin(alpha) - 3 * mu * std::cos(alpha)), 1e-10);
+      EXPECT_NEAR(r.at(last, "rim_Fx"), -mu * 2.0 * g * std::cos(alpha), 1e-10);
+    } else {
+      EXPECT_LT(r.summary.max_velocity_residual, 1e-10);
+    }
+    EXPECT_LT(r.summary.max_balance_error, 1e-10);
+  }
+  // friction = [mu_s, mu_k]: between 3 mu_k and 3 mu_s the static friction holds it from rest.
+  const Model held = load_model_text(incline_model(0.7, "[0.3, 0.2]"), "incline.toml");
+  const ModeRun r = run_modes(held, 1.0);
+  EXPECT_TRUE(r.summary.events.empty());
+  EXPECT_EQ(r.at(r.rows.size() - 1, "rim_mode"), 0.0);
+  EXPECT_NEAR(r.at(r.rows.size() - 1, "x'"), 2 * g * std::sin(0.7) / 3, 1e-10);
+}
+
+// A unilateral contact that would pull at t0 (gravity away from the ground) is refused before
+// the run, with N and the mode to start in.
+TEST(ContactModes, UnilateralContactPullingAtTheStartIsRefused) {
+  std::string text = test::read_text(example("ball_on_sphere.toml"));
+  text.replace(text.find("gravity = [0, 0, \"-g\"]"), 22, "gravity = [0, 0, \"g\"]");
+  const Model model = load_model_text(text, "sphere.toml");
+  SimulationOptions options;
+  options.t_end = 0.1;
+  try {
+    simulate(model, options, [](const Data&) {});
+    ADD_FAILURE() << "accepted";
+  } catch (const ModelError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("contact 'ball' is unilateral"), std::string::npos) << message;
+    EXPECT_NE(message.find("N = -"), std::string::npos) << message;
+    EXPECT_NE(message.find("mode = \"free\""), std::string::npos) << message;
+  }
+}
+
+// Section 10.2, a ball released at theta0 = 1e-3 from the top of a fixed sphere. Without a
+// friction limit it rolls until N = 0 at cos(theta) = 2 cos(theta0) / (3 + k) and lifts off; with
+// mu = 0.3 it slips at (R3) and lifts off while sliding, at the root of (R4).
+double sphere_angle(const EventRecord& e) { return std::atan2(e.q[0], e.q[2]); }
+
+TEST(ContactModes, BallOnASphereLiftsOffAtTenSeventeenthsOrSlipsFirst) {
+  const double k = 0.4, theta0 = 1e-3;
+  {
+    const Model model = load_model(example("ball_on_sphere.toml"));
+    const ModeRun r = run_modes(model, 3.2);
+    ASSERT_EQ(r.summary.events.size(), 1u);
+    EXPECT_EQ(r.summary.events[0].name, "ball_liftoff");
+    EXPECT_NEAR(std::cos(sphere_angle(r.summary.events[0])), 2 * std::cos(theta0) / (3 + k), 1e-9);
+    const std::size_t last = r.rows.size() - 1;
+    EXPECT_EQ(r.at(last, "ball_mode"), 2.0);
+    EXPECT_GT(r.at(last, "ball_gap"), 0.05);  // flying away from the sphere
+    EXPECT_NEAR(r.at(last, "ball_N"), 0.0, 1e-12);
+    EXPECT_LT(r.summary.max_balance_error, 1e-9);
+  }
+  std::string text = test::read_text(example("ball_on_sphere.toml"));
+  text.replace(text.find("unilateral = true\n"), 18, "unilateral = true\nfriction = 0.3\n");
+  const Model model = load_model_text(text, "sphere.toml");
+  const ModeRun r = run_modes(model, 3.1);
+  ASSERT_EQ(r.summary.events.size(), 2u);
+  EXPECT_EQ(r.summary.events[0].name, "ball_slip");
+  EXPECT_EQ(r.summary.events[1].name, "ball_liftoff");
+  const double mu = 0.3;
+  const double theta_s = std::atan2((3 + k) * mu, k) -
+                         std::asin(2 * mu * std::cos(theta0) / std::sqrt(k * k + (3 + k) * (3 + k) * mu * mu));
+  EXPECT_NEAR(sphere_angle(r.summary.events[0]), theta_s, 1e-8);
+  // (R4): rho u = rho theta'^2 while sliding, from theta_s; lift-off where rho u = g cos(theta).
+  const double rho_u_s = 2 * 9.81 * (std::cos(theta0) - std::cos(theta_s)) / (1 + k);
+  const auto p = [&](double x) { return (2 * mu * mu - 1) * std::cos(x) - 3 * mu * std::sin(x); };
+  const auto excess = [&](double x) {
+    const double E = std::exp(2 * mu * (x - theta_s));
+    return rho_u_s * E + 2 * 9.81 / (1 + 4 * mu * mu) * (p(x) - E * p(theta_s)) - 9.81 * std::cos(x);
+  };
+  double lo = theta_s + 1e-6, hi = 1.5;
+  for (int i = 0; i < 200; ++i) ((excess(0.5 * (lo + hi)) < 0) ? lo : hi) = 0.5 * (lo + hi);
+  EXPECT_NEAR(hi * 180 / M_PI, 52.12, 0.01);  // the derivation's figure
+  EXPECT_NEAR(sphere_angle(r.summary.events[1]), hi, 1e-7);
+  EXPECT_LT(r.at(r.rows.size() - 1, "work_friction"), 0.0);
+  EXPECT_LT(r.summary.max_balance_error, 1e-9);
+}
+
+// A ball dropped from h0 onto the plane (unilateral, Newton's restitution e, no friction limit:
+// a sticking impulse): it touches down at sqrt(2 h0 / g), bounces at e times its speed, and the
+// touchdowns accumulate at t1 (1 + 2 e / (1 - e)) (Zeno), which ends the run with a message and
+// its rows; plastic (e = 0) it stays on the ground, rolling, N = m g. The impacts' energy is
+// booked with the reactions' work, so h - h0 - W does not jump.
+std::string dropped_ball(double e) {
+  std::string text = test::read_text(example("ball_thrown_sliding.toml"));
+  const std::string keys = "friction = \"mu\"\nmode = \"sliding\"\n";
+  text.replace(text.find(keys), keys.size(),
+               "unilateral = true\nrestitution = " + std::to_string(e) + "\n");
+  text.replace(text.find("z = \"r\""), 7, "z = \"r + 0.2\"");
+  return text;
+}
+
+TEST(ContactModes, DroppedBallBouncesWithNewtonsLawUntilTheTouchdownsAccumulate) {
+  const double g = 9.81, h0 = 0.2, e = 0.5;
+  const double t1 = std::sqrt(2 * h0 / g), v1 = std::sqrt(2 * g * h0);
+  {
+    const Model model = load_model_text(dropped_ball(e), "drop.toml");
+    ModeRun r;
+    r.columns = make_result_columns(model);
+    SimulationOptions options;
+    options.t_end = 2.0;
+    options.output_step = 0.01;
+    options.integrator.rtol = 1e-10;
+    options.integrator.atol = 1e-12;
+    r.summary = simulate(model, options, [&](const Data& data) {
+      std::vector<double> row;
+      fill_result_row(model, data, row);
+      r.rows.push_back(std::move(row));
+    });
+    EXPECT_NE(r.summary.status, Status::ok);
+    EXPECT_NE(r.summary.message.find("Zeno"), std::string::npos) << r.summary.message;
+    ASSERT_GE(r.summary.events.size(), 4u);
+    double t = t1, v = v1;
+    for (std::size_t k = 0; k < 4; ++k) {
+      EXPECT_EQ(r.summary.events[k].name, "ball_touchdown");
+      EXPECT_NEAR(r.summary.events[k].t, t, 1e-9) << k;
+      EXPECT_NEAR(r.summary.events[k].v[2], e * v, 1e-8) << k;  // the row carries the velocity after
+      v *= e;
+      t += 2 * v / g;
+    }
+    const double t_inf = t1 * (1 + 2 * e / (1 - e));
+    EXPECT_LT(r.summary.t_reached, t_inf + 1e-6);
+    EXPECT_GT(r.summary.t_reached, t_inf - 1e-3);
+    EXPECT_LT(r.summary.max_balance_error, 1e-9);
+  }
+  const Model plastic = load_model_text(dropped_ball(0.0), "drop.toml");
+  const ModeRun r = run_modes(plastic, 0.5);
+  ASSERT_EQ(r.summary.events.size(), 1u);
+  EXPECT_NEAR(r.summary.events[0].t, t1, 1e-9);
+  const std::size_t last = r.rows.size() - 1;
+  EXPECT_EQ(r.at(last, "ball_mode"), 0.0);
+  EXPECT_NEAR(r.at(last, "z'"), 0.0, 1e-12);
+  EXPECT_NEAR(r.at(last, "ball_N"), 0.1 * g, 1e-10);
+  EXPECT_LT(r.summary.max_balance_error, 1e-9);
+}
+
+std::string thrown_ball_with(const std::string& keys) {
+  std::string text = test::read_text(example("ball_thrown_sliding.toml"));
+  const std::string old = "friction = \"mu\"\nmode = \"sliding\"\n";
+  const std::size_t at = text.find(old);
+  EXPECT_NE(at, std::string::npos);
+  return text.replace(at, old.size(), keys);
+}
+
+void expect_mode_keys_refused(const std::string& keys, const std::string& words) {
+  SCOPED_TRACE(keys);
+  try {
+    load_model_text(thrown_ball_with(keys), "ball.toml");
+    ADD_FAILURE() << "accepted";
+  } catch (const ModelError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("ball.toml:"), std::string::npos) << message;
+    EXPECT_NE(message.find("contact 'ball'"), std::string::npos) << message;
+    EXPECT_NE(message.find(words), std::string::npos) << message;
+  }
+}
+
+TEST(ContactModes, BadKeysAreRefusedNamingTheContactAndTheLine) {
+  expect_mode_keys_refused("friction = -0.1\n", "a Coulomb friction coefficient is a number >= 0");
+  expect_mode_keys_refused("friction = \"-mu\"\n", "a Coulomb friction coefficient is a number >= 0");
+  expect_mode_keys_refused("friction = [0.2, 0.3]\n", "mu_s = 0.2 below mu_k = 0.3");
+  expect_mode_keys_refused("friction = 0.2\nrestitution = 1.5\n", "between 0");
+  expect_mode_keys_refused("friction = 0.2\nmode = \"slipping\"\n", "unknown mode 'slipping'");
+  expect_mode_keys_refused("mode = \"sliding\"\n", "needs a friction coefficient");
+  expect_mode_keys_refused("friction = 0.2\nmode = \"free\"\n", "needs unilateral = true");
+}
+
+}  // namespace
+}  // namespace nhdyn
