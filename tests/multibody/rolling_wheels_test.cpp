@@ -18,7 +18,7 @@
 namespace nhdyn {
 namespace {
 
-int column(const ResultColumns& columns, const std::string& name) {
+int wheel_column(const ResultColumns& columns, const std::string& name) {
   for (std::size_t i = 0; i < columns.all.size(); ++i)
     if (columns.all[i] == name) return static_cast<int>(i);
   ADD_FAILURE() << "no column " << name;
@@ -76,10 +76,10 @@ void check_incline(const std::string& shape, const std::string& reach_text, doub
   const double k = J / (m * rho * rho), a = g * std::sin(alpha) / (1 + k);
   const double x0 = rho * std::sin(alpha), z0 = rho * std::cos(alpha);
   const ResultColumns columns = make_result_columns(model);
-  const int x = column(columns, "x"), y = column(columns, "y"), z = column(columns, "z");
-  const int theta = column(columns, "theta"), phi = column(columns, "phi"), phid = column(columns, "phi'");
-  const int N = column(columns, "tyre_N"), Fx = column(columns, "tyre_Fx"), Fz = column(columns, "tyre_Fz");
-  const int Z = column(columns, "tyre_Z"), X = column(columns, "tyre_X");
+  const int x = wheel_column(columns, "x"), y = wheel_column(columns, "y"), z = wheel_column(columns, "z");
+  const int theta = wheel_column(columns, "theta"), phi = wheel_column(columns, "phi"), phid = wheel_column(columns, "phi'");
+  const int N = wheel_column(columns, "tyre_N"), Fx = wheel_column(columns, "tyre_Fx"), Fz = wheel_column(columns, "tyre_Fz");
+  const int Z = wheel_column(columns, "tyre_Z"), X = wheel_column(columns, "tyre_X");
   SimulationOptions options;
   options.t_end = 1.0;
   options.output_step = 0.05;
@@ -245,7 +245,7 @@ void check_steady_circle(const std::string& shape, double R, double rt, double I
   const std::string text = steady_circle_model(shape, Ia, Id, height, V, Omega, spin, theta0);
   const Model model = load_model_text(text, "<wheel>");
   const ResultColumns columns = make_result_columns(model);
-  const int Fx = column(columns, "wheel_Fx"), Fy = column(columns, "wheel_Fy"), Fz = column(columns, "wheel_Fz");
+  const int Fx = wheel_column(columns, "wheel_Fx"), Fy = wheel_column(columns, "wheel_Fy"), Fz = wheel_column(columns, "wheel_Fz");
   SimulationOptions options;
   options.t_end = 2 * M_PI / Omega;
   options.output_step = 0.05;

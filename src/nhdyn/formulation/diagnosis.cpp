@@ -85,7 +85,8 @@ std::string explain_inertia_sparse(const Model& model, const Data& data) {
   return fmt::format(
       "the inertia matrix A is not positive definite at t = {:.6g} (smallest pivot of its LDL^T factorization "
       "{:.6g}, largest {:.6g}; asymmetry |A - A^T| = {:.3g}; n = {} coordinates). Check the kinetic energy: every "
-      "coordinate needs a velocity term, and masses and inertias must be positive.",
+      "coordinate needs a velocity term, and masses and inertias must be positive (a coordinate without inertia "
+      "of its own needs constraints that fix it: A may be singular only where [D A; b] is regular).",
       data.t, smallest, largest, asymmetry, model.n());
 }
 
@@ -123,7 +124,8 @@ std::string explain_inertia(const Model& model, const Data& data) {
   return fmt::format(
       "the inertia matrix A is not positive definite at t = {:.6g} (smallest eigenvalue {:.6g}, "
       "largest {:.6g}; coordinates {}). Check the kinetic energy: every coordinate needs a "
-      "velocity term, and masses and inertias must be positive.",
+      "velocity term, and masses and inertias must be positive (a coordinate without inertia of its own needs "
+      "constraints that fix it: A may be singular only where [D A; b] is regular).",
       data.t, eig.eigenvalues()(0), eig.eigenvalues()(eig.eigenvalues().size() - 1), coords);
 }
 
@@ -145,6 +147,24 @@ bool a_is_positive_definite(const Model& model, const Data& data) {
   }
   Eigen::LLT<Matrix> llt(data.A);
   return llt.info() == Eigen::Success && data.A.isApprox(data.A.transpose(), 1e-12);
+}
+
+// A singular A that is positive definite on the velocities the constraints allow (N^T A N > 0, N
+// a basis of the null space of b) still makes [D A; b] regular for every complement D, and the Do
+// Sanh form needs no inverse of A: coordinates with no inertia of their own, held by constraints
+// (the surface parameters of a rolling contact, docs/derivations/rolling-bodies.md section 8).
+// Checked only when A is not positive definite; dense (O(n^3)).
+bool a_is_positive_definite_on_the_constraints(const Model& model, const Data& data) {
+  if (model.s() == 0) return false;
+  const Matrix A = data.sparse ? Matrix(data.A_sparse) : data.A;
+  if (!A.isApprox(A.transpose(), 1e-12)) return false;
+  const Matrix b = data.sparse ? Matrix(data.b_sparse) : data.b;
+  Eigen::FullPivLU<Matrix> lu(b);
+  const Matrix N = lu.kernel();
+  if (lu.rank() == model.n()) return true;  // the constraints fix every velocity
+  const Matrix reduced = N.transpose() * A * N;
+  Eigen::LLT<Matrix> llt(reduced);
+  return llt.info() == Eigen::Success;
 }
 
 }  // namespace
@@ -182,7 +202,7 @@ std::string explain_failure(const Model& model, const Data& data) {
 }
 
 Status check_terms(const Model& model, Data& data) {
-  if (!a_is_positive_definite(model, data))
+  if (!a_is_positive_definite(model, data) && !a_is_positive_definite_on_the_constraints(model, data))
     return record_failure(data, Status::inertia_not_positive_definite, "inertia matrix A");
   if (model.s() > 0 && b_is_rank_deficient(model, data))
     return record_failure(data, Status::dependent_constraints, "constraint matrix b");

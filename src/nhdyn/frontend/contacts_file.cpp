@@ -161,7 +161,7 @@ class ContactReader {
     for (auto&& [key, value] : *table) {
       const std::string k(key.str());
       if (k == text.ground.key) continue;
-      text.ground.options.emplace_back(k, text_of(value, fmt::format("{}: ground.{}", what, k), "\"Omega\""));
+      text.ground.options.emplace_back(k, join(texts_of(value, fmt::format("{}: ground.{}", what, k), "\"Omega\""), ", "));
     }
   }
 

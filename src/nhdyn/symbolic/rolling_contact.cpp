@@ -225,12 +225,122 @@ class SurfaceGround final : public ContactGround {
   }
 };
 
+// Terrain Z = h(X, Y): a fixed smooth graph over the horizontal world plane. The contact point
+// P = (u, v, h(u, v)) is held by two coordinates of the model's own (named by `coordinates`), with
+// no inertia of their own, fixed by the two tangential components of body point - P
+// (docs/derivations/rolling-bodies.md section 8): A is singular, [D A; b] regular.
+class TerrainGround final : public ContactGround {
+ public:
+  std::string key() const override { return "terrain"; }
+  std::vector<std::string> options() const override { return {"coordinates"}; }
+  std::string example() const override {
+    return "ground = { terrain = \"0.05*sin(X)*cos(2*Y)\", coordinates = [\"u\", \"v\"] }";
+  }
+  void parse(const GroundText& text, const ContactParsers& p, const std::string& context,
+             ParsedGround& out) const override {
+    const Spec& spec = *p.spec;
+    const std::string written = text.value.at(0);
+    const GiNaC::symbol X("X"), Y("Y"), Z("Z");
+    const GiNaC::ex h = p.surface(written, Vector3{X, Y, Z}, text.where, context + ": terrain");
+    if (h.has(Z))
+      throw_model_error(text.where, context,
+                        fmt::format("the terrain \"{}\" contains Z: a terrain is the height Z = h(X, Y), a function of "
+                                    "X and Y only; write h without Z, or a surface g(X, Y, Z) = 0 as ground = {{ "
+                                    "surface = \"...\", side = \"outside\" }}",
+                                    written));
+    if (contact_has_coordinates(h, spec))
+      throw_model_error(text.where, context,
+                        fmt::format("the terrain \"{}\" depends on t or on a coordinate; a terrain is fixed: write it in "
+                                    "X, Y and the parameters",
+                                    written));
+    // Smooth: the contact's normal is grad h, and the equations take two more derivatives of it.
+    for (const GiNaC::ex& e : {h, h.diff(X), h.diff(Y)})
+      if (e.has(GiNaC::abs(GiNaC::wild())) || e.has(GiNaC::csgn(GiNaC::wild())) || e.has(GiNaC::step(GiNaC::wild())))
+        throw_model_error(text.where, context,
+                          fmt::format("the terrain \"{}\" is not differentiable (it uses abs): the contact's normal "
+                                      "and its derivatives must exist everywhere the body rolls; write a smooth "
+                                      "height, e.g. sqrt(X^2 + eps^2) for |X|",
+                                      written));
+    const std::string names = contact_option_of(text.options, "coordinates", "");
+    std::vector<std::string> at;
+    std::string current;
+    for (const char ch : names + ",") {
+      if (ch == ',') {
+        const std::size_t first = current.find_first_not_of(' '), last = current.find_last_not_of(' ');
+        if (first != std::string::npos) at.push_back(current.substr(first, last - first + 1));
+        current.clear();
+      } else {
+        current += ch;
+      }
+    }
+    if (at.size() != 2)
+      throw_model_error(text.where, context,
+                        fmt::format("a terrain needs the two coordinates that hold the contact point's X and Y, "
+                                    "declared in `coordinates` at the top of the file, e.g. {}; {}",
+                                    example(), names.empty() ? "none given" : fmt::format("\"{}\" given", names)));
+    for (std::size_t k = 0; k < 2; ++k) {
+      const auto found = std::find(spec.coordinates.begin(), spec.coordinates.end(), at[k]);
+      if (found == spec.coordinates.end()) {
+        const std::string nearest = nearest_name(at[k], spec.coordinates);
+        throw_model_error(text.where, context,
+                          fmt::format("'{}' is not a coordinate of the model; {}the contact point's X and Y need "
+                                      "coordinates of their own: add them to `coordinates` (the coordinates are: {})",
+                                      at[k], nearest.empty() ? "" : fmt::format("did you mean '{}'? ", nearest),
+                                      join(spec.coordinates)));
+      }
+      out.at[k] = static_cast<int>(found - spec.coordinates.begin());
+    }
+    if (out.at[0] == out.at[1])
+      throw_model_error(text.where, context,
+                        fmt::format("the contact point's X and Y need two different coordinates; '{}' is named twice",
+                                    at[0]));
+    out.height = h.subs(GiNaC::lst{X == spec.symbols.coordinate(out.at[0]), Y == spec.symbols.coordinate(out.at[1])});
+  }
+  void check(const ParsedContact&, const Spec&, const std::string&) const override {}
+  Touch touch(const ParsedContact& c, const PlacedFrame& F, const Spec& spec, const std::optional<Vector3>&,
+              const std::string&) const override {
+    Touch out;
+    const GiNaC::ex u = spec.symbols.coordinate(c.ground.at[0]), v = spec.symbols.coordinate(c.ground.at[1]);
+    const GiNaC::ex h = c.ground.height, hu = h.diff(GiNaC::ex_to<GiNaC::symbol>(u)),
+                    hv = h.diff(GiNaC::ex_to<GiNaC::symbol>(v));
+    const GiNaC::ex length = GiNaC::sqrt(1 + hu * hu + hv * hv);
+    const Vector3 ground_point = {u, v, h};
+    out.point = ground_point;
+    out.normal = {-hu / length, -hv / length, 1 / length};
+    // The tangents P_u, P_v of the graph: not unit, not orthogonal (a row may be scaled).
+    out.tangent1 = {1, 0, hu};
+    out.tangent2 = {0, 1, hv};
+    const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
+    // The body's point whose outward normal is -n (section 2, with n the terrain's normal at P);
+    // for a ball C - r n directly, without R R^T.
+    Vector3 body_point;
+    GiNaC::ex reach;
+    if (const std::optional<GiNaC::ex> r = c.shape->ball_radius(c.values)) {
+      body_point = subtract(C, scale(*r, out.normal));
+      reach = *r;
+    } else {
+      const ShapeSupport s = c.shape->support(c.values, multiply_transposed(F.rotation, out.normal));
+      body_point = add(C, multiply(F.rotation, s.point));
+      reach = s.reach;
+    }
+    out.gap = dot(out.normal, subtract(C, ground_point)) - reach;
+    const Vector3 apart = subtract(body_point, ground_point);
+    out.locate = {dot(out.tangent1, apart), dot(out.tangent2, apart)};
+    // The force acts at the body's point (the same as the ground's on the constraints): there the
+    // gap's gradient, the rolling rows and the force's moment agree at every state, also off the
+    // constraints, where the contact forces' consistency check at load looks.
+    out.point = body_point;
+    return out;
+  }
+};
+
 }  // namespace
 
 const std::vector<const ContactGround*>& contact_grounds() {
   static const PlaneGround plane;
   static const SurfaceGround surface;
-  static const std::vector<const ContactGround*> table = {&plane, &surface};
+  static const TerrainGround terrain;
+  static const std::vector<const ContactGround*> table = {&plane, &surface, &terrain};
   return table;
 }
 
@@ -343,6 +453,13 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
                                            "gap, in length units; --fix-initial moves the body onto the ground)",
                                            c.name)});
   }
+  // The contact point's coordinates on the ground, where they are coordinates (section 8).
+  for (std::size_t i = 0; i < touch.locate.size(); ++i)
+    out.constraints.push_back({fmt::format("{}_at{}", c.name, i + 1), ConstraintLevel::position,
+                               simplify_moderate(touch.locate[i]),
+                               fmt::format("contact '{}': the contact point on the ground is the body's point whose "
+                                           "normal is opposite to the ground's, tangential component {}",
+                                           c.name, i + 1)});
   // Rolling: the material point of the body at P has the ground's velocity there (section 4.2).
   const Vector3 vP = add(time_derivative(F.origin, spec.symbols), cross(F.omega, subtract(touch.point, F.origin)));
   const Vector3 relative = subtract(vP, touch.ground_velocity);
