@@ -68,7 +68,7 @@ TEST(RollingTerrainCli, UnknownContactCoordinate) {
   expect_terrain_refused(simulate_bump("coordinate", {{"coordinates = [\"u\", \"v\"]", "coordinates = [\"u\", \"vv\"]"}}),
                  {"bump.toml:46:10", "'vv' is not a coordinate", "did you mean 'v'?"});
   expect_terrain_refused(simulate_bump("missing", {{", coordinates = [\"u\", \"v\"]", ""}}),
-                 {"bump.toml:46:10", "a terrain needs the two coordinates", "none given"});
+                 {"bump.toml:46:10", "a terrain needs the 2 coordinates", "none given"});
 }
 
 TEST(RollingTerrainCli, StartOffTheTerrainGivesTheGap) {

@@ -106,6 +106,7 @@ struct RollingContact {
   };
   std::vector<Row> constraints;   // NAME_contact (the gap; left out when it holds identically),
                                   // NAME_at1, NAME_at2 on terrain (the contact point's coordinates),
+                                  // NAME_on, NAME_normal1, NAME_normal2 for an implicit surface,
                                   // NAME_roll1, NAME_roll2, and NAME_spin for rubber
   ContactPoint force;             // for the contact forces (system left for the builder to set)
   Vector3 point;                  // the contact point P, world
@@ -135,7 +136,8 @@ class ContactGround {
     // Position rows that hold the coordinates of the contact point on the ground (terrain: the
     // two tangential components of body point - ground point, rolling-bodies.md section 8); none
     // when the contact point is a closed form in the body's coordinates.
-    std::vector<GiNaC::ex> locate;
+    // Each row with the suffix of its constraint's name (NAME_at1, ...).
+    std::vector<std::pair<std::string, GiNaC::ex>> locate;
   };
   virtual Touch touch(const ParsedContact& contact, const PlacedFrame& frame, const Spec& spec,
                       const std::optional<Vector3>& gravity, const std::string& context) const = 0;
