@@ -74,10 +74,23 @@ int implicit_column(const Model& model, const std::string& name) {
   return 0;
 }
 
+// The same on the terrain h = 0 (both contact points coordinates: px, py, pz on the body, u, v on
+// the ground; rolling-bodies.md sections 8 and 9).
+std::string implicit_ellipsoid_on_terrain_text() {
+  std::string text = implicit_ellipsoid_text();
+  replace_once(text, "\"px\", \"py\", \"pz\"]\ngravity", "\"px\", \"py\", \"pz\", \"u\", \"v\"]\ngravity");
+  replace_once(text, "coordinates = [\"px\", \"py\", \"pz\"] }\n",
+               "coordinates = [\"px\", \"py\", \"pz\"] }\nground = { terrain = \"0*X\", coordinates = [\"u\", \"v\"] }\n");
+  replace_once(text, "py = 0, ", "py = 0, u = \"(a^2 - c^2)*sin(tilt)*cos(tilt)/sqrt(a^2*sin(tilt)^2 + c^2*cos(tilt)^2)\", v = 0, ");
+  return text;
+}
+
 TEST(RollingImplicit, EllipsoidAsASurfaceFollowsTheClosedFormEllipsoid) {
   const Model closed = load_model(std::string(NHDYN_SOURCE_DIR) + "/examples/ellipsoid_rocking.toml", {{"tilt", 0.3}});
-  const Model implicit = load_model_text(implicit_ellipsoid_text(), "<implicit>", {{"tilt", 0.3}});
-  for (const bool turned : {false, true}) {
+  const Model on_plane = load_model_text(implicit_ellipsoid_text(), "<implicit>", {{"tilt", 0.3}});
+  const Model on_terrain = load_model_text(implicit_ellipsoid_on_terrain_text(), "<implicit>", {{"tilt", 0.3}});
+  for (const auto& [implicit, turned] : {std::pair<const Model&, bool>{on_plane, false}, {on_plane, true},
+                                         {on_terrain, false}, {on_terrain, true}}) {
     const std::vector<std::vector<double>> a = implicit_run(closed, turned), b = implicit_run(implicit, turned);
     ASSERT_EQ(a.size(), 101u);
     ASSERT_EQ(b.size(), a.size());

@@ -66,8 +66,9 @@ position = { x = ")toml" +
 )toml";
 }
 
-// Rolling straight down the slope (rolling-bodies.md (6.8)): the centre accelerates along d = (cos(alpha), 0, -sin(alpha))
-// at a = g sin(alpha) / (1 + J / (m rho^2)), rho the distance from the centre to the contact (R + r
+// Rolling straight down the slope (rolling-bodies.md (6.8)): the centre accelerates along
+// d = (cos(alpha), 0, -sin(alpha)) at a = g sin(alpha) / (1 + J / (m rho^2)), rho the distance
+// from the centre to the contact (R + r
 // for the torus: the tube's radius adds to the rim's), and turns at phi' = s' / rho; the ground
 // pushes N = m g cos(alpha) and holds the wheel back with m g sin(alpha) k / (1 + k), k = J/(m rho^2).
 void check_incline(const std::string& shape, const std::string& reach_text, double rho) {
