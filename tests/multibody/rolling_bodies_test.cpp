@@ -278,34 +278,108 @@ TEST(RollingBodies, ChaplyginBallKeepsItsIntegrals) {
   EXPECT_LT(summary.energy_drift, 1e-10);
 }
 
-// Kane and Levinson's rattleback, spun at -5 rad/s: it rocks, stops turning and turns the other way
-// faster than 4 rad/s within 10 s; the contact does no work, so the energy stays (the constraints
-// are held by projection, the integration's drift of the position level being what would
-// otherwise do work).
+// Kane and Levinson's rattleback, spun at -5 rad/s: it rocks, stops turning and turns the other way;
+// the contact does no work, so the energy stays (the constraints are held by projection, the
+// integration's drift of the position level being what would otherwise do work). The reference
+// is the independent Newton-Euler model of docs/derivations/checks/rolling_rattleback.py from the
+// example's start (rolling_bodies_review.md note 4): psi' first changes sign at 2.351541 s, is
+// +4.320337 rad/s at 5 s and stays within [-5.3153, +5.3969] over 10 s.
 TEST(RollingBodies, RattlebackReversesItsSpinAndKeepsItsEnergy) {
   const Model model = load_model(example("rattleback.toml"));
   const ResultColumns columns = make_result_columns(model);
-  const int spin = column(columns, "psi'");
+  const int spin = column(columns, "psi'"), spin_rate = column(columns, "psi''");
   SimulationOptions options;
   options.t_end = 10.0;
-  options.output_step = 0.05;
+  options.output_step = 1e-3;
   options.integrator.rtol = 1e-10;
   options.integrator.atol = 1e-12;
   options.stabilization = Stabilization::projection;
   std::vector<double> row;
-  double lowest = 0.0, highest = 0.0, first_positive = -1.0;
+  double lowest = 0.0, highest = 0.0, reversal = -1.0, at_5 = 0.0;
+  double t0 = 0.0, w0 = 0.0, dw0 = 0.0;
   const SimulationSummary summary = simulate(model, options, [&](const Data& data) {
     fill_result_row(model, data, row);
-    const double w = row[static_cast<std::size_t>(spin)];
+    const double w = row[static_cast<std::size_t>(spin)], dw = row[static_cast<std::size_t>(spin_rate)];
     lowest = std::min(lowest, w);
     highest = std::max(highest, w);
-    if (w > 0 && first_positive < 0) first_positive = data.t;
+    // The crossing on the cubic Hermite interpolant of psi' and psi'' over the 1 ms step (the
+    // rocking at ~110 rad/s makes a linear one err by ~1e-5 s), by bisection.
+    if (reversal < 0 && w0 < 0 && w >= 0) {
+      const double h = data.t - t0;
+      const auto cubic = [&](double s) {
+        const double s2 = s * s, s3 = s2 * s;
+        return (2 * s3 - 3 * s2 + 1) * w0 + (s3 - 2 * s2 + s) * h * dw0 + (-2 * s3 + 3 * s2) * w + (s3 - s2) * h * dw;
+      };
+      double lo = 0.0, hi = 1.0;
+      for (int i = 0; i < 60; ++i) (cubic((lo + hi) / 2) < 0 ? lo : hi) = (lo + hi) / 2;
+      reversal = t0 + h * (lo + hi) / 2;
+    }
+    if (std::abs(data.t - 5.0) < 1e-9) at_5 = w;
+    t0 = data.t;
+    w0 = w;
+    dw0 = dw;
   });
-  EXPECT_LT(lowest, -4.9);
-  EXPECT_GT(highest, 4.0);
-  EXPECT_GT(first_positive, 0.5);
-  EXPECT_LT(first_positive, 4.0);
+  EXPECT_NEAR(reversal, 2.351541, 2e-6);
+  EXPECT_NEAR(at_5, 4.320337, 2e-6);
+  // The review's range was read on a coarser grid: the 1 ms grid reaches at least as far.
+  EXPECT_LT(lowest, -5.3153);
+  EXPECT_GT(lowest, -5.33);
+  EXPECT_GT(highest, 5.3969);
+  EXPECT_LT(highest, 5.41);
   EXPECT_LT(summary.energy_drift, 1e-9 * summary.energy_initial);
+}
+
+// The rattleback's linearization about upright spin psi' = s against the closed-form quartic of
+// rolling_bodies_review.md note 4 (derived from the exact contact: rho1 = a^2/c, rho2 = b^2/c,
+// ell = c - h). Its roots at s = +5 are -2.120692 +- 109.392323 i and +0.202521 +- 34.143692 i
+// (the slow pair grows: this sense is unstable, the reversal's seed); at s = -5 their negatives.
+// Every other eigenvalue is zero (the symmetry and the family of upright spins).
+TEST(RollingBodies, RattlebackEigenvaluesAboutUprightSpinSolveTheClosedFormQuartic) {
+  for (const double s : {5.0, -5.0}) {
+    const Model model = load_model(example("rattleback.toml"), {{"tilt", 0.0}, {"spin", s}});
+    const double m = parameter(model, "m"), g = parameter(model, "g"), a = parameter(model, "a"),
+                 b = parameter(model, "b"), c = parameter(model, "c"), h = parameter(model, "h");
+    const double A = m * parameter(model, "A"), B = m * parameter(model, "B"), C = m * parameter(model, "C"),
+                 D = m * parameter(model, "D");
+    const double rho1 = a * a / c, rho2 = b * b / c, ell = c - h;
+    const double A1 = A + m * ell * ell, B1 = B + m * ell * ell;
+    const double P1 = m * g * (rho1 - ell), P2 = m * g * (rho2 - ell);
+    const double Ap = A1 - C - m * ell * rho1, Bp = B1 - C - m * ell * rho2;
+    const double Delta = A1 * B1 - D * D, Deltap = Ap * Bp - D * D;
+    const std::array<double, 5> coefficient = {P1 * P2 - s * s * (P1 * Bp + P2 * Ap) + Deltap * s * s * s * s,
+                                               -D * m * ell * (rho1 - rho2) * s * s * s,
+                                               A1 * P1 + B1 * P2 + (Delta + Deltap) * s * s,
+                                               -D * m * ell * (rho1 - rho2) * s, Delta};
+    // The heading enters the rolling rows (world tangents) but, by symmetry, not the reduced
+    // dynamics: it is cyclic with x and y.
+    LinearizationOptions lin;
+    lin.cyclic = {"psi"};
+    const Linearization l = calc_linearization(model, lin);
+    std::vector<std::complex<double>> nontrivial;
+    for (const std::complex<double>& e : l.eigenvalues) {
+      if (std::abs(e) > 1.0) nontrivial.push_back(e);
+      else EXPECT_LT(std::abs(e), 1e-6) << e;
+    }
+    ASSERT_EQ(nontrivial.size(), 4u);
+    for (const std::complex<double>& e : nontrivial) {
+      std::complex<double> value = 0.0, power = 1.0;
+      double scale = 0.0;
+      for (const double k : coefficient) {
+        value += k * power;
+        scale += std::abs(k) * std::abs(power);
+        power *= e;
+      }
+      EXPECT_LT(std::abs(value), 1e-10 * scale) << "eigenvalue " << e << " at spin " << s;
+    }
+    // The figures of the review, for the sense s: the fast pair and the slow pair.
+    const double sign = s > 0 ? 1.0 : -1.0;
+    bool fast = false, slow = false;
+    for (const std::complex<double>& e : nontrivial) {
+      fast = fast || (std::abs(e.real() - sign * -2.120692) < 1e-6 && std::abs(std::abs(e.imag()) - 109.392323) < 1e-6);
+      slow = slow || (std::abs(e.real() - sign * 0.202521) < 1e-6 && std::abs(std::abs(e.imag()) - 34.143692) < 1e-6);
+    }
+    EXPECT_TRUE(fast && slow) << "spin " << s;
+  }
 }
 
 }  // namespace

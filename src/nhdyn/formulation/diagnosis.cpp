@@ -85,7 +85,8 @@ std::string explain_inertia_sparse(const Model& model, const Data& data) {
   return fmt::format(
       "the inertia matrix A is not positive definite at t = {:.6g} (smallest pivot of its LDL^T factorization "
       "{:.6g}, largest {:.6g}; asymmetry |A - A^T| = {:.3g}; n = {} coordinates). Check the kinetic energy: every "
-      "coordinate needs a velocity term, and masses and inertias must be positive.",
+      "coordinate needs a velocity term, and masses and inertias must be positive (a coordinate without inertia "
+      "of its own needs constraints that fix it: A may be singular only where [D A; b] is regular).",
       data.t, smallest, largest, asymmetry, model.n());
 }
 
@@ -102,9 +103,10 @@ std::string explain_dependent_constraints(const Model& model, const Data& data) 
     // A left singular vector with a small singular value combines rows of b to (almost) zero.
     for (int i = 0; i < model.s(); ++i)
       if (std::abs(svd.matrixU()(i, j)) > 1e-8) {
-        const std::string& name = model.constraints[static_cast<std::size_t>(i)].name;
-        if (involved.find("'" + name + "'") == std::string::npos)
-          involved += (involved.empty() ? "" : ", ") + ("'" + name + "'");
+        const Constraint& c = model.constraints[static_cast<std::size_t>(i)];
+        if (involved.find("'" + c.name + "'") == std::string::npos)
+          involved += (involved.empty() ? "" : ", ") + ("'" + c.name + "'") +
+                      (c.where.empty() ? "" : " (" + c.where + ")");
       }
   }
   const double condition = smallest > 0.0 ? largest / smallest : std::numeric_limits<double>::infinity();
@@ -115,15 +117,50 @@ std::string explain_dependent_constraints(const Model& model, const Data& data) 
       involved.empty() ? std::string("(all)") : involved, data.t, model.s(), condition);
 }
 
+// A singular A whose null directions the constraints do not all remove: the coordinates moving
+// along the free direction of N^T A N, or "" when A is not singular that way.
+std::string explain_free_massless_motion(const Model& model, const Data& data) {
+  if (model.s() == 0 || data.sparse) return "";
+  // Only a positive semidefinite A (an indefinite one is a wrong kinetic energy: said below).
+  Eigen::SelfAdjointEigenSolver<Matrix> of_a(data.A, Eigen::EigenvaluesOnly);
+  const Vector& a_values = of_a.eigenvalues();
+  if (a_values.size() == 0 || a_values(0) < -1e-12 * std::max(1.0, std::abs(a_values(a_values.size() - 1))))
+    return "";
+  Eigen::FullPivLU<Matrix> lu(data.b);
+  if (lu.rank() == model.n()) return "";
+  const Matrix N = lu.kernel();
+  Eigen::SelfAdjointEigenSolver<Matrix> eig(N.transpose() * data.A * N);
+  const Vector& values = eig.eigenvalues();
+  const double floor = 1e-10 * std::max(1.0, values.size() > 0 ? std::abs(values(values.size() - 1)) : 0.0);
+  if (values.size() == 0 || std::abs(values(0)) > floor) return "";
+  // Every free direction (the eigenvalues at zero), by the coordinates that carry it.
+  Vector weight = Vector::Zero(model.n());
+  for (Eigen::Index j = 0; j < values.size() && std::abs(values(j)) <= floor; ++j) {
+    const Vector z = N * eig.eigenvectors().col(j);
+    weight = weight.cwiseMax(z.cwiseAbs() / z.cwiseAbs().maxCoeff());
+  }
+  std::string coords;
+  for (int i = 0; i < model.n(); ++i)
+    if (weight(i) > 0.1) coords += (coords.empty() ? "" : ", ") + model.coordinates[static_cast<std::size_t>(i)];
+  return fmt::format(
+      "the inertia matrix A is singular at t = {:.6g} and the constraints do not fix the velocities it leaves out: "
+      "a motion of {} has no kinetic energy and no constraint holds it, so [D A; b] is singular. A coordinate "
+      "without inertia of its own needs constraints that fix it; the contact coordinates of a terrain are fixed "
+      "only where the contact point is unique (not where the body is as curved as a hollow of the ground)",
+      data.t, coords);
+}
+
 std::string explain_inertia(const Model& model, const Data& data) {
   if (sparse_checks(model, data)) return explain_inertia_sparse(model, data);
+  if (std::string free = explain_free_massless_motion(model, data); !free.empty()) return free;
   Eigen::SelfAdjointEigenSolver<Matrix> eig(data.A, Eigen::EigenvaluesOnly);
   std::string coords;
   for (const std::string& c : model.coordinates) coords += (coords.empty() ? "" : ", ") + c;
   return fmt::format(
       "the inertia matrix A is not positive definite at t = {:.6g} (smallest eigenvalue {:.6g}, "
       "largest {:.6g}; coordinates {}). Check the kinetic energy: every coordinate needs a "
-      "velocity term, and masses and inertias must be positive.",
+      "velocity term, and masses and inertias must be positive (a coordinate without inertia of its own needs "
+      "constraints that fix it: A may be singular only where [D A; b] is regular).",
       data.t, eig.eigenvalues()(0), eig.eigenvalues()(eig.eigenvalues().size() - 1), coords);
 }
 
@@ -145,6 +182,24 @@ bool a_is_positive_definite(const Model& model, const Data& data) {
   }
   Eigen::LLT<Matrix> llt(data.A);
   return llt.info() == Eigen::Success && data.A.isApprox(data.A.transpose(), 1e-12);
+}
+
+// A singular A that is positive definite on the velocities the constraints allow (N^T A N > 0, N
+// a basis of the null space of b) still makes [D A; b] regular for every complement D, and the Do
+// Sanh form needs no inverse of A: coordinates with no inertia of their own, held by constraints
+// (the surface parameters of a rolling contact, docs/derivations/rolling-bodies.md section 8).
+// Checked only when A is not positive definite; dense (O(n^3)).
+bool a_is_positive_definite_on_the_constraints(const Model& model, const Data& data) {
+  if (model.s() == 0) return false;
+  const Matrix A = data.sparse ? Matrix(data.A_sparse) : data.A;
+  if (!A.isApprox(A.transpose(), 1e-12)) return false;
+  const Matrix b = data.sparse ? Matrix(data.b_sparse) : data.b;
+  Eigen::FullPivLU<Matrix> lu(b);
+  const Matrix N = lu.kernel();
+  if (lu.rank() == model.n()) return true;  // the constraints fix every velocity
+  const Matrix reduced = N.transpose() * A * N;
+  Eigen::LLT<Matrix> llt(reduced);
+  return llt.info() == Eigen::Success;
 }
 
 }  // namespace
@@ -184,8 +239,13 @@ std::string explain_failure(const Model& model, const Data& data) {
 }
 
 Status check_terms(const Model& model, Data& data) {
-  if (!a_is_positive_definite(model, data))
-    return record_failure(data, Status::inertia_not_positive_definite, "inertia matrix A");
+  if (!a_is_positive_definite(model, data)) {
+    // A singular A is judged on the constraints, so dependent constraints are the first thing to say.
+    if (model.s() > 0 && b_is_rank_deficient(model, data))
+      return record_failure(data, Status::dependent_constraints, "constraint matrix b");
+    if (!a_is_positive_definite_on_the_constraints(model, data))
+      return record_failure(data, Status::inertia_not_positive_definite, "inertia matrix A");
+  }
   if (model.s() > 0 && b_is_rank_deficient(model, data))
     return record_failure(data, Status::dependent_constraints, "constraint matrix b");
   return Status::ok;

@@ -15,8 +15,9 @@ namespace nhdyn {
 // Explains data.status for the state held in data (terms must have been computed for it).
 std::string explain_failure(const Model& model, const Data& data);
 
-// Checks the terms in data (after compute_terms): A symmetric positive definite and b of full
-// row rank. Returns the first problem found, recording it in data, or Status::ok.
+// Checks the terms in data (after compute_terms): A symmetric positive definite, or, where it is
+// singular, positive definite on the velocities the constraints allow ([D A; b] regular), and b
+// of full row rank. Returns the first problem found, recording it in data, or Status::ok.
 Status check_terms(const Model& model, Data& data);
 
 // compute_terms at (t, q, v) then check_terms; throws ModelError with explain_failure's words.

@@ -153,7 +153,7 @@ class ContactReader {
     for (auto&& [key, value] : *table) {
       const std::string k(key.str());
       if (k == text.shape) continue;
-      text.shape_options.emplace_back(k, string_of(value, fmt::format("{}: shape.{}", what, k), "\"y\""));
+      text.shape_options.emplace_back(k, join(texts_of(value, fmt::format("{}: shape.{}", what, k), "\"y\""), ", "));
     }
   }
 
@@ -188,7 +188,7 @@ class ContactReader {
     for (auto&& [key, value] : *table) {
       const std::string k(key.str());
       if (k == text.ground.key) continue;
-      text.ground.options.emplace_back(k, text_of(value, fmt::format("{}: ground.{}", what, k), "\"Omega\""));
+      text.ground.options.emplace_back(k, join(texts_of(value, fmt::format("{}: ground.{}", what, k), "\"Omega\""), ", "));
     }
   }
 

@@ -77,6 +77,22 @@ class Torus final : public ContactShape {
   std::optional<VisualKind> drawing() const override { return VisualKind::wheel; }
 };
 
+// A smooth, strictly convex surface f(X, Y, Z) = 0 in the body's axes (f < 0 inside). The contact
+// point y is three coordinates of the model: the support point is y itself, its reach -nu . y.
+class ImplicitSurface final : public ContactShape {
+ public:
+  std::string key() const override { return "surface"; }
+  int size_count() const override { return 1; }
+  std::vector<std::string> size_names() const override { return {"f"}; }
+  std::vector<std::string> options() const override { return {"coordinates"}; }
+  std::string example() const override {
+    return "shape = { surface = \"X^2/a^2 + Y^4/b^4 + Z^2/c^2 - 1\", coordinates = [\"px\", \"py\", \"pz\"] }";
+  }
+  bool implicit() const override { return true; }
+  ShapeSupport support(const ShapeValues& v, const Vector3& nu) const override { return {v.point, -dot(nu, v.point)}; }
+  GiNaC::ex length(const ShapeValues&) const override { return 1; }
+};
+
 }  // namespace
 
 const std::vector<const ContactShape*>& contact_shapes() {
@@ -84,7 +100,8 @@ const std::vector<const ContactShape*>& contact_shapes() {
   static const Ellipsoid ellipsoid;
   static const Disk disk;
   static const Torus torus;
-  static const std::vector<const ContactShape*> table = {&sphere, &ellipsoid, &disk, &torus};
+  static const ImplicitSurface surface;
+  static const std::vector<const ContactShape*> table = {&sphere, &ellipsoid, &disk, &torus, &surface};
   return table;
 }
 

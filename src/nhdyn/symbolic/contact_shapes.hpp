@@ -9,6 +9,7 @@
 
 #include <ginac/ginac.h>
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,6 +23,11 @@ namespace nhdyn::symbolic {
 struct ShapeValues {
   std::vector<GiNaC::ex> sizes;  // sphere: r; ellipsoid: a, b, c; disk: r; torus: R, r
   int axis = -1;                 // disk, torus: 0, 1, 2 for the body's x, y, z
+  // An implicit surface: f in the three coordinates that hold the contact point in body axes
+  // (`point`, their symbols; `at`, their indices).
+  GiNaC::ex surface = 0;
+  Vector3 point = {0, 0, 0};
+  std::array<int, 3> at = {-1, -1, -1};
 };
 
 // The support mapping at the unit direction nu (body axes): the shape's point lowest along nu,
@@ -46,6 +52,10 @@ class ContactShape {
   virtual std::string example() const = 0;
   // y*(nu) and rho(nu) for a unit nu in body axes (docs/derivations/rolling-bodies.md section 2).
   virtual ShapeSupport support(const ShapeValues& values, const Vector3& nu) const = 0;
+  // An implicit surface f(X, Y, Z) = 0 (body axes): its contact point is not a closed form but
+  // three coordinates of the model, held by f = 0 and the normals' alignment
+  // (docs/derivations/rolling-bodies.md section 9). Its support() returns those coordinates.
+  virtual bool implicit() const { return false; }
   // The radius when the shape is a ball (the only shape offered on curved grounds so far).
   virtual std::optional<GiNaC::ex> ball_radius(const ShapeValues&) const { return std::nullopt; }
   // The size of the shape for the moment rows of the contact-force solve (a length).

@@ -91,6 +91,60 @@ Vector3 ground_plane_normal(const ParsedGround& ground, const Spec& spec, const 
   return {n[0] / norm, n[1] / norm, n[2] / norm};
 }
 
+// The coordinates named in an option's text ("u, v"): `count` of them, distinct, each a coordinate
+// of the model (docs/multibody.md: they hold a contact point).
+std::vector<int> contact_coordinates(const std::string& names, std::size_t count, const Spec& spec,
+                                     const SourceLocation& where, const std::string& context, const std::string& what,
+                                     const std::string& example) {
+  std::vector<std::string> at;
+  std::string current;
+  for (const char ch : names + ",") {
+    if (ch == ',') {
+      const std::size_t first = current.find_first_not_of(' '), last = current.find_last_not_of(' ');
+      if (first != std::string::npos) at.push_back(current.substr(first, last - first + 1));
+      current.clear();
+    } else {
+      current += ch;
+    }
+  }
+  if (at.size() != count)
+    throw_model_error(where, context,
+                      fmt::format("{} needs the {} coordinates that hold its contact point, declared in `coordinates` "
+                                  "at the top of the file, e.g. {}; {}",
+                                  what, count, example, names.empty() ? "none given" : fmt::format("\"{}\" given", names)));
+  std::vector<int> out;
+  for (const std::string& name : at) {
+    const auto found = std::find(spec.coordinates.begin(), spec.coordinates.end(), name);
+    if (found == spec.coordinates.end()) {
+      const std::string nearest = nearest_name(name, spec.coordinates);
+      throw_model_error(where, context,
+                        fmt::format("'{}' is not a coordinate of the model; {}the contact point needs coordinates of "
+                                    "its own: add them to `coordinates` (the coordinates are: {})",
+                                    name, nearest.empty() ? "" : fmt::format("did you mean '{}'? ", nearest),
+                                    join(spec.coordinates)));
+    }
+    const int index = static_cast<int>(found - spec.coordinates.begin());
+    if (std::find(out.begin(), out.end(), index) != out.end())
+      throw_model_error(where, context,
+                        fmt::format("the contact point needs {} different coordinates; '{}' is named twice", count, name));
+    out.push_back(index);
+  }
+  return out;
+}
+
+// The rows that hold an implicit shape's contact point y (body axes) where the ground's normal is
+// n with tangents t1, t2: f(y) = 0 and (R grad f(y)) . t_k = 0 (rolling-bodies.md section 9).
+void implicit_shape_rows(const ParsedContact& c, const PlacedFrame& F, const Vector3& t1, const Vector3& t2,
+                         ContactGround::Touch& out) {
+  const ShapeValues& v = c.values;
+  Vector3 gradient;
+  for (std::size_t i = 0; i < 3; ++i) gradient[i] = v.surface.diff(GiNaC::ex_to<GiNaC::symbol>(v.point[i]));
+  const Vector3 world = multiply(F.rotation, gradient);
+  out.locate.push_back({"_on", v.surface});
+  out.locate.push_back({"_normal1", dot(world, t1)});
+  out.locate.push_back({"_normal2", dot(world, t2)});
+}
+
 // ---- Grounds --------------------------------------------------------------------------------
 
 // The plane through the origin, fixed or turning about its normal (a turntable).
@@ -129,6 +183,7 @@ class PlaneGround final : public ContactGround {
     for (GiNaC::ex& e : out.tangent1) e = simplify(e);
     out.tangent2 = cross(n, out.tangent1);
     for (GiNaC::ex& e : out.tangent2) e = simplify(e);
+    if (c.shape->implicit()) implicit_shape_rows(c, F, out.tangent1, out.tangent2, out);
     return out;
   }
 };
@@ -225,12 +280,93 @@ class SurfaceGround final : public ContactGround {
   }
 };
 
+// Terrain Z = h(X, Y): a fixed smooth graph over the horizontal world plane. The contact point
+// P = (u, v, h(u, v)) is held by two coordinates of the model's own (named by `coordinates`), with
+// no inertia of their own, fixed by the two tangential components of body point - P
+// (docs/derivations/rolling-bodies.md section 8): A is singular, [D A; b] regular.
+class TerrainGround final : public ContactGround {
+ public:
+  std::string key() const override { return "terrain"; }
+  std::vector<std::string> options() const override { return {"coordinates"}; }
+  std::string example() const override {
+    return "ground = { terrain = \"0.05*sin(X)*cos(2*Y)\", coordinates = [\"u\", \"v\"] }";
+  }
+  void parse(const GroundText& text, const ContactParsers& p, const std::string& context,
+             ParsedGround& out) const override {
+    const Spec& spec = *p.spec;
+    const std::string written = text.value.at(0);
+    const GiNaC::symbol X("X"), Y("Y"), Z("Z");
+    const GiNaC::ex h = p.surface(written, Vector3{X, Y, Z}, text.where, context + ": terrain");
+    if (h.has(Z))
+      throw_model_error(text.where, context,
+                        fmt::format("the terrain \"{}\" contains Z: a terrain is the height Z = h(X, Y), a function of "
+                                    "X and Y only; write h without Z, or a surface g(X, Y, Z) = 0 as ground = {{ "
+                                    "surface = \"...\", side = \"outside\" }}",
+                                    written));
+    if (contact_has_coordinates(h, spec))
+      throw_model_error(text.where, context,
+                        fmt::format("the terrain \"{}\" depends on t or on a coordinate; a terrain is fixed: write it in "
+                                    "X, Y and the parameters",
+                                    written));
+    // Smooth: the contact's normal is grad h, and the equations take two more derivatives of it.
+    for (const GiNaC::ex& e : {h, h.diff(X), h.diff(Y)})
+      if (e.has(GiNaC::abs(GiNaC::wild())) || e.has(GiNaC::csgn(GiNaC::wild())) || e.has(GiNaC::step(GiNaC::wild())))
+        throw_model_error(text.where, context,
+                          fmt::format("the terrain \"{}\" is not differentiable (it uses abs): the contact's normal "
+                                      "and its derivatives must exist everywhere the body rolls; write a smooth "
+                                      "height, e.g. sqrt(X^2 + eps^2) for |X|",
+                                      written));
+    const std::vector<int> at = contact_coordinates(contact_option_of(text.options, "coordinates", ""), 2, spec,
+                                                    text.where, context, "a terrain", example());
+    out.at = {at[0], at[1]};
+    out.height = h.subs(GiNaC::lst{X == spec.symbols.coordinate(out.at[0]), Y == spec.symbols.coordinate(out.at[1])});
+  }
+  void check(const ParsedContact&, const Spec&, const std::string&) const override {}
+  Touch touch(const ParsedContact& c, const PlacedFrame& F, const Spec& spec, const std::optional<Vector3>&,
+              const std::string&) const override {
+    Touch out;
+    const GiNaC::ex u = spec.symbols.coordinate(c.ground.at[0]), v = spec.symbols.coordinate(c.ground.at[1]);
+    const GiNaC::ex h = c.ground.height, hu = h.diff(GiNaC::ex_to<GiNaC::symbol>(u)),
+                    hv = h.diff(GiNaC::ex_to<GiNaC::symbol>(v));
+    const GiNaC::ex length = GiNaC::sqrt(1 + hu * hu + hv * hv);
+    const Vector3 ground_point = {u, v, h};
+    out.point = ground_point;
+    out.normal = {-hu / length, -hv / length, 1 / length};
+    // The tangents P_u, P_v of the graph: not unit, not orthogonal (a row may be scaled).
+    out.tangent1 = {1, 0, hu};
+    out.tangent2 = {0, 1, hv};
+    const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
+    // The body's point whose outward normal is -n (section 2, with n the terrain's normal at P);
+    // for a ball C - r n directly, without R R^T.
+    Vector3 body_point;
+    GiNaC::ex reach;
+    if (const std::optional<GiNaC::ex> r = c.shape->ball_radius(c.values)) {
+      body_point = subtract(C, scale(*r, out.normal));
+      reach = *r;
+    } else {
+      const ShapeSupport s = c.shape->support(c.values, multiply_transposed(F.rotation, out.normal));
+      body_point = add(C, multiply(F.rotation, s.point));
+      reach = s.reach;
+    }
+    out.gap = dot(out.normal, subtract(C, ground_point)) - reach;
+    const Vector3 apart = subtract(body_point, ground_point);
+    out.locate = {{"_at1", dot(out.tangent1, apart)}, {"_at2", dot(out.tangent2, apart)}};
+    if (c.shape->implicit()) implicit_shape_rows(c, F, out.tangent1, out.tangent2, out);
+    // The force acts at the body's point (the same as the ground's on the constraints): there the
+    // gap's gradient, the rolling rows and the force's moment agree at every state, also off the
+    // constraints, where the contact forces' consistency check at load looks.
+    out.point = body_point;
+    return out;
+  }
+};
+
 }  // namespace
 
 const std::vector<const ContactGround*>& contact_grounds() {
   static const PlaneGround plane;
   static const SurfaceGround surface;
-  static const std::vector<const ContactGround*> table = {&plane, &surface};
+  static const TerrainGround terrain;
+  static const std::vector<const ContactGround*> table = {&plane, &surface, &terrain};
   return table;
 }
 
@@ -246,6 +382,35 @@ std::string contact_unknown_key(const std::string& what, const std::string& key,
   const std::string nearest = nearest_name(key, known);
   return fmt::format("unknown {} '{}'; {}choose one of: {}", what, key,
                      nearest.empty() ? "" : fmt::format("did you mean '{}'? ", nearest), join(known));
+}
+
+// shape = { surface = "f(X, Y, Z)", coordinates = [...] }: f in the body's axes, smooth; the
+// coordinates that hold the contact point.
+void parse_implicit_shape(const ContactText& text, const ContactParsers& p, const std::string& context,
+                          ShapeValues& out) {
+  const Spec& spec = *p.spec;
+  const GiNaC::symbol X("X"), Y("Y"), Z("Z");
+  const std::string written = text.sizes.at(0);
+  const GiNaC::ex f = p.surface(written, Vector3{X, Y, Z}, text.shape_where, context + ": surface");
+  if (contact_has_coordinates(f, spec))
+    throw_model_error(text.shape_where, context,
+                      fmt::format("the surface \"{}\" depends on t or on a coordinate; a body's shape is fixed in its "
+                                  "axes: write it in X, Y, Z (body axes) and the parameters",
+                                  written));
+  for (const GiNaC::ex& e : {f, f.diff(X), f.diff(Y), f.diff(Z)})
+    if (e.has(GiNaC::abs(GiNaC::wild())) || e.has(GiNaC::csgn(GiNaC::wild())))
+      throw_model_error(text.shape_where, context,
+                        fmt::format("the surface \"{}\" is not differentiable (it uses abs): its normal and curvature "
+                                    "must exist at every point that may touch; write a smooth f",
+                                    written));
+  const std::vector<int> at = contact_coordinates(contact_option_of(text.shape_options, "coordinates", ""), 3, spec,
+                                                  text.shape_where, context, "a surface shape",
+                                                  find_contact_shape("surface")->example());
+  for (std::size_t i = 0; i < 3; ++i) {
+    out.at[i] = at[i];
+    out.point[i] = spec.symbols.coordinate(at[i]);
+  }
+  out.surface = f.subs(GiNaC::lst{X == out.point[0], Y == out.point[1], Z == out.point[2]});
 }
 
 }  // namespace
@@ -268,7 +433,8 @@ ParsedContact parse_contact(const ContactText& text, const ContactParsers& p) {
                       fmt::format("a {} takes {} ({}), e.g. {}; {} given", shape.key(),
                                   shape.size_count() == 1 ? "one size" : fmt::format("{} sizes", shape.size_count()),
                                   join(names), shape.example(), text.sizes.size()));
-  for (std::size_t i = 0; i < text.sizes.size(); ++i) {
+  if (shape.implicit()) parse_implicit_shape(text, p, context, out.values);
+  for (std::size_t i = 0; i < text.sizes.size() && !shape.implicit(); ++i) {
     const std::string what = fmt::format("{}: {} {}", context, shape.key(), names[i]);
     const GiNaC::ex size = p.constant(text.sizes[i], text.shape_where, what);
     const std::optional<double> v = contact_number_of(size, *p.spec);
@@ -346,6 +512,12 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
                                            "gap, in length units; --fix-initial moves the body onto the ground)",
                                            c.name)});
   }
+  // The contact point's coordinates on the ground, where they are coordinates (section 8).
+  for (const auto& [suffix, row] : touch.locate)
+    out.constraints.push_back({c.name + suffix, ConstraintLevel::position, simplify_moderate(row),
+                               fmt::format("contact '{}': the contact point is where the body's normal is opposite "
+                                           "to the ground's ({})",
+                                           c.name, suffix.substr(1))});
   // Rolling: the material point of the body at P has the ground's velocity there (section 4.2).
   const Vector3 vP = add(time_derivative(F.origin, spec.symbols), cross(F.omega, subtract(touch.point, F.origin)));
   const Vector3 relative = subtract(vP, touch.ground_velocity);

@@ -33,8 +33,10 @@ using KeyTexts = std::vector<std::pair<std::string, std::string>>;  // further k
 // The ground as written: ground = "plane", or a table whose identifying key is `key`.
 struct GroundText {
   std::string key = "plane";
-  std::vector<std::string> value;  // plane: the normal (3 expressions) or none; surface: g (one)
-  KeyTexts options;                // angular_velocity = "Omega", side = "inside"
+  std::vector<std::string> value;  // plane: the normal (3 expressions) or none; surface: g (one);
+                                   // terrain: h (one)
+  KeyTexts options;                // angular_velocity = "Omega", side = "inside", coordinates = "u, v"
+                                   // (an array option's elements joined by ", ")
   SourceLocation where;
 };
 
@@ -62,6 +64,8 @@ struct ParsedGround {
   GiNaC::ex centre_x = 0, centre_y = 0, centre_z = 0;  // surface (a sphere): its centre K
   GiNaC::ex radius = 0;             // surface: its radius R_g
   bool inside = false;              // surface: the body is inside the sphere (a bowl)
+  std::array<int, 2> at = {-1, -1};  // terrain: the coordinates holding the contact point's X and Y
+  GiNaC::ex height = 0;             // terrain: h(X, Y) at X, Y = those coordinates
   SourceLocation where;
 };
 
@@ -102,6 +106,8 @@ struct RollingContact {
     std::string text;
   };
   std::vector<Row> constraints;   // NAME_contact (the gap; left out when it holds identically),
+                                  // NAME_at1, NAME_at2 on terrain (the contact point's coordinates),
+                                  // NAME_on, NAME_normal1, NAME_normal2 for an implicit surface,
                                   // NAME_roll1, NAME_roll2, and NAME_spin for rubber
   ContactPoint force;             // for the contact forces (system left for the builder to set)
   Vector3 point;                  // the contact point P, world
@@ -129,6 +135,11 @@ class ContactGround {
     GiNaC::ex gap;
     Vector3 ground_velocity = {0, 0, 0}, ground_omega = {0, 0, 0};
     Vector3 tangent1, tangent2;
+    // Position rows that hold the coordinates of the contact point on the ground (terrain: the
+    // two tangential components of body point - ground point, rolling-bodies.md section 8); none
+    // when the contact point is a closed form in the body's coordinates.
+    // Each row with the suffix of its constraint's name (NAME_at1, ...).
+    std::vector<std::pair<std::string, GiNaC::ex>> locate;
   };
   virtual Touch touch(const ParsedContact& contact, const PlacedFrame& frame, const Spec& spec,
                       const std::optional<Vector3>& gravity, const std::string& context) const = 0;

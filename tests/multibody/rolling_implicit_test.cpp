@@ -1,0 +1,146 @@
+// An implicit shape ([[contacts]] with shape = { surface = "f(X, Y, Z)", coordinates = [...] }):
+// the contact point is three coordinates of the model held by f = 0 and the normals' alignment
+// (docs/derivations/rolling-bodies.md section 9). The ellipsoid written as f must give the
+// trajectory and the contact force of the closed-form ellipsoid (examples/ellipsoid_rocking.toml).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "nhdyn/analysis/simulation.hpp"
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/io/results.hpp"
+
+namespace nhdyn {
+namespace {
+
+std::string ellipsoid_example_text() {
+  std::ifstream in(std::string(NHDYN_SOURCE_DIR) + "/examples/ellipsoid_rocking.toml");
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void replace_once(std::string& text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
+}
+
+// The example with the ellipsoid written as the surface f = 0 and its contact point (px, py, pz)
+// started at the support point of the tilted ellipsoid (rolling-bodies.md section 2).
+std::string implicit_ellipsoid_text() {
+  std::string text = ellipsoid_example_text();
+  replace_once(text, "coordinates = [\"x\", \"y\", \"z\", \"psi\", \"theta\", \"phi\"]",
+               "coordinates = [\"x\", \"y\", \"z\", \"psi\", \"theta\", \"phi\", \"px\", \"py\", \"pz\"]");
+  replace_once(text, "shape = { ellipsoid = [\"a\", \"b\", \"c\"] }",
+               "shape = { surface = \"X^2/a^2 + Y^2/b^2 + Z^2/c^2 - 1\", coordinates = [\"px\", \"py\", \"pz\"] }");
+  replace_once(text, "phi = \"tilt\" }",
+               "phi = \"tilt\", px = \"a^2*sin(tilt)/sqrt(a^2*sin(tilt)^2 + c^2*cos(tilt)^2)\", py = 0, "
+               "pz = \"-c^2*cos(tilt)/sqrt(a^2*sin(tilt)^2 + c^2*cos(tilt)^2)\" }");
+  return text;
+}
+
+std::vector<std::vector<double>> implicit_run(const Model& model, bool turned) {
+  Model m = model;
+  SimulationOptions options;
+  options.t_end = 1.0;
+  options.output_step = 0.01;
+  options.integrator.rtol = 1e-12;
+  options.integrator.atol = 1e-14;
+  if (turned) {
+    m.v0(3) = 2.0;  // psi'
+    m.v0(4) = 1.0;  // theta'
+    options.fix_initial = true;  // the rolling velocities (and the contact point's) from these
+  }
+  std::vector<std::vector<double>> rows;
+  std::vector<double> row;
+  simulate(m, options, [&](const Data& data) {
+    fill_result_row(m, data, row);
+    rows.push_back(row);
+  });
+  return rows;
+}
+
+int implicit_column(const Model& model, const std::string& name) {
+  const ResultColumns columns = make_result_columns(model);
+  for (std::size_t i = 0; i < columns.all.size(); ++i)
+    if (columns.all[i] == name) return static_cast<int>(i);
+  ADD_FAILURE() << "no column " << name;
+  return 0;
+}
+
+// The same on the terrain h = 0 (both contact points coordinates: px, py, pz on the body, u, v on
+// the ground; rolling-bodies.md sections 8 and 9).
+std::string implicit_ellipsoid_on_terrain_text() {
+  std::string text = implicit_ellipsoid_text();
+  replace_once(text, "\"px\", \"py\", \"pz\"]\ngravity", "\"px\", \"py\", \"pz\", \"u\", \"v\"]\ngravity");
+  replace_once(text, "coordinates = [\"px\", \"py\", \"pz\"] }\n",
+               "coordinates = [\"px\", \"py\", \"pz\"] }\nground = { terrain = \"0*X\", coordinates = [\"u\", \"v\"] }\n");
+  replace_once(text, "py = 0, ", "py = 0, u = \"(a^2 - c^2)*sin(tilt)*cos(tilt)/sqrt(a^2*sin(tilt)^2 + c^2*cos(tilt)^2)\", v = 0, ");
+  return text;
+}
+
+TEST(RollingImplicit, EllipsoidAsASurfaceFollowsTheClosedFormEllipsoid) {
+  const Model closed = load_model(std::string(NHDYN_SOURCE_DIR) + "/examples/ellipsoid_rocking.toml", {{"tilt", 0.3}});
+  const Model on_plane = load_model_text(implicit_ellipsoid_text(), "<implicit>", {{"tilt", 0.3}});
+  const Model on_terrain = load_model_text(implicit_ellipsoid_on_terrain_text(), "<implicit>", {{"tilt", 0.3}});
+  for (const auto& [implicit, turned] : {std::pair<const Model&, bool>{on_plane, false}, {on_plane, true},
+                                         {on_terrain, false}, {on_terrain, true}}) {
+    const std::vector<std::vector<double>> a = implicit_run(closed, turned), b = implicit_run(implicit, turned);
+    ASSERT_EQ(a.size(), 101u);
+    ASSERT_EQ(b.size(), a.size());
+    double largest = 0.0, moved = 0.0;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      for (int i = 1; i <= 6; ++i) {  // x, y, z, psi, theta, phi
+        largest = std::max(largest, std::abs(a[k][static_cast<std::size_t>(i)] - b[k][static_cast<std::size_t>(i)]));
+        moved = std::max(moved, std::abs(a[k][static_cast<std::size_t>(i)] - a[0][static_cast<std::size_t>(i)]));
+      }
+      const double Na = a[k][static_cast<std::size_t>(implicit_column(closed, "foot_N"))];
+      const double Nb = b[k][static_cast<std::size_t>(implicit_column(implicit, "foot_N"))];
+      EXPECT_NEAR(Na, Nb, 1e-8 * 9.81) << k;
+      // The contact point, the same in both, on the ellipsoid.
+      for (const char* c : {"foot_X", "foot_Y", "foot_Z"})
+        EXPECT_NEAR(a[k][static_cast<std::size_t>(implicit_column(closed, c))],
+                    b[k][static_cast<std::size_t>(implicit_column(implicit, c))], 1e-9);
+    }
+    EXPECT_GT(moved, 0.05) << "turned " << turned;  // the test is not about a body at rest
+    EXPECT_LT(largest, 1e-9) << "turned " << turned;
+  }
+}
+
+// Not a function of the body's axes only, or not smooth: refused with the shape's file:line.
+TEST(RollingImplicit, BadSurfacesAreRefused) {
+  std::string text = implicit_ellipsoid_text();
+  replace_once(text, "Z^2/c^2 - 1\"", "Z^2/c^2 - 1 + x\"");
+  try {
+    load_model_text(text, "e.toml");
+    FAIL() << "expected ModelError";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("e.toml:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("depends on t or on a coordinate"), std::string::npos) << e.what();
+  }
+  text = implicit_ellipsoid_text();
+  replace_once(text, "X^2/a^2", "abs(X)^3/a^3");
+  try {
+    load_model_text(text, "e.toml");
+    FAIL() << "expected ModelError";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("is not differentiable"), std::string::npos) << e.what();
+  }
+  text = implicit_ellipsoid_text();
+  replace_once(text, "coordinates = [\"px\", \"py\", \"pz\"] }", "coordinates = [\"px\", \"py\"] }");
+  try {
+    load_model_text(text, "e.toml");
+    FAIL() << "expected ModelError";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("a surface shape needs the 3 coordinates"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace nhdyn
