@@ -56,16 +56,17 @@ class CommandPaths : public ::testing::Test {
   fs::path dir_;
 };
 
-constexpr const char* kInput = "an input of this run";
-constexpr const char* kSame = "are the same file";
+constexpr const char* kIsAnInput = "an input of this run";
+constexpr const char* kIsSameFile = "are the same file";
 
 TEST_F(CommandPaths, Compare) {
   expect_refused({"compare", "sled.toml", "--t-end", "0.2", "-o", "./sled.toml"}, "the model file 'sled.toml'",
-                 "'./sled.toml'", kInput);
-  expect_refused({"compare", "sled.toml", "--t-end", "0.2", "-o", "sled-link.toml"}, "the model file", "-o", kInput);
+                 "'./sled.toml'", kIsAnInput);
+  expect_refused({"compare", "sled.toml", "--t-end", "0.2", "-o", "sled-link.toml"}, "the model file 'sled.toml'",
+                 "the table CSV 'sled-link.toml'", kIsAnInput);
   // The series CSV goes beside the table: c.csv -> c-series.csv; --plot onto it.
   expect_refused({"compare", "sled.toml", "--t-end", "0.2", "-o", "c.csv", "--plot", "c-series.csv"},
-                 "the series CSV 'c-series.csv'", "--plot 'c-series.csv'", kSame);
+                 "the series CSV 'c-series.csv'", "--plot 'c-series.csv'", kIsSameFile);
 }
 
 TEST_F(CommandPaths, Sweep) {
@@ -76,35 +77,36 @@ TEST_F(CommandPaths, Sweep) {
     args.insert(args.end(), more.begin(), more.end());
     return args;
   };
-  expect_refused(with({"-o", "rolling_disk_upright.toml"}), "the model file", "-o", kInput);
+  expect_refused(with({"-o", "rolling_disk_upright.toml"}), "the model file",
+                 "the eigenvalue CSV 'rolling_disk_upright.toml'", kIsAnInput);
   expect_refused(with({"-o", "s.csv", "--plot", "./s-crossings.csv"}), "the crossings CSV 's-crossings.csv'",
-                 "--plot './s-crossings.csv'", kSame);
+                 "--plot './s-crossings.csv'", kIsSameFile);
 }
 
 TEST_F(CommandPaths, Study) {
   expect_refused({"study", "error-relation", "appell.toml", "-o", "appell.toml"}, "the model file", "appell.toml",
-                 kInput);
+                 kIsAnInput);
   expect_refused({"study", "error-relation", "appell.toml", "-o", "e.csv", "--plot", "e-by-tolerance.csv"},
-                 "the by-tolerance CSV 'e-by-tolerance.csv'", "--plot", kSame);
+                 "the by-tolerance CSV 'e-by-tolerance.csv'", "--plot", kIsSameFile);
   expect_refused({"study", "tracking", "sled_heading_program.toml", "-o", "t.csv", "--plot", "t.csv"},
-                 "the table CSV 't.csv'", "--plot 't.csv'", kSame);
+                 "the table CSV 't.csv'", "--plot 't.csv'", kIsSameFile);
   // The plot of R goes beside the plot of q'': p.png -> p-reactions.png.
   expect_refused({"study", "spread-masses", "spread_masses.toml", "--plot", "p.png", "-o", "p-reactions.png"},
-                 "the table CSV 'p-reactions.png'", "the reactions plot", kSame);
+                 "the table CSV 'p-reactions.png'", "the reactions plot", kIsSameFile);
   expect_refused({"study", "spread-masses", "spread_masses.toml", "-o", "spread_masses.toml"}, "the model file",
-                 "the table CSV", kInput);
+                 "the table CSV", kIsAnInput);
 }
 
 TEST_F(CommandPaths, Linearize) {
   expect_refused({"linearize", "rolling_disk_upright.toml", "--cyclic", "psi", "-o", "./rolling_disk_upright.toml"},
-                 "the model file", "-o './rolling_disk_upright.toml'", kInput);
+                 "the model file", "-o './rolling_disk_upright.toml'", kIsAnInput);
 }
 
 TEST_F(CommandPaths, Codegen) {
   expect_refused({"codegen", "sled.toml", "-o", "sled-hard.toml"}, "the model file 'sled.toml'",
-                 "-o 'sled-hard.toml'", kInput);
+                 "-o 'sled-hard.toml'", kIsAnInput);
   expect_refused({"codegen", "sled-link.toml", "-o", "sled.toml"}, "the model file 'sled-link.toml'",
-                 "-o 'sled.toml'", kInput);
+                 "-o 'sled.toml'", kIsAnInput);
   // A distinct output is written as before.
   const ProcessRun ok = nhdyn({"codegen", "sled.toml", "-o", "sled.hpp"});
   EXPECT_EQ(ok.code, 0) << ok.err;
