@@ -26,6 +26,7 @@ std::function<int()> add_codegen_command(CLI::App& app) {
   cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   return [args] {
     protect_model_file(args->model);
+    check_command_paths(args->model, {{args->output, "-o"}});
     AtomicFile file(args->output);  // refuses an unwritable path before deriving
     const auto description = load_description(read_model_source(args->model), parse_parameter_sets(args->sets));
     file.write(generate_model_code(*description, args->namespace_name));

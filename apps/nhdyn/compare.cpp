@@ -104,6 +104,7 @@ int run_compare(const CompareArgs& args) {
   if (args.output.empty()) make_parent_directory(table_path);
   fs::path series_path = table_path;
   series_path.replace_filename(table_path.stem().string() + "-series.csv");
+  check_command_paths(args.model, {{table_path, "the table CSV"}, {series_path, "the series CSV"}, {args.plot, "--plot"}});
   check_plot_possible(args.plot);
   AtomicFile table(table_path);  // both paths are checked before any run
   std::vector<std::string> columns{"t"};

@@ -33,6 +33,7 @@ std::string join_names(const std::vector<std::string>& names) {
 
 int run_linearize(const LinearizeArgs& args) {
   protect_model_file(args.model);
+  check_command_paths(args.model, {{args.output, "-o"}});
   const LoadedModel resolved = load_model_argument(args.model, args.sets);
   const Model& model = resolved.model;
   LinearizationOptions options;

@@ -12,6 +12,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/plot.hpp"
+#include "nhdyn/io/run_paths.hpp"
 
 namespace nhdyn::cli {
 namespace {
@@ -89,6 +90,15 @@ extern "C" void on_interrupt(int signal_number) {
 void protect_model_file(const std::string& model) {
   std::error_code ec;
   if (std::filesystem::is_regular_file(model, ec)) protect_input(model);
+}
+
+void check_command_paths(const std::string& model,
+                         const std::vector<std::pair<std::filesystem::path, std::string>>& outputs) {
+  RunPaths paths;
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(model, ec)) paths.input(model, "the model file");
+  for (const auto& [path, role] : outputs) paths.output(path, role);
+  paths.check();
 }
 
 void make_parent_directory(const std::filesystem::path& file) {

@@ -7,6 +7,8 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace CLI {
 class App;
@@ -17,6 +19,13 @@ namespace nhdyn::cli {
 // Registers the MODEL argument, when it names a file, as an input no output may replace
 // (io/atomic_file.hpp, protect_input). Call before opening any output.
 void protect_model_file(const std::string& model);
+
+// The one rule for a command's files (io/run_paths.hpp) for a command whose input is its model
+// file: refuses (FileError, naming both) an output that is the model or two outputs that are one
+// file. `outputs` pairs a path with the option that names it; empty paths are skipped. Call before
+// any work.
+void check_command_paths(const std::string& model,
+                         const std::vector<std::pair<std::filesystem::path, std::string>>& outputs);
 
 // Makes the directory that will hold `file` (and its parents); errors are left to the writer,
 // which names the path when it cannot open the file.

@@ -66,6 +66,8 @@ int run_error_relation(const ErrorRelationArgs& args) {
   namespace fs = std::filesystem;
   const fs::path table_path = args.output;
   const fs::path series_path = by_tolerance_path(table_path);
+  check_command_paths(args.model,
+                      {{table_path, "the table CSV"}, {series_path, "the by-tolerance CSV"}, {args.plot, "--plot"}});
   make_parent_directory(table_path);
   check_plot_possible(args.plot);
   if (options.formulations.empty()) options.formulations = calc_study_formulations(model);

@@ -61,6 +61,9 @@ int run_spread_masses(const SpreadMassesArgs& args) {
 
   namespace fs = std::filesystem;
   const fs::path table_path = args.output;
+  check_command_paths(args.model, {{table_path, "the table CSV"},
+                                   {args.plot, "--plot"},
+                                   {args.plot.empty() ? fs::path() : reactions_plot_path(args.plot), "the reactions plot"}});
   make_parent_directory(table_path);
   check_plot_possible(args.plot);
 

@@ -84,6 +84,8 @@ int run_sweep(const SweepArgs& args) {
   make_parent_directory(table_path);
   fs::path crossings_path = table_path;
   crossings_path.replace_filename(table_path.stem().string() + "-crossings.csv");
+  check_command_paths(args.model,
+                      {{table_path, "the eigenvalue CSV"}, {crossings_path, "the crossings CSV"}, {args.plot, "--plot"}});
   check_plot_possible(args.plot);
   AtomicFile table(table_path);  // both files can be written: checked before any work
   AtomicFile crossings_file(crossings_path);

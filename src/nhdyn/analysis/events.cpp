@@ -44,6 +44,7 @@ ModelEventFunctions::ModelEventFunctions(const Model& model, const std::vector<c
   x_.assign(static_cast<std::size_t>(2 * n_ + contact_columns_), 0.0);
   xd_.assign(static_cast<std::size_t>(2 * n_ + contact_columns_), 0.0);
   g_.assign(events_.size(), 0.0);
+  non_finite_.y.assign(static_cast<std::size_t>(2 * n_), 0.0);
 }
 
 CrossingDirection ModelEventFunctions::direction(int i) const {
@@ -75,10 +76,17 @@ Status ModelEventFunctions::run_all(double t, const double* y, double* g) {
 }
 
 Status ModelEventFunctions::evaluate(double t, const double* y, double* g) {
+  non_finite_.index = -1;
   const Status status = run_all(t, y, g);
   if (status != Status::ok) return status;
   for (std::size_t i = 0; i < programs_.size(); ++i)
-    if (!std::isfinite(g[i])) return Status::non_finite;
+    if (!std::isfinite(g[i])) {
+      non_finite_.index = static_cast<int>(i);
+      non_finite_.t = t;
+      non_finite_.g = g[i];
+      std::copy(y, y + 2 * n_, non_finite_.y.begin());
+      return Status::non_finite;
+    }
   return Status::ok;
 }
 

@@ -46,13 +46,23 @@ class ModelEventFunctions final : public EventFunctions {
 
   int count() const override { return static_cast<int>(events_.size()); }
   CrossingDirection direction(int i) const override;
-  // Non-finite g: Status::non_finite. Allocates nothing.
+  // Non-finite g: Status::non_finite, and non_finite() records which event, where. Allocates
+  // nothing (the record's state has its size from the constructor).
   Status evaluate(double t, const double* y, double* g) override;
   Status on_event(int i, double t, const double* y) override;
 
   const Event& event(int i) const { return *events_[static_cast<std::size_t>(i)]; }
   // The index of the stop event that ended the run, or -1.
   int stopped_by() const { return stopped_by_; }
+  // The first event whose value was not finite at the latest evaluate (index -1 when all were),
+  // with t, the value and the state y = [q; q'] (2n) there: for the message of a run it ends.
+  struct NonFinite {
+    int index = -1;
+    double t = 0.0;
+    double g = 0.0;
+    std::vector<double> y;
+  };
+  const NonFinite& non_finite() const { return non_finite_; }
 
   // Throws InputError when an event is exactly zero (or not finite) at (t0, q0, q'0), or a stop
   // condition (Event::condition) already holds there, naming the event, where it was written and
@@ -65,6 +75,7 @@ class ModelEventFunctions final : public EventFunctions {
   std::vector<Program> programs_;   // bound to the parameter values
   std::vector<double> registers_;
   std::vector<double> g_;
+  NonFinite non_finite_;
   Handler handler_;
   Dynamics dynamics_;
   bool needs_dynamics_ = false;

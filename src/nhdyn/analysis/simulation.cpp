@@ -16,6 +16,26 @@
 namespace nhdyn {
 namespace {
 
+// "x = 1, phi = 0.5, x' = 0, phi' = 2": the state where an output or an event was not finite.
+std::string describe_state(const Model& model, const double* q, const double* v) {
+  std::string text;
+  for (int i = 0; i < model.n(); ++i)
+    text += fmt::format("{}{} = {:.6g}", i == 0 ? "" : ", ", model.coordinates[static_cast<std::size_t>(i)], q[i]);
+  for (int i = 0; i < model.n(); ++i)
+    text += fmt::format(", {}' = {:.6g}", model.coordinates[static_cast<std::size_t>(i)], v[i]);
+  return text;
+}
+
+// The rule for a derived output or an event that is NaN or infinite during a run (docs/cli.md):
+// the run ends there, as a numerical failure, with this message; the rows before are kept.
+std::string non_finite_message(const std::string& kind, const std::string& where, const std::string& name,
+                               const std::string& expression, double value, double t, const std::string& state) {
+  const std::string text = std::isnan(value) ? "NaN" : fmt::format("{}", value);  // not "-nan"
+  return fmt::format("{}{} '{}' ({}) is {} at t = {:.6g}, where {}: it is not defined on this motion; write it in a "
+                     "form defined along the motion, or end the run before (--t-end, a stop event)",
+                     where.empty() ? "" : where + ": ", kind, name, expression, text, t, state);
+}
+
 // Outputs beyond this many rows are refused: at ~100 bytes a row that is a 10 GB file.
 constexpr double kMaxOutputs = 1e8;
 
@@ -299,6 +319,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   std::copy(v0.data(), v0.data() + n, y0.begin() + n);
   std::vector<double> y_out(states);
   Status output_failure = Status::ok;
+  std::string output_message;  // why output_failure, when it is not the dynamics' own failure
   const OutputFn output = [&](double t, const double* y) -> Status {
     if (options.stabilization == Stabilization::projection) {
       // Between step ends the integrator interpolates; the solution it reports is the projected one.
@@ -321,6 +342,14 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     compute_energy(model, data);
     compute_contact_forces(model, data);  // nothing for a model without contacts
     compute_outputs(model, data);
+    for (int i = 0; i < model.outputs.count(); ++i)
+      if (!std::isfinite(data.outputs.values(i))) {
+        const DerivedOutput& o = model.outputs.list[static_cast<std::size_t>(i)];
+        output_message = non_finite_message("derived output", o.where, o.name, o.expression, data.outputs.values(i), t,
+                                            describe_state(model, data.q.data(), data.v.data()));
+        output_failure = Status::non_finite;
+        return Status::stopped;
+      }
     if (first_output) {
       summary.energy_initial = data.energy;
       summary.energy_function_initial = data.energy_function;
@@ -403,6 +432,15 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   if (summary.status != Status::ok) {
     // The kernels recorded the details of a failed evaluation in data; prefer those words.
     summary.message = data.status != Status::ok ? explain_failure(model, data) : result.message;
+    // An event not finite at its latest evaluation ended the run, unless the dynamics failed after it.
+    const ModelEventFunctions::NonFinite& bad_event = event_functions.non_finite();
+    if (summary.status == Status::non_finite && bad_event.index >= 0 &&
+        (data.status == Status::ok || !(data.failed_t > bad_event.t))) {
+      const Event& e = event_functions.event(bad_event.index);
+      summary.message = non_finite_message("event", e.where, e.name, e.expression, bad_event.g, bad_event.t,
+                                           describe_state(model, bad_event.y.data(), bad_event.y.data() + n));
+    }
+    if (!output_message.empty()) summary.message = output_message;
     if (summary.message.empty()) summary.message = fmt::format("{} at t = {:.6g}", describe(summary.status), result.t_reached);
   }
   return summary;
