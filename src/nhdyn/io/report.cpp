@@ -293,13 +293,6 @@ std::vector<PlotGroup> report_plot_groups(const ReportInput& input, const FrameC
   if (!input.columns.reactions.empty()) groups.push_back({"reactions R", false, false, input.columns.reactions, 1});
   if (!input.columns.actuators.empty())
     groups.push_back({"actuator forces u ([[programs]])", false, false, input.columns.actuators, 2});
-  // The largest |value| of each role over the rows shown, for the round-off rule.
-  double role_scale[3] = {0.0, 0.0, 0.0};
-  for (const PlotGroup& g : groups)
-    if (!g.log && !g.drift)
-      for (const std::string& c : g.columns)
-        for (const double x : column(c))
-          if (std::isfinite(x)) role_scale[g.role] = std::max(role_scale[g.role], std::abs(x));
   if (!input.columns.residuals.empty())
     groups.push_back({"|constraint residuals| (log scale)", true, false, input.columns.residuals});
   if (!input.columns.energy_balance.empty())
@@ -312,6 +305,13 @@ std::vector<PlotGroup> report_plot_groups(const ReportInput& input, const FrameC
 // The "plots" member of the page's data: each group's series at the frames drawn.
 void append_plots(std::string& data, const CsvTable& table, const std::vector<PlotGroup>& groups,
                   const FrameColumns& column) {
+  // The largest |value| of each role over the rows shown, for the round-off rule.
+  double role_scale[3] = {0.0, 0.0, 0.0};
+  for (const PlotGroup& g : groups)
+    if (!g.log && !g.drift)
+      for (const std::string& c : g.columns)
+        for (const double x : column(c))
+          if (std::isfinite(x)) role_scale[g.role] = std::max(role_scale[g.role], std::abs(x));
   for (std::size_t g = 0; g < groups.size(); ++g) {
     data += g > 0 ? ",{\"title\":" : "{\"title\":";
     append_string(data, groups[g].title);
