@@ -142,5 +142,56 @@ TEST(RollingImplicit, BadSurfacesAreRefused) {
   }
 }
 
+// The shape must be convex toward the ground where the run starts (rolling-bodies.md section 9):
+// released upright (tilt = 0) at (0, 0, -c), the principal curvatures there are those of the
+// surface along x and y, H_xx / |grad f| and H_yy / |grad f|, signed positive where it bends away
+// from the ground.
+std::string convexity_refusal(const std::string& text) {
+  try {
+    load_model_text(text, "e.toml", {{"tilt", 0.0}});
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected ModelError";
+  return {};
+}
+
+void expect_parts(const std::string& message, const std::vector<std::string>& parts) {
+  for (const std::string& part : parts)
+    EXPECT_NE(message.find(part), std::string::npos) << message << "\n  lacks: " << part;
+}
+
+TEST(RollingImplicit, SaddleIsRefused) {
+  // X^2/a^2 - Y^2/b^2 + Z^2/c^2 = 1 (a hyperboloid of one sheet) passes through (0, 0, -c) with
+  // the ellipsoid's normal: curvatures c/a^2 = 2.5 along x and -c/b^2 = -4.44444 along y.
+  std::string text = implicit_ellipsoid_text();
+  replace_once(text, "X^2/a^2 + Y^2/b^2", "X^2/a^2 - Y^2/b^2");
+  expect_parts(convexity_refusal(text),
+               {"e.toml:", "contact 'foot'", "not strictly convex", "-4.44444 and 2.5", "f < 0 inside"});
+}
+
+TEST(RollingImplicit, ConcaveShapeIsRefused) {
+  // An underside hollowed like an upturned bowl, Z = -c - (X^2 + Y^2) / (2 a): curvatures -1/a.
+  std::string text = implicit_ellipsoid_text();
+  replace_once(text, "X^2/a^2 + Y^2/b^2 + Z^2/c^2 - 1", "-Z - c - (X^2 + Y^2)/(2*a)");
+  expect_parts(convexity_refusal(text), {"e.toml:", "contact 'foot'", "not strictly convex", "-5 and -5"});
+  // The ellipsoid started at its highest point: the start is not the lowest point either.
+  text = implicit_ellipsoid_text();
+  replace_once(text, "pz = \"-c^2*cos(tilt)", "pz = \"c^2*cos(tilt)");
+  expect_parts(convexity_refusal(text), {"contact 'foot'", "not strictly convex", "-4.44444 and -2.5"});
+}
+
+TEST(RollingImplicit, FlatterThanTheTerrainsHollowIsRefused) {
+  // A bowl Z = k (X^2 + Y^2) / 2 has the curvature k at its bottom: k = 10 is more curved than the
+  // ellipsoid (2.5, 4.44444), k = 1 is not.
+  std::string text = implicit_ellipsoid_on_terrain_text();
+  replace_once(text, "terrain = \"0*X\"", "terrain = \"5*(X^2 + Y^2)\"");
+  expect_parts(convexity_refusal(text), {"e.toml:", "contact 'foot'", "flatter than the hollow",
+                                         "2.5 and 4.44444", "-7.5 and -5.55556"});
+  text = implicit_ellipsoid_on_terrain_text();
+  replace_once(text, "terrain = \"0*X\"", "terrain = \"0.5*(X^2 + Y^2)\"");
+  EXPECT_NO_THROW(load_model_text(text, "e.toml", {{"tilt", 0.0}}));
+}
+
 }  // namespace
 }  // namespace nhdyn

@@ -12,6 +12,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/symbolic/occurrence.hpp"
+#include "nhdyn/symbolic/rolling_contact.hpp"
 #include "nhdyn/symbolic/simplify.hpp"
 
 namespace nhdyn::symbolic {
@@ -517,6 +518,7 @@ Derivation derive(const Spec& spec) {
   if (const int i = Vs.first(&Contained::v); i >= 0)
     throw ModelError(model + fmt::format("the potential energy V contains the velocity {}'", name(i)));
   require_at_most_quadratic(spec, model);
+  check_contact_convexity(spec);  // an implicit rolling shape must be convex where the run starts
 
   Derivation d;
   std::vector<GiNaC::ex> Tv;

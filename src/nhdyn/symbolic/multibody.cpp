@@ -630,6 +630,7 @@ void MultibodyBuilder::add_contact(const Helper& h) {
       // The name is taken (a coordinate, a parameter, an earlier output): left out.
     }
   }
+  if (contact.convexity) builder_.convexity(std::move(*contact.convexity));
   contact.force.system = system_of(body.frame);
   contacts_.push_back(std::move(contact.force));
   if (h.mode) {

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -351,6 +353,13 @@ class TerrainGround final : public ContactGround {
     out.gap = dot(out.normal, subtract(C, ground_point)) - reach;
     const Vector3 apart = subtract(body_point, ground_point);
     out.locate = {{"_at1", dot(out.tangent1, apart)}, {"_at2", dot(out.tangent2, apart)}};
+    // As the implicit surface h(X, Y) - Z = 0, whose gradient is -n |grad|: the ground rises
+    // along n by 1/2 w^T [h_ij] w / length (a hollow where positive).
+    const GiNaC::symbol& us = GiNaC::ex_to<GiNaC::symbol>(u);
+    const GiNaC::symbol& vs = GiNaC::ex_to<GiNaC::symbol>(v);
+    out.curvature(0, 0) = hu.diff(us) / length;
+    out.curvature(0, 1) = out.curvature(1, 0) = hu.diff(vs) / length;
+    out.curvature(1, 1) = hv.diff(vs) / length;
     if (c.shape->implicit()) implicit_shape_rows(c, F, out.tangent1, out.tangent2, out);
     // The force acts at the body's point (the same as the ground's on the constraints): there the
     // gap's gradient, the rolling rows and the force's moment agree at every state, also off the
@@ -542,6 +551,25 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
     out.constraints.push_back({c.name + "_spin", ConstraintLevel::velocity, spin,
                                fmt::format("contact '{}': no spin about the normal, n.(omega - omega_ground) = 0", c.name)});
   }
+  if (c.shape->implicit()) {
+    // Near y the surface f = 0 leaves its tangent plane along -grad f by 1/2 w^T H w / |grad f|;
+    // along n that is -(unit grad f . n) times it, in world axes with R (section 9).
+    const ShapeValues& v = c.values;
+    Vector3 gradient;
+    for (std::size_t i = 0; i < 3; ++i) gradient[i] = v.surface.diff(GiNaC::ex_to<GiNaC::symbol>(v.point[i]));
+    const GiNaC::ex size = GiNaC::sqrt(dot(gradient, gradient));
+    const GiNaC::ex along = -dot(multiply(F.rotation, gradient), touch.normal) / size;
+    GiNaC::matrix H(3, 3);
+    for (unsigned i = 0; i < 3; ++i)
+      for (unsigned j = 0; j < 3; ++j) H(i, j) = gradient[i].diff(GiNaC::ex_to<GiNaC::symbol>(v.point[j]));
+    SpecConvexity check;
+    check.contact = c.name;
+    check.where = c.where;
+    check.normal = {touch.normal[0], touch.normal[1], touch.normal[2]};
+    check.body = F.rotation.mul(H).mul(F.rotation.transpose()).mul_scalar(along / size);
+    check.ground = touch.curvature;
+    out.convexity = std::move(check);
+  }
   ContactPoint& f = out.force;
   f.name = c.name;
   f.kind = ContactKind::rolling;
@@ -554,6 +582,65 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
   f.omega = F.omega;
   f.spin = c.rubber;
   return out;
+}
+
+void check_contact_convexity(const Spec& spec) {
+  if (spec.convexity.empty()) return;
+  const GiNaC::lst values = spec.parameter_values();
+  GiNaC::exmap at;
+  at[spec.symbols.time()] = GiNaC::numeric(spec.t0);
+  for (std::size_t i = 0; i < spec.coordinates.size(); ++i)
+    if (i < spec.q0.size()) at[spec.symbols.coordinate(static_cast<int>(i))] = spec.q0[i].subs(values);
+  const auto value = [&](const GiNaC::ex& e, double& out) {
+    try {
+      const GiNaC::ex x = e.subs(at, GiNaC::subs_options::no_pattern).subs(values).subs(values).evalf();
+      if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real()) return false;
+      out = GiNaC::ex_to<GiNaC::numeric>(x).to_double();
+      return std::isfinite(out);
+    } catch (const std::exception&) {
+      return false;
+    }
+  };
+  for (const SpecConvexity& check : spec.convexity) {
+    Eigen::Vector3d n;
+    Eigen::Matrix3d body, ground;
+    bool ok = true;
+    for (int i = 0; i < 3 && ok; ++i) {
+      ok = value(check.normal[static_cast<std::size_t>(i)], n(i));
+      for (int j = 0; j < 3 && ok; ++j)
+        ok = value(check.body(static_cast<unsigned>(i), static_cast<unsigned>(j)), body(i, j)) &&
+             value(check.ground(static_cast<unsigned>(i), static_cast<unsigned>(j)), ground(i, j));
+    }
+    if (!ok || !(n.norm() > 0)) continue;
+    n.normalize();
+    // An orthonormal basis E of the tangent plane; the curvatures are the eigenvalues of E^T K E.
+    Eigen::Vector3d e1 = n.unitOrthogonal();
+    Eigen::Matrix<double, 3, 2> E;
+    E << e1, n.cross(e1);
+    const auto curvatures = [&](const Eigen::Matrix3d& K) {
+      const Eigen::Matrix2d k = E.transpose() * K * E;
+      return Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(0.5 * (k + k.transpose())).eigenvalues();
+    };
+    const Eigen::Vector2d own = curvatures(body), relative = curvatures(body - ground);
+    // Relative to the shape's own size: a curvature 1e-12 of its largest counts as flat.
+    const double small = 1e-12 * std::max(own.cwiseAbs().maxCoeff(), 1e-300);
+    const std::string context = fmt::format("contact '{}'", check.contact);
+    if (!(own(0) > small))
+      throw_model_error(check.where, context, fmt::format(
+          "the shape is not strictly convex toward the ground at the initial contact point: its "
+          "principal curvatures there are {:.6g} and {:.6g} (the Hessian of f on the tangent plane divided by |grad f|, "
+          "positive where the surface bends away from the ground); a saddle or a hollow would roll on a point that is "
+          "not the lowest. Write a strictly convex f with f < 0 inside, and start the contact coordinates at the "
+          "shape's lowest point",
+          own(0), own(1)));
+    if (!(relative(0) > small))
+      throw_model_error(check.where, context, fmt::format(
+          "the shape is flatter than the hollow of the ground at the initial contact point, so the contact is not "
+          "unique: the shape's principal curvatures there are {:.6g} and {:.6g}, and those of the shape less the "
+          "ground's are {:.6g} and {:.6g} (both must be positive). Use a more curved shape, a smoother ground, or start "
+          "where the ground's hollow is shallower",
+          own(0), own(1), relative(0), relative(1)));
+  }
 }
 
 }  // namespace nhdyn::symbolic

@@ -113,6 +113,7 @@ struct RollingContact {
   Vector3 point;                  // the contact point P, world
   GiNaC::ex length;               // a length of the shape, for the moment rows
   Vector3 normal, tangent1, tangent2;  // world: the ground's normal and the no-slip rows' directions
+  std::optional<SpecConvexity> convexity;  // an implicit shape: checked at the initial state
 };
 
 // A ground type: its key, the further keys of its table, and where a shape touches it.
@@ -140,6 +141,8 @@ class ContactGround {
     // when the contact point is a closed form in the body's coordinates.
     // Each row with the suffix of its constraint's name (NAME_at1, ...).
     std::vector<std::pair<std::string, GiNaC::ex>> locate;
+    // The ground's curvature along the normal, world axes (SpecConvexity::ground); zero for a plane.
+    GiNaC::matrix curvature = GiNaC::matrix(3, 3);
   };
   virtual Touch touch(const ParsedContact& contact, const PlacedFrame& frame, const Spec& spec,
                       const std::optional<Vector3>& gravity, const std::string& context) const = 0;
@@ -156,5 +159,12 @@ ParsedContact parse_contact(const ContactText& text, const ContactParsers& parse
 // ground (the gap is a nonzero constant) or cannot move along it.
 RollingContact make_rolling_contact(const ParsedContact& contact, const PlacedFrame& frame, const Spec& spec,
                                     const std::optional<Vector3>& gravity);
+
+// Throws ModelError when an implicit shape is not convex toward the ground where the run starts
+// (spec.t0, spec.q0 with the parameter values), or is flatter than a hollow of the terrain there
+// (the contact would not be unique): names the contact, where it was written, the principal
+// curvatures found and what to do (docs/derivations/rolling-bodies.md section 9). States where
+// the expressions do not evaluate to finite reals are left to the other checks.
+void check_contact_convexity(const Spec& spec);
 
 }  // namespace nhdyn::symbolic

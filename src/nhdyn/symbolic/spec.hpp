@@ -115,6 +115,19 @@ struct SpecOutput {
   GiNaC::symbol symbol;    // stands for the output in the expressions of later outputs and events
 };
 
+// A rolling contact whose shape is an implicit surface f = 0 (rolling_contact.hpp): what its
+// convexity at the start is judged from (check_contact_convexity), in world axes at (t, q):
+// near the contact the shape rises along the ground's normal n by 1/2 w^T body w and the ground by
+// 1/2 w^T ground w, for w in the tangent plane. Rolling on the lowest point needs body positive
+// definite there and body - ground too (the contact is unique).
+struct SpecConvexity {
+  std::string contact;
+  SourceLocation where;
+  std::vector<GiNaC::ex> normal;                  // n, unit (3)
+  GiNaC::matrix body = GiNaC::matrix(3, 3);
+  GiNaC::matrix ground = GiNaC::matrix(3, 3);     // zero for a plane
+};
+
 struct Spec {
   std::string name;
   std::string description;
@@ -147,6 +160,7 @@ struct Spec {
   // The bodies and contacts of a multibody model, for its contact forces (contact_forces.hpp);
   // null for a hand-written model.
   std::shared_ptr<const SpecContactForces> contact_forces;
+  std::vector<SpecConvexity> convexity;  // checked at the initial state before the derivation
 
   int n() const { return static_cast<int>(coordinates.size()); }
   int s() const { return static_cast<int>(constraints.size()); }

@@ -81,6 +81,11 @@ class SpecBuilder {
     spec_.contact_forces = std::move(contacts);
     return *this;
   }
+  // An implicit shape's curvatures, checked at the initial state (spec.hpp, SpecConvexity).
+  SpecBuilder& convexity(SpecConvexity check) {
+    spec_.convexity.push_back(std::move(check));
+    return *this;
+  }
   // Derived outputs (docs/model-format.md, [outputs]; symbolic/outputs.hpp): a named expression
   // in t, q, q', q'', the reactions R_x, the parameters and the outputs declared before it, that
   // becomes a column of the results. Its name must be a new name (not a coordinate, parameter,
