@@ -125,6 +125,13 @@ void bind_batch(py::module_& m) {
                                                                              models.front()->velocity_constraints() +
                                                                              models.front()->s()),
                                  &Trajectory::residuals);
+        // A multibody model's contact forces and, for contacts with modes, NAME_mode, the slip,
+        // NAME_gap and work_friction (columns["contact_forces"], as in one run's Result).
+        const int contact_columns = shape.contact_columns;
+        out["contact_forces"] = contact_columns > 0
+                                    ? py::object(stack(results, longest, static_cast<std::size_t>(contact_columns),
+                                                       &Trajectory::contact_forces))
+                                    : py::object(py::none());
         out["energy"] = models.front()->evaluator->has_energy() ? py::object(stack(results, longest, 1, &Trajectory::energy, true))
                                                                 : py::object(py::none());
         std::vector<double> q_end(results.size() * un, std::numeric_limits<double>::quiet_NaN());

@@ -26,6 +26,7 @@
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
 #include "nhdyn/model/contact_forces.hpp"
+#include "nhdyn/model/contact_modes.hpp"
 #include "nhdyn/model/initial_values.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "progress.hpp"
@@ -291,6 +292,10 @@ int run_simulate(const SimulateArgs& args) {
       if (!o.automatic) request.others.push_back(o.name);
     for (const std::string& c : columns.contact_forces)
       if (c.size() > 2 && c.compare(c.size() - 2, 2, "_N") == 0) request.others.push_back(c);
+    // Contacts with modes: their mode columns as steps (docs/contact-modes.md); the switches are
+    // among the events marked on every panel.
+    for (const std::string& c : contact_mode_columns(model))
+      if (c.size() > 5 && c.compare(c.size() - 5, 5, "_mode") == 0) request.modes.push_back(c);
     if (model.path)
       request.path = std::make_pair(model.coordinates[static_cast<std::size_t>(model.path->x)],
                                     model.coordinates[static_cast<std::size_t>(model.path->y)]);

@@ -541,10 +541,15 @@ class BatchResult:
     failed), events (runs lists of {name, t, q, qd}), parameters (name -> runs values). Rows after
     a failed run's end are NaN. t is one vector when every run has the same output times; with
     events or a stop condition each run has its own rows, and t is runs x rows (NaN after a
-    run's last row)."""
+    run's last row). contact_forces (runs x rows x columns, or None) holds a multibody model's
+    contact forces and, for contacts with modes, NAME_mode, NAME_slip_speed, NAME_slip_x/y/z,
+    NAME_gap and work_friction, named by columns["contact_forces"] as in Model.simulate's Result;
+    batch["ball_mode"] gives one of them (or a coordinate, "x'", "energy") as runs x rows."""
 
-    def __init__(self, out, parameters, coordinates):
+    def __init__(self, out, parameters, coordinates, columns=None):
         self.t, self.q, self.qd, self.qdd = out["t"], out["q"], out["qd"], out["qdd"]
+        self.contact_forces = out.get("contact_forces")
+        self.columns = columns or {}
         self.R, self.residuals, self.energy = out["R"], out["residuals"], out["energy"]
         self.q_end, self.qd_end, self.max_residual = out["q_end"], out["qd_end"], out["max_residual"]
         self.ok = np.asarray(out["ok"], dtype=bool)
@@ -558,6 +563,21 @@ class BatchResult:
 
     def __len__(self):
         return len(self.ok)
+
+    def __getitem__(self, name):
+        """One column of every run by its CSV name, runs x rows: a coordinate ("x"), its velocity
+        ("x'"), "energy", or a contact column ("ball_N", "ball_mode", "work_friction")."""
+        if name in self.coordinates:
+            return self.q[:, :, self.coordinates.index(name)]
+        if name.endswith("'") and name[:-1] in self.coordinates:
+            return self.qd[:, :, self.coordinates.index(name[:-1])]
+        if name == "energy" and self.energy is not None:
+            return self.energy
+        contact = list(self.columns.get("contact_forces", []))
+        if self.contact_forces is not None and name in contact:
+            return self.contact_forces[:, :, contact.index(name)]
+        names = list(self.coordinates) + [c + "'" for c in self.coordinates] + contact
+        raise KeyError("{!r} is not a column of this batch; the columns are {}".format(name, ", ".join(names)))
 
     def summary(self):
         """One row per run: the parameters, the final state, the largest residual, the status
@@ -641,4 +661,5 @@ def simulate_batch(model, parameters=None, initial=None, t_end=None, threads=0, 
                                 t_end=t_end, **options)
     for run, summary in enumerate(out["summaries"]):
         _warn_constraints(model.name, summary, stacklevel=2, run=run)
-    return BatchResult(out, {name: values[:, j] for j, name in enumerate(names)}, model.coordinates)
+    return BatchResult(out, {name: values[:, j] for j, name in enumerate(names)}, model.coordinates,
+                       model._cpp.columns)

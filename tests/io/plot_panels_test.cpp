@@ -150,6 +150,23 @@ TEST(PlotPanels, ConstantsShareAPanelAtTheirLevels) {
   EXPECT_GT(panels[0].y_range->second, -14.3);
 }
 
+// Contacts with modes: every NAME_mode in one steps panel with the levels 0..2 in view, after the
+// other columns and before the residuals, whatever the modes' values (a constant mode too).
+TEST(PlotPanels, ContactModesShareOneStepsPanel) {
+  const std::vector<PlotPanel> panels = calc_plot_panels(
+      {col("x", PlotRole::coordinate, 0, 2), col("ball_N", PlotRole::other, 0.98, 0.98),
+       col("ball_mode", PlotRole::mode, 0, 1), col("wheel_mode", PlotRole::mode, 2, 2),
+       col("residual_pos", PlotRole::residual, 0, 1e-12)},
+      std::nullopt);
+  ASSERT_EQ(panels.size(), 4u);
+  EXPECT_EQ(panels[2].kind, PanelKind::steps);
+  EXPECT_EQ(panels[2].columns, (std::vector<std::string>{"ball_mode", "wheel_mode"}));
+  ASSERT_TRUE(panels[2].y_range);
+  EXPECT_LT(panels[2].y_range->first, 0.0);
+  EXPECT_GT(panels[2].y_range->second, 2.0);
+  EXPECT_EQ(panels[3].kind, PanelKind::log_abs);
+}
+
 // A model file names its angles by use (inside sin, cos, tan): alpha is one by its name, s by use.
 TEST(PlotPanels, AnglesKnownByUseJoinTheAngles) {
   const std::vector<PlotColumn> columns = {col("s", PlotRole::coordinate, 0, 3), col("x", PlotRole::coordinate, 0, 2),

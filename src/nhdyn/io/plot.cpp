@@ -145,6 +145,9 @@ class ScriptWriter {
         case PanelKind::lines:
           write_lines(p);
           break;
+        case PanelKind::steps:
+          write_lines(p, true);
+          break;
         case PanelKind::drift:
           write_drift(p, in_.drift0[drift_index++]);
           break;
@@ -224,17 +227,22 @@ class ScriptWriter {
     return p.panel.labels.size() == p.curves.size() ? p.panel.labels[i] : p.curves[i].name;
   }
 
-  void write_lines(const ScriptPanel& p) {
+  // steps: each value holds until the next row (a mode column; its switch row, at the event,
+  // carries the mode after it), every row drawn so no switch is thinned away.
+  void write_lines(const ScriptPanel& p, bool steps = false) {
     s_ += fmt::format("set title {}\n", gp_label(fmt::format("{}{}", p.panel.title, thinned_)));
     s_ += fmt::format("set xlabel {}\nset ylabel ''\n", gp_label(in_.time_name));
     std::vector<std::string> clauses;
     for (std::size_t i = 0; i < p.curves.size(); ++i)
-      clauses.push_back(plot_clause(every_, fmt::format("1:{}", p.curves[i].index), "lines", title_of(p, i)));
+      clauses.push_back(plot_clause(steps ? all_ : every_, fmt::format("1:{}", p.curves[i].index),
+                                    steps ? "steps" : "lines", title_of(p, i)));
     mark_events(clauses);
+    if (steps) s_ += "set ytics 1\n";
     if (p.panel.y_range)
       s_ += fmt::format("set yrange [{:.17g}:{:.17g}]\n", p.panel.y_range->first, p.panel.y_range->second);
     s_ += join_clauses(clauses);
     if (p.panel.y_range) s_ += "set autoscale y\n";
+    if (steps) s_ += "set ytics autofreq\n";
     clear_marks();
   }
 
@@ -377,7 +385,7 @@ void select_plot_columns(PlotRequest& request, const std::vector<std::string>& a
   };
   std::vector<std::string> placed;
   for (std::vector<std::string>* role : {&request.coordinates, &request.velocities, &request.reactions,
-                                         &request.actuators, &request.residuals, &request.others}) {
+                                         &request.actuators, &request.residuals, &request.others, &request.modes}) {
     std::erase_if(*role, [&](const std::string& name) { return !is_chosen(name); });
     placed.insert(placed.end(), role->begin(), role->end());
   }
@@ -454,7 +462,7 @@ void draw_panels(const std::string& title, const fs::path& csv, const CsvHead& h
 
 void write_plot(const PlotRequest& request, const std::filesystem::path& png) {
   if (request.coordinates.empty() && request.reactions.empty() && request.residuals.empty() &&
-      request.actuators.empty() && request.velocities.empty() && request.others.empty() && !request.path &&
+      request.actuators.empty() && request.velocities.empty() && request.others.empty() && request.modes.empty() && !request.path &&
       !request.energy) {
     throw InputError(fmt::format(
         "nothing to plot into '{}': the request names no coordinate, velocity, reaction, residual, path, "
@@ -475,6 +483,7 @@ void write_plot(const PlotRequest& request, const std::filesystem::path& png) {
   add(request.reactions, PlotRole::reaction, "reaction");
   add(request.actuators, PlotRole::actuator, "actuator force");
   add(request.others, PlotRole::other, "a");
+  add(request.modes, PlotRole::mode, "contact mode");
   add(request.residuals, PlotRole::residual, "residual");
   if (request.energy) add({*request.energy}, PlotRole::energy_error, "energy");
   std::optional<std::pair<PlotColumn, PlotColumn>> path;

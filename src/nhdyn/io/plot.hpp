@@ -37,6 +37,7 @@ struct PlotRequest {
   std::vector<std::string> actuators = {};  // actuator force columns against time, e.g. "u_heading"
   std::vector<std::string> velocities = {};  // velocity columns, e.g. "x'"
   std::vector<std::string> others = {};      // any other columns against time (outputs, x'', ...)
+  std::vector<std::string> modes = {};       // contact mode columns (NAME_mode), drawn as steps
   // Columns x and y of a planar system, drawn as its path y(x) (calc_plot_panels says how).
   std::optional<std::pair<std::string, std::string>> path;
   std::optional<std::string> energy;  // energy column, drawn as its drift E(t) - E(0)

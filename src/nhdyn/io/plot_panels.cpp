@@ -169,6 +169,13 @@ std::vector<PlotPanel> calc_plot_panels(const std::vector<PlotColumn>& columns,
   lines(PlotRole::reaction, 0, "reactions");
   lines(PlotRole::actuator, -1, "actuator forces u");
   lines(PlotRole::other, -1, "other columns");
+  // The contacts' modes share one panel whatever their values: a mode is a level, not a scale.
+  std::vector<std::string> modes;
+  for (const PlotColumn& c : columns)
+    if (c.role == PlotRole::mode) modes.push_back(c.name);
+  if (!modes.empty())
+    panels.push_back(PlotPanel{"contact modes: 0 rolling, 1 sliding, 2 free", PanelKind::steps, modes, {}, false,
+                               std::make_pair(-0.25, 2.25)});
   std::vector<std::string> residuals;
   for (const PlotColumn& c : columns)
     if (c.role == PlotRole::residual) residuals.push_back(c.name);

@@ -14,7 +14,8 @@
 namespace nhdyn {
 
 // What a column is; decides its panel (calc_plot_panels).
-enum class PlotRole { coordinate, velocity, reaction, actuator, residual, energy_error, other };
+// `mode`: a contact's mode column (NAME_mode: 0 rolling, 1 sliding, 2 free; docs/contact-modes.md).
+enum class PlotRole { coordinate, velocity, reaction, actuator, residual, energy_error, other, mode };
 
 // A column with the range of its values over the drawn rows (finite values only; min == max for
 // a constant column, both NaN when it has no finite value).
@@ -30,6 +31,7 @@ enum class PanelKind {
   log_abs,  // |value| against time on a logarithmic axis (exact zeros left out)
   drift,    // value(t) - value(t0) against time
   path,     // columns[1] against columns[0]
+  steps,    // piecewise-constant curves (contact modes): each value holds until the next row
 };
 
 // One panel of a figure: its heading, what it draws, its curves (for a path: {x, y}).
@@ -54,8 +56,9 @@ bool is_angle_name(std::string_view coordinate);
 // "What --plot draws"). In this order:
 //   coordinates that are angles, other coordinates (lengths, and names that say nothing),
 //   velocities of angles, other velocities, the path, reactions on angles, other reactions,
-//   actuator forces, other columns (outputs, accelerations, ...), |residuals| on a log scale, the
-//   energy balance error (drift from its first value).
+//   actuator forces, other columns (outputs, accelerations, ...), the contacts' modes (one steps
+//   panel, axis 0 rolling .. 2 free), |residuals| on a log scale, the energy balance error (drift
+//   from its first value).
 // A group of linear curves is split further by scale: a curve joins a panel only if the panel's
 // range, with it, spans at most `scale_ratio` (10) times the curve's own span, so every curve
 // spans at least a tenth of its panel's height (a constant curve joins a panel whose range it

@@ -126,6 +126,8 @@ struct PlotGroup {
   bool drift = false;  // drawn as v - v(first row)
   std::vector<std::string> columns;
   int role = 0;  // groups of one role (0 coordinates, 1 reactions, 2 actuators) share a scale
+  bool steps = false;  // piecewise constant (contact modes): drawn as steps, never "constant to round-off"
+  double role_scale = 0.0;  // the largest |value| of the groups of its role, for the round-off rule
 };
 
 // The PNG panels' rule (io/plot.cpp): a column whose values vary by no more than this fraction of
@@ -293,6 +295,19 @@ std::vector<PlotGroup> report_plot_groups(const ReportInput& input, const FrameC
   if (!input.columns.reactions.empty()) groups.push_back({"reactions R", false, false, input.columns.reactions, 1});
   if (!input.columns.actuators.empty())
     groups.push_back({"actuator forces u ([[programs]])", false, false, input.columns.actuators, 2});
+  // The largest |value| of each role over the rows shown, for the round-off rule.
+  double role_scale[3] = {0.0, 0.0, 0.0};
+  for (const PlotGroup& g : groups)
+    if (!g.log && !g.drift)
+      for (const std::string& c : g.columns)
+        for (const double x : column(c))
+          if (std::isfinite(x)) role_scale[g.role] = std::max(role_scale[g.role], std::abs(x));
+  for (PlotGroup& g : groups) g.role_scale = role_scale[g.role];
+  // Contacts with modes (docs/contact-modes.md): NAME_mode as steps, after the scaled groups.
+  PlotGroup modes{"contact modes: 0 rolling, 1 sliding, 2 free", false, false, {}, 0, true};
+  for (const std::string& c : input.columns.contact_forces)
+    if (c.size() > 5 && c.compare(c.size() - 5, 5, "_mode") == 0) modes.columns.push_back(c);
+  if (!modes.columns.empty()) groups.push_back(modes);
   if (!input.columns.residuals.empty())
     groups.push_back({"|constraint residuals| (log scale)", true, false, input.columns.residuals});
   if (!input.columns.energy_balance.empty())
@@ -305,16 +320,10 @@ std::vector<PlotGroup> report_plot_groups(const ReportInput& input, const FrameC
 // The "plots" member of the page's data: each group's series at the frames drawn.
 void append_plots(std::string& data, const CsvTable& table, const std::vector<PlotGroup>& groups,
                   const FrameColumns& column) {
-  // The largest |value| of each role over the rows shown, for the round-off rule.
-  double role_scale[3] = {0.0, 0.0, 0.0};
-  for (const PlotGroup& g : groups)
-    if (!g.log && !g.drift)
-      for (const std::string& c : g.columns)
-        for (const double x : column(c))
-          if (std::isfinite(x)) role_scale[g.role] = std::max(role_scale[g.role], std::abs(x));
   for (std::size_t g = 0; g < groups.size(); ++g) {
     data += g > 0 ? ",{\"title\":" : "{\"title\":";
     append_string(data, groups[g].title);
+    if (groups[g].steps) data += ",\"steps\":true";
     data += groups[g].log ? ",\"log\":true,\"series\":[" : ",\"log\":false,\"series\":[";
     for (std::size_t s = 0; s < groups[g].columns.size(); ++s) {
       std::vector<double> values = column(groups[g].columns[s]);
@@ -323,7 +332,7 @@ void append_plots(std::string& data, const CsvTable& table, const std::vector<Pl
         for (double& v : values) v -= first;
       }
       std::string label = groups[g].columns[s];
-      if (!groups[g].log && !groups[g].drift && role_scale[groups[g].role] > 0.0) {
+      if (!groups[g].log && !groups[g].drift && !groups[g].steps && groups[g].role_scale > 0.0) {
         double lo = std::numeric_limits<double>::infinity(), hi = -lo, sum = 0.0;
         std::size_t finite = 0;
         for (const double x : values)
@@ -333,7 +342,7 @@ void append_plots(std::string& data, const CsvTable& table, const std::vector<Pl
             sum += x;
             ++finite;
           }
-        if (finite > 0 && hi > lo && hi - lo <= kReportRoundOff * role_scale[groups[g].role]) {
+        if (finite > 0 && hi > lo && hi - lo <= kReportRoundOff * groups[g].role_scale) {
           const double level = sum / static_cast<double>(finite);
           for (double& x : values)
             if (std::isfinite(x)) x = level;

@@ -375,6 +375,8 @@
       let pen = false;
       for (let f = 0; f < frames; ++f) {
         if (!isFinite(s[f])) { pen = false; continue; }
+        // Steps (a contact's mode): the value holds until the next frame, then jumps.
+        if (pen && p.steps) g.lineTo(tx(T[f]), ty(s[f - 1]));
         if (pen) g.lineTo(tx(T[f]), ty(s[f])); else g.moveTo(tx(T[f]), ty(s[f]));
         pen = true;
       }
