@@ -9,5 +9,5 @@ if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
                       "-DCMAKE_C_COMPILER=clang-14, as fuzz/run does")
 endif()
 add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined
-                    -fno-omit-frame-pointer)
+                    -fno-omit-frame-pointer ${NHDYN_UBSAN_LEFT_OUT})
 add_link_options(-fsanitize=address,undefined)
