@@ -68,7 +68,7 @@ bench: configure
 	$(BUILD)/bench/nhdyn_bench --benchmark_min_time=0.2
 
 # The performance guard (scripts/bench-check; docs/performance.md, "The guard").
-BENCH_CHECK_TARGETS = nhdyn_cli nhdyn_sled_reference nhdyn_bench_check
+BENCH_CHECK_TARGETS = nhdyn_cli nhdyn_sled_reference nhdyn_rattleback_reference nhdyn_bench_check
 bench-check: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target $(BENCH_CHECK_TARGETS)
 	python3 scripts/bench-check $(BUILD)
