@@ -25,9 +25,11 @@
 #include "nhdyn/analysis/batch.hpp"
 #include "nhdyn/analysis/run_options.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/io/run_paths.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
@@ -192,8 +194,9 @@ void make_run_table(const BatchArgs& args, std::vector<std::string>& names, std:
 }
 
 // One run's rows as CSV, in the columns of `nhdyn simulate`.
-void write_run_file(const std::filesystem::path& path, const Model& model, const Trajectory& tr) {
-  CsvWriter writer(path, make_result_columns(model).all);
+void write_run_file(const std::filesystem::path& path, const Model& model, const Trajectory& tr,
+                    const std::string& provenance) {
+  CsvWriter writer(path, make_result_columns(model).all, provenance);
   std::vector<double> row;
   const auto slice = [&row](const std::vector<double>& column, std::size_t k, std::size_t width) {
     row.insert(row.end(), column.begin() + static_cast<std::ptrdiff_t>(k * width),
@@ -375,6 +378,24 @@ int run_batch(const BatchArgs& args) {
                                 ec ? ec.message() : "not a directory"));
   AtomicFile summary(dir / "summary.csv");  // checks the directory is writable before any run
   const std::vector<BatchRun> runs = make_runs(args, source, overrides, base, names, table);
+  // Every file says what made it (io/provenance.hpp): the summary the batch's model and options
+  // and its table of runs; each run's file that run's parameters and initial state, as simulate's.
+  const auto batch_provenance = [&](const Model& model) {
+    Provenance p = make_provenance(model, source, options.simulation, args.evaluator);
+    p.run.emplace_back("runs", args.runs_csv.empty() ? join(args.grids, " ") : args.runs_csv);
+    return p;
+  };
+  const std::string summary_provenance = format_provenance(batch_provenance(base));
+  const auto run_provenance = [&](std::size_t r) {
+    Provenance p = batch_provenance(*runs[r].model);
+    const std::size_t n = base.coordinates.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      if (runs[r].q0) p.initial[i].second = (*runs[r].q0)(static_cast<Eigen::Index>(i));
+      if (runs[r].v0) p.initial[n + i].second = (*runs[r].v0)(static_cast<Eigen::Index>(i));
+    }
+    p.run.emplace_back("batch_run", std::to_string(r));
+    return format_provenance(p);
+  };
 
   // Each run's file is written as soon as the run ends (not kept in memory), into a staging
   // directory; the files are moved into place when every run has ended and been written.
@@ -383,7 +404,8 @@ int run_batch(const BatchArgs& args) {
     staging.emplace(dir);
     options.on_result = [&](std::size_t r, BatchResult& result) {
       if (result.trajectory.rows() > 0)
-        write_run_file(staging->path / fmt::format("run_{:0{}}.csv", r, digits), *runs[r].model, result.trajectory);
+        write_run_file(staging->path / fmt::format("run_{:0{}}.csv", r, digits), *runs[r].model, result.trajectory,
+                       run_provenance(r));
       result.trajectory = Trajectory{};
     };
   }
@@ -399,7 +421,7 @@ int run_batch(const BatchArgs& args) {
     ::_exit(128 + sig);
   }
 
-  std::string header = "run";
+  std::string header = summary_provenance + "run";
   for (const std::string& name : names) header += "," + csv_text(name);
   header += ",status,t_reached";
   for (const std::string& c : base.coordinates) header += "," + csv_text(c);

@@ -15,7 +15,9 @@
 #include "nhdyn/analysis/comparison.hpp"
 #include "nhdyn/analysis/exact_solution.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
@@ -54,7 +56,8 @@ double energy_error(const SimulationSummary& s) { return s.has_energy_balance ? 
 
 int run_compare(const CompareArgs& args) {
   protect_model_file(args.model);
-  const LoadedModel resolved = load_model_argument(args.model, args.sets);
+  const ModelSource source = read_model_source(args.model);
+  const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
   std::string notice;
   const Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
   if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
@@ -118,7 +121,24 @@ int run_compare(const CompareArgs& args) {
       throw InputError("--plot-columns chooses what --plot draws; give --plot FILE.png too, or leave --plot-columns out");
     require_plot_columns(columns, args.plot_columns);
   }
-  CsvWriter series(series_path, columns);
+  // Both files say what made them (io/provenance.hpp): the model as loaded and the cases compared.
+  std::vector<std::string> method_names, integrator_names;
+  for (const std::string& m : methods) method_names.emplace_back(method_name(parse_method(m)));
+  for (const std::string& i : args.integrators) integrator_names.emplace_back(integrator_name(parse_integrator(i)));
+  const std::string provenance = format_provenance(make_command_provenance(
+      model, source, "compare",
+      {{"methods", join(method_names, ",")},
+       {"integrators", join(integrator_names, ",")},
+       {"reference", args.reference},
+       {"complement", std::string(complement_name(options.run.formulation.complement))},
+       {"rtol", fmt::format("{}", options.run.integrator.rtol)},
+       {"atol", fmt::format("{}", options.run.integrator.atol)},
+       {"t0", fmt::format("{}", model.t0)},
+       {"t_end", fmt::format("{}", options.run.t_end)},
+       {"output_step", fmt::format("{}", options.run.output_step)},
+       {"stabilize", std::string(stabilization_name(options.run.stabilization))},
+       {"evaluator", args.evaluator}}));
+  CsvWriter series(series_path, columns, provenance);
 
   const Comparison result = compare_formulations(model, options);
   // The constraint watch's warnings (analysis/constraint_watch.hpp), per case, whatever -q says.
@@ -126,7 +146,7 @@ int run_compare(const CompareArgs& args) {
     for (const std::string& w : r.summary.warnings)
       fmt::print(stderr, "nhdyn: warning ({}, {}): {}\n", method_name(r.which.method), integrator_name(r.which.integrator), w);
 
-  std::string text =
+  std::string text = provenance +
       "method,integrator,solve_ns,steps,rhs_evaluations,wall_time_s,max_residual_pos,max_residual_vel,"
       "max_residual_acc,energy_error,max_error_q,max_error_v,status\n";
   for (const ComparisonResult& r : result.results) {

@@ -5,13 +5,16 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "commands.hpp"
 #include "outputs.hpp"
 #include "nhdyn/analysis/linearization.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 
 namespace nhdyn::cli {
@@ -34,7 +37,8 @@ std::string join_names(const std::vector<std::string>& names) {
 int run_linearize(const LinearizeArgs& args) {
   protect_model_file(args.model);
   check_command_paths(args.model, {{args.output, "-o"}});
-  const LoadedModel resolved = load_model_argument(args.model, args.sets);
+  const ModelSource source = read_model_source(args.model);
+  const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
   const Model& model = resolved.model;
   LinearizationOptions options;
   options.cyclic = args.cyclic;
@@ -46,7 +50,13 @@ int run_linearize(const LinearizeArgs& args) {
   if (!args.output.empty()) {
     make_parent_directory(args.output);
     AtomicFile file(args.output);
-    std::string text = "index,real,imag\n";
+    std::vector<std::pair<std::string, std::string>> given;
+    if (!args.cyclic.empty()) given.emplace_back("cyclic", join(args.cyclic, ","));
+    if (!args.independent.empty()) given.emplace_back("independent", join(args.independent, ","));
+    if (!args.speeds.empty()) given.emplace_back("speeds", join(args.speeds, ","));
+    given.emplace_back("tolerance", fmt::format("{}", args.tolerance));
+    std::string text = format_provenance(make_command_provenance(model, source, "linearize", std::move(given)));
+    text += "index,real,imag\n";
     for (std::size_t i = 0; i < l.eigenvalues.size(); ++i)
       text += fmt::format("{},{:.17g},{:.17g}\n", i + 1, l.eigenvalues[i].real(), l.eigenvalues[i].imag());
     file.write(text);

@@ -13,7 +13,9 @@
 
 #include "outputs.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
@@ -51,7 +53,8 @@ StudyFormulation parse_formulation(const std::string& label) {
 
 int run_error_relation(const ErrorRelationArgs& args) {
   protect_model_file(args.model);
-  const LoadedModel resolved = load_model_argument(args.model, args.sets);
+  const ModelSource source = read_model_source(args.model);
+  const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
   const Model& model = resolved.model;
   ErrorRelationOptions options;
   options.tolerances = args.tolerances;
@@ -85,7 +88,20 @@ int run_error_relation(const ErrorRelationArgs& args) {
     }
   // Both files are opened (and so checked writable) before the runs; they appear only on commit.
   AtomicFile table(table_path);
-  CsvWriter series(series_path, columns);
+  // Both files say what made them (io/provenance.hpp): the model as loaded and the study's options.
+  std::vector<std::string> formulation_names, integrator_names, tolerances;
+  for (const StudyFormulation& f : options.formulations) formulation_names.push_back(formulation_label(f));
+  for (IntegratorKind i : options.integrators) integrator_names.emplace_back(integrator_name(i));
+  for (double tolerance : options.tolerances) tolerances.push_back(fmt::format("{}", tolerance));
+  const std::string provenance = format_provenance(make_command_provenance(
+      model, source, "study error-relation",
+      {{"methods", join(formulation_names, ",")},
+       {"integrators", join(integrator_names, ",")},
+       {"tolerances", join(tolerances, ",")},
+       {"atol_factor", fmt::format("{}", args.atol_factor)},
+       {"t_end", fmt::format("{}", args.t_end.value_or(model.defaults.t_end))},
+       {"output_step", fmt::format("{}", args.output_step.value_or(model.defaults.output_step))}}));
+  CsvWriter series(series_path, columns, provenance);
 
   const ErrorRelation study = study_error_relation(model, options);
   std::vector<double> row;
@@ -103,7 +119,7 @@ int run_error_relation(const ErrorRelationArgs& args) {
     series.write_row(row);
   }
 
-  std::string text = "formulation,integrator,rtol,atol,max_error_q,max_error_v,max_residual_pos,max_residual_vel,"
+  std::string text = provenance + "formulation,integrator,rtol,atol,max_error_q,max_error_v,max_residual_pos,max_residual_vel,"
                      "steps,rhs_evaluations,status\n";
   for (const ErrorRelationRun& r : study.runs)
     text += fmt::format("{},{},{:.3g},{:.3g},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{}\n", formulation_label(r.formulation),

@@ -13,7 +13,9 @@
 
 #include "outputs.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/xy_plot.hpp"
@@ -41,7 +43,8 @@ std::string gain_label(double gain) { return gain == 0.0 ? std::string("none") :
 
 int run_tracking(const TrackingArgs& args) {
   protect_model_file(args.model);
-  const LoadedModel resolved = load_model_argument(args.model, args.sets);
+  const ModelSource source = read_model_source(args.model);
+  const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
   const Model& model = resolved.model;
   TrackingOptions options;
   options.tolerances = args.tolerances;
@@ -68,7 +71,19 @@ int run_tracking(const TrackingArgs& args) {
     columns.push_back("residual_gain_" + gain_label(gain));
   }
   AtomicFile table(table_path);
-  CsvWriter series(series_path, columns);
+  // Both files say what made them (io/provenance.hpp): the model as loaded and the study's options.
+  std::vector<std::string> gains, tolerances;
+  for (double gain : args.gains) gains.push_back(fmt::format("{}", gain));
+  for (double tolerance : args.tolerances) tolerances.push_back(fmt::format("{}", tolerance));
+  const std::string provenance = format_provenance(make_command_provenance(
+      model, source, "study tracking",
+      {{"gains", join(gains, ",")},
+       {"integrator", std::string(integrator_name(options.integrator))},
+       {"tolerances", join(tolerances, ",")},
+       {"atol_factor", fmt::format("{}", args.atol_factor)},
+       {"t_end", fmt::format("{}", args.t_end.value_or(model.defaults.t_end))},
+       {"output_step", fmt::format("{}", args.output_step.value_or(model.defaults.output_step))}}));
+  CsvWriter series(series_path, columns, provenance);
 
   const Tracking study = study_tracking(model, options);
   // Like for like: the error of q against the position residual, of q' against the velocity one.
@@ -85,7 +100,7 @@ int run_tracking(const TrackingArgs& args) {
     }
     series.write_row(row);
   }
-  std::string text = "gain,rtol,atol,max_error_q,max_error_v,max_residual_pos,max_residual_vel,max_residual_acc,"
+  std::string text = provenance + "gain,rtol,atol,max_error_q,max_error_v,max_residual_pos,max_residual_vel,max_residual_acc,"
                      "steps,rhs_evaluations,status\n";
   for (const TrackingRun& r : study.runs)
     text += fmt::format("{:g},{:.3g},{:.3g},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{}\n", r.gain, r.tolerance,

@@ -11,13 +11,16 @@
 #include <system_error>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "commands.hpp"
 #include "outputs.hpp"
 #include "nhdyn/analysis/sweep.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/xy_plot.hpp"
 #include "nhdyn/model/parameters.hpp"
@@ -54,7 +57,8 @@ int run_sweep(const SweepArgs& args) {
   check_sweep_options(options);
   // Compiled once: each grid point and bisection step only sets the parameter (parameters as
   // data, model/parameters.hpp), which re-binds the evaluator without symbolic work.
-  const Model base = load_model_argument(args.model, args.sets).model;
+  const ModelSource source = read_model_source(args.model);
+  const Model base = load_model_described(source, parse_parameter_sets(args.sets)).model;
   {
     std::string names;
     bool known = false;
@@ -98,7 +102,17 @@ int run_sweep(const SweepArgs& args) {
     columns.push_back(fmt::format("re_{}", i));
     columns.push_back(fmt::format("im_{}", i));
   }
-  std::string text;
+  // Both files say what made them (io/provenance.hpp): the model as loaded and the sweep's options.
+  std::vector<std::pair<std::string, std::string>> given{{"param", args.param},
+                                                         {"from", fmt::format("{}", args.from)},
+                                                         {"to", fmt::format("{}", args.to)},
+                                                         {"steps", fmt::format("{}", args.steps)}};
+  if (!args.cyclic.empty()) given.emplace_back("cyclic", join(args.cyclic, ","));
+  if (!args.independent.empty()) given.emplace_back("independent", join(args.independent, ","));
+  if (!args.speeds.empty()) given.emplace_back("speeds", join(args.speeds, ","));
+  given.emplace_back("tolerance", fmt::format("{}", args.tolerance));
+  const std::string provenance = format_provenance(make_command_provenance(base, source, "sweep", std::move(given)));
+  std::string text = provenance;
   for (std::size_t c = 0; c < columns.size(); ++c) text += (c ? "," : "") + columns[c];
   text += "\n";
   for (const SweepPoint& p : sweep.points) {
@@ -107,7 +121,7 @@ int run_sweep(const SweepArgs& args) {
     text += "\n";
   }
   table.write(text);
-  std::string ctext = "parameter,value,kind,frequency,unstable_before,unstable_after,bracket\n";
+  std::string ctext = provenance + "parameter,value,kind,frequency,unstable_before,unstable_after,bracket\n";
   for (const StabilityCrossing& c : sweep.crossings)
     ctext += fmt::format("{},{:.17g},{},{:.17g},{},{},{:.3g}\n", args.param, c.value,
                          c.oscillatory ? "complex-pair" : "real", c.frequency, c.unstable_before, c.unstable_after,

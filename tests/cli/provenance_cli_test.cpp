@@ -1,13 +1,15 @@
 // The provenance header end to end (io/provenance.hpp, docs/cli.md "The CSV"): simulate writes it
 // into the CSV, the events file, the partial file and the HTML page; `nhdyn report` reads the
 // run's parameters back, so that a report without --set draws the run's scene, and refuses a
-// CSV whose model hash is not the model's, or whose header is cut short.
+// CSV whose model hash is not the model's, or whose header is cut short. batch, compare, sweep,
+// linearize and the error-relation and tracking studies write the same header into their CSVs.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "support/cli_run.hpp"
 
@@ -138,6 +140,81 @@ TEST_F(ProvenanceCli, AFailedRunsPartialFileCarriesIt) {
   EXPECT_NE(partial.find("\n# nhdyn version: "), std::string::npos) << partial;
   EXPECT_NE(partial.find("integrator=rk4, "), std::string::npos) << partial;
   EXPECT_NE(partial.find("\n# end of provenance\nt,x,y,phi,"), std::string::npos) << partial;
+}
+
+// Each batch run's file is that run's: its parameter and initial value as run, so that `report`
+// draws it without --set; the summary names the grid. The model hash and version lines are those
+// of a simulate run of the same file.
+TEST_F(ProvenanceCli, BatchFilesCarryEachRunsValues) {
+  nhdyn::test::CliOutcome r = nhdyn::test::run_nhdyn(
+      "batch sled.toml --grid a=0.2:0.4:2 --grid 'x(0)=1:3:2' --t-end 0.5 --write-runs -q -o out", dir_ / "a");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  ASSERT_EQ(nhdyn::test::run_nhdyn("simulate sled.toml --t-end 0.5 -q -o run.csv", dir_ / "a").exit_code, 0);
+  const std::string single = provenance_read(dir_ / "a" / "run.csv");
+  const auto line_of = [](const std::string& text, const std::string& key) {
+    const std::size_t at = text.find("\n# " + key + ": ");
+    return at == std::string::npos ? std::string("(no " + key + " line)") : text.substr(at + 1, text.find('\n', at + 1) - at - 1);
+  };
+  const std::string summary = provenance_read(dir_ / "a" / "out" / "summary.csv");
+  EXPECT_EQ(line_of(summary, "model hash"), line_of(single, "model hash"));
+  EXPECT_NE(line_of(summary, "run").find(", runs=a=0.2:0.4:2 x(0)=1:3:2"), std::string::npos) << summary.substr(0, 900);
+  EXPECT_NE(summary.find("\n# end of provenance\nrun,a,x(0),status,"), std::string::npos) << summary.substr(0, 900);
+  // Runs in row-major order: run 3 is a = 0.4, x(0) = 3.
+  const std::string run3 = provenance_read(dir_ / "a" / "out" / "run_3.csv");
+  EXPECT_NE(line_of(run3, "parameters").find(", a=0.4, "), std::string::npos) << line_of(run3, "parameters");
+  EXPECT_EQ(line_of(run3, "initial").rfind("# initial: x=3, y=0, phi=0, ", 0), 0u) << line_of(run3, "initial");
+  EXPECT_NE(line_of(run3, "run").find(", batch_run=3"), std::string::npos) << line_of(run3, "run");
+  // report takes a = 0.4 from the run's header: the same page as the report given --set a=0.4.
+  r = nhdyn::test::run_nhdyn("report out/run_3.csv --model sled.toml -q -o from_header.html", dir_ / "a");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  fs::create_directories(dir_ / "b" / "out");  // the same relative path: the page's title names it
+  provenance_write(dir_ / "b" / "out" / "run_3.csv", without_comments(run3));
+  r = nhdyn::test::run_nhdyn("report out/run_3.csv --model sled.toml --set a=0.4 -q -o given.html", dir_ / "b");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_TRUE(without_provenance_comment(provenance_read(dir_ / "a" / "from_header.html")) ==
+              provenance_read(dir_ / "b" / "given.html"));
+  // Without the header's a = 0.4 the scene is another (a = 0.5): the comparison above can fail.
+  r = nhdyn::test::run_nhdyn("report out/run_3.csv --model sled.toml -q -o plain.html", dir_ / "b");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_FALSE(provenance_read(dir_ / "b" / "plain.html") == provenance_read(dir_ / "b" / "given.html"));
+}
+
+// The commands that are not one simulation say which they are and with what options, before
+// the same model lines.
+TEST_F(ProvenanceCli, CompareSweepLinearizeAndStudiesSayWhatMadeThem) {
+  const std::string bicycle = (fs::path(NHDYN_SOURCE_DIR) / "examples" / "bicycle_linear.toml").string();
+  struct Case {
+    std::string command;
+    std::vector<std::string> files;
+    std::string run_line;
+  };
+  const std::vector<Case> cases{
+      {"compare sled.toml --methods sanh,lagrange --t-end 0.5 -q -o cmp.csv",
+       {"cmp.csv", "cmp-series.csv"},
+       "run: command=compare, methods=sanh,lagrange, integrators=dopri5, reference=tight, complement=qr, "},
+      {"linearize '" + bicycle + "' --set v=4 -o lin.csv", {"lin.csv"}, "run: command=linearize, tolerance=1e-09"},
+      {"sweep '" + bicycle + "' --param v --from 1 --to 3 --steps 3 --eigenvalues -q -o sw.csv",
+       {"sw.csv", "sw-crossings.csv"},
+       "run: command=sweep, param=v, from=1, to=3, steps=3, tolerance=1e-09"},
+      {"study error-relation sled.toml --methods sanh --integrators dopri5 --tolerances 1e-6,1e-8 -q -o er.csv",
+       {"er.csv", "er-by-tolerance.csv"},
+       "run: command=study error-relation, methods=sanh-qr, integrators=dopri5, tolerances=1e-06,1e-08, "},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.command);
+    const nhdyn::test::CliOutcome r = nhdyn::test::run_nhdyn(c.command, dir_ / "a");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    for (const std::string& file : c.files) {
+      SCOPED_TRACE(file);
+      const std::string text = provenance_read(dir_ / "a" / file);
+      EXPECT_EQ(text.rfind("# nhdyn version: ", 0), 0u) << text.substr(0, 300);
+      EXPECT_NE(text.find("\n# " + c.run_line), std::string::npos) << text.substr(0, 1200);
+      EXPECT_NE(text.find("\n# end of provenance\n"), std::string::npos);
+    }
+  }
+  // linearize's --set is in the parameters as run.
+  EXPECT_NE(provenance_read(dir_ / "a" / "lin.csv").find("\n# parameters: v=4, "), std::string::npos)
+      << provenance_read(dir_ / "a" / "lin.csv").substr(0, 600);
 }
 
 }  // namespace

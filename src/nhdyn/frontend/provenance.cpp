@@ -15,8 +15,10 @@ std::string calc_model_hash(const ModelSource& source) {
   return calc_text_hash(source.is_builtin() ? "builtin:" + source.builtin : source.text);
 }
 
-Provenance make_provenance(const Model& model, const ModelSource& source, const SimulationOptions& options,
-                           std::string_view evaluator) {
+namespace {
+
+// What every provenance says of the model: the run's options come after.
+Provenance make_model_provenance(const Model& model, const ModelSource& source) {
   Provenance p;
   p.version = nhdyn_version_text();
   p.model = model.name;
@@ -27,6 +29,22 @@ Provenance make_provenance(const Model& model, const ModelSource& source, const 
     p.initial.emplace_back(model.coordinates[i], model.q0(static_cast<Eigen::Index>(i)));
   for (std::size_t i = 0; i < model.coordinates.size(); ++i)
     p.initial.emplace_back(model.coordinates[i] + "'", model.v0(static_cast<Eigen::Index>(i)));
+  return p;
+}
+
+}  // namespace
+
+Provenance make_command_provenance(const Model& model, const ModelSource& source, std::string_view command,
+                                   std::vector<std::pair<std::string, std::string>> options) {
+  Provenance p = make_model_provenance(model, source);
+  p.run.emplace_back("command", std::string(command));
+  for (auto& option : options) p.run.push_back(std::move(option));
+  return p;
+}
+
+Provenance make_provenance(const Model& model, const ModelSource& source, const SimulationOptions& options,
+                           std::string_view evaluator) {
+  Provenance p = make_model_provenance(model, source);
   const auto add = [&](std::string name, std::string value) { p.run.emplace_back(std::move(name), std::move(value)); };
   add("method", std::string(method_name(options.formulation.method)));
   add("complement", std::string(complement_name(options.formulation.complement)));

@@ -24,6 +24,13 @@ std::string calc_model_hash(const ModelSource& source);
 Provenance make_provenance(const Model& model, const ModelSource& source, const SimulationOptions& options,
                            std::string_view evaluator);
 
+// The provenance of a command other than simulate (batch, compare, sweep, linearize, the
+// studies): the model's part of make_provenance (version, model, file, hash, parameters and
+// initial state as loaded), then `command` ("# run: command=sweep, ...") and the command's own
+// options as given, in order. The same header, so that every CSV nhdyn writes says what made it.
+Provenance make_command_provenance(const Model& model, const ModelSource& source, std::string_view command,
+                                   std::vector<std::pair<std::string, std::string>> options);
+
 // The overrides that load `source` as the run recorded in `provenance` (the CSV `csv`) had it:
 // every parameter at its value as run. Throws InputError when the model is not the run's: its hash
 // differs (the message names both hashes, the model names if they differ, and each parameter whose
