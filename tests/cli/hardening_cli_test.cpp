@@ -232,7 +232,7 @@ TEST_F(Hardening, BatchHonoursTheModelFilesEvents) {
                                                "action = \"stop\"\n");
   const ProcessRun r = nhdyn({"batch", "osc.toml", "--grid", "k=1:4:2", "--t-end", "5", "--rtol", "1e-10", "-o", "out"});
   ASSERT_EQ(r.code, 0) << r.err;
-  std::ifstream in(dir_ / "out" / "summary.csv");
+  std::istringstream in(nhdyn::test::csv_body(nhdyn::test::read_text(dir_ / "out" / "summary.csv")));
   std::string line;
   std::getline(in, line);
   const std::vector<std::string> header = nhdyn::test::split(line);

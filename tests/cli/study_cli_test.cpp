@@ -120,7 +120,7 @@ TEST_F(StudyCli, ErrorRelationWritesTableByToleranceAndPlot) {
                           "out/er.png"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("the model's exact solution"), std::string::npos) << r.out;
-  const std::string table = read_text(dir_ / "out/er.csv");
+  const std::string table = nhdyn::test::csv_body(read_text(dir_ / "out/er.csv"));
   EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 9);  // header and 2 x 2 x 2 runs
   EXPECT_EQ(table.rfind("formulation,integrator,rtol,atol,max_error_q", 0), 0u) << table;
   const nhdyn::CsvTable by_tolerance = nhdyn::load_csv(dir_ / "out/er-by-tolerance.csv");

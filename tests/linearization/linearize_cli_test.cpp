@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "linearization/support.hpp"
+#include "support/text.hpp"
 #include "nhdyn/io/plot.hpp"
 
 namespace {
@@ -65,7 +66,7 @@ TEST_F(CliRun, LinearizeBicyclePrintsTheStateMatrixAndEigenvalues) {
   EXPECT_NE(r.out.find("exact (tangent mode"), std::string::npos) << r.out;
   // The weave pair at 5 m/s, -0.775 +- 4.46 i (Meijaard et al. 2007, table 2), to the digits printed.
   const std::vector<std::complex<double>> want = nhdyn::testing::BicycleMatrices().eigenvalues(5.0);
-  std::istringstream csv(read(dir_ / "eig.csv"));
+  std::istringstream csv(nhdyn::test::csv_body(read(dir_ / "eig.csv")));
   std::string line;
   std::getline(csv, line);
   EXPECT_EQ(line, "index,real,imag");
@@ -83,10 +84,10 @@ TEST_F(CliRun, SweepBicycleFindsWeaveAndCapsizeSpeeds) {
   const CliResult r = run("sweep " + example("bicycle_linear.toml") +
                     " --param v --from 0 --to 10 --steps 101 --eigenvalues -o bike.csv");
   ASSERT_EQ(r.code, 0) << r.err;
-  const std::string table = read(dir_ / "bike.csv");
+  const std::string table = nhdyn::test::csv_body(read(dir_ / "bike.csv"));
   EXPECT_EQ(table.rfind("v,re_1,im_1,re_2,im_2,re_3,im_3,re_4,im_4\n", 0), 0u) << table.substr(0, 80);
   EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 102);
-  std::istringstream crossings(read(dir_ / "bike-crossings.csv"));
+  std::istringstream crossings(nhdyn::test::csv_body(read(dir_ / "bike-crossings.csv")));
   std::string line;
   std::getline(crossings, line);
   EXPECT_EQ(line, "parameter,value,kind,frequency,unstable_before,unstable_after,bracket");

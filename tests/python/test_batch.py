@@ -88,8 +88,9 @@ def test_cli_batch_writes_the_same_final_states(examples, cli, tmp_path):
     cli("batch", examples / "sled.toml", "--grid", "a=0.2:0.6:3", "--grid", "phi'(0)=0.5:1:2", "--t-end", 1,
         "--threads", 2, "--write-runs", "-q", "-o", out)
     with open(out / "summary.csv") as f:
-        header = f.readline().rstrip("\n").split(",")
-        rows = [line.rstrip("\n").split(",") for line in f]
+        lines = [line for line in f if not line.startswith("#")]  # the provenance header first
+    header = lines[0].rstrip("\n").split(",")
+    rows = [line.rstrip("\n").split(",") for line in lines[1:]]
     assert header[:5] == ["run", "a", "phi'(0)", "status", "t_reached"]
     assert len(rows) == 6 and all(row[3] == "ok" for row in rows)
     m = nhdyn.load(examples / "sled.toml")
@@ -108,7 +109,7 @@ def test_cli_batch_writes_the_same_final_states(examples, cli, tmp_path):
     failed = cli("batch", examples / "sled.toml", "--grid", "y'(0)=0:1:2", "-q", "-o", tmp_path / "f", check=False)
     assert failed.returncode == 1
     with open(tmp_path / "f" / "summary.csv") as f:
-        lines = f.read().splitlines()
+        lines = [line for line in f.read().splitlines() if not line.startswith("#")]
     assert lines[1].split(",")[2] == "ok" and lines[2].split(",")[2] == "failed" and "blade" in lines[2]
     bad = cli("batch", examples / "sled.toml", "--grid", "v=0:1:2", "-q", "-o", tmp_path / "g", check=False)
     assert bad.returncode == 2 and "no parameter 'v'" in bad.stderr

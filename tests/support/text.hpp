@@ -20,6 +20,18 @@ inline std::string read_text(const std::filesystem::path& path) {
   return text.str();
 }
 
+// A CSV's text after its provenance header (io/provenance.hpp): the leading '#' lines removed, so
+// that the column names come first. A text without them is returned as it is.
+inline std::string csv_body(const std::string& text) {
+  std::size_t at = 0;
+  while (at < text.size() && text[at] == '#') {
+    const std::size_t end = text.find('\n', at);
+    if (end == std::string::npos) return {};
+    at = end + 1;
+  }
+  return text.substr(at);
+}
+
 inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 // The fields of one CSV line as written by nhdyn (no quoting: its names hold no comma).
