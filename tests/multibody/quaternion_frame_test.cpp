@@ -443,5 +443,34 @@ TEST(QuaternionFrame, BadFrameInputIsRefusedWithWhereAndWhat) {
   refused(edited(text, "\nrotations = \"quaternion\"", "\n"), names, {"add rotations = \"quaternion\""});
 }
 
+// Kane and Levinson's rattleback with a quaternion frame (an ellipsoid contact, the centre of mass
+// off the frame's origin) from the start of examples/rattleback.toml converted by (6.1), (6.2):
+// the same motion as the z-x-y angle model through its spin reversal, to the integration's accuracy.
+TEST(QuaternionFrame, RattlebackFollowsTheAngleModelThroughItsReversal) {
+  const Model angles = load_model(example("rattleback.toml"));
+  const Model quaternion = load_model(example("rattleback_quaternion.toml"));
+  SimulationOptions o = options(3.0, 0.5);
+  o.integrator.rtol = 1e-11;
+  o.integrator.atol = 1e-13;
+  const Rows a = run(angles, o), q = run(quaternion, o);
+  ASSERT_EQ(a.rows.size(), 7u);
+  ASSERT_EQ(q.rows.size(), 7u);
+  double reversed = 0.0;
+  for (std::size_t k = 0; k < 7; ++k) {
+    const Matrix3 Ra = rotation_zxy(a.at(k, "psi"), a.at(k, "theta"), a.at(k, "phi"));
+    const Matrix3 Rq = rotation_of(q.quaternion(k));
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) EXPECT_NEAR(Rq[i][j], Ra[i][j], 1e-8) << "t = " << a.at(k, "t");
+    for (const char* c : {"x", "y", "z", "x'", "y'", "z'"}) EXPECT_NEAR(q.at(k, c), a.at(k, c), 1e-9) << c;
+    // The spin about the vertical, from the quaternion: omega_z = (R omega_F)_z.
+    const Vec3 wb = body_rate(q.quaternion(k), q.quaternion_rate(k));
+    const double wz = Rq[2][0] * wb[0] + Rq[2][1] * wb[1] + Rq[2][2] * wb[2];
+    const double wz_angles = a.at(k, "psi'") + a.at(k, "phi'") * std::sin(a.at(k, "theta"));
+    EXPECT_NEAR(wz, wz_angles, 1e-8) << "t = " << a.at(k, "t");
+    reversed = std::max(reversed, wz);
+  }
+  EXPECT_GT(reversed, 0.1);  // spun at -5 rad/s, it turns the other way from t = 2.35 s
+}
+
 }  // namespace
 }  // namespace nhdyn::multibody_test
