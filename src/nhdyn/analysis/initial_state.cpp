@@ -90,7 +90,7 @@ void check_initial_state(const Model& model, Data& data, double t, const Vector&
     for (const Constraint& c : model.constraints)
       if (c.name == r.constraint) {
         if (!c.where.empty()) where = " (" + c.where + ")";
-        if (c.expression.rfind("contact '", 0) == 0) says = ": " + c.expression;
+        if (c.expression.rfind("contact '", 0) == 0 || c.expression.rfind("frame '", 0) == 0) says = ": " + c.expression;
       }
     report += fmt::format("\n  {} ({} level): residual {:.6g}{}{}", r.constraint,
                           r.level == ConstraintLevel::position ? "position" : "velocity", r.value, where, says);

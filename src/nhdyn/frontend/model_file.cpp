@@ -54,7 +54,7 @@ const std::vector<std::string> top_level_keys = {
     "optimize",  // [optimize]: an optimal control problem, read by `nhdyn optimize` (frontend/optimize_problem.hpp)
     // The multibody description (docs/multibody.md).
     "gravity", "frames", "points", "bodies", "wheels", "knife_edges", "surfaces", "curves", "contacts"};
-const std::vector<std::string> frame_keys = {"name", "parent", "translation", "rotations"};
+const std::vector<std::string> frame_keys = {"name", "parent", "translation", "rotations", "quaternion"};
 const std::vector<std::string> point_keys = {"name", "frame", "position"};
 const std::vector<std::string> body_keys = {"name", "frame", "mass", "com", "inertia"};
 const std::vector<std::string> wheel_keys = {"name", "body", "axis", "radius", "normal"};
@@ -933,6 +933,12 @@ class Loader {
         symbolic::Triple translation{"0", "0", "0"};
         if (const toml::node* node = table->get("translation"))
           translation = triple_of(*node, fmt::format("frame '{}': translation", name), "translation = [\"x\", \"y\", 0]");
+        if (std::optional<std::array<std::string, 4>> quaternion = quaternion_of(*table, name)) {
+          mb.quaternion_frame(name, parent, translation, *quaternion, at(*table->get("quaternion")));
+          frame_names.push_back(name);
+          visual.items.push_back(frame_item(mb.placed_frame(name), symbolic::VisualKind::frame, at(*table)));
+          continue;
+        }
         std::vector<symbolic::FrameRotation> rotations;
         if (const toml::node* node = table->get("rotations")) {
           constexpr std::string_view example = "rotations = [[\"z\", \"psi\"], [\"x\", \"theta\"]]";
@@ -1053,6 +1059,39 @@ class Loader {
     mb.apply();
     // Every point's and frame origin's world position and velocity as result columns.
     symbolic::add_multibody_outputs(builder, mb, frame_names, point_names);
+  }
+
+  // A frame's `rotations = "quaternion"` with `quaternion = ["e0", "e1", "e2", "e3"]`: the four
+  // coordinates' names; nullopt for a frame turned by angles (docs/derivations/quaternion-frame.md).
+  std::optional<std::array<std::string, 4>> quaternion_of(const toml::table& table, const std::string& frame) const {
+    constexpr std::string_view example = "quaternion = [\"e0\", \"e1\", \"e2\", \"e3\"]";
+    const toml::node* rotations = table.get("rotations");
+    const toml::node* names = table.get("quaternion");
+    const bool by_quaternion = rotations != nullptr && rotations->is_string();
+    if (by_quaternion && rotations->value<std::string>().value_or("") != "quaternion")
+      fail(at(*rotations), fmt::format("frame '{}': rotations = \"{}\" is not known; write rotations = \"quaternion\" "
+                                       "(with {}) for a frame turned by a unit quaternion, or a list of [axis, angle] "
+                                       "pairs such as [[\"z\", \"psi\"], [\"x\", \"theta\"]]",
+                                       frame, rotations->value<std::string>().value_or(""), example));
+    if (!by_quaternion) {
+      if (names != nullptr)
+        fail(at(*names), fmt::format("frame '{}': 'quaternion' is given but the frame is not turned by one; add "
+                                     "rotations = \"quaternion\" (and no angles), or remove 'quaternion'",
+                                     frame));
+      return std::nullopt;
+    }
+    if (names == nullptr)
+      fail(at(*rotations), fmt::format("frame '{}': rotations = \"quaternion\" needs the four coordinates that hold "
+                                       "it, scalar first: {} (each listed in `coordinates`)",
+                                       frame, example));
+    const toml::array& array = array_of(*names, fmt::format("frame '{}': quaternion", frame), example);
+    if (array.size() != 4)
+      fail(at(*names), fmt::format("frame '{}': a quaternion has 4 components (scalar first), e.g. {}; {} {} given",
+                                   frame, example, array.size(), array.size() == 1 ? "is" : "are"));
+    std::array<std::string, 4> out;
+    for (std::size_t k = 0; k < 4; ++k)
+      out[k] = string_of(*array.get(k), fmt::format("frame '{}': quaternion[{}]", frame, k + 1), "\"e0\"");
+    return out;
   }
 
   // [Ixx, Iyy, Izz] (principal axes along the frame's) or a 3 x 3 array.

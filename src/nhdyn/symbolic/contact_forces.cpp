@@ -70,7 +70,10 @@ void compile_contact_forces(const Spec& spec, Model& model) {
   if (in.other_energy) why = "the kinetic or potential energy has hand-written parts";
   else if (forces) why = "the model has generalized forces ([forces])";
   else if (spec.m() > 0) why = "the model has programs, whose actuator forces act on the bodies";
-  else if (!hand.empty()) why = fmt::format("the constraint '{}' is written by hand", hand.front()->name);
+  else
+    for (const SpecConstraint* con : hand)
+      if (why.empty() && std::find(in.internal.begin(), in.internal.end(), con->name) == in.internal.end())
+        why = fmt::format("the constraint '{}' is written by hand", con->name);
   c.balance_rows.assign(static_cast<std::size_t>(c.systems), why.empty() ? 1 : 0);
   if (!why.empty())
     c.notes.push_back(fmt::format("the bodies' momentum balance is not used for the contact forces since {}: only "

@@ -63,6 +63,9 @@ struct SpecContactForces {
   std::vector<std::string> system_names;  // per system: that frame's name
   Vector3 gravity = {0, 0, 0};
   std::vector<std::string> generated;     // the constraints the contact helpers wrote
+  // Constraints of the coordinates themselves (a quaternion frame's unit norm): their multipliers are
+  // unknowns like a hand-written constraint's, but they act on no body, so the momentum balance stays.
+  std::vector<std::string> internal;
   bool other_energy = false;              // T or V written by hand besides the bodies'
   double length = 1.0;                    // L [m], the largest wheel radius (or 1)
   // The columns of the reported contacts as symbols (make_contact_force_symbols), for the

@@ -29,6 +29,16 @@ GiNaC::matrix rotation_about(int axis, const GiNaC::ex& angle);
 Vector3 multiply(const GiNaC::matrix& R, const Vector3& v);
 // R^T v (the inverse rotation, parent components to child components).
 Vector3 multiply_transposed(const GiNaC::matrix& R, const Vector3& v);
+// A quaternion e = (e0, e1, e2, e3), scalar first (docs/derivations/quaternion-frame.md).
+using Quaternion = std::array<GiNaC::ex, 4>;
+// The rotation of the unit quaternion e / |e|: ((e0^2 - |e~|^2) I + 2 e~ e~^T + 2 e0 [e~ x]) / (e.e),
+// (2.3), a rotation for every e != 0.
+GiNaC::matrix quaternion_rotation(const Quaternion& e);
+// Its angular velocity 2 E(e) e' / (e.e) in the parent's axes and 2 G(e) e' / (e.e) in the frame's
+// own, (3.3): exact for every e != 0 and every e' (a rate along e only rescales e).
+Vector3 quaternion_omega(const Quaternion& e, const Quaternion& rate);
+Vector3 quaternion_omega_local(const Quaternion& e, const Quaternion& rate);
+
 // Column `axis` of R: the child frame's axis in parent components.
 Vector3 column(const GiNaC::matrix& R, int axis);
 

@@ -222,6 +222,63 @@ MultibodyBuilder& MultibodyBuilder::frame(const std::string& name, const std::st
   return *this;
 }
 
+int MultibodyBuilder::coordinate_index(const std::string& name, const SourceLocation& where,
+                                       const std::string& context) const {
+  const std::vector<std::string>& coordinates = builder_.current().coordinates;
+  for (std::size_t i = 0; i < coordinates.size(); ++i)
+    if (coordinates[i] == name) return static_cast<int>(i);
+  const std::string nearest = nearest_name(name, coordinates);
+  throw_model_error(where, context,
+                    fmt::format("'{}' is not a coordinate of the model{}; list the quaternion's four components in "
+                                "`coordinates` and name them here (the coordinates: {})",
+                                name, nearest.empty() ? "" : fmt::format(" (did you mean '{}'?)", nearest),
+                                coordinates.empty() ? std::string("none") : join(coordinates)));
+}
+
+MultibodyBuilder& MultibodyBuilder::quaternion_frame(const std::string& name, const std::string& parent,
+                                                     const Triple& translation,
+                                                     const std::array<std::string, 4>& quaternion,
+                                                     SourceLocation where) {
+  const std::string context = fmt::format("frame '{}'", name);
+  check_new(frames_, name, "frame", where);
+  const int p = frame_index(parent, where, context + ": parent");
+  const PlacedFrame& up = frames_[static_cast<std::size_t>(p)];
+  const SymbolTable& symbols = builder_.current().symbols;
+
+  PlacedFrame f;
+  f.name = name;
+  f.parent = p;
+  f.where = where;
+  Quaternion e, rate;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const int i = coordinate_index(quaternion[k], where, fmt::format("{}: quaternion component e{}", context, k));
+    for (std::size_t j = 0; j < k; ++j)
+      if (quaternion[j] == quaternion[k])
+        throw_model_error(where, context,
+                          fmt::format("the coordinate '{}' is named twice in the quaternion (as e{} and e{}); name "
+                                      "four different coordinates",
+                                      quaternion[k], j, k));
+    for (const PlacedFrame& other : frames_)
+      if (std::find(other.quaternion.begin(), other.quaternion.end(), i) != other.quaternion.end())
+        throw_model_error(where, context,
+                          fmt::format("the coordinate '{}' already holds the quaternion of frame '{}'; each "
+                                      "quaternion frame needs four coordinates of its own",
+                                      quaternion[k], other.name));
+    f.quaternion.push_back(i);
+    e[k] = symbols.coordinate(i);
+    rate[k] = symbols.velocity(i);
+  }
+  // docs/derivations/quaternion-frame.md (3.2): R_F = R_P R(e), omega = omega_P + R_P 2 E(e) e',
+  // omega_F = R(e)^T omega_P,F + 2 G(e) e'.
+  const GiNaC::matrix Re = quaternion_rotation(e);
+  f.origin = add(up.origin, multiply(up.rotation, parse(translation, where, context + ": translation", true)));
+  f.rotation = up.rotation.mul(Re);
+  f.omega = add(up.omega, multiply(up.rotation, quaternion_omega(e, rate)));
+  f.omega_local = add(multiply_transposed(Re, up.omega_local), quaternion_omega_local(e, rate));
+  frames_.push_back(std::move(f));
+  return *this;
+}
+
 MultibodyBuilder& MultibodyBuilder::point(const std::string& name, const std::string& frame, const Triple& position,
                                           SourceLocation where) {
   const std::string context = fmt::format("point '{}'", name);
@@ -674,8 +731,29 @@ void MultibodyBuilder::apply() {
   applied_ = true;
   const bool other_energy =
       !builder_.current().kinetic_energy.is_zero() || !builder_.current().potential_energy.is_zero();
-  const std::size_t first_generated = builder_.current().constraints.size();
   builder_.add_energies(kinetic_energy(), potential_energy());
+  // The quaternion frames' unit norms (docs/derivations/quaternion-frame.md (4.1)): constraints of
+  // the coordinates, not of a contact, so they act on no body.
+  std::vector<std::string> unit_norms;
+  const Spec& spec = builder_.current();
+  for (const PlacedFrame& f : frames_) {
+    if (f.quaternion.empty()) continue;
+    GiNaC::ex norm = -1;
+    std::vector<std::string> names;
+    for (int i : f.quaternion) {
+      norm += GiNaC::pow(spec.symbols.coordinate(i), 2);
+      names.push_back(spec.coordinates[static_cast<std::size_t>(i)]);
+    }
+    unit_norms.push_back(f.name + "_unit");
+    builder_.constraint(unit_norms.back(), ConstraintLevel::position, norm,
+                        fmt::format("frame '{}': the quaternion ({}) has unit norm, {}^2 + {}^2 + {}^2 + {}^2 - 1 = 0 "
+                                    "(the position residual is |e|^2 - 1, so |e| = sqrt(1 + residual); the velocity "
+                                    "residual is 2 e.e'; --fix-initial moves e onto the unit sphere; a zero "
+                                    "quaternion has no direction: e = (1, 0, 0, 0) is the parent's axes)",
+                                    f.name, join(names), names[0], names[1], names[2], names[3]),
+                        f.where);
+  }
+  const std::size_t first_helper = builder_.current().constraints.size();
   for (const Helper& h : helpers_) {
     switch (h.kind) {
       case Helper::Kind::wheel: add_wheel(h); break;
@@ -708,7 +786,8 @@ void MultibodyBuilder::apply() {
   auto record = std::make_shared<SpecContactForces>();
   record->other_energy = other_energy;
   const std::vector<SpecConstraint>& constraints = builder_.current().constraints;
-  for (std::size_t i = first_generated; i < constraints.size(); ++i) record->generated.push_back(constraints[i].name);
+  for (std::size_t i = first_helper; i < constraints.size(); ++i) record->generated.push_back(constraints[i].name);
+  record->internal = std::move(unit_norms);
   record_contact_forces(*record);
   std::vector<ReportedContact> reported;  // the wheels, knife edges and rolling bodies, whose columns events may name
   for (const ContactPoint& c : record->contacts)

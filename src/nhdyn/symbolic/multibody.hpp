@@ -10,6 +10,9 @@
 // parent's axes) and then a body-fixed sequence of rotations about the x, y or z axis of the frame
 // produced so far, each by an angle (an expression in t, the coordinates and the parameters).
 // Angular velocities come from the rates of these angles, not from differentiating matrices.
+// Instead of angles, a frame may turn by a unit quaternion held in four coordinates
+// (quaternion_frame, docs/derivations/quaternion-frame.md): no orientation is singular, at the
+// cost of one more coordinate and the position-level constraint "<frame>_unit", e.e - 1 = 0.
 //
 // Every expression is text parsed by the SpecBuilder (its coordinates and parameters must be
 // declared first). Errors are ModelErrors that start with the SourceLocation given.
@@ -49,6 +52,7 @@ struct PlacedFrame {
   GiNaC::matrix rotation;     // R: frame components -> world components
   Vector3 omega;              // angular velocity, world components (linear in q')
   Vector3 omega_local;        // the same in the frame's own axes
+  std::vector<int> quaternion;  // a quaternion frame: the indices of its coordinates e0..e3; else empty
   SourceLocation where;
 };
 
@@ -59,6 +63,14 @@ class MultibodyBuilder {
 
   MultibodyBuilder& frame(const std::string& name, const std::string& parent, const Triple& translation,
                           const std::vector<FrameRotation>& rotations, SourceLocation where = {});
+  // A frame placed by `translation` (parent's axes) and then turned relative to its parent by the
+  // unit quaternion whose components (scalar first) are the four coordinates named in
+  // `quaternion` (docs/derivations/quaternion-frame.md (2.1), (3.2)). apply() adds the
+  // position-level constraint "<name>_unit": e0^2 + e1^2 + e2^2 + e3^2 - 1 = 0, after the
+  // hand-written constraints and before the helpers'. Throws a ModelError naming `where` for a
+  // name that is not a coordinate, a coordinate named twice or already another frame's.
+  MultibodyBuilder& quaternion_frame(const std::string& name, const std::string& parent, const Triple& translation,
+                                     const std::array<std::string, 4>& quaternion, SourceLocation where = {});
   // A point fixed in `frame`, at `position` in the frame's axes.
   MultibodyBuilder& point(const std::string& name, const std::string& frame, const Triple& position,
                           SourceLocation where = {});
@@ -146,6 +158,7 @@ class MultibodyBuilder {
                 bool coordinates_allowed) const;
   int frame_index(const std::string& name, const SourceLocation& where, const std::string& context) const;
   int point_index(const std::string& name, const SourceLocation& where, const std::string& context) const;
+  int coordinate_index(const std::string& name, const SourceLocation& where, const std::string& context) const;
   int body_index(const std::string& name, const SourceLocation& where, const std::string& context) const;
   void check_helper_name(const std::string& name, const SourceLocation& where) const;
   GiNaC::ex parse_surface(const std::string& text, const Vector3& at, const SourceLocation& where,
