@@ -339,12 +339,28 @@ TEST(ContactModes, DroppedBallBouncesWithNewtonsLawUntilTheTouchdownsAccumulate)
       v *= e;
       t += 2 * v / g;
     }
+    // impact_loss (I5), cumulative: the first touchdown (moving at v0 = 3 m/s along x, no spin)
+    // takes a sticking impulse, (1 - e^2) m V^2 / 2 + k m v0^2 / (2 (1 + k)); the ball then rolls
+    // and the next ones are normal, (1 - e^2) m V^2 / 2. The reactions' work stays that of the
+    // finite reactions (none in flight).
+    const double m = 0.1, k = 0.4, v0 = 3.0;
+    const std::size_t first = mode_switch_row(r, r.summary.events[0].t);
+    const double loss1 = (1 - e * e) * m * v1 * v1 / 2 + k * m * v0 * v0 / (2 * (1 + k));
+    EXPECT_NEAR(r.at(first, "impact_loss"), loss1, 1e-12);
+    EXPECT_NEAR(r.at(first - 1, "impact_loss"), 0.0, 1e-15);
+    const std::size_t second = mode_switch_row(r, r.summary.events[1].t);
+    EXPECT_NEAR(r.at(second, "impact_loss"), loss1 + (1 - e * e) * m * e * e * v1 * v1 / 2, 1e-12);
+    EXPECT_NEAR(r.at(second, "work_reactions"), 0.0, 1e-12);
+    EXPECT_NEAR(r.at(second, "work"), -r.at(second, "impact_loss") + r.at(second, "work_forces"), 1e-15);
     const double t_inf = t1 * (1 + 2 * e / (1 - e));
     EXPECT_LT(r.summary.t_reached, t_inf + 1e-6);
     EXPECT_GT(r.summary.t_reached, t_inf - 1e-3);
     EXPECT_LT(r.summary.max_balance_error, 1e-9);
   }
-  const Model plastic = load_model_text(dropped_ball(0.0), "drop.toml");
+  // A normal drop (v0 = 0), plastic: impact_loss = m V^2 / 2, the closed form (1 - e^2) m V^2 / 2.
+  std::string normal = dropped_ball(0.0);
+  normal.replace(normal.find("v0 = { value = 3.0"), 18, "v0 = { value = 0.0");
+  const Model plastic = load_model_text(normal, "drop.toml");
   const ModeRun r = run_modes(plastic, 0.5);
   ASSERT_EQ(r.summary.events.size(), 1u);
   EXPECT_NEAR(r.summary.events[0].t, t1, 1e-9);
@@ -352,7 +368,106 @@ TEST(ContactModes, DroppedBallBouncesWithNewtonsLawUntilTheTouchdownsAccumulate)
   EXPECT_EQ(r.at(last, "ball_mode"), 0.0);
   EXPECT_NEAR(r.at(last, "z'"), 0.0, 1e-12);
   EXPECT_NEAR(r.at(last, "ball_N"), 0.1 * g, 1e-10);
+  EXPECT_NEAR(r.at(last, "impact_loss"), 0.1 * v1 * v1 / 2, 1e-12);  // plastic: all the kinetic energy
   EXPECT_LT(r.summary.max_balance_error, 1e-9);
+}
+
+// A ball landing obliquely with spin (section 7.1): released at the height h with the centre
+// velocity (vx, vy, 0) and the spin w0 about y, a unilateral contact with friction mu and
+// restitution e. It touches down at t1 = sqrt(2 h / g) with V = g t1 and the slip
+// s- = (vx - r w0, vy); (I3) decides sticking or sliding, (I4) gives the velocities after, (I5)
+// the energy taken.
+std::string landing_ball(double e, double mu, double vx, double vy, double w0, double h) {
+  std::string text = test::read_text(example("ball_thrown_sliding.toml"));
+  const std::string keys = "friction = \"mu\"\nmode = \"sliding\"\n";
+  text.replace(text.find(keys), keys.size(),
+               "friction = \"mu\"\nunilateral = true\nrestitution = " + std::to_string(e) + "\n");
+  text.replace(text.find("mu = { value = 0.25 }"), 21, "mu = { value = " + std::to_string(mu) + " }");
+  text.replace(text.find("z = \"r\""), 7, "z = \"r + " + std::to_string(h) + "\"");
+  const std::string velocity = "velocity = { x = \"v0\", y = 0, z = 0, a = 0, b = \"w0\", c = 0 }";
+  text.replace(text.find(velocity), velocity.size(),
+               "velocity = { x = " + std::to_string(vx) + ", y = " + std::to_string(vy) + ", z = 0, a = 0, b = " +
+                   std::to_string(w0) + ", c = 0 }");
+  return text;
+}
+
+ModeRun run_landing(const std::string& text, double t_end) {
+  const Model model = load_model_text(text, "landing.toml");
+  return run_modes(model, t_end);
+}
+
+TEST(ContactModes, BallLandingObliquelyWithSpinTakesTheSlidingImpulseOfTheClosedForm) {
+  const double m = 0.1, r = 0.02, g = 9.81, k = 0.4, mu = 0.1, e = 0.5, h = 0.05;
+  const double vx = 2.0, w0 = -50.0;  // backspin: s- = vx - r w0 = 3 m/s
+  const ModeRun run = run_landing(landing_ball(e, mu, vx, 0.0, w0, h), 0.25);
+  ASSERT_EQ(run.summary.events.size(), 2u);
+  // Two touchdowns, each a sliding impact (I3 violated); in flight x', b' are constant.
+  double t = std::sqrt(2 * h / g), V = g * t, x_dot = vx, spin = w0, loss = 0.0;
+  for (std::size_t j = 0; j < 2; ++j) {
+    SCOPED_TRACE(j);
+    const EventRecord& ev = run.summary.events[j];
+    EXPECT_EQ(ev.name, "ball_touchdown");
+    EXPECT_NEAR(ev.t, t, 1e-9);
+    const double s_before = x_dot - r * spin;
+    EXPECT_GT(k * s_before / (1 + k), mu * (1 + e) * V);  // the sticking impulse is outside the cone
+    const double s_after = s_before - mu * (1 + e) * V * (1 + k) / k;
+    EXPECT_GT(s_after, 0.0);
+    x_dot -= mu * (1 + e) * V;
+    spin += mu * (1 + e) * V / (k * r);
+    loss += m * (1 - e * e) * V * V / 2 + mu * m * (1 + e) * V * (s_before + s_after) / 2;
+    EXPECT_NEAR(ev.v[0], x_dot, 1e-9);
+    EXPECT_NEAR(ev.v[2], e * V, 1e-9);
+    EXPECT_NEAR(ev.v[4], spin, 1e-7);
+    const std::size_t row = mode_switch_row(run, ev.t);
+    EXPECT_EQ(run.at(row, "ball_mode"), 2.0);  // it bounces
+    EXPECT_NEAR(run.at(row, "impact_loss"), loss, 1e-10);
+    t += 2 * e * V / g;
+    V *= e;
+  }
+  EXPECT_LT(run.summary.max_balance_error, 1e-9);  // h - h0 - W through the bounces
+  EXPECT_NEAR(run.at(run.rows.size() - 1, "work_reactions"), 0.0, 1e-12);
+  EXPECT_TRUE(run.summary.warnings.empty());
+}
+
+TEST(ContactModes, PlasticLandingSlidesOnAlongThePreImpactSlipOrSticksInsideTheCone) {
+  const double r = 0.02, g = 9.81, k = 0.4, h = 0.05;
+  const double t1 = std::sqrt(2 * h / g), V = g * t1;
+  {
+    // Spatial slip s- = (vx - r w0, vy): the impulse slides along it, the ball leaves the impact
+    // sliding with s+ = (|s-| - mu V (1 + k) / k) e_s and sticks k |s+| / (mu g (1 + k)) later.
+    const double mu = 0.2, vx = 1.0, vy = 1.5, w0 = 20.0;
+    const ModeRun run = run_landing(landing_ball(0.0, mu, vx, vy, w0, h), 1.0);
+    ASSERT_EQ(run.summary.events.size(), 2u);
+    EXPECT_EQ(run.summary.events[0].name, "ball_touchdown");
+    EXPECT_EQ(run.summary.events[1].name, "ball_stick");
+    const double sx = vx - r * w0, sy = vy, s = std::hypot(sx, sy);
+    const double s_after = s - mu * V * (1 + k) / k;
+    ASSERT_GT(s_after, 0.0);
+    const EventRecord& ev = run.summary.events[0];
+    EXPECT_NEAR(ev.v[0], vx - mu * V * sx / s, 1e-9);
+    EXPECT_NEAR(ev.v[1], vy - mu * V * sy / s, 1e-9);
+    EXPECT_NEAR(ev.v[2], 0.0, 1e-12);
+    const std::size_t row = mode_switch_row(run, ev.t);
+    EXPECT_EQ(run.at(row, "ball_mode"), 1.0);
+    EXPECT_NEAR(run.at(row, "ball_slip_x"), s_after * sx / s, 1e-9);
+    EXPECT_NEAR(run.at(row, "ball_slip_y"), s_after * sy / s, 1e-9);
+    EXPECT_NEAR(run.summary.events[1].t, t1 + k * s_after / (mu * g * (1 + k)), 1e-9);
+    EXPECT_NEAR(run.at(row, "impact_loss"), 0.1 * V * V / 2 + mu * 0.1 * V * (s + s_after) / 2, 1e-10);
+    EXPECT_LT(run.summary.max_balance_error, 1e-9);
+  }
+  {
+    // A small slip: the sticking impulse is inside the cone, the ball rolls at once at 5 vx / 7.
+    const double mu = 0.5, vx = 0.3;
+    const ModeRun run = run_landing(landing_ball(0.0, mu, vx, 0.0, 0.0, h), 0.3);
+    ASSERT_EQ(run.summary.events.size(), 1u);
+    const EventRecord& ev = run.summary.events[0];
+    EXPECT_NEAR(ev.v[0], 5 * vx / 7, 1e-10);
+    EXPECT_NEAR(ev.v[4], 5 * vx / 7 / r, 1e-8);
+    const std::size_t row = mode_switch_row(run, ev.t);
+    EXPECT_EQ(run.at(row, "ball_mode"), 0.0);
+    EXPECT_NEAR(run.at(row, "impact_loss"), 0.1 * V * V / 2 + k * 0.1 * vx * vx / (2 * (1 + k)), 1e-10);
+    EXPECT_LT(run.summary.max_balance_error, 1e-9);
+  }
 }
 
 std::string thrown_ball_with(const std::string& keys) {

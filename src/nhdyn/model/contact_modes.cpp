@@ -57,6 +57,7 @@ std::vector<std::string> contact_mode_columns(const Model& model) {
     for (const char* suffix : {"_mode", "_slip_speed", "_slip_x", "_slip_y", "_slip_z", "_gap"})
       columns.push_back(c.name + suffix);
   columns.push_back("work_friction");
+  columns.push_back("impact_loss");
   return columns;
 }
 
@@ -75,6 +76,7 @@ void append_contact_mode_values(const Data& data, std::vector<double>& row) {
     row.push_back(w.gap[i]);
   }
   row.push_back(data.work_friction);
+  row.push_back(data.impact_loss);
 }
 
 bool contact_mode_drops(const Model& model, const Data& data, const std::string& constraint) {

@@ -100,7 +100,7 @@ ContactModeData make_contact_mode_data(const Model& model);
 
 // The result columns of the contacts with modes: per contact NAME_mode, NAME_slip_speed,
 // NAME_slip_x, NAME_slip_y, NAME_slip_z, NAME_gap, then work_friction (the friction's work since
-// t0). Empty for a model without contact modes. Appended after the contact forces
+// t0) and impact_loss (the energy the touchdowns took since t0, analysis/contact_switches.hpp). Empty for a model without contact modes. Appended after the contact forces
 // (contact_forces.hpp).
 std::vector<std::string> contact_mode_columns(const Model& model);
 // Appends their values (after compute_mode_acceleration and record_contact_gaps); `work_friction`
