@@ -2,6 +2,7 @@
 // sliding on a plane against the closed forms of docs/derivations/contact-modes.md section 10.1
 // (the time they start rolling, their final speed, the friction's work), the energy balance
 // through the switch, and the keys' bad values.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -468,6 +469,127 @@ TEST(ContactModes, PlasticLandingSlidesOnAlongThePreImpactSlipOrSticksInsideTheC
     EXPECT_NEAR(run.at(row, "impact_loss"), 0.1 * V * V / 2 + k * 0.1 * vx * vx / (2 * (1 + k)), 1e-10);
     EXPECT_LT(run.summary.max_balance_error, 1e-9);
   }
+}
+
+// Painleve's rod (section 3.8): a rod of mass m, length 2 l, turned by b about y, with a ball of
+// radius rho at its end (l, 0, 0) touching the plane z = 0. Its contact's inverse inertia (S11):
+// Lambda_nn = (1 + 3 c^2) / m, Lambda_nt = 3 c (s + rho / l) / m, Lambda_tt = 1/m + 3 (s + rho/l)^2 / m.
+std::string painleve_rod(const std::string& keys, double b0, double h, double vx) {
+  return R"toml(
+name = "painleve-rod"
+coordinates = ["x", "y", "z", "b"]
+gravity = [0, 0, "-g"]
+[parameters]
+m = 1.0
+l = 0.5
+rho = 0.01
+g = 9.81
+b0 = )toml" + fmt::format("{:.17g}", b0) + R"toml(
+h = )toml" + fmt::format("{:.17g}", h) + R"toml(
+vx = )toml" + fmt::format("{:.17g}", vx) + R"toml(
+[[frames]]
+name = "rod"
+translation = ["x", "y", "z"]
+rotations = [["y", "b"]]
+[[bodies]]
+name = "rod"
+frame = "rod"
+mass = "m"
+inertia = ["m*l^2/3", "m*l^2/3", "m*l^2/3"]
+[[contacts]]
+name = "end"
+body = "rod"
+shape = { sphere = "rho" }
+centre = ["l", 0, 0]
+unilateral = true
+)toml" + keys + R"toml(
+[initial]
+position = { x = 0, y = 0, z = "l*sin(b0) + rho + h", b = "b0" }
+velocity = { x = "vx", y = 0, z = 0, b = 0 }
+)toml";
+}
+
+struct RodInertia {
+  double nn, nt, tt;
+};
+RodInertia rod_inertia(double b) {
+  const double c = std::cos(b), s = std::sin(b), a = s + 0.01 / 0.5;
+  return {1 + 3 * c * c, 3 * c * a, 1 + 3 * a * a};  // m = 1
+}
+
+// The end slides away from under the centre (sigma = +1) at b0 = atan(2): w_eff = Lambda_nn -
+// mu Lambda_nt vanishes at mu_c = (1 + 3 c^2) / (3 c (s + rho / l)) (S12). Above it the start is
+// refused naming the contact, t and w_eff; below it the rod slides with N = m g / (m w_eff) (S8).
+TEST(ContactModes, PainlevesRodStopsAboveTheCriticalFrictionAndSlidesBelowIt) {
+  const double b0 = std::atan(2.0), g = 9.81;
+  const RodInertia L = rod_inertia(b0);
+  const double mu_c = L.nn / L.nt;
+  EXPECT_NEAR(mu_c, 1.30417, 1e-5);
+  {
+    const double mu = 1.01 * mu_c;
+    const Model model = load_model_text(painleve_rod(fmt::format("friction = {:.17g}\n", mu), b0, 0.0, 2.0), "rod.toml");
+    SimulationOptions options;
+    options.t_end = 0.05;
+    try {
+      simulate(model, options, [](const Data&) {});
+      ADD_FAILURE() << "accepted";
+    } catch (const ModelError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("rod.toml:"), std::string::npos) << message;
+      EXPECT_NE(message.find("contact 'end' slides in Painleve's paradox at t = 0"), std::string::npos) << message;
+      EXPECT_NE(message.find(fmt::format("w_eff = {:.6g} 1/kg", L.nn - mu * L.nt)), std::string::npos) << message;
+      EXPECT_NE(message.find(fmt::format("frictionless {:.6g} 1/kg", L.nn)), std::string::npos) << message;
+      EXPECT_NE(message.find("no mode is consistent"), std::string::npos) << message;
+    }
+  }
+  const double mu = 0.99 * mu_c;
+  const Model model = load_model_text(painleve_rod(fmt::format("friction = {:.17g}\n", mu), b0, 0.0, 2.0), "rod.toml");
+  ModeRun r;
+  r.columns = make_result_columns(model);
+  SimulationOptions options;
+  options.t_end = 0.002;
+  options.output_step = 0.001;
+  options.integrator.rtol = 1e-10;
+  options.integrator.atol = 1e-12;
+  r.summary = simulate(model, options, [&](const Data& data) {
+    std::vector<double> row;
+    fill_result_row(model, data, row);
+    r.rows.push_back(std::move(row));
+  });
+  EXPECT_EQ(r.summary.status, Status::ok) << r.summary.message;
+  // It slides, until the large friction stops the slip (a stick, not a stop: the "dynamic jam").
+  EXPECT_EQ(r.at(0, "end_mode"), 1.0);
+  for (const EventRecord& e : r.summary.events) EXPECT_EQ(e.name, "end_stick");
+  // Near the singularity N is large: 100 m g at 1 % below mu_c.
+  EXPECT_NEAR(r.at(0, "end_N"), g / (L.nn - mu * L.nt), 1e-9 * g / (L.nn - mu * L.nt));
+  EXPECT_NEAR(r.at(0, "end_Fx"), -mu * r.at(0, "end_N"), 1e-9 * r.at(0, "end_N"));
+}
+
+// Newton's law with a sticking impulse gains energy at a coupled contact when e^2 > 1 - M_nt^2 /
+// (M_nn M_tt) = 1 - Lambda_nt^2 / (Lambda_nn Lambda_tt), for the approach v_t = (Lambda_nt /
+// Lambda_nn) v_n (section 7): the rod landing at b = 0.6 with e = 0.95. The impact is warned about
+// once, impact_loss is the closed form (v^T M v - e^2 M_nn v_n^2) / 2 < 0, and h - h0 - W holds.
+TEST(ContactModes, AnImpactThatGainsEnergyIsWarnedAboutOnceAndBookedInImpactLoss) {
+  const double b = 0.6, g = 9.81, h = 0.02, e = 0.95;
+  const RodInertia L = rod_inertia(b);
+  EXPECT_GT(e * e, 1 - L.nt * L.nt / (L.nn * L.tt));
+  const double t1 = std::sqrt(2 * h / g), vn = -g * t1, vt = L.nt / L.nn * vn;
+  const Model model = load_model_text(painleve_rod(fmt::format("restitution = {}\n", e), b, h, vt), "rod.toml");
+  const ModeRun r = run_modes(model, t1 + 0.01);
+  ASSERT_GE(r.summary.events.size(), 1u);
+  EXPECT_EQ(r.summary.events[0].name, "end_touchdown");
+  EXPECT_NEAR(r.summary.events[0].t, t1, 1e-9);
+  // M = Lambda^-1 (2 x 2, t and n): v^T M v = (Lnn vt^2 - 2 Lnt vt vn + Ltt vn^2) / det.
+  const double det = L.tt * L.nn - L.nt * L.nt;
+  const double loss = ((L.nn * vt * vt - 2 * L.nt * vt * vn + L.tt * vn * vn) / det - e * e * L.tt / det * vn * vn) / 2;
+  EXPECT_LT(loss, 0.0);
+  EXPECT_NEAR(r.at(mode_switch_row(r, t1 + (r.summary.events[0].t - t1)), "impact_loss"), loss, 1e-10);
+  ASSERT_EQ(r.summary.warnings.size(), 1u);
+  const std::string& warning = r.summary.warnings[0];
+  EXPECT_NE(warning.find("contact 'end': the impact at t = "), std::string::npos) << warning;
+  EXPECT_NE(warning.find("gains energy"), std::string::npos) << warning;
+  EXPECT_NE(warning.find(fmt::format("{:.6g} J", -loss)), std::string::npos) << warning;
+  EXPECT_LT(r.summary.max_balance_error, 1e-9);
 }
 
 std::string thrown_ball_with(const std::string& keys) {

@@ -36,6 +36,29 @@ std::array<double, 2> onset_direction(const ContactModeData& w, std::size_t i) {
   return {-w.friction[i][0] / size, -w.friction[i][1] / size};
 }
 
+// Painleve's paradox is watched on w_eff relative to its frictionless part (section 3.8): the run
+// stops before the matrix of (S4) turns singular at w_eff = 0.
+constexpr double kPainleve = 1e-9;
+
+bool painleve(const ContactModeData& w, std::size_t i) {
+  return w.mode[i] == ContactMode::sliding && !(w.w_eff[i] > kPainleve * w.lambda_nn[i]);
+}
+
+// The message of a sliding contact in Painleve's paradox, after compute_dynamics in that mode.
+std::string painleve_message(const ContactModeContact& c, const ContactModeData& w, std::size_t i, double t) {
+  const double N = w.normal_force[i];
+  const double nu0 = -N * w.w_eff[i];  // the gap's acceleration were the contact free, (S8)
+  const char* kind = w.w_eff[i] < 0.0 && nu0 < 0.0   ? "no mode is consistent (sliding would need the ground to pull, "
+                                                         "free the body would sink into it)"
+                     : w.w_eff[i] < 0.0 && nu0 > 0.0 ? "two modes are consistent (sliding with N > 0, and free)"
+                                                     : "its normal force would grow without bound";
+  return fmt::format("contact '{}' slides in Painleve's paradox at t = {:.9g}: with mu_k = {:.6g} its effective normal "
+                     "inverse mass w_eff = {:.6g} 1/kg is not positive (frictionless {:.6g} 1/kg; N = {:.6g} N, the free "
+                     "gap acceleration {:.6g} m/s^2): {} (docs/derivations/contact-modes.md 3.4, 3.8). Lower the friction "
+                     "coefficient",
+                     c.name, t, w.mu_k[i], w.w_eff[i], w.lambda_nn[i], N, nu0, kind);
+}
+
 void throw_at_start(const Model& model, const Data& data) {
   throw ModelError(fmt::format("model '{}': at the initial state: {}", model.name, explain_failure(model, data)));
 }
@@ -79,6 +102,9 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
   if (compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok) throw_at_start(model, data);
   for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
     const ContactModeContact& c = cm.contacts[i];
+    if (painleve(w, i))
+      throw ModelError(fmt::format("{}: at t0 {}; or start it in another mode (mode = \"rolling\" or \"free\")", c.where,
+                                   painleve_message(c, w, i, t0)));
     if (!c.unilateral || w.mode[i] == ContactMode::free || !(w.normal_force[i] < 0.0)) continue;
     throw ModelError(fmt::format("{}: contact '{}' is unilateral, but at t0 its normal force in the {} mode is N = "
                                  "{:.6g} N < 0: the ground would have to pull the body. Start it free (mode = "
@@ -132,6 +158,7 @@ Status ContactSwitches::evaluate(double t, const double* y, double* g) {
       case ContactMode::sliding:
         if (c.unilateral) gi[0] = N;
         gi[1] = w.slip[i][0] * w.direction[i][0] + w.slip[i][1] * w.direction[i][1];
+        gi[2] = w.w_eff[i] - kPainleve * w.lambda_nn[i];  // Painleve (section 3.8)
         break;
       case ContactMode::free: gi[0] = data_.phi(c.gap_position); break;
     }
@@ -158,11 +185,19 @@ std::string ContactSwitches::switch_contact(int contact, int slot, double t, con
     return c.name + "_liftoff";
   }
   if (slot == 0) return touchdown(contact, t);
+  if (slot == 2) {
+    // w_eff fell through 0 while sliding (section 3.8): Painleve's paradox ends the run here.
+    if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) == Status::ok)
+      accumulation_ = painleve_message(c, w, i, t) + "; the run ends here with its results so far";
+    return "";
+  }
   if (before == ContactMode::rolling) {
     // Slip starts: the friction that rolling needs leaves the cone; it slides opposite to it.
     if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
     w.direction[i] = onset_direction(w, i);
     w.mode[i] = ContactMode::sliding;
+    if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
+    if (!check_sliding(contact, t)) return "";
     return c.name + "_slip";
   }
   // The slip reached 0: stick if rolling is consistent and inside the cone, else lift off or slide
@@ -177,6 +212,8 @@ std::string ContactSwitches::switch_contact(int contact, int slot, double t, con
   if (norm2(w.friction[i]) <= w.mu_s[i] * std::abs(N)) return c.name + "_stick";
   w.direction[i] = onset_direction(w, i);
   w.mode[i] = ContactMode::sliding;
+  if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
+  if (!check_sliding(contact, t)) return "";
   return c.name + "_slip";
 }
 
@@ -219,7 +256,13 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
   return status == Status::ok ? Status::stopped : status;
 }
 
-bool ContactSwitches::check_sliding(int /*contact*/, double /*t*/) { return true; }
+bool ContactSwitches::check_sliding(int contact, double t) {
+  const auto i = static_cast<std::size_t>(contact);
+  if (!painleve(data_.modes, i)) return true;
+  accumulation_ = painleve_message(model_.contact_modes->contacts[i], data_.modes, i, t) +
+                  "; the run ends here with its results so far";
+  return false;
+}
 
 Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, bool sliding,
                                        const std::array<double, 2>& direction) {

@@ -38,6 +38,8 @@ ContactModeData make_contact_mode_data(const Model& model) {
   w.slip_world.assign(m, {0.0, 0.0, 0.0});
   w.sliding_direction.assign(m, {0.0, 0.0});
   w.friction_power.assign(m, 0.0);
+  w.w_eff.assign(m, 0.0);
+  w.lambda_nn.assign(m, 0.0);
   w.gap.assign(m, 0.0);
   w.gap_column.assign(m, -1);
   w.tangent_length.assign(m, {1.0, 1.0});
@@ -46,6 +48,8 @@ ContactModeData make_contact_mode_data(const Model& model) {
   const int n = model.n();
   w.M = Matrix::Zero(n, n);
   w.rhs = Vector::Zero(n);
+  w.probe = Vector::Zero(n);
+  w.response = Vector::Zero(n);
   w.lu = Eigen::PartialPivLU<Matrix>(n);
   return w;
 }
