@@ -565,6 +565,63 @@ TEST(ContactModes, PainlevesRodStopsAboveTheCriticalFrictionAndSlidesBelowIt) {
   EXPECT_NEAR(r.at(0, "end_Fx"), -mu * r.at(0, "end_N"), 1e-9 * r.at(0, "end_N"));
 }
 
+// Painleve's paradox met during a run: the rod stands on its end (rolling, at b0 = atan(2)) and a
+// torque -T t about y, growing, tips it over faster than gravity: the friction rolling needs
+// points to -x and grows while N falls, so the end slips, away from under the rod (sigma = +1).
+// With mu_k above mu_c(b) (S12) that sliding start is in Painleve's paradox: the run ends
+// there (not a bad start) with the contact, t and w_eff = Lambda_nn - mu Lambda_nt at the
+// configuration reached, and the rows so far; below min mu_c (1.30416 at b = 1.105) it slides on.
+TEST(ContactModes, PainlevesRodTippedByATorqueStopsWhereItWouldStartSliding) {
+  const double b0 = std::atan(2.0);
+  const auto rod = [&](double mu) {
+    std::string text = painleve_rod(fmt::format("friction = {}\nmode = \"rolling\"\n", mu), b0, 0.0, 0.0);
+    text.replace(text.find("[initial]"), 9, "[forces]\nb = \"-100*t\"\n[initial]");
+    return load_model_text(text, "rod.toml");
+  };
+  const auto run = [](const Model& model, double t_end) {
+    ModeRun r;
+    r.columns = make_result_columns(model);
+    SimulationOptions options;
+    options.t_end = t_end;
+    options.output_step = 1e-5;
+    options.integrator.rtol = 1e-10;
+    options.integrator.atol = 1e-12;
+    r.summary = simulate(model, options, [&](const Data& data) {
+      std::vector<double> row;
+      fill_result_row(model, data, row);
+      r.rows.push_back(std::move(row));
+    });
+    return r;
+  };
+  const ModeRun stop = run(rod(1.5), 0.1);
+  EXPECT_NE(stop.summary.status, Status::ok);
+  const std::string& message = stop.summary.message;
+  EXPECT_NE(message.find("contact 'end' slides in Painleve's paradox at t = "), std::string::npos) << message;
+  // The torque lifts the free rod's end (nu_0 > 0): sliding with N > 0 and free are both
+  // consistent, Painleve's indeterminacy (the table of 3.4).
+  EXPECT_NE(message.find("two modes are consistent"), std::string::npos) << message;
+  EXPECT_NE(message.find("the run ends here with its results so far"), std::string::npos) << message;
+  ASSERT_GT(stop.rows.size(), 100u);  // the rows before are kept
+  const std::size_t last = stop.rows.size() - 1;
+  EXPECT_EQ(stop.at(last, "end_mode"), 0.0);
+  // The stop is where the rolling friction reaches the cone, |F| = mu N, ...
+  EXPECT_NEAR(std::abs(stop.at(last, "end_Fx")) / stop.at(last, "end_N"), 1.5, 1e-2);
+  EXPECT_LT(stop.at(last, "end_Fx"), 0.0);
+  // ... and the w_eff it reports is (S11) at the configuration reached (the last row, 1e-5 s before).
+  const std::size_t at = message.find("w_eff = ");
+  ASSERT_NE(at, std::string::npos);
+  const double w_eff = std::stod(message.substr(at + 8));
+  const RodInertia L = rod_inertia(stop.at(last, "b"));
+  EXPECT_NEAR(w_eff, L.nn - 1.5 * L.nt, 1e-3);
+  EXPECT_LT(w_eff, 0.0);
+
+  const ModeRun slides = run(rod(1.2), 0.1);
+  ASSERT_GE(slides.summary.events.size(), 1u) << slides.summary.message;
+  EXPECT_EQ(slides.summary.events[0].name, "end_slip");
+  EXPECT_EQ(slides.at(mode_switch_row(slides, slides.summary.events[0].t), "end_mode"), 1.0);
+  EXPECT_EQ(slides.summary.message.find("Painleve"), std::string::npos) << slides.summary.message;
+}
+
 // Newton's law with a sticking impulse gains energy at a coupled contact when e^2 > 1 - M_nt^2 /
 // (M_nn M_tt) = 1 - Lambda_nt^2 / (Lambda_nn Lambda_tt), for the approach v_t = (Lambda_nt /
 // Lambda_nn) v_n (section 7): the rod landing at b = 0.6 with e = 0.95. The impact is warned about
