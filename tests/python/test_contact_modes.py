@@ -11,7 +11,7 @@ from conftest import read_csv
 
 G, V0, M = 9.81, 3.0, 0.1
 MODE_COLUMNS = ["ball_mode", "ball_slip_speed", "ball_slip_x", "ball_slip_y", "ball_slip_z", "ball_gap",
-                "work_friction"]
+                "work_friction", "impact_loss"]
 
 
 def t_star(mu):
@@ -74,6 +74,37 @@ def test_python_batch_carries_the_mode_columns(examples):
         assert [e["name"] for e in batch.events[i]] == ["ball_stick"]
     with pytest.raises(KeyError, match="ball_mode"):
         batch["ball_mood"]
+
+
+def test_dask_batch_carries_the_mode_columns_like_the_local_batch(examples):
+    """nhdyn.dask.simulate_batch over two worker processes: the same contact columns (NAME_mode,
+    the slip, the gap, work_friction, impact_loss) as nhdyn.simulate_batch, in run order, with the
+    switch of each run at its t* (the runs have their own rows: t is runs x rows)."""
+    distributed = pytest.importorskip("dask.distributed")
+    import nhdyn.dask
+
+    m = nhdyn.load(examples / "ball_thrown_sliding.toml")
+    mus = np.array([0.2, 0.25, 0.3, 0.4])
+    local = nhdyn.simulate_batch(m, parameters={"mu": mus}, threads=1)
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    client = distributed.Client(cluster)
+    try:
+        spread = nhdyn.dask.simulate_batch(client, m, parameters={"mu": mus}, chunk_size=1)
+    finally:
+        client.close()
+        cluster.close()
+    assert spread.ok.all()
+    assert list(spread.columns["contact_forces"]) == list(local.columns["contact_forces"])
+    assert spread.contact_forces is not None
+    np.testing.assert_array_equal(spread.t, local.t)
+    np.testing.assert_array_equal(spread.contact_forces, local.contact_forces)
+    for i, mu in enumerate(mus):
+        rows = int(np.sum(~np.isnan(spread.t[i])))
+        for name in MODE_COLUMNS:
+            np.testing.assert_array_equal(spread[name][i, :rows], local[name][i, :rows])
+        assert abs(switch_time(spread.t[i, :rows], spread["ball_mode"][i, :rows]) - t_star(mu)) < 1e-9
+        assert abs(spread["work_friction"][i, rows - 1] + M * V0**2 / 7) < 1e-9
+        assert [e["name"] for e in spread.events[i]] == ["ball_stick"]
 
 
 def test_cli_batch_run_files_have_the_columns_of_simulate(examples, cli, tmp_path):
