@@ -176,3 +176,57 @@ def test_another_method_is_refused_naming_the_one_to_use(examples, cli, method):
     # Python says it in its own terms (method=...): "method lagrange cannot solve them ... use method sanh"
     with pytest.raises(nhdyn.InputError, match="method {} cannot solve them.*use method sanh".format(method)):
         nhdyn.load(path).simulate(method=method)
+
+
+PAINLEVE_ROD = """
+name = "painleve-rod"
+coordinates = ["x", "y", "z", "b"]
+gravity = [0, 0, "-g"]
+[parameters]
+m = 1.0
+l = 0.5
+rho = 0.01
+g = 9.81
+b0 = 1.1071487177940904
+mu = 1.5
+[[frames]]
+name = "rod"
+translation = ["x", "y", "z"]
+rotations = [["y", "b"]]
+[[bodies]]
+name = "rod"
+frame = "rod"
+mass = "m"
+inertia = ["m*l^2/3", "m*l^2/3", "m*l^2/3"]
+[[contacts]]
+name = "end"
+body = "rod"
+shape = { sphere = "rho" }
+centre = ["l", 0, 0]
+unilateral = true
+friction = "mu"
+mode = "rolling"
+[forces]
+b = "-100*t"
+[initial]
+position = { x = 0, y = 0, z = "l*sin(b0) + rho", b = "b0" }
+velocity = { x = 0, y = 0, z = 0, b = 0 }
+"""
+
+
+def test_painleve_during_a_run_exits_1_with_the_partial_rows(cli, tmp_path):
+    """A rod on its end tipped by a growing torque would start sliding in Painleve's paradox
+    (docs/contact-modes.md): exit 1, the message names the contact and t, the rows before are in
+    FILE.partial.csv; with mu below 4/3 it slides on and the run ends normally."""
+    model = tmp_path / "rod.toml"
+    model.write_text(PAINLEVE_ROD)
+    run = cli("simulate", model, "-o", tmp_path / "rod.csv", "--t-end", "0.1", "--output-step", "0.001", check=False)
+    assert run.returncode == 1, run.stderr
+    assert "contact 'end' slides in Painleve's paradox at t = 0.04" in run.stderr
+    assert "Lower the friction coefficient" in run.stderr
+    partial = tmp_path / "rod.partial.csv"
+    assert partial.exists() and not (tmp_path / "rod.csv").exists()
+    rows = [line for line in partial.read_text().splitlines() if line and not line.startswith("#")]
+    assert len(rows) > 40  # a header and the rows up to t = 0.04
+    ok = cli("simulate", model, "--set", "mu=1.2", "-o", tmp_path / "slides.csv", "--t-end", "0.1")
+    assert "end_slip" in ok.stdout and "Painleve" not in ok.stderr
