@@ -395,9 +395,11 @@ int run_simulate(const SimulateArgs& args) {
       // change of the energy are physics.
       fmt::print("  energy balance error: {:.3g} (max |h - h0 - W|)\n", summary.max_balance_error);
       if (model.contact_modes)  // contacts that slide (docs/contact-modes.md)
-        fmt::print("  work W: {:.10g} (forces {:.6g}, reactions {:.6g}, explicit time {:.6g}, friction {:.6g})\n",
-                   summary.work_forces + summary.work_reactions + summary.work_time + summary.work_friction,
-                   summary.work_forces, summary.work_reactions, summary.work_time, summary.work_friction);
+        fmt::print("  work W: {:.10g} (forces {:.6g}, reactions {:.6g}, explicit time {:.6g}, friction {:.6g}{})\n",
+                   summary.work_forces + summary.work_reactions + summary.work_time + summary.work_friction -
+                       summary.impact_loss,
+                   summary.work_forces, summary.work_reactions, summary.work_time, summary.work_friction,
+                   summary.impact_loss != 0.0 ? fmt::format(", minus impact loss {:.6g}", summary.impact_loss) : "");
       else
         fmt::print("  work W: {:.10g} (forces {:.6g}, reactions {:.6g}, explicit time {:.6g})\n",
                    summary.work_forces + summary.work_reactions + summary.work_time, summary.work_forces,

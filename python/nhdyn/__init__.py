@@ -543,7 +543,8 @@ class BatchResult:
     events or a stop condition each run has its own rows, and t is runs x rows (NaN after a
     run's last row). contact_forces (runs x rows x columns, or None) holds a multibody model's
     contact forces and, for contacts with modes, NAME_mode, NAME_slip_speed, NAME_slip_x/y/z,
-    NAME_gap and work_friction, named by columns["contact_forces"] as in Model.simulate's Result;
+    NAME_gap, work_friction and impact_loss, named by columns["contact_forces"] as in Model.simulate's
+    Result (the same from nhdyn.dask.simulate_batch);
     batch["ball_mode"] gives one of them (or a coordinate, "x'", "energy") as runs x rows."""
 
     def __init__(self, out, parameters, coordinates, columns=None):

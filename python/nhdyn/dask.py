@@ -46,6 +46,7 @@ def _run_chunk(source, overrides, names, values, q0, qd0, threads, options):
     r = nhdyn.simulate_batch(model, parameters=parameters or None, initial=initial or None, threads=threads,
                              **options)
     return {"t": r.t, "q": r.q, "qd": r.qd, "qdd": r.qdd, "R": r.R, "residuals": r.residuals, "energy": r.energy,
+            "contact_forces": r.contact_forces,
             "q_end": r.q_end, "qd_end": r.qd_end, "max_residual": r.max_residual, "ok": list(r.ok),
             "messages": r.messages, "summaries": r.summaries, "events": r.events, "threads": r.threads,
             "cpp_seconds": r.cpp_seconds}
@@ -100,10 +101,15 @@ def simulate_batch(client, model, parameters=None, initial=None, chunk_size=None
     for key in ("q", "qd", "qdd", "R", "residuals"):
         out[key] = np.concatenate([_pad(p[key], rows) for p in parts])
     out["energy"] = None if parts[0]["energy"] is None else np.concatenate([_pad(p["energy"], rows) for p in parts])
+    # A multibody model's contact forces and, with contact modes, NAME_mode, the slip, the gap,
+    # work_friction and impact_loss: named by the model's columns["contact_forces"], as locally.
+    out["contact_forces"] = None if parts[0]["contact_forces"] is None else np.concatenate(
+        [_pad(p["contact_forces"], rows) for p in parts])
     for key in ("q_end", "qd_end", "max_residual"):
         out[key] = np.concatenate([p[key] for p in parts])
     for key in ("ok", "messages", "summaries", "events"):
         out[key] = [x for p in parts for x in p[key]]
     out["threads"] = max(p["threads"] for p in parts)
     out["cpp_seconds"] = sum(p["cpp_seconds"] for p in parts)
-    return nhdyn.BatchResult(out, {name: values[:, j] for j, name in enumerate(names)}, model.coordinates)
+    return nhdyn.BatchResult(out, {name: values[:, j] for j, name in enumerate(names)}, model.coordinates,
+                             model._cpp.columns)

@@ -2,6 +2,7 @@
 // sliding on a plane against the closed forms of docs/derivations/contact-modes.md section 10.1
 // (the time they start rolling, their final speed, the friction's work), the energy balance
 // through the switch, and the keys' bad values.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -339,12 +340,28 @@ TEST(ContactModes, DroppedBallBouncesWithNewtonsLawUntilTheTouchdownsAccumulate)
       v *= e;
       t += 2 * v / g;
     }
+    // impact_loss (I5), cumulative: the first touchdown (moving at v0 = 3 m/s along x, no spin)
+    // takes a sticking impulse, (1 - e^2) m V^2 / 2 + k m v0^2 / (2 (1 + k)); the ball then rolls
+    // and the next ones are normal, (1 - e^2) m V^2 / 2. The reactions' work stays that of the
+    // finite reactions (none in flight).
+    const double m = 0.1, k = 0.4, v0 = 3.0;
+    const std::size_t first = mode_switch_row(r, r.summary.events[0].t);
+    const double loss1 = (1 - e * e) * m * v1 * v1 / 2 + k * m * v0 * v0 / (2 * (1 + k));
+    EXPECT_NEAR(r.at(first, "impact_loss"), loss1, 1e-12);
+    EXPECT_NEAR(r.at(first - 1, "impact_loss"), 0.0, 1e-15);
+    const std::size_t second = mode_switch_row(r, r.summary.events[1].t);
+    EXPECT_NEAR(r.at(second, "impact_loss"), loss1 + (1 - e * e) * m * e * e * v1 * v1 / 2, 1e-12);
+    EXPECT_NEAR(r.at(second, "work_reactions"), 0.0, 1e-12);
+    EXPECT_NEAR(r.at(second, "work"), -r.at(second, "impact_loss") + r.at(second, "work_forces"), 1e-15);
     const double t_inf = t1 * (1 + 2 * e / (1 - e));
     EXPECT_LT(r.summary.t_reached, t_inf + 1e-6);
     EXPECT_GT(r.summary.t_reached, t_inf - 1e-3);
     EXPECT_LT(r.summary.max_balance_error, 1e-9);
   }
-  const Model plastic = load_model_text(dropped_ball(0.0), "drop.toml");
+  // A normal drop (v0 = 0), plastic: impact_loss = m V^2 / 2, the closed form (1 - e^2) m V^2 / 2.
+  std::string normal = dropped_ball(0.0);
+  normal.replace(normal.find("v0 = { value = 3.0"), 18, "v0 = { value = 0.0");
+  const Model plastic = load_model_text(normal, "drop.toml");
   const ModeRun r = run_modes(plastic, 0.5);
   ASSERT_EQ(r.summary.events.size(), 1u);
   EXPECT_NEAR(r.summary.events[0].t, t1, 1e-9);
@@ -352,6 +369,283 @@ TEST(ContactModes, DroppedBallBouncesWithNewtonsLawUntilTheTouchdownsAccumulate)
   EXPECT_EQ(r.at(last, "ball_mode"), 0.0);
   EXPECT_NEAR(r.at(last, "z'"), 0.0, 1e-12);
   EXPECT_NEAR(r.at(last, "ball_N"), 0.1 * g, 1e-10);
+  EXPECT_NEAR(r.at(last, "impact_loss"), 0.1 * v1 * v1 / 2, 1e-12);  // plastic: all the kinetic energy
+  EXPECT_LT(r.summary.max_balance_error, 1e-9);
+}
+
+// A ball landing obliquely with spin (section 7.1): released at the height h with the centre
+// velocity (vx, vy, 0) and the spin w0 about y, a unilateral contact with friction mu and
+// restitution e. It touches down at t1 = sqrt(2 h / g) with V = g t1 and the slip
+// s- = (vx - r w0, vy); (I3) decides sticking or sliding, (I4) gives the velocities after, (I5)
+// the energy taken.
+std::string landing_ball(double e, double mu, double vx, double vy, double w0, double h) {
+  std::string text = test::read_text(example("ball_thrown_sliding.toml"));
+  const std::string keys = "friction = \"mu\"\nmode = \"sliding\"\n";
+  text.replace(text.find(keys), keys.size(),
+               "friction = \"mu\"\nunilateral = true\nrestitution = " + std::to_string(e) + "\n");
+  text.replace(text.find("mu = { value = 0.25 }"), 21, "mu = { value = " + std::to_string(mu) + " }");
+  text.replace(text.find("z = \"r\""), 7, "z = \"r + " + std::to_string(h) + "\"");
+  const std::string velocity = "velocity = { x = \"v0\", y = 0, z = 0, a = 0, b = \"w0\", c = 0 }";
+  text.replace(text.find(velocity), velocity.size(),
+               "velocity = { x = " + std::to_string(vx) + ", y = " + std::to_string(vy) + ", z = 0, a = 0, b = " +
+                   std::to_string(w0) + ", c = 0 }");
+  return text;
+}
+
+ModeRun run_landing(const std::string& text, double t_end) {
+  const Model model = load_model_text(text, "landing.toml");
+  return run_modes(model, t_end);
+}
+
+TEST(ContactModes, BallLandingObliquelyWithSpinTakesTheSlidingImpulseOfTheClosedForm) {
+  const double m = 0.1, r = 0.02, g = 9.81, k = 0.4, mu = 0.1, e = 0.5, h = 0.05;
+  const double vx = 2.0, w0 = -50.0;  // backspin: s- = vx - r w0 = 3 m/s
+  const ModeRun run = run_landing(landing_ball(e, mu, vx, 0.0, w0, h), 0.25);
+  ASSERT_EQ(run.summary.events.size(), 2u);
+  // Two touchdowns, each a sliding impact (I3 violated); in flight x', b' are constant.
+  double t = std::sqrt(2 * h / g), V = g * t, x_dot = vx, spin = w0, loss = 0.0;
+  for (std::size_t j = 0; j < 2; ++j) {
+    SCOPED_TRACE(j);
+    const EventRecord& ev = run.summary.events[j];
+    EXPECT_EQ(ev.name, "ball_touchdown");
+    EXPECT_NEAR(ev.t, t, 1e-9);
+    const double s_before = x_dot - r * spin;
+    EXPECT_GT(k * s_before / (1 + k), mu * (1 + e) * V);  // the sticking impulse is outside the cone
+    const double s_after = s_before - mu * (1 + e) * V * (1 + k) / k;
+    EXPECT_GT(s_after, 0.0);
+    x_dot -= mu * (1 + e) * V;
+    spin += mu * (1 + e) * V / (k * r);
+    loss += m * (1 - e * e) * V * V / 2 + mu * m * (1 + e) * V * (s_before + s_after) / 2;
+    EXPECT_NEAR(ev.v[0], x_dot, 1e-9);
+    EXPECT_NEAR(ev.v[2], e * V, 1e-9);
+    EXPECT_NEAR(ev.v[4], spin, 1e-7);
+    const std::size_t row = mode_switch_row(run, ev.t);
+    EXPECT_EQ(run.at(row, "ball_mode"), 2.0);  // it bounces
+    EXPECT_NEAR(run.at(row, "impact_loss"), loss, 1e-10);
+    t += 2 * e * V / g;
+    V *= e;
+  }
+  EXPECT_LT(run.summary.max_balance_error, 1e-9);  // h - h0 - W through the bounces
+  EXPECT_NEAR(run.at(run.rows.size() - 1, "work_reactions"), 0.0, 1e-12);
+  EXPECT_TRUE(run.summary.warnings.empty());
+}
+
+TEST(ContactModes, PlasticLandingSlidesOnAlongThePreImpactSlipOrSticksInsideTheCone) {
+  const double r = 0.02, g = 9.81, k = 0.4, h = 0.05;
+  const double t1 = std::sqrt(2 * h / g), V = g * t1;
+  {
+    // Spatial slip s- = (vx - r w0, vy): the impulse slides along it, the ball leaves the impact
+    // sliding with s+ = (|s-| - mu V (1 + k) / k) e_s and sticks k |s+| / (mu g (1 + k)) later.
+    const double mu = 0.2, vx = 1.0, vy = 1.5, w0 = 20.0;
+    const ModeRun run = run_landing(landing_ball(0.0, mu, vx, vy, w0, h), 1.0);
+    ASSERT_EQ(run.summary.events.size(), 2u);
+    EXPECT_EQ(run.summary.events[0].name, "ball_touchdown");
+    EXPECT_EQ(run.summary.events[1].name, "ball_stick");
+    const double sx = vx - r * w0, sy = vy, s = std::hypot(sx, sy);
+    const double s_after = s - mu * V * (1 + k) / k;
+    ASSERT_GT(s_after, 0.0);
+    const EventRecord& ev = run.summary.events[0];
+    EXPECT_NEAR(ev.v[0], vx - mu * V * sx / s, 1e-9);
+    EXPECT_NEAR(ev.v[1], vy - mu * V * sy / s, 1e-9);
+    EXPECT_NEAR(ev.v[2], 0.0, 1e-12);
+    const std::size_t row = mode_switch_row(run, ev.t);
+    EXPECT_EQ(run.at(row, "ball_mode"), 1.0);
+    EXPECT_NEAR(run.at(row, "ball_slip_x"), s_after * sx / s, 1e-9);
+    EXPECT_NEAR(run.at(row, "ball_slip_y"), s_after * sy / s, 1e-9);
+    EXPECT_NEAR(run.summary.events[1].t, t1 + k * s_after / (mu * g * (1 + k)), 1e-9);
+    EXPECT_NEAR(run.at(row, "impact_loss"), 0.1 * V * V / 2 + mu * 0.1 * V * (s + s_after) / 2, 1e-10);
+    EXPECT_LT(run.summary.max_balance_error, 1e-9);
+  }
+  {
+    // A small slip: the sticking impulse is inside the cone, the ball rolls at once at 5 vx / 7.
+    const double mu = 0.5, vx = 0.3;
+    const ModeRun run = run_landing(landing_ball(0.0, mu, vx, 0.0, 0.0, h), 0.3);
+    ASSERT_EQ(run.summary.events.size(), 1u);
+    const EventRecord& ev = run.summary.events[0];
+    EXPECT_NEAR(ev.v[0], 5 * vx / 7, 1e-10);
+    EXPECT_NEAR(ev.v[4], 5 * vx / 7 / r, 1e-8);
+    const std::size_t row = mode_switch_row(run, ev.t);
+    EXPECT_EQ(run.at(row, "ball_mode"), 0.0);
+    EXPECT_NEAR(run.at(row, "impact_loss"), 0.1 * V * V / 2 + k * 0.1 * vx * vx / (2 * (1 + k)), 1e-10);
+    EXPECT_LT(run.summary.max_balance_error, 1e-9);
+  }
+}
+
+// Painleve's rod (section 3.8): a rod of mass m, length 2 l, turned by b about y, with a ball of
+// radius rho at its end (l, 0, 0) touching the plane z = 0. Its contact's inverse inertia (S11):
+// Lambda_nn = (1 + 3 c^2) / m, Lambda_nt = 3 c (s + rho / l) / m, Lambda_tt = 1/m + 3 (s + rho/l)^2 / m.
+std::string painleve_rod(const std::string& keys, double b0, double h, double vx) {
+  return R"toml(
+name = "painleve-rod"
+coordinates = ["x", "y", "z", "b"]
+gravity = [0, 0, "-g"]
+[parameters]
+m = 1.0
+l = 0.5
+rho = 0.01
+g = 9.81
+b0 = )toml" + fmt::format("{:.17g}", b0) + R"toml(
+h = )toml" + fmt::format("{:.17g}", h) + R"toml(
+vx = )toml" + fmt::format("{:.17g}", vx) + R"toml(
+[[frames]]
+name = "rod"
+translation = ["x", "y", "z"]
+rotations = [["y", "b"]]
+[[bodies]]
+name = "rod"
+frame = "rod"
+mass = "m"
+inertia = ["m*l^2/3", "m*l^2/3", "m*l^2/3"]
+[[contacts]]
+name = "end"
+body = "rod"
+shape = { sphere = "rho" }
+centre = ["l", 0, 0]
+unilateral = true
+)toml" + keys + R"toml(
+[initial]
+position = { x = 0, y = 0, z = "l*sin(b0) + rho + h", b = "b0" }
+velocity = { x = "vx", y = 0, z = 0, b = 0 }
+)toml";
+}
+
+struct RodInertia {
+  double nn, nt, tt;
+};
+RodInertia rod_inertia(double b) {
+  const double c = std::cos(b), s = std::sin(b), a = s + 0.01 / 0.5;
+  return {1 + 3 * c * c, 3 * c * a, 1 + 3 * a * a};  // m = 1
+}
+
+// The end slides away from under the centre (sigma = +1) at b0 = atan(2): w_eff = Lambda_nn -
+// mu Lambda_nt vanishes at mu_c = (1 + 3 c^2) / (3 c (s + rho / l)) (S12). Above it the start is
+// refused naming the contact, t and w_eff; below it the rod slides with N = m g / (m w_eff) (S8).
+TEST(ContactModes, PainlevesRodStopsAboveTheCriticalFrictionAndSlidesBelowIt) {
+  const double b0 = std::atan(2.0), g = 9.81;
+  const RodInertia L = rod_inertia(b0);
+  const double mu_c = L.nn / L.nt;
+  EXPECT_NEAR(mu_c, 1.30417, 1e-5);
+  {
+    const double mu = 1.01 * mu_c;
+    const Model model = load_model_text(painleve_rod(fmt::format("friction = {:.17g}\n", mu), b0, 0.0, 2.0), "rod.toml");
+    SimulationOptions options;
+    options.t_end = 0.05;
+    try {
+      simulate(model, options, [](const Data&) {});
+      ADD_FAILURE() << "accepted";
+    } catch (const ModelError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("rod.toml:"), std::string::npos) << message;
+      EXPECT_NE(message.find("contact 'end' slides in Painleve's paradox at t = 0"), std::string::npos) << message;
+      EXPECT_NE(message.find(fmt::format("w_eff = {:.6g} 1/kg", L.nn - mu * L.nt)), std::string::npos) << message;
+      EXPECT_NE(message.find(fmt::format("frictionless {:.6g} 1/kg", L.nn)), std::string::npos) << message;
+      EXPECT_NE(message.find("no mode is consistent"), std::string::npos) << message;
+    }
+  }
+  const double mu = 0.99 * mu_c;
+  const Model model = load_model_text(painleve_rod(fmt::format("friction = {:.17g}\n", mu), b0, 0.0, 2.0), "rod.toml");
+  ModeRun r;
+  r.columns = make_result_columns(model);
+  SimulationOptions options;
+  options.t_end = 0.002;
+  options.output_step = 0.001;
+  options.integrator.rtol = 1e-10;
+  options.integrator.atol = 1e-12;
+  r.summary = simulate(model, options, [&](const Data& data) {
+    std::vector<double> row;
+    fill_result_row(model, data, row);
+    r.rows.push_back(std::move(row));
+  });
+  EXPECT_EQ(r.summary.status, Status::ok) << r.summary.message;
+  // It slides, until the large friction stops the slip (a stick, not a stop: the "dynamic jam").
+  EXPECT_EQ(r.at(0, "end_mode"), 1.0);
+  for (const EventRecord& e : r.summary.events) EXPECT_EQ(e.name, "end_stick");
+  // Near the singularity N is large: 100 m g at 1 % below mu_c.
+  EXPECT_NEAR(r.at(0, "end_N"), g / (L.nn - mu * L.nt), 1e-9 * g / (L.nn - mu * L.nt));
+  EXPECT_NEAR(r.at(0, "end_Fx"), -mu * r.at(0, "end_N"), 1e-9 * r.at(0, "end_N"));
+}
+
+// Painleve's paradox met during a run: the rod stands on its end (rolling, at b0 = atan(2)) and a
+// torque -T t about y, growing, tips it over faster than gravity: the friction rolling needs
+// points to -x and grows while N falls, so the end slips, away from under the rod (sigma = +1).
+// With mu_k above mu_c(b) (S12) that sliding start is in Painleve's paradox: the run ends
+// there (not a bad start) with the contact, t and w_eff = Lambda_nn - mu Lambda_nt at the
+// configuration reached, and the rows so far; below min mu_c (1.30416 at b = 1.105) it slides on.
+TEST(ContactModes, PainlevesRodTippedByATorqueStopsWhereItWouldStartSliding) {
+  const double b0 = std::atan(2.0);
+  const auto rod = [&](double mu) {
+    std::string text = painleve_rod(fmt::format("friction = {}\nmode = \"rolling\"\n", mu), b0, 0.0, 0.0);
+    text.replace(text.find("[initial]"), 9, "[forces]\nb = \"-100*t\"\n[initial]");
+    return load_model_text(text, "rod.toml");
+  };
+  const auto run = [](const Model& model, double t_end) {
+    ModeRun r;
+    r.columns = make_result_columns(model);
+    SimulationOptions options;
+    options.t_end = t_end;
+    options.output_step = 1e-5;
+    options.integrator.rtol = 1e-10;
+    options.integrator.atol = 1e-12;
+    r.summary = simulate(model, options, [&](const Data& data) {
+      std::vector<double> row;
+      fill_result_row(model, data, row);
+      r.rows.push_back(std::move(row));
+    });
+    return r;
+  };
+  const ModeRun stop = run(rod(1.5), 0.1);
+  EXPECT_NE(stop.summary.status, Status::ok);
+  const std::string& message = stop.summary.message;
+  EXPECT_NE(message.find("contact 'end' slides in Painleve's paradox at t = "), std::string::npos) << message;
+  // The torque lifts the free rod's end (nu_0 > 0): sliding with N > 0 and free are both
+  // consistent, Painleve's indeterminacy (the table of 3.4).
+  EXPECT_NE(message.find("two modes are consistent"), std::string::npos) << message;
+  EXPECT_NE(message.find("the run ends here with its results so far"), std::string::npos) << message;
+  ASSERT_GT(stop.rows.size(), 100u);  // the rows before are kept
+  const std::size_t last = stop.rows.size() - 1;
+  EXPECT_EQ(stop.at(last, "end_mode"), 0.0);
+  // The stop is where the rolling friction reaches the cone, |F| = mu N, ...
+  EXPECT_NEAR(std::abs(stop.at(last, "end_Fx")) / stop.at(last, "end_N"), 1.5, 1e-2);
+  EXPECT_LT(stop.at(last, "end_Fx"), 0.0);
+  // ... and the w_eff it reports is (S11) at the configuration reached (the last row, 1e-5 s before).
+  const std::size_t at = message.find("w_eff = ");
+  ASSERT_NE(at, std::string::npos);
+  const double w_eff = std::stod(message.substr(at + 8));
+  const RodInertia L = rod_inertia(stop.at(last, "b"));
+  EXPECT_NEAR(w_eff, L.nn - 1.5 * L.nt, 1e-3);
+  EXPECT_LT(w_eff, 0.0);
+
+  const ModeRun slides = run(rod(1.2), 0.1);
+  ASSERT_GE(slides.summary.events.size(), 1u) << slides.summary.message;
+  EXPECT_EQ(slides.summary.events[0].name, "end_slip");
+  EXPECT_EQ(slides.at(mode_switch_row(slides, slides.summary.events[0].t), "end_mode"), 1.0);
+  EXPECT_EQ(slides.summary.message.find("Painleve"), std::string::npos) << slides.summary.message;
+}
+
+// Newton's law with a sticking impulse gains energy at a coupled contact when e^2 > 1 - M_nt^2 /
+// (M_nn M_tt) = 1 - Lambda_nt^2 / (Lambda_nn Lambda_tt), for the approach v_t = (Lambda_nt /
+// Lambda_nn) v_n (section 7): the rod landing at b = 0.6 with e = 0.95. The impact is warned about
+// once, impact_loss is the closed form (v^T M v - e^2 M_nn v_n^2) / 2 < 0, and h - h0 - W holds.
+TEST(ContactModes, AnImpactThatGainsEnergyIsWarnedAboutOnceAndBookedInImpactLoss) {
+  const double b = 0.6, g = 9.81, h = 0.02, e = 0.95;
+  const RodInertia L = rod_inertia(b);
+  EXPECT_GT(e * e, 1 - L.nt * L.nt / (L.nn * L.tt));
+  const double t1 = std::sqrt(2 * h / g), vn = -g * t1, vt = L.nt / L.nn * vn;
+  const Model model = load_model_text(painleve_rod(fmt::format("restitution = {}\n", e), b, h, vt), "rod.toml");
+  const ModeRun r = run_modes(model, t1 + 0.01);
+  ASSERT_GE(r.summary.events.size(), 1u);
+  EXPECT_EQ(r.summary.events[0].name, "end_touchdown");
+  EXPECT_NEAR(r.summary.events[0].t, t1, 1e-9);
+  // M = Lambda^-1 (2 x 2, t and n): v^T M v = (Lnn vt^2 - 2 Lnt vt vn + Ltt vn^2) / det.
+  const double det = L.tt * L.nn - L.nt * L.nt;
+  const double loss = ((L.nn * vt * vt - 2 * L.nt * vt * vn + L.tt * vn * vn) / det - e * e * L.tt / det * vn * vn) / 2;
+  EXPECT_LT(loss, 0.0);
+  EXPECT_NEAR(r.at(mode_switch_row(r, t1 + (r.summary.events[0].t - t1)), "impact_loss"), loss, 1e-10);
+  ASSERT_EQ(r.summary.warnings.size(), 1u);
+  const std::string& warning = r.summary.warnings[0];
+  EXPECT_NE(warning.find("contact 'end': the impact at t = "), std::string::npos) << warning;
+  EXPECT_NE(warning.find("gains energy"), std::string::npos) << warning;
+  EXPECT_NE(warning.find(fmt::format("{:.6g} J", -loss)), std::string::npos) << warning;
   EXPECT_LT(r.summary.max_balance_error, 1e-9);
 }
 

@@ -11,7 +11,7 @@ from conftest import read_csv
 
 G, V0, M = 9.81, 3.0, 0.1
 MODE_COLUMNS = ["ball_mode", "ball_slip_speed", "ball_slip_x", "ball_slip_y", "ball_slip_z", "ball_gap",
-                "work_friction"]
+                "work_friction", "impact_loss"]
 
 
 def t_star(mu):
@@ -74,6 +74,37 @@ def test_python_batch_carries_the_mode_columns(examples):
         assert [e["name"] for e in batch.events[i]] == ["ball_stick"]
     with pytest.raises(KeyError, match="ball_mode"):
         batch["ball_mood"]
+
+
+def test_dask_batch_carries_the_mode_columns_like_the_local_batch(examples):
+    """nhdyn.dask.simulate_batch over two worker processes: the same contact columns (NAME_mode,
+    the slip, the gap, work_friction, impact_loss) as nhdyn.simulate_batch, in run order, with the
+    switch of each run at its t* (the runs have their own rows: t is runs x rows)."""
+    distributed = pytest.importorskip("dask.distributed")
+    import nhdyn.dask
+
+    m = nhdyn.load(examples / "ball_thrown_sliding.toml")
+    mus = np.array([0.2, 0.25, 0.3, 0.4])
+    local = nhdyn.simulate_batch(m, parameters={"mu": mus}, threads=1)
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    client = distributed.Client(cluster)
+    try:
+        spread = nhdyn.dask.simulate_batch(client, m, parameters={"mu": mus}, chunk_size=1)
+    finally:
+        client.close()
+        cluster.close()
+    assert spread.ok.all()
+    assert list(spread.columns["contact_forces"]) == list(local.columns["contact_forces"])
+    assert spread.contact_forces is not None
+    np.testing.assert_array_equal(spread.t, local.t)
+    np.testing.assert_array_equal(spread.contact_forces, local.contact_forces)
+    for i, mu in enumerate(mus):
+        rows = int(np.sum(~np.isnan(spread.t[i])))
+        for name in MODE_COLUMNS:
+            np.testing.assert_array_equal(spread[name][i, :rows], local[name][i, :rows])
+        assert abs(switch_time(spread.t[i, :rows], spread["ball_mode"][i, :rows]) - t_star(mu)) < 1e-9
+        assert abs(spread["work_friction"][i, rows - 1] + M * V0**2 / 7) < 1e-9
+        assert [e["name"] for e in spread.events[i]] == ["ball_stick"]
 
 
 def test_cli_batch_run_files_have_the_columns_of_simulate(examples, cli, tmp_path):
@@ -145,3 +176,57 @@ def test_another_method_is_refused_naming_the_one_to_use(examples, cli, method):
     # Python says it in its own terms (method=...): "method lagrange cannot solve them ... use method sanh"
     with pytest.raises(nhdyn.InputError, match="method {} cannot solve them.*use method sanh".format(method)):
         nhdyn.load(path).simulate(method=method)
+
+
+PAINLEVE_ROD = """
+name = "painleve-rod"
+coordinates = ["x", "y", "z", "b"]
+gravity = [0, 0, "-g"]
+[parameters]
+m = 1.0
+l = 0.5
+rho = 0.01
+g = 9.81
+b0 = 1.1071487177940904
+mu = 1.5
+[[frames]]
+name = "rod"
+translation = ["x", "y", "z"]
+rotations = [["y", "b"]]
+[[bodies]]
+name = "rod"
+frame = "rod"
+mass = "m"
+inertia = ["m*l^2/3", "m*l^2/3", "m*l^2/3"]
+[[contacts]]
+name = "end"
+body = "rod"
+shape = { sphere = "rho" }
+centre = ["l", 0, 0]
+unilateral = true
+friction = "mu"
+mode = "rolling"
+[forces]
+b = "-100*t"
+[initial]
+position = { x = 0, y = 0, z = "l*sin(b0) + rho", b = "b0" }
+velocity = { x = 0, y = 0, z = 0, b = 0 }
+"""
+
+
+def test_painleve_during_a_run_exits_1_with_the_partial_rows(cli, tmp_path):
+    """A rod on its end tipped by a growing torque would start sliding in Painleve's paradox
+    (docs/contact-modes.md): exit 1, the message names the contact and t, the rows before are in
+    FILE.partial.csv; with mu below 4/3 it slides on and the run ends normally."""
+    model = tmp_path / "rod.toml"
+    model.write_text(PAINLEVE_ROD)
+    run = cli("simulate", model, "-o", tmp_path / "rod.csv", "--t-end", "0.1", "--output-step", "0.001", check=False)
+    assert run.returncode == 1, run.stderr
+    assert "contact 'end' slides in Painleve's paradox at t = 0.04" in run.stderr
+    assert "Lower the friction coefficient" in run.stderr
+    partial = tmp_path / "rod.partial.csv"
+    assert partial.exists() and not (tmp_path / "rod.csv").exists()
+    rows = [line for line in partial.read_text().splitlines() if line and not line.startswith("#")]
+    assert len(rows) > 40  # a header and the rows up to t = 0.04
+    ok = cli("simulate", model, "--set", "mu=1.2", "-o", tmp_path / "slides.csv", "--t-end", "0.1")
+    assert "end_slip" in ok.stdout and "Painleve" not in ok.stderr

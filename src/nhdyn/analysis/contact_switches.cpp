@@ -6,6 +6,9 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/LU>
+#include <Eigen/QR>
+
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
 #include "nhdyn/model/terms.hpp"
@@ -31,6 +34,29 @@ std::array<double, 2> onset_direction(const ContactModeData& w, std::size_t i) {
   const double size = norm2(w.friction[i]);
   if (!(size > 0.0)) return w.direction[i];
   return {-w.friction[i][0] / size, -w.friction[i][1] / size};
+}
+
+// Painleve's paradox is watched on w_eff relative to its frictionless part (section 3.8): the run
+// stops before the matrix of (S4) turns singular at w_eff = 0.
+constexpr double kPainleve = 1e-9;
+
+bool painleve(const ContactModeData& w, std::size_t i) {
+  return w.mode[i] == ContactMode::sliding && !(w.w_eff[i] > kPainleve * w.lambda_nn[i]);
+}
+
+// The message of a sliding contact in Painleve's paradox, after compute_dynamics in that mode.
+std::string painleve_message(const ContactModeContact& c, const ContactModeData& w, std::size_t i, double t) {
+  const double N = w.normal_force[i];
+  const double nu0 = -N * w.w_eff[i];  // the gap's acceleration were the contact free, (S8)
+  const char* kind = w.w_eff[i] < 0.0 && nu0 < 0.0   ? "no mode is consistent (sliding would need the ground to pull, "
+                                                         "free the body would sink into it)"
+                     : w.w_eff[i] < 0.0 && nu0 > 0.0 ? "two modes are consistent (sliding with N > 0, and free)"
+                                                     : "its normal force would grow without bound";
+  return fmt::format("contact '{}' slides in Painleve's paradox at t = {:.9g}: with mu_k = {:.6g} its effective normal "
+                     "inverse mass w_eff = {:.6g} 1/kg is not positive (frictionless {:.6g} 1/kg; N = {:.6g} N, the free "
+                     "gap acceleration {:.6g} m/s^2): {} (docs/derivations/contact-modes.md 3.4, 3.8). Lower the friction "
+                     "coefficient",
+                     c.name, t, w.mu_k[i], w.w_eff[i], w.lambda_nn[i], N, nu0, kind);
 }
 
 void throw_at_start(const Model& model, const Data& data) {
@@ -76,6 +102,9 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
   if (compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok) throw_at_start(model, data);
   for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
     const ContactModeContact& c = cm.contacts[i];
+    if (painleve(w, i))
+      throw ModelError(fmt::format("{}: at t0 {}; or start it in another mode (mode = \"rolling\" or \"free\")", c.where,
+                                   painleve_message(c, w, i, t0)));
     if (!c.unilateral || w.mode[i] == ContactMode::free || !(w.normal_force[i] < 0.0)) continue;
     throw ModelError(fmt::format("{}: contact '{}' is unilateral, but at t0 its normal force in the {} mode is N = "
                                  "{:.6g} N < 0: the ground would have to pull the body. Start it free (mode = "
@@ -129,6 +158,7 @@ Status ContactSwitches::evaluate(double t, const double* y, double* g) {
       case ContactMode::sliding:
         if (c.unilateral) gi[0] = N;
         gi[1] = w.slip[i][0] * w.direction[i][0] + w.slip[i][1] * w.direction[i][1];
+        gi[2] = w.w_eff[i] - kPainleve * w.lambda_nn[i];  // Painleve (section 3.8)
         break;
       case ContactMode::free: gi[0] = data_.phi(c.gap_position); break;
     }
@@ -155,11 +185,19 @@ std::string ContactSwitches::switch_contact(int contact, int slot, double t, con
     return c.name + "_liftoff";
   }
   if (slot == 0) return touchdown(contact, t);
+  if (slot == 2) {
+    // w_eff fell through 0 while sliding (section 3.8): Painleve's paradox ends the run here.
+    if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) == Status::ok)
+      accumulation_ = painleve_message(c, w, i, t) + "; the run ends here with its results so far";
+    return "";
+  }
   if (before == ContactMode::rolling) {
     // Slip starts: the friction that rolling needs leaves the cone; it slides opposite to it.
     if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
     w.direction[i] = onset_direction(w, i);
     w.mode[i] = ContactMode::sliding;
+    if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
+    if (!check_sliding(contact, t)) return "";
     return c.name + "_slip";
   }
   // The slip reached 0: stick if rolling is consistent and inside the cone, else lift off or slide
@@ -174,6 +212,8 @@ std::string ContactSwitches::switch_contact(int contact, int slot, double t, con
   if (norm2(w.friction[i]) <= w.mu_s[i] * std::abs(N)) return c.name + "_stick";
   w.direction[i] = onset_direction(w, i);
   w.mode[i] = ContactMode::sliding;
+  if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
+  if (!check_sliding(contact, t)) return "";
   return c.name + "_slip";
 }
 
@@ -216,13 +256,114 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
   return status == Status::ok ? Status::stopped : status;
 }
 
+bool ContactSwitches::check_sliding(int contact, double t) {
+  const auto i = static_cast<std::size_t>(contact);
+  if (!painleve(data_.modes, i)) return true;
+  accumulation_ = painleve_message(model_.contact_modes->contacts[i], data_.modes, i, t) +
+                  "; the run ends here with its results so far";
+  return false;
+}
+
+Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, bool sliding,
+                                       const std::array<double, 2>& direction) {
+  Impulse out;
+  const auto i = static_cast<std::size_t>(contact);
+  const ContactModeModel& cm = *model_.contact_modes;
+  const ContactModeContact& c = cm.contacts[i];
+  const ContactModeData& w = data_.modes;
+  const int n = model_.n();
+  const int s = model_.s();
+  const std::vector<double>& f = w.velocity_residuals;  // of the state before, by compute_dynamics
+  const double e = w.restitution[i];
+  const double vn = f[static_cast<std::size_t>(c.gap_velocity)];  // the gap's rate before, < 0
+  // (I1)-(I2): the rows kept after the impact hold their velocity residuals, the gap's rate
+  // becomes -e times what it was; sticking, the slip becomes 0; sliding, the no-slip rows leave b
+  // and the gap's column of B~ is w_n - mu_k w_s (section 7, "The sliding impulse, as solved").
+  std::vector<int> rows;
+  std::vector<double> target;
+  int velocity_index = 0;
+  const Eigen::Map<const Vector> v_before(v, n);
+  for (int row = 0; row < s; ++row) {
+    const bool has_velocity = model_.constraints[static_cast<std::size_t>(row)].level != ConstraintLevel::acceleration;
+    bool keep = !(sliding && (row == c.roll[0] || row == c.roll[1] || row == c.spin));
+    for (std::size_t j = 0; j < cm.contacts.size() && keep; ++j) {
+      const ContactModeContact& o = cm.contacts[j];
+      if (j == i || w.mode[j] == ContactMode::rolling) continue;
+      keep = row != o.roll[0] && row != o.roll[1] && row != o.spin && !(w.mode[j] == ContactMode::free && row == o.gap);
+    }
+    if (keep) {
+      double delta = 0.0;
+      if (row == c.gap) delta = -(1.0 + e) * vn;
+      else if (row == c.roll[0] || row == c.roll[1] || row == c.spin) delta = -f[static_cast<std::size_t>(velocity_index)];
+      rows.push_back(row);
+      target.push_back(data_.b.row(row).dot(v_before) + delta);
+    }
+    if (has_velocity) ++velocity_index;
+  }
+  const int r = static_cast<int>(rows.size());
+  Matrix Bt(n, r);
+  int gap_column = -1;
+  std::array<int, 2> roll_column{-1, -1};
+  for (int j = 0; j < r; ++j) {
+    const int row = rows[static_cast<std::size_t>(j)];
+    Bt.col(j) = data_.b.row(row).transpose();
+    if (row == c.gap) gap_column = j;
+    for (std::size_t a = 0; a < 2; ++a)
+      if (row == c.roll[a]) roll_column[a] = j;
+    // A sliding contact's reaction along n - mu_k e_s: this one's impulse when it slides, the
+    // others' as in their mode.
+    for (std::size_t o = 0; o < cm.contacts.size(); ++o) {
+      const ContactModeContact& other = cm.contacts[o];
+      if (row != other.gap) continue;
+      const bool slides = o == i ? sliding : w.mode[o] == ContactMode::sliding;
+      const std::array<double, 2>& d = o == i ? direction : w.sliding_direction[o];
+      if (slides)
+        for (std::size_t a = 0; a < 2; ++a)
+          Bt.col(j) -= (w.mu_k[o] * d[a] / w.tangent_length[o][a]) * data_.b.row(other.roll[a]).transpose();
+    }
+  }
+  Eigen::ColPivHouseholderQR<Matrix> qr(Bt);
+  if (qr.rank() < r || gap_column < 0) {
+    out.failure = fmt::format("contact '{}' touches down at t = {:.9g} where the constraints after the impact are "
+                              "dependent; the run ends here with its results so far",
+                              c.name, t);
+    return out;
+  }
+  const Matrix Qf = qr.householderQ();
+  const Matrix D = Qf.rightCols(n - r).transpose();
+  Matrix M(n, n);
+  Vector rhs(n);
+  M.topRows(n - r) = D * data_.A;
+  rhs.head(n - r) = D * (data_.A * v_before);
+  for (int j = 0; j < r; ++j) {
+    M.row(n - r + j) = data_.b.row(rows[static_cast<std::size_t>(j)]);
+    rhs(n - r + j) = target[static_cast<std::size_t>(j)];
+  }
+  Eigen::PartialPivLU<Matrix> lu(M);
+  if (!(lu.rcond() > 1e-14)) {
+    out.failure = fmt::format("contact '{}' touches down at t = {:.9g} where the impulse equations are singular{}; "
+                              "the run ends here with its results so far",
+                              c.name, t, sliding ? " (a sliding impact in Painleve's paradox: lower the friction)" : "");
+    return out;
+  }
+  out.v = lu.solve(rhs);
+  // The impulse, A (q'+ - q'-) = B~^T Pi, read on the columns as N is from R.
+  const Vector impulse = data_.A * (out.v - v_before);
+  const Vector Pi = qr.solve(impulse);
+  out.normal = Pi(gap_column);
+  for (std::size_t a = 0; a < 2; ++a)
+    out.tangential[a] = sliding ? -w.mu_k[i] * out.normal * direction[a]
+                                : (roll_column[a] >= 0 ? Pi(roll_column[a]) * w.tangent_length[i][a] : 0.0);
+  out.ok = true;
+  return out;
+}
+
 std::string ContactSwitches::touchdown(int contact, double t) {
   const auto i = static_cast<std::size_t>(contact);
   const ContactModeModel& cm = *model_.contact_modes;
   const ContactModeContact& c = cm.contacts[i];
   ContactModeData& w = data_.modes;
   const int n = model_.n();
-  const int s = model_.s();
   // Zeno (section 9): touchdowns 1e-7 s apart (relative to t) accumulate: bounces of a height
   // 1e-14 m, a few orders above what the event location resolves, so none is missed.
   const double interval = t - last_touchdown_[i];
@@ -241,74 +382,86 @@ std::string ContactSwitches::touchdown(int contact, double t) {
   }
   double* q = switch_y_.data();
   double* v = q + n;
-  if (compute_terms(model_, data_, t, q, v) != Status::ok) return "";
-  std::vector<double> f(static_cast<std::size_t>(model_.velocity_constraints()));
-  model_.evaluator->velocity_residual(t, q, v, data_.scratch.data(), f.data());
+  // The state before, in the current modes (this contact free): the terms, every contact's mu,
+  // slip and tangent lengths, and the velocity residuals.
+  if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return "";
   const double e = w.restitution[i];
-  const double vn = f[static_cast<std::size_t>(c.gap_velocity)];  // the gap's rate before, < 0
-  // (I1)-(I2) with a sticking impulse: the rows kept after the impact hold their velocity
-  // residuals, the gap's rate becomes -e times what it was, the slip becomes 0.
-  w.mode[i] = ContactMode::rolling;
-  std::vector<int> rows;
-  std::vector<double> target;
-  int velocity_index = 0;
-  const Eigen::Map<const Vector> v_before(v, n);
-  for (int row = 0; row < s; ++row) {
-    const bool has_velocity = model_.constraints[static_cast<std::size_t>(row)].level != ConstraintLevel::acceleration;
-    bool keep = true;
-    for (std::size_t j = 0; j < cm.contacts.size() && keep; ++j) {
-      const ContactModeContact& o = cm.contacts[j];
-      if (w.mode[j] == ContactMode::rolling) continue;
-      keep = row != o.roll[0] && row != o.roll[1] && row != o.spin && !(w.mode[j] == ContactMode::free && row == o.gap);
-    }
-    if (keep) {
-      double delta = 0.0;
-      if (row == c.gap) delta = -(1.0 + e) * vn;
-      else if (row == c.roll[0] || row == c.roll[1] || row == c.spin) delta = -f[static_cast<std::size_t>(velocity_index)];
-      rows.push_back(row);
-      target.push_back(data_.b.row(row).dot(v_before) + delta);
-    }
-    if (has_velocity) ++velocity_index;
-  }
-  const int r = static_cast<int>(rows.size());
-  Matrix Bt(n, r);
-  for (int j = 0; j < r; ++j) Bt.col(j) = data_.b.row(rows[static_cast<std::size_t>(j)]).transpose();
-  Eigen::ColPivHouseholderQR<Matrix> qr(Bt);
-  if (qr.rank() < r) {
-    accumulation_ = fmt::format("contact '{}' touches down at t = {:.9g} where the constraints after the impact are "
-                                "dependent; the run ends here with its results so far",
-                                c.name, t);
+  const double vn = w.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)];
+  const std::array<double, 2> slip_before = w.slip[i];
+  // Coulomb at the impulse level (section 7, "Which impulse"): sticking if inside the cone.
+  Impulse impulse = solve_impulse(contact, t, v, false, {0.0, 0.0});
+  if (!impulse.ok) {
+    accumulation_ = impulse.failure;
     return "";
   }
-  const Matrix Qf = qr.householderQ();
-  const Matrix D = Qf.rightCols(n - r).transpose();
-  Matrix M(n, n);
-  Vector rhs(n);
-  M.topRows(n - r) = D * data_.A;
-  rhs.head(n - r) = D * (data_.A * v_before);
-  for (int j = 0; j < r; ++j) {
-    M.row(n - r + j) = data_.b.row(rows[static_cast<std::size_t>(j)]);
-    rhs(n - r + j) = target[static_cast<std::size_t>(j)];
+  if (c.friction && norm2(impulse.tangential) > w.mu_s[i] * impulse.normal) {
+    std::array<double, 2> direction{0.0, 0.0};
+    const double slip = norm2(slip_before);
+    if (slip > slip_floor(data_)) direction = {slip_before[0] / slip, slip_before[1] / slip};
+    else {
+      const double size = norm2(impulse.tangential);
+      direction = {-impulse.tangential[0] / size, -impulse.tangential[1] / size};
+    }
+    impulse = solve_impulse(contact, t, v, true, direction);
+    if (!impulse.ok) {
+      accumulation_ = impulse.failure;
+      return "";
+    }
+    if (!(impulse.normal > 0.0)) {
+      accumulation_ = fmt::format(
+          "contact '{}' touches down at t = {:.9g} sliding (the sticking impulse is outside the friction cone) in "
+          "Painleve's paradox: with mu_k = {:.6g} the impulse along n - mu_k e_s would have to pull (normal impulse "
+          "{:.6g} N s), w_eff <= 0 (docs/derivations/contact-modes.md 3.8); no impact law of this model is "
+          "consistent there. The run ends here with its results so far; lower the friction coefficient",
+          c.name, t, w.mu_k[i], impulse.normal);
+      return "";
+    }
+    w.direction[i] = direction;
   }
-  const Vector v_after = M.partialPivLu().solve(rhs);
   const Evaluator& ev = *model_.evaluator;
-  const bool balance = ev.has_energy_balance() && size_ > 2 * n;
+  const bool balance = ev.has_energy_balance() && size_ > 2 * n + 4;
   const double h_before = balance ? ev.energy_function(t, q, v, data_.scratch.data()) : 0.0;
-  std::copy(v_after.data(), v_after.data() + n, v);
-  // The impulsive reactions' work, h+ - h- (section 8), booked with the reactions' work so that
-  // h - h0 - W does not jump.
-  if (balance) switch_y_[static_cast<std::size_t>(2 * n + 1)] += ev.energy_function(t, q, v, data_.scratch.data()) - h_before;
+  std::copy(impulse.v.data(), impulse.v.data() + n, v);
+  // The energy the impact takes, h- - h+ (section 8), booked as impact_loss (W includes -impact_loss),
+  // so that h - h0 - W does not jump; the reactions' work keeps its meaning (the finite reactions).
+  if (balance) {
+    const double h_after = ev.energy_function(t, q, v, data_.scratch.data());
+    const double loss = h_before - h_after;
+    switch_y_[static_cast<std::size_t>(2 * n + 4)] += loss;
+    if (loss < -1e-9 * (std::abs(h_before) + std::abs(h_after)) && !gained_energy_) {
+      gained_energy_ = true;
+      warnings_.push_back(fmt::format(
+          "contact '{}': the impact at t = {:.9g} gains energy ({:.6g} J): Newton's restitution e = {:.6g} with "
+          "friction at a contact whose normal and tangential motions couple can create energy "
+          "(docs/derivations/contact-modes.md section 7); a smaller restitution avoids it. Later impacts that gain "
+          "energy are not reported",
+          c.name, t, -loss, e));
+    }
+  }
   const std::string name = c.name + "_touchdown";
   if (e > 0.0 && -e * vn > slip_floor(data_)) {
     w.mode[i] = c.unilateral ? ContactMode::free : ContactMode::rolling;
     return name;
   }
-  // The contact stays closed: the mode as at the start (section 7, "After the impact").
+  // The contact stays closed: the mode as at the start (section 7, "After the impact"): sliding
+  // if it slips after the impact, else rolling if inside the cone, free if it would pull.
+  w.mode[i] = ContactMode::rolling;
   if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return "";
+  const double slip = norm2(w.slip[i]);
+  if (c.friction && slip > slip_floor(data_)) {
+    w.direction[i] = {w.slip[i][0] / slip, w.slip[i][1] / slip};
+    w.mode[i] = ContactMode::sliding;
+    if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return "";
+    if (!check_sliding(contact, t)) return "";
+    if (c.unilateral && w.normal_force[i] < 0.0) w.mode[i] = ContactMode::free;
+    return name;
+  }
   if (c.unilateral && w.normal_force[i] < 0.0) w.mode[i] = ContactMode::free;
   else if (c.friction && norm2(w.friction[i]) > w.mu_s[i] * std::abs(w.normal_force[i])) {
     w.direction[i] = onset_direction(w, i);
     w.mode[i] = ContactMode::sliding;
+    if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return "";
+    if (!check_sliding(contact, t)) return "";
   }
   return name;
 }

@@ -10,6 +10,7 @@
 //         -> integrate (one segment per mode set) -> ContactSwitches::on_event -> new modes
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <functional>
 #include <span>
@@ -35,6 +36,16 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
 // The mode events of every contact (3 per contact) after the run's own events (`user`, may be
 // null): located on the integrator's dense output; a crossing changes data.modes and ends the
 // current segment (Status::stopped), which integrate_contact_modes restarts from the state there.
+// The impulse of one touchdown (docs/derivations/contact-modes.md section 7): the velocities
+// after it, its normal part Pi_n and its tangential part Pi_t (unit tangent basis) at the contact.
+struct Impulse {
+  bool ok = false;
+  Vector v;
+  double normal = 0.0;
+  std::array<double, 2> tangential{0.0, 0.0};
+  std::string failure;  // why not, when !ok
+};
+
 class ContactSwitches final : public EventFunctions {
  public:
   // Writes the row of a switch (the mode after it) and records it as an event named NAME_stick,
@@ -58,11 +69,20 @@ class ContactSwitches final : public EventFunctions {
   // Set when the switches accumulate (Zeno or no consistent mode): the message ending the run.
   const std::string& accumulation() const { return accumulation_; }
   long switches() const { return switch_count_; }
+  // Warnings for the run's summary (an impact that gains energy: once per run).
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
   std::string switch_contact(int contact, int slot, double t, const double* y);
   // The impact of a touchdown (section 7): the velocities of switch_y_ after it, and the mode.
   std::string touchdown(int contact, double t);
+  // (I1)-(I2) for `contact` with the velocities v before, after compute_dynamics there: sticking
+  // (its no-slip rows target 0), or sliding along `direction` (unit tangent basis) with mu_k.
+  Impulse solve_impulse(int contact, double t, const double* v, bool sliding,
+                        const std::array<double, 2>& direction);
+  // Where a sliding mode starts, after compute_dynamics in it: false (with the message in
+  // accumulation_) when the contact is in Painleve's paradox (w_eff <= 0, section 3.8).
+  bool check_sliding(int contact, double t);
 
   const Model& model_;
   Data& data_;
@@ -82,6 +102,8 @@ class ContactSwitches final : public EventFunctions {
   std::vector<double> last_touchdown_;  // per contact: the times of its last two touchdowns
   std::vector<double> previous_touchdown_;
   std::vector<long> touchdowns_;
+  bool gained_energy_ = false;
+  std::vector<std::string> warnings_;
 };
 
 // Integrates as integrate() does, through any number of switches: each switch ends a segment,

@@ -32,7 +32,7 @@ void fill_energy_balance(const Data& data, double* out) {
   out[2] = data.work_forces;
   out[3] = data.work_reactions;
   out[4] = data.work_time;
-  out[5] = data.work_forces + data.work_reactions + data.work_time + data.work_friction;
+  out[5] = data.work_forces + data.work_reactions + data.work_time + data.work_friction - data.impact_loss;
   out[6] = data.balance_error;
 }
 

@@ -64,8 +64,9 @@ class MechanicalOde final : public OdeSystem {
         balance_(model.evaluator->has_energy_balance()), friction_(balance_ && model.contact_modes != nullptr) {}
 
   // The works: of the forces, the reactions, the explicit time dependence, and with contact modes
-  // the friction's (model/contact_modes.hpp).
-  int size() const override { return 2 * n_ + (balance_ ? kWorks : 0) + (friction_ ? 1 : 0); }
+  // the friction's and the impacts' loss (model/contact_modes.hpp; the loss changes only at
+  // touchdowns, analysis/contact_switches.cpp).
+  int size() const override { return 2 * n_ + (balance_ ? kWorks : 0) + (friction_ ? 2 : 0); }
   int error_size() const override { return 2 * n_; }
 
   Status rhs(double t, const double* y, double* ydot) override {
@@ -78,7 +79,10 @@ class MechanicalOde final : public OdeSystem {
       ydot[2 * n_] = data_.power_forces;
       ydot[2 * n_ + 1] = data_.power_reactions;
       ydot[2 * n_ + 2] = data_.power_time;
-      if (friction_) ydot[2 * n_ + 3] = data_.power_friction;
+      if (friction_) {
+        ydot[2 * n_ + 3] = data_.power_friction;
+        ydot[2 * n_ + 4] = 0.0;
+      }
     }
     return Status::ok;
   }
@@ -120,13 +124,15 @@ void record_balance(const Model& model, Data& data, const double* work, Simulati
   data.work_reactions = work[1];
   data.work_time = work[2];
   data.work_friction = model.contact_modes ? work[3] : 0.0;
-  const double W = work[0] + work[1] + work[2] + data.work_friction;
+  data.impact_loss = model.contact_modes ? work[4] : 0.0;
+  const double W = work[0] + work[1] + work[2] + data.work_friction - data.impact_loss;
   data.balance_error = data.energy_function - summary.energy_function_initial - W;
   summary.max_balance_error = std::max(summary.max_balance_error, std::abs(data.balance_error));
   summary.work_forces = work[0];
   summary.work_reactions = work[1];
   summary.work_time = work[2];
   summary.work_friction = data.work_friction;
+  summary.impact_loss = data.impact_loss;
   summary.energy_change = data.energy - summary.energy_initial;
   summary.energy_function_change = data.energy_function - summary.energy_function_initial;
 }
@@ -435,6 +441,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.energy_function_differs = summary.has_energy_balance && !model.evaluator->energy_function_is_energy();
   summary.constraint_warnings = watch.warnings;
   for (const ConstraintWarning& w : watch.warnings) summary.warnings.push_back(format_constraint_warning(model, w));
+  summary.warnings.insert(summary.warnings.end(), switches.warnings().begin(), switches.warnings().end());
   summary.largest_row_factor = watch.largest_row_factor;
   summary.largest_condition_factor = watch.largest_condition_factor;
   summary.watched_states = watch.states;

@@ -101,6 +101,7 @@ struct SimulationSummary {
   double max_balance_error = 0.0;
   double work_forces = 0.0, work_reactions = 0.0, work_time = 0.0;
   double work_friction = 0.0;           // contacts that slide (model/contact_modes.hpp); in W
+  double impact_loss = 0.0;             // energy taken by touchdowns (model/contact_modes.hpp); W has -impact_loss
   double energy_change = 0.0;           // E(t_last) - E(t0)
   double energy_function_change = 0.0;  // h(t_last) - h(t0)
   std::optional<InitialFix> initial_fix;  // set when options.fix_initial moved the initial state

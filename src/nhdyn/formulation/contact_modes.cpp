@@ -62,6 +62,36 @@ Status fail(Data& data, const ContactModeModel& cm, int contact, const std::stri
   return Status::singular_system;
 }
 
+// The coefficients y of f (n) on the columns of B~^T (r), f = B~^T y, by the QR of B~^T (least
+// squares; exact when f lies in their span). Overwrites f.
+void reaction_coefficients(ContactModeData& w, int r, Vector& f, Vector& y) {
+  f.applyOnTheLeft(w.qr.householderQ().adjoint());
+  w.qr.matrixQR().topLeftCorner(r, r).triangularView<Eigen::Upper>().solveInPlace(f.head(r));
+  for (int j = 0; j < r; ++j) y(w.qr.colsPermutation().indices()(j)) = f(j);
+}
+
+// (S9), (S10): w_eff and Lambda_nn of the sliding contact whose normal row is column j of B~^T
+// (row k + j of M), from the factorizations of M and B~^T already made: two more solves.
+void effective_inverse_mass(const Model& model, Data& data, int contact_gap_row, int j, int k, int r, double& w_eff,
+                            double& lambda_nn) {
+  ContactModeData& w = data.modes;
+  const int n = model.n();
+  w.probe.setZero();
+  w.probe(k + j) = 1.0;
+  w.response.noalias() = w.lu.solve(w.probe);
+  data.tmp_n.noalias() = data.A * w.response;
+  reaction_coefficients(w, r, data.tmp_n, w.coefficients);
+  const double inverse = w.coefficients(j);  // 1 / w_eff
+  w.probe.head(k).noalias() = data.Q_full.rightCols(k).transpose() * data.b.row(contact_gap_row).transpose();
+  w.probe.tail(n - k).setZero();
+  w.response.noalias() = w.lu.solve(w.probe);
+  data.tmp_n.noalias() = data.A * w.response;
+  data.tmp_n -= data.b.row(contact_gap_row).transpose();
+  reaction_coefficients(w, r, data.tmp_n, w.coefficients);
+  w_eff = 1.0 / inverse;
+  lambda_nn = -w.coefficients(j) / inverse;
+}
+
 }  // namespace
 
 Status compute_mode_acceleration(const Model& model, Data& data) {
@@ -93,6 +123,7 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
     w.reaction_rows.resize(n, r);
     w.multipliers.resize(r);
     w.qr = Eigen::ColPivHouseholderQR<Matrix>(n, r);
+    w.coefficients.resize(r);
   }
   for (int j = 0; j < r; ++j) w.reaction_rows.col(j) = data.b.row(w.kept[static_cast<std::size_t>(j)]).transpose();
   std::vector<int>& gap_column = w.gap_column;
@@ -150,14 +181,13 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
   // The multipliers, R = B~^T lambda (least squares through the same QR): N and F_t.
   if (r > 0) {
     data.tmp_n = data.R;
-    data.tmp_n.applyOnTheLeft(w.qr.householderQ().adjoint());
-    w.qr.matrixQR().topLeftCorner(r, r).triangularView<Eigen::Upper>().solveInPlace(data.tmp_n.head(r));
-    for (int j = 0; j < r; ++j) w.multipliers(w.qr.colsPermutation().indices()(j)) = data.tmp_n(j);
+    reaction_coefficients(w, r, data.tmp_n, w.multipliers);
   }
   w.power_friction = 0.0;
   for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
     const ContactModeContact& c = cm.contacts[i];
     w.friction_power[i] = 0.0;
+    w.w_eff[i] = w.lambda_nn[i] = 0.0;
     if (w.mode[i] == ContactMode::free || gap_column[i] < 0) {
       w.normal_force[i] = 0.0;
       w.friction[i] = {0.0, 0.0};
@@ -170,6 +200,7 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
       // -mu_k |N| |s| = F_t . s, the dissipation (section 8).
       w.friction_power[i] = w.friction[i][0] * w.slip[i][0] + w.friction[i][1] * w.slip[i][1];
       w.power_friction += w.friction_power[i];
+      effective_inverse_mass(model, data, c.gap, gap_column[i], k, r, w.w_eff[i], w.lambda_nn[i]);
       continue;
     }
     for (std::size_t a = 0; a < 2; ++a) {

@@ -38,6 +38,8 @@ ContactModeData make_contact_mode_data(const Model& model) {
   w.slip_world.assign(m, {0.0, 0.0, 0.0});
   w.sliding_direction.assign(m, {0.0, 0.0});
   w.friction_power.assign(m, 0.0);
+  w.w_eff.assign(m, 0.0);
+  w.lambda_nn.assign(m, 0.0);
   w.gap.assign(m, 0.0);
   w.gap_column.assign(m, -1);
   w.tangent_length.assign(m, {1.0, 1.0});
@@ -46,6 +48,8 @@ ContactModeData make_contact_mode_data(const Model& model) {
   const int n = model.n();
   w.M = Matrix::Zero(n, n);
   w.rhs = Vector::Zero(n);
+  w.probe = Vector::Zero(n);
+  w.response = Vector::Zero(n);
   w.lu = Eigen::PartialPivLU<Matrix>(n);
   return w;
 }
@@ -57,6 +61,7 @@ std::vector<std::string> contact_mode_columns(const Model& model) {
     for (const char* suffix : {"_mode", "_slip_speed", "_slip_x", "_slip_y", "_slip_z", "_gap"})
       columns.push_back(c.name + suffix);
   columns.push_back("work_friction");
+  columns.push_back("impact_loss");
   return columns;
 }
 
@@ -75,6 +80,7 @@ void append_contact_mode_values(const Data& data, std::vector<double>& row) {
     row.push_back(w.gap[i]);
   }
   row.push_back(data.work_friction);
+  row.push_back(data.impact_loss);
 }
 
 bool contact_mode_drops(const Model& model, const Data& data, const std::string& constraint) {

@@ -80,6 +80,10 @@ struct ContactModeData {
   std::vector<std::array<double, 3>> slip_world;  // s in world components
   std::vector<std::array<double, 2>> sliding_direction;  // e_s used by the solve (sliding)
   std::vector<double> friction_power;      // -mu_k |N| |s| [W] (sliding; 0 otherwise)
+  // Sliding: the effective normal inverse mass w_eff = n^T Lambda (n - mu_k e_s) and its
+  // frictionless part Lambda_nn [1/kg] (docs/derivations/contact-modes.md (S7), (S9), (S10));
+  // w_eff <= 0 is Painleve's paradox. 0 in the other modes.
+  std::vector<double> w_eff, lambda_nn;
   double power_friction = 0.0;             // the sum over the contacts
   std::vector<double> gap;                 // the gap [m] (record_contact_gaps; 0 while touching)
   // --- workspace (sized for the current modes) ---
@@ -90,6 +94,7 @@ struct ContactModeData {
   Matrix reaction_rows;                    // n x r, the reaction directions B~^T (columns)
   Matrix M;                                // n x n, [D A; b_kept]
   Vector rhs, multipliers;                 // n; r
+  Vector probe, response, coefficients;    // n, n, r: the solves of (S9) and (S10)
   Eigen::ColPivHouseholderQR<Matrix> qr;   // of reaction_rows
   Eigen::PartialPivLU<Matrix> lu;          // of M
   // The contact and time of a failed solve (a singular system: Painleve), for the message.
@@ -100,7 +105,7 @@ ContactModeData make_contact_mode_data(const Model& model);
 
 // The result columns of the contacts with modes: per contact NAME_mode, NAME_slip_speed,
 // NAME_slip_x, NAME_slip_y, NAME_slip_z, NAME_gap, then work_friction (the friction's work since
-// t0). Empty for a model without contact modes. Appended after the contact forces
+// t0) and impact_loss (the energy the touchdowns took since t0, analysis/contact_switches.hpp). Empty for a model without contact modes. Appended after the contact forces
 // (contact_forces.hpp).
 std::vector<std::string> contact_mode_columns(const Model& model);
 // Appends their values (after compute_mode_acceleration and record_contact_gaps); `work_friction`

@@ -142,6 +142,9 @@ struct Data {
   // Contacts that slide (contact_modes.hpp): the friction's power -mu_k N |s| (booked apart from
   // power_reactions, which keeps the rest of R . q') and its work since t0 (set by simulate).
   double power_friction = 0.0, work_friction = 0.0;
+  // The energy taken by the impacts of touchdowns since t0, h- - h+ summed (set by simulate); W
+  // includes -impact_loss.
+  double impact_loss = 0.0;
   double balance_error = 0.0;  // h - h(t0) - W, the accuracy figure (set by simulate)
   // Derived outputs (model/output.hpp): their values (compute_outputs) and workspace (make_data).
   OutputData outputs;
