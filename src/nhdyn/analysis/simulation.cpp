@@ -301,9 +301,12 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   Data data = make_data(model, data_options);
   // rk4 takes no smaller step near a singular S, and could step across it (model/data.hpp).
   data.motion.watch_sign = options.integrator.kind == IntegratorKind::rk4;
-  check_state_or_throw(model, data, model.t0, model.q0.data(), model.v0.data());
   SimulationSummary summary;
   Vector q0 = model.q0, v0 = model.v0;
+  // The contact points' coordinates the model added, found from the rest of the start (its
+  // parameters or initial values may have changed since it was made).
+  complete_initial_state(model, data, model.t0, q0, v0);
+  check_state_or_throw(model, data, model.t0, q0.data(), v0.data());
   if (options.fix_initial) {
     summary.initial_fix = fix_initial_state(model, data, model.t0, q0, v0);
     q0 = summary.initial_fix->q;

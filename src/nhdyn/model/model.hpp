@@ -71,6 +71,16 @@ struct PlanarPath {
   int y = 1;
 };
 
+// Coordinates a model added for a contact point (a [[contacts]] entry without `coordinates`,
+// docs/derivations/rolling-bodies.md section 10): their initial values are found at the start of a
+// run from the rest of the initial state (analysis/initial_state.hpp, complete_initial_state).
+struct ContactCoordinates {
+  std::string contact;
+  std::string where;             // file:line of the contact
+  std::vector<int> coordinates;  // indices into q
+  std::vector<int> constraints;  // as many position constraints that hold them (indices into constraints)
+};
+
 struct Model {
   std::string name;
   std::string description;
@@ -84,6 +94,9 @@ struct Model {
   double t0 = 0.0;
   Vector q0;                             // n, initial coordinates
   Vector v0;                             // n, initial velocities
+  // Which initial values the model file wrote (n each, or empty: none). --fix-initial keeps them.
+  std::vector<bool> q0_written, v0_written;
+  std::vector<ContactCoordinates> contact_coordinates;  // found at the start of every run
   SimulationDefaults defaults;
   std::optional<PlanarPath> path;
   // Immutable and bound to the values of `parameters`: Model copies (one per thread) share it

@@ -28,6 +28,7 @@ struct ShapeValues {
   GiNaC::ex surface = 0;
   Vector3 point = {0, 0, 0};
   std::array<int, 3> at = {-1, -1, -1};
+  bool added = false;  // those coordinates were added by nhdyn (no `coordinates` key), not the user's
 };
 
 // The support mapping at the unit direction nu (body axes): the shape's point lowest along nu,
