@@ -81,6 +81,18 @@ struct ContactCoordinates {
   std::vector<int> constraints;  // as many position constraints that hold them (indices into constraints)
 };
 
+// A contact whose closed-form point turns singular along a motion (a disk or torus lying flat,
+// docs/derivations/rolling-bodies.md section 2): where a run fails and `measure` (one output, in t
+// and q, reading the parameters: bind it) is below `threshold` there, the run's message is
+// `reason`, naming the contact (analysis/simulation.hpp).
+struct ContactWatch {
+  std::string contact;
+  std::string where;
+  Program measure;
+  double threshold = 0.0;
+  std::string reason;
+};
+
 struct Model {
   std::string name;
   std::string description;
@@ -97,6 +109,7 @@ struct Model {
   // Which initial values the model file wrote (n each, or empty: none). --fix-initial keeps them.
   std::vector<bool> q0_written, v0_written;
   std::vector<ContactCoordinates> contact_coordinates;  // found at the start of every run
+  std::vector<ContactWatch> contact_watches;            // a failed run looks at them
   SimulationDefaults defaults;
   std::optional<PlanarPath> path;
   // Immutable and bound to the values of `parameters`: Model copies (one per thread) share it

@@ -1122,6 +1122,10 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
         if (spec.constraints[static_cast<std::size_t>(i)].name == name) c.constraints.push_back(i);
     model.contact_coordinates.push_back(std::move(c));
   }
+  for (const SpecContactWatch& w : spec.contact_watches)
+    model.contact_watches.push_back({w.contact, w.where.describe(),
+                                     compile_expression(spec, w.measure, fmt::format("contact '{}'", w.contact)),
+                                     w.threshold, w.reason});
   model.defaults = spec.defaults;
   if (spec.path)
     model.path = PlanarPath{coordinate_index(spec, spec.path->first, "x"), coordinate_index(spec, spec.path->second, "y")};

@@ -61,6 +61,15 @@ class ContactShape {
   virtual std::optional<GiNaC::ex> ball_radius(const ShapeValues&) const { return std::nullopt; }
   // The size of the shape for the moment rows of the contact-force solve (a length).
   virtual GiNaC::ex length(const ShapeValues& values) const { return values.sizes.front(); }
+  // Where the closed-form contact point is singular along the motion: a measure that is positive
+  // where it is defined and 0 where it is not (a disk or torus lying flat: 1 - (e . nu)^2, e its
+  // axle), with the reason for the message that ends a run there; nothing for a shape whose
+  // contact point is defined for every nu (docs/derivations/rolling-bodies.md section 2).
+  struct Singularity {
+    GiNaC::ex measure;
+    std::string reason;
+  };
+  virtual std::optional<Singularity> singularity(const ShapeValues&, const Vector3&) const { return std::nullopt; }
   // How the scene draws it (a ball of its radius, a wheel about its axis), or nothing yet (the
   // body's ellipsoid of inertia is drawn in any case).
   virtual std::optional<VisualKind> drawing() const { return std::nullopt; }

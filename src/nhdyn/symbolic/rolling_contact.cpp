@@ -604,6 +604,10 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
     check.ground = touch.curvature;
     out.convexity = std::move(check);
   }
+  // 1 - (e . nu)^2 below 1e-4: the axle within 0.6 degree of the normal (rolling-bodies.md section 2).
+  if (const std::optional<ContactShape::Singularity> singular =
+          c.shape->singularity(c.values, multiply_transposed(F.rotation, touch.normal)))
+    out.watch = SpecContactWatch{c.name, c.where, singular->measure, 1e-4, singular->reason};
   if (c.ground.added || c.values.added) {
     // Where Newton starts (rolling-bodies.md section 10): on a terrain below the centre; an
     // implicit shape's point on its surface along -nu from its centre.

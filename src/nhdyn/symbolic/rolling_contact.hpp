@@ -121,6 +121,8 @@ struct RollingContact {
   std::optional<SpecConvexity> convexity;  // an implicit shape: checked at the initial state
   // The contact point's coordinates that nhdyn added (no `coordinates` key): found at the start.
   std::optional<SpecContactCoordinates> added;
+  // A closed form that turns singular along the motion (a disk lying flat): watched by the run.
+  std::optional<SpecContactWatch> watch;
 };
 
 // A ground type: its key, the further keys of its table, and where a shape touches it.

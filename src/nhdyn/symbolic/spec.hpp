@@ -149,6 +149,16 @@ struct SpecContactCoordinates {
   std::array<int, 3> point = {-1, -1, -1};  // the coordinates of y, when the ray is given
 };
 
+// A closed-form contact point that turns singular along the motion (a disk lying flat): a run
+// stops where `measure` (in t, q) falls below `threshold`, with `reason` (rolling_contact.hpp).
+struct SpecContactWatch {
+  std::string contact;
+  SourceLocation where;
+  GiNaC::ex measure;
+  double threshold = 0.0;
+  std::string reason;
+};
+
 struct Spec {
   std::string name;
   std::string description;
@@ -170,6 +180,7 @@ struct Spec {
   // C++). --fix-initial keeps those and moves the others (analysis/initial_state.hpp).
   std::vector<bool> q0_written, v0_written;
   std::vector<SpecContactCoordinates> contact_coordinates;  // found at the start, not written
+  std::vector<SpecContactWatch> contact_watches;  // checked where a run fails (model.hpp)
   // Optional exact motion q(t) from the initial state, n expressions in t and the parameters
   // (empty when the model gives none); compare --reference analytic measures runs against it.
   std::vector<GiNaC::ex> solution;
