@@ -207,7 +207,7 @@ TEST(RollingAddedCoordinates, FixInitialMovesOnlyTheValuesLeftFree) {
   Data data = make_data(model);
   Vector q = model.q0, v = model.v0;
   complete_initial_state(model, data, model.t0, q, v);
-  const InitialFix fix = fix_initial_state(model, data, model.t0, q, v);
+  const InitialFix fix = fix_free_initial_values(model, data, model.t0, q, v);
   const double H = 0.05, r = 0.05;
   EXPECT_NEAR(fix.q(2), H + r, 1e-13);  // z, free, onto the top
   for (int i : {0, 1, 3, 4, 5}) EXPECT_EQ(fix.dq(i), 0.0) << model.coordinates[static_cast<std::size_t>(i)];

@@ -209,13 +209,6 @@ InitialFix fix_initial_state(const Model& model, Data& data, double t, const Vec
   InitialFix fix;
   fix.q = q;
   fix.v = v;
-  const auto any = [](const std::vector<bool>& flags) { return std::find(flags.begin(), flags.end(), true) != flags.end(); };
-  if (any(model.q0_written) || any(model.v0_written)) {
-    fix_keeping_written(model, data, t, tolerance, max_iterations, fix);
-    fix.dq = fix.q - q;
-    fix.dv = fix.v - v;
-    return fix;
-  }
   ProjectionResult result;
   const Status status = compute_projection(model, data, t, fix.q.data(), fix.v.data(),
                                            ProjectionOptions{tolerance, max_iterations}, result);
@@ -238,6 +231,20 @@ InitialFix fix_initial_state(const Model& model, Data& data, double t, const Vec
   fix.velocity_iterations = result.velocity_iterations;
   fix.position_residual = result.position_residual;
   fix.velocity_residual = result.velocity_residual;
+  fix.dq = fix.q - q;
+  fix.dv = fix.v - v;
+  return fix;
+}
+
+InitialFix fix_free_initial_values(const Model& model, Data& data, double t, const Vector& q, const Vector& v,
+                                   double tolerance, int max_iterations) {
+  const auto any = [](const std::vector<bool>& flags) { return std::find(flags.begin(), flags.end(), true) != flags.end(); };
+  if (!any(model.q0_written) && !any(model.v0_written))
+    return fix_initial_state(model, data, t, q, v, tolerance, max_iterations);
+  InitialFix fix;
+  fix.q = q;
+  fix.v = v;
+  fix_keeping_written(model, data, t, tolerance, max_iterations, fix);
   fix.dq = fix.q - q;
   fix.dv = fix.v - v;
   return fix;

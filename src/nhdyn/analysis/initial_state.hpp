@@ -37,14 +37,19 @@ struct InitialFix {
   double velocity_residual = 0.0;  // max |f| after the fix
 };
 
-// Moves (q, v) onto the constraints. When the model file wrote some initial values
-// (model.q0_written, v0_written), those are kept and only the others move, with the smallest
-// change weighted by their block of A; throws ModelError naming the constraint and its residual
-// when the values kept leave a constraint unsatisfied. With none written, every value may move.
-// Throws ModelError when Newton does not converge (naming the residual reached and the
-// constraints) or when A or J is singular on the way.
+// Moves (q, v) onto the constraints, every value free to move. Throws ModelError when Newton does
+// not converge (naming the residual reached and the constraints) or when A or J is singular on
+// the way.
 InitialFix fix_initial_state(const Model& model, Data& data, double t, const Vector& q, const Vector& v,
                              double tolerance = 1e-13, int max_iterations = 50);
+
+// --fix-initial: the same, but the values the model file wrote (model.q0_written, v0_written) are
+// kept and only the others move, with the smallest change weighted by their block of A
+// (docs/derivations/rolling-bodies.md section 10). Throws ModelError naming the constraint, its
+// level, where it was written and its residual when the values kept leave it unsatisfied. With
+// none written it is fix_initial_state.
+InitialFix fix_free_initial_values(const Model& model, Data& data, double t, const Vector& q, const Vector& v,
+                                   double tolerance = 1e-13, int max_iterations = 50);
 
 // Finds the initial values of the coordinates a model added for its contact points
 // (model.contact_coordinates, docs/derivations/rolling-bodies.md section 10) from the rest of

@@ -327,7 +327,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   complete_initial_state(model, data, model.t0, q0, v0);
   check_state_or_throw(model, data, model.t0, q0.data(), v0.data());
   if (options.fix_initial) {
-    summary.initial_fix = fix_initial_state(model, data, model.t0, q0, v0);
+    summary.initial_fix = fix_free_initial_values(model, data, model.t0, q0, v0);
     q0 = summary.initial_fix->q;
     v0 = summary.initial_fix->v;
     check_state_or_throw(model, data, model.t0, q0.data(), v0.data());
