@@ -386,8 +386,10 @@ int run_simulate(const SimulateArgs& args) {
       fmt::print("  initial state moved onto the constraints (--fix-initial):\n");
       for (int i = 0; i < model.n(); ++i) {
         const std::string& c = model.coordinates[static_cast<std::size_t>(i)];
-        if (fix.dq(i) != 0.0) fmt::print("    {} = {:.12g} (changed by {:+.3g})\n", c, fix.q(i), fix.dq(i));
-        if (fix.dv(i) != 0.0) fmt::print("    {}' = {:.12g} (changed by {:+.3g})\n", c, fix.v(i), fix.dv(i));
+        if (fix.dq(i) != 0.0)
+          fmt::print("    {} = {:.12g} (changed by {:+.3g}), was {:.12g}\n", c, fix.q(i), fix.dq(i), fix.q(i) - fix.dq(i));
+        if (fix.dv(i) != 0.0)
+          fmt::print("    {}' = {:.12g} (changed by {:+.3g}), was {:.12g}\n", c, fix.v(i), fix.dv(i), fix.v(i) - fix.dv(i));
       }
     }
     if (summary.has_energy_balance) {

@@ -95,9 +95,19 @@ TEST_F(ModelFileCli, ViolatedInitialStateIsRefusedOrFixed) {
   EXPECT_EQ(refused.exit_code, 2) << refused.out;
   EXPECT_NE(refused.out.find("blade (velocity level): residual 0.3"), std::string::npos) << refused.out;
   EXPECT_FALSE(fs::exists(dir_ / "out.csv"));
-  const Outcome fixed = run_nhdyn("simulate bad.toml --t-end 1 -o out.csv --fix-initial", dir_);
+  // --fix-initial keeps the values [initial] writes: all three velocities are written, so it refuses.
+  const Outcome kept = run_nhdyn("simulate bad.toml --t-end 1 -o out.csv --fix-initial", dir_);
+  EXPECT_EQ(kept.exit_code, 2) << kept.out;
+  EXPECT_NE(kept.out.find("'blade' (velocity level"), std::string::npos) << kept.out;
+  EXPECT_NE(kept.out.find("residual 0.3"), std::string::npos) << kept.out;
+  // With y' left out (and the sled turned by 0.5 rad) it moves y' only, to x' tan(phi).
+  std::string free_toml = toml;
+  free_toml.replace(free_toml.find("velocity = { x = 1.0, y = 0.3, phi = 1.0 }"), 42, "velocity = { x = 1.0, phi = 1.0 }");
+  free_toml.replace(free_toml.find("position = { x = 0, y = 0, phi = 0 }"), 36, "position = { x = 0, y = 0, phi = 0.5 }");
+  std::ofstream(dir_ / "free.toml") << free_toml;
+  const Outcome fixed = run_nhdyn("simulate free.toml --t-end 1 -o out.csv --fix-initial", dir_);
   EXPECT_EQ(fixed.exit_code, 0) << fixed.out;
-  EXPECT_NE(fixed.out.find("y' = "), std::string::npos) << fixed.out;
+  EXPECT_NE(fixed.out.find("y' = 0.546302489844 (changed by +0.546), was 0"), std::string::npos) << fixed.out;
 }
 
 TEST_F(ModelFileCli, EquationsInTextAndLatex) {

@@ -68,10 +68,18 @@ TEST(RollingContactsCli, NotTouchingAtTheStartGivesTheGap) {
       simulate_altered("gap", "z = \"Rb - sqrt((Rb - r)^2 - x0^2)\"", "z = \"Rb - sqrt((Rb - r)^2 - x0^2) - 0.01\"");
   expect_refused(outcome, {"ball_contact (position level): residual -0.00999758 (bowl.toml:35:1)",
                            "the gap between the body and the ground", "--fix-initial"});
-  // --fix-initial moves it onto the wall.
+  // --fix-initial keeps the z written, so it cannot close the gap: refused, naming it.
   const fs::path dir = fs::temp_directory_path() / "nhdyn_rolling_gap";
-  const nhdyn::test::CliOutcome fixed = nhdyn::test::run_nhdyn("simulate bowl.toml -o out.csv --t-end 0.01 --fix-initial", dir);
+  const nhdyn::test::CliOutcome kept = nhdyn::test::run_nhdyn("simulate bowl.toml -o out.csv --t-end 0.01 --fix-initial", dir);
+  expect_refused(kept, {"keeps every value [initial] writes", "'ball_contact' (position level, bowl.toml:35:1)",
+                        "residual -0.00999758"});
+  // With z left out of [initial], --fix-initial moves it onto the wall and says so.
+  simulate_altered("gap_free", ", z = \"Rb - sqrt((Rb - r)^2 - x0^2)\"", "");
+  const nhdyn::test::CliOutcome fixed = nhdyn::test::run_nhdyn(
+      "simulate bowl.toml -o out.csv --t-end 0.01 --fix-initial", fs::temp_directory_path() / "nhdyn_rolling_gap_free");
   EXPECT_EQ(fixed.exit_code, 0) << fixed.out;
+  EXPECT_NE(fixed.out.find("    z = 0.0501111248"), std::string::npos) << fixed.out;  // Rb - sqrt((Rb - r)^2 - x0^2)
+  EXPECT_NE(fixed.out.find(", was 0\n"), std::string::npos) << fixed.out;
 }
 
 }  // namespace

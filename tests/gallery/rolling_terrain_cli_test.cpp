@@ -67,18 +67,25 @@ TEST(RollingTerrainCli, TerrainThatIsNotDifferentiable) {
 TEST(RollingTerrainCli, UnknownContactCoordinate) {
   expect_terrain_refused(simulate_bump("coordinate", {{"coordinates = [\"u\", \"v\"]", "coordinates = [\"u\", \"vv\"]"}}),
                  {"bump.toml:46:10", "'vv' is not a coordinate", "did you mean 'v'?"});
+  // Without `coordinates` nhdyn adds ball_u, ball_v: the model's own u, v then hold nothing, and
+  // without inertia or a constraint on them [D A; b] is singular, which the start says.
   expect_terrain_refused(simulate_bump("missing", {{", coordinates = [\"u\", \"v\"]", ""}}),
-                 {"bump.toml:46:10", "a terrain needs the 2 coordinates", "none given"});
+                 {"a motion of u, v has no kinetic energy and no constraint holds it"});
 }
 
 TEST(RollingTerrainCli, StartOffTheTerrainGivesTheGap) {
-  // The centre 1 cm above the top: the gap is 0.01 m; --fix-initial puts the ball back on the top.
+  // The centre 1 cm above the top: the gap is 0.01 m. --fix-initial keeps the z written, so it
+  // refuses, naming the gap; with z left out of [initial] it puts the ball back on the top.
   expect_terrain_refused(simulate_bump("gap", {{"z = \"H + r\"", "z = \"H + r + 0.01\""}}),
                  {"ball_contact (position level): residual 0.01 (bump.toml:42:1)",
                   "the gap between the body and the ground", "--fix-initial"});
+  expect_terrain_refused(
+      simulate_bump("gap_kept", {{"z = \"H + r\"", "z = \"H + r + 0.01\""}}, "--t-end 0.05 --fix-initial"),
+      {"keeps every value [initial] writes", "'ball_contact' (position level, bump.toml:42:1)", "residual 0.01"});
   const nhdyn::test::CliOutcome fixed =
-      simulate_bump("gap_fixed", {{"z = \"H + r\"", "z = \"H + r + 0.01\""}}, "--t-end 0.05 --fix-initial");
+      simulate_bump("gap_fixed", {{" z = \"H + r\",", ""}}, "--t-end 0.05 --fix-initial");
   EXPECT_EQ(fixed.exit_code, 0) << fixed.out;
+  EXPECT_NE(fixed.out.find("    z = 0.1 (changed by +0.1), was 0"), std::string::npos) << fixed.out;
 }
 
 TEST(RollingTerrainCli, BallAsCurvedAsAHollowIsSingular) {

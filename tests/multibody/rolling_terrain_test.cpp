@@ -98,7 +98,7 @@ position = { x = "-r*sin(alpha)", y = 0, z = "r*cos(alpha)", u = 0, v = 0, psi =
 // contact point is on the terrain, at the distance r from the centre, along the terrain's normal.
 TEST(RollingTerrain, BallOverABumpKeepsItsEnergyAndTouchesTheTerrain) {
   const Model model = load_model_text(ball_on_terrain("H*exp(-(X^2 + Y^2)/w^2)", R"toml([initial]
-position = { x = -0.6, y = 0.08, z = 0.1, u = -0.6, v = 0.08, psi = 0, theta = 0, phi = 0 }
+position = { x = -0.6, y = 0.08, psi = 0, theta = 0, phi = 0 }
 velocity = { x = 1.2, y = 0, phi = 12 }
 )toml"));
   const double r = 0.1, H = 0.05, w = 0.3;
@@ -110,7 +110,7 @@ velocity = { x = 1.2, y = 0, phi = 12 }
   options.output_step = 0.01;
   options.integrator.rtol = 1e-11;
   options.integrator.atol = 1e-13;
-  options.fix_initial = true;  // the centre's height and the rolling velocities from the values given
+  options.fix_initial = true;  // the centre's height, u, v and the rolling velocities, left free, from the rest
   std::vector<double> row;
   double highest = 0.0, farthest_y = 0.0;
   const SimulationSummary summary = simulate(model, options, [&](const Data& data) {

@@ -2,10 +2,17 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
 
 #include "nhdyn/analysis/projection.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
 #include "nhdyn/model/terms.hpp"
 
@@ -33,7 +40,157 @@ Vector residual(const Model& model, Data& data, double t, const Vector& q, const
   return r;
 }
 
+// For each constraint, its row in the residual of `level` (-1 when it is not of that level).
+std::vector<int> residual_rows(const Model& model, ConstraintLevel level) {
+  std::vector<int> out(static_cast<std::size_t>(model.s()), -1);
+  int j = 0;
+  for (int i : rows_at(model, level)) out[static_cast<std::size_t>(i)] = j++;
+  return out;
+}
+
+std::string where_of(const Model& model, int constraint) {
+  const std::string& where = model.constraints[static_cast<std::size_t>(constraint)].where;
+  return where.empty() ? "" : ", " + where;
+}
+
+std::string value_name(const Model& model, int i, ConstraintLevel level) {
+  return model.coordinates[static_cast<std::size_t>(i)] + (level == ConstraintLevel::position ? "" : "'");
+}
+
+// Newton's method on the residual of `level`, its rows those of the constraints `rows`, moving only
+// the entries `free` of q (position) or v (velocity), each step the smallest change weighted by
+// A's block of them: [W J^T; J 0] [d; mu] = [0; -r], W = A(free, free), J = b(rows, free), solved
+// by a complete orthogonal decomposition (least squares where it is singular). Returns the
+// residual of those rows reached (r) and the Newton steps taken.
+int restricted_newton(const Model& model, Data& data, double t, Vector& q, Vector& v, ConstraintLevel level,
+                      const std::vector<int>& free, const std::vector<int>& rows, double tolerance,
+                      int max_iterations, Vector& r) {
+  const std::vector<int> at = residual_rows(model, level);
+  const auto m = static_cast<Eigen::Index>(rows.size()), k = static_cast<Eigen::Index>(free.size());
+  Vector& x = level == ConstraintLevel::position ? q : v;
+  r.resize(m);
+  const auto evaluate = [&] {
+    const Vector all = residual(model, data, t, q, v, level);
+    for (Eigen::Index i = 0; i < m; ++i) r(i) = all(at[static_cast<std::size_t>(rows[static_cast<std::size_t>(i)])]);
+    return r.allFinite() ? (m == 0 ? 0.0 : r.cwiseAbs().maxCoeff()) : std::numeric_limits<double>::infinity();
+  };
+  int iterations = 0;
+  double worst = evaluate();
+  while (worst > tolerance && iterations < max_iterations && std::isfinite(worst) && k > 0) {
+    if (compute_terms(model, data, t, q.data(), v.data()) != Status::ok)
+      throw ModelError(fmt::format("model '{}': while moving the initial state onto the constraints: {}", model.name,
+                                   explain_failure(model, data)));
+    const Matrix A = data.sparse ? Matrix(data.A_sparse) : data.A;
+    const Matrix b = data.sparse ? Matrix(data.b_sparse) : data.b;
+    Matrix K = Matrix::Zero(k + m, k + m);
+    for (Eigen::Index i = 0; i < k; ++i)
+      for (Eigen::Index j = 0; j < k; ++j)
+        K(i, j) = A(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]);
+    for (Eigen::Index i = 0; i < m; ++i)
+      for (Eigen::Index j = 0; j < k; ++j)
+        K(k + i, j) = K(j, k + i) = b(rows[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]);
+    Vector rhs = Vector::Zero(k + m);
+    rhs.tail(m) = -r;
+    const Vector step = Eigen::CompleteOrthogonalDecomposition<Matrix>(K).solve(rhs);
+    if (!step.allFinite()) break;
+    double size = 0.0;
+    for (Eigen::Index j = 0; j < k; ++j) {
+      x(free[static_cast<std::size_t>(j)]) += step(j);
+      size = std::max(size, std::abs(x(free[static_cast<std::size_t>(j)])));
+    }
+    ++iterations;
+    worst = evaluate();
+    if (step.head(k).cwiseAbs().maxCoeff() <= 64.0 * std::numeric_limits<double>::epsilon() * size) break;
+  }
+  return iterations;
+}
+
+// --fix-initial when [initial] wrote some values: the others move, level by level.
+void fix_keeping_written(const Model& model, Data& data, double t, double tolerance, int max_iterations,
+                         InitialFix& fix) {
+  for (const ConstraintLevel level : {ConstraintLevel::position, ConstraintLevel::velocity}) {
+    const std::vector<bool>& written = level == ConstraintLevel::position ? model.q0_written : model.v0_written;
+    std::vector<int> free;
+    std::vector<std::string> free_names;
+    for (int i = 0; i < model.n(); ++i)
+      if (static_cast<std::size_t>(i) >= written.size() || !written[static_cast<std::size_t>(i)]) {
+        free.push_back(i);
+        free_names.push_back(value_name(model, i, level));
+      }
+    const std::vector<int> all = rows_at(model, level);
+    // The constraints none of the free values enter cannot be mended by moving them.
+    std::vector<int> movable, fixed_rows;
+    if (!all.empty()) {
+      if (compute_terms(model, data, t, fix.q.data(), fix.v.data()) != Status::ok)
+        throw ModelError(fmt::format("model '{}': while moving the initial state onto the constraints: {}",
+                                     model.name, explain_failure(model, data)));
+      const Matrix b = data.sparse ? Matrix(data.b_sparse) : data.b;
+      for (int row : all) {
+        bool enters = false;
+        for (int j : free) enters = enters || b(row, j) != 0.0;
+        (enters ? movable : fixed_rows).push_back(row);
+      }
+    }
+    Vector r;
+    const int iterations =
+        restricted_newton(model, data, t, fix.q, fix.v, level, free, movable, tolerance, max_iterations, r);
+    const Vector whole = residual(model, data, t, fix.q, fix.v, level);
+    const std::vector<int> at = residual_rows(model, level);
+    int worst_row = -1;
+    double worst = 0.0;
+    // Newton aims at `tolerance`; what round-off leaves above it is no reason to refuse.
+    const double refuse_above = std::max(tolerance, 1e-10);
+    for (int row : all) {
+      const double value = std::abs(whole(at[static_cast<std::size_t>(row)]));
+      if (value <= refuse_above) continue;
+      if (worst_row < 0 || !(value <= worst)) {
+        worst_row = row;
+        worst = value;
+      }
+    }
+    const char* level_name = level == ConstraintLevel::position ? "position" : "velocity";
+    if (worst_row >= 0) {
+      const bool alone = std::find(fixed_rows.begin(), fixed_rows.end(), worst_row) != fixed_rows.end();
+      throw ModelError(fmt::format(
+          "model '{}': --fix-initial keeps every value [initial] writes and moves only the others ({} at {} level: "
+          "{}); {} the constraint '{}' ({} level{}) keeps the residual {:.6g}, so the values written cannot "
+          "satisfy it. Correct them, or leave out of [initial] a value that --fix-initial may move.",
+          model.name, free.empty() ? "none is free" : "free", level_name, free.empty() ? "none" : join(free_names),
+          alone ? "no free value enters" : fmt::format("moving them ({} Newton steps),", iterations),
+          model.constraints[static_cast<std::size_t>(worst_row)].name, level_name, where_of(model, worst_row),
+          whole(at[static_cast<std::size_t>(worst_row)])));
+    }
+    (level == ConstraintLevel::position ? fix.position_iterations : fix.velocity_iterations) = iterations;
+    (level == ConstraintLevel::position ? fix.position_residual : fix.velocity_residual) =
+        whole.size() == 0 ? 0.0 : whole.cwiseAbs().maxCoeff();
+  }
+}
+
 }  // namespace
+
+void complete_initial_state(const Model& model, Data& data, double t, Vector& q, Vector& v) {
+  constexpr double tolerance = 1e-12;
+  for (const ContactCoordinates& added : model.contact_coordinates) {
+    for (const ConstraintLevel level : {ConstraintLevel::position, ConstraintLevel::velocity}) {
+      Vector r;
+      restricted_newton(model, data, t, q, v, level, added.coordinates, added.constraints, tolerance, 50, r);
+      if (r.size() == 0 || (r.allFinite() && r.cwiseAbs().maxCoeff() <= tolerance)) continue;
+      Eigen::Index row = 0;
+      if (r.allFinite()) r.cwiseAbs().maxCoeff(&row);
+      std::vector<std::string> names;
+      for (int i : added.coordinates) names.push_back(value_name(model, i, level));
+      throw ModelError(fmt::format(
+          "{}contact '{}': cannot find the {} of its contact point ({}) at the start: Newton's method stops with "
+          "the constraint '{}' at the residual {:.6g}. The body may be too far from the ground or its shape not "
+          "convex there; start the body on the ground, or name the contact point's coordinates and give their "
+          "initial values",
+          added.where.empty() ? "" : added.where + ": ", added.contact,
+          level == ConstraintLevel::position ? "coordinates" : "velocities", join(names),
+          model.constraints[static_cast<std::size_t>(added.constraints[static_cast<std::size_t>(row)])].name,
+          r.allFinite() ? r(row) : std::numeric_limits<double>::infinity()));
+    }
+  }
+}
 
 std::vector<ConstraintResidual> calc_initial_residuals(const Model& model, Data& data, double t, const Vector& q,
                                                       const Vector& v) {
@@ -74,6 +231,20 @@ InitialFix fix_initial_state(const Model& model, Data& data, double t, const Vec
   fix.velocity_iterations = result.velocity_iterations;
   fix.position_residual = result.position_residual;
   fix.velocity_residual = result.velocity_residual;
+  fix.dq = fix.q - q;
+  fix.dv = fix.v - v;
+  return fix;
+}
+
+InitialFix fix_free_initial_values(const Model& model, Data& data, double t, const Vector& q, const Vector& v,
+                                   double tolerance, int max_iterations) {
+  const auto any = [](const std::vector<bool>& flags) { return std::find(flags.begin(), flags.end(), true) != flags.end(); };
+  if (!any(model.q0_written) && !any(model.v0_written))
+    return fix_initial_state(model, data, t, q, v, tolerance, max_iterations);
+  InitialFix fix;
+  fix.q = q;
+  fix.v = v;
+  fix_keeping_written(model, data, t, tolerance, max_iterations, fix);
   fix.dq = fix.q - q;
   fix.dv = fix.v - v;
   return fix;

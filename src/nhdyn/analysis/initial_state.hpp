@@ -37,10 +37,27 @@ struct InitialFix {
   double velocity_residual = 0.0;  // max |f| after the fix
 };
 
-// Moves (q, v) onto the constraints. Throws ModelError when Newton does not converge (naming the
-// residual reached and the constraints) or when A or J is singular on the way.
+// Moves (q, v) onto the constraints, every value free to move. Throws ModelError when Newton does
+// not converge (naming the residual reached and the constraints) or when A or J is singular on
+// the way.
 InitialFix fix_initial_state(const Model& model, Data& data, double t, const Vector& q, const Vector& v,
                              double tolerance = 1e-13, int max_iterations = 50);
+
+// --fix-initial: the same, but the values the model file wrote (model.q0_written, v0_written) are
+// kept and only the others move, with the smallest change weighted by their block of A
+// (docs/derivations/rolling-bodies.md section 10). Throws ModelError naming the constraint, its
+// level, where it was written and its residual when the values kept leave it unsatisfied. With
+// none written it is fix_initial_state.
+InitialFix fix_free_initial_values(const Model& model, Data& data, double t, const Vector& q, const Vector& v,
+                                   double tolerance = 1e-13, int max_iterations = 50);
+
+// Finds the initial values of the coordinates a model added for its contact points
+// (model.contact_coordinates, docs/derivations/rolling-bodies.md section 10) from the rest of
+// (q, v), in place: Newton's method on the position constraints that hold them, then their
+// velocities from those constraints' time derivatives (linear in them). Values already on the
+// constraints (as the model's q0, solved when it was made) are left as they are. Throws ModelError
+// naming the contact, the constraint and its residual when they cannot be found.
+void complete_initial_state(const Model& model, Data& data, double t, Vector& q, Vector& v);
 
 // Throws ModelError listing every residual above `tolerance` and suggesting --fix-initial.
 void check_initial_state(const Model& model, Data& data, double t, const Vector& q, const Vector& v,

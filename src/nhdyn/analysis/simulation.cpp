@@ -36,6 +36,25 @@ std::string non_finite_message(const std::string& kind, const std::string& where
                      where.empty() ? "" : where + ": ", kind, name, expression, text, t, state);
 }
 
+// The contact whose closed-form point is singular at (t, q, v) (model.hpp, ContactWatch: a disk
+// lying flat), as the message of the run that failed there; "" when none is.
+std::string singular_contact_message(const Model& model, double t, const double* q, const double* v) {
+  std::vector<double> values;
+  for (const Parameter& p : model.parameters) values.push_back(p.value);
+  for (const ContactWatch& w : model.contact_watches) {
+    const Program measure = w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure;
+    std::vector<double> registers(static_cast<std::size_t>(measure.registers()));
+    double value = 0.0;
+    measure.run(t, q, v, registers.data(), &value);
+    if (value >= w.threshold) continue;
+    return fmt::format("{}contact '{}': {} (1 - (axle . normal)^2 = {:.3g}) at t = {:.6g}, where {}; the run stops "
+                       "there",
+                       w.where.empty() ? "" : w.where + ": ", w.contact, w.reason, value, t,
+                       describe_state(model, q, v));
+  }
+  return "";
+}
+
 // Outputs beyond this many rows are refused: at ~100 bytes a row that is a 10 GB file.
 constexpr double kMaxOutputs = 1e8;
 
@@ -307,11 +326,14 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   Data data = make_data(model, data_options);
   // rk4 takes no smaller step near a singular S, and could step across it (model/data.hpp).
   data.motion.watch_sign = options.integrator.kind == IntegratorKind::rk4;
-  check_state_or_throw(model, data, model.t0, model.q0.data(), model.v0.data());
   SimulationSummary summary;
   Vector q0 = model.q0, v0 = model.v0;
+  // The contact points' coordinates the model added, found from the rest of the start (its
+  // parameters or initial values may have changed since it was made).
+  complete_initial_state(model, data, model.t0, q0, v0);
+  check_state_or_throw(model, data, model.t0, q0.data(), v0.data());
   if (options.fix_initial) {
-    summary.initial_fix = fix_initial_state(model, data, model.t0, q0, v0);
+    summary.initial_fix = fix_free_initial_values(model, data, model.t0, q0, v0);
     q0 = summary.initial_fix->q;
     v0 = summary.initial_fix->v;
     check_state_or_throw(model, data, model.t0, q0.data(), v0.data());
@@ -457,6 +479,10 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
                                            describe_state(model, bad_event.y.data(), bad_event.y.data() + n));
     }
     if (!output_message.empty()) summary.message = output_message;
+    // A contact point that is not defined there says so, rather than the equations' symptom of it.
+    if (const std::string singular = singular_contact_message(model, data.t, data.q.data(), data.v.data());
+        !singular.empty())
+      summary.message = singular;
     if (summary.message.empty()) summary.message = fmt::format("{} at t = {:.6g}", describe(summary.status), result.t_reached);
   }
   return summary;

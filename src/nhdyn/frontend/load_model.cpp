@@ -16,6 +16,7 @@
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/frontend/describe.hpp"
 #include "nhdyn/symbolic/description.hpp"
+#include "nhdyn/symbolic/rolling_contact.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 
 namespace nhdyn {
@@ -42,6 +43,8 @@ std::vector<std::string> override_sets(const ParameterOverrides& overrides) {
 symbolic::Spec load_spec(const ModelSource& source, const ParameterOverrides& overrides) {
   symbolic::Spec spec = load_model_string(source.text, source.file_name);
   spec.apply_parameter_sets(override_sets(overrides));
+  // The contact points nhdyn added, found again at the parameters set here.
+  if (!overrides.empty()) symbolic::solve_contact_coordinates(spec);
   return spec;
 }
 

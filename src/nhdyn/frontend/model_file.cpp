@@ -186,6 +186,12 @@ class Loader {
     for (symbolic::SpecParameter& p : spec.parameters)
       for (const Parameter& loaded : parameter_values_)
         if (loaded.name == p.name) p.expression = loaded.expression;
+    spec.q0_written = std::move(q0_written_);
+    spec.v0_written = std::move(v0_written_);
+    spec.q0_written.resize(spec.coordinates.size(), false);
+    spec.v0_written.resize(spec.coordinates.size(), false);
+    // The contact points' coordinates nhdyn added (rolling_contact.hpp): found from the rest.
+    symbolic::solve_contact_coordinates(spec);
     return spec;
   }
 
@@ -807,6 +813,10 @@ class Loader {
     const bool any = std::any_of(q0.begin(), q0.end(), [](const InitialValue& v) { return v.given; }) ||
                      std::any_of(v0.begin(), v0.end(), [](const InitialValue& v) { return v.given; });
     if (!any) return;
+    for (std::size_t i = 0; i < coordinates_.size(); ++i) {
+      q0_written_.push_back(q0[i].given);
+      v0_written_.push_back(v0[i].given);
+    }
     // SpecBuilder::initial takes a coordinate's value and velocity with one location. To point at
     // the faulty one, the value is checked first with velocity 0; the second call, which sets both,
     // can then fail only on the velocity (initial() sets, so the second call replaces the first).
@@ -1228,6 +1238,7 @@ class Loader {
   std::vector<std::size_t> line_starts_;  // byte offset of the start of each line, line 1 first
   std::string file_;
   std::vector<std::string> coordinates_;
+  std::vector<bool> q0_written_, v0_written_;  // per coordinate: [initial] wrote its value, its velocity
   std::unordered_map<std::string, int> coordinate_by_name_;  // index into coordinates_ (first of a name)
   std::vector<Parameter> parameter_values_;  // as loaded so far, in file order
   double t0_ = 0.0;

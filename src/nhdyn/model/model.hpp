@@ -71,6 +71,28 @@ struct PlanarPath {
   int y = 1;
 };
 
+// Coordinates a model added for a contact point (a [[contacts]] entry without `coordinates`,
+// docs/derivations/rolling-bodies.md section 10): their initial values are found at the start of a
+// run from the rest of the initial state (analysis/initial_state.hpp, complete_initial_state).
+struct ContactCoordinates {
+  std::string contact;
+  std::string where;             // file:line of the contact
+  std::vector<int> coordinates;  // indices into q
+  std::vector<int> constraints;  // as many position constraints that hold them (indices into constraints)
+};
+
+// A contact whose closed-form point turns singular along a motion (a disk or torus lying flat,
+// docs/derivations/rolling-bodies.md section 2): where a run fails and `measure` (one output, in t
+// and q, reading the parameters: bind it) is below `threshold` there, the run's message is
+// `reason`, naming the contact (analysis/simulation.hpp).
+struct ContactWatch {
+  std::string contact;
+  std::string where;
+  Program measure;
+  double threshold = 0.0;
+  std::string reason;
+};
+
 struct Model {
   std::string name;
   std::string description;
@@ -84,6 +106,10 @@ struct Model {
   double t0 = 0.0;
   Vector q0;                             // n, initial coordinates
   Vector v0;                             // n, initial velocities
+  // Which initial values the model file wrote (n each, or empty: none). --fix-initial keeps them.
+  std::vector<bool> q0_written, v0_written;
+  std::vector<ContactCoordinates> contact_coordinates;  // found at the start of every run
+  std::vector<ContactWatch> contact_watches;            // a failed run looks at them
   SimulationDefaults defaults;
   std::optional<PlanarPath> path;
   // Immutable and bound to the values of `parameters`: Model copies (one per thread) share it

@@ -1113,6 +1113,19 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
     programs.solution = solution.finish();
   }
   compile_program_constraints(spec, derivation, programs, model);
+  model.q0_written = spec.q0_written;
+  model.v0_written = spec.v0_written;
+  for (const SpecContactCoordinates& added : spec.contact_coordinates) {
+    ContactCoordinates c{added.contact, added.where.describe(), added.coordinates, {}};
+    for (const std::string& name : added.constraints)
+      for (int i = 0; i < spec.s(); ++i)
+        if (spec.constraints[static_cast<std::size_t>(i)].name == name) c.constraints.push_back(i);
+    model.contact_coordinates.push_back(std::move(c));
+  }
+  for (const SpecContactWatch& w : spec.contact_watches)
+    model.contact_watches.push_back({w.contact, w.where.describe(),
+                                     compile_expression(spec, w.measure, fmt::format("contact '{}'", w.contact)),
+                                     w.threshold, w.reason});
   model.defaults = spec.defaults;
   if (spec.path)
     model.path = PlanarPath{coordinate_index(spec, spec.path->first, "x"), coordinate_index(spec, spec.path->second, "y")};

@@ -56,6 +56,11 @@ class Disk final : public ContactShape {
     const Vector3 d = rim_direction(nu, v.axis, length);
     return {scale(v.sizes[0], d), v.sizes[0] * length};
   }
+  std::optional<Singularity> singularity(const ShapeValues& v, const Vector3& nu) const override {
+    const GiNaC::ex along = nu[static_cast<std::size_t>(v.axis)];
+    return Singularity{1 - along * along, "the disk lies flat: its axle is along the ground's normal, where every point of "
+                                          "its rim is lowest and the contact point is not defined"};
+  }
   std::optional<VisualKind> drawing() const override { return VisualKind::wheel; }
 };
 
@@ -72,6 +77,11 @@ class Torus final : public ContactShape {
     GiNaC::ex length;
     const Vector3 d = rim_direction(nu, v.axis, length);
     return {subtract(scale(v.sizes[0], d), scale(v.sizes[1], nu)), v.sizes[0] * length + v.sizes[1]};
+  }
+  std::optional<Singularity> singularity(const ShapeValues& v, const Vector3& nu) const override {
+    const GiNaC::ex along = nu[static_cast<std::size_t>(v.axis)];
+    return Singularity{1 - along * along, "the torus lies flat: its axle is along the ground's normal, where every point of "
+                                          "its rim is lowest and the contact point is not defined"};
   }
   GiNaC::ex length(const ShapeValues& v) const override { return v.sizes[0] + v.sizes[1]; }
   std::optional<VisualKind> drawing() const override { return VisualKind::wheel; }

@@ -28,6 +28,7 @@ struct ShapeValues {
   GiNaC::ex surface = 0;
   Vector3 point = {0, 0, 0};
   std::array<int, 3> at = {-1, -1, -1};
+  bool added = false;  // those coordinates were added by nhdyn (no `coordinates` key), not the user's
 };
 
 // The support mapping at the unit direction nu (body axes): the shape's point lowest along nu,
@@ -60,6 +61,15 @@ class ContactShape {
   virtual std::optional<GiNaC::ex> ball_radius(const ShapeValues&) const { return std::nullopt; }
   // The size of the shape for the moment rows of the contact-force solve (a length).
   virtual GiNaC::ex length(const ShapeValues& values) const { return values.sizes.front(); }
+  // Where the closed-form contact point is singular along the motion: a measure that is positive
+  // where it is defined and 0 where it is not (a disk or torus lying flat: 1 - (e . nu)^2, e its
+  // axle), with the reason for the message that ends a run there; nothing for a shape whose
+  // contact point is defined for every nu (docs/derivations/rolling-bodies.md section 2).
+  struct Singularity {
+    GiNaC::ex measure;
+    std::string reason;
+  };
+  virtual std::optional<Singularity> singularity(const ShapeValues&, const Vector3&) const { return std::nullopt; }
   // How the scene draws it (a ball of its radius, a wheel about its axis), or nothing yet (the
   // body's ellipsoid of inertia is drawn in any case).
   virtual std::optional<VisualKind> drawing() const { return std::nullopt; }

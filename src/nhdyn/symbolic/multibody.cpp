@@ -655,6 +655,10 @@ MultibodyBuilder& MultibodyBuilder::contact(const ContactText& text) {
   parsers.body = [this](const std::string& name, const SourceLocation& where, const std::string& context) {
     return body_index(name, where, context);
   };
+  parsers.add_coordinate = [this](const std::string& name, const SourceLocation& where) {
+    builder_.coordinate(name, where);
+    return builder_.current().n() - 1;
+  };
   Helper h;
   h.kind = Helper::Kind::contact;
   h.name = text.name;
@@ -688,6 +692,8 @@ void MultibodyBuilder::add_contact(const Helper& h) {
     }
   }
   if (contact.convexity) builder_.convexity(std::move(*contact.convexity));
+  if (contact.added) builder_.contact_coordinates(std::move(*contact.added));
+  if (contact.watch) builder_.contact_watch(std::move(*contact.watch));
   contact.force.system = system_of(body.frame);
   contacts_.push_back(std::move(contact.force));
   if (h.mode) {

@@ -7,8 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <limits>
 #include <sstream>
 
+#include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/core/suggest.hpp"
 #include "nhdyn/symbolic/multibody.hpp"
@@ -130,6 +132,36 @@ std::vector<int> contact_coordinates(const std::string& names, std::size_t count
       throw_model_error(where, context,
                         fmt::format("the contact point needs {} different coordinates; '{}' is named twice", count, name));
     out.push_back(index);
+  }
+  return out;
+}
+
+// The coordinates that hold a contact point: those named by the `coordinates` key, or, without
+// it, new ones that nhdyn adds, named after the contact (added_contact_coordinates). `added` says
+// which.
+std::vector<int> contact_point_coordinates(const std::string& names, bool terrain, const ContactParsers& p,
+                                           const SourceLocation& where, const std::string& context,
+                                           const std::string& what, const std::string& example, bool& added) {
+  const std::size_t count = terrain ? 2 : 3;
+  added = names.empty() && p.add_coordinate;
+  if (!added) return contact_coordinates(names, count, *p.spec, where, context, what, example);
+  std::vector<int> out;
+  for (const std::string& name : added_contact_coordinates(p.contact, terrain)) {
+    const Spec& spec = *p.spec;
+    std::string taken;
+    if (std::find(spec.coordinates.begin(), spec.coordinates.end(), name) != spec.coordinates.end())
+      taken = "a coordinate";
+    for (const SpecParameter& parameter : spec.parameters)
+      if (parameter.name == name)
+        taken = parameter.where.describe().empty() ? "a parameter"
+                                                   : fmt::format("a parameter (declared at {})", parameter.where.describe());
+    if (!taken.empty())
+      throw_model_error(where, context,
+                        fmt::format("nhdyn adds the coordinate '{}' to hold the contact point, but '{}' is already {}; "
+                                    "rename the contact or that symbol, or name the contact point's coordinates "
+                                    "yourself, e.g. {}",
+                                    name, name, taken, example));
+    out.push_back(p.add_coordinate(name, where));
   }
   return out;
 }
@@ -318,8 +350,8 @@ class TerrainGround final : public ContactGround {
                                       "and its derivatives must exist everywhere the body rolls; write a smooth "
                                       "height, e.g. sqrt(X^2 + eps^2) for |X|",
                                       written));
-    const std::vector<int> at = contact_coordinates(contact_option_of(text.options, "coordinates", ""), 2, spec,
-                                                    text.where, context, "a terrain", example());
+    const std::vector<int> at = contact_point_coordinates(contact_option_of(text.options, "coordinates", ""), true, p,
+                                                          text.where, context, "a terrain", example(), out.added);
     out.at = {at[0], at[1]};
     out.height = h.subs(GiNaC::lst{X == spec.symbols.coordinate(out.at[0]), Y == spec.symbols.coordinate(out.at[1])});
   }
@@ -412,9 +444,9 @@ void parse_implicit_shape(const ContactText& text, const ContactParsers& p, cons
                         fmt::format("the surface \"{}\" is not differentiable (it uses abs): its normal and curvature "
                                     "must exist at every point that may touch; write a smooth f",
                                     written));
-  const std::vector<int> at = contact_coordinates(contact_option_of(text.shape_options, "coordinates", ""), 3, spec,
-                                                  text.shape_where, context, "a surface shape",
-                                                  find_contact_shape("surface")->example());
+  const std::vector<int> at = contact_point_coordinates(contact_option_of(text.shape_options, "coordinates", ""), false,
+                                                        p, text.shape_where, context, "a surface shape",
+                                                        find_contact_shape("surface")->example(), out.added);
   for (std::size_t i = 0; i < 3; ++i) {
     out.at[i] = at[i];
     out.point[i] = spec.symbols.coordinate(at[i]);
@@ -424,7 +456,9 @@ void parse_implicit_shape(const ContactText& text, const ContactParsers& p, cons
 
 }  // namespace
 
-ParsedContact parse_contact(const ContactText& text, const ContactParsers& p) {
+ParsedContact parse_contact(const ContactText& text, const ContactParsers& parsers) {
+  ContactParsers p = parsers;
+  p.contact = text.name;
   const std::string context = fmt::format("contact '{}'", text.name);
   ParsedContact out;
   out.name = text.name;
@@ -570,6 +604,37 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
     check.ground = touch.curvature;
     out.convexity = std::move(check);
   }
+  // 1 - (e . nu)^2 below 1e-4: the axle within 0.6 degree of the normal (rolling-bodies.md section 2).
+  if (const std::optional<ContactShape::Singularity> singular =
+          c.shape->singularity(c.values, multiply_transposed(F.rotation, touch.normal)))
+    out.watch = SpecContactWatch{c.name, c.where, singular->measure, 1e-4, singular->reason};
+  if (c.ground.added || c.values.added) {
+    // Where Newton starts (rolling-bodies.md section 10): on a terrain below the centre; an
+    // implicit shape's point on its surface along -nu from its centre.
+    SpecContactCoordinates added;
+    added.contact = c.name;
+    added.where = c.where;
+    if (c.ground.added) {
+      const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
+      for (std::size_t i = 0; i < 2; ++i) {
+        added.coordinates.push_back(c.ground.at[i]);
+        added.constraints.push_back(fmt::format("{}_at{}", c.name, i + 1));
+        added.start.push_back(C[i]);
+      }
+    }
+    if (c.values.added) {
+      const Vector3 down = multiply_transposed(F.rotation, scale(-1, touch.normal));
+      for (std::size_t i = 0; i < 3; ++i) {
+        added.coordinates.push_back(c.values.at[i]);
+        added.start.push_back(0);
+        added.ray.push_back(down[i]);
+      }
+      for (const char* suffix : {"_on", "_normal1", "_normal2"}) added.constraints.push_back(c.name + suffix);
+      added.surface = c.values.surface;
+      added.point = c.values.at;
+    }
+    out.added = std::move(added);
+  }
   ContactPoint& f = out.force;
   f.name = c.name;
   f.kind = ContactKind::rolling;
@@ -640,6 +705,170 @@ void check_contact_convexity(const Spec& spec) {
           "ground's are {:.6g} and {:.6g} (both must be positive). Use a more curved shape, a smoother ground, or start "
           "where the ground's hollow is shallower",
           own(0), own(1), relative(0), relative(1)));
+  }
+}
+
+}  // namespace nhdyn::symbolic
+
+namespace nhdyn::symbolic {
+
+std::vector<std::string> added_contact_coordinates(const std::string& contact, bool terrain) {
+  if (terrain) return {contact + "_u", contact + "_v"};
+  return {contact + "_px", contact + "_py", contact + "_pz"};
+}
+
+namespace {
+
+// A numeric value, NaN when `e` is not a finite real number once everything is substituted.
+double contact_value(const GiNaC::ex& e, const GiNaC::exmap& at) {
+  try {
+    const GiNaC::ex x = e.subs(at, GiNaC::subs_options::no_pattern).evalf();
+    if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real())
+      return std::numeric_limits<double>::quiet_NaN();
+    return GiNaC::ex_to<GiNaC::numeric>(x).to_double();
+  } catch (const std::exception&) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+// The point where the ray s d (s > 0) from the shape's centre leaves f < 0; NaN when f(0) is not
+// negative or f stays negative out to a huge distance.
+double ray_exit(const GiNaC::ex& f, const std::array<GiNaC::ex, 3>& y, const Eigen::Vector3d& d, GiNaC::exmap at) {
+  const auto value = [&](double s) {
+    for (int i = 0; i < 3; ++i) at[y[static_cast<std::size_t>(i)]] = GiNaC::numeric(s * d(i));
+    return contact_value(f, at);
+  };
+  if (!(value(0.0) < 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  double low = 0.0, high = 1e-6;
+  while (!(value(high) >= 0.0)) {
+    low = high;
+    high *= 2.0;
+    if (high > 1e12) return std::numeric_limits<double>::quiet_NaN();
+  }
+  for (int k = 0; k < 200 && high - low > 1e-15 * high; ++k) {
+    const double middle = 0.5 * (low + high);
+    (value(middle) < 0.0 ? low : high) = middle;
+  }
+  return 0.5 * (low + high);
+}
+
+const SpecConstraint& constraint_named(const Spec& spec, const std::string& name) {
+  for (const SpecConstraint& c : spec.constraints)
+    if (c.name == name) return c;
+  throw ModelError(fmt::format("model '{}': no constraint '{}' holds a contact point's coordinates", spec.name, name));
+}
+
+}  // namespace
+
+void solve_contact_coordinates(Spec& spec) {
+  if (spec.contact_coordinates.empty()) return;
+  const GiNaC::lst parameters = spec.parameter_values();
+  for (const SpecContactCoordinates& added : spec.contact_coordinates) {
+    const std::string context = fmt::format("contact '{}'", added.contact);
+    const auto k = static_cast<Eigen::Index>(added.coordinates.size());
+    std::vector<bool> unknown(spec.coordinates.size(), false);
+    for (int i : added.coordinates) unknown[static_cast<std::size_t>(i)] = true;
+    // Everything else at its initial value (numbers: the parameters substituted).
+    GiNaC::exmap at;
+    for (const GiNaC::ex& p : parameters) at[p.op(0)] = p.op(1);
+    at[spec.symbols.time()] = GiNaC::numeric(spec.t0);
+    for (std::size_t i = 0; i < spec.coordinates.size(); ++i)
+      if (!unknown[i]) {
+        const double q = contact_value(spec.q0[i].subs(parameters), at);
+        at[spec.symbols.coordinate(static_cast<int>(i))] = GiNaC::numeric(q);
+      }
+    // The start: a terrain's point below the centre, then the shape's point along -nu.
+    Eigen::VectorXd x(k);
+    std::size_t ray_from = added.coordinates.size();
+    if (!added.ray.empty()) ray_from -= 3;
+    for (std::size_t j = 0; j < ray_from; ++j) {
+      x(static_cast<Eigen::Index>(j)) = contact_value(added.start[j], at);
+      at[spec.symbols.coordinate(added.coordinates[j])] = GiNaC::numeric(x(static_cast<Eigen::Index>(j)));
+    }
+    if (!added.ray.empty()) {
+      Eigen::Vector3d d;
+      for (int i = 0; i < 3; ++i) d(i) = contact_value(added.ray[static_cast<std::size_t>(i)], at);
+      std::array<GiNaC::ex, 3> y;
+      for (std::size_t i = 0; i < 3; ++i) y[i] = spec.symbols.coordinate(added.point[i]);
+      const double s = d.allFinite() && d.norm() > 0 ? ray_exit(added.surface, y, d.normalized(), at)
+                                                       : std::numeric_limits<double>::quiet_NaN();
+      if (!std::isfinite(s))
+        throw_model_error(added.where, context,
+                          "cannot find the contact point at the start: the shape's surface f = 0 must enclose its "
+                          "centre (f < 0 there) and cross the line from it toward the ground; check the surface's "
+                          "sign (f < 0 inside) and the body's initial orientation, or name the contact point's "
+                          "coordinates and give their initial values");
+      for (std::size_t i = 0; i < 3; ++i) x(static_cast<Eigen::Index>(ray_from + i)) = s * d.normalized()(static_cast<Eigen::Index>(i));
+    }
+    // Newton on the rows that hold them, the Jacobian exact.
+    std::vector<GiNaC::ex> rows;
+    for (const std::string& name : added.constraints) rows.push_back(constraint_named(spec, name).expression);
+    const auto symbol = [&](std::size_t j) { return GiNaC::ex_to<GiNaC::symbol>(spec.symbols.coordinate(added.coordinates[j])); };
+    std::vector<std::vector<GiNaC::ex>> jacobian(rows.size());
+    for (std::size_t r = 0; r < rows.size(); ++r)
+      for (std::size_t j = 0; j < added.coordinates.size(); ++j) jacobian[r].push_back(rows[r].diff(symbol(j)));
+    const auto set_x = [&] {
+      for (std::size_t j = 0; j < added.coordinates.size(); ++j)
+        at[spec.symbols.coordinate(added.coordinates[j])] = GiNaC::numeric(x(static_cast<Eigen::Index>(j)));
+    };
+    Eigen::VectorXd r(static_cast<Eigen::Index>(rows.size()));
+    const auto residual = [&] {
+      set_x();
+      for (std::size_t i = 0; i < rows.size(); ++i) r(static_cast<Eigen::Index>(i)) = contact_value(rows[i], at);
+      return r.allFinite() ? r.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+    };
+    double worst = residual();
+    for (int iteration = 0; iteration < 50 && worst > 0.0 && std::isfinite(worst); ++iteration) {
+      Eigen::MatrixXd J(r.size(), k);
+      for (std::size_t i = 0; i < rows.size(); ++i)
+        for (std::size_t j = 0; j < added.coordinates.size(); ++j)
+          J(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = contact_value(jacobian[i][j], at);
+      if (!J.allFinite()) break;
+      const Eigen::FullPivLU<Eigen::MatrixXd> lu(J);
+      if (!lu.isInvertible()) break;
+      const Eigen::VectorXd step = lu.solve(-r);
+      x += step;
+      worst = residual();
+      if (step.cwiseAbs().maxCoeff() <= 4 * std::numeric_limits<double>::epsilon() * (1.0 + x.cwiseAbs().maxCoeff()))
+        break;
+    }
+    if (!(worst <= 1e-10)) {
+      Eigen::Index row = 0;
+      if (r.allFinite()) r.cwiseAbs().maxCoeff(&row);
+      throw_model_error(added.where, context,
+                        fmt::format("cannot find the contact point at the start: Newton's method on the constraints "
+                                    "that hold it ({}) stops with '{}' at the residual {:.3g}; the body may be too far "
+                                    "from the ground, or its shape not convex there. Start the body on the ground, or "
+                                    "name the contact point's coordinates and give their initial values",
+                                    join(added.constraints), added.constraints[static_cast<std::size_t>(row)],
+                                    r.allFinite() ? r(row) : std::numeric_limits<double>::infinity()));
+    }
+    for (std::size_t j = 0; j < added.coordinates.size(); ++j)
+      spec.q0[static_cast<std::size_t>(added.coordinates[j])] = GiNaC::numeric(x(static_cast<Eigen::Index>(j)));
+    // Velocities: d/dt row = sum_i (d row / d q_i) q_i' + d row / dt = 0, linear in the unknown ones.
+    Eigen::MatrixXd J(r.size(), k);
+    Eigen::VectorXd known = Eigen::VectorXd::Zero(r.size());
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const auto ii = static_cast<Eigen::Index>(i);
+      for (std::size_t j = 0; j < added.coordinates.size(); ++j)
+        J(ii, static_cast<Eigen::Index>(j)) = contact_value(jacobian[i][j], at);
+      known(ii) = contact_value(rows[i].diff(spec.symbols.time()), at);
+      for (std::size_t q = 0; q < spec.coordinates.size(); ++q) {
+        if (unknown[q]) continue;
+        const GiNaC::ex partial = rows[i].diff(GiNaC::ex_to<GiNaC::symbol>(spec.symbols.coordinate(static_cast<int>(q))));
+        if (partial.is_zero()) continue;
+        known(ii) += contact_value(partial, at) * contact_value(spec.v0[q].subs(parameters), at);
+      }
+    }
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu(J);
+    const Eigen::VectorXd v = lu.solve(-known);
+    if (!lu.isInvertible() || !v.allFinite())
+      throw_model_error(added.where, context,
+                        fmt::format("the constraints that hold the contact point ({}) do not fix its velocity at the "
+                                    "start: the contact is not unique there (the shape as flat as the ground)",
+                                    join(added.constraints)));
+    for (std::size_t j = 0; j < added.coordinates.size(); ++j)
+      spec.v0[static_cast<std::size_t>(added.coordinates[j])] = GiNaC::numeric(v(static_cast<Eigen::Index>(j)));
   }
 }
 

@@ -66,6 +66,7 @@ struct ParsedGround {
   bool inside = false;              // surface: the body is inside the sphere (a bowl)
   std::array<int, 2> at = {-1, -1};  // terrain: the coordinates holding the contact point's X and Y
   GiNaC::ex height = 0;             // terrain: h(X, Y) at X, Y = those coordinates
+  bool added = false;               // terrain: those coordinates were added by nhdyn (no `coordinates` key)
   SourceLocation where;
 };
 
@@ -95,6 +96,10 @@ struct ContactParsers {
       surface;
   // The index of a body, or a failure listing the bodies.
   std::function<int(const std::string& name, const SourceLocation& where, const std::string& context)> body;
+  // Adds a coordinate to the model (a contact point's, when the contact names none) and returns
+  // its index; unset where coordinates may not be added.
+  std::function<int(const std::string& name, const SourceLocation& where)> add_coordinate;
+  std::string contact;  // the contact's name, set by parse_contact (the added coordinates' prefix)
 };
 
 // What one contact adds to the model.
@@ -114,6 +119,10 @@ struct RollingContact {
   GiNaC::ex length;               // a length of the shape, for the moment rows
   Vector3 normal, tangent1, tangent2;  // world: the ground's normal and the no-slip rows' directions
   std::optional<SpecConvexity> convexity;  // an implicit shape: checked at the initial state
+  // The contact point's coordinates that nhdyn added (no `coordinates` key): found at the start.
+  std::optional<SpecContactCoordinates> added;
+  // A closed form that turns singular along the motion (a disk lying flat): watched by the run.
+  std::optional<SpecContactWatch> watch;
 };
 
 // A ground type: its key, the further keys of its table, and where a shape touches it.
@@ -166,5 +175,18 @@ RollingContact make_rolling_contact(const ParsedContact& contact, const PlacedFr
 // curvatures found and what to do (docs/derivations/rolling-bodies.md section 9). States where
 // the expressions do not evaluate to finite reals are left to the other checks.
 void check_contact_convexity(const Spec& spec);
+
+// The names nhdyn gives a contact point's coordinates when the contact names none: NAME_px,
+// NAME_py, NAME_pz for an implicit shape's point (body axes), NAME_u, NAME_v for a terrain's.
+std::vector<std::string> added_contact_coordinates(const std::string& contact, bool terrain);
+
+// Sets spec.q0 and spec.v0 of the coordinates nhdyn added for contact points
+// (spec.contact_coordinates) from the rest of the initial state, at spec.t0 and the parameter
+// values: Newton's method on the position constraints that hold them, started on the shape's
+// surface below its centre (docs/derivations/rolling-bodies.md section 10); then their velocities
+// from those constraints' time derivatives, which are linear in them. Throws ModelError naming the
+// contact, where it was written, the constraint left unsatisfied and its residual, when Newton
+// does not converge or the start does not define them (the shape's centre outside it).
+void solve_contact_coordinates(Spec& spec);
 
 }  // namespace nhdyn::symbolic

@@ -8,6 +8,7 @@
 
 #include <ginac/ginac.h>
 
+#include <array>
 #include <map>
 #include <memory>
 #include <optional>
@@ -128,6 +129,36 @@ struct SpecConvexity {
   GiNaC::matrix ground = GiNaC::matrix(3, 3);     // zero for a plane
 };
 
+// Coordinates that the multibody front end added for a contact point ([[contacts]] without
+// `coordinates`, docs/derivations/rolling-bodies.md section 10): nobody writes their initial values;
+// nhdyn finds them from the rest of the initial state by solving the position constraints that
+// hold them (Newton, solve_contact_coordinates in rolling_contact.hpp), and their velocities from
+// those constraints' time derivatives.
+struct SpecContactCoordinates {
+  std::string contact;
+  SourceLocation where;
+  std::vector<int> coordinates;          // the added coordinates' indices
+  std::vector<std::string> constraints;  // as many position constraints that hold them
+  // Where Newton starts: one expression per coordinate in t, q and the parameters (a terrain's
+  // u, v: the centre's X, Y). For an implicit shape's point y, 0 here and `ray` below.
+  std::vector<GiNaC::ex> start;
+  // An implicit shape f(y) = 0: y starts on the ray from its centre along `ray` (body axes, in t,
+  // q), where f changes sign; `surface` is f in the three coordinates (empty ray when none).
+  std::vector<GiNaC::ex> ray;
+  GiNaC::ex surface = 0;
+  std::array<int, 3> point = {-1, -1, -1};  // the coordinates of y, when the ray is given
+};
+
+// A closed-form contact point that turns singular along the motion (a disk lying flat): a run
+// stops where `measure` (in t, q) falls below `threshold`, with `reason` (rolling_contact.hpp).
+struct SpecContactWatch {
+  std::string contact;
+  SourceLocation where;
+  GiNaC::ex measure;
+  double threshold = 0.0;
+  std::string reason;
+};
+
 struct Spec {
   std::string name;
   std::string description;
@@ -145,6 +176,11 @@ struct Spec {
   SourceLocation complement_where;
   double t0 = 0.0;
   std::vector<GiNaC::ex> q0, v0;             // n initial values, expressions in the parameters
+  // Which of them the model file's [initial] wrote (n each; empty: none, as in a model built in
+  // C++). --fix-initial keeps those and moves the others (analysis/initial_state.hpp).
+  std::vector<bool> q0_written, v0_written;
+  std::vector<SpecContactCoordinates> contact_coordinates;  // found at the start, not written
+  std::vector<SpecContactWatch> contact_watches;  // checked where a run fails (model.hpp)
   // Optional exact motion q(t) from the initial state, n expressions in t and the parameters
   // (empty when the model gives none); compare --reference analytic measures runs against it.
   std::vector<GiNaC::ex> solution;

@@ -1140,11 +1140,20 @@ Spec SpecBuilder::build() const {
            fmt::format("D is {} x {} but must be k x n = {} x {} (k = n - s = {} - {})", D.rows(), D.cols(), k, n, n,
                        s));
   }
-  const auto given = static_cast<std::size_t>(std::count(initial_given_.begin(), initial_given_.end(), true));
-  if (given != 0 && given != initial_given_.size()) {
+  // A contact point's added coordinates are found at the start, never written.
+  std::vector<bool> found(initial_given_.size(), false);
+  for (const SpecContactCoordinates& added : spec_.contact_coordinates)
+    for (int i : added.coordinates) found[static_cast<std::size_t>(i)] = true;
+  std::size_t given = 0, writable = 0;
+  for (std::size_t i = 0; i < initial_given_.size(); ++i)
+    if (!found[i]) {
+      ++writable;
+      if (initial_given_[i]) ++given;
+    }
+  if (given != 0 && given != writable) {
     std::vector<std::string> missing;
     for (std::size_t i = 0; i < initial_given_.size(); ++i)
-      if (!initial_given_[i]) missing.push_back(spec_.coordinates[i]);
+      if (!initial_given_[i] && !found[i]) missing.push_back(spec_.coordinates[i]);
     fail(spec_.where, context,
          fmt::format("initial values are given for some coordinates but not for {}: give all or none "
                      "(none means all zero)",

@@ -86,6 +86,17 @@ class SpecBuilder {
     spec_.convexity.push_back(std::move(check));
     return *this;
   }
+  // Coordinates a front end added for a contact point, found at the start rather than written
+  // (spec.hpp, SpecContactCoordinates): build() does not ask for their initial values.
+  SpecBuilder& contact_coordinates(SpecContactCoordinates added) {
+    spec_.contact_coordinates.push_back(std::move(added));
+    return *this;
+  }
+  // A contact whose closed-form point may turn singular along the motion (spec.hpp).
+  SpecBuilder& contact_watch(SpecContactWatch watch) {
+    spec_.contact_watches.push_back(std::move(watch));
+    return *this;
+  }
   // Derived outputs (docs/model-format.md, [outputs]; symbolic/outputs.hpp): a named expression
   // in t, q, q', q'', the reactions R_x, the parameters and the outputs declared before it, that
   // becomes a column of the results. Its name must be a new name (not a coordinate, parameter,

@@ -1,0 +1,75 @@
+// A closed-form contact point that turns singular along the run (docs/multibody.md, "Rolling
+// bodies"): a thin disk released leaning far falls flat, where its contact point (the lowest point
+// of the rim) is not defined. The run stops there with exit code 1 and a message naming the
+// contact, the time and the reason; the rows before are in the partial file, with no NaN.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "nhdyn/io/csv.hpp"
+#include "support/cli_run.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kFallingDisk = R"toml(name = "disk-falling-flat"
+coordinates = ["x", "y", "z", "psi", "theta", "phi"]
+gravity = [0, 0, "-g"]
+
+[parameters]
+m = 0.5
+r = 0.2
+g = 9.81
+theta0 = 1.2
+
+[[frames]]
+name = "disk"
+translation = ["x", "y", "z"]
+rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
+
+[[bodies]]
+name = "disk"
+frame = "disk"
+mass = "m"
+inertia = ["m*r^2/4", "m*r^2/2", "m*r^2/4"]
+
+[[contacts]]
+name = "wheel"
+body = "disk"
+shape = { disk = "r", axis = "y" }
+
+[initial]
+position = { x = 0, y = 0, z = "r*cos(theta0)", psi = 0, theta = "theta0", phi = 0 }
+
+[simulation]
+t_end = 1
+output_step = 0.01
+)toml";
+
+TEST(RollingSingularCli, DiskFallingFlatStopsNamingTheContact) {
+  const fs::path dir = fs::temp_directory_path() / "nhdyn_rolling_flat";
+  fs::create_directories(dir);
+  fs::remove(dir / "o.csv");
+  fs::remove(dir / "o.partial.csv");
+  std::ofstream(dir / "flat.toml") << kFallingDisk;
+  const nhdyn::test::CliOutcome outcome = nhdyn::test::run_nhdyn("simulate flat.toml -o o.csv", dir);
+  EXPECT_EQ(outcome.exit_code, 1) << outcome.out;
+  EXPECT_NE(outcome.out.find("flat.toml:22:1: contact 'wheel': the disk lies flat"), std::string::npos) << outcome.out;
+  EXPECT_NE(outcome.out.find("its axle is along the ground's normal"), std::string::npos) << outcome.out;
+  EXPECT_NE(outcome.out.find("at t = 0.14"), std::string::npos) << outcome.out;
+  EXPECT_EQ(outcome.out.find("not a complement"), std::string::npos) << outcome.out;  // not the equations' symptom
+  EXPECT_FALSE(fs::exists(dir / "o.csv"));
+  const nhdyn::CsvTable partial = nhdyn::load_csv(dir / "o.partial.csv");
+  ASSERT_GE(partial.rows.size(), 10u);
+  const int theta = partial.column("theta");
+  for (const auto& row : partial.rows)
+    for (const double value : row) EXPECT_TRUE(std::isfinite(value));
+  // Falling: the lean grows toward pi/2 (flat) and the last row is close to it.
+  EXPECT_GT(partial.rows.back()[static_cast<std::size_t>(theta)], 1.5);
+}
+
+}  // namespace
