@@ -543,3 +543,21 @@ TEST_F(Hardening, ExtremeParameterMagnitudesAreNotSingular) {
 }
 
 }  // namespace
+
+namespace {
+
+// A name near the file system's limit failed: the temporary's name is 12 bytes longer.
+TEST_F(Hardening, NamesNearTheFileSystemLimitAreWritten) {
+  write("osc.toml", kOscillator);
+  const std::string longest = std::string(251, 'a') + ".csv";  // 255 bytes: NAME_MAX on ext4, tmpfs
+  const ProcessRun r = nhdyn({"simulate", "osc.toml", "--t-end", "0.1", "-q", "-o", longest});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / longest));
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_FALSE(contains(entry.path().filename().string(), ".tmp.")) << entry.path();
+  const ProcessRun over = nhdyn({"simulate", "osc.toml", "--t-end", "0.1", "-q", "-o", "b" + longest});
+  EXPECT_EQ(over.code, 2);
+  EXPECT_TRUE(contains(over.err, "above the file system's limit of 255")) << over.err;
+}
+
+}  // namespace
