@@ -3,12 +3,15 @@
 // paths) happens before the first step, so a bad option never costs a run.
 #include <fmt/format.h>
 
+#include <cctype>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <iterator>
 #include <memory>
 #include <optional>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "commands.hpp"
@@ -64,23 +67,31 @@ struct SimulateArgs {
   std::optional<long> max_steps;       // the integrator's step budget (default IntegratorOptions)
 };
 
-// --program-feedback alpha,beta: two non-negative rates [1/s].
+// --program-feedback alpha,beta: two non-negative rates [1/s], each a plain decimal number (no
+// hexadecimal, no nan or inf, no spaces), at most kMaxProgramFeedback (program_feedback.hpp).
 ProgramFeedback parse_program_feedback(const std::string& text) {
   ProgramFeedback out;
   if (text.empty()) return out;
   const std::size_t comma = text.find(',');
   const auto number = [&](const std::string& part, const char* name) {
-    std::size_t used = 0;
+    const auto fail = [&](const std::string& why) -> double {
+      throw InputError(fmt::format("--program-feedback {}: the gain {} '{}' {}; give two rates in 1/s as alpha,beta "
+                                   "(e.g. --program-feedback 10,10)",
+                                   text, name, part, why));
+    };
+    // Digits, one point, one exponent: std::from_chars alone would read 0x10 as 0 and take nan and inf.
+    const bool plain = !part.empty() && part.find_first_not_of("0123456789.eE+-") == std::string::npos &&
+                       (std::isdigit(static_cast<unsigned char>(part[0])) || part[0] == '.' || part[0] == '+' ||
+                        part[0] == '-');
+    if (!plain) return fail("is not a decimal number");
+    const char* begin = part.data() + (part[0] == '+' ? 1 : 0);
     double value = 0.0;
-    try {
-      value = std::stod(part, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != part.size())
-      throw InputError(fmt::format("--program-feedback {}: the gain {} '{}' is not a number; give two rates in 1/s "
-                                   "as alpha,beta (e.g. --program-feedback 10,10)",
-                                   text, name, part));
+    const std::from_chars_result read = std::from_chars(begin, part.data() + part.size(), value);
+    if (read.ec == std::errc::result_out_of_range)
+      return fail(part.find("e-") != std::string::npos || part.find("E-") != std::string::npos
+                      ? "is below the smallest double (about 1e-308): give 0 for no feedback on that level"
+                      : "is beyond the largest double");
+    if (read.ec != std::errc() || read.ptr != part.data() + part.size()) return fail("is not a decimal number");
     return value;
   };
   if (comma == std::string::npos || text.find(',', comma + 1) != std::string::npos)
@@ -254,6 +265,7 @@ int run_simulate(const SimulateArgs& args) {
   progress.finish();
   // The constraint watch's warnings (analysis/constraint_watch.hpp), whatever the outcome.
   for (const std::string& w : summary.warnings) fmt::print(stderr, "nhdyn: warning: {}\n", w);
+  for (const std::string& w : summary.unmet_stops) fmt::print(stderr, "nhdyn: warning: {}\n", w);
   if (summary.status != Status::ok) {
     fmt::print(stderr, "nhdyn: simulation of '{}' failed at t = {:.6g}: {}\n", model.name, summary.t_reached,
                summary.message);

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "nhdyn/analysis/contact_switches.hpp"
 #include "nhdyn/analysis/residuals.hpp"
@@ -356,6 +357,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   std::copy(v0.data(), v0.data() + n, y0.begin() + n);
   std::vector<double> y_out(states);
   Status output_failure = Status::ok;
+  double last_row_t = 0.0;  // the time of the last row written, once summary.outputs > 0
   std::string output_message;  // why output_failure, when it is not the dynamics' own failure
   const OutputFn output = [&](double t, const double* y) -> Status {
     if (options.stabilization == Stabilization::projection) {
@@ -409,6 +411,12 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
       hide_start = false;
       return Status::ok;
     }
+    // An event at an output time (or two events at one time) is one row (docs/cli.md, "Events"):
+    // the first written at that t, to round-off, stands for them all; each event keeps its record.
+    if (summary.outputs > 0 && std::abs(t - last_row_t) <= 64.0 * std::numeric_limits<double>::epsilon() *
+                                                              std::max({1.0, std::abs(t), std::abs(last_row_t)}))
+      return Status::ok;
+    last_row_t = t;
     ++summary.outputs;
     row(data);
     return Status::ok;
@@ -456,6 +464,23 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.stopped_by = event_functions.stopped_by();
   // A stop event ends the run as planned.
   if (summary.status == Status::stopped && summary.stopped_by >= 0) summary.status = Status::ok;
+  // A stop condition that never held: most likely a sign or threshold that cannot be met.
+  if (summary.status == Status::ok && summary.stopped_by < 0)
+    for (std::size_t i = 0; i < events.size(); ++i) {
+      const Event& e = *events[i];
+      if (e.action != EventAction::stop) continue;
+      if (std::any_of(summary.events.begin(), summary.events.end(),
+                      [&](const EventRecord& r) { return r.index == static_cast<int>(i) && r.name == e.name; }))
+        continue;
+      // An option quotes its own text ("--stop-when \"x > 2\""); a file's event is named at its place.
+      const bool option = e.where.starts_with("--") && e.where.find(e.expression) != std::string::npos;
+      const std::string what = option ? "the stop condition " + e.where
+                                      : fmt::format("{}the stop event '{}' ({})", e.where.empty() ? "" : e.where + ": ",
+                                                    e.name, e.expression);
+      summary.unmet_stops.push_back(fmt::format(
+          "{} never {} between t = {:g} and t = {:g}: the run went to the end; check its sign, direction or threshold",
+          what, e.condition ? "became true" : "crossed zero in its direction", model.t0, result.t_reached));
+    }
   summary.t_reached = result.t_reached;
   summary.sparse = data.sparse;
   summary.partition_changes = data.partition_changes;

@@ -122,6 +122,9 @@ struct SimulationSummary {
   // the number of states watched.
   std::vector<ConstraintWarning> constraint_warnings;
   std::vector<std::string> warnings;
+  // A stop condition (--stop-when, an event with action "stop") that never held on a run that
+  // reached its end: one sentence each, naming it (docs/cli.md, "Events").
+  std::vector<std::string> unmet_stops;
   double largest_row_factor = 1.0;
   double largest_condition_factor = 1.0;
   long watched_states = 0;

@@ -13,7 +13,13 @@ struct ProgramFeedback {
   double beta = 0.0;   // [1/s], stiffness of the position-level program residual
 };
 
-// Throws InputError unless both gains are finite and non-negative, naming the gain and value.
+// The largest gain accepted [1/s]: a time constant of a nanosecond. Beyond it the feedback makes
+// the motion stiffer than any step can follow, and beta^2 times a residual soon overflows (1e200
+// was accepted and then failed as "divides by zero or overflows").
+inline constexpr double kMaxProgramFeedback = 1e9;
+
+// Throws InputError unless both gains are finite, non-negative and at most kMaxProgramFeedback,
+// naming the gain and value.
 void check_program_feedback(const ProgramFeedback& feedback);
 
 }  // namespace nhdyn

@@ -45,6 +45,12 @@ void check_program_feedback(const ProgramFeedback& feedback) {
       throw InputError(fmt::format("the program feedback gain {} = {} must be finite and non-negative (a rate in "
                                    "1/s, e.g. --program-feedback 10,10)",
                                    name, value));
+    else if (value > kMaxProgramFeedback)
+      throw InputError(fmt::format("the program feedback gain {} = {:g} 1/s is above {:g} 1/s (a time constant under a "
+                                   "nanosecond): the feedback would make the motion stiffer than any step can follow "
+                                   "and its terms overflow; use a rate a few times the model's fastest frequency "
+                                   "(e.g. --program-feedback 10,10)",
+                                   name, value, kMaxProgramFeedback));
 }
 
 Status compute_program_motion(const Model& model, Data& data, Complement complement, const ProgramFeedback& feedback) {

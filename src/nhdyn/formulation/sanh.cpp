@@ -24,6 +24,29 @@ bool lu_is_singular(const Eigen::PartialPivLU<Matrix>& lu) {
   return !(smallest > largest * std::numeric_limits<double>::epsilon() * static_cast<double>(LU.rows()));
 }
 
+bool factor_equilibrated(Matrix& M, Vector& rhs, Eigen::PartialPivLU<Matrix>& lu) {
+  // Rows whose largest entries differ by more than kRowScaleRatio (rows in different units: the rows
+  // D A scale with the masses, the rows b do not, --set m=1e100) are scaled exactly by powers of two
+  // to a largest entry in [0.5, 1) before the factorization, so that the pivots' test is about the
+  // matrix and not its units: a well-posed system is solved, a singular one refused. Systems in
+  // comparable units are factored as they are. Allocates nothing.
+  double smallest_row = std::numeric_limits<double>::infinity(), largest_row = 0.0;
+  for (Eigen::Index i = 0; i < M.rows(); ++i) {
+    const double row = M.row(i).cwiseAbs().maxCoeff();
+    smallest_row = std::min(smallest_row, row);
+    largest_row = std::max(largest_row, row);
+  }
+  if (smallest_row > 0.0 && std::isfinite(largest_row) && largest_row > kRowScaleRatio * smallest_row)
+    for (Eigen::Index i = 0; i < M.rows(); ++i) {
+      int exponent = 0;
+      std::frexp(M.row(i).cwiseAbs().maxCoeff(), &exponent);
+      M.row(i) *= std::ldexp(1.0, -exponent);
+      rhs(i) = std::ldexp(rhs(i), -exponent);
+    }
+  lu.compute(M);
+  return !lu_is_singular(lu);
+}
+
 Status compute_sanh_acceleration(const Model& model, Data& data, Complement complement) {
   const int k = model.k();
   const int s = model.s();
@@ -40,8 +63,8 @@ Status compute_sanh_acceleration(const Model& model, Data& data, Complement comp
   data.M.bottomRows(s) = data.b;
   data.rhs.head(k).noalias() = data.D * data.h;
   data.rhs.tail(s) = -data.b0;
-  data.lu_n.compute(data.M);
-  if (lu_is_singular(data.lu_n)) return record_failure(data, Status::singular_system, "stacked matrix [D A; b]");
+  if (!factor_equilibrated(data.M, data.rhs, data.lu_n))
+    return record_failure(data, Status::singular_system, "stacked matrix [D A; b]");
   data.qdd = data.lu_n.solve(data.rhs);
   data.R.noalias() = data.A * data.qdd;
   data.R -= data.h;

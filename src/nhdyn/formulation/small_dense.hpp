@@ -19,6 +19,7 @@ namespace nhdyn::small {
 
 inline constexpr int kSmallMaxN = 8;
 inline constexpr double kEps = std::numeric_limits<double>::epsilon();
+inline constexpr double kRowScaleRatio = 67108864.0;  // 2^26, as nhdyn::kRowScaleRatio (sanh.hpp)
 
 // An orthonormal basis of null(b) as the rows of D (k x n): the last k columns of Q in a
 // Householder QR factorization with column pivoting b^T P = Q [R1; 0]. The rank test is that of
@@ -85,9 +86,38 @@ bool null_space_basis(const double* b, double* D) {
   }
 }
 
+// Gaussian elimination with partial pivoting of the N x N matrix M (column-major) and its right-
+// hand side r, in place; false when a pivot is zero or the smallest is round-off of the largest.
+template <int N>
+bool eliminate(std::array<double, N * N>& M, std::array<double, N>& r) {
+  double largest = 0.0;
+  double smallest = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < N; ++c) {
+    int p = c;
+    for (int i = c + 1; i < N; ++i)
+      if (std::abs(M[i + N * c]) > std::abs(M[p + N * c])) p = i;
+    if (p != c) {
+      for (int j = c; j < N; ++j) std::swap(M[c + N * j], M[p + N * j]);
+      std::swap(r[c], r[p]);
+    }
+    const double pivot = M[c + N * c];
+    largest = std::max(largest, std::abs(pivot));
+    smallest = std::min(smallest, std::abs(pivot));
+    if (pivot == 0.0) return false;
+    for (int i = c + 1; i < N; ++i) {
+      // A division, not a product with 1/pivot: a row equal to the pivot row then has l = 1
+      // exactly and cancels to zero, so that dependent rows are found singular as Eigen finds them.
+      const double l = M[i + N * c] / pivot;
+      for (int j = c + 1; j < N; ++j) M[i + N * j] -= l * M[c + N * j];
+      r[i] -= l * r[c];
+    }
+  }
+  return smallest > largest * kEps * N;
+}
+
 // The stacked system [D A; b] q'' = [D h; -b0] with h = Q + G, by Gaussian elimination with
-// partial pivoting, then R = A q'' - h. The singularity test is that of lu_is_singular
-// (sanh.cpp): the smallest pivot against the largest. Returns false when the system is singular.
+// partial pivoting, then R = A q'' - h. The singularity test is that of factor_equilibrated
+// (sanh.hpp): the smallest pivot against the largest, rows in very different units scaled first. Returns false when the system is singular.
 template <int N, int S>
 bool solve_stacked(const double* A, const double* Q, const double* G, const double* b, const double* b0,
                    const double* D, double* h, double* qdd, double* R) {
@@ -109,28 +139,23 @@ bool solve_stacked(const double* A, const double* Q, const double* G, const doub
     for (int c = 0; c < N; ++c) M[K + i + N * c] = b[i + S * c];
     r[K + i] = -b0[i];
   }
-  double largest = 0.0;
-  double smallest = std::numeric_limits<double>::infinity();
-  for (int c = 0; c < N; ++c) {
-    int p = c;
-    for (int i = c + 1; i < N; ++i)
-      if (std::abs(M[i + N * c]) > std::abs(M[p + N * c])) p = i;
-    if (p != c) {
-      for (int j = c; j < N; ++j) std::swap(M[c + N * j], M[p + N * j]);
-      std::swap(r[c], r[p]);
-    }
-    const double pivot = M[c + N * c];
-    largest = std::max(largest, std::abs(pivot));
-    smallest = std::min(smallest, std::abs(pivot));
-    if (pivot == 0.0) return false;
-    const double inverse = 1.0 / pivot;
-    for (int i = c + 1; i < N; ++i) {
-      const double l = M[i + N * c] * inverse;
-      for (int j = c + 1; j < N; ++j) M[i + N * j] -= l * M[c + N * j];
-      r[i] -= l * r[c];
-    }
+  // Rows in very different units scaled first, as factor_equilibrated does (sanh.hpp).
+  double smallest_row = std::numeric_limits<double>::infinity(), largest_row = 0.0;
+  std::array<double, N> row{};
+  for (int i = 0; i < N; ++i) {
+    for (int c = 0; c < N; ++c) row[i] = std::max(row[i], std::abs(M[i + N * c]));
+    smallest_row = std::min(smallest_row, row[i]);
+    largest_row = std::max(largest_row, row[i]);
   }
-  if (!(smallest > largest * kEps * N)) return false;
+  if (smallest_row > 0.0 && std::isfinite(largest_row) && largest_row > kRowScaleRatio * smallest_row)
+    for (int i = 0; i < N; ++i) {
+      int exponent = 0;
+      std::frexp(row[i], &exponent);
+      for (int c = 0; c < N; ++c) M[i + N * c] = std::ldexp(M[i + N * c], -exponent);
+      r[i] = std::ldexp(r[i], -exponent);
+    }
+  const bool regular = eliminate<N>(M, r);
+  if (!regular) return false;
   for (int i = N - 1; i >= 0; --i) {
     double acc = r[i];
     for (int j = i + 1; j < N; ++j) acc -= M[i + N * j] * qdd[j];

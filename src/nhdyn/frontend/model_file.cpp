@@ -533,13 +533,16 @@ class Loader {
   // outputs above it; one result column each, in file order (symbolic/outputs.hpp).
   void load_outputs(const toml::node& node, SpecBuilder& builder) const {
     const toml::table& table = table_of(node, "outputs", "[outputs] followed by energy = \"m/2*x'^2 + m*g*y\"");
+    std::vector<std::pair<std::string, SourceLocation>> names;  // for the message of a forward reference
+    for (const Entry& entry : in_file_order(table)) names.emplace_back(std::string(entry.key->str()), at(*entry.key));
+    builder.announce_outputs(names);
     for (const Entry& entry : in_file_order(table)) {
       check_not_misplaced(*entry.key, "in [outputs]");
       const std::string name(entry.key->str());
       const std::string text =
           expression_string(*entry.value, fmt::format("outputs.{}", name), "energy = \"m/2*x'^2 + m*g*y\"");
       const GiNaC::ex expression =
-          located(*entry.value, [&] { return builder.parse_derived(text, content_at(*entry.value)); });
+          located(*entry.value, [&] { return builder.parse_derived(text, content_at(*entry.value), name); });
       builder.output(name, expression, text, at(*entry.key));
     }
   }

@@ -147,7 +147,19 @@ AtomicFile::AtomicFile(const fs::path& target) : target_(target) {
     throw FileError(fmt::format("cannot write '{}': the directory '{}' does not exist; create it first",
                                 target.string(), dir.string()));
   // fmt rather than operator+ on strings: GCC 12 at -O3 warns falsely (-Wrestrict) on the latter.
-  std::string pattern = (dir / fmt::format(".{}.tmp.XXXXXX", resolved_.filename().string())).string();
+  // The temporary's name is the target's with 12 bytes more: near the file system's limit on a
+  // name (NAME_MAX, 255 on most) the target's is cut for it, so that any name the file system
+  // takes can be written; a target's name beyond the limit is refused in words.
+  const long name_max_read = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  const std::size_t name_max = name_max_read > 0 ? static_cast<std::size_t>(name_max_read) : 255;
+  std::string name = resolved_.filename().string();
+  if (name.size() > name_max)
+    throw FileError(fmt::format("cannot write '{}': its name is {} bytes, above the file system's limit of {}; "
+                                "choose a shorter name",
+                                target.string(), name.size(), name_max));
+  constexpr std::size_t kTemporaryExtra = 12;  // "." + ".tmp.XXXXXX"
+  if (name.size() + kTemporaryExtra > name_max) name.resize(name_max - kTemporaryExtra);
+  std::string pattern = (dir / fmt::format(".{}.tmp.XXXXXX", name)).string();
   const int fd = ::mkstemp(pattern.data());
   if (fd < 0)
     throw FileError(fmt::format("cannot write '{}': {} (check the directory's permissions)", target.string(),

@@ -359,6 +359,40 @@ void append_plots(std::string& data, const CsvTable& table, const std::vector<Pl
   }
 }
 
+// The rule for a [visual] position or rotation that is NaN or infinite at a row the page draws
+// (docs/cli.md, "What bad input gets"): as for a derived output, the item, its expression, t and
+// the state are named, and nothing is drawn (never a null that the page would show as garbage).
+void require_finite_scene(const symbolic::VisualScene& scene, const ReportInput& input,
+                          const std::vector<double>& outputs, double t, const std::vector<double>& q,
+                          const std::vector<double>& v) {
+  for (const symbolic::VisualShape& shape : scene.shapes) {
+    const int count = symbolic::visual_outputs(shape.kind);
+    for (int k = 0; k < count; ++k) {
+      const double x = outputs[static_cast<std::size_t>(shape.offset + k)];
+      if (std::isfinite(x)) continue;
+      std::string state;
+      for (std::size_t i = 0; i < q.size() && i < input.coordinates.size(); ++i)
+        state += fmt::format("{}{} = {:.6g}", i == 0 ? "" : ", ", input.coordinates[i], q[i]);
+      for (std::size_t i = 0; i < v.size() && i < input.coordinates.size(); ++i)
+        state += fmt::format(", {}' = {:.6g}", input.coordinates[i], v[i]);
+      std::string expression = static_cast<std::size_t>(k) < shape.expressions.size()
+                                   ? shape.expressions[static_cast<std::size_t>(k)]
+                                   : std::string("?");
+      if (expression.size() > 200) expression = expression.substr(0, 200) + "...";
+      const bool segment = shape.kind == symbolic::VisualKind::segment;
+      const char* part = segment ? (k < 3 ? "'from'" : "'to'") : k < 3 ? "position" : "rotation";
+      static constexpr const char* kinds[] = {"point", "segment", "wheel", "body", "frame"};
+      throw InputError(fmt::format(
+          "{}{}[visual] {} '{}' of '{}': its {} component {} ({}) is {} at t = {:.6g}, where {}: the scene cannot draw "
+          "it, so the report is not written; write the [visual] expression in a form defined along the motion, or "
+          "end the run before (--t-end, a stop event)",
+          shape.where, shape.where.empty() ? "" : ": ", kinds[static_cast<int>(shape.kind)], shape.name, input.model,
+          part, segment || k < 3 ? k % 3 + 1 : k - 2, expression,
+          std::isnan(x) ? std::string("NaN") : fmt::format("{}", x), t, state));
+    }
+  }
+}
+
 // The scene of a model with shapes: each shape's kind, size and place at every frame drawn (a
 // body along its principal axes).
 void append_scene_shapes(std::string& data, const ReportInput& input, const FrameColumns& column) {
@@ -390,6 +424,7 @@ void append_scene_shapes(std::string& data, const ReportInput& input, const Fram
       v[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(vc[static_cast<std::size_t>(i)])];
     }
     program.run(row[static_cast<std::size_t>(tc)], q.data(), v.data(), registers.data(), outputs.data());
+    require_finite_scene(scene, input, outputs, row[static_cast<std::size_t>(tc)], q, v);
     // A body is drawn along its principal axes: R E, E's columns the axes in the frame's components.
     for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
       if (scene.shapes[s].kind != symbolic::VisualKind::body) continue;

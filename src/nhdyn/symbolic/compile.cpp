@@ -35,6 +35,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/model/program.hpp"
+#include "nhdyn/symbolic/plain_words.hpp"
 #include "nhdyn/symbolic/contact_forces.hpp"
 #include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/events.hpp"
@@ -173,7 +174,7 @@ class ProgramCompiler {
     } catch (const Error&) {
       throw;
     } catch (const std::exception& error) {
-      fail(fmt::format("cannot be evaluated ({})", error.what()));
+      fail(fmt::format("cannot be evaluated: {}", plain_words(error.what())));
     }
     if (form.id == kOne)
       program_.add_constant_output(form.c);
@@ -865,8 +866,8 @@ double initial_value(const Spec& spec, const GiNaC::lst& values, const GiNaC::ex
   try {
     value = e.subs(values, GiNaC::subs_options::no_pattern).evalf();
   } catch (const std::exception& error) {
-    throw ModelError(fmt::format("model '{}': the initial value of {} = {} cannot be evaluated ({})", spec.name,
-                                 what, to_text(e), error.what()));
+    throw ModelError(fmt::format("model '{}': the initial value of {} = {} cannot be evaluated: {}", spec.name,
+                                 what, to_text(e), plain_words(error.what())));
   }
   if (!GiNaC::is_exactly_a<GiNaC::numeric>(value) || !GiNaC::ex_to<GiNaC::numeric>(value).is_real())
     throw ModelError(fmt::format("model '{}': the initial value of {} = {} is not a real number once the "

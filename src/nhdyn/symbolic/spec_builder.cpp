@@ -10,6 +10,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/symbolic/contact_forces.hpp"
 #include "nhdyn/symbolic/occurrence.hpp"
+#include "nhdyn/symbolic/plain_words.hpp"
 #include "nhdyn/core/suggest.hpp"
 
 namespace nhdyn::symbolic {
@@ -274,9 +276,12 @@ class Reader {
  public:
   // `scope`: names beyond the spec's symbols (the reactions and outputs that outputs and events
   // may use, SpecBuilder::parse_derived); null for T, V, constraints and the rest.
+  // `unavailable`: names that are not symbols here and why (an output's own name, the outputs
+  // declared below it: SpecBuilder::parse_derived), said instead of "unknown symbol".
   Reader(const Site& site, const Spec& spec, std::vector<Token> tokens,
-         const std::map<std::string, GiNaC::symbol>* scope = nullptr)
-      : site_(site), spec_(spec), tokens_(std::move(tokens)), scope_(scope) {}
+         const std::map<std::string, GiNaC::symbol>* scope = nullptr,
+         const std::map<std::string, std::string>* unavailable = nullptr)
+      : site_(site), spec_(spec), tokens_(std::move(tokens)), scope_(scope), unavailable_(unavailable) {}
 
   Parsed read() {
     if (tokens_.front().kind == TokenKind::end) site_.fail_at(tokens_.front().begin, "empty expression");
@@ -296,7 +301,7 @@ class Reader {
       GiNaC::parser parser(table, /*strict=*/true);
       parsed.value = parser(out_);
     } catch (const std::exception& e) {
-      site_.fail_at(tokens_.front().begin, fmt::format("cannot parse the expression: {}", e.what()));
+      site_.fail_at(tokens_.front().begin, plain_words(e.what()));
     }
     parsed.symbols = std::move(symbols_);
     parsed.present = symbols_of(parsed.value);
@@ -495,6 +500,10 @@ class Reader {
         const auto found = scope_->find(name);
         if (found != scope_->end()) symbol = found->second;
       }
+      if (!symbol && unavailable_ != nullptr) {
+        const auto why = unavailable_->find(name);
+        if (why != unavailable_->end()) site_.fail_at(token.begin, why->second);
+      }
       if (!symbol) {
         std::vector<std::string> known = {"t", "pi"};
         for (const std::string& c : spec_.coordinates) known.push_back(c);
@@ -543,6 +552,7 @@ class Reader {
   std::string out_;
   std::vector<Occurrence> symbols_;
   const std::map<std::string, GiNaC::symbol>* scope_ = nullptr;
+  const std::map<std::string, std::string>* unavailable_ = nullptr;
 };
 
 // Exponents beyond this make the derivation's expansion explode (a hang, not an answer); no
@@ -610,8 +620,9 @@ std::size_t node_count(const GiNaC::ex& e) {
 constexpr double kLargestExpansion = 1e5;
 
 Parsed read(const Spec& spec, const Site& site, std::size_t begin, std::size_t end,
-            const std::map<std::string, GiNaC::symbol>* scope = nullptr) {
-  Parsed parsed = Reader(site, spec, lex(site, begin, end), scope).read();
+            const std::map<std::string, GiNaC::symbol>* scope = nullptr,
+            const std::map<std::string, std::string>* unavailable = nullptr) {
+  Parsed parsed = Reader(site, spec, lex(site, begin, end), scope, unavailable).read();
   if (has_huge_exponent(parsed.value))
     site.fail_whole(fmt::format("an exponent larger than {} in magnitude; nhdyn expands powers symbolically, "
                                 "so rewrite the expression (e.g. with exp and log) or use a smaller power",
@@ -626,6 +637,25 @@ Parsed read(const Spec& spec, const Site& site, std::size_t begin, std::size_t e
 }
 
 Parsed read(const Spec& spec, const Site& site) { return read(spec, site, 0, site.text.size()); }
+
+// The number of nodes of `e` written out as a tree, each shared subexpression counted as often as
+// it occurs, capped at 1e300; computed once per shared node (GiNaC shares them), so in time linear
+// in the expression's memory. Walks of GiNaC (subs, has, evalf, printing) take time in this count.
+double tree_size(const GiNaC::ex& e, std::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, double>>& seen) {
+  const GiNaC::basic* key = &GiNaC::ex_to<GiNaC::basic>(e);
+  const auto found = seen.find(key);
+  if (found != seen.end()) return found->second.second;
+  double size = 1.0;
+  for (std::size_t i = 0; i < e.nops(); ++i) size = std::min(size + tree_size(e.op(i), seen), 1e300);
+  // The expression is kept with its size: op() of a sum or product may build a temporary, whose
+  // address must not be reused by another one while the table lives.
+  seen.emplace(key, std::make_pair(e, size));
+  return size;
+}
+
+// An output or event with the outputs it names written out: beyond this many nodes, the walks of
+// compiling it take minutes (outputs that each use the one before twice double at every line).
+constexpr double kLargestDerived = 2e5;
 
 // The first occurrence of a symbol of `kind` that the expression still contains (x' - x' does not).
 const Occurrence* first_of(const Parsed& parsed, SymbolKind kind) {
@@ -1070,17 +1100,51 @@ std::map<std::string, GiNaC::symbol> derived_scope(const Spec& spec) {
 
 }  // namespace
 
-GiNaC::ex SpecBuilder::parse_derived(const std::string& text, const SourceLocation& where) const {
+SpecBuilder& SpecBuilder::announce_outputs(std::vector<std::pair<std::string, SourceLocation>> names) {
+  announced_outputs_ = std::move(names);
+  return *this;
+}
+
+GiNaC::ex SpecBuilder::parse_derived(const std::string& text, const SourceLocation& where,
+                                     const std::string& defining) const {
   const std::map<std::string, GiNaC::symbol> scope = derived_scope(spec_);
-  const GiNaC::ex value = read(spec_, Site{text, where, ""}, 0, text.size(), &scope).value;
+  // An output's own name and the outputs announced below it are not in scope: say why.
+  std::map<std::string, std::string> unavailable;
+  if (!defining.empty())
+    unavailable.emplace(defining, fmt::format("output '{}' is defined through itself: its expression names '{}'; an "
+                                              "output may use t, q, q', q'', R_x, the parameters and the outputs "
+                                              "above it only",
+                                              defining, defining));
+  for (const auto& [name, at] : announced_outputs_) {
+    if (name == defining || scope.count(name) > 0) continue;
+    const std::string place = at.describe();
+    unavailable.emplace(
+        name, fmt::format("'{}' is an output declared below {}{}: an output may use only the outputs above it "
+                          "(they are computed in file order); move '{}' above it (two outputs that use each other "
+                          "have no value)",
+                          name, defining.empty() ? std::string("this one") : fmt::format("'{}'", defining),
+                          place.empty() ? "" : " (at " + place + ")", name));
+  }
+  const Site site{text, where, ""};
+  const GiNaC::ex value = read(spec_, site, 0, text.size(), &scope, &unavailable).value;
   if (spec_.outputs.empty()) return value;
   GiNaC::exmap outputs;
   for (const SpecOutput& o : spec_.outputs) outputs[o.symbol] = o.expression;
-  return value.subs(outputs);
+  const GiNaC::ex written_out = value.subs(outputs);
+  std::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, double>> seen;
+  const double size = tree_size(written_out, seen);
+  if (size > kLargestDerived)
+    site.fail_whole(fmt::format("with the outputs it names written out, this expression has about {:.2g} operations "
+                                "(the limit is {:g}): outputs that each use the one above more than once grow "
+                                "exponentially down the chain, and compiling them would take minutes; name each "
+                                "output once per expression (e.g. b = \"a^2\" rather than \"a*a\"), or write the "
+                                "expression in t, q, q', q'', R_x and the parameters",
+                                size, kLargestDerived));
+  return written_out;
 }
 
 SpecBuilder& SpecBuilder::output(const std::string& name, const std::string& text, SourceLocation where) {
-  const GiNaC::ex expression = parse_derived(text, where);
+  const GiNaC::ex expression = parse_derived(text, where, name);
   return output(name, expression, text, std::move(where));
 }
 

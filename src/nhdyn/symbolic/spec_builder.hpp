@@ -108,7 +108,15 @@ class SpecBuilder {
                       SourceLocation where = {}, bool automatic = false);
   // Parses `text` as parse() does, with the reactions R_x and the outputs declared so far known
   // too (each output replaced by its expression): the expressions of outputs and events.
-  GiNaC::ex parse_derived(const std::string& text, const SourceLocation& where = {}) const;
+  // `defining`: the output whose expression this is (naming it is refused as a self reference).
+  // Refused too: an announced output not declared yet (a forward reference, announce_outputs), and
+  // an expression that, with its outputs written out, has more than 2e5 operations (a chain of
+  // outputs each naming the one above several times grows exponentially).
+  GiNaC::ex parse_derived(const std::string& text, const SourceLocation& where = {},
+                          const std::string& defining = {}) const;
+  // The names (and places) of every output a front end is about to declare, in order, so that an
+  // output naming one declared below it is told so instead of "unknown symbol".
+  SpecBuilder& announce_outputs(std::vector<std::pair<std::string, SourceLocation>> names);
 
   // The spec as built so far: its symbols and parameter values, for such front ends.
   const Spec& current() const { return spec_; }
@@ -127,6 +135,7 @@ class SpecBuilder {
   // The index of each coordinate by name: a lookup per initial value, force or solution, which a
   // linear search made quadratic in the number of coordinates (10 000 particles).
   std::unordered_map<std::string, int> coordinate_by_name_;
+  std::vector<std::pair<std::string, SourceLocation>> announced_outputs_;  // announce_outputs()
   int coordinate_of(const std::string& name) const;  // -1 when not a coordinate
 };
 

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/symbolic/plain_words.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 
 namespace nhdyn::symbolic {
@@ -69,7 +70,7 @@ class Emitter {
     try {
       return e.evalf();
     } catch (const std::exception& error) {
-      fail(e, fmt::format("cannot be evaluated ({})", error.what()));
+      fail(e, fmt::format("cannot be evaluated: {}", plain_words(error.what())));
     }
   }
 
@@ -203,6 +204,8 @@ VisualScene compile_visual(const Spec& spec) {
       throw ModelError(fmt::format("{}{}[visual] {} '{}': {} values given, {} expected", item.where,
                                    item.where.empty() ? "" : ": ", kind_name(item.kind), item.name,
                                    item.at.size() + item.other.size(), expected));
+    for (const GiNaC::ex& e : item.at) shape.expressions.push_back(text_of(e));
+    for (const GiNaC::ex& e : item.other) shape.expressions.push_back(text_of(e));
     for (const GiNaC::ex& e : item.at) positions.output(e, item, "position");
     for (const GiNaC::ex& e : item.other) positions.output(e, item, item.kind == VisualKind::segment ? "position" : "rotation");
     if (item.kind == VisualKind::sphere || item.kind == VisualKind::wheel) {

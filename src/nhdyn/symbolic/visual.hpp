@@ -63,6 +63,7 @@ struct VisualShape {
   int size_offset = 0;
   int axis = 1;       // wheel: the axle's column of R
   std::string where;  // "file:line:column" of the item, for messages about its values
+  std::vector<std::string> expressions;  // the text of each of its outputs (at, then other), for messages
 };
 
 struct VisualScene {
