@@ -18,6 +18,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/results.hpp"
+#include "support/text.hpp"
 
 namespace nhdyn {
 namespace {
@@ -29,11 +30,7 @@ std::string example_text(const std::string& file) {
   return text.str();
 }
 
-void replace_once(std::string& text, const std::string& from, const std::string& to) {
-  const std::size_t at = text.find(from);
-  ASSERT_NE(at, std::string::npos) << from;
-  text.replace(at, from.size(), to);
-}
+using test::replace_once;
 
 // examples/ball_over_bump.toml without u, v: nhdyn adds ball_u, ball_v.
 std::string bump_added() {

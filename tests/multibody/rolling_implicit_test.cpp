@@ -14,6 +14,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/results.hpp"
+#include "support/text.hpp"
 
 namespace nhdyn {
 namespace {
@@ -25,11 +26,7 @@ std::string ellipsoid_example_text() {
   return text.str();
 }
 
-void replace_once(std::string& text, const std::string& from, const std::string& to) {
-  const std::size_t at = text.find(from);
-  ASSERT_NE(at, std::string::npos) << from;
-  text.replace(at, from.size(), to);
-}
+using test::replace_once;
 
 // The example with the ellipsoid written as the surface f = 0 and its contact point (px, py, pz)
 // started at the support point of the tilted ellipsoid (rolling-bodies.md section 2).

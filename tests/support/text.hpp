@@ -4,6 +4,8 @@
 // where two files' helpers of the same name would collide.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -30,6 +32,14 @@ inline std::string csv_body(const std::string& text) {
     at = end + 1;
   }
   return text.substr(at);
+}
+
+// Replaces the first `from` in `text` by `to`; a test failure naming `from` when it is not there
+// (an example file edited so that a test's edit no longer applies).
+inline void replace_once(std::string& text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
 }
 
 inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }

@@ -190,6 +190,12 @@ class Loader {
     spec.v0_written = std::move(v0_written_);
     spec.q0_written.resize(spec.coordinates.size(), false);
     spec.v0_written.resize(spec.coordinates.size(), false);
+    // A quaternion's components, written or not, are free for --fix-initial: its norm is a gauge,
+    // and the smallest change onto the unit sphere is along e itself (e/|e|, the same direction;
+    // e' loses its part along e), docs/derivations/quaternion-frame.md.
+    for (const std::string& name : quaternion_coordinates_)
+      for (std::size_t i = 0; i < spec.coordinates.size(); ++i)
+        if (spec.coordinates[i] == name) spec.q0_written[i] = spec.v0_written[i] = false;
     // The contact points' coordinates nhdyn added (rolling_contact.hpp): found from the rest.
     symbolic::solve_contact_coordinates(spec);
     return spec;
@@ -948,6 +954,7 @@ class Loader {
           translation = triple_of(*node, fmt::format("frame '{}': translation", name), "translation = [\"x\", \"y\", 0]");
         if (std::optional<std::array<std::string, 4>> quaternion = quaternion_of(*table, name)) {
           mb.quaternion_frame(name, parent, translation, *quaternion, at(*table->get("quaternion")));
+          quaternion_coordinates_.insert(quaternion_coordinates_.end(), quaternion->begin(), quaternion->end());
           frame_names.push_back(name);
           visual.items.push_back(frame_item(mb.placed_frame(name), symbolic::VisualKind::frame, at(*table)));
           continue;
@@ -1241,6 +1248,8 @@ class Loader {
   std::vector<std::size_t> line_starts_;  // byte offset of the start of each line, line 1 first
   std::string file_;
   std::vector<std::string> coordinates_;
+  // The quaternion frames' components, noted while the (const) multibody part is read.
+  mutable std::vector<std::string> quaternion_coordinates_;
   std::vector<bool> q0_written_, v0_written_;  // per coordinate: [initial] wrote its value, its velocity
   std::unordered_map<std::string, int> coordinate_by_name_;  // index into coordinates_ (first of a name)
   std::vector<Parameter> parameter_values_;  // as loaded so far, in file order
