@@ -400,6 +400,16 @@ std::string ContactSwitches::touchdown(int contact, double t) {
     if (slip > slip_floor(data_)) direction = {slip_before[0] / slip, slip_before[1] / slip};
     else {
       const double size = norm2(impulse.tangential);
+      if (!(size > 0.0)) {
+        // Outside the cone only because the sticking impulse pulls (normal <= 0), with no
+        // tangential part and no slip: no direction to slide in, and no impact law holds.
+        accumulation_ = fmt::format(
+            "contact '{}' touches down at t = {:.9g} with a sticking impulse that pulls (normal impulse {:.6g} N s) "
+            "and no slip to slide along: no impact law of this model is consistent there "
+            "(docs/derivations/contact-modes.md section 7). The run ends here with its results so far",
+            c.name, t, impulse.normal);
+        return "";
+      }
       direction = {-impulse.tangential[0] / size, -impulse.tangential[1] / size};
     }
     impulse = solve_impulse(contact, t, v, true, direction);

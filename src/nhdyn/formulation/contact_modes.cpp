@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "nhdyn/model/terms.hpp"
@@ -88,6 +89,12 @@ void effective_inverse_mass(const Model& model, Data& data, int contact_gap_row,
   data.tmp_n.noalias() = data.A * w.response;
   data.tmp_n -= data.b.row(contact_gap_row).transpose();
   reaction_coefficients(w, r, data.tmp_n, w.coefficients);
+  if (!(std::abs(inverse) > 0.0)) {
+    // The sliding column does not move the normal at all: no finite w_eff, and so no paradox.
+    w_eff = std::numeric_limits<double>::infinity();
+    lambda_nn = 0.0;
+    return;
+  }
   w_eff = 1.0 / inverse;
   lambda_nn = -w.coefficients(j) / inverse;
 }
