@@ -182,15 +182,12 @@ void check_new(const Items& items, const std::string& name, const char* kind, co
 
 }  // namespace
 
-MultibodyBuilder& MultibodyBuilder::frame(const std::string& name, const std::string& parent,
-                                          const Triple& translation, const std::vector<FrameRotation>& rotations,
-                                          SourceLocation where) {
-  const std::string context = fmt::format("frame '{}'", name);
+PlacedFrame MultibodyBuilder::child_frame(const std::string& name, const std::string& parent,
+                                         const Triple& translation, SourceLocation where,
+                                         const std::string& context) const {
   check_new(frames_, name, "frame", where);
   const int p = frame_index(parent, where, context + ": parent");
   const PlacedFrame& up = frames_[static_cast<std::size_t>(p)];
-  const SymbolTable& symbols = builder_.current().symbols;
-
   PlacedFrame f;
   f.name = name;
   f.parent = p;
@@ -199,6 +196,15 @@ MultibodyBuilder& MultibodyBuilder::frame(const std::string& name, const std::st
   f.rotation = up.rotation;
   f.omega = up.omega;
   f.omega_local = up.omega_local;
+  return f;
+}
+
+MultibodyBuilder& MultibodyBuilder::frame(const std::string& name, const std::string& parent,
+                                          const Triple& translation, const std::vector<FrameRotation>& rotations,
+                                          SourceLocation where) {
+  const std::string context = fmt::format("frame '{}'", name);
+  PlacedFrame f = child_frame(name, parent, translation, where, context);
+  const SymbolTable& symbols = builder_.current().symbols;
   for (std::size_t j = 0; j < rotations.size(); ++j) {
     const FrameRotation& r = rotations[j];
     const SourceLocation& at = r.where.line > 0 || r.where.file.size() > 0 ? r.where : where;
@@ -240,15 +246,9 @@ MultibodyBuilder& MultibodyBuilder::quaternion_frame(const std::string& name, co
                                                      const std::array<std::string, 4>& quaternion,
                                                      SourceLocation where) {
   const std::string context = fmt::format("frame '{}'", name);
-  check_new(frames_, name, "frame", where);
-  const int p = frame_index(parent, where, context + ": parent");
-  const PlacedFrame& up = frames_[static_cast<std::size_t>(p)];
+  PlacedFrame f = child_frame(name, parent, translation, where, context);
+  const PlacedFrame& up = frames_[static_cast<std::size_t>(f.parent)];
   const SymbolTable& symbols = builder_.current().symbols;
-
-  PlacedFrame f;
-  f.name = name;
-  f.parent = p;
-  f.where = where;
   Quaternion e, rate;
   for (std::size_t k = 0; k < 4; ++k) {
     const int i = coordinate_index(quaternion[k], where, fmt::format("{}: quaternion component e{}", context, k));
@@ -271,7 +271,6 @@ MultibodyBuilder& MultibodyBuilder::quaternion_frame(const std::string& name, co
   // docs/derivations/quaternion-frame.md (3.2): R_F = R_P R(e), omega = omega_P + R_P 2 E(e) e',
   // omega_F = R(e)^T omega_P,F + 2 G(e) e'.
   const GiNaC::matrix Re = quaternion_rotation(e);
-  f.origin = add(up.origin, multiply(up.rotation, parse(translation, where, context + ": translation", true)));
   f.rotation = up.rotation.mul(Re);
   f.omega = add(up.omega, multiply(up.rotation, quaternion_omega(e, rate)));
   f.omega_local = add(multiply_transposed(Re, up.omega_local), quaternion_omega_local(e, rate));

@@ -157,6 +157,10 @@ class MultibodyBuilder {
   Vector3 parse(const Triple& texts, const SourceLocation& where, const std::string& context,
                 bool coordinates_allowed) const;
   int frame_index(const std::string& name, const SourceLocation& where, const std::string& context) const;
+  // A new frame `name` under `parent` (both checked), at `translation` in the parent's axes, with
+  // the parent's rotation and angular velocity: what frame() and quaternion_frame() then turn.
+  PlacedFrame child_frame(const std::string& name, const std::string& parent, const Triple& translation,
+                          SourceLocation where, const std::string& context) const;
   int point_index(const std::string& name, const SourceLocation& where, const std::string& context) const;
   int coordinate_index(const std::string& name, const SourceLocation& where, const std::string& context) const;
   int body_index(const std::string& name, const SourceLocation& where, const std::string& context) const;
