@@ -51,6 +51,104 @@ StudyFormulation parse_formulation(const std::string& label) {
   return {parse_method(label), Complement::qr};  // throws naming the valid methods
 }
 
+// A run's label in the column names: its formulation and integrator.
+std::string run_label(const StudyFormulation& f, IntegratorKind i) {
+  return fmt::format("{}_{}", formulation_label(f), integrator_name(i));
+}
+
+// The by-tolerance series: one row per tolerance, each run's error and residuals (NaN where it failed).
+void write_series(const ErrorRelation& study, bool pos, bool vel, CsvWriter& series) {
+  std::vector<double> row;
+  for (std::size_t k = 0; k < study.tolerances.size(); ++k) {
+    row.assign(1, study.tolerances[k]);
+    for (std::size_t f = 0; f < study.formulations.size(); ++f)
+      for (std::size_t i = 0; i < study.integrators.size(); ++i) {
+        const ErrorRelationRun& r = study.run(f, i, k);
+        const bool ok = r.summary.status == Status::ok;
+        const double nan = std::nan("");
+        row.push_back(ok ? std::max(r.max_error_q, r.max_error_v) : nan);
+        if (vel) row.push_back(ok ? r.max_residual_vel : nan);
+        if (pos) row.push_back(ok ? r.max_residual_pos : nan);
+      }
+    series.write_row(row);
+  }
+}
+
+// The table: one line per run.
+std::string table_text(const ErrorRelation& study, const std::string& provenance, double atol_factor) {
+  std::string text = provenance + "formulation,integrator,rtol,atol,max_error_q,max_error_v,max_residual_pos,max_residual_vel,"
+                     "steps,rhs_evaluations,status\n";
+  for (const ErrorRelationRun& r : study.runs)
+    text += fmt::format("{},{},{:.3g},{:.3g},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{}\n", formulation_label(r.formulation),
+                        integrator_name(r.integrator), r.tolerance, r.tolerance * atol_factor, r.max_error_q,
+                        r.max_error_v, r.max_residual_pos, r.max_residual_vel, r.summary.stats.steps,
+                        r.summary.stats.rhs_evaluations,
+                        r.summary.status == Status::ok ? "ok" : std::string(describe(r.summary.status)));
+  return text;
+}
+
+// --plot: the relation itself. Each run is a point (its residual, its error); the points of one
+// formulation and integrator are joined in the order of the tolerances. On the diagonal the
+// residual equals the error.
+void plot_error_relation(const ErrorRelation& study, const Model& model, bool vel,
+                         const std::filesystem::path& series_path, const std::string& plot) {
+  const std::string level = vel ? "vel" : "pos";
+  XyPlotRequest request;
+  request.title = fmt::format("{}: global error against the {} constraint residual, rtol {:g} .. {:g}", model.name,
+                              vel ? "velocity" : "position", study.tolerances.front(), study.tolerances.back());
+  request.csv = series_path;
+  for (std::size_t f = 0; f < study.formulations.size(); ++f)
+    for (std::size_t i = 0; i < study.integrators.size(); ++i) {
+      const std::string label = run_label(study.formulations[f], study.integrators[i]);
+      request.y.push_back("error_" + label);
+      request.x_of_curve.push_back(fmt::format("residual_{}_{}", level, label));
+      request.titles.push_back(fmt::format("{} {}", formulation_label(study.formulations[f]),
+                                           integrator_name(study.integrators[i])));
+    }
+  request.x_label = fmt::format("max |{} residual| over the run", vel ? "velocity" : "position");
+  request.y_label = study.analytic ? "max |error| against the exact solution" : "max |error| against a tight run";
+  request.diagonal = true;
+  write_xy_plot(request, plot);
+}
+
+// The summary on standard output: one line per run, and where the files went.
+void print_error_relation(const ErrorRelation& study, const Model& model, const ErrorRelationArgs& args, bool pos,
+                          bool vel, const std::filesystem::path& table_path, const std::filesystem::path& series_path) {
+  const double t_end = args.t_end.value_or(model.defaults.t_end);
+  fmt::print("nhdyn study error-relation {}: t = {:g} .. {:g} s, atol = {:g} rtol, reference: {}\n", model.name,
+             model.t0, t_end, args.atol_factor,
+             study.analytic ? "the model's exact solution" : "sanh, dopri5, rtol 1e-13 (no exact solution)");
+  fmt::print("{:<16} {:<12} {:>7} {:>10} {:>10} {:>10} {:>10} {:>8}\n", "formulation", "integrator", "rtol",
+             "err q", "err q'", "res pos", "res vel", "steps");
+  for (const ErrorRelationRun& r : study.runs) {
+    const auto level = [](double value, bool defined) { return defined ? fmt::format("{:.2e}", value) : std::string("-"); };
+    fmt::print("{:<16} {:<12} {:>7.0e} {:>10.2e} {:>10.2e} {:>10} {:>10} {:>8}{}\n", formulation_label(r.formulation),
+               integrator_name(r.integrator), r.tolerance, r.max_error_q, r.max_error_v, level(r.max_residual_pos, pos),
+               level(r.max_residual_vel, vel), r.summary.stats.steps,
+               r.summary.status == Status::ok ? "" : fmt::format("  FAILED at t = {:.4g}: {}", r.summary.t_reached,
+                                                                r.summary.message));
+  }
+  fmt::print("table -> {}\nby tolerance -> {}\n", table_path.string(), series_path.string());
+  if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
+}
+
+// Both files say what made them (io/provenance.hpp): the model as loaded and the study's options.
+std::string error_relation_provenance(const Model& model, const ModelSource& source,
+                                      const ErrorRelationOptions& options, const ErrorRelationArgs& args) {
+  std::vector<std::string> formulation_names, integrator_names, tolerances;
+  for (const StudyFormulation& f : options.formulations) formulation_names.push_back(formulation_label(f));
+  for (IntegratorKind i : options.integrators) integrator_names.emplace_back(integrator_name(i));
+  for (double tolerance : options.tolerances) tolerances.push_back(fmt::format("{}", tolerance));
+  return format_provenance(make_command_provenance(
+      model, source, "study error-relation",
+      {{"methods", join(formulation_names, ",")},
+       {"integrators", join(integrator_names, ",")},
+       {"tolerances", join(tolerances, ",")},
+       {"atol_factor", fmt::format("{}", args.atol_factor)},
+       {"t_end", fmt::format("{}", args.t_end.value_or(model.defaults.t_end))},
+       {"output_step", fmt::format("{}", args.output_step.value_or(model.defaults.output_step))}}));
+}
+
 int run_error_relation(const ErrorRelationArgs& args) {
   protect_model_file(args.model);
   const ModelSource source = read_model_source(args.model);
@@ -76,102 +174,26 @@ int run_error_relation(const ErrorRelationArgs& args) {
   if (options.formulations.empty()) options.formulations = calc_study_formulations(model);
   const bool pos = model.position_constraints() > 0;
   const bool vel = model.velocity_constraints() > 0;
-  const auto label_of = [](const StudyFormulation& f, IntegratorKind i) {
-    return fmt::format("{}_{}", formulation_label(f), integrator_name(i));
-  };
   std::vector<std::string> columns{"tolerance"};
   for (const StudyFormulation& f : options.formulations)
     for (IntegratorKind i : options.integrators) {
-      columns.push_back("error_" + label_of(f, i));
-      if (vel) columns.push_back("residual_vel_" + label_of(f, i));
-      if (pos) columns.push_back("residual_pos_" + label_of(f, i));
+      columns.push_back("error_" + run_label(f, i));
+      if (vel) columns.push_back("residual_vel_" + run_label(f, i));
+      if (pos) columns.push_back("residual_pos_" + run_label(f, i));
     }
   // Both files are opened (and so checked writable) before the runs; they appear only on commit.
   AtomicFile table(table_path);
-  // Both files say what made them (io/provenance.hpp): the model as loaded and the study's options.
-  std::vector<std::string> formulation_names, integrator_names, tolerances;
-  for (const StudyFormulation& f : options.formulations) formulation_names.push_back(formulation_label(f));
-  for (IntegratorKind i : options.integrators) integrator_names.emplace_back(integrator_name(i));
-  for (double tolerance : options.tolerances) tolerances.push_back(fmt::format("{}", tolerance));
-  const std::string provenance = format_provenance(make_command_provenance(
-      model, source, "study error-relation",
-      {{"methods", join(formulation_names, ",")},
-       {"integrators", join(integrator_names, ",")},
-       {"tolerances", join(tolerances, ",")},
-       {"atol_factor", fmt::format("{}", args.atol_factor)},
-       {"t_end", fmt::format("{}", args.t_end.value_or(model.defaults.t_end))},
-       {"output_step", fmt::format("{}", args.output_step.value_or(model.defaults.output_step))}}));
+  const std::string provenance = error_relation_provenance(model, source, options, args);
   CsvWriter series(series_path, columns, provenance);
 
   const ErrorRelation study = study_error_relation(model, options);
-  std::vector<double> row;
-  for (std::size_t k = 0; k < study.tolerances.size(); ++k) {
-    row.assign(1, study.tolerances[k]);
-    for (std::size_t f = 0; f < study.formulations.size(); ++f)
-      for (std::size_t i = 0; i < study.integrators.size(); ++i) {
-        const ErrorRelationRun& r = study.run(f, i, k);
-        const bool ok = r.summary.status == Status::ok;
-        const double nan = std::nan("");
-        row.push_back(ok ? std::max(r.max_error_q, r.max_error_v) : nan);
-        if (vel) row.push_back(ok ? r.max_residual_vel : nan);
-        if (pos) row.push_back(ok ? r.max_residual_pos : nan);
-      }
-    series.write_row(row);
-  }
-
-  std::string text = provenance + "formulation,integrator,rtol,atol,max_error_q,max_error_v,max_residual_pos,max_residual_vel,"
-                     "steps,rhs_evaluations,status\n";
-  for (const ErrorRelationRun& r : study.runs)
-    text += fmt::format("{},{},{:.3g},{:.3g},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{}\n", formulation_label(r.formulation),
-                        integrator_name(r.integrator), r.tolerance, r.tolerance * args.atol_factor, r.max_error_q,
-                        r.max_error_v, r.max_residual_pos, r.max_residual_vel, r.summary.stats.steps,
-                        r.summary.stats.rhs_evaluations,
-                        r.summary.status == Status::ok ? "ok" : std::string(describe(r.summary.status)));
-  table.write(text);
+  write_series(study, pos, vel, series);
+  table.write(table_text(study, provenance, args.atol_factor));
   series.commit();
   table.commit();
 
-  if (!args.plot.empty()) {
-    // The relation itself: each run is a point (its residual, its error); the points of one
-    // formulation and integrator are joined in the order of the tolerances. On the diagonal the
-    // residual equals the error.
-    const std::string level = vel ? "vel" : "pos";
-    XyPlotRequest request;
-    request.title = fmt::format("{}: global error against the {} constraint residual, rtol {:g} .. {:g}", model.name,
-                                vel ? "velocity" : "position", study.tolerances.front(), study.tolerances.back());
-    request.csv = series_path;
-    for (std::size_t f = 0; f < study.formulations.size(); ++f)
-      for (std::size_t i = 0; i < study.integrators.size(); ++i) {
-        const std::string label = label_of(study.formulations[f], study.integrators[i]);
-        request.y.push_back("error_" + label);
-        request.x_of_curve.push_back(fmt::format("residual_{}_{}", level, label));
-        request.titles.push_back(fmt::format("{} {}", formulation_label(study.formulations[f]),
-                                             integrator_name(study.integrators[i])));
-      }
-    request.x_label = fmt::format("max |{} residual| over the run", vel ? "velocity" : "position");
-    request.y_label = study.analytic ? "max |error| against the exact solution" : "max |error| against a tight run";
-    request.diagonal = true;
-    write_xy_plot(request, args.plot);
-  }
-
-  if (!args.quiet) {
-    const double t_end = args.t_end.value_or(model.defaults.t_end);
-    fmt::print("nhdyn study error-relation {}: t = {:g} .. {:g} s, atol = {:g} rtol, reference: {}\n", model.name,
-               model.t0, t_end, args.atol_factor,
-               study.analytic ? "the model's exact solution" : "sanh, dopri5, rtol 1e-13 (no exact solution)");
-    fmt::print("{:<16} {:<12} {:>7} {:>10} {:>10} {:>10} {:>10} {:>8}\n", "formulation", "integrator", "rtol",
-               "err q", "err q'", "res pos", "res vel", "steps");
-    for (const ErrorRelationRun& r : study.runs) {
-      const auto level = [](double value, bool defined) { return defined ? fmt::format("{:.2e}", value) : std::string("-"); };
-      fmt::print("{:<16} {:<12} {:>7.0e} {:>10.2e} {:>10.2e} {:>10} {:>10} {:>8}{}\n", formulation_label(r.formulation),
-                 integrator_name(r.integrator), r.tolerance, r.max_error_q, r.max_error_v, level(r.max_residual_pos, pos),
-                 level(r.max_residual_vel, vel), r.summary.stats.steps,
-                 r.summary.status == Status::ok ? "" : fmt::format("  FAILED at t = {:.4g}: {}", r.summary.t_reached,
-                                                                  r.summary.message));
-    }
-    fmt::print("table -> {}\nby tolerance -> {}\n", table_path.string(), series_path.string());
-    if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
-  }
+  if (!args.plot.empty()) plot_error_relation(study, model, vel, series_path, args.plot);
+  if (!args.quiet) print_error_relation(study, model, args, pos, vel, table_path, series_path);
   for (const ErrorRelationRun& r : study.runs)
     if (r.summary.status != Status::ok) return 1;
   return 0;

@@ -43,59 +43,22 @@ struct SweepArgs {
   bool quiet = false;
 };
 
-int run_sweep(const SweepArgs& args) {
-  protect_model_file(args.model);
-  SweepOptions options;
-  options.parameter = args.param;
-  options.from = args.from;
-  options.to = args.to;
-  options.steps = args.steps;
-  options.linearization.cyclic = args.cyclic;
-  options.linearization.independent = args.independent;
-  options.linearization.speeds = args.speeds;
-  options.linearization.steady_tolerance = args.tolerance;
-  check_sweep_options(options);
-  // Compiled once: each grid point and bisection step only sets the parameter (parameters as
-  // data, model/parameters.hpp), which re-binds the evaluator without symbolic work.
-  const ModelSource source = read_model_source(args.model);
-  const Model base = load_model_described(source, parse_parameter_sets(args.sets)).model;
-  {
-    std::string names;
-    bool known = false;
-    for (const Parameter& p : base.parameters) {
-      names += (names.empty() ? "" : ", ") + p.name;
-      known = known || p.name == args.param;
-    }
-    if (!known)
-      throw InputError(fmt::format("--param {}: model '{}' ({}) has no parameter '{}'; its parameters are: {}",
-                                   args.param, base.name, args.model, args.param, names.empty() ? "(none)" : names));
+// --param must name one of the model's parameters.
+void check_swept_parameter(const Model& base, const SweepArgs& args) {
+  std::string names;
+  bool known = false;
+  for (const Parameter& p : base.parameters) {
+    names += (names.empty() ? "" : ", ") + p.name;
+    known = known || p.name == args.param;
   }
-  const ModelAtValue model_at = make_model_at_value(base, args.param);
+  if (!known)
+    throw InputError(fmt::format("--param {}: model '{}' ({}) has no parameter '{}'; its parameters are: {}",
+                                 args.param, base.name, args.model, args.param, names.empty() ? "(none)" : names));
+}
 
-  // The first point linearized before any file is made: a model that is not steady, or a bad
-  // --cyclic or --independent, is refused with nothing written.
-  try {
-    calc_linearization(model_at(args.from), options.linearization);
-  } catch (const InputError& e) {
-    throw InputError(fmt::format("at {} = {:g}: {}", args.param, args.from, e.what()));
-  } catch (const ModelError& e) {
-    throw ModelError(fmt::format("at {} = {:g}: {}", args.param, args.from, e.what()));
-  }
-
-  namespace fs = std::filesystem;
-  const fs::path table_path =
-      args.output.empty() ? fs::path("results") / (make_file_name(base.name + "-sweep-" + args.param) + ".csv") : fs::path(args.output);
-  make_parent_directory(table_path);
-  fs::path crossings_path = table_path;
-  crossings_path.replace_filename(table_path.stem().string() + "-crossings.csv");
-  check_command_paths(args.model,
-                      {{table_path, "the eigenvalue CSV"}, {crossings_path, "the crossings CSV"}, {args.plot, "--plot"}});
-  check_plot_possible(args.plot);
-  AtomicFile table(table_path);  // both files can be written: checked before any work
-  AtomicFile crossings_file(crossings_path);
-
-  const Sweep sweep = calc_eigenvalue_sweep(model_at, options);
-
+// The eigenvalue table and the crossings, each after the same provenance header.
+void write_sweep_tables(const Sweep& sweep, const Model& base, const ModelSource& source, const SweepArgs& args,
+                        AtomicFile& table, AtomicFile& crossings_file) {
   const std::size_t k = sweep.state.size();
   std::vector<std::string> columns{args.param};
   for (std::size_t i = 1; i <= k; ++i) {
@@ -127,86 +90,139 @@ int run_sweep(const SweepArgs& args) {
                          c.oscillatory ? "complex-pair" : "real", c.frequency, c.unstable_before, c.unstable_after,
                          c.bracket);
   crossings_file.write(ctext);
+}
+
+// --plot: the real parts and the |imaginary parts| each sorted at every value: the k-th largest of
+// continuous functions is continuous, so the curves have no jumps where the CSV's order (by real
+// part) swaps the imaginary parts. Its data go to a temporary file.
+void plot_sweep(const Sweep& sweep, const Model& base, const SweepArgs& args) {
+  namespace fs = std::filesystem;
+  const std::size_t k = sweep.state.size();
+  const fs::path data = fs::temp_directory_path() /
+                        fmt::format(".nhdyn-sweep-{}-{}.csv", ::getpid(), fs::path(args.plot).stem().string());
+  {
+    std::string plot_text = args.param;
+    for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",re_{}", i);
+    for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",absim_{}", i);
+    plot_text += "\n";
+    for (const SweepPoint& p : sweep.points) {
+      std::vector<double> re, im;
+      for (const std::complex<double>& e : p.eigenvalues) {
+        re.push_back(e.real());
+        im.push_back(std::abs(e.imag()));
+      }
+      std::sort(re.rbegin(), re.rend());
+      std::sort(im.rbegin(), im.rend());
+      plot_text += fmt::format("{:.17g}", p.value);
+      for (double x : re) plot_text += fmt::format(",{:.17g}", x);
+      for (double x : im) plot_text += fmt::format(",{:.17g}", x);
+      plot_text += "\n";
+    }
+    AtomicFile plot_data(data);
+    plot_data.write(plot_text);
+    plot_data.commit();
+  }
+  XyPlotRequest request;
+  request.title = fmt::format("{}: eigenvalues of the linearization against {}", base.name, args.param);
+  request.csv = data;
+  request.x = args.param;
+  for (std::size_t i = 1; i <= k; ++i) {
+    request.y.push_back(fmt::format("re_{}", i));
+    request.titles.push_back(fmt::format("Re, {}. largest", i));
+  }
+  for (std::size_t i = 1; i <= k; ++i) {
+    request.y.push_back(fmt::format("absim_{}", i));
+    request.titles.push_back(fmt::format("|Im|, {}. largest", i));
+  }
+  request.x_label = args.param;
+  request.y_label = "eigenvalues [1/s]: real parts and |imaginary parts|";
+  request.log_x = false;
+  request.log_y = false;
+  try {
+    write_xy_plot(request, args.plot);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(data, ignored);
+    throw;
+  }
+  std::error_code ignored;
+  fs::remove(data, ignored);
+}
+
+// The summary on standard output: the range, each crossing, and where the files went.
+void print_sweep(const Sweep& sweep, const Model& base, const SweepArgs& args, const std::filesystem::path& table_path,
+                 const std::filesystem::path& crossings_path) {
+  std::string state;
+  for (const std::string& s : sweep.state) state += (state.empty() ? "" : ", ") + s;
+  fmt::print("nhdyn sweep {}: eigenvalues of the linearization for {} = {:g} .. {:g} ({} points), state ({})\n",
+             base.name, args.param, args.from, args.to, args.steps, state);
+  if (sweep.crossings.empty())
+    fmt::print("no real part crosses zero in the range\n");
+  int undecided = 0;
+  for (const SweepPoint& p : sweep.points) undecided = std::max(undecided, p.undecided);
+  if (undecided > 0)
+    fmt::print("undecided: up to {} eigenvalues per value have a real part within their round-off uncertainty "
+                "(zero, on the imaginary axis, or a multiple eigenvalue split by round-off); they are never "
+                "counted unstable\n",
+                undecided);
+  for (const StabilityCrossing& c : sweep.crossings)
+    fmt::print("crossing: {} = {:.15g}  {} ({}), unstable eigenvalues {} -> {}\n", args.param, c.value,
+               c.oscillatory ? "a complex pair crosses the imaginary axis" : "a real eigenvalue crosses zero",
+               c.oscillatory ? fmt::format("frequency {:.6g} rad/s", c.frequency) : std::string("divergence"),
+               c.unstable_before, c.unstable_after);
+  fmt::print("eigenvalues -> {}\ncrossings -> {}\n", table_path.string(), crossings_path.string());
+  if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
+}
+
+int run_sweep(const SweepArgs& args) {
+  protect_model_file(args.model);
+  SweepOptions options;
+  options.parameter = args.param;
+  options.from = args.from;
+  options.to = args.to;
+  options.steps = args.steps;
+  options.linearization.cyclic = args.cyclic;
+  options.linearization.independent = args.independent;
+  options.linearization.speeds = args.speeds;
+  options.linearization.steady_tolerance = args.tolerance;
+  check_sweep_options(options);
+  // Compiled once: each grid point and bisection step only sets the parameter (parameters as
+  // data, model/parameters.hpp), which re-binds the evaluator without symbolic work.
+  const ModelSource source = read_model_source(args.model);
+  const Model base = load_model_described(source, parse_parameter_sets(args.sets)).model;
+  check_swept_parameter(base, args);
+  const ModelAtValue model_at = make_model_at_value(base, args.param);
+
+  // The first point linearized before any file is made: a model that is not steady, or a bad
+  // --cyclic or --independent, is refused with nothing written.
+  try {
+    calc_linearization(model_at(args.from), options.linearization);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("at {} = {:g}: {}", args.param, args.from, e.what()));
+  } catch (const ModelError& e) {
+    throw ModelError(fmt::format("at {} = {:g}: {}", args.param, args.from, e.what()));
+  }
+
+  namespace fs = std::filesystem;
+  const fs::path table_path =
+      args.output.empty() ? fs::path("results") / (make_file_name(base.name + "-sweep-" + args.param) + ".csv") : fs::path(args.output);
+  make_parent_directory(table_path);
+  fs::path crossings_path = table_path;
+  crossings_path.replace_filename(table_path.stem().string() + "-crossings.csv");
+  check_command_paths(args.model,
+                      {{table_path, "the eigenvalue CSV"}, {crossings_path, "the crossings CSV"}, {args.plot, "--plot"}});
+  check_plot_possible(args.plot);
+  AtomicFile table(table_path);  // both files can be written: checked before any work
+  AtomicFile crossings_file(crossings_path);
+
+  const Sweep sweep = calc_eigenvalue_sweep(model_at, options);
+
+  write_sweep_tables(sweep, base, source, args, table, crossings_file);
   table.commit();
   crossings_file.commit();
 
-  if (!args.plot.empty()) {
-    // The plot draws the real parts and the |imaginary parts| each sorted at every value: the
-    // k-th largest of continuous functions is continuous, so the curves have no jumps where the
-    // CSV's order (by real part) swaps the imaginary parts. Its data go to a temporary file.
-    const fs::path data = fs::temp_directory_path() /
-                          fmt::format(".nhdyn-sweep-{}-{}.csv", ::getpid(), fs::path(args.plot).stem().string());
-    {
-      std::string plot_text = args.param;
-      for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",re_{}", i);
-      for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",absim_{}", i);
-      plot_text += "\n";
-      for (const SweepPoint& p : sweep.points) {
-        std::vector<double> re, im;
-        for (const std::complex<double>& e : p.eigenvalues) {
-          re.push_back(e.real());
-          im.push_back(std::abs(e.imag()));
-        }
-        std::sort(re.rbegin(), re.rend());
-        std::sort(im.rbegin(), im.rend());
-        plot_text += fmt::format("{:.17g}", p.value);
-        for (double x : re) plot_text += fmt::format(",{:.17g}", x);
-        for (double x : im) plot_text += fmt::format(",{:.17g}", x);
-        plot_text += "\n";
-      }
-      AtomicFile plot_data(data);
-      plot_data.write(plot_text);
-      plot_data.commit();
-    }
-    XyPlotRequest request;
-    request.title = fmt::format("{}: eigenvalues of the linearization against {}", base.name, args.param);
-    request.csv = data;
-    request.x = args.param;
-    for (std::size_t i = 1; i <= k; ++i) {
-      request.y.push_back(fmt::format("re_{}", i));
-      request.titles.push_back(fmt::format("Re, {}. largest", i));
-    }
-    for (std::size_t i = 1; i <= k; ++i) {
-      request.y.push_back(fmt::format("absim_{}", i));
-      request.titles.push_back(fmt::format("|Im|, {}. largest", i));
-    }
-    request.x_label = args.param;
-    request.y_label = "eigenvalues [1/s]: real parts and |imaginary parts|";
-    request.log_x = false;
-    request.log_y = false;
-    try {
-      write_xy_plot(request, args.plot);
-    } catch (...) {
-      std::error_code ignored;
-      fs::remove(data, ignored);
-      throw;
-    }
-    std::error_code ignored;
-    fs::remove(data, ignored);
-  }
-
-  if (!args.quiet) {
-    std::string state;
-    for (const std::string& s : sweep.state) state += (state.empty() ? "" : ", ") + s;
-    fmt::print("nhdyn sweep {}: eigenvalues of the linearization for {} = {:g} .. {:g} ({} points), state ({})\n",
-               base.name, args.param, args.from, args.to, args.steps, state);
-    if (sweep.crossings.empty())
-      fmt::print("no real part crosses zero in the range\n");
-    int undecided = 0;
-    for (const SweepPoint& p : sweep.points) undecided = std::max(undecided, p.undecided);
-    if (undecided > 0)
-      fmt::print("undecided: up to {} eigenvalues per value have a real part within their round-off uncertainty "
-                  "(zero, on the imaginary axis, or a multiple eigenvalue split by round-off); they are never "
-                  "counted unstable\n",
-                  undecided);
-    for (const StabilityCrossing& c : sweep.crossings)
-      fmt::print("crossing: {} = {:.15g}  {} ({}), unstable eigenvalues {} -> {}\n", args.param, c.value,
-                 c.oscillatory ? "a complex pair crosses the imaginary axis" : "a real eigenvalue crosses zero",
-                 c.oscillatory ? fmt::format("frequency {:.6g} rad/s", c.frequency) : std::string("divergence"),
-                 c.unstable_before, c.unstable_after);
-    fmt::print("eigenvalues -> {}\ncrossings -> {}\n", table_path.string(), crossings_path.string());
-    if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
-  }
+  if (!args.plot.empty()) plot_sweep(sweep, base, args);
+  if (!args.quiet) print_sweep(sweep, base, args, table_path, crossings_path);
   return 0;
 }
 

@@ -932,6 +932,15 @@ class Loader {
     return triple_of(*node, what, "[0, 0, 1]");
   }
 
+  // What the multibody sections build together: the builder, the scene, and the names the
+  // automatic outputs and the wheels' scene need.
+  struct MultibodySections {
+    symbolic::MultibodyBuilder& mb;
+    symbolic::SpecVisual& visual;
+    std::vector<std::string> frame_names, point_names;                     // for the automatic outputs
+    std::vector<std::pair<std::string, symbolic::PlacedFrame>> body_frames;  // for the wheels' scene
+  };
+
   void load_multibody(const toml::table& root, SpecBuilder& builder, symbolic::SpecVisual& visual) const {
     bool any = false;
     for (const char* key : {"gravity", "frames", "points", "bodies", "wheels", "knife_edges", "surfaces", "curves", "contacts"})
@@ -939,10 +948,25 @@ class Loader {
     if (!any) return;
     symbolic::MultibodyBuilder mb(builder);
     visual.ground = true;
-    std::vector<std::string> frame_names, point_names;  // for the automatic outputs
-    std::vector<std::pair<std::string, symbolic::PlacedFrame>> body_frames;  // for the wheels' scene
+    MultibodySections scene{mb, visual, {}, {}, {}};
     if (const toml::node* gravity = root.get("gravity"))
       mb.gravity(triple_of(*gravity, "gravity", "gravity = [0, 0, \"-g\"]"), at(*gravity));
+    load_frames(root, scene);
+    load_points(root, scene);
+    load_bodies(root, builder, scene);
+    load_wheels(root, builder, scene);
+    load_knife_edges(root, scene);
+    load_surfaces(root, scene);
+    load_curves(root, scene);
+    if (const toml::node* contacts = root.get("contacts"))
+      load_contacts(*contacts, mb, visual, scene.body_frames, [this](const toml::node& node) { return at(node); });
+    mb.apply();
+    // Every point's and frame origin's world position and velocity as result columns.
+    symbolic::add_multibody_outputs(builder, mb, scene.frame_names, scene.point_names);
+  }
+
+  // [[frames]]: each turned by angles or by a quaternion, placed in its parent.
+  void load_frames(const toml::table& root, MultibodySections& scene) const {
     if (const toml::node* frames = root.get("frames"))
       for (const toml::table* table : tables_of(*frames, "frames", frame_keys)) {
         const std::string name = name_of(*table, "frames");
@@ -953,10 +977,10 @@ class Loader {
         if (const toml::node* node = table->get("translation"))
           translation = triple_of(*node, fmt::format("frame '{}': translation", name), "translation = [\"x\", \"y\", 0]");
         if (std::optional<std::array<std::string, 4>> quaternion = quaternion_of(*table, name)) {
-          mb.quaternion_frame(name, parent, translation, *quaternion, at(*table->get("quaternion")));
+          scene.mb.quaternion_frame(name, parent, translation, *quaternion, at(*table->get("quaternion")));
           quaternion_coordinates_.insert(quaternion_coordinates_.end(), quaternion->begin(), quaternion->end());
-          frame_names.push_back(name);
-          visual.items.push_back(frame_item(mb.placed_frame(name), symbolic::VisualKind::frame, at(*table)));
+          scene.frame_names.push_back(name);
+          scene.visual.items.push_back(frame_item(scene.mb.placed_frame(name), symbolic::VisualKind::frame, at(*table)));
           continue;
         }
         std::vector<symbolic::FrameRotation> rotations;
@@ -974,10 +998,14 @@ class Loader {
                                  number_or_expression(*pair.get(1), what + " angle", "\"psi\""), at(element)});
           }
         }
-        mb.frame(name, parent, translation, rotations, at(*table));
-        frame_names.push_back(name);
-        visual.items.push_back(frame_item(mb.placed_frame(name), symbolic::VisualKind::frame, at(*table)));
+        scene.mb.frame(name, parent, translation, rotations, at(*table));
+        scene.frame_names.push_back(name);
+        scene.visual.items.push_back(frame_item(scene.mb.placed_frame(name), symbolic::VisualKind::frame, at(*table)));
       }
+  }
+
+  // [[points]]: fixed in a frame.
+  void load_points(const toml::table& root, MultibodySections& scene) const {
     if (const toml::node* points = root.get("points"))
       for (const toml::table* table : tables_of(*points, "points", point_keys)) {
         const std::string name = name_of(*table, "points");
@@ -986,9 +1014,13 @@ class Loader {
         symbolic::Triple position{"0", "0", "0"};
         if (const toml::node* node = table->get("position"))
           position = triple_of(*node, fmt::format("point '{}': position", name), "position = [0, 0, \"-l\"]");
-        mb.point(name, frame, position, at(*table));
-        point_names.push_back(name);
+        scene.mb.point(name, frame, position, at(*table));
+        scene.point_names.push_back(name);
       }
+  }
+
+  // [[bodies]]: a mass and inertia on a frame, drawn as its ellipsoid of inertia.
+  void load_bodies(const toml::table& root, SpecBuilder& builder, MultibodySections& scene) const {
     if (const toml::node* bodies = root.get("bodies"))
       for (const toml::table* table : tables_of(*bodies, "bodies", body_keys)) {
         const std::string name = name_of(*table, "bodies");
@@ -1002,9 +1034,9 @@ class Loader {
         const toml::node& inertia_node = member(*table, "bodies", "inertia",
                                                 "inertia = [\"Ixx\", \"Iyy\", \"Izz\"] (principal moments) or a 3 x 3 array");
         const symbolic::InertiaText inertia = inertia_of(inertia_node, name);
-        mb.body(name, frame, mass, com, inertia, at(*table));
+        scene.mb.body(name, frame, mass, com, inertia, at(*table));
         // The scene's ellipsoid of the body: its centre of mass, moving with its frame.
-        symbolic::VisualItem item = frame_item(mb.placed_frame(frame), symbolic::VisualKind::body, at(*table));
+        symbolic::VisualItem item = frame_item(scene.mb.placed_frame(frame), symbolic::VisualKind::body, at(*table));
         item.name = name;
         item.size = builder.parse(mass, at(*table));
         for (std::size_t i = 0; i < 3; ++i) {
@@ -1013,9 +1045,13 @@ class Loader {
             item.inertia.push_back(builder.parse(inertia[i][j], at(*table)));
           }
         }
-        body_frames.emplace_back(name, mb.placed_frame(frame));
-        visual.items.push_back(std::move(item));
+        scene.body_frames.emplace_back(name, scene.mb.placed_frame(frame));
+        scene.visual.items.push_back(std::move(item));
       }
+  }
+
+  // [[wheels]]: thin wheels rolling on the ground, drawn as disks about their axles.
+  void load_wheels(const toml::table& root, SpecBuilder& builder, MultibodySections& scene) const {
     if (const toml::node* wheels = root.get("wheels"))
       for (const toml::table* table : tables_of(*wheels, "wheels", wheel_keys)) {
         const std::string name = name_of(*table, "wheels");
@@ -1026,38 +1062,50 @@ class Loader {
             string_of(member(*table, "wheels", "axis", "axis = \"y\""), what + ": axis", "axis = \"y\"");
         const std::string radius = number_or_expression(member(*table, "wheels", "radius", "radius = \"r\""),
                                                         what + ": radius", "radius = \"r\"");
-        mb.rolling_wheel(name, body, axis, radius, optional_triple(*table, "normal", what + ": normal"), at(*table));
+        scene.mb.rolling_wheel(name, body, axis, radius, optional_triple(*table, "normal", what + ": normal"), at(*table));
         // The scene draws the wheel's body as a disk of the wheel's radius about its axle.
-        for (const auto& [body_name, placed] : body_frames)
+        for (const auto& [body_name, placed] : scene.body_frames)
           if (body_name == body) {
             symbolic::VisualItem item = frame_item(placed, symbolic::VisualKind::wheel, at(*table));
             item.name = name;
             item.size = builder.parse(radius, at(*table));
             item.axis = axis == "x" ? 0 : axis == "y" ? 1 : 2;
-            visual.items.push_back(std::move(item));
+            scene.visual.items.push_back(std::move(item));
           }
       }
+  }
+
+  // [[knife_edges]]: a point that moves only along its blade.
+  void load_knife_edges(const toml::table& root, MultibodySections& scene) const {
     if (const toml::node* knives = root.get("knife_edges"))
       for (const toml::table* table : tables_of(*knives, "knife_edges", knife_edge_keys)) {
         const std::string name = name_of(*table, "knife_edges");
         const std::string what = fmt::format("knife edge '{}'", name);
-        mb.knife_edge(name,
+        scene.mb.knife_edge(name,
                       string_of(member(*table, "knife_edges", "point", "point = \"blade\""), what + ": point",
                                 "point = \"blade\""),
                       string_of(member(*table, "knife_edges", "axis", "axis = \"x\""), what + ": axis", "axis = \"x\""),
                       optional_triple(*table, "normal", what + ": normal"), at(*table));
       }
+  }
+
+  // [[surfaces]]: a point held on a fixed surface.
+  void load_surfaces(const toml::table& root, MultibodySections& scene) const {
     if (const toml::node* surfaces = root.get("surfaces"))
       for (const toml::table* table : tables_of(*surfaces, "surfaces", surface_keys)) {
         const std::string name = name_of(*table, "surfaces");
         const std::string what = fmt::format("surface '{}'", name);
         const toml::node& surface = member(*table, "surfaces", "surface", "surface = \"X^2 + Y^2 - R^2\"");
         const std::string text = expression_string(surface, what + ": surface", "surface = \"X^2 + Y^2 - R^2\"");
-        mb.point_on_surface(name,
+        scene.mb.point_on_surface(name,
                             string_of(member(*table, "surfaces", "point", "point = \"bead\""), what + ": point",
                                       "point = \"bead\""),
                             text, content_at(surface));
       }
+  }
+
+  // [[curves]]: a point held on the meeting of two fixed surfaces.
+  void load_curves(const toml::table& root, MultibodySections& scene) const {
     if (const toml::node* curves = root.get("curves"))
       for (const toml::table* table : tables_of(*curves, "curves", curve_keys)) {
         const std::string name = name_of(*table, "curves");
@@ -1068,17 +1116,12 @@ class Loader {
         if (array.size() != 2)
           fail(at(node), fmt::format("{}: a curve is the meeting of two surfaces, e.g. {}; {} are given", what, example,
                                      array.size()));
-        mb.point_on_curve(name,
+        scene.mb.point_on_curve(name,
                           string_of(member(*table, "curves", "point", "point = \"bead\""), what + ": point",
                                     "point = \"bead\""),
                           expression_string(*array.get(0), what + ": surfaces[1]", example),
                           expression_string(*array.get(1), what + ": surfaces[2]", example), at(node));
       }
-    if (const toml::node* contacts = root.get("contacts"))
-      load_contacts(*contacts, mb, visual, body_frames, [this](const toml::node& node) { return at(node); });
-    mb.apply();
-    // Every point's and frame origin's world position and velocity as result columns.
-    symbolic::add_multibody_outputs(builder, mb, frame_names, point_names);
   }
 
   // A frame's `rotations = "quaternion"` with `quaternion = ["e0", "e1", "e2", "e3"]`: the four

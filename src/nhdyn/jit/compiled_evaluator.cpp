@@ -394,31 +394,25 @@ bool is_compiled(const Model& model) {
   return dynamic_cast<const CompiledEvaluator*>(model.evaluator.get()) != nullptr;
 }
 
-Model make_compiled(const Model& model, const JitOptions& options, JitReport* report) {
-  auto base = std::dynamic_pointer_cast<const ProgramEvaluator>(model.evaluator);
-  if (!base)
-    throw JitError(fmt::format("model '{}' has no compiled programs (a hand-written built-in model): nothing to "
-                               "compile",
-                               model.name));
-  const bool sparse = base->sparsity() != nullptr;
-  // The terms, and the programs of the output rows: a compiled model computes its rows compiled too.
-  std::string source = make_terms_source(base->parametric_programs().terms, base->n(), base->s(), base->sparsity());
+namespace {
+
+// The C++ source of a model: its terms, and the programs of the output rows (a compiled model
+// computes its rows compiled too).
+std::string model_source(const ProgramEvaluator& base, const Model& model) {
+  std::string source = make_terms_source(base.parametric_programs().terms, base.n(), base.s(), base.sparsity());
   for (int i = 0; i < kRowPrograms; ++i)
-    if (const Program* program = row_program(base->parametric_programs(), i))
+    if (const Program* program = row_program(base.parametric_programs(), i))
       source += make_program_source(kRowProgramNames[i], *program);
   if (model.contact_forces) source += make_program_source("contact", model.contact_forces->program);
   if (!model.outputs.list.empty()) source += make_program_source("outputs", model.outputs.program);
-  std::string compiler = options.compiler.empty() ? env("NHDYN_CXX") : options.compiler;
-  if (compiler.empty()) compiler = "c++";
-  const fs::path dir = cache_directory(options);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw JitError(fmt::format("cannot create the cache directory {}: {}", dir.string(), ec.message()));
+  return source;
+}
 
-  // The compiler's identity: its --version (which also says whether it runs at all).
-  const std::string suffix = unique_suffix();
+// The compiler's identity: its --version (which also says whether it runs at all).
+std::string compiler_version(const std::string& compiler, const fs::path& dir, const std::string& suffix) {
   const fs::path version_log = dir / ("version-" + suffix + ".log");
   std::string error;
+  std::error_code ec;
   int caught = 0;
   int version_status = 0;
   {
@@ -436,100 +430,113 @@ Model make_compiled(const Model& model, const JitOptions& options, JitReport* re
     throw JitError(version_status < 0
                        ? fmt::format("the C++ compiler '{}' cannot be run ({}); set NHDYN_CXX to one", compiler, error)
                        : fmt::format("the C++ compiler '{}' fails on --version ({})", compiler, first_error(version)));
+  return version;
+}
 
-  std::string flags;
-  for (const std::string& f : kFlags) flags += f + " ";
-  const std::string identity = compiler + "\n" + version + "\n" + flags + "\n";
-  const std::uint64_t h1 = fnv1a(source, fnv1a(identity, 0xcbf29ce484222325ULL));
-  const std::uint64_t h2 = fnv1a(identity, fnv1a(source, 0x84222325cbf29ce4ULL));
-  const std::string key = fmt::format("{:016x}{:016x}", h1, h2);
+// The cache entry `object` if it is there and sound, else null (a damaged entry is removed, and
+// the report's note says why).
+std::shared_ptr<Library> load_cached(const fs::path& object, const fs::path& check, const std::string& key,
+                                     bool sparse, JitReport* report) {
+  std::error_code ec;
+  if (!fs::exists(object, ec) && !fs::exists(check, ec)) return nullptr;
+  // Verified before dlopen: a truncated object would end the process in SIGBUS, and an object
+  // copied over another model's name would give that model's motion.
+  std::shared_ptr<Library> library;
+  std::string error;
+  std::string damage = verify_entry(object, check, key);
+  if (damage.empty()) {
+    library = load(object, sparse, error);
+    if (!library)
+      damage = error;
+    else if (!library->key || key != library->key())
+      damage = "it was compiled for another model";
+  }
+  if (damage.empty()) return library;
+  library.reset();
+  fs::remove(object, ec);
+  fs::remove(check, ec);
+  if (report)
+    report->note = fmt::format("nhdyn: note: the cached compiled model {} was unusable ({}); compiling it again",
+                               object.string(), damage);
+  return nullptr;
+}
+
+// Compiles `source` into the cache entry `object` (with its check file) and loads it. Every
+// temporary is removed on failure or interruption.
+std::shared_ptr<Library> compile_entry(const std::string& source, const std::string& compiler, const fs::path& dir,
+                                       const std::string& key, const std::string& suffix, const Model& model,
+                                       bool sparse, JitReport* report) {
   const fs::path object = dir / (key + ".so");
   const fs::path check = dir / (key + ".so.check");
-  if (report) report->object = object.string();
+  const fs::path source_file = dir / (key + "-" + suffix + ".cpp");
+  const fs::path temporary = dir / (key + ".so.tmp-" + suffix);
+  const fs::path check_temporary = dir / (key + ".so.check.tmp-" + suffix);
+  const fs::path log = dir / (key + "-" + suffix + ".log");
+  std::error_code ec;
+  std::string error;
+  int caught = 0;
+  const auto remove_all = [&] {
+    for (const fs::path* p : {&source_file, &temporary, &check_temporary, &log}) fs::remove(*p, ec);
+  };
+  HeldSignals held;
+  {
+    std::ofstream out(source_file, std::ios::binary);
+    // The key inside the object: a file renamed or copied to another model's name is caught.
+    out << source << fmt::format("\nextern \"C\" const char* nhdyn_jit_key() {{ return \"{}\"; }}\n", key);
+    if (!out) {
+      remove_all();
+      throw JitError(fmt::format("cannot write {}", source_file.string()));
+    }
+  }
+  std::vector<std::string> argv = {compiler};
+  argv.insert(argv.end(), kFlags.begin(), kFlags.end());
+  argv.insert(argv.end(), {"-o", temporary.string(), source_file.string()});
+  const auto start = std::chrono::steady_clock::now();
+  const int status = run(argv, log, error, caught);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::string output = status == -2 ? std::string() : read_file(log);
+  if (status != 0) {
+    remove_all();
+    if (caught) {
+      held.release_and_raise(caught);
+      throw JitError("the compile was interrupted");
+    }
+    throw JitError(status < 0 ? fmt::format("the C++ compiler '{}' cannot be run ({})", compiler, error)
+                              : fmt::format("the C++ compiler '{}' failed on model '{}': {}", compiler, model.name,
+                                            first_error(output)));
+  }
+  fs::remove(source_file, ec);
+  fs::remove(log, ec);
+  // The check file first, then the object: whoever sees the object finds its check. Each is
+  // renamed into place whole, so a concurrent process sees no file or the whole one.
+  const std::string bytes = read_file(temporary);
+  {
+    std::ofstream out(check_temporary, std::ios::binary);
+    out << entry_check(key, bytes);
+    if (!out) {
+      remove_all();
+      throw JitError(fmt::format("cannot write {}", check_temporary.string()));
+    }
+  }
+  fs::rename(check_temporary, check, ec);
+  if (!ec) fs::rename(temporary, object, ec);
+  if (ec) {
+    const std::string reason = ec.message();
+    remove_all();
+    throw JitError(fmt::format("cannot move the compiled model into {}: {}", object.string(), reason));
+  }
+  if (report) {
+    report->compiled = true;
+    report->compile_seconds = seconds;
+  }
+  std::shared_ptr<Library> library = load(object, sparse, error);
+  if (!library) throw JitError(fmt::format("cannot load the compiled model: {}", error));
+  return library;
+}
 
-  std::shared_ptr<Library> library;
-  if (fs::exists(object, ec) || fs::exists(check, ec)) {
-    // Verified before dlopen: a truncated object would end the process in SIGBUS, and an object
-    // copied over another model's name would give that model's motion.
-    std::string damage = verify_entry(object, check, key);
-    if (damage.empty()) {
-      library = load(object, sparse, error);
-      if (!library)
-        damage = error;
-      else if (!library->key || key != library->key())
-        damage = "it was compiled for another model";
-    }
-    if (!damage.empty()) {
-      library.reset();
-      fs::remove(object, ec);
-      fs::remove(check, ec);
-      if (report)
-        report->note = fmt::format("nhdyn: note: the cached compiled model {} was unusable ({}); compiling it again",
-                                   object.string(), damage);
-    }
-  }
-  if (!library) {
-    const fs::path source_file = dir / (key + "-" + suffix + ".cpp");
-    const fs::path temporary = dir / (key + ".so.tmp-" + suffix);
-    const fs::path check_temporary = dir / (key + ".so.check.tmp-" + suffix);
-    const fs::path log = dir / (key + "-" + suffix + ".log");
-    const auto remove_all = [&] {
-      for (const fs::path* p : {&source_file, &temporary, &check_temporary, &log}) fs::remove(*p, ec);
-    };
-    HeldSignals held;
-    {
-      std::ofstream out(source_file, std::ios::binary);
-      // The key inside the object: a file renamed or copied to another model's name is caught.
-      out << source << fmt::format("\nextern \"C\" const char* nhdyn_jit_key() {{ return \"{}\"; }}\n", key);
-      if (!out) {
-        remove_all();
-        throw JitError(fmt::format("cannot write {}", source_file.string()));
-      }
-    }
-    std::vector<std::string> argv = {compiler};
-    argv.insert(argv.end(), kFlags.begin(), kFlags.end());
-    argv.insert(argv.end(), {"-o", temporary.string(), source_file.string()});
-    const auto start = std::chrono::steady_clock::now();
-    const int status = run(argv, log, error, caught);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const std::string output = status == -2 ? std::string() : read_file(log);
-    if (status != 0) {
-      remove_all();
-      if (caught) {
-        held.release_and_raise(caught);
-        throw JitError("the compile was interrupted");
-      }
-      throw JitError(status < 0 ? fmt::format("the C++ compiler '{}' cannot be run ({})", compiler, error)
-                                : fmt::format("the C++ compiler '{}' failed on model '{}': {}", compiler, model.name,
-                                              first_error(output)));
-    }
-    fs::remove(source_file, ec);
-    fs::remove(log, ec);
-    // The check file first, then the object: whoever sees the object finds its check. Each is
-    // renamed into place whole, so a concurrent process sees no file or the whole one.
-    const std::string bytes = read_file(temporary);
-    {
-      std::ofstream out(check_temporary, std::ios::binary);
-      out << entry_check(key, bytes);
-      if (!out) {
-        remove_all();
-        throw JitError(fmt::format("cannot write {}", check_temporary.string()));
-      }
-    }
-    fs::rename(check_temporary, check, ec);
-    if (!ec) fs::rename(temporary, object, ec);
-    if (ec) {
-      const std::string reason = ec.message();
-      remove_all();
-      throw JitError(fmt::format("cannot move the compiled model into {}: {}", object.string(), reason));
-    }
-    if (report) {
-      report->compiled = true;
-      report->compile_seconds = seconds;
-    }
-    library = load(object, sparse, error);
-    if (!library) throw JitError(fmt::format("cannot load the compiled model: {}", error));
-  }
+// The model with the library's functions in place of its programs.
+Model bind_library(const Model& model, std::shared_ptr<const ProgramEvaluator> base, std::shared_ptr<Library> library,
+                   const fs::path& object) {
   Model out = model;
   if (model.contact_forces) {
     auto contact = std::make_shared<ContactForceModel>(*model.contact_forces);
@@ -550,6 +557,39 @@ Model make_compiled(const Model& model, const JitOptions& options, JitReport* re
   }
   out.evaluator = std::make_shared<CompiledEvaluator>(std::move(base), std::move(library), std::move(rows));
   return out;
+}
+
+}  // namespace
+
+Model make_compiled(const Model& model, const JitOptions& options, JitReport* report) {
+  auto base = std::dynamic_pointer_cast<const ProgramEvaluator>(model.evaluator);
+  if (!base)
+    throw JitError(fmt::format("model '{}' has no compiled programs (a hand-written built-in model): nothing to "
+                               "compile",
+                               model.name));
+  const bool sparse = base->sparsity() != nullptr;
+  const std::string source = model_source(*base, model);
+  std::string compiler = options.compiler.empty() ? env("NHDYN_CXX") : options.compiler;
+  if (compiler.empty()) compiler = "c++";
+  const fs::path dir = cache_directory(options);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw JitError(fmt::format("cannot create the cache directory {}: {}", dir.string(), ec.message()));
+
+  const std::string suffix = unique_suffix();
+  const std::string version = compiler_version(compiler, dir, suffix);
+  std::string flags;
+  for (const std::string& f : kFlags) flags += f + " ";
+  const std::string identity = compiler + "\n" + version + "\n" + flags + "\n";
+  const std::uint64_t h1 = fnv1a(source, fnv1a(identity, 0xcbf29ce484222325ULL));
+  const std::uint64_t h2 = fnv1a(identity, fnv1a(source, 0x84222325cbf29ce4ULL));
+  const std::string key = fmt::format("{:016x}{:016x}", h1, h2);
+  const fs::path object = dir / (key + ".so");
+  if (report) report->object = object.string();
+
+  std::shared_ptr<Library> library = load_cached(object, dir / (key + ".so.check"), key, sparse, report);
+  if (!library) library = compile_entry(source, compiler, dir, key, suffix, model, sparse, report);
+  return bind_library(model, std::move(base), std::move(library), object);
 }
 
 Model with_evaluator(const Model& model, EvaluatorChoice choice, std::string* notice, const JitOptions& options,

@@ -635,17 +635,12 @@ std::vector<Step> schedule(const std::vector<Step>& steps, std::size_t registers
   return out;
 }
 
-}  // namespace
-
-ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, const std::vector<int>& sizes) {
+// Constants folded, constant operands made immediates; program order, every step to a register.
+// known[reg] says that the register holds the constant value[reg].
+std::vector<Step> fold_constants(const Program& program, std::vector<char>& known, std::vector<double>& value) {
   const std::vector<Instruction>& code = program.code();
   const int inputs = program.inputs();
-  const std::size_t registers = static_cast<std::size_t>(program.registers());
   const auto at = [](int reg) { return static_cast<std::size_t>(reg); };
-
-  // Constants folded, constant operands made immediates; program order, every step to a register.
-  std::vector<char> known(registers, 0);  // the register holds the constant value[reg]
-  std::vector<double> value(registers, 0.0);
   std::vector<Step> steps;
   for (std::size_t i = 0; i < code.size(); ++i) {
     const Instruction& in = code[i];
@@ -708,26 +703,22 @@ ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, con
     }
     steps.push_back(step);
   }
+  return steps;
+}
 
-  // The outputs: constants into the image, the others wanted from their registers.
-  Prepared p;
-  struct Want {
-    int array, index;
-  };
-  std::vector<std::vector<Want>> wants(registers);
-  const std::vector<Output>& outputs = program.output_list();
-  std::size_t j = 0;
-  for (std::size_t array = 0; array < sizes.size(); ++array)
-    for (int i = 0; i < sizes[array]; ++i, ++j) {
-      const Output& o = outputs[j];
-      const bool constant = o.reg < 0 || known[at(o.reg)];
-      p.image.push_back(o.reg < 0 ? o.value : constant ? value[at(o.reg)] : 0.0);
-      if (!constant) wants[at(o.reg)].push_back(Want{static_cast<int>(array) + 1, i});
-    }
+// Where an output wants a register's value: array (1-based: 0 is the registers) and index.
+struct Want {
+  int array, index;
+};
 
-  // Only the steps an output needs, found backwards; then who reads each register.
-  std::vector<char> live(registers, 0), keep(steps.size(), 0);
-  std::vector<int> readers(registers, 0);
+// Only the steps an output needs (keep), found backwards; and how many kept steps read each register.
+void mark_live(const std::vector<Step>& steps, const std::vector<std::vector<Want>>& wants, std::vector<char>& keep,
+               std::vector<int>& readers) {
+  const std::size_t registers = wants.size();
+  const auto at = [](int reg) { return static_cast<std::size_t>(reg); };
+  std::vector<char> live(registers, 0);
+  keep.assign(steps.size(), 0);
+  readers.assign(registers, 0);
   for (std::size_t r = 0; r < registers; ++r) live[r] = !wants[r].empty();
   for (std::size_t i = steps.size(); i-- > 0;) {
     const Step& step = steps[i];
@@ -739,12 +730,16 @@ ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, con
       ++readers[at(operands[k])];
     }
   }
+}
 
-  // A product a * b (or a * a) read only by a k * x or k * x + c that follows becomes part of it:
-  // k * (a * b) is mulk, k * (a * b) + c mulk_muladd, which round exactly as the two steps did.
-  // A parameter times a product of the state, c * p * (a * b) with c * p in the parameter stage,
-  // then costs one step, as it did when parameters were numbers in the program.
-  std::vector<int> producer(registers, -1);
+// A product a * b (or a * a) read only by a k * x or k * x + c that follows becomes part of it:
+// k * (a * b) is mulk, k * (a * b) + c mulk_muladd, which round exactly as the two steps did.
+// A parameter times a product of the state, c * p * (a * b) with c * p in the parameter stage,
+// then costs one step, as it did when parameters were numbers in the program.
+void fuse_products(std::vector<Step>& steps, const std::vector<std::vector<Want>>& wants, std::vector<char>& keep,
+                   const std::vector<int>& readers) {
+  const auto at = [](int reg) { return static_cast<std::size_t>(reg); };
+  std::vector<int> producer(wants.size(), -1);
   for (std::size_t i = 0; i < steps.size(); ++i)
     if (keep[i]) producer[at(steps[i].to)] = static_cast<int>(i);
   for (std::size_t i = 0; i < steps.size(); ++i) {
@@ -761,6 +756,35 @@ ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, con
       step = Step{Op::mulk_muladd, 0, step.to, a, b, step.b, step.k};
     keep[static_cast<std::size_t>(j)] = 0;
   }
+}
+
+}  // namespace
+
+ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, const std::vector<int>& sizes) {
+  const int inputs = program.inputs();
+  const std::size_t registers = static_cast<std::size_t>(program.registers());
+  const auto at = [](int reg) { return static_cast<std::size_t>(reg); };
+  std::vector<char> known(registers, 0);
+  std::vector<double> value(registers, 0.0);
+  std::vector<Step> steps = fold_constants(program, known, value);
+
+  // The outputs: constants into the image, the others wanted from their registers.
+  Prepared p;
+  std::vector<std::vector<Want>> wants(registers);
+  const std::vector<Output>& outputs = program.output_list();
+  std::size_t j = 0;
+  for (std::size_t array = 0; array < sizes.size(); ++array)
+    for (int i = 0; i < sizes[array]; ++i, ++j) {
+      const Output& o = outputs[j];
+      const bool constant = o.reg < 0 || known[at(o.reg)];
+      p.image.push_back(o.reg < 0 ? o.value : constant ? value[at(o.reg)] : 0.0);
+      if (!constant) wants[at(o.reg)].push_back(Want{static_cast<int>(array) + 1, i});
+    }
+
+  std::vector<char> keep;
+  std::vector<int> readers;
+  mark_live(steps, wants, keep, readers);
+  fuse_products(steps, wants, keep, readers);
 
   // Each step in place: an output computed once for all is written where it goes; a copy (1 * x,
   // exact) serves an input or a sincos, a clone of its step every further output of a register.

@@ -953,9 +953,8 @@ void compile_program_constraints(const Spec& spec, const Derivation& derivation,
   programs.program_constraint_velocity_residual = f.finish();
 }
 
-}  // namespace
-
-Model compile_model(const Spec& spec, const Derivation& derivation, const CompileOptions& options) {
+// The sizes of what the derivation gives, against the Spec's n coordinates and s constraints.
+void check_derivation(const Spec& spec, const Derivation& derivation) {
   const int n = spec.n(), s = spec.s();
   if (n == 0) throw ModelError(fmt::format("model '{}' has no coordinates", spec.name));
   if (s >= n)
@@ -971,8 +970,10 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
   check_size(spec, "b", derivation.b, s, n);
   check_size(spec, "b0", derivation.b0, s, 1);
   if (derivation.D) check_size(spec, "D", *derivation.D, n - s, n);
+}
 
-  Model model;
+// The names, constraints and parameters the Model carries as text and values.
+void describe_model(const Spec& spec, const Derivation& derivation, Model& model) {
   model.name = spec.name;
   model.description = spec.description;
   model.coordinates = spec.coordinates;
@@ -987,135 +988,150 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
                                  "position and {} position-or-velocity constraints",
                                  spec.name, derivation.phi.size(), derivation.f.size(),
                                  model.position_constraints(), model.velocity_constraints()));
+}
 
+// A, Q, G, b and b0 in one program (sharing subexpressions), dense or by A's and b's patterns.
+void compile_terms(const Spec& spec, const Derivation& derivation, TermsLayout layout, ModelPrograms& programs) {
+  const int n = spec.n(), s = spec.s();
   const auto q_name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
   const auto c_name = [&](int i) { return spec.constraints[static_cast<std::size_t>(i)].name; };
+  TermsSparsity sparsity{pattern_of(derivation.A), pattern_of(derivation.b)};
+  const bool sparse = compile_sparse(sparsity, n, s, layout);
+  ProgramCompiler terms(spec);
+  // Column by column: every entry when dense, the pattern's nonzeros when sparse. Entry names
+  // are formatted only when compiled (a thousand-body chain has 18 million entries).
+  const auto matrix_outputs = [&](const ExMatrix& m, const SparsityPattern& pattern, const char* symbol,
+                                  auto row_name) {
+    for (int j = 0; j < static_cast<int>(m.cols()); ++j) {
+      const auto output = [&](int i) {
+        const GiNaC::ex& e = m(static_cast<unsigned>(i), static_cast<unsigned>(j));
+        if (e.is_zero())
+          terms.add_output(e, "");
+        else
+          terms.add_output(e, fmt::format("{}({}, {})", symbol, row_name(i), q_name(j)));
+      };
+      if (sparse) {
+        for (int k = pattern.outer[static_cast<std::size_t>(j)]; k < pattern.outer[static_cast<std::size_t>(j) + 1];
+             ++k)
+          output(pattern.inner[static_cast<std::size_t>(k)]);
+      } else {
+        for (int i = 0; i < static_cast<int>(m.rows()); ++i) output(i);
+      }
+    }
+  };
+  matrix_outputs(derivation.A, sparsity.A, "A", q_name);
+  for (int i = 0; i < n; ++i)
+    terms.add_output(derivation.Q(static_cast<unsigned>(i), 0), fmt::format("Q({})", q_name(i)));
+  for (int i = 0; i < n; ++i)
+    terms.add_output(derivation.G(static_cast<unsigned>(i), 0), fmt::format("G({})", q_name(i)));
+  matrix_outputs(derivation.b, sparsity.b, "b", c_name);
+  for (int i = 0; i < s; ++i)
+    terms.add_output(derivation.b0(static_cast<unsigned>(i), 0), fmt::format("b0({})", c_name(i)));
+  programs.terms = terms.finish();
+  if (sparse) programs.sparsity = std::move(sparsity);
+}
+
+// The user's complement D, when the derivation has one.
+void compile_complement(const Spec& spec, const Derivation& derivation, ModelPrograms& programs) {
+  if (!derivation.D) return;
+  const int n = spec.n(), s = spec.s();
+  ProgramCompiler complement(spec);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n - s; ++i)
+      complement.add_output((*derivation.D)(static_cast<unsigned>(i), static_cast<unsigned>(j)),
+                            fmt::format("D({}, {})", i + 1, spec.coordinates[static_cast<std::size_t>(j)]));
+  programs.complement = complement.finish();
+}
+
+// The constraints' residuals: phi of the position-level ones, f of those at the position or
+// velocity level (residual i belongs to the i-th constraint of its level, in constraint order).
+void compile_residuals(const Spec& spec, const Derivation& derivation, ModelPrograms& programs) {
+  const auto c_name = [&](int i) { return spec.constraints[static_cast<std::size_t>(i)].name; };
+  std::vector<int> position, velocity;
+  for (int i = 0; i < spec.s(); ++i) {
+    const ConstraintLevel level = spec.constraints[static_cast<std::size_t>(i)].level;
+    if (level == ConstraintLevel::position) position.push_back(i);
+    if (level != ConstraintLevel::acceleration) velocity.push_back(i);
+  }
+  ProgramCompiler phi(spec);
+  for (std::size_t i = 0; i < derivation.phi.size(); ++i)
+    phi.add_output(derivation.phi[i], fmt::format("phi({})", c_name(position[i])));
+  programs.position_residual = phi.finish();
+  if (programs.position_residual.reads_velocities())
+    throw ModelError(fmt::format("model '{}': a position-level residual depends on the velocities", spec.name));
+  ProgramCompiler f(spec);
+  for (std::size_t i = 0; i < derivation.f.size(); ++i)
+    f.add_output(derivation.f[i], fmt::format("f({})", c_name(velocity[i])));
+  programs.velocity_residual = f.finish();
+}
+
+// The energy and its balance (docs/derivations/energy-balance.md): h where it differs from E, and
+// the symbolic parts of the power where they are not zero (the power program runs at every
+// right-hand side of a run, so a conservative model has none).
+void compile_energy(const Spec& spec, const Derivation& derivation, ModelPrograms& programs) {
+  if (!derivation.energy) return;
+  ProgramCompiler energy(spec);
+  energy.add_output(*derivation.energy, "energy");
+  programs.energy = energy.finish();
+  programs.energy_balance = true;
+  if (derivation.energy_function) {
+    ProgramCompiler h(spec);
+    h.add_output(*derivation.energy_function, "energy function");
+    programs.energy_function = h.finish();
+  }
+  if (!derivation.conservative) {
+    ProgramCompiler power(spec);
+    power.add_output(derivation.power_forces, "power of the forces");
+    power.add_output(derivation.power_time, "power of the explicit time dependence");
+    programs.power = power.finish();
+  }
+}
+
+// The initial state's program, when the Spec gives one (else q0 = v0 = 0).
+void compile_initial_state(const Spec& spec, ModelPrograms& programs) {
+  const int n = spec.n();
+  if (spec.q0.empty() && spec.v0.empty()) return;
+  if (static_cast<int>(spec.q0.size()) != n || static_cast<int>(spec.v0.size()) != n)
+    throw ModelError(fmt::format("model '{}': {} initial coordinates and {} initial velocities for {} coordinates",
+                                 spec.name, spec.q0.size(), spec.v0.size(), n));
+  const auto q_name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
+  // Checked here, symbolically (an initial value may use the parameters only); its values come
+  // from the initial-state program, which follows the parameters when they change.
   const GiNaC::lst values = spec.parameter_values();
+  for (int i = 0; i < n; ++i) {
+    initial_value(spec, values, spec.q0[static_cast<std::size_t>(i)], q_name(i));
+    initial_value(spec, values, spec.v0[static_cast<std::size_t>(i)], q_name(i) + "'");
+  }
+  ProgramCompiler initial(spec);
+  for (int i = 0; i < n; ++i) initial.add_output(spec.q0[static_cast<std::size_t>(i)], "initial " + q_name(i));
+  for (int i = 0; i < n; ++i) initial.add_output(spec.v0[static_cast<std::size_t>(i)], "initial " + q_name(i) + "'");
+  programs.initial_state = initial.finish();
+}
 
-  ModelPrograms programs;
-  programs.parameters = static_cast<int>(spec.parameters.size());
-  {
-    TermsSparsity sparsity{pattern_of(derivation.A), pattern_of(derivation.b)};
-    const bool sparse = compile_sparse(sparsity, n, s, options.layout);
-    ProgramCompiler terms(spec);
-    // Column by column: every entry when dense, the pattern's nonzeros when sparse. Entry names
-    // are formatted only when compiled (a thousand-body chain has 18 million entries).
-    const auto matrix_outputs = [&](const ExMatrix& m, const SparsityPattern& pattern, const char* symbol,
-                                    auto row_name) {
-      for (int j = 0; j < static_cast<int>(m.cols()); ++j) {
-        const auto output = [&](int i) {
-          const GiNaC::ex& e = m(static_cast<unsigned>(i), static_cast<unsigned>(j));
-          if (e.is_zero())
-            terms.add_output(e, "");
-          else
-            terms.add_output(e, fmt::format("{}({}, {})", symbol, row_name(i), q_name(j)));
-        };
-        if (sparse) {
-          for (int k = pattern.outer[static_cast<std::size_t>(j)]; k < pattern.outer[static_cast<std::size_t>(j) + 1];
-               ++k)
-            output(pattern.inner[static_cast<std::size_t>(k)]);
-        } else {
-          for (int i = 0; i < static_cast<int>(m.rows()); ++i) output(i);
-        }
+// A closed-form solution's q(t), then its first and second derivatives: the exact velocities and
+// accelerations. A closed form that cannot be evaluated at these parameter values (v0/w with w =
+// 0) must not stop the model: that output is NaN, which check_solution refuses where the solution
+// is used.
+void compile_solution(const Spec& spec, ModelPrograms& programs) {
+  if (spec.solution.empty()) return;
+  ProgramCompiler solution(spec);
+  const GiNaC::symbol& t = spec.symbols.time();
+  for (int order = 0; order < 3; ++order)
+    for (int i = 0; i < spec.n(); ++i) {
+      try {
+        solution.add_output(spec.solution[static_cast<std::size_t>(i)].diff(t, order),
+                            fmt::format("solution {}{}", spec.coordinates[static_cast<std::size_t>(i)],
+                                        std::string(static_cast<std::size_t>(order), '\'')));
+      } catch (const ModelError&) {
+        solution.add_nan_output();
       }
-    };
-    matrix_outputs(derivation.A, sparsity.A, "A", q_name);
-    for (int i = 0; i < n; ++i)
-      terms.add_output(derivation.Q(static_cast<unsigned>(i), 0), fmt::format("Q({})", q_name(i)));
-    for (int i = 0; i < n; ++i)
-      terms.add_output(derivation.G(static_cast<unsigned>(i), 0), fmt::format("G({})", q_name(i)));
-    matrix_outputs(derivation.b, sparsity.b, "b", c_name);
-    for (int i = 0; i < s; ++i)
-      terms.add_output(derivation.b0(static_cast<unsigned>(i), 0), fmt::format("b0({})", c_name(i)));
-    programs.terms = terms.finish();
-    if (sparse) programs.sparsity = std::move(sparsity);
-  }
-  if (derivation.D) {
-    ProgramCompiler complement(spec);
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n - s; ++i)
-        complement.add_output((*derivation.D)(static_cast<unsigned>(i), static_cast<unsigned>(j)),
-                              fmt::format("D({}, {})", i + 1, q_name(j)));
-    programs.complement = complement.finish();
-  }
-  {
-    // Residual i belongs to the i-th constraint of its level (constraint order).
-    std::vector<int> position, velocity;
-    for (int i = 0; i < s; ++i) {
-      const ConstraintLevel level = spec.constraints[static_cast<std::size_t>(i)].level;
-      if (level == ConstraintLevel::position) position.push_back(i);
-      if (level != ConstraintLevel::acceleration) velocity.push_back(i);
     }
-    ProgramCompiler phi(spec);
-    for (std::size_t i = 0; i < derivation.phi.size(); ++i)
-      phi.add_output(derivation.phi[i], fmt::format("phi({})", c_name(position[i])));
-    programs.position_residual = phi.finish();
-    if (programs.position_residual.reads_velocities())
-      throw ModelError(fmt::format("model '{}': a position-level residual depends on the velocities", spec.name));
-    ProgramCompiler f(spec);
-    for (std::size_t i = 0; i < derivation.f.size(); ++i)
-      f.add_output(derivation.f[i], fmt::format("f({})", c_name(velocity[i])));
-    programs.velocity_residual = f.finish();
-  }
-  if (derivation.energy) {
-    ProgramCompiler energy(spec);
-    energy.add_output(*derivation.energy, "energy");
-    programs.energy = energy.finish();
-    // The energy balance (docs/derivations/energy-balance.md): h where it differs from E, and the
-    // symbolic parts of the power where they are not zero (the power program runs at every
-    // right-hand side of a run, so a conservative model has none).
-    programs.energy_balance = true;
-    if (derivation.energy_function) {
-      ProgramCompiler h(spec);
-      h.add_output(*derivation.energy_function, "energy function");
-      programs.energy_function = h.finish();
-    }
-    if (!derivation.conservative) {
-      ProgramCompiler power(spec);
-      power.add_output(derivation.power_forces, "power of the forces");
-      power.add_output(derivation.power_time, "power of the explicit time dependence");
-      programs.power = power.finish();
-    }
-  }
+  programs.solution = solution.finish();
+}
 
-  model.t0 = spec.t0;
-  model.q0 = Vector::Zero(n);
-  model.v0 = Vector::Zero(n);
-  if (!spec.q0.empty() || !spec.v0.empty()) {
-    if (static_cast<int>(spec.q0.size()) != n || static_cast<int>(spec.v0.size()) != n)
-      throw ModelError(fmt::format("model '{}': {} initial coordinates and {} initial velocities for {} coordinates",
-                                   spec.name, spec.q0.size(), spec.v0.size(), n));
-    // Checked here, symbolically (an initial value may use the parameters only); its values come
-    // from the initial-state program, which follows the parameters when they change.
-    for (int i = 0; i < n; ++i) {
-      initial_value(spec, values, spec.q0[static_cast<std::size_t>(i)], q_name(i));
-      initial_value(spec, values, spec.v0[static_cast<std::size_t>(i)], q_name(i) + "'");
-    }
-    ProgramCompiler initial(spec);
-    for (int i = 0; i < n; ++i) initial.add_output(spec.q0[static_cast<std::size_t>(i)], "initial " + q_name(i));
-    for (int i = 0; i < n; ++i) initial.add_output(spec.v0[static_cast<std::size_t>(i)], "initial " + q_name(i) + "'");
-    programs.initial_state = initial.finish();
-  }
-  if (!spec.solution.empty()) {
-    // q(t), then its first and second derivatives: the exact velocities and accelerations. A
-    // closed form that cannot be evaluated at these parameter values (v0/w with w = 0) must not
-    // stop the model: that output is NaN, which check_solution refuses where the solution is used.
-    ProgramCompiler solution(spec);
-    const GiNaC::symbol& t = spec.symbols.time();
-    for (int order = 0; order < 3; ++order)
-      for (int i = 0; i < n; ++i) {
-        try {
-          solution.add_output(spec.solution[static_cast<std::size_t>(i)].diff(t, order),
-                              fmt::format("solution {}{}", q_name(i), std::string(static_cast<std::size_t>(order), '\'')));
-        } catch (const ModelError&) {
-          solution.add_nan_output();
-        }
-      }
-    programs.solution = solution.finish();
-  }
-  compile_program_constraints(spec, derivation, programs, model);
-  model.q0_written = spec.q0_written;
-  model.v0_written = spec.v0_written;
+// The contact coordinates nhdyn added (with the constraints that fix their start) and the contacts'
+// watched measures (a disk or torus lying flat).
+void compile_contact_coordinates(const Spec& spec, Model& model) {
   for (const SpecContactCoordinates& added : spec.contact_coordinates) {
     ContactCoordinates c{added.contact, added.where.describe(), added.coordinates, {}};
     for (const std::string& name : added.constraints)
@@ -1127,6 +1143,32 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
     model.contact_watches.push_back({w.contact, w.where.describe(),
                                      compile_expression(spec, w.measure, fmt::format("contact '{}'", w.contact)),
                                      w.threshold, w.reason});
+}
+
+}  // namespace
+
+Model compile_model(const Spec& spec, const Derivation& derivation, const CompileOptions& options) {
+  check_derivation(spec, derivation);
+  const int n = spec.n(), s = spec.s();
+  Model model;
+  describe_model(spec, derivation, model);
+
+  ModelPrograms programs;
+  programs.parameters = static_cast<int>(spec.parameters.size());
+  compile_terms(spec, derivation, options.layout, programs);
+  compile_complement(spec, derivation, programs);
+  compile_residuals(spec, derivation, programs);
+  compile_energy(spec, derivation, programs);
+  compile_initial_state(spec, programs);
+  compile_solution(spec, programs);
+  compile_program_constraints(spec, derivation, programs, model);
+
+  model.t0 = spec.t0;
+  model.q0 = Vector::Zero(n);
+  model.v0 = Vector::Zero(n);
+  model.q0_written = spec.q0_written;
+  model.v0_written = spec.v0_written;
+  compile_contact_coordinates(spec, model);
   model.defaults = spec.defaults;
   if (spec.path)
     model.path = PlanarPath{coordinate_index(spec, spec.path->first, "x"), coordinate_index(spec, spec.path->second, "y")};
