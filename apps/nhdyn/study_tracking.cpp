@@ -41,6 +41,91 @@ struct TrackingArgs {
 
 std::string gain_label(double gain) { return gain == 0.0 ? std::string("none") : fmt::format("{:g}", gain); }
 
+// Both files say what made them (io/provenance.hpp): the model as loaded and the study's options.
+std::string tracking_provenance(const Model& model, const ModelSource& source, const TrackingOptions& options,
+                                const TrackingArgs& args) {
+  std::vector<std::string> gains, tolerances;
+  for (double gain : args.gains) gains.push_back(fmt::format("{}", gain));
+  for (double tolerance : args.tolerances) tolerances.push_back(fmt::format("{}", tolerance));
+  return format_provenance(make_command_provenance(
+      model, source, "study tracking",
+      {{"gains", join(gains, ",")},
+       {"integrator", std::string(integrator_name(options.integrator))},
+       {"tolerances", join(tolerances, ",")},
+       {"atol_factor", fmt::format("{}", args.atol_factor)},
+       {"t_end", fmt::format("{}", args.t_end.value_or(model.defaults.t_end))},
+       {"output_step", fmt::format("{}", args.output_step.value_or(model.defaults.output_step))}}));
+}
+
+// The by-tolerance series (one row per tolerance: each gain's error and residual, NaN where the run
+// failed) and the table's text (one line per run).
+std::string write_tracking_series(const Tracking& study, bool pos, const std::string& provenance, double atol_factor,
+                                  CsvWriter& series) {
+  // Like for like: the error of q against the position residual, of q' against the velocity one.
+  const auto error_of = [&](const TrackingRun& r) { return pos ? r.max_error_q : r.max_error_v; };
+  const auto residual_of = [&](const TrackingRun& r) { return pos ? r.max_residual_pos : r.max_residual_vel; };
+  std::vector<double> row;
+  for (std::size_t k = 0; k < study.tolerances.size(); ++k) {
+    row.assign(1, study.tolerances[k]);
+    for (std::size_t g = 0; g < study.gains.size(); ++g) {
+      const TrackingRun& r = study.run(g, k);
+      const bool ok = r.summary.status == Status::ok;
+      row.push_back(ok ? error_of(r) : std::nan(""));
+      row.push_back(ok ? residual_of(r) : std::nan(""));
+    }
+    series.write_row(row);
+  }
+  std::string text = provenance + "gain,rtol,atol,max_error_q,max_error_v,max_residual_pos,max_residual_vel,max_residual_acc,"
+                     "steps,rhs_evaluations,status\n";
+  for (const TrackingRun& r : study.runs)
+    text += fmt::format("{:g},{:.3g},{:.3g},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{}\n", r.gain, r.tolerance,
+                        r.tolerance * atol_factor, r.max_error_q, r.max_error_v, r.max_residual_pos,
+                        r.max_residual_vel, r.max_residual_acc, r.summary.stats.steps, r.summary.stats.rhs_evaluations,
+                        r.summary.status == Status::ok ? "ok" : std::string(describe(r.summary.status)));
+  return text;
+}
+
+// --plot: each run a point (its program residual, its error); the runs of one gain joined in the
+// order of the tolerances. On the diagonal the residual equals the error.
+void plot_tracking(const Tracking& study, const Model& model, bool pos, const std::filesystem::path& series_path,
+                   const std::string& plot) {
+  XyPlotRequest request;
+  request.title = fmt::format("{}: error of the solution against the {} program residual, rtol {:g} .. {:g}",
+                              model.name, pos ? "position" : "velocity", study.tolerances.front(),
+                              study.tolerances.back());
+  request.csv = series_path;
+  for (double gain : study.gains) {
+    request.y.push_back("error_gain_" + gain_label(gain));
+    request.x_of_curve.push_back("residual_gain_" + gain_label(gain));
+    request.titles.push_back(gain == 0.0 ? std::string("no feedback")
+                                         : fmt::format("feedback alpha = beta = {:g} 1/s", gain));
+  }
+  request.x_label = fmt::format("max |{} program residual| over the run (tracking error)", pos ? "position" : "velocity");
+  request.y_label = fmt::format("max |error of {}| against the exact programmed motion", pos ? "q" : "q'");
+  request.diagonal = true;
+  write_xy_plot(request, plot);
+}
+
+// The summary on standard output: one line per run, and where the files went.
+void print_tracking(const Tracking& study, const Model& model, const TrackingArgs& args,
+                    const std::filesystem::path& table_path, const std::filesystem::path& series_path) {
+  const double t_end = args.t_end.value_or(model.defaults.t_end);
+  fmt::print("nhdyn study tracking {}: t = {:g} .. {:g} s, {}, atol = {:g} rtol, reference: the model's exact "
+             "solution\n",
+             model.name, model.t0, t_end, args.integrator, args.atol_factor);
+  fmt::print("{:>6} {:>7} {:>10} {:>10} {:>10} {:>10} {:>10} {:>8}\n", "gain", "rtol", "err q", "err q'", "res pos",
+             "res vel", "res acc", "steps");
+  for (const TrackingRun& r : study.runs)
+    fmt::print("{:>6} {:>7.0e} {:>10.2e} {:>10.2e} {:>10.2e} {:>10.2e} {:>10.2e} {:>8}{}\n", gain_label(r.gain),
+               r.tolerance, r.max_error_q, r.max_error_v, r.max_residual_pos, r.max_residual_vel, r.max_residual_acc,
+               r.summary.stats.steps,
+               r.summary.status == Status::ok
+                   ? ""
+                   : fmt::format("  FAILED at t = {:.4g}: {}", r.summary.t_reached, r.summary.message));
+  fmt::print("table -> {}\nby tolerance -> {}\n", table_path.string(), series_path.string());
+  if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
+}
+
 int run_tracking(const TrackingArgs& args) {
   protect_model_file(args.model);
   const ModelSource source = read_model_source(args.model);
@@ -71,83 +156,17 @@ int run_tracking(const TrackingArgs& args) {
     columns.push_back("residual_gain_" + gain_label(gain));
   }
   AtomicFile table(table_path);
-  // Both files say what made them (io/provenance.hpp): the model as loaded and the study's options.
-  std::vector<std::string> gains, tolerances;
-  for (double gain : args.gains) gains.push_back(fmt::format("{}", gain));
-  for (double tolerance : args.tolerances) tolerances.push_back(fmt::format("{}", tolerance));
-  const std::string provenance = format_provenance(make_command_provenance(
-      model, source, "study tracking",
-      {{"gains", join(gains, ",")},
-       {"integrator", std::string(integrator_name(options.integrator))},
-       {"tolerances", join(tolerances, ",")},
-       {"atol_factor", fmt::format("{}", args.atol_factor)},
-       {"t_end", fmt::format("{}", args.t_end.value_or(model.defaults.t_end))},
-       {"output_step", fmt::format("{}", args.output_step.value_or(model.defaults.output_step))}}));
+  const std::string provenance = tracking_provenance(model, source, options, args);
   CsvWriter series(series_path, columns, provenance);
 
   const Tracking study = study_tracking(model, options);
-  // Like for like: the error of q against the position residual, of q' against the velocity one.
-  const auto error_of = [&](const TrackingRun& r) { return pos ? r.max_error_q : r.max_error_v; };
-  const auto residual_of = [&](const TrackingRun& r) { return pos ? r.max_residual_pos : r.max_residual_vel; };
-  std::vector<double> row;
-  for (std::size_t k = 0; k < study.tolerances.size(); ++k) {
-    row.assign(1, study.tolerances[k]);
-    for (std::size_t g = 0; g < study.gains.size(); ++g) {
-      const TrackingRun& r = study.run(g, k);
-      const bool ok = r.summary.status == Status::ok;
-      row.push_back(ok ? error_of(r) : std::nan(""));
-      row.push_back(ok ? residual_of(r) : std::nan(""));
-    }
-    series.write_row(row);
-  }
-  std::string text = provenance + "gain,rtol,atol,max_error_q,max_error_v,max_residual_pos,max_residual_vel,max_residual_acc,"
-                     "steps,rhs_evaluations,status\n";
-  for (const TrackingRun& r : study.runs)
-    text += fmt::format("{:g},{:.3g},{:.3g},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{}\n", r.gain, r.tolerance,
-                        r.tolerance * args.atol_factor, r.max_error_q, r.max_error_v, r.max_residual_pos,
-                        r.max_residual_vel, r.max_residual_acc, r.summary.stats.steps, r.summary.stats.rhs_evaluations,
-                        r.summary.status == Status::ok ? "ok" : std::string(describe(r.summary.status)));
-  table.write(text);
+  table.write(write_tracking_series(study, pos, provenance, args.atol_factor, series));
   series.commit();
   table.commit();
 
-  if (!args.plot.empty()) {
-    // Each run a point (its program residual, its error); the runs of one gain joined in the
-    // order of the tolerances. On the diagonal the residual equals the error.
-    XyPlotRequest request;
-    request.title = fmt::format("{}: error of the solution against the {} program residual, rtol {:g} .. {:g}",
-                                model.name, pos ? "position" : "velocity", study.tolerances.front(),
-                                study.tolerances.back());
-    request.csv = series_path;
-    for (double gain : study.gains) {
-      request.y.push_back("error_gain_" + gain_label(gain));
-      request.x_of_curve.push_back("residual_gain_" + gain_label(gain));
-      request.titles.push_back(gain == 0.0 ? std::string("no feedback")
-                                           : fmt::format("feedback alpha = beta = {:g} 1/s", gain));
-    }
-    request.x_label = fmt::format("max |{} program residual| over the run (tracking error)", pos ? "position" : "velocity");
-    request.y_label = fmt::format("max |error of {}| against the exact programmed motion", pos ? "q" : "q'");
-    request.diagonal = true;
-    write_xy_plot(request, args.plot);
-  }
+  if (!args.plot.empty()) plot_tracking(study, model, pos, series_path, args.plot);
 
-  if (!args.quiet) {
-    const double t_end = args.t_end.value_or(model.defaults.t_end);
-    fmt::print("nhdyn study tracking {}: t = {:g} .. {:g} s, {}, atol = {:g} rtol, reference: the model's exact "
-               "solution\n",
-               model.name, model.t0, t_end, args.integrator, args.atol_factor);
-    fmt::print("{:>6} {:>7} {:>10} {:>10} {:>10} {:>10} {:>10} {:>8}\n", "gain", "rtol", "err q", "err q'", "res pos",
-               "res vel", "res acc", "steps");
-    for (const TrackingRun& r : study.runs)
-      fmt::print("{:>6} {:>7.0e} {:>10.2e} {:>10.2e} {:>10.2e} {:>10.2e} {:>10.2e} {:>8}{}\n", gain_label(r.gain),
-                 r.tolerance, r.max_error_q, r.max_error_v, r.max_residual_pos, r.max_residual_vel, r.max_residual_acc,
-                 r.summary.stats.steps,
-                 r.summary.status == Status::ok
-                     ? ""
-                     : fmt::format("  FAILED at t = {:.4g}: {}", r.summary.t_reached, r.summary.message));
-    fmt::print("table -> {}\nby tolerance -> {}\n", table_path.string(), series_path.string());
-    if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
-  }
+  if (!args.quiet) print_tracking(study, model, args, table_path, series_path);
   for (const TrackingRun& r : study.runs)
     if (r.summary.status != Status::ok) return 1;
   return 0;

@@ -40,7 +40,6 @@ const std::set<std::string> kLongCommandsToCut = {
     "apps/nhdyn/compare.cpp: run_compare",
     "apps/nhdyn/simulate.cpp: run_simulate",
     "apps/nhdyn/study_spread_masses.cpp: run_spread_masses",
-    "apps/nhdyn/study_tracking.cpp: run_tracking",
 };
 
 // The functions over the limit today, as "path relative to the source root: name". Remove an
