@@ -102,6 +102,20 @@ void effective_inverse_mass(const Model& model, Data& data, int contact_gap_row,
   lambda_nn = -w.coefficients(j) / inverse;
 }
 
+// Rows of M in different units (the masses' --set m=1e-100) scaled exactly, with rhs, as in every
+// solve of [D A; b] (row_scaling.hpp), so that the conditioning test is about the matrix and not its
+// units; the factors stay in w.row_scale for the probes of effective_inverse_mass.
+void scale_rows(ContactModeData& w) {
+  w.row_scale.setOnes();
+  scale_rows_by_powers_of_two(
+      static_cast<int>(w.M.rows()), [&](int i) { return w.M.row(i).cwiseAbs().maxCoeff(); },
+      [&](int i, int exponent) {
+        w.row_scale(i) = std::ldexp(1.0, -exponent);
+        w.M.row(i) *= w.row_scale(i);
+        w.rhs(i) *= w.row_scale(i);
+      });
+}
+
 }  // namespace
 
 Status compute_mode_acceleration(const Model& model, Data& data) {
@@ -171,16 +185,7 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
     w.M.row(k + j) = data.b.row(row);
     w.rhs(k + j) = -data.b0(row);
   }
-  // Rows in different units (the masses' --set m=1e-100) scaled exactly first, as every solve of
-  // [D A; b] (row_scaling.hpp), so that the conditioning test is about the matrix, not its units.
-  w.row_scale.setOnes();
-  scale_rows_by_powers_of_two(
-      n, [&](int i) { return w.M.row(i).cwiseAbs().maxCoeff(); },
-      [&](int i, int exponent) {
-        w.row_scale(i) = std::ldexp(1.0, -exponent);
-        w.M.row(i) *= w.row_scale(i);
-        w.rhs(i) *= w.row_scale(i);
-      });
+  scale_rows(w);
   w.lu.compute(w.M);
   const double rcond = w.lu.rcond();
   if (!(rcond > 1e-14)) {

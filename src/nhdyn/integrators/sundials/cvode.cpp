@@ -128,6 +128,26 @@ std::string flag_name(int flag) {
   return name ? std::string(name.get()) : fmt::format("flag {}", flag);
 }
 
+// A sign change is a crossing only where g is continuous (events.hpp, is_jump): CVODE's root
+// finding stops at a pole (1/x) or a wrap-around (atan2) too, where |g| stays as large as at the
+// ends of the step. Writes g at the root t_new (state y_root) and at the ends of CVODE's last step
+// [tn - h, tn] (its interpolant is valid over the whole step); a non-finite g (status non_finite:
+// a pole) still has its values written. Returns false when another failure leaves the roots
+// unjudged (they are then reported as CVODE found them). The root last, so that on_event follows it.
+bool evaluate_around_root(void* mem, EventFunctions& events, double t_new, const double* y_root, N_Vector y_dky,
+                          std::vector<double>& g_root, std::vector<double>& g_start, std::vector<double>& g_end) {
+  double t_step_end = t_new, h_last = 0.0;
+  CVodeGetCurrentTime(mem, &t_step_end);
+  CVodeGetLastStep(mem, &h_last);
+  const auto usable = [](Status status) { return status == Status::ok || status == Status::non_finite; };
+  const auto at = [&](double t, std::vector<double>& g) {
+    if (CVodeGetDky(mem, t, 0, y_dky) != CV_SUCCESS) return false;
+    return usable(events.evaluate(t, N_VGetArrayPointer(y_dky), g.data()));
+  };
+  return at(t_step_end - h_last, g_start) && at(t_step_end, g_end) &&
+         usable(events.evaluate(t_new, y_root, g_root.data()));
+}
+
 }  // namespace
 
 IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& options, double t0,
@@ -268,21 +288,7 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
         }
       }
       CVodeGetRootInfo(mem, roots.data());
-      // A sign change is a crossing only where g is continuous (events.hpp, is_jump): CVODE's root
-      // finding stops at a pole (1/x) or a wrap-around (atan2) too, where |g| stays as large as at
-      // the ends of the step (CVODE's interpolant is valid over the whole step [tn - h, tn]).
-      double t_step_end = t_new, h_last = 0.0;
-      CVodeGetCurrentTime(mem, &t_step_end);
-      CVodeGetLastStep(mem, &h_last);
-      const auto g_at = [&](double t_at, std::vector<double>& g) {
-        if (CVodeGetDky(mem, t_at, 0, y_dky.get()) != CV_SUCCESS) return Status::integrator_failure;
-        return events->evaluate(t_at, N_VGetArrayPointer(y_dky.get()), g.data());
-      };
-      // A non-finite g (non_finite: a pole) still has its values written; another failure leaves the
-      // root unjudged, reported as CVODE found it. The root last, so that on_event follows it.
-      const auto usable = [](Status status) { return status == Status::ok || status == Status::non_finite; };
-      const bool judged = usable(g_at(t_step_end - h_last, g_start)) && usable(g_at(t_step_end, g_end)) &&
-                          usable(events->evaluate(t_new, y_data, g_root.data()));
+      const bool judged = evaluate_around_root(mem, *events, t_new, y_data, y_dky.get(), g_root, g_start, g_end);
       for (std::size_t i = 0; i < roots.size(); ++i) {
         if (roots[i] == 0) continue;
         if (judged && is_jump(g_root[i], g_start[i], g_end[i])) continue;
