@@ -65,6 +65,8 @@ int thread_count(const py::object& value) {
 }  // namespace
 
 void bind_batch(py::module_& m) {
+  // The batch's stop conditions that never held, each once with its runs (as `nhdyn batch` warns).
+  m.def("format_batch_unmet_stops", &format_batch_unmet_stops, py::arg("unmet_stops"));
   m.def(
       "simulate_batch",
       [](const std::vector<ModelPtr>& models, const py::object& q0, const py::object& v0, const py::object& threads_arg,

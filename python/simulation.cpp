@@ -173,6 +173,9 @@ py::dict summary_dict(const SimulationSummary& s) {
     watch.append(item);
   }
   d["constraint_warnings"] = watch;
+  // A stop condition that never held on a run that reached its end: simulate's sentences
+  // (analysis/simulation.hpp); the Python package raises them as StopConditionWarning.
+  d["unmet_stops"] = s.unmet_stops;
   d["largest_row_factor"] = s.largest_row_factor;
   d["largest_condition_factor"] = s.largest_condition_factor;
   d["stopped_by"] = s.stopped_by >= 0 ? py::cast(s.event_names[static_cast<std::size_t>(s.stopped_by)]) : py::none();

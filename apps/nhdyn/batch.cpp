@@ -139,6 +139,10 @@ void print_batch_outcome(const BatchArgs& args, const Model& base, const std::ve
       for (const std::string& w : results[r].summary.warnings) fmt::print(stderr, "nhdyn: warning: run {}: {}\n", r, w);
   }
   if (warned > 1) fmt::print(stderr, "nhdyn: warning: {} of {} runs had constraint-watch warnings\n", warned, results.size());
+  // A stop condition that never held, in simulate's words, once with the runs it names.
+  std::vector<std::vector<std::string>> unmet(results.size());
+  for (std::size_t r = 0; r < results.size(); ++r) unmet[r] = results[r].summary.unmet_stops;
+  for (const std::string& w : format_batch_unmet_stops(unmet)) fmt::print(stderr, "nhdyn: warning: {}\n", w);
   if (!args.quiet) {
     fmt::print("nhdyn batch {}: {} runs on {} threads, {} failed -> {}\n", base.name, results.size(),
                batch_threads(args.threads, results.size()), failed, (dir / "summary.csv").string());

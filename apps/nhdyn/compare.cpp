@@ -140,6 +140,15 @@ int run_compare(const CompareArgs& args) {
        {"evaluator", args.evaluator}}));
   CsvWriter series(series_path, columns, provenance);
 
+  // compare measures every case against the reference row by row to t_end, so a stop event of the
+  // model (which would end each run at its own time) is not applied: said here, as simulate says
+  // that a stop condition never held, rather than left for the user to find.
+  for (const Event& e : model.events)
+    if (e.action == EventAction::stop)
+      fmt::print(stderr,
+                 "nhdyn: warning: {}{}the stop event '{}' ({}) is not applied by compare: every case runs to t = {:g} "
+                 "to be measured against the reference row by row; nhdyn simulate stops there\n",
+                 e.where, e.where.empty() ? "" : ": ", e.name, e.expression, options.run.t_end);
   const Comparison result = compare_formulations(model, options);
   // The constraint watch's warnings (analysis/constraint_watch.hpp), per case, whatever -q says.
   for (const ComparisonResult& r : result.results)

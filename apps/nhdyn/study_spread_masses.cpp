@@ -13,8 +13,10 @@
 
 #include "outputs.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/frontend/describe.hpp"
 #include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/io/xy_plot.hpp"
@@ -57,7 +59,8 @@ int run_spread_masses(const SpreadMassesArgs& args) {
   if (args.samples < 1) throw InputError(fmt::format("--samples {}: give at least 1 state per ratio", args.samples));
   if (args.digits < 20)
     throw InputError(fmt::format("--digits {}: the reference needs 20 digits or more (default 50)", args.digits));
-  const auto description = load_description(read_model_source(args.model), parse_parameter_sets(args.sets));
+  const ModelSource source = read_model_source(args.model);
+  const auto description = load_description(source, parse_parameter_sets(args.sets));
 
   namespace fs = std::filesystem;
   const fs::path table_path = args.output;
@@ -84,7 +87,19 @@ int run_spread_masses(const SpreadMassesArgs& args) {
   columns.insert(columns.end(), qdd_columns.begin(), qdd_columns.end());
   columns.insert(columns.end(), R_columns.begin(), R_columns.end());
   columns.insert(columns.end(), other_columns.begin(), other_columns.end());
-  CsvWriter csv(table_path, columns);
+  // The CSV says what made it (io/provenance.hpp), as every CSV nhdyn writes: the model as loaded
+  // (compiled once for its parameters and initial state) and the study's options.
+  std::vector<std::string> ratios, labels;
+  for (double ratio : options.ratios) ratios.push_back(fmt::format("{}", ratio));
+  for (const StudyFormulation& f : options.formulations) labels.push_back(formulation_label(f));
+  const std::string provenance = format_provenance(make_command_provenance(
+      load_model(source, parse_parameter_sets(args.sets)), source, "study spread-masses",
+      {{"parameter", options.parameter},
+       {"ratios", join(ratios, ",")},
+       {"samples", fmt::format("{}", options.samples)},
+       {"digits", fmt::format("{}", options.digits)},
+       {"formulations", join(labels, ",")}}));
+  CsvWriter csv(table_path, columns, provenance);
 
   const SpreadMasses study = study_spread_masses(description_spec(*description), options);
   std::vector<double> row;

@@ -110,6 +110,7 @@ def _check_t_eval(t_eval, t0, t_end):
 
 __all__ = [
     "__version__", "Error", "InputError", "ModelError", "FileError", "SimulationError", "ConstraintWarning",
+    "StopConditionWarning",
     "load", "loads", "builtin_models", "Model", "Result", "Equations", "Linearization", "Sweep",
     "BatchResult", "simulate_batch", "from_sympy",
 ]
@@ -127,6 +128,26 @@ def _warn_constraints(model_name, summary, stacklevel, run=None):
     where = "" if run is None else " (run {})".format(run)
     for text in summary.get("warnings", []):
         warnings.warn("nhdyn: {}{}: {}".format(model_name, where, text), ConstraintWarning, stacklevel=stacklevel + 1)
+
+
+class StopConditionWarning(UserWarning):
+    """A stop condition (stop_when=, or an event with action = "stop" in the model file) that never
+    held on a run that went to its end: most likely a sign, direction or threshold that cannot be
+    met. The words of `nhdyn simulate`'s warning (docs/cli.md, "Events"), in Python's terms; a
+    batch warns once per condition, naming the runs. Result.summary["unmet_stops"] has the
+    sentences. Filter with warnings.simplefilter("error", nhdyn.StopConditionWarning) to make it
+    fatal."""
+
+
+def _warn_unmet_stops(model_name, summaries, stacklevel, batch=False):
+    """Warns with each stop condition that never held: for one run (batch=False, summaries of one
+    element) its sentences; for a batch each sentence once with the runs it holds for, as
+    `nhdyn batch` prints them."""
+    per_run = [summary.get("unmet_stops", []) for summary in summaries]
+    texts = _nhdyn.format_batch_unmet_stops(per_run) if batch else [t for run in per_run for t in run]
+    for text in texts:
+        warnings.warn("nhdyn: {}: {}".format(model_name, _python_text(text)), StopConditionWarning,
+                      stacklevel=stacklevel + 1)
 
 
 def builtin_models():
@@ -280,6 +301,7 @@ class Model:
         except Error as error:
             raise _in_python_terms(error) from None
         _warn_constraints(self.name, out["summary"], stacklevel=2)
+        _warn_unmet_stops(self.name, [out["summary"]], stacklevel=2)
         # The provenance header is made when asked for (Result.provenance), from the compiled model
         # as it ran (a later parameter change makes a new one) and the same options.
         cpp, source = self._cpp, self.source
@@ -620,6 +642,9 @@ def _batch_runs(model, parameters, initial):
         if values.ndim != 1:
             raise InputError("parameters[{!r}]: expected a 1-D array of values, got shape {}".format(
                 name, values.shape))
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:  # checked here, so that a batch spread in chunks (nhdyn.dask) names the run in the batch
+            raise InputError("run {}: parameter {} = {} is not a finite number".format(bad[0], name, values[bad[0]]))
         if runs is not None and values.size != runs:
             raise InputError("parameters[{!r}]: {} values, but other inputs give {} runs".format(
                 name, values.size, runs))
@@ -662,5 +687,6 @@ def simulate_batch(model, parameters=None, initial=None, t_end=None, threads=0, 
                                 t_end=t_end, **options)
     for run, summary in enumerate(out["summaries"]):
         _warn_constraints(model.name, summary, stacklevel=2, run=run)
+    _warn_unmet_stops(model.name, out["summaries"], stacklevel=2, batch=True)
     return BatchResult(out, {name: values[:, j] for j, name in enumerate(names)}, model.coordinates,
                        model._cpp.columns)

@@ -13,6 +13,8 @@ on the others (each with nhdyn importable), then Client("tcp://SCHEDULER:8786");
 """
 
 import math
+import re
+import warnings
 
 import numpy as np
 
@@ -34,22 +36,36 @@ def _model_on_worker(source, overrides):
     return model
 
 
-def _run_chunk(source, overrides, names, values, q0, qd0, threads, options):
-    """One task: a chunk of runs on one worker. Returns plain arrays and lists (picklable)."""
-    model = _model_on_worker(source, overrides)
-    parameters = {name: values[:, j] for j, name in enumerate(names)}
-    initial = {}
-    if q0 is not None:
-        initial["q"] = q0
-    if qd0 is not None:
-        initial["qd"] = qd0
-    r = nhdyn.simulate_batch(model, parameters=parameters or None, initial=initial or None, threads=threads,
-                             **options)
+def _run_chunk(source, overrides, names, values, q0, qd0, threads, options, start=0):
+    """One task: a chunk of runs on one worker, the first being run `start` of the batch. Returns
+    plain arrays and lists (picklable); an nhdyn error is returned too, as (type name, message with
+    the batch's run numbers), so that the client raises it and the worker logs nothing (a failed
+    task's log would repeat its arguments, the whole model text, once per chunk). Warnings are
+    left to the client, which knows each run's number in the batch."""
+    try:
+        model = _model_on_worker(source, overrides)
+        parameters = {name: values[:, j] for j, name in enumerate(names)}
+        initial = {}
+        if q0 is not None:
+            initial["q"] = q0
+        if qd0 is not None:
+            initial["qd"] = qd0
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            r = nhdyn.simulate_batch(model, parameters=parameters or None, initial=initial or None, threads=threads,
+                                     **options)
+    except nhdyn.Error as error:
+        return {"error": (type(error).__name__, _RUN.sub(lambda m: "run {}".format(start + int(m.group(1))),
+                                                         str(error)))}
     return {"t": r.t, "q": r.q, "qd": r.qd, "qdd": r.qdd, "R": r.R, "residuals": r.residuals, "energy": r.energy,
             "contact_forces": r.contact_forces,
             "q_end": r.q_end, "qd_end": r.qd_end, "max_residual": r.max_residual, "ok": list(r.ok),
             "messages": r.messages, "summaries": r.summaries, "events": r.events, "threads": r.threads,
             "cpp_seconds": r.cpp_seconds}
+
+
+# A message's "run K" (the library's numbering within the chunk's batch).
+_RUN = re.compile(r"\brun (\d+)\b")
 
 
 def _pad(array, rows):
@@ -87,8 +103,12 @@ def simulate_batch(client, model, parameters=None, initial=None, chunk_size=None
         futures.append(client.submit(
             _run_chunk, source, overrides, names, values[start:stop],
             None if q0 is None else q0[start:stop], None if qd0 is None else qd0[start:stop], threads, options,
-            pure=False))
+            start, pure=False))
     parts = client.gather(futures)
+    for part in parts:
+        if "error" in part:
+            kind, message = part["error"]
+            raise getattr(nhdyn, kind, nhdyn.Error)(message)
     rows = max(np.shape(p["t"])[-1] for p in parts)
     longest = next(p["t"] for p in parts if np.ndim(p["t"]) == 1 and len(p["t"]) == rows) if all(
         np.ndim(p["t"]) == 1 for p in parts) else None
@@ -111,5 +131,9 @@ def simulate_batch(client, model, parameters=None, initial=None, chunk_size=None
         out[key] = [x for p in parts for x in p[key]]
     out["threads"] = max(p["threads"] for p in parts)
     out["cpp_seconds"] = sum(p["cpp_seconds"] for p in parts)
+    # The warnings of the runs, numbered in the batch (the workers kept theirs), as nhdyn.simulate_batch gives them.
+    for run, summary in enumerate(out["summaries"]):
+        nhdyn._warn_constraints(model.name, summary, stacklevel=2, run=run)
+    nhdyn._warn_unmet_stops(model.name, out["summaries"], stacklevel=2, batch=True)
     return nhdyn.BatchResult(out, {name: values[:, j] for j, name in enumerate(names)}, model.coordinates,
                              model._cpp.columns)

@@ -300,17 +300,21 @@ TEST_F(Hardening, Rk4DoesNotStepAcrossASingularProgramMatrix) {
 
 // --event z=1/x reported a crossing at the pole, and atan2's wrap-around counted as one: a sign
 // change by a jump of g is not a crossing. x = cos t crosses zero at pi/2 (the event z = x).
+// Every integrator that locates events: CVODE's own root finding stopped at the pole too.
 TEST_F(Hardening, PolesAndWrapAroundsAreNotCrossings) {
   write("osc.toml", kOscillator);
-  const ProcessRun r = nhdyn({"simulate", "osc.toml", "--t-end", "3", "--event", "p=1/x", "--event", "z=x", "--event",
-                              "w=atan2(x, -1)", "-q", "-o", "e.csv"});
-  ASSERT_EQ(r.code, 0) << r.err;
-  const std::string events = read_whole(dir_ / "e-events.csv");
-  EXPECT_FALSE(contains(events, "\np,")) << events;
-  EXPECT_FALSE(contains(events, "\nw,")) << events;
-  const std::size_t at = events.find("\nz,");
-  ASSERT_NE(at, std::string::npos) << events;
-  EXPECT_NEAR(std::stod(events.substr(at + 3)), 3.14159265358979 / 2, 1e-7);
+  for (const char* integrator : {"dopri5", "dop853", "cvode-bdf", "cvode-adams"}) {
+    SCOPED_TRACE(integrator);
+    const ProcessRun r = nhdyn({"simulate", "osc.toml", "--t-end", "3", "--integrator", integrator, "--event", "p=1/x",
+                                "--event", "z=x", "--event", "w=atan2(x, -1)", "-q", "-o", "e.csv"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string events = read_whole(dir_ / "e-events.csv");
+    EXPECT_FALSE(contains(events, "\np,")) << events;
+    EXPECT_FALSE(contains(events, "\nw,")) << events;
+    const std::size_t at = events.find("\nz,");
+    ASSERT_NE(at, std::string::npos) << events;
+    EXPECT_NEAR(std::stod(events.substr(at + 3)), 3.14159265358979 / 2, 1e-6);
+  }
 }
 
 // report could not read nhdyn's own FILE.partial.csv (its reason line), refused a byte-order mark
@@ -492,6 +496,37 @@ TEST_F(Hardening, AStopConditionThatNeverHoldsIsWarned) {
   EXPECT_FALSE(contains(met.err, "never")) << met.err;
 }
 
+// batch and compare said nothing of a stop condition that never held. batch: simulate's sentence
+// once, with the runs it holds for. x = cos t + v sin t reaches sqrt(1 + v^2): 1, 1.41, 2.24 for
+// v = 0, 1, 2, so x - 1.2 never crosses zero on run 0 only, and x - 3 on none (but runs 1 and 2
+// stop at the first).
+TEST_F(Hardening, BatchAndCompareSayWhenAStopConditionNeverHolds) {
+  write("osc.toml", std::string(kOscillator) + "[[events]]\nname = \"up\"\nwhen = \"x - 1.2\"\naction = \"stop\"\n" +
+                        "[[events]]\nname = \"high\"\nwhen = \"x - 3\"\naction = \"stop\"\n");
+  const ProcessRun r = nhdyn({"batch", "osc.toml", "--grid", "x'(0)=0:2:3", "--t-end", "2", "--threads", "2", "-q",
+                              "-o", "out"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string up = "osc.toml:13:9: the stop event 'up' (x - 1.2) never crossed zero in its direction between "
+                         "t = 0 and t = 2: the run went to the end; check its sign, direction or threshold (run 0 of 3)";
+  EXPECT_TRUE(contains(r.err, "nhdyn: warning: " + up + "\n")) << r.err;
+  // Runs 1 and 2 stopped at 'up', so only run 0 went to its end without meeting 'high'.
+  EXPECT_TRUE(contains(r.err, "the stop event 'high' (x - 3) never crossed zero")) << r.err;
+  EXPECT_EQ(r.err.find("'high'"), r.err.rfind("'high'")) << r.err;
+  // x'(0) up to 0.5: x stays below 1.2 on every run, and each sentence is said once, for all.
+  const ProcessRun all = nhdyn({"batch", "osc.toml", "--grid", "x'(0)=0:0.5:3", "--t-end", "2", "-q", "-o", "out2"});
+  ASSERT_EQ(all.code, 0) << all.err;
+  EXPECT_TRUE(contains(all.err, "(x - 1.2) never crossed zero")) << all.err;
+  EXPECT_EQ(all.err.find("'up'"), all.err.rfind("'up'")) << all.err;
+  EXPECT_EQ(all.err.find("'high'"), all.err.rfind("'high'")) << all.err;
+  EXPECT_EQ(std::count(all.err.begin(), all.err.end(), '\n'), 2) << all.err;
+  EXPECT_TRUE(contains(all.err, "threshold (every run of 3)\n")) << all.err;
+  // compare does not apply stop events (its cases are measured row by row to t_end): it says so.
+  const ProcessRun c = nhdyn({"compare", "osc.toml", "--methods", "sanh", "--t-end", "1", "-q", "-o", "c.csv"});
+  ASSERT_EQ(c.code, 0) << c.err;
+  EXPECT_TRUE(contains(c.err, "osc.toml:13:9: the stop event 'up' (x - 1.2) is not applied by compare")) << c.err;
+  EXPECT_TRUE(contains(c.err, "the stop event 'high' (x - 3) is not applied by compare")) << c.err;
+}
+
 // GiNaC's own words ("power::eval(): division by zero", "log_eval(): log(0)") reached the user.
 TEST_F(Hardening, GinacWordsAreTranslated) {
   const std::vector<std::pair<std::string, std::string>> cases = {
@@ -539,6 +574,91 @@ TEST_F(Hardening, ExtremeParameterMagnitudesAreNotSingular) {
     ASSERT_GE(values.size(), 7u);
     for (std::size_t i = 0; i < 7; ++i)  // t, x, y, phi and their velocities
       EXPECT_NEAR(values[i], reference[i], 1e-9 * (1.0 + std::abs(reference[i]))) << m << " column " << i;
+  }
+}
+
+// The same for the program-motion solve and the contact modes' solves (the stacked matrix, the
+// effective inverse mass of a sliding contact): every force of these models scales with m, so
+// m = 1e154, 1e-100 or 1e-300 gives the motion of the file's m; and a singular system (a program that no
+// actuator can realize, Painleve's paradox) is still refused at every scale.
+TEST_F(Hardening, ExtremeMassesInProgramsAndContactModesAreNotSingular) {
+  const fs::path examples = fs::path(NHDYN_SOURCE_DIR) / "examples";
+  // The state columns t, q, q' of the last row.
+  const auto last_state = [&](const std::string& file, std::size_t columns) {
+    std::stringstream in(read_whole(dir_ / file));
+    std::string line, last;
+    while (std::getline(in, line))
+      if (!line.empty() && line[0] != '#') last = line;
+    std::vector<double> values;
+    std::stringstream fields(last);
+    for (std::string field; values.size() < columns && std::getline(fields, field, ',');) values.push_back(std::stod(field));
+    return values;
+  };
+  for (const auto& [model, columns] : {std::pair<const char*, std::size_t>{"sled_heading_program.toml", 7},
+                                       {"ball_thrown_sliding.toml", 13}}) {
+    SCOPED_TRACE(model);
+    const std::string path = (examples / model).string();
+    const ProcessRun one = nhdyn({"simulate", path, "--t-end", "0.5", "-q", "-o", "one.csv"});
+    ASSERT_EQ(one.code, 0) << one.err;
+    const std::vector<double> reference = last_state("one.csv", columns);
+    ASSERT_EQ(reference.size(), columns);
+    for (const char* m : {"1e154", "1e-100", "1e-300"}) {
+      const ProcessRun r =
+          nhdyn({"simulate", path, "--set", std::string("m=") + m, "--t-end", "0.5", "-q", "-o", "scaled.csv"});
+      ASSERT_EQ(r.code, 0) << m << ": " << r.err;
+      const std::vector<double> values = last_state("scaled.csv", columns);
+      ASSERT_EQ(values.size(), columns);
+      for (std::size_t i = 0; i < columns; ++i)
+        EXPECT_NEAR(values[i], reference[i], 1e-8 * (1.0 + std::abs(reference[i]))) << m << " column " << i;
+    }
+  }
+  // Singular at any scale: the cart's force cannot turn a horizontal pendulum (S = 0 at theta = pi/2).
+  for (const char* m : {"1", "1e100", "1e-100"}) {
+    const ProcessRun r = nhdyn({"simulate", (examples / "cart_pendulum_program.toml").string(), "--set", "theta0=pi/2",
+                                "--set", std::string("mc=") + m, "--set", std::string("mb=") + m, "-q", "-o", "s.csv"});
+    EXPECT_EQ(r.code, 2) << m << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, "'swing'")) << m << ": " << r.err;
+  }
+  // Painleve's paradox: a rod on its end tipped by a torque that grows (in proportion to m) would
+  // have to start sliding with mu = 1.5 > 4/3 at t = 0.04 (tests/python/test_contact_modes.py).
+  write("rod.toml", R"(name = "painleve-rod"
+coordinates = ["x", "y", "z", "b"]
+gravity = [0, 0, "-g"]
+[parameters]
+m = 1.0
+l = 0.5
+rho = 0.01
+g = 9.81
+b0 = 1.1071487177940904
+mu = 1.5
+[[frames]]
+name = "rod"
+translation = ["x", "y", "z"]
+rotations = [["y", "b"]]
+[[bodies]]
+name = "rod"
+frame = "rod"
+mass = "m"
+inertia = ["m*l^2/3", "m*l^2/3", "m*l^2/3"]
+[[contacts]]
+name = "end"
+body = "rod"
+shape = { sphere = "rho" }
+centre = ["l", 0, 0]
+unilateral = true
+friction = "mu"
+mode = "rolling"
+[forces]
+b = "-100*m*t"
+[initial]
+position = { x = 0, y = 0, z = "l*sin(b0) + rho", b = "b0" }
+velocity = { x = 0, y = 0, z = 0, b = 0 }
+)");
+  for (const char* m : {"1", "1e100", "1e-100"}) {
+    const ProcessRun r = nhdyn({"simulate", "rod.toml", "--set", std::string("m=") + m, "--t-end", "0.1",
+                                "--output-step", "0.01", "-q", "-o", "rod.csv"});
+    EXPECT_EQ(r.code, 1) << m << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, "contact 'end' slides in Painleve's paradox at t = 0.04")) << m << ": " << r.err;
   }
 }
 

@@ -2,7 +2,8 @@
 // into the CSV, the events file, the partial file and the HTML page; `nhdyn report` reads the
 // run's parameters back, so that a report without --set draws the run's scene, and refuses a
 // CSV whose model hash is not the model's, or whose header is cut short. batch, compare, sweep,
-// linearize and the error-relation and tracking studies write the same header into their CSVs.
+// linearize and the error-relation, tracking and spread-masses studies write the same header into
+// their CSVs.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -211,6 +212,21 @@ TEST_F(ProvenanceCli, CompareSweepLinearizeAndStudiesSayWhatMadeThem) {
       EXPECT_NE(text.find("\n# " + c.run_line), std::string::npos) << text.substr(0, 1200);
       EXPECT_NE(text.find("\n# end of provenance\n"), std::string::npos);
     }
+  }
+  // study spread-masses: its table too, with the model's parameters as loaded (--set applied).
+  {
+    const std::string spread = (fs::path(NHDYN_SOURCE_DIR) / "examples" / "spread_masses.toml").string();
+    const nhdyn::test::CliOutcome r = nhdyn::test::run_nhdyn(
+        "study spread-masses '" + spread + "' --ratios 1,1e3 --samples 1 --set ratio=7 -q -o sm.csv", dir_ / "a");
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    const std::string text = provenance_read(dir_ / "a" / "sm.csv");
+    EXPECT_EQ(text.rfind("# nhdyn version: ", 0), 0u) << text.substr(0, 300);
+    EXPECT_NE(text.find("\n# run: command=study spread-masses, parameter=ratio, ratios=1,1000, samples=1, digits=50, "
+                        "formulations=sanh-qr,"),
+              std::string::npos)
+        << text.substr(0, 1200);
+    EXPECT_NE(text.find("\n# parameters: ratio=7"), std::string::npos) << text.substr(0, 1200);
+    EXPECT_NE(text.find("\n# end of provenance\nratio,cond_A,"), std::string::npos) << text.substr(0, 1200);
   }
   // linearize's --set is in the parameters as run.
   EXPECT_NE(provenance_read(dir_ / "a" / "lin.csv").find("\n# parameters: v=4, "), std::string::npos)

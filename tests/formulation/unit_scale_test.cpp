@@ -7,8 +7,12 @@
 // every scale.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
 #include <random>
+#include <vector>
 
+#include "nhdyn/formulation/row_scaling.hpp"
 #include "nhdyn/formulation/sanh.hpp"
 #include "nhdyn/formulation/small_dense.hpp"
 
@@ -86,6 +90,30 @@ TEST(UnitScale, SingularSystemsAreRefusedAtAnyScale) {
       EXPECT_FALSE(solve_small(s, scale, qdd)) << "scale " << scale << " trial " << trial;
     }
   }
+}
+
+// The one scaling rule (row_scaling.hpp) that every solve of [D A; b] applies: rows within
+// kRowScaleRatio of each other are left alone; beyond it every row gets the power of two that
+// brings its largest entry into [0.5, 1), and a zero or non-finite row scales nothing.
+TEST(UnitScale, RowsAreScaledByPowersOfTwoOnlyBeyondTheRatio) {
+  const auto exponents = [](std::vector<double> row_max) {
+    std::vector<int> out(row_max.size(), 0);
+    const bool scaled = scale_rows_by_powers_of_two(
+        static_cast<int>(row_max.size()), [&](int i) { return row_max[static_cast<std::size_t>(i)]; },
+        [&](int i, int e) { out[static_cast<std::size_t>(i)] = e; });
+    return scaled ? out : std::vector<int>{};
+  };
+  EXPECT_TRUE(exponents({1.0, 0.99 * kRowScaleRatio}).empty());
+  EXPECT_EQ(exponents({1.0, 2.0 * kRowScaleRatio}), (std::vector<int>{1, 28}));
+  EXPECT_EQ(exponents({3e-100, 0.75, 1e100}), (std::vector<int>{-330, 0, 333}));
+  EXPECT_TRUE(exponents({0.0, 1e100}).empty());
+  EXPECT_TRUE(exponents({1.0, std::numeric_limits<double>::infinity()}).empty());
+  // Exact: a row times its factor and back is the row, bit for bit.
+  std::vector<int> e = exponents({3e-100, 1e100});
+  ASSERT_EQ(e.size(), 2u);
+  EXPECT_EQ(std::ldexp(std::ldexp(3e-100, -e[0]), e[0]), 3e-100);
+  EXPECT_GE(std::ldexp(3e-100, -e[0]), 0.5);
+  EXPECT_LT(std::ldexp(3e-100, -e[0]), 1.0);
 }
 
 }  // namespace

@@ -40,3 +40,39 @@ def test_dask_keeps_a_failing_member(examples, client):
     assert list(spread.ok) == [True, True, True, False, True]
     assert "blade" in spread.messages[3]
     assert np.array_equal(spread.q[0], m.simulate(t_end=0.5).q)
+
+
+OSCILLATOR = """name = "oscillator"
+coordinates = ["x"]
+kinetic_energy = "m/2 * x'^2"
+potential_energy = "k/2 * x^2"
+[parameters]
+m = 1.0
+k = 1.0
+[initial]
+position = { x = 1 }
+velocity = { x = 0 }
+"""
+
+
+def test_dask_numbers_runs_in_the_batch_and_keeps_the_worker_logs_clean(client):
+    """Errors and warnings name a run by its number in the whole batch, not in its chunk; an error
+    is raised on the client with its own type, and no worker logs a failed task (whose log would
+    repeat the whole model text per chunk). x = cos(sqrt(k) t) falls below 0 within t_end = 1 for
+    k = 4 only, so the stop condition never holds on runs 0, 2 and 4."""
+    m = nhdyn.loads(OSCILLATOR)
+    with pytest.raises(nhdyn.InputError, match=r"^run 3: parameter k = nan is not a finite number"):
+        nhdyn.dask.simulate_batch(client, m, parameters={"k": [1.0, 2.0, 3.0, float("nan")]}, t_end=0.1,
+                                  chunk_size=2)
+    with pytest.raises(nhdyn.InputError, match="rtol = -1"):
+        nhdyn.dask.simulate_batch(client, m, parameters={"k": [1.0, 2.0, 3.0]}, t_end=0.1, chunk_size=2, rtol=-1)
+    with pytest.raises(nhdyn.InputError, match="no runs"):
+        nhdyn.dask.simulate_batch(client, m, parameters={"k": []}, t_end=0.1)
+    logs = client.get_worker_logs()
+    assert not any("Compute Failed" in line for worker in logs.values() for _, line in worker), logs
+    with pytest.warns(nhdyn.StopConditionWarning) as caught:
+        spread = nhdyn.dask.simulate_batch(client, m, parameters={"k": [1.0, 4.0, 1.0, 4.0, 1.0]}, t_end=1.0,
+                                           chunk_size=2, stop_when="x < 0")
+    texts = [str(w.message) for w in caught]
+    assert len(texts) == 1 and texts[0].endswith("(runs 0, 2 and 4 of 5)"), texts
+    assert [s["stopped_by"] for s in spread.summaries] == [None, "x < 0", None, "x < 0", None]

@@ -108,3 +108,29 @@ def test_ctrl_c_stops_a_batch_promptly(tmp_path):
                          text=True, timeout=300, env=dict(os.environ))
     assert out.stdout.startswith("interrupted"), out.stdout + out.stderr
     assert float(out.stdout.split()[1]) < 10.0
+
+
+def test_a_stop_condition_that_never_holds_is_warned(oscillator):
+    """The sentence of `nhdyn simulate`'s warning, in Python's terms, as a StopConditionWarning;
+    a batch says it once, naming the runs: x = cos(sqrt(k) t) never exceeds 1, and falls below
+    0 at pi / (2 sqrt(k)), within t_end = 1 for k = 4 (0.785) but not for k = 1 (1.571)."""
+    with pytest.warns(nhdyn.StopConditionWarning) as caught:
+        r = oscillator.simulate(t_end=1.0, stop_when="x > 2")
+    texts = [str(w.message) for w in caught]
+    assert texts == ["nhdyn: oscillator: the stop condition stop_when \"x > 2\" never became true between t = 0 and "
+                     "t = 1: the run went to the end; check its sign, direction or threshold"]
+    assert r.summary["unmet_stops"] and r.summary["stopped_by"] is None
+    with pytest.warns(nhdyn.StopConditionWarning) as caught:
+        b = nhdyn.simulate_batch(oscillator, parameters={"k": [1.0, 4.0, 1.0]}, t_end=1.0, stop_when="x < 0")
+    texts = [str(w.message) for w in caught]
+    assert len(texts) == 1 and texts[0].endswith("check its sign, direction or threshold (runs 0 and 2 of 3)"), texts
+    assert [s["stopped_by"] for s in b.summaries] == [None, "x < 0", None]
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", nhdyn.StopConditionWarning)
+        oscillator.simulate(t_end=2.0, stop_when="x < 0")  # met: no warning
+
+
+def test_a_non_finite_parameter_value_names_its_run(oscillator):
+    with pytest.raises(nhdyn.InputError, match=r"run 3: parameter k = nan is not a finite number"):
+        nhdyn.simulate_batch(oscillator, parameters={"k": [1.0, 2.0, 3.0, float("nan")]}, t_end=0.1)

@@ -8,7 +8,10 @@
 #include <exception>
 #include <mutex>
 #include <system_error>
+#include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/core/error.hpp"
@@ -194,6 +197,33 @@ std::vector<BatchResult> simulate_batch(const std::vector<BatchRun>& runs, const
     if (result.interrupted) result.message = "not run: the batch was interrupted";
   if (failure) std::rethrow_exception(failure);
   return results;
+}
+
+std::vector<std::string> format_batch_unmet_stops(const std::vector<std::vector<std::string>>& unmet_stops) {
+  // Each sentence once, in the order of the first run that has it, with the runs it holds for.
+  std::vector<std::pair<std::string, std::vector<std::size_t>>> groups;
+  for (std::size_t run = 0; run < unmet_stops.size(); ++run)
+    for (const std::string& sentence : unmet_stops[run]) {
+      auto group = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == sentence; });
+      if (group == groups.end()) group = groups.insert(groups.end(), {sentence, {}});
+      group->second.push_back(run);
+    }
+  constexpr std::size_t kListed = 20;
+  std::vector<std::string> out;
+  for (const auto& [sentence, runs] : groups) {
+    if (runs.size() == unmet_stops.size()) {
+      out.push_back(fmt::format("{} (every run of {})", sentence, runs.size()));
+      continue;
+    }
+    std::string list;
+    const std::size_t listed = std::min(runs.size(), kListed);
+    for (std::size_t i = 0; i < listed; ++i)
+      list += fmt::format("{}{}", i == 0 ? "" : (i + 1 == runs.size() ? " and " : ", "), runs[i]);
+    if (runs.size() > listed) list += fmt::format(" and {} more", runs.size() - listed);
+    out.push_back(fmt::format("{} ({} {} of {})", sentence, runs.size() == 1 ? "run" : "runs", list,
+                              unmet_stops.size()));
+  }
+  return out;
 }
 
 }  // namespace nhdyn

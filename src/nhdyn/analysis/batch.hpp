@@ -88,6 +88,11 @@ int max_batch_threads();
 // at most max_batch_threads() and `runs`. Fewer run when the system refuses to create a thread.
 int batch_threads(int threads, std::size_t runs);
 
+// The stop conditions that never held in a batch (SimulationSummary::unmet_stops, the sentence
+// simulate warns with), each once with the runs it names: "SENTENCE (runs 0, 2 and 5 of 10)", or
+// "(every run of 10)"; at most 20 runs are listed, then how many more. `unmet_stops[i]` is run i's.
+std::vector<std::string> format_batch_unmet_stops(const std::vector<std::vector<std::string>>& unmet_stops);
+
 // Runs every member; result i belongs to runs[i], whatever the number of threads (the results do
 // not depend on it: each run is the same sequential computation). Throws InputError only for
 // options that no run could use (a run without a model, an initial state of the wrong size);

@@ -11,6 +11,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
+#include "nhdyn/formulation/row_scaling.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {
@@ -339,6 +340,14 @@ Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, b
     M.row(n - r + j) = data_.b.row(rows[static_cast<std::size_t>(j)]);
     rhs(n - r + j) = target[static_cast<std::size_t>(j)];
   }
+  // Rows in different units scaled exactly first, as every solve of [D A; b] (formulation/row_scaling.hpp).
+  scale_rows_by_powers_of_two(
+      n, [&](int i) { return M.row(i).cwiseAbs().maxCoeff(); },
+      [&](int i, int exponent) {
+        const double factor = std::ldexp(1.0, -exponent);
+        M.row(i) *= factor;
+        rhs(i) *= factor;
+      });
   Eigen::PartialPivLU<Matrix> lu(M);
   if (!(lu.rcond() > 1e-14)) {
     out.failure = fmt::format("contact '{}' touches down at t = {:.9g} where the impulse equations are singular{}; "

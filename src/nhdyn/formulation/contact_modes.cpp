@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "nhdyn/formulation/row_scaling.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {
@@ -77,14 +78,16 @@ void effective_inverse_mass(const Model& model, Data& data, int contact_gap_row,
                             double& lambda_nn) {
   ContactModeData& w = data.modes;
   const int n = model.n();
+  // The probes are right-hand sides of M: they take its rows' scaling (w.row_scale).
   w.probe.setZero();
-  w.probe(k + j) = 1.0;
+  w.probe(k + j) = w.row_scale(k + j);
   w.response.noalias() = w.lu.solve(w.probe);
   data.tmp_n.noalias() = data.A * w.response;
   reaction_coefficients(w, r, data.tmp_n, w.coefficients);
   const double inverse = w.coefficients(j);  // 1 / w_eff
   w.probe.head(k).noalias() = data.Q_full.rightCols(k).transpose() * data.b.row(contact_gap_row).transpose();
   w.probe.tail(n - k).setZero();
+  w.probe.head(k).array() *= w.row_scale.head(k).array();
   w.response.noalias() = w.lu.solve(w.probe);
   data.tmp_n.noalias() = data.A * w.response;
   data.tmp_n -= data.b.row(contact_gap_row).transpose();
@@ -97,6 +100,20 @@ void effective_inverse_mass(const Model& model, Data& data, int contact_gap_row,
   }
   w_eff = 1.0 / inverse;
   lambda_nn = -w.coefficients(j) / inverse;
+}
+
+// Rows of M in different units (the masses' --set m=1e-100) scaled exactly, with rhs, as in every
+// solve of [D A; b] (row_scaling.hpp), so that the conditioning test is about the matrix and not its
+// units; the factors stay in w.row_scale for the probes of effective_inverse_mass.
+void scale_rows(ContactModeData& w) {
+  w.row_scale.setOnes();
+  scale_rows_by_powers_of_two(
+      static_cast<int>(w.M.rows()), [&](int i) { return w.M.row(i).cwiseAbs().maxCoeff(); },
+      [&](int i, int exponent) {
+        w.row_scale(i) = std::ldexp(1.0, -exponent);
+        w.M.row(i) *= w.row_scale(i);
+        w.rhs(i) *= w.row_scale(i);
+      });
 }
 
 }  // namespace
@@ -168,6 +185,7 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
     w.M.row(k + j) = data.b.row(row);
     w.rhs(k + j) = -data.b0(row);
   }
+  scale_rows(w);
   w.lu.compute(w.M);
   const double rcond = w.lu.rcond();
   if (!(rcond > 1e-14)) {

@@ -12,6 +12,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/formulation/complement.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
+#include "nhdyn/formulation/row_scaling.hpp"
 #include "nhdyn/formulation/sanh.hpp"
 #include "nhdyn/model/terms.hpp"
 
@@ -85,23 +86,35 @@ Status compute_program_motion(const Model& model, Data& data, Complement complem
   data.M.bottomRows(s) = data.b;
   data.rhs.head(k).noalias() = data.D * data.h;
   data.rhs.tail(s) = -data.b0;
-  data.lu_n.compute(data.M);
-  if (lu_is_singular(data.lu_n)) return record_failure(data, Status::singular_system, "stacked matrix [D A; b]");
-  w.qdd0.noalias() = data.lu_n.solve(data.rhs);
   w.DB.topRows(k).noalias() = data.D * w.B;
   w.DB.bottomRows(s).setZero();
+  // An actuator that the physical constraints take up entirely (D B_j = 0), judged on D B as it is.
+  w.absorbed = -1;
+  const double d_norm = data.D.norm();
+  for (int j = 0; j < m && w.absorbed < 0; ++j)
+    if (!(w.DB.col(j).norm() > kAbsorbed * d_norm * w.B.col(j).norm())) w.absorbed = j;
+  // Rows in different units (the masses' --set m=1e-100) scaled exactly first, as sanh does
+  // (row_scaling.hpp): D B is a second right-hand side of [D A; b] and takes the same scaling.
+  scale_rows_by_powers_of_two(
+      n, [&](int i) { return data.M.row(i).cwiseAbs().maxCoeff(); },
+      [&](int i, int exponent) {
+        const double factor = std::ldexp(1.0, -exponent);
+        data.M.row(i) *= factor;
+        data.rhs(i) *= factor;
+        w.DB.row(i) *= factor;
+      });
+  data.lu_n.compute(data.M);
+  if (lu_is_singular(data.lu_n)) {
+    w.absorbed = -1;  // the stacked matrix is at fault, not an actuator
+    return record_failure(data, Status::singular_system, "stacked matrix [D A; b]");
+  }
+  w.qdd0.noalias() = data.lu_n.solve(data.rhs);
   w.PB.noalias() = data.lu_n.solve(w.DB);
 
   // S = b_p P B (P4), scaled to unit rows and columns before it is judged and solved.
-  w.absorbed = -1;
-  const double d_norm = data.D.norm();
-  for (int j = 0; j < m; ++j) {
-    if (!(w.DB.col(j).norm() > kAbsorbed * d_norm * w.B.col(j).norm())) {
-      w.absorbed = j;
-      return record_failure(data, Status::singular_system, kProgramMatrix);
-    }
-    w.col_scale(j) = w.PB.col(j).norm();
-  }
+  if (w.absorbed >= 0) return record_failure(data, Status::singular_system, kProgramMatrix);
+  // P B scales as 1/mass (1e300 for m = 1e-300): a norm that does not square it into overflow.
+  for (int j = 0; j < m; ++j) w.col_scale(j) = w.PB.col(j).stableNorm();
   for (int i = 0; i < m; ++i) w.row_scale(i) = w.b_p.row(i).norm();
   w.S.noalias() = w.b_p * w.PB;
   for (int j = 0; j < m; ++j)

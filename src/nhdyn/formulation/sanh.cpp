@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "nhdyn/formulation/complement.hpp"
+#include "nhdyn/formulation/row_scaling.hpp"
 #include "nhdyn/formulation/small_dense.hpp"
 #include "nhdyn/model/terms.hpp"
 
@@ -25,24 +26,14 @@ bool lu_is_singular(const Eigen::PartialPivLU<Matrix>& lu) {
 }
 
 bool factor_equilibrated(Matrix& M, Vector& rhs, Eigen::PartialPivLU<Matrix>& lu) {
-  // Rows whose largest entries differ by more than kRowScaleRatio (rows in different units: the rows
-  // D A scale with the masses, the rows b do not, --set m=1e100) are scaled exactly by powers of two
-  // to a largest entry in [0.5, 1) before the factorization, so that the pivots' test is about the
-  // matrix and not its units: a well-posed system is solved, a singular one refused. Systems in
-  // comparable units are factored as they are. Allocates nothing.
-  double smallest_row = std::numeric_limits<double>::infinity(), largest_row = 0.0;
-  for (Eigen::Index i = 0; i < M.rows(); ++i) {
-    const double row = M.row(i).cwiseAbs().maxCoeff();
-    smallest_row = std::min(smallest_row, row);
-    largest_row = std::max(largest_row, row);
-  }
-  if (smallest_row > 0.0 && std::isfinite(largest_row) && largest_row > kRowScaleRatio * smallest_row)
-    for (Eigen::Index i = 0; i < M.rows(); ++i) {
-      int exponent = 0;
-      std::frexp(M.row(i).cwiseAbs().maxCoeff(), &exponent);
-      M.row(i) *= std::ldexp(1.0, -exponent);
-      rhs(i) = std::ldexp(rhs(i), -exponent);
-    }
+  // Rows in different units (the rows D A scale with the masses, the rows b do not) are scaled
+  // exactly first (row_scaling.hpp), so that the pivots' test is about the matrix and not its units.
+  scale_rows_by_powers_of_two(
+      static_cast<int>(M.rows()), [&](int i) { return M.row(i).cwiseAbs().maxCoeff(); },
+      [&](int i, int exponent) {
+        M.row(i) *= std::ldexp(1.0, -exponent);
+        rhs(i) = std::ldexp(rhs(i), -exponent);
+      });
   lu.compute(M);
   return !lu_is_singular(lu);
 }

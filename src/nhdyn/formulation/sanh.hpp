@@ -18,12 +18,11 @@ bool lu_is_singular(const Eigen::PartialPivLU<Matrix>& lu);
 
 // Factors M into `lu` and says whether it is regular, independently of the units of its rows
 // (docs/cli.md, "What bad input gets"): when the largest entries of two rows differ by more than
-// kRowScaleRatio, each row of M and of rhs is first scaled exactly by a power of two to a largest
-// entry near 1, so that a well-posed system with huge or tiny parameters (--set m=1e100) is solved
-// and a singular one still refused (without it, pivots 1e100 apart looked singular, and a singular
-// system of such rows could pass). Solve with lu.solve(rhs) afterwards. Cost: O(n^2) and one LU;
-// allocates nothing.
-inline constexpr double kRowScaleRatio = 67108864.0;  // 2^26
+// kRowScaleRatio (row_scaling.hpp), each row of M and of rhs is first scaled exactly by a power
+// of two to a largest entry near 1, so that a well-posed system with huge or tiny parameters
+// (--set m=1e100) is solved and a singular one still refused (without it, pivots 1e100 apart
+// looked singular, and a singular system of such rows could pass). Solve with lu.solve(rhs)
+// afterwards. Cost: O(n^2) and one LU; allocates nothing.
 bool factor_equilibrated(Matrix& M, Vector& rhs, Eigen::PartialPivLU<Matrix>& lu);
 
 }  // namespace nhdyn

@@ -15,11 +15,12 @@
 #include <limits>
 #include <utility>
 
+#include "nhdyn/formulation/row_scaling.hpp"
+
 namespace nhdyn::small {
 
 inline constexpr int kSmallMaxN = 8;
 inline constexpr double kEps = std::numeric_limits<double>::epsilon();
-inline constexpr double kRowScaleRatio = 67108864.0;  // 2^26, as nhdyn::kRowScaleRatio (sanh.hpp)
 
 // An orthonormal basis of null(b) as the rows of D (k x n): the last k columns of Q in a
 // Householder QR factorization with column pivoting b^T P = Q [R1; 0]. The rank test is that of
@@ -139,21 +140,16 @@ bool solve_stacked(const double* A, const double* Q, const double* G, const doub
     for (int c = 0; c < N; ++c) M[K + i + N * c] = b[i + S * c];
     r[K + i] = -b0[i];
   }
-  // Rows in very different units scaled first, as factor_equilibrated does (sanh.hpp).
-  double smallest_row = std::numeric_limits<double>::infinity(), largest_row = 0.0;
+  // Rows in very different units scaled first, as factor_equilibrated does (row_scaling.hpp).
   std::array<double, N> row{};
-  for (int i = 0; i < N; ++i) {
+  for (int i = 0; i < N; ++i)
     for (int c = 0; c < N; ++c) row[i] = std::max(row[i], std::abs(M[i + N * c]));
-    smallest_row = std::min(smallest_row, row[i]);
-    largest_row = std::max(largest_row, row[i]);
-  }
-  if (smallest_row > 0.0 && std::isfinite(largest_row) && largest_row > kRowScaleRatio * smallest_row)
-    for (int i = 0; i < N; ++i) {
-      int exponent = 0;
-      std::frexp(row[i], &exponent);
-      for (int c = 0; c < N; ++c) M[i + N * c] = std::ldexp(M[i + N * c], -exponent);
-      r[i] = std::ldexp(r[i], -exponent);
-    }
+  scale_rows_by_powers_of_two(
+      N, [&](int i) { return row[i]; },
+      [&](int i, int exponent) {
+        for (int c = 0; c < N; ++c) M[i + N * c] = std::ldexp(M[i + N * c], -exponent);
+        r[i] = std::ldexp(r[i], -exponent);
+      });
   const bool regular = eliminate<N>(M, r);
   if (!regular) return false;
   for (int i = N - 1; i >= 0; --i) {

@@ -14,6 +14,11 @@ constexpr double kJumpFraction = 1e-3;
 
 }  // namespace
 
+bool is_jump(double g_root, double g_start, double g_end) {
+  const double scale = std::max(std::abs(g_start), std::abs(g_end));
+  return !(std::isfinite(g_root) && !(std::abs(g_root) > kJumpFraction * scale));
+}
+
 Status find_root(const std::function<Status(double x, double& fx)>& f, double a, double fa, double b,
                  double fb, double& root) {
   constexpr double eps = std::numeric_limits<double>::epsilon();
@@ -162,8 +167,7 @@ Status EventTracker::locate(double t, double h, const Interpolant& interpolate, 
     double g_root = 0.0;
     status = value(i, t, h, theta, interpolate, g_root);
     if (status != Status::ok) return status;
-    const double scale = std::max(std::abs(g0), std::abs(g_end_[k]));
-    if (std::isfinite(g_root) && !(std::abs(g_root) > kJumpFraction * scale)) {
+    if (!is_jump(g_root, g0, g_end_[k])) {
       out.push_back({i, theta >= 1.0 ? t + h : t + theta * h, theta});
     } else {
       ++jumps_;

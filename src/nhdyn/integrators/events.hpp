@@ -86,6 +86,13 @@ class EventTracker {
   double first_jump_t_ = 0.0;
 };
 
+// Whether a sign change of g located at a point where g = g_root is a jump of g (a pole such as
+// 1/x, the wrap-around of atan2), not a zero: |g_root| above 1e-3 of max(|g_start|, |g_end|), its
+// size at the ends of the step that holds the change, or g_root not finite. At a true root |g| is
+// round-off, orders of magnitude below. The one test of EventTracker::locate and of CVODE's root
+// returns (sundials/cvode.cpp), so that every integrator reports the same crossings.
+bool is_jump(double g_root, double g_start, double g_end);
+
 // Brent's method (Brent 1973, "zeroin") for a root of f in [a, b] given fa = f(a), fb = f(b) of
 // opposite signs (or one of them zero), to the resolution of double precision: the final bracket
 // is at most a few ulps wide, and `root` is its end on b's side (where f has the sign of fb), so

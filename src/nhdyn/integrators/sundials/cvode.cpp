@@ -128,6 +128,26 @@ std::string flag_name(int flag) {
   return name ? std::string(name.get()) : fmt::format("flag {}", flag);
 }
 
+// A sign change is a crossing only where g is continuous (events.hpp, is_jump): CVODE's root
+// finding stops at a pole (1/x) or a wrap-around (atan2) too, where |g| stays as large as at the
+// ends of the step. Writes g at the root t_new (state y_root) and at the ends of CVODE's last step
+// [tn - h, tn] (its interpolant is valid over the whole step); a non-finite g (status non_finite:
+// a pole) still has its values written. Returns false when another failure leaves the roots
+// unjudged (they are then reported as CVODE found them). The root last, so that on_event follows it.
+bool evaluate_around_root(void* mem, EventFunctions& events, double t_new, const double* y_root, N_Vector y_dky,
+                          std::vector<double>& g_root, std::vector<double>& g_start, std::vector<double>& g_end) {
+  double t_step_end = t_new, h_last = 0.0;
+  CVodeGetCurrentTime(mem, &t_step_end);
+  CVodeGetLastStep(mem, &h_last);
+  const auto usable = [](Status status) { return status == Status::ok || status == Status::non_finite; };
+  const auto at = [&](double t, std::vector<double>& g) {
+    if (CVodeGetDky(mem, t, 0, y_dky) != CV_SUCCESS) return false;
+    return usable(events.evaluate(t, N_VGetArrayPointer(y_dky), g.data()));
+  };
+  return at(t_step_end - h_last, g_start) && at(t_step_end, g_end) &&
+         usable(events.evaluate(t_new, y_root, g_root.data()));
+}
+
 }  // namespace
 
 IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& options, double t0,
@@ -207,11 +227,15 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
   // Events: CVODE's own root finding on its interpolating polynomial (CVodeRootInit), which
   // returns at each root with the state there (CV_ROOT_RETURN) before the step's end.
   std::vector<int> directions, roots;
+  std::vector<double> g_root, g_start, g_end;  // g at a root and at the ends of its step (is_jump)
   if (events != nullptr && events->count() > 0) {
     state.events = events;
     const int m = events->count();
     for (int i = 0; i < m; ++i) directions.push_back(static_cast<int>(events->direction(i)));
     roots.assign(static_cast<std::size_t>(m), 0);
+    g_root.assign(static_cast<std::size_t>(m), 0.0);
+    g_start.assign(static_cast<std::size_t>(m), 0.0);
+    g_end.assign(static_cast<std::size_t>(m), 0.0);
     if (CVodeRootInit(mem, m, cvode_roots) != CV_SUCCESS) return setup_failure("CVodeRootInit");
     if (CVodeSetRootDirection(mem, directions.data()) != CV_SUCCESS) return setup_failure("CVodeSetRootDirection");
   }
@@ -264,8 +288,10 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
         }
       }
       CVodeGetRootInfo(mem, roots.data());
+      const bool judged = evaluate_around_root(mem, *events, t_new, y_data, y_dky.get(), g_root, g_start, g_end);
       for (std::size_t i = 0; i < roots.size(); ++i) {
         if (roots[i] == 0) continue;
+        if (judged && is_jump(g_root[i], g_start[i], g_end[i])) continue;
         const Status event_status = events->on_event(static_cast<int>(i), t_new, y_data);
         if (event_status == Status::ok) continue;
         t = t_new;
