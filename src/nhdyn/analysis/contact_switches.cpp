@@ -181,8 +181,32 @@ std::string ContactSwitches::switch_contact(int contact, int slot, double t, con
   ContactModeData& w = data_.modes;
   const ContactMode before = w.mode[i];
   if (slot == 0 && before != ContactMode::free) {
+    // From rolling, N can reach 0 while the friction rolling needs does not (a contact without
+    // friction limit): free, the contact then starts with g'' = -Lambda_nt F_t, which is < 0 for a
+    // coupled contact: it would sink into the ground at once while rolling would pull. No mode is
+    // consistent there (docs/derivations/contact-modes.md section 6, "Lift-off"): the lift-off row
+    // is written and the run ends with the reason. From sliding F_t = mu_k N falls to 0 with N.
+    double needed = 0.0;
+    if (before == ContactMode::rolling) {
+      if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
+      needed = norm2(w.friction[i]);
+    }
     w.mode[i] = ContactMode::free;
-    return c.name + "_liftoff";
+    const std::string name = c.name + "_liftoff";
+    if (before != ContactMode::rolling) return name;
+    if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
+    const auto row = static_cast<Eigen::Index>(c.gap);
+    const double gap_acceleration = data_.b.row(row).dot(data_.qdd) + data_.b0(row);
+    const double scale = data_.b.row(row).cwiseAbs().dot(data_.qdd.cwiseAbs()) + std::abs(data_.b0(row));
+    if (!(gap_acceleration < -1e-6 * scale)) return name;
+    if (handler_(name, t, switch_y_.data()) != Status::ok) return "";
+    accumulation_ = fmt::format(
+        "contact '{}': its normal force falls to 0 at t = {:.12g} while rolling still needs the friction |F_t| = "
+        "{:.6g} N; free, the contact would at once sink into the ground (gap acceleration {:.6g} m/s^2): no mode is "
+        "consistent (docs/derivations/contact-modes.md section 6, \"Lift-off\"). Give the contact a friction "
+        "coefficient (friction = ...): it then slides before N reaches 0; the run ends here with its results so far",
+        c.name, t, needed, gap_acceleration);
+    return "";
   }
   if (slot == 0) return touchdown(contact, t);
   if (slot == 2) {
