@@ -27,6 +27,11 @@ namespace fs = std::filesystem;
 constexpr double kTopM = 0.02, kTopR = 0.02, kTopA = 0.3 * kTopR;
 constexpr double kTopI1 = 0.45 * kTopM * kTopR * kTopR, kTopI3 = 0.4 * kTopM * kTopR * kTopR;
 
+struct TopBody {
+  double R, a, I1, I3;
+};
+constexpr TopBody kExampleTop{kTopR, kTopA, kTopI1, kTopI3};
+
 struct TopState {
   double kz;       // the symmetry axis' vertical component
   double jellett;  // L_G . (R e_z - a k)
@@ -36,7 +41,7 @@ struct TopState {
 // From the unit quaternion e (normalized here: the integrator lets its norm drift at rtol) and its
 // rate: the body's angular velocity w_b = 2 conj(e) e' (vector part), L_G = diag(I1, I1, I3) w_b in
 // body axes, and e_z in body axes, the third row of the rotation matrix.
-TopState top_state(const std::array<double, 4>& q, const std::array<double, 4>& qd) {
+TopState top_state(const std::array<double, 4>& q, const std::array<double, 4>& qd, const TopBody& b = kExampleTop) {
   const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
   const double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
   const double dw = qd[0] / n, dx = qd[1] / n, dy = qd[2] / n, dz = qd[3] / n;
@@ -44,9 +49,9 @@ TopState top_state(const std::array<double, 4>& q, const std::array<double, 4>& 
   const std::array<double, 3> wb = {2 * (w * dx - dw * x - (y * dz - z * dy)), 2 * (w * dy - dw * y - (z * dx - x * dz)),
                                     2 * (w * dz - dw * z - (x * dy - y * dx))};
   const std::array<double, 3> ez = {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)};
-  const std::array<double, 3> L = {kTopI1 * wb[0], kTopI1 * wb[1], kTopI3 * wb[2]};
+  const std::array<double, 3> L = {b.I1 * wb[0], b.I1 * wb[1], b.I3 * wb[2]};
   const double lz = L[0] * ez[0] + L[1] * ez[1] + L[2] * ez[2];
-  return {ez[2], kTopR * lz - kTopA * L[2], lz};
+  return {ez[2], b.R * lz - b.a * L[2], lz};
 }
 
 class CliTippeTop : public ::testing::Test {
@@ -144,6 +149,36 @@ TEST_F(CliTippeTop, TurnsOverWithJellettsQuantityConstantThroughEverySwitch) {
     EXPECT_EQ(names[i], (i - 4) % 2 == 0 ? "ball_liftoff" : "ball_touchdown") << i;
     EXPECT_GT(times[i], 4.0);
     EXPECT_LT(times[i], 7.0);
+  }
+}
+
+TEST_F(CliTippeTop, LeineAndGlockersTopSticksAndRollsUprightUnderPointCoulombFriction) {
+  // docs/derivations/contact-modes.md 10.4, "A published top": m = 6 g, R = 15 mm, a = 3 mm,
+  // I1 = 8e-7, I3 = 7e-7 kg m^2, mu = 0.3. Rolling keeps E and J, and the upright spin is stable.
+  const std::string example = std::string(NHDYN_SOURCE_DIR) + "/examples/tippe_top.toml";
+  const nhdyn::test::CliOutcome run = nhdyn::test::run_nhdyn(
+      "simulate '" + example +
+          "' --set m=0.006 --set R=0.015 --set alpha=0.2 --set k1=0.5925925925925926 --set k3=0.5185185185185185 "
+          "--set mu=0.3 --t-end 2 -o lg.csv",
+      dir_);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_TRUE(nhdyn::test::contains(run.out, "events: 1 located")) << run.out;
+  EXPECT_TRUE(nhdyn::test::contains(run.out, "ball_stick at t = 0.0361")) << run.out;
+  const TopBody body{0.015, 0.003, 8e-7, 7e-7};
+  const nhdyn::CsvTable csv = nhdyn::load_csv(dir_ / "lg.csv");
+  const auto col = [&](const char* name) { return static_cast<std::size_t>(csv.column(name)); };
+  const auto state = [&](const std::vector<double>& row) {
+    return top_state({row[col("e0")], row[col("e1")], row[col("e2")], row[col("e3")]},
+                     {row[col("e0'")], row[col("e1'")], row[col("e2'")], row[col("e3'")]}, body);
+  };
+  const TopState first = state(csv.rows.front());
+  EXPECT_NEAR(first.jellett, (0.015 * std::cos(0.1) - 0.003) * 7e-7 * 180.0, 1e-14);
+  for (const std::vector<double>& row : csv.rows) {
+    const TopState s = state(row);
+    EXPECT_NEAR(s.jellett, first.jellett, 1e-7 * std::abs(first.jellett)) << row[0];
+    EXPECT_GT(s.kz, 0.99) << row[0];  // upright: it does not turn over
+    EXPECT_EQ(row[col("ball_mode")], row[0] < 0.0361 ? 1.0 : 0.0) << row[0];
+    EXPECT_LT(std::abs(row[col("balance_error")]), 1e-10);
   }
 }
 
