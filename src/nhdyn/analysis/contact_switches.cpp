@@ -241,7 +241,26 @@ std::string ContactSwitches::switch_contact(int contact, int slot, double t, con
   return c.name + "_slip";
 }
 
+void ContactSwitches::hold_row(double t, const double* y) {
+  held_y_.assign(y, y + size_);
+  held_t_ = t;
+  held_ = true;
+}
+
+Status ContactSwitches::flush_row() {
+  if (!held_) return Status::ok;
+  held_ = false;
+  return output_ ? (*output_)(held_t_, held_y_.data()) : Status::ok;
+}
+
 Status ContactSwitches::on_event(int i, double t, const double* y) {
+  // The row held at an output time goes first; a switch at that time, to round-off, takes its
+  // place instead (a user event's row keeps the rule that the first row written stands).
+  if (held_ && i >= user_count_ &&
+      std::abs(t - held_t_) <= 64 * std::numeric_limits<double>::epsilon() *
+                                   std::max({1.0, std::abs(t), std::abs(held_t_)}))
+    held_ = false;
+  if (const Status status = flush_row(); status != Status::ok) return status;
   if (i < user_count_) return user_->on_event(i, t, y);
   const int contact = (i - user_count_) / kSlots;
   const int slot = (i - user_count_) % kSlots;
@@ -508,8 +527,18 @@ IntegrationResult integrate_contact_modes(OdeSystem& ode, const IntegratorOption
   std::size_t next = 0;
   IntegratorStats total;
   IntegratorOptions segment = options;
+  // Each output time's row waits for the next call (ContactSwitches::hold_row): a switch found
+  // within round-off after it replaces it.
+  switches.set_output(&output);
+  const OutputFn held = [&switches](double time, const double* state) {
+    const Status status = switches.flush_row();
+    if (status == Status::ok) switches.hold_row(time, state);
+    return status;
+  };
   while (true) {
-    IntegrationResult result = integrate(ode, segment, t, y.data(), output_times.subspan(next), output, &switches);
+    IntegrationResult result = integrate(ode, segment, t, y.data(), output_times.subspan(next), held, &switches);
+    if (const Status status = switches.flush_row(); status != Status::ok && result.status == Status::ok)
+      result.status = status;
     total.steps += result.stats.steps;
     total.rejected_steps += result.stats.rejected_steps;
     total.rhs_evaluations += result.stats.rhs_evaluations;
