@@ -270,6 +270,18 @@ TEST_F(CliContactEvents, TheDiskReleasedOnTheFloorSlipsAtTheClosedFormAndDoesNot
   EXPECT_LT(csv.rows.back()[csv_column(csv, "work_friction")], -1e-3);
 }
 
+TEST_F(CliContactEvents, TheSlidingDiskThatFallsFlatEndsTheRunSayingSoWithTheRowsBefore) {
+  // Sliding on, the disk lies flat near t = 0.562 s, where its contact point is not defined: the
+  // run ends with that reason (not the solver's symptom) and every output row before it.
+  const nhdyn::test::CliOutcome run =
+      run_nhdyn("simulate '" + kHopExample + "' --set h=0 --set theta0=0.1 --t-end 0.8 -o flat.csv", dir_);
+  EXPECT_EQ(run.exit_code, 1) << run.out;
+  EXPECT_TRUE(contains(run.out, "contact 'disk': the disk lies flat")) << run.out;
+  const nhdyn::CsvTable csv = nhdyn::load_csv(dir_ / "flat.partial.csv");
+  ASSERT_GT(csv.rows.size(), 2u);
+  EXPECT_NEAR(csv.rows.back()[csv_column(csv, "t")], 0.56, 1e-12);  // the last output time before it
+}
+
 TEST_F(CliContactEvents, WithoutAFrictionLimitTheDiskReachesNZeroAtTheClosedFormWhereNoModeIsConsistent) {
   std::string text = read_text(kHopExample);
   nhdyn::test::replace_once(text, "friction = \"mu\"\n", "");

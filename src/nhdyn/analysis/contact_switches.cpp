@@ -253,6 +253,27 @@ Status ContactSwitches::flush_row() {
   return output_ ? (*output_)(held_t_, held_y_.data()) : Status::ok;
 }
 
+Status ContactSwitches::flush_row_after_failure() {
+  if (!held_) return Status::ok;
+  // What the run's message reads (explain_failure, singular_contact_message): the failure's
+  // record and the state it happened at.
+  const double t = data_.t, failed_t = data_.failed_t, failed_value = data_.failed_value;
+  const Vector q = data_.q, v = data_.v;
+  const Status failure = data_.status;
+  const std::string quantity = data_.failed_quantity;
+  const int contact = data_.modes.failed_contact;
+  const Status status = flush_row();
+  data_.t = t;
+  data_.q = q;
+  data_.v = v;
+  data_.status = failure;
+  data_.failed_quantity = quantity;
+  data_.failed_t = failed_t;
+  data_.failed_value = failed_value;
+  data_.modes.failed_contact = contact;
+  return status;
+}
+
 Status ContactSwitches::on_event(int i, double t, const double* y) {
   // The row held at an output time goes first; a switch at that time, to round-off, takes its
   // place instead (a user event's row keeps the rule that the first row written stands).
@@ -537,7 +558,9 @@ IntegrationResult integrate_contact_modes(OdeSystem& ode, const IntegratorOption
   };
   while (true) {
     IntegrationResult result = integrate(ode, segment, t, y.data(), output_times.subspan(next), held, &switches);
-    if (const Status status = switches.flush_row(); status != Status::ok && result.status == Status::ok)
+    const bool failed = result.status != Status::ok && !(result.status == Status::stopped && switches.switched());
+    if (const Status status = failed ? switches.flush_row_after_failure() : switches.flush_row();
+        status != Status::ok && result.status == Status::ok)
       result.status = status;
     total.steps += result.stats.steps;
     total.rejected_steps += result.stats.rejected_steps;

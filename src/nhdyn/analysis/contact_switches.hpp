@@ -78,6 +78,9 @@ class ContactSwitches final : public EventFunctions {
   // simulate() writes them). integrate_contact_modes holds and flushes them through `output`.
   void hold_row(double t, const double* y);
   Status flush_row();
+  // The same after a failed step: Data keeps the failure's record (its t, state and reason, which
+  // the run's message reads), not the evaluation of the row written.
+  Status flush_row_after_failure();
   void set_output(const OutputFn* output) { output_ = output; }
 
  private:
