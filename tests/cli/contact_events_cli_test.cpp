@@ -4,6 +4,12 @@
 // section 6.4; the event is a row of the CSV (with disk_N zero to round-off) and of
 // FILE-events.csv; --stop-when and --event name the columns too; and an event on a contact force
 // that the model lacks or does not determine (NaN by design) is refused with exit 2 before the run.
+// The same disk as a [[contacts]] entry that may slide, lift off and land
+// (examples/rolling_disk_hop.toml, docs/contact-modes.md): dropped at a lean it lands where its rim
+// meets the floor, flies between its bounces as a free body, and the impacts' energy is booked in
+// impact_loss; released on the floor it slips at the closed-form angle and does not hop; without a
+// friction limit it reaches N = 0 at the same closed form and the run ends there (no mode is
+// consistent).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -11,6 +17,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -134,6 +141,166 @@ TEST_F(CliContactEvents, StopWhenAndEventNameTheColumns) {
   EXPECT_EQ(events.names[0], "slide");
   EXPECT_NEAR(events.rows[0][events.column("theta")], std::acos(2 * std::cos(0.1) / 3), kLiftoffCliTolerance);
   EXPECT_EQ(events.names[1], "liftoff");
+}
+
+const std::string kHopExample = std::string(NHDYN_SOURCE_DIR) + "/examples/rolling_disk_hop.toml";
+
+// The hop example's parameters (m, r, g) and its drop (theta0, h).
+constexpr double kM = 0.5, kR = 0.2, kG = 9.81, kTheta0 = 0.3, kH = 0.05;
+
+// The planar state of the disk (it leans about x; x, psi and phi stay 0) from a CSV or events row.
+struct DiskState {
+  double t, y, z, theta, vy, vz, w;
+  double kinetic() const { return 0.5 * kM * (vy * vy + vz * vz) + 0.5 * (kM * kR * kR / 4) * w * w; }
+  // Free flight: the centre on a parabola, the lean rate constant (no moment about the centre, and
+  // the diameter it turns about is a principal axis).
+  DiskState fly(double tau) const {
+    return {t + tau, y + vy * tau, z + vz * tau - kG * tau * tau / 2, theta + w * tau, vy, vz - kG * tau, w};
+  }
+  double gap() const { return z - kR * std::cos(theta); }  // the rim's lowest point above the floor
+};
+
+DiskState disk_state(const std::vector<double>& row, const std::function<std::size_t(const std::string&)>& col) {
+  for (const char* zero : {"x", "psi", "phi", "x'", "psi'", "phi'"}) EXPECT_EQ(row[col(zero)], 0.0) << zero;
+  return {row[col("t")], row[col("y")], row[col("z")], row[col("theta")], row[col("y'")], row[col("z'")],
+          row[col("theta'")]};
+}
+
+// The first time after `from` (gap 0, rising) at which the free flight's gap falls through 0.
+double next_touchdown(const DiskState& from) {
+  double lo = 1e-9, hi = lo;
+  while (from.fly(hi).gap() > 0.0) {
+    lo = hi;
+    hi += 1e-3;
+    if (hi > 1.0) return NAN;
+  }
+  for (int i = 0; i < 200 && hi - lo > 1e-15; ++i) {
+    const double mid = (lo + hi) / 2;
+    (from.fly(mid).gap() > 0.0 ? lo : hi) = mid;
+  }
+  return from.t + (lo + hi) / 2;
+}
+
+TEST_F(CliContactEvents, TheDroppedDiskLandsWhereItsRimMeetsTheFloorAndFliesAsAFreeBodyBetweenBounces) {
+  const nhdyn::test::CliOutcome run = run_nhdyn("simulate '" + kHopExample + "' -o hop.csv", dir_);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const ContactEventsTable events = load_contact_events(dir_ / "hop-events.csv");
+  ASSERT_EQ(events.names.size(), 3u) << run.out;
+  const nhdyn::CsvTable csv = nhdyn::load_csv(dir_ / "hop.csv");
+  const auto col = [&](const std::string& name) { return csv_column(csv, name); };
+  const auto event_col = [&](const std::string& name) { return events.column(name); };
+
+  // The first fall: the rim drops h at rest, theta stays theta0.
+  const double t1 = std::sqrt(2 * kH / kG);
+  double loss_before = 0.0, kinetic_before = 0.5 * kM * (kG * t1) * (kG * t1);
+  double t_landing = t1;
+  for (std::size_t k = 0; k < events.names.size(); ++k) {
+    EXPECT_EQ(events.names[k], "disk_touchdown");
+    const std::vector<double>& e = events.rows[k];
+    // Located where the rim meets the floor, on the flight before it (closed form).
+    EXPECT_NEAR(e[event_col("t")], t_landing, 1e-9) << k;
+    if (k == 0) {
+      EXPECT_NEAR(e[event_col("theta")], kTheta0, 1e-12);
+    }
+    // The touchdown's row carries the velocities after the impact; h jumps by T+ - T-, booked in
+    // impact_loss (V is continuous), so h - h0 - W does not jump.
+    std::size_t at = 0;
+    while (at < csv.rows.size() && csv.rows[at][col("t")] != e[event_col("t")]) ++at;
+    ASSERT_LT(at, csv.rows.size()) << "no row at touchdown " << k;
+    const DiskState after = disk_state(csv.rows[at], col);
+    EXPECT_EQ(csv.rows[at][col("disk_mode")], 2.0);  // it bounces: free
+    EXPECT_GT(after.vz + kR * std::sin(after.theta) * after.w, 0.0);  // the rim's lowest point rises
+    const double loss = csv.rows[at][col("impact_loss")];
+    EXPECT_GT(loss - loss_before, 0.0);
+    EXPECT_NEAR(loss - loss_before, kinetic_before - after.kinetic(), 1e-9) << k;
+    loss_before = loss;
+
+    // The flight to the next touchdown (or t_end): every row on the closed-form free flight.
+    const double t_next = next_touchdown(after);
+    const double t_until = k + 1 < events.names.size() ? events.rows[k + 1][event_col("t")] : 0.3;
+    int rows = 0;
+    for (std::size_t i = at + 1; i < csv.rows.size() && csv.rows[i][col("t")] < t_until; ++i, ++rows) {
+      const DiskState s = disk_state(csv.rows[i], col);
+      const DiskState f = after.fly(s.t - after.t);
+      EXPECT_NEAR(s.y, f.y, 1e-10);
+      EXPECT_NEAR(s.z, f.z, 1e-10);
+      EXPECT_NEAR(s.theta, f.theta, 1e-10);
+      EXPECT_NEAR(s.vy, f.vy, 1e-10);
+      EXPECT_NEAR(s.vz, f.vz, 1e-10);
+      EXPECT_NEAR(s.w, f.w, 1e-10);  // the angular momentum about the centre, I w, is constant
+      EXPECT_EQ(csv.rows[i][col("disk_mode")], 2.0);
+      EXPECT_GT(csv.rows[i][col("disk_gap")], 0.0);
+      EXPECT_EQ(csv.rows[i][col("impact_loss")], loss);
+    }
+    EXPECT_GT(rows, 1) << k;
+    t_landing = t_next;
+    kinetic_before = after.fly(t_next - after.t).kinetic();
+  }
+  EXPECT_GT(t_landing, 0.3);  // the fourth landing is after t_end
+  for (const std::vector<double>& row : csv.rows) EXPECT_LT(std::abs(row[col("balance_error")]), 1e-12);
+}
+
+TEST_F(CliContactEvents, TheDiskReleasedOnTheFloorSlipsAtTheClosedFormAndDoesNotHop) {
+  // Released at rest at theta0 = 0.1 it rolls about its contact point (N and F_lat of
+  // docs/derivations/contact-forces.md 6.4) until |F_lat| = mu N, then slides with N > 0.
+  const double mu = 0.5, c0 = std::cos(0.1);
+  const auto excess = [&](double theta) {
+    const double c = std::cos(theta);
+    return 0.8 * std::sin(theta) * std::abs(2 * c0 - 3 * c) - mu * (1 - 8 * c0 * c + 12 * c * c) / 5;
+  };
+  double lo = 0.1, hi = liftoff_theta(0.0);
+  for (int i = 0; i < 200 && hi - lo > 1e-15; ++i) {
+    const double mid = (lo + hi) / 2;
+    (excess(mid) < 0.0 ? lo : hi) = mid;
+  }
+  const nhdyn::test::CliOutcome run =
+      run_nhdyn("simulate '" + kHopExample + "' --set h=0 --set theta0=0.1 --t-end 0.54 -o slide.csv", dir_);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const ContactEventsTable events = load_contact_events(dir_ / "slide-events.csv");
+  ASSERT_EQ(events.names.size(), 1u) << run.out;
+  EXPECT_EQ(events.names[0], "disk_slip");
+  EXPECT_NEAR(events.rows[0][events.column("theta")], (lo + hi) / 2, 1e-9);
+  const nhdyn::CsvTable csv = nhdyn::load_csv(dir_ / "slide.csv");
+  const std::size_t mode = csv_column(csv, "disk_mode");
+  for (const std::vector<double>& row : csv.rows) {
+    EXPECT_GT(row[csv_column(csv, "disk_N")], 0.5) << row[0];  // m g = 4.905 N: far from lifting off
+    EXPECT_LT(std::abs(row[csv_column(csv, "balance_error")]), 1e-9);
+    EXPECT_EQ(row[mode], row[0] < events.rows[0][events.column("t")] ? 0.0 : 1.0) << row[0];
+  }
+  EXPECT_LT(csv.rows.back()[csv_column(csv, "work_friction")], -1e-3);
+}
+
+TEST_F(CliContactEvents, TheSlidingDiskThatFallsFlatEndsTheRunSayingSoWithTheRowsBefore) {
+  // Sliding on, the disk lies flat near t = 0.562 s, where its contact point is not defined: the
+  // run ends with that reason (not the solver's symptom) and every output row before it.
+  const nhdyn::test::CliOutcome run =
+      run_nhdyn("simulate '" + kHopExample + "' --set h=0 --set theta0=0.1 --t-end 0.8 -o flat.csv", dir_);
+  EXPECT_EQ(run.exit_code, 1) << run.out;
+  EXPECT_TRUE(contains(run.out, "contact 'disk': the disk lies flat")) << run.out;
+  const nhdyn::CsvTable csv = nhdyn::load_csv(dir_ / "flat.partial.csv");
+  ASSERT_GT(csv.rows.size(), 2u);
+  EXPECT_NEAR(csv.rows.back()[csv_column(csv, "t")], 0.56, 1e-12);  // the last output time before it
+}
+
+TEST_F(CliContactEvents, WithoutAFrictionLimitTheDiskReachesNZeroAtTheClosedFormWhereNoModeIsConsistent) {
+  std::string text = read_text(kHopExample);
+  nhdyn::test::replace_once(text, "friction = \"mu\"\n", "");
+  std::ofstream(dir_ / "rolling.toml") << text;
+  const nhdyn::test::CliOutcome run = run_nhdyn("simulate rolling.toml --set h=0 --set theta0=0.1 --t-end 0.55 -o r.csv", dir_);
+  EXPECT_EQ(run.exit_code, 1) << run.out;
+  for (const char* said : {"contact 'disk': its normal force falls to 0 at t = 0.4901525", "|F_t| = 1.72209 N",
+                           "gap acceleration -5.925", "no mode is consistent", "Give the contact a friction coefficient"})
+    EXPECT_TRUE(contains(run.out, said)) << said << "\n" << run.out;
+  // The lift-off row ends the partial results: at the closed-form theta, the mode free.
+  const nhdyn::CsvTable csv = nhdyn::load_csv(dir_ / "r.partial.csv");
+  ASSERT_GT(csv.rows.size(), 2u);
+  const std::vector<double>& last = csv.rows.back();
+  EXPECT_NEAR(last[csv_column(csv, "theta")], liftoff_theta(0.0), kLiftoffCliTolerance);
+  EXPECT_EQ(last[csv_column(csv, "disk_mode")], 2.0);
+  for (std::size_t i = 0; i + 1 < csv.rows.size(); ++i) EXPECT_GT(csv.rows[i][csv_column(csv, "disk_N")], 0.0);
+  // F_lat = (4/5) m g sin(theta)(2 c0 - 3 c) there, which the message gives.
+  const double c = std::cos(liftoff_theta(0.0));
+  EXPECT_NEAR(0.8 * kM * kG * std::sin(liftoff_theta(0.0)) * (2 * std::cos(0.1) - 3 * c), 1.72209, 1e-5);
 }
 
 TEST_F(CliContactEvents, MissingOrUndeterminedContactForcesAreRefusedBeforeTheRun) {

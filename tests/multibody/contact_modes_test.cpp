@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/results.hpp"
+#include "nhdyn/model/parameters.hpp"
 #include "support/text.hpp"
 
 namespace nhdyn {
@@ -99,6 +101,36 @@ TEST(ContactModes, BallThrownSlidingSticksAtTheClosedFormTimeAndRollsAtFiveSeven
   EXPECT_LT(r.summary.max_velocity_residual, 1e-12);
   EXPECT_LT(r.summary.max_balance_error, 1e-12);
   EXPECT_NEAR(r.summary.energy_change, -m * v0 * v0 / 7, 1e-12);
+}
+
+// A switch located within round-off of an output time: one row stands for that time, and it is the
+// switch's row, with the mode after it, on whichever side of the output time the switch falls.
+// v0 puts t* = 2 v0 / (7 mu g) on the output time 0.35; its last bits move t* across it.
+TEST(ContactModes, ASwitchAtAnOutputTimeReplacesItsRow) {
+  Model model = load_model(example("ball_thrown_sliding.toml"));
+  const double g = mode_parameter(model, "g"), mu = mode_parameter(model, "mu");
+  const double v_grid = 0.35 * 7 * mu * g / 2;
+  const double window = 64 * std::numeric_limits<double>::epsilon();
+  const double t_grid = make_output_times(0.0, 0.36, 0.01).at(35);  // the output time 0.35
+  int after = 0, before = 0;
+  for (int k = -5; k <= 5; ++k) {
+    const double v0 = v_grid * (1 + k * 3e-15);
+    set_parameter(model, "v0", v0);  // the initial velocity follows
+    const ModeRun r = run_modes(model, 0.36);
+    ASSERT_EQ(r.summary.events.size(), 1u);
+    const double t_switch = r.summary.events[0].t;
+    std::vector<std::size_t> near;
+    for (std::size_t i = 0; i < r.rows.size(); ++i)
+      if (std::abs(r.rows[i][0] - t_switch) <= window) near.push_back(i);
+    ASSERT_EQ(near.size(), 1u) << k;
+    EXPECT_EQ(r.rows[near[0]][0], t_switch) << k;  // the switch's own row
+    EXPECT_EQ(r.at(near[0], "ball_mode"), 0.0) << k;
+    EXPECT_EQ(r.at(near[0] - 1, "ball_mode"), 1.0) << k;
+    if (std::abs(t_switch - t_grid) <= window) (t_switch > t_grid ? after : before) += 1;
+  }
+  // Both sides were met (the rows are those of the switch on both).
+  EXPECT_GT(after, 0);
+  EXPECT_GT(before, 0);
 }
 
 // With backspin r W > 5 v0 / 2 the ball comes back: it sticks at t* = k (v0 + r W) / (mu g (1 + k))

@@ -182,8 +182,32 @@ std::string ContactSwitches::switch_contact(int contact, int slot, double t, con
   ContactModeData& w = data_.modes;
   const ContactMode before = w.mode[i];
   if (slot == 0 && before != ContactMode::free) {
+    // From rolling, N can reach 0 while the friction rolling needs does not (a contact without
+    // friction limit): free, the contact then starts with g'' = -Lambda_nt F_t, which is < 0 for a
+    // coupled contact: it would sink into the ground at once while rolling would pull. No mode is
+    // consistent there (docs/derivations/contact-modes.md section 6, "Lift-off"): the lift-off row
+    // is written and the run ends with the reason. From sliding F_t = mu_k N falls to 0 with N.
+    double needed = 0.0;
+    if (before == ContactMode::rolling) {
+      if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
+      needed = norm2(w.friction[i]);
+    }
     w.mode[i] = ContactMode::free;
-    return c.name + "_liftoff";
+    const std::string name = c.name + "_liftoff";
+    if (before != ContactMode::rolling) return name;
+    if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
+    const auto row = static_cast<Eigen::Index>(c.gap);
+    const double gap_acceleration = data_.b.row(row).dot(data_.qdd) + data_.b0(row);
+    const double scale = data_.b.row(row).cwiseAbs().dot(data_.qdd.cwiseAbs()) + std::abs(data_.b0(row));
+    if (!(gap_acceleration < -1e-6 * scale)) return name;
+    if (handler_(name, t, switch_y_.data()) != Status::ok) return "";
+    accumulation_ = fmt::format(
+        "contact '{}': its normal force falls to 0 at t = {:.12g} while rolling still needs the friction |F_t| = "
+        "{:.6g} N; free, the contact would at once sink into the ground (gap acceleration {:.6g} m/s^2): no mode is "
+        "consistent (docs/derivations/contact-modes.md section 6, \"Lift-off\"). Give the contact a friction "
+        "coefficient (friction = ...): it then slides before N reaches 0; the run ends here with its results so far",
+        c.name, t, needed, gap_acceleration);
+    return "";
   }
   if (slot == 0) return touchdown(contact, t);
   if (slot == 2) {
@@ -218,7 +242,47 @@ std::string ContactSwitches::switch_contact(int contact, int slot, double t, con
   return c.name + "_slip";
 }
 
+void ContactSwitches::hold_row(double t, const double* y) {
+  held_y_.assign(y, y + size_);
+  held_t_ = t;
+  held_ = true;
+}
+
+Status ContactSwitches::flush_row() {
+  if (!held_) return Status::ok;
+  held_ = false;
+  return output_ ? (*output_)(held_t_, held_y_.data()) : Status::ok;
+}
+
+Status ContactSwitches::flush_row_after_failure() {
+  if (!held_) return Status::ok;
+  // What the run's message reads (explain_failure, singular_contact_message): the failure's
+  // record and the state it happened at.
+  const double t = data_.t, failed_t = data_.failed_t, failed_value = data_.failed_value;
+  const Vector q = data_.q, v = data_.v;
+  const Status failure = data_.status;
+  const std::string quantity = data_.failed_quantity;
+  const int contact = data_.modes.failed_contact;
+  const Status status = flush_row();
+  data_.t = t;
+  data_.q = q;
+  data_.v = v;
+  data_.status = failure;
+  data_.failed_quantity = quantity;
+  data_.failed_t = failed_t;
+  data_.failed_value = failed_value;
+  data_.modes.failed_contact = contact;
+  return status;
+}
+
 Status ContactSwitches::on_event(int i, double t, const double* y) {
+  // The row held at an output time goes first; a switch at that time, to round-off, takes its
+  // place instead (a user event's row keeps the rule that the first row written stands).
+  if (held_ && i >= user_count_ &&
+      std::abs(t - held_t_) <= 64 * std::numeric_limits<double>::epsilon() *
+                                   std::max({1.0, std::abs(t), std::abs(held_t_)}))
+    held_ = false;
+  if (const Status status = flush_row(); status != Status::ok) return status;
   if (i < user_count_) return user_->on_event(i, t, y);
   const int contact = (i - user_count_) / kSlots;
   const int slot = (i - user_count_) % kSlots;
@@ -493,8 +557,20 @@ IntegrationResult integrate_contact_modes(OdeSystem& ode, const IntegratorOption
   std::size_t next = 0;
   IntegratorStats total;
   IntegratorOptions segment = options;
+  // Each output time's row waits for the next call (ContactSwitches::hold_row): a switch found
+  // within round-off after it replaces it.
+  switches.set_output(&output);
+  const OutputFn held = [&switches](double time, const double* state) {
+    const Status status = switches.flush_row();
+    if (status == Status::ok) switches.hold_row(time, state);
+    return status;
+  };
   while (true) {
-    IntegrationResult result = integrate(ode, segment, t, y.data(), output_times.subspan(next), output, &switches);
+    IntegrationResult result = integrate(ode, segment, t, y.data(), output_times.subspan(next), held, &switches);
+    const bool failed = result.status != Status::ok && !(result.status == Status::stopped && switches.switched());
+    if (const Status status = failed ? switches.flush_row_after_failure() : switches.flush_row();
+        status != Status::ok && result.status == Status::ok)
+      result.status = status;
     total.steps += result.stats.steps;
     total.rejected_steps += result.stats.rejected_steps;
     total.rhs_evaluations += result.stats.rhs_evaluations;

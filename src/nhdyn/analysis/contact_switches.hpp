@@ -72,6 +72,17 @@ class ContactSwitches final : public EventFunctions {
   // Warnings for the run's summary (an impact that gains energy: once per run).
   const std::vector<std::string>& warnings() const { return warnings_; }
 
+  // The row of an output time is held until the next call of the output (or an event, or the
+  // end): a switch located within round-off after it, 64 eps max(1, |t|), replaces it, so that the
+  // row at that time shows the mode and impact_loss after the switch (one row per time, as
+  // simulate() writes them). integrate_contact_modes holds and flushes them through `output`.
+  void hold_row(double t, const double* y);
+  Status flush_row();
+  // The same after a failed step: Data keeps the failure's record (its t, state and reason, which
+  // the run's message reads), not the evaluation of the row written.
+  Status flush_row_after_failure();
+  void set_output(const OutputFn* output) { output_ = output; }
+
  private:
   std::string switch_contact(int contact, int slot, double t, const double* y);
   // The impact of a touchdown (section 7): the velocities of switch_y_ after it, and the mode.
@@ -104,6 +115,10 @@ class ContactSwitches final : public EventFunctions {
   std::vector<long> touchdowns_;
   bool gained_energy_ = false;
   std::vector<std::string> warnings_;
+  const OutputFn* output_ = nullptr;
+  bool held_ = false;  // a row of an output time not yet written
+  double held_t_ = 0.0;
+  std::vector<double> held_y_;
 };
 
 // Integrates as integrate() does, through any number of switches: each switch ends a segment,
