@@ -2,13 +2,14 @@
 // (docs/derivations/optimal-programs.md, section 10): the double integrator's closed-form optimum
 // (Hermite-Simpson exact, the trapezoidal J_N in closed form), the Brockett integrator's circle
 // (J = 2 pi a / T), the brachistochrone's cycloid, the motion `nhdyn simulate` computes under the
-// same force, and each refusal of bad input with its exit code.
+// same force (the double integrator, parallel parking), and each refusal of bad input with its exit code.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
 #include <map>
 #include <sstream>
 #include <string>
@@ -224,6 +225,94 @@ TEST_F(OptimizeCli, BrachistochroneFollowsTheCycloid) {
     EXPECT_NEAR(x[i], R * (phi - std::sin(phi)), 1e-4) << time[i];
     EXPECT_NEAR(y[i], R * (1 - std::cos(phi)), 1e-4) << time[i];
   }
+}
+
+// The controls of a Hermite-Simpson result (quadratic through node, midpoint, node on each interval,
+// continuous at the nodes) as one expression in t: the first interval's quadratic plus, at each
+// later node t_k, the change of slope and curvature switched on by H(t - t_k), with
+// H(s) s = (s + |s|)/2. `time` and `u` hold the points in order (2N + 1 of them).
+std::string piecewise_quadratic(const std::vector<double>& time, const std::vector<double>& u) {
+  const auto num = [](double v) {
+    std::ostringstream s;
+    s.precision(17);
+    s << "(" << v << ")";
+    return s.str();
+  };
+  std::vector<double> alpha, beta, start, length;
+  for (std::size_t a = 0; a + 2 < time.size(); a += 2) {
+    const double h = time[a + 2] - time[a];
+    const double b = 2 * (u[a] - 2 * u[a + 1] + u[a + 2]) / (h * h);
+    beta.push_back(b);
+    alpha.push_back((u[a + 2] - u[a]) / h - b * h);
+    start.push_back(time[a]);
+    length.push_back(h);
+  }
+  const std::string s0 = "(t - " + num(start[0]) + ")";
+  std::string out = num(u[0]) + " + " + num(alpha[0]) + "*" + s0 + " + " + num(beta[0]) + "*" + s0 + "^2";
+  for (std::size_t k = 1; k < alpha.size(); ++k) {
+    const double d_alpha = alpha[k] - (alpha[k - 1] + 2 * beta[k - 1] * length[k - 1]), d_beta = beta[k] - beta[k - 1];
+    const std::string s = "(t - " + num(start[k]) + ")";
+    out += " + (" + num(d_alpha) + " + " + num(d_beta) + "*" + s + ")*(" + s + " + abs" + s + ")/2";
+  }
+  return out;
+}
+
+TEST_F(OptimizeCli, ParallelParkingMeetsItsEndsKeepsClearAndReplaysInSimulate) {
+  // examples/parking.toml at 31 nodes (the example has 61) from its guess: IPOPT converges, the
+  // final state is the one asked for, the steer, force and torque bounds and the post's clearance
+  // hold at every point, and `nhdyn simulate` under the optimal controls (as [forces], interpolated
+  // as Hermite-Simpson defines them) ends where the optimized motion ends, to within the
+  // collocation error that the replay difference measures.
+  write_variant("parking.toml", "park.toml", {{"nodes = 61", "nodes = 31"}});
+  const Outcome run = optimize("park.toml --guess " + example("parking_guess.csv") + " -o park.csv");
+  SKIP_WITHOUT_IPOPT(run);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("status: solved"), std::string::npos) << run.out;
+  const double replay = summary_value(run.out, "replay difference");
+  EXPECT_LT(replay, 0.1) << run.out;
+  const Table t = read_csv(dir_ / "park.csv");
+  const std::vector<double> time = t.column("t"), x = t.column("x"), y = t.column("y"), theta = t.column("theta"),
+                            delta = t.column("delta"), F = t.column("u_F"), T = t.column("u_T");
+  ASSERT_EQ(time.size(), 61U);
+  const std::size_t last = time.size() - 1;
+  EXPECT_NEAR(x[last], 0.0, 1e-8);
+  EXPECT_NEAR(y[last], 2.0, 1e-8);
+  EXPECT_NEAR(theta[last], 0.0, 1e-8);
+  EXPECT_NEAR(delta[last], 0.0, 1e-8);
+  EXPECT_NEAR(t.column("x'")[last], 0.0, 1e-8);
+  EXPECT_NEAR(t.column("delta'")[last], 0.0, 1e-8);
+  EXPECT_LT(std::abs(t.column("y'")[last]), 1e-2);  // released: the drift of the blade constraints
+  EXPECT_LT(std::abs(t.column("theta'")[last]), 1e-2);
+  double clearance = 1e9, front_clearance = 1e9, x_max = 0.0;
+  for (std::size_t i = 0; i < time.size(); ++i) {
+    clearance = std::min(clearance, std::hypot(x[i] - 5.5, y[i] - 2.0));
+    front_clearance = std::min(front_clearance, std::hypot(x[i] + 1.5 * std::cos(theta[i]) - 5.5, y[i] + 1.5 * std::sin(theta[i]) - 2.0));
+    x_max = std::max(x_max, x[i]);
+    EXPECT_LE(std::abs(delta[i]), kPi / 4 + 1e-6) << time[i];
+    EXPECT_LE(std::abs(F[i]), 300 + 1e-4) << time[i];
+    EXPECT_LE(std::abs(T[i]), 50 + 1e-4) << time[i];
+  }
+  EXPECT_GE(clearance, 1.2 - 1e-6);
+  EXPECT_GE(front_clearance, 1.2 - 1e-6);
+  EXPECT_LT(front_clearance, 1.2 + 1e-4);  // the post is in the way: the constraint is active
+  EXPECT_GT(x_max, 1.0);                   // the car cannot slide sideways: it drives out and back
+
+  // The independent check: simulate's own integration of the model under F and T as forces.
+  const std::string f = piecewise_quadratic(time, F), torque = piecewise_quadratic(time, T);
+  write_variant("parking.toml", "forced.toml",
+                {{"[optimize]", "[forces]\nx = \"(" + f + ")*cos(theta)\"\ny = \"(" + f + ")*sin(theta)\"\ndelta = \"" +
+                                    torque + "\"\n\n[optimize]"}});
+  const Outcome sim = run_nhdyn("simulate forced.toml --t-end 30 --output-step 0.5 --rtol 1e-11 --atol 1e-11 -o sim.csv", dir_);
+  ASSERT_EQ(sim.exit_code, 0) << sim.out;
+  const Table s = read_csv(dir_ / "sim.csv");
+  ASSERT_EQ(s.column("t").size(), 61U);
+  double worst = 0.0;
+  for (const char* c : {"x", "y", "theta", "delta"}) {
+    const std::vector<double> optimized = t.column(c), simulated = s.column(c);
+    for (std::size_t i = 0; i < time.size(); i += 2) worst = std::max(worst, std::abs(optimized[i] - simulated[i]));
+  }
+  EXPECT_LT(worst, 1.5 * replay + 1e-6) << "replay difference " << replay;
+  EXPECT_GT(worst, 0.5 * replay) << "replay difference " << replay;  // the same error, seen twice
 }
 
 TEST_F(OptimizeCli, FinalValuesTheConstraintsDetermineAreReleased) {
