@@ -315,6 +315,76 @@ TEST_F(OptimizeCli, ParallelParkingMeetsItsEndsKeepsClearAndReplaysInSimulate) {
   EXPECT_GT(worst, 0.5 * replay) << "replay difference " << replay;  // the same error, seen twice
 }
 
+// The values of the report's plotted series `name` ({"name":"R_x","v":[...]} in the page's data).
+std::vector<double> report_series(const std::string& page, const std::string& name) {
+  const std::string key = "{\"name\":\"" + name + "\",\"v\":[";
+  const std::size_t at = page.find(key);
+  std::vector<double> out;
+  if (at == std::string::npos) return out;
+  std::stringstream s(page.substr(at + key.size(), page.find(']', at) - at - key.size()));
+  std::string cell;
+  while (std::getline(s, cell, ',')) out.push_back(std::stod(cell));
+  return out;
+}
+
+TEST_F(OptimizeCli, HtmlReportsTheOptimalMotionWithTheControlsTakenOutOfTheReactions) {
+  // A knife edge pushed along its blade by F and turned by T: the blade's reaction
+  // R = A q'' - Q - G - B u has no theta part (b has none), so R_theta = J theta'' - T = 0 to the
+  // solver's tolerance, where J theta'' alone is not. The double integrator has no constraint:
+  // R_x = m x'' - F = 0, and its energy balance error is the trapezoidal rule's error on the work
+  // of F (the controls' work booked with the forces), small and back to 0 at t_end (F v is odd
+  // about T/2).
+  write("blade.toml", R"toml(name = "blade"
+coordinates = ["x", "y", "theta"]
+kinetic_energy = "m/2 * (x'^2 + y'^2) + J/2 * theta'^2"
+[parameters]
+m = 1.0
+J = 1.0
+[[constraints]]
+name = "blade"
+velocity = "-sin(theta)*x' + cos(theta)*y'"
+[optimize]
+controls = [{ name = "F", actuator = ["cos(theta)", "sin(theta)", 0] }, { name = "T", actuator = "theta" }]
+objective = "F^2 + T^2"
+t_end = 2
+nodes = 11
+initial = { position = { x = 0, y = 0, theta = 0 }, velocity = { x = 0, y = 0, theta = 0 } }
+final = { position = { x = 1, y = 0.1, theta = 0.2 }, velocity = { x = 0, y = 0, theta = 0 } }
+)toml");
+  const Outcome run = optimize("blade.toml -o blade.csv --html blade.html");
+  SKIP_WITHOUT_IPOPT(run);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("report -> blade.html"), std::string::npos) << run.out;
+  std::ifstream in(dir_ / "blade.html");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string page = text.str();
+  EXPECT_NE(page.find("blade: optimal program, 11 nodes, hermite-simpson"), std::string::npos);
+  EXPECT_NE(page.find("replay difference"), std::string::npos);
+  const std::vector<double> r_theta = report_series(page, "R_theta"), theta2 = read_csv(dir_ / "blade.csv").column("theta''");
+  ASSERT_EQ(r_theta.size(), 21U);
+  double largest_theta2 = 0.0;
+  for (double v : theta2) largest_theta2 = std::max(largest_theta2, std::abs(v));
+  EXPECT_GT(largest_theta2, 0.1);
+  for (std::size_t i = 0; i < r_theta.size(); ++i) EXPECT_LT(std::abs(r_theta[i]), 1e-7) << i;
+
+  const Outcome di = optimize(example("double_integrator.toml") + " -o di.csv --html di.html");
+  ASSERT_EQ(di.exit_code, 0) << di.out;
+  std::ifstream in2(dir_ / "di.html");
+  std::stringstream text2;
+  text2 << in2.rdbuf();
+  const std::vector<double> rx = report_series(text2.str(), "R_x"), balance = report_series(text2.str(), "balance_error");
+  ASSERT_EQ(rx.size(), 33U);
+  for (double v : rx) EXPECT_LT(std::abs(v), 1e-9);
+  ASSERT_EQ(balance.size(), 33U);
+  for (double v : balance) EXPECT_LT(std::abs(v), 2e-3);
+  EXPECT_LT(std::abs(balance.back()), 1e-9);
+
+  const Outcome no_csv = optimize(example("double_integrator.toml") + " --html x.html");
+  EXPECT_EQ(no_csv.exit_code, 2) << no_csv.out;
+  EXPECT_NE(no_csv.out.find("give -o FILE.csv too"), std::string::npos) << no_csv.out;
+}
+
 TEST_F(OptimizeCli, FinalValuesTheConstraintsDetermineAreReleased) {
   // A knife edge brought to rest: x' = y' = 0 at t_end fixes the sideways speed twice (the blade
   // constraint already does), which the discrete motion meets only up to its drift. The rank rule
