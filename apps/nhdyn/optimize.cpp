@@ -22,6 +22,7 @@
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/io/report.hpp"
 #include "nhdyn/io/results.hpp"
+#include "nhdyn/io/run_paths.hpp"
 #include "nhdyn/model/output.hpp"
 #include "nhdyn/model/terms.hpp"
 #include "nhdyn/optimize/solve.hpp"
@@ -138,6 +139,18 @@ int run_optimize(const OptimizeArgs& args) {
   const LoadedModel loaded = load_model_described(source, parse_parameter_sets(args.sets));
   if (!args.html.empty() && args.output.empty())
     throw InputError("--html reports the CSV of -o: give -o FILE.csv too");
+  {
+    // Every file of the command, checked together before the solve (io/run_paths.hpp).
+    RunPaths paths;
+    if (fs::is_regular_file(args.model)) paths.input(args.model, "the model file");
+    if (!args.output.empty()) {
+      paths.output(args.output, "-o");
+      paths.output(partial_path(args.output), "the partial-results file");
+    }
+    if (!args.plot.empty()) paths.output(args.plot, "--plot");
+    if (!args.html.empty()) paths.output(args.html, "--html");
+    paths.check();
+  }
   const OptimalControlProblem problem = load_optimal_control_problem(source, loaded);
   OptimizeOptions options;
   options.nlp.tolerance = args.tolerance;

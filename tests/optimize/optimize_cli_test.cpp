@@ -380,6 +380,9 @@ final = { position = { x = 1, y = 0.1, theta = 0.2 }, velocity = { x = 0, y = 0,
   for (double v : balance) EXPECT_LT(std::abs(v), 2e-3);
   EXPECT_LT(std::abs(balance.back()), 1e-9);
 
+  const Outcome same = optimize(example("double_integrator.toml") + " -o di2.csv --html di2.csv");
+  EXPECT_EQ(same.exit_code, 2) << same.out;
+  EXPECT_NE(same.out.find("--html"), std::string::npos) << same.out;
   const Outcome no_csv = optimize(example("double_integrator.toml") + " --html x.html");
   EXPECT_EQ(no_csv.exit_code, 2) << no_csv.out;
   EXPECT_NE(no_csv.out.find("give -o FILE.csv too"), std::string::npos) << no_csv.out;
