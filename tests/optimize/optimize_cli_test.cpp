@@ -263,8 +263,8 @@ TEST_F(OptimizeCli, ParallelParkingMeetsItsEndsKeepsClearAndReplaysInSimulate) {
   // hold at every point, and `nhdyn simulate` under the optimal controls (as [forces], interpolated
   // as Hermite-Simpson defines them) ends where the optimized motion ends, to within the
   // collocation error that the replay difference measures.
-  write_variant("parking.toml", "park.toml", {{"nodes = 61", "nodes = 31"}});
-  const Outcome run = optimize("park.toml --guess " + example("parking_guess.csv") + " -o park.csv");
+  const Outcome run = optimize(example("parking.toml") + " --set node_count=31 --guess " + example("parking_guess.csv") +
+                               " -o park.csv");
   SKIP_WITHOUT_IPOPT(run);
   ASSERT_EQ(run.exit_code, 0) << run.out;
   EXPECT_NE(run.out.find("status: solved"), std::string::npos) << run.out;
