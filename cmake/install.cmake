@@ -22,8 +22,10 @@ endforeach()
 install(TARGETS ${nhdyn_installed_targets} EXPORT nhdynTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# optimize/ is not an installed module (its library links IPOPT, which the CLI and the Python
+# package carry): its headers stay out with it.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/src/nhdyn DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
-        FILES_MATCHING PATTERN "*.hpp" PATTERN "resources" EXCLUDE)
+        FILES_MATCHING PATTERN "*.hpp" PATTERN "resources" EXCLUDE PATTERN "optimize" EXCLUDE)
 install(FILES ${NHDYN_GENERATED_INCLUDE_DIR}/nhdyn/core/version.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/nhdyn/core)
 
 set(nhdyn_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/nhdyn)

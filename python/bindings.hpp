@@ -30,6 +30,7 @@ void bind_simulation(py::module_& m);
 void bind_batch(py::module_& m);
 void bind_analysis(py::module_& m);
 void bind_report(py::module_& m);  // report.cpp: provenance and the HTML report
+void bind_optimize(py::module_& m);  // optimize.cpp: optimal programs (`nhdyn optimize`)
 
 // A NumPy array that takes over `values` (no copy), with the given shape (C order).
 py::array_t<double> take_array(std::vector<double>&& values, std::vector<py::ssize_t> shape);

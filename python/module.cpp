@@ -48,4 +48,5 @@ PYBIND11_MODULE(_nhdyn, m) {
   nhdyn::python::bind_batch(m);
   nhdyn::python::bind_analysis(m);
   nhdyn::python::bind_report(m);
+  nhdyn::python::bind_optimize(m);
 }

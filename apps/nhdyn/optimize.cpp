@@ -1,7 +1,9 @@
-// `nhdyn optimize MODEL -o out.csv [--plot out.png] [--guess FILE.csv]`: the optimal program of
-// the model's [optimize] section by direct collocation with IPOPT (docs/optimize.md,
-// optimize/solve.hpp) — the summary lines on stdout and the motion with its controls (u_NAME) as
-// CSV. A solve that does not converge exits 1 and leaves its last iterate in FILE.partial.csv.
+// `nhdyn optimize MODEL -o out.csv [--plot out.png] [--html out.html] [--guess FILE.csv]`: the
+// optimal program of the model's [optimize] section by direct collocation with IPOPT
+// (docs/optimize.md, optimize/solve.hpp) — the summary lines on stdout, the motion with its
+// controls (u_NAME) as CSV, and the HTML report of the optimal motion (the page `simulate --html`
+// writes, its rows the optimized points). A solve that does not converge exits 1 and leaves its
+// last iterate in FILE.partial.csv.
 #include <fmt/format.h>
 
 #include <filesystem>
@@ -11,12 +13,18 @@
 
 #include "commands.hpp"
 #include "outputs.hpp"
+#include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/frontend/optimize_problem.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
+#include "nhdyn/io/report.hpp"
+#include "nhdyn/io/results.hpp"
+#include "nhdyn/io/run_paths.hpp"
+#include "nhdyn/model/output.hpp"
+#include "nhdyn/model/terms.hpp"
 #include "nhdyn/optimize/solve.hpp"
 
 namespace nhdyn::cli {
@@ -30,6 +38,7 @@ struct OptimizeArgs {
   std::string output;
   std::string plot;
   std::string guess;
+  std::string html;
   double tolerance = 1e-8;
   int max_iterations = 3000;
 };
@@ -65,10 +74,83 @@ void write_plot_of(const OptimalControlProblem& problem, const fs::path& csv, co
   write_plot(request, png);
 }
 
+// The optimized points in the columns of a simulation (io/results.hpp), for the report: q, q', q''
+// from the optimum; R = A q'' - Q - G - B u, the constraints' reactions with the controls' force
+// taken out (an applied force, as the actuators of program motion); the residuals, energy and
+// outputs from the model's kernels at each point; the energy balance with the controls' work
+// booked with the forces (as for program motion) and the works by the trapezoidal rule over the
+// points, so that its error column shows the quadrature's error.
+CsvTable optimum_table(const OptimalControlProblem& problem, const OptimizeResult& result) {
+  const Model& model = problem.model;
+  const ResultColumns columns = make_result_columns(model);
+  if (!columns.contact_forces.empty() || model.m() > 0)
+    throw InputError("--html: the report of an optimum is for models without contacts and [[programs]]");
+  const int n = model.n(), m = problem.m();
+  Data data = make_data(model);
+  std::vector<double> registers(static_cast<std::size_t>(problem.force.registers())), layout_q(static_cast<std::size_t>(n + m)),
+      layout_v(layout_q.size(), 0.0), force(static_cast<std::size_t>(n));
+  CsvTable table;
+  table.header = columns.all;
+  double h0 = 0.0, previous_t = 0.0, previous_power[3] = {0.0, 0.0, 0.0};
+  std::vector<double> row;
+  for (int p = 0; p < result.points; ++p) {
+    const double t = result.times[static_cast<std::size_t>(p)];
+    const double* q = result.q.data() + static_cast<std::ptrdiff_t>(p) * n;
+    const double* v = result.v.data() + static_cast<std::ptrdiff_t>(p) * n;
+    const double* u = result.u.data() + static_cast<std::ptrdiff_t>(p) * m;
+    if (compute_terms(model, data, t, q, v) != Status::ok)
+      throw InputError(fmt::format("--html: the model's terms cannot be evaluated at t = {}", t));
+    std::copy(q, q + n, layout_q.begin());
+    std::copy(v, v + n, layout_v.begin());
+    std::copy(u, u + m, layout_q.begin() + n);
+    problem.force.run(t, layout_q.data(), layout_v.data(), registers.data(), force.data());
+    for (int i = 0; i < n; ++i) data.qdd(i) = result.a[static_cast<std::size_t>(p * n + i)];
+    data.R = data.A * data.qdd - data.Q - data.G;
+    for (int i = 0; i < n; ++i) data.R(i) -= force[static_cast<std::size_t>(i)];
+    data.stage = Stage::acceleration;
+    compute_residuals(model, data);
+    compute_energy(model, data);
+    if (model.evaluator->has_energy_balance()) {
+      compute_power(model, data);
+      for (int i = 0; i < n; ++i) data.power_forces += force[static_cast<std::size_t>(i)] * v[i];
+      const double power[3] = {data.power_forces, data.power_reactions, data.power_time};
+      if (p == 0) {
+        h0 = data.energy_function;
+      } else {
+        const double dt = 0.5 * (t - previous_t);
+        data.work_forces += dt * (power[0] + previous_power[0]);
+        data.work_reactions += dt * (power[1] + previous_power[1]);
+        data.work_time += dt * (power[2] + previous_power[2]);
+      }
+      std::copy(power, power + 3, previous_power);
+      data.balance_error = data.energy_function - h0 - (data.work_forces + data.work_reactions + data.work_time);
+    }
+    previous_t = t;
+    compute_outputs(model, data);
+    fill_result_row(model, data, row);
+    table.rows.push_back(row);
+  }
+  return table;
+}
+
 int run_optimize(const OptimizeArgs& args) {
   protect_model_file(args.model);
   const ModelSource source = read_model_source(args.model);
   const LoadedModel loaded = load_model_described(source, parse_parameter_sets(args.sets));
+  if (!args.html.empty() && args.output.empty())
+    throw InputError("--html reports the CSV of -o: give -o FILE.csv too");
+  {
+    // Every file of the command, checked together before the solve (io/run_paths.hpp).
+    RunPaths paths;
+    if (fs::is_regular_file(args.model)) paths.input(args.model, "the model file");
+    if (!args.output.empty()) {
+      paths.output(args.output, "-o");
+      paths.output(partial_path(args.output), "the partial-results file");
+    }
+    if (!args.plot.empty()) paths.output(args.plot, "--plot");
+    if (!args.html.empty()) paths.output(args.html, "--html");
+    paths.check();
+  }
   const OptimalControlProblem problem = load_optimal_control_problem(source, loaded);
   OptimizeOptions options;
   options.nlp.tolerance = args.tolerance;
@@ -77,6 +159,7 @@ int run_optimize(const OptimizeArgs& args) {
   options.guess = args.guess;
   if (!args.output.empty()) make_parent_directory(args.output);
   if (!args.plot.empty()) make_parent_directory(args.plot);
+  if (!args.html.empty()) make_parent_directory(args.html);
   const OptimizeResult result = solve_optimal_control(problem, options);
   // A build without IPOPT: bad input is still reported as such (the transcription checks it
   // before the solver is called), then the command says how to get IPOPT.
@@ -108,6 +191,19 @@ int run_optimize(const OptimizeArgs& args) {
     write_plot_of(problem, args.output, args.plot);
     fmt::print("plot -> {}\n", args.plot);
   }
+  if (!args.html.empty()) {
+    const std::string notice = write_model_report(
+        problem.model, loaded.description.get(), optimum_table(problem, result),
+        fmt::format("{}: optimal program, {} nodes, {}", problem.model.name, problem.nodes,
+                    collocation_method_name(problem.method)),
+        {{"status", fmt::format("{} ({})", nlp_status_name(result.solver.status), result.solver.message)},
+         {"iterations", fmt::format("{}", result.solver.iterations)},
+         {"objective", fmt::format("{:.10g}", result.objective)},
+         {"replay difference", result.replayed ? fmt::format("{:.3e}", result.replay_difference) : "none"},
+         {"results", args.output}},
+        args.html);
+    fmt::print("report -> {}{}\n", args.html, notice.empty() ? "" : "\nnote: " + notice);
+  }
   return 0;
 }
 
@@ -121,6 +217,8 @@ std::function<int()> add_optimize_command(CLI::App& app) {
   cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   cmd->add_option("-o,--output", args->output, "CSV of the motion and the controls (t, q, q', q'', u_NAME)");
   cmd->add_option("--plot", args->plot, "PNG of the coordinates, velocities and controls (needs -o)");
+  cmd->add_option("--html", args->html, "HTML report of the optimal motion (needs -o): animation, plots, equations "
+                                        "(docs/report.md)");
   cmd->add_option("--guess", args->guess, "CSV of a first guess (t, q, q', optionally q'' and u_NAME), e.g. a "
                                           "previous result");
   cmd->add_option("--tolerance", args->tolerance, "IPOPT's tolerance (tol and constr_viol_tol)")->capture_default_str();

@@ -111,7 +111,7 @@ def _check_t_eval(t_eval, t0, t_end):
 __all__ = [
     "__version__", "Error", "InputError", "ModelError", "FileError", "SimulationError", "ConstraintWarning",
     "StopConditionWarning",
-    "load", "loads", "builtin_models", "Model", "Result", "Equations", "Linearization", "Sweep",
+    "load", "loads", "builtin_models", "Model", "Result", "Optimum", "Equations", "Linearization", "Sweep",
     "BatchResult", "simulate_batch", "from_sympy",
 ]
 
@@ -337,6 +337,24 @@ class Model:
         return _nhdyn.write_report(self.source, list(result._overrides.items()), names, rows, comments,
                                    os.fspath(path), title, extra, max_frames)
 
+    def optimize(self, guess=None, *, tolerance=1e-8, max_iterations=3000):
+        """The optimal program of the model file's [optimize] section, as `nhdyn optimize` finds
+        it (direct collocation of the Do Sanh form with IPOPT; docs/optimize.md), with this model's
+        parameters. guess: a CSV path with the columns `nhdyn optimize` writes (t, the coordinates
+        and their velocities, optionally x'' and u_NAME), else the straight line between the
+        boundary states. Returns an Optimum; one that did not converge (Optimum.converged False,
+        its last iterate in it) also warns."""
+        if self.source.is_builtin:
+            raise InputError("optimize: '{}' is a built-in model; optimize reads the [optimize] section of a model "
+                             "file".format(self.name))
+        out = _nhdyn.optimize(self.source, list(self.overrides.items()), "" if guess is None else os.fspath(guess),
+                              float(tolerance), int(max_iterations))
+        result = Optimum(self, out)
+        if not result.converged:
+            warnings.warn("optimize '{}': IPOPT did not converge: {} ({}); the result is its last iterate".format(
+                self.name, result.status, result.solver_message), RuntimeWarning, stacklevel=2)
+        return result
+
     def equations(self, format="latex"):
         """The equations of motion (T, V, A, Q, G, b, b0, D, A0 = D A, C = D (Q + G)) as
         `nhdyn equations` shows them; displayed as LaTeX in Jupyter."""
@@ -515,6 +533,45 @@ class Result:
     def __repr__(self):
         return "<nhdyn.Result {!r}: {} rows, t = {:g} .. {:g}>".format(
             self.model_name, len(self.t), self.t[0], self.t[-1])
+
+
+class Optimum:
+    """An optimal program (Model.optimize), one row per point (the nodes and, for Hermite-Simpson,
+    the midpoints): t (points), q, qd, qdd (points x n), u (points x controls, named in
+    `controls`). `columns` and `rows` are the CSV that `nhdyn optimize -o` writes (t, the
+    coordinates, x', x'', u_NAME); `summary` its summary text. status ("solved", "solved to
+    acceptable level", "infeasible", "iteration limit", "failed"), iterations, objective, t_end,
+    constraint_violation, replay_difference (None when the replay failed: replay_message says why)
+    and notes are the summary's values."""
+
+    def __init__(self, model, out):
+        self.model_name = model.name
+        self.coordinates = model.coordinates
+        self.controls = list(out["controls"])
+        self.t, self.q, self.qd, self.qdd, self.u = out["t"], out["q"], out["qd"], out["qdd"], out["u"]
+        self.columns, self.rows = list(out["columns"]), out["table"]
+        self.summary = out["summary_text"]
+        for key in ("status", "solver_message", "converged", "iterations", "objective", "t_end", "free_time",
+                    "constraint_violation", "replay_difference", "replay_message"):
+            setattr(self, key, out[key])
+        self.notes = list(out["notes"])
+
+    def column(self, name):
+        """The column `name` of the CSV (e.g. "x", "x'", "u_F")."""
+        if name not in self.columns:
+            raise InputError("no column '{}': the columns are {}".format(name, ", ".join(self.columns)))
+        return self.rows[:, self.columns.index(name)]
+
+    def to_csv(self, path):
+        """Writes the CSV of `nhdyn optimize -o` to `path`."""
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(",".join(self.columns) + "\n")
+            for row in self.rows:
+                f.write(",".join(repr(float(v)) for v in row) + "\n")
+
+    def __repr__(self):
+        return "<nhdyn.Optimum {!r}: {}, objective {:.10g}, {} points>".format(
+            self.model_name, self.status, self.objective, len(self.t))
 
 
 class Equations:

@@ -2,13 +2,14 @@
 // (docs/derivations/optimal-programs.md, section 10): the double integrator's closed-form optimum
 // (Hermite-Simpson exact, the trapezoidal J_N in closed form), the Brockett integrator's circle
 // (J = 2 pi a / T), the brachistochrone's cycloid, the motion `nhdyn simulate` computes under the
-// same force, and each refusal of bad input with its exit code.
+// same force (the double integrator, parallel parking), and each refusal of bad input with its exit code.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
 #include <map>
 #include <sstream>
 #include <string>
@@ -224,6 +225,167 @@ TEST_F(OptimizeCli, BrachistochroneFollowsTheCycloid) {
     EXPECT_NEAR(x[i], R * (phi - std::sin(phi)), 1e-4) << time[i];
     EXPECT_NEAR(y[i], R * (1 - std::cos(phi)), 1e-4) << time[i];
   }
+}
+
+// The controls of a Hermite-Simpson result (quadratic through node, midpoint, node on each interval,
+// continuous at the nodes) as one expression in t: the first interval's quadratic plus, at each
+// later node t_k, the change of slope and curvature switched on by H(t - t_k), with
+// H(s) s = (s + |s|)/2. `time` and `u` hold the points in order (2N + 1 of them).
+std::string piecewise_quadratic(const std::vector<double>& time, const std::vector<double>& u) {
+  const auto num = [](double v) {
+    std::ostringstream s;
+    s.precision(17);
+    s << "(" << v << ")";
+    return s.str();
+  };
+  std::vector<double> alpha, beta, start, length;
+  for (std::size_t a = 0; a + 2 < time.size(); a += 2) {
+    const double h = time[a + 2] - time[a];
+    const double b = 2 * (u[a] - 2 * u[a + 1] + u[a + 2]) / (h * h);
+    beta.push_back(b);
+    alpha.push_back((u[a + 2] - u[a]) / h - b * h);
+    start.push_back(time[a]);
+    length.push_back(h);
+  }
+  const std::string s0 = "(t - " + num(start[0]) + ")";
+  std::string out = num(u[0]) + " + " + num(alpha[0]) + "*" + s0 + " + " + num(beta[0]) + "*" + s0 + "^2";
+  for (std::size_t k = 1; k < alpha.size(); ++k) {
+    const double d_alpha = alpha[k] - (alpha[k - 1] + 2 * beta[k - 1] * length[k - 1]), d_beta = beta[k] - beta[k - 1];
+    const std::string s = "(t - " + num(start[k]) + ")";
+    out += " + (" + num(d_alpha) + " + " + num(d_beta) + "*" + s + ")*(" + s + " + abs" + s + ")/2";
+  }
+  return out;
+}
+
+TEST_F(OptimizeCli, ParallelParkingMeetsItsEndsKeepsClearAndReplaysInSimulate) {
+  // examples/parking.toml at 31 nodes (the example has 61) from its guess: IPOPT converges, the
+  // final state is the one asked for, the steer, force and torque bounds and the post's clearance
+  // hold at every point, and `nhdyn simulate` under the optimal controls (as [forces], interpolated
+  // as Hermite-Simpson defines them) ends where the optimized motion ends, to within the
+  // collocation error that the replay difference measures.
+  const Outcome run = optimize(example("parking.toml") + " --set node_count=31 --guess " + example("parking_guess.csv") +
+                               " -o park.csv");
+  SKIP_WITHOUT_IPOPT(run);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("status: solved"), std::string::npos) << run.out;
+  const double replay = summary_value(run.out, "replay difference");
+  EXPECT_LT(replay, 0.1) << run.out;
+  const Table t = read_csv(dir_ / "park.csv");
+  const std::vector<double> time = t.column("t"), x = t.column("x"), y = t.column("y"), theta = t.column("theta"),
+                            delta = t.column("delta"), F = t.column("u_F"), T = t.column("u_T");
+  ASSERT_EQ(time.size(), 61U);
+  const std::size_t last = time.size() - 1;
+  EXPECT_NEAR(x[last], 0.0, 1e-8);
+  EXPECT_NEAR(y[last], 2.0, 1e-8);
+  EXPECT_NEAR(theta[last], 0.0, 1e-8);
+  EXPECT_NEAR(delta[last], 0.0, 1e-8);
+  EXPECT_NEAR(t.column("x'")[last], 0.0, 1e-8);
+  EXPECT_NEAR(t.column("delta'")[last], 0.0, 1e-8);
+  EXPECT_LT(std::abs(t.column("y'")[last]), 1e-2);  // released: the drift of the blade constraints
+  EXPECT_LT(std::abs(t.column("theta'")[last]), 1e-2);
+  double clearance = 1e9, front_clearance = 1e9, x_max = 0.0;
+  for (std::size_t i = 0; i < time.size(); ++i) {
+    clearance = std::min(clearance, std::hypot(x[i] - 5.5, y[i] - 2.0));
+    front_clearance = std::min(front_clearance, std::hypot(x[i] + 1.5 * std::cos(theta[i]) - 5.5, y[i] + 1.5 * std::sin(theta[i]) - 2.0));
+    x_max = std::max(x_max, x[i]);
+    EXPECT_LE(std::abs(delta[i]), kPi / 4 + 1e-6) << time[i];
+    EXPECT_LE(std::abs(F[i]), 300 + 1e-4) << time[i];
+    EXPECT_LE(std::abs(T[i]), 50 + 1e-4) << time[i];
+  }
+  EXPECT_GE(clearance, 1.2 - 1e-6);
+  EXPECT_GE(front_clearance, 1.2 - 1e-6);
+  EXPECT_LT(front_clearance, 1.2 + 1e-4);  // the post is in the way: the constraint is active
+  EXPECT_GT(x_max, 1.0);                   // the car cannot slide sideways: it drives out and back
+
+  // The independent check: simulate's own integration of the model under F and T as forces.
+  const std::string f = piecewise_quadratic(time, F), torque = piecewise_quadratic(time, T);
+  write_variant("parking.toml", "forced.toml",
+                {{"[optimize]", "[forces]\nx = \"(" + f + ")*cos(theta)\"\ny = \"(" + f + ")*sin(theta)\"\ndelta = \"" +
+                                    torque + "\"\n\n[optimize]"}});
+  const Outcome sim = run_nhdyn("simulate forced.toml --t-end 30 --output-step 0.5 --rtol 1e-11 --atol 1e-11 -o sim.csv", dir_);
+  ASSERT_EQ(sim.exit_code, 0) << sim.out;
+  const Table s = read_csv(dir_ / "sim.csv");
+  ASSERT_EQ(s.column("t").size(), 61U);
+  double worst = 0.0;
+  for (const char* c : {"x", "y", "theta", "delta"}) {
+    const std::vector<double> optimized = t.column(c), simulated = s.column(c);
+    for (std::size_t i = 0; i < time.size(); i += 2) worst = std::max(worst, std::abs(optimized[i] - simulated[i]));
+  }
+  EXPECT_LT(worst, 1.5 * replay + 1e-6) << "replay difference " << replay;
+  EXPECT_GT(worst, 0.5 * replay) << "replay difference " << replay;  // the same error, seen twice
+}
+
+// The values of the report's plotted series `name` ({"name":"R_x","v":[...]} in the page's data).
+std::vector<double> report_series(const std::string& page, const std::string& name) {
+  const std::string key = "{\"name\":\"" + name + "\",\"v\":[";
+  const std::size_t at = page.find(key);
+  std::vector<double> out;
+  if (at == std::string::npos) return out;
+  std::stringstream s(page.substr(at + key.size(), page.find(']', at) - at - key.size()));
+  std::string cell;
+  while (std::getline(s, cell, ',')) out.push_back(std::stod(cell));
+  return out;
+}
+
+TEST_F(OptimizeCli, HtmlReportsTheOptimalMotionWithTheControlsTakenOutOfTheReactions) {
+  // A knife edge pushed along its blade by F and turned by T: the blade's reaction
+  // R = A q'' - Q - G - B u has no theta part (b has none), so R_theta = J theta'' - T = 0 to the
+  // solver's tolerance, where J theta'' alone is not. The double integrator has no constraint:
+  // R_x = m x'' - F = 0, and its energy balance error is the trapezoidal rule's error on the work
+  // of F (the controls' work booked with the forces), small and back to 0 at t_end (F v is odd
+  // about T/2).
+  write("blade.toml", R"toml(name = "blade"
+coordinates = ["x", "y", "theta"]
+kinetic_energy = "m/2 * (x'^2 + y'^2) + J/2 * theta'^2"
+[parameters]
+m = 1.0
+J = 1.0
+[[constraints]]
+name = "blade"
+velocity = "-sin(theta)*x' + cos(theta)*y'"
+[optimize]
+controls = [{ name = "F", actuator = ["cos(theta)", "sin(theta)", 0] }, { name = "T", actuator = "theta" }]
+objective = "F^2 + T^2"
+t_end = 2
+nodes = 11
+initial = { position = { x = 0, y = 0, theta = 0 }, velocity = { x = 0, y = 0, theta = 0 } }
+final = { position = { x = 1, y = 0.1, theta = 0.2 }, velocity = { x = 0, y = 0, theta = 0 } }
+)toml");
+  const Outcome run = optimize("blade.toml -o blade.csv --html blade.html");
+  SKIP_WITHOUT_IPOPT(run);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("report -> blade.html"), std::string::npos) << run.out;
+  std::ifstream in(dir_ / "blade.html");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string page = text.str();
+  EXPECT_NE(page.find("blade: optimal program, 11 nodes, hermite-simpson"), std::string::npos);
+  EXPECT_NE(page.find("replay difference"), std::string::npos);
+  const std::vector<double> r_theta = report_series(page, "R_theta"), theta2 = read_csv(dir_ / "blade.csv").column("theta''");
+  ASSERT_EQ(r_theta.size(), 21U);
+  double largest_theta2 = 0.0;
+  for (double v : theta2) largest_theta2 = std::max(largest_theta2, std::abs(v));
+  EXPECT_GT(largest_theta2, 0.1);
+  for (std::size_t i = 0; i < r_theta.size(); ++i) EXPECT_LT(std::abs(r_theta[i]), 1e-7) << i;
+
+  const Outcome di = optimize(example("double_integrator.toml") + " -o di.csv --html di.html");
+  ASSERT_EQ(di.exit_code, 0) << di.out;
+  std::ifstream in2(dir_ / "di.html");
+  std::stringstream text2;
+  text2 << in2.rdbuf();
+  const std::vector<double> rx = report_series(text2.str(), "R_x"), balance = report_series(text2.str(), "balance_error");
+  ASSERT_EQ(rx.size(), 33U);
+  for (double v : rx) EXPECT_LT(std::abs(v), 1e-9);
+  ASSERT_EQ(balance.size(), 33U);
+  for (double v : balance) EXPECT_LT(std::abs(v), 2e-3);
+  EXPECT_LT(std::abs(balance.back()), 1e-9);
+
+  const Outcome same = optimize(example("double_integrator.toml") + " -o di2.csv --html di2.csv");
+  EXPECT_EQ(same.exit_code, 2) << same.out;
+  EXPECT_NE(same.out.find("--html"), std::string::npos) << same.out;
+  const Outcome no_csv = optimize(example("double_integrator.toml") + " --html x.html");
+  EXPECT_EQ(no_csv.exit_code, 2) << no_csv.out;
+  EXPECT_NE(no_csv.out.find("give -o FILE.csv too"), std::string::npos) << no_csv.out;
 }
 
 TEST_F(OptimizeCli, FinalValuesTheConstraintsDetermineAreReleased) {

@@ -1,11 +1,13 @@
 // The transcription of [optimize] problems (optimize/transcription.hpp) on its own, without IPOPT:
 // its exact Jacobian (tangent mode, the dD-free form (O7) of
 // docs/derivations/optimal-programs.md) against central differences of its constraints at random
-// points, its gradient against differences of its objective, and the reader's refusals.
+// points, its gradient against differences of its objective, the Hessian of its Lagrangian against
+// second differences of the Lagrangian's value, and the reader's refusals.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -62,6 +64,58 @@ void check_derivatives(Transcription& nlp, const std::vector<double>& x0) {
   EXPECT_LT(worst_gradient, 1e-6);
 }
 
+// The Hessian of the Lagrangian sigma f + lambda^T g (hessian_values: central differences of the
+// exact gradient, grouped by the block structure) against second differences of the Lagrangian's
+// value alone, over every pair of variables: an entry outside the pattern, a block that misses a
+// coupling, or a wrong T row errs by O(1).
+void check_hessian(Transcription& nlp, const std::vector<double>& x0, unsigned seed) {
+  const int nv = nlp.variables(), nc = nlp.constraints(), nz = nlp.hessian_nonzeros();
+  ASSERT_GT(nz, 0);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> d(-2.0, 2.0);
+  std::vector<double> lambda(static_cast<std::size_t>(nc));
+  for (double& l : lambda) l = d(rng);
+  const double sigma = 0.7;
+  std::vector<int> rows(static_cast<std::size_t>(nz)), cols(static_cast<std::size_t>(nz));
+  nlp.hessian_pattern(rows.data(), cols.data());
+  std::vector<double> values(static_cast<std::size_t>(nz));
+  ASSERT_TRUE(nlp.hessian_values(x0.data(), sigma, lambda.data(), values.data()));
+  std::vector<double> H(static_cast<std::size_t>(nv) * static_cast<std::size_t>(nv), 0.0);
+  for (int e = 0; e < nz; ++e) {
+    ASSERT_GE(rows[e], cols[e]);  // one triangle
+    H[static_cast<std::size_t>(rows[e]) * nv + cols[e]] += values[e];
+    if (rows[e] != cols[e]) H[static_cast<std::size_t>(cols[e]) * nv + rows[e]] += values[e];
+  }
+  std::vector<double> g(static_cast<std::size_t>(nc));
+  const auto lagrangian = [&](const std::vector<double>& x) {
+    double f = 0.0;
+    EXPECT_TRUE(nlp.objective(x.data(), f));
+    EXPECT_TRUE(nlp.constraint_values(x.data(), g.data()));
+    double value = sigma * f;
+    for (int r = 0; r < nc; ++r) value += lambda[static_cast<std::size_t>(r)] * g[static_cast<std::size_t>(r)];
+    return value;
+  };
+  double worst = 0.0;
+  for (int i = 0; i < nv; ++i)
+    for (int j = 0; j <= i; ++j) {
+      const double hi = 3e-4 * std::max(1.0, std::abs(x0[static_cast<std::size_t>(i)]));
+      const double hj = 3e-4 * std::max(1.0, std::abs(x0[static_cast<std::size_t>(j)]));
+      double sum = 0.0;
+      for (const auto& [si, sj] : {std::pair{1, 1}, std::pair{1, -1}, std::pair{-1, 1}, std::pair{-1, -1}}) {
+        std::vector<double> x = x0;
+        x[static_cast<std::size_t>(i)] += si * hi;
+        x[static_cast<std::size_t>(j)] += sj * hj;
+        sum += si * sj * lagrangian(x);
+      }
+      const double difference = sum / (4 * hi * hj);
+      const double e = H[static_cast<std::size_t>(i) * nv + j];
+      worst = std::max(worst, std::abs(difference - e) / std::max(1.0, std::abs(e)));
+    }
+  // Second differences of values err by O(h^2) + round-off/h^2, about 1e-6 here (the car's
+  // Lagrangian is of order 1e4).
+  EXPECT_LT(worst, 1e-5);
+}
+
 std::vector<double> random_point(const Transcription& nlp, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> d(-0.8, 0.8);
@@ -111,6 +165,39 @@ path = ["x^2 + y^2*F >= t - 1"]
   const OptimalControlProblem p = problem_of(model_source_from_text(text, "plane.toml"));
   Transcription nlp(p);
   check_derivatives(nlp, random_point(nlp, 5));
+}
+
+TEST(Transcription, HessianOfTheLagrangianMatchesSecondDifferences) {
+  // Free time, a velocity constraint nonlinear in theta (both methods); two knife edges, two
+  // controls and path constraints (parking); a final term and a time-dependent integrand (plane).
+  OptimalControlProblem p = problem_from_file("brachistochrone.toml");
+  p.nodes = 3;
+  Transcription nlp(p);
+  check_hessian(nlp, random_point(nlp, 11), 12);
+  p.method = CollocationMethod::trapezoidal;
+  Transcription trapezoidal(p);
+  check_hessian(trapezoidal, random_point(trapezoidal, 13), 14);
+  OptimalControlProblem parking = problem_from_file("parking.toml");
+  parking.nodes = 2;
+  Transcription car(parking);
+  check_hessian(car, random_point(car, 15), 16);
+  const std::string text = R"toml(name = "plane"
+coordinates = ["x", "y"]
+kinetic_energy = "m/2 * (x'^2 + y'^2)"
+[parameters]
+m = 2.0
+[optimize]
+controls = [{ name = "F", actuator = ["cos(y)", "x*y'"] }, { name = "G", actuator = "y" }]
+objective = "F^2*x + G^2 + t*x*y'"
+objective_final = "x^2*y + y'^2 + t^2"
+t_end = { free = [0.5, 3] }
+nodes = 3
+initial = { x = 0, y = 0 }
+path = ["x^2 + y^2*F >= t - 1"]
+)toml";
+  const OptimalControlProblem plane = problem_of(model_source_from_text(text, "plane.toml"));
+  Transcription planar(plane);
+  check_hessian(planar, random_point(planar, 17), 18);
 }
 
 TEST(Transcription, DoubleIntegratorStartsOnTheStraightLine) {

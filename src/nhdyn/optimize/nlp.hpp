@@ -35,6 +35,14 @@ class Nlp {
   virtual int jacobian_nonzeros() const = 0;
   virtual void jacobian_pattern(int* rows, int* columns) const = 0;
   virtual bool jacobian_values(const double* x, double* values) = 0;
+  // The Hessian of the Lagrangian sigma f + lambda^T g, one triangle in triplets: hessian_nonzeros()
+  // (row, column) pairs with row >= column, fixed, and their values in the same order. A negative
+  // count (the default) says the program gives none: the solver then approximates it.
+  virtual int hessian_nonzeros() const { return -1; }
+  virtual void hessian_pattern(int* /*rows*/, int* /*columns*/) const {}
+  virtual bool hessian_values(const double* /*x*/, double /*sigma*/, const double* /*lambda*/, double* /*values*/) {
+    return false;
+  }
 };
 
 // How a solve ended, in nhdyn's words; the solver's own name of the status is in NlpResult::message.
@@ -53,7 +61,14 @@ inline bool nlp_converged(NlpStatus status) {
   return status == NlpStatus::solved || status == NlpStatus::solved_acceptable;
 }
 
+// Where the Hessian of the Lagrangian comes from (docs/derivations/optimal-programs.md, section 8).
+enum class NlpHessian {
+  program,         // the program's hessian_values (the transcription: differences of exact first derivatives)
+  limited_memory,  // the solver's limited-memory quasi-Newton approximation (L-BFGS)
+};
+
 struct NlpOptions {
+  NlpHessian hessian = NlpHessian::program;  // limited_memory when the program gives none
   double tolerance = 1e-8;         // IPOPT's tol
   double constraint_tolerance = 1e-8;  // IPOPT's constr_viol_tol
   int max_iterations = 3000;
@@ -68,8 +83,8 @@ struct NlpResult {
   std::vector<double> x;            // the last iterate (the solution when converged)
 };
 
-// IPOPT with its limited-memory quasi-Newton Hessian (docs/derivations/optimal-programs.md,
-// section 8), printing nothing. Without IPOPT in the build: status unavailable and a message
+// IPOPT with the program's Hessian or its limited-memory quasi-Newton approximation
+// (docs/derivations/optimal-programs.md, section 8), printing nothing. Without IPOPT in the build: status unavailable and a message
 // that says how to install it.
 NlpResult solve_nlp(Nlp& nlp, const NlpOptions& options);
 

@@ -15,7 +15,8 @@
 // determine from the other fixed final values is released (the rank rule of section 5, item 1). The objective is the quadrature (O8) of
 // the integrand plus the final term (or T for minimum time). Every derivative is exact: the
 // tangent mode of the compiled programs (model/program_tangent.hpp), contracted as in (O5), (O7),
-// so that no derivative of D is needed. Plain C++, no solver types.
+// so that no derivative of D is needed; the Hessian of the Lagrangian from forward differences of
+// these exact first derivatives (section 8). Plain C++, no solver types.
 #pragma once
 
 #include <string>
@@ -66,6 +67,14 @@ class Transcription final : public Nlp {
   int jacobian_nonzeros() const override { return static_cast<int>(jac_rows_.size()); }
   void jacobian_pattern(int* rows, int* columns) const override;
   bool jacobian_values(const double* x, double* values) override;
+  // The Hessian of the Lagrangian by forward differences of its exact gradient sigma grad f + J^T
+  // lambda (docs/derivations/optimal-programs.md, section 8): a dense block per point and the row
+  // of T. The gradient at a point depends on that point's variables and T only, so one difference
+  // along the same variable of every point at once gives a column of every block: 3n + m + 2
+  // gradients (each an exact Jacobian), whatever the number of nodes.
+  int hessian_nonzeros() const override { return static_cast<int>(hess_rows_.size()); }
+  void hessian_pattern(int* rows, int* columns) const override;
+  bool hessian_values(const double* x, double sigma, const double* lambda, double* values) override;
 
  private:
   struct CollocationTerm {
@@ -77,6 +86,9 @@ class Transcription final : public Nlp {
   double weight(int p) const;
   void build_collocation();
   void build_pattern();
+  void build_hessian_pattern();
+  // sigma grad f + J^T lambda at x into `out` (variables() values).
+  bool lagrangian_gradient(const double* x, double sigma, const double* lambda, double* out);
   void choose_splits_and_initial_rows();
   void make_start();
   void check_controls_act();
@@ -108,6 +120,8 @@ class Transcription final : public Nlp {
   std::vector<double> start_;
   std::vector<double> x_lower_, x_upper_;
   std::vector<int> jac_rows_, jac_columns_;
+  std::vector<int> hess_rows_, hess_columns_;
+  std::vector<double> jac_work_, hess_x_, hess_plus_, hess_minus_, hess_blocks_, hess_step_;
 
   // Work arrays (sized once).
   const Program* terms_ = nullptr;

@@ -20,13 +20,13 @@ using Ipopt::Number;
 
 class Adapter final : public Ipopt::TNLP {
  public:
-  explicit Adapter(Nlp& nlp) : nlp_(nlp) {}
+  Adapter(Nlp& nlp, bool hessian) : nlp_(nlp), hessian_(hessian) {}
 
   bool get_nlp_info(Index& n, Index& m, Index& nnz_jac_g, Index& nnz_h_lag, IndexStyleEnum& index_style) override {
     n = nlp_.variables();
     m = nlp_.constraints();
     nnz_jac_g = nlp_.jacobian_nonzeros();
-    nnz_h_lag = 0;  // limited-memory quasi-Newton: no Hessian is evaluated
+    nnz_h_lag = hessian_ ? nlp_.hessian_nonzeros() : 0;  // 0: limited-memory quasi-Newton
     index_style = C_STYLE;
     return true;
   }
@@ -48,6 +48,14 @@ class Adapter final : public Ipopt::TNLP {
     }
     return nlp_.jacobian_values(x, values);
   }
+  bool eval_h(Index, const Number* x, bool, Number obj_factor, Index, const Number* lambda, bool, Index,
+              Index* iRow, Index* jCol, Number* values) override {
+    if (values == nullptr) {
+      nlp_.hessian_pattern(iRow, jCol);
+      return true;
+    }
+    return nlp_.hessian_values(x, obj_factor, lambda, values);
+  }
   void finalize_solution(Ipopt::SolverReturn, Index n, const Number* x, const Number*, const Number*, Index,
                          const Number*, const Number*, Number obj_value, const Ipopt::IpoptData*,
                          Ipopt::IpoptCalculatedQuantities*) override {
@@ -60,6 +68,7 @@ class Adapter final : public Ipopt::TNLP {
 
  private:
   Nlp& nlp_;
+  bool hessian_;
 };
 
 // IPOPT's ApplicationReturnStatus as nhdyn's status and IPOPT's own words for it.
@@ -89,11 +98,12 @@ NlpStatus status_of(Ipopt::ApplicationReturnStatus s, std::string& message) {
 bool nlp_solver_available() { return true; }
 
 NlpResult solve_nlp(Nlp& nlp, const NlpOptions& options) {
-  Ipopt::SmartPtr<Adapter> adapter = new Adapter(nlp);
+  const bool hessian = options.hessian == NlpHessian::program && nlp.hessian_nonzeros() >= 0;
+  Ipopt::SmartPtr<Adapter> adapter = new Adapter(nlp, hessian);
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
   app->Options()->SetIntegerValue("print_level", 0);
   app->Options()->SetStringValue("sb", "yes");  // no banner: the library never prints
-  app->Options()->SetStringValue("hessian_approximation", "limited-memory");
+  app->Options()->SetStringValue("hessian_approximation", hessian ? "exact" : "limited-memory");
   app->Options()->SetNumericValue("tol", options.tolerance);
   app->Options()->SetNumericValue("constr_viol_tol", options.constraint_tolerance);
   app->Options()->SetIntegerValue("max_iter", options.max_iterations);

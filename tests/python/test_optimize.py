@@ -1,0 +1,73 @@
+"""Optimal programs from Python (docs/optimize.md, docs/python.md): Model.optimize against the CLI's
+CSV and summary on the Brockett integrator, against its closed form J = 2 pi a / T, with --set's
+parameters, and a solve that does not converge."""
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import nhdyn
+from conftest import read_csv
+
+
+def needs_ipopt(call):
+    try:
+        return call()
+    except nhdyn.InputError as error:
+        if "built without IPOPT" in str(error):
+            pytest.skip(str(error))
+        raise
+
+
+def test_brockett_matches_the_cli(examples, cli, tmp_path):
+    guess = examples / "brockett_guess.csv"
+    m = nhdyn.load(examples / "brockett.toml")
+    r = needs_ipopt(lambda: m.optimize(guess, tolerance=1e-10))
+    assert r.converged and r.status == "solved"
+    run = cli("optimize", examples / "brockett.toml", "--guess", guess, "--tolerance", "1e-10", "-o",
+              tmp_path / "b.csv")
+    header, rows = read_csv(tmp_path / "b.csv")
+    assert r.columns == header
+    assert r.columns[-2:] == ["u_Fx", "u_Fy"] and r.controls == ["Fx", "Fy"]
+    assert r.rows.shape == rows.shape == (17, 12)  # 9 nodes and 8 midpoints
+    # The same solve: the CSV's numbers are printed to the shortest round trip.
+    np.testing.assert_allclose(r.rows, rows, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(r.t, r.column("t"))
+    np.testing.assert_array_equal(r.q[:, 2], r.column("z"))
+    np.testing.assert_array_equal(r.qd[:, 0], r.column("x'"))
+    np.testing.assert_array_equal(r.u[:, 1], r.column("u_Fy"))
+    # The summary is the CLI's, line for line.
+    assert r.summary.splitlines() == run.stdout.splitlines()[:len(r.summary.splitlines())]
+    assert "objective: {:.10g}".format(r.objective) in run.stdout
+    # Hermite-Simpson at 9 nodes: J_N - 2 pi = 1.32e-3 (docs/derivations/optimal-programs.md 10.2).
+    assert r.objective - 2 * math.pi == pytest.approx(1.32e-3, abs=3e-5)
+    assert 0 < r.replay_difference < 2e-2  # the drift of the constraint at the level given, 9.7e-3
+    r.to_csv(tmp_path / "again.csv")
+    np.testing.assert_array_equal(read_csv(tmp_path / "again.csv")[1], r.rows)
+
+
+def test_parameters_reach_the_problem(examples):
+    # J = 12 d^2 / T^3 for the double integrator, exact with Hermite-Simpson: d = 2, T = 1 -> 48.
+    m = nhdyn.load(examples / "double_integrator.toml", d=2.0, duration=1.0)
+    r = needs_ipopt(lambda: m.optimize())
+    assert r.objective == pytest.approx(48.0, rel=1e-9)
+    assert r.t_end == pytest.approx(1.0) and r.q[-1, 0] == pytest.approx(2.0)
+
+
+def test_not_converged_warns_and_keeps_the_last_iterate(examples):
+    m = nhdyn.load(examples / "brockett.toml")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = needs_ipopt(lambda: m.optimize())  # the straight line: a stationary point of the violation
+    assert not r.converged and r.status in ("infeasible", "failed", "iteration limit")
+    assert any("did not converge" in str(w.message) for w in caught)
+    assert r.rows.shape == (17, 12)
+    assert any("--guess" in note for note in r.notes)
+
+
+def test_builtin_model_is_refused():
+    m = nhdyn.load(next(iter(nhdyn.builtin_models())))
+    with pytest.raises(nhdyn.InputError, match="model file"):
+        m.optimize()
