@@ -202,10 +202,13 @@ class PlaneGround final : public ContactGround {
     Touch out;
     const Vector3 n = ground_plane_normal(c.ground, spec, gravity, context);
     const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
-    // nu = R^T n, the normal in the body's axes; the support point lowest along it.
-    const Vector3 nu = multiply_transposed(F.rotation, n);
+    // nu = R^T n, the normal in the body's axes; the support point lowest along it. Taken as
+    // N^T n, R = N / s (a quaternion frame: N = R_2(e), s = e.e), of length s: the support
+    // mapping depends on the direction only, and without the fraction the expressions that are
+    // differentiated twice stay polynomial inside the root (rolling-bodies.md section 2.1).
+    const Vector3 nu = multiply_transposed(F.rotation_numerator, n);
     const Vector3 nu_s = {simplify_moderate(nu[0]), simplify_moderate(nu[1]), simplify_moderate(nu[2])};
-    const ShapeSupport s = c.shape->support(c.values, nu_s);
+    const ShapeSupport s = c.shape->support(c.values, nu_s, F.rotation_denominator);
     out.point = add(C, multiply(F.rotation, s.point));
     out.normal = n;
     out.gap = dot(n, C) - s.reach;
@@ -378,7 +381,8 @@ class TerrainGround final : public ContactGround {
       body_point = subtract(C, scale(*r, out.normal));
       reach = *r;
     } else {
-      const ShapeSupport s = c.shape->support(c.values, multiply_transposed(F.rotation, out.normal));
+      const ShapeSupport s = c.shape->support(c.values, multiply_transposed(F.rotation_numerator, out.normal),
+                                              F.rotation_denominator);
       body_point = add(C, multiply(F.rotation, s.point));
       reach = s.reach;
     }
