@@ -137,9 +137,12 @@ std::vector<std::string> contact_force_columns(const Model& model);
 // Appends the values of those columns (after compute_contact_forces).
 void append_contact_force_values(const Model& model, const Data& data, std::vector<double>& row);
 
-// At load (step 5): checks the stacked system at a fixed generic state near the initial one (q0, q'0
-// shifted by fixed amounts; the identities hold off the constraints too), with q'' and R of the
-// ideal-constraint dynamics there (a dense KKT solve with the model's terms). Drops the balance
+// At load (step 5): checks the stacked system at a fixed generic admissible state near the initial
+// one (q0, q'0 shifted by fixed amounts, then moved onto the position and velocity constraints by
+// least-norm Newton steps; the start itself if that fails; no check, with a note, if the start is
+// off them too), with q'' and R of the ideal-constraint dynamics there (a dense KKT solve with the
+// model's terms). Off the constraints the balance of a contact whose point is held by coordinates
+// (an implicit shape) does not close, so the check looks only on them. Drops the balance
 // rows of a system whose balance is inconsistent with (C1), marks the components that the rest does
 // not determine (NaN), and writes the notes. Cold path: allocates.
 void analyse_contact_forces(const Model& model, ContactForceModel& contact);

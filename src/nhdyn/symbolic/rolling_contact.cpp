@@ -398,8 +398,8 @@ class TerrainGround final : public ContactGround {
     out.curvature(1, 1) = hv.diff(vs) / length;
     if (c.shape->implicit()) implicit_shape_rows(c, F, out.tangent1, out.tangent2, out);
     // The force acts at the body's point (the same as the ground's on the constraints): there the
-    // gap's gradient, the rolling rows and the force's moment agree at every state, also off the
-    // constraints, where the contact forces' consistency check at load looks.
+    // gap's gradient, the rolling rows and the force's moment agree also off the constraints,
+    // where a drifting integration goes (rolling-bodies.md section 8).
     out.point = body_point;
     return out;
   }
