@@ -157,10 +157,11 @@ const char* contact_component_name(ContactComponent component) {
   return k >= 0 && k < kContactComponentKinds ? names[k] : "?";
 }
 
-std::vector<ContactComponent> contact_components(ContactKind kind, bool spin) {
+std::vector<ContactComponent> contact_components(ContactKind kind, bool spin, bool axle) {
   using C = ContactComponent;
   if (kind == ContactKind::rolling) {
     std::vector<C> out = {C::Fx, C::Fy, C::Fz, C::N};
+    if (axle) out.insert(out.end(), {C::Flong, C::Flat});
     if (spin) out.push_back(C::Mspin);
     return out;
   }

@@ -33,13 +33,15 @@ struct Data;
 enum class ContactKind { wheel, knife_edge, surface, curve, rolling };
 
 // An output component of a reported contact: the world force, its parts along the ground's normal
-// n and (wheels, knife edges) e_long, e_lat, and the spin moment about n of rubber rolling.
+// n and (wheels, knife edges, rolling bodies with an axle) e_long, e_lat, and the spin moment about
+// n of rubber rolling.
 enum class ContactComponent { Fx, Fy, Fz, N, Flong, Flat, Mspin };
 inline constexpr int kContactComponentKinds = 7;
 const char* contact_component_name(ContactComponent component);  // "Fx", ..., "Mspin"
 // The columns of a contact, in order: a wheel or knife edge Fx, Fy, Fz, N, Flong, Flat; a rolling
-// body Fx, Fy, Fz, N, and Mspin with `spin` (rubber rolling).
-std::vector<ContactComponent> contact_components(ContactKind kind, bool spin);
+// body Fx, Fy, Fz, N, then Flong, Flat when its shape has an axle (`axle`: a disk, a torus), then
+// Mspin with `spin` (rubber rolling).
+std::vector<ContactComponent> contact_components(ContactKind kind, bool spin, bool axle = false);
 
 // One contact of the stacked system: its unknowns are the magnitudes along `unknowns` world
 // directions (3 for a wheel, a point on a surface or curve: the force's world components; 2 for a

@@ -803,7 +803,7 @@ void MultibodyBuilder::apply() {
   std::vector<ReportedContact> reported;  // the wheels, knife edges and rolling bodies, whose columns events may name
   for (const ContactPoint& c : record->contacts)
     if (c.kind == ContactKind::wheel || c.kind == ContactKind::knife_edge || c.kind == ContactKind::rolling)
-      reported.emplace_back(c.name, contact_components(c.kind, c.spin));
+      reported.emplace_back(c.name, contact_components(c.kind, c.spin, c.axle));
   record->columns = make_contact_force_symbols(reported);
   record->modes = modes_;
   builder_.contact_forces(std::move(record));

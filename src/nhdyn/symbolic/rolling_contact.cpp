@@ -648,6 +648,17 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
   f.normal = touch.normal;
   f.longitudinal = {0, 0, 0};
   f.lateral = {0, 0, 0};
+  if (c.values.axis >= 0) {
+    // A shape with an axle a (world): e_long = (a x n) / |a x n|, the direction the wheel rolls
+    // along the ground, and e_lat = n x e_long, as a [[wheels]] entry has (rolling-bodies.md
+    // section 5); |a x n| = sqrt(1 - (a . n)^2) vanishes only lying flat, where the run stops. The
+    // axle's direction from R's numerator (a positive multiple of it, quaternion-frame.md section 8).
+    const Vector3 a = column(F.rotation_numerator, c.values.axis);
+    const Vector3 along = cross(a, touch.normal);
+    f.longitudinal = scale(1 / GiNaC::sqrt(dot(along, along)), along);
+    f.lateral = cross(touch.normal, f.longitudinal);
+    f.axle = true;
+  }
   f.omega = F.omega;
   f.spin = c.rubber;
   return out;
