@@ -21,6 +21,73 @@ constexpr double kConsistent = 1e-8;
 // A null vector of M with a component above this (relative) along an output leaves it undetermined.
 constexpr double kDetermined = 1e-8;
 
+// A state counts as on the constraints when every position and velocity residual is at most this.
+constexpr double kOnConstraints = 1e-11;
+
+// The largest |residual| of the position-level (velocity = false) or the position- and
+// velocity-level constraints at (t, q, v), into `r`; infinity when one is not finite. The
+// evaluator's default leaves `r` as it finds it, zero: a model with no residuals is on them.
+double largest_residual(const Model& model, double t, const Vector& q, const Vector& v, bool velocity,
+                        std::vector<double>& scratch, Vector& r) {
+  r.setZero();
+  if (r.size() == 0) return 0.0;
+  if (velocity) model.evaluator->velocity_residual(t, q.data(), v.data(), scratch.data(), r.data());
+  else model.evaluator->position_residual(t, q.data(), scratch.data(), r.data());
+  return r.allFinite() ? r.cwiseAbs().maxCoeff() : std::numeric_limits<double>::infinity();
+}
+
+// Moves (q, v) onto the position- and velocity-level constraints (docs/derivations/contact-forces.md
+// step 5: the check's identities hold on the constraints; off them a model whose contact point is
+// held by coordinates of its own, an implicit shape's, does not balance). Gauss-Newton with the
+// least-norm step through the constraints' rows of b (their gradients), halved until the residual
+// falls; then the velocities, linear in v, by the least-norm change. False when it does not
+// converge. Cold path: allocates.
+bool onto_constraints(const Model& model, double t, Vector& q, Vector& v, std::vector<double>& scratch) {
+  const int n = model.n(), s = model.s();
+  std::vector<int> position_rows, velocity_rows;
+  for (int i = 0; i < s; ++i) {
+    const ConstraintLevel level = model.constraints[static_cast<std::size_t>(i)].level;
+    if (level == ConstraintLevel::position) position_rows.push_back(i);
+    if (level != ConstraintLevel::acceleration) velocity_rows.push_back(i);
+  }
+  Matrix A(n, n), b(s, n);
+  Vector Q(n), G(n), b0(s);
+  const auto rows_of_b = [&](const std::vector<int>& rows) {
+    model.evaluator->terms(t, q.data(), v.data(), scratch.data(), TermsOut{A.data(), Q.data(), G.data(), b.data(), b0.data()});
+    Matrix J(static_cast<Eigen::Index>(rows.size()), n);
+    for (std::size_t k = 0; k < rows.size(); ++k) J.row(static_cast<Eigen::Index>(k)) = b.row(rows[k]);
+    return J;
+  };
+  Vector phi(static_cast<Eigen::Index>(position_rows.size())), trial_phi = phi;
+  double worst = largest_residual(model, t, q, v, false, scratch, phi);
+  for (int iteration = 0; iteration < 40 && worst > kOnConstraints && std::isfinite(worst); ++iteration) {
+    const Matrix J = rows_of_b(position_rows);
+    const Vector step = Eigen::CompleteOrthogonalDecomposition<Matrix>(J).solve(-phi);
+    if (!step.allFinite()) return false;
+    bool better = false;
+    for (double scale = 1.0; scale > 1e-3 && !better; scale *= 0.5) {
+      const Vector trial = q + scale * step;
+      const double w = largest_residual(model, t, trial, v, false, scratch, trial_phi);
+      if (w < worst) {
+        q = trial;
+        phi = trial_phi;
+        worst = w;
+        better = true;
+      }
+    }
+    if (!better) break;
+  }
+  if (!(worst <= kOnConstraints)) return false;
+  Vector f(static_cast<Eigen::Index>(velocity_rows.size()));
+  worst = largest_residual(model, t, q, v, true, scratch, f);
+  for (int iteration = 0; iteration < 3 && worst > kOnConstraints && std::isfinite(worst); ++iteration) {
+    const Matrix J = rows_of_b(velocity_rows);
+    v += Eigen::CompleteOrthogonalDecomposition<Matrix>(J).solve(-f);
+    worst = largest_residual(model, t, q, v, true, scratch, f);
+  }
+  return worst <= kOnConstraints && q.allFinite() && v.allFinite();
+}
+
 // M and rhs from the program's outputs, q'' and R (docs/derivations/contact-forces.md step 6).
 void assemble(const ContactForceModel& c, const double* o, const double* qdd, const double* R, Matrix& M,
               Vector& rhs) {
@@ -90,10 +157,11 @@ const char* contact_component_name(ContactComponent component) {
   return k >= 0 && k < kContactComponentKinds ? names[k] : "?";
 }
 
-std::vector<ContactComponent> contact_components(ContactKind kind, bool spin) {
+std::vector<ContactComponent> contact_components(ContactKind kind, bool spin, bool axle) {
   using C = ContactComponent;
   if (kind == ContactKind::rolling) {
     std::vector<C> out = {C::Fx, C::Fy, C::Fz, C::N};
+    if (axle) out.insert(out.end(), {C::Flong, C::Flat});
     if (spin) out.push_back(C::Mspin);
     return out;
   }
@@ -212,16 +280,27 @@ void analyse_contact_forces(const Model& model, ContactForceModel& c) {
   const int n = model.n();
   const int s = model.s();
   c.determined.assign(static_cast<std::size_t>(c.values()), 1);
-  // A generic state near the initial one (fixed shifts: the same model gives the same verdict).
+  // A generic admissible state near the initial one: shifted by fixed amounts (the same model gives
+  // the same verdict), then moved onto the constraints (step 5); failing that the start itself when
+  // it is on them. With neither, nothing is checked: a verdict off the constraints can be wrong.
+  const double t = model.t0;
+  std::vector<double> scratch(model.evaluator->scratch_size());
   Vector q = model.q0, v = model.v0;
   for (int i = 0; i < n; ++i) {
     q(i) += 0.1 * std::sin(1.3 * i + 0.7);
     v(i) += 0.3 * std::cos(0.9 * i + 0.2);
   }
-  const double t = model.t0;
+  if (!onto_constraints(model, t, q, v, scratch)) {
+    q = model.q0;
+    v = model.v0;
+    if (!onto_constraints(model, t, q, v, scratch)) {
+      c.notes.push_back("the contact forces could not be checked at load (no state on the constraints was found near "
+                        "the start); they are reported as solved, with the residual column as the check");
+      return;
+    }
+  }
   Matrix A = Matrix::Zero(n, n), b = Matrix::Zero(s, n);
   Vector Q = Vector::Zero(n), G = Vector::Zero(n), b0 = Vector::Zero(s);
-  std::vector<double> scratch(model.evaluator->scratch_size());
   model.evaluator->terms(t, q.data(), v.data(), scratch.data(), TermsOut{A.data(), Q.data(), G.data(), b.data(), b0.data()});
   // The ideal-constraint dynamics: [A b^T; b 0] [q''; -lambda] = [Q + G; -b0], R = A q'' - Q - G.
   Matrix K = Matrix::Zero(n + s, n + s);

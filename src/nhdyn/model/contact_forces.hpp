@@ -33,13 +33,15 @@ struct Data;
 enum class ContactKind { wheel, knife_edge, surface, curve, rolling };
 
 // An output component of a reported contact: the world force, its parts along the ground's normal
-// n and (wheels, knife edges) e_long, e_lat, and the spin moment about n of rubber rolling.
+// n and (wheels, knife edges, rolling bodies with an axle) e_long, e_lat, and the spin moment about
+// n of rubber rolling.
 enum class ContactComponent { Fx, Fy, Fz, N, Flong, Flat, Mspin };
 inline constexpr int kContactComponentKinds = 7;
 const char* contact_component_name(ContactComponent component);  // "Fx", ..., "Mspin"
 // The columns of a contact, in order: a wheel or knife edge Fx, Fy, Fz, N, Flong, Flat; a rolling
-// body Fx, Fy, Fz, N, and Mspin with `spin` (rubber rolling).
-std::vector<ContactComponent> contact_components(ContactKind kind, bool spin);
+// body Fx, Fy, Fz, N, then Flong, Flat when its shape has an axle (`axle`: a disk, a torus), then
+// Mspin with `spin` (rubber rolling).
+std::vector<ContactComponent> contact_components(ContactKind kind, bool spin, bool axle = false);
 
 // One contact of the stacked system: its unknowns are the magnitudes along `unknowns` world
 // directions (3 for a wheel, a point on a surface or curve: the force's world components; 2 for a
@@ -137,9 +139,12 @@ std::vector<std::string> contact_force_columns(const Model& model);
 // Appends the values of those columns (after compute_contact_forces).
 void append_contact_force_values(const Model& model, const Data& data, std::vector<double>& row);
 
-// At load (step 5): checks the stacked system at a fixed generic state near the initial one (q0, q'0
-// shifted by fixed amounts; the identities hold off the constraints too), with q'' and R of the
-// ideal-constraint dynamics there (a dense KKT solve with the model's terms). Drops the balance
+// At load (step 5): checks the stacked system at a fixed generic admissible state near the initial
+// one (q0, q'0 shifted by fixed amounts, then moved onto the position and velocity constraints by
+// least-norm Newton steps; the start itself if that fails; no check, with a note, if the start is
+// off them too), with q'' and R of the ideal-constraint dynamics there (a dense KKT solve with the
+// model's terms). Off the constraints the balance of a contact whose point is held by coordinates
+// (an implicit shape) does not close, so the check looks only on them. Drops the balance
 // rows of a system whose balance is inconsistent with (C1), marks the components that the rest does
 // not determine (NaN), and writes the notes. Cold path: allocates.
 void analyse_contact_forces(const Model& model, ContactForceModel& contact);

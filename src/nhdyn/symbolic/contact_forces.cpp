@@ -93,7 +93,7 @@ void compile_contact_forces(const Spec& spec, Model& model) {
     contact.unknowns = static_cast<int>(p.directions.size()) + (p.spin ? 1 : 0);
     contact.system = std::max(p.system, 0);
     if (contact.reported) {
-      contact.components = contact_components(p.kind, p.spin);
+      contact.components = contact_components(p.kind, p.spin, p.axle);
       contact.first_value = values;
       values += static_cast<int>(contact.components.size());
     }

@@ -31,7 +31,8 @@ struct ContactBody {
 };
 
 // A contact: the material point P (world) with its velocity v_P (linear in q'), the world
-// directions of its unknowns, and (wheels, knife edges) the plane's normal n and e_long, e_lat.
+// directions of its unknowns, and (wheels, knife edges, rolling bodies with an axle) the ground's
+// normal n and e_long, e_lat.
 struct ContactPoint {
   std::string name;
   ContactKind kind = ContactKind::wheel;
@@ -45,6 +46,9 @@ struct ContactPoint {
   // velocity (world).
   bool spin = false;
   Vector3 omega = {0, 0, 0};
+  // A rolling body whose shape has an axle (disk, torus): longitudinal and lateral are set and
+  // reported as NAME_Flong, NAME_Flat (rolling-bodies.md section 5).
+  bool axle = false;
 };
 
 // A contact-force column (NAME_Fx ... NAME_Flat of a wheel or knife edge, NAME_Fx ... NAME_Mspin of

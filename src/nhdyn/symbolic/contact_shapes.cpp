@@ -5,13 +5,14 @@
 namespace nhdyn::symbolic {
 namespace {
 
-// y . e e - nu over |e x nu|: the unit direction in the plane normal to e closest to -nu
-// (the rim point of a disk, docs/derivations/rolling-wheel.md); with |e x nu| = sqrt(1 - (e.nu)^2).
-Vector3 rim_direction(const Vector3& nu, int axis, GiNaC::ex& length) {
+// e (e . nu) - nu over |e x nu|: the unit direction in the plane normal to e closest to -nu
+// (the rim point of a disk, docs/derivations/rolling-wheel.md), the same for every length of nu;
+// `across` = |e x nu| = sqrt(nu . nu - (e . nu)^2), with nu . nu = length^2.
+Vector3 rim_direction(const Vector3& nu, const GiNaC::ex& length, int axis, GiNaC::ex& across) {
   const Vector3 e = unit(axis);
   const GiNaC::ex en = nu[static_cast<std::size_t>(axis)];
-  length = GiNaC::sqrt(1 - en * en);
-  return scale(1 / length, subtract(scale(en, e), nu));
+  across = GiNaC::sqrt(length * length - en * en);
+  return scale(1 / across, subtract(scale(en, e), nu));
 }
 
 class Sphere final : public ContactShape {
@@ -20,25 +21,26 @@ class Sphere final : public ContactShape {
   int size_count() const override { return 1; }
   std::vector<std::string> size_names() const override { return {"r"}; }
   std::string example() const override { return "shape = { sphere = \"r\" }"; }
-  ShapeSupport support(const ShapeValues& v, const Vector3& nu) const override {
-    return {scale(-v.sizes[0], nu), v.sizes[0]};
+  ShapeSupport support(const ShapeValues& v, const Vector3& nu, const GiNaC::ex& length) const override {
+    return {scale(-v.sizes[0] / length, nu), v.sizes[0]};
   }
   std::optional<GiNaC::ex> ball_radius(const ShapeValues& v) const override { return v.sizes[0]; }
   std::optional<VisualKind> drawing() const override { return VisualKind::sphere; }
 };
 
-// x^T M x = 1, M = diag(1/a^2, 1/b^2, 1/c^2): y* = -M^{-1} nu / sqrt(nu^T M^{-1} nu).
+// x^T M x = 1, M = diag(1/a^2, 1/b^2, 1/c^2): y* = -M^{-1} nu / sqrt(nu^T M^{-1} nu), the same for
+// every length of nu; the reach sqrt(nu^T M^{-1} nu) is of degree 1 in nu, so divided by its length.
 class Ellipsoid final : public ContactShape {
  public:
   std::string key() const override { return "ellipsoid"; }
   int size_count() const override { return 3; }
   std::vector<std::string> size_names() const override { return {"a", "b", "c"}; }
   std::string example() const override { return "shape = { ellipsoid = [\"a\", \"b\", \"c\"] }"; }
-  ShapeSupport support(const ShapeValues& v, const Vector3& nu) const override {
+  ShapeSupport support(const ShapeValues& v, const Vector3& nu, const GiNaC::ex& length) const override {
     const Vector3 Minv_nu = {v.sizes[0] * v.sizes[0] * nu[0], v.sizes[1] * v.sizes[1] * nu[1],
                              v.sizes[2] * v.sizes[2] * nu[2]};
-    const GiNaC::ex reach = GiNaC::sqrt(dot(nu, Minv_nu));
-    return {scale(-1 / reach, Minv_nu), reach};
+    const GiNaC::ex root = GiNaC::sqrt(dot(nu, Minv_nu));
+    return {scale(-1 / root, Minv_nu), root / length};
   }
   GiNaC::ex length(const ShapeValues& v) const override { return v.sizes[0]; }
 };
@@ -51,10 +53,10 @@ class Disk final : public ContactShape {
   std::vector<std::string> size_names() const override { return {"r"}; }
   std::vector<std::string> options() const override { return {"axis"}; }
   std::string example() const override { return "shape = { disk = \"r\", axis = \"y\" }"; }
-  ShapeSupport support(const ShapeValues& v, const Vector3& nu) const override {
-    GiNaC::ex length;
-    const Vector3 d = rim_direction(nu, v.axis, length);
-    return {scale(v.sizes[0], d), v.sizes[0] * length};
+  ShapeSupport support(const ShapeValues& v, const Vector3& nu, const GiNaC::ex& length) const override {
+    GiNaC::ex across;
+    const Vector3 d = rim_direction(nu, length, v.axis, across);
+    return {scale(v.sizes[0], d), v.sizes[0] * across / length};
   }
   std::optional<Singularity> singularity(const ShapeValues& v, const Vector3& nu) const override {
     const GiNaC::ex along = nu[static_cast<std::size_t>(v.axis)];
@@ -73,10 +75,10 @@ class Torus final : public ContactShape {
   std::vector<std::string> size_names() const override { return {"R", "r"}; }
   std::vector<std::string> options() const override { return {"axis"}; }
   std::string example() const override { return "shape = { torus = [\"R\", \"r\"], axis = \"y\" }"; }
-  ShapeSupport support(const ShapeValues& v, const Vector3& nu) const override {
-    GiNaC::ex length;
-    const Vector3 d = rim_direction(nu, v.axis, length);
-    return {subtract(scale(v.sizes[0], d), scale(v.sizes[1], nu)), v.sizes[0] * length + v.sizes[1]};
+  ShapeSupport support(const ShapeValues& v, const Vector3& nu, const GiNaC::ex& length) const override {
+    GiNaC::ex across;
+    const Vector3 d = rim_direction(nu, length, v.axis, across);
+    return {subtract(scale(v.sizes[0], d), scale(v.sizes[1] / length, nu)), v.sizes[0] * across / length + v.sizes[1]};
   }
   std::optional<Singularity> singularity(const ShapeValues& v, const Vector3& nu) const override {
     const GiNaC::ex along = nu[static_cast<std::size_t>(v.axis)];
@@ -99,7 +101,9 @@ class ImplicitSurface final : public ContactShape {
     return "shape = { surface = \"X^2/a^2 + Y^4/b^4 + Z^2/c^2 - 1\", coordinates = [\"px\", \"py\", \"pz\"] }";
   }
   bool implicit() const override { return true; }
-  ShapeSupport support(const ShapeValues& v, const Vector3& nu) const override { return {v.point, -dot(nu, v.point)}; }
+  ShapeSupport support(const ShapeValues& v, const Vector3& nu, const GiNaC::ex& length) const override {
+    return {v.point, -dot(nu, v.point) / length};
+  }
   GiNaC::ex length(const ShapeValues&) const override { return 1; }
 };
 

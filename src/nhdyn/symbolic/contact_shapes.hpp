@@ -51,8 +51,10 @@ class ContactShape {
   virtual std::vector<std::string> options() const { return {}; }
   // An example of the table, for messages.
   virtual std::string example() const = 0;
-  // y*(nu) and rho(nu) for a unit nu in body axes (docs/derivations/rolling-bodies.md section 2).
-  virtual ShapeSupport support(const ShapeValues& values, const Vector3& nu) const = 0;
+  // y*(nu) and rho(nu) for the unit direction nu / length in body axes, `length` > 0 the length
+  // of nu (1 when nu is unit): a quaternion frame's nu is taken without its fraction, R_2^T n,
+  // whose length is e.e (docs/derivations/rolling-bodies.md sections 2 and 2.1).
+  virtual ShapeSupport support(const ShapeValues& values, const Vector3& nu, const GiNaC::ex& length) const = 0;
   // An implicit surface f(X, Y, Z) = 0 (body axes): its contact point is not a closed form but
   // three coordinates of the model, held by f = 0 and the normals' alignment
   // (docs/derivations/rolling-bodies.md section 9). Its support() returns those coordinates.

@@ -38,13 +38,18 @@ Vector3 multiply_transposed(const GiNaC::matrix& R, const Vector3& v) {
   return out;
 }
 
-namespace {
-GiNaC::ex squared_norm(const Quaternion& e) { return e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]; }
-}  // namespace
+GiNaC::ex quaternion_squared_norm(const Quaternion& e) { return e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]; }
+
+GiNaC::matrix quaternion_rotation_polynomial(const Quaternion& e) {
+  const GiNaC::ex &e0 = e[0], &e1 = e[1], &e2 = e[2], &e3 = e[3];
+  return GiNaC::matrix{{e0 * e0 + e1 * e1 - e2 * e2 - e3 * e3, 2 * (e1 * e2 - e0 * e3), 2 * (e1 * e3 + e0 * e2)},
+                       {2 * (e1 * e2 + e0 * e3), e0 * e0 - e1 * e1 + e2 * e2 - e3 * e3, 2 * (e2 * e3 - e0 * e1)},
+                       {2 * (e1 * e3 - e0 * e2), 2 * (e2 * e3 + e0 * e1), e0 * e0 - e1 * e1 - e2 * e2 + e3 * e3}};
+}
 
 GiNaC::matrix quaternion_rotation(const Quaternion& e) {
   const GiNaC::ex &e0 = e[0], &e1 = e[1], &e2 = e[2], &e3 = e[3];
-  const GiNaC::ex s = 1 / squared_norm(e);
+  const GiNaC::ex s = 1 / quaternion_squared_norm(e);
   return GiNaC::matrix{{s * (e0 * e0 + e1 * e1 - e2 * e2 - e3 * e3), s * 2 * (e1 * e2 - e0 * e3), s * 2 * (e1 * e3 + e0 * e2)},
                        {s * 2 * (e1 * e2 + e0 * e3), s * (e0 * e0 - e1 * e1 + e2 * e2 - e3 * e3), s * 2 * (e2 * e3 - e0 * e1)},
                        {s * 2 * (e1 * e3 - e0 * e2), s * 2 * (e2 * e3 + e0 * e1), s * (e0 * e0 - e1 * e1 - e2 * e2 + e3 * e3)}};
@@ -52,7 +57,7 @@ GiNaC::matrix quaternion_rotation(const Quaternion& e) {
 
 Vector3 quaternion_omega(const Quaternion& e, const Quaternion& d) {
   // 2 E(e) e' / (e.e), E = [-e~ | e0 I + [e~ x]].
-  const GiNaC::ex s = 2 / squared_norm(e);
+  const GiNaC::ex s = 2 / quaternion_squared_norm(e);
   return {s * (-e[1] * d[0] + e[0] * d[1] - e[3] * d[2] + e[2] * d[3]),
           s * (-e[2] * d[0] + e[3] * d[1] + e[0] * d[2] - e[1] * d[3]),
           s * (-e[3] * d[0] - e[2] * d[1] + e[1] * d[2] + e[0] * d[3])};
@@ -60,7 +65,7 @@ Vector3 quaternion_omega(const Quaternion& e, const Quaternion& d) {
 
 Vector3 quaternion_omega_local(const Quaternion& e, const Quaternion& d) {
   // 2 G(e) e' / (e.e), G = [-e~ | e0 I - [e~ x]].
-  const GiNaC::ex s = 2 / squared_norm(e);
+  const GiNaC::ex s = 2 / quaternion_squared_norm(e);
   return {s * (-e[1] * d[0] + e[0] * d[1] + e[3] * d[2] - e[2] * d[3]),
           s * (-e[2] * d[0] - e[3] * d[1] + e[0] * d[2] + e[1] * d[3]),
           s * (-e[3] * d[0] + e[2] * d[1] - e[1] * d[2] + e[0] * d[3])};

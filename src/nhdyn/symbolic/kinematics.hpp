@@ -34,6 +34,11 @@ using Quaternion = std::array<GiNaC::ex, 4>;
 // The rotation of the unit quaternion e / |e|: ((e0^2 - |e~|^2) I + 2 e~ e~^T + 2 e0 [e~ x]) / (e.e),
 // (2.3), a rotation for every e != 0.
 GiNaC::matrix quaternion_rotation(const Quaternion& e);
+// Its two factors, R(e) = R_2(e) / (e.e): the polynomial matrix R_2(e) of (2.1) and e.e. R_2 is
+// homogeneous of degree 2, so R_2(e)^T n = (e.e) R(e)^T n has the direction of R(e)^T n with no
+// fraction in it: what a shape's support mapping, homogeneous in its direction, needs (section 8).
+GiNaC::matrix quaternion_rotation_polynomial(const Quaternion& e);
+GiNaC::ex quaternion_squared_norm(const Quaternion& e);
 // Its angular velocity 2 E(e) e' / (e.e) in the parent's axes and 2 G(e) e' / (e.e) in the frame's
 // own, (3.3): exact for every e != 0 and every e' (a rate along e only rescales e).
 Vector3 quaternion_omega(const Quaternion& e, const Quaternion& rate);

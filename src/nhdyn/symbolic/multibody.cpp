@@ -94,6 +94,7 @@ MultibodyBuilder::MultibodyBuilder(SpecBuilder& builder) : builder_(builder) {
   ground.name = "ground";
   ground.origin = {0, 0, 0};
   ground.rotation = GiNaC::matrix{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  ground.rotation_numerator = ground.rotation;
   ground.omega = {0, 0, 0};
   ground.omega_local = {0, 0, 0};
   frames_.push_back(ground);
@@ -194,6 +195,8 @@ PlacedFrame MultibodyBuilder::child_frame(const std::string& name, const std::st
   f.where = where;
   f.origin = add(up.origin, multiply(up.rotation, parse(translation, where, context + ": translation", true)));
   f.rotation = up.rotation;
+  f.rotation_numerator = up.rotation_numerator;
+  f.rotation_denominator = up.rotation_denominator;
   f.omega = up.omega;
   f.omega_local = up.omega_local;
   return f;
@@ -222,6 +225,7 @@ MultibodyBuilder& MultibodyBuilder::frame(const std::string& name, const std::st
     f.omega = add(f.omega, scale(rate, column(f.rotation, axis)));
     const GiNaC::matrix Rj = rotation_about(axis, angle);
     f.rotation = f.rotation.mul(Rj);
+    f.rotation_numerator = f.rotation_numerator.mul(Rj);
     f.omega_local = add(multiply_transposed(Rj, f.omega_local), scale(rate, unit(axis)));
   }
   frames_.push_back(std::move(f));
@@ -272,6 +276,8 @@ MultibodyBuilder& MultibodyBuilder::quaternion_frame(const std::string& name, co
   // omega_F = R(e)^T omega_P,F + 2 G(e) e'.
   const GiNaC::matrix Re = quaternion_rotation(e);
   f.rotation = up.rotation.mul(Re);
+  f.rotation_numerator = up.rotation_numerator.mul(quaternion_rotation_polynomial(e));
+  f.rotation_denominator = up.rotation_denominator * quaternion_squared_norm(e);
   f.omega = add(up.omega, multiply(up.rotation, quaternion_omega(e, rate)));
   f.omega_local = add(multiply_transposed(Re, up.omega_local), quaternion_omega_local(e, rate));
   frames_.push_back(std::move(f));
@@ -797,7 +803,7 @@ void MultibodyBuilder::apply() {
   std::vector<ReportedContact> reported;  // the wheels, knife edges and rolling bodies, whose columns events may name
   for (const ContactPoint& c : record->contacts)
     if (c.kind == ContactKind::wheel || c.kind == ContactKind::knife_edge || c.kind == ContactKind::rolling)
-      reported.emplace_back(c.name, contact_components(c.kind, c.spin));
+      reported.emplace_back(c.name, contact_components(c.kind, c.spin, c.axle));
   record->columns = make_contact_force_symbols(reported);
   record->modes = modes_;
   builder_.contact_forces(std::move(record));

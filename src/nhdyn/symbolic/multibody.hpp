@@ -50,6 +50,12 @@ struct PlacedFrame {
   int parent = -1;            // index among the frames; -1 for ground
   Vector3 origin;             // position of the origin
   GiNaC::matrix rotation;     // R: frame components -> world components
+  // R = rotation_numerator / rotation_denominator, the denominator a positive scalar: the product
+  // of e.e over the quaternion frames of the chain (R_2(e) in the numerator), 1 when there are
+  // none. R^T n and rotation_numerator^T n have the same direction; the rolling contacts take the
+  // direction without the fraction (docs/derivations/quaternion-frame.md section 8).
+  GiNaC::matrix rotation_numerator;
+  GiNaC::ex rotation_denominator = 1;
   Vector3 omega;              // angular velocity, world components (linear in q')
   Vector3 omega_local;        // the same in the frame's own axes
   std::vector<int> quaternion;  // a quaternion frame: the indices of its coordinates e0..e3; else empty

@@ -202,10 +202,13 @@ class PlaneGround final : public ContactGround {
     Touch out;
     const Vector3 n = ground_plane_normal(c.ground, spec, gravity, context);
     const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
-    // nu = R^T n, the normal in the body's axes; the support point lowest along it.
-    const Vector3 nu = multiply_transposed(F.rotation, n);
+    // nu = R^T n, the normal in the body's axes; the support point lowest along it. Taken as
+    // N^T n, R = N / s (a quaternion frame: N = R_2(e), s = e.e), of length s: the support
+    // mapping depends on the direction only, and without the fraction the expressions that are
+    // differentiated twice stay polynomial inside the root (rolling-bodies.md section 2.1).
+    const Vector3 nu = multiply_transposed(F.rotation_numerator, n);
     const Vector3 nu_s = {simplify_moderate(nu[0]), simplify_moderate(nu[1]), simplify_moderate(nu[2])};
-    const ShapeSupport s = c.shape->support(c.values, nu_s);
+    const ShapeSupport s = c.shape->support(c.values, nu_s, F.rotation_denominator);
     out.point = add(C, multiply(F.rotation, s.point));
     out.normal = n;
     out.gap = dot(n, C) - s.reach;
@@ -378,7 +381,8 @@ class TerrainGround final : public ContactGround {
       body_point = subtract(C, scale(*r, out.normal));
       reach = *r;
     } else {
-      const ShapeSupport s = c.shape->support(c.values, multiply_transposed(F.rotation, out.normal));
+      const ShapeSupport s = c.shape->support(c.values, multiply_transposed(F.rotation_numerator, out.normal),
+                                              F.rotation_denominator);
       body_point = add(C, multiply(F.rotation, s.point));
       reach = s.reach;
     }
@@ -394,8 +398,8 @@ class TerrainGround final : public ContactGround {
     out.curvature(1, 1) = hv.diff(vs) / length;
     if (c.shape->implicit()) implicit_shape_rows(c, F, out.tangent1, out.tangent2, out);
     // The force acts at the body's point (the same as the ground's on the constraints): there the
-    // gap's gradient, the rolling rows and the force's moment agree at every state, also off the
-    // constraints, where the contact forces' consistency check at load looks.
+    // gap's gradient, the rolling rows and the force's moment agree also off the constraints,
+    // where a drifting integration goes (rolling-bodies.md section 8).
     out.point = body_point;
     return out;
   }
@@ -644,6 +648,17 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
   f.normal = touch.normal;
   f.longitudinal = {0, 0, 0};
   f.lateral = {0, 0, 0};
+  if (c.values.axis >= 0) {
+    // A shape with an axle a (world): e_long = (a x n) / |a x n|, the direction the wheel rolls
+    // along the ground, and e_lat = n x e_long, as a [[wheels]] entry has (rolling-bodies.md
+    // section 5); |a x n| = sqrt(1 - (a . n)^2) vanishes only lying flat, where the run stops. The
+    // axle's direction from R's numerator (a positive multiple of it, quaternion-frame.md section 8).
+    const Vector3 a = column(F.rotation_numerator, c.values.axis);
+    const Vector3 along = cross(a, touch.normal);
+    f.longitudinal = scale(1 / GiNaC::sqrt(dot(along, along)), along);
+    f.lateral = cross(touch.normal, f.longitudinal);
+    f.axle = true;
+  }
   f.omega = F.omega;
   f.spin = c.rubber;
   return out;
