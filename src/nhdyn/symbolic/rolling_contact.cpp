@@ -535,6 +535,89 @@ ParsedContact parse_contact(const ContactText& text, const ContactParsers& parse
   return out;
 }
 
+namespace {
+
+// The convexity check of an implicit shape: near y the surface f = 0 leaves its tangent plane
+// along -grad f by 1/2 w^T H w / |grad f|; along n that is -(unit grad f . n) times it, in world
+// axes with R (rolling-bodies.md section 9).
+SpecConvexity convexity_check(const ParsedContact& c, const PlacedFrame& F, const ContactGround::Touch& touch) {
+  const ShapeValues& v = c.values;
+  Vector3 gradient;
+  for (std::size_t i = 0; i < 3; ++i) gradient[i] = v.surface.diff(GiNaC::ex_to<GiNaC::symbol>(v.point[i]));
+  const GiNaC::ex size = GiNaC::sqrt(dot(gradient, gradient));
+  const GiNaC::ex along = -dot(multiply(F.rotation, gradient), touch.normal) / size;
+  GiNaC::matrix H(3, 3);
+  for (unsigned i = 0; i < 3; ++i)
+    for (unsigned j = 0; j < 3; ++j) H(i, j) = gradient[i].diff(GiNaC::ex_to<GiNaC::symbol>(v.point[j]));
+  SpecConvexity check;
+  check.contact = c.name;
+  check.where = c.where;
+  check.normal = {touch.normal[0], touch.normal[1], touch.normal[2]};
+  check.body = F.rotation.mul(H).mul(F.rotation.transpose()).mul_scalar(along / size);
+  check.ground = touch.curvature;
+  return check;
+}
+
+// The contact coordinates nhdyn adds, and where Newton starts (rolling-bodies.md section 10): on a
+// terrain below the centre; an implicit shape's point on its surface along -nu from its centre.
+SpecContactCoordinates added_coordinates(const ParsedContact& c, const PlacedFrame& F,
+                                         const ContactGround::Touch& touch) {
+  SpecContactCoordinates added;
+  added.contact = c.name;
+  added.where = c.where;
+  if (c.ground.added) {
+    const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
+    for (std::size_t i = 0; i < 2; ++i) {
+      added.coordinates.push_back(c.ground.at[i]);
+      added.constraints.push_back(fmt::format("{}_at{}", c.name, i + 1));
+      added.start.push_back(C[i]);
+    }
+  }
+  if (c.values.added) {
+    const Vector3 down = multiply_transposed(F.rotation, scale(-1, touch.normal));
+    for (std::size_t i = 0; i < 3; ++i) {
+      added.coordinates.push_back(c.values.at[i]);
+      added.start.push_back(0);
+      added.ray.push_back(down[i]);
+    }
+    for (const char* suffix : {"_on", "_normal1", "_normal2"}) added.constraints.push_back(c.name + suffix);
+    added.surface = c.values.surface;
+    added.point = c.values.at;
+  }
+  return added;
+}
+
+// The contact point as the contact forces see it: its point, velocity, normal, and the axle's
+// directions for a disk or torus.
+ContactPoint contact_force_point(const ParsedContact& c, const PlacedFrame& F, const ContactGround::Touch& touch,
+                                 const Vector3& vP) {
+  ContactPoint f;
+  f.name = c.name;
+  f.kind = ContactKind::rolling;
+  f.point = touch.point;
+  f.velocity = vP;
+  f.directions = {unit(0), unit(1), unit(2)};
+  f.normal = touch.normal;
+  f.longitudinal = {0, 0, 0};
+  f.lateral = {0, 0, 0};
+  if (c.values.axis >= 0) {
+    // A shape with an axle a (world): e_long = (a x n) / |a x n|, the direction the wheel rolls
+    // along the ground, and e_lat = n x e_long, as a [[wheels]] entry has (rolling-bodies.md
+    // section 5); |a x n| = sqrt(1 - (a . n)^2) vanishes only lying flat, where the run stops. The
+    // axle's direction from R's numerator (a positive multiple of it, quaternion-frame.md section 8).
+    const Vector3 a = column(F.rotation_numerator, c.values.axis);
+    const Vector3 along = cross(a, touch.normal);
+    f.longitudinal = scale(1 / GiNaC::sqrt(dot(along, along)), along);
+    f.lateral = cross(touch.normal, f.longitudinal);
+    f.axle = true;
+  }
+  f.omega = F.omega;
+  f.spin = c.rubber;
+  return f;
+}
+
+}  // namespace
+
 RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F, const Spec& spec,
                                     const std::optional<Vector3>& gravity) {
   const std::string context = fmt::format("contact '{}'", c.name);
@@ -589,78 +672,13 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
     out.constraints.push_back({c.name + "_spin", ConstraintLevel::velocity, spin,
                                fmt::format("contact '{}': no spin about the normal, n.(omega - omega_ground) = 0", c.name)});
   }
-  if (c.shape->implicit()) {
-    // Near y the surface f = 0 leaves its tangent plane along -grad f by 1/2 w^T H w / |grad f|;
-    // along n that is -(unit grad f . n) times it, in world axes with R (section 9).
-    const ShapeValues& v = c.values;
-    Vector3 gradient;
-    for (std::size_t i = 0; i < 3; ++i) gradient[i] = v.surface.diff(GiNaC::ex_to<GiNaC::symbol>(v.point[i]));
-    const GiNaC::ex size = GiNaC::sqrt(dot(gradient, gradient));
-    const GiNaC::ex along = -dot(multiply(F.rotation, gradient), touch.normal) / size;
-    GiNaC::matrix H(3, 3);
-    for (unsigned i = 0; i < 3; ++i)
-      for (unsigned j = 0; j < 3; ++j) H(i, j) = gradient[i].diff(GiNaC::ex_to<GiNaC::symbol>(v.point[j]));
-    SpecConvexity check;
-    check.contact = c.name;
-    check.where = c.where;
-    check.normal = {touch.normal[0], touch.normal[1], touch.normal[2]};
-    check.body = F.rotation.mul(H).mul(F.rotation.transpose()).mul_scalar(along / size);
-    check.ground = touch.curvature;
-    out.convexity = std::move(check);
-  }
+  if (c.shape->implicit()) out.convexity = convexity_check(c, F, touch);
   // 1 - (e . nu)^2 below 1e-4: the axle within 0.6 degree of the normal (rolling-bodies.md section 2).
   if (const std::optional<ContactShape::Singularity> singular =
           c.shape->singularity(c.values, multiply_transposed(F.rotation, touch.normal)))
     out.watch = SpecContactWatch{c.name, c.where, singular->measure, 1e-4, singular->reason};
-  if (c.ground.added || c.values.added) {
-    // Where Newton starts (rolling-bodies.md section 10): on a terrain below the centre; an
-    // implicit shape's point on its surface along -nu from its centre.
-    SpecContactCoordinates added;
-    added.contact = c.name;
-    added.where = c.where;
-    if (c.ground.added) {
-      const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
-      for (std::size_t i = 0; i < 2; ++i) {
-        added.coordinates.push_back(c.ground.at[i]);
-        added.constraints.push_back(fmt::format("{}_at{}", c.name, i + 1));
-        added.start.push_back(C[i]);
-      }
-    }
-    if (c.values.added) {
-      const Vector3 down = multiply_transposed(F.rotation, scale(-1, touch.normal));
-      for (std::size_t i = 0; i < 3; ++i) {
-        added.coordinates.push_back(c.values.at[i]);
-        added.start.push_back(0);
-        added.ray.push_back(down[i]);
-      }
-      for (const char* suffix : {"_on", "_normal1", "_normal2"}) added.constraints.push_back(c.name + suffix);
-      added.surface = c.values.surface;
-      added.point = c.values.at;
-    }
-    out.added = std::move(added);
-  }
-  ContactPoint& f = out.force;
-  f.name = c.name;
-  f.kind = ContactKind::rolling;
-  f.point = touch.point;
-  f.velocity = vP;
-  f.directions = {unit(0), unit(1), unit(2)};
-  f.normal = touch.normal;
-  f.longitudinal = {0, 0, 0};
-  f.lateral = {0, 0, 0};
-  if (c.values.axis >= 0) {
-    // A shape with an axle a (world): e_long = (a x n) / |a x n|, the direction the wheel rolls
-    // along the ground, and e_lat = n x e_long, as a [[wheels]] entry has (rolling-bodies.md
-    // section 5); |a x n| = sqrt(1 - (a . n)^2) vanishes only lying flat, where the run stops. The
-    // axle's direction from R's numerator (a positive multiple of it, quaternion-frame.md section 8).
-    const Vector3 a = column(F.rotation_numerator, c.values.axis);
-    const Vector3 along = cross(a, touch.normal);
-    f.longitudinal = scale(1 / GiNaC::sqrt(dot(along, along)), along);
-    f.lateral = cross(touch.normal, f.longitudinal);
-    f.axle = true;
-  }
-  f.omega = F.omega;
-  f.spin = c.rubber;
+  if (c.ground.added || c.values.added) out.added = added_coordinates(c, F, touch);
+  out.force = contact_force_point(c, F, touch, vP);
   return out;
 }
 
