@@ -263,10 +263,12 @@ TEST_F(OptimizeCli, ParallelParkingMeetsItsEndsKeepsClearAndReplaysInSimulate) {
   // hold at every point, and `nhdyn simulate` under the optimal controls (as [forces], interpolated
   // as Hermite-Simpson defines them) ends where the optimized motion ends, to within the
   // collocation error that the replay difference measures.
-  const Outcome run = optimize(example("parking.toml") + " --set node_count=31 --guess " + example("parking_guess.csv") +
-                               " -o park.csv");
+  // The guess is the one the file names (guess = "parking_guess.csv", beside it), run from another
+  // folder.
+  const Outcome run = optimize(example("parking.toml") + " --set node_count=31 -o park.csv");
   SKIP_WITHOUT_IPOPT(run);
   ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("first guess: " + example("parking_guess.csv")), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("status: solved"), std::string::npos) << run.out;
   const double replay = summary_value(run.out, "replay difference");
   EXPECT_LT(replay, 0.1) << run.out;
@@ -449,6 +451,19 @@ TEST_F(OptimizeCli, BadInputExitsTwoNamingWhere) {
   const Outcome nothing = run_nhdyn("optimize nothing.toml", dir_);
   EXPECT_EQ(nothing.exit_code, 2) << nothing.out;
   EXPECT_NE(nothing.out.find("control 'F' acts on nothing"), std::string::npos) << nothing.out;
+
+  // guess = "..." names a CSV relative to the model file's folder: a missing one, or a value that is
+  // not a path, is refused before the solve, at its line.
+  write_variant("double_integrator.toml", "guess.toml", {{"final =", "guess = \"missing.csv\"\nfinal ="}});
+  const Outcome guess = run_nhdyn("optimize guess.toml", dir_);
+  EXPECT_EQ(guess.exit_code, 2) << guess.out;
+  EXPECT_NE(guess.out.find("guess.toml:18:9: the guess file missing.csv does not exist"), std::string::npos)
+      << guess.out;
+  write_variant("double_integrator.toml", "guess_number.toml", {{"final =", "guess = 3\nfinal ="}});
+  const Outcome number = run_nhdyn("optimize guess_number.toml", dir_);
+  EXPECT_EQ(number.exit_code, 2) << number.out;
+  EXPECT_NE(number.out.find("guess_number.toml:18:9: guess must be the path of a CSV"), std::string::npos)
+      << number.out;
 
   const Outcome no_section = run_nhdyn("optimize " + example("sled.toml"), dir_);
   EXPECT_EQ(no_section.exit_code, 2) << no_section.out;

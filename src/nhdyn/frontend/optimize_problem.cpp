@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -38,7 +39,7 @@ using symbolic::SourceLocation;
 
 const std::vector<std::string> kOptimizeKeys = {"controls", "objective", "objective_final", "t_end",
                                                 "nodes",    "method",    "constraint_level", "initial",
-                                                "final",    "bounds",    "path"};
+                                                "final",    "bounds",    "path",          "guess"};
 const std::vector<std::string> kControlKeys = {"name", "actuator"};
 
 class SectionReader {
@@ -83,6 +84,7 @@ class SectionReader {
     if (const toml::node* v = section->get("final"); v != nullptr && !v->is_string()) p.final = read_state(*v, "final");
     read_objective(*section, p);
     if (const toml::node* v = section->get("path")) read_path(*v, p);
+    if (const toml::node* v = section->get("guess")) p.guess = read_guess(*v);
     compile_force(p);
     check_controls_seen(p);
     return p;
@@ -114,6 +116,24 @@ class SectionReader {
       fail(value, fmt::format("unknown key '{}' {}; {}the keys are: {}", name, where,
                               nearest.empty() ? "" : fmt::format("did you mean '{}'? ", nearest), join(keys)));
     }
+  }
+
+  // guess = "FILE.csv": relative to the model file's folder (a model given as text: to the
+  // working directory); it must exist, so that a typo is caught before the solve.
+  std::string read_guess(const toml::node& node) const {
+    const std::optional<std::string> name = node.value<std::string>();
+    if (!name || name->empty() || !node.is_string())
+      fail(node, "guess must be the path of a CSV in quotes, e.g. guess = \"parking_guess.csv\" (relative to the "
+                 "model file's folder)");
+    std::filesystem::path path(*name);
+    const std::filesystem::path file(file_);
+    if (path.is_relative() && file_ != "<string>" && file.has_parent_path()) path = file.parent_path() / path;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+      fail(node, fmt::format("the guess file {} does not exist (guess is relative to the model file's folder); "
+                             "write its path, or leave guess out and give --guess FILE.csv",
+                             path.string()));
+    return path.string();
   }
 
   // A number, or an expression in quotes, as text for the parser.

@@ -76,6 +76,9 @@ struct OptimalControlProblem {
   // Bounds on the coordinates and velocities at every point: 2n each, [q; q'].
   std::vector<double> state_lower, state_upper;
   std::vector<std::string> warnings;  // e.g. a control that neither the objective nor a bound sees
+  // [optimize] guess = "FILE.csv": the first guess when none is given (--guess, guess=), its path
+  // relative to the model file's folder resolved; empty without the key.
+  std::string guess;
 
   int n() const { return model.n(); }
   int m() const { return static_cast<int>(controls.size()); }

@@ -76,11 +76,13 @@ OptimizeResult solve_optimal_control(const OptimalControlProblem& problem, const
   OptimizeResult result;
   result.notes = problem.warnings;
   for (const std::string& note : nlp.notes()) result.notes.push_back(note);
-  if (!options.guess.empty()) {
+  // The guess given with the solve, else the one the [optimize] section names.
+  const std::filesystem::path guess = options.guess.empty() ? std::filesystem::path(problem.guess) : options.guess;
+  if (!guess.empty()) {
     std::vector<double> x = nlp.start();
-    apply_guess(nlp, options.guess, x);
+    apply_guess(nlp, guess, x);
     nlp.set_start(std::move(x));
-    result.notes.push_back("first guess: " + options.guess.string());
+    result.notes.push_back("first guess: " + guess.string());
   }
   result.solver = solve_nlp(nlp, options.nlp);
   if (result.solver.status == NlpStatus::unavailable) return result;
@@ -104,7 +106,7 @@ OptimizeResult solve_optimal_control(const OptimalControlProblem& problem, const
   result.replayed = replay.ok;
   result.replay_difference = replay.difference;
   result.replay_message = replay.message;
-  if (!result.converged() && options.guess.empty())
+  if (!result.converged() && guess.empty())
     result.notes.push_back("IPOPT did not converge from the straight line between the boundary states, which can be a "
                            "stationary point of the constraints' violation (as for the Brockett integrator): give a "
                            "first guess, --guess FILE.csv (docs/optimize.md)");
