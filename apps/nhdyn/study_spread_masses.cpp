@@ -45,6 +45,95 @@ std::filesystem::path reactions_plot_path(const std::filesystem::path& plot) {
   return out;
 }
 
+// The options' values, checked before the model file is read.
+void check_spread_masses_options(const SpreadMassesOptions& options) {
+  for (double ratio : options.ratios)
+    if (!(ratio > 0.0 && std::isfinite(ratio)))
+      throw InputError(fmt::format("--ratios: {} is not a positive number; give ratios such as 1,1e6,1e12", ratio));
+  if (options.samples < 1) throw InputError(fmt::format("--samples {}: give at least 1 state per ratio", options.samples));
+  if (options.digits < 20)
+    throw InputError(fmt::format("--digits {}: the reference needs 20 digits or more (default 50)", options.digits));
+}
+
+// One CSV row per ratio: the ratio, cond(A), the reference's error, then each formulation's errors.
+void write_spread_masses_rows(const SpreadMasses& study, CsvWriter& csv) {
+  std::vector<double> row;
+  for (std::size_t r = 0; r < study.ratios.size(); ++r) {
+    const SpreadMassesRatio& ratio = study.ratios[r];
+    row = {ratio.ratio, ratio.cond_A, ratio.reference_error};
+    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).error_qdd);
+    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).error_R);
+    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).solve_error_qdd);
+    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).solve_error_R);
+    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).residual);
+    csv.write_row(row);
+  }
+}
+
+// --plot: the errors of q'' in one plot, those of R in a second beside it.
+void plot_spread_masses(const SpreadMasses& study, const std::filesystem::path& table_path,
+                        const std::vector<std::string>& qdd_columns, const std::vector<std::string>& R_columns,
+                        const std::string& plot) {
+  XyPlotRequest request;
+  request.csv = table_path;
+  request.x = "ratio";
+  request.x_label = "mass ratio (largest / smallest)";
+  request.title = fmt::format("{}: relative error of the accelerations q'', {}-digit reference (max over {} states)",
+                              study.model, study.digits, study.states.size());
+  request.y = qdd_columns;
+  request.y_label = "|q'' - q''_ref| / |q''_ref|";
+  write_xy_plot(request, plot);
+  request.title = fmt::format("{}: relative error of the reactions R, {}-digit reference (max over {} states)",
+                              study.model, study.digits, study.states.size());
+  request.y = R_columns;
+  request.y_label = "|R - R_ref| / |R_ref|";
+  write_xy_plot(request, reactions_plot_path(plot));
+}
+
+// The summary on standard output: one block per error, each formulation's refusals, the reference.
+void print_spread_masses(const SpreadMasses& study, const std::filesystem::path& table_path, const std::string& plot) {
+  fmt::print("nhdyn study spread-masses {}: {} states per ratio, reference at {} digits (Lagrange system, "
+             "exact rationals)\n",
+             study.model, study.states.size(), study.digits);
+  const auto block = [&](const char* title, auto value) {
+    fmt::print("\n{}\n{:>8} {:>9}", title, "ratio", "cond(A)");
+    for (const StudyFormulation& f : study.formulations) fmt::print(" {:>14}", formulation_label(f));
+    fmt::print("\n");
+    for (std::size_t r = 0; r < study.ratios.size(); ++r) {
+      fmt::print("{:>8.0e} {:>9.1e}", study.ratios[r].ratio, study.ratios[r].cond_A);
+      for (std::size_t f = 0; f < study.formulations.size(); ++f) {
+        const SpreadMassesPoint& p = study.point(r, f);
+        if (p.failures > 0)
+          fmt::print(" {:>14}", "refused");
+        else
+          fmt::print(" {:>14.2e}", value(p));
+      }
+      fmt::print("\n");
+    }
+  };
+  block("relative error of q'' (max over the states)", [](const SpreadMassesPoint& p) { return p.error_qdd; });
+  block("relative error of R (max over the states)", [](const SpreadMassesPoint& p) { return p.error_R; });
+  block("relative error of q'' of the solve alone (against the exact solution of the rounded terms)",
+        [](const SpreadMassesPoint& p) { return p.solve_error_qdd; });
+  block("relative error of R of the solve alone", [](const SpreadMassesPoint& p) { return p.solve_error_R; });
+  block("acceleration-level residual max |b q'' + b0|", [](const SpreadMassesPoint& p) { return p.residual; });
+  for (std::size_t f = 0; f < study.formulations.size(); ++f)
+    for (std::size_t r = 0; r < study.ratios.size(); ++r)
+      if (study.point(r, f).failures > 0) {
+        fmt::print("\n{} refused {} of {} states from ratio {:g} on, first: {}\n", formulation_label(study.formulations[f]),
+                   study.point(r, f).failures, study.states.size(), study.ratios[r].ratio,
+                   describe(study.point(r, f).failure));
+        break;
+      }
+  double reference_error = 0.0;
+  for (const SpreadMassesRatio& r : study.ratios) reference_error = std::max(reference_error, r.reference_error);
+  fmt::print("\nreference: estimated relative error at most {:.1e} (against {} digits)\n", reference_error,
+             study.digits + 20);
+  fmt::print("table -> {}\n", table_path.string());
+  if (!plot.empty())
+    fmt::print("plots -> {}, {}\n", plot, reactions_plot_path(plot).string());
+}
+
 int run_spread_masses(const SpreadMassesArgs& args) {
   protect_model_file(args.model);
   // Options first, so that a bad value is reported before the model file is read.
@@ -53,12 +142,7 @@ int run_spread_masses(const SpreadMassesArgs& args) {
   options.samples = args.samples;
   options.digits = args.digits;
   options.parameter = args.parameter;
-  for (double ratio : options.ratios)
-    if (!(ratio > 0.0 && std::isfinite(ratio)))
-      throw InputError(fmt::format("--ratios: {} is not a positive number; give ratios such as 1,1e6,1e12", ratio));
-  if (args.samples < 1) throw InputError(fmt::format("--samples {}: give at least 1 state per ratio", args.samples));
-  if (args.digits < 20)
-    throw InputError(fmt::format("--digits {}: the reference needs 20 digits or more (default 50)", args.digits));
+  check_spread_masses_options(options);
   const ModelSource source = read_model_source(args.model);
   const auto description = load_description(source, parse_parameter_sets(args.sets));
 
@@ -102,78 +186,11 @@ int run_spread_masses(const SpreadMassesArgs& args) {
   CsvWriter csv(table_path, columns, provenance);
 
   const SpreadMasses study = study_spread_masses(description_spec(*description), options);
-  std::vector<double> row;
-  for (std::size_t r = 0; r < study.ratios.size(); ++r) {
-    const SpreadMassesRatio& ratio = study.ratios[r];
-    row = {ratio.ratio, ratio.cond_A, ratio.reference_error};
-    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).error_qdd);
-    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).error_R);
-    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).solve_error_qdd);
-    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).solve_error_R);
-    for (std::size_t f = 0; f < study.formulations.size(); ++f) row.push_back(study.point(r, f).residual);
-    csv.write_row(row);
-  }
+  write_spread_masses_rows(study, csv);
   csv.commit();
 
-  if (!args.plot.empty()) {
-    XyPlotRequest request;
-    request.csv = table_path;
-    request.x = "ratio";
-    request.x_label = "mass ratio (largest / smallest)";
-    request.title = fmt::format("{}: relative error of the accelerations q'', {}-digit reference (max over {} states)",
-                                study.model, study.digits, study.states.size());
-    request.y = qdd_columns;
-    request.y_label = "|q'' - q''_ref| / |q''_ref|";
-    write_xy_plot(request, args.plot);
-    request.title = fmt::format("{}: relative error of the reactions R, {}-digit reference (max over {} states)",
-                                study.model, study.digits, study.states.size());
-    request.y = R_columns;
-    request.y_label = "|R - R_ref| / |R_ref|";
-    write_xy_plot(request, reactions_plot_path(args.plot));
-  }
-
-  if (!args.quiet) {
-    fmt::print("nhdyn study spread-masses {}: {} states per ratio, reference at {} digits (Lagrange system, "
-               "exact rationals)\n",
-               study.model, study.states.size(), study.digits);
-    const auto block = [&](const char* title, auto value) {
-      fmt::print("\n{}\n{:>8} {:>9}", title, "ratio", "cond(A)");
-      for (const StudyFormulation& f : study.formulations) fmt::print(" {:>14}", formulation_label(f));
-      fmt::print("\n");
-      for (std::size_t r = 0; r < study.ratios.size(); ++r) {
-        fmt::print("{:>8.0e} {:>9.1e}", study.ratios[r].ratio, study.ratios[r].cond_A);
-        for (std::size_t f = 0; f < study.formulations.size(); ++f) {
-          const SpreadMassesPoint& p = study.point(r, f);
-          if (p.failures > 0)
-            fmt::print(" {:>14}", "refused");
-          else
-            fmt::print(" {:>14.2e}", value(p));
-        }
-        fmt::print("\n");
-      }
-    };
-    block("relative error of q'' (max over the states)", [](const SpreadMassesPoint& p) { return p.error_qdd; });
-    block("relative error of R (max over the states)", [](const SpreadMassesPoint& p) { return p.error_R; });
-    block("relative error of q'' of the solve alone (against the exact solution of the rounded terms)",
-          [](const SpreadMassesPoint& p) { return p.solve_error_qdd; });
-    block("relative error of R of the solve alone", [](const SpreadMassesPoint& p) { return p.solve_error_R; });
-    block("acceleration-level residual max |b q'' + b0|", [](const SpreadMassesPoint& p) { return p.residual; });
-    for (std::size_t f = 0; f < study.formulations.size(); ++f)
-      for (std::size_t r = 0; r < study.ratios.size(); ++r)
-        if (study.point(r, f).failures > 0) {
-          fmt::print("\n{} refused {} of {} states from ratio {:g} on, first: {}\n", formulation_label(study.formulations[f]),
-                     study.point(r, f).failures, study.states.size(), study.ratios[r].ratio,
-                     describe(study.point(r, f).failure));
-          break;
-        }
-    double reference_error = 0.0;
-    for (const SpreadMassesRatio& r : study.ratios) reference_error = std::max(reference_error, r.reference_error);
-    fmt::print("\nreference: estimated relative error at most {:.1e} (against {} digits)\n", reference_error,
-               study.digits + 20);
-    fmt::print("table -> {}\n", table_path.string());
-    if (!args.plot.empty())
-      fmt::print("plots -> {}, {}\n", args.plot, reactions_plot_path(args.plot).string());
-  }
+  if (!args.plot.empty()) plot_spread_masses(study, table_path, qdd_columns, R_columns, args.plot);
+  if (!args.quiet) print_spread_masses(study, table_path, args.plot);
   // A formulation that refuses a badly scaled system is one of the study's findings (printed
   // and left as NaN in the CSV), not a failure of the command.
   return 0;

@@ -39,7 +39,6 @@ const std::set<std::string> kLongCommandsToCut = {
     "apps/nhdyn/batch.cpp: run_batch",
     "apps/nhdyn/compare.cpp: run_compare",
     "apps/nhdyn/simulate.cpp: run_simulate",
-    "apps/nhdyn/study_spread_masses.cpp: run_spread_masses",
 };
 
 // The functions over the limit today, as "path relative to the source root: name". Remove an
