@@ -343,20 +343,64 @@ void check_batch_paths(const BatchArgs& args, const std::filesystem::path& dir, 
   }
 }
 
-int run_batch(const BatchArgs& args) {
-  if (args.grids.empty() == args.runs_csv.empty())
-    throw InputError("give the runs either as --grid NAME=FROM:TO:COUNT (repeatable) or as --runs FILE.csv");
-  if (args.threads < 0) throw InputError(fmt::format("--threads {}: give 0 (every core) or a positive number", args.threads));
-  if (args.threads > max_batch_threads())
-    fmt::print(stderr, "nhdyn: note: --threads {}: this machine has {} cores; using at most {} threads\n", args.threads,
+// --threads: 0 is every core; more than the machine runs is capped, with a note.
+void check_batch_threads(int threads) {
+  if (threads < 0) throw InputError(fmt::format("--threads {}: give 0 (every core) or a positive number", threads));
+  if (threads > max_batch_threads())
+    fmt::print(stderr, "nhdyn: note: --threads {}: this machine has {} cores; using at most {} threads\n", threads,
                std::max(1U, std::thread::hardware_concurrency()), max_batch_threads());
+}
+
+// --set NAME=VALUE, each given to every run.
+ParameterOverrides batch_overrides(const std::vector<std::string>& sets) {
   ParameterOverrides overrides;
-  for (const std::string& set : args.sets) {
+  for (const std::string& set : sets) {
     const std::size_t eq = set.find('=');
     if (eq == std::string::npos || eq == 0)
       throw InputError(fmt::format("--set '{}': write it as NAME=VALUE, e.g. --set a=0.3", set));
     overrides.emplace_back(set.substr(0, eq), set.substr(eq + 1));
   }
+  return overrides;
+}
+
+// The summary's provenance and column names: the run, its varied names, its outcome, its final
+// state and residuals.
+std::string summary_header(const std::string& provenance, const std::vector<std::string>& names, const Model& base) {
+  std::string header = provenance + "run";
+  for (const std::string& name : names) header += "," + csv_text(name);
+  header += ",status,t_reached";
+  for (const std::string& c : base.coordinates) header += "," + csv_text(c);
+  for (const std::string& c : base.coordinates) header += "," + csv_text(c + "'");
+  header += ",max_residual_pos,max_residual_vel,max_residual_acc,message\n";
+  return header;
+}
+
+// The run files, staged while the runs ended, moved into the output directory.
+void move_run_files(const std::filesystem::path& staged, const std::filesystem::path& dir) {
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(staged)) {
+    std::filesystem::rename(entry.path(), dir / entry.path().filename(), ec);
+    if (ec)
+      throw FileError(fmt::format("cannot move {} into {}: {}", entry.path().string(), dir.string(), ec.message()));
+  }
+}
+
+// An interrupted batch writes nothing: the staged run files and the summary's temporary go, and
+// the process ends as the signal would have ended it.
+[[noreturn]] void exit_interrupted(int sig, std::optional<StagingDirectory>& staging) {
+  staging.reset();
+  remove_temporary_files();  // the summary's temporary (_exit runs no destructor)
+  fmt::print(stderr, "\nnhdyn: batch interrupted by {}; nothing was written (no summary, no run files)\n",
+             signal_name(sig));
+  std::signal(sig, SIG_DFL);
+  ::_exit(128 + sig);
+}
+
+int run_batch(const BatchArgs& args) {
+  if (args.grids.empty() == args.runs_csv.empty())
+    throw InputError("give the runs either as --grid NAME=FROM:TO:COUNT (repeatable) or as --runs FILE.csv");
+  check_batch_threads(args.threads);
+  const ParameterOverrides overrides = batch_overrides(args.sets);
   const ModelSource source = read_model_source(args.model);
   const Model base = load_model(source, overrides);
   std::vector<std::string> names;
@@ -416,33 +460,15 @@ int run_batch(const BatchArgs& args) {
   install_batch_signal_handlers();
   options.keep_going = [] { return batch_signal.load() == 0; };
   const std::vector<BatchResult> results = simulate_batch(runs, options);
-  if (const int sig = batch_signal.load()) {
-    staging.reset();
-    remove_temporary_files();  // the summary's temporary (_exit runs no destructor)
-    fmt::print(stderr, "\nnhdyn: batch interrupted by {}; nothing was written (no summary, no run files)\n",
-               signal_name(sig));
-    std::signal(sig, SIG_DFL);
-    ::_exit(128 + sig);
-  }
+  if (const int sig = batch_signal.load()) exit_interrupted(sig, staging);
 
-  std::string header = summary_provenance + "run";
-  for (const std::string& name : names) header += "," + csv_text(name);
-  header += ",status,t_reached";
-  for (const std::string& c : base.coordinates) header += "," + csv_text(c);
-  for (const std::string& c : base.coordinates) header += "," + csv_text(c + "'");
-  header += ",max_residual_pos,max_residual_vel,max_residual_acc,message\n";
-  summary.write(header);
+  summary.write(summary_header(summary_provenance, names, base));
   long failed = 0;
   for (std::size_t r = 0; r < results.size(); ++r) {
     failed += results[r].ok ? 0 : 1;
     summary.write(summary_line(r, table[r], results[r], base));
   }
-  if (staging)
-    for (const auto& entry : fs::directory_iterator(staging->path)) {
-      fs::rename(entry.path(), dir / entry.path().filename(), ec);
-      if (ec)
-        throw FileError(fmt::format("cannot move {} into {}: {}", entry.path().string(), dir.string(), ec.message()));
-    }
+  if (staging) move_run_files(staging->path, dir);
   summary.commit();
   print_batch_outcome(args, base, results, failed, dir);
   return failed > 0 ? 1 : 0;
