@@ -24,7 +24,8 @@ namespace nhdyn::bench {
 namespace {
 
 std::filesystem::path example(const std::string& file) {
-  return std::filesystem::path(__FILE__).parent_path().parent_path() / "examples" / file;
+  // Not __FILE__: a compiler cache may make it relative to the build folder.
+  return std::filesystem::path(NHDYN_SOURCE_DIR) / "examples" / file;
 }
 
 void load(benchmark::State& state, const std::string& file) {
