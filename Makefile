@@ -13,13 +13,15 @@
 #   make bench-update  the same, and rewrites docs/performance.md's table (BASELINES=1: and
 #               bench/baselines)
 #   make package  the Debian package build/nhdyn_VERSION_ARCH.deb (CPack; docs/install.md)
+#   make perf-figures  measure the figures of docs/performance.md and rewrite its table (several
+#               minutes; QUICK=1: about one)
 #   make docs-update  rewrite the quoted outputs of README.md and docs/ from real runs
 BUILD ?= build
 JOBS ?= $(shell nproc)
 MODEL ?= examples/sled.toml
 NAME ?= sled
 
-.PHONY: run test build configure configure-run deps deps-run bench bench-check bench-update python package asan fuzz clean docs-update
+.PHONY: run test build configure configure-run deps deps-run bench bench-check bench-update python package asan fuzz clean docs-update perf-figures
 
 deps:
 	@bash scripts/install-deps
@@ -72,6 +74,11 @@ BENCH_CHECK_TARGETS = nhdyn_cli nhdyn_sled_reference nhdyn_rattleback_reference 
 bench-check: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target $(BENCH_CHECK_TARGETS)
 	python3 scripts/bench-check $(BUILD)
+
+# The figures the performance page quotes (scripts/perf-figures; docs/performance.md, "The figures").
+perf-figures: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_cli nhdyn_bench $(if $(wildcard $(BUILD)/python),nhdyn_python)
+	python3 scripts/perf-figures $(BUILD) $(if $(QUICK),--quick)
 
 bench-update: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target $(BENCH_CHECK_TARGETS)
