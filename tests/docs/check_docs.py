@@ -22,6 +22,11 @@ measure the machine rather than the program. They are masked on both sides befor
 
     wall time <number> ms|s        (the summary of simulate)
 
+Python. With --python-path DIR (ctest gives the build's package folder when the Python package is
+built), the commands run with PYTHONPATH=DIR, so a marker may quote what `/usr/bin/python3 -c ...`
+prints, and the one-line Python examples (lines `/usr/bin/python3 -c ...`) run with the others.
+Without it, markers whose command runs python3 are skipped, and said to be.
+
 Trailing blanks of a line are ignored too. Nothing else varies: the runs are deterministic, so every other figure, path and count is
 compared as written. Commands that take long (more than about a second on a loaded 2-core
 machine) are not marked: the whole check must stay well under a minute of CPU.
@@ -55,6 +60,9 @@ from pathlib import Path
 MARKER = re.compile(r"^(\s*)<!-- check: (.*) -->\s*$")
 EXIT_COMMENT = re.compile(r"#\s*exit\s+(\d+)\s*$")
 # The placeholders of the module docstring: (pattern, what it becomes on both sides).
+PYTHON_COMMAND = re.compile(r"(^|[\s;|&(])(/usr/bin/)?python3\b")
+PYTHON_EXAMPLE = "/usr/bin/python3 -c "
+PYTHON_PATH = None  # --python-path: the folder that holds the package nhdyn, or None
 MASKS = [(re.compile(r"wall time [0-9]+(\.[0-9]+)?(e[-+]?[0-9]+)? (ms|s)\b"), "wall time <time>")]
 TIMEOUT_S = 120
 
@@ -99,6 +107,8 @@ def environment(nhdyn, workdir):
     env["PATH"] = str(Path(nhdyn).resolve().parent) + os.pathsep + env.get("PATH", "/usr/bin:/bin")
     env["XDG_CACHE_HOME"] = str(workdir / ".cache")
     env["LC_ALL"] = "C"
+    if PYTHON_PATH:
+        env["PYTHONPATH"] = PYTHON_PATH
     return env
 
 
@@ -131,7 +141,7 @@ def expected_exit(command):
 
 
 def check_outputs(source, nhdyn, update):
-    failures, count = [], 0
+    failures, count, skipped = [], 0, 0
     for path in doc_files(source):
         lines = path.read_text(encoding="utf-8").split("\n")
         blocks, errors = find_blocks(path.relative_to(source), lines)
@@ -139,6 +149,9 @@ def check_outputs(source, nhdyn, update):
         changed = False
         # Last block first, so that rewriting one keeps the line numbers of those before it.
         for block in reversed(blocks):
+            if PYTHON_PATH is None and PYTHON_COMMAND.search(block.command):
+                skipped += 1
+                continue
             count += 1
             workdir = fresh_directory(source)
             try:
@@ -167,6 +180,8 @@ def check_outputs(source, nhdyn, update):
                                 f"(make docs-update rewrites it):\n" + "\n".join(diff))
         if changed:
             path.write_text("\n".join(lines), encoding="utf-8")
+    if skipped:
+        print(f"{skipped} quoted outputs of Python commands skipped (no --python-path: the package is not built)")
     return count, failures
 
 
@@ -180,7 +195,7 @@ def readme_examples(source):
     blocks, current = [], []
 
     def flush():
-        if any(command.startswith("nhdyn ") for _, command in current):
+        if any(command.startswith(("nhdyn ", PYTHON_EXAMPLE)) for _, command in current):
             blocks.append(list(current))
         current.clear()
 
@@ -189,8 +204,8 @@ def readme_examples(source):
             command = text[4:]
             if command.startswith("build/apps/nhdyn/nhdyn "):
                 current.append((number, "nhdyn " + command[len("build/apps/nhdyn/nhdyn "):]))
-            elif command.startswith("mkdir "):
-                current.append((number, command))
+            elif command.startswith("mkdir ") or (PYTHON_PATH and command.startswith(PYTHON_EXAMPLE)):
+                current.append((number, command.split("   #")[0].rstrip()))
         elif text.strip():  # a paragraph ends the block; blank lines do not
             flush()
     flush()
@@ -220,6 +235,8 @@ def docs_examples(path):
         command = text[4:] if text.startswith("    ") else ""
         if command.startswith(("nhdyn ", "mkdir ")) and not SYNOPSIS.search(command):
             commands.append((i + 1, command))
+        elif PYTHON_PATH and command.startswith(PYTHON_EXAMPLE):
+            commands.append((i + 1, command))
         i += 1
     return commands
 
@@ -230,7 +247,7 @@ def check_examples(source, nhdyn):
     blocks = [("README.md", block) for block in readme_examples(source)]
     for path in sorted((source / "docs").rglob("*.md")):
         commands = docs_examples(path)
-        if any(c.startswith("nhdyn ") for _, c in commands):
+        if any(c.startswith(("nhdyn ", PYTHON_EXAMPLE)) for _, c in commands):
             blocks.append((str(path.relative_to(source)), commands))
     for name, block in blocks:
         workdir = fresh_directory(source)
@@ -254,7 +271,11 @@ def main():
                         help="the source tree (default: the one holding this script)")
     parser.add_argument("--update", action="store_true", help="rewrite the quoted outputs that differ")
     parser.add_argument("--examples", action="store_true", help="run the example commands of the README and docs/")
+    parser.add_argument("--python-path", help="PYTHONPATH for the commands: the folder holding the package nhdyn "
+                        "(without it, Python's quoted outputs and examples are left out)")
     args = parser.parse_args()
+    global PYTHON_PATH
+    PYTHON_PATH = str(Path(args.python_path).resolve()) if args.python_path else None
     source = Path(args.source).resolve()
     if not Path(args.nhdyn).is_file():
         print(f"check_docs.py: no nhdyn binary at '{args.nhdyn}': build the target nhdyn_cli first",
