@@ -37,7 +37,15 @@ GiNaC::numeric to_float(const GiNaC::numeric& x) { return GiNaC::ex_to<GiNaC::nu
 
 // One term evaluated to a real float of the current Digits.
 GiNaC::numeric evaluate(const GiNaC::ex& e, const GiNaC::lst& values, const std::string& what) {
-  const GiNaC::ex value = e.subs(values, GiNaC::subs_options::no_pattern).evalf();
+  // GiNaC orders a sum's terms by hashes that depend on where its library was loaded, so a sum
+  // evaluated at the working precision rounds differently from run to run. Evaluated with 20
+  // guard digits and then rounded to the working precision (below), it gives the same number
+  // every run.
+  GiNaC::ex value;
+  {
+    DigitsScope guard(GiNaC::Digits + 20);
+    value = e.subs(values, GiNaC::subs_options::no_pattern).evalf();
+  }
   if (!GiNaC::is_exactly_a<GiNaC::numeric>(value) || !GiNaC::ex_to<GiNaC::numeric>(value).is_real())
     throw ModelError(fmt::format("the term {} is not a real number at this state: {}", what, to_text(value)));
   // evalf leaves exact integers such as 0 exact; make every entry a float of this precision so
