@@ -37,7 +37,7 @@ struct ChainParameters {
 };
 
 // The largest chain the generator builds. The model file grows by about 0.5 kB a body (5 MB at
-// the limit) and the derivation about as N^1.3 (2.7 s at N = 1000, docs/performance.md). A
+// the limit) and the derivation about linearly (docs/performance.md, "The figures"). A
 // simulation with the dense solvers holds n x n matrices (n = 3N): make_data refuses a model whose
 // dense matrices exceed the machine's memory (check_dense_memory), which on a machine of 24 GB is
 // from about N = 4000 on; the sparse path (model/data.hpp) needs megabytes at the limit.
