@@ -227,6 +227,49 @@ TEST_F(OptimizeCli, BrachistochroneFollowsTheCycloid) {
   }
 }
 
+// The sled turned from rest to a heading with the least integral of T^2 (examples/sled_heading_optimal.toml).
+// With a = 0 it turns in place, m rho^2 phi'' = T: the cubic optimum, J = 12 (m rho^2)^2 heading^2 / T^3,
+// which Hermite-Simpson meets exactly. With the file's a = 0.5 there is no closed form; the result must
+// keep two identities of the exact dynamics that the transcription does not impose as such: the speed
+// along the blade v' = a phi'^2, so v(T) = a int phi'^2 dt, and the work of the torque, int T phi' dt,
+// equal to the final kinetic energy m v(T)^2 / 2 (phi'(T) = 0; the blade does no work).
+TEST_F(OptimizeCli, SledTurnedToAHeadingMeetsItsClosedFormAndItsIdentities) {
+  const Outcome turn = optimize(example("sled_heading_optimal.toml") + " --set a=0 -o turn.csv");
+  SKIP_WITHOUT_IPOPT(turn);
+  ASSERT_EQ(turn.exit_code, 0) << turn.out;
+  const double I = 0.7 * 0.7, heading = kPi / 2, T = 2.0;
+  EXPECT_NEAR(summary_value(turn.out, "objective"), 12 * I * I * heading * heading / (T * T * T), 1e-8) << turn.out;
+  const Table in_place = read_csv(dir_ / "turn.csv");
+  const std::vector<double> t0 = in_place.column("t"), u0 = in_place.column("u_T"), x0 = in_place.column("x");
+  for (std::size_t i = 0; i < t0.size(); ++i) {
+    EXPECT_NEAR(u0[i], I * 6 * heading / (T * T) * (1 - 2 * t0[i] / T), 1e-6) << "t = " << t0[i];
+    EXPECT_NEAR(x0[i], 0.0, 1e-9) << "t = " << t0[i];
+  }
+
+  const Outcome run = optimize(example("sled_heading_optimal.toml") + " -o sled.csv");
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_LT(summary_value(run.out, "replay difference"), 1e-5) << run.out;
+  const Table t = read_csv(dir_ / "sled.csv");
+  const std::vector<double> time = t.column("t"), w = t.column("phi'"), u = t.column("u_T"), phi = t.column("phi");
+  const std::vector<double> xd = t.column("x'"), yd = t.column("y'");
+  ASSERT_EQ(time.size(), 41U);  // 21 nodes and 20 midpoints
+  EXPECT_NEAR(phi.back(), heading, 1e-9);
+  EXPECT_NEAR(w.back(), 0.0, 1e-9);
+  // Simpson's rule over node, midpoint, node (the quadrature of the transcription itself).
+  const auto integral = [&](const auto& f) {
+    double sum = 0;
+    for (std::size_t k = 0; k + 2 < time.size(); k += 2)
+      sum += (time[k + 2] - time[k]) / 6 * (f(k) + 4 * f(k + 1) + f(k + 2));
+    return sum;
+  };
+  const double v_end = std::hypot(xd.back(), yd.back());
+  ASSERT_GT(v_end, 0.5);  // the sled has moved off: the identities below are not 0 = 0
+  EXPECT_NEAR(v_end, 0.5 * integral([&](std::size_t k) { return w[k] * w[k]; }), 1e-5 * v_end);
+  EXPECT_NEAR(0.5 * v_end * v_end, integral([&](std::size_t k) { return u[k] * w[k]; }), 1e-5 * v_end * v_end);
+  // Turning costs less than in place: the term m a v phi' brakes the turn the torque must stop.
+  EXPECT_LT(summary_value(run.out, "objective"), 12 * I * I * heading * heading / (T * T * T));
+}
+
 // The controls of a Hermite-Simpson result (quadratic through node, midpoint, node on each interval,
 // continuous at the nodes) as one expression in t: the first interval's quadratic plus, at each
 // later node t_k, the change of slope and curvature switched on by H(t - t_k), with
