@@ -270,6 +270,31 @@ TEST_F(OptimizeCli, SledTurnedToAHeadingMeetsItsClosedFormAndItsIdentities) {
   EXPECT_LT(summary_value(run.out, "objective"), 12 * I * I * heading * heading / (T * T * T));
 }
 
+// The Whipple bicycle moved one lane over at 5 m/s by its steer torque (examples/bicycle_lane_change.toml),
+// at 15 nodes to keep the test short. The ends are imposed; what is not imposed is how a bicycle must
+// turn: it counter-steers (the steer first turns away from the lane, delta < 0, and the rear contact
+// point first moves away from it, y < 0) before it turns towards it, and it leans into the turn.
+TEST_F(OptimizeCli, BicycleChangesLaneByCounterSteering) {
+  const Outcome run = optimize(example("bicycle_lane_change.toml") + " --set node_count=15 -o lane.csv");
+  SKIP_WITHOUT_IPOPT(run);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("status: solved"), std::string::npos) << run.out;
+  EXPECT_LT(summary_value(run.out, "replay difference"), 2e-3) << run.out;  // of a 1 m lane, order 4 in h
+  const Table t = read_csv(dir_ / "lane.csv");
+  const std::vector<double> time = t.column("t"), y = t.column("y"), delta = t.column("delta"), phi = t.column("phi");
+  ASSERT_EQ(time.size(), 29U);
+  EXPECT_NEAR(y.back(), 1.0, 1e-8);
+  EXPECT_NEAR(phi.back(), 0.0, 1e-8);
+  double first_delta = 0, first_y = 0, largest_lean = 0;
+  for (std::size_t i = 0; i < time.size(); ++i) {
+    if (time[i] < 0.75) first_delta = std::min(first_delta, delta[i]), first_y = std::min(first_y, y[i]);
+    if (time[i] > 0.5 && time[i] < 1.5) largest_lean = std::max(largest_lean, phi[i]);
+  }
+  EXPECT_LT(first_delta, -0.01) << "no counter-steer";
+  EXPECT_LT(first_y, -0.01) << "the rear contact did not first move away from the lane";
+  EXPECT_GT(largest_lean, 0.05) << "no lean into the turn towards +y (phi > 0 leans right, z down)";
+}
+
 // The controls of a Hermite-Simpson result (quadratic through node, midpoint, node on each interval,
 // continuous at the nodes) as one expression in t: the first interval's quadratic plus, at each
 // later node t_k, the change of slope and curvature switched on by H(t - t_k), with
