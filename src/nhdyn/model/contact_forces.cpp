@@ -303,12 +303,19 @@ void analyse_contact_forces(const Model& model, ContactForceModel& c) {
   Vector Q = Vector::Zero(n), G = Vector::Zero(n), b0 = Vector::Zero(s);
   model.evaluator->terms(t, q.data(), v.data(), scratch.data(), TermsOut{A.data(), Q.data(), G.data(), b.data(), b0.data()});
   // The ideal-constraint dynamics: [A b^T; b 0] [q''; -lambda] = [Q + G; -b0], R = A q'' - Q - G.
+  // A and Q + G carry the masses and b does not: with the upper rows divided by mu, a power of two
+  // near the largest |A|, and lambda by the same mu, every block is of order one whatever the
+  // masses (`--set m=1e-100` made A's pivots look like round-off beside b's). Exact: q'' is the same.
+  const double largest_A = A.size() > 0 ? A.cwiseAbs().maxCoeff() : 0.0;
+  int mass_exponent = 0;
+  if (largest_A > 0.0 && std::isfinite(largest_A)) std::frexp(largest_A, &mass_exponent);
+  const auto unit = [&](double x) { return std::ldexp(x, -mass_exponent); };
   Matrix K = Matrix::Zero(n + s, n + s);
-  K.topLeftCorner(n, n) = A;
+  K.topLeftCorner(n, n) = A.unaryExpr(unit);
   K.topRightCorner(n, s) = b.transpose();
   K.bottomLeftCorner(s, n) = b;
   Vector k(n + s);
-  k.head(n) = Q + G;
+  k.head(n) = (Q + G).unaryExpr(unit);
   k.tail(s) = -b0;
   const Vector solution = K.fullPivLu().solve(k);
   const Vector qdd = solution.head(n);
