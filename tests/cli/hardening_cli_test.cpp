@@ -703,6 +703,36 @@ TEST_F(Hardening, ContactForcesAreDeterminedAtExtremeMasses) {
 
 namespace {
 
+// --fix-initial on a model with programs: the start must lie on the programs as on the constraints.
+// It moved only onto the constraints, left phi' at 0 off the program phi = omega t, and then refused
+// the start as off its program. Now a free value moves onto the program too, and a written one that
+// no free value can mend is named with the program.
+TEST_F(Hardening, FixInitialMeetsThePrograms) {
+  std::string model = read_whole(fs::path(NHDYN_SOURCE_DIR) / "examples" / "sled_heading_program.toml");
+  const auto replace = [&](std::string text, const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    return text;
+  };
+  // y' and phi' left free (phi' then starts at 0), the heading not written.
+  std::string free_rate = replace(model, "velocity = { x = \"v0\", y = 0, phi = \"omega\" }", "velocity = { x = \"v0\" }");
+  free_rate = replace(free_rate, "position = { x = 0, y = 0, phi = 0 }", "position = { x = 0, y = 0 }");
+  write("free.toml", free_rate);
+  const ProcessRun refused = nhdyn({"simulate", "free.toml", "--t-end", "1", "-o", "free.csv"});
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_TRUE(contains(refused.err, "heading (velocity level): residual -1")) << refused.err;
+  const ProcessRun fixed = nhdyn({"simulate", "free.toml", "--t-end", "1", "-o", "free.csv", "--fix-initial"});
+  ASSERT_EQ(fixed.code, 0) << fixed.err;
+  EXPECT_TRUE(contains(fixed.out, "phi' = 1 (changed by +1), was 0")) << fixed.out;  // omega = 1
+  // A heading written off the program, with no free value to mend it: the program is named.
+  write("off.toml", replace(model, "position = { x = 0, y = 0, phi = 0 }", "position = { x = 0, y = 0, phi = 0.2 }"));
+  const ProcessRun off = nhdyn({"simulate", "off.toml", "--t-end", "1", "-o", "off.csv", "--fix-initial"});
+  EXPECT_EQ(off.code, 2);
+  EXPECT_TRUE(contains(off.err, "no free value enters the program 'heading' (position level) keeps the residual 0.2"))
+      << off.err;
+}
+
 // A name near the file system's limit failed: the temporary's name is 12 bytes longer.
 TEST_F(Hardening, NamesNearTheFileSystemLimitAreWritten) {
   write("osc.toml", kOscillator);

@@ -19,38 +19,73 @@
 namespace nhdyn {
 namespace {
 
-// Rows of b (constraint indices) whose residual lives at `level` or below.
-std::vector<int> rows_at(const Model& model, ConstraintLevel level) {
+// The rows of the initial state's conditions: constraint i is row i; with `programs`, program j
+// (docs/derivations/program-motion.md) is row s + j after them, since a motion must start on its
+// programs as on its constraints.
+bool lives_at(ConstraintLevel row_level, ConstraintLevel level) {
+  return level == ConstraintLevel::position ? row_level == ConstraintLevel::position
+                                            : row_level != ConstraintLevel::acceleration;
+}
+
+// Rows (as above) whose residual lives at `level`.
+std::vector<int> rows_at(const Model& model, ConstraintLevel level, bool programs = false) {
   std::vector<int> rows;
-  for (int i = 0; i < model.s(); ++i) {
-    const ConstraintLevel l = model.constraints[static_cast<std::size_t>(i)].level;
-    if (level == ConstraintLevel::position ? l == ConstraintLevel::position : l != ConstraintLevel::acceleration)
-      rows.push_back(i);
-  }
+  for (int i = 0; i < model.s(); ++i)
+    if (lives_at(model.constraints[static_cast<std::size_t>(i)].level, level)) rows.push_back(i);
+  if (programs)
+    for (int j = 0; j < model.m(); ++j)
+      if (lives_at(model.program_constraints[static_cast<std::size_t>(j)].level, level)) rows.push_back(model.s() + j);
   return rows;
 }
 
-Vector residual(const Model& model, Data& data, double t, const Vector& q, const Vector& v, ConstraintLevel level) {
-  Vector r(level == ConstraintLevel::position ? model.position_constraints() : model.velocity_constraints());
-  if (r.size() == 0) return r;
-  if (level == ConstraintLevel::position)
-    model.evaluator->position_residual(t, q.data(), data.scratch.data(), r.data());
-  else
-    model.evaluator->velocity_residual(t, q.data(), v.data(), data.scratch.data(), r.data());
+// The residual of those rows, in that order.
+Vector residual(const Model& model, Data& data, double t, const Vector& q, const Vector& v, ConstraintLevel level,
+                bool programs = false) {
+  const bool position = level == ConstraintLevel::position;
+  const Eigen::Index own = position ? model.position_constraints() : model.velocity_constraints();
+  const Eigen::Index of_programs = static_cast<Eigen::Index>(rows_at(model, level, programs).size()) - own;
+  Vector r = Vector::Zero(own + of_programs);
+  if (own > 0) {
+    if (position) model.evaluator->position_residual(t, q.data(), data.scratch.data(), r.data());
+    else model.evaluator->velocity_residual(t, q.data(), v.data(), data.scratch.data(), r.data());
+  }
+  if (of_programs > 0) {
+    if (position) model.evaluator->program_constraint_position_residual(t, q.data(), data.scratch.data(), r.data() + own);
+    else model.evaluator->program_constraint_velocity_residual(t, q.data(), v.data(), data.scratch.data(), r.data() + own);
+  }
   return r;
 }
 
-// For each constraint, its row in the residual of `level` (-1 when it is not of that level).
-std::vector<int> residual_rows(const Model& model, ConstraintLevel level) {
-  std::vector<int> out(static_cast<std::size_t>(model.s()), -1);
+// For each row, its place in the residual of `level` (-1 when it is not of that level).
+std::vector<int> residual_rows(const Model& model, ConstraintLevel level, bool programs = false) {
+  std::vector<int> out(static_cast<std::size_t>(model.s() + (programs ? model.m() : 0)), -1);
   int j = 0;
-  for (int i : rows_at(model, level)) out[static_cast<std::size_t>(i)] = j++;
+  for (int i : rows_at(model, level, programs)) out[static_cast<std::size_t>(i)] = j++;
   return out;
 }
 
-std::string where_of(const Model& model, int constraint) {
-  const std::string& where = model.constraints[static_cast<std::size_t>(constraint)].where;
-  return where.empty() ? "" : ", " + where;
+// The gradients of the rows at (t, q, v) after compute_terms: b, and with `programs` the programs'
+// b_p below it (their rows at acceleration level are their gradients, as b's are). Cold path.
+Matrix gradient_rows(const Model& model, Data& data, double t, const Vector& q, const Vector& v, bool programs) {
+  const Matrix b = data.sparse ? Matrix(data.b_sparse) : data.b;
+  if (!programs || model.m() == 0) return b;
+  Matrix b_p(model.m(), model.n()), B(model.n(), model.m());
+  Vector b_p0(model.m());
+  model.evaluator->program_constraint_terms(t, q.data(), v.data(), data.scratch.data(), b_p.data(), b_p0.data(),
+                                            B.data());
+  Matrix out(model.s() + model.m(), model.n());
+  out << b, b_p;
+  return out;
+}
+
+// "the constraint 'NAME' (velocity level, file:line)" or "the program 'NAME' (position level)".
+std::string row_label(const Model& model, int row, const char* level) {
+  if (row < model.s()) {
+    const Constraint& c = model.constraints[static_cast<std::size_t>(row)];
+    return fmt::format("the constraint '{}' ({} level{})", c.name, level, c.where.empty() ? "" : ", " + c.where);
+  }
+  return fmt::format("the program '{}' ({} level)", model.program_constraints[static_cast<std::size_t>(row - model.s())].name,
+                     level);
 }
 
 std::string value_name(const Model& model, int i, ConstraintLevel level) {
@@ -64,13 +99,13 @@ std::string value_name(const Model& model, int i, ConstraintLevel level) {
 // residual of those rows reached (r) and the Newton steps taken.
 int restricted_newton(const Model& model, Data& data, double t, Vector& q, Vector& v, ConstraintLevel level,
                       const std::vector<int>& free, const std::vector<int>& rows, double tolerance,
-                      int max_iterations, Vector& r) {
-  const std::vector<int> at = residual_rows(model, level);
+                      int max_iterations, Vector& r, bool programs = false) {
+  const std::vector<int> at = residual_rows(model, level, programs);
   const auto m = static_cast<Eigen::Index>(rows.size()), k = static_cast<Eigen::Index>(free.size());
   Vector& x = level == ConstraintLevel::position ? q : v;
   r.resize(m);
   const auto evaluate = [&] {
-    const Vector all = residual(model, data, t, q, v, level);
+    const Vector all = residual(model, data, t, q, v, level, programs);
     for (Eigen::Index i = 0; i < m; ++i) r(i) = all(at[static_cast<std::size_t>(rows[static_cast<std::size_t>(i)])]);
     return r.allFinite() ? (m == 0 ? 0.0 : r.cwiseAbs().maxCoeff()) : std::numeric_limits<double>::infinity();
   };
@@ -81,7 +116,7 @@ int restricted_newton(const Model& model, Data& data, double t, Vector& q, Vecto
       throw ModelError(fmt::format("model '{}': while moving the initial state onto the constraints: {}", model.name,
                                    explain_failure(model, data)));
     const Matrix A = data.sparse ? Matrix(data.A_sparse) : data.A;
-    const Matrix b = data.sparse ? Matrix(data.b_sparse) : data.b;
+    const Matrix b = gradient_rows(model, data, t, q, v, programs);
     Matrix K = Matrix::Zero(k + m, k + m);
     for (Eigen::Index i = 0; i < k; ++i)
       for (Eigen::Index j = 0; j < k; ++j)
@@ -117,14 +152,14 @@ void fix_keeping_written(const Model& model, Data& data, double t, double tolera
         free.push_back(i);
         free_names.push_back(value_name(model, i, level));
       }
-    const std::vector<int> all = rows_at(model, level);
-    // The constraints none of the free values enter cannot be mended by moving them.
+    const std::vector<int> all = rows_at(model, level, true);
+    // The constraints and programs none of the free values enter cannot be mended by moving them.
     std::vector<int> movable, fixed_rows;
     if (!all.empty()) {
       if (compute_terms(model, data, t, fix.q.data(), fix.v.data()) != Status::ok)
         throw ModelError(fmt::format("model '{}': while moving the initial state onto the constraints: {}",
                                      model.name, explain_failure(model, data)));
-      const Matrix b = data.sparse ? Matrix(data.b_sparse) : data.b;
+      const Matrix b = gradient_rows(model, data, t, fix.q, fix.v, true);
       for (int row : all) {
         bool enters = false;
         for (int j : free) enters = enters || b(row, j) != 0.0;
@@ -133,9 +168,9 @@ void fix_keeping_written(const Model& model, Data& data, double t, double tolera
     }
     Vector r;
     const int iterations =
-        restricted_newton(model, data, t, fix.q, fix.v, level, free, movable, tolerance, max_iterations, r);
-    const Vector whole = residual(model, data, t, fix.q, fix.v, level);
-    const std::vector<int> at = residual_rows(model, level);
+        restricted_newton(model, data, t, fix.q, fix.v, level, free, movable, tolerance, max_iterations, r, true);
+    const Vector whole = residual(model, data, t, fix.q, fix.v, level, true);
+    const std::vector<int> at = residual_rows(model, level, true);
     int worst_row = -1;
     double worst = 0.0;
     // Newton aims at `tolerance`; what round-off leaves above it is no reason to refuse.
@@ -153,12 +188,11 @@ void fix_keeping_written(const Model& model, Data& data, double t, double tolera
       const bool alone = std::find(fixed_rows.begin(), fixed_rows.end(), worst_row) != fixed_rows.end();
       throw ModelError(fmt::format(
           "model '{}': --fix-initial keeps every value [initial] writes and moves only the others ({} at {} level: "
-          "{}); {} the constraint '{}' ({} level{}) keeps the residual {:.6g}, so the values written cannot "
-          "satisfy it. Correct them, or leave out of [initial] a value that --fix-initial may move.",
+          "{}); {} {} keeps the residual {:.6g}, so the values written cannot satisfy it. Correct them, or leave "
+          "out of [initial] a value that --fix-initial may move.",
           model.name, free.empty() ? "none is free" : "free", level_name, free.empty() ? "none" : join(free_names),
           alone ? "no free value enters" : fmt::format("moving them ({} Newton steps),", iterations),
-          model.constraints[static_cast<std::size_t>(worst_row)].name, level_name, where_of(model, worst_row),
-          whole(at[static_cast<std::size_t>(worst_row)])));
+          row_label(model, worst_row, level_name), whole(at[static_cast<std::size_t>(worst_row)])));
     }
     (level == ConstraintLevel::position ? fix.position_iterations : fix.velocity_iterations) = iterations;
     (level == ConstraintLevel::position ? fix.position_residual : fix.velocity_residual) =
@@ -241,7 +275,9 @@ InitialFix fix_initial_state(const Model& model, Data& data, double t, const Vec
 InitialFix fix_free_initial_values(const Model& model, Data& data, double t, const Vector& q, const Vector& v,
                                    double tolerance, int max_iterations) {
   const auto any = [](const std::vector<bool>& flags) { return std::find(flags.begin(), flags.end(), true) != flags.end(); };
-  if (!any(model.q0_written) && !any(model.v0_written))
+  // The projection knows the constraints only: a model with programs takes the restricted Newton
+  // steps, every value free when none is written (the same smallest inertia-weighted change).
+  if (!any(model.q0_written) && !any(model.v0_written) && model.m() == 0)
     return fix_initial_state(model, data, t, q, v, tolerance, max_iterations);
   InitialFix fix;
   fix.q = q;

@@ -45,9 +45,10 @@ InitialFix fix_initial_state(const Model& model, Data& data, double t, const Vec
 
 // --fix-initial: the same, but the values the model file wrote (model.q0_written, v0_written) are
 // kept and only the others move, with the smallest change weighted by their block of A
-// (docs/derivations/rolling-bodies.md section 10). Throws ModelError naming the constraint, its
-// level, where it was written and its residual when the values kept leave it unsatisfied. With
-// none written it is fix_initial_state.
+// (docs/derivations/rolling-bodies.md section 10). A model's programs at position and velocity
+// level are met as its constraints are (a motion starts on its programs). Throws ModelError naming
+// the constraint or program, its level, where it was written and its residual when the values
+// kept leave it unsatisfied. With none written and no program it is fix_initial_state.
 InitialFix fix_free_initial_values(const Model& model, Data& data, double t, const Vector& q, const Vector& v,
                                    double tolerance = 1e-13, int max_iterations = 50);
 
