@@ -1,0 +1,117 @@
+#!/usr/bin/env python3
+"""Doxygen's INPUT_FILTER for nhdyn's headers (docs/Doxyfile): turns their plain `//` comments into
+Doxygen comments, so that the C++ API reference (docs/api/cpp.md) shows the contracts the headers
+already state, without a second comment syntax in the sources (docs/design.md, "Build and CI").
+
+Usage (Doxygen calls it): doxygen_filter.py HEADER > what Doxygen parses instead.
+
+- The paragraph that opens a header (before `#pragma once`) becomes the file's description.
+- A block of `//` lines directly above a declaration (no blank line between) documents it.
+- A `//` comment after code on the same line (`double t_end = 10.0;  // end time [s]`) documents
+  that member; `//` lines right below it, at the same column, continue it.
+- Any other comment (a section rule, a note followed by a blank line) stays a plain comment.
+
+The comments are prose, not Doxygen markup: the characters Doxygen would read as commands or HTML
+are escaped; `code` in backticks stays code; a line indented deeper than its block (a formula, a
+table) is kept as it stands, in a verbatim block. Line count is preserved, so Doxygen's
+file:line in a warning points at the header's own line.
+"""
+
+import re
+import sys
+
+_SPECIAL = re.compile(r"([\\@<>&#%$*_|]|-{2,3})")
+_TRAILING = re.compile(r'^(?P<code>[^"\'/]*?\S)(?P<gap>\s+)//(?P<text>(?!/).*)$')
+
+
+def _escape(text):
+    """Prose for Doxygen: special characters escaped outside `code` spans."""
+    parts = text.split("`")
+    if len(parts) % 2 == 0:  # an unpaired backtick: no code span at all
+        return _SPECIAL.sub(r"\\\1", text)
+    return "`".join(part if i % 2 else _SPECIAL.sub(r"\\\1", part) for i, part in enumerate(parts))
+
+
+def _comment_text(line):
+    """The text of a whole-line `//` comment, without the slashes and one space."""
+    body = line.lstrip()[2:]
+    return body[1:] if body.startswith(" ") else body
+
+
+def _doc_block(lines, opener):
+    """A block of whole-line comments as Doxygen comment lines (same count), indented deeper lines
+    in a verbatim block."""
+    indent = lines[0][: len(lines[0]) - len(lines[0].lstrip())]
+    texts = [_comment_text(line) for line in lines]
+    prose = [t for t in texts if t.strip()]
+    base = min((len(t) - len(t.lstrip()) for t in prose), default=0)
+    out = []
+    in_verbatim = False
+    for i, text in enumerate(texts):
+        deeper = text.strip() != "" and len(text) - len(text.lstrip()) >= base + 4
+        prefix = opener if i == 0 else "///"
+        if deeper and not in_verbatim:
+            out.append(f"{indent}{prefix} \\verbatim {text}")
+            in_verbatim = True
+        elif deeper:
+            out.append(f"{indent}{prefix} {text}")
+        else:
+            close = " \\endverbatim" if in_verbatim else ""
+            in_verbatim = False
+            out.append(f"{indent}{prefix}{close} {_escape(text)}".rstrip())
+    if in_verbatim:
+        out[-1] += " \\endverbatim"
+    return out
+
+
+def _is_comment(line):
+    return line.lstrip().startswith("//")
+
+
+def filter_header(text):
+    lines = text.split("\n")
+    out = []
+    i = 0
+    seen_code = False
+    trailing_column = None  # the column of the last trailing comment, for its continuation lines
+    while i < len(lines):
+        line = lines[i]
+        if _is_comment(line):
+            j = i
+            while j < len(lines) and _is_comment(lines[j]):
+                j += 1
+            block = lines[i:j]
+            following = lines[j] if j < len(lines) else ""
+            column = len(line) - len(line.lstrip())
+            if trailing_column is not None and column == trailing_column:
+                out.extend(line[:column] + "///< " + _escape(_comment_text(line)) for line in block)
+            elif not seen_code:
+                # \file at the end of the block: at its start, it would read the first word as a file name.
+                doc = _doc_block(block, "///")
+                doc[-1] += " \\file"
+                out.extend(doc)
+            elif following.strip() and not following.lstrip().startswith(("#", "}", "namespace")):
+                out.extend(_doc_block(block, "///"))
+            else:
+                out.extend(block)
+            trailing_column = None
+            i = j
+            continue
+        match = _TRAILING.match(line)
+        if match and seen_code and not match.group("code").lstrip().startswith(("}", "#", "namespace", "public:", "private:", "protected:")):
+            column = len(match.group("code")) + len(match.group("gap"))
+            text = match.group("text")
+            out.append(match.group("code") + match.group("gap") + "///< " + _escape(text[1:] if text.startswith(" ") else text))
+            trailing_column = column
+        else:
+            out.append(line)
+            trailing_column = None
+        if line.strip():
+            seen_code = True
+        i += 1
+    return "\n".join(out)
+
+
+if __name__ == "__main__":
+    with open(sys.argv[1], encoding="utf-8") as f:
+        sys.stdout.write(filter_header(f.read()))
