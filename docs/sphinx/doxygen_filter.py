@@ -38,30 +38,38 @@ def _comment_text(line):
     return body[1:] if body.startswith(" ") else body
 
 
-def _doc_block(lines, opener):
-    """A block of whole-line comments as Doxygen comment lines (same count), indented deeper lines
-    in a verbatim block."""
+def _doc_block(lines):
+    """A block of whole-line comments as one Doxygen comment /** ... */ over the same lines; lines
+    indented deeper than the block's prose in a verbatim block. (Not ///: Doxygen keeps the
+    slashes of /// lines inside a verbatim block.)"""
     indent = lines[0][: len(lines[0]) - len(lines[0].lstrip())]
     texts = [_comment_text(line) for line in lines]
     prose = [t for t in texts if t.strip()]
     base = min((len(t) - len(t.lstrip()) for t in prose), default=0)
     out = []
     in_verbatim = False
-    for i, text in enumerate(texts):
+    for text in texts:
         deeper = text.strip() != "" and len(text) - len(text.lstrip()) >= base + 4
-        prefix = opener if i == 0 else "///"
-        if deeper and not in_verbatim:
-            out.append(f"{indent}{prefix} \\verbatim {text}")
+        if deeper:
+            text = text.replace("*/", "* /")
+            if not in_verbatim and out:
+                # Opened at the end of the line before, so that this line keeps its indentation.
+                out[-1] += " \\verbatim"
+            elif not in_verbatim:
+                text = "\\verbatim " + text
             in_verbatim = True
-        elif deeper:
-            out.append(f"{indent}{prefix} {text}")
+            out.append(text)
         else:
-            close = " \\endverbatim" if in_verbatim else ""
+            if in_verbatim:
+                out[-1] += " \\endverbatim"
             in_verbatim = False
-            out.append(f"{indent}{prefix}{close} {_escape(text)}".rstrip())
+            out.append(_escape(text).replace("*/", "* /"))
     if in_verbatim:
         out[-1] += " \\endverbatim"
-    return out
+    first, rest = out[0], out[1:]
+    block = [f"{indent}/** {first}"] + [f"{indent} * {text}" for text in rest]
+    block[-1] += " */"
+    return [line.rstrip() if not line.endswith(" */") else line for line in block]
 
 
 def _is_comment(line):
@@ -87,11 +95,11 @@ def filter_header(text):
                 out.extend(line[:column] + "///< " + _escape(_comment_text(line)) for line in block)
             elif not seen_code:
                 # \file at the end of the block: at its start, it would read the first word as a file name.
-                doc = _doc_block(block, "///")
-                doc[-1] += " \\file"
+                doc = _doc_block(block)
+                doc[-1] = doc[-1][: -len(" */")] + " \\file */"
                 out.extend(doc)
             elif following.strip() and not following.lstrip().startswith(("#", "}", "namespace")):
-                out.extend(_doc_block(block, "///"))
+                out.extend(_doc_block(block))
             else:
                 out.extend(block)
             trailing_column = None

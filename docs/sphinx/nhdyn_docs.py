@@ -4,7 +4,7 @@
   reads its XML). The headers' plain `//` comments are turned into Doxygen's first, all in this
   one process (docs/sphinx/doxygen_filter.py; as Doxygen's INPUT_FILTER it would start Python once
   per header: 20 s). A Doxygen warning fails the build, as a Sphinx one does.
-- Checks that docs/api/cpp.md gives every installed header its place (and names no other), so a
+- Checks that the C++ API (docs/api/cpp.md, api/cpp/LAYER.md) gives every installed header its place (and names no other), so a
   new header cannot go missing from the reference and a removed one cannot leave a stale entry.
 - Links from the pages to what is not a page: the pages link the repository's files as they sit
   in a checkout (`../examples/sled.toml`, `checks/impact.py`, `../CONTRIBUTING.md`). A file
@@ -79,18 +79,22 @@ def run_doxygen(app):
 
 
 def check_cpp_page(app):
-    """Every installed header has its `doxygenfile` in api/cpp.md, and no other file has one."""
-    page = DOCS / "api" / "cpp.md"
-    listed = re.findall(r"^```\{doxygenfile\}\s+(\S+)", page.read_text(encoding="utf-8"), re.M)
+    """Every installed header has its `doxygenfile` in api/cpp.md or its layer's page
+    api/cpp/LAYER.md, and no other file has one."""
+    listed = {}
+    for page in [DOCS / "api" / "cpp.md"] + sorted((DOCS / "api" / "cpp").glob("*.md")):
+        for name in re.findall(r"^```\{doxygenfile\}\s+(\S+)", page.read_text(encoding="utf-8"), re.M):
+            listed[name] = page.relative_to(DOCS).as_posix()
     headers = installed_headers()
     for name in headers:
         if name not in listed:
-            logger.warning("api/cpp.md: the installed header %s has no {doxygenfile} entry: add one "
-                           "in its layer's section", name, location=(page.stem and "api/cpp"))
-    for name in listed:
+            layer = name.split("/")[1]
+            logger.warning("the installed header %s has no {doxygenfile} entry in the C++ API: add one "
+                           "to docs/api/cpp/%s.md", name, layer)
+    for name, page in listed.items():
         if name not in headers:
-            logger.warning("api/cpp.md: {doxygenfile} %s names no installed header (src/%s): remove "
-                           "or rename the entry", name, name, location="api/cpp")
+            logger.warning("docs/%s: {doxygenfile} %s names no installed header (src/%s): remove or "
+                           "rename the entry", page, name, name)
 
 
 class RepositoryLinks(Transform):
