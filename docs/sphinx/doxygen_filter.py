@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Doxygen's INPUT_FILTER for nhdyn's headers (docs/Doxyfile): turns their plain `//` comments into
-Doxygen comments, so that the C++ API reference (docs/api/cpp.md) shows the contracts the headers
+"""The headers as Doxygen reads them for the C++ API reference (docs/api/cpp.md): their plain `//`
+comments turned into Doxygen comments, so that the reference shows the contracts the headers
 already state, without a second comment syntax in the sources (docs/design.md, "Build and CI").
-
-Usage (Doxygen calls it): doxygen_filter.py HEADER > what Doxygen parses instead.
+docs/sphinx/nhdyn_docs.py writes the filtered copies Doxygen reads; by hand:
+doxygen_filter.py HEADER > what Doxygen reads instead.
 
 - The paragraph that opens a header (before `#pragma once`) becomes the file's description.
 - A block of `//` lines directly above a declaration (no blank line between) documents it.
@@ -67,7 +67,8 @@ def _doc_block(lines):
     if in_verbatim:
         out[-1] += " \\endverbatim"
     first, rest = out[0], out[1:]
-    block = [f"{indent}/** {first}"] + [f"{indent} * {text}" for text in rest]
+    # No leading * on the lines after the first: Doxygen keeps it inside a verbatim block.
+    block = [f"{indent}/** {first}"] + [f"{indent}    {text}" for text in rest]
     block[-1] += " */"
     return [line.rstrip() if not line.endswith(" */") else line for line in block]
 

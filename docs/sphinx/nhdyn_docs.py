@@ -11,6 +11,8 @@
   becomes a download (Sphinx copies it into the site: the site stands alone, in the build tree
   as installed); a folder (`../bench/`), which a site cannot show, becomes its name as text.
 - Drops a rule that ends a page (docutils refuses a document that ends with one).
+- Works around three things of Sphinx 5.3 and Breathe 4.34 (Debian 12's): the namespace every
+  header opens, the C++ domain's cost on a large namespace, the search index's order (below).
 - Turns the Python docstrings, written as plain text for help(), into reStructuredText that
   says the same (an indented example is a literal block, `x` is code, a trailing `_` or a `*`
   is a character, not markup).
@@ -195,20 +197,66 @@ def docstring_as_rst(app, what, name, obj, options, lines):
 def _namespace_as_scope(original):
     """Breathe's doxygenfile renders the namespace a header opens as a declaration of its own, so
     the second header that opens `nhdyn` declares it again (a duplicate C++ declaration and ID).
-    In a file's entry the namespace is only the members' scope: render its members (qualified
-    nhdyn::..., as before) without declaring it."""
+    In a file's entry the namespace is only the members' scope: make it the C++ domain's current
+    scope, as `.. cpp:namespace-push::` does, and render the members in it (declared and linked
+    as nhdyn::..., as before), without declaring the namespace."""
     from breathe.renderer.sphinxrenderer import WithContext
+    from sphinx.domains import cpp
 
     def visit_namespace(self, node):
         if self.context.directive_args[0] != "doxygenfile":
             return original(self, node)
         file_data = self.compound_parser.parse(node.refid)
+        env = self.state.document.settings.env
+        parser = cpp.DefinitionParser(file_data.compounddef.compoundname,
+                                      location=(env.docname, self.context.directive_args[4]), config=env.config)
+        ast = parser.parse_namespace_object()
+        parser.assert_end()
+        # The full name from the root: a nested namespace (nhdyn::symbolic) is rendered inside nhdyn's.
+        symbol = env.domaindata["cpp"]["root_symbol"].add_name(ast.nestedName, ast.templatePrefix)
+        old_parent = env.temp_data.get("cpp:parent_symbol")
+        old_key = env.ref_context.get("cpp:parent_key")
+        env.temp_data["cpp:parent_symbol"] = symbol
+        env.ref_context["cpp:parent_key"] = symbol.get_lookup_key()
         parent_context = self.context.create_child_context(file_data)
         new_context = parent_context.create_child_context(file_data.compounddef)
-        with WithContext(self, new_context):
-            return self.render(file_data, parent_context)
+        try:
+            with WithContext(self, new_context):
+                return self.render(file_data, parent_context)
+        finally:
+            for store, key, old in ((env.temp_data, "cpp:parent_symbol", old_parent),
+                                    (env.ref_context, "cpp:parent_key", old_key)):
+                if old is None:
+                    store.pop(key, None)
+                else:
+                    store[key] = old
 
     return visit_namespace
+
+
+def _sorted_titles():
+    """Sphinx 5.3 writes the search index's entries in the order the parallel readers finished
+    their pages: sorted (each table by its keys, each title's pages), the same tree gives the same
+    searchindex.js, byte for byte."""
+    from sphinx.search import IndexBuilder
+
+    original = IndexBuilder.freeze
+    if getattr(original, "_nhdyn_sorted", False):
+        return
+
+    def by_key(value):
+        if isinstance(value, dict):
+            return {key: by_key(value[key]) for key in sorted(value, key=str)}
+        return value
+
+    def freeze(self):
+        data = original(self)
+        for pages in data.get("alltitles", {}).values():
+            pages.sort()
+        return by_key(data)
+
+    freeze._nhdyn_sorted = True
+    IndexBuilder.freeze = freeze
 
 
 def _cache_newest_id():
@@ -238,6 +286,7 @@ def setup(app):
     from breathe.renderer.sphinxrenderer import SphinxRenderer
 
     _cache_newest_id()
+    _sorted_titles()
 
     SphinxRenderer.visit_namespace = _namespace_as_scope(SphinxRenderer.visit_namespace)
     app.connect("builder-inited", run_doxygen)
