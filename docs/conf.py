@@ -49,7 +49,7 @@ breathe_show_enumvalue_initializer = True
 primary_domain = "cpp"
 highlight_language = "text"
 
-autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": True}
+autodoc_default_options = {"members": True, "undoc-members": False}
 autodoc_member_order = "bysource"
 autodoc_typehints = "signature"
 
