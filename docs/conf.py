@@ -13,6 +13,8 @@ docs_dir = Path(__file__).resolve().parent
 repository = docs_dir.parent
 # The build directory whose Python module the Python API is read from (make docs: $(BUILD)).
 build_dir = Path(os.environ.get("NHDYN_BUILD_DIR", repository / "build")).resolve()
+# No __pycache__ beside the extension: docs/ is installed as it is (cmake/install.cmake).
+sys.dont_write_bytecode = True
 sys.path.insert(0, str(docs_dir / "sphinx"))
 sys.path.insert(0, str(build_dir / "python"))
 
