@@ -65,7 +65,7 @@ html_show_sourcelink = False
 html_theme_options = {
     "description": "Constrained mechanical systems, holonomic and nonholonomic: the Do Sanh equations",
     "fixed_sidebar": True,
-    "page_width": "1100px",
+    "page_width": "1240px",
     "sidebar_width": "260px",
 }
 html_sidebars = {"**": ["about.html", "navigation.html", "relations.html", "searchbox.html"]}
