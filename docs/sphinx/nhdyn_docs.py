@@ -220,10 +220,14 @@ def _namespace_as_scope(original):
         env.ref_context["cpp:parent_key"] = symbol.get_lookup_key()
         parent_context = self.context.create_child_context(file_data)
         new_context = parent_context.create_child_context(file_data.compounddef)
+        # Nested, as inside the namespace's declaration: a class is named in the scope
+        # (Trajectory in nhdyn), not with its full name again (nhdyn::nhdyn::Trajectory).
+        self.nesting_level += 1
         try:
             with WithContext(self, new_context):
                 return self.render(file_data, parent_context)
         finally:
+            self.nesting_level -= 1
             for store, key, old in ((env.temp_data, "cpp:parent_symbol", old_parent),
                                     (env.ref_context, "cpp:parent_key", old_key)):
                 if old is None:
