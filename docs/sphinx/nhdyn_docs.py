@@ -4,8 +4,9 @@
   reads its XML). The headers' plain `//` comments are turned into Doxygen's first, all in this
   one process (docs/sphinx/doxygen_filter.py; as Doxygen's INPUT_FILTER it would start Python once
   per header: 20 s). A Doxygen warning fails the build, as a Sphinx one does.
-- Checks that the C++ API (docs/api/cpp.md, api/cpp/LAYER.md) gives every installed header its place (and names no other), so a
-  new header cannot go missing from the reference and a removed one cannot leave a stale entry.
+- Checks that the C++ API (docs/api/cpp.md, docs/api/cpp/LAYER.md) gives every installed header
+  its place (and names no other), so a new header cannot go missing from the reference and a
+  removed one cannot leave a stale entry.
 - Links from the pages to what is not a page: the pages link the repository's files as they sit
   in a checkout (`../examples/sled.toml`, `checks/impact.py`, `../CONTRIBUTING.md`). A file
   becomes a download (Sphinx copies it into the site: the site stands alone, in the build tree
@@ -18,7 +19,6 @@
   is a character, not markup).
 """
 
-import os
 import re
 import subprocess
 from pathlib import Path
@@ -71,8 +71,12 @@ def run_doxygen(app):
         f'OUTPUT_DIRECTORY = "{out}"',
         "",
     ])
-    result = subprocess.run(["doxygen", "-"], input=settings, text=True, cwd=out,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    try:
+        result = subprocess.run(["doxygen", "-"], input=settings, text=True, cwd=out,
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    except FileNotFoundError:
+        raise ExtensionError("doxygen not found: the C++ API needs it (apt-get install doxygen, or "
+                             "scripts/install-deps)") from None
     for line in result.stdout.splitlines():
         # Doxygen names the filtered copy: name the header itself (the line numbers are the same).
         logger.warning("doxygen: %s", line.replace(str(include), str(HEADERS_ROOT)))
@@ -158,7 +162,7 @@ def docstring_as_rst(app, what, name, obj, options, lines):
     out = []
     in_literal = False
     base = None
-    for i, line in enumerate(lines):
+    for line in lines:
         stripped = line.strip()
         indent = len(line) - len(line.lstrip())
         if base is None and stripped:
