@@ -15,13 +15,14 @@
 #   make package  the Debian package build/nhdyn_VERSION_ARCH.deb (CPack; docs/install.md)
 #   make perf-figures  measure the figures of docs/performance.md and rewrite its table (several
 #               minutes; QUICK=1: about one)
+#   make docs   the documentation site in $(BUILD)/docs/html (docs/install.md): Sphinx, Doxygen
 #   make docs-update  rewrite the quoted outputs of README.md and docs/ from real runs
 BUILD ?= build
 JOBS ?= $(shell nproc)
 MODEL ?= examples/sled.toml
 NAME ?= sled
 
-.PHONY: run test build configure configure-run deps deps-run bench bench-check bench-update python package asan fuzz clean docs-update perf-figures
+.PHONY: run test build configure configure-run deps deps-run bench bench-check bench-update python package asan fuzz clean docs docs-update perf-figures
 
 deps:
 	@bash scripts/install-deps
@@ -55,6 +56,17 @@ test: build
 python: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_python
 	@echo "export PYTHONPATH=$(abspath $(BUILD))/python   # then: /usr/bin/python3 -c 'import nhdyn'"
+
+# The documentation site (docs/install.md, "The documentation site"; docs/conf.py): the pages of
+# docs/ (Sphinx with MyST), the C++ API from the headers (Doxygen, Breathe) and the Python API from
+# the built module's docstrings. Every warning is an error (a broken link, a missing reference, a
+# page in no toctree). Built afresh each time (-E, and no stale page left), dated by the last commit.
+docs: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_python
+	@rm -rf $(BUILD)/docs/html
+	SOURCE_DATE_EPOCH=$$(git log -1 --format=%ct 2>/dev/null || echo 0) NHDYN_BUILD_DIR=$(abspath $(BUILD)) \
+	  sphinx-build -E -W --keep-going -q -j $(JOBS) -b html -d $(BUILD)/docs/doctrees docs $(BUILD)/docs/html
+	@echo "docs: open $(abspath $(BUILD))/docs/html/index.html"
 
 # The fenced blocks after a `<!-- check: COMMAND -->` line show what COMMAND prints: this rewrites
 # those that differ from a real run; ctest checks them (tests/docs/check_docs.py, label docs).

@@ -6,6 +6,7 @@
 #   P/lib/pkgconfig/nhdyn.pc                         pkg-config --cflags --libs nhdyn
 #   P/lib/python3.X/site-packages/nhdyn              the Python package (the interpreter's layout: below)
 #   P/share/doc/nhdyn                                README, CHANGELOG, docs/, examples/
+#   P/share/doc/nhdyn/html                           the documentation site, when `make docs` has built it
 #   P/share/man/man1/nhdyn.1                         the man page (help2man, when installed)
 #   P/share/bash-completion/completions/nhdyn        bash completion
 include(GNUInstallDirs)
@@ -106,3 +107,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples
         PATTERN "CMakeLists.txt" EXCLUDE)
 install(FILES ${PROJECT_SOURCE_DIR}/examples/find_package/CMakeLists.txt DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples/find_package)
+# The documentation site, if `make docs` has built it into this build directory: a build without
+# Sphinx installs everything else.
+install(DIRECTORY ${PROJECT_BINARY_DIR}/docs/html/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/html OPTIONAL
+        PATTERN ".buildinfo" EXCLUDE)
