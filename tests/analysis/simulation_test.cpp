@@ -200,5 +200,24 @@ TEST(OutputTimes, EndExactlyAtTheEndTime) {
   EXPECT_THROW(make_output_times(0.0, 1e9, 1e-9), InputError);
 }
 
+// Given output times that all sit on the start leave no interval to integrate: the library refuses
+// them as the command line and Python do, naming the last time and t0.
+TEST(OutputTimes, GivenTimesMustEndAfterTheStart) {
+  const Model model = make_sled_model();
+  SimulationOptions o;
+  o.output_times = {model.t0};
+  try {
+    check_simulation_options(model, o);
+    ADD_FAILURE() << "output times {t0} accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("the last output time 0 must be after the model's start time t0 = 0"),
+              std::string::npos)
+        << e.what();
+  }
+  o.output_times = {model.t0, model.t0 + 0.5};
+  o.t_end = 0.5;
+  EXPECT_NO_THROW(check_simulation_options(model, o));
+}
+
 }  // namespace
 }  // namespace nhdyn

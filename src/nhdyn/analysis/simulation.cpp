@@ -225,6 +225,10 @@ std::vector<double> calc_run_times(const Model& model, const SimulationOptions& 
   if (options.output_times.size() > static_cast<std::size_t>(kMaxOutputs))
     throw InputError(fmt::format("{} output times, more than the limit of {:.0g}", options.output_times.size(),
                                  kMaxOutputs));
+  // A run needs an interval: output times that all sit on the start leave nothing to integrate.
+  if (!(times.back() > model.t0))
+    throw InputError(fmt::format("the last output time {} must be after the model's start time t0 = {}",
+                                 times.back(), model.t0));
   return times;
 }
 
