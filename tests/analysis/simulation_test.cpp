@@ -219,5 +219,22 @@ TEST(OutputTimes, GivenTimesMustEndAfterTheStart) {
   EXPECT_NO_THROW(check_simulation_options(model, o));
 }
 
+// Rows closer than the resolution of time are one row (an event at an output time): output times
+// or an output step that close would lose rows silently, so they are refused.
+TEST(OutputTimes, TimesCloserThanTheResolutionAreRefused) {
+  const Model model = make_sled_model();
+  SimulationOptions o;
+  o.output_times = {0.0, 1e-300};
+  o.t_end = 1e-300;
+  EXPECT_THROW(check_simulation_options(model, o), InputError);
+  o.output_times = {0.0, 0.5, 0.5 + 1e-17};
+  o.t_end = 1.0;
+  EXPECT_THROW(check_simulation_options(model, o), InputError);
+  o.output_times = {0.0, 0.5, 0.5 + 1e-12};
+  EXPECT_NO_THROW(check_simulation_options(model, o));
+  EXPECT_THROW(make_output_times(1e6, 1e6 + 1e-9, 1e-12), InputError);
+  EXPECT_NO_THROW(make_output_times(1e6, 1e6 + 1e-6, 1e-7));
+}
+
 }  // namespace
 }  // namespace nhdyn

@@ -183,12 +183,26 @@ Stabilization parse_stabilization(std::string_view name) {
   throw InputError("unknown stabilization '" + std::string(name) + "'; choose one of: " + list_names(kStabilizations));
 }
 
+namespace {
+
+// Two times closer than this are one row (simulate's row callback below): the resolution of time
+// near a and b, 64 units of round-off of the larger.
+double time_resolution(double a, double b) {
+  return 64.0 * std::numeric_limits<double>::epsilon() * std::max({1.0, std::abs(a), std::abs(b)});
+}
+
+}  // namespace
+
 std::vector<double> make_output_times(double t0, double t_end, double output_step) {
   if (!std::isfinite(t_end) || !(t_end > t0))
     throw InputError(fmt::format("the end time t_end = {} must be a finite time after the start time {}",
                                  t_end, t0));
   if (!std::isfinite(output_step) || !(output_step > 0.0))
     throw InputError(fmt::format("the output step {} must be a positive, finite time", output_step));
+  if (!(output_step > time_resolution(t0, t_end)))
+    throw InputError(fmt::format("the output step {} is below the resolution of time over [{}, {}] ({:.3g}): its "
+                                 "rows would be one; choose a larger output step",
+                                 output_step, t0, t_end, time_resolution(t0, t_end)));
   const double count = std::floor((t_end - t0) / output_step + 1e-9);
   if (count > kMaxOutputs)
     throw InputError(fmt::format("an output step of {} over [{}, {}] gives {:.3g} rows, more than the "
@@ -220,6 +234,11 @@ std::vector<double> calc_run_times(const Model& model, const SimulationOptions& 
     if (i > 0 && !(t > options.output_times[i - 1]))
       throw InputError(fmt::format("the output times must increase: {} (index {}) follows {}", t, i,
                                    options.output_times[i - 1]));
+    const double before = i > 0 ? options.output_times[i - 1] : model.t0;
+    if ((i > 0 || t != model.t0) && !(t - before > time_resolution(t, before)))
+      throw InputError(fmt::format("the output time {} (index {}) is within the resolution of time ({:.3g}) of {}, "
+                                   "so the two would be one row; leave one out",
+                                   t, i, time_resolution(t, before), before));
     times.push_back(t);
   }
   if (options.output_times.size() > static_cast<std::size_t>(kMaxOutputs))
@@ -417,8 +436,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     }
     // An event at an output time (or two events at one time) is one row (docs/cli.md, "Events"):
     // the first written at that t, to round-off, stands for them all; each event keeps its record.
-    if (summary.outputs > 0 && std::abs(t - last_row_t) <= 64.0 * std::numeric_limits<double>::epsilon() *
-                                                              std::max({1.0, std::abs(t), std::abs(last_row_t)}))
+    if (summary.outputs > 0 && std::abs(t - last_row_t) <= time_resolution(t, last_row_t))
       return Status::ok;
     last_row_t = t;
     ++summary.outputs;

@@ -88,6 +88,26 @@ bool onto_constraints(const Model& model, double t, Vector& q, Vector& v, std::v
   return worst <= kOnConstraints && q.allFinite() && v.allFinite();
 }
 
+// The ideal-constraint dynamics: [A b^T; b 0] [q''; -lambda] = [Q + G; -b0], R = A q'' - Q - G.
+// A and Q + G carry the masses and b does not: with the upper rows divided by mu, a power of two
+// near the largest |A|, and lambda by the same mu, every block is of order one whatever the
+// masses (`--set m=1e-100` made A's pivots look like round-off beside b's). Exact: q'' is the same.
+Vector ideal_acceleration(const Matrix& A, const Vector& h, const Matrix& b, const Vector& b0) {
+  const auto n = A.rows(), s = b.rows();
+  const double largest_A = A.size() > 0 ? A.cwiseAbs().maxCoeff() : 0.0;
+  int mass_exponent = 0;
+  if (largest_A > 0.0 && std::isfinite(largest_A)) std::frexp(largest_A, &mass_exponent);
+  const auto unit = [&](double x) { return std::ldexp(x, -mass_exponent); };
+  Matrix K = Matrix::Zero(n + s, n + s);
+  K.topLeftCorner(n, n) = A.unaryExpr(unit);
+  K.topRightCorner(n, s) = b.transpose();
+  K.bottomLeftCorner(s, n) = b;
+  Vector k(n + s);
+  k.head(n) = h.unaryExpr(unit);
+  k.tail(s) = -b0;
+  return K.fullPivLu().solve(k).head(n);
+}
+
 // M and rhs from the program's outputs, q'' and R (docs/derivations/contact-forces.md step 6).
 void assemble(const ContactForceModel& c, const double* o, const double* qdd, const double* R, Matrix& M,
               Vector& rhs) {
@@ -302,23 +322,7 @@ void analyse_contact_forces(const Model& model, ContactForceModel& c) {
   Matrix A = Matrix::Zero(n, n), b = Matrix::Zero(s, n);
   Vector Q = Vector::Zero(n), G = Vector::Zero(n), b0 = Vector::Zero(s);
   model.evaluator->terms(t, q.data(), v.data(), scratch.data(), TermsOut{A.data(), Q.data(), G.data(), b.data(), b0.data()});
-  // The ideal-constraint dynamics: [A b^T; b 0] [q''; -lambda] = [Q + G; -b0], R = A q'' - Q - G.
-  // A and Q + G carry the masses and b does not: with the upper rows divided by mu, a power of two
-  // near the largest |A|, and lambda by the same mu, every block is of order one whatever the
-  // masses (`--set m=1e-100` made A's pivots look like round-off beside b's). Exact: q'' is the same.
-  const double largest_A = A.size() > 0 ? A.cwiseAbs().maxCoeff() : 0.0;
-  int mass_exponent = 0;
-  if (largest_A > 0.0 && std::isfinite(largest_A)) std::frexp(largest_A, &mass_exponent);
-  const auto unit = [&](double x) { return std::ldexp(x, -mass_exponent); };
-  Matrix K = Matrix::Zero(n + s, n + s);
-  K.topLeftCorner(n, n) = A.unaryExpr(unit);
-  K.topRightCorner(n, s) = b.transpose();
-  K.bottomLeftCorner(s, n) = b;
-  Vector k(n + s);
-  k.head(n) = (Q + G).unaryExpr(unit);
-  k.tail(s) = -b0;
-  const Vector solution = K.fullPivLu().solve(k);
-  const Vector qdd = solution.head(n);
+  const Vector qdd = ideal_acceleration(A, Q + G, b, b0);
   const Vector R = A * qdd - Q - G;
 
   ContactForceModel probe = c;
