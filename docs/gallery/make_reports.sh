@@ -11,14 +11,20 @@ root=$(cd "$here/../.." && pwd)
 nhdyn=${1:-$root/build/apps/nhdyn/nhdyn}
 out=${2:-$root/build/gallery-reports}
 mkdir -p "$out"
-# name, end time, time of the screenshot
+# name, end time, time of the screenshot, further options of simulate; the model is
+# examples/NAME.toml, or docs/gallery/NAME.toml for the gallery's own (the torus wheel)
 runs=(
   "sled 6 4" "sled_paper 6 4" "chaplygin_sleigh 10 6" "knife_edge 4 3" "appell 2 1.5"
   "double_pendulum 5 3" "pendulum_cartesian 4 1" "rolling_disk_bodies 6 2" "whipple_bicycle 10 4"
+  "rattleback 6 2.5" "chaplygin_ball 5 3" "ball_in_bowl 3 1.2 --set x0=0.06" "ball_over_bump 2 0.3"
+  "tippe_top 3 2" "torus_wheel 4 1"
 )
 for run in "${runs[@]}"; do
-  read -r name t_end shot <<<"$run"
-  "$nhdyn" simulate "$root/examples/$name.toml" --t-end "$t_end" -q -o "$out/$name.csv" --html "$out/$name.html"
+  read -r name t_end shot options <<<"$run"
+  model="$root/examples/$name.toml"
+  [[ -f "$model" ]] || model="$here/$name.toml"
+  # shellcheck disable=SC2086 # the options are words
+  "$nhdyn" simulate "$model" --t-end "$t_end" $options -q -o "$out/$name.csv" --html "$out/$name.html"
   if command -v chromium >/dev/null; then
     profile=$(mktemp -d)
     chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking \

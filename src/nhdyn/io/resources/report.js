@@ -307,11 +307,24 @@
         o.object = group;
       } else {
         const group = new THREE.Group();
-        const ground = new THREE.MeshLambertMaterial({ color: 0xa8c8a0, side: THREE.DoubleSide, transparent: true,
-                                                       opacity: s.kind === "surface" ? 0.45 : 0.8, depthWrite: false });
+        // A terrain coloured by height (low darker, high lighter), so that its relief shows.
+        let zmin = Infinity, zmax = -Infinity;
+        for (let k = 2; k < s.mesh.v.length; k += 3) { zmin = Math.min(zmin, s.mesh.v[k]); zmax = Math.max(zmax, s.mesh.v[k]); }
+        const relief = s.kind === "terrain" && zmax > zmin;
+        if (relief) {
+          const c = new Float32Array(s.mesh.v.length);
+          const low = new THREE.Color(0x6f9a68), high = new THREE.Color(0xe8f0d8), mix = new THREE.Color();
+          for (let k = 0; k < s.mesh.v.length; k += 3)
+            mix.copy(low).lerp(high, (s.mesh.v[k + 2] - zmin) / (zmax - zmin)).toArray(c, k);
+          const attribute = new THREE.BufferAttribute(c, 3);
+          if (geometry.setAttribute) geometry.setAttribute("color", attribute); else geometry.addAttribute("color", attribute);
+        }
+        const ground = new THREE.MeshLambertMaterial({ color: relief ? 0xffffff : 0xa8c8a0, side: THREE.DoubleSide, transparent: true,
+                                                       opacity: s.kind === "surface" ? 0.45 : 0.8, depthWrite: false,
+                                                       vertexColors: relief ? (THREE.VertexColors !== undefined ? THREE.VertexColors : true) : (THREE.NoColors !== undefined ? THREE.NoColors : false) });
         group.add(new THREE.Mesh(geometry, ground));
         group.add(new THREE.LineSegments(new THREE.WireframeGeometry(geometry),
-                                         new THREE.LineBasicMaterial({ color: 0x6f8f68, transparent: true, opacity: 0.5 })));
+                                         new THREE.LineBasicMaterial({ color: 0x6f8f68, transparent: true, opacity: 0.3 })));
         o.object = group;
       }
     } else if (s.kind === "track") {
