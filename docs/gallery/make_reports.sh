@@ -3,8 +3,9 @@
 # screenshot of each taken by headless Chromium, into OUT (default build/gallery-reports):
 #     docs/gallery/make_reports.sh [NHDYN] [OUT]
 # The reports are 1.5-3 MB each (the embedded JavaScript libraries), so the repository keeps only
-# the screenshots, in docs/gallery/reports/ (cp OUT/*.png docs/gallery/reports/), shown in the
-# table of docs/gallery/README.md with the command that writes each report.
+# the screenshots (made smaller by shrink_png.py), in docs/gallery/reports/ (cp OUT/*.png
+# docs/gallery/reports/), shown in the table of docs/gallery/README.md with the command that
+# writes each report.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
@@ -16,8 +17,8 @@ mkdir -p "$out"
 runs=(
   "sled 6 4" "sled_paper 6 4" "chaplygin_sleigh 10 6" "knife_edge 4 3" "appell 2 1.5"
   "double_pendulum 5 3" "pendulum_cartesian 4 1" "rolling_disk_bodies 6 2" "whipple_bicycle 10 4"
-  "rattleback 6 2.5" "chaplygin_ball 5 3" "ball_in_bowl 3 1.2 --set x0=0.06" "ball_over_bump 2 0.3"
-  "tippe_top 3 2" "torus_wheel 4 1"
+  "rattleback 6 2.5" "chaplygin_ball 5 3" "ball_in_bowl 3 1.2 --set x0=0.03" "ball_over_bump 2 0.3"
+  "tippe_top 3 2" "torus_wheel 6 1"
 )
 for run in "${runs[@]}"; do
   read -r name t_end shot options <<<"$run"
@@ -32,6 +33,7 @@ for run in "${runs[@]}"; do
       --window-size=1300,760 --virtual-time-budget=5000 --screenshot="$out/$name.png" \
       "file://$out/$name.html#paused&t=$shot" >/dev/null 2>&1 || echo "no screenshot of $name" >&2
     rm -rf "$profile"
+    [[ -f "$out/$name.png" ]] && python3 "$here/shrink_png.py" "$out/$name.png"
   fi
   echo "$name: $(du -h "$out/$name.html" | cut -f1) -> $out/$name.html"
 done
