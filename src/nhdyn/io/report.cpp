@@ -303,6 +303,7 @@ SceneMesh solid_mesh(Field& f, const symbolic::VisualShape& shape, const std::st
     }
   }
   grid_triangles(rings, around, mesh.triangles);
+  mesh.rows = rings;
   return mesh;
 }
 
@@ -340,6 +341,7 @@ SceneMesh terrain_mesh(Field& h, const std::vector<Point>& path, double length) 
       mesh.vertices.insert(mesh.vertices.end(), {x, y, h(x, y)});
     }
   grid_triangles(nx, ny, mesh.triangles);
+  mesh.rows = nx;
   return mesh;
 }
 
@@ -393,6 +395,7 @@ SceneMesh surface_mesh(Field& g, const symbolic::VisualShape& shape, const std::
     }
   }
   grid_triangles(rings, around, mesh.triangles);
+  mesh.rows = rings;
   return mesh;
 }
 
@@ -658,7 +661,7 @@ void append_scene_shapes(std::string& data, const ReportInput& input, const Fram
     if (!meshes[s].vertices.empty()) {
       data += ",\"mesh\":{\"v\":";
       append_numbers(data, meshes[s].vertices);
-      data += fmt::format(",\"i\":[{}]}}", fmt::join(meshes[s].triangles, ","));
+      data += fmt::format(",\"i\":[{}],\"rows\":{}}}", fmt::join(meshes[s].triangles, ","), meshes[s].rows);
     }
     data += '}';
   }

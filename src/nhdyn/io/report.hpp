@@ -122,7 +122,8 @@ std::vector<SceneSize> calc_scene_sizes(const symbolic::VisualScene& scene, cons
 // zero of f or g.
 struct SceneMesh {
   std::vector<double> vertices;  // x, y, z per vertex (solid: the frame's axes; terrain, surface: world)
-  std::vector<int> triangles;    // three vertex indices each, counter-clockwise seen from outside
+  std::vector<int> triangles;    // three vertex indices each, two per cell of the grid
+  int rows = 0;                  // the vertices are a grid of `rows` rows, row-major (lines drawn along it)
 };
 std::vector<SceneMesh> calc_scene_meshes(const symbolic::VisualScene& scene, const std::vector<Parameter>& parameters,
                                          const std::vector<double>& values, std::size_t stride, const std::string& model);

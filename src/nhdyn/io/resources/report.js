@@ -323,8 +323,17 @@
                                                        opacity: s.kind === "surface" ? 0.45 : 0.8, depthWrite: false,
                                                        vertexColors: relief ? (THREE.VertexColors !== undefined ? THREE.VertexColors : true) : (THREE.NoColors !== undefined ? THREE.NoColors : false) });
         group.add(new THREE.Mesh(geometry, ground));
-        group.add(new THREE.LineSegments(new THREE.WireframeGeometry(geometry),
-                                         new THREE.LineBasicMaterial({ color: 0x6f8f68, transparent: true, opacity: 0.3 })));
+        // About a dozen lines each way along the mesh's grid (rows x columns of vertices).
+        const rows = s.mesh.rows, columns = s.mesh.v.length / 3 / rows, lines = [];
+        const every = (n) => Math.max(1, Math.round((n - 1) / 12));
+        const vertex = (i, j) => { const k = 3 * (i * columns + j); return [s.mesh.v[k], s.mesh.v[k + 1], s.mesh.v[k + 2]]; };
+        for (let i = 0; i < rows; i += every(rows))
+          for (let j = 0; j + 1 < columns; ++j) lines.push(...vertex(i, j), ...vertex(i, j + 1));
+        for (let j = 0; j < columns; j += every(columns))
+          for (let i = 0; i + 1 < rows; ++i) lines.push(...vertex(i, j), ...vertex(i + 1, j));
+        const wire = new THREE.BufferGeometry();
+        setPositions(wire, new Float32Array(lines));
+        group.add(new THREE.LineSegments(wire, new THREE.LineBasicMaterial({ color: 0x6f8f68, transparent: true, opacity: 0.5 })));
         o.object = group;
       }
     } else if (s.kind === "track") {
