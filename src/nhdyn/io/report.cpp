@@ -291,12 +291,27 @@ SceneMesh solid_mesh(Field& f, const symbolic::VisualShape& shape, const std::st
     mesh_failure(shape, model, fmt::format("its surface function is {} at the shape's centre, where it must be "
                                            "negative (inside); the report samples the surface along rays from there",
                                            f(0.0, 0.0, 0.0)));
+  // The rays are spread as the points of the unit sphere stretched by the shape's reach along
+  // each axis: on an ellipsoid they fall where its own parameter lines do, so that a long thin
+  // shape (a rattleback) is sampled along its length as finely as across it.
+  Point reach = {0.0, 0.0, 0.0};
+  for (std::size_t k = 0; k < 3; ++k)
+    for (const double sign : {1.0, -1.0}) {
+      Point axis = {0.0, 0.0, 0.0};
+      axis[k] = sign;
+      reach[k] = std::max(reach[k], ray_zero(f, {0.0, 0.0, 0.0}, axis, 1e-3));
+    }
+  if (!(std::isfinite(reach[0]) && std::isfinite(reach[1]) && std::isfinite(reach[2])))
+    mesh_failure(shape, model, "a ray from its centre along an axis meets no point where the surface function is zero; is the shape closed?");
   SceneMesh mesh;
   for (int i = 0; i < rings; ++i) {
     const double polar = std::numbers::pi * i / (rings - 1);
     for (int j = 0; j < around; ++j) {
       const double azimuth = 2 * std::numbers::pi * j / (around - 1);
-      const Point d = {std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth), std::cos(polar)};
+      Point d = {reach[0] * std::sin(polar) * std::cos(azimuth), reach[1] * std::sin(polar) * std::sin(azimuth),
+                 reach[2] * std::cos(polar)};
+      const double length = std::hypot(d[0], d[1], d[2]);
+      for (double& x : d) x /= length;
       const double s = ray_zero(f, {0.0, 0.0, 0.0}, d, 1e-3);
       if (!std::isfinite(s)) mesh_failure(shape, model, "a ray from its centre meets no point where the surface function is zero; is the shape closed?");
       mesh.vertices.insert(mesh.vertices.end(), {s * d[0], s * d[1], s * d[2]});

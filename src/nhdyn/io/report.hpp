@@ -113,7 +113,8 @@ std::vector<SceneSize> calc_scene_sizes(const symbolic::VisualScene& scene, cons
 // The triangle meshes of the scene's solid, terrain and surface shapes for the given parameter
 // values, computed once per report from `values` (the scene program's outputs at the frames
 // drawn, `stride` per frame): a solid's zero set f = 0 in its frame's axes, sampled along 25 x 49
-// rays from its centre (f < 0 there; bisection to round-off); a terrain's height h(X, Y) at the
+// rays from its centre (f < 0 there; bisection to round-off), spread as the unit sphere stretched
+// by the shape's reach along each axis; a terrain's height h(X, Y) at the
 // nodes of a grid of 49 x 49 (at most) over the region its contact point covers, widened by a
 // margin (a third of the region's width, at least four lengths of the shape); a surface's zero
 // set g = 0 along rays from the point inside it, over the cap that the contact point's
