@@ -578,3 +578,192 @@ TEST_F(Cli, ModelWithNothingToDrawSaysSoAndDrawsThePath) {
 }
 
 }  // namespace
+
+// ---- [[contacts]]: each shape on its body and each ground, as the run's parameters make them ----
+
+namespace {
+
+// The index of the scene's shape of this kind and name, or -1.
+int find_shape(const nhdyn::symbolic::VisualScene& scene, VisualKind kind, const std::string& name) {
+  for (std::size_t i = 0; i < scene.shapes.size(); ++i)
+    if (scene.shapes[i].kind == kind && scene.shapes[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+// The rattleback's ellipsoid: its semi-axes are the parameters a, b, c of the run (a set after
+// compiling), at the body frame's origin (x, y, z) and turning with it (the body's rotation, its centre of
+// mass being below the shape's centre); the body is drawn by it (the page hides its ellipsoid of
+// inertia); the contact point's track is NAME_X, NAME_Y, NAME_Z.
+TEST(ContactScene, EllipsoidHasTheRunsSemiAxesAndTurnsWithItsBody) {
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_file(example("rattleback.toml"));
+  nhdyn::Model model = nhdyn::symbolic::compile_model(spec);
+  nhdyn::set_parameter(model, "a", 0.23);
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  const int shape = find_shape(scene, VisualKind::ellipsoid, "rattleback");
+  const int body = find_shape(scene, VisualKind::body, "rattleback");
+  const int track = find_shape(scene, VisualKind::track, "rattleback");
+  ASSERT_GE(shape, 0);
+  ASSERT_GE(body, 0);
+  ASSERT_GE(track, 0);
+  EXPECT_EQ(scene.shapes[static_cast<std::size_t>(shape)].body, "rattleback");
+  const std::vector<nhdyn::SceneSize> sizes = nhdyn::calc_scene_sizes(scene, model.parameters, model.name);
+  const std::array<double, 3> semi = sizes[static_cast<std::size_t>(shape)].size;
+  EXPECT_EQ(semi[0], 0.23);
+  EXPECT_EQ(semi[1], parameter(spec, "b"));
+  EXPECT_EQ(semi[2], parameter(spec, "c"));
+  const std::vector<double> q = {0.1, -0.2, 0.03, 0.7, 0.2, -0.1}, v(q.size(), 0.0);
+  ASSERT_EQ(static_cast<int>(q.size()), spec.n());
+  const std::vector<double> out = run_scene(scene, spec, 0.0, q, v);
+  const int s = scene.shapes[static_cast<std::size_t>(shape)].offset, b = scene.shapes[static_cast<std::size_t>(body)].offset;
+  for (int k = 3; k < 12; ++k) EXPECT_EQ(out[static_cast<std::size_t>(s + k)], out[static_cast<std::size_t>(b + k)]) << k;
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(out[static_cast<std::size_t>(s + k)], q[static_cast<std::size_t>(k)]);  // the frame's origin
+}
+
+// A ball over a bump of terrain, run by the command line: the page has the ball (a sphere drawn
+// as an ellipsoid of three equal semi-axes r), the terrain's mesh and the track, whose positions
+// are the CSV's columns ball_X, ball_Y, ball_Z; the mesh's heights are h(X, Y) at its vertices to
+// round-off, over a region that holds the whole track.
+TEST_F(Cli, BallOverBumpDrawsTheTerrainAndTheTrack) {
+  std::string out, err;
+  const fs::path csv = dir / "bump.csv", html = dir / "bump.html";
+  ASSERT_EQ(run("simulate " + example("ball_over_bump.toml").string() + " --t-end 0.5 -o " + csv.string() +
+                    " --html " + html.string() + " -q",
+                out, err, dir),
+            0)
+      << err;
+  const std::string page = nhdyn::test::read_text(html);
+  const nhdyn::CsvTable table = nhdyn::load_csv(csv);
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_file(example("ball_over_bump.toml"));
+  const double r = parameter(spec, "r"), H = parameter(spec, "H"), w = parameter(spec, "w");
+  const ReportShape ball = report_shape(page, "ellipsoid", "ball");
+  ASSERT_GE(ball.offset, 0) << "no ball in the page";
+  EXPECT_EQ(ball.size, (std::vector<double>{r, r, r}));
+  const ReportShape track = report_shape(page, "track", "ball");
+  ASSERT_GE(track.offset, 0) << "no track in the page";
+  EXPECT_GE(report_shape(page, "terrain", "ball").offset, 0) << "no terrain in the page";
+  EXPECT_NE(page.find("\"mesh\":{\"v\":", page.find("{\"kind\":\"terrain\"")), std::string::npos);
+  const std::vector<double> values = report_scene_values(page);
+  const std::size_t stride = static_cast<std::size_t>(report_scene_stride(page));
+  ASSERT_EQ(values.size(), table.rows.size() * stride) << "every row is a frame";
+  const int X = table.column("ball_X"), Y = table.column("ball_Y"), Z = table.column("ball_Z");
+  ASSERT_GE(X, 0);
+  for (std::size_t f = 0; f < table.rows.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const double column = table.rows[f][static_cast<std::size_t>((k == 0 ? X : k == 1 ? Y : Z))];
+      EXPECT_NEAR(values[f * stride + static_cast<std::size_t>(track.offset + k)], column, 1e-6 * std::max(1.0, std::abs(column)));
+    }
+
+  // The mesh itself, from the library at full precision.
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  const int terrain = find_shape(scene, VisualKind::terrain, "ball");
+  ASSERT_GE(terrain, 0);
+  const std::vector<nhdyn::SceneMesh> meshes =
+      nhdyn::calc_scene_meshes(scene, spec_parameters(spec), values, stride, spec.name);
+  const nhdyn::SceneMesh& mesh = meshes[static_cast<std::size_t>(terrain)];
+  ASSERT_GE(mesh.vertices.size(), 3u * 81);
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (std::size_t k = 0; k < mesh.vertices.size(); k += 3) {
+    const double x = mesh.vertices[k], y = mesh.vertices[k + 1];
+    EXPECT_NEAR(mesh.vertices[k + 2], H * std::exp(-(x * x + y * y) / (w * w)), 4e-16 * H);
+    lo[0] = std::min(lo[0], x), lo[1] = std::min(lo[1], y), hi[0] = std::max(hi[0], x), hi[1] = std::max(hi[1], y);
+  }
+  for (const std::vector<double>& row : table.rows) {
+    EXPECT_LT(lo[0], row[static_cast<std::size_t>(X)]);
+    EXPECT_GT(hi[0], row[static_cast<std::size_t>(X)]);
+    EXPECT_LT(lo[1], row[static_cast<std::size_t>(Y)]);
+    EXPECT_GT(hi[1], row[static_cast<std::size_t>(Y)]);
+  }
+  for (const int i : mesh.triangles) EXPECT_LT(static_cast<std::size_t>(3 * i), mesh.vertices.size());
+}
+
+// A ball in a bowl: the bowl's mesh lies on the sphere of radius Rb about (0, 0, Rb) to round-off
+// and covers the ball's contact point wherever it goes; the ball's radius is the run's r.
+TEST(ContactScene, BowlIsAMeshOfItsSphereAroundTheMotion) {
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_file(example("ball_in_bowl.toml"));
+  nhdyn::Model model = nhdyn::symbolic::compile_model(spec);
+  nhdyn::set_parameter(model, "r", 0.08);
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  const int ball = find_shape(scene, VisualKind::ellipsoid, "ball"), bowl = find_shape(scene, VisualKind::surface, "ball");
+  const int track = find_shape(scene, VisualKind::track, "ball");
+  ASSERT_GE(ball, 0);
+  ASSERT_GE(bowl, 0);
+  ASSERT_GE(track, 0);
+  EXPECT_EQ(nhdyn::calc_scene_sizes(scene, model.parameters, model.name)[static_cast<std::size_t>(ball)].size,
+            (std::array<double, 3>{0.08, 0.08, 0.08}));
+  // Frames of the ball's centre on the sphere of radius Rb - r about the bowl's centre.
+  const double Rb = parameter(spec, "Rb"), r = 0.08;
+  std::vector<double> values;
+  std::vector<double> parameters;
+  for (const nhdyn::Parameter& p : model.parameters) parameters.push_back(p.value);
+  const nhdyn::Program program = scene.program.bind(parameters.data(), parameters.size());
+  std::vector<double> registers(static_cast<std::size_t>(program.registers())), out(static_cast<std::size_t>(program.outputs()));
+  std::vector<std::array<double, 3>> contact;
+  for (const double angle : {0.0, 0.2, -0.3}) {
+    const std::vector<double> q = {(Rb - r) * std::sin(angle), 0.0, Rb - (Rb - r) * std::cos(angle), 0.3, 0.1, angle},
+                              v(q.size(), 0.0);
+    program.run(0.0, q.data(), v.data(), registers.data(), out.data());
+    values.insert(values.end(), out.begin(), out.end());
+    const double* p = out.data() + scene.shapes[static_cast<std::size_t>(track)].offset;
+    contact.push_back({p[0], p[1], p[2]});
+  }
+  const nhdyn::SceneMesh mesh = nhdyn::calc_scene_meshes(scene, model.parameters, values, out.size(), model.name)[static_cast<std::size_t>(bowl)];
+  ASSERT_FALSE(mesh.vertices.empty());
+  for (std::size_t k = 0; k < mesh.vertices.size(); k += 3)
+    EXPECT_NEAR(std::hypot(mesh.vertices[k], mesh.vertices[k + 1], mesh.vertices[k + 2] - Rb), Rb, 1e-14);
+  // Every contact point is on the bowl, and within the cap: a vertex is near it, and the cap
+  // reaches beyond it (higher up the wall).
+  double highest = 0.0;
+  for (std::size_t k = 0; k < mesh.vertices.size(); k += 3) highest = std::max(highest, mesh.vertices[k + 2]);
+  for (const auto& p : contact) {
+    EXPECT_NEAR(std::hypot(p[0], p[1], p[2] - Rb), Rb, 1e-14) << "the contact point is on the bowl";
+    double nearest = 1e300;
+    for (std::size_t k = 0; k < mesh.vertices.size(); k += 3)
+      nearest = std::min(nearest, std::hypot(mesh.vertices[k] - p[0], mesh.vertices[k + 1] - p[1], mesh.vertices[k + 2] - p[2]));
+    EXPECT_LT(nearest, 0.05 * Rb);
+    EXPECT_LT(p[2], highest);
+  }
+}
+
+// An implicit shape (the rattleback's ellipsoid written as f = 0): its mesh lies on f = 0 to
+// round-off, with the run's semi-axes, in the body's axes about the shape's centre.
+TEST(ContactScene, ImplicitShapeIsAMeshOfItsZeroSet) {
+  std::string text = nhdyn::read_model_text(example("rattleback.toml"));
+  const std::string ellipsoid = "shape = { ellipsoid = [\"a\", \"b\", \"c\"] }";
+  ASSERT_NE(text.find(ellipsoid), std::string::npos);
+  text.replace(text.find(ellipsoid), ellipsoid.size(), "shape = { surface = \"X^2/a^2 + Y^2/b^2 + Z^2/c^2 - 1\" }");
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_string(text, "rattleback_surface.toml");
+  nhdyn::Model model = nhdyn::symbolic::compile_model(spec);
+  const double a = 0.21;
+  nhdyn::set_parameter(model, "a", a);
+  const double b = parameter(spec, "b"), c = parameter(spec, "c");
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  const int solid = find_shape(scene, VisualKind::solid, "rattleback");
+  ASSERT_GE(solid, 0);
+  const nhdyn::SceneMesh mesh = nhdyn::calc_scene_meshes(scene, model.parameters, {}, 0, model.name)[static_cast<std::size_t>(solid)];
+  ASSERT_GE(mesh.vertices.size(), 3u * 100);
+  double reach[3] = {0, 0, 0};
+  for (std::size_t k = 0; k < mesh.vertices.size(); k += 3) {
+    const double x = mesh.vertices[k], y = mesh.vertices[k + 1], z = mesh.vertices[k + 2];
+    EXPECT_NEAR(x * x / (a * a) + y * y / (b * b) + z * z / (c * c), 1.0, 1e-13);
+    for (int i = 0; i < 3; ++i) reach[i] = std::max(reach[i], std::abs(mesh.vertices[k + static_cast<std::size_t>(i)]));
+  }
+  EXPECT_NEAR(reach[2], c, 1e-14);  // the poles are vertices
+  EXPECT_NEAR(reach[0], a, 1e-14);  // and the ends of x (azimuth 0, polar pi/2)
+}
+
+// The round tyre: the torus's radii are the run's R and r, about the wheel's axle y.
+TEST(ContactScene, TorusHasTheRunsRadiiAboutItsAxle) {
+  const nhdyn::symbolic::Spec spec =
+      nhdyn::load_model_file(fs::path(NHDYN_SOURCE_DIR) / "docs" / "gallery" / "torus_wheel.toml");
+  nhdyn::Model model = nhdyn::symbolic::compile_model(spec);
+  nhdyn::set_parameter(model, "R", 0.3);
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  const int torus = find_shape(scene, VisualKind::torus, "tyre");
+  ASSERT_GE(torus, 0);
+  EXPECT_EQ(scene.shapes[static_cast<std::size_t>(torus)].axis, 1);
+  EXPECT_EQ(nhdyn::calc_scene_sizes(scene, model.parameters, model.name)[static_cast<std::size_t>(torus)].size,
+            (std::array<double, 3>{0.3, parameter(spec, "r"), 0.0}));
+  EXPECT_GE(find_shape(scene, VisualKind::track, "tyre"), 0);
+}
+
+}  // namespace

@@ -142,6 +142,28 @@ def check_report(browser, html, shape, label, screenshots, follows=False):
     check(browser.errors() == [], f"{label}: no console error after moving the slider ({browser.errors()[:3]})")
 
 
+def check_contacts(browser, html, label, kinds):
+    """A page of [[contacts]]: no console error, the shapes and grounds of `kinds` in its scene, and the
+    first contact shape drawn where the camera projects it at two times, turning between them."""
+    browser.events.clear()
+    browser.open("file://" + os.path.abspath(html) + "#paused")
+    check(browser.errors() == [], f"{label}: no console error on opening ({browser.errors()[:3]})")
+    present = browser.evaluate("NHDYN.scene.shapes.map(s => s.kind)")
+    check(all(k in present for k in kinds), f"{label}: the scene has {kinds} ({present})")
+    shape = browser.evaluate("NHDYN.scene.shapes.findIndex(s => s.body)")
+    screens = []
+    for fraction in (0.2, 0.7):
+        browser.evaluate(f"nhdyn.setFrame(Math.round({fraction} * (nhdyn.frames - 1)))")
+        where = browser.evaluate(f"nhdyn.screen({shape})")
+        rect, rows, _ = canvas_pixels(browser)
+        check(coloured_near(rows, rect, where, 20) > 100,
+              f"{label}: the shape is drawn at {where[0]:.0f}, {where[1]:.0f} ({fraction:.0%} of the run)")
+        screens.append((rows, rect, where))
+    (a, rect, where), (b, _, _) = screens
+    check(changed_near(a, b, rect, where, 20) > 20, f"{label}: the drawing changed where the shape was")
+    check(browser.errors() == [], f"{label}: no console error after moving ({browser.errors()[:3]})")
+
+
 def main():
     chromium = find_chromium()
     if chromium is None:
@@ -158,6 +180,11 @@ def main():
     bicycle = os.path.join(WORK, "whipple_bicycle.html")
     run("simulate", os.path.join(SOURCE, "examples/whipple_bicycle.toml"), "--t-end", "10", "--output-step", "0.01",
         "-q", "-o", os.path.join(WORK, "bicycle.csv"), "--html", bicycle)
+    # (one page of [[contacts]]: KaTeX lays out a terrain's long equations for seconds; the
+    # terrain's mesh is checked in report_test.cpp)
+    bowl = os.path.join(WORK, "ball_in_bowl.html")
+    run("simulate", os.path.join(SOURCE, "examples/ball_in_bowl.toml"), "--t-end", "1.6", "--set", "x0=0.15", "-q",
+        "-o", os.path.join(WORK, "bowl.csv"), "--html", bowl)
     size = os.path.getsize(bicycle)
     check(size < 5e6, f"whipple_bicycle: a 10 s run at 100 frames/s gives a page of {size / 1e6:.2f} MB (< 5 MB)")
     try:
@@ -178,6 +205,7 @@ def main():
         # (the rendered formulas in the paragraphs keep their TeX source in KaTeX's annotation)
         check("Constraint disk_slip1, given at velocity level" in text and "disk\\_slip" not in text,
               f"rolling_disk_bodies: a constraint's name reads as written, without TeX escapes ({text[:120]!r})")
+        check_contacts(browser, bowl, "ball_in_bowl", ["ellipsoid", "surface", "track"])
         browser.events.clear()
         browser.open("file://" + os.path.abspath(bicycle) + "#paused")
         check(browser.evaluate("nhdyn.frames") == 1001, "whipple_bicycle: all 1001 rows shown")

@@ -214,22 +214,34 @@ void load_contacts(const toml::node& contacts, symbolic::MultibodyBuilder& multi
     const symbolic::ContactText text = reader.read(*element.as_table());
     multibody.contact(text);
     const symbolic::ParsedContact* parsed = multibody.parsed_contact(text.name);
-    const std::optional<symbolic::VisualKind> kind = parsed ? parsed->shape->drawing() : std::nullopt;
-    if (!kind) continue;
+    if (parsed == nullptr) continue;
+    // The shape on its body, at its centre, turning with the body frame.
     for (const auto& [body, frame] : body_frames) {
       if (body != text.body) continue;
-      symbolic::VisualItem item;
-      item.kind = *kind;
+      symbolic::VisualItem item = parsed->shape->drawing(parsed->values);
       item.name = text.name;
       item.where = text.where.describe();
+      item.axis = std::max(item.axis, 0);
+      item.body = body;
       const symbolic::Vector3 centre =
           symbolic::add(frame.origin, symbolic::multiply(frame.rotation, parsed->centre));
       item.at.assign(centre.begin(), centre.end());
-      if (*kind == symbolic::VisualKind::wheel)
-        for (unsigned i = 0; i < 3; ++i)
-          for (unsigned j = 0; j < 3; ++j) item.other.push_back(frame.rotation(i, j));
-      item.size = parsed->shape->length(parsed->values);
-      item.axis = std::max(parsed->values.axis, 0);
+      for (unsigned i = 0; i < 3; ++i)
+        for (unsigned j = 0; j < 3; ++j) item.other.push_back(frame.rotation(i, j));
+      visual.items.push_back(std::move(item));
+    }
+    // The ground where it is not the plane's grid, and the contact point's path on it: the
+    // contact's outputs NAME_X, NAME_Y, NAME_Z.
+    const std::vector<std::string> point = {text.name + "_X", text.name + "_Y", text.name + "_Z"};
+    std::vector<symbolic::VisualItem> ground;
+    if (std::optional<symbolic::VisualItem> drawn = parsed->ground.type->drawing(*parsed)) ground.push_back(std::move(*drawn));
+    symbolic::VisualItem track;
+    track.kind = symbolic::VisualKind::track;
+    ground.push_back(std::move(track));
+    for (symbolic::VisualItem& item : ground) {
+      item.name = text.name;
+      item.where = text.where.describe();
+      item.at_outputs = point;
       visual.items.push_back(std::move(item));
     }
   }

@@ -201,6 +201,15 @@ std::vector<SceneSize> calc_scene_sizes(const symbolic::VisualScene& scene, cons
                                      shape.kind == symbolic::VisualKind::wheel ? "wheel" : "point", shape.name, model,
                                      x[0]));
       size.size = {x[0], x[0], x[0]};
+    } else if (shape.kind == symbolic::VisualKind::ellipsoid || shape.kind == symbolic::VisualKind::torus) {
+      const int count = symbolic::visual_sizes(shape.kind);
+      for (int k = 0; k < count; ++k)
+        if (!(x[k] > 0.0 && std::isfinite(x[k])))
+          throw InputError(fmt::format("{}{}contact '{}' of '{}': the {}'s size {} is {} with the run's parameter "
+                                       "values; it must be positive (check the parameters set with --set)",
+                                       shape.where, shape.where.empty() ? "" : ": ", shape.name, model,
+                                       symbolic::visual_kind_name(shape.kind), k + 1, x[k]));
+      size.size = {x[0], x[1], count > 2 ? x[2] : 0.0};
     } else if (shape.kind == symbolic::VisualKind::body) {
       Eigen::Matrix3d inertia;
       for (int i = 0; i < 3; ++i)
@@ -214,6 +223,219 @@ std::vector<SceneSize> calc_scene_sizes(const symbolic::VisualScene& scene, cons
     result.push_back(size);
   }
   return result;
+}
+
+namespace {
+
+// A bound field program (symbolic/visual.hpp) evaluated at points.
+class Field {
+ public:
+  Field(const Program& field, const std::vector<double>& parameters)
+      : program_(field.bind(parameters.data(), parameters.size())),
+        registers_(static_cast<std::size_t>(program_.registers())),
+        zeros_(static_cast<std::size_t>(program_.coordinates()), 0.0) {}
+  double operator()(double x, double y, double z = 0.0) {
+    const double at[3] = {x, y, z};
+    double out = 0.0;
+    program_.run(0.0, at, zeros_.data(), registers_.data(), &out);
+    return out;
+  }
+
+ private:
+  Program program_;
+  std::vector<double> registers_;
+  std::vector<double> zeros_;
+};
+
+using Point = std::array<double, 3>;
+
+// The distance along the unit direction d from `from` to the first zero of f, whose sign at
+// `from` is the opposite of its sign far enough along d: found by doubling from `start`, then
+// bisection to round-off. NaN when no change of sign is found.
+double ray_zero(Field& f, const Point& from, const Point& d, double start) {
+  const auto at = [&](double s) { return f(from[0] + s * d[0], from[1] + s * d[1], from[2] + s * d[2]); };
+  const bool inside = at(0.0) < 0.0;
+  double lo = 0.0, hi = start;
+  int doublings = 0;
+  while ((at(hi) < 0.0) == inside) {
+    lo = hi;
+    hi *= 2.0;
+    if (++doublings > 80) return std::nan("");
+  }
+  for (int i = 0; i < 200 && hi - lo > 4 * std::numeric_limits<double>::epsilon() * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    ((at(mid) < 0.0) == inside ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+// Rows x columns of vertices, row-major: two triangles per cell.
+void grid_triangles(int rows, int columns, std::vector<int>& out) {
+  for (int i = 0; i + 1 < rows; ++i)
+    for (int j = 0; j + 1 < columns; ++j) {
+      const int a = i * columns + j, b = a + 1, c = a + columns, d = c + 1;
+      out.insert(out.end(), {a, c, b, b, c, d});
+    }
+}
+
+[[noreturn]] void mesh_failure(const symbolic::VisualShape& shape, const std::string& model, const std::string& why) {
+  throw InputError(fmt::format("{}{}contact '{}' of '{}': the report cannot draw its {}: {}", shape.where,
+                               shape.where.empty() ? "" : ": ", shape.name, model,
+                               shape.kind == symbolic::VisualKind::solid ? "shape" : "ground", why));
+}
+
+// A solid's zero set along rays from its centre: rings of constant polar angle about the frame's z.
+SceneMesh solid_mesh(Field& f, const symbolic::VisualShape& shape, const std::string& model) {
+  constexpr int rings = 25, around = 49;
+  if (!(f(0.0, 0.0, 0.0) < 0.0))
+    mesh_failure(shape, model, fmt::format("its surface function is {} at the shape's centre, where it must be "
+                                           "negative (inside); the report samples the surface along rays from there",
+                                           f(0.0, 0.0, 0.0)));
+  // The rays are spread as the points of the unit sphere stretched by the shape's reach along
+  // each axis: on an ellipsoid they fall where its own parameter lines do, so that a long thin
+  // shape (a rattleback) is sampled along its length as finely as across it.
+  Point reach = {0.0, 0.0, 0.0};
+  for (std::size_t k = 0; k < 3; ++k)
+    for (const double sign : {1.0, -1.0}) {
+      Point axis = {0.0, 0.0, 0.0};
+      axis[k] = sign;
+      reach[k] = std::max(reach[k], ray_zero(f, {0.0, 0.0, 0.0}, axis, 1e-3));
+    }
+  if (!(std::isfinite(reach[0]) && std::isfinite(reach[1]) && std::isfinite(reach[2])))
+    mesh_failure(shape, model, "a ray from its centre along an axis meets no point where the surface function is zero; is the shape closed?");
+  SceneMesh mesh;
+  for (int i = 0; i < rings; ++i) {
+    const double polar = std::numbers::pi * i / (rings - 1);
+    for (int j = 0; j < around; ++j) {
+      const double azimuth = 2 * std::numbers::pi * j / (around - 1);
+      Point d = {reach[0] * std::sin(polar) * std::cos(azimuth), reach[1] * std::sin(polar) * std::sin(azimuth),
+                 reach[2] * std::cos(polar)};
+      const double length = std::hypot(d[0], d[1], d[2]);
+      for (double& x : d) x /= length;
+      const double s = ray_zero(f, {0.0, 0.0, 0.0}, d, 1e-3);
+      if (!std::isfinite(s)) mesh_failure(shape, model, "a ray from its centre meets no point where the surface function is zero; is the shape closed?");
+      mesh.vertices.insert(mesh.vertices.end(), {s * d[0], s * d[1], s * d[2]});
+    }
+  }
+  grid_triangles(rings, around, mesh.triangles);
+  mesh.rows = rings;
+  return mesh;
+}
+
+// The finite positions of a shape's three outputs over the frames.
+std::vector<Point> shape_path(const symbolic::VisualShape& shape, const std::vector<double>& values, std::size_t stride) {
+  std::vector<Point> out;
+  for (std::size_t f = 0; f + stride <= values.size(); f += stride) {
+    const double* p = values.data() + f + static_cast<std::size_t>(shape.offset);
+    if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])) out.push_back({p[0], p[1], p[2]});
+  }
+  return out;
+}
+
+// A terrain's heights over the box its contact point covers, widened by the margin.
+SceneMesh terrain_mesh(Field& h, const std::vector<Point>& path, double length) {
+  double lo[2] = {0.0, 0.0}, hi[2] = {0.0, 0.0};
+  if (!path.empty()) {
+    lo[0] = hi[0] = path[0][0];
+    lo[1] = hi[1] = path[0][1];
+  }
+  for (const Point& p : path)
+    for (int k = 0; k < 2; ++k) {
+      lo[k] = std::min(lo[k], p[static_cast<std::size_t>(k)]);
+      hi[k] = std::max(hi[k], p[static_cast<std::size_t>(k)]);
+    }
+  const double margin = std::max(std::max(hi[0] - lo[0], hi[1] - lo[1]) / 3.0, 4.0 * std::abs(length));
+  const double width[2] = {hi[0] - lo[0] + 2 * margin, hi[1] - lo[1] + 2 * margin};
+  const double step = std::max(width[0], width[1]) / 48.0;
+  const int nx = std::max(9, static_cast<int>(std::ceil(width[0] / step)) + 1);
+  const int ny = std::max(9, static_cast<int>(std::ceil(width[1] / step)) + 1);
+  SceneMesh mesh;
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j) {
+      const double x = lo[0] - margin + width[0] * i / (nx - 1), y = lo[1] - margin + width[1] * j / (ny - 1);
+      mesh.vertices.insert(mesh.vertices.end(), {x, y, h(x, y)});
+    }
+  grid_triangles(nx, ny, mesh.triangles);
+  mesh.rows = nx;
+  return mesh;
+}
+
+// A fixed surface's zero set along rays from the point K inside it, over the cap around the mean
+// direction of the contact point from K that holds every direction of the path, widened by the
+// margin (as an angle at the path's mean distance).
+SceneMesh surface_mesh(Field& g, const symbolic::VisualShape& shape, const std::string& model,
+                       const std::vector<Point>& path, double length, const Point& K) {
+  Point mean = {0.0, 0.0, 0.0};
+  double distance = 0.0;
+  std::vector<Point> directions;
+  for (const Point& p : path) {
+    const Point d = {p[0] - K[0], p[1] - K[1], p[2] - K[2]};
+    const double r = std::hypot(d[0], d[1], d[2]);
+    if (!(r > 0.0)) continue;
+    directions.push_back({d[0] / r, d[1] / r, d[2] / r});
+    for (int k = 0; k < 3; ++k) mean[static_cast<std::size_t>(k)] += directions.back()[static_cast<std::size_t>(k)];
+    distance += r;
+  }
+  double norm = std::hypot(mean[0], mean[1], mean[2]);
+  if (directions.empty() || !(norm > 0.0)) {
+    mean = {0.0, 0.0, -1.0};
+    norm = 1.0;
+    distance = 1.0;
+  } else {
+    distance /= static_cast<double>(directions.size());
+  }
+  for (double& m : mean) m /= norm;
+  double half = 0.0;
+  for (const Point& d : directions)
+    half = std::max(half, std::acos(std::clamp(d[0] * mean[0] + d[1] * mean[1] + d[2] * mean[2], -1.0, 1.0)));
+  half = std::min(std::numbers::pi, half + std::max(half / 3.0, 4.0 * std::abs(length) / distance));
+  // e1, e2: unit vectors normal to the mean direction.
+  const Point axis = std::abs(mean[2]) < 0.9 ? Point{0.0, 0.0, 1.0} : Point{1.0, 0.0, 0.0};
+  Point e1 = {axis[1] * mean[2] - axis[2] * mean[1], axis[2] * mean[0] - axis[0] * mean[2], axis[0] * mean[1] - axis[1] * mean[0]};
+  const double n1 = std::hypot(e1[0], e1[1], e1[2]);
+  for (double& e : e1) e /= n1;
+  const Point e2 = {mean[1] * e1[2] - mean[2] * e1[1], mean[2] * e1[0] - mean[0] * e1[2], mean[0] * e1[1] - mean[1] * e1[0]};
+  constexpr int rings = 25, around = 49;
+  SceneMesh mesh;
+  for (int i = 0; i < rings; ++i) {
+    const double a = half * i / (rings - 1);
+    for (int j = 0; j < around; ++j) {
+      const double b = 2 * std::numbers::pi * j / (around - 1);
+      Point d;
+      for (std::size_t k = 0; k < 3; ++k)
+        d[k] = std::cos(a) * mean[k] + std::sin(a) * (std::cos(b) * e1[k] + std::sin(b) * e2[k]);
+      const double s = ray_zero(g, K, d, 1e-3 * distance);
+      if (!std::isfinite(s)) mesh_failure(shape, model, "a ray from the point inside it meets no point of the surface");
+      mesh.vertices.insert(mesh.vertices.end(), {K[0] + s * d[0], K[1] + s * d[1], K[2] + s * d[2]});
+    }
+  }
+  grid_triangles(rings, around, mesh.triangles);
+  mesh.rows = rings;
+  return mesh;
+}
+
+}  // namespace
+
+std::vector<SceneMesh> calc_scene_meshes(const symbolic::VisualScene& scene, const std::vector<Parameter>& parameters,
+                                         const std::vector<double>& values, std::size_t stride, const std::string& model) {
+  const std::vector<double> parameter_values = parameter_values_for(scene, parameters, model);
+  const Program sizes = scene.sizes.bind(parameter_values.data(), parameter_values.size());
+  std::vector<double> registers(static_cast<std::size_t>(sizes.registers()));
+  std::vector<double> size(static_cast<std::size_t>(sizes.outputs()));
+  sizes.run(0.0, nullptr, nullptr, registers.data(), size.data());
+  std::vector<SceneMesh> out(scene.shapes.size());
+  for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
+    const symbolic::VisualShape& shape = scene.shapes[s];
+    if (shape.kind != symbolic::VisualKind::solid && shape.kind != symbolic::VisualKind::terrain &&
+        shape.kind != symbolic::VisualKind::surface)
+      continue;
+    Field field(shape.field, parameter_values);
+    const double* x = size.data() + shape.size_offset;
+    if (shape.kind == symbolic::VisualKind::solid) out[s] = solid_mesh(field, shape, model);
+    else if (shape.kind == symbolic::VisualKind::terrain) out[s] = terrain_mesh(field, shape_path(shape, values, stride), x[0]);
+    else out[s] = surface_mesh(field, shape, model, shape_path(shape, values, stride), x[0], {x[1], x[2], x[3]});
+  }
+  return out;
 }
 
 std::string write_model_report(const Model& model, const symbolic::Spec* spec, const CsvTable& table,
@@ -381,12 +603,12 @@ void require_finite_scene(const symbolic::VisualScene& scene, const ReportInput&
       if (expression.size() > 200) expression = expression.substr(0, 200) + "...";
       const bool segment = shape.kind == symbolic::VisualKind::segment;
       const char* part = segment ? (k < 3 ? "'from'" : "'to'") : k < 3 ? "position" : "rotation";
-      static constexpr const char* kinds[] = {"point", "segment", "wheel", "body", "frame"};
       throw InputError(fmt::format(
           "{}{}[visual] {} '{}' of '{}': its {} component {} ({}) is {} at t = {:.6g}, where {}: the scene cannot draw "
           "it, so the report is not written; write the [visual] expression in a form defined along the motion, or "
           "end the run before (--t-end, a stop event)",
-          shape.where, shape.where.empty() ? "" : ": ", kinds[static_cast<int>(shape.kind)], shape.name, input.model,
+          shape.where, shape.where.empty() ? "" : ": ",
+          shape.kind == symbolic::VisualKind::sphere ? "point" : symbolic::visual_kind_name(shape.kind), shape.name, input.model,
           part, segment || k < 3 ? k % 3 + 1 : k - 2, expression,
           std::isnan(x) ? std::string("NaN") : fmt::format("{}", x), t, state));
     }
@@ -438,15 +660,24 @@ void append_scene_shapes(std::string& data, const ReportInput& input, const Fram
     }
     values.insert(values.end(), outputs.begin(), outputs.end());
   }
+  const std::vector<SceneMesh> meshes = calc_scene_meshes(scene, input.parameters, values, outputs.size(), input.model);
   data += fmt::format("\"planar\":{},\"ground\":{},\"stride\":{},\"shapes\":[", scene.planar, scene.ground,
                       outputs.size());
   for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
     const symbolic::VisualShape& shape = scene.shapes[s];
-    static constexpr const char* kinds[] = {"sphere", "segment", "wheel", "body", "frame"};
-    data += fmt::format("{}{{\"kind\":\"{}\",\"name\":", s > 0 ? "," : "", kinds[static_cast<int>(shape.kind)]);
+    data += fmt::format("{}{{\"kind\":\"{}\",\"name\":", s > 0 ? "," : "", symbolic::visual_kind_name(shape.kind));
     append_string(data, shape.name);
     data += fmt::format(",\"offset\":{},\"axis\":{},\"size\":", shape.offset, shape.axis);
     append_numbers(data, {sizes[s].size[0], sizes[s].size[1], sizes[s].size[2]});
+    if (!shape.body.empty()) {
+      data += ",\"body\":";
+      append_string(data, shape.body);
+    }
+    if (!meshes[s].vertices.empty()) {
+      data += ",\"mesh\":{\"v\":";
+      append_numbers(data, meshes[s].vertices);
+      data += fmt::format(",\"i\":[{}],\"rows\":{}}}", fmt::join(meshes[s].triangles, ","), meshes[s].rows);
+    }
     data += '}';
   }
   data += "],\"values\":";

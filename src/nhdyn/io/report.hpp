@@ -107,5 +107,26 @@ struct SceneSize {
 };
 std::vector<SceneSize> calc_scene_sizes(const symbolic::VisualScene& scene, const std::vector<Parameter>& parameters,
                                         const std::string& model);
+// (calc_scene_sizes also gives: ellipsoid its semi-axes (a, b, c) along the frame's axes; torus
+// (R, r, 0); solid, track, terrain and surface (0, 0, 0), their extent being their mesh's or path's.)
+
+// The triangle meshes of the scene's solid, terrain and surface shapes for the given parameter
+// values, computed once per report from `values` (the scene program's outputs at the frames
+// drawn, `stride` per frame): a solid's zero set f = 0 in its frame's axes, sampled along 25 x 49
+// rays from its centre (f < 0 there; bisection to round-off), spread as the unit sphere stretched
+// by the shape's reach along each axis; a terrain's height h(X, Y) at the
+// nodes of a grid of 49 x 49 (at most) over the region its contact point covers, widened by a
+// margin (a third of the region's width, at least four lengths of the shape); a surface's zero
+// set g = 0 along rays from the point inside it, over the cap that the contact point's
+// directions from there cover, widened by the same margin. Empty for the other kinds. Throws
+// InputError naming the contact when a solid's f is not negative at its centre or a ray meets no
+// zero of f or g.
+struct SceneMesh {
+  std::vector<double> vertices;  // x, y, z per vertex (solid: the frame's axes; terrain, surface: world)
+  std::vector<int> triangles;    // three vertex indices each, two per cell of the grid
+  int rows = 0;                  // the vertices are a grid of `rows` rows, row-major (lines drawn along it)
+};
+std::vector<SceneMesh> calc_scene_meshes(const symbolic::VisualScene& scene, const std::vector<Parameter>& parameters,
+                                         const std::vector<double>& values, std::size_t stride, const std::string& model);
 
 }  // namespace nhdyn

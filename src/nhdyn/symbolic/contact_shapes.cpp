@@ -15,6 +15,13 @@ Vector3 rim_direction(const Vector3& nu, const GiNaC::ex& length, int axis, GiNa
   return scale(1 / across, subtract(scale(en, e), nu));
 }
 
+VisualItem drawn(VisualKind kind, std::vector<GiNaC::ex> sizes) {
+  VisualItem item;
+  item.kind = kind;
+  item.sizes = std::move(sizes);
+  return item;
+}
+
 class Sphere final : public ContactShape {
  public:
   std::string key() const override { return "sphere"; }
@@ -25,7 +32,7 @@ class Sphere final : public ContactShape {
     return {scale(-v.sizes[0] / length, nu), v.sizes[0]};
   }
   std::optional<GiNaC::ex> ball_radius(const ShapeValues& v) const override { return v.sizes[0]; }
-  std::optional<VisualKind> drawing() const override { return VisualKind::sphere; }
+  VisualItem drawing(const ShapeValues& v) const override { return drawn(VisualKind::ellipsoid, {v.sizes[0], v.sizes[0], v.sizes[0]}); }
 };
 
 // x^T M x = 1, M = diag(1/a^2, 1/b^2, 1/c^2): y* = -M^{-1} nu / sqrt(nu^T M^{-1} nu), the same for
@@ -43,6 +50,7 @@ class Ellipsoid final : public ContactShape {
     return {scale(-1 / root, Minv_nu), root / length};
   }
   GiNaC::ex length(const ShapeValues& v) const override { return v.sizes[0]; }
+  VisualItem drawing(const ShapeValues& v) const override { return drawn(VisualKind::ellipsoid, v.sizes); }
 };
 
 // A thin disk of radius r normal to its axis.
@@ -63,7 +71,12 @@ class Disk final : public ContactShape {
     return Singularity{1 - along * along, "the disk lies flat: its axle is along the ground's normal, where every point of "
                                           "its rim is lowest and the contact point is not defined"};
   }
-  std::optional<VisualKind> drawing() const override { return VisualKind::wheel; }
+  VisualItem drawing(const ShapeValues& v) const override {
+    VisualItem item = drawn(VisualKind::wheel, {});
+    item.size = v.sizes[0];
+    item.axis = v.axis;
+    return item;
+  }
 };
 
 // The round tyre: the rim circle of radius R swept by a ball of radius r (its convex hull touches
@@ -86,7 +99,11 @@ class Torus final : public ContactShape {
                                           "its rim is lowest and the contact point is not defined"};
   }
   GiNaC::ex length(const ShapeValues& v) const override { return v.sizes[0] + v.sizes[1]; }
-  std::optional<VisualKind> drawing() const override { return VisualKind::wheel; }
+  VisualItem drawing(const ShapeValues& v) const override {
+    VisualItem item = drawn(VisualKind::torus, v.sizes);
+    item.axis = v.axis;
+    return item;
+  }
 };
 
 // A smooth, strictly convex surface f(X, Y, Z) = 0 in the body's axes (f < 0 inside). The contact
@@ -105,6 +122,14 @@ class ImplicitSurface final : public ContactShape {
     return {v.point, -dot(nu, v.point) / length};
   }
   GiNaC::ex length(const ShapeValues&) const override { return 1; }
+  // The zero set of f in the contact point's coordinates, which stand for the body's axes about
+  // the centre: the report samples it once, along rays from the centre (f < 0 there).
+  VisualItem drawing(const ShapeValues& v) const override {
+    VisualItem item = drawn(VisualKind::solid, {});
+    item.field = v.surface;
+    item.field_variables.assign(v.point.begin(), v.point.end());
+    return item;
+  }
 };
 
 }  // namespace

@@ -72,9 +72,11 @@ class ContactShape {
     std::string reason;
   };
   virtual std::optional<Singularity> singularity(const ShapeValues&, const Vector3&) const { return std::nullopt; }
-  // How the scene draws it (a ball of its radius, a wheel about its axis), or nothing yet (the
-  // body's ellipsoid of inertia is drawn in any case).
-  virtual std::optional<VisualKind> drawing() const { return std::nullopt; }
+  // How the report's scene draws it (symbolic/visual.hpp): the item's kind, sizes, axle and, for
+  // an implicit shape, the function whose zero set is drawn, in the body's axes about the shape's
+  // centre; the loader places it (`at`, `other`: the centre and the body frame's rotation) and
+  // names it.
+  virtual VisualItem drawing(const ShapeValues& values) const = 0;
 };
 
 // The registered shapes, in the order the docs list them.

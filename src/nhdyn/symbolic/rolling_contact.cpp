@@ -279,6 +279,17 @@ class SurfaceGround final : public ContactGround {
     out.radius = radius;
     // g < 0 is inside the sphere when alpha > 0.
     out.inside = (side == "inside") == (*a > 0.0);
+    out.written = g;
+    out.variables = {X, Y, Z};
+  }
+  // The zero set of g, sampled along rays from the sphere's centre (every ray meets it once).
+  std::optional<VisualItem> drawing(const ParsedContact& c) const override {
+    VisualItem item;
+    item.kind = VisualKind::surface;
+    item.sizes = {c.shape->length(c.values), c.ground.centre_x, c.ground.centre_y, c.ground.centre_z};
+    item.field = c.ground.written;
+    item.field_variables = c.ground.variables;
+    return item;
   }
   void check(const ParsedContact& c, const Spec& spec, const std::string& context) const override {
     const std::optional<GiNaC::ex> r = c.shape->ball_radius(c.values);
@@ -357,6 +368,16 @@ class TerrainGround final : public ContactGround {
                                                           text.where, context, "a terrain", example(), out.added);
     out.at = {at[0], at[1]};
     out.height = h.subs(GiNaC::lst{X == spec.symbols.coordinate(out.at[0]), Y == spec.symbols.coordinate(out.at[1])});
+    out.written = h;
+    out.variables = {X, Y};
+  }
+  std::optional<VisualItem> drawing(const ParsedContact& c) const override {
+    VisualItem item;
+    item.kind = VisualKind::terrain;
+    item.sizes = {c.shape->length(c.values)};
+    item.field = c.ground.written;
+    item.field_variables = c.ground.variables;
+    return item;
   }
   void check(const ParsedContact&, const Spec&, const std::string&) const override {}
   Touch touch(const ParsedContact& c, const PlacedFrame& F, const Spec& spec, const std::optional<Vector3>&,

@@ -67,6 +67,9 @@ struct ParsedGround {
   std::array<int, 2> at = {-1, -1};  // terrain: the coordinates holding the contact point's X and Y
   GiNaC::ex height = 0;             // terrain: h(X, Y) at X, Y = those coordinates
   bool added = false;               // terrain: those coordinates were added by nhdyn (no `coordinates` key)
+  // terrain: h in `variables` X, Y; surface: g in X, Y, Z (world): what the report draws.
+  GiNaC::ex written = 0;
+  std::vector<GiNaC::ex> variables;
   SourceLocation where;
 };
 
@@ -155,6 +158,11 @@ class ContactGround {
   };
   virtual Touch touch(const ParsedContact& contact, const PlacedFrame& frame, const Spec& spec,
                       const std::optional<Vector3>& gravity, const std::string& context) const = 0;
+  // How the report's scene draws the ground of `contact` (symbolic/visual.hpp): a terrain's
+  // height field, a surface's zero set, each near the contact point's path (the loader fills
+  // at_outputs with NAME_X, NAME_Y, NAME_Z); nothing for a plane, which the scene's ground grid
+  // shows.
+  virtual std::optional<VisualItem> drawing(const ParsedContact&) const { return std::nullopt; }
 };
 
 const std::vector<const ContactGround*>& contact_grounds();

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "nhdyn/core/error.hpp"
@@ -20,16 +21,7 @@ std::string text_of(const GiNaC::ex& e) {
   return out.str();
 }
 
-const char* kind_name(VisualKind kind) {
-  switch (kind) {
-    case VisualKind::sphere: return "sphere";
-    case VisualKind::segment: return "segment";
-    case VisualKind::wheel: return "wheel";
-    case VisualKind::body: return "body";
-    case VisualKind::frame: return "frame";
-  }
-  return "?";
-}
+const char* kind_name(VisualKind kind) { return visual_kind_name(kind); }
 
 // Expressions of one spec into one Program whose `parameter` instructions read the parameters in
 // the order of spec.parameters, so that the program follows the values of the run it draws. The
@@ -47,6 +39,23 @@ class Emitter {
     for (int i = 0; i < spec.n(); ++i) {
       variables_.emplace(spec.symbols.coordinate(i), parameters_only ? -1 : program_.coordinate_register(i));
       variables_.emplace(spec.symbols.velocity(i), parameters_only ? -1 : program_.velocity_register(i));
+    }
+  }
+
+  // A field: a function of `variables` (in the places of the coordinates) and the parameters. A
+  // variable may be a coordinate of the spec (an implicit shape's point): it is read as the
+  // variable, and every other coordinate, t and the velocities are refused.
+  Emitter(const Spec& spec, const std::vector<GiNaC::ex>& variables)
+      : program_(static_cast<int>(variables.size()), static_cast<int>(spec.parameters.size())),
+        parameters_only_(true) {
+    for (std::size_t i = 0; i < spec.parameters.size(); ++i)
+      parameters_.emplace(spec.symbols.parameter(spec.parameters[i].name), static_cast<int>(i));
+    for (std::size_t i = 0; i < variables.size(); ++i)
+      variables_.emplace(variables[i], program_.coordinate_register(static_cast<int>(i)));
+    variables_.emplace(spec.symbols.time(), -1);
+    for (int i = 0; i < spec.n(); ++i) {
+      variables_.emplace(spec.symbols.coordinate(i), -1);
+      variables_.emplace(spec.symbols.velocity(i), -1);
     }
   }
 
@@ -103,7 +112,7 @@ class Emitter {
       const auto variable = variables_.find(e);
       if (variable == variables_.end())
         fail(original, fmt::format("uses '{}', which is not t, a coordinate, a velocity or a parameter", text_of(e)));
-      if (parameters_only_)
+      if (parameters_only_ && variable->second < 0)
         fail(original, fmt::format("uses '{}': a {} must depend on the parameters only", text_of(e), what_));
       return variable->second;
     }
@@ -169,11 +178,62 @@ void mark_angles(const Spec& spec, const GiNaC::ex& e, std::vector<bool>& angles
 
 int visual_outputs(VisualKind kind) {
   switch (kind) {
-    case VisualKind::sphere: return 3;
+    case VisualKind::sphere:
+    case VisualKind::track:
+    case VisualKind::terrain:
+    case VisualKind::surface: return 3;
     case VisualKind::segment: return 6;
     default: return 12;
   }
 }
+
+int visual_sizes(VisualKind kind) {
+  switch (kind) {
+    case VisualKind::sphere:
+    case VisualKind::wheel:
+    case VisualKind::terrain: return 1;
+    case VisualKind::body: return 10;
+    case VisualKind::ellipsoid: return 3;
+    case VisualKind::torus: return 2;
+    case VisualKind::surface: return 4;
+    default: return 0;
+  }
+}
+
+const char* visual_kind_name(VisualKind kind) {
+  switch (kind) {
+    case VisualKind::sphere: return "sphere";
+    case VisualKind::segment: return "segment";
+    case VisualKind::wheel: return "wheel";
+    case VisualKind::body: return "body";
+    case VisualKind::frame: return "frame";
+    case VisualKind::ellipsoid: return "ellipsoid";
+    case VisualKind::torus: return "torus";
+    case VisualKind::solid: return "solid";
+    case VisualKind::track: return "track";
+    case VisualKind::terrain: return "terrain";
+    case VisualKind::surface: return "surface";
+  }
+  return "?";
+}
+
+namespace {
+
+// The expressions of the spec's automatic outputs `item.at_outputs` (a contact point's NAME_X,
+// NAME_Y, NAME_Z), or nothing when one is not there: the multibody builder leaves out an output
+// whose name the user took, and the path is then not drawn rather than another quantity's.
+std::optional<std::vector<GiNaC::ex>> output_expressions(const Spec& spec, const VisualItem& item) {
+  std::vector<GiNaC::ex> out;
+  for (const std::string& name : item.at_outputs) {
+    const auto found = std::find_if(spec.outputs.begin(), spec.outputs.end(),
+                                    [&](const SpecOutput& o) { return o.name == name && o.automatic; });
+    if (found == spec.outputs.end()) return std::nullopt;
+    out.push_back(found->expression);
+  }
+  return out;
+}
+
+}  // namespace
 
 VisualScene compile_visual(const Spec& spec) {
   VisualScene scene;
@@ -188,7 +248,15 @@ VisualScene compile_visual(const Spec& spec) {
 
   Emitter positions(spec, false), sizes(spec, true);
   int offset = 0, size_offset = 0;
-  for (const VisualItem& item : spec.visual.items) {
+  for (const VisualItem& written : spec.visual.items) {
+    VisualItem resolved;
+    if (!written.at_outputs.empty()) {
+      std::optional<std::vector<GiNaC::ex>> at = output_expressions(spec, written);
+      if (!at) continue;
+      resolved = written;
+      resolved.at = std::move(*at);
+    }
+    const VisualItem& item = written.at_outputs.empty() ? written : resolved;
     for (const GiNaC::ex& e : item.at) mark_angles(spec, e, scene.angles);
     for (const GiNaC::ex& e : item.other) mark_angles(spec, e, scene.angles);
     VisualShape shape;
@@ -198,9 +266,12 @@ VisualScene compile_visual(const Spec& spec) {
     shape.size_offset = size_offset;
     shape.axis = item.axis;
     shape.where = item.where;
+    shape.body = item.body;
     const std::size_t expected = static_cast<std::size_t>(visual_outputs(item.kind));
     if (item.at.size() + item.other.size() != expected ||
-        (item.kind == VisualKind::body && item.inertia.size() != 9))
+        (item.kind == VisualKind::body && item.inertia.size() != 9) ||
+        (item.kind != VisualKind::body && item.kind != VisualKind::sphere && item.kind != VisualKind::wheel &&
+         item.sizes.size() != static_cast<std::size_t>(visual_sizes(item.kind))))
       throw ModelError(fmt::format("{}{}[visual] {} '{}': {} values given, {} expected", item.where,
                                    item.where.empty() ? "" : ": ", kind_name(item.kind), item.name,
                                    item.at.size() + item.other.size(), expected));
@@ -216,6 +287,15 @@ VisualScene compile_visual(const Spec& spec) {
       sizes.output(item.size, item, "mass");
       for (const GiNaC::ex& e : item.inertia) sizes.output(e, item, "inertia");
       size_offset += 10;
+    }
+    if (item.kind != VisualKind::body && item.kind != VisualKind::sphere && item.kind != VisualKind::wheel) {
+      for (const GiNaC::ex& e : item.sizes) sizes.output(e, item, "size");
+      size_offset += visual_sizes(item.kind);
+    }
+    if (item.kind == VisualKind::solid || item.kind == VisualKind::terrain || item.kind == VisualKind::surface) {
+      Emitter field(spec, item.field_variables);
+      field.output(item.field, item, "surface");
+      shape.field = field.take();
     }
     offset += visual_outputs(item.kind);
     scene.shapes.push_back(shape);

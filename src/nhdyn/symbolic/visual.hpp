@@ -29,6 +29,14 @@ enum class VisualKind {
   wheel,    // a multibody wheel: a disk of its radius about the axle of its frame
   body,     // a multibody body: its equivalent ellipsoid of inertia, moving with its frame
   frame,    // a multibody frame: three small axes at its origin
+  // The drawings of [[contacts]] (each shape and ground type says which it is: contact_shapes.hpp,
+  // rolling_contact.hpp):
+  ellipsoid,  // a contact's sphere or ellipsoid: its semi-axes along the frame's axes, at its centre
+  torus,      // a contact's round tyre: the rim's radius and the tube's, about the axle of its frame
+  solid,      // a contact's implicit shape f(X, Y, Z) = 0 in its frame's axes: a mesh of the zero set
+  track,      // a contact point's path over the ground (a line through its positions)
+  terrain,    // a terrain Z = h(X, Y): a height-field mesh over the region its contact point covers
+  surface,    // a fixed ground surface g(X, Y, Z) = 0: a mesh of its zero set near its contact point
 };
 
 // One item of the scene, symbolic. Positions are world components (x, y, z); expressions may use
@@ -41,8 +49,21 @@ struct VisualItem {
                                  // frame components -> world components)
   GiNaC::ex size = 0;            // sphere, wheel: radius; segment: 0 (a line); body: its mass
   std::vector<GiNaC::ex> inertia;  // body: inertia about the centre of mass in the frame's axes (9, row-major)
-  int axis = 1;                  // wheel: the axle, 0, 1 or 2 for the frame's x, y or z axis
+  int axis = 1;                  // wheel, torus: the axle, 0, 1 or 2 for the frame's x, y or z axis
   std::string where;             // "file:line:column" for messages
+  // ellipsoid: the semi-axes (3); torus: the rim's radius and the tube's (2); terrain, surface: a
+  // length of the contact's shape (1), the margin of the region drawn, then (surface) a point from
+  // which every ray meets the surface once (3), where its mesh is sampled from. Parameters only.
+  std::vector<GiNaC::ex> sizes;
+  // solid, terrain, surface: the function whose zero set is drawn (terrain: the height h) in the
+  // symbols `field_variables` (solid: 3, the frame's axes about `at`; terrain: 2, X and Y;
+  // surface: 3, world X, Y, Z) and the parameters.
+  GiNaC::ex field = 0;
+  std::vector<GiNaC::ex> field_variables;
+  // track, terrain, surface: `at` is the value of these three outputs of the spec (a contact
+  // point's NAME_X, NAME_Y, NAME_Z), resolved by compile_visual: the line drawn is the column.
+  std::vector<std::string> at_outputs;
+  std::string body;  // ellipsoid, torus, wheel, solid of a contact: the body it is the shape of
 };
 
 struct SpecVisual {
@@ -52,10 +73,12 @@ struct SpecVisual {
 };
 
 // A shape of the compiled scene. Its outputs start at `offset` in the outputs of
-// VisualScene::program: sphere 3 (centre), segment 6 (both ends), wheel, body and frame 12 (origin,
-// then R row-major); its sizes at `size_offset` in those of VisualScene::sizes: sphere and wheel 1
-// (radius), body 10 (mass, then the inertia about the centre of mass in the frame's axes, 9
-// row-major), segment and frame none.
+// VisualScene::program: sphere, track, terrain and surface 3 (centre; a contact point), segment 6
+// (both ends), wheel, body, frame, ellipsoid, torus and solid 12 (origin, then R row-major); its
+// sizes at `size_offset` in those of VisualScene::sizes: sphere and wheel 1 (radius), body 10
+// (mass, then the inertia about the centre of mass in the frame's axes, 9 row-major), ellipsoid 3
+// (semi-axes), torus 2 (R, r), terrain 1 (a length), surface 4 (a length, a point inside), segment,
+// frame, track and solid none.
 struct VisualShape {
   VisualKind kind = VisualKind::sphere;
   std::string name;
@@ -64,6 +87,10 @@ struct VisualShape {
   int axis = 1;       // wheel: the axle's column of R
   std::string where;  // "file:line:column" of the item, for messages about its values
   std::vector<std::string> expressions;  // the text of each of its outputs (at, then other), for messages
+  std::string body;   // a contact's shape: the body it is the shape of (drawn instead of its ellipsoid)
+  // solid, terrain, surface: the function drawn, its inputs the field variables in the places of
+  // the coordinates (Program::coordinate_register(i)); reads the parameters (bind them).
+  Program field;
 };
 
 struct VisualScene {
@@ -86,5 +113,9 @@ VisualScene compile_visual(const Spec& spec);
 
 // Output count of a shape of this kind.
 int visual_outputs(VisualKind kind);
+// Size count of a shape of this kind (the outputs of VisualScene::sizes it has).
+int visual_sizes(VisualKind kind);
+// Its name in messages and in the report's page: "sphere", "ellipsoid", ...
+const char* visual_kind_name(VisualKind kind);
 
 }  // namespace nhdyn::symbolic

@@ -39,8 +39,10 @@
   const follow = el("select", { id: "follow", title: "camera follows" }, controls);
   el("option", { value: "-1", text: "whole motion" }, follow);
   el("option", { value: "-2", text: "follow the bodies" }, follow);
+  // Kinds that are not a moving thing to follow: axes, a contact point's path, a ground.
+  const fixedKinds = ["frame", "track", "terrain", "surface"];
   D.scene.shapes.forEach((s, i) => {
-    if (s.kind !== "frame") el("option", { value: String(i), text: "follow " + s.name }, follow);
+    if (!fixedKinds.includes(s.kind)) el("option", { value: String(i), text: "follow " + s.name }, follow);
   });
   if (D.note) el("div", { id: "note", text: D.note }, left);
   el("h2", { text: "Summary" }, left);
@@ -55,6 +57,18 @@
   const S = D.scene;
   const stride = S.stride;
   const value = (f, i) => S.values[f * stride + i];
+  // The largest distance of a shape's points from its origin (a path or a ground: 0, its points
+  // are those of the contact it follows).
+  const reach = (s) => {
+    if (s.kind === "frame" || s.kind === "track" || s.kind === "terrain" || s.kind === "surface") return 0;
+    if (s.kind === "torus") return s.size[0] + s.size[1];
+    if (s.kind === "solid") {
+      let r = 0;
+      for (let k = 0; k < s.mesh.v.length; k += 3) r = Math.max(r, Math.hypot(s.mesh.v[k], s.mesh.v[k + 1], s.mesh.v[k + 2]));
+      return r;
+    }
+    return Math.max(s.size[0], s.size[1], s.size[2]);
+  };
   // Every point a shape passes through, for the bounds of the scene.
   const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
   const grow = (x, y, z, r) => {
@@ -66,7 +80,7 @@
     }
   };
   for (const s of S.shapes) {
-    const r = s.kind === "frame" ? 0 : Math.max(s.size[0], s.size[1], s.size[2]);
+    const r = reach(s);
     for (let f = 0; f < frames; ++f) {
       grow(value(f, s.offset), value(f, s.offset + 1), value(f, s.offset + 2), r);
       if (s.kind === "segment") grow(value(f, s.offset + 3), value(f, s.offset + 4), value(f, s.offset + 5), 0);
@@ -82,7 +96,7 @@
     const out = [];
     for (const s of S.shapes) {
       if (s.kind === "frame") continue;
-      const r = Math.max(s.size[0], s.size[1], s.size[2]);
+      const r = reach(s);
       for (const k of s.kind === "segment" ? [0, 3] : [0]) {
         const b = s.offset + k;
         out.push([value(f, b) - r, value(f, b + 1) - r, value(f, b + 2) - r], [value(f, b) + r, value(f, b + 1) + r, value(f, b + 2) + r]);
@@ -203,6 +217,8 @@
     scene.add(line);
     return line;
   };
+  const light = () => new THREE.MeshLambertMaterial({ color: 0xeeeeee });
+  const shaped = new Set(S.shapes.filter((s) => s.body).map((s) => s.body));
   const objects = S.shapes.map((s, i) => {
     const o = { shape: s, object: null, trail: null };
     if (s.kind === "sphere") {
@@ -243,6 +259,93 @@
         for (let k = 0; k < 3; ++k) points[3 * f + k] = c[k] - (upward * r * d[k]) / norm;
       }
       o.trail = trail(points, 0x444444);
+    } else if (s.kind === "ellipsoid") {
+      // The contact's ball or ellipsoid in eight octants of two colours, so that its turning shows.
+      const group = new THREE.Group();
+      const inner = new THREE.Group();
+      for (let k = 0; k < 8; ++k) {
+        const piece = new Sphere(1, 12, 8, (k % 4) * Math.PI / 2, Math.PI / 2, (k >> 2) * Math.PI / 2, Math.PI / 2);
+        inner.add(new THREE.Mesh(piece, ((k + (k >> 2)) % 2) ? material(i, 1) : light()));
+      }
+      inner.scale.set(s.size[0], s.size[1], s.size[2]);
+      group.add(inner);
+      o.object = group;
+    } else if (s.kind === "torus") {
+      // The round tyre: the tube about the rim, in quarters of two colours; its axle the frame's s.axis.
+      const group = new THREE.Group();
+      const inner = new THREE.Group();
+      for (let k = 0; k < 4; ++k) {
+        const quarter = new THREE.Mesh(new Torus(s.size[0], s.size[1], 12, 16, Math.PI / 2), k % 2 ? material(i, 1) : light());
+        quarter.rotation.z = (k * Math.PI) / 2;
+        inner.add(quarter);
+      }
+      const disk = new THREE.Mesh(new Circle(s.size[0], 48), material(i, 0.25));
+      disk.material.side = THREE.DoubleSide;
+      inner.add(disk);
+      if (s.axis === 0) inner.rotation.y = Math.PI / 2;
+      if (s.axis === 1) inner.rotation.x = Math.PI / 2;
+      group.add(inner);
+      o.object = group;
+    } else if (s.kind === "solid" || s.kind === "terrain" || s.kind === "surface") {
+      // A mesh computed by nhdyn: a shape's zero set in its frame's axes (coloured by octant, so
+      // that its turning shows), or a ground's in world axes.
+      const geometry = new THREE.BufferGeometry();
+      setPositions(geometry, new Float32Array(s.mesh.v));
+      geometry.setIndex(s.mesh.i);
+      geometry.computeVertexNormals();
+      if (s.kind === "solid") {
+        const c = new Float32Array(s.mesh.v.length);
+        const a = new THREE.Color(colours[i % colours.length]), b = new THREE.Color(0xeeeeee);
+        for (let k = 0; k < s.mesh.v.length; k += 3) {
+          const odd = (s.mesh.v[k] < 0) !== (s.mesh.v[k + 1] < 0) !== (s.mesh.v[k + 2] < 0);
+          (odd ? a : b).toArray(c, k);
+        }
+        const attribute = new THREE.BufferAttribute(c, 3);
+        if (geometry.setAttribute) geometry.setAttribute("color", attribute); else geometry.addAttribute("color", attribute);
+        const group = new THREE.Group();
+        group.add(new THREE.Mesh(geometry, new THREE.MeshLambertMaterial({ vertexColors: THREE.VertexColors !== undefined ? THREE.VertexColors : true })));
+        o.object = group;
+      } else {
+        const group = new THREE.Group();
+        // A terrain coloured by height (low darker, high lighter), so that its relief shows.
+        let zmin = Infinity, zmax = -Infinity;
+        for (let k = 2; k < s.mesh.v.length; k += 3) { zmin = Math.min(zmin, s.mesh.v[k]); zmax = Math.max(zmax, s.mesh.v[k]); }
+        const relief = s.kind === "terrain" && zmax > zmin;
+        if (relief) {
+          const c = new Float32Array(s.mesh.v.length);
+          const low = new THREE.Color(0x6f9a68), high = new THREE.Color(0xe8f0d8), mix = new THREE.Color();
+          for (let k = 0; k < s.mesh.v.length; k += 3)
+            mix.copy(low).lerp(high, (s.mesh.v[k + 2] - zmin) / (zmax - zmin)).toArray(c, k);
+          const attribute = new THREE.BufferAttribute(c, 3);
+          if (geometry.setAttribute) geometry.setAttribute("color", attribute); else geometry.addAttribute("color", attribute);
+        }
+        const ground = new THREE.MeshLambertMaterial({ color: relief ? 0xffffff : 0xa8c8a0, side: THREE.DoubleSide, transparent: true,
+                                                       opacity: s.kind === "surface" ? 0.45 : 0.8, depthWrite: false,
+                                                       vertexColors: relief ? (THREE.VertexColors !== undefined ? THREE.VertexColors : true) : (THREE.NoColors !== undefined ? THREE.NoColors : false) });
+        group.add(new THREE.Mesh(geometry, ground));
+        // About a dozen lines each way along the mesh's grid (rows x columns of vertices).
+        const rows = s.mesh.rows, columns = s.mesh.v.length / 3 / rows, lines = [];
+        const every = (n) => Math.max(1, Math.round((n - 1) / 12));
+        const vertex = (i, j) => { const k = 3 * (i * columns + j); return [s.mesh.v[k], s.mesh.v[k + 1], s.mesh.v[k + 2]]; };
+        for (let i = 0; i < rows; i += every(rows))
+          for (let j = 0; j + 1 < columns; ++j) lines.push(...vertex(i, j), ...vertex(i, j + 1));
+        for (let j = 0; j < columns; j += every(columns))
+          for (let i = 0; i + 1 < rows; ++i) lines.push(...vertex(i, j), ...vertex(i + 1, j));
+        const wire = new THREE.BufferGeometry();
+        setPositions(wire, new Float32Array(lines));
+        group.add(new THREE.LineSegments(wire, new THREE.LineBasicMaterial({ color: 0x6f8f68, transparent: true, opacity: 0.5 })));
+        o.object = group;
+      }
+    } else if (s.kind === "track") {
+      // The contact point's path over the ground (the contact's NAME_X, NAME_Y, NAME_Z).
+      const points = new Float32Array(frames * 3);
+      for (let f = 0; f < frames; ++f)
+        for (let k = 0; k < 3; ++k) points[3 * f + k] = value(f, s.offset + k);
+      o.trail = trail(points, 0x444444);
+      return o;
+    } else if (s.kind === "body" && shaped.has(s.name)) {
+      // A body drawn by its contact's shape: its ellipsoid of inertia would hide it.
+      return o;
     } else if (s.kind === "body") {
       const group = new THREE.Group();
       const ball = new THREE.Mesh(new Sphere(1, 24, 16), material(i, 0.55));
@@ -253,6 +356,7 @@
       o.object = new THREE.AxesHelper(near * 0.08);
     }
     if (s.kind !== "sphere" && s.kind !== "segment") o.object.matrixAutoUpdate = false;
+    if (s.kind === "terrain" || s.kind === "surface") o.object.matrixAutoUpdate = true;  // fixed, in world axes
     scene.add(o.object);
     return o;
   });
@@ -264,6 +368,10 @@
     const thin = 0.006 * viewWidth;
     for (const o of objects) {
       const s = o.shape, b = s.offset;
+      if (!o.object || s.kind === "terrain" || s.kind === "surface") {
+        if (o.trail) o.trail.geometry.setDrawRange(0, f + 1);
+        continue;
+      }
       if (s.kind === "sphere") {
         o.object.position.set(value(f, b), value(f, b + 1), value(f, b + 2));
         o.object.scale.setScalar(Math.max(1, thin / s.size[0]));
