@@ -85,10 +85,8 @@ SimulationOptions make_options(const Model& model, const py::dict& kwargs) {
   options.integrator.step = get<double>(kwargs, "step").value_or(0.0);
   options.fix_initial = get<bool>(kwargs, "fix_initial").value_or(false);
   options.stabilization = parse_stabilization(get<std::string>(kwargs, "stabilize").value_or("none"));
-  if (const std::optional<long> max_steps = get<long>(kwargs, "max_steps")) {
-    if (*max_steps < 1) throw InputError(fmt::format("max_steps={}: the step budget must be at least 1", *max_steps));
-    options.integrator.max_steps = *max_steps;
-  }
+  // Checked with the other options by check_simulation_options below.
+  if (const std::optional<long> max_steps = get<long>(kwargs, "max_steps")) options.integrator.max_steps = *max_steps;
   // program_feedback=(alpha, beta): the PD feedback of program motion (docs/derivations/program-motion.md
   // section 5), as --program-feedback alpha,beta.
   if (kwargs.contains("program_feedback") && !py::object(kwargs["program_feedback"]).is_none()) {

@@ -186,13 +186,7 @@ SimulationOptions make_run_options(const Model& model, const SimulateArgs& args)
   options.formulation.baumgarte.alpha = args.baumgarte_alpha;
   options.formulation.baumgarte.beta = args.baumgarte_beta;
   options.projection.tolerance = args.projection_tolerance;
-  if (args.max_steps) {
-    if (*args.max_steps < 1)
-      throw InputError(fmt::format("--max-steps {}: the step budget must be at least 1 (accepted + rejected steps "
-                                   "of the whole run; the default is {})",
-                                   *args.max_steps, IntegratorOptions{}.max_steps));
-    options.integrator.max_steps = *args.max_steps;
-  }
+  if (args.max_steps) options.integrator.max_steps = *args.max_steps;  // checked by check_simulation_options
   options.events = model.events;
   for (const std::string& condition : args.stop_when)
     options.events.push_back(symbolic::make_stop_condition(model, condition));

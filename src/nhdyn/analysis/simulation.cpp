@@ -242,8 +242,11 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
       throw InputError(fmt::format("the relative tolerance rtol = {} is below what double precision can "
                                    "deliver; use 1e-14 or more", io.rtol));
   }
+  // The one check of the step budget, for the command line and Python alike.
   if (io.max_steps < 1)
-    throw InputError(fmt::format("the step budget (--max-steps) {} must be at least 1", io.max_steps));
+    throw InputError(fmt::format("the step budget max_steps (--max-steps) = {} must be at least 1: it counts the "
+                                 "accepted and rejected steps of the whole run (default {})",
+                                 io.max_steps, IntegratorOptions{}.max_steps));
   if (!options.events.empty() && !supports_events(io.kind))
     throw InputError(fmt::format("events need an integrator that can locate them; {} has no continuous extension: "
                                  "choose dopri5, dop853, cvode-bdf or cvode-adams",
