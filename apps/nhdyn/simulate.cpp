@@ -234,12 +234,8 @@ void open_run_files(RunFiles& files, const SimulateArgs& args, const Model& mode
     if (!args.html.empty()) paths.output(args.html, "--html");
     paths.check();
   }
-  if (!args.plot.empty()) {
-    if (!gnuplot_available())
-      throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
-                      "or run without --plot");
-    files.plot_probe.emplace(args.plot);  // checks the plot's directory now; removed unused
-  }
+  check_plot_possible(args.plot);
+  if (!args.plot.empty()) files.plot_probe.emplace(args.plot);  // checks the plot's directory now; removed unused
   if (default_csv) {
     // The default place is ours to create; a path the user names must already be writable.
     std::error_code ec;
