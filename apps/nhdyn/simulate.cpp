@@ -66,8 +66,8 @@ struct SimulateArgs {
   std::optional<long> max_steps;       // the integrator's step budget (default IntegratorOptions)
 };
 
-// --program-feedback alpha,beta: two non-negative rates [1/s], each a plain decimal number (no
-// hexadecimal, no nan or inf, no spaces), at most kMaxProgramFeedback (program_feedback.hpp).
+// --program-feedback alpha,beta: two plain decimal numbers (no hexadecimal, no nan or inf, no
+// spaces); check_simulation_options checks them as rates [1/s], >= 0 and at most kMaxProgramFeedback.
 ProgramFeedback parse_program_feedback(const std::string& text) {
   ProgramFeedback out;
   if (text.empty()) return out;
@@ -100,8 +100,7 @@ ProgramFeedback parse_program_feedback(const std::string& text) {
   out.enabled = true;
   out.alpha = number(text.substr(0, comma), "alpha");
   out.beta = number(text.substr(comma + 1), "beta");
-  check_program_feedback(out);
-  return out;
+  return out;  // the gains' range is checked with the other options, by check_simulation_options
 }
 
 // Where a run's companion files go: FILE.csv -> FILE-events.csv and FILE.partial.csv (the
