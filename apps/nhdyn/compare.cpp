@@ -245,11 +245,7 @@ int run_compare(const CompareArgs& args) {
   check_plot_possible(args.plot);
   AtomicFile table(table_path);  // both paths are checked before any run
   const std::vector<std::string> columns = series_columns(model, options);
-  if (!args.plot_columns.empty()) {
-    if (args.plot.empty())
-      throw InputError("--plot-columns chooses what --plot draws; give --plot FILE.png too, or leave --plot-columns out");
-    require_plot_columns(columns, args.plot_columns);
-  }
+  check_plot_columns(args.plot, columns, args.plot_columns);
   const std::string provenance = compare_provenance(model, source, args, methods, options);
   CsvWriter series(series_path, columns, provenance);
 

@@ -211,11 +211,7 @@ struct RunFiles {
 void open_run_files(RunFiles& files, const SimulateArgs& args, const Model& model, const SimulationOptions& options,
                     const ResultColumns& columns, const std::string& provenance) {
   namespace fs = std::filesystem;
-  if (!args.plot_columns.empty()) {
-    if (args.plot.empty())
-      throw InputError("--plot-columns chooses what --plot draws; give --plot FILE.png too, or leave --plot-columns out");
-    require_plot_columns(columns.all, args.plot_columns);
-  }
+  check_plot_columns(args.plot, columns.all, args.plot_columns);
   const bool default_csv = args.output.empty();
   files.csv = default_csv ? fs::path("results") / (make_file_name(model.name) + ".csv") : fs::path(args.output);
   files.events = companion(files.csv, "-events.csv");
