@@ -156,7 +156,7 @@ std::string format_table(const std::string& provenance, const Comparison& result
                         method_name(r.which.method), integrator_name(r.which.integrator), r.solve_ns, s.stats.steps,
                         s.stats.rhs_evaluations, s.wall_time, s.residuals.position, s.residuals.velocity,
                         s.residuals.acceleration, energy_error(s), r.max_error_q, r.max_error_v,
-                        s.status == Status::ok ? "ok" : std::string(describe(s.status)));
+                        format_status(s));
   }
   return text;
 }
@@ -216,7 +216,7 @@ void print_comparison(const CompareArgs& args, const Model& model, const Compari
                level(s.residuals.position, model.position_constraints() > 0),
                level(s.residuals.velocity, model.velocity_constraints() > 0),
                energy_error(s), r.max_error_q, r.max_error_v,
-               s.status == Status::ok ? "" : fmt::format("  FAILED at t = {:.4g}: {}", s.t_reached, s.message));
+               format_failure_note(s));
   }
   fmt::print("table -> {}\nseries -> {}\n", table_path.string(), series_path.string());
   if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);

@@ -88,5 +88,16 @@ TEST(SimulationSummaryText, StabilizationAndTheInitialFix) {
   EXPECT_EQ(format_contact_force_notes(sled), "");
 }
 
+TEST(SimulationSummaryText, OutcomeInATableRow) {
+  SimulationSummary summary;
+  EXPECT_EQ(format_status(summary), "ok");
+  EXPECT_EQ(format_failure_note(summary), "");
+  summary.status = Status::non_finite;
+  summary.t_reached = 1.23456;
+  summary.message = "non-finite value in A";
+  EXPECT_EQ(format_status(summary), describe(Status::non_finite));
+  EXPECT_EQ(format_failure_note(summary), "  FAILED at t = 1.235: non-finite value in A");
+}
+
 }  // namespace
 }  // namespace nhdyn

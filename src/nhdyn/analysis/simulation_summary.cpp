@@ -14,6 +14,15 @@ std::string format_residual(double value, bool defined) { return defined ? fmt::
 
 }  // namespace
 
+std::string format_status(const SimulationSummary& summary) {
+  return summary.status == Status::ok ? "ok" : std::string(describe(summary.status));
+}
+
+std::string format_failure_note(const SimulationSummary& summary) {
+  if (summary.status == Status::ok) return {};
+  return fmt::format("  FAILED at t = {:.4g}: {}", summary.t_reached, summary.message);
+}
+
 std::string format_steps(const SimulationSummary& summary) {
   return fmt::format("  steps {} (rejected {}), right-hand-side evaluations {}, wall time {:.3g} ms\n",
                      summary.stats.steps, summary.stats.rejected_steps, summary.stats.rhs_evaluations,

@@ -105,6 +105,12 @@ struct SimulationSummary {
 // spaces and ended by a newline; an empty string when the group has nothing to say for this model
 // and these options.
 
+// The outcome in a table's cell: "ok", or the status in words (describe, core/status.hpp).
+std::string format_status(const SimulationSummary& summary);
+
+// What ends a table's row of a run that failed: "  FAILED at t = T: MESSAGE"; empty when it succeeded.
+std::string format_failure_note(const SimulationSummary& summary);
+
 // "  steps S (rejected R), right-hand-side evaluations N, wall time T ms"
 std::string format_steps(const SimulationSummary& summary);
 
