@@ -31,6 +31,6 @@ int main() {
   // The horizontal speed grows linearly: u(10) = u0 + 10 g a / (1 + a^2) (docs/derivations/appell.md).
   const double expected = std::sqrt(1.25) + 10.0 * 9.81 * 0.5 / 1.25;
   fmt::print("horizontal speed at t = 10 s: {:.12f} (closed form {:.12f}); energy drift {:.2e}\n", speed, expected,
-             s.energy_drift);
+             s.energy.drift);
   return std::abs(speed - expected) < 1e-8 * expected ? 0 : 1;
 }

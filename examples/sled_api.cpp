@@ -34,6 +34,6 @@ int main() {
     return 1;
   }
   fmt::print("10 s: x = {:.6f} m, {} steps, max velocity residual {:.2e}, energy drift {:.2e}\n", x_end,
-             summary.stats.steps, summary.max_velocity_residual, summary.energy_drift);
+             summary.stats.steps, summary.residuals.velocity, summary.energy.drift);
   return 0;
 }

@@ -145,13 +145,13 @@ void bind_batch(py::module_& m) {
           if (res.q_end.size() == n) {
             std::copy(res.q_end.data(), res.q_end.data() + n, q_end.begin() + static_cast<std::ptrdiff_t>(r * un));
             std::copy(res.v_end.data(), res.v_end.data() + n, v_end.begin() + static_cast<std::ptrdiff_t>(r * un));
-            max_residual[r] = std::max({res.summary.max_position_residual, res.summary.max_velocity_residual,
-                                        res.summary.max_acceleration_residual});
+            max_residual[r] = std::max({res.summary.residuals.position, res.summary.residuals.velocity,
+                                        res.summary.residuals.acceleration});
           }
           ok.append(res.ok);
           messages.append(res.message);
           py::list run_events;
-          for (const EventRecord& e : res.summary.events) {
+          for (const EventRecord& e : res.summary.events.crossings) {
             py::dict event;
             event["name"] = e.name;
             event["t"] = e.t;

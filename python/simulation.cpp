@@ -85,10 +85,8 @@ SimulationOptions make_options(const Model& model, const py::dict& kwargs) {
   options.integrator.step = get<double>(kwargs, "step").value_or(0.0);
   options.fix_initial = get<bool>(kwargs, "fix_initial").value_or(false);
   options.stabilization = parse_stabilization(get<std::string>(kwargs, "stabilize").value_or("none"));
-  if (const std::optional<long> max_steps = get<long>(kwargs, "max_steps")) {
-    if (*max_steps < 1) throw InputError(fmt::format("max_steps={}: the step budget must be at least 1", *max_steps));
-    options.integrator.max_steps = *max_steps;
-  }
+  // Checked with the other options by check_simulation_options below.
+  if (const std::optional<long> max_steps = get<long>(kwargs, "max_steps")) options.integrator.max_steps = *max_steps;
   // program_feedback=(alpha, beta): the PD feedback of program motion (docs/derivations/program-motion.md
   // section 5), as --program-feedback alpha,beta.
   if (kwargs.contains("program_feedback") && !py::object(kwargs["program_feedback"]).is_none()) {
@@ -139,8 +137,12 @@ std::optional<Vector> state_vector(const py::dict& kwargs, const char* key, int 
 
 }  // namespace
 
-py::dict summary_dict(const SimulationSummary& s) {
-  py::dict d;
+namespace {
+
+// The summary dict, group by group (analysis/simulation_summary.hpp); the keys are the package's
+// interface (tests/python) and keep their order.
+
+void add_run(py::dict& d, const SimulationSummary& s) {
   d["status"] = std::string(describe(s.status));
   d["message"] = s.message;
   d["t_reached"] = s.t_reached;
@@ -149,20 +151,23 @@ py::dict summary_dict(const SimulationSummary& s) {
   d["rhs_evaluations"] = s.stats.rhs_evaluations;
   d["outputs"] = s.outputs;
   d["wall_time"] = s.wall_time;
-  d["max_position_residual"] = s.max_position_residual;
-  d["max_velocity_residual"] = s.max_velocity_residual;
-  d["max_acceleration_residual"] = s.max_acceleration_residual;
-  d["energy_drift"] = s.has_energy ? py::cast(s.energy_drift) : py::none();
-  d["max_program_position_residual"] = s.max_program_position_residual;
-  d["max_program_velocity_residual"] = s.max_program_velocity_residual;
-  d["max_program_acceleration_residual"] = s.max_program_acceleration_residual;
-  // The constraint watch (analysis/constraint_watch.hpp): its warnings in words, and each one's
-  // constraint, measure, time and factor; the Python package raises them as ConstraintWarning.
+}
+
+void add_residuals(py::dict& d, const ResidualMaxima& r, const char* prefix) {
+  d[py::str(fmt::format("max_{}position_residual", prefix))] = r.position;
+  d[py::str(fmt::format("max_{}velocity_residual", prefix))] = r.velocity;
+  d[py::str(fmt::format("max_{}acceleration_residual", prefix))] = r.acceleration;
+}
+
+// The constraint watch (analysis/constraint_watch.hpp): the run's warnings in words, and each
+// watch warning's constraint, measure, time and factor; the Python package raises them as
+// ConstraintWarning.
+void add_watch_warnings(py::dict& d, const SimulationSummary& s) {
   py::list warnings;
   for (const std::string& w : s.warnings) warnings.append(w);
   d["warnings"] = warnings;
   py::list watch;
-  for (const ConstraintWarning& w : s.constraint_warnings) {
+  for (const ConstraintWarning& w : s.watch.warnings) {
     py::dict item;
     item["constraint"] = w.constraint;
     item["measure"] = w.measure == WatchMeasure::row_norm ? "row_norm" : "conditioning";
@@ -173,35 +178,52 @@ py::dict summary_dict(const SimulationSummary& s) {
     watch.append(item);
   }
   d["constraint_warnings"] = watch;
+}
+
+// fix_initial=True: where the initial state was moved, and by how much (coordinate order).
+py::object initial_fix_dict(const std::optional<InitialFix>& initial_fix) {
+  if (!initial_fix) return py::none();
+  py::dict fix;
+  const auto array = [](const Vector& v) {
+    return take_array(std::vector<double>(v.data(), v.data() + v.size()), {v.size()});
+  };
+  fix["q"] = array(initial_fix->q);
+  fix["qd"] = array(initial_fix->v);
+  fix["dq"] = array(initial_fix->dq);
+  fix["dqd"] = array(initial_fix->dv);
+  return fix;
+}
+
+// docs/derivations/energy-balance.md: the balance error (accuracy), the work by agent and the
+// change of E (physics).
+void add_energy_balance(py::dict& d, const EnergySummary& e) {
+  if (!e.has_balance) return;
+  d["energy_balance_error"] = e.balance_error;
+  d["work_forces"] = e.work_forces;
+  d["work_reactions"] = e.work_reactions;
+  d["work_time"] = e.work_time;
+  d["energy_change"] = e.change;
+}
+
+}  // namespace
+
+py::dict summary_dict(const SimulationSummary& s) {
+  py::dict d;
+  add_run(d, s);
+  add_residuals(d, s.residuals, "");
+  d["energy_drift"] = s.energy.has_energy ? py::cast(s.energy.drift) : py::none();
+  add_residuals(d, s.program, "program_");
+  add_watch_warnings(d, s);
   // A stop condition that never held on a run that reached its end: simulate's sentences
   // (analysis/simulation.hpp); the Python package raises them as StopConditionWarning.
-  d["unmet_stops"] = s.unmet_stops;
-  d["largest_row_factor"] = s.largest_row_factor;
-  d["largest_condition_factor"] = s.largest_condition_factor;
-  d["stopped_by"] = s.stopped_by >= 0 ? py::cast(s.event_names[static_cast<std::size_t>(s.stopped_by)]) : py::none();
-  // docs/derivations/energy-balance.md: the balance error (accuracy), the work by agent and the
-  // change of E (physics).
-  // fix_initial=True: where the initial state was moved, and by how much (coordinate order).
-  if (s.initial_fix) {
-    py::dict fix;
-    const auto array = [](const Vector& v) {
-      return take_array(std::vector<double>(v.data(), v.data() + v.size()), {v.size()});
-    };
-    fix["q"] = array(s.initial_fix->q);
-    fix["qd"] = array(s.initial_fix->v);
-    fix["dq"] = array(s.initial_fix->dq);
-    fix["dqd"] = array(s.initial_fix->dv);
-    d["initial_fix"] = fix;
-  } else {
-    d["initial_fix"] = py::none();
-  }
-  if (s.has_energy_balance) {
-    d["energy_balance_error"] = s.max_balance_error;
-    d["work_forces"] = s.work_forces;
-    d["work_reactions"] = s.work_reactions;
-    d["work_time"] = s.work_time;
-    d["energy_change"] = s.energy_change;
-  }
+  d["unmet_stops"] = s.events.unmet_stops;
+  d["largest_row_factor"] = s.watch.largest_row_factor;
+  d["largest_condition_factor"] = s.watch.largest_condition_factor;
+  const EventSummary& events = s.events;
+  d["stopped_by"] =
+      events.stopped_by >= 0 ? py::cast(events.names[static_cast<std::size_t>(events.stopped_by)]) : py::none();
+  d["initial_fix"] = initial_fix_dict(s.initial_fix);
+  add_energy_balance(d, s.energy);
   return d;
 }
 
@@ -263,7 +285,7 @@ void bind_simulation(py::module_& m) {
         out["summary"] = summary_dict(summary);
         // The located crossings, in time order: name, t, q, qd at each.
         py::list events;
-        for (const EventRecord& e : summary.events) {
+        for (const EventRecord& e : summary.events.crossings) {
           py::dict event;
           event["name"] = e.name;
           event["t"] = e.t;

@@ -141,7 +141,7 @@ void print_batch_outcome(const BatchArgs& args, const Model& base, const std::ve
   if (warned > 1) fmt::print(stderr, "nhdyn: warning: {} of {} runs had constraint-watch warnings\n", warned, results.size());
   // A stop condition that never held, in simulate's words, once with the runs it names.
   std::vector<std::vector<std::string>> unmet(results.size());
-  for (std::size_t r = 0; r < results.size(); ++r) unmet[r] = results[r].summary.unmet_stops;
+  for (std::size_t r = 0; r < results.size(); ++r) unmet[r] = results[r].summary.events.unmet_stops;
   for (const std::string& w : format_batch_unmet_stops(unmet)) fmt::print(stderr, "nhdyn: warning: {}\n", w);
   if (!args.quiet) {
     fmt::print("nhdyn batch {}: {} runs on {} threads, {} failed -> {}\n", base.name, results.size(),
@@ -271,8 +271,8 @@ std::string summary_line(std::size_t r, const std::vector<double>& values, const
   line += fmt::format(",{}", res.summary.t_reached);
   for (int i = 0; i < base.n(); ++i) line += res.q_end.size() == base.n() ? fmt::format(",{}", res.q_end(i)) : ",";
   for (int i = 0; i < base.n(); ++i) line += res.v_end.size() == base.n() ? fmt::format(",{}", res.v_end(i)) : ",";
-  line += fmt::format(",{},{},{},{}\n", res.summary.max_position_residual, res.summary.max_velocity_residual,
-                      res.summary.max_acceleration_residual, csv_text(res.message));
+  line += fmt::format(",{},{},{},{}\n", res.summary.residuals.position, res.summary.residuals.velocity,
+                      res.summary.residuals.acceleration, csv_text(res.message));
   return line;
 }
 

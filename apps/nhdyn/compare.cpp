@@ -52,29 +52,13 @@ std::string case_name(const ComparisonCase& c) {
 
 // The accuracy of a run's energy: the largest |h - h0 - W| (docs/derivations/energy-balance.md),
 // or, for a built-in model without a balance, the drift of its conserved E.
-double energy_error(const SimulationSummary& s) { return s.has_energy_balance ? s.max_balance_error : s.energy_drift; }
+double energy_error(const SimulationSummary& s) {
+  return s.energy.has_balance ? s.energy.balance_error : s.energy.drift;
+}
 
-int run_compare(const CompareArgs& args) {
-  protect_model_file(args.model);
-  const ModelSource source = read_model_source(args.model);
-  const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
-  std::string notice;
-  const Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
-  if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
-  if (args.reference != "tight" && args.reference != "analytic")
-    throw InputError(fmt::format("unknown reference '{}'; choose one of: tight, analytic", args.reference));
-
-  ComparisonOptions options;
-  options.reference = args.reference == "analytic" ? Reference::analytic : Reference::tight;
-  if (options.reference == Reference::analytic) check_solution(model);  // before any file is opened
-  options.run.t_end = args.t_end.value_or(model.defaults.t_end);
-  options.run.output_step = args.output_step.value_or(model.defaults.output_step);
-  options.run.formulation.complement = parse_complement(args.complement);
-  options.run.integrator.rtol = args.rtol.value_or(model.defaults.rtol);
-  options.run.integrator.atol = args.atol.value_or(model.defaults.atol);
-  options.run.stabilization = parse_stabilization(args.stabilize);
-  // Programs are solved by sanh alone: by default it is then the one method compared, with a note;
-  // another one asked for by name is refused.
+// The methods compared: those asked for, except that programs are solved by sanh alone: by default
+// it is then the one method compared, with a note; another one asked for by name is refused.
+std::vector<std::string> compared_methods(const Model& model, const CompareArgs& args) {
   std::vector<std::string> methods = args.methods;
   if (model.m() > 0) {
     for (const std::string& m : methods)
@@ -99,33 +83,42 @@ int run_compare(const CompareArgs& args) {
       if (parse_integrator(args.integrators[i]) == parse_integrator(args.integrators[j]))
         throw InputError(fmt::format("--integrators: '{}' is named twice; name each integrator once",
                                      args.integrators[j]));
-  for (const std::string& m : methods)
-    for (const std::string& i : args.integrators) options.cases.push_back({parse_method(m), parse_integrator(i)});
+  return methods;
+}
 
-  namespace fs = std::filesystem;
-  const fs::path table_path = args.output.empty() ? fs::path("results") / (make_file_name(model.name) + "-compare.csv") : fs::path(args.output);
-  if (args.output.empty()) make_parent_directory(table_path);
-  fs::path series_path = table_path;
-  series_path.replace_filename(table_path.stem().string() + "-series.csv");
-  check_command_paths(args.model, {{table_path, "the table CSV"}, {series_path, "the series CSV"}, {args.plot, "--plot"}});
-  check_plot_possible(args.plot);
-  AtomicFile table(table_path);  // both paths are checked before any run
+// The comparison's options: the reference and the run options every case shares (the cases are
+// added by the caller, each method with each integrator).
+ComparisonOptions make_comparison_options(const Model& model, const CompareArgs& args) {
+  ComparisonOptions options;
+  options.reference = args.reference == "analytic" ? Reference::analytic : Reference::tight;
+  if (options.reference == Reference::analytic) check_solution(model);  // before any file is opened
+  options.run.t_end = args.t_end.value_or(model.defaults.t_end);
+  options.run.output_step = args.output_step.value_or(model.defaults.output_step);
+  options.run.formulation.complement = parse_complement(args.complement);
+  options.run.integrator.rtol = args.rtol.value_or(model.defaults.rtol);
+  options.run.integrator.atol = args.atol.value_or(model.defaults.atol);
+  options.run.stabilization = parse_stabilization(args.stabilize);
+  return options;
+}
+
+// The series CSV's columns: t, then per case its error and the residuals the model has.
+std::vector<std::string> series_columns(const Model& model, const ComparisonOptions& options) {
   std::vector<std::string> columns{"t"};
   for (const ComparisonCase& c : options.cases) {
     columns.push_back("error_" + case_name(c));
     if (model.position_constraints() > 0) columns.push_back("residual_pos_" + case_name(c));
     if (model.velocity_constraints() > 0) columns.push_back("residual_vel_" + case_name(c));
   }
-  if (!args.plot_columns.empty()) {
-    if (args.plot.empty())
-      throw InputError("--plot-columns chooses what --plot draws; give --plot FILE.png too, or leave --plot-columns out");
-    require_plot_columns(columns, args.plot_columns);
-  }
-  // Both files say what made them (io/provenance.hpp): the model as loaded and the cases compared.
+  return columns;
+}
+
+// Both files say what made them (io/provenance.hpp): the model as loaded and the cases compared.
+std::string compare_provenance(const Model& model, const ModelSource& source, const CompareArgs& args,
+                               const std::vector<std::string>& methods, const ComparisonOptions& options) {
   std::vector<std::string> method_names, integrator_names;
   for (const std::string& m : methods) method_names.emplace_back(method_name(parse_method(m)));
   for (const std::string& i : args.integrators) integrator_names.emplace_back(integrator_name(parse_integrator(i)));
-  const std::string provenance = format_provenance(make_command_provenance(
+  return format_provenance(make_command_provenance(
       model, source, "compare",
       {{"methods", join(method_names, ",")},
        {"integrators", join(integrator_names, ",")},
@@ -138,23 +131,22 @@ int run_compare(const CompareArgs& args) {
        {"output_step", fmt::format("{}", options.run.output_step)},
        {"stabilize", std::string(stabilization_name(options.run.stabilization))},
        {"evaluator", args.evaluator}}));
-  CsvWriter series(series_path, columns, provenance);
+}
 
-  // compare measures every case against the reference row by row to t_end, so a stop event of the
-  // model (which would end each run at its own time) is not applied: said here, as simulate says
-  // that a stop condition never held, rather than left for the user to find.
+// compare measures every case against the reference row by row to t_end, so a stop event of the
+// model (which would end each run at its own time) is not applied: said here, as simulate says
+// that a stop condition never held, rather than left for the user to find.
+void warn_stop_events(const Model& model, double t_end) {
   for (const Event& e : model.events)
     if (e.action == EventAction::stop)
       fmt::print(stderr,
                  "nhdyn: warning: {}{}the stop event '{}' ({}) is not applied by compare: every case runs to t = {:g} "
                  "to be measured against the reference row by row; nhdyn simulate stops there\n",
-                 e.where, e.where.empty() ? "" : ": ", e.name, e.expression, options.run.t_end);
-  const Comparison result = compare_formulations(model, options);
-  // The constraint watch's warnings (analysis/constraint_watch.hpp), per case, whatever -q says.
-  for (const ComparisonResult& r : result.results)
-    for (const std::string& w : r.summary.warnings)
-      fmt::print(stderr, "nhdyn: warning ({}, {}): {}\n", method_name(r.which.method), integrator_name(r.which.integrator), w);
+                 e.where, e.where.empty() ? "" : ": ", e.name, e.expression, t_end);
+}
 
+// The table CSV: one row per case, its cost, its residuals and errors, its outcome.
+std::string format_table(const std::string& provenance, const Comparison& result) {
   std::string text = provenance +
       "method,integrator,solve_ns,steps,rhs_evaluations,wall_time_s,max_residual_pos,max_residual_vel,"
       "max_residual_acc,energy_error,max_error_q,max_error_v,status\n";
@@ -162,11 +154,14 @@ int run_compare(const CompareArgs& args) {
     const SimulationSummary& s = r.summary;
     text += fmt::format("{},{},{:.4g},{},{},{:.4g},{:.3e},{:.3e},{:.3e},{:.3e},{:.3e},{:.3e},{}\n",
                         method_name(r.which.method), integrator_name(r.which.integrator), r.solve_ns, s.stats.steps,
-                        s.stats.rhs_evaluations, s.wall_time, s.max_position_residual, s.max_velocity_residual,
-                        s.max_acceleration_residual, energy_error(s), r.max_error_q, r.max_error_v,
-                        s.status == Status::ok ? "ok" : std::string(describe(s.status)));
+                        s.stats.rhs_evaluations, s.wall_time, s.residuals.position, s.residuals.velocity,
+                        s.residuals.acceleration, energy_error(s), r.max_error_q, r.max_error_v,
+                        format_status(s));
   }
-  table.write(text);
+  return text;
+}
+
+void write_series(CsvWriter& series, const Model& model, const Comparison& result) {
   std::vector<double> row;
   for (std::size_t k = 0; k < result.times.size(); ++k) {
     row.assign(1, result.times[k]);
@@ -177,50 +172,95 @@ int run_compare(const CompareArgs& args) {
     }
     series.write_row(row);
   }
+}
+
+// --plot: the error and the residuals against time, one panel per method or integrator.
+void plot_comparison(const CompareArgs& args, const Model& model, const ComparisonOptions& options,
+                     const std::filesystem::path& series_path) {
+  PanelPlotRequest request;
+  request.title = fmt::format("{}: |error| against the reference and constraint residuals", model.name);
+  request.csv = series_path;
+  std::vector<std::string> methods, integrators, quantities{"error"};
+  for (const ComparisonCase& c : options.cases) {
+    const std::string m(method_name(c.method)), i(integrator_name(c.integrator));
+    if (std::find(methods.begin(), methods.end(), m) == methods.end()) methods.push_back(m);
+    if (std::find(integrators.begin(), integrators.end(), i) == integrators.end()) integrators.push_back(i);
+  }
+  if (model.position_constraints() > 0) quantities.push_back("residual_pos");
+  if (model.velocity_constraints() > 0) quantities.push_back("residual_vel");
+  request.panels = calc_comparison_panels(methods, integrators, quantities);
+  if (methods.size() > 1 && integrators.size() > 1) request.layout_columns = static_cast<int>(methods.size());
+  select_panel_columns(request.panels, args.plot_columns);
+  request.same_log_range = true;  // heights compare across panels
+  write_panel_plot(request, args.plot);
+}
+
+// The table on standard output, and where the files went.
+void print_comparison(const CompareArgs& args, const Model& model, const ComparisonOptions& options,
+                      const Comparison& result, const std::filesystem::path& table_path,
+                      const std::filesystem::path& series_path) {
+  fmt::print("nhdyn compare {}: t = {:g} .. {:g} s, D: {}, rtol {:g}, atol {:g}, stabilization {}\n", model.name,
+             model.t0, options.run.t_end, args.complement, options.run.integrator.rtol, options.run.integrator.atol, args.stabilize);
+  if (options.reference == Reference::analytic)
+    fmt::print("reference: the model's exact solution\n");
+  else
+    fmt::print("reference: sanh, dopri5, rtol 1e-13, atol 1e-15 ({} steps)\n", result.reference.stats.steps);
+  auto level = [](double value, bool defined) { return defined ? fmt::format("{:.2e}", value) : std::string("-"); };
+  fmt::print("{:<15} {:<12} {:>9} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "method", "integrator",
+             "solve ns", "steps", "rhs", "wall ms", "res pos", "res vel", "energy", "err q", "err q'");
+  for (const ComparisonResult& r : result.results) {
+    const SimulationSummary& s = r.summary;
+    fmt::print("{:<15} {:<12} {:>9.1f} {:>8} {:>9} {:>9.3g} {:>9} {:>9} {:>9.2e} {:>9.2e} {:>9.2e}{}\n",
+               method_name(r.which.method), integrator_name(r.which.integrator), r.solve_ns, s.stats.steps,
+               s.stats.rhs_evaluations, s.wall_time * 1e3,
+               level(s.residuals.position, model.position_constraints() > 0),
+               level(s.residuals.velocity, model.velocity_constraints() > 0),
+               energy_error(s), r.max_error_q, r.max_error_v,
+               format_failure_note(s));
+  }
+  fmt::print("table -> {}\nseries -> {}\n", table_path.string(), series_path.string());
+  if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
+}
+
+int run_compare(const CompareArgs& args) {
+  protect_model_file(args.model);
+  const ModelSource source = read_model_source(args.model);
+  const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
+  std::string notice;
+  const Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
+  if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
+  if (args.reference != "tight" && args.reference != "analytic")
+    throw InputError(fmt::format("unknown reference '{}'; choose one of: tight, analytic", args.reference));
+  ComparisonOptions options = make_comparison_options(model, args);
+  const std::vector<std::string> methods = compared_methods(model, args);
+  for (const std::string& m : methods)
+    for (const std::string& i : args.integrators) options.cases.push_back({parse_method(m), parse_integrator(i)});
+
+  namespace fs = std::filesystem;
+  const fs::path table_path = args.output.empty() ? fs::path("results") / (make_file_name(model.name) + "-compare.csv") : fs::path(args.output);
+  if (args.output.empty()) make_parent_directory(table_path);
+  fs::path series_path = table_path;
+  series_path.replace_filename(table_path.stem().string() + "-series.csv");
+  check_command_paths(args.model, {{table_path, "the table CSV"}, {series_path, "the series CSV"}, {args.plot, "--plot"}});
+  check_plot_possible(args.plot);
+  AtomicFile table(table_path);  // both paths are checked before any run
+  const std::vector<std::string> columns = series_columns(model, options);
+  check_plot_columns(args.plot, columns, args.plot_columns);
+  const std::string provenance = compare_provenance(model, source, args, methods, options);
+  CsvWriter series(series_path, columns, provenance);
+
+  warn_stop_events(model, options.run.t_end);
+  const Comparison result = compare_formulations(model, options);
+  // The constraint watch's warnings (analysis/constraint_watch.hpp), per case, whatever -q says.
+  for (const ComparisonResult& r : result.results)
+    for (const std::string& w : r.summary.warnings)
+      fmt::print(stderr, "nhdyn: warning ({}, {}): {}\n", method_name(r.which.method), integrator_name(r.which.integrator), w);
+  table.write(format_table(provenance, result));
+  write_series(series, model, result);
   series.commit();
   table.commit();
-  if (!args.plot.empty()) {
-    PanelPlotRequest request;
-    request.title = fmt::format("{}: |error| against the reference and constraint residuals", model.name);
-    request.csv = series_path;
-    std::vector<std::string> methods, integrators, quantities{"error"};
-    for (const ComparisonCase& c : options.cases) {
-      const std::string m(method_name(c.method)), i(integrator_name(c.integrator));
-      if (std::find(methods.begin(), methods.end(), m) == methods.end()) methods.push_back(m);
-      if (std::find(integrators.begin(), integrators.end(), i) == integrators.end()) integrators.push_back(i);
-    }
-    if (model.position_constraints() > 0) quantities.push_back("residual_pos");
-    if (model.velocity_constraints() > 0) quantities.push_back("residual_vel");
-    request.panels = calc_comparison_panels(methods, integrators, quantities);
-    if (methods.size() > 1 && integrators.size() > 1) request.layout_columns = static_cast<int>(methods.size());
-    select_panel_columns(request.panels, args.plot_columns);
-    request.same_log_range = true;  // heights compare across panels
-    write_panel_plot(request, args.plot);
-  }
-
-  if (!args.quiet) {
-    fmt::print("nhdyn compare {}: t = {:g} .. {:g} s, D: {}, rtol {:g}, atol {:g}, stabilization {}\n", model.name,
-               model.t0, options.run.t_end, args.complement, options.run.integrator.rtol, options.run.integrator.atol, args.stabilize);
-    if (options.reference == Reference::analytic)
-      fmt::print("reference: the model's exact solution\n");
-    else
-      fmt::print("reference: sanh, dopri5, rtol 1e-13, atol 1e-15 ({} steps)\n", result.reference.stats.steps);
-    auto level = [](double value, bool defined) { return defined ? fmt::format("{:.2e}", value) : std::string("-"); };
-    fmt::print("{:<15} {:<12} {:>9} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "method", "integrator",
-               "solve ns", "steps", "rhs", "wall ms", "res pos", "res vel", "energy", "err q", "err q'");
-    for (const ComparisonResult& r : result.results) {
-      const SimulationSummary& s = r.summary;
-      fmt::print("{:<15} {:<12} {:>9.1f} {:>8} {:>9} {:>9.3g} {:>9} {:>9} {:>9.2e} {:>9.2e} {:>9.2e}{}\n",
-                 method_name(r.which.method), integrator_name(r.which.integrator), r.solve_ns, s.stats.steps,
-                 s.stats.rhs_evaluations, s.wall_time * 1e3,
-                 level(s.max_position_residual, model.position_constraints() > 0),
-                 level(s.max_velocity_residual, model.velocity_constraints() > 0),
-                 energy_error(s), r.max_error_q, r.max_error_v,
-                 s.status == Status::ok ? "" : fmt::format("  FAILED at t = {:.4g}: {}", s.t_reached, s.message));
-    }
-    fmt::print("table -> {}\nseries -> {}\n", table_path.string(), series_path.string());
-    if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
-  }
+  if (!args.plot.empty()) plot_comparison(args, model, options, series_path);
+  if (!args.quiet) print_comparison(args, model, options, result, table_path, series_path);
   for (const ComparisonResult& r : result.results)
     if (r.summary.status != Status::ok) return 1;
   return 0;

@@ -115,6 +115,14 @@ void check_plot_possible(const std::string& plot) {
                     "or run without --plot");
 }
 
+void check_plot_columns(const std::string& plot, const std::vector<std::string>& columns,
+                        const std::vector<std::string>& chosen) {
+  if (chosen.empty()) return;
+  if (plot.empty())
+    throw InputError("--plot-columns chooses what --plot draws; give --plot FILE.png too, or leave --plot-columns out");
+  require_plot_columns(columns, chosen);
+}
+
 void install_interrupt_handlers() {
   struct sigaction action{};
   action.sa_handler = on_interrupt;

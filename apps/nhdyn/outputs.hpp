@@ -35,6 +35,11 @@ void make_parent_directory(const std::filesystem::path& file);
 // terminal is missing, and FileError when `plot` names an input of the run.
 void check_plot_possible(const std::string& plot);
 
+// --plot-columns: refused without --plot (InputError saying to give both), and each name checked
+// against the columns the plot can draw (require_plot_columns, io/plot.hpp). Nothing when not given.
+void check_plot_columns(const std::string& plot, const std::vector<std::string>& columns,
+                        const std::vector<std::string>& chosen);
+
 // Installs the SIGINT and SIGTERM handlers: remove the temporary files under way, print
 // "interrupted by SIGINT at t = ..." (the last time passed to note_time, if any) and exit with
 // 128 + the signal's number.

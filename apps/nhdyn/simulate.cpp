@@ -28,7 +28,6 @@
 #include "nhdyn/io/report.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
-#include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/contact_modes.hpp"
 #include "nhdyn/model/initial_values.hpp"
 #include "nhdyn/symbolic/events.hpp"
@@ -67,8 +66,8 @@ struct SimulateArgs {
   std::optional<long> max_steps;       // the integrator's step budget (default IntegratorOptions)
 };
 
-// --program-feedback alpha,beta: two non-negative rates [1/s], each a plain decimal number (no
-// hexadecimal, no nan or inf, no spaces), at most kMaxProgramFeedback (program_feedback.hpp).
+// --program-feedback alpha,beta: two plain decimal numbers (no hexadecimal, no nan or inf, no
+// spaces); check_simulation_options checks them as rates [1/s], >= 0 and at most kMaxProgramFeedback.
 ProgramFeedback parse_program_feedback(const std::string& text) {
   ProgramFeedback out;
   if (text.empty()) return out;
@@ -101,11 +100,8 @@ ProgramFeedback parse_program_feedback(const std::string& text) {
   out.enabled = true;
   out.alpha = number(text.substr(0, comma), "alpha");
   out.beta = number(text.substr(comma + 1), "beta");
-  check_program_feedback(out);
-  return out;
+  return out;  // the gains' range is checked with the other options, by check_simulation_options
 }
-
-std::string format_residual(double value, bool defined) { return defined ? fmt::format("{:.3g}", value) : "-"; }
 
 // Where a run's companion files go: FILE.csv -> FILE-events.csv and FILE.partial.csv (the
 // extension .csv, if any, replaced).
@@ -150,7 +146,7 @@ void write_events_file(AtomicFile& file, const Model& model, const SimulationSum
   for (const std::string& q : model.coordinates) header.push_back(q);
   for (const std::string& q : model.coordinates) header.push_back(q + "'");
   std::string text = provenance + csv_line(header);
-  for (const EventRecord& e : summary.events) {
+  for (const EventRecord& e : summary.events.crossings) {
     text += csv_cell(e.name);
     fmt::format_to(std::back_inserter(text), ",{}", e.t);
     for (double x : e.q) fmt::format_to(std::back_inserter(text), ",{}", x);
@@ -168,279 +164,245 @@ bool is_regular_target(const std::filesystem::path& csv) {
   return ec || !std::filesystem::exists(status) || std::filesystem::is_regular_file(status);
 }
 
-int run_simulate(const SimulateArgs& args) {
-  protect_model_file(args.model);
-  const ModelSource source = read_model_source(args.model);
-  const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
+// The model as the run uses it: its evaluator chosen and its initial values set, with what loading
+// and choosing found said on stderr.
+Model prepare_model(const LoadedModel& resolved, const SimulateArgs& args) {
   std::string notice;
   Model model = jit::with_evaluator(resolved.model, jit::parse_evaluator_choice(args.evaluator), &notice);
   apply_initial_values(model, args.initial);
   if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
-  if (model.contact_forces)  // what loading found about the contact forces (docs/multibody.md)
-    for (const std::string& note : model.contact_forces->notes) fmt::print(stderr, "note: contact forces: {}\n", note);
-  RunOptions run = run_options_with(model, args);
-  SimulationOptions options = make_simulation_options(run);
+  fmt::print(stderr, "{}", format_contact_force_notes(model));
+  return model;
+}
+
+// The run's options: the model's, the command line's overrides, the file's [[events]] then the
+// command line's; checked whole before any file is opened.
+SimulationOptions make_run_options(const Model& model, const SimulateArgs& args) {
+  SimulationOptions options = make_simulation_options(run_options_with(model, args));
   options.integrator.step = args.step;
   options.fix_initial = args.fix_initial;
   options.stabilization = parse_stabilization(args.stabilize);
   options.formulation.baumgarte.alpha = args.baumgarte_alpha;
   options.formulation.baumgarte.beta = args.baumgarte_beta;
   options.projection.tolerance = args.projection_tolerance;
-  if (args.max_steps) {
-    if (*args.max_steps < 1)
-      throw InputError(fmt::format("--max-steps {}: the step budget must be at least 1 (accepted + rejected steps "
-                                   "of the whole run; the default is {})",
-                                   *args.max_steps, IntegratorOptions{}.max_steps));
-    options.integrator.max_steps = *args.max_steps;
-  }
-  options.events = model.events;  // the file's [[events]], then the command line's
+  if (args.max_steps) options.integrator.max_steps = *args.max_steps;  // checked by check_simulation_options
+  options.events = model.events;
   for (const std::string& condition : args.stop_when)
     options.events.push_back(symbolic::make_stop_condition(model, condition));
   for (const std::string& definition : args.events)
     options.events.push_back(symbolic::make_record_event(model, definition));
   options.formulation.program_feedback = parse_program_feedback(args.program_feedback);
   check_simulation_options(model, options);
-  const ResultColumns columns = make_result_columns(model);
-  // Every file of the run says where it came from (io/provenance.hpp).
-  const std::string provenance = format_provenance(make_provenance(model, source, options, args.evaluator));
-  if (!args.plot_columns.empty()) {
-    if (args.plot.empty())
-      throw InputError("--plot-columns chooses what --plot draws; give --plot FILE.png too, or leave --plot-columns out");
-    require_plot_columns(columns.all, args.plot_columns);
-  }
+  return options;
+}
 
+// A run's files: the CSV, its companions (FILE-events.csv, FILE.partial.csv), the plot and the
+// report. Opened (or probed) before the first step, committed after the last.
+struct RunFiles {
+  std::filesystem::path csv, events, partial;
+  bool companions = false;  // the CSV is a regular file, with a place beside it
+  std::optional<AtomicFile> plot_probe, html_probe, events_file;
+  std::optional<CsvWriter> writer;
+  std::vector<double> kept;  // every row, for FILE.partial.csv if the run fails
+};
+
+// Every file of the run checked together (io/run_paths.hpp), then opened, before any work: a bad
+// path never costs a run.
+void open_run_files(RunFiles& files, const SimulateArgs& args, const Model& model, const SimulationOptions& options,
+                    const ResultColumns& columns, const std::string& provenance) {
   namespace fs = std::filesystem;
+  check_plot_columns(args.plot, columns.all, args.plot_columns);
   const bool default_csv = args.output.empty();
-  const fs::path csv_path = default_csv ? fs::path("results") / (make_file_name(model.name) + ".csv") : fs::path(args.output);
-  const fs::path events_path = companion(csv_path, "-events.csv");
-  const fs::path partial_path = companion(csv_path, ".partial.csv");
-  const bool companions = is_regular_target(csv_path);
+  files.csv = default_csv ? fs::path("results") / (make_file_name(model.name) + ".csv") : fs::path(args.output);
+  files.events = companion(files.csv, "-events.csv");
+  files.partial = companion(files.csv, ".partial.csv");
+  files.companions = is_regular_target(files.csv);
+  // Contacts with modes write their switches in the events file too (docs/contact-modes.md).
+  const bool events_file = files.companions && (!options.events.empty() || model.contact_modes);
   {
-    // Every file of the run, checked together before any work (io/run_paths.hpp).
     RunPaths paths;
     if (fs::is_regular_file(args.model)) paths.input(args.model, "the model file");
-    paths.output(csv_path, "the CSV output");
-    if (companions) {
-      if (!options.events.empty() || model.contact_modes) paths.output(events_path, "the events file");
-      paths.output(partial_path, "the partial-results file");
-    }
+    paths.output(files.csv, "the CSV output");
+    if (events_file) paths.output(files.events, "the events file");
+    if (files.companions) paths.output(files.partial, "the partial-results file");
     if (!args.plot.empty()) paths.output(args.plot, "--plot");
     if (!args.html.empty()) paths.output(args.html, "--html");
     paths.check();
   }
-  std::optional<AtomicFile> plot_probe;
-  if (!args.plot.empty()) {
-    if (!gnuplot_available())
-      throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
-                      "or run without --plot");
-    plot_probe.emplace(args.plot);  // checks the plot's directory now; removed unused
-  }
+  check_plot_possible(args.plot);
+  if (!args.plot.empty()) files.plot_probe.emplace(args.plot);  // checks the plot's directory now; removed unused
   if (default_csv) {
     // The default place is ours to create; a path the user names must already be writable.
     std::error_code ec;
-    fs::create_directories(csv_path.parent_path(), ec);
+    fs::create_directories(files.csv.parent_path(), ec);
     if (ec)
       throw FileError(fmt::format("cannot create the directory '{}' for the results: {}; give another path with -o",
-                                  csv_path.parent_path().string(), ec.message()));
+                                  files.csv.parent_path().string(), ec.message()));
   }
-  std::optional<AtomicFile> html_probe;
-  if (!args.html.empty()) {
-    html_probe.emplace(args.html);  // checks the report's directory now; removed unused
-  }
-  CsvWriter writer(csv_path, columns.all, provenance);  // refuses an unwritable path before any step
-  std::optional<AtomicFile> events_file;
-  // Contacts with modes write their switches there too (docs/contact-modes.md).
-  if (companions && (!options.events.empty() || model.contact_modes)) events_file.emplace(events_path);
+  if (!args.html.empty()) files.html_probe.emplace(args.html);  // checks the report's directory now; removed unused
+  files.writer.emplace(files.csv, columns.all, provenance);  // refuses an unwritable path before any step
+  if (events_file) files.events_file.emplace(files.events);
+}
 
+// Integrates, writing each row to the CSV (and keeping it for FILE.partial.csv) as it comes.
+SimulationSummary run_to_files(const Model& model, const SimulationOptions& options, const ResultColumns& columns,
+                               RunFiles& files) {
   std::vector<double> row;
   row.reserve(columns.all.size());
-  std::vector<double> kept;  // every row, for FILE.partial.csv if the run fails
   ProgressBar progress(model.t0, options.t_end);
   const SimulationSummary summary = simulate(model, options, [&](const Data& data) {
     fill_result_row(model, data, row);
-    writer.write_row(row);
-    if (companions) kept.insert(kept.end(), row.begin(), row.end());
+    files.writer->write_row(row);
+    if (files.companions) files.kept.insert(files.kept.end(), row.begin(), row.end());
     progress.update(data.t);
   });
   progress.finish();
-  // The constraint watch's warnings (analysis/constraint_watch.hpp), whatever the outcome.
-  for (const std::string& w : summary.warnings) fmt::print(stderr, "nhdyn: warning: {}\n", w);
-  for (const std::string& w : summary.unmet_stops) fmt::print(stderr, "nhdyn: warning: {}\n", w);
-  if (summary.status != Status::ok) {
-    fmt::print(stderr, "nhdyn: simulation of '{}' failed at t = {:.6g}: {}\n", model.name, summary.t_reached,
-               summary.message);
-    if (companions) {
-      std::string reason = fmt::format("# nhdyn: simulation of '{}' failed at t = {:.6g}: {}", model.name,
-                                       summary.t_reached, summary.message);
-      for (char& c : reason)
-        if (c == '\n' || c == '\r') c = ' ';
-      AtomicFile partial(partial_path);
-      partial.write(reason + "\n" + provenance + csv_line(columns.all) + format_rows(kept, columns.all.size()));
-      partial.commit();
-      fmt::print(stderr, "nhdyn: the {} rows up to the failure are in {} ({} is left as it was)\n",
-                 summary.outputs, partial_path.string(), csv_path.string());
-    } else {
-      fmt::print(stderr, "nhdyn: no results written ({} is left as it was)\n", csv_path.string());
-    }
+  return summary;
+}
+
+// A failed run: the reason, and the rows up to the failure in FILE.partial.csv (the CSV itself is
+// never committed). Returns the exit code.
+int report_failure(const Model& model, const SimulationSummary& summary, const RunFiles& files,
+                   const ResultColumns& columns, const std::string& provenance) {
+  fmt::print(stderr, "nhdyn: simulation of '{}' failed at t = {:.6g}: {}\n", model.name, summary.t_reached,
+             summary.message);
+  if (!files.companions) {
+    fmt::print(stderr, "nhdyn: no results written ({} is left as it was)\n", files.csv.string());
     return 1;
   }
-  writer.commit();
-  if (events_file) write_events_file(*events_file, model, summary, provenance);
-  plot_probe.reset();
-  if (!args.plot.empty()) {
-    PlotRequest request;
-    request.title = fmt::format("{}: {}, {}", model.name, method_name(options.formulation.method),
-                                integrator_name(options.integrator.kind));
-    request.csv = csv_path;
-    request.coordinates = columns.coordinates;
-    for (const std::string& q : model.coordinates) request.velocities.push_back(q + "'");
-    request.reactions = columns.reactions;
-    request.residuals = columns.residuals;
-    request.actuators = columns.actuators;
-    // Drawn without asking: the file's own [outputs] and each contact's normal force (the load,
-    // whose sign says whether the wheel would lift off); the rest of the contact columns and the
-    // multibody points' coordinates through --plot-columns.
-    for (const DerivedOutput& o : model.outputs.list)
-      if (!o.automatic) request.others.push_back(o.name);
-    for (const std::string& c : columns.contact_forces)
-      if (c.size() > 2 && c.compare(c.size() - 2, 2, "_N") == 0) request.others.push_back(c);
-    // Contacts with modes: their mode columns as steps (docs/contact-modes.md); the switches are
-    // among the events marked on every panel.
-    for (const std::string& c : contact_mode_columns(model))
-      if (c.size() > 5 && c.compare(c.size() - 5, 5, "_mode") == 0) request.modes.push_back(c);
-    if (model.path)
-      request.path = std::make_pair(model.coordinates[static_cast<std::size_t>(model.path->x)],
-                                    model.coordinates[static_cast<std::size_t>(model.path->y)]);
-    // With an energy balance the drawn error is h - h(t0) - W (the change of E may be physics).
-    if (!columns.energy.empty())
-      request.energy = columns.energy_balance.empty() ? columns.energy : columns.energy_balance.back();
-    for (const EventRecord& e : summary.events) {
-      PlotEvent& mark = request.events.emplace_back(PlotEvent{e.name, e.t});
-      for (std::size_t i = 0; i < model.coordinates.size(); ++i) {
-        mark.state.emplace_back(model.coordinates[i], e.q[i]);
-        mark.state.emplace_back(model.coordinates[i] + "'", e.v[i]);
-      }
-    }
-    // A model file also tells its angles by use: the coordinates inside sin, cos or tan.
-    if (resolved.description) {
-      try {
-        const std::vector<bool>& angles = description_angles(*resolved.description);
-        for (std::size_t i = 0; i < angles.size() && i < model.coordinates.size(); ++i)
-          if (angles[i]) request.angles.push_back(model.coordinates[i]);
-      } catch (const Error&) {
-        // A [visual] item that does not compile costs the plot only this hint; the names remain.
-      }
-    }
-    select_plot_columns(request, columns.all, args.plot_columns);
-    write_plot(request, args.plot);
-  }
-  html_probe.reset();
-  std::string html_notice;
-  if (!args.html.empty())
-    html_notice = write_model_report(model, resolved.description.get(), load_csv(csv_path),
-                       fmt::format("{}: {}, {}", model.name, method_name(options.formulation.method),
-                                   integrator_name(options.integrator.kind)),
-                       {{"steps", fmt::format("{} (rejected {})", summary.stats.steps, summary.stats.rejected_steps)},
-                        {"right-hand sides", fmt::format("{}", summary.stats.rhs_evaluations)},
-                        {"results", csv_path.string()}},
-                       args.html);
+  std::string reason = fmt::format("# nhdyn: simulation of '{}' failed at t = {:.6g}: {}", model.name,
+                                   summary.t_reached, summary.message);
+  for (char& c : reason)
+    if (c == '\n' || c == '\r') c = ' ';
+  AtomicFile partial(files.partial);
+  partial.write(reason + "\n" + provenance + csv_line(columns.all) + format_rows(files.kept, columns.all.size()));
+  partial.commit();
+  fmt::print(stderr, "nhdyn: the {} rows up to the failure are in {} ({} is left as it was)\n", summary.outputs,
+             files.partial.string(), files.csv.string());
+  return 1;
+}
 
-  if (!args.quiet) {
-    const bool adaptive = options.integrator.kind != IntegratorKind::rk4;
-    fmt::print("nhdyn simulate {}: method {} ({}), integrator {}{}\n", model.name,
-               method_name(options.formulation.method),
-               summary.sparse ? std::string(options.formulation.method == Method::sanh ? "sparse path, D: partition"
-                                                                                        : "sparse path")
-                              : fmt::format("D: {}", complement_name(options.formulation.complement)),
-               integrator_name(options.integrator.kind),
-               adaptive ? fmt::format(" (rtol {:g}, atol {:g})", options.integrator.rtol, options.integrator.atol) : "");
-    if (options.stabilization == Stabilization::baumgarte)
-      fmt::print("  stabilization: baumgarte (alpha {:g} 1/s, beta {:g} 1/s)\n", options.formulation.baumgarte.alpha,
-                 options.formulation.baumgarte.beta);
-    if (options.stabilization == Stabilization::projection)
-      fmt::print("  stabilization: projection, {} projections ({} Newton iterations), largest correction "
-                 "{:.3g} in a coordinate, {:.3g} in a velocity\n",
-                 summary.projections, summary.projection_iterations, summary.max_position_correction,
-                 summary.max_velocity_correction);
-    if (summary.stopped_by >= 0)
-      fmt::print("  t = {:g} .. {:.10g} s: stopped by event '{}', {} rows -> {}\n", model.t0, summary.t_reached,
-                 summary.event_names[static_cast<std::size_t>(summary.stopped_by)], summary.outputs,
-                 csv_path.string());
-    else
-      fmt::print("  t = {:g} .. {:g} s, {} rows -> {}\n", model.t0, options.t_end, summary.outputs, csv_path.string());
-    if (!summary.event_names.empty()) {
-      fmt::print("  events: {} located{}\n", summary.events.size(),
-                 events_file ? fmt::format(" -> {}", events_path.string()) : std::string());
-      constexpr std::size_t shown = 10;
-      for (std::size_t i = 0; i < summary.events.size() && i < shown; ++i)
-        fmt::print("    {} at t = {:.12g}\n", summary.events[i].name, summary.events[i].t);
-      if (summary.events.size() > shown) fmt::print("    ... and {} more\n", summary.events.size() - shown);
+std::string run_title(const Model& model, const SimulationOptions& options) {
+  return fmt::format("{}: {}, {}", model.name, method_name(options.formulation.method),
+                     integrator_name(options.integrator.kind));
+}
+
+// --plot: the run's panels (docs/cli.md), drawn from the committed CSV.
+void plot_run(const SimulateArgs& args, const LoadedModel& resolved, const Model& model,
+              const SimulationOptions& options, const ResultColumns& columns, const SimulationSummary& summary,
+              const std::filesystem::path& csv) {
+  PlotRequest request;
+  request.title = run_title(model, options);
+  request.csv = csv;
+  request.coordinates = columns.coordinates;
+  for (const std::string& q : model.coordinates) request.velocities.push_back(q + "'");
+  request.reactions = columns.reactions;
+  request.residuals = columns.residuals;
+  request.actuators = columns.actuators;
+  // Drawn without asking: the file's own [outputs] and each contact's normal force (the load,
+  // whose sign says whether the wheel would lift off); the rest of the contact columns and the
+  // multibody points' coordinates through --plot-columns.
+  for (const DerivedOutput& o : model.outputs.list)
+    if (!o.automatic) request.others.push_back(o.name);
+  for (const std::string& c : columns.contact_forces)
+    if (c.size() > 2 && c.compare(c.size() - 2, 2, "_N") == 0) request.others.push_back(c);
+  // Contacts with modes: their mode columns as steps (docs/contact-modes.md); the switches are
+  // among the events marked on every panel.
+  for (const std::string& c : contact_mode_columns(model))
+    if (c.size() > 5 && c.compare(c.size() - 5, 5, "_mode") == 0) request.modes.push_back(c);
+  if (model.path)
+    request.path = std::make_pair(model.coordinates[static_cast<std::size_t>(model.path->x)],
+                                  model.coordinates[static_cast<std::size_t>(model.path->y)]);
+  // With an energy balance the drawn error is h - h(t0) - W (the change of E may be physics).
+  if (!columns.energy.empty())
+    request.energy = columns.energy_balance.empty() ? columns.energy : columns.energy_balance.back();
+  for (const EventRecord& e : summary.events.crossings) {
+    PlotEvent& mark = request.events.emplace_back(PlotEvent{e.name, e.t});
+    for (std::size_t i = 0; i < model.coordinates.size(); ++i) {
+      mark.state.emplace_back(model.coordinates[i], e.q[i]);
+      mark.state.emplace_back(model.coordinates[i] + "'", e.v[i]);
     }
-    fmt::print("  steps {} (rejected {}), right-hand-side evaluations {}, wall time {:.3g} ms\n",
-               summary.stats.steps, summary.stats.rejected_steps, summary.stats.rhs_evaluations,
-               summary.wall_time * 1e3);
-    fmt::print("  max residual: position {}, velocity {}, acceleration {}\n",
-               format_residual(summary.max_position_residual, model.position_constraints() > 0),
-               format_residual(summary.max_velocity_residual, model.velocity_constraints() > 0),
-               format_residual(summary.max_acceleration_residual, model.s() > 0));
-    if (model.m() > 0) {
-      fmt::print("  programs: {}, max residual: position {}, velocity {}, acceleration {}{}\n", model.m(),
-                 format_residual(summary.max_program_position_residual, model.position_programs() > 0),
-                 format_residual(summary.max_program_velocity_residual, model.velocity_programs() > 0),
-                 format_residual(summary.max_program_acceleration_residual, true),
-                 options.formulation.program_feedback.enabled
-                     ? fmt::format(" (feedback alpha {:g} 1/s, beta {:g} 1/s)", options.formulation.program_feedback.alpha,
-                                   options.formulation.program_feedback.beta)
-                     : "");
-    }
-    if (summary.initial_fix) {
-      const InitialFix& fix = *summary.initial_fix;
-      fmt::print("  initial state moved onto the constraints (--fix-initial):\n");
-      for (int i = 0; i < model.n(); ++i) {
-        const std::string& c = model.coordinates[static_cast<std::size_t>(i)];
-        if (fix.dq(i) != 0.0)
-          fmt::print("    {} = {:.12g} (changed by {:+.3g}), was {:.12g}\n", c, fix.q(i), fix.dq(i), fix.q(i) - fix.dq(i));
-        if (fix.dv(i) != 0.0)
-          fmt::print("    {}' = {:.12g} (changed by {:+.3g}), was {:.12g}\n", c, fix.v(i), fix.dv(i), fix.v(i) - fix.dv(i));
-      }
-    }
-    if (summary.has_energy_balance) {
-      // docs/derivations/energy-balance.md section 3: the balance is the error; the work and the
-      // change of the energy are physics.
-      fmt::print("  energy balance error: {:.3g} (max |h - h0 - W|)\n", summary.max_balance_error);
-      if (model.contact_modes)  // contacts that slide (docs/contact-modes.md)
-        fmt::print("  work W: {:.10g} (forces {:.6g}, reactions {:.6g}, explicit time {:.6g}, friction {:.6g}{})\n",
-                   summary.work_forces + summary.work_reactions + summary.work_time + summary.work_friction -
-                       summary.impact_loss,
-                   summary.work_forces, summary.work_reactions, summary.work_time, summary.work_friction,
-                   summary.impact_loss != 0.0 ? fmt::format(", minus impact loss {:.6g}", summary.impact_loss) : "");
-      else
-        fmt::print("  work W: {:.10g} (forces {:.6g}, reactions {:.6g}, explicit time {:.6g})\n",
-                   summary.work_forces + summary.work_reactions + summary.work_time, summary.work_forces,
-                   summary.work_reactions, summary.work_time);
-      fmt::print("  energy change: E - E0 = {:.10g} (E0 = {:.10g})\n", summary.energy_change, summary.energy_initial);
-      if (summary.energy_function_differs)
-        fmt::print("  energy function change: h - h0 = {:.10g} (h0 = {:.10g})\n", summary.energy_function_change,
-                   summary.energy_function_initial);
-    } else if (summary.has_energy && model.m() > 0) {
-      fmt::print("  energy change: {:.3g} (E0 = {:.10g}; the actuators do work, so E is not conserved)\n",
-                 summary.energy_drift, summary.energy_initial);
-    } else if (summary.has_energy) {
-      fmt::print("  energy drift: {:.3g} (E0 = {:.10g})\n", summary.energy_drift, summary.energy_initial);
-    }
-    // The constraint watch: its warnings are on stderr above; here their count and the largest
-    // degradation seen, so that a clean run says the watch had nothing to report.
-    if (model.s() > 0)
-      fmt::print("  constraint watch: {}; largest change of a row of b x{:.3g}{}\n",
-                 summary.warnings.empty() ? std::string("no warning")
-                                          : fmt::format("{} warning{} on stderr", summary.warnings.size(),
-                                                        summary.warnings.size() == 1 ? "" : "s"),
-                 summary.largest_row_factor,
-                 summary.sparse ? std::string()
-                                : fmt::format(", of the conditioning x{:.3g}", summary.largest_condition_factor));
-    if (!args.plot.empty()) fmt::print("  plot -> {}\n", args.plot);
-    if (!args.html.empty()) fmt::print("  report -> {}{}\n", args.html, html_notice.empty() ? "" : "\n  note: " + html_notice);
   }
+  // A model file also tells its angles by use: the coordinates inside sin, cos or tan.
+  if (resolved.description) {
+    try {
+      const std::vector<bool>& angles = description_angles(*resolved.description);
+      for (std::size_t i = 0; i < angles.size() && i < model.coordinates.size(); ++i)
+        if (angles[i]) request.angles.push_back(model.coordinates[i]);
+    } catch (const Error&) {
+      // A [visual] item that does not compile costs the plot only this hint; the names remain.
+    }
+  }
+  select_plot_columns(request, columns.all, args.plot_columns);
+  write_plot(request, args.plot);
+}
+
+// After a run that succeeded: the CSV and the events file committed, then the plot and the report
+// drawn from them. Returns the report's notice, if any.
+std::string commit_run(const SimulateArgs& args, const LoadedModel& resolved, const Model& model,
+                       const SimulationOptions& options, const ResultColumns& columns,
+                       const SimulationSummary& summary, const std::string& provenance, RunFiles& files) {
+  files.writer->commit();
+  if (files.events_file) write_events_file(*files.events_file, model, summary, provenance);
+  files.plot_probe.reset();
+  if (!args.plot.empty()) plot_run(args, resolved, model, options, columns, summary, files.csv);
+  files.html_probe.reset();
+  if (args.html.empty()) return {};
+  return write_model_report(
+      model, resolved.description.get(), load_csv(files.csv), run_title(model, options),
+      {{"steps", fmt::format("{} (rejected {})", summary.stats.steps, summary.stats.rejected_steps)},
+       {"right-hand sides", fmt::format("{}", summary.stats.rhs_evaluations)},
+       {"results", files.csv.string()}},
+      args.html);
+}
+
+// The summary on standard output: the run's choices, then each group's lines (analysis/simulation_summary.hpp).
+void print_summary(const SimulateArgs& args, const Model& model, const SimulationOptions& options,
+                   const SimulationSummary& summary, const RunFiles& files, const std::string& html_notice) {
+  const bool adaptive = options.integrator.kind != IntegratorKind::rk4;
+  fmt::print("nhdyn simulate {}: method {} ({}), integrator {}{}\n", model.name,
+             method_name(options.formulation.method),
+             summary.sparse ? std::string(options.formulation.method == Method::sanh ? "sparse path, D: partition"
+                                                                                      : "sparse path")
+                            : fmt::format("D: {}", complement_name(options.formulation.complement)),
+             integrator_name(options.integrator.kind),
+             adaptive ? fmt::format(" (rtol {:g}, atol {:g})", options.integrator.rtol, options.integrator.atol) : "");
+  fmt::print("{}", format_stabilization(options, summary.projection));
+  if (summary.events.stopped_by >= 0)
+    fmt::print("  t = {:g} .. {:.10g} s: stopped by event '{}', {} rows -> {}\n", model.t0, summary.t_reached,
+               summary.events.names[static_cast<std::size_t>(summary.events.stopped_by)], summary.outputs,
+               files.csv.string());
+  else
+    fmt::print("  t = {:g} .. {:g} s, {} rows -> {}\n", model.t0, options.t_end, summary.outputs, files.csv.string());
+  fmt::print("{}", format_events(summary.events, files.events_file ? files.events.string() : std::string()));
+  fmt::print("{}", format_steps(summary));
+  fmt::print("{}", format_residuals(model, summary.residuals));
+  fmt::print("{}", format_program(model, summary.program, options.formulation.program_feedback));
+  if (summary.initial_fix) fmt::print("{}", format_initial_fix(model, *summary.initial_fix));
+  fmt::print("{}", format_energy(model, summary.energy));
+  fmt::print("{}", format_constraint_watch(model, summary.watch, summary.warnings.size(), summary.sparse));
+  if (!args.plot.empty()) fmt::print("  plot -> {}\n", args.plot);
+  if (!args.html.empty()) fmt::print("  report -> {}{}\n", args.html, html_notice.empty() ? "" : "\n  note: " + html_notice);
+}
+
+int run_simulate(const SimulateArgs& args) {
+  protect_model_file(args.model);
+  const ModelSource source = read_model_source(args.model);
+  const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
+  const Model model = prepare_model(resolved, args);
+  const SimulationOptions options = make_run_options(model, args);
+  const ResultColumns columns = make_result_columns(model);
+  // Every file of the run says where it came from (io/provenance.hpp).
+  const std::string provenance = format_provenance(make_provenance(model, source, options, args.evaluator));
+  RunFiles files;
+  open_run_files(files, args, model, options, columns, provenance);
+  const SimulationSummary summary = run_to_files(model, options, columns, files);
+  // The run's warnings (the constraint watch's, analysis/constraint_watch.hpp), whatever the outcome.
+  for (const std::string& w : summary.warnings) fmt::print(stderr, "nhdyn: warning: {}\n", w);
+  for (const std::string& w : summary.events.unmet_stops) fmt::print(stderr, "nhdyn: warning: {}\n", w);
+  if (summary.status != Status::ok) return report_failure(model, summary, files, columns, provenance);
+  const std::string html_notice = commit_run(args, resolved, model, options, columns, summary, provenance, files);
+  if (!args.quiet) print_summary(args, model, options, summary, files, html_notice);
   return 0;
 }
 

@@ -83,7 +83,7 @@ std::string table_text(const ErrorRelation& study, const std::string& provenance
                         integrator_name(r.integrator), r.tolerance, r.tolerance * atol_factor, r.max_error_q,
                         r.max_error_v, r.max_residual_pos, r.max_residual_vel, r.summary.stats.steps,
                         r.summary.stats.rhs_evaluations,
-                        r.summary.status == Status::ok ? "ok" : std::string(describe(r.summary.status)));
+                        format_status(r.summary));
   return text;
 }
 
@@ -125,8 +125,7 @@ void print_error_relation(const ErrorRelation& study, const Model& model, const 
     fmt::print("{:<16} {:<12} {:>7.0e} {:>10.2e} {:>10.2e} {:>10} {:>10} {:>8}{}\n", formulation_label(r.formulation),
                integrator_name(r.integrator), r.tolerance, r.max_error_q, r.max_error_v, level(r.max_residual_pos, pos),
                level(r.max_residual_vel, vel), r.summary.stats.steps,
-               r.summary.status == Status::ok ? "" : fmt::format("  FAILED at t = {:.4g}: {}", r.summary.t_reached,
-                                                                r.summary.message));
+               format_failure_note(r.summary));
   }
   fmt::print("table -> {}\nby tolerance -> {}\n", table_path.string(), series_path.string());
   if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);

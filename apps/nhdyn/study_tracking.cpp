@@ -81,7 +81,7 @@ std::string write_tracking_series(const Tracking& study, bool pos, const std::st
     text += fmt::format("{:g},{:.3g},{:.3g},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{},{},{}\n", r.gain, r.tolerance,
                         r.tolerance * atol_factor, r.max_error_q, r.max_error_v, r.max_residual_pos,
                         r.max_residual_vel, r.max_residual_acc, r.summary.stats.steps, r.summary.stats.rhs_evaluations,
-                        r.summary.status == Status::ok ? "ok" : std::string(describe(r.summary.status)));
+                        format_status(r.summary));
   return text;
 }
 
@@ -119,9 +119,7 @@ void print_tracking(const Tracking& study, const Model& model, const TrackingArg
     fmt::print("{:>6} {:>7.0e} {:>10.2e} {:>10.2e} {:>10.2e} {:>10.2e} {:>10.2e} {:>8}{}\n", gain_label(r.gain),
                r.tolerance, r.max_error_q, r.max_error_v, r.max_residual_pos, r.max_residual_vel, r.max_residual_acc,
                r.summary.stats.steps,
-               r.summary.status == Status::ok
-                   ? ""
-                   : fmt::format("  FAILED at t = {:.4g}: {}", r.summary.t_reached, r.summary.message));
+               format_failure_note(r.summary));
   fmt::print("table -> {}\nby tolerance -> {}\n", table_path.string(), series_path.string());
   if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
 }

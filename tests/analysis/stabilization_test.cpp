@@ -66,13 +66,13 @@ TEST(Stabilization, NoneDriftsWhereBaumgarteAndProjectionStayBounded) {
   EXPECT_LT(baumgarte.late_position, 0.01 * none.late_position);
   EXPECT_LT(baumgarte.late_velocity, 2.0 * baumgarte.early_velocity + 1e-12);
   // Projection: at round-off at both levels, all along.
-  EXPECT_LT(projection.summary.max_position_residual, 1e-12);
-  EXPECT_LT(projection.summary.max_velocity_residual, 1e-12);
-  EXPECT_GT(projection.summary.projections, 100);
-  EXPECT_GT(projection.summary.max_position_correction, 0.0);
+  EXPECT_LT(projection.summary.residuals.position, 1e-12);
+  EXPECT_LT(projection.summary.residuals.velocity, 1e-12);
+  EXPECT_GT(projection.summary.projection.count, 100);
+  EXPECT_GT(projection.summary.projection.max_position_correction, 0.0);
   // Energy of the projected run stays at the level of the tolerance; none's drifts away.
-  EXPECT_LT(std::abs(projection.last_energy - projection.summary.energy_initial),
-            std::abs(none.last_energy - none.summary.energy_initial));
+  EXPECT_LT(std::abs(projection.last_energy - projection.summary.energy.initial),
+            std::abs(none.last_energy - none.summary.energy.initial));
 }
 
 TEST(Stabilization, ProjectionKeepsEveryBuiltInExampleOnItsConstraints) {

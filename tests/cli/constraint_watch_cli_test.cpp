@@ -40,17 +40,17 @@ TEST(ConstraintWatchModels, RollingDiskOverTenTurnsStaysSilent) {
   const SimulationSummary summary = run_watched_example("rolling_disk.toml", 31.4159);
   ASSERT_EQ(summary.status, Status::ok) << summary.message;
   EXPECT_TRUE(summary.warnings.empty()) << summary.warnings.front();
-  EXPECT_GT(summary.watched_states, 3000);
-  EXPECT_LT(summary.largest_row_factor, 10.0);
-  EXPECT_LT(summary.largest_condition_factor, 10.0);
+  EXPECT_GT(summary.watch.watched_states, 3000);
+  EXPECT_LT(summary.watch.largest_row_factor, 10.0);
+  EXPECT_LT(summary.watch.largest_condition_factor, 10.0);
 }
 
 TEST(ConstraintWatchModels, WhippleBicycleAtFiveMetresPerSecondStaysSilent) {
   const SimulationSummary summary = run_watched_example("whipple_bicycle.toml", 20.0);
   ASSERT_EQ(summary.status, Status::ok) << summary.message;
   EXPECT_TRUE(summary.warnings.empty()) << summary.warnings.front();
-  EXPECT_LT(summary.largest_row_factor, 10.0);
-  EXPECT_LT(summary.largest_condition_factor, 10.0);
+  EXPECT_LT(summary.watch.largest_row_factor, 10.0);
+  EXPECT_LT(summary.watch.largest_condition_factor, 10.0);
 }
 
 TEST(ConstraintWatchModels, TanFormNamedWithinAMillisecondOfTheSingularity) {
@@ -59,8 +59,8 @@ TEST(ConstraintWatchModels, TanFormNamedWithinAMillisecondOfTheSingularity) {
   options.t_end = 3.0;
   options.output_step = 1.0;  // the singularity falls between two outputs: the steps see it
   const SimulationSummary summary = simulate(model, options, [](const Data&) {});
-  ASSERT_EQ(summary.constraint_warnings.size(), 1u);
-  const ConstraintWarning& w = summary.constraint_warnings[0];
+  ASSERT_EQ(summary.watch.warnings.size(), 1u);
+  const ConstraintWarning& w = summary.watch.warnings[0];
   EXPECT_EQ(model.constraints[static_cast<std::size_t>(w.constraint)].name, "blade");
   EXPECT_LE(std::abs(w.t - std::numbers::pi / 2), 1e-3) << w.t;
   EXPECT_NEAR(w.factor, 1.0 / std::abs(std::cos(w.t)), 1e-6 * w.factor);
@@ -123,8 +123,8 @@ TEST_F(ConstraintWatchCli, SparseChainRunsWatchedAndSilent) {
   ASSERT_EQ(summary.status, Status::ok) << summary.message;
   EXPECT_TRUE(summary.sparse);
   EXPECT_TRUE(summary.warnings.empty());
-  EXPECT_GE(summary.watched_states, 51);
-  EXPECT_LT(summary.largest_row_factor, 10.0);
+  EXPECT_GE(summary.watch.watched_states, 51);
+  EXPECT_LT(summary.watch.largest_row_factor, 10.0);
 }
 
 TEST_F(ConstraintWatchCli, WellPosedExamplesPrintNoWarning) {

@@ -278,8 +278,8 @@ TEST_F(CliEvents, BadInputIsRefusedBeforeTheRun) {
       {"simulate " + sleigh + " --stop-when 'abs(phii) > 1'",
        {"--stop-when \"abs(phii) > 1\": unknown symbol 'phii'; did you mean 'phi'? (column 5 of \"abs(phii) > 1\")"}},
       {"simulate " + sleigh + " --stop-when 'phi > 1 > 2'", {"expected one comparison"}},
-      {"simulate " + pendulum + " --max-steps 0", {"--max-steps 0", "at least 1"}},
-      {"simulate " + pendulum + " --max-steps=-5", {"--max-steps -5", "at least 1"}},
+      {"simulate " + pendulum + " --max-steps 0", {"max_steps (--max-steps) = 0 must be at least 1", "(default 50000000)"}},
+      {"simulate " + pendulum + " --max-steps=-5", {"max_steps (--max-steps) = -5 must be at least 1"}},
       {"simulate " + pendulum + " --event bottom=x --integrator rk4", {"rk4", "dopri5, dop853"}},
       {"simulate " + pendulum + " --event \"up=R_xx\"", {"unknown symbol 'R_xx'", "did you mean 'R_x'?"}},
   };

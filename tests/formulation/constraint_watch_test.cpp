@@ -46,9 +46,9 @@ SimulationSummary run_watch(const Model& model, Method method, Complement comple
 
 void expect_blade_warning_before_singularity(const Model& model, const SimulationSummary& summary,
                                              const std::string& what) {
-  ASSERT_EQ(summary.constraint_warnings.size(), 1u) << what;
+  ASSERT_EQ(summary.watch.warnings.size(), 1u) << what;
   ASSERT_EQ(summary.warnings.size(), 1u) << what;
-  const ConstraintWarning& w = summary.constraint_warnings[0];
+  const ConstraintWarning& w = summary.watch.warnings[0];
   EXPECT_EQ(model.constraints[static_cast<std::size_t>(w.constraint)].name, "blade") << what;
   EXPECT_EQ(w.measure, WatchMeasure::row_norm) << what;
   // phi = t exactly (phi'' = 0): the first watched state past the factor lies in
@@ -77,7 +77,7 @@ TEST(ConstraintWatch, TanFormOfTheBladeIsWarnedAboutJustBeforePhiCrossesHalfPi) 
     const std::string what = fmt::format("{} / {}", method_name(run.method), complement_name(run.complement));
     EXPECT_FALSE(summary.sparse) << what;
     expect_blade_warning_before_singularity(model, summary, what);
-    EXPECT_GT(summary.watched_states, 157) << what;  // every output at least
+    EXPECT_GT(summary.watch.watched_states, 157) << what;  // every output at least
   }
 }
 
@@ -99,9 +99,9 @@ TEST(ConstraintWatch, RegularFormOfTheSameMotionStaysSilent) {
     const SimulationSummary summary = run_watch(run_model, Method::sanh, Complement::qr, 10.0, path);
     ASSERT_EQ(summary.status, Status::ok) << summary.message;
     EXPECT_TRUE(summary.warnings.empty()) << summary.warnings.front();
-    EXPECT_LT(summary.largest_row_factor, 1.0 + 1e-12);
+    EXPECT_LT(summary.watch.largest_row_factor, 1.0 + 1e-12);
     if (path == Path::dense) {
-      EXPECT_LT(summary.largest_condition_factor, 10.0);
+      EXPECT_LT(summary.watch.largest_condition_factor, 10.0);
     }
   }
 }
@@ -112,8 +112,8 @@ TEST(ConstraintWatch, SledOverALongRunStaysSilent) {
     const SimulationSummary summary = run_watch(model, method, Complement::qr, 200.0);
     ASSERT_EQ(summary.status, Status::ok) << summary.message;
     EXPECT_TRUE(summary.warnings.empty()) << summary.warnings.front();
-    EXPECT_LT(summary.largest_row_factor, 1.0 + 1e-12);
-    EXPECT_LT(summary.largest_condition_factor, 10.0) << method_name(method);
+    EXPECT_LT(summary.watch.largest_row_factor, 1.0 + 1e-12);
+    EXPECT_LT(summary.watch.largest_condition_factor, 10.0) << method_name(method);
   }
 }
 
@@ -124,14 +124,14 @@ TEST(ConstraintWatch, ThresholdIsAnOptionAndOffMeansSilent) {
   options.watch_constraints = false;
   const SimulationSummary off = simulate(model, options, [](const Data&) {});
   EXPECT_TRUE(off.warnings.empty());
-  EXPECT_EQ(off.watched_states, 0);
+  EXPECT_EQ(off.watch.watched_states, 0);
   // A factor of 10 is passed at t = acos(1/10) = 1.4706.
   options.watch_constraints = true;
   options.watch_factor = 10.0;
   const SimulationSummary ten = simulate(model, options, [](const Data&) {});
-  ASSERT_EQ(ten.constraint_warnings.size(), 1u);
-  EXPECT_GE(ten.constraint_warnings[0].t, std::acos(0.1));
-  EXPECT_LE(ten.constraint_warnings[0].t, std::acos(0.1) + options.output_step);
+  ASSERT_EQ(ten.watch.warnings.size(), 1u);
+  EXPECT_GE(ten.watch.warnings[0].t, std::acos(0.1));
+  EXPECT_LE(ten.watch.warnings[0].t, std::acos(0.1) + options.output_step);
   options.watch_factor = 1.0;
   EXPECT_THROW(simulate(model, options, [](const Data&) {}), InputError);
 }

@@ -197,12 +197,12 @@ TEST(ChainSparsePath, SimulationsOnBothPathsFollowTheSameMotion) {
         EXPECT_LT((sparse[i].q - dense[i].q).cwiseAbs().maxCoeff(), 1e-8) << "t = " << sparse[i].t;
         EXPECT_LT((sparse[i].v - dense[i].v).cwiseAbs().maxCoeff(), 1e-8) << "t = " << sparse[i].t;
       }
-      EXPECT_LT(std::abs(sparse_summary.max_position_residual - dense_summary.max_position_residual), 1e-8);
+      EXPECT_LT(std::abs(sparse_summary.residuals.position - dense_summary.residuals.position), 1e-8);
       // Without Baumgarte's terms b q'' + b0 is round-off; with them it is the stabilization itself.
       if (stabilization == Stabilization::baumgarte) {
-        EXPECT_LT(std::abs(sparse_summary.max_acceleration_residual - dense_summary.max_acceleration_residual), 1e-9);
+        EXPECT_LT(std::abs(sparse_summary.residuals.acceleration - dense_summary.residuals.acceleration), 1e-9);
       } else {
-        EXPECT_LT(sparse_summary.max_acceleration_residual, 1e-10);
+        EXPECT_LT(sparse_summary.residuals.acceleration, 1e-10);
       }
     }
 }

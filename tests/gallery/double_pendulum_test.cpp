@@ -119,8 +119,8 @@ TEST(DoublePendulum, EnergyIsConserved) {
   const Pendulum2 p = parameters_of(model);
   SimulationSummary summary;
   run_rows(model, tight_options(10.0, 0.005), &summary);
-  ASSERT_TRUE(summary.has_energy);
-  EXPECT_LT(summary.energy_drift / ((p.m1 + p.m2) * p.g * (p.l1 + p.l2)), 1e-8);
+  ASSERT_TRUE(summary.energy.has_energy);
+  EXPECT_LT(summary.energy.drift / ((p.m1 + p.m2) * p.g * (p.l1 + p.l2)), 1e-8);
 }
 
 // Negative controls: the lower mass given the upper one's in T, or in V, fails the pointwise exam.

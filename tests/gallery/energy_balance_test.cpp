@@ -35,7 +35,7 @@ std::vector<BalanceRow> run_balance(const Model& model, const SimulationOptions&
                     d.balance_error});
   });
   EXPECT_EQ(s.status, Status::ok) << model.name << ": " << s.message;
-  EXPECT_TRUE(s.has_energy_balance) << model.name;
+  EXPECT_TRUE(s.energy.has_balance) << model.name;
   if (summary) *summary = s;
   return rows;
 }
@@ -63,9 +63,9 @@ TEST(EnergyBalance, HoopBeadTheMotorsWorkIsTheReactionsWork) {
   EXPECT_GT(E_swing, 0.8);  // 0.88 J: physics, not error
   EXPECT_LT(work_error, 100 * 1e-10 * scale);
   EXPECT_LT(balance, 100 * 1e-10 * scale);
-  EXPECT_EQ(summary.max_balance_error, balance);
-  EXPECT_FALSE(summary.energy_function_differs);
-  EXPECT_NEAR(summary.energy_change, rows.back().E - rows.front().E, 0.0);
+  EXPECT_EQ(summary.energy.balance_error, balance);
+  EXPECT_FALSE(summary.energy.function_differs);
+  EXPECT_NEAR(summary.energy.change, rows.back().E - rows.front().E, 0.0);
 }
 
 // The hoop's frame: T = m/2 (x'^2 + z'^2 + Omega^2 x^2) has T0, so h = J (the Jacobi integral) is
@@ -85,7 +85,7 @@ TEST(EnergyBalance, HoopBeadRotatingFrameConservesTheEnergyFunction) {
     E_swing = std::max(E_swing, std::abs(row.E - rows.front().E));
     EXPECT_LT(std::abs(row.W()), 1e-9);  // the hoop's constraint is fixed: R . q' at the residual's level
   }
-  EXPECT_TRUE(summary.energy_function_differs);
+  EXPECT_TRUE(summary.energy.function_differs);
   EXPECT_GT(E_swing, 0.8);
   EXPECT_LT(h_error, 1e-8);
 }
@@ -111,7 +111,7 @@ TEST(EnergyBalance, IsokineticParticleTheConstraintDoesWork) {
   }
   const double scale = std::abs(m * g * rows.back().q(1));  // the energy lost: about 17 J
   EXPECT_GT(scale, 10.0);
-  EXPECT_NEAR(summary.energy_change, m * g * rows.back().q(1), 1e-8 * scale);
+  EXPECT_NEAR(summary.energy.change, m * g * rows.back().q(1), 1e-8 * scale);
   EXPECT_LT(q_error, 1e-8);
   EXPECT_LT(work_error, 100 * 1e-10 * scale);
   EXPECT_LT(balance, 100 * 1e-10 * scale);
@@ -145,7 +145,7 @@ TEST(EnergyBalance, DiffDriveTheForcesWorkIsTheChangeOfEnergy) {
   EXPECT_LT(last.E, 0.04);                     // ... leave 0.0356 J in the robot
   EXPECT_LT(work_error, 100 * 1e-10 * torque_work);
   EXPECT_LT(balance, 100 * 1e-10 * torque_work);
-  EXPECT_NEAR(summary.work_forces, last.W_forces, 0.0);
+  EXPECT_NEAR(summary.energy.work_forces, last.W_forces, 0.0);
 }
 
 // A pendulum in its angle: no forces, no constraint, no explicit time, so W = 0 to round-off and
@@ -196,8 +196,8 @@ TEST(EnergyBalance, ConservativeModelTheBalanceIsTheDrift) {
     EXPECT_LT(std::abs(row.W_reactions), 1e-12 * scale);
     EXPECT_NEAR(row.balance, row.E - rows.front().E, 1e-12 * scale);
   }
-  EXPECT_GT(summary.energy_drift, 1e-9 * scale);
-  EXPECT_NEAR(summary.max_balance_error, summary.energy_drift, 1e-12 * scale);
+  EXPECT_GT(summary.energy.drift, 1e-9 * scale);
+  EXPECT_NEAR(summary.energy.balance_error, summary.energy.drift, 1e-12 * scale);
 }
 
 // (E3) at arbitrary states, on the constraints or not: dh/dt along (q', q'') from the solve equals

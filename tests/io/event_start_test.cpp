@@ -47,9 +47,9 @@ TEST(EventAtTheStart, WithADirectionItIsFoundWhereItComesBack) {
     options.events = model.events;
     const SimulationSummary summary = simulate(model, options, [](const Data&) {});
     ASSERT_EQ(summary.status, Status::ok) << summary.message;
-    ASSERT_EQ(summary.events.size(), 1u) << integrator_name(kind);
-    EXPECT_EQ(summary.stopped_by, 0);
-    EXPECT_NEAR(summary.events[0].t, 2 * 4.0 / 9.81, 1e-8) << integrator_name(kind);
+    ASSERT_EQ(summary.events.crossings.size(), 1u) << integrator_name(kind);
+    EXPECT_EQ(summary.events.stopped_by, 0);
+    EXPECT_NEAR(summary.events.crossings[0].t, 2 * 4.0 / 9.81, 1e-8) << integrator_name(kind);
     EXPECT_NEAR(summary.t_reached, 2 * 4.0 / 9.81, 1e-8) << integrator_name(kind);
   }
 }

@@ -67,28 +67,28 @@ TEST(Events, ModelFileEventsThroughTheApi) {
   SimulationSummary summary = simulate(model, options, [](const Data&) {});
   ASSERT_EQ(summary.status, Status::ok) << summary.message;
   // The top at w/g, passed at L/u = 0.75 s, landed at (w + sqrt(w^2 + 2 g h))/g, which stops the run.
-  ASSERT_EQ(summary.events.size(), 3u);
-  EXPECT_EQ(summary.events[0].name, "top");
-  EXPECT_NEAR(summary.events[0].t, 4.0 / 9.81, 1e-12);
-  EXPECT_EQ(summary.events[1].name, "passed");
-  EXPECT_NEAR(summary.events[1].t, 0.75, 1e-12);
-  EXPECT_NEAR(summary.events[1].q[0], 1.5, 1e-12);
-  EXPECT_EQ(summary.events[2].name, "landed");
-  EXPECT_NEAR(summary.events[2].t, (4.0 + std::sqrt(16.0 + 2.0 * 9.81 * 0.5)) / 9.81, 1e-12);
-  EXPECT_EQ(summary.stopped_by, 2);
-  EXPECT_EQ(summary.t_reached, summary.events[2].t);
+  ASSERT_EQ(summary.events.crossings.size(), 3u);
+  EXPECT_EQ(summary.events.crossings[0].name, "top");
+  EXPECT_NEAR(summary.events.crossings[0].t, 4.0 / 9.81, 1e-12);
+  EXPECT_EQ(summary.events.crossings[1].name, "passed");
+  EXPECT_NEAR(summary.events.crossings[1].t, 0.75, 1e-12);
+  EXPECT_NEAR(summary.events.crossings[1].q[0], 1.5, 1e-12);
+  EXPECT_EQ(summary.events.crossings[2].name, "landed");
+  EXPECT_NEAR(summary.events.crossings[2].t, (4.0 + std::sqrt(16.0 + 2.0 * 9.81 * 0.5)) / 9.81, 1e-12);
+  EXPECT_EQ(summary.events.stopped_by, 2);
+  EXPECT_EQ(summary.t_reached, summary.events.crossings[2].t);
 
   // Parameters are data: L = 0.5 moves the crossing to 0.25 s with the same compiled programs.
   set_parameter(model, "L", 0.5);
   summary = simulate(model, options, [](const Data&) {});
   ASSERT_EQ(summary.status, Status::ok) << summary.message;
-  EXPECT_EQ(summary.events[0].name, "passed");
-  EXPECT_NEAR(summary.events[0].t, 0.25, 1e-12);
+  EXPECT_EQ(summary.events.crossings[0].name, "passed");
+  EXPECT_NEAR(summary.events.crossings[0].t, 0.25, 1e-12);
 
   // Without options.events the run ignores them and reaches t_end.
   options.events.clear();
   summary = simulate(model, options, [](const Data&) {});
-  EXPECT_TRUE(summary.events.empty());
+  EXPECT_TRUE(summary.events.crossings.empty());
   EXPECT_EQ(summary.t_reached, 5.0);
 }
 

@@ -105,7 +105,7 @@ TEST(Outputs, PendulumEnergyAndTensionAgainstClosedForms) {
   // The rod goes slack once per swing up (period 3.26 s: at least three times in 5 s), each time
   // where 3 cos(theta) = 2 cos(theta0).
   int slack = 0;
-  for (const EventRecord& e : summary.events) {
+  for (const EventRecord& e : summary.events.crossings) {
     ASSERT_EQ(e.name, "slack");
     ++slack;
     EXPECT_NEAR(-e.q[1] / l, 2.0 * std::cos(theta0) / 3.0, 1e-9) << "t = " << e.t;
@@ -140,7 +140,7 @@ TEST(Outputs, StopConditionOnAnOutput) {
   std::vector<double> last;
   const SimulationSummary summary = simulate(model, options, [&](const Data& data) { fill_result_row(model, data, last); });
   ASSERT_EQ(summary.status, Status::ok) << summary.message;
-  ASSERT_EQ(summary.stopped_by, 0);
+  ASSERT_EQ(summary.events.stopped_by, 0);
   EXPECT_NEAR(last[static_cast<std::size_t>(column(c, "speed"))], 4.0, 1e-9);
   // The speed from the energy: v^2 = 2 g (y0 - y).
   const double g = parameter_of(model, "g"), l = parameter_of(model, "l"), theta0 = parameter_of(model, "theta0");
@@ -149,7 +149,7 @@ TEST(Outputs, StopConditionOnAnOutput) {
   // released above the horizontal, the rod pushes (N < 0) until 3 cos(theta) = 2 cos(theta0).
   options.events = {symbolic::make_stop_condition(model, "tension > 0")};
   const SimulationSummary slack = simulate(model, options, [&](const Data& data) { fill_result_row(model, data, last); });
-  ASSERT_EQ(slack.stopped_by, 0) << slack.message;
+  ASSERT_EQ(slack.events.stopped_by, 0) << slack.message;
   EXPECT_NEAR(-last[static_cast<std::size_t>(column(c, "y"))] / l, 2.0 * std::cos(theta0) / 3.0, 1e-9);
 }
 

@@ -79,9 +79,9 @@ TEST(ContactEvents, FileEventStopsTheDiskWhereItsNormalForceVanishes) {
     N_rows.push_back(data.contact.values(3));
   });
   ASSERT_EQ(summary.status, Status::ok) << summary.message;
-  ASSERT_EQ(summary.events.size(), 1u);
-  EXPECT_EQ(summary.stopped_by, 0);
-  const EventRecord& e = summary.events.front();
+  ASSERT_EQ(summary.events.crossings.size(), 1u);
+  EXPECT_EQ(summary.events.stopped_by, 0);
+  const EventRecord& e = summary.events.crossings.front();
   EXPECT_EQ(e.name, "liftoff");
   EXPECT_NEAR(e.q[3], theta_star, kLiftoffTolerance);
   EXPECT_NEAR(e.v[3], exact.theta_rate(theta_star), kLiftoffTolerance * exact.theta_rate(theta_star));
@@ -107,9 +107,9 @@ TEST(ContactEvents, RecordEventFindsBothRootsAndStopConditionItsThreshold) {
   ASSERT_TRUE(options.events.front().contact_forces);
   SimulationSummary summary = simulate(model, options, [](const Data&) {});
   ASSERT_EQ(summary.status, Status::ok) << summary.message;
-  ASSERT_EQ(summary.events.size(), 2u);
-  EXPECT_NEAR(summary.events[0].q[3], exact.theta_at(0.0, true), kLiftoffTolerance);
-  EXPECT_NEAR(summary.events[1].q[3], exact.theta_at(0.0, false), kLiftoffTolerance);
+  ASSERT_EQ(summary.events.crossings.size(), 2u);
+  EXPECT_NEAR(summary.events.crossings[0].q[3], exact.theta_at(0.0, true), kLiftoffTolerance);
+  EXPECT_NEAR(summary.events.crossings[1].q[3], exact.theta_at(0.0, false), kLiftoffTolerance);
   EXPECT_EQ(summary.t_reached, options.t_end);  // a record event does not stop the run
 
   // --stop-when "disk_N < m*g/10": an expression of the column and the parameters; N = m g / 10
@@ -117,11 +117,11 @@ TEST(ContactEvents, RecordEventFindsBothRootsAndStopConditionItsThreshold) {
   options.events = {symbolic::make_stop_condition(model, "disk_N < m*g/10")};
   summary = simulate(model, options, [](const Data&) {});
   ASSERT_EQ(summary.status, Status::ok) << summary.message;
-  ASSERT_EQ(summary.events.size(), 1u);
-  EXPECT_EQ(summary.stopped_by, 0);
+  ASSERT_EQ(summary.events.crossings.size(), 1u);
+  EXPECT_EQ(summary.events.stopped_by, 0);
   const double theta_tenth = exact.theta_at(0.1);
   EXPECT_LT(theta_tenth, exact.theta_at(0.0) - 0.05);  // a different state from the liftoff
-  EXPECT_NEAR(summary.events[0].q[3], theta_tenth, kLiftoffTolerance);
+  EXPECT_NEAR(summary.events.crossings[0].q[3], theta_tenth, kLiftoffTolerance);
 }
 
 // test::kFlatSledBodies, the sled held flat by its frames: its blade's N and Fz are NaN by design,

@@ -77,14 +77,14 @@ TEST(ContactModes, BallThrownSlidingSticksAtTheClosedFormTimeAndRollsAtFiveSeven
   const double m = mode_parameter(model, "m"), g = mode_parameter(model, "g"), mu = mode_parameter(model, "mu");
   const double v0 = mode_parameter(model, "v0");
   const ModeRun r = run_modes(model, 1.0);
-  ASSERT_EQ(r.summary.events.size(), 1u);
-  EXPECT_EQ(r.summary.events[0].name, "ball_stick");
+  ASSERT_EQ(r.summary.events.crossings.size(), 1u);
+  EXPECT_EQ(r.summary.events.crossings[0].name, "ball_stick");
   const double t_star = 2 * v0 / (7 * mu * g);
   EXPECT_NEAR(t_star, 0.3495, 1e-4);  // the derivation's test value
-  EXPECT_NEAR(r.summary.events[0].t, t_star, 1e-12);
+  EXPECT_NEAR(r.summary.events.crossings[0].t, t_star, 1e-12);
   // Until t* the centre decelerates at mu g: x(t*) = v0 t* - mu g t*^2 / 2.
-  EXPECT_NEAR(r.summary.events[0].q[0], v0 * t_star - mu * g * t_star * t_star / 2, 1e-11);
-  const std::size_t s = mode_switch_row(r, r.summary.events[0].t);
+  EXPECT_NEAR(r.summary.events.crossings[0].q[0], v0 * t_star - mu * g * t_star * t_star / 2, 1e-11);
+  const std::size_t s = mode_switch_row(r, r.summary.events.crossings[0].t);
   EXPECT_EQ(r.at(s, "ball_mode"), 0.0);  // a switch row carries the mode after it
   EXPECT_EQ(r.at(s - 1, "ball_mode"), 1.0);
   EXPECT_EQ(r.at(0, "ball_mode"), 1.0);
@@ -98,9 +98,9 @@ TEST(ContactModes, BallThrownSlidingSticksAtTheClosedFormTimeAndRollsAtFiveSeven
   EXPECT_NEAR(r.at(last, "ball_Fx"), 0.0, 1e-12);
   EXPECT_NEAR(r.at(last, "work_friction"), -m * v0 * v0 / 7, 1e-12);
   // Rolling after the stick: its no-slip rows hold to round-off, the friction does no more work.
-  EXPECT_LT(r.summary.max_velocity_residual, 1e-12);
-  EXPECT_LT(r.summary.max_balance_error, 1e-12);
-  EXPECT_NEAR(r.summary.energy_change, -m * v0 * v0 / 7, 1e-12);
+  EXPECT_LT(r.summary.residuals.velocity, 1e-12);
+  EXPECT_LT(r.summary.energy.balance_error, 1e-12);
+  EXPECT_NEAR(r.summary.energy.change, -m * v0 * v0 / 7, 1e-12);
 }
 
 // A switch located within round-off of an output time: one row stands for that time, and it is the
@@ -117,8 +117,8 @@ TEST(ContactModes, ASwitchAtAnOutputTimeReplacesItsRow) {
     const double v0 = v_grid * (1 + k * 3e-15);
     set_parameter(model, "v0", v0);  // the initial velocity follows
     const ModeRun r = run_modes(model, 0.36);
-    ASSERT_EQ(r.summary.events.size(), 1u);
-    const double t_switch = r.summary.events[0].t;
+    ASSERT_EQ(r.summary.events.crossings.size(), 1u);
+    const double t_switch = r.summary.events.crossings[0].t;
     std::vector<std::size_t> near;
     for (std::size_t i = 0; i < r.rows.size(); ++i)
       if (std::abs(r.rows[i][0] - t_switch) <= window) near.push_back(i);
@@ -140,13 +140,13 @@ TEST(ContactModes, BallWithBackspinComesBack) {
   const double g = mode_parameter(model, "g"), mu = mode_parameter(model, "mu"), v0 = mode_parameter(model, "v0");
   const double r_ball = mode_parameter(model, "r"), W = 500.0, k = 0.4;
   const ModeRun r = run_modes(model, 2.0);
-  ASSERT_EQ(r.summary.events.size(), 1u);
-  EXPECT_EQ(r.summary.events[0].name, "ball_stick");
-  EXPECT_NEAR(r.summary.events[0].t, k * (v0 + r_ball * W) / (mu * g * (1 + k)), 1e-11);
+  ASSERT_EQ(r.summary.events.crossings.size(), 1u);
+  EXPECT_EQ(r.summary.events.crossings[0].name, "ball_stick");
+  EXPECT_NEAR(r.summary.events.crossings[0].t, k * (v0 + r_ball * W) / (mu * g * (1 + k)), 1e-11);
   const double back = (v0 - k * r_ball * W) / (1 + k);
   EXPECT_LT(back, 0.0);
   EXPECT_NEAR(r.at(r.rows.size() - 1, "x'"), back, 1e-11);
-  EXPECT_LT(r.summary.max_balance_error, 1e-11);
+  EXPECT_LT(r.summary.energy.balance_error, 1e-11);
 }
 
 // A thin disk (k = 1/2) or a hoop (k = 1) thrown along its plane: t* = v0 / (3 mu g) and
@@ -193,12 +193,12 @@ TEST(ContactModes, DiskAndHoopThrownSlidingStickAtTheirClosedFormTimes) {
     const Model model = load_model_text(thrown_wheel_model(c.inertia), "wheel.toml");
     const double g = 9.81, mu = 0.2, v0 = 2.0;
     const ModeRun r = run_modes(model, 2.0);
-    ASSERT_EQ(r.summary.events.size(), 1u);
-    EXPECT_EQ(r.summary.events[0].name, "rim_stick");
-    EXPECT_NEAR(r.summary.events[0].t, c.k * v0 / (mu * g * (1 + c.k)), 1e-11);
+    ASSERT_EQ(r.summary.events.crossings.size(), 1u);
+    EXPECT_EQ(r.summary.events.crossings[0].name, "rim_stick");
+    EXPECT_NEAR(r.summary.events.crossings[0].t, c.k * v0 / (mu * g * (1 + c.k)), 1e-11);
     EXPECT_NEAR(r.at(r.rows.size() - 1, "x'"), v0 / (1 + c.k), 1e-11);
     EXPECT_NEAR(r.at(r.rows.size() - 1, "work_friction"), -0.5 * 0.5 * v0 * v0 * c.k / (1 + c.k), 1e-11);
-    EXPECT_LT(r.summary.max_balance_error, 1e-11);
+    EXPECT_LT(r.summary.energy.balance_error, 1e-11);
   }
 }
 
@@ -243,7 +243,7 @@ TEST(ContactModes, CylinderOnASteepInclineSlidesFromTheStartAndRollsBelowTheBoun
     const bool steep = std::tan(alpha) > 3 * mu;
     const Model model = load_model_text(incline_model(alpha), "incline.toml");
     const ModeRun r = run_modes(model, 1.0);
-    EXPECT_TRUE(r.summary.events.empty());
+    EXPECT_TRUE(r.summary.events.crossings.empty());
     const std::size_t last = r.rows.size() - 1;
     EXPECT_EQ(r.at(0, "rim_mode"), steep ? 1.0 : 0.0);
     EXPECT_EQ(r.at(last, "rim_mode"), steep ? 1.0 : 0.0);
@@ -254,14 +254,14 @@ TEST(ContactModes, CylinderOnASteepInclineSlidesFromTheStartAndRollsBelowTheBoun
       EXPECT_NEAR(r.at(last, "rim_slip_speed"), g * (std::sin(alpha) - 3 * mu * std::cos(alpha)), 1e-10);
       EXPECT_NEAR(r.at(last, "rim_Fx"), -mu * 2.0 * g * std::cos(alpha), 1e-10);
     } else {
-      EXPECT_LT(r.summary.max_velocity_residual, 1e-10);
+      EXPECT_LT(r.summary.residuals.velocity, 1e-10);
     }
-    EXPECT_LT(r.summary.max_balance_error, 1e-10);
+    EXPECT_LT(r.summary.energy.balance_error, 1e-10);
   }
   // friction = [mu_s, mu_k]: between 3 mu_k and 3 mu_s the static friction holds it from rest.
   const Model held = load_model_text(incline_model(0.7, "[0.3, 0.2]"), "incline.toml");
   const ModeRun r = run_modes(held, 1.0);
-  EXPECT_TRUE(r.summary.events.empty());
+  EXPECT_TRUE(r.summary.events.crossings.empty());
   EXPECT_EQ(r.at(r.rows.size() - 1, "rim_mode"), 0.0);
   EXPECT_NEAR(r.at(r.rows.size() - 1, "x'"), 2 * g * std::sin(0.7) / 3, 1e-10);
 }
@@ -295,26 +295,26 @@ TEST(ContactModes, BallOnASphereLiftsOffAtTenSeventeenthsOrSlipsFirst) {
   {
     const Model model = load_model(example("ball_on_sphere.toml"));
     const ModeRun r = run_modes(model, 3.2);
-    ASSERT_EQ(r.summary.events.size(), 1u);
-    EXPECT_EQ(r.summary.events[0].name, "ball_liftoff");
-    EXPECT_NEAR(std::cos(sphere_angle(r.summary.events[0])), 2 * std::cos(theta0) / (3 + k), 1e-9);
+    ASSERT_EQ(r.summary.events.crossings.size(), 1u);
+    EXPECT_EQ(r.summary.events.crossings[0].name, "ball_liftoff");
+    EXPECT_NEAR(std::cos(sphere_angle(r.summary.events.crossings[0])), 2 * std::cos(theta0) / (3 + k), 1e-9);
     const std::size_t last = r.rows.size() - 1;
     EXPECT_EQ(r.at(last, "ball_mode"), 2.0);
     EXPECT_GT(r.at(last, "ball_gap"), 0.05);  // flying away from the sphere
     EXPECT_NEAR(r.at(last, "ball_N"), 0.0, 1e-12);
-    EXPECT_LT(r.summary.max_balance_error, 1e-9);
+    EXPECT_LT(r.summary.energy.balance_error, 1e-9);
   }
   std::string text = test::read_text(example("ball_on_sphere.toml"));
   text.replace(text.find("unilateral = true\n"), 18, "unilateral = true\nfriction = 0.3\n");
   const Model model = load_model_text(text, "sphere.toml");
   const ModeRun r = run_modes(model, 3.1);
-  ASSERT_EQ(r.summary.events.size(), 2u);
-  EXPECT_EQ(r.summary.events[0].name, "ball_slip");
-  EXPECT_EQ(r.summary.events[1].name, "ball_liftoff");
+  ASSERT_EQ(r.summary.events.crossings.size(), 2u);
+  EXPECT_EQ(r.summary.events.crossings[0].name, "ball_slip");
+  EXPECT_EQ(r.summary.events.crossings[1].name, "ball_liftoff");
   const double mu = 0.3;
   const double theta_s = std::atan2((3 + k) * mu, k) -
                          std::asin(2 * mu * std::cos(theta0) / std::sqrt(k * k + (3 + k) * (3 + k) * mu * mu));
-  EXPECT_NEAR(sphere_angle(r.summary.events[0]), theta_s, 1e-8);
+  EXPECT_NEAR(sphere_angle(r.summary.events.crossings[0]), theta_s, 1e-8);
   // (R4): rho u = rho theta'^2 while sliding, from theta_s; lift-off where rho u = g cos(theta).
   const double rho_u_s = 2 * 9.81 * (std::cos(theta0) - std::cos(theta_s)) / (1 + k);
   const auto p = [&](double x) { return (2 * mu * mu - 1) * std::cos(x) - 3 * mu * std::sin(x); };
@@ -325,9 +325,9 @@ TEST(ContactModes, BallOnASphereLiftsOffAtTenSeventeenthsOrSlipsFirst) {
   double lo = theta_s + 1e-6, hi = 1.5;
   for (int i = 0; i < 200; ++i) ((excess(0.5 * (lo + hi)) < 0) ? lo : hi) = 0.5 * (lo + hi);
   EXPECT_NEAR(hi * 180 / M_PI, 52.12, 0.01);  // the derivation's figure
-  EXPECT_NEAR(sphere_angle(r.summary.events[1]), hi, 1e-7);
+  EXPECT_NEAR(sphere_angle(r.summary.events.crossings[1]), hi, 1e-7);
   EXPECT_LT(r.at(r.rows.size() - 1, "work_friction"), 0.0);
-  EXPECT_LT(r.summary.max_balance_error, 1e-9);
+  EXPECT_LT(r.summary.energy.balance_error, 1e-9);
 }
 
 // A ball dropped from h0 onto the plane (unilateral, Newton's restitution e, no friction limit:
@@ -363,12 +363,12 @@ TEST(ContactModes, DroppedBallBouncesWithNewtonsLawUntilTheTouchdownsAccumulate)
     });
     EXPECT_NE(r.summary.status, Status::ok);
     EXPECT_NE(r.summary.message.find("Zeno"), std::string::npos) << r.summary.message;
-    ASSERT_GE(r.summary.events.size(), 4u);
+    ASSERT_GE(r.summary.events.crossings.size(), 4u);
     double t = t1, v = v1;
     for (std::size_t k = 0; k < 4; ++k) {
-      EXPECT_EQ(r.summary.events[k].name, "ball_touchdown");
-      EXPECT_NEAR(r.summary.events[k].t, t, 1e-9) << k;
-      EXPECT_NEAR(r.summary.events[k].v[2], e * v, 1e-8) << k;  // the row carries the velocity after
+      EXPECT_EQ(r.summary.events.crossings[k].name, "ball_touchdown");
+      EXPECT_NEAR(r.summary.events.crossings[k].t, t, 1e-9) << k;
+      EXPECT_NEAR(r.summary.events.crossings[k].v[2], e * v, 1e-8) << k;  // the row carries the velocity after
       v *= e;
       t += 2 * v / g;
     }
@@ -377,32 +377,32 @@ TEST(ContactModes, DroppedBallBouncesWithNewtonsLawUntilTheTouchdownsAccumulate)
     // and the next ones are normal, (1 - e^2) m V^2 / 2. The reactions' work stays that of the
     // finite reactions (none in flight).
     const double m = 0.1, k = 0.4, v0 = 3.0;
-    const std::size_t first = mode_switch_row(r, r.summary.events[0].t);
+    const std::size_t first = mode_switch_row(r, r.summary.events.crossings[0].t);
     const double loss1 = (1 - e * e) * m * v1 * v1 / 2 + k * m * v0 * v0 / (2 * (1 + k));
     EXPECT_NEAR(r.at(first, "impact_loss"), loss1, 1e-12);
     EXPECT_NEAR(r.at(first - 1, "impact_loss"), 0.0, 1e-15);
-    const std::size_t second = mode_switch_row(r, r.summary.events[1].t);
+    const std::size_t second = mode_switch_row(r, r.summary.events.crossings[1].t);
     EXPECT_NEAR(r.at(second, "impact_loss"), loss1 + (1 - e * e) * m * e * e * v1 * v1 / 2, 1e-12);
     EXPECT_NEAR(r.at(second, "work_reactions"), 0.0, 1e-12);
     EXPECT_NEAR(r.at(second, "work"), -r.at(second, "impact_loss") + r.at(second, "work_forces"), 1e-15);
     const double t_inf = t1 * (1 + 2 * e / (1 - e));
     EXPECT_LT(r.summary.t_reached, t_inf + 1e-6);
     EXPECT_GT(r.summary.t_reached, t_inf - 1e-3);
-    EXPECT_LT(r.summary.max_balance_error, 1e-9);
+    EXPECT_LT(r.summary.energy.balance_error, 1e-9);
   }
   // A normal drop (v0 = 0), plastic: impact_loss = m V^2 / 2, the closed form (1 - e^2) m V^2 / 2.
   std::string normal = dropped_ball(0.0);
   normal.replace(normal.find("v0 = { value = 3.0"), 18, "v0 = { value = 0.0");
   const Model plastic = load_model_text(normal, "drop.toml");
   const ModeRun r = run_modes(plastic, 0.5);
-  ASSERT_EQ(r.summary.events.size(), 1u);
-  EXPECT_NEAR(r.summary.events[0].t, t1, 1e-9);
+  ASSERT_EQ(r.summary.events.crossings.size(), 1u);
+  EXPECT_NEAR(r.summary.events.crossings[0].t, t1, 1e-9);
   const std::size_t last = r.rows.size() - 1;
   EXPECT_EQ(r.at(last, "ball_mode"), 0.0);
   EXPECT_NEAR(r.at(last, "z'"), 0.0, 1e-12);
   EXPECT_NEAR(r.at(last, "ball_N"), 0.1 * g, 1e-10);
   EXPECT_NEAR(r.at(last, "impact_loss"), 0.1 * v1 * v1 / 2, 1e-12);  // plastic: all the kinetic energy
-  EXPECT_LT(r.summary.max_balance_error, 1e-9);
+  EXPECT_LT(r.summary.energy.balance_error, 1e-9);
 }
 
 // A ball landing obliquely with spin (section 7.1): released at the height h with the centre
@@ -433,12 +433,12 @@ TEST(ContactModes, BallLandingObliquelyWithSpinTakesTheSlidingImpulseOfTheClosed
   const double m = 0.1, r = 0.02, g = 9.81, k = 0.4, mu = 0.1, e = 0.5, h = 0.05;
   const double vx = 2.0, w0 = -50.0;  // backspin: s- = vx - r w0 = 3 m/s
   const ModeRun run = run_landing(landing_ball(e, mu, vx, 0.0, w0, h), 0.25);
-  ASSERT_EQ(run.summary.events.size(), 2u);
+  ASSERT_EQ(run.summary.events.crossings.size(), 2u);
   // Two touchdowns, each a sliding impact (I3 violated); in flight x', b' are constant.
   double t = std::sqrt(2 * h / g), V = g * t, x_dot = vx, spin = w0, loss = 0.0;
   for (std::size_t j = 0; j < 2; ++j) {
     SCOPED_TRACE(j);
-    const EventRecord& ev = run.summary.events[j];
+    const EventRecord& ev = run.summary.events.crossings[j];
     EXPECT_EQ(ev.name, "ball_touchdown");
     EXPECT_NEAR(ev.t, t, 1e-9);
     const double s_before = x_dot - r * spin;
@@ -457,7 +457,7 @@ TEST(ContactModes, BallLandingObliquelyWithSpinTakesTheSlidingImpulseOfTheClosed
     t += 2 * e * V / g;
     V *= e;
   }
-  EXPECT_LT(run.summary.max_balance_error, 1e-9);  // h - h0 - W through the bounces
+  EXPECT_LT(run.summary.energy.balance_error, 1e-9);  // h - h0 - W through the bounces
   EXPECT_NEAR(run.at(run.rows.size() - 1, "work_reactions"), 0.0, 1e-12);
   EXPECT_TRUE(run.summary.warnings.empty());
 }
@@ -470,13 +470,13 @@ TEST(ContactModes, PlasticLandingSlidesOnAlongThePreImpactSlipOrSticksInsideTheC
     // sliding with s+ = (|s-| - mu V (1 + k) / k) e_s and sticks k |s+| / (mu g (1 + k)) later.
     const double mu = 0.2, vx = 1.0, vy = 1.5, w0 = 20.0;
     const ModeRun run = run_landing(landing_ball(0.0, mu, vx, vy, w0, h), 1.0);
-    ASSERT_EQ(run.summary.events.size(), 2u);
-    EXPECT_EQ(run.summary.events[0].name, "ball_touchdown");
-    EXPECT_EQ(run.summary.events[1].name, "ball_stick");
+    ASSERT_EQ(run.summary.events.crossings.size(), 2u);
+    EXPECT_EQ(run.summary.events.crossings[0].name, "ball_touchdown");
+    EXPECT_EQ(run.summary.events.crossings[1].name, "ball_stick");
     const double sx = vx - r * w0, sy = vy, s = std::hypot(sx, sy);
     const double s_after = s - mu * V * (1 + k) / k;
     ASSERT_GT(s_after, 0.0);
-    const EventRecord& ev = run.summary.events[0];
+    const EventRecord& ev = run.summary.events.crossings[0];
     EXPECT_NEAR(ev.v[0], vx - mu * V * sx / s, 1e-9);
     EXPECT_NEAR(ev.v[1], vy - mu * V * sy / s, 1e-9);
     EXPECT_NEAR(ev.v[2], 0.0, 1e-12);
@@ -484,22 +484,22 @@ TEST(ContactModes, PlasticLandingSlidesOnAlongThePreImpactSlipOrSticksInsideTheC
     EXPECT_EQ(run.at(row, "ball_mode"), 1.0);
     EXPECT_NEAR(run.at(row, "ball_slip_x"), s_after * sx / s, 1e-9);
     EXPECT_NEAR(run.at(row, "ball_slip_y"), s_after * sy / s, 1e-9);
-    EXPECT_NEAR(run.summary.events[1].t, t1 + k * s_after / (mu * g * (1 + k)), 1e-9);
+    EXPECT_NEAR(run.summary.events.crossings[1].t, t1 + k * s_after / (mu * g * (1 + k)), 1e-9);
     EXPECT_NEAR(run.at(row, "impact_loss"), 0.1 * V * V / 2 + mu * 0.1 * V * (s + s_after) / 2, 1e-10);
-    EXPECT_LT(run.summary.max_balance_error, 1e-9);
+    EXPECT_LT(run.summary.energy.balance_error, 1e-9);
   }
   {
     // A small slip: the sticking impulse is inside the cone, the ball rolls at once at 5 vx / 7.
     const double mu = 0.5, vx = 0.3;
     const ModeRun run = run_landing(landing_ball(0.0, mu, vx, 0.0, 0.0, h), 0.3);
-    ASSERT_EQ(run.summary.events.size(), 1u);
-    const EventRecord& ev = run.summary.events[0];
+    ASSERT_EQ(run.summary.events.crossings.size(), 1u);
+    const EventRecord& ev = run.summary.events.crossings[0];
     EXPECT_NEAR(ev.v[0], 5 * vx / 7, 1e-10);
     EXPECT_NEAR(ev.v[4], 5 * vx / 7 / r, 1e-8);
     const std::size_t row = mode_switch_row(run, ev.t);
     EXPECT_EQ(run.at(row, "ball_mode"), 0.0);
     EXPECT_NEAR(run.at(row, "impact_loss"), 0.1 * V * V / 2 + k * 0.1 * vx * vx / (2 * (1 + k)), 1e-10);
-    EXPECT_LT(run.summary.max_balance_error, 1e-9);
+    EXPECT_LT(run.summary.energy.balance_error, 1e-9);
   }
 }
 
@@ -591,7 +591,7 @@ TEST(ContactModes, PainlevesRodStopsAboveTheCriticalFrictionAndSlidesBelowIt) {
   EXPECT_EQ(r.summary.status, Status::ok) << r.summary.message;
   // It slides, until the large friction stops the slip (a stick, not a stop: the "dynamic jam").
   EXPECT_EQ(r.at(0, "end_mode"), 1.0);
-  for (const EventRecord& e : r.summary.events) EXPECT_EQ(e.name, "end_stick");
+  for (const EventRecord& e : r.summary.events.crossings) EXPECT_EQ(e.name, "end_stick");
   // Near the singularity N is large: 100 m g at 1 % below mu_c.
   EXPECT_NEAR(r.at(0, "end_N"), g / (L.nn - mu * L.nt), 1e-9 * g / (L.nn - mu * L.nt));
   EXPECT_NEAR(r.at(0, "end_Fx"), -mu * r.at(0, "end_N"), 1e-9 * r.at(0, "end_N"));
@@ -648,9 +648,9 @@ TEST(ContactModes, PainlevesRodTippedByATorqueStopsWhereItWouldStartSliding) {
   EXPECT_LT(w_eff, 0.0);
 
   const ModeRun slides = run(rod(1.2), 0.1);
-  ASSERT_GE(slides.summary.events.size(), 1u) << slides.summary.message;
-  EXPECT_EQ(slides.summary.events[0].name, "end_slip");
-  EXPECT_EQ(slides.at(mode_switch_row(slides, slides.summary.events[0].t), "end_mode"), 1.0);
+  ASSERT_GE(slides.summary.events.crossings.size(), 1u) << slides.summary.message;
+  EXPECT_EQ(slides.summary.events.crossings[0].name, "end_slip");
+  EXPECT_EQ(slides.at(mode_switch_row(slides, slides.summary.events.crossings[0].t), "end_mode"), 1.0);
   EXPECT_EQ(slides.summary.message.find("Painleve"), std::string::npos) << slides.summary.message;
 }
 
@@ -665,20 +665,20 @@ TEST(ContactModes, AnImpactThatGainsEnergyIsWarnedAboutOnceAndBookedInImpactLoss
   const double t1 = std::sqrt(2 * h / g), vn = -g * t1, vt = L.nt / L.nn * vn;
   const Model model = load_model_text(painleve_rod(fmt::format("restitution = {}\n", e), b, h, vt), "rod.toml");
   const ModeRun r = run_modes(model, t1 + 0.01);
-  ASSERT_GE(r.summary.events.size(), 1u);
-  EXPECT_EQ(r.summary.events[0].name, "end_touchdown");
-  EXPECT_NEAR(r.summary.events[0].t, t1, 1e-9);
+  ASSERT_GE(r.summary.events.crossings.size(), 1u);
+  EXPECT_EQ(r.summary.events.crossings[0].name, "end_touchdown");
+  EXPECT_NEAR(r.summary.events.crossings[0].t, t1, 1e-9);
   // M = Lambda^-1 (2 x 2, t and n): v^T M v = (Lnn vt^2 - 2 Lnt vt vn + Ltt vn^2) / det.
   const double det = L.tt * L.nn - L.nt * L.nt;
   const double loss = ((L.nn * vt * vt - 2 * L.nt * vt * vn + L.tt * vn * vn) / det - e * e * L.tt / det * vn * vn) / 2;
   EXPECT_LT(loss, 0.0);
-  EXPECT_NEAR(r.at(mode_switch_row(r, t1 + (r.summary.events[0].t - t1)), "impact_loss"), loss, 1e-10);
+  EXPECT_NEAR(r.at(mode_switch_row(r, t1 + (r.summary.events.crossings[0].t - t1)), "impact_loss"), loss, 1e-10);
   ASSERT_EQ(r.summary.warnings.size(), 1u);
   const std::string& warning = r.summary.warnings[0];
   EXPECT_NE(warning.find("contact 'end': the impact at t = "), std::string::npos) << warning;
   EXPECT_NE(warning.find("gains energy"), std::string::npos) << warning;
   EXPECT_NE(warning.find(fmt::format("{:.6g} J", -loss)), std::string::npos) << warning;
-  EXPECT_LT(r.summary.max_balance_error, 1e-9);
+  EXPECT_LT(r.summary.energy.balance_error, 1e-9);
 }
 
 std::string thrown_ball_with(const std::string& keys) {

@@ -371,7 +371,7 @@ TEST(QuaternionFrame, TumblingChaplyginBallKeepsItsIntegrals) {
   EXPECT_LT(lowest_zz, -0.9);       // the ball has turned over
   EXPECT_GT(highest_lock, 0.99);    // and come near the z-x-y angles' lock (|sin theta| = 1)
   EXPECT_LT(drift, 1e-10 * std::sqrt(K0[0] * K0[0] + K0[1] * K0[1] + K0[2] * K0[2]));
-  EXPECT_LT(summary.energy_drift, 1e-10);
+  EXPECT_LT(summary.energy.drift, 1e-10);
   EXPECT_LT(force, 1e-9 * m * g);
   EXPECT_LT(norm, 1e-9);
 }

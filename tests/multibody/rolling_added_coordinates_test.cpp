@@ -106,7 +106,7 @@ TEST(RollingAddedCoordinates, BallOverABumpFollowsTheOneWithWrittenCoordinates) 
     }
   }
   EXPECT_GT(std::abs(a.back()[static_cast<std::size_t>(column_of(ca, "y"))]), 0.01);  // it did turn
-  EXPECT_LT(std::abs(summary.energy_change), 1e-9);                                  // energy conserved
+  EXPECT_LT(std::abs(summary.energy.change), 1e-9);                                  // energy conserved
 }
 
 // examples/ellipsoid_rocking.toml with the ellipsoid written as f = 0 and no coordinates.

@@ -214,7 +214,7 @@ TEST(RollingBodies, EllipsoidContactPointIsOnBothSurfaces) {
     const double length = std::sqrt(nw[0] * nw[0] + nw[1] * nw[1] + nw[2] * nw[2]);
     EXPECT_NEAR(nw[2] / length, -1.0, 1e-12);
   });
-  EXPECT_LT(summary.energy_drift, 1e-10);
+  EXPECT_LT(summary.energy.drift, 1e-10);
 }
 
 // Rolling-bodies.md (6.5): the solid hemisphere, rubber rolling: omega^2 = 15 g / (26 r), twice;
@@ -275,7 +275,7 @@ TEST(RollingBodies, ChaplyginBallKeepsItsIntegrals) {
   });
   EXPECT_GT(largest_angle, 0.3);  // the ball has turned: the test is not about a ball at rest
   EXPECT_LT(drift, 1e-10 * std::sqrt(K0[0] * K0[0] + K0[1] * K0[1] + K0[2] * K0[2]));
-  EXPECT_LT(summary.energy_drift, 1e-10);
+  EXPECT_LT(summary.energy.drift, 1e-10);
 }
 
 // Kane and Levinson's rattleback, spun at -5 rad/s: it rocks, stops turning and turns the other way;
@@ -326,7 +326,7 @@ TEST(RollingBodies, RattlebackReversesItsSpinAndKeepsItsEnergy) {
   EXPECT_GT(lowest, -5.33);
   EXPECT_GT(highest, 5.3969);
   EXPECT_LT(highest, 5.41);
-  EXPECT_LT(summary.energy_drift, 1e-9 * summary.energy_initial);
+  EXPECT_LT(summary.energy.drift, 1e-9 * summary.energy.initial);
 }
 
 // The rattleback's linearization about upright spin psi' = s against the closed-form quartic of

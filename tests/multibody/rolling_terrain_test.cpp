@@ -91,7 +91,7 @@ position = { x = "-r*sin(alpha)", y = 0, z = "r*cos(alpha)", u = 0, v = 0, psi =
     ++rows;
   });
   EXPECT_EQ(rows, 21);
-  EXPECT_LT(summary.energy_drift, 1e-12);
+  EXPECT_LT(summary.energy.drift, 1e-12);
 }
 
 // Over a Gaussian bump, started off its axis with a velocity across it: the energy stays, the
@@ -132,7 +132,7 @@ velocity = { x = 1.2, y = 0, phi = 12 }
   ASSERT_TRUE(summary.initial_fix.has_value());
   EXPECT_GT(highest, 0.6 * H);     // it went over the bump, not around it
   EXPECT_GT(farthest_y, 0.1);      // and was deflected sideways
-  EXPECT_LT(summary.energy_drift, 1e-10);
+  EXPECT_LT(summary.energy.drift, 1e-10);
 }
 
 }  // namespace

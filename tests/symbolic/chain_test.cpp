@@ -105,12 +105,12 @@ TEST(Chain, ConservesEnergyAndHoldsTheConstraints) {
     const SimulationSummary s = simulate(model, tight(5.0), [](const Data&) {});
     ASSERT_EQ(s.status, Status::ok) << s.message;
     const double T0 = initial_energy(p);
-    EXPECT_LT(s.energy_drift / T0, 1e-8) << bodies;
-    EXPECT_LT(s.max_position_residual, 1e-8) << bodies;
-    EXPECT_LT(s.max_velocity_residual, 1e-8) << bodies;
-    EXPECT_LT(s.max_acceleration_residual, 1e-10) << bodies;
+    EXPECT_LT(s.energy.drift / T0, 1e-8) << bodies;
+    EXPECT_LT(s.residuals.position, 1e-8) << bodies;
+    EXPECT_LT(s.residuals.velocity, 1e-8) << bodies;
+    EXPECT_LT(s.residuals.acceleration, 1e-10) << bodies;
     std::printf("chain N = %d: energy drift %.2e relative, residuals pos %.2e vel %.2e acc %.2e\n", bodies,
-                s.energy_drift / T0, s.max_position_residual, s.max_velocity_residual, s.max_acceleration_residual);
+                s.energy.drift / T0, s.residuals.position, s.residuals.velocity, s.residuals.acceleration);
   }
 }
 

@@ -65,10 +65,10 @@ StepEnd project(const Model& model, Data& data, const ProjectionOptions& options
   const Status status = compute_projection(model, data, t, y, y + model.n(), options, result);
   if (status != Status::ok) return {status, false};
   if (result.changed()) {
-    ++summary.projections;
-    summary.projection_iterations += result.position_iterations + result.velocity_iterations;
-    summary.max_position_correction = std::max(summary.max_position_correction, result.position_change);
-    summary.max_velocity_correction = std::max(summary.max_velocity_correction, result.velocity_change);
+    ++summary.projection.count;
+    summary.projection.iterations += result.position_iterations + result.velocity_iterations;
+    summary.projection.max_position_correction = std::max(summary.projection.max_position_correction, result.position_change);
+    summary.projection.max_velocity_correction = std::max(summary.projection.max_velocity_correction, result.velocity_change);
   }
   return {Status::ok, result.changed()};
 }
@@ -146,15 +146,15 @@ void record_balance(const Model& model, Data& data, const double* work, Simulati
   data.work_friction = model.contact_modes ? work[3] : 0.0;
   data.impact_loss = model.contact_modes ? work[4] : 0.0;
   const double W = work[0] + work[1] + work[2] + data.work_friction - data.impact_loss;
-  data.balance_error = data.energy_function - summary.energy_function_initial - W;
-  summary.max_balance_error = std::max(summary.max_balance_error, std::abs(data.balance_error));
-  summary.work_forces = work[0];
-  summary.work_reactions = work[1];
-  summary.work_time = work[2];
-  summary.work_friction = data.work_friction;
-  summary.impact_loss = data.impact_loss;
-  summary.energy_change = data.energy - summary.energy_initial;
-  summary.energy_function_change = data.energy_function - summary.energy_function_initial;
+  data.balance_error = data.energy_function - summary.energy.function_initial - W;
+  summary.energy.balance_error = std::max(summary.energy.balance_error, std::abs(data.balance_error));
+  summary.energy.work_forces = work[0];
+  summary.energy.work_reactions = work[1];
+  summary.energy.work_time = work[2];
+  summary.energy.work_friction = data.work_friction;
+  summary.energy.impact_loss = data.impact_loss;
+  summary.energy.change = data.energy - summary.energy.initial;
+  summary.energy.function_change = data.energy_function - summary.energy.function_initial;
 }
 
 // The dynamics that events reading q'' or R (or the contact forces) need
@@ -265,8 +265,11 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
       throw InputError(fmt::format("the relative tolerance rtol = {} is below what double precision can "
                                    "deliver; use 1e-14 or more", io.rtol));
   }
+  // The one check of the step budget, for the command line and Python alike.
   if (io.max_steps < 1)
-    throw InputError(fmt::format("the step budget (--max-steps) {} must be at least 1", io.max_steps));
+    throw InputError(fmt::format("the step budget max_steps (--max-steps) = {} must be at least 1: it counts the "
+                                 "accepted and rejected steps of the whole run (default {})",
+                                 io.max_steps, IntegratorOptions{}.max_steps));
   if (!options.events.empty() && !supports_events(io.kind))
     throw InputError(fmt::format("events need an integrator that can locate them; {} has no continuous extension: "
                                  "choose dopri5, dop853, cvode-bdf or cvode-adams",
@@ -368,8 +371,8 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   check_programs_at_initial_state(model, data, options.formulation, model.t0, q0, v0, options.initial_tolerance);
 
   const int n = model.n();
-  summary.has_energy = model.evaluator->has_energy();
-  summary.has_energy_balance = model.evaluator->has_energy_balance();
+  summary.energy.has_energy = model.evaluator->has_energy();
+  summary.energy.has_balance = model.evaluator->has_energy_balance();
   FormulationOptions formulation = options.formulation;
   formulation.baumgarte.enabled = options.stabilization == Stabilization::baumgarte;
   ConstraintWatch watch = make_constraint_watch(model, data, options.formulation.method, options.watch_factor);
@@ -413,23 +416,23 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
         return Status::stopped;
       }
     if (first_output) {
-      summary.energy_initial = data.energy;
-      summary.energy_function_initial = data.energy_function;
+      summary.energy.initial = data.energy;
+      summary.energy.function_initial = data.energy_function;
       first_output = false;
     }
-    if (summary.has_energy_balance) record_balance(model, data, y + 2 * n, summary);
-    summary.max_position_residual = std::max(summary.max_position_residual, max_abs(data.phi));
-    summary.max_velocity_residual = std::max(summary.max_velocity_residual, max_abs(data.f));
-    summary.max_acceleration_residual = std::max(summary.max_acceleration_residual, max_abs(data.e));
+    if (summary.energy.has_balance) record_balance(model, data, y + 2 * n, summary);
+    summary.residuals.position = std::max(summary.residuals.position, max_abs(data.phi));
+    summary.residuals.velocity = std::max(summary.residuals.velocity, max_abs(data.f));
+    summary.residuals.acceleration = std::max(summary.residuals.acceleration, max_abs(data.e));
     if (model.m() > 0) {
       compute_program_residuals(model, data);
-      summary.max_program_position_residual = std::max(summary.max_program_position_residual, max_abs(data.motion.phi));
-      summary.max_program_velocity_residual = std::max(summary.max_program_velocity_residual, max_abs(data.motion.f));
-      summary.max_program_acceleration_residual =
-          std::max(summary.max_program_acceleration_residual, max_abs(data.motion.e));
+      summary.program.position = std::max(summary.program.position, max_abs(data.motion.phi));
+      summary.program.velocity = std::max(summary.program.velocity, max_abs(data.motion.f));
+      summary.program.acceleration =
+          std::max(summary.program.acceleration, max_abs(data.motion.e));
     }
-    if (summary.has_energy)
-      summary.energy_drift = std::max(summary.energy_drift, std::abs(data.energy - summary.energy_initial));
+    if (summary.energy.has_energy)
+      summary.energy.drift = std::max(summary.energy.drift, std::abs(data.energy - summary.energy.initial));
     if (hide_start) {
       hide_start = false;
       return Status::ok;
@@ -446,7 +449,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
 
   std::vector<const Event*> events;
   for (const Event& e : options.events) events.push_back(&e);
-  for (const Event* e : events) summary.event_names.push_back(e->name);
+  for (const Event* e : events) summary.events.names.push_back(e->name);
   ModelEventFunctions event_functions(model, events, [&](int i, double t, const double* y) -> Status {
     // The row at the crossing, then its record with the state as written (projected, if so).
     if (output(t, y) == Status::stopped) return output_failure;
@@ -456,7 +459,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     record.t = t;
     record.q.assign(data.q.data(), data.q.data() + n);
     record.v.assign(data.v.data(), data.v.data() + n);
-    summary.events.push_back(std::move(record));
+    summary.events.crossings.push_back(std::move(record));
     return Status::ok;
   }, event_dynamics(model, data, formulation));
   event_functions.require_valid_start(model.t0, y0.data());
@@ -466,15 +469,15 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   ContactSwitches switches(model, data, formulation, static_cast<int>(states), events.empty() ? nullptr : &event_functions,
                            [&](const std::string& name, double t, const double* y) -> Status {
                              if (output(t, y) == Status::stopped) return output_failure;
-                             auto at = std::find(summary.event_names.begin(), summary.event_names.end(), name);
-                             if (at == summary.event_names.end()) at = summary.event_names.insert(at, name);
+                             auto at = std::find(summary.events.names.begin(), summary.events.names.end(), name);
+                             if (at == summary.events.names.end()) at = summary.events.names.insert(at, name);
                              EventRecord record;
-                             record.index = static_cast<int>(at - summary.event_names.begin());
+                             record.index = static_cast<int>(at - summary.events.names.begin());
                              record.name = name;
                              record.t = t;
                              record.q.assign(data.q.data(), data.q.data() + n);
                              record.v.assign(data.v.data(), data.v.data() + n);
-                             summary.events.push_back(std::move(record));
+                             summary.events.crossings.push_back(std::move(record));
                              return Status::ok;
                            });
   const IntegrationResult result =
@@ -483,15 +486,15 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
                                       events.empty() ? nullptr : &event_functions);
   summary.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.status = output_failure != Status::ok ? output_failure : result.status;
-  summary.stopped_by = event_functions.stopped_by();
+  summary.events.stopped_by = event_functions.stopped_by();
   // A stop event ends the run as planned.
-  if (summary.status == Status::stopped && summary.stopped_by >= 0) summary.status = Status::ok;
+  if (summary.status == Status::stopped && summary.events.stopped_by >= 0) summary.status = Status::ok;
   // A stop condition that never held: most likely a sign or threshold that cannot be met.
-  if (summary.status == Status::ok && summary.stopped_by < 0)
+  if (summary.status == Status::ok && summary.events.stopped_by < 0)
     for (std::size_t i = 0; i < events.size(); ++i) {
       const Event& e = *events[i];
       if (e.action != EventAction::stop) continue;
-      if (std::any_of(summary.events.begin(), summary.events.end(),
+      if (std::any_of(summary.events.crossings.begin(), summary.events.crossings.end(),
                       [&](const EventRecord& r) { return r.index == static_cast<int>(i) && r.name == e.name; }))
         continue;
       // An option quotes its own text ("--stop-when \"x > 2\""); a file's event is named at its place.
@@ -499,7 +502,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
       const std::string what = option ? "the stop condition " + e.where
                                       : fmt::format("{}the stop event '{}' ({})", e.where.empty() ? "" : e.where + ": ",
                                                     e.name, e.expression);
-      summary.unmet_stops.push_back(fmt::format(
+      summary.events.unmet_stops.push_back(fmt::format(
           "{} never {} between t = {:g} and t = {:g}: the run went to the end; check its sign, direction or threshold",
           what, e.condition ? "became true" : "crossed zero in its direction", model.t0, result.t_reached));
     }
@@ -507,13 +510,13 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.sparse = data.sparse;
   summary.partition_changes = data.partition_changes;
   summary.stats = result.stats;
-  summary.energy_function_differs = summary.has_energy_balance && !model.evaluator->energy_function_is_energy();
-  summary.constraint_warnings = watch.warnings;
+  summary.energy.function_differs = summary.energy.has_balance && !model.evaluator->energy_function_is_energy();
+  summary.watch.warnings = watch.warnings;
   for (const ConstraintWarning& w : watch.warnings) summary.warnings.push_back(format_constraint_warning(model, w));
   summary.warnings.insert(summary.warnings.end(), switches.warnings().begin(), switches.warnings().end());
-  summary.largest_row_factor = watch.largest_row_factor;
-  summary.largest_condition_factor = watch.largest_condition_factor;
-  summary.watched_states = watch.states;
+  summary.watch.largest_row_factor = watch.largest_row_factor;
+  summary.watch.largest_condition_factor = watch.largest_condition_factor;
+  summary.watch.watched_states = watch.states;
   if (summary.status != Status::ok) {
     // The kernels recorded the details of a failed evaluation in data; prefer those words.
     summary.message = data.status != Status::ok ? explain_failure(model, data) : result.message;

@@ -15,6 +15,7 @@
 #include "nhdyn/analysis/events.hpp"
 #include "nhdyn/analysis/initial_state.hpp"
 #include "nhdyn/analysis/projection.hpp"
+#include "nhdyn/analysis/simulation_summary.hpp"
 #include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/integrators/ode.hpp"
 #include "nhdyn/model/data.hpp"
@@ -60,74 +61,15 @@ struct SimulationOptions {
   Path path = Path::automatic;
   // Events located during the run (analysis/events.hpp; a model file's [[events]] are in
   // Model::events: copy them here to locate them). Each crossing writes a row at its time (the
-  // exact event state, between the output rows) and is listed in SimulationSummary::events; a stop
-  // event ends the run there with status ok. rk4 cannot locate events: check_simulation_options
-  // refuses them.
+  // exact event state, between the output rows) and is listed in SimulationSummary::events
+  // (analysis/simulation_summary.hpp); a stop event ends the run there with status ok. rk4 cannot
+  // locate events: check_simulation_options refuses them.
   std::vector<Event> events;
   // The constraint watch (analysis/constraint_watch.hpp): warns when a constraint's row of b or the
   // conditioning of the stacked matrix degrades by watch_factor or more during the run. Checked at
   // every output and at every accepted step whose end state the right-hand side last evaluated.
   bool watch_constraints = true;
   double watch_factor = kConstraintWatchFactor;
-};
-
-struct SimulationSummary {
-  Status status = Status::ok;
-  std::string message;              // empty when ok: what went wrong, where
-  double t_reached = 0.0;
-  IntegratorStats stats;
-  long outputs = 0;                 // rows handed to the caller
-  double wall_time = 0.0;           // [s], integration and output evaluation
-  bool sparse = false;              // whether the run took the sparse kernels (model/data.hpp)
-  long partition_changes = 0;       // sparse sanh: times the dependent coordinates were chosen anew
-  double max_position_residual = 0.0;      // max |phi| over outputs and constraints
-  double max_velocity_residual = 0.0;      // max |f|
-  double max_acceleration_residual = 0.0;  // max |b q'' + b0|
-  // Program motion (model.m() > 0): the same maxima for the programs' residuals, the tracking
-  // error of the realized motion (docs/derivations/program-motion.md section 5).
-  double max_program_position_residual = 0.0;
-  double max_program_velocity_residual = 0.0;
-  double max_program_acceleration_residual = 0.0;
-  bool has_energy = false;
-  double energy_initial = 0.0;
-  double energy_drift = 0.0;        // max |E(t) - E(t0)| over outputs: error only when no agent does work
-  // The energy balance (docs/derivations/energy-balance.md), when the model has one: the largest
-  // |h - h(t0) - W| over outputs (the accuracy figure), and as physics the work W done up to the
-  // last output by each agent and the change of E = T + V and of h (which differs from E when T
-  // has parts of degree 1 or 0 in the velocities).
-  bool has_energy_balance = false;
-  bool energy_function_differs = false;  // h is not E for this model
-  double energy_function_initial = 0.0;
-  double max_balance_error = 0.0;
-  double work_forces = 0.0, work_reactions = 0.0, work_time = 0.0;
-  double work_friction = 0.0;           // contacts that slide (model/contact_modes.hpp); in W
-  double impact_loss = 0.0;             // energy taken by touchdowns (model/contact_modes.hpp); W has -impact_loss
-  double energy_change = 0.0;           // E(t_last) - E(t0)
-  double energy_function_change = 0.0;  // h(t_last) - h(t0)
-  std::optional<InitialFix> initial_fix;  // set when options.fix_initial moved the initial state
-  // Stabilization::projection: projections that changed the state (after steps and at outputs),
-  // their Newton iterations, and the largest change of a coordinate and of a velocity.
-  long projections = 0;
-  long projection_iterations = 0;
-  double max_position_correction = 0.0;
-  double max_velocity_correction = 0.0;
-  // The crossings located, in time order, and the stop event that ended the run (its index in
-  // `event_names`), or -1 when the run reached t_end.
-  std::vector<std::string> event_names;  // the run's events, those of SimulationOptions::events
-  std::vector<EventRecord> events;
-  int stopped_by = -1;
-  // The constraint watch (SimulationOptions::watch_constraints): at most one warning per
-  // constraint, in time order, and the same in words (format_constraint_warning); the largest
-  // degradation factor of the row norms and of the conditioning seen (1 when nothing changed) and
-  // the number of states watched.
-  std::vector<ConstraintWarning> constraint_warnings;
-  std::vector<std::string> warnings;
-  // A stop condition (--stop-when, an event with action "stop") that never held on a run that
-  // reached its end: one sentence each, naming it (docs/cli.md, "Events").
-  std::vector<std::string> unmet_stops;
-  double largest_row_factor = 1.0;
-  double largest_condition_factor = 1.0;
-  long watched_states = 0;
 };
 
 // Called at every output time, and at every event (its row is the state at the crossing), with

@@ -92,8 +92,8 @@ ErrorRelation study_error_relation(const Model& model, const ErrorRelationOption
         run.summary = r.summary;
         run.max_error_q = r.max_error_q;
         run.max_error_v = r.max_error_v;
-        run.max_residual_pos = r.summary.max_position_residual;
-        run.max_residual_vel = r.summary.max_velocity_residual;
+        run.max_residual_pos = r.summary.residuals.position;
+        run.max_residual_vel = r.summary.residuals.velocity;
       }
     }
   return out;
