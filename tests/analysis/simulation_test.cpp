@@ -234,6 +234,14 @@ TEST(OutputTimes, TimesCloserThanTheResolutionAreRefused) {
   EXPECT_NO_THROW(check_simulation_options(model, o));
   EXPECT_THROW(make_output_times(1e6, 1e6 + 1e-9, 1e-12), InputError);
   EXPECT_NO_THROW(make_output_times(1e6, 1e6 + 1e-6, 1e-7));
+  // A first time just after t0 merges with nothing (the start is then no row).
+  o.output_times = {1e-15, 0.5};
+  o.t_end = 0.5;
+  EXPECT_NO_THROW(check_simulation_options(model, o));
+  // A grid whose last time falls within the resolution of t_end ends at t_end itself, one row.
+  const std::vector<double> grid = make_output_times(1e5, 1e5 + 1.000000001, 0.1);
+  EXPECT_EQ(grid.size(), 11u);
+  EXPECT_EQ(grid.back(), 1e5 + 1.000000001);
 }
 
 }  // namespace

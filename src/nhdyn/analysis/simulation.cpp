@@ -200,9 +200,9 @@ std::vector<double> make_output_times(double t0, double t_end, double output_ste
   if (!std::isfinite(output_step) || !(output_step > 0.0))
     throw InputError(fmt::format("the output step {} must be a positive, finite time", output_step));
   if (!(output_step > time_resolution(t0, t_end)))
-    throw InputError(fmt::format("the output step {} is below the resolution of time over [{}, {}] ({:.3g}): its "
-                                 "rows would be one; choose a larger output step",
-                                 output_step, t0, t_end, time_resolution(t0, t_end)));
+    throw InputError(fmt::format("the output step {} is below {:.3g}, closer than nhdyn tells rows apart over "
+                                 "[{}, {}]: its rows would be one; choose a larger output step",
+                                 output_step, time_resolution(t0, t_end), t0, t_end));
   const double count = std::floor((t_end - t0) / output_step + 1e-9);
   if (count > kMaxOutputs)
     throw InputError(fmt::format("an output step of {} over [{}, {}] gives {:.3g} rows, more than the "
@@ -212,7 +212,9 @@ std::vector<double> make_output_times(double t0, double t_end, double output_ste
   times.reserve(static_cast<std::size_t>(count) + 2);
   for (long i = 0; i <= static_cast<long>(count); ++i) times.push_back(t0 + static_cast<double>(i) * output_step);
   // The last output is t_end itself, whether or not the step divides the interval.
-  if (t_end - times.back() > 1e-9 * output_step) times.push_back(t_end);
+  // (A last grid time within the resolution of t_end would be merged with its row: it becomes t_end.)
+  if (t_end - times.back() > std::max(1e-9 * output_step, time_resolution(times.back(), t_end)))
+    times.push_back(t_end);
   else times.back() = t_end;
   return times;
 }
@@ -234,10 +236,11 @@ std::vector<double> calc_run_times(const Model& model, const SimulationOptions& 
     if (i > 0 && !(t > options.output_times[i - 1]))
       throw InputError(fmt::format("the output times must increase: {} (index {}) follows {}", t, i,
                                    options.output_times[i - 1]));
+    // (The start, when it is not an output time, is no row: a first time near it merges with nothing.)
     const double before = i > 0 ? options.output_times[i - 1] : model.t0;
-    if ((i > 0 || t != model.t0) && !(t - before > time_resolution(t, before)))
-      throw InputError(fmt::format("the output time {} (index {}) is within the resolution of time ({:.3g}) of {}, "
-                                   "so the two would be one row; leave one out",
+    if (i > 0 && !(t - before > time_resolution(t, before)))
+      throw InputError(fmt::format("the output time {} (index {}) is within {:.3g} of {}, closer than nhdyn tells "
+                                   "rows apart, so the two would be one row; leave one out",
                                    t, i, time_resolution(t, before), before));
     times.push_back(t);
   }
