@@ -6,6 +6,11 @@ Each expression is printed in the model file's syntax: a coordinate q(t) becomes
 derivatives q' and q''; SymPy's ** becomes ^, Abs abs, E exp(1); every other symbol must be a
 parameter (given a value in `parameters`) or the time. A symbol that fits none of these is refused,
 naming it and what it could have been.
+
+nhdyn.from_sympy_mechanics takes sympy.physics.mechanics' own description (frames, bodies,
+generalized speeds and their kinematic differential equations, a KanesMethod) and writes it in q
+and q' for from_sympy: nhdyn's equations are in the coordinates' velocities, so the speeds are
+solved for from the kinematic differential equations and replaced.
 """
 
 import json
@@ -181,6 +186,8 @@ def _events(tr, events, extra):
     for ename, value in (events or {}).items():
         ename = _key(ename, "events")
         options = dict(value) if isinstance(value, dict) else {"expression": value}
+        if "when" in options and "expression" not in options:  # the model file's spelling
+            options["expression"] = options.pop("when")
         unknown = sorted(set(options) - {"expression", "direction", "action"})
         if unknown or "expression" not in options:
             raise _input_error("event {}: {}; give an expression or dict(expression=..., direction=..., "
