@@ -350,7 +350,8 @@ def from_sympy_mechanics(frame=None, bodies=(), q=None, u=None, kd_eqs=None, vel
     loads ((Point, force) and (ReferenceFrame, torque)) become generalized forces F . dv/dq'_j
     ([forces], nonconservative: gravity given as a load runs as V would, but the energy column then
     leaves it out). simplify=False keeps SymPy's expressions as they come. The other arguments are
-    those of from_sympy; initial takes q and q(t).diff(t) (not u)."""
+    those of from_sympy; programs, events and outputs may use the speeds u (replaced as in T);
+    initial takes q and q(t).diff(t), not u."""
     sympy = _sympy()
     from sympy.physics import mechanics
 
@@ -416,6 +417,16 @@ def from_sympy_mechanics(frame=None, bodies=(), q=None, u=None, kd_eqs=None, vel
             raise _input_error("forces: {} is not a coordinate ({})".format(key, ", ".join(names)))
         all_forces[key] = all_forces.get(key, 0) + in_velocities(value, "forces[{}]".format(key))
     coordinate = dict(zip(names, q))
+    # Programs, events and outputs may be written in the speeds too: they are replaced the same way.
+    if replace:
+        def speeds(e):
+            return sympy.sympify(e).subs(replace) if isinstance(e, sympy.Basic) else e
+
+        programs = {k: (speeds(v[0]), [speeds(e) for e in v[1]] if isinstance(v[1], (list, tuple)) else v[1])
+                    if isinstance(v, (list, tuple)) and len(v) == 2 else v for k, v in (programs or {}).items()}
+        events = {k: dict(v, **{key: speeds(v[key]) for key in ("expression", "when") if key in v})
+                  if isinstance(v, dict) else speeds(v) for k, v in (events or {}).items()}
+        outputs = {k: speeds(v) for k, v in (outputs or {}).items()}
     return from_sympy(T, V, q, constraints, parameters, forces={coordinate.get(k, k): v for k, v in all_forces.items()},
                       initial=initial, programs=programs, events=events, outputs=outputs, name=name,
                       simulation=simulation, file_name=file_name)

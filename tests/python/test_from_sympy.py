@@ -195,8 +195,11 @@ def test_a_knife_edge_from_frames_with_gravity_as_potential_or_as_a_load(example
     assert "[forces]" not in potential.text
     blade.potential_energy = 0
     load = nhdyn.from_sympy_mechanics(N, [blade], [x, y, phi], [u1, u2, u3], kd, {"blade": u2},
-                                      loads=[(P, m * g * sp.sin(alpha) * N.x)], **common)
+                                      loads=[(P, m * g * sp.sin(alpha) * N.x)], outputs={"along": u1}, **common)
     assert "[forces]\nx = \"g*m*sin(alpha)\"" in load.text
+    along = load.simulate(**options)  # an output in the speed u1: the speed of P along the blade
+    assert np.allclose(along.outputs["along"], np.cos(along.q[:, 2]) * along.qd[:, 0] +
+                       np.sin(along.q[:, 2]) * along.qd[:, 1], rtol=0, atol=1e-12)
     for model in (potential, load):
         mine = model.simulate(**options)
         assert np.allclose(mine.q, theirs.q, rtol=0, atol=1e-12) and np.allclose(mine.R, theirs.R, rtol=0, atol=1e-12)
