@@ -150,15 +150,15 @@ def _actuator(tr, program, actuator):
             raise _input_error("{} {!r} is not a coordinate ({}); give a coordinate or a generalized-force vector "
                                "of {} expressions".format(what, str(actuator), ", ".join(tr.names), len(tr.names)))
         return json.dumps(name)
-    if isinstance(actuator, sympy.MatrixBase):
-        entries = list(actuator) if 1 in actuator.shape or not actuator.shape[0] else None
-    elif isinstance(actuator, (list, tuple)):
+    if isinstance(actuator, sympy.MatrixBase):  # a column or a row
+        entries = list(actuator) if 1 in actuator.shape else None
+    elif isinstance(actuator, (list, tuple)) or getattr(actuator, "ndim", None) == 1:  # numpy too
         entries = list(actuator)
     else:
         entries = None
     if entries is None or len(entries) != len(tr.names):
-        raise _input_error("{} {!r} is neither a coordinate ({}) nor a generalized-force vector of {} entries, one "
-                           "per coordinate{}".format(what, actuator, ", ".join(tr.names), len(tr.names),
+        raise _input_error("{} {} is neither a coordinate ({}) nor a generalized-force vector of {} entries, one "
+                           "per coordinate{}".format(what, str(actuator), ", ".join(tr.names), len(tr.names),
                                                      "" if entries is None else " (it has {})".format(len(entries))))
     return json.dumps([tr(e, "{}[{}]".format(what, i)) for i, e in enumerate(entries)])
 
@@ -367,7 +367,7 @@ def from_sympy_mechanics(frame=None, bodies=(), q=None, u=None, kd_eqs=None, vel
         frame, bodies, q, u = kane._inertial, list(kane.bodies or ()), list(kane.q), list(kane.u)
         qdot = [c.diff(mechanics.dynamicsymbols._t) for c in q]
         if kane._k_ku:
-            kd_eqs = list(sympy.Matrix(qdot) + kane._k_ku * sympy.Matrix(u) + kane._f_k)
+            kd_eqs = list(kane._k_kqdot * sympy.Matrix(qdot) + kane._k_ku * sympy.Matrix(u) + kane._f_k)
         if kane._k_nh:
             velocity_constraints = list(kane._k_nh * sympy.Matrix(u) + kane._f_nh)
         configuration_constraints = list(kane._f_h)
