@@ -335,6 +335,47 @@ def _loads_as_forces(sympy, frame, loads, qd, replace, names):
     return {name: sympy.simplify(e) for name, e in zip(names, Q) if e != 0}
 
 
+def _derived_from_configuration(sympy, holonomic, velocity, q, t):
+    """The names of the velocity constraints that are time derivatives (combinations of them) of
+    the configuration constraints: KanesMethod has them among its velocity_constraints to make
+    u_dependent dependent, but nhdyn differentiates the position constraints itself, and twice the
+    same constraint would leave its equations singular. Tested by the rank of [dc/dq', c(q' = 0)]
+    at a random point (generic: an independent constraint raises the rank there)."""
+    if not holonomic or not velocity:
+        return set()
+    import random
+
+    import numpy as np
+
+    qd = [c.diff(t) for c in q]
+    speeds = [sympy.Dummy("v{}".format(i)) for i in range(len(q))]
+    places = [sympy.Dummy("q{}".format(i)) for i in range(len(q))]
+    rows = {}
+    for name, e in list(holonomic.items()) + list(velocity.items()):
+        e = sympy.sympify(e)
+        if name in holonomic:
+            e = e.diff(t)
+        e = e.subs(list(zip(qd, speeds))).subs(list(zip(q, places)))
+        rows[name] = list(sympy.Matrix([e]).jacobian(speeds)) + [e.xreplace({v: 0 for v in speeds})]
+    free = set().union(*(sympy.Matrix([r]).free_symbols for r in rows.values())) - set(speeds)
+    generator = random.Random(2718)
+    point = {s: sympy.Float(generator.uniform(0.3, 1.3)) for s in free}
+
+    def numeric(names):
+        return np.array([[float(sympy.sympify(v).xreplace(point).evalf()) for v in rows[n]] for n in names])
+
+    kept = list(holonomic)
+    base = np.linalg.matrix_rank(numeric(kept), tol=1e-9)
+    derived = set()
+    for name in velocity:
+        if np.linalg.matrix_rank(numeric(kept + [name]), tol=1e-9) == base:
+            derived.add(name)
+        else:
+            kept.append(name)
+            base += 1
+    return derived
+
+
 def from_sympy_mechanics(frame=None, bodies=(), q=None, u=None, kd_eqs=None, velocity_constraints=(),
                          parameters=None, *, kane=None, V=None, loads=(), configuration_constraints=(),
                          forces=None, initial=None, programs=None, events=None, outputs=None, simplify=True,
@@ -405,7 +446,10 @@ def from_sympy_mechanics(frame=None, bodies=(), q=None, u=None, kd_eqs=None, vel
                 for i, e in enumerate(items)}
 
     constraints = named(configuration_constraints, "h")
-    for k, e in named(velocity_constraints, "nh").items():
+    nonholonomic = named(velocity_constraints, "nh")
+    for k in _derived_from_configuration(sympy, constraints, nonholonomic, q, t):
+        del nonholonomic[k]
+    for k, e in nonholonomic.items():
         if k in constraints:
             raise _input_error("constraint {}: named twice".format(k))
         constraints[k] = e

@@ -228,3 +228,29 @@ def test_bad_programs_events_and_speeds_are_named():
         nhdyn.from_sympy_mechanics(N, [blade], [x, y, phi], [u1, u2, u3], kd[:2] + [kd[0]])
     with pytest.raises(nhdyn.InputError, match=r"kd_eqs: 2 equations for 3 generalized speeds"):
         nhdyn.from_sympy_mechanics(N, [blade], [x, y, phi], [u1, u2, u3], kd[:2])
+
+
+def test_a_particle_on_a_rod_from_a_kanes_method_with_a_dependent_coordinate(examples):
+    """KanesMethod's configuration constraint becomes a position constraint; its derivative, which
+    KanesMethod needs among the velocity constraints, is left to nhdyn (twice the same constraint
+    would be singular)."""
+    x, y = mechanics.dynamicsymbols("x y")
+    u1, u2 = mechanics.dynamicsymbols("u1 u2")
+    m, g, l, theta0 = sp.symbols("m g l theta0")
+    N = mechanics.ReferenceFrame("N")
+    O = mechanics.Point("O")
+    O.set_vel(N, 0)
+    P = O.locatenew("P", x * N.x + y * N.y)
+    P.set_vel(N, u1 * N.x + u2 * N.y)
+    bob = mechanics.Particle("bob", P, m)
+    bob.potential_energy = m * g * y
+    kane = mechanics.KanesMethod(N, [x], [u1], kd_eqs=[x.diff() - u1, y.diff() - u2], q_dependent=[y],
+                                 configuration_constraints=[x**2 + y**2 - l**2], u_dependent=[u2],
+                                 velocity_constraints=[x * u1 + y * u2], bodies=[bob])
+    model = nhdyn.from_sympy_mechanics(kane=kane, parameters={m: 0.5, g: 9.81, l: 1.5, theta0: 2.0},
+                                       initial={x: l * sp.sin(theta0), y: -l * sp.cos(theta0)})
+    assert model.constraints == ["h1"]
+    options = dict(t_end=2, rtol=1e-10, atol=1e-12)
+    mine = model.simulate(**options)
+    theirs = nhdyn.load(examples / "pendulum_cartesian.toml").simulate(**options)
+    assert np.allclose(mine.q, theirs.q, rtol=0, atol=1e-12) and np.allclose(mine.R, theirs.R, rtol=0, atol=1e-12)
