@@ -286,7 +286,7 @@ def _speeds_in_velocities(sympy, q, u, kd_eqs, t):
     if kd_eqs is None:
         raise _input_error("u: generalized speeds need kd_eqs, the kinematic differential equations (each = 0) "
                            "that give them in terms of q and q'")
-    kd = sympy.Matrix(list(kd_eqs))
+    kd = sympy.Matrix([e.lhs - e.rhs if isinstance(e, sympy.Equality) else e for e in kd_eqs])
     if len(kd) != len(u):
         raise _input_error("kd_eqs: {} equations for {} generalized speeds {}; give one per speed".format(
             len(kd), len(u), ", ".join(map(_name, u))))
