@@ -57,7 +57,7 @@ except ImportError as error:
     # the missing piece is usually NumPy, which Debian installs for its own interpreter only.
     raise _wrong_interpreter(str(error)) from error
 from ._nhdyn import Error, FileError, InputError, ModelError, SimulationError
-from ._from_sympy import from_sympy
+from ._from_sympy import from_sympy, from_sympy_mechanics
 
 __version__ = _nhdyn.__version__
 
@@ -112,7 +112,7 @@ __all__ = [
     "__version__", "Error", "InputError", "ModelError", "FileError", "SimulationError", "ConstraintWarning",
     "StopConditionWarning",
     "load", "loads", "builtin_models", "Model", "Result", "Optimum", "Equations", "Linearization", "Sweep",
-    "BatchResult", "simulate_batch", "from_sympy",
+    "BatchResult", "simulate_batch", "from_sympy", "from_sympy_mechanics",
 ]
 
 
