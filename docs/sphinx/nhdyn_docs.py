@@ -260,7 +260,8 @@ def _sorted_titles():
     def freeze(self):
         data = original(self)
         for pages in data.get("alltitles", {}).values():
-            pages.sort()
+            # (page, anchor or None): a title on a section and on an id-less element mixes them.
+            pages.sort(key=lambda page: tuple("" if part is None else part for part in page))
         return by_key(data)
 
     freeze._nhdyn_sorted = True

@@ -299,9 +299,12 @@ SceneMesh solid_mesh(Field& f, const symbolic::VisualShape& shape, const std::st
     for (const double sign : {1.0, -1.0}) {
       Point axis = {0.0, 0.0, 0.0};
       axis[k] = sign;
-      reach[k] = std::max(reach[k], ray_zero(f, {0.0, 0.0, 0.0}, axis, 1e-3));
+      // (std::max would swallow a NaN: a ray that meets no zero is tested first.)
+      const double r = ray_zero(f, {0.0, 0.0, 0.0}, axis, 1e-3);
+      reach[k] = std::isfinite(r) ? std::max(reach[k], r) : std::numeric_limits<double>::quiet_NaN();
     }
-  if (!(std::isfinite(reach[0]) && std::isfinite(reach[1]) && std::isfinite(reach[2])))
+  if (!(reach[0] > 0.0 && reach[1] > 0.0 && reach[2] > 0.0 && std::isfinite(reach[0]) && std::isfinite(reach[1]) &&
+        std::isfinite(reach[2])))
     mesh_failure(shape, model, "a ray from its centre along an axis meets no point where the surface function is zero; is the shape closed?");
   SceneMesh mesh;
   for (int i = 0; i < rings; ++i) {
@@ -347,6 +350,9 @@ SceneMesh terrain_mesh(Field& h, const std::vector<Point>& path, double length) 
   const double margin = std::max(std::max(hi[0] - lo[0], hi[1] - lo[1]) / 3.0, 4.0 * std::abs(length));
   const double width[2] = {hi[0] - lo[0] + 2 * margin, hi[1] - lo[1] + 2 * margin};
   const double step = std::max(width[0], width[1]) / 48.0;
+  // A path that did not move and a shape of no length, or one that ran off to infinity, leave no
+  // region to mesh.
+  if (!(step > 0.0 && std::isfinite(step))) return {};
   const int nx = std::max(9, static_cast<int>(std::ceil(width[0] / step)) + 1);
   const int ny = std::max(9, static_cast<int>(std::ceil(width[1] / step)) + 1);
   SceneMesh mesh;
