@@ -33,7 +33,7 @@ for run in "${runs[@]}"; do
       --window-size=1300,760 --virtual-time-budget=5000 --screenshot="$out/$name.png" \
       "file://$out/$name.html#paused&t=$shot" >/dev/null 2>&1 || echo "no screenshot of $name" >&2
     rm -rf "$profile"
-    [[ -f "$out/$name.png" ]] && python3 "$here/shrink_png.py" "$out/$name.png"
+    [[ -f "$out/$name.png" ]] && "$(command -v /usr/bin/python3 || command -v python3)" "$here/shrink_png.py" "$out/$name.png"
   fi
   echo "$name: $(du -h "$out/$name.html" | cut -f1) -> $out/$name.html"
 done
