@@ -1,33 +1,70 @@
-// libFuzzer target for the model-file loader: any bytes go through load_model_string, and a file
-// that loads is compiled (derive + compile_model) and its terms evaluated once at the initial
-// state. Every rejection must be an nhdyn::Error (the CLI's exit 2); any other exception is what
-// the CLI reports as "internal error" with exit 3, and aborts here, as do a crash, a leak and
-// undefined behaviour. An input that takes more than 10 s is a bug too (fuzz/run: -timeout=10).
+// libFuzzer target for the model-file loader: any bytes go through the front door the CLI uses
+// (frontend/load_model.hpp: parse, parameter values and their expressions, derivation,
+// compilation of the terms, [outputs], [[events]], [[programs]] and contacts, the result columns).
+// A file that loads is then run the way `nhdyn simulate` starts a run, over one short output step
+// (a few steps at most): the initial-state checks, the events at the start, the dynamics (with the
+// programs' actuators), the outputs and contact forces at each row. A small model also gets its
+// equations printed as `nhdyn equations` does.
+//
+// Every rejection must be an nhdyn::Error (the CLI's exit 2); any other exception is what the CLI
+// reports as "internal error" with exit 3, and aborts here, as do a crash, a leak and undefined
+// behaviour. An input that takes more than 10 s is a bug too (fuzz/run: -timeout=10).
 // Built and run by fuzz/run (see fuzz/CMakeLists.txt).
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <string>
 #include <string_view>
-#include <vector>
 
+#include "nhdyn/analysis/run_options.hpp"
+#include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/frontend/model_file.hpp"
-#include "nhdyn/model/model.hpp"
-#include "nhdyn/symbolic/compile.hpp"
+#include "nhdyn/frontend/describe.hpp"
+#include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/model/data.hpp"
+
+namespace {
+
+// Models up to this many coordinates get their equations printed: the printed matrices grow as
+// n^2 and the CLI's own limit (1000) is far beyond what one fuzz input may spend.
+constexpr int kEquationsUpTo = 24;
+
+void run_briefly(const nhdyn::Model& model) {
+  nhdyn::SimulationOptions options = nhdyn::make_simulation_options(model);
+  options.events = model.events;
+  // One output step, short enough that a stiff or fast model takes few steps, and a step budget
+  // that bounds the work whatever the model does.
+  const double span = std::isfinite(model.defaults.output_step) && model.defaults.output_step > 0
+                          ? std::min(model.defaults.output_step, 1e-3)
+                          : 1e-3;
+  options.t_end = model.t0 + span;
+  options.output_step = span;
+  options.integrator.max_steps = 200;
+  double sink = 0.0;
+  nhdyn::simulate(model, options, [&sink](const nhdyn::Data& data) {
+    // Read what a CSV row writes, so that nothing computed is optimized away.
+    for (int i = 0; i < data.outputs.values.size(); ++i) sink += data.outputs.values[i];
+  });
+  if (sink == 12345.678) std::fputs("", stderr);
+}
+
+}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   try {
-    const nhdyn::symbolic::Spec spec = nhdyn::load_model_string(text, "fuzz.toml");
-    const nhdyn::Model model = nhdyn::symbolic::compile_model(spec);
-    const auto n = static_cast<std::size_t>(model.n()), s = static_cast<std::size_t>(model.s());
-    std::vector<double> scratch(model.evaluator->scratch_size()), A(n * n), Q(n), G(n), b(s * n), b0(s);
-    model.evaluator->terms(model.t0, model.q0.data(), model.v0.data(), scratch.data(),
-                           {A.data(), Q.data(), G.data(), b.data(), b0.data()});
-  } catch (const nhdyn::Error&) {
-    // A clear rejection: what the loader is for.
+    const nhdyn::LoadedModel loaded =
+        nhdyn::load_model_described(nhdyn::model_source_from_text(std::string(text), "fuzz.toml"));
+    if (loaded.description && loaded.model.n() <= kEquationsUpTo)
+      (void)nhdyn::format_model_equations(*loaded.description, nhdyn::EquationsFormat::text);
+    run_briefly(loaded.model);
+  } catch (const nhdyn::Error& e) {
+    if (std::getenv("NHDYN_FUZZ_VERBOSE")) std::fprintf(stderr, "refused: %s\n", e.what());
+    // A clear rejection: what the loader and the run's checks are for.
   } catch (const std::exception& e) {
     std::fprintf(stderr, "internal error (the CLI would exit 3): %s\n", e.what());
     std::abort();

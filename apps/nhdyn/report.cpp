@@ -64,14 +64,7 @@ std::function<int()> add_report_command(CLI::App& app) {
     for (auto& set : parse_parameter_sets(args->sets)) overrides.push_back(std::move(set));
     const LoadedModel resolved = load_model_described(source, overrides);
     check_report_columns(table.header, make_result_columns(resolved.model), args->csv, resolved.model.name);
-    // The time column must be a time: finite and never decreasing (an event row may share a time).
-    if (const int t = table.column("t"); t >= 0)
-      for (std::size_t r = 0; r < table.rows.size(); ++r) {
-        const double value = table.rows[r][static_cast<std::size_t>(t)];
-        if (!std::isfinite(value) || (r > 0 && value < table.rows[r - 1][static_cast<std::size_t>(t)]))
-          throw InputError(fmt::format("{}: row {}: t = {} {}; a result's times are finite and never decrease",
-                                       args->csv, r + 1, value, std::isfinite(value) ? "is before the row above" : "is not finite"));
-      }
+    check_report_times(table, args->csv);  // finite and never decreasing
     probe.reset();
     ReportOptions options;
     options.max_frames = args->max_frames;

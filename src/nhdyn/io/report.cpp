@@ -481,6 +481,17 @@ void check_report_columns(const std::vector<std::string>& header, const ResultCo
   }
 }
 
+void check_report_times(const CsvTable& table, const std::string& csv) {
+  const int t = table.column("t");
+  if (t < 0) return;
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    const double value = table.rows[r][static_cast<std::size_t>(t)];
+    if (!std::isfinite(value) || (r > 0 && value < table.rows[r - 1][static_cast<std::size_t>(t)]))
+      throw InputError(fmt::format("{}: row {}: t = {} {}; a result's times are finite and never decrease", csv, r + 1,
+                                   value, std::isfinite(value) ? "is before the row above" : "is not finite"));
+  }
+}
+
 namespace {
 
 // The values of a column at the frames drawn (NaN for a column the table does not have).

@@ -64,6 +64,11 @@ struct ReportOptions {
 void check_report_columns(const std::vector<std::string>& header, const ResultColumns& expected,
                           const std::string& csv, const std::string& model);
 
+// Throws InputError when the time column "t" of `table` (read from `csv`) holds a value that is not
+// finite or is below the row above (an event row may share its time with an output row), naming
+// the row and the value. A table without a "t" column passes (check_report_columns refuses it).
+void check_report_times(const CsvTable& table, const std::string& csv);
+
 // The page as text. Throws InputError when the table has no row or its header is not
 // input.columns.all, when input.parameters are not the scene's, or when a size of the scene is not
 // positive with these values (naming the [visual] item, its place and the value). Same input -> same bytes. `notice`, when given, receives the note the page
