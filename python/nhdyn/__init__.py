@@ -14,6 +14,7 @@ subclasses InputError, ModelError, FileError) with the library's message (file:l
 See docs/python.md.
 """
 
+import functools
 import os
 import re
 import sys
@@ -61,28 +62,65 @@ from ._from_sympy import from_sympy, from_sympy_mechanics
 
 __version__ = _nhdyn.__version__
 
-# What the library's messages call a command-line option, in Python's terms (the keyword of
-# Model.simulate): a Python user gets "fix_initial=True", not "--fix-initial".
+# What the library's messages call a command-line option, in Python's terms (the keywords of
+# Model.simulate, Model.linearize, Model.sweep, simulate_batch, nhdyn.load): a Python user gets
+# "fix_initial=True", not "--fix-initial". Whole phrases first (an option with its value), then
+# single options; an option the table lacks is left as it is.
+_PYTHON_PHRASES = [
+    # --event "NAME=EXPR" and --stop-when "COND", as the events dict and stop_when give them.
+    (re.compile(r'--event "([^"=]*)=([^"]*)"'), lambda m: 'events={{"{}": "{}"}}'.format(m.group(1), m.group(2))),
+    (re.compile(r'--stop-when "([^"]*)"'), r'stop_when="\1"'),
+    # nhdyn.load(path, k="1/0") reaches the library as --set k=1/0.
+    (re.compile(r"--set ([A-Za-z_][A-Za-z0-9_]*)="), r"\1="),
+    (re.compile(r"--guess FILE\.csv"), 'guess="FILE.csv"'),
+    (re.compile(r"--steps (\d+)"), r"len(values) = \1"),
+    (re.compile(r"expected NAME=EXPR, a name"), "expected a name"),
+    (re.compile(r"`nhdyn equations MODEL --format latex` prints them"), "Model.equations() gives them"),
+    (re.compile(r"load it without --compiled"), "load it with the interpreted evaluator"),
+]
 _PYTHON_TERMS = {
     "--fix-initial": "fix_initial=True", "--t-end": "t_end", "--output-step": "output_step", "--rtol": "rtol",
     "--atol": "atol", "--step": "step", "--method": "method", "--integrator": "integrator",
     "--complement": "complement", "--stabilize": "stabilize", "--max-steps": "max_steps",
     "--stop-when": "stop_when", "--event": "events", "--program-feedback": "program_feedback",
-    "--set": "m.parameters[NAME] =", "--initial": "q0/qd0",
+    "--set": "m.parameters[NAME] = value", "--initial": "q0/qd0", "--threads": "threads",
+    "--cyclic": "cyclic=[...]", "--independent": "independent=[...]", "--speeds": "speeds=[...]",
+    "--from": "values[0]", "--to": "values[-1]", "--steps": "len(values)", "--guess": "guess",
 }
 _OPTION = re.compile(r"--[a-z][a-z-]*[a-z]")
+# "max_steps (--max-steps)" names the keyword twice once translated.
+_TWICE = re.compile(r"\b(\w+) \(\1\)")
 
 
 def _python_text(text):
     """`text` with the command line's options named as Python keywords."""
-    return _OPTION.sub(lambda m: _PYTHON_TERMS.get(m.group(0), m.group(0)), text)
+    for pattern, replacement in _PYTHON_PHRASES:
+        text = pattern.sub(replacement, text)
+    text = _OPTION.sub(lambda m: _PYTHON_TERMS.get(m.group(0), m.group(0)), text)
+    return _TWICE.sub(r"\1", text)
 
 
 def _in_python_terms(error):
-    """The same exception (its type kept) with the command line's options named as Python keywords."""
+    """The same exception (its type and attributes kept) with the command line's options named as
+    Python keywords."""
     text = str(error)
     translated = _python_text(text)
-    return error if translated == text else type(error)(translated)
+    if translated == text:
+        return error
+    other = type(error)(translated)
+    other.__dict__.update(error.__dict__)
+    return other
+
+
+def _python_errors(function):
+    """`function` raising the library's errors in Python's terms (_in_python_terms)."""
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        try:
+            return function(*args, **kwargs)
+        except Error as error:
+            raise _in_python_terms(error) from None
+    return wrapper
 
 
 def _check_t_eval(t_eval, t0, t_end):
@@ -155,12 +193,14 @@ def builtin_models():
     return dict(_nhdyn.builtin_models())
 
 
+@_python_errors
 def load(source, **parameters):
     """A model from a model file's path or a built-in model's name; keyword arguments override
     the file's parameters (numbers, or the text of one)."""
     return Model(_nhdyn.read_source(str(source)), parameters)
 
 
+@_python_errors
 def loads(text, file_name="<string>", **parameters):
     """A model from the text of a model file; `file_name` appears in error messages."""
     return Model(_nhdyn.source_from_text(text, file_name), parameters)
@@ -181,6 +221,7 @@ class Parameters(MutableMapping):
                 return value
         raise KeyError(name)
 
+    @_python_errors
     def __setitem__(self, name, value):
         self._model._set_parameters({name: value})
 
@@ -201,6 +242,7 @@ class Model:
     """A model and where it came from: its source (a built-in name or a model file's text) and
     the parameter overrides, from which it can be compiled again (here, or on a Dask worker)."""
 
+    @_python_errors
     def __init__(self, source, overrides=None):
         self.source = source
         self.overrides = dict(overrides or {})
@@ -273,6 +315,7 @@ class Model:
         return "<nhdyn.Model {!r}: n = {}, s = {}>".format(self.name, self.n, self.s)
 
     # --- runs and analyses ---------------------------------------------------------------------
+    @_python_errors
     def simulate(self, t_end=None, *, rtol=None, atol=None, method=None, integrator=None, output_step=None,
                  complement=None, step=None, fix_initial=None, stabilize=None, q0=None, qd0=None,
                  stop_when=None, events=None, max_steps=None, program_feedback=None, t_eval=None):
@@ -315,6 +358,7 @@ class Model:
             raise error
         return result
 
+    @_python_errors
     def report(self, result, path, max_frames=2000):
         """Writes the HTML report of `result` (a run of this model) to `path`: the page `nhdyn
         simulate --html` writes (3-D animation, plots, equations; docs/report.md), with the run's
@@ -337,6 +381,7 @@ class Model:
         return _nhdyn.write_report(self.source, list(result._overrides.items()), names, rows, comments,
                                    os.fspath(path), title, extra, max_frames)
 
+    @_python_errors
     def optimize(self, guess=None, *, tolerance=1e-8, max_iterations=3000):
         """The optimal program of the model file's [optimize] section, as `nhdyn optimize` finds
         it (direct collocation of the Do Sanh form with IPOPT; docs/optimize.md), with this model's
@@ -355,18 +400,21 @@ class Model:
                 self.name, result.status, result.solver_message), RuntimeWarning, stacklevel=2)
         return result
 
+    @_python_errors
     def equations(self, format="latex"):
         """The equations of motion (T, V, A, Q, G, b, b0, D, A0 = D A, C = D (Q + G)) as
         `nhdyn equations` shows them; displayed as LaTeX in Jupyter."""
         return Equations(_nhdyn.equations(self.source, list(self.overrides.items()), "text"),
                          _nhdyn.equations(self.source, list(self.overrides.items()), "latex"))
 
+    @_python_errors
     def linearize(self, cyclic=(), independent=(), speeds=(), detect_cyclic=True):
         """The linearization about the model's steady motion (its initial state): state names,
         state matrix and eigenvalues (docs/linearization.md)."""
         return Linearization(_nhdyn.linearize(self._cpp, list(cyclic), list(independent), list(speeds),
                                               detect_cyclic))
 
+    @_python_errors
     def sweep(self, parameter, values, cyclic=(), independent=(), speeds=(), detect_cyclic=True,
               find_crossings=True):
         """The eigenvalues of the linearization at each of `values` (evenly spaced, increasing) of
@@ -375,6 +423,9 @@ class Model:
         if values.ndim != 1 or values.size < 2:
             raise InputError("sweep values: give at least two values in a 1-D array")
         first, last = float(values[0]), float(values[-1])
+        if not last > first:
+            raise InputError("sweep values: give increasing values (values[0] = {:g} is not below values[-1] = {:g}), "
+                             "e.g. np.linspace(0, 10, 101)".format(first, last))
         grid = np.linspace(first, last, values.size)
         if not np.allclose(values, grid, rtol=0, atol=1e-12 * max(1.0, abs(first), abs(last))):
             raise InputError("sweep values: give evenly spaced increasing values, e.g. np.linspace(0, 10, 101)")
@@ -554,7 +605,7 @@ class Optimum:
         for key in ("status", "solver_message", "converged", "iterations", "objective", "t_end", "free_time",
                     "constraint_violation", "replay_difference", "replay_message"):
             setattr(self, key, out[key])
-        self.notes = list(out["notes"])
+        self.notes = [_python_text(note) for note in out["notes"]]
 
     def column(self, name):
         """The column `name` of the CSV (e.g. "x", "x'", "u_F")."""
@@ -633,7 +684,7 @@ class BatchResult:
         self.R, self.residuals, self.energy = out["R"], out["residuals"], out["energy"]
         self.q_end, self.qd_end, self.max_residual = out["q_end"], out["qd_end"], out["max_residual"]
         self.ok = np.asarray(out["ok"], dtype=bool)
-        self.messages = list(out["messages"])
+        self.messages = [_python_text(message) for message in out["messages"]]
         self.summaries = out["summaries"]
         self.events = out.get("events", [[] for _ in out["ok"]])
         self.threads = out["threads"]
@@ -729,6 +780,7 @@ def _batch_models(model, names, values, runs):
     return _nhdyn.load_variants(model.source, list(model.overrides.items()), names, values)
 
 
+@_python_errors
 def simulate_batch(model, parameters=None, initial=None, t_end=None, threads=0, keep_trajectories=True, **options):
     """Many runs of one model on a pool of C++ threads (threads=0: every core), the GIL released.
 

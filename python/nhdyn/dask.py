@@ -108,7 +108,7 @@ def simulate_batch(client, model, parameters=None, initial=None, chunk_size=None
     for part in parts:
         if "error" in part:
             kind, message = part["error"]
-            raise getattr(nhdyn, kind, nhdyn.Error)(message)
+            raise getattr(nhdyn, kind, nhdyn.Error)(nhdyn._python_text(message))
     rows = max(np.shape(p["t"])[-1] for p in parts)
     longest = next(p["t"] for p in parts if np.ndim(p["t"]) == 1 and len(p["t"]) == rows) if all(
         np.ndim(p["t"]) == 1 for p in parts) else None

@@ -117,7 +117,7 @@ def test_a_stop_condition_that_never_holds_is_warned(oscillator):
     with pytest.warns(nhdyn.StopConditionWarning) as caught:
         r = oscillator.simulate(t_end=1.0, stop_when="x > 2")
     texts = [str(w.message) for w in caught]
-    assert texts == ["nhdyn: oscillator: the stop condition stop_when \"x > 2\" never became true between t = 0 and "
+    assert texts == ["nhdyn: oscillator: the stop condition stop_when=\"x > 2\" never became true between t = 0 and "
                      "t = 1: the run went to the end; check its sign, direction or threshold"]
     assert r.summary["unmet_stops"] and r.summary["stopped_by"] is None
     with pytest.warns(nhdyn.StopConditionWarning) as caught:
@@ -134,3 +134,53 @@ def test_a_stop_condition_that_never_holds_is_warned(oscillator):
 def test_a_non_finite_parameter_value_names_its_run(oscillator):
     with pytest.raises(nhdyn.InputError, match=r"run 3: parameter k = nan is not a finite number"):
         nhdyn.simulate_batch(oscillator, parameters={"k": [1.0, 2.0, 3.0, float("nan")]}, t_end=0.1)
+
+
+# Each call passes a keyword that the command line spells as an option; the message must name the
+# keyword (or the Python way to do it), never the option ("--set", "--cyclic", ...).
+SLED = """name = "sled"
+coordinates = ["x", "y", "phi"]
+kinetic_energy = "m/2 * (x'^2 + y'^2) + m*a*phi' * (cos(phi)*y' - sin(phi)*x') + m*rho^2/2 * phi'^2"
+[parameters]
+m = 1.0
+a = 0.5
+rho = 0.7
+[[constraints]]
+name = "blade"
+velocity = "-sin(phi)*x' + cos(phi)*y'"
+[initial]
+position = { x = 0, y = 0, phi = 0 }
+velocity = { x = 1, y = 0, phi = 0 }
+"""
+KEYWORD_MESSAGES = [
+    (lambda m: nhdyn.loads(OSCILLATOR, k="1/0"), "k=1/0: parameter 'k' = inf is too large"),
+    (lambda m: nhdyn.loads(OSCILLATOR, zz=1), "zz=1: model 'oscillator' has no parameter 'zz'"),
+    (lambda m: m.simulate(1.0, max_steps=0), "the step budget max_steps = 0 must be at least 1"),
+    (lambda m: m.simulate(1.0, stop_when="x"), 'stop_when="x": expected a condition'),
+    (lambda m: m.simulate(1.0, events={"": "x"}), 'events={"": "x"}: expected a name'),
+    (lambda m: m.simulate(1.0, program_feedback=(1, 1)), "program_feedback needs programs"),
+    (lambda m: m.simulate(1.0, complement="analytic"), "choose complement qr or partition"),
+    (lambda m: nhdyn.simulate_batch(m, parameters={"k": [1.0]}, t_end=0.1, max_steps=0), "max_steps = 0"),
+    (lambda m: nhdyn.simulate_batch(m, parameters={"k": [1.0]}, t_end=0.1, stop_when="x"), 'stop_when="x"'),
+    (lambda m: nhdyn.simulate_batch(m, parameters={"k": [1.0]}, t_end=0.1, events={"": "x"}), 'events={"": "x"}'),
+    (lambda m: nhdyn.simulate_batch(m, parameters={"k": [1.0]}, t_end=0.1, complement="analytic"),
+     "choose complement qr"),
+    (lambda m: nhdyn.simulate_batch(m, parameters={"k": [1.0]}, t_end=0.1, program_feedback=(1, 1)),
+     "program_feedback needs programs"),
+    (lambda m: m.linearize(), "the coordinates that may move steadily with cyclic=[...]"),
+    (lambda m: nhdyn.loads(SLED).linearize(cyclic=["zz"]), "cyclic=[...]: 'zz' is not a coordinate"),
+    (lambda m: nhdyn.loads(SLED).linearize(cyclic=["x", "y"], independent=["zz"]),
+     "independent=[...]: 'zz' is not a coordinate"),
+    (lambda m: nhdyn.loads(SLED).linearize(cyclic=["x", "y"], speeds=["zz"]), "speeds=[...]: 'zz' is not a coordinate"),
+    (lambda m: m.sweep("k", [2.0, 1.0]), "sweep values: give increasing values"),
+    (lambda m: m.sweep("k", np.linspace(0.0, 1.0, 1000001)), "len(values) = 1000001: give the number of grid points"),
+]
+
+
+@pytest.mark.parametrize("call, expected", KEYWORD_MESSAGES)
+def test_messages_name_the_python_keyword_not_the_command_line_option(oscillator, call, expected):
+    with pytest.raises(nhdyn.Error) as caught:
+        call(oscillator)
+    message = str(caught.value)
+    assert expected in message, message
+    assert "--" not in message, message

@@ -64,7 +64,7 @@ def test_not_converged_warns_and_keeps_the_last_iterate(examples):
     assert not r.converged and r.status in ("infeasible", "failed", "iteration limit")
     assert any("did not converge" in str(w.message) for w in caught)
     assert r.rows.shape == (17, 12)
-    assert any("--guess" in note for note in r.notes)
+    assert any('guess="FILE.csv"' in note and "--" not in note for note in r.notes)
 
 
 def test_builtin_model_is_refused():
