@@ -281,6 +281,44 @@ TEST_F(Hardening, InterruptedBatchLeavesNothing) {
   }
 }
 
+// A full disk while batch --write-runs wrote its run files left some of them, and the message said
+// nothing was written. The files are staged and moved into place once all are written, so a write
+// that fails (here past a file-size limit, as on a full disk) leaves the output folder empty.
+TEST_F(Hardening, BatchOnAFullDiskWritesNothing) {
+  write("osc.toml", kOscillator);
+  const std::vector<std::string> args = {"batch", "osc.toml", "--grid", "k=1:2:20", "--t-end", "20", "--write-runs",
+                                         "-o", "out"};
+  ProcessOptions full;
+  full.file_size_limit = 64 * 1024;  // a run file of 2001 rows is about 150 kB
+  const ProcessRun r = nhdyn(args, full);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "failed (disk full?); nothing was written")) << r.err;
+  if (fs::exists(dir_ / "out")) {
+    EXPECT_TRUE(fs::is_empty(dir_ / "out"));
+  }
+  // With room, the summary and every run's file.
+  ASSERT_EQ(nhdyn(args).code, 0);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_ / "out"), fs::directory_iterator()), 21);
+}
+
+// batch --write-runs kept every trajectory in memory until the end (760 MB for 2000 sled runs):
+// each run's file is now written as the run ends, so 100 runs take the memory of 10.
+TEST_F(Hardening, BatchWriteRunsStreamsToDisk) {
+  write("osc.toml", kOscillator);
+  const auto peak_kb = [this](int runs) {
+    const ProcessRun r = nhdyn({"batch", "osc.toml", "--grid", "k=1:2:" + std::to_string(runs), "--t-end", "10",
+                                "--output-step", "0.002", "--threads", "2", "--write-runs", "-o",
+                                "out" + std::to_string(runs)});
+    EXPECT_EQ(r.code, 0) << r.err;
+    return r.max_rss_kb;
+  };
+  const long few = peak_kb(10), many = peak_kb(100);
+  // Kept, the 90 more trajectories (5001 rows of t, x, x', x'', R_x, residuals, energy) would be
+  // about 25 MB more.
+  EXPECT_GT(few, 0);
+  EXPECT_LT(many - few, 8 * 1024) << few << " kB for 10 runs, " << many << " kB for 100";
+}
+
 // rk4 stepped across the singular S of a program (theta = 0.3 + 0.2 t reaches pi/2 at 6.354):
 // the sign of det S is watched, and the run fails between the two solves that bracket it.
 TEST_F(Hardening, Rk4DoesNotStepAcrossASingularProgramMatrix) {

@@ -1,10 +1,12 @@
 // Runs the nhdyn command in a child process with its arguments as an argv (no shell, so that an
 // argument may be megabytes long or hold any byte), extra environment variables, and optionally a
-// signal sent some time into the run: for the tests that try hostile input and interruptions.
+// signal sent some time into the run, a limit on the size of the files it writes (a full disk, as
+// the process sees it): for the tests that try hostile input and interruptions.
 #pragma once
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,6 +25,7 @@ namespace nhdyn::test {
 struct ProcessRun {
   int code = -1;  // exit status, or 128 + signal, or -1 when killed on the deadline
   std::string out, err;
+  long max_rss_kb = 0;  // the child's peak resident memory (getrusage's ru_maxrss)
 };
 
 struct ProcessOptions {
@@ -30,6 +33,9 @@ struct ProcessOptions {
   int signal = 0;                                          // sent `after` into the run
   std::chrono::milliseconds after{0};
   double deadline = 120.0;  // seconds, then SIGKILL
+  // When > 0, the largest file the child may write (RLIMIT_FSIZE, SIGXFSZ ignored): a write past it
+  // fails with EFBIG, as a write to a full disk fails with ENOSPC.
+  long file_size_limit = 0;
 };
 
 inline std::string read_whole(const std::filesystem::path& p) {
@@ -63,6 +69,11 @@ inline ProcessRun run_process(const std::vector<std::string>& args, const std::f
         ::chdir(cwd.c_str()) != 0)
       ::_exit(126);
     for (const auto& [name, value] : options.env) ::setenv(name.c_str(), value.c_str(), 1);
+    if (options.file_size_limit > 0) {
+      ::signal(SIGXFSZ, SIG_IGN);
+      const rlimit limit{static_cast<rlim_t>(options.file_size_limit), static_cast<rlim_t>(options.file_size_limit)};
+      if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) ::_exit(126);
+    }
     ::execv(argv[0], argv.data());
     ::_exit(127);
   }
@@ -70,7 +81,11 @@ inline ProcessRun run_process(const std::vector<std::string>& args, const std::f
   bool signalled = false;
   int status = 0;
   for (;;) {
-    if (::waitpid(pid, &status, WNOHANG) == pid) break;
+    rusage usage{};
+    if (::wait4(pid, &status, WNOHANG, &usage) == pid) {
+      r.max_rss_kb = usage.ru_maxrss;
+      break;
+    }
     const auto elapsed = std::chrono::steady_clock::now() - start;
     if (options.signal && !signalled && elapsed >= options.after) {
       ::kill(pid, options.signal);
