@@ -11,6 +11,7 @@
 // behaviour. An input that takes more than 10 s is a bug too (fuzz/run: -timeout=10).
 // Built and run by fuzz/run (see fuzz/CMakeLists.txt).
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -56,14 +57,26 @@ void run_briefly(const nhdyn::Model& model) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
+  // NHDYN_FUZZ_VERBOSE=1: why an input was refused, and the time of each stage (for a replay).
+  const bool verbose = std::getenv("NHDYN_FUZZ_VERBOSE") != nullptr;
+  auto start = std::chrono::steady_clock::now();
+  const auto stage = [&](const char* what) {
+    const auto now = std::chrono::steady_clock::now();
+    if (verbose) std::fprintf(stderr, "%s: %.3f s\n", what, std::chrono::duration<double>(now - start).count());
+    start = now;
+  };
   try {
     const nhdyn::LoadedModel loaded =
         nhdyn::load_model_described(nhdyn::model_source_from_text(std::string(text), "fuzz.toml"));
-    if (loaded.description && loaded.model.n() <= kEquationsUpTo)
+    stage("load (parse, derive, compile)");
+    if (loaded.description && loaded.model.n() <= kEquationsUpTo) {
       (void)nhdyn::format_model_equations(*loaded.description, nhdyn::EquationsFormat::text);
+      stage("equations");
+    }
     run_briefly(loaded.model);
+    stage("short run");
   } catch (const nhdyn::Error& e) {
-    if (std::getenv("NHDYN_FUZZ_VERBOSE")) std::fprintf(stderr, "refused: %s\n", e.what());
+    if (verbose) std::fprintf(stderr, "refused: %s\n", e.what());
     // A clear rejection: what the loader and the run's checks are for.
   } catch (const std::exception& e) {
     std::fprintf(stderr, "internal error (the CLI would exit 3): %s\n", e.what());
