@@ -62,7 +62,6 @@ const std::vector<Allowance> kGinacByDesign = {
     {"bench/chain_bench.cpp", "times the making of the chain's Spec (symbolic/chain)"},
     {"src/nhdyn/frontend/model_file.hpp", "the model-file parser's interface: it returns the Spec that load_model compiles "
                                           "and the parser's tests inspect; the CLI and Python include load_model.hpp only"},
-    {"fuzz/model_file_fuzzer.cpp", "fuzzes the model-file parser, whose output is a Spec"},
     {"tests/io/", "tests of the model-file parser: they inspect the Spec it makes (locations, parameters, events)"},
     {"tests/gallery/", "models built with SpecBuilder or symbolic/chain next to their model files, and their equations"},
     {"tests/linearization/", "sweeps that recompile a kept Spec and derivation at each point, against set_parameter"},
