@@ -751,6 +751,57 @@ TEST(ContactScene, ImplicitShapeIsAMeshOfItsZeroSet) {
   EXPECT_NEAR(reach[0], a, 1e-14);  // and the ends of x (azimuth 0, polar pi/2)
 }
 
+// An implicit shape whose frame origin lies outside it (a ball of radius r centred 0.3 below the
+// origin): the report finds a point inside by descending f and draws the whole sphere from there.
+TEST(ContactScene, ImplicitShapeOffItsFramesOriginIsDrawnFromAPointInside) {
+  const std::string text = R"(name = "offset-ball"
+coordinates = ["x", "y", "z", "psi", "theta", "phi", "px", "py", "pz"]
+gravity = [0, 0, "-g"]
+[parameters]
+m = 1.0
+r = 0.1
+g = 9.81
+[[frames]]
+name = "ball"
+translation = ["x", "y", "z"]
+rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
+[[bodies]]
+name = "ball"
+frame = "ball"
+mass = "m"
+com = [0, 0, -0.3]
+inertia = ["2/5*m*r^2", "2/5*m*r^2", "2/5*m*r^2"]
+[[contacts]]
+name = "foot"
+body = "ball"
+shape = { surface = "X^2 + Y^2 + (Z + 0.3)^2 - r^2", coordinates = ["px", "py", "pz"] }
+[initial]
+position = { x = 0, y = 0, z = 0.4, psi = 0, theta = 0, phi = 0, px = 0, py = 0, pz = -0.4 }
+velocity = { x = 0.4, phi = 1 }
+)";
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_string(text, "offset_ball.toml");
+  nhdyn::Model model = nhdyn::symbolic::compile_model(spec);
+  const double r = 0.12;
+  nhdyn::set_parameter(model, "r", r);
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  const int solid = find_shape(scene, VisualKind::solid, "foot");
+  ASSERT_GE(solid, 0);
+  const nhdyn::SceneMesh mesh = nhdyn::calc_scene_meshes(scene, model.parameters, {}, 0, model.name)[static_cast<std::size_t>(solid)];
+  ASSERT_GE(mesh.vertices.size(), 3u * 100);
+  double lo[3] = {1e9, 1e9, 1e9}, hi[3] = {-1e9, -1e9, -1e9};
+  for (std::size_t k = 0; k < mesh.vertices.size(); k += 3) {
+    const double x = mesh.vertices[k], y = mesh.vertices[k + 1], z = mesh.vertices[k + 2];
+    EXPECT_NEAR(std::sqrt(x * x + y * y + (z + 0.3) * (z + 0.3)), r, 1e-12);
+    for (std::size_t i = 0; i < 3; ++i) {
+      lo[i] = std::min(lo[i], mesh.vertices[k + i]);
+      hi[i] = std::max(hi[i], mesh.vertices[k + i]);
+    }
+  }
+  // The whole sphere, not a cap: its extent is 2r along each axis (to the mesh's resolution).
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(hi[i] - lo[i], 2 * r, 0.02 * r) << i;
+  EXPECT_NEAR(0.5 * (hi[2] + lo[2]), -0.3, 0.01 * r);
+}
+
 // The round tyre: the torus's radii are the run's R and r, about the wheel's axle y.
 TEST(ContactScene, TorusHasTheRunsRadiiAboutItsAxle) {
   const nhdyn::symbolic::Spec spec =

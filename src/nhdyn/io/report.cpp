@@ -284,13 +284,59 @@ void grid_triangles(int rows, int columns, std::vector<int>& out) {
                                shape.kind == symbolic::VisualKind::solid ? "shape" : "ground", why));
 }
 
-// A solid's zero set along rays from its centre: rings of constant polar angle about the frame's z.
+// A point inside a solid (f < 0) from which every point of its surface is seen: its centre when
+// that is inside, else the end of a descent of f from the centre (steepest descent, the gradient
+// by central differences, a backtracking line search), towards the minimum of f. A strictly convex
+// shape is seen whole from any point inside it. Nothing when no point inside is found.
+std::optional<Point> inside_point(Field& f) {
+  Point p = {0.0, 0.0, 0.0};
+  double fp = f(0.0, 0.0, 0.0);
+  if (fp < 0.0) return p;
+  if (!std::isfinite(fp)) return std::nullopt;
+  double t = 0.0;  // the last accepted step along -grad f; 0: none yet
+  for (int iteration = 0; iteration < 200; ++iteration) {
+    const double h = 1e-7 * std::max(1.0, std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}));
+    Point g;
+    for (std::size_t k = 0; k < 3; ++k) {
+      Point a = p, b = p;
+      a[k] += h;
+      b[k] -= h;
+      g[k] = (f(a[0], a[1], a[2]) - f(b[0], b[1], b[2])) / (2 * h);
+    }
+    const double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+    if (!(g2 > 0.0) || !std::isfinite(g2)) break;
+    // The first step goes twice as far as the linearization's zero of f; later ones start from
+    // twice the last accepted step.
+    double step = t > 0.0 ? 2.0 * t : 2.0 * std::abs(fp) / g2;
+    bool moved = false;
+    for (int halving = 0; halving < 60; ++halving, step *= 0.5) {
+      const Point q = {p[0] - step * g[0], p[1] - step * g[1], p[2] - step * g[2]};
+      const double fq = f(q[0], q[1], q[2]);
+      if (std::isfinite(fq) && fq < fp) {
+        p = q;
+        fp = fq;
+        t = step;
+        moved = true;
+        break;
+      }
+    }
+    if (!moved) break;
+  }
+  if (fp < 0.0) return p;
+  return std::nullopt;
+}
+
+// A solid's zero set along rays from a point inside it (its centre when that is inside): rings of
+// constant polar angle about the frame's z.
 SceneMesh solid_mesh(Field& f, const symbolic::VisualShape& shape, const std::string& model) {
   constexpr int rings = 25, around = 49;
-  if (!(f(0.0, 0.0, 0.0) < 0.0))
-    mesh_failure(shape, model, fmt::format("its surface function is {} at the shape's centre, where it must be "
-                                           "negative (inside); the report samples the surface along rays from there",
+  const std::optional<Point> inside = inside_point(f);
+  if (!inside)
+    mesh_failure(shape, model, fmt::format("its surface function is {} at the shape's centre and no point where it "
+                                           "is negative (inside) was found by descending it from there; the report "
+                                           "samples the surface along rays from a point inside",
                                            f(0.0, 0.0, 0.0)));
+  const Point& o = *inside;
   // The rays are spread as the points of the unit sphere stretched by the shape's reach along
   // each axis: on an ellipsoid they fall where its own parameter lines do, so that a long thin
   // shape (a rattleback) is sampled along its length as finely as across it.
@@ -300,12 +346,12 @@ SceneMesh solid_mesh(Field& f, const symbolic::VisualShape& shape, const std::st
       Point axis = {0.0, 0.0, 0.0};
       axis[k] = sign;
       // (std::max would swallow a NaN: a ray that meets no zero is tested first.)
-      const double r = ray_zero(f, {0.0, 0.0, 0.0}, axis, 1e-3);
+      const double r = ray_zero(f, o, axis, 1e-3);
       reach[k] = std::isfinite(r) ? std::max(reach[k], r) : std::numeric_limits<double>::quiet_NaN();
     }
   if (!(reach[0] > 0.0 && reach[1] > 0.0 && reach[2] > 0.0 && std::isfinite(reach[0]) && std::isfinite(reach[1]) &&
         std::isfinite(reach[2])))
-    mesh_failure(shape, model, "a ray from its centre along an axis meets no point where the surface function is zero; is the shape closed?");
+    mesh_failure(shape, model, "a ray along an axis from a point inside it meets no point where the surface function is zero; is the shape closed?");
   SceneMesh mesh;
   for (int i = 0; i < rings; ++i) {
     const double polar = std::numbers::pi * i / (rings - 1);
@@ -315,9 +361,9 @@ SceneMesh solid_mesh(Field& f, const symbolic::VisualShape& shape, const std::st
                  reach[2] * std::cos(polar)};
       const double length = std::hypot(d[0], d[1], d[2]);
       for (double& x : d) x /= length;
-      const double s = ray_zero(f, {0.0, 0.0, 0.0}, d, 1e-3);
-      if (!std::isfinite(s)) mesh_failure(shape, model, "a ray from its centre meets no point where the surface function is zero; is the shape closed?");
-      mesh.vertices.insert(mesh.vertices.end(), {s * d[0], s * d[1], s * d[2]});
+      const double s = ray_zero(f, o, d, 1e-3);
+      if (!std::isfinite(s)) mesh_failure(shape, model, "a ray from a point inside it meets no point where the surface function is zero; is the shape closed?");
+      mesh.vertices.insert(mesh.vertices.end(), {o[0] + s * d[0], o[1] + s * d[1], o[2] + s * d[2]});
     }
   }
   grid_triangles(rings, around, mesh.triangles);
