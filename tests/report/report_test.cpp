@@ -724,6 +724,46 @@ TEST(ContactScene, BowlIsAMeshOfItsSphereAroundTheMotion) {
   }
 }
 
+// A terrain undefined over part of the drawn box (sqrt(X + 0.1), a term too small to move the
+// ball, is not real for X < -0.1, inside the box's margin): no triangle there, rather than a
+// ground drawn at 0; every triangle's vertices are finite and the terrain's value.
+TEST_F(Cli, TerrainUndefinedInPartOfTheBoxIsLeftOutThere) {
+  std::string text = nhdyn::read_model_text(example("ball_over_bump.toml"));
+  const std::string terrain = "terrain = \"H*exp(-(X^2 + Y^2)/w^2)\"";
+  ASSERT_NE(text.find(terrain), std::string::npos);
+  text.replace(text.find(terrain), terrain.size(), "terrain = \"H*exp(-(X^2 + Y^2)/w^2) + 1e-12*sqrt(X + 0.1)\"");
+  const fs::path model = dir / "half.toml";
+  std::ofstream(model) << text;
+  std::string out, err;
+  const fs::path csv = dir / "half.csv", html = dir / "half.html";
+  ASSERT_EQ(run("simulate " + model.string() + " --t-end 0.2 -o " + csv.string() + " --html " +
+                    html.string() + " -q",
+                out, err, dir),
+            0)
+      << err;
+  const std::string page = nhdyn::test::read_text(html);
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_file(model);
+  const double H = parameter(spec, "H"), w = parameter(spec, "w");
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  const int index = find_shape(scene, VisualKind::terrain, "ball");
+  ASSERT_GE(index, 0);
+  const nhdyn::SceneMesh mesh = nhdyn::calc_scene_meshes(scene, spec_parameters(spec), report_scene_values(page),
+                                                         static_cast<std::size_t>(report_scene_stride(page)),
+                                                         spec.name)[static_cast<std::size_t>(index)];
+  int undefined = 0;
+  for (std::size_t k = 0; k < mesh.vertices.size(); k += 3) undefined += !std::isfinite(mesh.vertices[k + 2]);
+  EXPECT_GT(undefined, 0) << "the box reaches X < -0.1";
+  ASSERT_FALSE(mesh.triangles.empty());
+  for (const int i : mesh.triangles) {
+    const std::size_t k = 3 * static_cast<std::size_t>(i);
+    const double x = mesh.vertices[k], y = mesh.vertices[k + 1];
+    ASSERT_GE(x, -0.1);
+    EXPECT_NEAR(mesh.vertices[k + 2], H * std::exp(-(x * x + y * y) / (w * w)) + 1e-12 * std::sqrt(x + 0.1), 4e-16 * H);
+  }
+  // The page carries those vertices as null (no number made up for them).
+  EXPECT_NE(page.find("null", page.find("{\"kind\":\"terrain\"")), std::string::npos);
+}
+
 // An implicit shape (the rattleback's ellipsoid written as f = 0): its mesh lies on f = 0 to
 // round-off, with the run's semi-axes, in the body's axes about the shape's centre.
 TEST(ContactScene, ImplicitShapeIsAMeshOfItsZeroSet) {

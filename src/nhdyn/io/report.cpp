@@ -269,12 +269,18 @@ double ray_zero(Field& f, const Point& from, const Point& d, double start) {
   return 0.5 * (lo + hi);
 }
 
-// Rows x columns of vertices, row-major: two triangles per cell.
-void grid_triangles(int rows, int columns, std::vector<int>& out) {
+// Rows x columns of vertices, row-major: two triangles per cell, leaving out a cell with a vertex
+// that is not finite (a terrain undefined there: it is not drawn, rather than drawn at 0; the
+// page writes such a vertex as null and draws no grid line to it).
+void grid_triangles(int rows, int columns, const std::vector<double>& vertices, std::vector<int>& out) {
+  const auto finite = [&](int v) {
+    const std::size_t k = 3 * static_cast<std::size_t>(v);
+    return std::isfinite(vertices[k]) && std::isfinite(vertices[k + 1]) && std::isfinite(vertices[k + 2]);
+  };
   for (int i = 0; i + 1 < rows; ++i)
     for (int j = 0; j + 1 < columns; ++j) {
       const int a = i * columns + j, b = a + 1, c = a + columns, d = c + 1;
-      out.insert(out.end(), {a, c, b, b, c, d});
+      if (finite(a) && finite(b) && finite(c) && finite(d)) out.insert(out.end(), {a, c, b, b, c, d});
     }
 }
 
@@ -366,7 +372,7 @@ SceneMesh solid_mesh(Field& f, const symbolic::VisualShape& shape, const std::st
       mesh.vertices.insert(mesh.vertices.end(), {o[0] + s * d[0], o[1] + s * d[1], o[2] + s * d[2]});
     }
   }
-  grid_triangles(rings, around, mesh.triangles);
+  grid_triangles(rings, around, mesh.vertices, mesh.triangles);
   mesh.rows = rings;
   return mesh;
 }
@@ -407,7 +413,7 @@ SceneMesh terrain_mesh(Field& h, const std::vector<Point>& path, double length) 
       const double x = lo[0] - margin + width[0] * i / (nx - 1), y = lo[1] - margin + width[1] * j / (ny - 1);
       mesh.vertices.insert(mesh.vertices.end(), {x, y, h(x, y)});
     }
-  grid_triangles(nx, ny, mesh.triangles);
+  grid_triangles(nx, ny, mesh.vertices, mesh.triangles);
   mesh.rows = nx;
   return mesh;
 }
@@ -461,7 +467,7 @@ SceneMesh surface_mesh(Field& g, const symbolic::VisualShape& shape, const std::
       mesh.vertices.insert(mesh.vertices.end(), {K[0] + s * d[0], K[1] + s * d[1], K[2] + s * d[2]});
     }
   }
-  grid_triangles(rings, around, mesh.triangles);
+  grid_triangles(rings, around, mesh.vertices, mesh.triangles);
   mesh.rows = rings;
   return mesh;
 }
