@@ -764,6 +764,43 @@ TEST_F(Cli, TerrainUndefinedInPartOfTheBoxIsLeftOutThere) {
   EXPECT_NE(page.find("null", page.find("{\"kind\":\"terrain\"")), std::string::npos);
 }
 
+// The ball over the bump written as an implicit sphere: the terrain's margin around the track is
+// four times the shape's half extent (its mesh's), 4 r = 0.2 m, as for the closed-form ball,
+// not a length of 1 m.
+TEST_F(Cli, TerrainUnderAnImplicitShapeHasTheShapesMargin) {
+  std::string text = nhdyn::read_model_text(example("ball_over_bump.toml"));
+  const std::string sphere = "shape = { sphere = \"r\" }";
+  ASSERT_NE(text.find(sphere), std::string::npos);
+  text.replace(text.find(sphere), sphere.size(), "shape = { surface = \"X^2 + Y^2 + Z^2 - r^2\" }");
+  const fs::path model = dir / "implicit.toml";
+  std::ofstream(model) << text;
+  std::string out, err;
+  const fs::path csv = dir / "implicit.csv", html = dir / "implicit.html";
+  ASSERT_EQ(run("simulate " + model.string() + " --t-end 0.2 -o " + csv.string() + " --html " + html.string() + " -q",
+                out, err, dir),
+            0)
+      << err;
+  const std::string page = nhdyn::test::read_text(html);
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_file(model);
+  const double r = parameter(spec, "r");
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  const int index = find_shape(scene, VisualKind::terrain, "ball");
+  ASSERT_GE(index, 0);
+  const nhdyn::SceneMesh mesh = nhdyn::calc_scene_meshes(scene, spec_parameters(spec), report_scene_values(page),
+                                                         static_cast<std::size_t>(report_scene_stride(page)),
+                                                         spec.name)[static_cast<std::size_t>(index)];
+  const nhdyn::CsvTable table = nhdyn::load_csv(csv);
+  const int X = table.column("ball_X");
+  ASSERT_GE(X, 0);
+  double lo = 1e300, hi = -1e300, path_lo = 1e300, path_hi = -1e300;
+  for (std::size_t k = 0; k < mesh.vertices.size(); k += 3) lo = std::min(lo, mesh.vertices[k]), hi = std::max(hi, mesh.vertices[k]);
+  for (const std::vector<double>& row : table.rows)
+    path_lo = std::min(path_lo, row[static_cast<std::size_t>(X)]), path_hi = std::max(path_hi, row[static_cast<std::size_t>(X)]);
+  ASSERT_LT(path_hi - path_lo, 3 * 4 * r);  // the margin is then 4 r, not a third of the path
+  EXPECT_NEAR(path_lo - lo, 4 * r, 1e-3 * r);
+  EXPECT_NEAR(hi - path_hi, 4 * r, 1e-3 * r);
+}
+
 // An implicit shape (the rattleback's ellipsoid written as f = 0): its mesh lies on f = 0 to
 // round-off, with the run's semi-axes, in the body's axes about the shape's centre.
 TEST(ContactScene, ImplicitShapeIsAMeshOfItsZeroSet) {

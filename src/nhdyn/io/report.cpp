@@ -248,6 +248,7 @@ class Field {
 };
 
 using Point = std::array<double, 3>;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // The distance along the unit direction d from `from` to the first zero of f, whose sign at
 // `from` is the opposite of its sign far enough along d: found by doubling from `start`, then
@@ -482,16 +483,35 @@ std::vector<SceneMesh> calc_scene_meshes(const symbolic::VisualScene& scene, con
   std::vector<double> size(static_cast<std::size_t>(sizes.outputs()));
   sizes.run(0.0, nullptr, nullptr, registers.data(), size.data());
   std::vector<SceneMesh> out(scene.shapes.size());
+  // The solids first: a ground's margin is its contact's size, which an implicit shape gives only
+  // through its mesh (its half extent) rather than a size of the model.
   for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
     const symbolic::VisualShape& shape = scene.shapes[s];
-    if (shape.kind != symbolic::VisualKind::solid && shape.kind != symbolic::VisualKind::terrain &&
-        shape.kind != symbolic::VisualKind::surface)
-      continue;
+    if (shape.kind != symbolic::VisualKind::solid) continue;
+    Field field(shape.field, parameter_values);
+    out[s] = solid_mesh(field, shape, model);
+  }
+  const auto length_of = [&](const symbolic::VisualShape& ground, double written) {
+    for (std::size_t s = 0; s < scene.shapes.size(); ++s)
+      if (scene.shapes[s].kind == symbolic::VisualKind::solid && scene.shapes[s].name == ground.name) {
+        const std::vector<double>& v = out[s].vertices;
+        double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+        for (std::size_t k = 0; k < v.size(); ++k) {
+          lo[k % 3] = std::min(lo[k % 3], v[k]);
+          hi[k % 3] = std::max(hi[k % 3], v[k]);
+        }
+        return 0.5 * std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+      }
+    return written;
+  };
+  for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
+    const symbolic::VisualShape& shape = scene.shapes[s];
+    if (shape.kind != symbolic::VisualKind::terrain && shape.kind != symbolic::VisualKind::surface) continue;
     Field field(shape.field, parameter_values);
     const double* x = size.data() + shape.size_offset;
-    if (shape.kind == symbolic::VisualKind::solid) out[s] = solid_mesh(field, shape, model);
-    else if (shape.kind == symbolic::VisualKind::terrain) out[s] = terrain_mesh(field, shape_path(shape, values, stride), x[0]);
-    else out[s] = surface_mesh(field, shape, model, shape_path(shape, values, stride), x[0], {x[1], x[2], x[3]});
+    const double length = length_of(shape, x[0]);
+    if (shape.kind == symbolic::VisualKind::terrain) out[s] = terrain_mesh(field, shape_path(shape, values, stride), length);
+    else out[s] = surface_mesh(field, shape, model, shape_path(shape, values, stride), length, {x[1], x[2], x[3]});
   }
   return out;
 }
