@@ -594,7 +594,7 @@ std::vector<PlotGroup> report_plot_groups(const ReportInput& input, const FrameC
     if (!g->columns.empty()) groups.push_back(*g);
   if (!input.columns.reactions.empty()) groups.push_back({"reactions R", false, false, input.columns.reactions, 1});
   if (!input.columns.actuators.empty())
-    groups.push_back({"actuator forces u ([[programs]])", false, false, input.columns.actuators, 2});
+    groups.push_back({input.actuators_title, false, false, input.columns.actuators, 2});
   // The largest |value| of each role over the rows shown, for the round-off rule.
   double role_scale[3] = {0.0, 0.0, 0.0};
   for (const PlotGroup& g : groups)
@@ -907,6 +907,11 @@ std::string write_model_report(const Model& model, const symbolic::ModelDescript
   input.model = model.name;
   input.coordinates = model.coordinates;
   input.columns = make_result_columns(model);
+  if (!options.controls.empty()) {
+    input.columns.all.insert(input.columns.all.end(), options.controls.begin(), options.controls.end());
+    input.columns.actuators.insert(input.columns.actuators.end(), options.controls.begin(), options.controls.end());
+    input.actuators_title = "controls u (the optimum's)";
+  }
   check_report_columns(table.header, input.columns, "the results", model.name);
   input.table = table;
   if (description != nullptr) {
