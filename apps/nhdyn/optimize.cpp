@@ -91,6 +91,7 @@ CsvTable optimum_table(const OptimalControlProblem& problem, const OptimizeResul
       layout_v(layout_q.size(), 0.0), force(static_cast<std::size_t>(n));
   CsvTable table;
   table.header = columns.all;
+  for (const OptimizeControl& c : problem.controls) table.header.push_back("u_" + c.name);
   double h0 = 0.0, previous_t = 0.0, previous_power[3] = {0.0, 0.0, 0.0};
   std::vector<double> row;
   for (int p = 0; p < result.points; ++p) {
@@ -128,6 +129,7 @@ CsvTable optimum_table(const OptimalControlProblem& problem, const OptimizeResul
     previous_t = t;
     compute_outputs(model, data);
     fill_result_row(model, data, row);
+    row.insert(row.end(), u, u + m);  // the controls, after the model's columns (ReportOptions::controls)
     table.rows.push_back(row);
   }
   return table;
@@ -192,6 +194,8 @@ int run_optimize(const OptimizeArgs& args) {
     fmt::print("plot -> {}\n", args.plot);
   }
   if (!args.html.empty()) {
+    ReportOptions report_options;
+    for (const OptimizeControl& c : problem.controls) report_options.controls.push_back("u_" + c.name);
     const std::string notice = write_model_report(
         problem.model, loaded.description.get(), optimum_table(problem, result),
         fmt::format("{}: optimal program, {} nodes, {}", problem.model.name, problem.nodes,
@@ -201,7 +205,7 @@ int run_optimize(const OptimizeArgs& args) {
          {"objective", fmt::format("{:.10g}", result.objective)},
          {"replay difference", result.replayed ? fmt::format("{:.3e}", result.replay_difference) : "none"},
          {"results", args.output}},
-        args.html);
+        args.html, report_options);
     fmt::print("report -> {}{}\n", args.html, notice.empty() ? "" : "\nnote: " + notice);
   }
   return 0;

@@ -13,6 +13,12 @@
 //                                        CsvWriter): 1001 rows (output step 0.01 s) over 2 rows,
 //                                        interpreted
 //   bicycle_rows_1001_vs_2_compiled      the same with the compiled evaluator
+//   sled_watch_on_vs_off                 simulate() 200 s of examples/sled.toml (dopri5 at rtol 1e-8,
+//                                        atol 1e-10, 2001 rows, nothing written) with the constraint
+//                                        watch over the same without it: what the watch costs a
+//                                        small model, whose right-hand side is cheapest
+//   bicycle_watch_on_vs_off_compiled     the bicycle's 10 s run as above (1001 rows, compiled
+//                                        evaluator, nothing written), with the watch over without
 // The compiled object comes from the compiled evaluator's cache ($XDG_CACHE_HOME/nhdyn), so only
 // the first run on a machine pays the compiler.
 //   nhdyn_bench_check EXAMPLES_DIR [PAIRS [FILTER]]   (PAIRS: pairs per ratio, default 7; FILTER:
@@ -123,6 +129,23 @@ void run_with_rows(const Model& model, double output_step, const fs::path& csv) 
   writer.commit();
 }
 
+// A run whose rows are not written: what the integration and the watch cost alone.
+void run_watched(const Model& model, double t_end, double output_step, double rtol, double atol, bool watch) {
+  SimulationOptions options;
+  options.t_end = t_end;
+  options.output_step = output_step;
+  options.formulation = {Method::sanh, Complement::qr};
+  options.integrator.kind = IntegratorKind::dopri5;
+  options.integrator.rtol = rtol;
+  options.integrator.atol = atol;
+  options.watch_constraints = watch;
+  const SimulationSummary summary = simulate(model, options, [](const Data&) {});
+  if (summary.status != Status::ok) {
+    std::fprintf(stderr, "bench-check: the run of %s failed: %s\n", model.name.c_str(), summary.message.c_str());
+    std::exit(1);
+  }
+}
+
 // FILTER "breakdown": what one output row of the bicycle costs, kernel by kernel (CPU time per
 // call, microseconds), the way simulate() computes a row: for finding where the time goes.
 void breakdown(const Model& model, const char* label) {
@@ -187,6 +210,12 @@ int main(int argc, char** argv) {
     pair("bicycle_rows_1001_vs_2_compiled", pairs, [&] { run_with_rows(compiled, 0.01, csv); },
          [&] { run_with_rows(compiled, 10.0, csv); });
     fs::remove_all(dir);
+
+    const Model sled = load_model((examples / "sled.toml").string());
+    pair("sled_watch_on_vs_off", pairs, [&] { run_watched(sled, 200.0, 0.1, 1e-8, 1e-10, true); },
+         [&] { run_watched(sled, 200.0, 0.1, 1e-8, 1e-10, false); });
+    pair("bicycle_watch_on_vs_off_compiled", pairs, [&] { run_watched(compiled, 10.0, 0.01, 1e-10, 1e-12, true); },
+         [&] { run_watched(compiled, 10.0, 0.01, 1e-10, 1e-12, false); });
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench-check: %s\n", e.what());
     return 1;

@@ -14,7 +14,11 @@
 #include <numbers>
 #include <string>
 
+#include <Eigen/SVD>
+
+#include "nhdyn/analysis/constraint_watch.hpp"
 #include "nhdyn/analysis/run_options.hpp"
+#include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "support/cli_run.hpp"
@@ -64,6 +68,87 @@ TEST(ConstraintWatchModels, TanFormNamedWithinAMillisecondOfTheSingularity) {
   EXPECT_EQ(model.constraints[static_cast<std::size_t>(w.constraint)].name, "blade");
   EXPECT_LE(std::abs(w.t - std::numbers::pi / 2), 1e-3) << w.t;
   EXPECT_NEAR(w.factor, 1.0 / std::abs(std::cos(w.t)), 1e-6 * w.factor);
+}
+
+// Two blades on one body, x' = 0 and cos(phi) x' + sin(phi) y' = 0, whose rows of b (1, 0, 0)
+// and (cos phi, sin phi, 0) keep the norm 1 and become parallel as phi goes to 0: the body stays
+// at rest while phi = 1 - t/2 turns freely. The row-scaled [D A; b] is (0, 0, 1), (cos phi,
+// sin phi, 0), (1, 0, 0), with singular values 1, sqrt(2) cos(phi/2), sqrt(2) sin(phi/2): its
+// condition number cot(phi/2) grows past 1000 times its value at phi = 1 (1.83) at phi = 1.09e-3,
+// t = 1.9978. Only the conditioning can see it.
+constexpr const char* kMergingBlades = R"(name = "merging-blades"
+coordinates = ["x", "y", "phi"]
+kinetic_energy = "m/2 * (x'^2 + y'^2) + m*rho^2/2 * phi'^2"
+[parameters]
+m = 1.0
+rho = 0.5
+[[constraints]]
+name = "straight"
+velocity = "x'"
+[[constraints]]
+name = "turning"
+velocity = "cos(phi)*x' + sin(phi)*y'"
+[initial]
+position = { x = 0, y = 0, phi = 1 }
+velocity = { x = 0, y = 0, phi = -0.5 }
+)";
+
+TEST(ConstraintWatchModels, MergingBladesNamedByTheConditioning) {
+  const Model model = load_model_text(kMergingBlades, "blades.toml");
+  SimulationOptions options = make_simulation_options(model);
+  options.t_end = 1.9995;
+  options.output_step = 5e-4;
+  const SimulationSummary summary = simulate(model, options, [](const Data&) {});
+  ASSERT_EQ(summary.status, Status::ok) << summary.message;
+  ASSERT_EQ(summary.watch.warnings.size(), 1u);
+  const ConstraintWarning& w = summary.watch.warnings[0];
+  EXPECT_EQ(w.measure, WatchMeasure::conditioning);
+  EXPECT_GE(w.constraint, 0);
+  // Past the crossing at t = 1.9978 (the estimate is within a modest factor of the true number),
+  // and before the run's end.
+  EXPECT_GE(w.t, 1.996) << w.t;
+  EXPECT_LE(w.t, 1.9995) << w.t;
+  EXPECT_GE(w.factor, kConstraintWatchFactor);
+  EXPECT_LT(summary.watch.largest_row_factor, 1.0 + 1e-12);
+}
+
+// The amortized estimate (constraint_watch.hpp): between two factorizations the true condition
+// number of the row-scaled stacked matrix, from an SVD at every state, stays within a factor 5/3
+// of its value at the last factorization; and far fewer states are factorized than watched.
+TEST(ConstraintWatchModels, AmortizedEstimateBoundsTheTrueConditionNumber) {
+  const Model model = load_model_text(kMergingBlades, "blades.toml");
+  Data data = make_data(model);
+  const FormulationOptions formulation{Method::sanh, Complement::qr};
+  ConstraintWatch watch = make_constraint_watch(model, data, formulation.method);
+  const int states = 4000;
+  double at_estimate = 0.0;
+  long estimates = 0;
+  for (int i = 0; i < states; ++i) {
+    const double phi = std::pow(1e-4, static_cast<double>(i) / (states - 1));  // 1 down to 1e-4
+    Vector q(3), v(3);
+    q << 0.0, 0.0, phi;
+    v << 0.0, 0.0, -0.5;
+    ASSERT_EQ(compute_dynamics(model, data, formulation, 0.0, q.data(), v.data()), Status::ok) << phi;
+    compute_constraint_watch(model, data, watch);
+    Matrix m(3, 3);
+    m.topRows(1) = data.D * data.A;
+    m.bottomRows(2) = data.b;
+    for (int r = 0; r < 3; ++r) m.row(r).normalize();
+    const Eigen::JacobiSVD<Matrix> svd(m);
+    const double condition = svd.singularValues()(0) / svd.singularValues()(2);
+    EXPECT_NEAR(condition, 1.0 / std::tan(phi / 2), 1e-6 / std::tan(phi / 2)) << phi;
+    if (watch.estimates != estimates) {
+      estimates = watch.estimates;
+      at_estimate = condition;
+    }
+    EXPECT_LE(condition, at_estimate * 5.0 / 3.0) << phi;
+    EXPECT_GE(condition, at_estimate * 3.0 / 5.0) << phi;
+  }
+  EXPECT_EQ(watch.states, states);
+  EXPECT_LT(watch.estimates, states / 10) << watch.estimates;
+  EXPECT_GT(watch.estimates, 10) << watch.estimates;  // the approach to phi = 0 is followed
+  ASSERT_EQ(watch.warnings.size(), 1u);
+  EXPECT_EQ(watch.warnings[0].measure, WatchMeasure::conditioning);
 }
 
 class ConstraintWatchCli : public ::testing::Test {

@@ -437,6 +437,18 @@ final = { position = { x = 1, y = 0.1, theta = 0.2 }, velocity = { x = 0, y = 0,
   for (double v : theta2) largest_theta2 = std::max(largest_theta2, std::abs(v));
   EXPECT_GT(largest_theta2, 0.1);
   for (std::size_t i = 0; i < r_theta.size(); ++i) EXPECT_LT(std::abs(r_theta[i]), 1e-7) << i;
+  // The controls in a panel of their own, the CSV's u_F and u_T to the page's 6 digits.
+  EXPECT_NE(page.find("\"title\":\"controls u (the optimum's)\""), std::string::npos);
+  for (const char* control : {"u_F", "u_T"}) {
+    const std::vector<double> shown = report_series(page, control), written = read_csv(dir_ / "blade.csv").column(control);
+    ASSERT_EQ(shown.size(), written.size()) << control;
+    double largest = 0.0;
+    for (std::size_t i = 0; i < shown.size(); ++i) {
+      EXPECT_NEAR(shown[i], written[i], 1e-5 * std::abs(written[i]) + 1e-12) << control << " " << i;
+      largest = std::max(largest, std::abs(written[i]));
+    }
+    EXPECT_GT(largest, 0.1) << control;  // a control that acts
+  }
 
   const Outcome di = optimize(example("double_integrator.toml") + " -o di.csv --html di.html");
   ASSERT_EQ(di.exit_code, 0) << di.out;

@@ -724,6 +724,83 @@ TEST(ContactScene, BowlIsAMeshOfItsSphereAroundTheMotion) {
   }
 }
 
+// A terrain undefined over part of the drawn box (sqrt(X + 0.1), a term too small to move the
+// ball, is not real for X < -0.1, inside the box's margin): no triangle there, rather than a
+// ground drawn at 0; every triangle's vertices are finite and the terrain's value.
+TEST_F(Cli, TerrainUndefinedInPartOfTheBoxIsLeftOutThere) {
+  std::string text = nhdyn::read_model_text(example("ball_over_bump.toml"));
+  const std::string terrain = "terrain = \"H*exp(-(X^2 + Y^2)/w^2)\"";
+  ASSERT_NE(text.find(terrain), std::string::npos);
+  text.replace(text.find(terrain), terrain.size(), "terrain = \"H*exp(-(X^2 + Y^2)/w^2) + 1e-12*sqrt(X + 0.1)\"");
+  const fs::path model = dir / "half.toml";
+  std::ofstream(model) << text;
+  std::string out, err;
+  const fs::path csv = dir / "half.csv", html = dir / "half.html";
+  ASSERT_EQ(run("simulate " + model.string() + " --t-end 0.2 -o " + csv.string() + " --html " +
+                    html.string() + " -q",
+                out, err, dir),
+            0)
+      << err;
+  const std::string page = nhdyn::test::read_text(html);
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_file(model);
+  const double H = parameter(spec, "H"), w = parameter(spec, "w");
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  const int index = find_shape(scene, VisualKind::terrain, "ball");
+  ASSERT_GE(index, 0);
+  const nhdyn::SceneMesh mesh = nhdyn::calc_scene_meshes(scene, spec_parameters(spec), report_scene_values(page),
+                                                         static_cast<std::size_t>(report_scene_stride(page)),
+                                                         spec.name)[static_cast<std::size_t>(index)];
+  int undefined = 0;
+  for (std::size_t k = 0; k < mesh.vertices.size(); k += 3) undefined += !std::isfinite(mesh.vertices[k + 2]);
+  EXPECT_GT(undefined, 0) << "the box reaches X < -0.1";
+  ASSERT_FALSE(mesh.triangles.empty());
+  for (const int i : mesh.triangles) {
+    const std::size_t k = 3 * static_cast<std::size_t>(i);
+    const double x = mesh.vertices[k], y = mesh.vertices[k + 1];
+    ASSERT_GE(x, -0.1);
+    EXPECT_NEAR(mesh.vertices[k + 2], H * std::exp(-(x * x + y * y) / (w * w)) + 1e-12 * std::sqrt(x + 0.1), 4e-16 * H);
+  }
+  // The page carries those vertices as null (no number made up for them).
+  EXPECT_NE(page.find("null", page.find("{\"kind\":\"terrain\"")), std::string::npos);
+}
+
+// The ball over the bump written as an implicit sphere: the terrain's margin around the track is
+// four times the shape's half extent (its mesh's), 4 r = 0.2 m, as for the closed-form ball,
+// not a length of 1 m.
+TEST_F(Cli, TerrainUnderAnImplicitShapeHasTheShapesMargin) {
+  std::string text = nhdyn::read_model_text(example("ball_over_bump.toml"));
+  const std::string sphere = "shape = { sphere = \"r\" }";
+  ASSERT_NE(text.find(sphere), std::string::npos);
+  text.replace(text.find(sphere), sphere.size(), "shape = { surface = \"X^2 + Y^2 + Z^2 - r^2\" }");
+  const fs::path model = dir / "implicit.toml";
+  std::ofstream(model) << text;
+  std::string out, err;
+  const fs::path csv = dir / "implicit.csv", html = dir / "implicit.html";
+  ASSERT_EQ(run("simulate " + model.string() + " --t-end 0.2 -o " + csv.string() + " --html " + html.string() + " -q",
+                out, err, dir),
+            0)
+      << err;
+  const std::string page = nhdyn::test::read_text(html);
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_file(model);
+  const double r = parameter(spec, "r");
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  const int index = find_shape(scene, VisualKind::terrain, "ball");
+  ASSERT_GE(index, 0);
+  const nhdyn::SceneMesh mesh = nhdyn::calc_scene_meshes(scene, spec_parameters(spec), report_scene_values(page),
+                                                         static_cast<std::size_t>(report_scene_stride(page)),
+                                                         spec.name)[static_cast<std::size_t>(index)];
+  const nhdyn::CsvTable table = nhdyn::load_csv(csv);
+  const int X = table.column("ball_X");
+  ASSERT_GE(X, 0);
+  double lo = 1e300, hi = -1e300, path_lo = 1e300, path_hi = -1e300;
+  for (std::size_t k = 0; k < mesh.vertices.size(); k += 3) lo = std::min(lo, mesh.vertices[k]), hi = std::max(hi, mesh.vertices[k]);
+  for (const std::vector<double>& row : table.rows)
+    path_lo = std::min(path_lo, row[static_cast<std::size_t>(X)]), path_hi = std::max(path_hi, row[static_cast<std::size_t>(X)]);
+  ASSERT_LT(path_hi - path_lo, 3 * 4 * r);  // the margin is then 4 r, not a third of the path
+  EXPECT_NEAR(path_lo - lo, 4 * r, 1e-3 * r);
+  EXPECT_NEAR(hi - path_hi, 4 * r, 1e-3 * r);
+}
+
 // An implicit shape (the rattleback's ellipsoid written as f = 0): its mesh lies on f = 0 to
 // round-off, with the run's semi-axes, in the body's axes about the shape's centre.
 TEST(ContactScene, ImplicitShapeIsAMeshOfItsZeroSet) {
@@ -749,6 +826,57 @@ TEST(ContactScene, ImplicitShapeIsAMeshOfItsZeroSet) {
   }
   EXPECT_NEAR(reach[2], c, 1e-14);  // the poles are vertices
   EXPECT_NEAR(reach[0], a, 1e-14);  // and the ends of x (azimuth 0, polar pi/2)
+}
+
+// An implicit shape whose frame origin lies outside it (a ball of radius r centred 0.3 below the
+// origin): the report finds a point inside by descending f and draws the whole sphere from there.
+TEST(ContactScene, ImplicitShapeOffItsFramesOriginIsDrawnFromAPointInside) {
+  const std::string text = R"(name = "offset-ball"
+coordinates = ["x", "y", "z", "psi", "theta", "phi", "px", "py", "pz"]
+gravity = [0, 0, "-g"]
+[parameters]
+m = 1.0
+r = 0.1
+g = 9.81
+[[frames]]
+name = "ball"
+translation = ["x", "y", "z"]
+rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
+[[bodies]]
+name = "ball"
+frame = "ball"
+mass = "m"
+com = [0, 0, -0.3]
+inertia = ["2/5*m*r^2", "2/5*m*r^2", "2/5*m*r^2"]
+[[contacts]]
+name = "foot"
+body = "ball"
+shape = { surface = "X^2 + Y^2 + (Z + 0.3)^2 - r^2", coordinates = ["px", "py", "pz"] }
+[initial]
+position = { x = 0, y = 0, z = 0.4, psi = 0, theta = 0, phi = 0, px = 0, py = 0, pz = -0.4 }
+velocity = { x = 0.4, phi = 1 }
+)";
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_string(text, "offset_ball.toml");
+  nhdyn::Model model = nhdyn::symbolic::compile_model(spec);
+  const double r = 0.12;
+  nhdyn::set_parameter(model, "r", r);
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  const int solid = find_shape(scene, VisualKind::solid, "foot");
+  ASSERT_GE(solid, 0);
+  const nhdyn::SceneMesh mesh = nhdyn::calc_scene_meshes(scene, model.parameters, {}, 0, model.name)[static_cast<std::size_t>(solid)];
+  ASSERT_GE(mesh.vertices.size(), 3u * 100);
+  double lo[3] = {1e9, 1e9, 1e9}, hi[3] = {-1e9, -1e9, -1e9};
+  for (std::size_t k = 0; k < mesh.vertices.size(); k += 3) {
+    const double x = mesh.vertices[k], y = mesh.vertices[k + 1], z = mesh.vertices[k + 2];
+    EXPECT_NEAR(std::sqrt(x * x + y * y + (z + 0.3) * (z + 0.3)), r, 1e-12);
+    for (std::size_t i = 0; i < 3; ++i) {
+      lo[i] = std::min(lo[i], mesh.vertices[k + i]);
+      hi[i] = std::max(hi[i], mesh.vertices[k + i]);
+    }
+  }
+  // The whole sphere, not a cap: its extent is 2r along each axis (to the mesh's resolution).
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(hi[i] - lo[i], 2 * r, 0.02 * r) << i;
+  EXPECT_NEAR(0.5 * (hi[2] + lo[2]), -0.3, 0.01 * r);
 }
 
 // The round tyre: the torus's radii are the run's R and r, about the wheel's axle y.

@@ -34,6 +34,23 @@ double change_factor(double initial, double value) {
   return std::max(value / initial, initial / value);
 }
 
+// A lower bound of the smallest singular value of the upper triangle of R's leading m x m block
+// (nonzero diagonal): 1 / ||R^-1||_F, column by column of R^-1 through `unit` (m). O(m^3), no
+// allocation. 0 when it is not finite.
+double smallest_singular_value_bound(const Matrix& R, Eigen::Index m, Vector& unit) {
+  double sum = 0.0;
+  for (Eigen::Index j = 0; j < m; ++j) {
+    // Column j of R^-1 has its nonzeros in rows 0..j: solve with the leading (j+1) block.
+    auto x = unit.head(j + 1);
+    x.setZero();
+    x(j) = 1.0;
+    R.topLeftCorner(j + 1, j + 1).triangularView<Eigen::Upper>().solveInPlace(x);
+    sum += x.squaredNorm();
+  }
+  const double bound = 1.0 / std::sqrt(sum);
+  return std::isfinite(bound) ? bound : 0.0;
+}
+
 // The conditioning estimate of the row-scaled watched matrix and the index of its last pivot row.
 double stacked_condition(const Model& model, const Data& data, ConstraintWatch& watch, Eigen::Index& last) {
   const int k = model.k();
@@ -41,11 +58,20 @@ double stacked_condition(const Model& model, const Data& data, ConstraintWatch& 
   Matrix& rows = watch.rows;
   if (watch.stacked && k > 0) rows.topRows(k).noalias() = data.D * data.A;
   rows.bottomRows(s) = data.b;
+  const Eigen::Index top = rows.rows() - s;
+  double moved = 0.0;  // ||M - M at the last estimate||_F^2, in the same pass as the scaling
   for (Eigen::Index i = 0; i < rows.rows(); ++i) {
-    const double norm = rows.row(i).norm();
+    // The rows of b have their norms in watch.norm already.
+    const double norm = i < top ? rows.row(i).norm() : watch.norm(i - top);
     if (!std::isfinite(norm)) return kInfinity;
     if (norm > 0.0) rows.row(i) /= norm;
+    moved += (rows.row(i) - watch.estimated_rows.row(i)).squaredNorm();
   }
+  if (moved <= watch.reuse_radius * watch.reuse_radius && watch.reuse_radius > 0.0) {
+    last = watch.last_pivot;
+    return watch.condition;
+  }
+  ++watch.estimates;
   watch.rows_t = rows.transpose();
   watch.qr.compute(watch.rows_t);
   const Matrix& R = watch.qr.matrixQR();
@@ -58,6 +84,9 @@ double stacked_condition(const Model& model, const Data& data, ConstraintWatch& 
     smallest = std::min(smallest, d);
   }
   last = watch.qr.colsPermutation().indices()(m - 1);
+  watch.last_pivot = last;
+  watch.estimated_rows = rows;
+  watch.reuse_radius = smallest > 0.0 ? kConditioningReuse * smallest_singular_value_bound(R, m, watch.unit) : 0.0;
   if (!(smallest > 0.0)) return kInfinity;
   return largest / smallest;
 }
@@ -99,6 +128,8 @@ ConstraintWatch make_constraint_watch(const Model& model, const Data& data, std:
     watch.rows = Matrix::Zero(watched, n);
     watch.rows_t = Matrix::Zero(n, watched);
     watch.qr = Eigen::ColPivHouseholderQR<Matrix>(n, watched);
+    watch.estimated_rows = Matrix::Zero(watched, n);
+    watch.unit = Vector::Zero(watched);
   }
   return watch;
 }

@@ -10,6 +10,12 @@
 //      of the largest to the smallest |R_ii| of a QR with column pivoting of its transpose, the
 //      last pivot naming the row most nearly dependent on the others. O(n^3), in workspace
 //      allocated once. For a formulation without D (lagrange, udwadia-kalaba) the rows of b alone.
+//      The factorization is amortized: the rows of b change slowly, so the estimate is made again
+//      only once the row-scaled matrix M has moved, in the Frobenius norm, by more than
+//      kConditioningReuse times a lower bound of its smallest singular value at the last estimate
+//      (1 / ||R^-1||_F). By Weyl's inequality the true condition number of M in between stays
+//      within a factor (1 + r) / (1 - r), r = kConditioningReuse, of its value there, so a loss by
+//      orders of magnitude always crosses the bound and is measured. Forming M is O(k n^2).
 //
 // A measure that has grown (or a row norm that has shrunk) by kConstraintWatchFactor or more from
 // its first value, or that is no longer finite, makes one warning per constraint: which measure,
@@ -34,6 +40,11 @@ namespace nhdyn {
 // runs, tests/formulation/constraint_watch_test.cpp), while the tan(phi) form reaches it at
 // |cos(phi)| = 1e-3, 1 ms of rotation before the singularity at 1 rad/s.
 inline constexpr double kConstraintWatchFactor = 1e3;
+
+// How far (relative to its smallest singular value) the row-scaled stacked matrix may move before
+// its conditioning is estimated again: the true condition number stays within a factor 5/3 of
+// the last estimate, far inside kConstraintWatchFactor.
+inline constexpr double kConditioningReuse = 0.25;
 
 // Which measure degraded.
 enum class WatchMeasure {
@@ -68,7 +79,12 @@ struct ConstraintWatch {
   Matrix rows;                              // (rows watched) x n, the row-scaled stacked matrix
   Matrix rows_t;                            // n x (rows watched), its transpose for the QR
   Eigen::ColPivHouseholderQR<Matrix> qr;    // of rows_t
+  Matrix estimated_rows;                    // rows at the last estimate
+  double reuse_radius = 0.0;                // kConditioningReuse / ||R^-1||_F there; 0: estimate again
+  Eigen::Index last_pivot = 0;              // the last pivot's row at the last estimate
+  Vector unit;                              // workspace of the bound, (rows watched)
   long states = 0;                          // states watched
+  long estimates = 0;                       // of them, those whose conditioning was estimated
 };
 
 // The watch for a run of `model` on `data` (its path, dense or sparse) with the formulation

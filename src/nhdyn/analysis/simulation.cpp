@@ -342,24 +342,14 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
     throw InputError(fmt::format("model '{}' has no analytic D; choose --complement qr or partition", model.name));
 }
 
-SimulationSummary simulate(const Model& model, const SimulationOptions& options, const RowFn& row) {
-  check_simulation_options(model, options);
-  const std::vector<double> times = calc_run_times(model, options);
-  // With given output times that do not start at t0, the start is computed but not a row.
-  bool hide_start = !options.output_times.empty() && options.output_times.front() != model.t0;
-  bool first_output = true;
-  // The Data of the chosen formulation only, on the path the model takes (model/data.hpp).
-  DataOptions data_options;
-  data_options.path = options.path;
-  data_options.method = options.formulation.method;
-  data_options.projection = options.fix_initial || options.stabilization == Stabilization::projection;
-  Data data = make_data(model, data_options);
-  // rk4 takes no smaller step near a singular S, and could step across it (model/data.hpp).
-  data.motion.watch_sign = options.integrator.kind == IntegratorKind::rk4;
-  SimulationSummary summary;
-  Vector q0 = model.q0, v0 = model.v0;
-  // The contact points' coordinates the model added, found from the rest of the start (its
-  // parameters or initial values may have changed since it was made).
+namespace {
+
+// The run's start state: the model's q0 and v0 with the contact points' coordinates the model
+// added found from the rest of the start (its parameters or initial values may have changed since
+// it was made), fixed when asked, checked against the constraints and the programs; and the mode
+// each contact starts in.
+void prepare_start_state(const Model& model, Data& data, const SimulationOptions& options, SimulationSummary& summary,
+                         Vector& q0, Vector& v0) {
   complete_initial_state(model, data, model.t0, q0, v0);
   check_state_or_throw(model, data, model.t0, q0.data(), v0.data());
   if (options.fix_initial) {
@@ -372,6 +362,179 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   choose_initial_contact_modes(model, data, options.formulation, model.t0, q0, v0);
   if (!options.fix_initial) check_initial_state(model, data, model.t0, q0, v0, options.initial_tolerance);
   check_programs_at_initial_state(model, data, options.formulation, model.t0, q0, v0, options.initial_tolerance);
+}
+
+// What simulate does at each output time (and at each event, before its record): the state
+// (projected, with projection), the dynamics and every quantity of a row computed in Data, the
+// summary's maxima updated, and the row handed to the caller unless it is a hidden start or the
+// same time as the last row.
+class RowRecorder {
+ public:
+  RowRecorder(const Model& model, Data& data, const SimulationOptions& options, const FormulationOptions& formulation,
+              ConstraintWatch& watch, SimulationSummary& summary, const RowFn& row, std::size_t states)
+      : model_(model), data_(data), options_(options), formulation_(formulation), watch_(watch), summary_(summary),
+        row_(row), states_(states), y_out_(states),
+        // With given output times that do not start at t0, the start is computed but not a row.
+        hide_start_(!options.output_times.empty() && options.output_times.front() != model.t0) {}
+
+  Status record(double t, const double* y) {
+    const int n = model_.n();
+    if (options_.stabilization == Stabilization::projection) {
+      // Between step ends the integrator interpolates; the solution it reports is the projected one.
+      std::copy(y, y + states_, y_out_.begin());
+      y = y_out_.data();
+      const StepEnd end = project(model_, data_, options_.projection, t, y_out_.data(), summary_);
+      if (end.status != Status::ok) {
+        failure_ = end.status;
+        return Status::stopped;
+      }
+    }
+    const Status status = compute_dynamics(model_, data_, formulation_, t, y, y + n);
+    if (status != Status::ok) {
+      failure_ = status;
+      return Status::stopped;
+    }
+    if (options_.watch_constraints) compute_constraint_watch(model_, data_, watch_);
+    compute_residuals(model_, data_);
+    record_contact_gaps(model_, data_);  // nothing without contact modes
+    compute_energy(model_, data_);
+    compute_contact_forces(model_, data_);  // nothing for a model without contacts
+    compute_outputs(model_, data_);
+    for (int i = 0; i < model_.outputs.count(); ++i)
+      if (!std::isfinite(data_.outputs.values(i))) {
+        const DerivedOutput& o = model_.outputs.list[static_cast<std::size_t>(i)];
+        message_ = non_finite_message("derived output", o.where, o.name, o.expression, data_.outputs.values(i), t,
+                                      describe_state(model_, data_.q.data(), data_.v.data()));
+        failure_ = Status::non_finite;
+        return Status::stopped;
+      }
+    update_summary(y);
+    if (hide_start_) {
+      hide_start_ = false;
+      return Status::ok;
+    }
+    // An event at an output time (or two events at one time) is one row (docs/cli.md, "Events"):
+    // the first written at that t, to round-off, stands for them all; each event keeps its record.
+    if (summary_.outputs > 0 && std::abs(t - last_row_t_) <= time_resolution(t, last_row_t_)) return Status::ok;
+    last_row_t_ = t;
+    ++summary_.outputs;
+    row_(data_);
+    return Status::ok;
+  }
+
+  // Why a row stopped the run (ok when none did), and the message when it is not the dynamics' own failure.
+  Status failure() const { return failure_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  // The summary's energies and largest residuals, with the row's Data computed.
+  void update_summary(const double* y) {
+    const int n = model_.n();
+    if (first_output_) {
+      summary_.energy.initial = data_.energy;
+      summary_.energy.function_initial = data_.energy_function;
+      first_output_ = false;
+    }
+    if (summary_.energy.has_balance) record_balance(model_, data_, y + 2 * n, summary_);
+    summary_.residuals.position = std::max(summary_.residuals.position, max_abs(data_.phi));
+    summary_.residuals.velocity = std::max(summary_.residuals.velocity, max_abs(data_.f));
+    summary_.residuals.acceleration = std::max(summary_.residuals.acceleration, max_abs(data_.e));
+    if (model_.m() > 0) {
+      compute_program_residuals(model_, data_);
+      summary_.program.position = std::max(summary_.program.position, max_abs(data_.motion.phi));
+      summary_.program.velocity = std::max(summary_.program.velocity, max_abs(data_.motion.f));
+      summary_.program.acceleration = std::max(summary_.program.acceleration, max_abs(data_.motion.e));
+    }
+    if (summary_.energy.has_energy)
+      summary_.energy.drift = std::max(summary_.energy.drift, std::abs(data_.energy - summary_.energy.initial));
+  }
+
+  const Model& model_;
+  Data& data_;
+  const SimulationOptions& options_;
+  const FormulationOptions& formulation_;
+  ConstraintWatch& watch_;
+  SimulationSummary& summary_;
+  const RowFn& row_;
+  std::size_t states_;
+  std::vector<double> y_out_;
+  bool hide_start_;
+  bool first_output_ = true;
+  double last_row_t_ = 0.0;  // the time of the last row written, once summary.outputs > 0
+  Status failure_ = Status::ok;
+  std::string message_;  // why failure_, when it is not the dynamics' own failure
+};
+
+// An event's record, with the state as written (projected, if so), after its row.
+void record_crossing(const Model& model, const Data& data, int index, const std::string& name, double t,
+                     SimulationSummary& summary) {
+  EventRecord record;
+  record.index = index;
+  record.name = name;
+  record.t = t;
+  record.q.assign(data.q.data(), data.q.data() + model.n());
+  record.v.assign(data.v.data(), data.v.data() + model.n());
+  summary.events.crossings.push_back(std::move(record));
+}
+
+// A stop condition that never held: most likely a sign or threshold that cannot be met.
+void note_unmet_stops(const Model& model, const std::vector<const Event*>& events, double t_reached,
+                      SimulationSummary& summary) {
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const Event& e = *events[i];
+    if (e.action != EventAction::stop) continue;
+    if (std::any_of(summary.events.crossings.begin(), summary.events.crossings.end(),
+                    [&](const EventRecord& r) { return r.index == static_cast<int>(i) && r.name == e.name; }))
+      continue;
+    // An option quotes its own text ("--stop-when \"x > 2\""); a file's event is named at its place.
+    const bool option = e.where.starts_with("--") && e.where.find(e.expression) != std::string::npos;
+    const std::string what = option ? "the stop condition " + e.where
+                                    : fmt::format("{}the stop event '{}' ({})", e.where.empty() ? "" : e.where + ": ",
+                                                  e.name, e.expression);
+    summary.events.unmet_stops.push_back(fmt::format(
+        "{} never {} between t = {:g} and t = {:g}: the run went to the end; check its sign, direction or threshold",
+        what, e.condition ? "became true" : "crossed zero in its direction", model.t0, t_reached));
+  }
+}
+
+// The message of a run that failed, in the most telling words there are.
+std::string explain_run_failure(const Model& model, const Data& data, const ModelEventFunctions& event_functions,
+                                const IntegrationResult& result, const std::string& output_message, Status status) {
+  // The kernels recorded the details of a failed evaluation in data; prefer those words.
+  std::string message = data.status != Status::ok ? explain_failure(model, data) : result.message;
+  // An event not finite at its latest evaluation ended the run, unless the dynamics failed after it.
+  const ModelEventFunctions::NonFinite& bad_event = event_functions.non_finite();
+  if (status == Status::non_finite && bad_event.index >= 0 &&
+      (data.status == Status::ok || !(data.failed_t > bad_event.t))) {
+    const Event& e = event_functions.event(bad_event.index);
+    message = non_finite_message("event", e.where, e.name, e.expression, bad_event.g, bad_event.t,
+                                 describe_state(model, bad_event.y.data(), bad_event.y.data() + model.n()));
+  }
+  if (!output_message.empty()) message = output_message;
+  // A contact point that is not defined there says so, rather than the equations' symptom of it.
+  if (const std::string singular = singular_contact_message(model, data.t, data.q.data(), data.v.data());
+      !singular.empty())
+    message = singular;
+  if (message.empty()) message = fmt::format("{} at t = {:.6g}", describe(status), result.t_reached);
+  return message;
+}
+
+}  // namespace
+
+SimulationSummary simulate(const Model& model, const SimulationOptions& options, const RowFn& row) {
+  check_simulation_options(model, options);
+  const std::vector<double> times = calc_run_times(model, options);
+  // The Data of the chosen formulation only, on the path the model takes (model/data.hpp).
+  DataOptions data_options;
+  data_options.path = options.path;
+  data_options.method = options.formulation.method;
+  data_options.projection = options.fix_initial || options.stabilization == Stabilization::projection;
+  Data data = make_data(model, data_options);
+  // rk4 takes no smaller step near a singular S, and could step across it (model/data.hpp).
+  data.motion.watch_sign = options.integrator.kind == IntegratorKind::rk4;
+  SimulationSummary summary;
+  Vector q0 = model.q0, v0 = model.v0;
+  prepare_start_state(model, data, options, summary, q0, v0);
 
   const int n = model.n();
   summary.energy.has_energy = model.evaluator->has_energy();
@@ -384,85 +547,16 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   std::vector<double> y0(states, 0.0);  // the work starts at 0
   std::copy(q0.data(), q0.data() + n, y0.begin());
   std::copy(v0.data(), v0.data() + n, y0.begin() + n);
-  std::vector<double> y_out(states);
-  Status output_failure = Status::ok;
-  double last_row_t = 0.0;  // the time of the last row written, once summary.outputs > 0
-  std::string output_message;  // why output_failure, when it is not the dynamics' own failure
-  const OutputFn output = [&](double t, const double* y) -> Status {
-    if (options.stabilization == Stabilization::projection) {
-      // Between step ends the integrator interpolates; the solution it reports is the projected one.
-      std::copy(y, y + states, y_out.begin());
-      y = y_out.data();
-      const StepEnd end = project(model, data, options.projection, t, y_out.data(), summary);
-      if (end.status != Status::ok) {
-        output_failure = end.status;
-        return Status::stopped;
-      }
-    }
-    const Status status = compute_dynamics(model, data, formulation, t, y, y + n);
-    if (status != Status::ok) {
-      output_failure = status;
-      return Status::stopped;
-    }
-    if (options.watch_constraints) compute_constraint_watch(model, data, watch);
-    compute_residuals(model, data);
-    record_contact_gaps(model, data);  // nothing without contact modes
-    compute_energy(model, data);
-    compute_contact_forces(model, data);  // nothing for a model without contacts
-    compute_outputs(model, data);
-    for (int i = 0; i < model.outputs.count(); ++i)
-      if (!std::isfinite(data.outputs.values(i))) {
-        const DerivedOutput& o = model.outputs.list[static_cast<std::size_t>(i)];
-        output_message = non_finite_message("derived output", o.where, o.name, o.expression, data.outputs.values(i), t,
-                                            describe_state(model, data.q.data(), data.v.data()));
-        output_failure = Status::non_finite;
-        return Status::stopped;
-      }
-    if (first_output) {
-      summary.energy.initial = data.energy;
-      summary.energy.function_initial = data.energy_function;
-      first_output = false;
-    }
-    if (summary.energy.has_balance) record_balance(model, data, y + 2 * n, summary);
-    summary.residuals.position = std::max(summary.residuals.position, max_abs(data.phi));
-    summary.residuals.velocity = std::max(summary.residuals.velocity, max_abs(data.f));
-    summary.residuals.acceleration = std::max(summary.residuals.acceleration, max_abs(data.e));
-    if (model.m() > 0) {
-      compute_program_residuals(model, data);
-      summary.program.position = std::max(summary.program.position, max_abs(data.motion.phi));
-      summary.program.velocity = std::max(summary.program.velocity, max_abs(data.motion.f));
-      summary.program.acceleration =
-          std::max(summary.program.acceleration, max_abs(data.motion.e));
-    }
-    if (summary.energy.has_energy)
-      summary.energy.drift = std::max(summary.energy.drift, std::abs(data.energy - summary.energy.initial));
-    if (hide_start) {
-      hide_start = false;
-      return Status::ok;
-    }
-    // An event at an output time (or two events at one time) is one row (docs/cli.md, "Events"):
-    // the first written at that t, to round-off, stands for them all; each event keeps its record.
-    if (summary.outputs > 0 && std::abs(t - last_row_t) <= time_resolution(t, last_row_t))
-      return Status::ok;
-    last_row_t = t;
-    ++summary.outputs;
-    row(data);
-    return Status::ok;
-  };
+  RowRecorder recorder(model, data, options, formulation, watch, summary, row, states);
+  const OutputFn output = [&recorder](double t, const double* y) { return recorder.record(t, y); };
 
   std::vector<const Event*> events;
   for (const Event& e : options.events) events.push_back(&e);
   for (const Event* e : events) summary.events.names.push_back(e->name);
   ModelEventFunctions event_functions(model, events, [&](int i, double t, const double* y) -> Status {
     // The row at the crossing, then its record with the state as written (projected, if so).
-    if (output(t, y) == Status::stopped) return output_failure;
-    EventRecord record;
-    record.index = i;
-    record.name = events[static_cast<std::size_t>(i)]->name;
-    record.t = t;
-    record.q.assign(data.q.data(), data.q.data() + n);
-    record.v.assign(data.v.data(), data.v.data() + n);
-    summary.events.crossings.push_back(std::move(record));
+    if (output(t, y) == Status::stopped) return recorder.failure();
+    record_crossing(model, data, i, events[static_cast<std::size_t>(i)]->name, t, summary);
     return Status::ok;
   }, event_dynamics(model, data, formulation));
   event_functions.require_valid_start(model.t0, y0.data());
@@ -471,16 +565,11 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   // Contacts that may slide or lift off: the run goes on through their switches (contact_switches.hpp).
   ContactSwitches switches(model, data, formulation, static_cast<int>(states), events.empty() ? nullptr : &event_functions,
                            [&](const std::string& name, double t, const double* y) -> Status {
-                             if (output(t, y) == Status::stopped) return output_failure;
+                             if (output(t, y) == Status::stopped) return recorder.failure();
                              auto at = std::find(summary.events.names.begin(), summary.events.names.end(), name);
                              if (at == summary.events.names.end()) at = summary.events.names.insert(at, name);
-                             EventRecord record;
-                             record.index = static_cast<int>(at - summary.events.names.begin());
-                             record.name = name;
-                             record.t = t;
-                             record.q.assign(data.q.data(), data.q.data() + n);
-                             record.v.assign(data.v.data(), data.v.data() + n);
-                             summary.events.crossings.push_back(std::move(record));
+                             record_crossing(model, data, static_cast<int>(at - summary.events.names.begin()), name, t,
+                                             summary);
                              return Status::ok;
                            });
   const IntegrationResult result =
@@ -488,27 +577,12 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
                           : integrate(ode, options.integrator, model.t0, y0.data(), times, output,
                                       events.empty() ? nullptr : &event_functions);
   summary.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  summary.status = output_failure != Status::ok ? output_failure : result.status;
+  summary.status = recorder.failure() != Status::ok ? recorder.failure() : result.status;
   summary.events.stopped_by = event_functions.stopped_by();
   // A stop event ends the run as planned.
   if (summary.status == Status::stopped && summary.events.stopped_by >= 0) summary.status = Status::ok;
-  // A stop condition that never held: most likely a sign or threshold that cannot be met.
   if (summary.status == Status::ok && summary.events.stopped_by < 0)
-    for (std::size_t i = 0; i < events.size(); ++i) {
-      const Event& e = *events[i];
-      if (e.action != EventAction::stop) continue;
-      if (std::any_of(summary.events.crossings.begin(), summary.events.crossings.end(),
-                      [&](const EventRecord& r) { return r.index == static_cast<int>(i) && r.name == e.name; }))
-        continue;
-      // An option quotes its own text ("--stop-when \"x > 2\""); a file's event is named at its place.
-      const bool option = e.where.starts_with("--") && e.where.find(e.expression) != std::string::npos;
-      const std::string what = option ? "the stop condition " + e.where
-                                      : fmt::format("{}the stop event '{}' ({})", e.where.empty() ? "" : e.where + ": ",
-                                                    e.name, e.expression);
-      summary.events.unmet_stops.push_back(fmt::format(
-          "{} never {} between t = {:g} and t = {:g}: the run went to the end; check its sign, direction or threshold",
-          what, e.condition ? "became true" : "crossed zero in its direction", model.t0, result.t_reached));
-    }
+    note_unmet_stops(model, events, result.t_reached, summary);
   summary.t_reached = result.t_reached;
   summary.sparse = data.sparse;
   summary.partition_changes = data.partition_changes;
@@ -520,24 +594,8 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.watch.largest_row_factor = watch.largest_row_factor;
   summary.watch.largest_condition_factor = watch.largest_condition_factor;
   summary.watch.watched_states = watch.states;
-  if (summary.status != Status::ok) {
-    // The kernels recorded the details of a failed evaluation in data; prefer those words.
-    summary.message = data.status != Status::ok ? explain_failure(model, data) : result.message;
-    // An event not finite at its latest evaluation ended the run, unless the dynamics failed after it.
-    const ModelEventFunctions::NonFinite& bad_event = event_functions.non_finite();
-    if (summary.status == Status::non_finite && bad_event.index >= 0 &&
-        (data.status == Status::ok || !(data.failed_t > bad_event.t))) {
-      const Event& e = event_functions.event(bad_event.index);
-      summary.message = non_finite_message("event", e.where, e.name, e.expression, bad_event.g, bad_event.t,
-                                           describe_state(model, bad_event.y.data(), bad_event.y.data() + n));
-    }
-    if (!output_message.empty()) summary.message = output_message;
-    // A contact point that is not defined there says so, rather than the equations' symptom of it.
-    if (const std::string singular = singular_contact_message(model, data.t, data.q.data(), data.v.data());
-        !singular.empty())
-      summary.message = singular;
-    if (summary.message.empty()) summary.message = fmt::format("{} at t = {:.6g}", describe(summary.status), result.t_reached);
-  }
+  if (summary.status != Status::ok)
+    summary.message = explain_run_failure(model, data, event_functions, result, recorder.message(), summary.status);
   return summary;
 }
 

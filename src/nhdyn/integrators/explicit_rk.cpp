@@ -346,6 +346,139 @@ class ContinuousExtension<rk::DormandPrince853> {
   std::array<std::vector<double>, 8> r_;  // r_0 = y, then r1..r7 above
 };
 
+// The state of one run of the adaptive driver below, shared by its parts; allocated once per run.
+template <class Tableau>
+struct AdaptiveRun {
+  AdaptiveRun(std::string_view method, OdeSystem& system, const IntegratorOptions& options, const double* y0,
+              std::span<const double> output_times, const OutputFn& output, EventFunctions* events)
+      : method(method), system(system), options(options), output_times(output_times), output(output), events(events),
+        n(system.size()), y(y0, y0 + n), y1(static_cast<std::size_t>(n)), y_out(static_cast<std::size_t>(n)),
+        stepper(n), extension(n) {}
+
+  std::string_view method;
+  OdeSystem& system;
+  const IntegratorOptions& options;
+  std::span<const double> output_times;
+  const OutputFn& output;
+  EventFunctions* events;
+  int n;
+  std::vector<double> y;      // the state at the step's start
+  std::vector<double> y1;     // the state at the step's end
+  std::vector<double> y_out;  // a state interpolated inside the step
+  Stepper<Tableau> stepper;
+  ContinuousExtension<Tableau> extension;
+  IntegratorStats stats;
+  std::optional<EventTracker> tracker;  // with events only
+  std::vector<EventTracker::Crossing> crossings;
+  std::size_t next = 0;  // the first output time not yet written
+};
+
+// Before the first step from t: the event tracker started, f(t, y) in the first stage and the
+// first step size h (the given one, or Hairer's estimate). A failure is the run's result.
+template <class Tableau>
+std::optional<IntegrationResult> start_adaptive(AdaptiveRun<Tableau>& run, double t, double hmax, double& h) {
+  if (run.events != nullptr && run.events->count() > 0) {
+    run.tracker.emplace(*run.events, run.n);
+    run.crossings.reserve(static_cast<std::size_t>(run.events->count()));
+    const Status status = run.tracker->restart(t, run.y.data());
+    if (status != Status::ok) return rhs_failure(run.method, status, t, t, run.stats);
+  }
+  ++run.stats.rhs_evaluations;
+  Status status = run.system.rhs(t, run.y.data(), run.stepper.k(0));
+  if (status != Status::ok) return rhs_failure(run.method, status, t, t, run.stats);
+  if (run.options.step > 0.0) {
+    h = std::min(run.options.step, hmax);
+  } else {
+    status = initial_step(run.system, run.options, Tableau::order, t, run.y.data(), run.stepper.k(0), hmax,
+                          run.stepper.scratch(), run.stepper.k(1), run.stats, h);
+    if (status != Status::ok) return rhs_failure(run.method, status, t, t, run.stats);
+  }
+  return std::nullopt;
+}
+
+// A step size too small to advance t: underflow, or no finite state at any step size.
+IntegrationResult step_size_failure(std::string_view method, bool error_finite, double t, double h,
+                                    const IntegratorStats& stats) {
+  IntegrationResult failure;
+  failure.status = error_finite ? Status::step_size_underflow : Status::non_finite;
+  failure.t_reached = t;
+  failure.stats = stats;
+  failure.message = error_finite ? fmt::format("{}: step size underflow at t = {} (h = {}): the solution may be "
+                                               "singular there, or the tolerances too tight",
+                                               method, t, h)
+                                 : fmt::format("{}: non-finite states at t = {} for every step size down to h = {}",
+                                               method, t, h);
+  return failure;
+}
+
+// The outputs of the step from t (size h) before t_limit, from its continuous extension.
+template <class Tableau>
+std::optional<IntegrationResult> write_outputs_before(AdaptiveRun<Tableau>& run, double t, double h, double t_limit) {
+  for (; run.next < run.output_times.size() && run.output_times[run.next] < t_limit; ++run.next) {
+    const double t_out = run.output_times[run.next];
+    run.extension.evaluate((t_out - t) / h, run.y_out.data());
+    if (run.output(t_out, run.y_out.data()) == Status::stopped) return stopped_at(t_out, run.stats);
+  }
+  return std::nullopt;
+}
+
+// Inside an accepted step from t to t_new (size h) with outputs or event crossings in it: the
+// continuous extension prepared, the crossings located on it and handed on in order, each after
+// the outputs before it, then the outputs before t_new. Outputs inside the step follow the step's
+// own solution; after_step acts at the step end, so an output there sees the state it leaves.
+template <class Tableau>
+std::optional<IntegrationResult> inside_step(AdaptiveRun<Tableau>& run, double t, double h, double t_new,
+                                             bool crossed, bool& last_stage_ready) {
+  if (!last_stage_ready) {
+    ++run.stats.rhs_evaluations;
+    const Status status = run.system.rhs(t_new, run.y1.data(), run.stepper.k(Tableau::stages - 1));
+    if (status != Status::ok) return rhs_failure(run.method, status, t_new, t, run.stats);
+    last_stage_ready = true;
+  }
+  double t_fail = t;
+  Status status = run.extension.prepare(run.system, run.stepper, t, run.y.data(), run.y1.data(), h, run.stats, t_fail);
+  if (status != Status::ok) return rhs_failure(run.method, status, t_fail, t, run.stats);
+  if (crossed) {
+    status = run.tracker->locate(
+        t, h, [&](double theta, double* out) { run.extension.evaluate(theta, out); }, run.crossings);
+    if (status != Status::ok) return rhs_failure(run.method, status, t_new, t, run.stats);
+    for (const EventTracker::Crossing& crossing : run.crossings) {
+      if (auto stop = write_outputs_before(run, t, h, crossing.t)) return stop;
+      if (crossing.theta >= 1.0) std::copy(run.y1.begin(), run.y1.end(), run.y_out.begin());
+      else run.extension.evaluate(crossing.theta, run.y_out.data());
+      const Status event_status = run.events->on_event(crossing.index, crossing.t, run.y_out.data());
+      if (event_status == Status::stopped) return stopped_at(crossing.t, run.stats);
+      if (event_status != Status::ok) return step_end_failure(run.method, event_status, crossing.t, run.stats);
+    }
+  }
+  return write_outputs_before(run, t, h, t_new);
+}
+
+// At the end t_new of an accepted step: after_step on the end state (the events restarted
+// if it changed it), the FSAL stage of the state the next step starts from, the output at t_new.
+template <class Tableau>
+std::optional<IntegrationResult> end_step(AdaptiveRun<Tableau>& run, double t_new, bool last_stage_ready) {
+  if (run.tracker) run.tracker->advance();
+  const StepEnd end = run.system.after_step(t_new, run.y1.data());
+  if (end.status != Status::ok) return step_end_failure(run.method, end.status, t_new, run.stats);
+  if (run.tracker && end.changed) {
+    const Status status = run.tracker->restart(t_new, run.y1.data());
+    if (status != Status::ok) return rhs_failure(run.method, status, t_new, t_new, run.stats);
+  }
+  // The FSAL stage belongs to the state before a change; evaluated here, it is that of the
+  // state the next step starts from.
+  if (end.changed || !last_stage_ready) {
+    ++run.stats.rhs_evaluations;
+    const Status status = run.system.rhs(t_new, run.y1.data(), run.stepper.k(Tableau::stages - 1));
+    if (status != Status::ok) return rhs_failure(run.method, status, t_new, t_new, run.stats);
+  }
+  if (run.next < run.output_times.size() && run.output_times[run.next] == t_new) {
+    if (run.output(t_new, run.y1.data()) == Status::stopped) return stopped_at(t_new, run.stats);
+    ++run.next;
+  }
+  return std::nullopt;
+}
+
 // The driver of the adaptive pairs: Hairer's step-size control with the tableau's constants,
 // outputs inside a step from the continuous extension (never shortening a step), only the last
 // step shortened to end on the last output time, so the rhs is never evaluated beyond it.
@@ -359,94 +492,56 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
   constexpr double fac_min = Tableau::fac_min;
   constexpr double fac_max = Tableau::fac_max;
   constexpr double safety = Tableau::safety;
-  constexpr int last_stage = Tableau::stages - 1;
   static_assert(Tableau::fsal, "the adaptive driver reuses the last stage as the next first one");
 
-  const int n = system.size();
   IntegrationResult result;
   result.t_reached = t0;
   if (output_times.empty()) return result;
 
-  std::vector<double> y(y0, y0 + n);
-  std::vector<double> y1(static_cast<std::size_t>(n));
-  std::vector<double> y_out(static_cast<std::size_t>(n));
-  Stepper<Tableau> stepper(n);
-  ContinuousExtension<Tableau> extension(n);
-  IntegratorStats stats;
-
-  std::size_t next = 0;
+  AdaptiveRun<Tableau> run(method, system, options, y0, output_times, output, events);
   if (output_times.front() == t0) {
-    if (output(t0, y.data()) == Status::stopped) return stopped_at(t0, stats);
-    ++next;
+    if (output(t0, run.y.data()) == Status::stopped) return stopped_at(t0, run.stats);
+    ++run.next;
   }
-  if (next == output_times.size()) return result;
+  if (run.next == output_times.size()) return result;
   const double t_end = output_times.back();
   const double hmax = options.max_step > 0.0 ? std::min(options.max_step, t_end - t0) : t_end - t0;
 
   double t = t0;
-  std::optional<EventTracker> tracker;
-  std::vector<EventTracker::Crossing> crossings;
-  if (events != nullptr && events->count() > 0) {
-    tracker.emplace(*events, n);
-    crossings.reserve(static_cast<std::size_t>(events->count()));
-    const Status status = tracker->restart(t, y.data());
-    if (status != Status::ok) return rhs_failure(method, status, t, t, stats);
-  }
-  ++stats.rhs_evaluations;
-  Status status = system.rhs(t, y.data(), stepper.k(0));
-  if (status != Status::ok) return rhs_failure(method, status, t, t, stats);
   double h = 0.0;
-  if (options.step > 0.0) {
-    h = std::min(options.step, hmax);
-  } else {
-    status = initial_step(system, options, Tableau::order, t, y.data(), stepper.k(0), hmax,
-                          stepper.scratch(), stepper.k(1), stats, h);
-    if (status != Status::ok) return rhs_failure(method, status, t, t, stats);
-  }
+  if (auto failure = start_adaptive(run, t, hmax, h)) return *std::move(failure);
 
   double err_old = 1e-4;  // Hairer's FACOLD: the previous accepted error, floored
   bool last_rejected = false;
   bool last_error_finite = true;
   for (;;) {
-    if (stats.steps + stats.rejected_steps >= options.max_steps)
-      return budget_exhausted(method, options.max_steps, t, stats);
-    if (!(h >= 16.0 * eps * std::max(std::abs(t), std::numeric_limits<double>::min()))) {
-      IntegrationResult failure;
-      failure.status = last_error_finite ? Status::step_size_underflow : Status::non_finite;
-      failure.t_reached = t;
-      failure.stats = stats;
-      failure.message =
-          last_error_finite
-              ? fmt::format("{}: step size underflow at t = {} (h = {}): the solution may be "
-                            "singular there, or the tolerances too tight",
-                            method, t, h)
-              : fmt::format("{}: non-finite states at t = {} for every step size down to h = {}",
-                            method, t, h);
-      return failure;
-    }
+    if (run.stats.steps + run.stats.rejected_steps >= options.max_steps)
+      return budget_exhausted(method, options.max_steps, t, run.stats);
+    if (!(h >= 16.0 * eps * std::max(std::abs(t), std::numeric_limits<double>::min())))
+      return step_size_failure(method, last_error_finite, t, h, run.stats);
     // Reaching t_end within 1% of a step is done in that step; stretching the last step a little
     // is cheaper than a sliver of a step after it.
     const bool last = t + 1.01 * h >= t_end;
     if (last) h = t_end - t;
 
     double t_fail = t;
-    status = stepper.step(system, t, y.data(), h, y1.data(), stats, t_fail,
-                          error_uses_last_stage<Tableau>);
-    if (status != Status::ok) return rhs_failure(method, status, t_fail, t, stats);
+    Status status = run.stepper.step(system, t, run.y.data(), h, run.y1.data(), run.stats, t_fail,
+                                     error_uses_last_stage<Tableau>);
+    if (status != Status::ok) return rhs_failure(method, status, t_fail, t, run.stats);
 
-    const double err = step_error(stepper, system.error_size(), y.data(), y1.data(), h, options);
-    last_error_finite = std::isfinite(err) && all_finite(y1.data(), n);
+    const double err = step_error(run.stepper, system.error_size(), run.y.data(), run.y1.data(), h, options);
+    last_error_finite = std::isfinite(err) && all_finite(run.y1.data(), run.n);
 
     if (!last_error_finite) {
       // An overflow in a too-long step: retreat as far as the controller ever does.
-      ++stats.rejected_steps;
+      ++run.stats.rejected_steps;
       last_rejected = true;
       h *= fac_min;
       continue;
     }
     const double fac11 = std::pow(err, expo1);
     if (err > 1.0) {
-      ++stats.rejected_steps;
+      ++run.stats.rejected_steps;
       last_rejected = true;
       h /= std::min(1.0 / fac_min, fac11 / safety);
       continue;
@@ -459,78 +554,29 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
     // Right after a rejection, growing the step again invites another one.
     if (last_rejected) h_new = std::min(h_new, h);
     last_rejected = false;
-    ++stats.steps;
+    ++run.stats.steps;
 
     const double t_new = last ? t_end : t + h;
     bool last_stage_ready = error_uses_last_stage<Tableau>;
     // Events: a change of sign of some g between the step's ends is located on the step's
     // continuous extension (events.hpp), before after_step moves the end state.
     bool crossed = false;
-    if (tracker) {
-      status = tracker->check(t_new, y1.data(), crossed);
-      if (status != Status::ok) return rhs_failure(method, status, t_new, t, stats);
+    if (run.tracker) {
+      status = run.tracker->check(t_new, run.y1.data(), crossed);
+      if (status != Status::ok) return rhs_failure(method, status, t_new, t, run.stats);
     }
-    // Outputs inside the step follow the step's own solution; after_step acts at the step end,
-    // so an output there sees the state it leaves.
-    if (crossed || (next < output_times.size() && output_times[next] < t_new)) {
-      if (!last_stage_ready) {
-        ++stats.rhs_evaluations;
-        status = system.rhs(t_new, y1.data(), stepper.k(last_stage));
-        if (status != Status::ok) return rhs_failure(method, status, t_new, t, stats);
-        last_stage_ready = true;
-      }
-      status = extension.prepare(system, stepper, t, y.data(), y1.data(), h, stats, t_fail);
-      if (status != Status::ok) return rhs_failure(method, status, t_fail, t, stats);
-      if (crossed) {
-        status = tracker->locate(
-            t, h, [&](double theta, double* out) { extension.evaluate(theta, out); }, crossings);
-        if (status != Status::ok) return rhs_failure(method, status, t_new, t, stats);
-        for (const EventTracker::Crossing& crossing : crossings) {
-          for (; next < output_times.size() && output_times[next] < crossing.t; ++next) {
-            const double t_out = output_times[next];
-            extension.evaluate((t_out - t) / h, y_out.data());
-            if (output(t_out, y_out.data()) == Status::stopped) return stopped_at(t_out, stats);
-          }
-          if (crossing.theta >= 1.0) std::copy(y1.begin(), y1.end(), y_out.begin());
-          else extension.evaluate(crossing.theta, y_out.data());
-          const Status event_status = events->on_event(crossing.index, crossing.t, y_out.data());
-          if (event_status == Status::stopped) return stopped_at(crossing.t, stats);
-          if (event_status != Status::ok) return step_end_failure(method, event_status, crossing.t, stats);
-        }
-      }
-      for (; next < output_times.size() && output_times[next] < t_new; ++next) {
-        const double t_out = output_times[next];
-        extension.evaluate((t_out - t) / h, y_out.data());
-        if (output(t_out, y_out.data()) == Status::stopped) return stopped_at(t_out, stats);
-      }
-    }
-    if (tracker) tracker->advance();
-    const StepEnd end = system.after_step(t_new, y1.data());
-    if (end.status != Status::ok) return step_end_failure(method, end.status, t_new, stats);
-    if (tracker && end.changed) {
-      status = tracker->restart(t_new, y1.data());
-      if (status != Status::ok) return rhs_failure(method, status, t_new, t_new, stats);
-    }
-    // The FSAL stage belongs to the state before a change; evaluated here, it is that of the
-    // state the next step starts from.
-    if (end.changed || !last_stage_ready) {
-      ++stats.rhs_evaluations;
-      status = system.rhs(t_new, y1.data(), stepper.k(last_stage));
-      if (status != Status::ok) return rhs_failure(method, status, t_new, t_new, stats);
-    }
-    if (next < output_times.size() && output_times[next] == t_new) {
-      if (output(t_new, y1.data()) == Status::stopped) return stopped_at(t_new, stats);
-      ++next;
-    }
+    if (crossed || (run.next < output_times.size() && output_times[run.next] < t_new))
+      if (auto stop = inside_step(run, t, h, t_new, crossed, last_stage_ready)) return *std::move(stop);
+    if (auto stop = end_step(run, t_new, last_stage_ready)) return *std::move(stop);
 
-    std::swap(y, y1);
-    stepper.reuse_last_stage();
+    std::swap(run.y, run.y1);
+    run.stepper.reuse_last_stage();
     t = t_new;
     if (last) break;
     h = std::min(h_new, hmax);
   }
   result.t_reached = t;
-  result.stats = stats;
+  result.stats = run.stats;
   return result;
 }
 

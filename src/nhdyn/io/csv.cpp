@@ -1,5 +1,6 @@
 #include "nhdyn/io/csv.hpp"
 
+#include <fmt/compile.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -44,7 +45,7 @@ void CsvWriter::write_row(std::span<const double> values) {
   // per character, twice the formatting itself on an 89-column row.
   char cell[40];  // the shortest round-trip form of a double takes at most 24 characters
   for (std::size_t i = 0; i < values.size(); ++i) {
-    char* end = fmt::format_to(cell, "{}", values[i]);
+    char* end = fmt::format_to(cell, FMT_COMPILE("{}"), values[i]);
     if (i) buffer_ += ',';
     buffer_.append(cell, end);
   }

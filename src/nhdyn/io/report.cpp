@@ -248,6 +248,7 @@ class Field {
 };
 
 using Point = std::array<double, 3>;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // The distance along the unit direction d from `from` to the first zero of f, whose sign at
 // `from` is the opposite of its sign far enough along d: found by doubling from `start`, then
@@ -269,12 +270,18 @@ double ray_zero(Field& f, const Point& from, const Point& d, double start) {
   return 0.5 * (lo + hi);
 }
 
-// Rows x columns of vertices, row-major: two triangles per cell.
-void grid_triangles(int rows, int columns, std::vector<int>& out) {
+// Rows x columns of vertices, row-major: two triangles per cell, leaving out a cell with a vertex
+// that is not finite (a terrain undefined there: it is not drawn, rather than drawn at 0; the
+// page writes such a vertex as null and draws no grid line to it).
+void grid_triangles(int rows, int columns, const std::vector<double>& vertices, std::vector<int>& out) {
+  const auto finite = [&](int v) {
+    const std::size_t k = 3 * static_cast<std::size_t>(v);
+    return std::isfinite(vertices[k]) && std::isfinite(vertices[k + 1]) && std::isfinite(vertices[k + 2]);
+  };
   for (int i = 0; i + 1 < rows; ++i)
     for (int j = 0; j + 1 < columns; ++j) {
       const int a = i * columns + j, b = a + 1, c = a + columns, d = c + 1;
-      out.insert(out.end(), {a, c, b, b, c, d});
+      if (finite(a) && finite(b) && finite(c) && finite(d)) out.insert(out.end(), {a, c, b, b, c, d});
     }
 }
 
@@ -284,13 +291,59 @@ void grid_triangles(int rows, int columns, std::vector<int>& out) {
                                shape.kind == symbolic::VisualKind::solid ? "shape" : "ground", why));
 }
 
-// A solid's zero set along rays from its centre: rings of constant polar angle about the frame's z.
+// A point inside a solid (f < 0) from which every point of its surface is seen: its centre when
+// that is inside, else the end of a descent of f from the centre (steepest descent, the gradient
+// by central differences, a backtracking line search), towards the minimum of f. A strictly convex
+// shape is seen whole from any point inside it. Nothing when no point inside is found.
+std::optional<Point> inside_point(Field& f) {
+  Point p = {0.0, 0.0, 0.0};
+  double fp = f(0.0, 0.0, 0.0);
+  if (fp < 0.0) return p;
+  if (!std::isfinite(fp)) return std::nullopt;
+  double t = 0.0;  // the last accepted step along -grad f; 0: none yet
+  for (int iteration = 0; iteration < 200; ++iteration) {
+    const double h = 1e-7 * std::max(1.0, std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}));
+    Point g;
+    for (std::size_t k = 0; k < 3; ++k) {
+      Point a = p, b = p;
+      a[k] += h;
+      b[k] -= h;
+      g[k] = (f(a[0], a[1], a[2]) - f(b[0], b[1], b[2])) / (2 * h);
+    }
+    const double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+    if (!(g2 > 0.0) || !std::isfinite(g2)) break;
+    // The first step goes twice as far as the linearization's zero of f; later ones start from
+    // twice the last accepted step.
+    double step = t > 0.0 ? 2.0 * t : 2.0 * std::abs(fp) / g2;
+    bool moved = false;
+    for (int halving = 0; halving < 60; ++halving, step *= 0.5) {
+      const Point q = {p[0] - step * g[0], p[1] - step * g[1], p[2] - step * g[2]};
+      const double fq = f(q[0], q[1], q[2]);
+      if (std::isfinite(fq) && fq < fp) {
+        p = q;
+        fp = fq;
+        t = step;
+        moved = true;
+        break;
+      }
+    }
+    if (!moved) break;
+  }
+  if (fp < 0.0) return p;
+  return std::nullopt;
+}
+
+// A solid's zero set along rays from a point inside it (its centre when that is inside): rings of
+// constant polar angle about the frame's z.
 SceneMesh solid_mesh(Field& f, const symbolic::VisualShape& shape, const std::string& model) {
   constexpr int rings = 25, around = 49;
-  if (!(f(0.0, 0.0, 0.0) < 0.0))
-    mesh_failure(shape, model, fmt::format("its surface function is {} at the shape's centre, where it must be "
-                                           "negative (inside); the report samples the surface along rays from there",
+  const std::optional<Point> inside = inside_point(f);
+  if (!inside)
+    mesh_failure(shape, model, fmt::format("its surface function is {} at the shape's centre and no point where it "
+                                           "is negative (inside) was found by descending it from there; the report "
+                                           "samples the surface along rays from a point inside",
                                            f(0.0, 0.0, 0.0)));
+  const Point& o = *inside;
   // The rays are spread as the points of the unit sphere stretched by the shape's reach along
   // each axis: on an ellipsoid they fall where its own parameter lines do, so that a long thin
   // shape (a rattleback) is sampled along its length as finely as across it.
@@ -300,12 +353,12 @@ SceneMesh solid_mesh(Field& f, const symbolic::VisualShape& shape, const std::st
       Point axis = {0.0, 0.0, 0.0};
       axis[k] = sign;
       // (std::max would swallow a NaN: a ray that meets no zero is tested first.)
-      const double r = ray_zero(f, {0.0, 0.0, 0.0}, axis, 1e-3);
+      const double r = ray_zero(f, o, axis, 1e-3);
       reach[k] = std::isfinite(r) ? std::max(reach[k], r) : std::numeric_limits<double>::quiet_NaN();
     }
   if (!(reach[0] > 0.0 && reach[1] > 0.0 && reach[2] > 0.0 && std::isfinite(reach[0]) && std::isfinite(reach[1]) &&
         std::isfinite(reach[2])))
-    mesh_failure(shape, model, "a ray from its centre along an axis meets no point where the surface function is zero; is the shape closed?");
+    mesh_failure(shape, model, "a ray along an axis from a point inside it meets no point where the surface function is zero; is the shape closed?");
   SceneMesh mesh;
   for (int i = 0; i < rings; ++i) {
     const double polar = std::numbers::pi * i / (rings - 1);
@@ -315,12 +368,12 @@ SceneMesh solid_mesh(Field& f, const symbolic::VisualShape& shape, const std::st
                  reach[2] * std::cos(polar)};
       const double length = std::hypot(d[0], d[1], d[2]);
       for (double& x : d) x /= length;
-      const double s = ray_zero(f, {0.0, 0.0, 0.0}, d, 1e-3);
-      if (!std::isfinite(s)) mesh_failure(shape, model, "a ray from its centre meets no point where the surface function is zero; is the shape closed?");
-      mesh.vertices.insert(mesh.vertices.end(), {s * d[0], s * d[1], s * d[2]});
+      const double s = ray_zero(f, o, d, 1e-3);
+      if (!std::isfinite(s)) mesh_failure(shape, model, "a ray from a point inside it meets no point where the surface function is zero; is the shape closed?");
+      mesh.vertices.insert(mesh.vertices.end(), {o[0] + s * d[0], o[1] + s * d[1], o[2] + s * d[2]});
     }
   }
-  grid_triangles(rings, around, mesh.triangles);
+  grid_triangles(rings, around, mesh.vertices, mesh.triangles);
   mesh.rows = rings;
   return mesh;
 }
@@ -361,7 +414,7 @@ SceneMesh terrain_mesh(Field& h, const std::vector<Point>& path, double length) 
       const double x = lo[0] - margin + width[0] * i / (nx - 1), y = lo[1] - margin + width[1] * j / (ny - 1);
       mesh.vertices.insert(mesh.vertices.end(), {x, y, h(x, y)});
     }
-  grid_triangles(nx, ny, mesh.triangles);
+  grid_triangles(nx, ny, mesh.vertices, mesh.triangles);
   mesh.rows = nx;
   return mesh;
 }
@@ -415,7 +468,7 @@ SceneMesh surface_mesh(Field& g, const symbolic::VisualShape& shape, const std::
       mesh.vertices.insert(mesh.vertices.end(), {K[0] + s * d[0], K[1] + s * d[1], K[2] + s * d[2]});
     }
   }
-  grid_triangles(rings, around, mesh.triangles);
+  grid_triangles(rings, around, mesh.vertices, mesh.triangles);
   mesh.rows = rings;
   return mesh;
 }
@@ -430,16 +483,35 @@ std::vector<SceneMesh> calc_scene_meshes(const symbolic::VisualScene& scene, con
   std::vector<double> size(static_cast<std::size_t>(sizes.outputs()));
   sizes.run(0.0, nullptr, nullptr, registers.data(), size.data());
   std::vector<SceneMesh> out(scene.shapes.size());
+  // The solids first: a ground's margin is its contact's size, which an implicit shape gives only
+  // through its mesh (its half extent) rather than a size of the model.
   for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
     const symbolic::VisualShape& shape = scene.shapes[s];
-    if (shape.kind != symbolic::VisualKind::solid && shape.kind != symbolic::VisualKind::terrain &&
-        shape.kind != symbolic::VisualKind::surface)
-      continue;
+    if (shape.kind != symbolic::VisualKind::solid) continue;
+    Field field(shape.field, parameter_values);
+    out[s] = solid_mesh(field, shape, model);
+  }
+  const auto length_of = [&](const symbolic::VisualShape& ground, double written) {
+    for (std::size_t s = 0; s < scene.shapes.size(); ++s)
+      if (scene.shapes[s].kind == symbolic::VisualKind::solid && scene.shapes[s].name == ground.name) {
+        const std::vector<double>& v = out[s].vertices;
+        double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+        for (std::size_t k = 0; k < v.size(); ++k) {
+          lo[k % 3] = std::min(lo[k % 3], v[k]);
+          hi[k % 3] = std::max(hi[k % 3], v[k]);
+        }
+        return 0.5 * std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+      }
+    return written;
+  };
+  for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
+    const symbolic::VisualShape& shape = scene.shapes[s];
+    if (shape.kind != symbolic::VisualKind::terrain && shape.kind != symbolic::VisualKind::surface) continue;
     Field field(shape.field, parameter_values);
     const double* x = size.data() + shape.size_offset;
-    if (shape.kind == symbolic::VisualKind::solid) out[s] = solid_mesh(field, shape, model);
-    else if (shape.kind == symbolic::VisualKind::terrain) out[s] = terrain_mesh(field, shape_path(shape, values, stride), x[0]);
-    else out[s] = surface_mesh(field, shape, model, shape_path(shape, values, stride), x[0], {x[1], x[2], x[3]});
+    const double length = length_of(shape, x[0]);
+    if (shape.kind == symbolic::VisualKind::terrain) out[s] = terrain_mesh(field, shape_path(shape, values, stride), length);
+    else out[s] = surface_mesh(field, shape, model, shape_path(shape, values, stride), length, {x[1], x[2], x[3]});
   }
   return out;
 }
@@ -533,7 +605,7 @@ std::vector<PlotGroup> report_plot_groups(const ReportInput& input, const FrameC
     if (!g->columns.empty()) groups.push_back(*g);
   if (!input.columns.reactions.empty()) groups.push_back({"reactions R", false, false, input.columns.reactions, 1});
   if (!input.columns.actuators.empty())
-    groups.push_back({"actuator forces u ([[programs]])", false, false, input.columns.actuators, 2});
+    groups.push_back({input.actuators_title, false, false, input.columns.actuators, 2});
   // The largest |value| of each role over the rows shown, for the round-off rule.
   double role_scale[3] = {0.0, 0.0, 0.0};
   for (const PlotGroup& g : groups)
@@ -846,6 +918,11 @@ std::string write_model_report(const Model& model, const symbolic::ModelDescript
   input.model = model.name;
   input.coordinates = model.coordinates;
   input.columns = make_result_columns(model);
+  if (!options.controls.empty()) {
+    input.columns.all.insert(input.columns.all.end(), options.controls.begin(), options.controls.end());
+    input.columns.actuators.insert(input.columns.actuators.end(), options.controls.begin(), options.controls.end());
+    input.actuators_title = "controls u (the optimum's)";
+  }
   check_report_columns(table.header, input.columns, "the results", model.name);
   input.table = table;
   if (description != nullptr) {

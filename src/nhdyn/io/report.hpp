@@ -46,6 +46,9 @@ struct ReportInput {
   // programs read them. Their names are checked against the scene's.
   std::vector<Parameter> parameters;
   std::optional<std::pair<std::string, std::string>> path;
+  // The title of the panel of columns.actuators: program motion's actuator forces by default, an
+  // optimum's controls (ReportOptions::controls) otherwise.
+  std::string actuators_title = "actuator forces u ([[programs]])";
 };
 
 struct ReportOptions {
@@ -56,6 +59,9 @@ struct ReportOptions {
   // Equations longer than this (bytes of LaTeX) are left out with a note: KaTeX would take
   // seconds to lay out a bicycle's pages of terms, and `nhdyn equations` prints them anyway.
   std::size_t max_equations = 200000;
+  // Columns after the model's own (make_result_columns), each plotted in one panel: the controls
+  // u_NAME of `nhdyn optimize`, applied forces as program motion's actuators are.
+  std::vector<std::string> controls;
 };
 
 // Throws InputError when `header` is not the column layout `expected` (make_result_columns of the

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "nhdyn/model/program_printer.hpp"
+
 namespace nhdyn::jit {
 namespace {
 
@@ -17,148 +19,33 @@ std::string literal(double x) {
   return x < 0 || std::signbit(x) ? fmt::format("({:a})", x) : fmt::format("{:a}", x);
 }
 
-class Printer {
- public:
-  Printer(const Program& p) : program_(p) {
-    const std::size_t registers = static_cast<std::size_t>(p.registers());
-    stage_.assign(registers, 0);
-    constant_.assign(registers, 0);
-    slot_.assign(registers, -1);
-    const std::vector<Instruction>& code = p.code();
-    const std::size_t inputs = static_cast<std::size_t>(p.inputs());
-    std::vector<char> read_by_call(registers, 0);
-    for (std::size_t i = 0; i < code.size(); ++i) {
-      const Instruction& in = code[i];
-      const std::size_t r = inputs + i;
-      if (in.op == Op::nop) {
-        stage_[r] = stage_[r - 1];
-        continue;
-      }
-      if (in.op == Op::constant) {
-        constant_[r] = 1;
-        continue;
-      }
-      if (in.op == Op::parameter) {
-        stage_[r] = 1;
-        continue;
-      }
-      // Computed once when every operand is a constant or a stage register.
-      const int operands[3] = {in.a, in.b, in.c};
-      const int count = operand_count(in.op);
-      bool only = count > 0;
-      for (int k = 0; k < count; ++k) {
-        const std::size_t o = static_cast<std::size_t>(operands[k]);
-        only = only && (stage_[o] || constant_[o]);
-      }
-      stage_[r] = only;
-    }
-    for (std::size_t i = 0; i < code.size(); ++i) {
-      const Instruction& in = code[i];
-      const std::size_t r = inputs + i;
-      if (in.op == Op::nop || stage_[r]) continue;
-      const int operands[3] = {in.a, in.b, in.c};
-      for (int k = 0; k < operand_count(in.op); ++k) read_by_call[static_cast<std::size_t>(operands[k])] = 1;
-    }
-    for (const Output& o : p.output_list())
-      if (o.reg >= 0) read_by_call[static_cast<std::size_t>(o.reg)] = 1;
-    for (std::size_t r = 0; r < registers; ++r)
-      if (stage_[r] && read_by_call[r]) slot_[r] = stage_size_++;
-  }
+// The compiled evaluator's spelling of a program (program_printer.hpp): exact hexadecimal literals,
+// the parameters from p, the stage's results from m.
+ProgramPrintStyle jit_style() {
+  ProgramPrintStyle style;
+  style.literal = literal;
+  style.parameter = [](int i) { return fmt::format("p[{}]", i); };
+  style.stored = [](int, int place) { return fmt::format("m[{}]", place); };
+  style.declare_constants = false;
+  return style;
+}
 
-  int stage_size() const { return stage_size_; }
+// The stage: every stage instruction, then the registers a call reads stored in m.
+std::string stage_body(const ProgramPrinter& printer) { return printer.statements(true, "  "); }
 
-  // The stage: every stage instruction, then the registers a call reads stored in m.
-  std::string stage_body() const {
-    std::string out;
-    for_each(true, out);
-    for (std::size_t r = 0; r < slot_.size(); ++r)
-      if (slot_[r] >= 0) out += fmt::format("  m[{}] = r{};\n", slot_[r], r);
-    return out;
-  }
-
-  // The call: every other instruction, then the outputs through `destination(j)`.
-  template <class Destination>
-  std::string call_body(Destination destination) const {
-    std::string out;
-    for_each(false, out);
-    const std::vector<Output>& outputs = program_.output_list();
-    for (std::size_t j = 0; j < outputs.size(); ++j) {
-      const Output& o = outputs[j];
-      out += fmt::format("  {} = {};\n", destination(static_cast<int>(j)),
-                         o.reg < 0 ? literal(o.value) : reg(o.reg, false));
-    }
-    return out;
-  }
-
- private:
-  void for_each(bool stage, std::string& out) const {
-    const std::vector<Instruction>& code = program_.code();
-    const std::size_t inputs = static_cast<std::size_t>(program_.inputs());
-    for (std::size_t i = 0; i < code.size(); ++i) {
-      const Instruction& in = code[i];
-      const std::size_t r = inputs + i;
-      if (in.op == Op::nop || in.op == Op::constant || static_cast<bool>(stage_[r]) != stage) continue;
-      if (in.op == Op::sincos) {
-        const std::string a = reg(in.a, stage);
-        out += fmt::format("  const double r{} = std::sin({});\n  const double r{} = std::cos({});\n", r, a, r + 1, a);
-        continue;
-      }
-      out += fmt::format("  const double r{} = {};\n", r, expression(in, stage));
-    }
-  }
-
-  // A register as C++: inputs by name, constants as literals, stage registers in a call from m.
-  std::string reg(int r, bool in_stage) const {
-    const int n = program_.coordinates();
-    const std::size_t at = static_cast<std::size_t>(r);
-    if (r == Program::time_register()) return "t";
-    if (r <= n) return fmt::format("q[{}]", r - 1);
-    if (r <= 2 * n) return fmt::format("v[{}]", r - 1 - n);
-    if (constant_[at]) return literal(program_.code()[at - static_cast<std::size_t>(program_.inputs())].k);
-    if (!in_stage && stage_[at]) return fmt::format("m[{}]", slot_[at]);
-    return "r" + std::to_string(r);
-  }
-
-  std::string expression(const Instruction& in, bool in_stage) const {
-    const int count = operand_count(in.op);
-    const std::string a = count >= 1 ? reg(in.a, in_stage) : "", b = count >= 2 ? reg(in.b, in_stage) : "",
-                      c = count >= 3 ? reg(in.c, in_stage) : "";
-    const std::string k = literal(in.k);
-    switch (in.op) {
-      case Op::parameter: return fmt::format("p[{}]", in.a);
-      case Op::add: return a + " + " + b;
-      case Op::sub: return a + " - " + b;
-      case Op::mul: return a + " * " + b;
-      case Op::div: return a + " / " + b;
-      case Op::neg: return "-" + a;
-      case Op::add_k: return a + " + " + k;
-      case Op::mul_k: return k + " * " + a;
-      case Op::mulk: return k + " * (" + a + " * " + b + ")";
-      case Op::div_k: return k + " / " + a;
-      case Op::muladd: return a + " * " + b + " + " + c;
-      case Op::mulsub: return c + " - " + a + " * " + b;
-      case Op::mulk_add: return k + " * " + a + " + " + b;
-      case Op::mulk_muladd: return k + " * (" + a + " * " + b + ") + " + c;
-      case Op::square: return a + " * " + a;
-      case Op::cube: return a + " * " + a + " * " + a;
-      case Op::powi: return fmt::format("powi({}, {})", a, static_cast<int>(in.k));
-      case Op::pow: return "std::pow(" + a + ", " + b + ")";
-      case Op::pow_k: return "std::pow(" + a + ", " + k + ")";
-      case Op::atan2: return "std::atan2(" + a + ", " + b + ")";
-      default: return std::string("std::") + op_name(in.op) + "(" + a + ")";
-    }
-  }
-
-  const Program& program_;
-  std::vector<char> stage_, constant_;
-  std::vector<int> slot_;  // register -> its place in the stage array, -1 if none
-  int stage_size_ = 0;
-};
+// The call: every other instruction, then the outputs through `destination(j)`.
+template <class Destination>
+std::string call_body(const ProgramPrinter& printer, Destination destination) {
+  std::string out = printer.statements(false, "  ");
+  for (int j = 0; j < printer.program().outputs(); ++j)
+    out += fmt::format("  {} = {};\n", destination(j), printer.output(j));
+  return out;
+}
 
 }  // namespace
 
 std::string make_terms_source(const Program& terms, int n, int s, const TermsSparsity* sparsity) {
-  const Printer printer(terms);
+  const ProgramPrinter printer(terms, jit_style());
   const int a_size = sparsity ? sparsity->A.nonzeros() : n * n;
   const int b_size = sparsity ? sparsity->b.nonzeros() : s * n;
   // Output j -> where it goes: A, Q, G, b, b0 one after the other; with `dense`, a sparse
@@ -192,30 +79,30 @@ std::string make_terms_source(const Program& terms, int n, int s, const TermsSpa
   out += "    base *= base;\n  }\n  return n < 0 ? 1.0 / result : result;\n}\n}  // namespace\n\n";
   out += "extern \"C\" {\n";
   out += fmt::format("int nhdyn_jit_version(void) {{ return {}; }}\n", kInterfaceVersion);
-  out += fmt::format("std::size_t nhdyn_jit_stage_size(void) {{ return {}; }}\n\n", printer.stage_size());
+  out += fmt::format("std::size_t nhdyn_jit_stage_size(void) {{ return {}; }}\n\n", printer.stored_count());
   out += "void nhdyn_jit_stage([[maybe_unused]] const double* p, [[maybe_unused]] double* m) {\n";
-  out += printer.stage_body() + "}\n\n";
+  out += stage_body(printer) + "}\n\n";
   const char* signature =
       "([[maybe_unused]] const double* m, [[maybe_unused]] double t, [[maybe_unused]] const double* q, "
       "[[maybe_unused]] const double* v, double* A, double* Q, double* G, double* b, double* b0) {\n"
       "  (void)A; (void)Q; (void)G; (void)b; (void)b0;\n";
-  out += std::string("void nhdyn_jit_terms") + signature + printer.call_body(destination(false)) + "}\n";
+  out += std::string("void nhdyn_jit_terms") + signature + call_body(printer, destination(false)) + "}\n";
   if (sparsity)
-    out += std::string("\nvoid nhdyn_jit_terms_dense") + signature + printer.call_body(destination(true)) + "}\n";
+    out += std::string("\nvoid nhdyn_jit_terms_dense") + signature + call_body(printer, destination(true)) + "}\n";
   out += "}  // extern \"C\"\n";
   return out;
 }
 
 std::string make_program_source(const std::string& name, const Program& program) {
-  const Printer printer(program);
+  const ProgramPrinter printer(program, jit_style());
   std::string out = fmt::format("\n// The program '{}'.\nextern \"C\" {{\n", name);
-  out += fmt::format("std::size_t nhdyn_jit_{}_stage_size(void) {{ return {}; }}\n", name, printer.stage_size());
+  out += fmt::format("std::size_t nhdyn_jit_{}_stage_size(void) {{ return {}; }}\n", name, printer.stored_count());
   out += fmt::format("void nhdyn_jit_{}_stage([[maybe_unused]] const double* p, [[maybe_unused]] double* m) {{\n", name);
-  out += printer.stage_body() + "}\n";
+  out += stage_body(printer) + "}\n";
   out += fmt::format("void nhdyn_jit_{}([[maybe_unused]] const double* m, [[maybe_unused]] double t, "
                      "[[maybe_unused]] const double* q, [[maybe_unused]] const double* v, double* out) {{\n  (void)out;\n",
                      name);
-  out += printer.call_body([](int j) { return fmt::format("out[{}]", j); }) + "}\n";
+  out += call_body(printer, [](int j) { return fmt::format("out[{}]", j); }) + "}\n";
   out += "}  // extern \"C\"\n";
   return out;
 }

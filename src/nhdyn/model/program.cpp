@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <set>
@@ -187,71 +188,17 @@ NHDYN_ALWAYS_INLINE void run_steps(const Step* s, double* const* arrays) {
 
 }  // namespace
 
-int operand_count(Op op) {
-  switch (op) {
-    case Op::constant:
-    case Op::parameter:
-    case Op::nop:
-      return 0;
-    case Op::add:
-    case Op::sub:
-    case Op::mul:
-    case Op::div:
-    case Op::mulk:
-    case Op::mulk_add:
-    case Op::pow:
-    case Op::atan2:
-      return 2;
-    case Op::muladd:
-    case Op::mulsub:
-    case Op::mulk_muladd:
-      return 3;
-    default:
-      return 1;
-  }
+// Every row of kOps at its Op's index, every Op in it.
+constexpr bool ops_in_order() {
+  for (std::size_t i = 0; i < std::size(kOps); ++i)
+    if (static_cast<std::size_t>(kOps[i].op) != i) return false;
+  return std::size(kOps) == static_cast<std::size_t>(Op::nop) + 1;
 }
+static_assert(ops_in_order(), "kOps lists every Op once, in the order of the enum");
 
-const char* op_name(Op op) {
-  switch (op) {
-    case Op::constant: return "constant";
-    case Op::add: return "add";
-    case Op::sub: return "sub";
-    case Op::mul: return "mul";
-    case Op::div: return "div";
-    case Op::neg: return "neg";
-    case Op::add_k: return "add_k";
-    case Op::mul_k: return "mul_k";
-    case Op::mulk: return "mulk";
-    case Op::div_k: return "div_k";
-    case Op::muladd: return "muladd";
-    case Op::mulsub: return "mulsub";
-    case Op::mulk_add: return "mulk_add";
-    case Op::mulk_muladd: return "mulk_muladd";
-    case Op::square: return "square";
-    case Op::cube: return "cube";
-    case Op::powi: return "powi";
-    case Op::pow: return "pow";
-    case Op::pow_k: return "pow_k";
-    case Op::sqrt: return "sqrt";
-    case Op::sin: return "sin";
-    case Op::cos: return "cos";
-    case Op::sincos: return "sincos";
-    case Op::tan: return "tan";
-    case Op::exp: return "exp";
-    case Op::log: return "log";
-    case Op::abs: return "abs";
-    case Op::asin: return "asin";
-    case Op::acos: return "acos";
-    case Op::atan: return "atan";
-    case Op::atan2: return "atan2";
-    case Op::sinh: return "sinh";
-    case Op::cosh: return "cosh";
-    case Op::tanh: return "tanh";
-    case Op::parameter: return "parameter";
-    case Op::nop: return "nop";
-  }
-  return "?";
-}
+int operand_count(Op op) { return op_info(op).operands; }
+
+const char* op_name(Op op) { return op_info(op).name; }
 
 Program::Program(int coordinates, int parameters) : n_(coordinates), parameters_(parameters), steps_(1) {
   if (coordinates < 0) throw std::invalid_argument("Program: negative number of coordinates");

@@ -67,6 +67,60 @@ enum class Op : std::uint8_t {
   nop,          // the cos slot of a sincos; never pushed on its own
 };
 
+// The table of operations: one row per Op, in its order, read by the interpreter and the tangent
+// (operand_count), describe() (op_name) and the C++ printer of jit and codegen
+// (program_printer.hpp). `cpp` is the operation as a C++ expression: {a}, {b}, {c} its operand
+// registers, {k} its immediate as a double, {n} the immediate as an integer, {p} the parameter it
+// reads. A sincos prints its sine; the cosine is its nop companion's, printed with it.
+struct OpInfo {
+  Op op;
+  const char* name;  // as describe() prints it ("mulk_add", "sin", ...)
+  int operands;      // register operands: 0, 1, 2 or 3
+  const char* cpp;
+};
+
+inline constexpr OpInfo kOps[] = {
+    {Op::constant, "constant", 0, "{k}"},
+    {Op::add, "add", 2, "{a} + {b}"},
+    {Op::sub, "sub", 2, "{a} - {b}"},
+    {Op::mul, "mul", 2, "{a} * {b}"},
+    {Op::div, "div", 2, "{a} / {b}"},
+    {Op::neg, "neg", 1, "-{a}"},
+    {Op::add_k, "add_k", 1, "{a} + {k}"},
+    {Op::mul_k, "mul_k", 1, "{k} * {a}"},
+    {Op::mulk, "mulk", 2, "{k} * ({a} * {b})"},
+    {Op::div_k, "div_k", 1, "{k} / {a}"},
+    {Op::muladd, "muladd", 3, "{a} * {b} + {c}"},
+    {Op::mulsub, "mulsub", 3, "{c} - {a} * {b}"},
+    {Op::mulk_add, "mulk_add", 2, "{k} * {a} + {b}"},
+    {Op::mulk_muladd, "mulk_muladd", 3, "{k} * ({a} * {b}) + {c}"},
+    {Op::square, "square", 1, "{a} * {a}"},
+    {Op::cube, "cube", 1, "{a} * {a} * {a}"},
+    {Op::powi, "powi", 1, "powi({a}, {n})"},
+    {Op::pow, "pow", 2, "std::pow({a}, {b})"},
+    {Op::pow_k, "pow_k", 1, "std::pow({a}, {k})"},
+    {Op::sqrt, "sqrt", 1, "std::sqrt({a})"},
+    {Op::sin, "sin", 1, "std::sin({a})"},
+    {Op::cos, "cos", 1, "std::cos({a})"},
+    {Op::sincos, "sincos", 1, "std::sin({a})"},
+    {Op::tan, "tan", 1, "std::tan({a})"},
+    {Op::exp, "exp", 1, "std::exp({a})"},
+    {Op::log, "log", 1, "std::log({a})"},
+    {Op::abs, "abs", 1, "std::abs({a})"},
+    {Op::asin, "asin", 1, "std::asin({a})"},
+    {Op::acos, "acos", 1, "std::acos({a})"},
+    {Op::atan, "atan", 1, "std::atan({a})"},
+    {Op::atan2, "atan2", 2, "std::atan2({a}, {b})"},
+    {Op::sinh, "sinh", 1, "std::sinh({a})"},
+    {Op::cosh, "cosh", 1, "std::cosh({a})"},
+    {Op::tanh, "tanh", 1, "std::tanh({a})"},
+    {Op::parameter, "parameter", 0, "{p}"},
+    {Op::nop, "nop", 0, ""},
+};
+
+// The row of `op` (each row sits at its Op's index: checked where the table is defined).
+constexpr const OpInfo& op_info(Op op) { return kOps[static_cast<std::size_t>(op)]; }
+
 // Number of register operands of `op` (0, 1, 2 or 3).
 int operand_count(Op op);
 // The instruction's name as printed by describe() ("mulk_add", "sin", ...).

@@ -12,6 +12,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/model/program.hpp"
+#include "nhdyn/model/program_printer.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 
 namespace nhdyn::symbolic {
@@ -110,143 +111,32 @@ std::string comment_text(const std::string& s) {
   return out;
 }
 
-// How one program is printed. Its parameter stage (the instructions that read parameters and
-// constants only) is computed once per parameter change, in the evaluator's constructor, into
-// members named <prefix>rN_; the calls compute the rest. Parameters read as p_.<field>.
-struct CodePrinter {
-  const Program& program;
-  std::string prefix;                          // of the members that hold stage registers
-  const std::vector<std::string>& fields;      // parameter index -> field of the parameter struct
-  std::vector<char> stage;                     // register -> computed in the stage
-  std::vector<char> constant;                  // register -> a constant instruction
-  std::vector<char> read_by_stage, read_by_call;
+// How codegen spells a program (model/program_printer.hpp): its parameter stage is computed once
+// per parameter change, in the evaluator's constructor, into members named <prefix>rN_; the calls
+// compute the rest. Parameters read as p_.<field>; constants are declared where read, with
+// literals that read back to the same value.
+ProgramPrintStyle codegen_style(const std::string& prefix, const std::vector<std::string>& fields) {
+  ProgramPrintStyle style;
+  style.literal = literal;
+  style.parameter = [fields](int i) { return "p_." + fields[static_cast<std::size_t>(i)]; };
+  style.stored = [prefix](int r, int) { return prefix + "r" + std::to_string(r) + "_"; };
+  style.declare_constants = true;
+  return style;
+}
 
-  // hoist = false: no stage, every instruction in the call (a program that runs once anyway).
-  CodePrinter(const Program& p, std::string member_prefix, const std::vector<std::string>& parameter_fields,
-          bool hoist = true)
-      : program(p), prefix(std::move(member_prefix)), fields(parameter_fields) {
-    const std::size_t registers = static_cast<std::size_t>(p.registers());
-    stage.assign(registers, 0);
-    constant.assign(registers, 0);
-    read_by_stage.assign(registers, 0);
-    read_by_call.assign(registers, 0);
-    const std::vector<Instruction>& code = p.code();
-    const auto at = [](int r) { return static_cast<std::size_t>(r); };
-    for (std::size_t i = 0; i < code.size(); ++i) {
-      const Instruction& in = code[i];
-      const std::size_t r = static_cast<std::size_t>(p.inputs()) + i;
-      if (in.op == Op::nop) {
-        stage[r] = stage[r - 1];
-        continue;
-      }
-      if (in.op == Op::constant) {
-        constant[r] = 1;
-        continue;
-      }
-      const int operands[3] = {in.a, in.b, in.c};
-      const int count = operand_count(in.op);
-      bool only = in.op == Op::parameter || count > 0;
-      bool any = in.op == Op::parameter;
-      for (int k = 0; k < count; ++k) {
-        only = only && (stage[at(operands[k])] || constant[at(operands[k])]);
-        any = any || stage[at(operands[k])];
-      }
-      stage[r] = hoist && only && any;
-    }
-    for (std::size_t i = 0; i < code.size(); ++i) {
-      const Instruction& in = code[i];
-      if (in.op == Op::nop) continue;
-      const std::size_t r = static_cast<std::size_t>(p.inputs()) + i;
-      const int operands[3] = {in.a, in.b, in.c};
-      for (int k = 0; k < operand_count(in.op); ++k) (stage[r] ? read_by_stage : read_by_call)[at(operands[k])] = 1;
-    }
-    for (const Output& o : p.output_list())
-      if (o.reg >= 0) read_by_call[at(o.reg)] = 1;
-  }
+// hoist = false: no stage, every instruction in the call (a program that runs once anyway).
+ProgramPrinter make_printer(const Program& program, const std::string& prefix, const std::vector<std::string>& fields,
+                            bool hoist = true) {
+  return ProgramPrinter(program, codegen_style(prefix, fields), hoist);
+}
 
-  bool member(int r) const {
-    return stage[static_cast<std::size_t>(r)] && read_by_call[static_cast<std::size_t>(r)];
-  }
-  std::string member_name(int r) const { return prefix + "r" + std::to_string(r) + "_"; }
-
-  // A register as C++: the inputs by their parameter (t, q[i], v[i]), stage registers in a call by
-  // their member, the others rN.
-  std::string reg(int r, bool in_stage) const {
-    const int n = program.coordinates();
-    if (r == Program::time_register()) return "t";
-    if (r <= n) return fmt::format("q[{}]", r - 1);
-    if (r <= 2 * n) return fmt::format("v[{}]", r - 1 - n);
-    if (!in_stage && stage[static_cast<std::size_t>(r)]) return member_name(r);
-    return "r" + std::to_string(r);
-  }
-
-  // The right-hand side of instruction `in` (not a sincos).
-  std::string expression(const Instruction& in, bool in_stage) const {
-    const int count = operand_count(in.op);
-    const std::string a = count >= 1 ? reg(in.a, in_stage) : "", b = count >= 2 ? reg(in.b, in_stage) : "",
-                      c = count >= 3 ? reg(in.c, in_stage) : "";
-    switch (in.op) {
-      case Op::constant: return literal(in.k);
-      case Op::parameter: return "p_." + fields[static_cast<std::size_t>(in.a)];
-      case Op::add: return a + " + " + b;
-      case Op::sub: return a + " - " + b;
-      case Op::mul: return a + " * " + b;
-      case Op::div: return a + " / " + b;
-      case Op::neg: return "-" + a;
-      case Op::add_k: return a + " + " + literal(in.k);
-      case Op::mul_k: return literal(in.k) + " * " + a;
-      case Op::mulk: return literal(in.k) + " * (" + a + " * " + b + ")";
-      case Op::div_k: return literal(in.k) + " / " + a;
-      case Op::muladd: return a + " * " + b + " + " + c;
-      case Op::mulsub: return c + " - " + a + " * " + b;
-      case Op::mulk_add: return literal(in.k) + " * " + a + " + " + b;
-      case Op::mulk_muladd: return literal(in.k) + " * (" + a + " * " + b + ") + " + c;
-      case Op::square: return a + " * " + a;
-      case Op::cube: return a + " * " + a + " * " + a;
-      case Op::powi: return fmt::format("powi({}, {})", a, static_cast<int>(in.k));
-      case Op::pow: return "std::pow(" + a + ", " + b + ")";
-      case Op::pow_k: return "std::pow(" + a + ", " + literal(in.k) + ")";
-      case Op::atan2: return "std::atan2(" + a + ", " + b + ")";
-      case Op::sincos:
-      case Op::nop: break;
-      default: return std::string("std::") + op_name(in.op) + "(" + a + ")";
-    }
-    return "";
-  }
-
-  // The statements of the stage (in_stage) or of a call, indented by `indent`.
-  std::string statements(bool in_stage, const char* indent) const {
-    std::string out;
-    const std::vector<Instruction>& code = program.code();
-    for (std::size_t i = 0; i < code.size(); ++i) {
-      const Instruction& in = code[i];
-      const int r = program.inputs() + static_cast<int>(i);
-      const std::size_t at = static_cast<std::size_t>(r);
-      if (in.op == Op::nop) continue;
-      const bool wanted = in_stage ? (stage[at] || (constant[at] && read_by_stage[at]))
-                                   : (!stage[at] && (!constant[at] || read_by_call[at]));
-      if (!wanted) continue;
-      if (in.op == Op::sincos) {
-        out += fmt::format("{}const double {} = std::sin({});\n", indent, reg(r, true), reg(in.a, in_stage));
-        out += fmt::format("{}const double {} = std::cos({});\n", indent, reg(r + 1, true), reg(in.a, in_stage));
-      } else {
-        out += fmt::format("{}const double {} = {};\n", indent, reg(r, true), expression(in, in_stage));
-      }
-    }
-    if (in_stage)
-      for (std::size_t r = 0; r < stage.size(); ++r)
-        if (member(static_cast<int>(r)))
-          out += fmt::format("{}{} = r{};\n", indent, member_name(static_cast<int>(r)), r);
-    return out;
-  }
-  // The declarations of the stage's members.
-  std::string members() const {
-    std::string out;
-    for (std::size_t r = 0; r < stage.size(); ++r)
-      if (member(static_cast<int>(r))) out += fmt::format("  double {} = 0.0;\n", member_name(static_cast<int>(r)));
-    return out;
-  }
-};
+// The declarations of a program's stage members.
+std::string members(const ProgramPrinter& printer) {
+  std::string out;
+  for (const std::pair<int, int>& stored : printer.stored_registers())
+    out += fmt::format("  double {} = 0.0;\n", printer.stored(stored.first));
+  return out;
+}
 
 struct Body {
   std::string code;
@@ -254,18 +144,14 @@ struct Body {
 };
 
 // The statements of a program's call, then `sink(i, register)` for each output i.
-Body print_body(const CodePrinter& printer, const std::function<std::string(int, const std::string&)>& sink) {
-  const Program& program = printer.program;
+Body print_body(const ProgramPrinter& printer, const std::function<std::string(int, const std::string&)>& sink) {
+  const Program& program = printer.program();
   Body body;
   body.reads_t = program.reads_time();
   body.reads_q = program.reads_coordinates();
   body.reads_v = program.reads_velocities();
   body.code = printer.statements(false, "    ");
-  const std::vector<Output>& outputs = program.output_list();
-  for (std::size_t i = 0; i < outputs.size(); ++i) {
-    const Output& o = outputs[i];
-    body.code += sink(static_cast<int>(i), o.reg < 0 ? literal(o.value) : printer.reg(o.reg, false));
-  }
+  for (int i = 0; i < program.outputs(); ++i) body.code += sink(i, printer.output(i));
   return body;
 }
 
@@ -340,17 +226,17 @@ struct Generated {
         cls(camel_case(id_) + "Evaluator"),
         parameters_struct(camel_case(id_) + "Parameters"),
         fields(parameter_fields(model_.parameters)),
-        terms_printer(programs_.terms, "terms_", fields),
-        complement_printer(programs_.complement ? std::optional<CodePrinter>(std::in_place, *programs_.complement,
-                                                                             "complement_", fields)
-                                                : std::nullopt),
-        phi_printer(programs_.position_residual, "phi_", fields),
-        f_printer(programs_.velocity_residual, "f_", fields),
+        terms_printer(make_printer(programs_.terms, "terms_", fields)),
+        complement_printer(programs_.complement
+                               ? std::optional<ProgramPrinter>(make_printer(*programs_.complement, "complement_", fields))
+                               : std::nullopt),
+        phi_printer(make_printer(programs_.position_residual, "phi_", fields)),
+        f_printer(make_printer(programs_.velocity_residual, "f_", fields)),
         energy_printer(programs_.energy
-                           ? std::optional<CodePrinter>(std::in_place, *programs_.energy, "energy_", fields)
+                           ? std::optional<ProgramPrinter>(make_printer(*programs_.energy, "energy_", fields))
                            : std::nullopt),
-        initial_printer(programs_.initial_state ? std::optional<CodePrinter>(std::in_place, *programs_.initial_state,
-                                                                             "initial_", fields, false)
+        initial_printer(programs_.initial_state ? std::optional<ProgramPrinter>(make_printer(
+                                                      *programs_.initial_state, "initial_", fields, false))
                                                 : std::nullopt) {}
 
   std::string q_name(int i) const { return comment_text(model.coordinates[static_cast<std::size_t>(i)]); }
@@ -362,12 +248,12 @@ struct Generated {
   const std::string cls;
   const std::string parameters_struct;
   const std::vector<std::string> fields;
-  const CodePrinter terms_printer;
-  const std::optional<CodePrinter> complement_printer;
-  const CodePrinter phi_printer;
-  const CodePrinter f_printer;
-  const std::optional<CodePrinter> energy_printer;
-  const std::optional<CodePrinter> initial_printer;
+  const ProgramPrinter terms_printer;
+  const std::optional<ProgramPrinter> complement_printer;
+  const ProgramPrinter phi_printer;
+  const ProgramPrinter f_printer;
+  const std::optional<ProgramPrinter> energy_printer;
+  const std::optional<ProgramPrinter> initial_printer;
 };
 
 // The file's opening comment (what it was made from, its operation counts) and its includes.
@@ -416,7 +302,7 @@ std::string evaluator_head_code(const Generated& g) {
   {
     std::string stage;
     // One block per program: each numbers its registers from its own inputs.
-    const auto add_stage = [&stage](const CodePrinter& printer) {
+    const auto add_stage = [&stage](const ProgramPrinter& printer) {
       const std::string statements = printer.statements(true, "      ");
       if (!statements.empty()) stage += "    {\n" + statements + "    }\n";
     };
@@ -525,10 +411,10 @@ std::string evaluator_members_code(const Generated& g) {
   std::string out;
   out += "\n private:\n";
   out += fmt::format("  {} p_;\n", g.parameters_struct);
-  out += g.terms_printer.members();
-  if (g.complement_printer) out += g.complement_printer->members();
-  out += g.phi_printer.members() + g.f_printer.members();
-  if (g.energy_printer) out += g.energy_printer->members();
+  out += members(g.terms_printer);
+  if (g.complement_printer) out += members(*g.complement_printer);
+  out += members(g.phi_printer) + members(g.f_printer);
+  if (g.energy_printer) out += members(*g.energy_printer);
   if (uses_powi(programs)) {
     // The interpreter's algorithm (model/program.cpp), so that both round alike.
     out += "  // a^n by repeated squaring, n != 0.\n";

@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <memory>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/symbolic/compile.hpp"
@@ -43,27 +45,19 @@ std::vector<GiNaC::ex> b_row(const Spec& spec, const SpecConstraint& c) {
   return row;
 }
 
-}  // namespace
-
-void compile_contact_forces(const Spec& spec, Model& model) {
-  if (!spec.contact_forces || spec.contact_forces->contacts.empty()) return;
-  const SpecContactForces& in = *spec.contact_forces;
-  const SymbolTable& symbols = spec.symbols;
-  const int n = spec.n();
-  auto out = std::make_shared<ContactForceModel>();
-  ContactForceModel& c = *out;
-  c.n = n;
-  c.systems = static_cast<int>(in.origins.size());
-  c.system_names = in.system_names;
-  c.length = in.length;
-  const GiNaC::ex per_length = GiNaC::numeric(1.0 / in.length);
-
-  // Whether the momentum balance (C3) describes every force on the bodies: not when T or V has
-  // hand-written parts, there are generalized forces or programs (actuator forces), or constraints
-  // that no contact helper wrote (forces at points nhdyn does not know).
+// The constraints that no contact helper wrote (hand-written rows of b, each an unknown of (C1)).
+std::vector<const SpecConstraint*> hand_constraints(const Spec& spec, const SpecContactForces& in) {
   std::vector<const SpecConstraint*> hand;
   for (const SpecConstraint& con : spec.constraints)
     if (std::find(in.generated.begin(), in.generated.end(), con.name) == in.generated.end()) hand.push_back(&con);
+  return hand;
+}
+
+// Whether the momentum balance (C3) describes every force on the bodies: not when T or V has
+// hand-written parts, there are generalized forces or programs (actuator forces), or constraints
+// that no contact helper wrote (forces at points nhdyn does not know). Empty when it does, else why not.
+std::string why_balance_is_incomplete(const Spec& spec, const SpecContactForces& in,
+                                      const std::vector<const SpecConstraint*>& hand) {
   bool forces = false;
   for (const GiNaC::ex& f : spec.forces) forces = forces || !f.is_zero();
   std::string why;
@@ -74,16 +68,14 @@ void compile_contact_forces(const Spec& spec, Model& model) {
     for (const SpecConstraint* con : hand)
       if (why.empty() && std::find(in.internal.begin(), in.internal.end(), con->name) == in.internal.end())
         why = fmt::format("the constraint '{}' is written by hand", con->name);
-  c.balance_rows.assign(static_cast<std::size_t>(c.systems), why.empty() ? 1 : 0);
-  if (!why.empty())
-    c.notes.push_back(fmt::format("the bodies' momentum balance is not used for the contact forces since {}: only "
-                                  "what the reactions R determine is reported",
-                                  why));
-  c.hand_constraints = static_cast<int>(hand.size());
+  return why;
+}
 
-  std::vector<GiNaC::ex> outputs;
+// Per contact and unknown: J^T d (n), E d (6), d (3); fills the contacts' layout in c.
+void append_contact_unknowns(const SpecContactForces& in, const SymbolTable& symbols, const GiNaC::ex& per_length,
+                             ContactForceModel& c, std::vector<GiNaC::ex>& outputs) {
+  const int n = c.n;
   int values = 0;  // result columns so far
-  // Per contact and unknown: J^T d (n), E d (6), d (3).
   for (const ContactPoint& p : in.contacts) {
     ContactForceContact contact;
     contact.name = p.name;
@@ -126,40 +118,71 @@ void compile_contact_forces(const Spec& spec, Model& model) {
     }
     c.contacts.push_back(std::move(contact));
   }
+}
+
+// Per system s: K (6 x n, column-major) and k, the balance K q'' + k of the bodies of s about its origin.
+void append_system_balance(const SpecContactForces& in, const SymbolTable& symbols, const GiNaC::ex& per_length,
+                           int n, int s, std::vector<GiNaC::ex>& outputs) {
+  const Vector3 O = s < static_cast<int>(in.origins.size()) ? in.origins[static_cast<std::size_t>(s)] : Vector3{0, 0, 0};
+  std::vector<GiNaC::ex> K(static_cast<std::size_t>(6 * n), 0);
+  Vector3 force{0, 0, 0}, moment{0, 0, 0};
+  for (const ContactBody& b : in.bodies) {
+    if (b.system != s) continue;
+    const Vector3 arm = subtract(b.centre, O);
+    const Vector3 velocity = time_derivative(b.centre, symbols);
+    for (int j = 0; j < n; ++j) {
+      // m_B dv_B/dq_j' = m_B dr_B/dq_j: the column of q_j'' in m_B a_B.
+      const Vector3 Jv = scale(b.mass, diff(b.centre, symbols.coordinate(j)));
+      const Vector3 Jw = diff(b.omega, symbols.velocity(j));
+      const Vector3 m = add(cross(arm, Jv), times(b.inertia, Jw));
+      for (int r = 0; r < 3; ++r) {
+        K[static_cast<std::size_t>(6 * j + r)] += Jv[static_cast<std::size_t>(r)];
+        K[static_cast<std::size_t>(6 * j + 3 + r)] += per_length * m[static_cast<std::size_t>(r)];
+      }
+    }
+    const Vector3 a0 = subtract(drift(velocity, symbols), in.gravity);  // a_B - g without q''
+    const Vector3 ma = scale(b.mass, a0);
+    force = add(force, ma);
+    const Vector3 Iw = times(b.inertia, b.omega);
+    moment = add(moment, add(add(cross(arm, ma), times(b.inertia, drift(b.omega, symbols))), cross(b.omega, Iw)));
+  }
+  outputs.insert(outputs.end(), K.begin(), K.end());
+  append(outputs, force);
+  append(outputs, scale(per_length, moment));
+}
+
+}  // namespace
+
+void compile_contact_forces(const Spec& spec, Model& model) {
+  if (!spec.contact_forces || spec.contact_forces->contacts.empty()) return;
+  const SpecContactForces& in = *spec.contact_forces;
+  const SymbolTable& symbols = spec.symbols;
+  const int n = spec.n();
+  auto out = std::make_shared<ContactForceModel>();
+  ContactForceModel& c = *out;
+  c.n = n;
+  c.systems = static_cast<int>(in.origins.size());
+  c.system_names = in.system_names;
+  c.length = in.length;
+  const GiNaC::ex per_length = GiNaC::numeric(1.0 / in.length);
+
+  const std::vector<const SpecConstraint*> hand = hand_constraints(spec, in);
+  const std::string why = why_balance_is_incomplete(spec, in, hand);
+  c.balance_rows.assign(static_cast<std::size_t>(c.systems), why.empty() ? 1 : 0);
+  if (!why.empty())
+    c.notes.push_back(fmt::format("the bodies' momentum balance is not used for the contact forces since {}: only "
+                                  "what the reactions R determine is reported",
+                                  why));
+  c.hand_constraints = static_cast<int>(hand.size());
+
+  std::vector<GiNaC::ex> outputs;
+  append_contact_unknowns(in, symbols, per_length, c, outputs);
   if (c.systems == 0) {
     c.systems = 1;  // contacts on bodies fixed to the ground: one empty system keeps the layout
     c.system_names.push_back("ground");
     c.balance_rows.assign(1, 0);
   }
-  // Per system: K (6 x n, column-major) and k, the balance K q'' + k.
-  for (int s = 0; s < c.systems; ++s) {
-    const Vector3 O = s < static_cast<int>(in.origins.size()) ? in.origins[static_cast<std::size_t>(s)] : Vector3{0, 0, 0};
-    std::vector<GiNaC::ex> K(static_cast<std::size_t>(6 * n), 0);
-    Vector3 force{0, 0, 0}, moment{0, 0, 0};
-    for (const ContactBody& b : in.bodies) {
-      if (b.system != s) continue;
-      const Vector3 arm = subtract(b.centre, O);
-      const Vector3 velocity = time_derivative(b.centre, symbols);
-      for (int j = 0; j < n; ++j) {
-        // m_B dv_B/dq_j' = m_B dr_B/dq_j: the column of q_j'' in m_B a_B.
-        const Vector3 Jv = scale(b.mass, diff(b.centre, symbols.coordinate(j)));
-        const Vector3 Jw = diff(b.omega, symbols.velocity(j));
-        const Vector3 m = add(cross(arm, Jv), times(b.inertia, Jw));
-        for (int r = 0; r < 3; ++r) {
-          K[static_cast<std::size_t>(6 * j + r)] += Jv[static_cast<std::size_t>(r)];
-          K[static_cast<std::size_t>(6 * j + 3 + r)] += per_length * m[static_cast<std::size_t>(r)];
-        }
-      }
-      const Vector3 a0 = subtract(drift(velocity, symbols), in.gravity);  // a_B - g without q''
-      const Vector3 ma = scale(b.mass, a0);
-      force = add(force, ma);
-      const Vector3 Iw = times(b.inertia, b.omega);
-      moment = add(moment, add(add(cross(arm, ma), times(b.inertia, drift(b.omega, symbols))), cross(b.omega, Iw)));
-    }
-    outputs.insert(outputs.end(), K.begin(), K.end());
-    append(outputs, force);
-    append(outputs, scale(per_length, moment));
-  }
+  for (int s = 0; s < c.systems; ++s) append_system_balance(in, symbols, per_length, n, s, outputs);
   // Per reported contact: n, e_long, e_lat.
   for (const ContactPoint& p : in.contacts) {
     if (p.kind != ContactKind::wheel && p.kind != ContactKind::knife_edge && p.kind != ContactKind::rolling) continue;

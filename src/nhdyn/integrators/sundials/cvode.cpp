@@ -6,7 +6,10 @@
 #include <exception>
 #include <limits>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -25,9 +28,8 @@ namespace {
 
 static_assert(std::is_same_v<realtype, double>, "nhdyn needs SUNDIALS built in double precision");
 
-// Owners of SUNDIALS objects, so that every return and every exception frees them. Declared in
-// the order they are created; destruction in reverse frees CVODE before the solver, matrix and
-// vectors it uses, and the context last.
+// Owners of SUNDIALS objects, so that every return and every exception frees them (CvodeObjects
+// below holds them in the order of their destruction).
 struct ContextFree {
   void operator()(SUNContext context) const { SUNContext_Free(&context); }
 };
@@ -148,35 +150,87 @@ bool evaluate_around_root(void* mem, EventFunctions& events, double t_new, const
          usable(events.evaluate(t_new, y_root, g_root.data()));
 }
 
-}  // namespace
+// The SUNDIALS objects of one run. Declared in the order they are created; destruction in
+// reverse frees CVODE before the solver, matrix and vectors it uses, and the context last.
+struct CvodeObjects {
+  ContextPtr context;
+  VectorPtr y;      // the state CVODE advances
+  VectorPtr y_dky;  // a state interpolated by CVodeGetDky
+  MatrixPtr jacobian;
+  LinearSolverPtr linear_solver;
+  CvodePtr cvode;
+};
 
-IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& options, double t0,
-                                  const double* y0, std::span<const double> output_times,
-                                  const OutputFn& output, EventFunctions* events) {
-  const std::string_view method = integrator_name(options.kind);
-  const int n = system.size();
-  IntegrationResult result;
-  result.t_reached = t0;
-  if (output_times.empty()) return result;
+// The buffers of CVODE's root finding, sized once per run (empty without events).
+struct RootBuffers {
+  std::vector<int> directions, roots;
+  std::vector<double> g_root, g_start, g_end;  // g at a root and at the ends of its step (is_jump)
+};
 
-  std::size_t next = 0;
-  if (output_times.front() == t0) {
-    if (output(t0, y0) == Status::stopped) {
-      result.status = Status::stopped;
-      return result;
-    }
-    ++next;
+// Creates CVODE for y' = f from (t0, y0) up to t_end with the options, its dense linear solver and,
+// with events, its root finding. Returns the name of the call that failed, or nullptr.
+const char* create_cvode(CvodeObjects& o, RootBuffers& r, CallbackState& state, const IntegratorOptions& options,
+                         int n, double t0, const double* y0, double t_end, EventFunctions* events) {
+  SUNContext raw_context = nullptr;
+  if (SUNContext_Create(nullptr, &raw_context) != 0) return "SUNContext_Create";
+  o.context.reset(raw_context);
+  o.y.reset(N_VNew_Serial(n, o.context.get()));
+  o.y_dky.reset(N_VNew_Serial(n, o.context.get()));
+  if (!o.y || !o.y_dky) return "N_VNew_Serial";
+  std::copy(y0, y0 + n, N_VGetArrayPointer(o.y.get()));
+  o.jacobian.reset(SUNDenseMatrix(n, n, o.context.get()));
+  if (!o.jacobian) return "SUNDenseMatrix";
+  o.linear_solver.reset(SUNLinSol_Dense(o.y.get(), o.jacobian.get(), o.context.get()));
+  if (!o.linear_solver) return "SUNLinSol_Dense";
+  const int lmm = options.kind == IntegratorKind::cvode_adams ? CV_ADAMS : CV_BDF;
+  o.cvode.reset(CVodeCreate(lmm, o.context.get()));
+  if (!o.cvode) return "CVodeCreate";
+  void* mem = o.cvode.get();
+  // The handler first, so that the messages of the calls below are kept rather than printed.
+  if (CVodeSetErrHandlerFn(mem, cvode_error_handler, &state) != CV_SUCCESS) return "CVodeSetErrHandlerFn";
+  if (CVodeInit(mem, cvode_rhs, t0, o.y.get()) != CV_SUCCESS) return "CVodeInit";
+  if (CVodeSetUserData(mem, &state) != CV_SUCCESS) return "CVodeSetUserData";
+  if (CVodeSStolerances(mem, options.rtol, options.atol) != CV_SUCCESS) return "CVodeSStolerances";
+  // No Jacobian function: CVODE's difference quotients, counted in CVodeGetNumLinRhsEvals.
+  if (CVodeSetLinearSolver(mem, o.linear_solver.get(), o.jacobian.get()) != CV_SUCCESS)
+    return "CVodeSetLinearSolver";
+  if (options.max_step > 0.0 && CVodeSetMaxStep(mem, options.max_step) != CV_SUCCESS) return "CVodeSetMaxStep";
+  if (options.step > 0.0 && CVodeSetInitStep(mem, options.step) != CV_SUCCESS) return "CVodeSetInitStep";
+  if (CVodeSetStopTime(mem, t_end) != CV_SUCCESS) return "CVodeSetStopTime";
+  // Events: CVODE's own root finding on its interpolating polynomial (CVodeRootInit), which
+  // returns at each root with the state there (CV_ROOT_RETURN) before the step's end.
+  if (events != nullptr && events->count() > 0) {
+    state.events = events;
+    const int m = events->count();
+    for (int i = 0; i < m; ++i) r.directions.push_back(static_cast<int>(events->direction(i)));
+    r.roots.assign(static_cast<std::size_t>(m), 0);
+    r.g_root.assign(static_cast<std::size_t>(m), 0.0);
+    r.g_start.assign(static_cast<std::size_t>(m), 0.0);
+    r.g_end.assign(static_cast<std::size_t>(m), 0.0);
+    if (CVodeRootInit(mem, m, cvode_roots) != CV_SUCCESS) return "CVodeRootInit";
+    if (CVodeSetRootDirection(mem, r.directions.data()) != CV_SUCCESS) return "CVodeSetRootDirection";
   }
-  if (next == output_times.size()) return result;
-  const double t_end = output_times.back();
+  return nullptr;
+}
 
+// One run of integrate_cvode: its options, its SUNDIALS objects and where it stands.
+struct CvodeRun {
+  std::string_view method;
+  const IntegratorOptions& options;
+  std::span<const double> output_times;
+  const OutputFn& output;
+  EventFunctions* events;
   CallbackState state;
-  state.system = &system;
-  state.cvode_message.reserve(512);
+  CvodeObjects objects;
+  RootBuffers roots;
   Counters totals;  // counters of the CVODE runs before the last re-initialization
+  IntegrationResult result;
+  double t = 0.0;        // where the solution is known
+  std::size_t next = 0;  // the first output time not yet written
 
-  double t = t0;
-  auto finish = [&](Status status, std::string message, void* cvode) {
+  // The run's result: its status, message and counters, reached at t.
+  IntegrationResult finish(Status status, std::string message) {
+    void* cvode = objects.cvode.get();
     const Counters current = cvode ? read_counters(cvode) : Counters{};
     result.status = status;
     result.t_reached = t;
@@ -185,172 +239,157 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
     result.stats.rhs_evaluations = totals.rhs_evaluations + current.rhs_evaluations;
     result.message = std::move(message);
     return result;
-  };
-  auto setup_failure = [&](std::string_view what) {
-    return finish(Status::integrator_failure,
-                  fmt::format("{}: setting up CVODE failed ({}) {}", method, what,
-                              state.cvode_message),
-                  nullptr);
-  };
-
-  SUNContext raw_context = nullptr;
-  if (SUNContext_Create(nullptr, &raw_context) != 0) return setup_failure("SUNContext_Create");
-  const ContextPtr context(raw_context);
-  const VectorPtr y(N_VNew_Serial(n, context.get()));
-  const VectorPtr y_dky(N_VNew_Serial(n, context.get()));
-  if (!y || !y_dky) return setup_failure("N_VNew_Serial");
-  double* y_data = N_VGetArrayPointer(y.get());
-  std::copy(y0, y0 + n, y_data);
-  const MatrixPtr jacobian(SUNDenseMatrix(n, n, context.get()));
-  if (!jacobian) return setup_failure("SUNDenseMatrix");
-  const LinearSolverPtr linear_solver(SUNLinSol_Dense(y.get(), jacobian.get(), context.get()));
-  if (!linear_solver) return setup_failure("SUNLinSol_Dense");
-  const int lmm = options.kind == IntegratorKind::cvode_adams ? CV_ADAMS : CV_BDF;
-  const CvodePtr cvode(CVodeCreate(lmm, context.get()));
-  if (!cvode) return setup_failure("CVodeCreate");
-  void* mem = cvode.get();
-  // The handler first, so that the messages of the calls below are kept rather than printed.
-  if (CVodeSetErrHandlerFn(mem, cvode_error_handler, &state) != CV_SUCCESS)
-    return setup_failure("CVodeSetErrHandlerFn");
-  if (CVodeInit(mem, cvode_rhs, t0, y.get()) != CV_SUCCESS) return setup_failure("CVodeInit");
-  if (CVodeSetUserData(mem, &state) != CV_SUCCESS) return setup_failure("CVodeSetUserData");
-  if (CVodeSStolerances(mem, options.rtol, options.atol) != CV_SUCCESS)
-    return setup_failure("CVodeSStolerances");
-  // No Jacobian function: CVODE's difference quotients, counted in CVodeGetNumLinRhsEvals.
-  if (CVodeSetLinearSolver(mem, linear_solver.get(), jacobian.get()) != CV_SUCCESS)
-    return setup_failure("CVodeSetLinearSolver");
-  if (options.max_step > 0.0 && CVodeSetMaxStep(mem, options.max_step) != CV_SUCCESS)
-    return setup_failure("CVodeSetMaxStep");
-  if (options.step > 0.0 && CVodeSetInitStep(mem, options.step) != CV_SUCCESS)
-    return setup_failure("CVodeSetInitStep");
-  if (CVodeSetStopTime(mem, t_end) != CV_SUCCESS) return setup_failure("CVodeSetStopTime");
-  // Events: CVODE's own root finding on its interpolating polynomial (CVodeRootInit), which
-  // returns at each root with the state there (CV_ROOT_RETURN) before the step's end.
-  std::vector<int> directions, roots;
-  std::vector<double> g_root, g_start, g_end;  // g at a root and at the ends of its step (is_jump)
-  if (events != nullptr && events->count() > 0) {
-    state.events = events;
-    const int m = events->count();
-    for (int i = 0; i < m; ++i) directions.push_back(static_cast<int>(events->direction(i)));
-    roots.assign(static_cast<std::size_t>(m), 0);
-    g_root.assign(static_cast<std::size_t>(m), 0.0);
-    g_start.assign(static_cast<std::size_t>(m), 0.0);
-    g_end.assign(static_cast<std::size_t>(m), 0.0);
-    if (CVodeRootInit(mem, m, cvode_roots) != CV_SUCCESS) return setup_failure("CVodeRootInit");
-    if (CVodeSetRootDirection(mem, directions.data()) != CV_SUCCESS) return setup_failure("CVodeSetRootDirection");
   }
+};
+
+// The outputs before t_limit, from CVODE's interpolating polynomial (valid until a
+// re-initialization). A failed interpolation or a stop ends the run (its result).
+std::optional<IntegrationResult> write_outputs_before(CvodeRun& run, double t_limit) {
+  void* mem = run.objects.cvode.get();
+  for (; run.next < run.output_times.size() && run.output_times[run.next] < t_limit; ++run.next) {
+    const double t_out = run.output_times[run.next];
+    const int dky_flag = CVodeGetDky(mem, t_out, 0, run.objects.y_dky.get());
+    if (dky_flag != CV_SUCCESS)
+      return run.finish(Status::integrator_failure,
+                        fmt::format("{}: interpolation at output time {} failed ({}): {}", run.method, t_out,
+                                    flag_name(dky_flag), run.state.cvode_message));
+    if (run.output(t_out, N_VGetArrayPointer(run.objects.y_dky.get())) == Status::stopped) {
+      run.t = t_out;
+      return run.finish(Status::stopped, {});
+    }
+  }
+  return std::nullopt;
+}
+
+// CVODE returned at a root t_new inside its step, y the state there (the next call returns the
+// step's end, CV_ONE_STEP, where after_step acts): the outputs before it, then each event whose
+// g crossed zero there continuously (not a pole or a wrap-around, is_jump).
+std::optional<IntegrationResult> handle_roots(CvodeRun& run, double t_new) {
+  if (auto stop = write_outputs_before(run, t_new)) return stop;
+  void* mem = run.objects.cvode.get();
+  double* y_data = N_VGetArrayPointer(run.objects.y.get());
+  RootBuffers& r = run.roots;
+  CVodeGetRootInfo(mem, r.roots.data());
+  const bool judged =
+      evaluate_around_root(mem, *run.events, t_new, y_data, run.objects.y_dky.get(), r.g_root, r.g_start, r.g_end);
+  for (std::size_t i = 0; i < r.roots.size(); ++i) {
+    if (r.roots[i] == 0) continue;
+    if (judged && is_jump(r.g_root[i], r.g_start[i], r.g_end[i])) continue;
+    const Status event_status = run.events->on_event(static_cast<int>(i), t_new, y_data);
+    if (event_status == Status::ok) continue;
+    run.t = t_new;
+    if (event_status == Status::stopped) return run.finish(Status::stopped, {});
+    return run.finish(event_status,
+                      fmt::format("{}: at the event at t = {}: {}", run.method, run.t, describe(event_status)));
+  }
+  return std::nullopt;
+}
+
+// After after_step changed the state: CVODE starts again from it (its counters banked first,
+// since re-initialization resets them).
+std::optional<IntegrationResult> restart(CvodeRun& run, double t_end) {
+  void* mem = run.objects.cvode.get();
+  const Counters before = read_counters(mem);
+  run.totals.steps += before.steps;
+  run.totals.rejected_steps += before.rejected_steps;
+  run.totals.rhs_evaluations += before.rhs_evaluations;
+  if (CVodeReInit(mem, run.t, run.objects.y.get()) != CV_SUCCESS || CVodeSetStopTime(mem, t_end) != CV_SUCCESS)
+    return run.finish(Status::integrator_failure,
+                      fmt::format("{}: re-initializing CVODE at t = {} after after_step changed "
+                                  "the state failed: {}",
+                                  run.method, run.t, run.state.cvode_message));
+  return std::nullopt;
+}
+
+}  // namespace
+
+IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& options, double t0,
+                                  const double* y0, std::span<const double> output_times,
+                                  const OutputFn& output, EventFunctions* events) {
+  const std::string_view method = integrator_name(options.kind);
+  const int n = system.size();
+  CvodeRun run{method, options, output_times, output, events, {}, {}, {}, {}, {}, t0, 0};
+  run.result.t_reached = t0;
+  if (output_times.empty()) return run.result;
+
+  if (output_times.front() == t0) {
+    if (output(t0, y0) == Status::stopped) {
+      run.result.status = Status::stopped;
+      return run.result;
+    }
+    ++run.next;
+  }
+  if (run.next == output_times.size()) return run.result;
+  const double t_end = output_times.back();
+
+  run.state.system = &system;
+  run.state.cvode_message.reserve(512);
+  if (const char* what = create_cvode(run.objects, run.roots, run.state, options, n, t0, y0, t_end, events)) {
+    // A failed setup reports no counters: CVODE may be half made.
+    IntegrationResult& result = run.result;
+    result.status = Status::integrator_failure;
+    result.t_reached = run.t;
+    result.message = fmt::format("{}: setting up CVODE failed ({}) {}", method, what, run.state.cvode_message);
+    return result;
+  }
+  void* mem = run.objects.cvode.get();
+  double* y_data = N_VGetArrayPointer(run.objects.y.get());
 
   for (;;) {
     const Counters current = read_counters(mem);
-    if (totals.steps + current.steps + totals.rejected_steps + current.rejected_steps >=
-        options.max_steps)
-      return finish(Status::too_many_steps,
-                    fmt::format("{}: the budget of {} steps (accepted + rejected) was used up at "
-                                "t = {}; raise max_steps or loosen the tolerances",
-                                method, options.max_steps, t),
-                    mem);
+    if (run.totals.steps + current.steps + run.totals.rejected_steps + current.rejected_steps >= options.max_steps)
+      return run.finish(Status::too_many_steps,
+                        fmt::format("{}: the budget of {} steps (accepted + rejected) was used up at "
+                                    "t = {}; raise max_steps or loosen the tolerances",
+                                    method, options.max_steps, run.t));
 
     // In CV_ONE_STEP mode tout only bounds the first step after (re)initialization.
-    double t_new = t;
-    const int flag = CVode(mem, t_end, y.get(), &t_new, CV_ONE_STEP);
-    if (state.exception) std::rethrow_exception(state.exception);
-    if (state.rhs_status != Status::ok)
-      return finish(state.rhs_status,
-                    fmt::format("{}: the right-hand side failed at t = {}: {}", method,
-                                state.t_fail, describe(state.rhs_status)),
-                    mem);
+    double t_new = run.t;
+    const int flag = CVode(mem, t_end, run.objects.y.get(), &t_new, CV_ONE_STEP);
+    if (run.state.exception) std::rethrow_exception(run.state.exception);
+    if (run.state.rhs_status != Status::ok)
+      return run.finish(run.state.rhs_status, fmt::format("{}: the right-hand side failed at t = {}: {}", method,
+                                                          run.state.t_fail, describe(run.state.rhs_status)));
     double h_next = 0.0;
     CVodeGetCurrentStep(mem, &h_next);
     if (flag < 0) {
       const Status status = flag == CV_TOO_MUCH_WORK ? Status::too_many_steps
-                            : below_floor(h_next, t) ? Status::step_size_underflow
-                                                     : Status::integrator_failure;
-      return finish(status,
-                    fmt::format("{}: CVODE failed after t = {} ({}, h = {}): {}", method, t,
-                                flag_name(flag), h_next, state.cvode_message),
-                    mem);
+                            : below_floor(h_next, run.t) ? Status::step_size_underflow
+                                                         : Status::integrator_failure;
+      return run.finish(status, fmt::format("{}: CVODE failed after t = {} ({}, h = {}): {}", method, run.t,
+                                            flag_name(flag), h_next, run.state.cvode_message));
     }
 
     if (flag == CV_ROOT_RETURN) {
-      // t_new is a root inside the step and y the state there; the next call returns the step's
-      // end (CV_ONE_STEP), where after_step acts.
-      for (; next < output_times.size() && output_times[next] < t_new; ++next) {
-        const double t_out = output_times[next];
-        const int dky_flag = CVodeGetDky(mem, t_out, 0, y_dky.get());
-        if (dky_flag != CV_SUCCESS)
-          return finish(Status::integrator_failure,
-                        fmt::format("{}: interpolation at output time {} failed ({}): {}", method,
-                                    t_out, flag_name(dky_flag), state.cvode_message),
-                        mem);
-        if (output(t_out, N_VGetArrayPointer(y_dky.get())) == Status::stopped) {
-          t = t_out;
-          return finish(Status::stopped, {}, mem);
-        }
-      }
-      CVodeGetRootInfo(mem, roots.data());
-      const bool judged = evaluate_around_root(mem, *events, t_new, y_data, y_dky.get(), g_root, g_start, g_end);
-      for (std::size_t i = 0; i < roots.size(); ++i) {
-        if (roots[i] == 0) continue;
-        if (judged && is_jump(g_root[i], g_start[i], g_end[i])) continue;
-        const Status event_status = events->on_event(static_cast<int>(i), t_new, y_data);
-        if (event_status == Status::ok) continue;
-        t = t_new;
-        if (event_status == Status::stopped) return finish(Status::stopped, {}, mem);
-        return finish(event_status, fmt::format("{}: at the event at t = {}: {}", method, t, describe(event_status)), mem);
-      }
+      if (auto stop = handle_roots(run, t_new)) return *std::move(stop);
       continue;
     }
 
     // Outputs inside the step come from CVODE's interpolating polynomial, valid until the
     // re-initialization below; after_step acts at the step end, so an output there sees the
     // state it leaves.
-    for (; next < output_times.size() && output_times[next] < t_new; ++next) {
-      const double t_out = output_times[next];
-      const int dky_flag = CVodeGetDky(mem, t_out, 0, y_dky.get());
-      if (dky_flag != CV_SUCCESS)
-        return finish(Status::integrator_failure,
-                      fmt::format("{}: interpolation at output time {} failed ({}): {}", method,
-                                  t_out, flag_name(dky_flag), state.cvode_message),
-                      mem);
-      if (output(t_out, N_VGetArrayPointer(y_dky.get())) == Status::stopped) {
-        t = t_out;
-        return finish(Status::stopped, {}, mem);
-      }
-    }
-    t = t_new;
-    const StepEnd end = system.after_step(t, y_data);
+    if (auto stop = write_outputs_before(run, t_new)) return *std::move(stop);
+    run.t = t_new;
+    const StepEnd end = system.after_step(run.t, y_data);
     if (end.status != Status::ok)
-      return finish(end.status, fmt::format("{}: after the step to t = {}: {}", method, t, describe(end.status)), mem);
-    const bool changed = end.changed;
-    if (next < output_times.size() && output_times[next] == t) {
-      if (output(t, y_data) == Status::stopped) return finish(Status::stopped, {}, mem);
-      ++next;
+      return run.finish(end.status,
+                        fmt::format("{}: after the step to t = {}: {}", method, run.t, describe(end.status)));
+    if (run.next < output_times.size() && output_times[run.next] == run.t) {
+      if (output(run.t, y_data) == Status::stopped) return run.finish(Status::stopped, {});
+      ++run.next;
     }
-    if (flag == CV_TSTOP_RETURN || next == output_times.size()) break;
+    if (flag == CV_TSTOP_RETURN || run.next == output_times.size()) break;
     // CVODE itself only warns when t + h == t and can go on for thousands of steps that do not
     // advance t; stop where dopri5 would.
-    if (below_floor(h_next, t))
-      return finish(Status::step_size_underflow,
-                    fmt::format("{}: step size underflow at t = {} (h = {}): the solution may be "
-                                "singular there, or the tolerances too tight",
-                                method, t, h_next),
-                    mem);
-
-    if (changed) {
-      // Re-initialization resets CVODE's counters: bank them first.
-      const Counters before = read_counters(mem);
-      totals.steps += before.steps;
-      totals.rejected_steps += before.rejected_steps;
-      totals.rhs_evaluations += before.rhs_evaluations;
-      if (CVodeReInit(mem, t, y.get()) != CV_SUCCESS || CVodeSetStopTime(mem, t_end) != CV_SUCCESS)
-        return finish(Status::integrator_failure,
-                      fmt::format("{}: re-initializing CVODE at t = {} after after_step changed "
-                                  "the state failed: {}",
-                                  method, t, state.cvode_message),
-                      mem);
-    }
+    if (below_floor(h_next, run.t))
+      return run.finish(Status::step_size_underflow,
+                        fmt::format("{}: step size underflow at t = {} (h = {}): the solution may be "
+                                    "singular there, or the tolerances too tight",
+                                    method, run.t, h_next));
+    if (end.changed)
+      if (auto failure = restart(run, t_end)) return *std::move(failure);
   }
-  return finish(Status::ok, {}, mem);
+  return run.finish(Status::ok, {});
 }
 
 }  // namespace nhdyn

@@ -309,7 +309,8 @@
         const group = new THREE.Group();
         // A terrain coloured by height (low darker, high lighter), so that its relief shows.
         let zmin = Infinity, zmax = -Infinity;
-        for (let k = 2; k < s.mesh.v.length; k += 3) { zmin = Math.min(zmin, s.mesh.v[k]); zmax = Math.max(zmax, s.mesh.v[k]); }
+        for (let k = 2; k < s.mesh.v.length; k += 3)
+          if (s.mesh.v[k] !== null) { zmin = Math.min(zmin, s.mesh.v[k]); zmax = Math.max(zmax, s.mesh.v[k]); }
         const relief = s.kind === "terrain" && zmax > zmin;
         if (relief) {
           const c = new Float32Array(s.mesh.v.length);
@@ -327,10 +328,12 @@
         const rows = s.mesh.rows, columns = s.mesh.v.length / 3 / rows, lines = [];
         const every = (n) => Math.max(1, Math.round((n - 1) / 12));
         const vertex = (i, j) => { const k = 3 * (i * columns + j); return [s.mesh.v[k], s.mesh.v[k + 1], s.mesh.v[k + 2]]; };
+        // A vertex where the ground is undefined is null: no line goes to it.
+        const segment = (p, q) => { if (!p.includes(null) && !q.includes(null)) lines.push(...p, ...q); };
         for (let i = 0; i < rows; i += every(rows))
-          for (let j = 0; j + 1 < columns; ++j) lines.push(...vertex(i, j), ...vertex(i, j + 1));
+          for (let j = 0; j + 1 < columns; ++j) segment(vertex(i, j), vertex(i, j + 1));
         for (let j = 0; j < columns; j += every(columns))
-          for (let i = 0; i + 1 < rows; ++i) lines.push(...vertex(i, j), ...vertex(i + 1, j));
+          for (let i = 0; i + 1 < rows; ++i) segment(vertex(i, j), vertex(i + 1, j));
         const wire = new THREE.BufferGeometry();
         setPositions(wire, new Float32Array(lines));
         group.add(new THREE.LineSegments(wire, new THREE.LineBasicMaterial({ color: 0x6f8f68, transparent: true, opacity: 0.5 })));
