@@ -829,6 +829,15 @@ position = { x1 = 0, y1 = 0, psi1 = 0, theta1 = 0.1, phi1 = 0, x2 = 1, y2 = 0, p
   const ProcessRun apart = nhdyn({"simulate", "two.toml", "--set", "m1=1e-16", "--t-end", "0.02", "-o", "far.csv"});
   EXPECT_EQ(apart.code, 1) << apart.err;
   EXPECT_TRUE(contains(apart.err, "singular at t = 0")) << apart.err;
+  // The message says why (A's diagonal spans 1e-18 to 1) and what to do, for each formulation; it
+  // does not blame a complement D, which lagrange has none of and the default D is by construction.
+  for (const char* method : {"sanh", "lagrange"}) {
+    const ProcessRun m = nhdyn({"simulate", "two.toml", "--set", "m1=1e-16", "--method", method, "--t-end", "0.02", "-o", "far.csv"});
+    EXPECT_EQ(m.code, 1) << method << ": " << m.err;
+    EXPECT_TRUE(contains(m.err, "the diagonal of A spans")) << method << ": " << m.err;
+    EXPECT_TRUE(contains(m.err, "within about 1e12 of each other")) << method << ": " << m.err;
+    EXPECT_FALSE(contains(m.err, "not a complement")) << method << ": " << m.err;
+  }
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseQR>
 #include <cmath>
+#include <algorithm>
 #include <limits>
 #include <vector>
 
@@ -204,6 +205,38 @@ bool a_is_positive_definite_on_the_constraints(const Model& model, const Data& d
 
 }  // namespace
 
+namespace {
+
+// The stacked (or KKT) matrix singular although A is positive definite on the constraints and b
+// has full rank. Inertias many orders of magnitude apart in one model (a 1e-14 kg body beside a
+// 1 kg one) leave the lighter body's rows below round-off: say so, with the spread of A's
+// diagonal. Otherwise, with a D of the user's own, D is the suspect; without D (lagrange) nothing
+// the model says explains it.
+std::string explain_singular_with_regular_parts(const Model& model, const Data& data) {
+  double largest = 0.0, smallest = std::numeric_limits<double>::infinity();
+  const int n = model.n();
+  for (int i = 0; i < n; ++i) {
+    const double d = data.sparse ? data.A_sparse.coeff(i, i) : data.A(i, i);
+    if (!(d > 0.0)) continue;
+    largest = std::max(largest, d);
+    smallest = std::min(smallest, d);
+  }
+  const std::string head = fmt::format("the {} is singular at t = {:.6g} although A is positive definite and b has "
+                                       "full rank",
+                                       data.failed_quantity, data.failed_t);
+  if (largest > 0.0 && largest / smallest > 1e12)
+    return fmt::format("{}: the diagonal of A spans {:.3g} to {:.3g}, more orders of magnitude than double "
+                       "precision resolves beside the constraints' rows; write the model in units that bring "
+                       "its masses and inertias within about 1e12 of each other",
+                       head, smallest, largest);
+  if (data.failed_quantity.find("[D A; b]") != std::string::npos)
+    return head + "; this points to a D that is not a complement of b";
+  return head + "; the constraints and the inertia are nearly dependent there: check the model's constraints "
+                "and masses at that state";
+}
+
+}  // namespace
+
 std::string explain_failure(const Model& model, const Data& data) {
   switch (data.status) {
     case Status::ok: return "no failure";
@@ -225,9 +258,7 @@ std::string explain_failure(const Model& model, const Data& data) {
                            data.failed_t, data.failed_value);
       if (b_is_rank_deficient(model, data)) return explain_dependent_constraints(model, data);
       if (!a_is_positive_definite(model, data)) return explain_inertia(model, data);
-      return fmt::format("the {} is singular at t = {:.6g} although A is positive definite and b has "
-                         "full rank; this points to a D that is not a complement of b",
-                         data.failed_quantity, data.failed_t);
+      return explain_singular_with_regular_parts(model, data);
     case Status::projection_failed:
       return fmt::format("the projection onto the {} did not converge at t = {:.6g}: the residual is still "
                          "{:.3g} after the Newton iterations. The step left the state too far from the "
