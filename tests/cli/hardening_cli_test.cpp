@@ -268,7 +268,10 @@ TEST_F(Hardening, InterruptedBatchLeavesNothing) {
   for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGUSR1}) {
     ProcessOptions options;
     options.signal = sig;
-    options.after = std::chrono::milliseconds(1200);
+    // Into the runs: once the batch has begun writing into out/ (a fixed delay alone raced the
+    // start-up on a loaded machine), and at least 300 ms in.
+    options.after = std::chrono::milliseconds(300);
+    options.signal_when_written = dir_ / "out";
     options.deadline = 60;
     const ProcessRun r = nhdyn({"batch", "osc.toml", "--grid", "k=1:2:4000", "--t-end", "200", "--write-runs",
                                 "--threads", "2", "-o", "out"},

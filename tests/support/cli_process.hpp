@@ -32,6 +32,9 @@ struct ProcessOptions {
   std::vector<std::pair<std::string, std::string>> env;  // set in the child
   int signal = 0;                                          // sent `after` into the run
   std::chrono::milliseconds after{0};
+  // When set, the signal waits (past `after`) until this folder exists and holds something: the
+  // run has begun writing, whatever the machine's load made of its start-up.
+  std::filesystem::path signal_when_written;
   double deadline = 120.0;  // seconds, then SIGKILL
   // When > 0, the largest file the child may write (RLIMIT_FSIZE, SIGXFSZ ignored): a write past it
   // fails with EFBIG, as a write to a full disk fails with ENOSPC.
@@ -87,7 +90,13 @@ inline ProcessRun run_process(const std::vector<std::string>& args, const std::f
       break;
     }
     const auto elapsed = std::chrono::steady_clock::now() - start;
-    if (options.signal && !signalled && elapsed >= options.after) {
+    const auto begun = [&] {
+      std::error_code ec;
+      return options.signal_when_written.empty() ||
+             (std::filesystem::is_directory(options.signal_when_written, ec) &&
+              !std::filesystem::is_empty(options.signal_when_written, ec));
+    };
+    if (options.signal && !signalled && elapsed >= options.after && begun()) {
       ::kill(pid, options.signal);
       signalled = true;
     }
