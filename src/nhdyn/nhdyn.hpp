@@ -7,7 +7,7 @@
 // It includes no GiNaC and no SUNDIALS (tests/layering checks it): models come from the front door
 // (frontend/load_model.hpp) or from the built-in C++ models, and everything after is numeric. The
 // headers not listed here are the library's own: a kernel's helpers (formulation/small_dense.hpp,
-// model/program_tangent.hpp, symbolic/occurrence.hpp and the like) and the symbolic front end
+// model/tape_tangent.hpp, symbolic/occurrence.hpp and the like) and the symbolic front end
 // (symbolic/, for programs that build a Spec in C++: examples/appell_builder.cpp). docs/design.md,
 // "Architecture", shows where each part sits.
 #pragma once

@@ -43,7 +43,7 @@ std::string singular_contact_message(const Model& model, double t, const double*
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
   for (const ContactWatch& w : model.contact_watches) {
-    const Program measure = w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure;
+    const Tape measure = w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure;
     std::vector<double> registers(static_cast<std::size_t>(measure.registers()));
     double value = 0.0;
     measure.run(t, q, v, registers.data(), &value);
