@@ -15,7 +15,7 @@
 #include "nhdyn/core/error.hpp"             // InputError, FileError, ModelError
 #include "nhdyn/core/status.hpp"            // Status of a kernel or a run
 #include "nhdyn/model/model.hpp"            // Model: frozen, numeric
-#include "nhdyn/model/data.hpp"             // Data: the workspace of one thread; Method
+#include "nhdyn/model/data.hpp"             // Data: the workspace of one thread; Formulation
 #include "nhdyn/model/parameters.hpp"       // set_parameter: parameters are data
 #include "nhdyn/model/builtin.hpp"          // the built-in C++ models
 #include "nhdyn/formulation/formulation.hpp"  // compute_acceleration, compute_dynamics; kFormulations
