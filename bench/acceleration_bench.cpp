@@ -20,14 +20,14 @@ namespace nhdyn::bench {
 namespace {
 
 std::vector<FormulationOptions> all_formulations() {
-  return {{Method::sanh, Complement::qr},
-          {Method::sanh, Complement::partition},
-          {Method::sanh, Complement::analytic},
-          {Method::lagrange, Complement::qr},
-          {Method::udwadia_kalaba, Complement::qr},
-          {Method::nullspace, Complement::qr},
-          {Method::nullspace, Complement::partition},
-          {Method::nullspace, Complement::analytic}};
+  return {{Formulation::sanh, Complement::qr},
+          {Formulation::sanh, Complement::partition},
+          {Formulation::sanh, Complement::analytic},
+          {Formulation::lagrange, Complement::qr},
+          {Formulation::udwadia_kalaba, Complement::qr},
+          {Formulation::nullspace, Complement::qr},
+          {Formulation::nullspace, Complement::partition},
+          {Formulation::nullspace, Complement::analytic}};
 }
 
 void bench_dynamics(benchmark::State& state, ModelId id, FormulationOptions options) {
@@ -68,14 +68,14 @@ void bench_acceleration_only(benchmark::State& state, ModelId id, FormulationOpt
 const bool registered = [] {
   for (ModelId id : all_models()) {
     for (const FormulationOptions& options : all_formulations()) {
-      const std::string suffix = model_name(id) + "/" + std::string(method_name(options.method)) + "/" +
+      const std::string suffix = model_name(id) + "/" + std::string(formulation_name(options.method)) + "/" +
                                  std::string(complement_name(options.complement));
       benchmark::RegisterBenchmark(("acceleration/" + suffix).c_str(), bench_dynamics, id, options);
     }
   }
   for (ModelId id : all_models()) {
     for (const FormulationOptions& options : all_formulations()) {
-      const std::string suffix = model_name(id) + "/" + std::string(method_name(options.method)) + "/" +
+      const std::string suffix = model_name(id) + "/" + std::string(formulation_name(options.method)) + "/" +
                                  std::string(complement_name(options.complement));
       benchmark::RegisterBenchmark(("acceleration_only/" + suffix).c_str(), bench_acceleration_only, id,
                                    options);

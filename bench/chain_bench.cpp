@@ -47,7 +47,7 @@ void bench_derive_and_compile(benchmark::State& state) {
 
 void bench_dense_terms(benchmark::State& state) {
   const Model model = make_chain_model(static_cast<int>(state.range(0)), symbolic::TermsLayout::dense);
-  Data data = make_data(model, DataOptions{Path::dense, Method::sanh, false});
+  Data data = make_data(model, DataOptions{Path::dense, Formulation::sanh, false});
   for (auto _ : state) {
     compute_terms(model, data, model.t0, model.q0.data(), model.v0.data());
     benchmark::DoNotOptimize(data.A.data());
@@ -58,7 +58,7 @@ void bench_dense_terms(benchmark::State& state) {
 
 void bench_sparse_terms(benchmark::State& state) {
   const Model model = make_chain_model(static_cast<int>(state.range(0)), symbolic::TermsLayout::sparse);
-  Data data = make_data(model, DataOptions{Path::sparse, Method::sanh, false});
+  Data data = make_data(model, DataOptions{Path::sparse, Formulation::sanh, false});
   for (auto _ : state) {
     compute_terms(model, data, model.t0, model.q0.data(), model.v0.data());
     benchmark::DoNotOptimize(data.A_sparse.valuePtr());
@@ -126,18 +126,18 @@ const bool registered = [] {
   sparse_terms->Unit(benchmark::kMicrosecond);
 
   const std::vector<std::pair<std::string, FormulationOptions>> dense{
-      {"sanh/qr", {Method::sanh, Complement::qr}},
-      {"sanh/partition", {Method::sanh, Complement::partition}},
-      {"lagrange", {Method::lagrange, Complement::qr}},
-      {"udwadia-kalaba", {Method::udwadia_kalaba, Complement::qr}},
-      {"nullspace/qr", {Method::nullspace, Complement::qr}}};
+      {"sanh/qr", {Formulation::sanh, Complement::qr}},
+      {"sanh/partition", {Formulation::sanh, Complement::partition}},
+      {"lagrange", {Formulation::lagrange, Complement::qr}},
+      {"udwadia-kalaba", {Formulation::udwadia_kalaba, Complement::qr}},
+      {"nullspace/qr", {Formulation::nullspace, Complement::qr}}};
   for (const auto& [name, options] : dense) {
     auto* b = benchmark::RegisterBenchmark(("chain/solve/dense/" + name).c_str(), bench_dense_solve, options);
     for (long n : dense_sizes) b->Arg(n);
     b->Unit(benchmark::kMicrosecond);
   }
-  const std::vector<std::pair<std::string, FormulationOptions>> sparse{{"sanh", FormulationOptions(Method::sanh)},
-                                                                       {"lagrange", FormulationOptions(Method::lagrange)}};
+  const std::vector<std::pair<std::string, FormulationOptions>> sparse{{"sanh", FormulationOptions(Formulation::sanh)},
+                                                                       {"lagrange", FormulationOptions(Formulation::lagrange)}};
   for (const auto& [name, options] : sparse) {
     auto* b = benchmark::RegisterBenchmark(("chain/solve/sparse/" + name).c_str(), bench_sparse_solve, options);
     for (long n : sparse_sizes) b->Arg(n);

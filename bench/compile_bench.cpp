@@ -1,7 +1,7 @@
 // Cost of the terms of a compiled model (symbolic/compile.hpp) against the hand-written Evaluator
 // of the same system, on the models and states of bench_cases.hpp:
 //   compiled_terms/<model>/hand_written  Evaluator::terms of make_sled_model / make_appell_model
-//   compiled_terms/<model>/interpreted   the same call on the ProgramEvaluator that compile_model
+//   compiled_terms/<model>/interpreted   the same call on the TapeEvaluator that compile_model
 //                                        makes from the hand-built Spec and Derivation
 //                                        (tests/codegen/hand_built_specs.hpp): one straight-line
 //                                        program for A, Q, G, b, b0, run by the interpreter
@@ -30,7 +30,7 @@
 
 #include "../tests/codegen/hand_built_specs.hpp"
 #include "bench_cases.hpp"
-#include "nhdyn/model/program.hpp"
+#include "nhdyn/model/tape.hpp"
 #include "nhdyn/symbolic/codegen.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"

@@ -42,7 +42,7 @@ SimulationOptions options_for(IntegratorKind kind, double rtol, double output_st
   SimulationOptions options;
   options.t_end = 10.0;
   options.output_step = output_step;
-  options.formulation = {Method::sanh, Complement::qr};
+  options.formulation = {Formulation::sanh, Complement::qr};
   options.integrator.kind = kind;
   options.integrator.rtol = rtol;
   options.integrator.atol = rtol / 100.0;

@@ -91,7 +91,7 @@ void simulate_10s(benchmark::State& state, bool compiled) {
   SimulationOptions options;
   options.t_end = 10.0;
   options.output_step = 0.01;
-  options.formulation = {Method::sanh, Complement::qr};
+  options.formulation = {Formulation::sanh, Complement::qr};
   options.integrator.kind = IntegratorKind::dopri5;
   options.integrator.rtol = 1e-10;
   options.integrator.atol = 1e-12;

@@ -21,7 +21,7 @@ namespace {
 
 std::string example(const std::string& file) { return std::string(NHDYN_SOURCE_DIR) + "/examples/" + file; }
 
-// Hides the ProgramEvaluator behind the plain Evaluator interface.
+// Hides the TapeEvaluator behind the plain Evaluator interface.
 class Forwarding final : public Evaluator {
  public:
   explicit Forwarding(std::shared_ptr<const Evaluator> inner) : inner_(std::move(inner)) {}

@@ -45,7 +45,7 @@ void simulate_bicycle(benchmark::State& state, IntegratorKind integrator, double
   SimulationOptions options;
   options.t_end = 10.0;
   options.output_step = output_step;
-  options.formulation = {Method::sanh, Complement::qr};
+  options.formulation = {Formulation::sanh, Complement::qr};
   options.integrator.kind = integrator;
   options.integrator.rtol = 1e-10;
   options.integrator.atol = 1e-12;

@@ -199,7 +199,7 @@ void verify_references() {
     check(d <= tolerance, "closed-form q'' and the value printed in docs/derivations", id, d);
     for (Complement complement : {Complement::qr, Complement::partition, Complement::analytic}) {
       const Status status =
-          compute_dynamics(model, data, {Method::sanh, complement}, 0.0, x.q.data(), x.v.data());
+          compute_dynamics(model, data, {Formulation::sanh, complement}, 0.0, x.q.data(), x.v.data());
       check(status == Status::ok, "sanh failed; its status and the references", id, 0.0);
       d = max_difference(closed.qdd.data(), data.qdd.data());
       check(d <= tolerance, "closed-form q'' and nhdyn's sanh", id, d);

@@ -13,15 +13,15 @@ int main() {
   const Model model = make_sled_model(SledVariant::centre_of_mass);
   Data data = make_data(model);
 
-  for (Method method : {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace}) {
+  for (Formulation method : {Formulation::sanh, Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace}) {
     const Status status = compute_dynamics(model, data, {method, Complement::qr}, model.t0, model.q0.data(),
                                            model.v0.data());
     if (status != Status::ok) {
-      fmt::print(stderr, "{}: {}\n", method_name(method), describe(status));
+      fmt::print(stderr, "{}: {}\n", formulation_name(method), describe(status));
       return 1;
     }
     fmt::print("{:<15} q'' = ({:+.12f}, {:+.12f}, {:+.12f})   R = ({:+.12f}, {:+.12f}, {:+.12f})\n",
-               method_name(method), data.qdd(0), data.qdd(1), data.qdd(2), data.R(0), data.R(1), data.R(2));
+               formulation_name(method), data.qdd(0), data.qdd(1), data.qdd(2), data.R(0), data.R(1), data.R(2));
   }
 
   SimulationOptions options;

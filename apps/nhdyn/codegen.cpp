@@ -5,7 +5,7 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "outputs.hpp"
+#include "output_guard.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/frontend/describe.hpp"
 

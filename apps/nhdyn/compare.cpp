@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "outputs.hpp"
+#include "output_guard.hpp"
 #include "nhdyn/analysis/comparison.hpp"
 #include "nhdyn/analysis/exact_solution.hpp"
 #include "nhdyn/core/error.hpp"
@@ -47,7 +47,7 @@ struct CompareArgs {
 };
 
 std::string case_name(const ComparisonCase& c) {
-  return fmt::format("{}_{}", method_name(c.method), integrator_name(c.integrator));
+  return fmt::format("{}_{}", formulation_name(c.method), integrator_name(c.integrator));
 }
 
 // The accuracy of a run's energy: the largest |h - h0 - W| (docs/derivations/energy-balance.md),
@@ -62,7 +62,7 @@ std::vector<std::string> compared_methods(const Model& model, const CompareArgs&
   std::vector<std::string> methods = args.methods;
   if (model.m() > 0) {
     for (const std::string& m : methods)
-      if (args.methods_given && parse_method(m) != Method::sanh)
+      if (args.methods_given && parse_formulation(m) != Formulation::sanh)
         throw InputError(fmt::format("--methods {}: model '{}' has programs ([[programs]]), which only the sanh "
                                      "formulation solves; give --methods sanh (and --integrators to compare "
                                      "integrators)",
@@ -76,7 +76,7 @@ std::vector<std::string> compared_methods(const Model& model, const CompareArgs&
   // A name given twice would give two runs of one case and two columns of one name.
   for (std::size_t j = 0; j < methods.size(); ++j)
     for (std::size_t i = 0; i < j; ++i)
-      if (parse_method(methods[i]) == parse_method(methods[j]))
+      if (parse_formulation(methods[i]) == parse_formulation(methods[j]))
         throw InputError(fmt::format("--methods: '{}' is named twice; name each method once", methods[j]));
   for (std::size_t j = 0; j < args.integrators.size(); ++j)
     for (std::size_t i = 0; i < j; ++i)
@@ -116,7 +116,7 @@ std::vector<std::string> series_columns(const Model& model, const ComparisonOpti
 std::string compare_provenance(const Model& model, const ModelSource& source, const CompareArgs& args,
                                const std::vector<std::string>& methods, const ComparisonOptions& options) {
   std::vector<std::string> method_names, integrator_names;
-  for (const std::string& m : methods) method_names.emplace_back(method_name(parse_method(m)));
+  for (const std::string& m : methods) method_names.emplace_back(formulation_name(parse_formulation(m)));
   for (const std::string& i : args.integrators) integrator_names.emplace_back(integrator_name(parse_integrator(i)));
   return format_provenance(make_command_provenance(
       model, source, "compare",
@@ -153,7 +153,7 @@ std::string format_table(const std::string& provenance, const Comparison& result
   for (const ComparisonResult& r : result.results) {
     const SimulationSummary& s = r.summary;
     text += fmt::format("{},{},{:.4g},{},{},{:.4g},{:.3e},{:.3e},{:.3e},{:.3e},{:.3e},{:.3e},{}\n",
-                        method_name(r.which.method), integrator_name(r.which.integrator), r.solve_ns, s.stats.steps,
+                        formulation_name(r.which.method), integrator_name(r.which.integrator), r.solve_ns, s.stats.steps,
                         s.stats.rhs_evaluations, s.wall_time, s.residuals.position, s.residuals.velocity,
                         s.residuals.acceleration, energy_error(s), r.max_error_q, r.max_error_v,
                         format_status(s));
@@ -182,7 +182,7 @@ void plot_comparison(const CompareArgs& args, const Model& model, const Comparis
   request.csv = series_path;
   std::vector<std::string> methods, integrators, quantities{"error"};
   for (const ComparisonCase& c : options.cases) {
-    const std::string m(method_name(c.method)), i(integrator_name(c.integrator));
+    const std::string m(formulation_name(c.method)), i(integrator_name(c.integrator));
     if (std::find(methods.begin(), methods.end(), m) == methods.end()) methods.push_back(m);
     if (std::find(integrators.begin(), integrators.end(), i) == integrators.end()) integrators.push_back(i);
   }
@@ -211,7 +211,7 @@ void print_comparison(const CompareArgs& args, const Model& model, const Compari
   for (const ComparisonResult& r : result.results) {
     const SimulationSummary& s = r.summary;
     fmt::print("{:<15} {:<12} {:>9.1f} {:>8} {:>9} {:>9.3g} {:>9} {:>9} {:>9.2e} {:>9.2e} {:>9.2e}{}\n",
-               method_name(r.which.method), integrator_name(r.which.integrator), r.solve_ns, s.stats.steps,
+               formulation_name(r.which.method), integrator_name(r.which.integrator), r.solve_ns, s.stats.steps,
                s.stats.rhs_evaluations, s.wall_time * 1e3,
                level(s.residuals.position, model.position_constraints() > 0),
                level(s.residuals.velocity, model.velocity_constraints() > 0),
@@ -234,7 +234,7 @@ int run_compare(const CompareArgs& args) {
   ComparisonOptions options = make_comparison_options(model, args);
   const std::vector<std::string> methods = compared_methods(model, args);
   for (const std::string& m : methods)
-    for (const std::string& i : args.integrators) options.cases.push_back({parse_method(m), parse_integrator(i)});
+    for (const std::string& i : args.integrators) options.cases.push_back({parse_formulation(m), parse_integrator(i)});
 
   namespace fs = std::filesystem;
   const fs::path table_path = args.output.empty() ? fs::path("results") / (make_file_name(model.name) + "-compare.csv") : fs::path(args.output);
@@ -254,7 +254,7 @@ int run_compare(const CompareArgs& args) {
   // The constraint watch's warnings (analysis/constraint_watch.hpp), per case, whatever -q says.
   for (const ComparisonResult& r : result.results)
     for (const std::string& w : r.summary.warnings)
-      fmt::print(stderr, "nhdyn: warning ({}, {}): {}\n", method_name(r.which.method), integrator_name(r.which.integrator), w);
+      fmt::print(stderr, "nhdyn: warning ({}, {}): {}\n", formulation_name(r.which.method), integrator_name(r.which.integrator), w);
   table.write(format_table(provenance, result));
   write_series(series, model, result);
   series.commit();

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "outputs.hpp"
+#include "output_guard.hpp"
 #include "nhdyn/analysis/linearization.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"

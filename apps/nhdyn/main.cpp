@@ -12,7 +12,7 @@
 #include "commands.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/version.hpp"
-#include "outputs.hpp"
+#include "output_guard.hpp"
 
 namespace nhdyn::cli {
 

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "outputs.hpp"
+#include "output_guard.hpp"
 #include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/frontend/load_model.hpp"

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <string>
 
-#include "outputs.hpp"
+#include "output_guard.hpp"
 
 namespace nhdyn::cli {
 

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "outputs.hpp"
+#include "output_guard.hpp"
 #include "nhdyn/analysis/run_options.hpp"
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
@@ -283,7 +283,7 @@ int report_failure(const Model& model, const SimulationSummary& summary, const R
 }
 
 std::string run_title(const Model& model, const SimulationOptions& options) {
-  return fmt::format("{}: {}, {}", model.name, method_name(options.formulation.method),
+  return fmt::format("{}: {}, {}", model.name, formulation_name(options.formulation.method),
                      integrator_name(options.integrator.kind));
 }
 
@@ -361,8 +361,8 @@ void print_summary(const SimulateArgs& args, const Model& model, const Simulatio
                    const SimulationSummary& summary, const RunFiles& files, const std::string& html_notice) {
   const bool adaptive = options.integrator.kind != IntegratorKind::rk4;
   fmt::print("nhdyn simulate {}: method {} ({}), integrator {}{}\n", model.name,
-             method_name(options.formulation.method),
-             summary.sparse ? std::string(options.formulation.method == Method::sanh ? "sparse path, D: partition"
+             formulation_name(options.formulation.method),
+             summary.sparse ? std::string(options.formulation.method == Formulation::sanh ? "sparse path, D: partition"
                                                                                       : "sparse path")
                             : fmt::format("D: {}", complement_name(options.formulation.complement)),
              integrator_name(options.integrator.kind),
@@ -431,7 +431,7 @@ std::function<int()> add_simulate_command(CLI::App& app) {
                   "Projection: residual at which Newton stops")->capture_default_str();
   cmd->add_option("--t-end", args->t_end, "End time [s] (default: the model's)");
   cmd->add_option("--output-step", args->output_step, "Time between output rows [s] (default: the model's)");
-  cmd->add_option("--method", args->method, "Formulation: " + help_choices(kFormulations, Method::sanh));
+  cmd->add_option("--method", args->method, "Formulation: " + help_choices(kFormulations, Formulation::sanh));
   cmd->add_option("--complement", args->complement, "Where D comes from (sanh, nullspace): " + help_choices(kComplements, Complement::qr));
   cmd->add_option("--integrator", args->integrator, help_choices(kIntegrators, IntegratorKind::dopri5));
   cmd->add_option("--rtol", args->rtol, "Relative tolerance of the adaptive integrators (default: the model's, else 1e-8)");

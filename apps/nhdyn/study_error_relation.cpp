@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "outputs.hpp"
+#include "output_guard.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/frontend/load_model.hpp"
@@ -40,15 +40,15 @@ struct ErrorRelationArgs {
   bool quiet = false;
 };
 
-StudyFormulation parse_formulation(const std::string& label) {
-  if (label == "sanh" || label == "sanh-qr") return {Method::sanh, Complement::qr};
-  if (label == "sanh-partition") return {Method::sanh, Complement::partition};
-  if (label == "sanh-analytic") return {Method::sanh, Complement::analytic};
+StudyFormulation parse_study_formulation(const std::string& label) {
+  if (label == "sanh" || label == "sanh-qr") return {Formulation::sanh, Complement::qr};
+  if (label == "sanh-partition") return {Formulation::sanh, Complement::partition};
+  if (label == "sanh-analytic") return {Formulation::sanh, Complement::analytic};
   if (label == "sanh-" || label.starts_with("sanh-"))
     throw InputError(fmt::format("unknown formulation '{}'; sanh takes its D from qr, partition or analytic: "
                                  "sanh-qr, sanh-partition, sanh-analytic",
                                  label));
-  return {parse_method(label), Complement::qr};  // throws naming the valid methods
+  return {parse_formulation(label), Complement::qr};  // throws naming the valid methods
 }
 
 // A run's label in the column names: its formulation and integrator.
@@ -156,7 +156,7 @@ int run_error_relation(const ErrorRelationArgs& args) {
   ErrorRelationOptions options;
   options.tolerances = args.tolerances;
   options.atol_factor = args.atol_factor;
-  for (const std::string& m : args.methods) options.formulations.push_back(parse_formulation(m));
+  for (const std::string& m : args.methods) options.formulations.push_back(parse_study_formulation(m));
   options.integrators.clear();
   for (const std::string& i : args.integrators) options.integrators.push_back(parse_integrator(i));
   options.t_end = args.t_end.value_or(0.0);

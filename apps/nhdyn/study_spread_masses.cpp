@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "outputs.hpp"
+#include "output_guard.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/frontend/describe.hpp"
@@ -156,9 +156,9 @@ int run_spread_masses(const SpreadMassesArgs& args) {
 
   // Every formulation the model allows, named before the run so that the CSV (its columns) is
   // opened, and its directory proved writable, before anything is computed.
-  options.formulations = {{Method::sanh, Complement::qr}, {Method::sanh, Complement::partition}};
-  if (description_gives_complement(*description)) options.formulations.push_back({Method::sanh, Complement::analytic});
-  for (Method m : {Method::lagrange, Method::udwadia_kalaba, Method::nullspace}) options.formulations.push_back({m, Complement::qr});
+  options.formulations = {{Formulation::sanh, Complement::qr}, {Formulation::sanh, Complement::partition}};
+  if (description_gives_complement(*description)) options.formulations.push_back({Formulation::sanh, Complement::analytic});
+  for (Formulation m : {Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace}) options.formulations.push_back({m, Complement::qr});
   std::vector<std::string> columns{"ratio", "cond_A", "reference_error"};
   std::vector<std::string> qdd_columns, R_columns, other_columns;
   for (const StudyFormulation& f : options.formulations) {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "outputs.hpp"
+#include "output_guard.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/frontend/load_model.hpp"

@@ -98,7 +98,7 @@ void pair(const std::string& name, int pairs, const std::function<void()>& a, co
 }
 
 void rhs_loop(const Model& model, Data& data, long calls) {
-  const FormulationOptions options{Method::sanh, Complement::qr};
+  const FormulationOptions options{Formulation::sanh, Complement::qr};
   for (long i = 0; i < calls; ++i) {
     if (compute_dynamics(model, data, options, 0.0, model.q0.data(), model.v0.data()) != Status::ok) {
       std::fprintf(stderr, "bench-check: compute_dynamics failed on the bicycle\n");
@@ -111,7 +111,7 @@ void run_with_rows(const Model& model, double output_step, const fs::path& csv) 
   SimulationOptions options;
   options.t_end = 10.0;
   options.output_step = output_step;
-  options.formulation = {Method::sanh, Complement::qr};
+  options.formulation = {Formulation::sanh, Complement::qr};
   options.integrator.kind = IntegratorKind::dopri5;
   options.integrator.rtol = 1e-10;
   options.integrator.atol = 1e-12;
@@ -134,7 +134,7 @@ void run_watched(const Model& model, double t_end, double output_step, double rt
   SimulationOptions options;
   options.t_end = t_end;
   options.output_step = output_step;
-  options.formulation = {Method::sanh, Complement::qr};
+  options.formulation = {Formulation::sanh, Complement::qr};
   options.integrator.kind = IntegratorKind::dopri5;
   options.integrator.rtol = rtol;
   options.integrator.atol = atol;
@@ -150,7 +150,7 @@ void run_watched(const Model& model, double t_end, double output_step, double rt
 // call, microseconds), the way simulate() computes a row: for finding where the time goes.
 void breakdown(const Model& model, const char* label) {
   Data data = make_data(model);
-  const FormulationOptions options{Method::sanh, Complement::qr};
+  const FormulationOptions options{Formulation::sanh, Complement::qr};
   ConstraintWatch watch = make_constraint_watch(model, data, options.method, kConstraintWatchFactor);
   const ResultColumns columns = make_result_columns(model);
   std::vector<double> row(columns.all.size());

@@ -7,7 +7,7 @@
 // It includes no GiNaC and no SUNDIALS (tests/layering checks it): models come from the front door
 // (frontend/load_model.hpp) or from the built-in C++ models, and everything after is numeric. The
 // headers not listed here are the library's own: a kernel's helpers (formulation/small_dense.hpp,
-// model/program_tangent.hpp, symbolic/occurrence.hpp and the like) and the symbolic front end
+// model/tape_tangent.hpp, symbolic/occurrence.hpp and the like) and the symbolic front end
 // (symbolic/, for programs that build a Spec in C++: examples/appell_builder.cpp). docs/design.md,
 // "Architecture", shows where each part sits.
 #pragma once
@@ -15,7 +15,7 @@
 #include "nhdyn/core/error.hpp"             // InputError, FileError, ModelError
 #include "nhdyn/core/status.hpp"            // Status of a kernel or a run
 #include "nhdyn/model/model.hpp"            // Model: frozen, numeric
-#include "nhdyn/model/data.hpp"             // Data: the workspace of one thread; Method
+#include "nhdyn/model/data.hpp"             // Data: the workspace of one thread; Formulation
 #include "nhdyn/model/parameters.hpp"       // set_parameter: parameters are data
 #include "nhdyn/model/builtin.hpp"          // the built-in C++ models
 #include "nhdyn/formulation/formulation.hpp"  // compute_acceleration, compute_dynamics; kFormulations

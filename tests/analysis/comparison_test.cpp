@@ -19,7 +19,7 @@ Comparison run(IntegratorKind kind, double rtol, double step) {
   options.run.integrator.atol = rtol * 1e-2;
   options.run.integrator.step = step;
   options.cost_samples = 10;
-  options.cases = {{Method::sanh, kind}, {Method::lagrange, kind}};
+  options.cases = {{Formulation::sanh, kind}, {Formulation::lagrange, kind}};
   return compare_formulations(model, options);
 }
 

@@ -33,7 +33,7 @@ std::vector<Row> run(const Model& model, const SimulationOptions& options, Simul
   return rows;
 }
 
-SimulationOptions tight(double t_end, Method method = Method::sanh, Complement complement = Complement::qr,
+SimulationOptions tight(double t_end, Formulation method = Formulation::sanh, Complement complement = Complement::qr,
                         IntegratorKind kind = IntegratorKind::dopri5) {
   SimulationOptions o;
   o.t_end = t_end;
@@ -53,7 +53,7 @@ TEST(AppellExam, MatchesTheClosedFormAtTenSecondsForEveryFormulation) {
   const double u0 = std::hypot(model.v0(0), model.v0(1));
   const double ex = model.v0(0) / u0, ey = model.v0(1) / u0;
   const double c = p.g * p.a / (1.0 + p.a * p.a);
-  for (Method m : {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace}) {
+  for (Formulation m : {Formulation::sanh, Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace}) {
     SimulationSummary summary;
     const std::vector<Row> rows = run(model, tight(10.0, m), &summary);
     ASSERT_FALSE(rows.empty());
@@ -65,10 +65,10 @@ TEST(AppellExam, MatchesTheClosedFormAtTenSecondsForEveryFormulation) {
       v << u * ex, u * ey, u * p.a;
       R << p.a * ex, p.a * ey, -1.0;
       R *= p.m * p.g / (1.0 + p.a * p.a);
-      EXPECT_LT((r.q - q).norm(), 1e-9 * q.norm() + 1e-12) << method_name(m) << " t=" << r.t;
-      EXPECT_LT((r.v - v).norm(), 1e-9 * v.norm()) << method_name(m) << " t=" << r.t;
-      EXPECT_LT((r.R - R).norm(), 1e-9 * R.norm()) << method_name(m) << " t=" << r.t;
-      EXPECT_LT(std::abs(r.energy - rows.front().energy), 1e-9 * (1.0 + std::abs(r.energy))) << method_name(m);
+      EXPECT_LT((r.q - q).norm(), 1e-9 * q.norm() + 1e-12) << formulation_name(m) << " t=" << r.t;
+      EXPECT_LT((r.v - v).norm(), 1e-9 * v.norm()) << formulation_name(m) << " t=" << r.t;
+      EXPECT_LT((r.R - R).norm(), 1e-9 * R.norm()) << formulation_name(m) << " t=" << r.t;
+      EXPECT_LT(std::abs(r.energy - rows.front().energy), 1e-9 * (1.0 + std::abs(r.energy))) << formulation_name(m);
     }
     EXPECT_DOUBLE_EQ(rows.back().t, 10.0);
     EXPECT_LT(summary.residuals.acceleration, 1e-12);
@@ -90,7 +90,7 @@ TEST(SledExam, HorizontalPlaneMatchesTheClosedForm) {
   const double psi0 = std::atan2(-p.rho * w0, u0);
   const double beta = K * p.a / (p.rho * p.rho);
   for (IntegratorKind kind : {IntegratorKind::dopri5, IntegratorKind::cvode_bdf, IntegratorKind::cvode_adams}) {
-    SimulationOptions o = tight(8.0, Method::sanh, Complement::qr, kind);
+    SimulationOptions o = tight(8.0, Formulation::sanh, Complement::qr, kind);
     const std::vector<Row> rows = run(model, o);
     double worst = 0.0;
     for (const Row& r : rows) {
@@ -109,14 +109,14 @@ TEST(SledExam, HorizontalPlaneMatchesTheClosedForm) {
 TEST(SledConsistency, FormulationsAndComplementsGiveTheSameTrajectory) {
   const Model model = make_sled_model();
   const std::vector<Row> reference = run(model, tight(5.0));
-  for (Method m : {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace})
+  for (Formulation m : {Formulation::sanh, Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace})
     for (Complement c : {Complement::qr, Complement::partition, Complement::analytic}) {
-      if ((m == Method::lagrange || m == Method::udwadia_kalaba) && c != Complement::qr) continue;
+      if ((m == Formulation::lagrange || m == Formulation::udwadia_kalaba) && c != Complement::qr) continue;
       const std::vector<Row> rows = run(model, tight(5.0, m, c));
       ASSERT_EQ(rows.size(), reference.size());
       for (std::size_t i = 0; i < rows.size(); ++i) {
-        EXPECT_LT((rows[i].q - reference[i].q).norm(), 1e-8) << method_name(m) << "/" << complement_name(c);
-        EXPECT_LT((rows[i].R - reference[i].R).norm(), 1e-7) << method_name(m) << "/" << complement_name(c);
+        EXPECT_LT((rows[i].q - reference[i].q).norm(), 1e-8) << formulation_name(m) << "/" << complement_name(c);
+        EXPECT_LT((rows[i].R - reference[i].R).norm(), 1e-7) << formulation_name(m) << "/" << complement_name(c);
       }
     }
 }

@@ -118,7 +118,7 @@ TEST(ConstraintWatchModels, MergingBladesNamedByTheConditioning) {
 TEST(ConstraintWatchModels, AmortizedEstimateBoundsTheTrueConditionNumber) {
   const Model model = load_model_text(kMergingBlades, "blades.toml");
   Data data = make_data(model);
-  const FormulationOptions formulation{Method::sanh, Complement::qr};
+  const FormulationOptions formulation{Formulation::sanh, Complement::qr};
   ConstraintWatch watch = make_constraint_watch(model, data, formulation.method);
   const int states = 4000;
   double at_estimate = 0.0;

@@ -97,7 +97,7 @@ namespace {
 TEST(Allocation, AccelerationSolveAllocatesNothingAfterTheFirstCall) {
   for (const Model& model : {make_sled_model(), make_sled_model(SledVariant::paper), make_appell_model()}) {
     Data data = make_data(model);
-    for (Method m : {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace})
+    for (Formulation m : {Formulation::sanh, Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace})
       for (Complement c : {Complement::qr, Complement::partition, Complement::analytic}) {
         Vector q(3), v(3);
         q << 0.1, 0.2, 0.3;
@@ -114,18 +114,18 @@ TEST(Allocation, AccelerationSolveAllocatesNothingAfterTheFirstCall) {
           compute_energy(model, data);
         }
         g_counting = false;
-        EXPECT_EQ(g_allocations.load(), 0) << model.name << " " << method_name(m) << "/" << complement_name(c);
+        EXPECT_EQ(g_allocations.load(), 0) << model.name << " " << formulation_name(m) << "/" << complement_name(c);
       }
   }
 }
 
 TEST(Allocation, ProgramMotionAllocatesNothingAfterTheFirstCall) {
   const Model model = testing::make_sled_heading_model();
-  Data data = make_data(model, {Path::automatic, Method::sanh});
+  Data data = make_data(model, {Path::automatic, Formulation::sanh});
   const double q[3] = {0.1, -0.2, 0.3}, v[3] = {0.9, 0.1, 1.1};
   for (Complement c : {Complement::qr, Complement::partition, Complement::analytic}) {
     for (bool feedback : {false, true}) {
-      FormulationOptions options{Method::sanh, c};
+      FormulationOptions options{Formulation::sanh, c};
       options.program_feedback = {feedback, 2.0, 3.0};
       ASSERT_EQ(compute_dynamics(model, data, options, 0.5, q, v), Status::ok);
       compute_program_residuals(model, data);
@@ -146,7 +146,7 @@ TEST(Allocation, StabilizationAllocatesNothing) {
   // scaled row takes several Newton steps with the forward-difference factor).
   for (const Model& model : {make_sled_model(), make_appell_model()}) {
     Data data = make_data(model);
-    FormulationOptions options{Method::sanh, Complement::qr};
+    FormulationOptions options{Formulation::sanh, Complement::qr};
     options.baumgarte.enabled = true;
     Vector q(3), v(3);
     q << 0.1, 0.2, 0.3;
@@ -187,7 +187,7 @@ TEST(Allocation, SparsePathAllocatesOnlyInsideItsSparseFactorizations) {
     Vector q(3), v(3);
     q << 0.1, 0.2, 0.3;
     v << 0.5, 0.6, 0.7;
-    FormulationOptions options{Method::sanh, Complement::qr};
+    FormulationOptions options{Formulation::sanh, Complement::qr};
     options.baumgarte.enabled = true;
     ASSERT_EQ(compute_dynamics(model, data, options, 0.0, q.data(), v.data()), Status::ok);
     const long terms = count_allocations([&] {
@@ -203,13 +203,13 @@ TEST(Allocation, SparsePathAllocatesOnlyInsideItsSparseFactorizations) {
       compute_energy(model, data);
     });
     EXPECT_EQ(side, 0) << model.name << ": terms, Baumgarte's terms, residuals or energy allocated";
-    for (Method m : {Method::sanh, Method::lagrange}) {
+    for (Formulation m : {Formulation::sanh, Formulation::lagrange}) {
       const FormulationOptions plain(m);
       ASSERT_EQ(compute_dynamics(model, data, plain, 0.2, q.data(), v.data()), Status::ok);
       const long solve = count_allocations([&] { compute_acceleration(model, data, plain); });
       // The same factorization and solve alone, on the matrices the kernel has just filled.
       const long factors = count_allocations([&] {
-        if (m == Method::sanh) {
+        if (m == Formulation::sanh) {
           data.lu_dep->factorize(data.b_dep_sparse);
           data.X = data.lu_dep->solve(data.b_ind);
         } else {
@@ -217,7 +217,7 @@ TEST(Allocation, SparsePathAllocatesOnlyInsideItsSparseFactorizations) {
           data.kkt_sol = data.lu_kkt_sparse->solve(data.kkt_rhs);
         }
       });
-      EXPECT_EQ(solve, factors) << model.name << " " << method_name(m);
+      EXPECT_EQ(solve, factors) << model.name << " " << formulation_name(m);
       if (kCountsMalloc) {
         EXPECT_GT(factors, 0) << "SparseLU no longer allocates: tighten this test to zero";
       }
@@ -252,9 +252,9 @@ TEST(Allocation, ConstraintWatchAllocatesNothingEvenWhenItWarns) {
   // on the sparse one.
   const Model paper = make_sled_model(SledVariant::paper);
   for (const Model& model : {paper, testing::make_sparse_twin(paper)}) {
-    Data data = make_data(model, DataOptions{Path::automatic, Method::sanh, false});
-    ConstraintWatch watch = make_constraint_watch(model, data, Method::sanh);
-    const FormulationOptions options{Method::sanh, Complement::qr};
+    Data data = make_data(model, DataOptions{Path::automatic, Formulation::sanh, false});
+    ConstraintWatch watch = make_constraint_watch(model, data, Formulation::sanh);
+    const FormulationOptions options{Formulation::sanh, Complement::qr};
     Vector q(3), v(3);
     q << 0.0, 0.0, 0.0;
     v << 1.0, 0.0, 0.0;

@@ -72,7 +72,7 @@ TEST(ComplementCheck, ADriftingComplementIsRefusedWhereItFailsWhenChecked) {
 #endif
   data.check_complement = true;  // what a debug build does
   const Vector q = Vector::Zero(2), v = Vector::Zero(2);
-  const FormulationOptions options(Method::sanh, Complement::analytic);
+  const FormulationOptions options(Formulation::sanh, Complement::analytic);
   EXPECT_EQ(compute_dynamics(model, data, options, 0.0, q.data(), v.data()), Status::ok);
   // Still within the tolerance just after t = 0, refused once D b^T is far from zero.
   EXPECT_EQ(compute_dynamics(model, data, options, 1e-10, q.data(), v.data()), Status::ok);

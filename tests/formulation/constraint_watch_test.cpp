@@ -33,7 +33,7 @@ Model make_turning_blade_for_watch(SledVariant variant) {
   return model;
 }
 
-SimulationSummary run_watch(const Model& model, Method method, Complement complement, double t_end,
+SimulationSummary run_watch(const Model& model, Formulation method, Complement complement, double t_end,
                             Path path = Path::automatic) {
   SimulationOptions options;
   options.t_end = t_end;
@@ -64,17 +64,17 @@ void expect_blade_warning_before_singularity(const Model& model, const Simulatio
 TEST(ConstraintWatch, TanFormOfTheBladeIsWarnedAboutJustBeforePhiCrossesHalfPi) {
   const Model model = make_turning_blade_for_watch(SledVariant::paper);
   const struct {
-    Method method;
+    Formulation method;
     Complement complement;
-  } runs[] = {{Method::sanh, Complement::qr},
-              {Method::sanh, Complement::analytic},
-              {Method::sanh, Complement::partition},
-              {Method::lagrange, Complement::qr},
-              {Method::udwadia_kalaba, Complement::qr},
-              {Method::nullspace, Complement::qr}};
+  } runs[] = {{Formulation::sanh, Complement::qr},
+              {Formulation::sanh, Complement::analytic},
+              {Formulation::sanh, Complement::partition},
+              {Formulation::lagrange, Complement::qr},
+              {Formulation::udwadia_kalaba, Complement::qr},
+              {Formulation::nullspace, Complement::qr}};
   for (const auto& run : runs) {
     const SimulationSummary summary = run_watch(model, run.method, run.complement, 1.6);
-    const std::string what = fmt::format("{} / {}", method_name(run.method), complement_name(run.complement));
+    const std::string what = fmt::format("{} / {}", formulation_name(run.method), complement_name(run.complement));
     EXPECT_FALSE(summary.sparse) << what;
     expect_blade_warning_before_singularity(model, summary, what);
     EXPECT_GT(summary.watch.watched_states, 157) << what;  // every output at least
@@ -83,10 +83,10 @@ TEST(ConstraintWatch, TanFormOfTheBladeIsWarnedAboutJustBeforePhiCrossesHalfPi) 
 
 TEST(ConstraintWatch, SparsePathFollowsTheRowsOfB) {
   const Model model = testing::make_sparse_twin(make_turning_blade_for_watch(SledVariant::paper));
-  const SimulationSummary summary = run_watch(model, Method::sanh, Complement::qr, 1.6, Path::sparse);
+  const SimulationSummary summary = run_watch(model, Formulation::sanh, Complement::qr, 1.6, Path::sparse);
   EXPECT_TRUE(summary.sparse);
   expect_blade_warning_before_singularity(model, summary, "sparse sanh");
-  const SimulationSummary lagrange = run_watch(model, Method::lagrange, Complement::qr, 1.6, Path::sparse);
+  const SimulationSummary lagrange = run_watch(model, Formulation::lagrange, Complement::qr, 1.6, Path::sparse);
   EXPECT_TRUE(lagrange.sparse);
   expect_blade_warning_before_singularity(model, lagrange, "sparse lagrange");
 }
@@ -96,7 +96,7 @@ TEST(ConstraintWatch, RegularFormOfTheSameMotionStaysSilent) {
   const Model model = make_turning_blade_for_watch(SledVariant::centre_of_mass);
   for (Path path : {Path::dense, Path::sparse}) {
     const Model run_model = path == Path::sparse ? testing::make_sparse_twin(model) : model;
-    const SimulationSummary summary = run_watch(run_model, Method::sanh, Complement::qr, 10.0, path);
+    const SimulationSummary summary = run_watch(run_model, Formulation::sanh, Complement::qr, 10.0, path);
     ASSERT_EQ(summary.status, Status::ok) << summary.message;
     EXPECT_TRUE(summary.warnings.empty()) << summary.warnings.front();
     EXPECT_LT(summary.watch.largest_row_factor, 1.0 + 1e-12);
@@ -108,12 +108,12 @@ TEST(ConstraintWatch, RegularFormOfTheSameMotionStaysSilent) {
 
 TEST(ConstraintWatch, SledOverALongRunStaysSilent) {
   const Model model = make_sled_model();
-  for (Method method : {Method::sanh, Method::lagrange}) {
+  for (Formulation method : {Formulation::sanh, Formulation::lagrange}) {
     const SimulationSummary summary = run_watch(model, method, Complement::qr, 200.0);
     ASSERT_EQ(summary.status, Status::ok) << summary.message;
     EXPECT_TRUE(summary.warnings.empty()) << summary.warnings.front();
     EXPECT_LT(summary.watch.largest_row_factor, 1.0 + 1e-12);
-    EXPECT_LT(summary.watch.largest_condition_factor, 10.0) << method_name(method);
+    EXPECT_LT(summary.watch.largest_condition_factor, 10.0) << formulation_name(method);
   }
 }
 

@@ -17,7 +17,7 @@
 namespace nhdyn {
 namespace {
 
-const Method kDiagnosedMethods[] = {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace};
+const Formulation kDiagnosedMethods[] = {Formulation::sanh, Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace};
 
 using nhdyn::test::contains;
 
@@ -27,17 +27,17 @@ TEST(Diagnosis, DependentConstraintsAreNamedWithAConditionEstimate) {
        0, 1, 1, 0,
        2, 0, 0, 0;  // c3 = 2 c1
   const Model model = testing::make_constant_model(Matrix::Identity(4, 4), Vector::Ones(4), b, Vector::Zero(3));
-  for (Method m : kDiagnosedMethods) {
+  for (Formulation m : kDiagnosedMethods) {
     Data data = make_data(model);
     const Status status = compute_dynamics(model, data, {m, Complement::qr}, 0.0, model.q0.data(), model.v0.data());
-    ASSERT_NE(status, Status::ok) << method_name(m);
+    ASSERT_NE(status, Status::ok) << formulation_name(m);
     const std::string message = explain_failure(model, data);
-    EXPECT_TRUE(contains(message, "'c1'") && contains(message, "'c3'")) << method_name(m) << ": " << message;
+    EXPECT_TRUE(contains(message, "'c1'") && contains(message, "'c3'")) << formulation_name(m) << ": " << message;
     EXPECT_FALSE(contains(message, "'c2'")) << message;
     EXPECT_TRUE(contains(message, "condition estimate")) << message;
   }
   Data data = make_data(model);
-  EXPECT_EQ(compute_dynamics(model, data, {Method::sanh, Complement::partition}, 0.0, model.q0.data(), model.v0.data()),
+  EXPECT_EQ(compute_dynamics(model, data, {Formulation::sanh, Complement::partition}, 0.0, model.q0.data(), model.v0.data()),
             Status::dependent_constraints);
   try {
     check_state_or_throw(model, data, 0.0, model.q0.data(), model.v0.data());
@@ -54,10 +54,10 @@ TEST(Diagnosis, IndefiniteInertiaIsReportedWithItsSmallestEigenvalue) {
   b << 1, 0, 0;
   const Model model = testing::make_constant_model(A, Vector::Ones(3), b, Vector::Zero(1));
   Data data = make_data(model);
-  EXPECT_EQ(compute_dynamics(model, data, {Method::udwadia_kalaba, Complement::qr}, 0.0, model.q0.data(),
+  EXPECT_EQ(compute_dynamics(model, data, {Formulation::udwadia_kalaba, Complement::qr}, 0.0, model.q0.data(),
                              model.v0.data()),
             Status::inertia_not_positive_definite);
-  EXPECT_EQ(compute_dynamics(model, data, {Method::nullspace, Complement::qr}, 0.0, model.q0.data(), model.v0.data()),
+  EXPECT_EQ(compute_dynamics(model, data, {Formulation::nullspace, Complement::qr}, 0.0, model.q0.data(), model.v0.data()),
             Status::inertia_not_positive_definite);
   try {
     check_state_or_throw(model, data, 0.0, model.q0.data(), model.v0.data());
@@ -74,9 +74,9 @@ TEST(Diagnosis, NonFiniteTermsNameTheQuantityAndTime) {
   Data data = make_data(model);
   Vector q = Vector::Zero(3), v(3);
   v << 1.0, 0.0, 0.0;
-  for (Method m : kDiagnosedMethods) {
+  for (Formulation m : kDiagnosedMethods) {
     const Status status = compute_dynamics(model, data, {m, Complement::qr}, 2.5, q.data(), v.data());
-    ASSERT_EQ(status, Status::non_finite) << method_name(m);
+    ASSERT_EQ(status, Status::non_finite) << formulation_name(m);
     const std::string message = explain_failure(model, data);
     EXPECT_TRUE(contains(message, "constraint matrix b")) << message;
     EXPECT_TRUE(contains(message, "t = 2.5")) << message;
@@ -93,7 +93,7 @@ TEST(Diagnosis, AnalyticComplementOfAModelWithoutOneIsAnInputError) {
   b << 1, 1;
   const Model model = testing::make_constant_model(Matrix::Identity(2, 2), Vector::Ones(2), b, Vector::Zero(1));
   Data data = make_data(model);
-  EXPECT_THROW(compute_dynamics(model, data, {Method::sanh, Complement::analytic}, 0.0, model.q0.data(), model.v0.data()),
+  EXPECT_THROW(compute_dynamics(model, data, {Formulation::sanh, Complement::analytic}, 0.0, model.q0.data(), model.v0.data()),
                InputError);
 }
 

@@ -17,7 +17,7 @@
 namespace nhdyn {
 namespace {
 
-const Method kMethods[] = {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace};
+const Formulation kMethods[] = {Formulation::sanh, Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace};
 const Complement kComplements[] = {Complement::qr, Complement::partition, Complement::analytic};
 
 struct Solution {
@@ -26,7 +26,7 @@ struct Solution {
 
 Solution solve(const Model& model, Data& data, FormulationOptions options, const Vector& q, const Vector& v) {
   const Status status = compute_dynamics(model, data, options, 0.0, q.data(), v.data());
-  EXPECT_EQ(status, Status::ok) << method_name(options.method) << " " << complement_name(options.complement);
+  EXPECT_EQ(status, Status::ok) << formulation_name(options.method) << " " << complement_name(options.complement);
   return {data.qdd, data.R};
 }
 
@@ -57,14 +57,14 @@ TEST(SledFormulations, AllMethodsAndComplementsMatchClosedFormAtRandomStates) {
     // R = A q'' - Q - G from the closed form, evaluated independently of any formulation.
     compute_terms(model, data, 0.0, q.data(), v.data());
     const Vector expected_R = data.A * expected - data.Q - data.G;
-    for (Method m : kMethods)
+    for (Formulation m : kMethods)
       for (Complement c : kComplements) {
-        if ((m == Method::lagrange || m == Method::udwadia_kalaba) && c != Complement::qr) continue;
+        if ((m == Formulation::lagrange || m == Formulation::udwadia_kalaba) && c != Complement::qr) continue;
         const Solution sol = solve(model, data, {m, c}, q, v);
         EXPECT_LT((sol.qdd - expected).norm(), 1e-10 * (1.0 + expected.norm()))
-            << method_name(m) << "/" << complement_name(c) << " trial " << trial;
+            << formulation_name(m) << "/" << complement_name(c) << " trial " << trial;
         EXPECT_LT((sol.R - expected_R).norm(), 1e-10 * (1.0 + expected_R.norm()))
-            << method_name(m) << "/" << complement_name(c) << " trial " << trial;
+            << formulation_name(m) << "/" << complement_name(c) << " trial " << trial;
       }
   }
 }
@@ -81,9 +81,9 @@ TEST(SledFormulations, PaperVariantSatisfiesThePapersReducedEquations) {
     v << U(rng), 0.0, U(rng);
     v(1) = std::tan(q(2)) * v(0);  // on the constraint
     const double m = p.m, a = p.a, phi = q(2), w = v(2);
-    for (Method method : kMethods)
+    for (Formulation method : kMethods)
       for (Complement c : kComplements) {
-        if ((method == Method::lagrange || method == Method::udwadia_kalaba) && c != Complement::qr) continue;
+        if ((method == Formulation::lagrange || method == Formulation::udwadia_kalaba) && c != Complement::qr) continue;
         const Solution sol = solve(model, data, {method, c}, q, v);
         const Vector& a_ = sol.qdd;
         // docs/notation.md section 6: the paper's equations with the paper's potential.
@@ -92,9 +92,9 @@ TEST(SledFormulations, PaperVariantSatisfiesThePapersReducedEquations) {
         // The constraint y' = tan(phi) x' differentiated once.
         const double eq3 = a_(1) - std::tan(phi) * a_(0) - v(0) * w / (std::cos(phi) * std::cos(phi));
         const double scale = 1.0 + a_.norm() + w * w;
-        EXPECT_LT(std::abs(eq1), 1e-11 * scale) << method_name(method) << "/" << complement_name(c);
-        EXPECT_LT(std::abs(eq2), 1e-11 * scale) << method_name(method) << "/" << complement_name(c);
-        EXPECT_LT(std::abs(eq3), 1e-11 * scale) << method_name(method) << "/" << complement_name(c);
+        EXPECT_LT(std::abs(eq1), 1e-11 * scale) << formulation_name(method) << "/" << complement_name(c);
+        EXPECT_LT(std::abs(eq2), 1e-11 * scale) << formulation_name(method) << "/" << complement_name(c);
+        EXPECT_LT(std::abs(eq3), 1e-11 * scale) << formulation_name(method) << "/" << complement_name(c);
       }
   }
 }
@@ -117,12 +117,12 @@ TEST(AppellFormulations, AllMethodsMatchClosedFormOffTheConstraint) {
     expected << p.g * a2 * v(0) * v(2) / N, p.g * a2 * v(1) * v(2) / N, p.g * a2 * a2 * h2 / N;
     Vector expected_R = p.m * expected;
     expected_R(2) -= p.m * p.g;
-    for (Method m : kMethods)
+    for (Formulation m : kMethods)
       for (Complement c : kComplements) {
-        if ((m == Method::lagrange || m == Method::udwadia_kalaba) && c != Complement::qr) continue;
+        if ((m == Formulation::lagrange || m == Formulation::udwadia_kalaba) && c != Complement::qr) continue;
         const Solution sol = solve(model, data, {m, c}, q, v);
-        EXPECT_LT((sol.qdd - expected).norm(), 1e-12 * (1.0 + expected.norm())) << method_name(m) << "/" << complement_name(c);
-        EXPECT_LT((sol.R - expected_R).norm(), 1e-12 * (1.0 + expected_R.norm())) << method_name(m) << "/" << complement_name(c);
+        EXPECT_LT((sol.qdd - expected).norm(), 1e-12 * (1.0 + expected.norm())) << formulation_name(m) << "/" << complement_name(c);
+        EXPECT_LT((sol.R - expected_R).norm(), 1e-12 * (1.0 + expected_R.norm())) << formulation_name(m) << "/" << complement_name(c);
       }
   }
 }
@@ -133,14 +133,14 @@ TEST(Multipliers, ReactionsAreBTransposeLambdaWhereMultipliersExist) {
   Vector q(3), v(3);
   q << 0.3, -0.2, 0.7;
   v << 1.2, 0.4, -0.8;
-  for (Method m : {Method::lagrange, Method::udwadia_kalaba}) {
+  for (Formulation m : {Formulation::lagrange, Formulation::udwadia_kalaba}) {
     ASSERT_EQ(compute_dynamics(model, data, {m, Complement::qr}, 0.0, q.data(), v.data()), Status::ok);
     ASSERT_TRUE(data.has_multipliers);
     const Vector bt_lambda = data.b.transpose() * data.lambda;
-    EXPECT_LT((data.R - bt_lambda).norm(), 1e-12 * (1.0 + data.R.norm())) << method_name(m);
+    EXPECT_LT((data.R - bt_lambda).norm(), 1e-12 * (1.0 + data.R.norm())) << formulation_name(m);
     // The reactions of an ideal constraint do no virtual work on admissible motions: D R = 0 (2.8).
     ASSERT_EQ(compute_complement(model, data, Complement::qr), Status::ok);
-    EXPECT_LT((data.D * data.R).norm(), 1e-12 * (1.0 + data.R.norm())) << method_name(m);
+    EXPECT_LT((data.D * data.R).norm(), 1e-12 * (1.0 + data.R.norm())) << formulation_name(m);
   }
 }
 
@@ -171,10 +171,10 @@ TEST(Complements, EveryChoiceIsAFullRankComplementOfB) {
 }
 
 TEST(Names, MethodsAndComplementsRoundTripAndRejectUnknownNames) {
-  for (Method m : kMethods) EXPECT_EQ(parse_method(method_name(m)), m);
+  for (Formulation m : kMethods) EXPECT_EQ(parse_formulation(formulation_name(m)), m);
   for (Complement c : kComplements) EXPECT_EQ(parse_complement(complement_name(c)), c);
   try {
-    parse_method("kane");
+    parse_formulation("kane");
     FAIL() << "expected an error";
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("udwadia-kalaba"), std::string::npos);

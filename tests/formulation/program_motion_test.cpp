@@ -26,7 +26,7 @@ TEST(ProgramMotionKernel, SledTorqueIsTheClosedFormForEveryComplement) {
   const double q[3] = {0.3, 0.4, phi}, v[3] = {speed * std::cos(phi), speed * std::sin(phi), omega};
   const double expected = p.m * p.a * omega * speed + p.m * p.g * p.a * std::sin(p.alpha) * std::sin(phi);
   for (Complement c : {Complement::qr, Complement::partition, Complement::analytic}) {
-    ASSERT_EQ(compute_dynamics(model, data, {Method::sanh, c}, t, q, v), Status::ok) << complement_name(c);
+    ASSERT_EQ(compute_dynamics(model, data, {Formulation::sanh, c}, t, q, v), Status::ok) << complement_name(c);
     EXPECT_NEAR(data.motion.u(0), expected, 1e-13) << complement_name(c);
     EXPECT_NEAR(data.motion.S(0, 0), 1.0 / (p.m * p.rho * p.rho), 1e-14) << complement_name(c);
     // v' = g sin(alpha) cos(phi) + a omega^2 along the blade, phi'' = 0.
@@ -40,7 +40,7 @@ TEST(ProgramMotionKernel, OtherFormulationsRefuseAModelWithPrograms) {
   const Model model = testing::make_sled_heading_model();
   Data data = make_data(model);
   ASSERT_EQ(compute_terms(model, data, 0.0, model.q0.data(), model.v0.data()), Status::ok);
-  EXPECT_THROW(compute_acceleration(model, data, {Method::lagrange}), InputError);
+  EXPECT_THROW(compute_acceleration(model, data, {Formulation::lagrange}), InputError);
 }
 
 TEST(ProgramMotionKernel, AZeroActuatorIsReportedAsAbsorbed) {

@@ -37,7 +37,7 @@ struct SmallSolution {
   Vector qdd, R;
 };
 
-SmallSolution solve(const Model& model, bool small, Complement complement, Method method = Method::sanh) {
+SmallSolution solve(const Model& model, bool small, Complement complement, Formulation method = Formulation::sanh) {
   Data data = make_data(model);
   data.small_kernels = small;
   SmallSolution s;
@@ -56,7 +56,7 @@ TEST(SmallKernels, SameAccelerationsAsTheDynamicPathForEverySize) {
         const RandomSystem sys = random_system(n, s, rng);
         const Model model = testing::make_constant_model(sys.A, sys.Q, sys.b, sys.b0);
         const std::string where = "n = " + std::to_string(n) + ", s = " + std::to_string(s);
-        for (Method method : {Method::sanh, Method::nullspace}) {
+        for (Formulation method : {Formulation::sanh, Formulation::nullspace}) {
           for (Complement c : {Complement::qr, Complement::partition}) {
             const SmallSolution fast = solve(model, true, c, method);
             const SmallSolution slow = solve(model, false, c, method);

@@ -44,9 +44,9 @@ TEST(SparseKernels, AgreeWithTheDenseKernelsOnTheBuiltInModels) {
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     for (int trial = 0; trial < 10; ++trial)
-      for (Method m : {Method::sanh, Method::lagrange})
+      for (Formulation m : {Formulation::sanh, Formulation::lagrange})
         for (bool baumgarte : {false, true}) {
-          SCOPED_TRACE(model.name + " " + std::string(method_name(m)) + (baumgarte ? " baumgarte" : ""));
+          SCOPED_TRACE(model.name + " " + std::string(formulation_name(m)) + (baumgarte ? " baumgarte" : ""));
           Vector q = model.q0, v = model.v0;
           for (int i = 0; i < model.n(); ++i) {
             q(i) += u(rng);
@@ -74,7 +74,7 @@ TEST(SparseKernels, AgreeWithTheDenseKernelsOnTheBuiltInModels) {
           EXPECT_EQ(sparse.f, dense.f);
           EXPECT_EQ(sparse.energy, dense.energy);
           // The sparse sanh solve's own invariants: D b^T = 0 and D R = 0.
-          if (m == Method::sanh) {
+          if (m == Formulation::sanh) {
             EXPECT_LT((sparse.D * dense.b.transpose()).norm(), 1e-13 * (1.0 + sparse.D.norm() * dense.b.norm()));
             EXPECT_LT((sparse.D * sparse.R).norm(), 1e-12 * sparse.D.norm() * (1.0 + sparse.R.norm()));
           }
@@ -106,7 +106,7 @@ TEST(SparseKernels, FormulationsWithoutSparseKernelsAreRefusedOrTakeTheDensePath
   const Model twin = testing::make_sparse_twin(make_sled_model());
   Data sparse = make_data(twin);
   ASSERT_EQ(compute_terms(twin, sparse, 0.0, twin.q0.data(), twin.v0.data()), Status::ok);
-  for (Method m : {Method::udwadia_kalaba, Method::nullspace}) {
+  for (Formulation m : {Formulation::udwadia_kalaba, Formulation::nullspace}) {
     try {
       compute_acceleration(twin, sparse, FormulationOptions(m));
       FAIL() << "expected logic_error";
@@ -123,7 +123,7 @@ TEST(SparseKernels, FormulationsWithoutSparseKernelsAreRefusedOrTakeTheDensePath
       make_data(twin, options);
       FAIL() << "expected InputError";
     } catch (const InputError& e) {
-      EXPECT_TRUE(contains(e.what(), method_name(m).data()) && contains(e.what(), "sanh, lagrange")) << e.what();
+      EXPECT_TRUE(contains(e.what(), formulation_name(m).data()) && contains(e.what(), "sanh, lagrange")) << e.what();
     }
   }
 }
@@ -132,7 +132,7 @@ TEST(SparseKernels, DataHoldsOnlyTheWorkspaceOfItsPathAndFormulation) {
   const Model model = make_sled_model();
   const int n = model.n(), s = model.s();
   DataOptions sanh_only;
-  sanh_only.method = Method::sanh;
+  sanh_only.method = Formulation::sanh;
   sanh_only.projection = false;
   Data d = make_data(model, sanh_only);
   EXPECT_EQ(d.M.rows(), n);
@@ -142,7 +142,7 @@ TEST(SparseKernels, DataHoldsOnlyTheWorkspaceOfItsPathAndFormulation) {
   EXPECT_LT(dense_data_bytes(n, s, sanh_only), dense_data_bytes(n, s));
   // Asking it for another formulation or a projection says what to do.
   ASSERT_EQ(compute_terms(model, d, 0.0, model.q0.data(), model.v0.data()), Status::ok);
-  EXPECT_THROW(compute_acceleration(model, d, FormulationOptions(Method::lagrange)), std::logic_error);
+  EXPECT_THROW(compute_acceleration(model, d, FormulationOptions(Formulation::lagrange)), std::logic_error);
   Vector q = model.q0, v = model.v0;
   ProjectionResult result;
   EXPECT_THROW(compute_projection(model, d, 0.0, q.data(), v.data(), ProjectionOptions{}, result), std::logic_error);

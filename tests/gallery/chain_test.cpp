@@ -44,7 +44,7 @@ symbolic::ChainParameters sleigh_parameters() {
 // blade along it (other bodies get random states: the models must agree everywhere).
 double acceleration_difference(const Model& m1, const Model& m2, bool on_blade) {
   Data d1 = make_data(m1), d2 = make_data(m2);
-  const FormulationOptions options{Method::sanh, Complement::qr};
+  const FormulationOptions options{Formulation::sanh, Complement::qr};
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-2.0, 2.0);
   double worst = 0.0;
@@ -152,7 +152,7 @@ TEST(ChainSparsePath, SparseAndDenseKernelsAgreeAtRandomStates) {
     std::mt19937 rng(13);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     for (int trial = 0; trial < 5; ++trial)
-      for (Method m : {Method::sanh, Method::lagrange}) {
+      for (Formulation m : {Formulation::sanh, Formulation::lagrange}) {
         Vector q = model.q0, v = model.v0;
         for (int i = 0; i < model.n(); ++i) {
           q(i) += 0.3 * u(rng);
@@ -162,14 +162,14 @@ TEST(ChainSparsePath, SparseAndDenseKernelsAgreeAtRandomStates) {
         ASSERT_EQ(compute_dynamics(model, dense, options, 0.0, q.data(), v.data()), Status::ok);
         ASSERT_EQ(compute_dynamics(model, sparse, options, 0.0, q.data(), v.data()), Status::ok)
             << sparse.failed_quantity;
-        EXPECT_LT(relative(sparse.qdd, dense.qdd), 1e-11) << method_name(m);
-        EXPECT_LT(relative(sparse.R, dense.R), 1e-10) << method_name(m);
-        if (m == Method::lagrange) {
+        EXPECT_LT(relative(sparse.qdd, dense.qdd), 1e-11) << formulation_name(m);
+        EXPECT_LT(relative(sparse.R, dense.R), 1e-10) << formulation_name(m);
+        if (m == Formulation::lagrange) {
           EXPECT_LT(relative(sparse.lambda, dense.lambda), 1e-10);
         }
         compute_residuals(model, dense);
         compute_residuals(model, sparse);
-        EXPECT_LT((sparse.e - dense.e).norm(), 1e-11 * (1.0 + dense.b.norm() * dense.qdd.norm())) << method_name(m);
+        EXPECT_LT((sparse.e - dense.e).norm(), 1e-11 * (1.0 + dense.b.norm() * dense.qdd.norm())) << formulation_name(m);
         EXPECT_EQ(sparse.phi, dense.phi);
         EXPECT_EQ(sparse.f, dense.f);
       }
@@ -179,8 +179,8 @@ TEST(ChainSparsePath, SparseAndDenseKernelsAgreeAtRandomStates) {
 TEST(ChainSparsePath, SimulationsOnBothPathsFollowTheSameMotion) {
   const Model model = chain_model(5, symbolic::TermsLayout::sparse);
   for (Stabilization stabilization : {Stabilization::none, Stabilization::projection, Stabilization::baumgarte})
-    for (Method m : {Method::sanh, Method::lagrange}) {
-      SCOPED_TRACE(std::string(stabilization_name(stabilization)) + " " + std::string(method_name(m)));
+    for (Formulation m : {Formulation::sanh, Formulation::lagrange}) {
+      SCOPED_TRACE(std::string(stabilization_name(stabilization)) + " " + std::string(formulation_name(m)));
       SimulationOptions options = tight_options(1.0, 0.25, m);
       options.stabilization = stabilization;
       options.fix_initial = stabilization == Stabilization::projection;
@@ -209,14 +209,14 @@ TEST(ChainSparsePath, SimulationsOnBothPathsFollowTheSameMotion) {
 
 TEST(ChainSparsePath, UdwadiaKalabaAndNullspaceOfASparseModelRunDense) {
   const Model model = chain_model(3, symbolic::TermsLayout::sparse);
-  for (Method m : {Method::udwadia_kalaba, Method::nullspace}) {
+  for (Formulation m : {Formulation::udwadia_kalaba, Formulation::nullspace}) {
     SimulationSummary summary;
     const std::vector<Row> rows = run_rows(model, tight_options(0.5, 0.25, m), &summary);
-    EXPECT_FALSE(summary.sparse) << method_name(m);
+    EXPECT_FALSE(summary.sparse) << formulation_name(m);
     SimulationSummary reference;
     const std::vector<Row> sanh = run_rows(model, tight_options(0.5, 0.25), &reference);
     EXPECT_TRUE(reference.sparse);
-    EXPECT_LT((rows.back().q - sanh.back().q).cwiseAbs().maxCoeff(), 1e-8) << method_name(m);
+    EXPECT_LT((rows.back().q - sanh.back().q).cwiseAbs().maxCoeff(), 1e-8) << formulation_name(m);
   }
 }
 

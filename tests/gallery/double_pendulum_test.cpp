@@ -51,7 +51,7 @@ void cartesian_state(const Pendulum2& p, double th1, double th2, double w1, doub
 }
 
 // max over random states of |theta'' (Cartesian model) - theta'' (minimal)| / (g / l1).
-double pointwise_error(const Model& model, Method method) {
+double pointwise_error(const Model& model, Formulation method) {
   const Pendulum2 p = parameters_of(model);
   Data data = make_data(model);
   std::mt19937 rng(11);
@@ -73,9 +73,9 @@ double pointwise_error(const Model& model, Method method) {
 
 TEST(DoublePendulum, AccelerationsAgreeWithTheMinimalCoordinateEquationsEverywhere) {
   const Model model = load_example("double_pendulum.toml");
-  for (Method method : {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace}) {
+  for (Formulation method : {Formulation::sanh, Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace}) {
     const double err = pointwise_error(model, method);
-    EXPECT_LT(err, 1e-12) << method_name(method);
+    EXPECT_LT(err, 1e-12) << formulation_name(method);
   }
 }
 
@@ -126,9 +126,9 @@ TEST(DoublePendulum, EnergyIsConserved) {
 // Negative controls: the lower mass given the upper one's in T, or in V, fails the pointwise exam.
 TEST(DoublePendulum, TheExamRejectsWrongModels) {
   const Model wrong_mass = load_altered_example("double_pendulum.toml", "m2/2 * (x2'^2", "m1/2 * (x2'^2");
-  EXPECT_GT(pointwise_error(wrong_mass, Method::sanh), 1e-2);
+  EXPECT_GT(pointwise_error(wrong_mass, Formulation::sanh), 1e-2);
   const Model wrong_gravity = load_altered_example("double_pendulum.toml", "m2*g*y2", "m1*g*y2");
-  EXPECT_GT(pointwise_error(wrong_gravity, Method::sanh), 1e-2);
+  EXPECT_GT(pointwise_error(wrong_gravity, Formulation::sanh), 1e-2);
 }
 
 }  // namespace

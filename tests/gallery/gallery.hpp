@@ -57,7 +57,7 @@ inline Model load_altered_example(const std::string& file, const std::string& fr
 }
 
 // Options for a tight run: dopri5 at rtol 1e-10, atol 1e-12 (the files' own defaults).
-inline SimulationOptions tight_options(double t_end, double output_step, Method method = Method::sanh) {
+inline SimulationOptions tight_options(double t_end, double output_step, Formulation method = Formulation::sanh) {
   SimulationOptions o;
   o.t_end = t_end;
   o.output_step = output_step;

@@ -56,7 +56,7 @@ double minimal_acceleration(const Crank& p, double alpha, double w) {
 }
 
 // max over random states on the loop of |alpha'' - alpha''_minimal| / (w_max^2).
-double pointwise_error(const Model& model, Method method) {
+double pointwise_error(const Model& model, Formulation method) {
   const Crank p = parameters_of(model);
   Data data = make_data(model);
   std::mt19937 rng(5);
@@ -113,8 +113,8 @@ MotionErrors measure_crank(const Model& model) {
 
 TEST(SliderCrank, AccelerationsAgreeWithTheOneCoordinateEquationEverywhere) {
   const Model model = load_example("slider_crank.toml");
-  for (Method method : {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace})
-    EXPECT_LT(pointwise_error(model, method), 1e-8) << method_name(method);
+  for (Formulation method : {Formulation::sanh, Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace})
+    EXPECT_LT(pointwise_error(model, method), 1e-8) << formulation_name(method);
 }
 
 TEST(SliderCrank, MotionFollowsTheLoopKinematicsAndConservesEnergy) {
@@ -130,11 +130,11 @@ TEST(SliderCrank, MotionFollowsTheLoopKinematicsAndConservesEnergy) {
 // centre put at B in V, fail the exam.
 TEST(SliderCrank, TheExamRejectsWrongModels) {
   const Model no_rod_inertia = load_altered_example("slider_crank.toml", "+ m2*l^2/24 * beta'^2", "");
-  EXPECT_GT(pointwise_error(no_rod_inertia, Method::sanh), 1e-3);
+  EXPECT_GT(pointwise_error(no_rod_inertia, Formulation::sanh), 1e-3);
   EXPECT_GT(measure_crank(no_rod_inertia).energy, 1e-3);
   const Model wrong_potential = load_altered_example("slider_crank.toml", "m2*(a*sin(alpha) - l/2*sin(beta))",
                                                      "m2*(a*sin(alpha) - l*sin(beta))");
-  EXPECT_GT(pointwise_error(wrong_potential, Method::sanh), 1e-3);
+  EXPECT_GT(pointwise_error(wrong_potential, Formulation::sanh), 1e-3);
 }
 
 }  // namespace

@@ -33,13 +33,13 @@ TEST(FileModels, SameAccelerationsAndReactionsAsTheHandWrittenModels) {
       Vector q(3), v(3);
       q << U(rng), U(rng), U(rng);
       v << U(rng), U(rng), 0.5 + std::abs(U(rng));  // Appell's paper form needs z' != 0
-      for (Method m : {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace}) {
+      for (Formulation m : {Formulation::sanh, Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace}) {
         ASSERT_EQ(compute_dynamics(model, data_file, {m, Complement::qr}, 0.0, q.data(), v.data()), Status::ok);
         ASSERT_EQ(compute_dynamics(hand, data_hand, {m, Complement::qr}, 0.0, q.data(), v.data()), Status::ok);
         EXPECT_LT((data_file.qdd - data_hand.qdd).norm(), 1e-12 * (1.0 + data_hand.qdd.norm()))
-            << file << " " << method_name(m);
+            << file << " " << formulation_name(m);
         EXPECT_LT((data_file.R - data_hand.R).norm(), 1e-12 * (1.0 + data_hand.R.norm()))
-            << file << " " << method_name(m);
+            << file << " " << formulation_name(m);
       }
     }
   }

@@ -87,7 +87,7 @@ atol = 1e-9
   EXPECT_EQ(set.defaults.atol, 1e-9);
   const SimulationOptions options = make_simulation_options(set);
   EXPECT_EQ(options.integrator.kind, IntegratorKind::rk4);
-  EXPECT_EQ(options.formulation.method, Method::lagrange);
+  EXPECT_EQ(options.formulation.method, Formulation::lagrange);
   EXPECT_EQ(options.integrator.rtol, 1e-6);
 }
 

@@ -309,9 +309,9 @@ path = ["x", "y"]
 // The names the loader accepts for [simulation] are those of the formulation and integrator modules.
 TEST(ModelFile, SimulationNamesAgreeWithTheLibrary) {
   const std::string head = "name = \"p\"\ncoordinates = [\"x\"]\nkinetic_energy = \"x'^2/2\"\n[simulation]\n";
-  for (Method method : {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace}) {
-    const symbolic::Spec spec = load_model_string(head + "method = \"" + std::string(method_name(method)) + "\"\n", "m.toml");
-    EXPECT_EQ(parse_method(spec.method), method);
+  for (Formulation method : {Formulation::sanh, Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace}) {
+    const symbolic::Spec spec = load_model_string(head + "method = \"" + std::string(formulation_name(method)) + "\"\n", "m.toml");
+    EXPECT_EQ(parse_formulation(spec.method), method);
   }
   for (IntegratorKind kind : {IntegratorKind::rk4, IntegratorKind::dopri5, IntegratorKind::cvode_bdf,
                               IntegratorKind::cvode_adams}) {

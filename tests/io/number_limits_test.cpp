@@ -1,6 +1,6 @@
 // Inputs that used to end in an internal error or a hang now get a user error naming what is
 // wrong (the CLI's exit 2), at once: a subnormal parameter value or literal (CLN's "floating
-// point underflow", Program::push's powi), and a product of powers of sums that multiplied out
+// point underflow", Tape::push's powi), and a product of powers of sums that multiplied out
 // has millions of terms (minutes in expand). Timed loosely (a hang is minutes; the refusal is
 // milliseconds), so that the test fails on a hang, not on a slow machine.
 #include <gtest/gtest.h>

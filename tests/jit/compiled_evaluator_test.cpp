@@ -3,7 +3,7 @@
 // parameter change too; the cache reused by a second build; and the failures it must survive (no
 // compiler, a corrupt cache entry) turned into a clear error or, under `auto`, the interpreter.
 // The reference of both: the interpreter's prepared terms (constants folded, steps fused and
-// reordered, model/program.hpp) equal their program run instruction by instruction, to the bit.
+// reordered, model/tape.hpp) equal their program run instruction by instruction, to the bit.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -26,7 +26,7 @@
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/model/output.hpp"
 #include "nhdyn/model/parameters.hpp"
-#include "nhdyn/model/program.hpp"
+#include "nhdyn/model/tape.hpp"
 
 namespace nhdyn::jit {
 namespace {
@@ -124,7 +124,7 @@ TEST_F(Jit, ProgramsKeepTheirActuatorForces) {
   }
 }
 
-// The output rows of a compiled model run compiled too (NativeProgram, model/program.hpp): the
+// The output rows of a compiled model run compiled too (NativeTape, model/tape.hpp): the
 // bicycle's contact forces, residuals, energy and derived outputs (the multibody points), and a
 // file's [outputs], equal the interpreter's, before and after a parameter change (the stage follows the values).
 TEST_F(Jit, OutputRowsGiveTheInterpretersContactForcesAndOutputs) {
@@ -308,9 +308,9 @@ TEST(Interpreter, PreparedTermsOfEveryExampleAreItsProgramToTheBit) {
                            "rolling_disk.toml", "diff_drive.toml", "whipple_bicycle.toml"}) {
     SCOPED_TRACE(file);
     const Model model = load_model(example(file));
-    const auto& evaluator = dynamic_cast<const ProgramEvaluator&>(*model.evaluator);
-    const Program& program = evaluator.programs().terms;  // bound to the parameters
-    ASSERT_FALSE(evaluator.programs().sparsity.has_value());
+    const auto& evaluator = dynamic_cast<const TapeEvaluator&>(*model.evaluator);
+    const Tape& program = evaluator.tapes().terms;  // bound to the parameters
+    ASSERT_FALSE(evaluator.tapes().sparsity.has_value());
     const int n = model.n(), s = model.s();
     std::mt19937 random(11);
     std::uniform_real_distribution<double> d(-0.5, 0.5);

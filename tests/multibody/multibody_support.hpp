@@ -36,7 +36,7 @@ inline double evaluate(const symbolic::Spec& spec, const GiNaC::ex& e, const std
 // compute_dynamics (sanh, QR complement) at (0, q, v); the data keeps A, Q, G, b, b0, q'' and R.
 inline Data dynamics_at(const Model& model, const std::vector<double>& q, const std::vector<double>& v) {
   Data data = make_data(model);
-  const Status status = compute_dynamics(model, data, {Method::sanh, Complement::qr}, 0.0, q.data(), v.data());
+  const Status status = compute_dynamics(model, data, {Formulation::sanh, Complement::qr}, 0.0, q.data(), v.data());
   EXPECT_EQ(status, Status::ok);
   return data;
 }

@@ -132,7 +132,7 @@ KickRun kick(double v, double t_end) {
   SimulationOptions options;
   options.t_end = t_end;
   options.output_step = 0.05;
-  options.formulation = {Method::sanh, Complement::qr};
+  options.formulation = {Formulation::sanh, Complement::qr};
   options.integrator.kind = IntegratorKind::dopri5;
   options.integrator.rtol = 1e-9;
   options.integrator.atol = 1e-11;

@@ -29,8 +29,8 @@ TEST(ErrorRelation, KnifeEdgeResidualTracksTheError) {
                                                               "examples/knife_edge.toml"));
   ErrorRelationOptions options;
   options.tolerances = {1e-4, 1e-8};
-  options.formulations = {{Method::sanh, Complement::qr}, {Method::lagrange, Complement::qr},
-                          {Method::udwadia_kalaba, Complement::qr}};
+  options.formulations = {{Formulation::sanh, Complement::qr}, {Formulation::lagrange, Complement::qr},
+                          {Formulation::udwadia_kalaba, Complement::qr}};
   options.integrators = {IntegratorKind::dopri5, IntegratorKind::cvode_bdf};
   const ErrorRelation study = study_error_relation(model, options);
   ASSERT_TRUE(study.analytic);
@@ -57,8 +57,8 @@ TEST(ErrorRelation, AppellErrorStaysOnTheConstraintWhereTheResidualCannotSeeIt) 
   const Model model = make_appell_model();
   ErrorRelationOptions options;
   options.tolerances = {1e-3, 1e-6};
-  options.formulations = {{Method::sanh, Complement::qr}, {Method::sanh, Complement::analytic},
-                          {Method::lagrange, Complement::qr}};
+  options.formulations = {{Formulation::sanh, Complement::qr}, {Formulation::sanh, Complement::analytic},
+                          {Formulation::lagrange, Complement::qr}};
   options.integrators = {IntegratorKind::dopri5, IntegratorKind::cvode_bdf};
   const ErrorRelation study = study_error_relation(model, options);
   ASSERT_TRUE(study.analytic);
@@ -78,7 +78,7 @@ TEST(ErrorRelation, WithoutAnExactSolutionATightRunIsTheReference) {
   const Model model = make_sled_model();
   ErrorRelationOptions options;
   options.tolerances = {1e-5};
-  options.formulations = {{Method::sanh, Complement::qr}};
+  options.formulations = {{Formulation::sanh, Complement::qr}};
   options.integrators = {IntegratorKind::dopri5};
   options.t_end = 2.0;
   const ErrorRelation study = study_error_relation(model, options);
@@ -115,9 +115,9 @@ TEST(ErrorRelation, BadOptionsAreRefused) {
   options.tolerances = {1e-3, 1e-3};
   EXPECT_THROW(study_error_relation(appell, options), InputError);
   options.tolerances = {1e-3};
-  options.formulations = {{Method::lagrange, Complement::qr}, {Method::lagrange, Complement::partition}};
+  options.formulations = {{Formulation::lagrange, Complement::qr}, {Formulation::lagrange, Complement::partition}};
   EXPECT_THROW(study_error_relation(appell, options), InputError);  // the same formulation: lagrange has no D
-  options.formulations = {{Method::sanh, Complement::qr}};
+  options.formulations = {{Formulation::sanh, Complement::qr}};
   options.t_end = -1.0;
   EXPECT_THROW(study_error_relation(appell, options), InputError);
   options.t_end = 0.0;
@@ -132,7 +132,7 @@ TEST(ErrorRelation, BadOptionsAreRefused) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("no constraints"), std::string::npos) << e.what();
   }
-  options.formulations = {{Method::sanh, Complement::analytic}};
+  options.formulations = {{Formulation::sanh, Complement::analytic}};
   const Model knife = symbolic::compile_model(load_model_file(std::filesystem::path(NHDYN_SOURCE_DIR) /
                                                               "examples/knife_edge.toml"));
   ASSERT_FALSE(knife.evaluator->has_complement());  // the file gives neither D nor independent coordinates

@@ -34,7 +34,7 @@ const SpreadMasses& small_study() {
   return study;
 }
 
-bool is_lagrange(const StudyFormulation& f) { return f.method == Method::lagrange; }
+bool is_lagrange(const StudyFormulation& f) { return f.method == Formulation::lagrange; }
 
 TEST(SpreadMasses, EveryFormulationTheModelAllowsIsRun) {
   const SpreadMasses& study = small_study();

@@ -34,7 +34,7 @@ SimulationOptions tight(double t_end) {
   SimulationOptions o;
   o.t_end = t_end;
   o.output_step = 0.05;
-  o.formulation = {Method::sanh, Complement::qr};
+  o.formulation = {Formulation::sanh, Complement::qr};
   o.integrator.kind = IntegratorKind::dopri5;
   o.integrator.rtol = 1e-10;
   o.integrator.atol = 1e-12;
@@ -70,7 +70,7 @@ TEST(Chain, InitialStateIsOnTheConstraintsWithTheEnergyOfThePage) {
     p.bodies = bodies;
     const Model model = compile_model(make_chain_spec(p));
     Data data = make_data(model);
-    const FormulationOptions options{Method::sanh, Complement::qr};
+    const FormulationOptions options{Formulation::sanh, Complement::qr};
     ASSERT_EQ(compute_dynamics(model, data, options, 0.0, model.q0.data(), model.v0.data()), Status::ok);
     compute_residuals(model, data);
     compute_energy(model, data);

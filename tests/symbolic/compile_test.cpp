@@ -15,8 +15,8 @@
 #include "codegen/hand_built_specs.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/model/appell.hpp"
-#include "nhdyn/model/program.hpp"
 #include "nhdyn/model/sled.hpp"
+#include "nhdyn/model/tape.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
 
 namespace nhdyn::symbolic {
@@ -56,8 +56,8 @@ void expect_near(const std::vector<double>& got, const std::vector<double>& expe
     EXPECT_NEAR(got[i], expected[i], tolerance * std::max(1.0, std::abs(expected[i]))) << what << "[" << i << "]";
 }
 
-const ProgramEvaluator& programs_of(const Model& model) {
-  return dynamic_cast<const ProgramEvaluator&>(*model.evaluator);
+const TapeEvaluator& programs_of(const Model& model) {
+  return dynamic_cast<const TapeEvaluator&>(*model.evaluator);
 }
 
 void expect_same_description(const Model& compiled, const Model& hand) {
@@ -208,7 +208,7 @@ TEST(Compile, BuiltAndDerivedModelsEqualTheHandWrittenOnes) {
 TEST(Compile, CommonSubexpressionsAreComputedOnce) {
   const HandBuilt built = make_hand_built_sled();
   const Model model = compile_model(built.spec, built.derivation);
-  const Program& terms = programs_of(model).programs().terms;
+  const Tape& terms = programs_of(model).tapes().terms;
   // sin(phi) occurs in A twice, Q, G, b and b0; cos(phi) in A twice, G, b and b0: each once in the
   // program, and the two fused. (The program also computes sin(alpha), of a parameter: the
   // evaluator folds it once per parameter change, the parameter stage.)
@@ -227,11 +227,11 @@ TEST(Compile, CommonSubexpressionsAreComputedOnce) {
   EXPECT_EQ(out[1].value, 0.0);
   // What runs per call, the parameters folded: 13 operations when the values were literals in the
   // program; a parameter coefficient of a state product, (c p) (a b) + acc, is one mulk_muladd
-  // step as k (a b) + acc was (model/program.hpp), and terms differing only in their parameters
+  // step as k (a b) + acc was (model/tape.hpp), and terms differing only in their parameters
   // are one term (16 without either).
   EXPECT_LE(programs_of(model).terms_operations(), 14) << terms.describe();
   // The complement and residuals have their own sin and cos.
-  EXPECT_EQ(programs_of(model).programs().complement->count(Op::sincos), 1);
+  EXPECT_EQ(programs_of(model).tapes().complement->count(Op::sincos), 1);
 }
 
 TEST(Compile, PowersQuotientsAndFunctions) {
@@ -339,7 +339,7 @@ TEST(Compile, ShapesAndPathAreChecked) {
 
 // The instructions of `program` that read t, q or q' (directly or through another): what runs at
 // every call once the parameter stage is folded.
-int state_instructions(const Program& program) {
+int state_instructions(const Tape& program) {
   std::vector<char> state(static_cast<std::size_t>(program.registers()), 0);
   for (int r = 0; r < program.inputs(); ++r) state[static_cast<std::size_t>(r)] = 1;
   int count = 0;
@@ -374,12 +374,12 @@ TEST(Compile, TermsThatDifferOnlyInTheirParametersAreOneTerm) {
   const GiNaC::ex m1 = spec.symbols.parameter("m1"), m2 = spec.symbols.parameter("m2"), r = spec.symbols.parameter("r");
   const GiNaC::ex s = GiNaC::sin(x) * GiNaC::cos(x) * v;
   const GiNaC::ex e = m1 * s + m2 * s + m1 * m2 * s + r * s + 3 * s + m1 * r + m2 + 4 * x;
-  const Program program = compile_expression(spec, e, "merged");
+  const Tape program = compile_expression(spec, e, "merged");
   // sincos, sin cos, times x', times the coefficient; 4 x plus that; plus m1 r + m2 (one
   // parameter-stage number).
   EXPECT_EQ(state_instructions(program), 6) << program.describe();
   for (const std::vector<double>& values : {std::vector<double>{2.0, 3.0, 0.25}, std::vector<double>{-0.7, 5.5, 1e-3}}) {
-    const Program bound = program.bind(values.data(), values.size());
+    const Tape bound = program.bind(values.data(), values.size());
     const double M1 = values[0], M2 = values[1], R = values[2];
     for (const double X : {0.3, -2.1}) {
       const double V = 1.7 - X;
@@ -408,7 +408,7 @@ TEST(Compile, ProgramsDoNotDependOnSymbolCreationOrder) {
   for (int i = 0; i < 17; ++i) noise.emplace_back("noise");
   const HandBuilt second = make_hand_built_sled();
   const Model a = compile_model(first.spec, first.derivation), b = compile_model(second.spec, second.derivation);
-  EXPECT_EQ(programs_of(a).programs().terms.describe(), programs_of(b).programs().terms.describe());
+  EXPECT_EQ(programs_of(a).tapes().terms.describe(), programs_of(b).tapes().terms.describe());
 }
 
 }  // namespace

@@ -149,13 +149,13 @@ TEST(PreciseReference, DoubleFormulationsAgreeToRoundOffOnly) {
   const std::vector<double> q{0.2, -1.1, 3.3};
   const std::vector<double> v{1.0, 0.5, 0.7};
   const PreciseAcceleration ref = calc_precise_acceleration(spec, derivation, 0.0, q, v);
-  for (Method method : {Method::sanh, Method::lagrange, Method::udwadia_kalaba, Method::nullspace}) {
+  for (Formulation method : {Formulation::sanh, Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace}) {
     ASSERT_EQ(compute_terms(model, data, 0.0, q.data(), v.data()), Status::ok);
     ASSERT_EQ(compute_acceleration(model, data, FormulationOptions(method)), Status::ok);
     const double error = calc_relative_error({data.qdd.data(), 3}, ref.qdd);
-    EXPECT_LT(error, 1e-14) << method_name(method);
-    EXPECT_GT(error, 1e-30) << method_name(method);
-    EXPECT_LT(calc_relative_error({data.R.data(), 3}, ref.R), 1e-14) << method_name(method);
+    EXPECT_LT(error, 1e-14) << formulation_name(method);
+    EXPECT_GT(error, 1e-30) << formulation_name(method);
+    EXPECT_LT(calc_relative_error({data.R.data(), 3}, ref.R), 1e-14) << formulation_name(method);
   }
 }
 

@@ -82,9 +82,9 @@ TEST(SparsePath, SanhAndKktGiveTheDenseAccelerationsAndReactions) {
         q[i] += 0.2 * u(rng);
         v[i] += u(rng);
       }
-      ASSERT_EQ(compute_dynamics(dense, dd, FormulationOptions(Method::lagrange), 0.0, q.data(), v.data()),
+      ASSERT_EQ(compute_dynamics(dense, dd, FormulationOptions(Formulation::lagrange), 0.0, q.data(), v.data()),
                 Status::ok);
-      ASSERT_EQ(compute_dynamics(sparse, sd, FormulationOptions(Method::sanh), 0.0, q.data(), v.data()), Status::ok)
+      ASSERT_EQ(compute_dynamics(sparse, sd, FormulationOptions(Formulation::sanh), 0.0, q.data(), v.data()), Status::ok)
           << sd.failed_quantity;
       EXPECT_LT(relative(sd.qdd, dd.qdd), 1e-11);
       EXPECT_LT(relative(sd.R, dd.R), 1e-10);
@@ -96,7 +96,7 @@ TEST(SparsePath, SanhAndKktGiveTheDenseAccelerationsAndReactions) {
       EXPECT_LT((sd.D * sd.R).norm(), 1e-12 * sd.D.norm() * (1.0 + sd.R.norm())) << sd.D.norm();
 
       const Vector sanh_qdd = sd.qdd;
-      ASSERT_EQ(compute_dynamics(sparse, sd, FormulationOptions(Method::lagrange), 0.0, q.data(), v.data()),
+      ASSERT_EQ(compute_dynamics(sparse, sd, FormulationOptions(Formulation::lagrange), 0.0, q.data(), v.data()),
                 Status::ok)
           << sd.failed_quantity;
       EXPECT_LT(relative(sd.qdd, dd.qdd), 1e-11);
@@ -116,11 +116,11 @@ TEST(SparsePath, UnconstrainedModelNeedsNoPartition) {
   ASSERT_TRUE(d.sparse);
   EXPECT_TRUE(d.dependent.empty());
   EXPECT_EQ(d.D.size(), 0);  // no k x n complement without constraints: a sparse Cholesky factorization of A
-  ASSERT_EQ(compute_dynamics(model, d, FormulationOptions(Method::sanh), 0.0, model.q0.data(), model.v0.data()),
+  ASSERT_EQ(compute_dynamics(model, d, FormulationOptions(Formulation::sanh), 0.0, model.q0.data(), model.v0.data()),
             Status::ok);
   EXPECT_NEAR(d.qdd[0], 0.0, 1e-15);
   EXPECT_NEAR(d.qdd[1], -9.81, 1e-14);
-  ASSERT_EQ(compute_dynamics(model, d, FormulationOptions(Method::lagrange), 0.0, model.q0.data(), model.v0.data()),
+  ASSERT_EQ(compute_dynamics(model, d, FormulationOptions(Formulation::lagrange), 0.0, model.q0.data(), model.v0.data()),
             Status::ok);
   EXPECT_NEAR(d.qdd[1], -9.81, 1e-14);
 }

@@ -60,7 +60,7 @@ Comparison compare_formulations(const Model& model, const ComparisonOptions& opt
     }
   } else {
     SimulationOptions tight = options.run;
-    tight.formulation.method = Method::sanh;
+    tight.formulation.method = Formulation::sanh;
     tight.integrator.kind = IntegratorKind::dopri5;
     tight.integrator.rtol = 1e-13;
     tight.integrator.atol = 1e-15;

@@ -12,7 +12,7 @@
 namespace nhdyn {
 
 struct ComparisonCase {
-  Method method = Method::sanh;
+  Formulation method = Formulation::sanh;
   IntegratorKind integrator = IntegratorKind::dopri5;
 };
 

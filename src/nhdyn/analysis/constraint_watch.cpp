@@ -108,7 +108,7 @@ void record(ConstraintWatch& watch, int constraint, int slot, WatchMeasure measu
 
 }  // namespace
 
-ConstraintWatch make_constraint_watch(const Model& model, const Data& data, std::optional<Method> method,
+ConstraintWatch make_constraint_watch(const Model& model, const Data& data, std::optional<Formulation> method,
                                       double threshold) {
   ConstraintWatch watch;
   watch.threshold = threshold;
@@ -122,7 +122,7 @@ ConstraintWatch make_constraint_watch(const Model& model, const Data& data, std:
   watch.conditioning = !data.sparse && s > 0;
   if (watch.conditioning) {
     // D is there, k x n, for the formulations that solve with it (sanh, nullspace).
-    watch.stacked = method && (*method == Method::sanh || *method == Method::nullspace) && data.D.rows() == k &&
+    watch.stacked = method && (*method == Formulation::sanh || *method == Formulation::nullspace) && data.D.rows() == k &&
                     data.D.cols() == n;
     const int watched = watch.stacked ? n : s;
     watch.rows = Matrix::Zero(watched, n);

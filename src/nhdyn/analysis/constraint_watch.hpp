@@ -89,7 +89,7 @@ struct ConstraintWatch {
 
 // The watch for a run of `model` on `data` (its path, dense or sparse) with the formulation
 // `method`: sizes every workspace. Cold path.
-ConstraintWatch make_constraint_watch(const Model& model, const Data& data, std::optional<Method> method,
+ConstraintWatch make_constraint_watch(const Model& model, const Data& data, std::optional<Formulation> method,
                                       double threshold = kConstraintWatchFactor);
 
 // Watches the state held in data (b, and on the dense path D and A, after compute_acceleration):

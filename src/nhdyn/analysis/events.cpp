@@ -37,8 +37,8 @@ ModelEventFunctions::ModelEventFunctions(const Model& model, const std::vector<c
                                    event->name));
     needs_dynamics_ = needs_dynamics_ || event->dynamics || event->contact_forces;
     needs_contact_forces_ = needs_contact_forces_ || event->contact_forces;
-    programs_.push_back(event->g.reads_parameters() ? event->g.bind(values.data(), values.size()) : event->g);
-    registers = std::max(registers, programs_.back().registers());
+    tapes_.push_back(event->g.reads_parameters() ? event->g.bind(values.data(), values.size()) : event->g);
+    registers = std::max(registers, tapes_.back().registers());
   }
   registers_.assign(static_cast<std::size_t>(registers), 0.0);
   x_.assign(static_cast<std::size_t>(2 * n_ + contact_columns_), 0.0);
@@ -66,11 +66,11 @@ Status ModelEventFunctions::run_all(double t, const double* y, double* g) {
     pack_dynamics_inputs(n_, y, y + n_, qdd, R, x_.data(), xd_.data());
     if (needs_contact_forces_) std::copy(F, F + contact_columns_, x_.begin() + 2 * n_);
   }
-  for (std::size_t i = 0; i < programs_.size(); ++i) {
+  for (std::size_t i = 0; i < tapes_.size(); ++i) {
     if (events_[i]->dynamics)
-      programs_[i].run(t, x_.data(), xd_.data(), registers_.data(), g + i);
+      tapes_[i].run(t, x_.data(), xd_.data(), registers_.data(), g + i);
     else
-      programs_[i].run(t, y, y + n_, registers_.data(), g + i);
+      tapes_[i].run(t, y, y + n_, registers_.data(), g + i);
   }
   return Status::ok;
 }
@@ -79,7 +79,7 @@ Status ModelEventFunctions::evaluate(double t, const double* y, double* g) {
   non_finite_.index = -1;
   const Status status = run_all(t, y, g);
   if (status != Status::ok) return status;
-  for (std::size_t i = 0; i < programs_.size(); ++i)
+  for (std::size_t i = 0; i < tapes_.size(); ++i)
     if (!std::isfinite(g[i])) {
       non_finite_.index = static_cast<int>(i);
       non_finite_.t = t;
@@ -101,12 +101,12 @@ Status ModelEventFunctions::on_event(int i, double t, const double* y) {
 }
 
 void ModelEventFunctions::require_valid_start(double t0, const double* y0) {
-  if (programs_.empty()) return;
+  if (tapes_.empty()) return;
   if (run_all(t0, y0, g_.data()) != Status::ok)
     throw InputError(fmt::format("the events cannot be evaluated at the start (t0 = {}): the dynamics there could "
                                  "not be solved",
                                  t0));
-  for (std::size_t i = 0; i < programs_.size(); ++i) {
+  for (std::size_t i = 0; i < tapes_.size(); ++i) {
     const Event& e = *events_[i];
     const std::string where = e.where.empty() ? "" : e.where + ": ";
     if (!std::isfinite(g_[i]))

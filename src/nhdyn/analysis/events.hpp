@@ -72,7 +72,7 @@ class ModelEventFunctions final : public EventFunctions {
  private:
   int n_;
   std::vector<const Event*> events_;
-  std::vector<Program> programs_;   // bound to the parameter values
+  std::vector<Tape> tapes_;   // bound to the parameter values
   std::vector<double> registers_;
   std::vector<double> g_;
   NonFinite non_finite_;

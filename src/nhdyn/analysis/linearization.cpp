@@ -12,8 +12,8 @@
 #include <optional>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/model/program.hpp"
-#include "nhdyn/model/program_tangent.hpp"
+#include "nhdyn/model/tape.hpp"
+#include "nhdyn/model/tape_tangent.hpp"
 
 namespace nhdyn {
 namespace {
@@ -41,11 +41,11 @@ class Differentiator {
  public:
   Differentiator(const Model& model, const Layout& layout, double t, const Vector& q, const Vector& v)
       : model_(model), layout_(layout), t_(t), q_(q), v_(v) {
-    programs_ = dynamic_cast<const ProgramEvaluator*>(model.evaluator.get());
+    tapes_ = dynamic_cast<const TapeEvaluator*>(model.evaluator.get());
     scratch_.assign(model.evaluator->scratch_size(), 0.0);
-    if (programs_ != nullptr) {
-      const ModelPrograms& p = programs_->programs();
-      for (const Program* program : {&p.terms, &p.position_residual, &p.velocity_residual}) {
+    if (tapes_ != nullptr) {
+      const ModelTapes& p = tapes_->tapes();
+      for (const Tape* program : {&p.terms, &p.position_residual, &p.velocity_residual}) {
         values_.emplace_back(static_cast<std::size_t>(program->registers()), 0.0);
         program->execute(t, q.data(), v.data(), values_.back().data());
       }
@@ -55,7 +55,7 @@ class Differentiator {
     }
   }
 
-  DerivativeMethod method() const { return programs_ != nullptr ? DerivativeMethod::tangent : DerivativeMethod::richardson; }
+  DerivativeMethod method() const { return tapes_ != nullptr ? DerivativeMethod::tangent : DerivativeMethod::richardson; }
 
   // The flat vector at (t, q, v).
   void evaluate(double t, const Vector& q, const Vector& v, Vector& out) {
@@ -73,7 +73,7 @@ class Differentiator {
   void derivative(int input, Vector& out) {
     const int n = layout_.n;
     out.setZero(layout_.size());
-    if (programs_ != nullptr) {
+    if (tapes_ != nullptr) {
       dq_.setZero(n);
       dv_.setZero(n);
       double dt = 0.0;
@@ -83,8 +83,8 @@ class Differentiator {
         dq_(input - 1) = 1.0;
       else
         dv_(input - 1 - n) = 1.0;
-      const ModelPrograms& p = programs_->programs();
-      if (const TermsSparsity* sparsity = programs_->sparsity()) {
+      const ModelTapes& p = tapes_->tapes();
+      if (const TermsSparsity* sparsity = tapes_->sparsity()) {
         // A program compiled sparse writes only the nonzeros of A and b (model/sparsity.hpp):
         // its tangent comes in that layout and is scattered into the dense one of Layout.
         const int a_nz = sparsity->A.nonzeros(), b_nz = sparsity->b.nonzeros();
@@ -152,7 +152,7 @@ class Differentiator {
   Layout layout_;
   double t_;
   Vector q_, v_;
-  const ProgramEvaluator* programs_ = nullptr;
+  const TapeEvaluator* tapes_ = nullptr;
   std::vector<double> scratch_;
   std::vector<std::vector<double>> values_;
   std::vector<double> tangents_;
@@ -166,8 +166,8 @@ std::vector<char> find_dependence(const Model& model, const Layout& layout, Diff
                                   const Vector& v) {
   const int n = layout.n;
   std::vector<char> depends(static_cast<std::size_t>(1 + 2 * n), 0);
-  if (const auto* pe = dynamic_cast<const ProgramEvaluator*>(model.evaluator.get())) {
-    const ModelPrograms& p = pe->programs();
+  if (const auto* pe = dynamic_cast<const TapeEvaluator*>(model.evaluator.get())) {
+    const ModelTapes& p = pe->tapes();
     // Time: any program. Coordinates: the terms and the velocity residuals only — a position
     // residual may depend on a coordinate whose gradient is constant (x - r theta), and what the
     // linearization needs of it, its gradient, is a row of b, which the terms carry.

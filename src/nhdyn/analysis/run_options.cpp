@@ -6,7 +6,7 @@ SimulationOptions make_simulation_options(const RunOptions& run) {
   SimulationOptions options;
   options.t_end = run.t_end;
   options.output_step = run.output_step;
-  options.formulation.method = parse_method(run.method);
+  options.formulation.method = parse_formulation(run.method);
   options.formulation.complement = parse_complement(run.complement);
   options.integrator.kind = parse_integrator(run.integrator);
   options.integrator.rtol = run.rtol;

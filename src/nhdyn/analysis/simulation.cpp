@@ -43,7 +43,7 @@ std::string singular_contact_message(const Model& model, double t, const double*
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
   for (const ContactWatch& w : model.contact_watches) {
-    const Program measure = w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure;
+    const Tape measure = w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure;
     std::vector<double> registers(static_cast<std::size_t>(measure.registers()));
     double value = 0.0;
     measure.run(t, q, v, registers.data(), &value);
@@ -301,7 +301,7 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
                                                                       : options.events[j].where,
                                      e.where.empty() ? e.expression : e.where));
   }
-  if (model.m() > 0 && options.formulation.method != Method::sanh)
+  if (model.m() > 0 && options.formulation.method != Formulation::sanh)
     throw InputError(fmt::format("model '{}' has programs ([[programs]]), which only the sanh formulation solves "
                                  "(docs/derivations/program-motion.md); choose --method sanh",
                                  model.name));
@@ -321,13 +321,13 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
     // A sliding contact's friction is a reaction along a direction that is not a constraint row:
     // only the Do Sanh form takes it (D annihilates that direction), so another method is refused
     // by name, with the one to use.
-    if (options.formulation.method != Method::sanh)
+    if (options.formulation.method != Formulation::sanh)
       throw InputError(fmt::format(
           "model '{}' has contacts that may slide or lift off (friction or unilateral, docs/contact-modes.md): "
           "--method {} cannot solve them (a sliding contact's friction is a reaction the Do Sanh form alone "
           "takes); use --method sanh (the default; method=\"sanh\" from Python), or remove friction and "
           "unilateral from the [[contacts]] to run --method {}",
-          model.name, method_name(options.formulation.method), method_name(options.formulation.method)));
+          model.name, formulation_name(options.formulation.method), formulation_name(options.formulation.method)));
     const char* why = options.stabilization == Stabilization::projection
                           ? "no projection (the projection would hold a sliding contact's slip at zero)"
                       : !supports_events(io.kind) ? "an integrator that locates events (dopri5, dop853, cvode-bdf, cvode-adams)"

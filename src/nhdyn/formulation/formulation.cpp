@@ -17,9 +17,9 @@
 
 namespace nhdyn {
 
-std::string_view method_name(Method method) { return name_of(kFormulations, method); }
+std::string_view formulation_name(Formulation method) { return name_of(kFormulations, method); }
 
-Method parse_method(std::string_view name) {
+Formulation parse_formulation(std::string_view name) {
   if (const FormulationInfo* info = find_named(kFormulations, name)) return info->value;
   throw InputError("unknown method '" + std::string(name) + "'; choose one of: " + list_names(kFormulations));
 }
@@ -35,15 +35,15 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
   if (data.stage < Stage::terms)
     throw std::logic_error("compute_acceleration: call compute_terms first for the current state");
   if (data.method && *data.method != options.method)
-    throw std::logic_error("compute_acceleration: this Data was made for the " + std::string(method_name(*data.method)) +
-                           " formulation; make one for " + std::string(method_name(options.method)) +
+    throw std::logic_error("compute_acceleration: this Data was made for the " + std::string(formulation_name(*data.method)) +
+                           " formulation; make one for " + std::string(formulation_name(options.method)) +
                            " (make_data with DataOptions::method)");
   if (data.sparse && !find_value(kFormulations, options.method)->sparse)
-    throw std::logic_error("compute_acceleration: the " + std::string(method_name(options.method)) +
+    throw std::logic_error("compute_acceleration: the " + std::string(formulation_name(options.method)) +
                            " formulation has no sparse kernels; use sanh or lagrange on the sparse path, or make "
-                           "the Data with DataOptions::method = " + std::string(method_name(options.method)) +
+                           "the Data with DataOptions::method = " + std::string(formulation_name(options.method)) +
                            " (the dense path)");
-  if (model.m() > 0 && (options.method != Method::sanh || data.sparse))
+  if (model.m() > 0 && (options.method != Formulation::sanh || data.sparse))
     throw InputError("model '" + model.name + "' has programs ([[programs]]), which only the sanh formulation solves, "
                      "on the dense path (docs/derivations/program-motion.md); choose --method sanh");
   data.has_multipliers = false;
@@ -56,16 +56,16 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
   if (data.modes.active && !data.sparse)
     status = compute_mode_acceleration(model, data);  // contacts that may slide or lift off (contact_modes.hpp)
   else if (data.sparse)
-    status = options.method == Method::sanh ? compute_sparse_sanh_acceleration(model, data)
+    status = options.method == Formulation::sanh ? compute_sparse_sanh_acceleration(model, data)
                                             : compute_sparse_lagrange_acceleration(model, data);
   else switch (options.method) {
-    case Method::sanh:
+    case Formulation::sanh:
       status = model.m() > 0 ? compute_program_motion(model, data, options.complement, options.program_feedback)
                              : compute_sanh_acceleration(model, data, options.complement);
       break;
-    case Method::lagrange: status = compute_lagrange_acceleration(model, data); break;
-    case Method::udwadia_kalaba: status = compute_udwadia_kalaba_acceleration(model, data); break;
-    case Method::nullspace: status = compute_nullspace_acceleration(model, data, options.complement); break;
+    case Formulation::lagrange: status = compute_lagrange_acceleration(model, data); break;
+    case Formulation::udwadia_kalaba: status = compute_udwadia_kalaba_acceleration(model, data); break;
+    case Formulation::nullspace: status = compute_nullspace_acceleration(model, data, options.complement); break;
   }
   if (options.baumgarte.enabled) data.b0 = data.b0_model;
   if (status != Status::ok) return status;

@@ -16,8 +16,8 @@
 
 namespace nhdyn {
 
-// enum class Method { sanh, lagrange, udwadia_kalaba, nullspace } is declared in model/data.hpp,
-// because make_data sizes the workspace of one formulation.
+// enum class Formulation { sanh, lagrange, udwadia_kalaba, nullspace } is declared in model/data.hpp,
+// because make_data sizes the workspace of one formulation and model/ is below formulation/.
 
 // Where D comes from (docs/notation.md section 3): the model's analytic D, coordinate
 // partitioning, or an orthonormal basis of null(b) from a QR factorization (the default).
@@ -26,27 +26,27 @@ enum class Complement { qr, partition, analytic };
 struct FormulationOptions {
   // A constructor rather than an aggregate, so that the usual {method, complement} leaves the
   // gains at their defaults without -Wmissing-field-initializers.
-  FormulationOptions(Method m = Method::sanh, Complement c = Complement::qr, BaumgarteGains gains = {})
+  FormulationOptions(Formulation m = Formulation::sanh, Complement c = Complement::qr, BaumgarteGains gains = {})
       : method(m), complement(c), baumgarte(gains) {}
-  Method method = Method::sanh;
+  Formulation method = Formulation::sanh;
   Complement complement = Complement::qr;
   BaumgarteGains baumgarte;  // off unless enabled (baumgarte.hpp)
   ProgramFeedback program_feedback;  // off unless enabled; only for a model with programs (program_motion.hpp)
 };
 
 // The formulations and the choices of D, once (core/names.hpp): their names in the CLI, model
-// files and Python, and what each formulation can do. A new formulation adds its Method
-// (model/data.hpp), its line here and its case in compute_acceleration.
+// files and Python, and what each formulation can do. A new formulation adds its enumerator
+// of Formulation (model/data.hpp), its line here and its case in compute_acceleration.
 struct FormulationInfo {
-  Method value;
+  Formulation value;
   std::string_view name;
   bool sparse;  // has sparse kernels (sparse_sanh.hpp, sparse_lagrange.hpp)
 };
 inline constexpr std::array<FormulationInfo, 4> kFormulations{{
-    {Method::sanh, "sanh", true},
-    {Method::lagrange, "lagrange", true},
-    {Method::udwadia_kalaba, "udwadia-kalaba", false},
-    {Method::nullspace, "nullspace", false},
+    {Formulation::sanh, "sanh", true},
+    {Formulation::lagrange, "lagrange", true},
+    {Formulation::udwadia_kalaba, "udwadia-kalaba", false},
+    {Formulation::nullspace, "nullspace", false},
 }};
 
 using ComplementInfo = Named<Complement>;
@@ -54,8 +54,8 @@ inline constexpr std::array<ComplementInfo, 3> kComplements{
     {{Complement::qr, "qr"}, {Complement::partition, "partition"}, {Complement::analytic, "analytic"}}};
 
 // Its name in kFormulations: "sanh", "lagrange", "udwadia-kalaba", "nullspace".
-std::string_view method_name(Method method);
-Method parse_method(std::string_view name);  // throws InputError listing valid names
+std::string_view formulation_name(Formulation method);
+Formulation parse_formulation(std::string_view name);  // throws InputError listing valid names
 // Its name in kComplements: "qr", "partition", "analytic".
 std::string_view complement_name(Complement complement);
 Complement parse_complement(std::string_view name);  // throws InputError listing valid names

@@ -72,7 +72,7 @@ const std::vector<std::string> visual_keys = {"points", "segments"};
 const std::vector<std::string> visual_point_keys = {"name", "position", "radius"};
 const std::vector<std::string> visual_segment_keys = {"name", "from", "to"};
 
-// The names parse_method and parse_integrator accept, from their tables (formulation.hpp, ode.hpp).
+// The names parse_formulation and parse_integrator accept, from their tables (formulation.hpp, ode.hpp).
 const std::vector<std::string> method_names = names_of(kFormulations);
 const std::vector<std::string> integrator_names = names_of(kIntegrators);
 

@@ -242,8 +242,8 @@ class SectionReader {
     return value;
   }
 
-  Program compile(const std::vector<GiNaC::ex>& expressions, const std::vector<std::string>& what) const {
-    const Program parametric = symbolic::compile_expressions(layout_.current(), expressions, what);
+  Tape compile(const std::vector<GiNaC::ex>& expressions, const std::vector<std::string>& what) const {
+    const Tape parametric = symbolic::compile_expressions(layout_.current(), expressions, what);
     std::vector<double> values;
     for (const Parameter& q : model_.parameters) values.push_back(q.value);
     return parametric.bind(values.data(), values.size());
@@ -531,7 +531,7 @@ OptimalControlProblem load_optimal_control_problem(const ModelSource& source, co
     throw InputError(fmt::format("'{}' is a built-in model: optimize reads an [optimize] section from a model file "
                                  "(docs/optimize.md)",
                                  source.builtin));
-  if (dynamic_cast<const ProgramEvaluator*>(loaded.model.evaluator.get()) == nullptr)
+  if (dynamic_cast<const TapeEvaluator*>(loaded.model.evaluator.get()) == nullptr)
     throw InputError("optimize needs the model's compiled programs (the interpreted evaluator): load it without "
                      "--compiled");
   SectionReader reader(source, loaded.model);

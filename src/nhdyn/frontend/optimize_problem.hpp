@@ -4,7 +4,7 @@
 // (docs/derivations/optimal-programs.md, section 1). The expressions that read the controls (the
 // actuator forces B u, the integrand, the final-time term, the path constraints) are compiled into
 // straight-line programs over the "control layout": n + m coordinates [q; u] whose velocities are
-// [q'; 0], so that the tangent mode of model/program_tangent.hpp differentiates them in q, q', u
+// [q'; 0], so that the tangent mode of model/tape_tangent.hpp differentiates them in q, q', u
 // and t alike. The transcription and the solver (src/nhdyn/optimize/) read this struct only.
 //
 //     model file --load_model_described--> Model --load_optimal_control_problem--> OptimalControlProblem
@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "nhdyn/frontend/load_model.hpp"
-#include "nhdyn/model/program.hpp"
+#include "nhdyn/model/tape.hpp"
 
 namespace nhdyn {
 
@@ -54,14 +54,14 @@ struct PathConstraint {
 };
 
 struct OptimalControlProblem {
-  Model model;                           // the system (its evaluator a ProgramEvaluator)
+  Model model;                           // the system (its evaluator a TapeEvaluator)
   std::vector<OptimizeControl> controls;  // m
   // Programs over the control layout (n + m coordinates [q; u], velocities [q'; 0]), bound to the
   // model's parameter values:
-  Program force;                  // n outputs: B(t, q, q') u, the actuators' generalized force
-  Program integrand;              // 1 output: L(t, q, q', u) (the constant 0 when not given)
-  std::optional<Program> final_term;  // 1 output: the Mayer term M(t, q, q') at t_end
-  Program path;                   // one output per path constraint
+  Tape force;                  // n outputs: B(t, q, q') u, the actuators' generalized force
+  Tape integrand;              // 1 output: L(t, q, q', u) (the constant 0 when not given)
+  std::optional<Tape> final_term;  // 1 output: the Mayer term M(t, q, q') at t_end
+  Tape path;                   // one output per path constraint
   std::vector<PathConstraint> path_constraints;
   bool minimum_time = false;      // objective = "time": J = t_end - t0
   std::string objective_text;     // as written, for the summary

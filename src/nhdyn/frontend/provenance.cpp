@@ -46,7 +46,7 @@ Provenance make_provenance(const Model& model, const ModelSource& source, const 
                            std::string_view evaluator) {
   Provenance p = make_model_provenance(model, source);
   const auto add = [&](std::string name, std::string value) { p.run.emplace_back(std::move(name), std::move(value)); };
-  add("method", std::string(method_name(options.formulation.method)));
+  add("method", std::string(formulation_name(options.formulation.method)));
   add("complement", std::string(complement_name(options.formulation.complement)));
   add("integrator", std::string(integrator_name(options.integrator.kind)));
   add("rtol", fmt::format("{}", options.integrator.rtol));

@@ -185,7 +185,7 @@ std::vector<double> parameter_values_for(const symbolic::VisualScene& scene, con
 std::vector<SceneSize> calc_scene_sizes(const symbolic::VisualScene& scene, const std::vector<Parameter>& parameters,
                                         const std::string& model) {
   const std::vector<double> values = parameter_values_for(scene, parameters, model);
-  const Program sizes = scene.sizes.bind(values.data(), values.size());
+  const Tape sizes = scene.sizes.bind(values.data(), values.size());
   std::vector<double> registers(static_cast<std::size_t>(sizes.registers()));
   std::vector<double> out(static_cast<std::size_t>(sizes.outputs()));
   sizes.run(0.0, nullptr, nullptr, registers.data(), out.data());
@@ -230,19 +230,19 @@ namespace {
 // A bound field program (symbolic/visual.hpp) evaluated at points.
 class Field {
  public:
-  Field(const Program& field, const std::vector<double>& parameters)
-      : program_(field.bind(parameters.data(), parameters.size())),
-        registers_(static_cast<std::size_t>(program_.registers())),
-        zeros_(static_cast<std::size_t>(program_.coordinates()), 0.0) {}
+  Field(const Tape& field, const std::vector<double>& parameters)
+      : tape_(field.bind(parameters.data(), parameters.size())),
+        registers_(static_cast<std::size_t>(tape_.registers())),
+        zeros_(static_cast<std::size_t>(tape_.coordinates()), 0.0) {}
   double operator()(double x, double y, double z = 0.0) {
     const double at[3] = {x, y, z};
     double out = 0.0;
-    program_.run(0.0, at, zeros_.data(), registers_.data(), &out);
+    tape_.run(0.0, at, zeros_.data(), registers_.data(), &out);
     return out;
   }
 
  private:
-  Program program_;
+  Tape tape_;
   std::vector<double> registers_;
   std::vector<double> zeros_;
 };
@@ -478,7 +478,7 @@ SceneMesh surface_mesh(Field& g, const symbolic::VisualShape& shape, const std::
 std::vector<SceneMesh> calc_scene_meshes(const symbolic::VisualScene& scene, const std::vector<Parameter>& parameters,
                                          const std::vector<double>& values, std::size_t stride, const std::string& model) {
   const std::vector<double> parameter_values = parameter_values_for(scene, parameters, model);
-  const Program sizes = scene.sizes.bind(parameter_values.data(), parameter_values.size());
+  const Tape sizes = scene.sizes.bind(parameter_values.data(), parameter_values.size());
   std::vector<double> registers(static_cast<std::size_t>(sizes.registers()));
   std::vector<double> size(static_cast<std::size_t>(sizes.outputs()));
   sizes.run(0.0, nullptr, nullptr, registers.data(), size.data());
@@ -712,7 +712,7 @@ void append_scene_shapes(std::string& data, const ReportInput& input, const Fram
   const symbolic::VisualScene& scene = *input.scene;
   const std::vector<SceneSize> sizes = calc_scene_sizes(scene, input.parameters, input.model);
   const std::vector<double> parameter_values = parameter_values_for(scene, input.parameters, input.model);
-  const Program program = scene.program.bind(parameter_values.data(), parameter_values.size());
+  const Tape program = scene.program.bind(parameter_values.data(), parameter_values.size());
   const int n = program.coordinates();
   if (n != static_cast<int>(input.coordinates.size()))
     throw InputError(fmt::format("the scene of '{}' has {} coordinates, the run {}", input.model, n,

@@ -24,7 +24,7 @@
 
 #include "nhdyn/jit/source.hpp"
 #include "nhdyn/model/contact_forces.hpp"
-#include "nhdyn/model/program.hpp"
+#include "nhdyn/model/tape.hpp"
 
 extern char** environ;
 
@@ -231,8 +231,8 @@ std::string verify_entry(const fs::path& object, const fs::path& check, const st
 using ProgramStage = void (*)(const double*, double*);
 using ProgramRun = void (*)(const double*, double, const double*, const double*, double*);
 
-// A program of make_program_source in a loaded object (the contact forces', the outputs').
-class CompiledProgram final : public NativeProgram {
+// A tape of make_tape_source in a loaded object (the contact forces', the outputs').
+class CompiledProgram final : public NativeTape {
  public:
   CompiledProgram(std::shared_ptr<const Library> library, StageSize size, ProgramStage stage, ProgramRun run)
       : library_(std::move(library)), size_(size), stage_(stage), run_(run) {}
@@ -250,7 +250,7 @@ class CompiledProgram final : public NativeProgram {
 };
 
 // The program NAME of the loaded object, or null when the object lacks it.
-std::shared_ptr<const NativeProgram> native_program(const std::shared_ptr<const Library>& library,
+std::shared_ptr<const NativeTape> native_program(const std::shared_ptr<const Library>& library,
                                                     const std::string& name) {
   const auto size = reinterpret_cast<StageSize>(dlsym(library->handle, ("nhdyn_jit_" + name + "_stage_size").c_str()));
   const auto stage = reinterpret_cast<ProgramStage>(dlsym(library->handle, ("nhdyn_jit_" + name + "_stage").c_str()));
@@ -261,10 +261,10 @@ std::shared_ptr<const NativeProgram> native_program(const std::shared_ptr<const 
 
 // The programs of an output row that the evaluator runs (the residuals, the energy, h and the
 // power), compiled when the model has them; null: the interpreter's.
-enum RowProgram { kPositionResidual, kVelocityResidual, kEnergy, kEnergyFunction, kPower, kRowPrograms };
-const char* const kRowProgramNames[kRowPrograms] = {"position_residual", "velocity_residual", "energy",
+enum RowProgram { kPositionResidual, kVelocityResidual, kEnergy, kEnergyFunction, kPower, kRowTapes };
+const char* const kRowTapeNames[kRowTapes] = {"position_residual", "velocity_residual", "energy",
                                                     "energy_function", "power"};
-const Program* row_program(const ModelPrograms& p, int which) {
+const Tape* row_tape(const ModelTapes& p, int which) {
   switch (which) {
     case kPositionResidual: return &p.position_residual;
     case kVelocityResidual: return &p.velocity_residual;
@@ -274,19 +274,19 @@ const Program* row_program(const ModelPrograms& p, int which) {
     default: return nullptr;
   }
 }
-using RowPrograms = std::array<std::shared_ptr<const NativeProgram>, kRowPrograms>;
+using RowPrograms = std::array<std::shared_ptr<const NativeTape>, kRowTapes>;
 
 // The interpreter's evaluator with its terms, and the programs of a row, replaced by compiled ones.
 class CompiledEvaluator final : public Evaluator {
  public:
-  CompiledEvaluator(std::shared_ptr<const ProgramEvaluator> base, std::shared_ptr<const Library> library,
+  CompiledEvaluator(std::shared_ptr<const TapeEvaluator> base, std::shared_ptr<const Library> library,
                     RowPrograms rows)
       : base_(std::move(base)), library_(std::move(library)), sparse_(base_->sparsity() != nullptr),
         rows_(std::move(rows)) {
     const std::vector<double>& p = base_->parameter_values();
     stage_.assign(library_->stage_size() + 1, 0.0);
     library_->stage(p.data(), stage_.data());
-    for (int i = 0; i < kRowPrograms; ++i) {
+    for (int i = 0; i < kRowTapes; ++i) {
       if (!rows_[i]) continue;
       row_stages_[i].assign(rows_[i]->stage_size() + 1, 0.0);  // + 1: data() of an empty stage
       rows_[i]->stage(p.data(), row_stages_[i].data());
@@ -294,7 +294,7 @@ class CompiledEvaluator final : public Evaluator {
   }
 
   std::shared_ptr<const Evaluator> with_parameters(const double* values, std::size_t count) const override {
-    auto rebound = std::dynamic_pointer_cast<const ProgramEvaluator>(base_->with_parameters(values, count));
+    auto rebound = std::dynamic_pointer_cast<const TapeEvaluator>(base_->with_parameters(values, count));
     if (!rebound) return nullptr;
     return std::make_shared<CompiledEvaluator>(std::move(rebound), library_, rows_);
   }
@@ -374,12 +374,12 @@ class CompiledEvaluator final : public Evaluator {
   void solution(double t, double* scratch, double* qva) const override { base_->solution(t, scratch, qva); }
 
  private:
-  std::shared_ptr<const ProgramEvaluator> base_;
+  std::shared_ptr<const TapeEvaluator> base_;
   std::shared_ptr<const Library> library_;
   bool sparse_ = false;
   std::vector<double> stage_;  // what the terms read of the parameter stage (one spare entry)
   RowPrograms rows_;
-  std::array<std::vector<double>, kRowPrograms> row_stages_;  // their parameter stages
+  std::array<std::vector<double>, kRowTapes> row_stages_;  // their parameter stages
 };
 
 }  // namespace
@@ -398,13 +398,13 @@ namespace {
 
 // The C++ source of a model: its terms, and the programs of the output rows (a compiled model
 // computes its rows compiled too).
-std::string model_source(const ProgramEvaluator& base, const Model& model) {
-  std::string source = make_terms_source(base.parametric_programs().terms, base.n(), base.s(), base.sparsity());
-  for (int i = 0; i < kRowPrograms; ++i)
-    if (const Program* program = row_program(base.parametric_programs(), i))
-      source += make_program_source(kRowProgramNames[i], *program);
-  if (model.contact_forces) source += make_program_source("contact", model.contact_forces->program);
-  if (!model.outputs.list.empty()) source += make_program_source("outputs", model.outputs.program);
+std::string model_source(const TapeEvaluator& base, const Model& model) {
+  std::string source = make_terms_source(base.parametric_tapes().terms, base.n(), base.s(), base.sparsity());
+  for (int i = 0; i < kRowTapes; ++i)
+    if (const Tape* program = row_tape(base.parametric_tapes(), i))
+      source += make_tape_source(kRowTapeNames[i], *program);
+  if (model.contact_forces) source += make_tape_source("contact", model.contact_forces->program);
+  if (!model.outputs.list.empty()) source += make_tape_source("outputs", model.outputs.program);
   return source;
 }
 
@@ -535,7 +535,7 @@ std::shared_ptr<Library> compile_entry(const std::string& source, const std::str
 }
 
 // The model with the library's functions in place of its programs.
-Model bind_library(const Model& model, std::shared_ptr<const ProgramEvaluator> base, std::shared_ptr<Library> library,
+Model bind_library(const Model& model, std::shared_ptr<const TapeEvaluator> base, std::shared_ptr<Library> library,
                    const fs::path& object) {
   Model out = model;
   if (model.contact_forces) {
@@ -549,11 +549,11 @@ Model bind_library(const Model& model, std::shared_ptr<const ProgramEvaluator> b
     if (!out.outputs.native) throw JitError(fmt::format("{} lacks the outputs' program", object.string()));
   }
   RowPrograms rows;
-  for (int i = 0; i < kRowPrograms; ++i) {
-    if (!row_program(base->parametric_programs(), i)) continue;
-    rows[static_cast<std::size_t>(i)] = native_program(library, kRowProgramNames[i]);
+  for (int i = 0; i < kRowTapes; ++i) {
+    if (!row_tape(base->parametric_tapes(), i)) continue;
+    rows[static_cast<std::size_t>(i)] = native_program(library, kRowTapeNames[i]);
     if (!rows[static_cast<std::size_t>(i)])
-      throw JitError(fmt::format("{} lacks the program {}", object.string(), kRowProgramNames[i]));
+      throw JitError(fmt::format("{} lacks the program {}", object.string(), kRowTapeNames[i]));
   }
   out.evaluator = std::make_shared<CompiledEvaluator>(std::move(base), std::move(library), std::move(rows));
   return out;
@@ -562,7 +562,7 @@ Model bind_library(const Model& model, std::shared_ptr<const ProgramEvaluator> b
 }  // namespace
 
 Model make_compiled(const Model& model, const JitOptions& options, JitReport* report) {
-  auto base = std::dynamic_pointer_cast<const ProgramEvaluator>(model.evaluator);
+  auto base = std::dynamic_pointer_cast<const TapeEvaluator>(model.evaluator);
   if (!base)
     throw JitError(fmt::format("model '{}' has no compiled programs (a hand-written built-in model): nothing to "
                                "compile",
@@ -595,7 +595,7 @@ Model make_compiled(const Model& model, const JitOptions& options, JitReport* re
 Model with_evaluator(const Model& model, EvaluatorChoice choice, std::string* notice, const JitOptions& options,
                      JitReport* report) {
   if (choice == EvaluatorChoice::interpreted) return model;
-  const auto* base = dynamic_cast<const ProgramEvaluator*>(model.evaluator.get());
+  const auto* base = dynamic_cast<const TapeEvaluator*>(model.evaluator.get());
   if (base == nullptr) {
     if (choice == EvaluatorChoice::compiled && notice)
       *notice = fmt::format(
@@ -603,7 +603,7 @@ Model with_evaluator(const Model& model, EvaluatorChoice choice, std::string* no
     return model;
   }
   if (choice == EvaluatorChoice::automatic &&
-      base->parametric_programs().terms.code().size() < static_cast<std::size_t>(kAutoCompileFrom))
+      base->parametric_tapes().terms.code().size() < static_cast<std::size_t>(kAutoCompileFrom))
     return model;
   // Asked for or worth it: compiled where possible, and otherwise the interpreter with a notice —
   // a missing compiler or a failed compile never fails a run (make_compiled reports it as an error).

@@ -14,10 +14,10 @@
 // compiler's whole process group, removes its source, log and temporary object, and then lets the
 // signal take its course. The programs of an output row go into the same object, so a compiled
 // model computes its rows compiled too: the residuals, the energy, h and the power (the
-// evaluator's), the contact forces' and the derived outputs' programs (NativeProgram, set on the
+// evaluator's), the contact forces' and the derived outputs' programs (NativeTape, set on the
 // Model's ContactForceModel and ModelOutputs). The other programs (complement, solution, initial
 // state, program constraints) and the parameter handling stay with the interpreter, whose
-// ProgramEvaluator the compiled evaluator wraps; so every formulation, the sparse path and
+// TapeEvaluator the compiled evaluator wraps; so every formulation, the sparse path and
 // linearization's finite differences work unchanged.
 #pragma once
 

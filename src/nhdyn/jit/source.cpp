@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "nhdyn/model/program_printer.hpp"
+#include "nhdyn/model/tape_printer.hpp"
 
 namespace nhdyn::jit {
 namespace {
@@ -19,10 +19,10 @@ std::string literal(double x) {
   return x < 0 || std::signbit(x) ? fmt::format("({:a})", x) : fmt::format("{:a}", x);
 }
 
-// The compiled evaluator's spelling of a program (program_printer.hpp): exact hexadecimal literals,
+// The compiled evaluator's spelling of a program (tape_printer.hpp): exact hexadecimal literals,
 // the parameters from p, the stage's results from m.
-ProgramPrintStyle jit_style() {
-  ProgramPrintStyle style;
+TapePrintStyle jit_style() {
+  TapePrintStyle style;
   style.literal = literal;
   style.parameter = [](int i) { return fmt::format("p[{}]", i); };
   style.stored = [](int, int place) { return fmt::format("m[{}]", place); };
@@ -31,21 +31,21 @@ ProgramPrintStyle jit_style() {
 }
 
 // The stage: every stage instruction, then the registers a call reads stored in m.
-std::string stage_body(const ProgramPrinter& printer) { return printer.statements(true, "  "); }
+std::string stage_body(const TapePrinter& printer) { return printer.statements(true, "  "); }
 
 // The call: every other instruction, then the outputs through `destination(j)`.
 template <class Destination>
-std::string call_body(const ProgramPrinter& printer, Destination destination) {
+std::string call_body(const TapePrinter& printer, Destination destination) {
   std::string out = printer.statements(false, "  ");
-  for (int j = 0; j < printer.program().outputs(); ++j)
+  for (int j = 0; j < printer.tape().outputs(); ++j)
     out += fmt::format("  {} = {};\n", destination(j), printer.output(j));
   return out;
 }
 
 }  // namespace
 
-std::string make_terms_source(const Program& terms, int n, int s, const TermsSparsity* sparsity) {
-  const ProgramPrinter printer(terms, jit_style());
+std::string make_terms_source(const Tape& terms, int n, int s, const TermsSparsity* sparsity) {
+  const TapePrinter printer(terms, jit_style());
   const int a_size = sparsity ? sparsity->A.nonzeros() : n * n;
   const int b_size = sparsity ? sparsity->b.nonzeros() : s * n;
   // Output j -> where it goes: A, Q, G, b, b0 one after the other; with `dense`, a sparse
@@ -93,8 +93,8 @@ std::string make_terms_source(const Program& terms, int n, int s, const TermsSpa
   return out;
 }
 
-std::string make_program_source(const std::string& name, const Program& program) {
-  const ProgramPrinter printer(program, jit_style());
+std::string make_tape_source(const std::string& name, const Tape& program) {
+  const TapePrinter printer(program, jit_style());
   std::string out = fmt::format("\n// The program '{}'.\nextern \"C\" {{\n", name);
   out += fmt::format("std::size_t nhdyn_jit_{}_stage_size(void) {{ return {}; }}\n", name, printer.stored_count());
   out += fmt::format("void nhdyn_jit_{}_stage([[maybe_unused]] const double* p, [[maybe_unused]] double* m) {{\n", name);

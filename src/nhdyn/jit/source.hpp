@@ -1,5 +1,5 @@
 // The C++ source of a model's terms program for the compiled evaluator (compiled_evaluator.hpp):
-// the parametric terms program (model/program.hpp) printed as straight-line code behind a C
+// the parametric terms program (model/tape.hpp) printed as straight-line code behind a C
 // interface, so the shared object needs no header of the library and no C++ ABI across dlopen.
 // What depends on parameters and constants only (the parameter stage) is a function of its own,
 // run once per parameter change; the call reads its results from an array. Operations and their
@@ -9,7 +9,7 @@
 
 #include <string>
 
-#include "nhdyn/model/program.hpp"
+#include "nhdyn/model/tape.hpp"
 
 namespace nhdyn::jit {
 
@@ -26,15 +26,15 @@ inline constexpr int kInterfaceVersion = 2;
 //   void   nhdyn_jit_terms_dense(...)           the same signature, A and b dense (every entry
 //          the caller has zeroed); only for a sparse program
 // n, s: the model's dimensions; `sparsity` null for a dense program.
-std::string make_terms_source(const Program& terms, int n, int s, const TermsSparsity* sparsity);
+std::string make_terms_source(const Tape& terms, int n, int s, const TermsSparsity* sparsity);
 
-// Another program of the model (the contact forces', the derived outputs') to append to the terms'
-// source, so that a model's output rows run compiled as its terms do (NativeProgram in
-// model/program.hpp). It defines, for NAME:
+// Another tape of the model (the contact forces', the derived outputs') to append to the terms'
+// source, so that a model's output rows run compiled as its terms do (NativeTape in
+// model/tape.hpp). It defines, for NAME:
 //   size_t nhdyn_jit_NAME_stage_size(void)
 //   void   nhdyn_jit_NAME_stage(const double* p, double* m)
 //   void   nhdyn_jit_NAME(const double* m, double t, const double* q, const double* v, double* out)
-//          out: the program's outputs in order (Program::run's)
-std::string make_program_source(const std::string& name, const Program& program);
+//          out: the tape's outputs in order (Tape::run's)
+std::string make_tape_source(const std::string& name, const Tape& program);
 
 }  // namespace nhdyn::jit

@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "nhdyn/core/types.hpp"
-#include "nhdyn/model/program.hpp"
+#include "nhdyn/model/tape.hpp"
 
 namespace nhdyn {
 
@@ -87,9 +87,9 @@ struct ContactForceModel {
   // Per reported contact (in the order of `contacts` that are reported), one flag per component
   // (at its first_value): whether the model determines that component (else it is NaN).
   std::vector<char> determined;
-  Program program;             // parametric: reads the model's parameters (bound by make_data)
+  Tape program;             // parametric: reads the model's parameters (bound by make_data)
   // `program` compiled (jit::make_compiled), run in its place when set; null for the interpreter.
-  std::shared_ptr<const NativeProgram> native;
+  std::shared_ptr<const NativeTape> native;
   // What loading found about the forces not determined, one line each (empty when all are).
   std::vector<std::string> notes;
 
@@ -110,7 +110,7 @@ struct ContactForceModel {
 struct ContactForceData {
   bool active = false;       // the model has contact forces
   std::vector<double> stage; // ContactForceModel::native's parameter stage (empty without it)
-  Program program;           // ContactForceModel::program bound to the model's parameter values
+  Tape program;           // ContactForceModel::program bound to the model's parameter values
   std::vector<double> registers;
   std::vector<double> outputs;
   Matrix M;                  // rows() x columns(), the stacked system, moment rows divided by L

@@ -27,29 +27,29 @@ struct DenseWorkspace {
 
 DenseWorkspace dense_workspace(const DataOptions& options) {
   DenseWorkspace w;
-  const auto wants = [&](Method m) { return !options.method || *options.method == m; };
-  w.stacked = wants(Method::sanh);
-  w.complement = wants(Method::sanh) || wants(Method::nullspace);
-  w.kkt = wants(Method::lagrange) || options.projection;
-  w.gauss = wants(Method::udwadia_kalaba);
-  w.reduced = wants(Method::nullspace);
+  const auto wants = [&](Formulation m) { return !options.method || *options.method == m; };
+  w.stacked = wants(Formulation::sanh);
+  w.complement = wants(Formulation::sanh) || wants(Formulation::nullspace);
+  w.kkt = wants(Formulation::lagrange) || options.projection;
+  w.gauss = wants(Formulation::udwadia_kalaba);
+  w.reduced = wants(Formulation::nullspace);
   w.orthogonal = w.complement || w.gauss;
   return w;
 }
 
 std::string methods_with_sparse_kernels() { return "sanh, lagrange"; }
 
-const char* method_label(Method m) {
+const char* method_label(Formulation m) {
   switch (m) {
-    case Method::sanh: return "sanh";
-    case Method::lagrange: return "lagrange";
-    case Method::udwadia_kalaba: return "udwadia-kalaba";
-    case Method::nullspace: return "nullspace";
+    case Formulation::sanh: return "sanh";
+    case Formulation::lagrange: return "lagrange";
+    case Formulation::udwadia_kalaba: return "udwadia-kalaba";
+    case Formulation::nullspace: return "nullspace";
   }
   return "?";
 }
 
-bool has_sparse_kernels(Method m) { return m == Method::sanh || m == Method::lagrange; }
+bool has_sparse_kernels(Formulation m) { return m == Formulation::sanh || m == Formulation::lagrange; }
 
 // A sparse matrix on `pattern` (values zero), built without triplets: the pattern is already in
 // compressed columns.

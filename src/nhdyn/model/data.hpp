@@ -38,9 +38,14 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 using SparseLU = Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>>;
 using SparseLLT = Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>;
 
-// The formulations (formulation/formulation.hpp says what each one solves). Declared here because
-// make_data sizes the workspace of the one it is asked for.
-enum class Method { sanh, lagrange, udwadia_kalaba, nullspace };
+// The formulations (formulation/formulation.hpp says what each one solves, and kFormulations
+// there their names). Declared here, below formulation/, because make_data sizes the workspace of
+// the one it is asked for and model/ may not include formulation/ (docs/design.md, "Choices and
+// their reasons").
+// The option that chooses one keeps its name `method` (--method, method=, [simulation] method).
+enum class Formulation { sanh, lagrange, udwadia_kalaba, nullspace };
+// The former name of Formulation, kept for C++ users for one release.
+using Method [[deprecated("nhdyn::Method is now nhdyn::Formulation")]] = Formulation;
 
 // Which kernels a Data is made for: `automatic` takes the sparse path for a model compiled sparse
 // (Evaluator::sparsity() not null) and a formulation that has sparse kernels (sanh, lagrange),
@@ -51,7 +56,7 @@ struct DataOptions {
   Path path = Path::automatic;
   // The formulation the Data will run. Empty: the workspace of every formulation (dense path),
   // for tools and tests that switch formulations on one Data.
-  std::optional<Method> method;
+  std::optional<Formulation> method;
   // The KKT workspace of compute_projection (analysis/projection.hpp): (n + s)^2 on the dense
   // path. Always there on the sparse path, where it costs O(nonzeros).
   bool projection = true;
@@ -97,7 +102,7 @@ struct ProgramMotionData {
 struct Data {
   // --- how this Data was made (make_data) ---------------------------------------------------------
   bool sparse = false;           // the sparse path: A_sparse, b_sparse and the sparse workspace
-  std::optional<Method> method;  // the formulation sized for; empty: every formulation
+  std::optional<Formulation> method;  // the formulation sized for; empty: every formulation
   bool projection_workspace = false;  // whether compute_projection may run on this Data
 
   // --- state, set by compute_terms -------------------------------------------------------------

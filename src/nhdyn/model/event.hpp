@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "nhdyn/model/program.hpp"
+#include "nhdyn/model/tape.hpp"
 
 namespace nhdyn {
 
@@ -29,7 +29,7 @@ struct Event {
   // Written as a condition (lhs > rhs) that becomes true at the crossing: a run whose initial state
   // already satisfies it is refused rather than stopped at once.
   bool condition = false;
-  Program g;  // one output, g(t, q, q'); reads the model's parameters (bind before running)
+  Tape g;  // one output, g(t, q, q'); reads the model's parameters (bind before running)
   // g reads q'' or the reactions R (through an output, model/output.hpp): g is then in the
   // dynamics layout (2n coordinates, [q; q''] and [q'; R]) and each evaluation solves the dynamics
   // at the state first (analysis/events.hpp).

@@ -88,7 +88,7 @@ struct ContactCoordinates {
 struct ContactWatch {
   std::string contact;
   std::string where;
-  Program measure;
+  Tape measure;
   double threshold = 0.0;
   std::string reason;
 };

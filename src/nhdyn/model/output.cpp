@@ -16,7 +16,7 @@ OutputData make_output_data(const Model& model) {
   if (model.outputs.list.empty()) return d;
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
-  const Program& program = model.outputs.program;
+  const Tape& program = model.outputs.program;
   d.program = program.reads_parameters() ? program.bind(values.data(), values.size()) : program;
   d.registers.assign(static_cast<std::size_t>(d.program.registers()), 0.0);
   if (model.outputs.native) {

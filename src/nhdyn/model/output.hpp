@@ -9,7 +9,7 @@
 //                                                          --compute_outputs--> Data::outputs.values
 //
 // A program that reads q'' or R (an output's, or an event's, model/event.hpp) uses the "dynamics
-// layout" below: it is a Program of 2n coordinates whose coordinate inputs are [q; q''] and whose
+// layout" below: it is a Tape of 2n coordinates whose coordinate inputs are [q; q''] and whose
 // velocity inputs are [q'; R]. Its caller packs those from a solved state (pack_dynamics_inputs).
 #pragma once
 
@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "nhdyn/core/types.hpp"
-#include "nhdyn/model/program.hpp"
+#include "nhdyn/model/tape.hpp"
 
 namespace nhdyn {
 
@@ -36,15 +36,15 @@ struct ModelOutputs {
   std::vector<DerivedOutput> list;  // in column order
   // One output per entry of `list`, in the dynamics layout (2n coordinates: [q; q''], [q'; R]);
   // reads the model's parameters (bind before running). Empty program when `list` is.
-  Program program = Program();
+  Tape program = Tape();
   // `program` compiled (jit::make_compiled), run in its place when set; null for the interpreter.
-  std::shared_ptr<const NativeProgram> native;
+  std::shared_ptr<const NativeTape> native;
   int count() const { return static_cast<int>(list.size()); }
 };
 
 // The evaluation state of the outputs for one Data (make_output_data, from make_data).
 struct OutputData {
-  Program program = Program();    // ModelOutputs::program bound to the parameter values
+  Tape program = Tape();    // ModelOutputs::program bound to the parameter values
   std::vector<double> x, xd;       // 2n each: [q; q''] and [q'; R] (pack_dynamics_inputs)
   std::vector<double> registers;   // program.registers()
   std::vector<double> stage;       // ModelOutputs::native's parameter stage (empty without it)

@@ -5,7 +5,7 @@
 // written here and nowhere else.
 //
 // The formulation, complement and integrator are kept by name: their enums live in formulation/
-// and integrators/, above this module, and parse_method / parse_complement / parse_integrator turn
+// and integrators/, above this module, and parse_formulation / parse_complement / parse_integrator turn
 // the names into them (make_simulation_options in analysis/simulation.hpp). A model file's names
 // are checked when it is loaded (frontend/load_model.hpp), so a bad name is reported with its file.
 #pragma once

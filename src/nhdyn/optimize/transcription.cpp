@@ -13,7 +13,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
-#include "nhdyn/model/program_tangent.hpp"
+#include "nhdyn/model/tape_tangent.hpp"
 
 namespace nhdyn {
 namespace {
@@ -24,14 +24,14 @@ double nlp_bound(double b) { return std::isfinite(b) ? b : (b > 0 ? kNlpInfinity
 
 Transcription::Transcription(const OptimalControlProblem& problem) : problem_(problem) {
   const Model& model = problem_.model;
-  const auto* programs = dynamic_cast<const ProgramEvaluator*>(model.evaluator.get());
+  const auto* programs = dynamic_cast<const TapeEvaluator*>(model.evaluator.get());
   if (programs == nullptr) throw InputError("optimize needs a model compiled from a model file");
   if (programs->sparsity() != nullptr)
     throw InputError(fmt::format("optimize takes models compiled dense; {} is compiled sparse ({} coordinates)",
                                  model.name, model.n()));
-  terms_ = &programs->programs().terms;
-  position_residual_ = &programs->programs().position_residual;
-  velocity_residual_ = &programs->programs().velocity_residual;
+  terms_ = &programs->tapes().terms;
+  position_residual_ = &programs->tapes().position_residual;
+  velocity_residual_ = &programs->tapes().velocity_residual;
   n_ = model.n();
   m_ = problem_.m();
   s_ = model.s();
@@ -45,7 +45,7 @@ Transcription::Transcription(const OptimalControlProblem& problem) : problem_(pr
   path_count_ = static_cast<int>(problem_.path_constraints.size());
 
   std::size_t registers = 0;
-  for (const Program* program : std::initializer_list<const Program*>{terms_, position_residual_, velocity_residual_,
+  for (const Tape* program : std::initializer_list<const Tape*>{terms_, position_residual_, velocity_residual_,
                                  &problem_.force, &problem_.integrand, &problem_.path})
     registers = std::max(registers, static_cast<std::size_t>(program->registers()));
   if (problem_.final_term) registers = std::max(registers, static_cast<std::size_t>(problem_.final_term->registers()));
@@ -433,7 +433,7 @@ bool Transcription::gradient(const double* x, double* grad) {
   const double T = duration(x);
   const double h = T / intervals_;
   double value = 0.0, dvalue = 0.0, dT = 0.0;
-  const auto differentiate = [&](const Program& program, int p, double w) {
+  const auto differentiate = [&](const Tape& program, int p, double w) {
     layout_inputs(p, x);
     program.run(time(p, x), layout_q_.data(), layout_v_.data(), other_registers_.data(), &value);
     for (int c = 0; c < 2 * n_ + m_; ++c) {

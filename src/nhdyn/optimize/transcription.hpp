@@ -14,7 +14,7 @@
 // Boundary values and bounds are bounds on the variables; a fixed final value that the constraints
 // determine from the other fixed final values is released (the rank rule of section 5, item 1). The objective is the quadrature (O8) of
 // the integrand plus the final term (or T for minimum time). Every derivative is exact: the
-// tangent mode of the compiled programs (model/program_tangent.hpp), contracted as in (O5), (O7),
+// tangent mode of the compiled programs (model/tape_tangent.hpp), contracted as in (O5), (O7),
 // so that no derivative of D is needed; the Hessian of the Lagrangian from forward differences of
 // these exact first derivatives (section 8). Plain C++, no solver types.
 #pragma once
@@ -124,9 +124,9 @@ class Transcription final : public Nlp {
   std::vector<double> jac_work_, hess_x_, hess_plus_, hess_minus_, hess_blocks_, hess_step_;
 
   // Work arrays (sized once).
-  const Program* terms_ = nullptr;
-  const Program* position_residual_ = nullptr;
-  const Program* velocity_residual_ = nullptr;
+  const Tape* terms_ = nullptr;
+  const Tape* position_residual_ = nullptr;
+  const Tape* velocity_residual_ = nullptr;
   std::vector<double> terms_registers_, force_registers_, velocity_registers_, other_registers_, tangents_;
   std::vector<double> terms_out_, dterms_, force_out_, dforce_;
   std::vector<double> layout_q_, layout_v_, layout_dq_, layout_dv_;

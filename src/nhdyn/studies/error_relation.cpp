@@ -10,14 +10,14 @@
 namespace nhdyn {
 
 std::string formulation_label(const StudyFormulation& formulation) {
-  if (formulation.method != Method::sanh) return std::string(method_name(formulation.method));
+  if (formulation.method != Formulation::sanh) return std::string(formulation_name(formulation.method));
   return fmt::format("sanh-{}", complement_name(formulation.complement));
 }
 
 std::vector<StudyFormulation> calc_study_formulations(const Model& model) {
-  std::vector<StudyFormulation> out{{Method::sanh, Complement::qr}, {Method::sanh, Complement::partition}};
-  if (model.evaluator->has_complement()) out.push_back({Method::sanh, Complement::analytic});
-  for (Method m : {Method::lagrange, Method::udwadia_kalaba, Method::nullspace}) out.push_back({m, Complement::qr});
+  std::vector<StudyFormulation> out{{Formulation::sanh, Complement::qr}, {Formulation::sanh, Complement::partition}};
+  if (model.evaluator->has_complement()) out.push_back({Formulation::sanh, Complement::analytic});
+  for (Formulation m : {Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace}) out.push_back({m, Complement::qr});
   return out;
 }
 
@@ -49,7 +49,7 @@ ErrorRelation study_error_relation(const Model& model, const ErrorRelationOption
   for (std::size_t i = 0; i < options.formulations.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (options.formulations[i].method == options.formulations[j].method &&
-          (options.formulations[i].method != Method::sanh ||
+          (options.formulations[i].method != Formulation::sanh ||
            options.formulations[i].complement == options.formulations[j].complement))
         throw InputError(fmt::format("formulation {} is given twice; give each once",
                                      formulation_label(options.formulations[i])));

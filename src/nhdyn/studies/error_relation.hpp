@@ -15,7 +15,7 @@ namespace nhdyn {
 
 // One formulation: the method, and for sanh where its complement D comes from.
 struct StudyFormulation {
-  Method method = Method::sanh;
+  Formulation method = Formulation::sanh;
   Complement complement = Complement::qr;
 };
 

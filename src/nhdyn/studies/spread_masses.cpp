@@ -90,12 +90,12 @@ SpreadMasses study_spread_masses(const symbolic::Spec& spec, const SpreadMassesO
   out.formulations = options.formulations;
   const bool analytic = derivation.D.has_value();
   if (out.formulations.empty()) {
-    out.formulations = {{Method::sanh, Complement::qr}, {Method::sanh, Complement::partition}};
-    if (analytic) out.formulations.push_back({Method::sanh, Complement::analytic});
-    for (Method m : {Method::lagrange, Method::udwadia_kalaba, Method::nullspace}) out.formulations.push_back({m, Complement::qr});
+    out.formulations = {{Formulation::sanh, Complement::qr}, {Formulation::sanh, Complement::partition}};
+    if (analytic) out.formulations.push_back({Formulation::sanh, Complement::analytic});
+    for (Formulation m : {Formulation::lagrange, Formulation::udwadia_kalaba, Formulation::nullspace}) out.formulations.push_back({m, Complement::qr});
   }
   for (const StudyFormulation& f : out.formulations)
-    if (f.complement == Complement::analytic && f.method == Method::sanh && !analytic)
+    if (f.complement == Complement::analytic && f.method == Formulation::sanh && !analytic)
       throw InputError(fmt::format("model '{}' gives no analytic complement D, so {} cannot run; leave it out",
                                    spec.name, formulation_label(f)));
   out.states = make_spread_masses_states(spec, options.parameter, options.samples);

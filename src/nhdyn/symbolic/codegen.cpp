@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/model/program.hpp"
-#include "nhdyn/model/program_printer.hpp"
+#include "nhdyn/model/tape.hpp"
+#include "nhdyn/model/tape_printer.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 
 namespace nhdyn::symbolic {
@@ -111,12 +111,12 @@ std::string comment_text(const std::string& s) {
   return out;
 }
 
-// How codegen spells a program (model/program_printer.hpp): its parameter stage is computed once
+// How codegen spells a program (model/tape_printer.hpp): its parameter stage is computed once
 // per parameter change, in the evaluator's constructor, into members named <prefix>rN_; the calls
 // compute the rest. Parameters read as p_.<field>; constants are declared where read, with
 // literals that read back to the same value.
-ProgramPrintStyle codegen_style(const std::string& prefix, const std::vector<std::string>& fields) {
-  ProgramPrintStyle style;
+TapePrintStyle codegen_style(const std::string& prefix, const std::vector<std::string>& fields) {
+  TapePrintStyle style;
   style.literal = literal;
   style.parameter = [fields](int i) { return "p_." + fields[static_cast<std::size_t>(i)]; };
   style.stored = [prefix](int r, int) { return prefix + "r" + std::to_string(r) + "_"; };
@@ -125,13 +125,13 @@ ProgramPrintStyle codegen_style(const std::string& prefix, const std::vector<std
 }
 
 // hoist = false: no stage, every instruction in the call (a program that runs once anyway).
-ProgramPrinter make_printer(const Program& program, const std::string& prefix, const std::vector<std::string>& fields,
+TapePrinter make_printer(const Tape& program, const std::string& prefix, const std::vector<std::string>& fields,
                             bool hoist = true) {
-  return ProgramPrinter(program, codegen_style(prefix, fields), hoist);
+  return TapePrinter(program, codegen_style(prefix, fields), hoist);
 }
 
 // The declarations of a program's stage members.
-std::string members(const ProgramPrinter& printer) {
+std::string members(const TapePrinter& printer) {
   std::string out;
   for (const std::pair<int, int>& stored : printer.stored_registers())
     out += fmt::format("  double {} = 0.0;\n", printer.stored(stored.first));
@@ -144,8 +144,8 @@ struct Body {
 };
 
 // The statements of a program's call, then `sink(i, register)` for each output i.
-Body print_body(const ProgramPrinter& printer, const std::function<std::string(int, const std::string&)>& sink) {
-  const Program& program = printer.program();
+Body print_body(const TapePrinter& printer, const std::function<std::string(int, const std::string&)>& sink) {
+  const Tape& program = printer.tape();
   Body body;
   body.reads_t = program.reads_time();
   body.reads_q = program.reads_coordinates();
@@ -159,8 +159,8 @@ std::string parameter(bool used, const char* declaration, const char* name) {
   return used ? fmt::format("{} {}", declaration, name) : fmt::format("{} /*{}*/", declaration, name);
 }
 
-bool uses_powi(const ModelPrograms& p) {
-  const auto in = [](const Program& program) { return program.count(Op::powi) > 0; };
+bool uses_powi(const ModelTapes& p) {
+  const auto in = [](const Tape& program) { return program.count(Op::powi) > 0; };
   return in(p.terms) || (p.complement && in(*p.complement)) || in(p.position_residual) ||
          in(p.velocity_residual) || (p.energy && in(*p.energy)) || (p.initial_state && in(*p.initial_state));
 }
@@ -219,52 +219,52 @@ std::vector<std::string> split_namespace(const CodegenOptions& options) {
 
 // The names the generated code gives its model's parts, and the printers of its programs.
 struct Generated {
-  Generated(const Model& model_, const ModelPrograms& programs_, const std::string& id_)
+  Generated(const Model& model_, const ModelTapes& tapes_, const std::string& id_)
       : model(model_),
-        programs(programs_),
+        programs(tapes_),
         id(id_),
         cls(camel_case(id_) + "Evaluator"),
         parameters_struct(camel_case(id_) + "Parameters"),
         fields(parameter_fields(model_.parameters)),
-        terms_printer(make_printer(programs_.terms, "terms_", fields)),
-        complement_printer(programs_.complement
-                               ? std::optional<ProgramPrinter>(make_printer(*programs_.complement, "complement_", fields))
+        terms_printer(make_printer(tapes_.terms, "terms_", fields)),
+        complement_printer(tapes_.complement
+                               ? std::optional<TapePrinter>(make_printer(*tapes_.complement, "complement_", fields))
                                : std::nullopt),
-        phi_printer(make_printer(programs_.position_residual, "phi_", fields)),
-        f_printer(make_printer(programs_.velocity_residual, "f_", fields)),
-        energy_printer(programs_.energy
-                           ? std::optional<ProgramPrinter>(make_printer(*programs_.energy, "energy_", fields))
+        phi_printer(make_printer(tapes_.position_residual, "phi_", fields)),
+        f_printer(make_printer(tapes_.velocity_residual, "f_", fields)),
+        energy_printer(tapes_.energy
+                           ? std::optional<TapePrinter>(make_printer(*tapes_.energy, "energy_", fields))
                            : std::nullopt),
-        initial_printer(programs_.initial_state ? std::optional<ProgramPrinter>(make_printer(
-                                                      *programs_.initial_state, "initial_", fields, false))
+        initial_printer(tapes_.initial_state ? std::optional<TapePrinter>(make_printer(
+                                                      *tapes_.initial_state, "initial_", fields, false))
                                                 : std::nullopt) {}
 
   std::string q_name(int i) const { return comment_text(model.coordinates[static_cast<std::size_t>(i)]); }
   std::string c_name(int i) const { return comment_text(model.constraints[static_cast<std::size_t>(i)].name); }
 
   const Model& model;
-  const ModelPrograms& programs;
+  const ModelTapes& programs;
   const std::string id;
   const std::string cls;
   const std::string parameters_struct;
   const std::vector<std::string> fields;
-  const ProgramPrinter terms_printer;
-  const std::optional<ProgramPrinter> complement_printer;
-  const ProgramPrinter phi_printer;
-  const ProgramPrinter f_printer;
-  const std::optional<ProgramPrinter> energy_printer;
-  const std::optional<ProgramPrinter> initial_printer;
+  const TapePrinter terms_printer;
+  const std::optional<TapePrinter> complement_printer;
+  const TapePrinter phi_printer;
+  const TapePrinter f_printer;
+  const std::optional<TapePrinter> energy_printer;
+  const std::optional<TapePrinter> initial_printer;
 };
 
 // The file's opening comment (what it was made from, its operation counts) and its includes.
 std::string file_head(const Generated& g) {
   const Model& model = g.model;
-  const ModelPrograms& programs = g.programs;
+  const ModelTapes& programs = g.programs;
   std::string out;
   out += fmt::format("// Generated by nhdyn (symbolic/codegen.hpp) from the model '{}'. Do not edit: regenerate.\n",
                      comment_text(model.name));
   if (!model.description.empty()) out += fmt::format("// {}\n", comment_text(model.description));
-  const auto operations = [](const Program& p) { return p.code().size() - static_cast<std::size_t>(p.count(Op::nop)); };
+  const auto operations = [](const Tape& p) { return p.code().size() - static_cast<std::size_t>(p.count(Op::nop)); };
   out += fmt::format("// Operations: terms {}, complement {}, residuals {} + {}, energy {}.\n",
                      operations(programs.terms), programs.complement ? operations(*programs.complement) : 0,
                      operations(programs.position_residual), operations(programs.velocity_residual),
@@ -302,7 +302,7 @@ std::string evaluator_head_code(const Generated& g) {
   {
     std::string stage;
     // One block per program: each numbers its registers from its own inputs.
-    const auto add_stage = [&stage](const ProgramPrinter& printer) {
+    const auto add_stage = [&stage](const TapePrinter& printer) {
       const std::string statements = printer.statements(true, "      ");
       if (!statements.empty()) stage += "    {\n" + statements + "    }\n";
     };
@@ -337,7 +337,7 @@ std::string evaluator_head_code(const Generated& g) {
 // The evaluator's kernels: terms, complement, residuals, energy.
 std::string evaluator_kernels_code(const Generated& g) {
   const Model& model = g.model;
-  const ModelPrograms& programs = g.programs;
+  const ModelTapes& programs = g.programs;
   const int n = model.n(), s = model.s();
   const auto q_name = [&](int i) { return g.q_name(i); };
   const auto c_name = [&](int i) { return g.c_name(i); };
@@ -407,7 +407,7 @@ std::string evaluator_kernels_code(const Generated& g) {
 
 // The evaluator's members: the parameters, each program's parameter stage, powi if used.
 std::string evaluator_members_code(const Generated& g) {
-  const ModelPrograms& programs = g.programs;
+  const ModelTapes& programs = g.programs;
   std::string out;
   out += "\n private:\n";
   out += fmt::format("  {} p_;\n", g.parameters_struct);
@@ -416,7 +416,7 @@ std::string evaluator_members_code(const Generated& g) {
   out += members(g.phi_printer) + members(g.f_printer);
   if (g.energy_printer) out += members(*g.energy_printer);
   if (uses_powi(programs)) {
-    // The interpreter's algorithm (model/program.cpp), so that both round alike.
+    // The interpreter's algorithm (model/tape.cpp), so that both round alike.
     out += "  // a^n by repeated squaring, n != 0.\n";
     out += "  static double powi(double a, int n) {\n";
     out += "    unsigned m = n < 0 ? 0u - static_cast<unsigned>(n) : static_cast<unsigned>(n);\n";
@@ -431,7 +431,7 @@ std::string evaluator_members_code(const Generated& g) {
 // make_<id>_model: the Model with the generated evaluator.
 std::string make_model_code(const Generated& g) {
   const Model& model = g.model;
-  const ModelPrograms& programs = g.programs;
+  const ModelTapes& programs = g.programs;
   const int n = model.n();
   const std::string& id = g.id;
   std::string out;
@@ -478,9 +478,9 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
     throw InputError(fmt::format("codegen: model '{}' has programs ([[programs]]), which generated code does not "
                                  "carry yet; run it through the interpreted evaluator (nhdyn simulate)",
                                  model.name));
-  const auto* evaluator = dynamic_cast<const ProgramEvaluator*>(model.evaluator.get());
-  if (evaluator == nullptr) throw std::logic_error("generate_code: compile_model did not make a ProgramEvaluator");
-  const Generated g(model, evaluator->parametric_programs(), id);
+  const auto* evaluator = dynamic_cast<const TapeEvaluator*>(model.evaluator.get());
+  if (evaluator == nullptr) throw std::logic_error("generate_code: compile_model did not make a TapeEvaluator");
+  const Generated g(model, evaluator->parametric_tapes(), id);
 
   std::string out = file_head(g);
   for (const std::string& part : namespaces) out += fmt::format("namespace {} {{\n", part);

@@ -1,4 +1,4 @@
-// Compilation of GiNaC expressions into straight-line programs (model/program.hpp).
+// Compilation of GiNaC expressions into tapes, straight-line code on doubles (model/tape.hpp).
 //
 // Parameters stay symbols: each becomes a `parameter` instruction, which the evaluator binds to
 // the Model's current values (so a parameter changes without recompiling). The constants (pi) are
@@ -34,12 +34,12 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/model/parameters.hpp"
-#include "nhdyn/model/program.hpp"
-#include "nhdyn/symbolic/plain_words.hpp"
+#include "nhdyn/model/tape.hpp"
 #include "nhdyn/symbolic/contact_forces.hpp"
 #include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "nhdyn/symbolic/outputs.hpp"
+#include "nhdyn/symbolic/plain_words.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
@@ -88,7 +88,7 @@ double numeric_value(const GiNaC::numeric& x) { return x.to_double(); }
 // Translated here, both become the same node times the same coefficient: the -1 of a sum moves
 // into the product, power or function that uses it (through an integer power by its parity,
 // through an odd function such as sin out of it, into an even one such as cos not at all), and
-// negation is exact, so the programs — and their rounding — are the same in every process.
+// negation is exact, so the tapes — and their rounding — are the same in every process.
 
 // c * node: a node times a coefficient (kOne for a plain number c).
 struct Scaled {
@@ -143,18 +143,18 @@ bool is_odd(Op op) {
 // f(-x) = f(x).
 bool is_even(Op op) { return op == Op::cos || op == Op::cosh || op == Op::abs; }
 
-// The translation of expressions of one spec into one Program.
-class ProgramCompiler {
+// The translation of expressions of one spec into one Tape.
+class TapeCompiler {
  public:
-  explicit ProgramCompiler(const Spec& spec)
-      : spec_(spec), program_(spec.n(), static_cast<int>(spec.parameters.size())) {
+  explicit TapeCompiler(const Spec& spec)
+      : spec_(spec), tape_(spec.n(), static_cast<int>(spec.parameters.size())) {
     for (std::size_t i = 0; i < spec.parameters.size(); ++i)
       parameters_.emplace(spec.symbols.parameter(spec.parameters[i].name), static_cast<int>(i));
     const SymbolTable& symbols = spec.symbols;
-    variables_.emplace(symbols.time(), Program::time_register());
+    variables_.emplace(symbols.time(), Tape::time_register());
     for (int i = 0; i < symbols.coordinates(); ++i) {
-      variables_.emplace(symbols.coordinate(i), program_.coordinate_register(i));
-      variables_.emplace(symbols.velocity(i), program_.velocity_register(i));
+      variables_.emplace(symbols.coordinate(i), tape_.coordinate_register(i));
+      variables_.emplace(symbols.velocity(i), tape_.velocity_register(i));
     }
     nodes_.emplace_back();  // kOne
     nodes_.back().key = 1;
@@ -163,7 +163,7 @@ class ProgramCompiler {
   // Compiles `e` (parameters still symbolic) into the next output; `what` names it in errors.
   void add_output(const GiNaC::ex& e, const std::string& what) {
     if (e.is_zero()) {
-      program_.add_constant_output(0.0);
+      tape_.add_constant_output(0.0);
       return;
     }
     what_ = what;
@@ -177,16 +177,16 @@ class ProgramCompiler {
       fail(fmt::format("cannot be evaluated: {}", plain_words(error.what())));
     }
     if (form.id == kOne)
-      program_.add_constant_output(form.c);
+      tape_.add_constant_output(form.c);
     else
-      program_.add_output(emit(form));
+      tape_.add_output(emit(form));
   }
 
   // An output that is NaN at every call (an expression that cannot be evaluated).
-  void add_nan_output() { program_.add_constant_output(std::numeric_limits<double>::quiet_NaN()); }
+  void add_nan_output() { tape_.add_constant_output(std::numeric_limits<double>::quiet_NaN()); }
 
   // The finished program, with each sin(x), cos(x) pair fused into one sincos.
-  Program finish() const { return fuse_sincos(program_); }
+  Tape finish() const { return fuse_sincos(tape_); }
 
  private:
   [[noreturn]] void fail(const std::string& message) const {
@@ -581,17 +581,17 @@ class ProgramCompiler {
   int emit_node(int id) {
     const Node& n = node(id);
     switch (n.kind) {
-      case Kind::symbol: return n.input >= 0 ? n.input : program_.push_parameter(n.parameter);
+      case Kind::symbol: return n.input >= 0 ? n.input : tape_.push_parameter(n.parameter);
       case Kind::add: return emit_add(id);
       case Kind::power: return emit_power(id);
       case Kind::function: {
         if (n.op == Op::atan2) {
           const Scaled x = n.items[1];
           const int y = emit(n.items[0]);
-          return program_.push(Op::atan2, y, emit(x));
+          return tape_.push(Op::atan2, y, emit(x));
         }
         const Op op = n.op;
-        return program_.push(op, emit(n.items[0]));
+        return tape_.push(op, emit(n.items[0]));
       }
       default: break;
     }
@@ -601,7 +601,7 @@ class ProgramCompiler {
   int constant(double value) {
     const auto found = constants_.find(hash_double(value));
     if (found != constants_.end()) return found->second;
-    const int r = program_.push_constant(value);
+    const int r = tape_.push_constant(value);
     constants_.emplace(hash_double(value), r);
     return r;
   }
@@ -618,7 +618,7 @@ class ProgramCompiler {
     // unless the whole product is needed elsewhere anyway.
     int acc;
     if (auto split = parameter_split(terms[0])) {
-      acc = program_.push(Op::mul, emit(split->first), emit(split->second));
+      acc = tape_.push(Op::mul, emit(split->first), emit(split->second));
     } else if (auto factors = fusable_factors(terms[0].id)) {
       acc = product(*factors, terms[0].c);
     } else {
@@ -629,8 +629,8 @@ class ProgramCompiler {
       const int rest = terms[i].id;
       if (auto split = parameter_split(terms[i])) {
         // (c p) * s + acc: the evaluator makes it k * s + acc, with the last multiplication of s
-        // inside (model/program.hpp), one step as when the parameters were numbers.
-        acc = program_.push(Op::muladd, emit(split->first), emit(split->second), acc);
+        // inside (model/tape.hpp), one step as when the parameters were numbers.
+        acc = tape_.push(Op::muladd, emit(split->first), emit(split->second), acc);
       } else if (auto factors = fusable_factors(rest)) {
         const Scaled last = factors->back();
         factors->pop_back();
@@ -644,18 +644,18 @@ class ProgramCompiler {
         }
         const int f = emit(last);
         if (c == 1.0)
-          acc = program_.push(Op::muladd, h, f, acc);
+          acc = tape_.push(Op::muladd, h, f, acc);
         else if (c == -1.0)
-          acc = program_.push(Op::mulsub, h, f, acc);
+          acc = tape_.push(Op::mulsub, h, f, acc);
         else
-          acc = program_.push(Op::mulk_muladd, h, f, acc, c);
+          acc = tape_.push(Op::mulk_muladd, h, f, acc, c);
       } else if (c == 1.0 || c == -1.0) {
-        acc = program_.push(c == 1.0 ? Op::add : Op::sub, acc, emit({1.0, rest}));
+        acc = tape_.push(c == 1.0 ? Op::add : Op::sub, acc, emit({1.0, rest}));
       } else {
-        acc = program_.push(Op::mulk_add, emit({1.0, rest}), acc, 0, c);
+        acc = tape_.push(Op::mulk_add, emit({1.0, rest}), acc, 0, c);
       }
     }
-    if (offset != 0.0) acc = program_.push(Op::add_k, acc, 0, 0, offset);
+    if (offset != 0.0) acc = tape_.push(Op::add_k, acc, 0, 0, offset);
     return acc;
   }
 
@@ -700,8 +700,8 @@ class ProgramCompiler {
 
   int scaled(int r, double c) {
     if (c == 1.0) return r;
-    if (c == -1.0) return program_.push(Op::neg, r);
-    return program_.push(Op::mul_k, r, 0, 0, c);
+    if (c == -1.0) return tape_.push(Op::neg, r);
+    return tape_.push(Op::mul_k, r, 0, 0, c);
   }
 
   // c * f1 * f2 * ... as ((f1 f2) ...) with the coefficient folded into the last multiplication
@@ -712,8 +712,8 @@ class ProgramCompiler {
     int acc = emit(factors[0]);
     for (std::size_t i = 1; i < factors.size(); ++i) {
       const int next = emit(factors[i]);
-      if (i + 1 == factors.size() && c != 1.0) return program_.push(Op::mulk, acc, next, 0, c);
-      acc = program_.push(Op::mul, acc, next);
+      if (i + 1 == factors.size() && c != 1.0) return tape_.push(Op::mulk, acc, next, 0, c);
+      acc = tape_.push(Op::mul, acc, next);
     }
     return scaled(acc, c);
   }
@@ -727,7 +727,7 @@ class ProgramCompiler {
       for (const Scaled& f : items) (node(f.id).parameters_only ? k : rest).push_back(f.id);
       if (!k.empty() && !rest.empty()) {
         const int stage = emit(make_mul(std::move(k), c));
-        return program_.push(Op::mul, stage, emit(make_mul(std::move(rest), 1.0)));
+        return tape_.push(Op::mul, stage, emit(make_mul(std::move(rest), 1.0)));
       }
     }
     std::vector<Scaled> numerator, denominator;
@@ -739,19 +739,19 @@ class ProgramCompiler {
         numerator.push_back(f);
       }
     }
-    if (numerator.empty()) return program_.push(Op::div_k, product(denominator), 0, 0, c);
+    if (numerator.empty()) return tape_.push(Op::div_k, product(denominator), 0, 0, c);
     if (denominator.empty()) return product(numerator, c);
-    const int r = program_.push(Op::div, product(numerator), product(denominator));
+    const int r = tape_.push(Op::div, product(numerator), product(denominator));
     return scaled(r, c);
   }
 
   // base^n for an integer n != 0, from the register of base.
   int integer_power(int base, int n) {
-    if (n < 0) return program_.push(Op::div_k, integer_power(base, -n), 0, 0, 1.0);
+    if (n < 0) return tape_.push(Op::div_k, integer_power(base, -n), 0, 0, 1.0);
     if (n == 1) return base;
-    if (n == 2) return program_.push(Op::square, base);
-    if (n == 3) return program_.push(Op::cube, base);
-    return program_.push(Op::powi, base, 0, 0, n);
+    if (n == 2) return tape_.push(Op::square, base);
+    if (n == 3) return tape_.push(Op::cube, base);
+    return tape_.push(Op::powi, base, 0, 0, n);
   }
 
   int emit_power(int id) {
@@ -760,14 +760,14 @@ class ProgramCompiler {
     if (n.items.size() == 2) {
       const Scaled exponent = n.items[1];
       const int b = emit(base);
-      return program_.push(Op::pow, b, emit(exponent));
+      return tape_.push(Op::pow, b, emit(exponent));
     }
     const double p = n.exponent;
     constexpr double kLargest = 1 << 20;
     if (p == std::trunc(p) && std::abs(p) <= kLargest) {
       const int k = static_cast<int>(p);
       // x^-n = 1 / x^n, with x^n shared with its other uses.
-      if (k < 0) return program_.push(Op::div_k, emit(make_power(base, -k)), 0, 0, 1.0);
+      if (k < 0) return tape_.push(Op::div_k, emit(make_power(base, -k)), 0, 0, 1.0);
       return integer_power(emit(base), k);
     }
     if (2.0 * p == std::trunc(2.0 * p) && std::abs(p) <= kLargest) {
@@ -778,17 +778,17 @@ class ProgramCompiler {
       if (found != memo_.end()) {
         r = found->second;
       } else {
-        r = program_.push(Op::sqrt, emit(base));
+        r = tape_.push(Op::sqrt, emit(base));
         memo_.emplace(MemoKey{root.id, hash_double(1.0)}, r);
       }
       return integer_power(r, static_cast<int>(2.0 * p));
     }
-    return program_.push(Op::pow_k, emit(base), 0, 0, p);
+    return tape_.push(Op::pow_k, emit(base), 0, 0, p);
   }
 
   // Rewrites a program so that sin(x) and cos(x) of the same register become one sincos (one
   // call to the math library less when the compiler fuses them, and always one dispatch less).
-  static Program fuse_sincos(const Program& in) {
+  static Tape fuse_sincos(const Tape& in) {
     const std::vector<Instruction>& code = in.code();
     const int inputs = in.inputs();
     std::map<int, int> sin_of, cos_of;  // operand register -> instruction index
@@ -803,7 +803,7 @@ class ProgramCompiler {
       partner[static_cast<std::size_t>(i)] = c->second;
       partner[static_cast<std::size_t>(c->second)] = i;
     }
-    Program out(in.coordinates(), in.parameters());
+    Tape out(in.coordinates(), in.parameters());
     std::vector<int> map(static_cast<std::size_t>(in.registers()), -1);  // old register -> new
     for (int r = 0; r < inputs; ++r) map[static_cast<std::size_t>(r)] = r;
     const auto arg = [&](int reg) { return map[static_cast<std::size_t>(reg)]; };
@@ -846,7 +846,7 @@ class ProgramCompiler {
   std::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, Scaled>> translated_;
   std::deque<Node> nodes_;  // a deque: references stay valid while nodes are added
   std::unordered_map<std::uint64_t, std::vector<int>> by_key_;
-  Program program_;
+  Tape tape_;
   std::map<MemoKey, int> memo_;
   std::map<std::uint64_t, int> constants_;  // by the bits of the value
   std::string what_;
@@ -904,9 +904,9 @@ bool compile_sparse(const TermsSparsity& sparsity, int n, int s, TermsLayout lay
   return n >= kSparseFrom && sparsity.A.nonzeros() + sparsity.b.nonzeros() <= 0.25 * entries;
 }
 
-// The programs of program motion (docs/derivations/program-motion.md): b_p, b_p0 and B in one
-// program (sharing subexpressions), and the programs' residuals in two more, like the constraints'.
-void compile_program_constraints(const Spec& spec, const Derivation& derivation, ModelPrograms& programs,
+// The tapes of program motion (docs/derivations/program-motion.md): b_p, b_p0 and B in one
+// tape (sharing subexpressions), and the programs' residuals in two more, like the constraints'.
+void compile_program_constraints(const Spec& spec, const Derivation& derivation, ModelTapes& tapes,
                                  Model& model) {
   const int n = spec.n(), m = spec.m();
   if (m == 0) return;
@@ -927,7 +927,7 @@ void compile_program_constraints(const Spec& spec, const Derivation& derivation,
                                  velocity.size()));
   const auto q_name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
   const auto p_name = [&](int j) { return spec.programs[static_cast<std::size_t>(j)].constraint.name; };
-  ProgramCompiler terms(spec);
+  TapeCompiler terms(spec);
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < m; ++i)
       terms.add_output(derivation.b_p(static_cast<unsigned>(i), static_cast<unsigned>(j)),
@@ -938,19 +938,19 @@ void compile_program_constraints(const Spec& spec, const Derivation& derivation,
     for (int i = 0; i < n; ++i)
       terms.add_output(derivation.B(static_cast<unsigned>(i), static_cast<unsigned>(j)),
                        fmt::format("B({}, {})", q_name(i), p_name(j)));
-  programs.program_constraints = m;
-  programs.program_constraint_terms = terms.finish();
-  ProgramCompiler phi(spec);
+  tapes.program_constraints = m;
+  tapes.program_constraint_terms = terms.finish();
+  TapeCompiler phi(spec);
   for (std::size_t i = 0; i < position.size(); ++i)
     phi.add_output(derivation.phi_p[i], fmt::format("phi({})", p_name(position[i])));
-  programs.program_constraint_position_residual = phi.finish();
-  if (programs.program_constraint_position_residual->reads_velocities())
+  tapes.program_constraint_position_residual = phi.finish();
+  if (tapes.program_constraint_position_residual->reads_velocities())
     throw ModelError(fmt::format("model '{}': a program's position-level residual depends on the velocities",
                                  spec.name));
-  ProgramCompiler f(spec);
+  TapeCompiler f(spec);
   for (std::size_t i = 0; i < velocity.size(); ++i)
     f.add_output(derivation.f_p[i], fmt::format("f({})", p_name(velocity[i])));
-  programs.program_constraint_velocity_residual = f.finish();
+  tapes.program_constraint_velocity_residual = f.finish();
 }
 
 // The sizes of what the derivation gives, against the Spec's n coordinates and s constraints.
@@ -990,14 +990,14 @@ void describe_model(const Spec& spec, const Derivation& derivation, Model& model
                                  model.position_constraints(), model.velocity_constraints()));
 }
 
-// A, Q, G, b and b0 in one program (sharing subexpressions), dense or by A's and b's patterns.
-void compile_terms(const Spec& spec, const Derivation& derivation, TermsLayout layout, ModelPrograms& programs) {
+// A, Q, G, b and b0 in one tape (sharing subexpressions), dense or by A's and b's patterns.
+void compile_terms(const Spec& spec, const Derivation& derivation, TermsLayout layout, ModelTapes& tapes) {
   const int n = spec.n(), s = spec.s();
   const auto q_name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
   const auto c_name = [&](int i) { return spec.constraints[static_cast<std::size_t>(i)].name; };
   TermsSparsity sparsity{pattern_of(derivation.A), pattern_of(derivation.b)};
   const bool sparse = compile_sparse(sparsity, n, s, layout);
-  ProgramCompiler terms(spec);
+  TapeCompiler terms(spec);
   // Column by column: every entry when dense, the pattern's nonzeros when sparse. Entry names
   // are formatted only when compiled (a thousand-body chain has 18 million entries).
   const auto matrix_outputs = [&](const ExMatrix& m, const SparsityPattern& pattern, const char* symbol,
@@ -1027,25 +1027,25 @@ void compile_terms(const Spec& spec, const Derivation& derivation, TermsLayout l
   matrix_outputs(derivation.b, sparsity.b, "b", c_name);
   for (int i = 0; i < s; ++i)
     terms.add_output(derivation.b0(static_cast<unsigned>(i), 0), fmt::format("b0({})", c_name(i)));
-  programs.terms = terms.finish();
-  if (sparse) programs.sparsity = std::move(sparsity);
+  tapes.terms = terms.finish();
+  if (sparse) tapes.sparsity = std::move(sparsity);
 }
 
 // The user's complement D, when the derivation has one.
-void compile_complement(const Spec& spec, const Derivation& derivation, ModelPrograms& programs) {
+void compile_complement(const Spec& spec, const Derivation& derivation, ModelTapes& tapes) {
   if (!derivation.D) return;
   const int n = spec.n(), s = spec.s();
-  ProgramCompiler complement(spec);
+  TapeCompiler complement(spec);
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n - s; ++i)
       complement.add_output((*derivation.D)(static_cast<unsigned>(i), static_cast<unsigned>(j)),
                             fmt::format("D({}, {})", i + 1, spec.coordinates[static_cast<std::size_t>(j)]));
-  programs.complement = complement.finish();
+  tapes.complement = complement.finish();
 }
 
 // The constraints' residuals: phi of the position-level ones, f of those at the position or
 // velocity level (residual i belongs to the i-th constraint of its level, in constraint order).
-void compile_residuals(const Spec& spec, const Derivation& derivation, ModelPrograms& programs) {
+void compile_residuals(const Spec& spec, const Derivation& derivation, ModelTapes& tapes) {
   const auto c_name = [&](int i) { return spec.constraints[static_cast<std::size_t>(i)].name; };
   std::vector<int> position, velocity;
   for (int i = 0; i < spec.s(); ++i) {
@@ -1053,42 +1053,42 @@ void compile_residuals(const Spec& spec, const Derivation& derivation, ModelProg
     if (level == ConstraintLevel::position) position.push_back(i);
     if (level != ConstraintLevel::acceleration) velocity.push_back(i);
   }
-  ProgramCompiler phi(spec);
+  TapeCompiler phi(spec);
   for (std::size_t i = 0; i < derivation.phi.size(); ++i)
     phi.add_output(derivation.phi[i], fmt::format("phi({})", c_name(position[i])));
-  programs.position_residual = phi.finish();
-  if (programs.position_residual.reads_velocities())
+  tapes.position_residual = phi.finish();
+  if (tapes.position_residual.reads_velocities())
     throw ModelError(fmt::format("model '{}': a position-level residual depends on the velocities", spec.name));
-  ProgramCompiler f(spec);
+  TapeCompiler f(spec);
   for (std::size_t i = 0; i < derivation.f.size(); ++i)
     f.add_output(derivation.f[i], fmt::format("f({})", c_name(velocity[i])));
-  programs.velocity_residual = f.finish();
+  tapes.velocity_residual = f.finish();
 }
 
 // The energy and its balance (docs/derivations/energy-balance.md): h where it differs from E, and
 // the symbolic parts of the power where they are not zero (the power program runs at every
 // right-hand side of a run, so a conservative model has none).
-void compile_energy(const Spec& spec, const Derivation& derivation, ModelPrograms& programs) {
+void compile_energy(const Spec& spec, const Derivation& derivation, ModelTapes& tapes) {
   if (!derivation.energy) return;
-  ProgramCompiler energy(spec);
+  TapeCompiler energy(spec);
   energy.add_output(*derivation.energy, "energy");
-  programs.energy = energy.finish();
-  programs.energy_balance = true;
+  tapes.energy = energy.finish();
+  tapes.energy_balance = true;
   if (derivation.energy_function) {
-    ProgramCompiler h(spec);
+    TapeCompiler h(spec);
     h.add_output(*derivation.energy_function, "energy function");
-    programs.energy_function = h.finish();
+    tapes.energy_function = h.finish();
   }
   if (!derivation.conservative) {
-    ProgramCompiler power(spec);
+    TapeCompiler power(spec);
     power.add_output(derivation.power_forces, "power of the forces");
     power.add_output(derivation.power_time, "power of the explicit time dependence");
-    programs.power = power.finish();
+    tapes.power = power.finish();
   }
 }
 
-// The initial state's program, when the Spec gives one (else q0 = v0 = 0).
-void compile_initial_state(const Spec& spec, ModelPrograms& programs) {
+// The initial state's tape, when the Spec gives one (else q0 = v0 = 0).
+void compile_initial_state(const Spec& spec, ModelTapes& tapes) {
   const int n = spec.n();
   if (spec.q0.empty() && spec.v0.empty()) return;
   if (static_cast<int>(spec.q0.size()) != n || static_cast<int>(spec.v0.size()) != n)
@@ -1102,19 +1102,19 @@ void compile_initial_state(const Spec& spec, ModelPrograms& programs) {
     initial_value(spec, values, spec.q0[static_cast<std::size_t>(i)], q_name(i));
     initial_value(spec, values, spec.v0[static_cast<std::size_t>(i)], q_name(i) + "'");
   }
-  ProgramCompiler initial(spec);
+  TapeCompiler initial(spec);
   for (int i = 0; i < n; ++i) initial.add_output(spec.q0[static_cast<std::size_t>(i)], "initial " + q_name(i));
   for (int i = 0; i < n; ++i) initial.add_output(spec.v0[static_cast<std::size_t>(i)], "initial " + q_name(i) + "'");
-  programs.initial_state = initial.finish();
+  tapes.initial_state = initial.finish();
 }
 
 // A closed-form solution's q(t), then its first and second derivatives: the exact velocities and
 // accelerations. A closed form that cannot be evaluated at these parameter values (v0/w with w =
 // 0) must not stop the model: that output is NaN, which check_solution refuses where the solution
 // is used.
-void compile_solution(const Spec& spec, ModelPrograms& programs) {
+void compile_solution(const Spec& spec, ModelTapes& tapes) {
   if (spec.solution.empty()) return;
-  ProgramCompiler solution(spec);
+  TapeCompiler solution(spec);
   const GiNaC::symbol& t = spec.symbols.time();
   for (int order = 0; order < 3; ++order)
     for (int i = 0; i < spec.n(); ++i) {
@@ -1126,7 +1126,7 @@ void compile_solution(const Spec& spec, ModelPrograms& programs) {
         solution.add_nan_output();
       }
     }
-  programs.solution = solution.finish();
+  tapes.solution = solution.finish();
 }
 
 // The contact coordinates nhdyn added (with the constraints that fix their start) and the contacts'
@@ -1153,15 +1153,15 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
   Model model;
   describe_model(spec, derivation, model);
 
-  ModelPrograms programs;
-  programs.parameters = static_cast<int>(spec.parameters.size());
-  compile_terms(spec, derivation, options.layout, programs);
-  compile_complement(spec, derivation, programs);
-  compile_residuals(spec, derivation, programs);
-  compile_energy(spec, derivation, programs);
-  compile_initial_state(spec, programs);
-  compile_solution(spec, programs);
-  compile_program_constraints(spec, derivation, programs, model);
+  ModelTapes tapes;
+  tapes.parameters = static_cast<int>(spec.parameters.size());
+  compile_terms(spec, derivation, options.layout, tapes);
+  compile_complement(spec, derivation, tapes);
+  compile_residuals(spec, derivation, tapes);
+  compile_energy(spec, derivation, tapes);
+  compile_initial_state(spec, tapes);
+  compile_solution(spec, tapes);
+  compile_program_constraints(spec, derivation, tapes, model);
 
   model.t0 = spec.t0;
   model.q0 = Vector::Zero(n);
@@ -1174,7 +1174,7 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
     model.path = PlanarPath{coordinate_index(spec, spec.path->first, "x"), coordinate_index(spec, spec.path->second, "y")};
   std::vector<double> parameter_values;
   for (const Parameter& p : model.parameters) parameter_values.push_back(p.value);
-  model.evaluator = std::make_shared<ProgramEvaluator>(n, s, std::move(programs), std::move(parameter_values));
+  model.evaluator = std::make_shared<TapeEvaluator>(n, s, std::move(tapes), std::move(parameter_values));
   if (model.evaluator->has_initial_state()) {
     std::vector<double> scratch(model.evaluator->scratch_size());
     model.evaluator->initial_state(scratch.data(), model.q0.data(), model.v0.data());
@@ -1188,15 +1188,15 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
   return model;
 }
 
-Program compile_expression(const Spec& spec, const GiNaC::ex& expression, const std::string& what) {
-  ProgramCompiler compiler(spec);
+Tape compile_expression(const Spec& spec, const GiNaC::ex& expression, const std::string& what) {
+  TapeCompiler compiler(spec);
   compiler.add_output(expression, what);
   return compiler.finish();
 }
 
-Program compile_expressions(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
+Tape compile_expressions(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
                             const std::vector<std::string>& what) {
-  ProgramCompiler compiler(spec);
+  TapeCompiler compiler(spec);
   for (std::size_t i = 0; i < expressions.size(); ++i) compiler.add_output(expressions[i], what.at(i));
   return compiler.finish();
 }

@@ -1,5 +1,5 @@
 // From symbols to numbers: compile a Spec and its Derivation into a frozen numeric Model whose
-// Evaluator runs straight-line programs (model/program.hpp) — all the terms A, Q, G, b, b0 in one
+// Evaluator runs straight-line programs (model/tape.hpp) — all the terms A, Q, G, b, b0 in one
 // program with common subexpressions shared, and D, the residuals and the energy in their own —
 // evaluated on doubles without allocation. The programs read the parameters, whose values the
 // Model holds: set_parameter (model/parameters.hpp) changes them without recompiling.
@@ -33,10 +33,10 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
 
 // One expression of t, q, q' and the parameters of `spec` as a program with one output (events,
 // symbolic/events.hpp); `what` names it in errors. Throws ModelError as compile_model does.
-Program compile_expression(const Spec& spec, const GiNaC::ex& expression, const std::string& what);
+Tape compile_expression(const Spec& spec, const GiNaC::ex& expression, const std::string& what);
 // Several expressions as one program, one output each, common subexpressions computed once
 // (outputs, contact forces); what[i] names expression i in messages.
-Program compile_expressions(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
+Tape compile_expressions(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
                             const std::vector<std::string>& what);
 
 // derive() then compile_model().

@@ -73,9 +73,9 @@ Event finish(const Spec& spec, const Model& model, const GiNaC::ex& g, std::stri
   // solved dynamics.
   event.dynamics = event.contact_forces || reads_dynamics(spec, g);
   if (event.contact_forces)
-    event.g = compile_dynamics_program(spec, {g}, {what}, spec.contact_forces->columns);
+    event.g = compile_dynamics_tape(spec, {g}, {what}, spec.contact_forces->columns);
   else
-    event.g = event.dynamics ? compile_dynamics_program(spec, {g}, {what}) : compile_expression(spec, g, what);
+    event.g = event.dynamics ? compile_dynamics_tape(spec, {g}, {what}) : compile_expression(spec, g, what);
   event.name = std::move(name);
   event.expression = std::move(text);
   event.where = std::move(where);

@@ -18,7 +18,7 @@ bool reads_dynamics(const Spec& spec, const GiNaC::ex& e) {
   return false;
 }
 
-Program compile_dynamics_program(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
+Tape compile_dynamics_tape(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
                                  const std::vector<std::string>& what, const std::vector<ContactForceSymbol>& contact) {
   // A spec of 2n coordinates whose symbols stand for [q; q''] and, as their velocities, [q'; R]:
   // the compiler then maps them to the input registers of the dynamics layout.
@@ -138,7 +138,7 @@ void compile_outputs(const Spec& spec, Model& model) {
     expressions.push_back(o.expression);
     what.push_back(fmt::format("{}output '{}'", o.where.describe().empty() ? "" : o.where.describe() + ": ", o.name));
   }
-  model.outputs.program = compile_dynamics_program(spec, expressions, what);
+  model.outputs.program = compile_dynamics_tape(spec, expressions, what);
 }
 
 }  // namespace nhdyn::symbolic

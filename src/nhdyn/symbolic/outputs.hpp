@@ -29,7 +29,7 @@ bool reads_dynamics(const Spec& spec, const GiNaC::ex& e);
 // (the symbols of the contact-force columns, SpecContactForces::columns) the program is in the
 // contact layout (model/event.hpp): 2n + contact.size() coordinates, the values of those columns
 // after [q; q''] (and zeros after [q'; R]), so that an event may read NAME_N.
-Program compile_dynamics_program(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
+Tape compile_dynamics_tape(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
                                  const std::vector<std::string>& what,
                                  const std::vector<ContactForceSymbol>& contact = {});
 

@@ -23,7 +23,7 @@ std::string text_of(const GiNaC::ex& e) {
 
 const char* kind_name(VisualKind kind) { return visual_kind_name(kind); }
 
-// Expressions of one spec into one Program whose `parameter` instructions read the parameters in
+// Expressions of one spec into one Tape whose `parameter` instructions read the parameters in
 // the order of spec.parameters, so that the program follows the values of the run it draws. The
 // scene's expressions are short (a few positions and rotations), so this translation aims at being
 // plain rather than at the smallest program: a subexpression met twice is computed once. With
@@ -31,14 +31,14 @@ const char* kind_name(VisualKind kind) { return visual_kind_name(kind); }
 class Emitter {
  public:
   Emitter(const Spec& spec, bool parameters_only)
-      : program_(parameters_only ? 0 : spec.n(), static_cast<int>(spec.parameters.size())),
+      : tape_(parameters_only ? 0 : spec.n(), static_cast<int>(spec.parameters.size())),
         parameters_only_(parameters_only) {
     for (std::size_t i = 0; i < spec.parameters.size(); ++i)
       parameters_.emplace(spec.symbols.parameter(spec.parameters[i].name), static_cast<int>(i));
-    variables_.emplace(spec.symbols.time(), parameters_only ? -1 : Program::time_register());
+    variables_.emplace(spec.symbols.time(), parameters_only ? -1 : Tape::time_register());
     for (int i = 0; i < spec.n(); ++i) {
-      variables_.emplace(spec.symbols.coordinate(i), parameters_only ? -1 : program_.coordinate_register(i));
-      variables_.emplace(spec.symbols.velocity(i), parameters_only ? -1 : program_.velocity_register(i));
+      variables_.emplace(spec.symbols.coordinate(i), parameters_only ? -1 : tape_.coordinate_register(i));
+      variables_.emplace(spec.symbols.velocity(i), parameters_only ? -1 : tape_.velocity_register(i));
     }
   }
 
@@ -46,12 +46,12 @@ class Emitter {
   // variable may be a coordinate of the spec (an implicit shape's point): it is read as the
   // variable, and every other coordinate, t and the velocities are refused.
   Emitter(const Spec& spec, const std::vector<GiNaC::ex>& variables)
-      : program_(static_cast<int>(variables.size()), static_cast<int>(spec.parameters.size())),
+      : tape_(static_cast<int>(variables.size()), static_cast<int>(spec.parameters.size())),
         parameters_only_(true) {
     for (std::size_t i = 0; i < spec.parameters.size(); ++i)
       parameters_.emplace(spec.symbols.parameter(spec.parameters[i].name), static_cast<int>(i));
     for (std::size_t i = 0; i < variables.size(); ++i)
-      variables_.emplace(variables[i], program_.coordinate_register(static_cast<int>(i)));
+      variables_.emplace(variables[i], tape_.coordinate_register(static_cast<int>(i)));
     variables_.emplace(spec.symbols.time(), -1);
     for (int i = 0; i < spec.n(); ++i) {
       variables_.emplace(spec.symbols.coordinate(i), -1);
@@ -65,13 +65,13 @@ class Emitter {
     what_ = what;
     const GiNaC::ex value = numeric_form(e);
     if (GiNaC::is_exactly_a<GiNaC::numeric>(value)) {
-      program_.add_constant_output(number(value, e));
+      tape_.add_constant_output(number(value, e));
       return;
     }
-    program_.add_output(emit(value, e));
+    tape_.add_output(emit(value, e));
   }
 
-  Program take() { return std::move(program_); }
+  Tape take() { return std::move(tape_); }
 
  private:
   // Numbers, pi and exact fractions as doubles; the parameters stay symbols.
@@ -105,10 +105,10 @@ class Emitter {
   }
 
   int emit_new(const GiNaC::ex& e, const GiNaC::ex& original) {
-    if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) return program_.push_constant(number(e, original));
+    if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) return tape_.push_constant(number(e, original));
     if (GiNaC::is_a<GiNaC::symbol>(e)) {
       const auto parameter = parameters_.find(e);
-      if (parameter != parameters_.end()) return program_.push_parameter(parameter->second);
+      if (parameter != parameters_.end()) return tape_.push_parameter(parameter->second);
       const auto variable = variables_.find(e);
       if (variable == variables_.end())
         fail(original, fmt::format("uses '{}', which is not t, a coordinate, a velocity or a parameter", text_of(e)));
@@ -118,12 +118,12 @@ class Emitter {
     }
     if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
       int sum = emit(e.op(0), original);
-      for (std::size_t i = 1; i < e.nops(); ++i) sum = program_.push(Op::add, sum, emit(e.op(i), original));
+      for (std::size_t i = 1; i < e.nops(); ++i) sum = tape_.push(Op::add, sum, emit(e.op(i), original));
       return sum;
     }
     if (GiNaC::is_exactly_a<GiNaC::mul>(e)) {
       int product = emit(e.op(0), original);
-      for (std::size_t i = 1; i < e.nops(); ++i) product = program_.push(Op::mul, product, emit(e.op(i), original));
+      for (std::size_t i = 1; i < e.nops(); ++i) product = tape_.push(Op::mul, product, emit(e.op(i), original));
       return product;
     }
     if (GiNaC::is_exactly_a<GiNaC::power>(e)) {
@@ -131,11 +131,11 @@ class Emitter {
       const GiNaC::ex exponent = e.op(1);
       if (GiNaC::is_exactly_a<GiNaC::numeric>(exponent)) {
         const double k = number(exponent, original);
-        if (k == 0.5) return program_.push(Op::sqrt, base);
-        if (k == std::round(k) && k != 0.0 && std::abs(k) <= 64.0) return program_.push(Op::powi, base, 0, 0, k);
-        return program_.push(Op::pow_k, base, 0, 0, k);
+        if (k == 0.5) return tape_.push(Op::sqrt, base);
+        if (k == std::round(k) && k != 0.0 && std::abs(k) <= 64.0) return tape_.push(Op::powi, base, 0, 0, k);
+        return tape_.push(Op::pow_k, base, 0, 0, k);
       }
-      return program_.push(Op::pow, base, emit(exponent, original));
+      return tape_.push(Op::pow, base, emit(exponent, original));
     }
     if (GiNaC::is_a<GiNaC::function>(e)) {
       const std::string name = GiNaC::ex_to<GiNaC::function>(e).get_name();
@@ -144,15 +144,15 @@ class Emitter {
           {"abs", Op::abs},   {"sqrt", Op::sqrt}, {"asin", Op::asin}, {"acos", Op::acos}, {"atan", Op::atan},
           {"sinh", Op::sinh}, {"cosh", Op::cosh}, {"tanh", Op::tanh}};
       const auto op = unary.find(name);
-      if (op != unary.end() && e.nops() == 1) return program_.push(op->second, emit(e.op(0), original));
+      if (op != unary.end() && e.nops() == 1) return tape_.push(op->second, emit(e.op(0), original));
       if (name == "atan2" && e.nops() == 2)
-        return program_.push(Op::atan2, emit(e.op(0), original), emit(e.op(1), original));
+        return tape_.push(Op::atan2, emit(e.op(0), original), emit(e.op(1), original));
       fail(original, fmt::format("calls {}(), which the scene cannot evaluate", name));
     }
     fail(original, fmt::format("contains '{}', which is not a scalar expression", text_of(e)));
   }
 
-  Program program_;
+  Tape tape_;
   bool parameters_only_ = false;
   const VisualItem* item_ = nullptr;
   const char* what_ = "";

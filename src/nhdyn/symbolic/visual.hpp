@@ -2,7 +2,7 @@
 // [visual] table (hand-written models: spheres and segments whose ends are expressions in t, the
 // coordinates and the parameters) and its multibody description (bodies, wheels, frames) become
 // VisualItems of the Spec; compile_visual() turns them into two straight-line Programs
-// (model/program.hpp) that read the parameters, like the model's own programs: `program`, whose
+// (model/tape.hpp) that read the parameters, like the model's own programs: `program`, whose
 // outputs, run on a row of results (t, q, q'), are every position and orientation the scene
 // needs, and `sizes`, which reads the parameters only (radii, masses, inertias). Parameters are
 // data (docs/design.md): io/report.hpp binds both to the values of the run's Model, so a
@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "nhdyn/model/program.hpp"
+#include "nhdyn/model/tape.hpp"
 
 namespace nhdyn::symbolic {
 
@@ -89,14 +89,14 @@ struct VisualShape {
   std::vector<std::string> expressions;  // the text of each of its outputs (at, then other), for messages
   std::string body;   // a contact's shape: the body it is the shape of (drawn instead of its ellipsoid)
   // solid, terrain, surface: the function drawn, its inputs the field variables in the places of
-  // the coordinates (Program::coordinate_register(i)); reads the parameters (bind them).
-  Program field;
+  // the coordinates (Tape::coordinate_register(i)); reads the parameters (bind them).
+  Tape field;
 };
 
 struct VisualScene {
   std::vector<VisualShape> shapes;
-  Program program;  // inputs t, q, q'; reads the parameters; outputs as the shapes say
-  Program sizes;    // no coordinate input; reads the parameters only; outputs as the shapes say
+  Tape program;  // inputs t, q, q'; reads the parameters; outputs as the shapes say
+  Tape sizes;    // no coordinate input; reads the parameters only; outputs as the shapes say
   std::vector<std::string> parameters;  // the names the programs' `parameter` instructions index
   bool planar = false;
   bool ground = false;

@@ -1,4 +1,4 @@
-#include "nhdyn/model/program.hpp"
+#include "nhdyn/model/tape.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -79,7 +79,7 @@ bool calls_library(Op op) {
 #define NHDYN_UNREACHABLE() ((void)0)
 #endif
 
-// Copies in the inputs the program reads (a position residual has no v, say); inlined with n
+// Copies in the inputs the tape reads (a position residual has no v, say); inlined with n
 // known at compile time where it is.
 NHDYN_ALWAYS_INLINE void load_inputs(const bool* reads, std::size_t n, double t, const double* q, const double* v,
                                      double* x) {
@@ -200,21 +200,21 @@ int operand_count(Op op) { return op_info(op).operands; }
 
 const char* op_name(Op op) { return op_info(op).name; }
 
-Program::Program(int coordinates, int parameters) : n_(coordinates), parameters_(parameters), steps_(1) {
-  if (coordinates < 0) throw std::invalid_argument("Program: negative number of coordinates");
-  if (parameters < 0) throw std::invalid_argument("Program: negative number of parameters");
+Tape::Tape(int coordinates, int parameters) : n_(coordinates), parameters_(parameters), steps_(1) {
+  if (coordinates < 0) throw std::invalid_argument("Tape: negative number of coordinates");
+  if (parameters < 0) throw std::invalid_argument("Tape: negative number of parameters");
 }
 
-int Program::coordinate_register(int i) const {
+int Tape::coordinate_register(int i) const {
   if (i < 0 || i >= n_)
-    throw std::invalid_argument("Program: coordinate index " + std::to_string(i) + " out of range [0, " +
+    throw std::invalid_argument("Tape: coordinate index " + std::to_string(i) + " out of range [0, " +
                                 std::to_string(n_) + ")");
   return 1 + i;
 }
 
-int Program::velocity_register(int i) const { return coordinate_register(i) + n_; }
+int Tape::velocity_register(int i) const { return coordinate_register(i) + n_; }
 
-void Program::note_read(int reg) {
+void Tape::note_read(int reg) {
   if (reg == 0)
     reads_[0] = true;
   else if (reg <= n_)
@@ -223,23 +223,23 @@ void Program::note_read(int reg) {
     reads_[2] = true;
 }
 
-int Program::push(Op op, int a, int b, int c, double k) {
+int Tape::push(Op op, int a, int b, int c, double k) {
   const int next = registers();
-  if (op == Op::nop) throw std::invalid_argument("Program::push: nop is only the companion of a sincos");
+  if (op == Op::nop) throw std::invalid_argument("Tape::push: nop is only the companion of a sincos");
   const int operands[3] = {a, b, c};
   const int count = operand_count(op);
   for (int i = 0; i < count; ++i)
     if (operands[i] < 0 || operands[i] >= next)
-      throw std::invalid_argument(std::string("Program::push: ") + op_name(op) + " reads register " +
+      throw std::invalid_argument(std::string("Tape::push: ") + op_name(op) + " reads register " +
                                   std::to_string(operands[i]) + ", which is not written before register " +
                                   std::to_string(next));
   if (op == Op::powi && !(k != 0.0 && std::abs(k) <= kMaxPowi && k == std::trunc(k)))
-    throw std::invalid_argument("Program::push: powi needs a nonzero integer exponent of magnitude at most 2^20, not " +
+    throw std::invalid_argument("Tape::push: powi needs a nonzero integer exponent of magnitude at most 2^20, not " +
                                 format_double(k));
   if (op == Op::parameter && (a < 0 || a >= parameters_))
-    throw std::invalid_argument("Program::push: parameter " + std::to_string(a) + " out of range [0, " +
+    throw std::invalid_argument("Tape::push: parameter " + std::to_string(a) + " out of range [0, " +
                                 std::to_string(parameters_) + ")");
-  // Unused fields are zeroed so that equal programs compare equal field by field.
+  // Unused fields are zeroed so that equal tapes compare equal field by field.
   Instruction in{op, 0, 0, 0, 0.0};
   if (op == Op::parameter) {
     in.a = a;
@@ -258,27 +258,27 @@ int Program::push(Op op, int a, int b, int c, double k) {
   return next;
 }
 
-void Program::add_output(int reg) {
+void Tape::add_output(int reg) {
   if (reg < 0 || reg >= registers())
-    throw std::invalid_argument("Program::add_output: register " + std::to_string(reg) + " is not written");
+    throw std::invalid_argument("Tape::add_output: register " + std::to_string(reg) + " is not written");
   note_read(reg);
   outputs_.push_back(Output{reg, 0.0});
 }
 
-void Program::add_constant_output(double value) { outputs_.push_back(Output{-1, value}); }
+void Tape::add_constant_output(double value) { outputs_.push_back(Output{-1, value}); }
 
-int Program::count(Op op) const {
+int Tape::count(Op op) const {
   int total = 0;
   for (const Instruction& in : code_) total += in.op == op ? 1 : 0;
   return total;
 }
 
-Program Program::bind(const double* values, std::size_t count) const {
+Tape Tape::bind(const double* values, std::size_t count) const {
   if (static_cast<std::size_t>(parameters_) > count)
-    throw std::invalid_argument("Program::bind: " + std::to_string(count) + " values for " +
+    throw std::invalid_argument("Tape::bind: " + std::to_string(count) + " values for " +
                                 std::to_string(parameters_) + " parameters");
   if (!reads_parameters_) return *this;
-  Program out(n_, parameters_);
+  Tape out(n_, parameters_);
   for (const Instruction& in : code_) {
     if (in.op == Op::nop) continue;  // pushed with its sincos
     if (in.op == Op::parameter)
@@ -292,9 +292,9 @@ Program Program::bind(const double* values, std::size_t count) const {
   return out;
 }
 
-void Program::execute(double t, const double* q, const double* v, double* registers) const {
+void Tape::execute(double t, const double* q, const double* v, double* registers) const {
   if (reads_parameters_)
-    throw std::logic_error("Program::execute: the program reads parameters; run the program bind() returns");
+    throw std::logic_error("Tape::execute: the tape reads parameters; run the tape bind() returns");
   load_inputs(reads_, static_cast<std::size_t>(n_), t, q, v, registers);
   double* const arrays[1] = {registers};
   if (calls_)
@@ -303,21 +303,21 @@ void Program::execute(double t, const double* q, const double* v, double* regist
     run_steps<false>(steps_.data(), arrays);
 }
 
-void Program::run(double t, const double* q, const double* v, double* registers, double* outputs) const {
+void Tape::run(double t, const double* q, const double* v, double* registers, double* outputs) const {
   execute(t, q, v, registers);
   const std::size_t m = outputs_.size();
   const Output* o = outputs_.data();
   for (std::size_t i = 0; i < m; ++i) outputs[i] = o[i].reg < 0 ? o[i].value : registers[o[i].reg];
 }
 
-std::string Program::register_name(int reg) const {
+std::string Tape::register_name(int reg) const {
   if (reg == 0) return "t";
   if (reg >= 1 && reg <= n_) return "q" + std::to_string(reg - 1);
   if (reg > n_ && reg <= 2 * n_) return "v" + std::to_string(reg - 1 - n_);
   return "r" + std::to_string(reg);
 }
 
-std::string Program::describe() const {
+std::string Tape::describe() const {
   std::string out;
   for (std::size_t i = 0; i < code_.size(); ++i) {
     const Instruction& in = code_[i];
@@ -338,18 +338,18 @@ std::string Program::describe() const {
   return out;
 }
 
-// --- ProgramEvaluator ---------------------------------------------------------------------------
+// --- TapeEvaluator ---------------------------------------------------------------------------
 
 namespace {
 
-void check_program(const Program& program, const char* what, int n, int outputs) {
-  if (program.coordinates() != n)
-    throw std::invalid_argument(std::string("ProgramEvaluator: the ") + what + " program reads " +
-                                std::to_string(program.coordinates()) + " coordinates, the model has " +
+void check_tape(const Tape& tape, const char* what, int n, int outputs) {
+  if (tape.coordinates() != n)
+    throw std::invalid_argument(std::string("TapeEvaluator: the ") + what + " tape reads " +
+                                std::to_string(tape.coordinates()) + " coordinates, the model has " +
                                 std::to_string(n));
-  if (outputs >= 0 && program.outputs() != outputs)
-    throw std::invalid_argument(std::string("ProgramEvaluator: the ") + what + " program has " +
-                                std::to_string(program.outputs()) + " outputs, " + std::to_string(outputs) +
+  if (outputs >= 0 && tape.outputs() != outputs)
+    throw std::invalid_argument(std::string("TapeEvaluator: the ") + what + " tape has " +
+                                std::to_string(tape.outputs()) + " outputs, " + std::to_string(outputs) +
                                 " expected");
 }
 
@@ -357,20 +357,20 @@ void check_program(const Program& program, const char* what, int n, int outputs)
 
 namespace {
 
-ModelPrograms bind_programs(const ModelPrograms& parametric, const std::vector<double>& values) {
+ModelTapes bind_programs(const ModelTapes& parametric, const std::vector<double>& values) {
   if (values.size() < static_cast<std::size_t>(parametric.parameters))
-    throw std::invalid_argument("ProgramEvaluator: " + std::to_string(values.size()) + " parameter values for " +
+    throw std::invalid_argument("TapeEvaluator: " + std::to_string(values.size()) + " parameter values for " +
                                 std::to_string(parametric.parameters) + " parameters");
-  const auto bound = [&values](const Program& p) {
+  const auto bound = [&values](const Tape& p) {
     if (p.parameters() > static_cast<int>(values.size()))
-      throw std::invalid_argument("ProgramEvaluator: a program reads more parameters than the model has");
+      throw std::invalid_argument("TapeEvaluator: a tape reads more parameters than the model has");
     return p.bind(values.data(), values.size());
   };
-  const auto bound_optional = [&bound](const std::optional<Program>& p) -> std::optional<Program> {
+  const auto bound_optional = [&bound](const std::optional<Tape>& p) -> std::optional<Tape> {
     if (!p) return std::nullopt;
     return bound(*p);
   };
-  ModelPrograms out;
+  ModelTapes out;
   out.parameters = parametric.parameters;
   out.terms = bound(parametric.terms);
   out.complement = bound_optional(parametric.complement);
@@ -392,126 +392,126 @@ ModelPrograms bind_programs(const ModelPrograms& parametric, const std::vector<d
 
 }  // namespace
 
-ProgramEvaluator::ProgramEvaluator(int n, int s, ModelPrograms programs, std::vector<double> parameters)
-    : n_(n), s_(s), parametric_(std::make_shared<const ModelPrograms>(std::move(programs))),
+TapeEvaluator::TapeEvaluator(int n, int s, ModelTapes tapes, std::vector<double> parameters)
+    : n_(n), s_(s), parametric_(std::make_shared<const ModelTapes>(std::move(tapes))),
       parameters_(std::move(parameters)) {
   build();
 }
 
-ProgramEvaluator::ProgramEvaluator(const ProgramEvaluator& other, std::vector<double> parameters)
+TapeEvaluator::TapeEvaluator(const TapeEvaluator& other, std::vector<double> parameters)
     : n_(other.n_), s_(other.s_), parametric_(other.parametric_), parameters_(std::move(parameters)) {
   build();
 }
 
-std::shared_ptr<const Evaluator> ProgramEvaluator::with_parameters(const double* values, std::size_t count) const {
+std::shared_ptr<const Evaluator> TapeEvaluator::with_parameters(const double* values, std::size_t count) const {
   if (count < static_cast<std::size_t>(parametric_->parameters))
-    throw std::invalid_argument("ProgramEvaluator::with_parameters: " + std::to_string(count) + " values for " +
+    throw std::invalid_argument("TapeEvaluator::with_parameters: " + std::to_string(count) + " values for " +
                                 std::to_string(parameters_.size()) + " parameters");
-  return std::make_shared<ProgramEvaluator>(*this, std::vector<double>(values, values + count));
+  return std::make_shared<TapeEvaluator>(*this, std::vector<double>(values, values + count));
 }
 
-void ProgramEvaluator::build() {
+void TapeEvaluator::build() {
   const int n = n_, s = s_;
   if (n <= 0 || s < 0 || s >= n)
-    throw std::invalid_argument("ProgramEvaluator: needs 0 <= s < n, got n = " + std::to_string(n) +
+    throw std::invalid_argument("TapeEvaluator: needs 0 <= s < n, got n = " + std::to_string(n) +
                                 ", s = " + std::to_string(s));
-  programs_ = bind_programs(*parametric_, parameters_);
+  tapes_ = bind_programs(*parametric_, parameters_);
   std::size_t a_size = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
   std::size_t b_size = static_cast<std::size_t>(s) * static_cast<std::size_t>(n);
-  if (programs_.sparsity) {
-    check_pattern(programs_.sparsity->A, n, n, "A");
-    check_pattern(programs_.sparsity->b, s, n, "b");
-    a_size = static_cast<std::size_t>(programs_.sparsity->A.nonzeros());
-    b_size = static_cast<std::size_t>(programs_.sparsity->b.nonzeros());
+  if (tapes_.sparsity) {
+    check_pattern(tapes_.sparsity->A, n, n, "A");
+    check_pattern(tapes_.sparsity->b, s, n, "b");
+    a_size = static_cast<std::size_t>(tapes_.sparsity->A.nonzeros());
+    b_size = static_cast<std::size_t>(tapes_.sparsity->b.nonzeros());
   }
   terms_sizes_[0] = a_size;
   terms_sizes_[1] = terms_sizes_[2] = static_cast<std::size_t>(n);
   terms_sizes_[3] = b_size;
   terms_sizes_[4] = static_cast<std::size_t>(s);
-  check_program(programs_.terms, "terms", n, static_cast<int>(a_size + b_size) + 2 * n + s);
-  if (programs_.complement) check_program(*programs_.complement, "complement", n, (n - s) * n);
-  check_program(programs_.position_residual, "position residual", n, -1);
-  check_program(programs_.velocity_residual, "velocity residual", n, -1);
-  if (programs_.energy) check_program(*programs_.energy, "energy", n, 1);
-  if (programs_.energy_function) check_program(*programs_.energy_function, "energy function", n, 1);
-  if (programs_.power) check_program(*programs_.power, "power", n, 2);
-  if (programs_.solution) {
-    check_program(*programs_.solution, "solution", n, 3 * n);
-    if (programs_.solution->reads_coordinates() || programs_.solution->reads_velocities())
-      throw std::invalid_argument("ProgramEvaluator: the solution program reads the state; it may read only t");
+  check_tape(tapes_.terms, "terms", n, static_cast<int>(a_size + b_size) + 2 * n + s);
+  if (tapes_.complement) check_tape(*tapes_.complement, "complement", n, (n - s) * n);
+  check_tape(tapes_.position_residual, "position residual", n, -1);
+  check_tape(tapes_.velocity_residual, "velocity residual", n, -1);
+  if (tapes_.energy) check_tape(*tapes_.energy, "energy", n, 1);
+  if (tapes_.energy_function) check_tape(*tapes_.energy_function, "energy function", n, 1);
+  if (tapes_.power) check_tape(*tapes_.power, "power", n, 2);
+  if (tapes_.solution) {
+    check_tape(*tapes_.solution, "solution", n, 3 * n);
+    if (tapes_.solution->reads_coordinates() || tapes_.solution->reads_velocities())
+      throw std::invalid_argument("TapeEvaluator: the solution tape reads the state; it may read only t");
   }
-  if (programs_.initial_state) {
-    check_program(*programs_.initial_state, "initial state", n, 2 * n);
-    if (programs_.initial_state->reads_time() || programs_.initial_state->reads_coordinates() ||
-        programs_.initial_state->reads_velocities())
-      throw std::invalid_argument("ProgramEvaluator: the initial state program reads t, q or q'");
+  if (tapes_.initial_state) {
+    check_tape(*tapes_.initial_state, "initial state", n, 2 * n);
+    if (tapes_.initial_state->reads_time() || tapes_.initial_state->reads_coordinates() ||
+        tapes_.initial_state->reads_velocities())
+      throw std::invalid_argument("TapeEvaluator: the initial state tape reads t, q or q'");
   }
-  if (programs_.position_residual.reads_velocities())
-    throw std::invalid_argument("ProgramEvaluator: the position residual program reads velocities");
-  if (programs_.position_residual.outputs() > s || programs_.velocity_residual.outputs() > s ||
-      programs_.position_residual.outputs() > programs_.velocity_residual.outputs())
-    throw std::invalid_argument("ProgramEvaluator: more residuals than constraints");
+  if (tapes_.position_residual.reads_velocities())
+    throw std::invalid_argument("TapeEvaluator: the position residual tape reads velocities");
+  if (tapes_.position_residual.outputs() > s || tapes_.velocity_residual.outputs() > s ||
+      tapes_.position_residual.outputs() > tapes_.velocity_residual.outputs())
+    throw std::invalid_argument("TapeEvaluator: more residuals than constraints");
 
-  const int m = programs_.program_constraints;
-  if (m < 0 || m > n - s || (m > 0) != programs_.program_constraint_terms.has_value() ||
-      (m > 0) != programs_.program_constraint_position_residual.has_value() ||
-      (m > 0) != programs_.program_constraint_velocity_residual.has_value())
-    throw std::invalid_argument("ProgramEvaluator: " + std::to_string(m) +
-                                " programs need their terms and residual programs (and at most n - s of them)");
+  const int m = tapes_.program_constraints;
+  if (m < 0 || m > n - s || (m > 0) != tapes_.program_constraint_terms.has_value() ||
+      (m > 0) != tapes_.program_constraint_position_residual.has_value() ||
+      (m > 0) != tapes_.program_constraint_velocity_residual.has_value())
+    throw std::invalid_argument("TapeEvaluator: " + std::to_string(m) +
+                                " programs need their terms and residual tapes (and at most n - s of them)");
   if (m > 0) {
-    check_program(*programs_.program_constraint_terms, "program terms", n, 2 * m * n + m);
-    check_program(*programs_.program_constraint_position_residual, "program position residual", n, -1);
-    check_program(*programs_.program_constraint_velocity_residual, "program velocity residual", n, -1);
-    if (programs_.program_constraint_position_residual->reads_velocities())
-      throw std::invalid_argument("ProgramEvaluator: the program position residual program reads velocities");
-    if (programs_.program_constraint_position_residual->outputs() > m ||
-        programs_.program_constraint_velocity_residual->outputs() > m)
-      throw std::invalid_argument("ProgramEvaluator: more program residuals than programs");
+    check_tape(*tapes_.program_constraint_terms, "program terms", n, 2 * m * n + m);
+    check_tape(*tapes_.program_constraint_position_residual, "program position residual", n, -1);
+    check_tape(*tapes_.program_constraint_velocity_residual, "program velocity residual", n, -1);
+    if (tapes_.program_constraint_position_residual->reads_velocities())
+      throw std::invalid_argument("TapeEvaluator: the program position residual tape reads velocities");
+    if (tapes_.program_constraint_position_residual->outputs() > m ||
+        tapes_.program_constraint_velocity_residual->outputs() > m)
+      throw std::invalid_argument("TapeEvaluator: more program residuals than programs");
   }
 
-  std::size_t largest = static_cast<std::size_t>(programs_.terms.registers());
-  const auto widen = [&largest](const Program& p) {
+  std::size_t largest = static_cast<std::size_t>(tapes_.terms.registers());
+  const auto widen = [&largest](const Tape& p) {
     largest = std::max(largest, static_cast<std::size_t>(p.registers()));
   };
-  if (programs_.complement) widen(*programs_.complement);
-  widen(programs_.position_residual);
-  widen(programs_.velocity_residual);
-  if (programs_.energy) widen(*programs_.energy);
-  if (programs_.energy_function) widen(*programs_.energy_function);
-  if (programs_.power) widen(*programs_.power);
-  if (programs_.solution) widen(*programs_.solution);
-  if (programs_.initial_state) widen(*programs_.initial_state);
+  if (tapes_.complement) widen(*tapes_.complement);
+  widen(tapes_.position_residual);
+  widen(tapes_.velocity_residual);
+  if (tapes_.energy) widen(*tapes_.energy);
+  if (tapes_.energy_function) widen(*tapes_.energy_function);
+  if (tapes_.power) widen(*tapes_.power);
+  if (tapes_.solution) widen(*tapes_.solution);
+  if (tapes_.initial_state) widen(*tapes_.initial_state);
   if (m > 0) {
-    widen(*programs_.program_constraint_terms);
-    widen(*programs_.program_constraint_position_residual);
-    widen(*programs_.program_constraint_velocity_residual);
+    widen(*tapes_.program_constraint_terms);
+    widen(*tapes_.program_constraint_position_residual);
+    widen(*tapes_.program_constraint_velocity_residual);
   }
   scratch_ = largest;
-  if (programs_.sparsity) {
-    // The nonzeros of A and b, between the program's run and their scatter into dense matrices.
-    values_offset_ = static_cast<std::size_t>(programs_.terms.registers());
+  if (tapes_.sparsity) {
+    // The nonzeros of A and b, between the tape's run and their scatter into dense matrices.
+    values_offset_ = static_cast<std::size_t>(tapes_.terms.registers());
     scratch_ = std::max(scratch_, values_offset_ + a_size + b_size);
   }
 
-  terms_ = prepare(programs_.terms, {static_cast<int>(a_size), n, n, static_cast<int>(b_size), s});
-  if (programs_.complement) complement_ = prepare(*programs_.complement, {(n - s) * n});
-  position_residual_ = prepare(programs_.position_residual, {programs_.position_residual.outputs()});
-  velocity_residual_ = prepare(programs_.velocity_residual, {programs_.velocity_residual.outputs()});
-  if (programs_.energy) energy_ = prepare(*programs_.energy, {1});
-  if (programs_.energy_function) energy_function_ = prepare(*programs_.energy_function, {1});
-  if (programs_.power) power_ = prepare(*programs_.power, {2});
-  if (programs_.solution) solution_ = prepare(*programs_.solution, {3 * n});
-  if (programs_.initial_state) initial_state_ = prepare(*programs_.initial_state, {2 * n});
+  terms_ = prepare(tapes_.terms, {static_cast<int>(a_size), n, n, static_cast<int>(b_size), s});
+  if (tapes_.complement) complement_ = prepare(*tapes_.complement, {(n - s) * n});
+  position_residual_ = prepare(tapes_.position_residual, {tapes_.position_residual.outputs()});
+  velocity_residual_ = prepare(tapes_.velocity_residual, {tapes_.velocity_residual.outputs()});
+  if (tapes_.energy) energy_ = prepare(*tapes_.energy, {1});
+  if (tapes_.energy_function) energy_function_ = prepare(*tapes_.energy_function, {1});
+  if (tapes_.power) power_ = prepare(*tapes_.power, {2});
+  if (tapes_.solution) solution_ = prepare(*tapes_.solution, {3 * n});
+  if (tapes_.initial_state) initial_state_ = prepare(*tapes_.initial_state, {2 * n});
   if (m > 0) {
     program_sizes_[0] = program_sizes_[2] = static_cast<std::size_t>(m) * static_cast<std::size_t>(n);
     program_sizes_[1] = static_cast<std::size_t>(m);
-    program_terms_ = prepare(*programs_.program_constraint_terms, {m * n, m, n * m});
-    program_phi_ = prepare(*programs_.program_constraint_position_residual,
-                           {programs_.program_constraint_position_residual->outputs()});
-    program_f_ = prepare(*programs_.program_constraint_velocity_residual,
-                         {programs_.program_constraint_velocity_residual->outputs()});
+    program_terms_ = prepare(*tapes_.program_constraint_terms, {m * n, m, n * m});
+    program_phi_ = prepare(*tapes_.program_constraint_position_residual,
+                           {tapes_.program_constraint_position_residual->outputs()});
+    program_f_ = prepare(*tapes_.program_constraint_velocity_residual,
+                         {tapes_.program_constraint_velocity_residual->outputs()});
   }
-  if (programs_.sparsity) {
+  if (tapes_.sparsity) {
     terms_function_ = terms_.calls ? &terms_scatter<true> : &terms_scatter<false>;
     sparse_function_ = terms_.calls ? &terms_any<true> : &terms_any<false>;
   } else {
@@ -533,7 +533,7 @@ double fold(const Instruction& in, double a, double b, double c, double* cosine)
 
 // The steps in an order that makes runs long: each step still comes after the steps whose registers
 // it reads, and among the steps whose operands are ready, one of the op and destination of the
-// previous step comes first (else the earliest in program order). Every step computes what it did,
+// previous step comes first (else the earliest in tape order). Every step computes what it did,
 // so the values are the same to the bit; only the dispatches, one per run, are fewer (a derived
 // model's sums of products interleave mul, muladd and mulk_add step by step).
 std::vector<Step> schedule(const std::vector<Step>& steps, std::size_t registers) {
@@ -582,11 +582,11 @@ std::vector<Step> schedule(const std::vector<Step>& steps, std::size_t registers
   return out;
 }
 
-// Constants folded, constant operands made immediates; program order, every step to a register.
+// Constants folded, constant operands made immediates; tape order, every step to a register.
 // known[reg] says that the register holds the constant value[reg].
-std::vector<Step> fold_constants(const Program& program, std::vector<char>& known, std::vector<double>& value) {
-  const std::vector<Instruction>& code = program.code();
-  const int inputs = program.inputs();
+std::vector<Step> fold_constants(const Tape& tape, std::vector<char>& known, std::vector<double>& value) {
+  const std::vector<Instruction>& code = tape.code();
+  const int inputs = tape.inputs();
   const auto at = [](int reg) { return static_cast<std::size_t>(reg); };
   std::vector<Step> steps;
   for (std::size_t i = 0; i < code.size(); ++i) {
@@ -682,7 +682,7 @@ void mark_live(const std::vector<Step>& steps, const std::vector<std::vector<Wan
 // A product a * b (or a * a) read only by a k * x or k * x + c that follows becomes part of it:
 // k * (a * b) is mulk, k * (a * b) + c mulk_muladd, which round exactly as the two steps did.
 // A parameter times a product of the state, c * p * (a * b) with c * p in the parameter stage,
-// then costs one step, as it did when parameters were numbers in the program.
+// then costs one step, as it did when parameters were numbers in the tape.
 void fuse_products(std::vector<Step>& steps, const std::vector<std::vector<Want>>& wants, std::vector<char>& keep,
                    const std::vector<int>& readers) {
   const auto at = [](int reg) { return static_cast<std::size_t>(reg); };
@@ -707,18 +707,18 @@ void fuse_products(std::vector<Step>& steps, const std::vector<std::vector<Want>
 
 }  // namespace
 
-ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, const std::vector<int>& sizes) {
-  const int inputs = program.inputs();
-  const std::size_t registers = static_cast<std::size_t>(program.registers());
+TapeEvaluator::Prepared TapeEvaluator::prepare(const Tape& tape, const std::vector<int>& sizes) {
+  const int inputs = tape.inputs();
+  const std::size_t registers = static_cast<std::size_t>(tape.registers());
   const auto at = [](int reg) { return static_cast<std::size_t>(reg); };
   std::vector<char> known(registers, 0);
   std::vector<double> value(registers, 0.0);
-  std::vector<Step> steps = fold_constants(program, known, value);
+  std::vector<Step> steps = fold_constants(tape, known, value);
 
   // The outputs: constants into the image, the others wanted from their registers.
   Prepared p;
   std::vector<std::vector<Want>> wants(registers);
-  const std::vector<Output>& outputs = program.output_list();
+  const std::vector<Output>& outputs = tape.output_list();
   std::size_t j = 0;
   for (std::size_t array = 0; array < sizes.size(); ++array)
     for (int i = 0; i < sizes[array]; ++i, ++j) {
@@ -735,7 +735,7 @@ ProgramEvaluator::Prepared ProgramEvaluator::prepare(const Program& program, con
 
   // Each step in place: an output computed once for all is written where it goes; a copy (1 * x,
   // exact) serves an input or a sincos, a clone of its step every further output of a register.
-  const int n = program.coordinates();
+  const int n = tape.coordinates();
   const auto note_read = [&p, n](int reg) {
     if (reg == 0)
       p.reads[0] = true;
@@ -814,7 +814,7 @@ NHDYN_ALWAYS_INLINE void copy_fixed(const double* from, double* to) {
 // them constant): with the sizes known at compile time the input copies and the image copies
 // become a few vector moves instead of loops.
 template <int N, int S, bool Calls>
-void ProgramEvaluator::terms_fixed(const ProgramEvaluator& self, double t, const double* q, const double* v,
+void TapeEvaluator::terms_fixed(const TapeEvaluator& self, double t, const double* q, const double* v,
                                    double* scratch, const TermsOut& out) {
   const Prepared& p = self.terms_;
   load_inputs(p.reads, N, t, q, v, scratch);
@@ -828,7 +828,7 @@ void ProgramEvaluator::terms_fixed(const ProgramEvaluator& self, double t, const
 }
 
 template <bool Calls>
-void ProgramEvaluator::terms_any(const ProgramEvaluator& self, double t, const double* q, const double* v,
+void TapeEvaluator::terms_any(const TapeEvaluator& self, double t, const double* q, const double* v,
                                  double* scratch, const TermsOut& out) {
   const Prepared& p = self.terms_;
   load_inputs(p.reads, static_cast<std::size_t>(self.n_), t, q, v, scratch);
@@ -843,7 +843,7 @@ void ProgramEvaluator::terms_any(const ProgramEvaluator& self, double t, const d
 }
 
 template <bool Calls>
-void ProgramEvaluator::terms_scatter(const ProgramEvaluator& self, double t, const double* q, const double* v,
+void TapeEvaluator::terms_scatter(const TapeEvaluator& self, double t, const double* q, const double* v,
                                      double* scratch, const TermsOut& out) {
   double* const a_values = scratch + self.values_offset_;
   double* const b_values = a_values + self.terms_sizes_[0];
@@ -856,12 +856,12 @@ void ProgramEvaluator::terms_scatter(const ProgramEvaluator& self, double t, con
         dense[static_cast<std::size_t>(j) * rows + static_cast<std::size_t>(pattern.inner[static_cast<std::size_t>(k)])] =
             values[k];
   };
-  scatter(self.programs_.sparsity->A, a_values, out.A);
-  scatter(self.programs_.sparsity->b, b_values, out.b);
+  scatter(self.tapes_.sparsity->A, a_values, out.A);
+  scatter(self.tapes_.sparsity->b, b_values, out.b);
 }
 
 template <bool Calls>
-ProgramEvaluator::TermsFunction ProgramEvaluator::choose_terms(int n, int s) {
+TapeEvaluator::TermsFunction TapeEvaluator::choose_terms(int n, int s) {
   switch (n * 8 + s) {
     case 1 * 8 + 0: return &terms_fixed<1, 0, Calls>;
     case 2 * 8 + 0: return &terms_fixed<2, 0, Calls>;
@@ -877,19 +877,19 @@ ProgramEvaluator::TermsFunction ProgramEvaluator::choose_terms(int n, int s) {
   }
 }
 
-void ProgramEvaluator::terms(double t, const double* q, const double* v, double* scratch,
+void TapeEvaluator::terms(double t, const double* q, const double* v, double* scratch,
                              const TermsOut& out) const {
   terms_function_(*this, t, q, v, scratch, out);
 }
 
-void ProgramEvaluator::sparse_terms(double t, const double* q, const double* v, double* scratch,
+void TapeEvaluator::sparse_terms(double t, const double* q, const double* v, double* scratch,
                                     const TermsOut& out) const {
   if (sparse_function_ == nullptr)
-    throw std::logic_error("ProgramEvaluator::sparse_terms: this model was compiled dense (sparsity() is null)");
+    throw std::logic_error("TapeEvaluator::sparse_terms: this model was compiled dense (sparsity() is null)");
   sparse_function_(*this, t, q, v, scratch, out);
 }
 
-void ProgramEvaluator::run(const Prepared& p, double t, const double* q, const double* v, double* scratch,
+void TapeEvaluator::run(const Prepared& p, double t, const double* q, const double* v, double* scratch,
                            double* out) const {
   load_inputs(p.reads, static_cast<std::size_t>(n_), t, q, v, scratch);
   const std::size_t m = p.image.size();
@@ -904,23 +904,23 @@ void ProgramEvaluator::run(const Prepared& p, double t, const double* q, const d
     run_steps<false>(p.steps.data(), arrays);
 }
 
-void ProgramEvaluator::complement(double t, const double* q, const double* v, double* scratch, double* D) const {
-  if (!programs_.complement) return;
+void TapeEvaluator::complement(double t, const double* q, const double* v, double* scratch, double* D) const {
+  if (!tapes_.complement) return;
   run(complement_, t, q, v, scratch, D);
 }
 
-void ProgramEvaluator::position_residual(double t, const double* q, double* scratch, double* phi) const {
+void TapeEvaluator::position_residual(double t, const double* q, double* scratch, double* phi) const {
   run(position_residual_, t, q, nullptr, scratch, phi);
 }
 
-void ProgramEvaluator::velocity_residual(double t, const double* q, const double* v, double* scratch,
+void TapeEvaluator::velocity_residual(double t, const double* q, const double* v, double* scratch,
                                          double* f) const {
   run(velocity_residual_, t, q, v, scratch, f);
 }
 
-void ProgramEvaluator::program_constraint_terms(double t, const double* q, const double* v, double* scratch,
+void TapeEvaluator::program_constraint_terms(double t, const double* q, const double* v, double* scratch,
                                                 double* b_p, double* b_p0, double* B) const {
-  if (!programs_.program_constraint_terms) return;
+  if (!tapes_.program_constraint_terms) return;
   const Prepared& p = program_terms_;
   load_inputs(p.reads, static_cast<std::size_t>(n_), t, q, v, scratch);
   double* arrays[4];
@@ -942,47 +942,47 @@ void ProgramEvaluator::program_constraint_terms(double t, const double* q, const
     run_steps<false>(p.steps.data(), arrays);
 }
 
-void ProgramEvaluator::program_constraint_position_residual(double t, const double* q, double* scratch,
+void TapeEvaluator::program_constraint_position_residual(double t, const double* q, double* scratch,
                                                             double* phi) const {
-  if (!programs_.program_constraint_position_residual) return;
+  if (!tapes_.program_constraint_position_residual) return;
   run(program_phi_, t, q, nullptr, scratch, phi);
 }
 
-void ProgramEvaluator::program_constraint_velocity_residual(double t, const double* q, const double* v,
+void TapeEvaluator::program_constraint_velocity_residual(double t, const double* q, const double* v,
                                                             double* scratch, double* f) const {
-  if (!programs_.program_constraint_velocity_residual) return;
+  if (!tapes_.program_constraint_velocity_residual) return;
   run(program_f_, t, q, v, scratch, f);
 }
 
-double ProgramEvaluator::energy(double t, const double* q, const double* v, double* scratch) const {
-  if (!programs_.energy) return 0.0;
+double TapeEvaluator::energy(double t, const double* q, const double* v, double* scratch) const {
+  if (!tapes_.energy) return 0.0;
   double e = 0.0;
   run(energy_, t, q, v, scratch, &e);
   return e;
 }
 
-double ProgramEvaluator::energy_function(double t, const double* q, const double* v, double* scratch) const {
-  if (!programs_.energy_function) return energy(t, q, v, scratch);  // T = T2: h = E
+double TapeEvaluator::energy_function(double t, const double* q, const double* v, double* scratch) const {
+  if (!tapes_.energy_function) return energy(t, q, v, scratch);  // T = T2: h = E
   double h = 0.0;
   run(energy_function_, t, q, v, scratch, &h);
   return h;
 }
 
-void ProgramEvaluator::power(double t, const double* q, const double* v, double* scratch, double* out) const {
-  if (!programs_.power) {
+void TapeEvaluator::power(double t, const double* q, const double* v, double* scratch, double* out) const {
+  if (!tapes_.power) {
     out[0] = out[1] = 0.0;
     return;
   }
   run(power_, t, q, v, scratch, out);
 }
 
-void ProgramEvaluator::solution(double t, double* scratch, double* qva) const {
-  if (!programs_.solution) return;
+void TapeEvaluator::solution(double t, double* scratch, double* qva) const {
+  if (!tapes_.solution) return;
   run(solution_, t, nullptr, nullptr, scratch, qva);
 }
 
-void ProgramEvaluator::initial_state(double* scratch, double* q0, double* v0) const {
-  if (!programs_.initial_state) return;
+void TapeEvaluator::initial_state(double* scratch, double* q0, double* v0) const {
+  if (!tapes_.initial_state) return;
   std::vector<double> out(2 * static_cast<std::size_t>(n_));
   run(initial_state_, 0.0, nullptr, nullptr, scratch, out.data());
   std::copy(out.begin(), out.begin() + n_, q0);

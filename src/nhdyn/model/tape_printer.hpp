@@ -1,14 +1,14 @@
-// A Program printed as straight-line C++: the one printer of the compiled evaluator's source
+// A Tape printed as straight-line C++: the one printer of the compiled evaluator's source
 // (jit/source.hpp) and of the headers `nhdyn codegen` writes (symbolic/codegen.hpp). Each
 // instruction becomes `const double rN = <expression>;`, the expression read from the table of
-// operations (kOps in program.hpp), so that the printed code does the program's operations in its
+// operations (kOps in tape.hpp), so that the printed code does the tape's operations in its
 // order and rounds as the interpreter does (when compiled without contraction into fused
 // multiply-adds).
 //
 // The parameter stage: what depends on parameters and constants only is computed once per
 // parameter change (jit: a function of its own writing an array; codegen: the evaluator's
 // constructor writing members), and a call reads the stage registers it needs from there. The two
-// users differ only in spelling, given by a ProgramPrintStyle: how a double, a parameter and a
+// users differ only in spelling, given by a TapePrintStyle: how a double, a parameter and a
 // stored stage register are written, and whether constants are declared as registers or written
 // as literals where they are read.
 #pragma once
@@ -19,23 +19,23 @@
 #include <utility>
 #include <vector>
 
-#include "nhdyn/model/program.hpp"
+#include "nhdyn/model/tape.hpp"
 
 namespace nhdyn {
 
-struct ProgramPrintStyle {
+struct TapePrintStyle {
   std::function<std::string(double)> literal;        // a double as a C++ literal of type double
   std::function<std::string(int)> parameter;         // model parameter i as C++ ("p[3]", "p_.mass")
   std::function<std::string(int, int)> stored;       // stage register r, stored in place `slot` (0, 1, ...)
   bool declare_constants = false;  // constants as `const double rN = k;` where read, else literals inline
 };
 
-class ProgramPrinter {
+class TapePrinter {
  public:
-  // hoist = false: no stage, every instruction in the call (a program that runs once anyway).
-  ProgramPrinter(const Program& program, ProgramPrintStyle style, bool hoist = true);
+  // hoist = false: no stage, every instruction in the call (a tape that runs once anyway).
+  TapePrinter(const Tape& tape, TapePrintStyle style, bool hoist = true);
 
-  const Program& program() const { return program_; }
+  const Tape& tape() const { return tape_; }
 
   // Number of stage registers a call reads (their places are 0 .. stored_count() - 1, in register order).
   int stored_count() const { return stored_count_; }
@@ -52,14 +52,14 @@ class ProgramPrinter {
   // register, in a call, as style.stored; a constant as its literal unless declared; else rN.
   std::string reg(int r, bool in_stage) const;
 
-  // Output j of the program as C++ in a call: its register, or its literal when constant.
+  // Output j of the tape as C++ in a call: its register, or its literal when constant.
   std::string output(int j) const;
 
  private:
   std::string expression(const Instruction& in, bool in_stage) const;
 
-  const Program& program_;
-  ProgramPrintStyle style_;
+  const Tape& tape_;
+  TapePrintStyle style_;
   std::vector<char> stage_;          // register -> computed in the stage
   std::vector<char> constant_;       // register -> a constant instruction
   std::vector<char> read_by_stage_;  // register -> read by a stage instruction

@@ -1,18 +1,18 @@
-// Straight-line programs on doubles: the numeric form of a model compiled from symbols
-// (symbolic/compile.hpp). A Program is a flat array of instructions in single-assignment form with
+// Straight-line programs on doubles (tapes): the numeric form of a model compiled from symbols
+// (symbolic/compile.hpp). A Tape is a flat array of instructions in single-assignment form with
 // no branches and no allocation when it runs, so its cost is one switch dispatch per run of
 // instructions of the same op, plus the arithmetic. Registers: r[0] = t, r[1 + i] = q_i,
-// r[1 + n + i] = q'_i (the inputs, copied in when the program starts), then instruction j writes
+// r[1 + n + i] = q'_i (the inputs, copied in when the tape starts), then instruction j writes
 // register inputs() + j and reads only registers below it. Outputs are registers or constants;
 // constant outputs cost no instruction. A `parameter` instruction reads the value of a model
-// parameter: the programs as compiled are parametric, and binding them to values (Program::bind)
+// parameter: the tapes as compiled are parametric, and binding them to values (Tape::bind)
 // turns those instructions into constants.
-// ProgramEvaluator runs such programs as an Evaluator: all the terms A, Q, G, b, b0 in one
-// program (common subexpressions computed once), the complement D, the residuals and the energy
+// TapeEvaluator runs such tapes as an Evaluator: all the terms A, Q, G, b, b0 in one
+// tape (common subexpressions computed once), the complement D, the residuals and the energy
 // in their own, each in a prepared form: what depends on constants and parameters only is
 // computed once when the evaluator is bound to parameter values (with_parameters, the "parameter
 // stage"), what no output needs is dropped, and results go straight to the output arrays.
-// Generated C++ (symbolic/codegen.hpp) prints the same programs as source code.
+// Generated C++ (symbolic/codegen.hpp) prints the same tapes as source code.
 #pragma once
 
 #include <cstddef>
@@ -63,13 +63,13 @@ enum class Op : std::uint8_t {
   sinh,
   cosh,
   tanh,
-  parameter,    // r = the value of model parameter a (an index, not a register); see Program::bind
+  parameter,    // r = the value of model parameter a (an index, not a register); see Tape::bind
   nop,          // the cos slot of a sincos; never pushed on its own
 };
 
 // The table of operations: one row per Op, in its order, read by the interpreter and the tangent
 // (operand_count), describe() (op_name) and the C++ printer of jit and codegen
-// (program_printer.hpp). `cpp` is the operation as a C++ expression: {a}, {b}, {c} its operand
+// (tape_printer.hpp). `cpp` is the operation as a C++ expression: {a}, {b}, {c} its operand
 // registers, {k} its immediate as a double, {n} the immediate as an integer, {p} the parameter it
 // reads. A sincos prints its sine; the cosine is its nop companion's, printed with it.
 struct OpInfo {
@@ -135,7 +135,7 @@ struct Instruction {
 };
 
 // An instruction as the interpreter runs it: it writes to[...] of the array `dest` (0: the
-// registers; ProgramEvaluator lets a step write an output array directly) from operand registers
+// registers; TapeEvaluator lets a step write an output array directly) from operand registers
 // a, b, c and immediate k. A sincos is one step; a nop ends a list of steps. Consecutive steps of
 // the same op and dest form a run, which costs one dispatch.
 struct Step {
@@ -148,17 +148,17 @@ struct Step {
   double k = 0.0;
 };
 
-// An output of a program: register `reg`, or the constant `value` when reg < 0.
+// An output of a tape: register `reg`, or the constant `value` when reg < 0.
 struct Output {
   int reg = -1;
   double value = 0.0;
 };
 
-class Program {
+class Tape {
  public:
-  // A program of a system with `coordinates` coordinates (its inputs are t, q and q') and
+  // A tape of a system with `coordinates` coordinates (its inputs are t, q and q') and
   // `parameters` parameters (read by `parameter` instructions).
-  explicit Program(int coordinates = 0, int parameters = 0);
+  explicit Tape(int coordinates = 0, int parameters = 0);
 
   int coordinates() const { return n_; }
   int parameters() const { return parameters_; }
@@ -192,13 +192,13 @@ class Program {
   bool reads_velocities() const { return reads_[2]; }
   bool reads_parameters() const { return reads_parameters_; }
 
-  // The program with every `parameter` instruction replaced by the constant values[index]
+  // The tape with every `parameter` instruction replaced by the constant values[index]
   // (`count` values, at least parameters()); register numbers and outputs stay as they are.
-  Program bind(const double* values, std::size_t count) const;
+  Tape bind(const double* values, std::size_t count) const;
 
-  // Runs the program: q and v hold coordinates() values (v may be null when the program reads no
+  // Runs the tape: q and v hold coordinates() values (v may be null when the tape reads no
   // velocity), `registers` registers() doubles, `outputs` outputs() doubles. Allocates nothing.
-  // Throws std::logic_error for a program that reads parameters: bind() it first.
+  // Throws std::logic_error for a tape that reads parameters: bind() it first.
   void run(double t, const double* q, const double* v, double* registers, double* outputs) const;
   // The same without writing the outputs: register outputs stay in registers[output_list()[i].reg].
   void execute(double t, const double* q, const double* v, double* registers) const;
@@ -221,38 +221,38 @@ class Program {
   bool reads_[3] = {false, false, false};  // t, q, q'
 };
 
-// The programs of a compiled model, with the output each must have (n coordinates, s
+// The tapes of a compiled model, with the output each must have (n coordinates, s
 // constraints, p of them at position level, r = number at position or velocity level). Each may
 // read the model's parameters (in the order of Model::parameters).
-struct ModelPrograms {
+struct ModelTapes {
   // outputs: A (n x n, col-major), Q (n), G (n), b (s x n, col-major), b0 (s); with a sparsity,
   // only its nonzeros of A and b (compressed columns) in their places
-  Program terms;
-  std::optional<Program> complement;  // outputs: D, k x n col-major (k = n - s)
-  Program position_residual;         // outputs: phi (p); reads no velocity
-  Program velocity_residual;         // outputs: f (r)
-  std::optional<Program> energy;     // one output: T + V
-  std::optional<Program> solution;   // outputs: q (n), q' (n), q'' (n) of the exact motion; reads only t
+  Tape terms;
+  std::optional<Tape> complement;  // outputs: D, k x n col-major (k = n - s)
+  Tape position_residual;         // outputs: phi (p); reads no velocity
+  Tape velocity_residual;         // outputs: f (r)
+  std::optional<Tape> energy;     // one output: T + V
+  std::optional<Tape> solution;   // outputs: q (n), q' (n), q'' (n) of the exact motion; reads only t
   std::optional<TermsSparsity> sparsity;  // the nonzeros of A and b that terms writes, if not all
-  std::optional<Program> initial_state = std::nullopt;  // outputs: q0 (n), q'0 (n); reads parameters only
-  int parameters = 0;                // number of parameters the programs may read
+  std::optional<Tape> initial_state = std::nullopt;  // outputs: q0 (n), q'0 (n); reads parameters only
+  int parameters = 0;                // number of parameters the tapes may read
   // Program motion (docs/derivations/program-motion.md), with m programs: outputs b_p (m x n
   // col-major), b_p0 (m), B (n x m col-major); the programs' position residuals (reading no
   // velocity) and velocity residuals. Absent when m = 0.
   int program_constraints = 0;       // m
-  std::optional<Program> program_constraint_terms = std::nullopt;
-  std::optional<Program> program_constraint_position_residual = std::nullopt;
-  std::optional<Program> program_constraint_velocity_residual = std::nullopt;
-  // The energy balance (docs/derivations/energy-balance.md), for a model whose energy program is
+  std::optional<Tape> program_constraint_terms = std::nullopt;
+  std::optional<Tape> program_constraint_position_residual = std::nullopt;
+  std::optional<Tape> program_constraint_velocity_residual = std::nullopt;
+  // The energy balance (docs/derivations/energy-balance.md), for a model whose energy tape is
   // E = T + V of any system (not only a conservative one): h where it differs from E, and the
   // power Q_nc . q', -dL/dt|explicit where it is not identically zero.
   bool energy_balance = false;
-  std::optional<Program> energy_function = std::nullopt;  // one output: h = q' . dT/dq' - T + V
-  std::optional<Program> power = std::nullopt;            // outputs: Q_nc . q', -dL/dt|explicit
+  std::optional<Tape> energy_function = std::nullopt;  // one output: h = q' . dT/dq' - T + V
+  std::optional<Tape> power = std::nullopt;            // outputs: Q_nc . q', -dL/dt|explicit
 };
 
-// An Evaluator that runs straight-line programs. It keeps the parametric programs (shared by every
-// evaluator bound from them) and the values it computes with; each program is bound to those
+// An Evaluator that runs straight-line tapes. It keeps the parametric tapes (shared by every
+// evaluator bound from them) and the values it computes with; each tape is bound to those
 // values and prepared once, when the evaluator is built (with_parameters builds another):
 // - an instruction whose operands are all constants or parameters becomes a constant, computed by
 //   the interpreter itself so to the same bits (a parameter-only subexpression costs nothing per
@@ -269,62 +269,62 @@ struct ModelPrograms {
 // - the steps are reordered, each still after the steps it reads, so that steps of one op and
 //   destination follow each other: the interpreter dispatches once per such run (a derived model's
 //   terms interleave mul, muladd and mulk_add step by step; the bicycle's 3963 steps are 215 runs).
-// Programs that call no math library function run in an interpreter without those calls, whose
-// fixed cost per call is lower. The prepared form computes the same values as the programs, to the
-// bit. scratch_size() is the largest register count of the programs.
-class ProgramEvaluator final : public Evaluator {
+// Tapes that call no math library function run in an interpreter without those calls, whose
+// fixed cost per call is lower. The prepared form computes the same values as the tapes, to the
+// bit. scratch_size() is the largest register count of the tapes.
+class TapeEvaluator final : public Evaluator {
  public:
-  // Throws std::invalid_argument when a program's output count or coordinate count does not
+  // Throws std::invalid_argument when a tape's output count or coordinate count does not
   // match n and s, the position residual reads velocities, or there are fewer `parameters` than
-  // programs.parameters.
-  ProgramEvaluator(int n, int s, ModelPrograms programs, std::vector<double> parameters = {});
-  // The same programs bound to other values (no copy of the parametric programs).
-  ProgramEvaluator(const ProgramEvaluator& other, std::vector<double> parameters);
+  // tapes.parameters.
+  TapeEvaluator(int n, int s, ModelTapes tapes, std::vector<double> parameters = {});
+  // The same tapes bound to other values (no copy of the parametric tapes).
+  TapeEvaluator(const TapeEvaluator& other, std::vector<double> parameters);
 
   int n() const { return n_; }
   int s() const { return s_; }
-  // The programs bound to this evaluator's parameter values: `parameter` instructions are
+  // The tapes bound to this evaluator's parameter values: `parameter` instructions are
   // constants (what linearization's tangents and tests run).
-  const ModelPrograms& programs() const { return programs_; }
-  // The programs as compiled, reading the parameters (generated code prints these).
-  const ModelPrograms& parametric_programs() const { return *parametric_; }
+  const ModelTapes& tapes() const { return tapes_; }
+  // The tapes as compiled, reading the parameters (generated code prints these).
+  const ModelTapes& parametric_tapes() const { return *parametric_; }
   const std::vector<double>& parameter_values() const { return parameters_; }
 
   std::shared_ptr<const Evaluator> with_parameters(const double* values, std::size_t count) const override;
-  bool has_initial_state() const override { return programs_.initial_state.has_value(); }
+  bool has_initial_state() const override { return tapes_.initial_state.has_value(); }
   void initial_state(double* scratch, double* q0, double* v0) const override;
   // Number of operations the prepared terms run per call (a sincos counts one).
   int terms_operations() const { return static_cast<int>(terms_.steps.size()) - 1; }
 
   std::size_t scratch_size() const override { return scratch_; }
-  // The Evaluator interface; each call runs one program and writes its outputs. A sparse terms
-  // program fills a dense A and b by zeroing them and scattering its nonzeros (through scratch).
+  // The Evaluator interface; each call runs one tape and writes its outputs. A sparse terms
+  // tape fills a dense A and b by zeroing them and scattering its nonzeros (through scratch).
   void terms(double t, const double* q, const double* v, double* scratch, const TermsOut& out) const override;
   const TermsSparsity* sparsity() const override {
-    return programs_.sparsity ? &*programs_.sparsity : nullptr;
+    return tapes_.sparsity ? &*tapes_.sparsity : nullptr;
   }
   void sparse_terms(double t, const double* q, const double* v, double* scratch, const TermsOut& out) const override;
-  bool has_complement() const override { return programs_.complement.has_value(); }
+  bool has_complement() const override { return tapes_.complement.has_value(); }
   void complement(double t, const double* q, const double* v, double* scratch, double* D) const override;
   void position_residual(double t, const double* q, double* scratch, double* phi) const override;
   void velocity_residual(double t, const double* q, const double* v, double* scratch, double* f) const override;
-  bool has_energy() const override { return programs_.energy.has_value(); }
+  bool has_energy() const override { return tapes_.energy.has_value(); }
   double energy(double t, const double* q, const double* v, double* scratch) const override;
-  bool has_program_constraints() const override { return programs_.program_constraint_terms.has_value(); }
+  bool has_program_constraints() const override { return tapes_.program_constraint_terms.has_value(); }
   void program_constraint_terms(double t, const double* q, const double* v, double* scratch, double* b_p,
                                 double* b_p0, double* B) const override;
   void program_constraint_position_residual(double t, const double* q, double* scratch, double* phi) const override;
   void program_constraint_velocity_residual(double t, const double* q, const double* v, double* scratch,
                                             double* f) const override;
-  bool has_energy_balance() const override { return programs_.energy_balance && programs_.energy.has_value(); }
-  bool energy_function_is_energy() const override { return !programs_.energy_function.has_value(); }
+  bool has_energy_balance() const override { return tapes_.energy_balance && tapes_.energy.has_value(); }
+  bool energy_function_is_energy() const override { return !tapes_.energy_function.has_value(); }
   double energy_function(double t, const double* q, const double* v, double* scratch) const override;
   void power(double t, const double* q, const double* v, double* scratch, double* out) const override;
-  bool has_solution() const override { return programs_.solution.has_value(); }
+  bool has_solution() const override { return tapes_.solution.has_value(); }
   void solution(double t, double* scratch, double* qva) const override;
 
  private:
-  // A program ready to run: its steps (destination 0 the registers, 1 + i the i-th output array),
+  // A tape ready to run: its steps (destination 0 the registers, 1 + i the i-th output array),
   // ended by a nop, the inputs they read, and every output as an image (constants, 0 where a
   // step writes) that is copied before the steps run.
   struct Prepared {
@@ -333,21 +333,21 @@ class ProgramEvaluator final : public Evaluator {
     bool reads[3] = {false, false, false};  // t, q, q'
     std::vector<double> image;
   };
-  // Prepares `program`, whose outputs fill arrays of the given sizes one after the other.
-  static Prepared prepare(const Program& program, const std::vector<int>& sizes);
+  // Prepares `tape`, whose outputs fill arrays of the given sizes one after the other.
+  static Prepared prepare(const Tape& tape, const std::vector<int>& sizes);
 
   // The whole terms() call, with the sizes fixed at compile time for n <= 4 (terms_fixed) or not:
   // the input copies and the image copies then become a few moves instead of loops.
-  using TermsFunction = void (*)(const ProgramEvaluator& self, double t, const double* q, const double* v,
+  using TermsFunction = void (*)(const TapeEvaluator& self, double t, const double* q, const double* v,
                                  double* scratch, const TermsOut& out);
   template <int N, int S, bool Calls>
-  static void terms_fixed(const ProgramEvaluator& self, double t, const double* q, const double* v,
+  static void terms_fixed(const TapeEvaluator& self, double t, const double* q, const double* v,
                           double* scratch, const TermsOut& out);
   template <bool Calls>
-  static void terms_any(const ProgramEvaluator& self, double t, const double* q, const double* v,
+  static void terms_any(const TapeEvaluator& self, double t, const double* q, const double* v,
                         double* scratch, const TermsOut& out);
   template <bool Calls>
-  static void terms_scatter(const ProgramEvaluator& self, double t, const double* q, const double* v,
+  static void terms_scatter(const TapeEvaluator& self, double t, const double* q, const double* v,
                             double* scratch, const TermsOut& out);
   template <bool Calls>
   static TermsFunction choose_terms(int n, int s);
@@ -357,9 +357,9 @@ class ProgramEvaluator final : public Evaluator {
 
   int n_ = 0;
   int s_ = 0;
-  std::shared_ptr<const ModelPrograms> parametric_;
+  std::shared_ptr<const ModelTapes> parametric_;
   std::vector<double> parameters_;
-  ModelPrograms programs_;  // *parametric_ bound to parameters_
+  ModelTapes tapes_;  // *parametric_ bound to parameters_
   std::size_t scratch_ = 0;
   Prepared terms_, complement_, position_residual_, velocity_residual_, energy_, solution_, initial_state_;
   Prepared program_terms_, program_phi_, program_f_;  // program motion (empty without programs)
@@ -371,18 +371,18 @@ class ProgramEvaluator final : public Evaluator {
   TermsFunction sparse_function_ = nullptr;
 };
 
-// A Program turned into machine code by the compiled evaluator (jit/compiled_evaluator.hpp): the
-// same outputs as Program::run with the same parameter values, in the same order of operations, so
+// A Tape turned into machine code by the compiled evaluator (jit/compiled_evaluator.hpp): the
+// same outputs as Tape::run with the same parameter values, in the same order of operations, so
 // the same rounding. model/ only calls it (the contact forces, the derived outputs: the rows of a
 // compiled model go through compiled code, as its terms do); jit::make_compiled makes it.
-class NativeProgram {
+class NativeTape {
  public:
-  virtual ~NativeProgram() = default;
+  virtual ~NativeTape() = default;
   // What depends on the parameters alone, computed once per parameter change into stage_size()
-  // doubles; `parameters` in the model's order (Program::bind's).
+  // doubles; `parameters` in the model's order (Tape::bind's).
   virtual std::size_t stage_size() const = 0;
   virtual void stage(const double* parameters, double* stage) const = 0;
-  // One call: Program::run's inputs and outputs, with the stage in place of the registers.
+  // One call: Tape::run's inputs and outputs, with the stage in place of the registers.
   virtual void run(const double* stage, double t, const double* q, const double* v, double* outputs) const = 0;
 };
 

@@ -1,4 +1,4 @@
-#include "nhdyn/model/program_printer.hpp"
+#include "nhdyn/model/tape_printer.hpp"
 
 #include <fmt/format.h>
 
@@ -35,16 +35,16 @@ std::string expand(std::string_view form, const std::string& a, const std::strin
 
 }  // namespace
 
-ProgramPrinter::ProgramPrinter(const Program& program, ProgramPrintStyle style, bool hoist)
-    : program_(program), style_(std::move(style)) {
-  const std::size_t registers = static_cast<std::size_t>(program.registers());
+TapePrinter::TapePrinter(const Tape& tape, TapePrintStyle style, bool hoist)
+    : tape_(tape), style_(std::move(style)) {
+  const std::size_t registers = static_cast<std::size_t>(tape.registers());
   stage_.assign(registers, 0);
   constant_.assign(registers, 0);
   read_by_stage_.assign(registers, 0);
   read_by_call_.assign(registers, 0);
   place_.assign(registers, -1);
-  const std::vector<Instruction>& code = program.code();
-  const std::size_t inputs = static_cast<std::size_t>(program.inputs());
+  const std::vector<Instruction>& code = tape.code();
+  const std::size_t inputs = static_cast<std::size_t>(tape.inputs());
   const auto at = [](int r) { return static_cast<std::size_t>(r); };
   // In the stage: a parameter, and what reads only stage registers and constants.
   for (std::size_t i = 0; i < code.size(); ++i) {
@@ -71,37 +71,37 @@ ProgramPrinter::ProgramPrinter(const Program& program, ProgramPrintStyle style, 
     const int operands[3] = {in.a, in.b, in.c};
     for (int k = 0; k < operand_count(in.op); ++k) (stage_[r] ? read_by_stage_ : read_by_call_)[at(operands[k])] = 1;
   }
-  for (const Output& o : program.output_list())
+  for (const Output& o : tape.output_list())
     if (o.reg >= 0) read_by_call_[at(o.reg)] = 1;
   for (std::size_t r = 0; r < registers; ++r)
     if (stage_[r] && read_by_call_[r]) place_[r] = stored_count_++;
 }
 
-std::vector<std::pair<int, int>> ProgramPrinter::stored_registers() const {
+std::vector<std::pair<int, int>> TapePrinter::stored_registers() const {
   std::vector<std::pair<int, int>> out;
   for (std::size_t r = 0; r < place_.size(); ++r)
     if (place_[r] >= 0) out.emplace_back(static_cast<int>(r), place_[r]);
   return out;
 }
 
-std::string ProgramPrinter::reg(int r, bool in_stage) const {
-  const int n = program_.coordinates();
+std::string TapePrinter::reg(int r, bool in_stage) const {
+  const int n = tape_.coordinates();
   const std::size_t at = static_cast<std::size_t>(r);
-  if (r == Program::time_register()) return "t";
+  if (r == Tape::time_register()) return "t";
   if (r <= n) return fmt::format("q[{}]", r - 1);
   if (r <= 2 * n) return fmt::format("v[{}]", r - 1 - n);
   if (constant_[at] && !style_.declare_constants)
-    return style_.literal(program_.code()[at - static_cast<std::size_t>(program_.inputs())].k);
+    return style_.literal(tape_.code()[at - static_cast<std::size_t>(tape_.inputs())].k);
   if (!in_stage && stage_[at]) return style_.stored(r, place_[at]);
   return "r" + std::to_string(r);
 }
 
-std::string ProgramPrinter::output(int j) const {
-  const Output& o = program_.output_list()[static_cast<std::size_t>(j)];
+std::string TapePrinter::output(int j) const {
+  const Output& o = tape_.output_list()[static_cast<std::size_t>(j)];
   return o.reg < 0 ? style_.literal(o.value) : reg(o.reg, false);
 }
 
-std::string ProgramPrinter::expression(const Instruction& in, bool in_stage) const {
+std::string TapePrinter::expression(const Instruction& in, bool in_stage) const {
   const int count = operand_count(in.op);
   const std::string a = count >= 1 ? reg(in.a, in_stage) : "", b = count >= 2 ? reg(in.b, in_stage) : "",
                     c = count >= 3 ? reg(in.c, in_stage) : "";
@@ -110,12 +110,12 @@ std::string ProgramPrinter::expression(const Instruction& in, bool in_stage) con
   return expand(op_info(in.op).cpp, a, b, c, style_.literal(in.k), power, p);
 }
 
-std::string ProgramPrinter::statements(bool in_stage, std::string_view indent) const {
+std::string TapePrinter::statements(bool in_stage, std::string_view indent) const {
   std::string out;
-  const std::vector<Instruction>& code = program_.code();
+  const std::vector<Instruction>& code = tape_.code();
   for (std::size_t i = 0; i < code.size(); ++i) {
     const Instruction& in = code[i];
-    const int r = program_.inputs() + static_cast<int>(i);
+    const int r = tape_.inputs() + static_cast<int>(i);
     const std::size_t at = static_cast<std::size_t>(r);
     if (in.op == Op::nop) continue;
     const bool wanted = constant_[at] ? style_.declare_constants && (in_stage ? read_by_stage_[at] : read_by_call_[at])

@@ -1,4 +1,4 @@
-#include "nhdyn/model/program_tangent.hpp"
+#include "nhdyn/model/tape_tangent.hpp"
 
 #include <cmath>
 #include <cstddef>
@@ -21,16 +21,16 @@ double integer_power(double a, int m) {
 
 }  // namespace
 
-void run_tangent(const Program& program, const double* x, double dt, const double* dq, const double* dv,
+void run_tangent(const Tape& tape, const double* x, double dt, const double* dq, const double* dv,
                  double* d, double* doutputs) {
-  const int n = program.coordinates();
+  const int n = tape.coordinates();
   d[0] = dt;
   for (int i = 0; i < n; ++i) {
     d[1 + i] = dq[i];
     d[1 + n + i] = dv != nullptr ? dv[i] : 0.0;
   }
-  const std::vector<Instruction>& code = program.code();
-  const int first = program.inputs();
+  const std::vector<Instruction>& code = tape.code();
+  const int first = tape.inputs();
   for (std::size_t j = 0; j < code.size(); ++j) {
     const Instruction& in = code[j];
     const std::size_t r = static_cast<std::size_t>(first) + j;
@@ -88,18 +88,18 @@ void run_tangent(const Program& program, const double* x, double dt, const doubl
     }
     d[r] = value;
   }
-  const std::vector<Output>& outputs = program.output_list();
+  const std::vector<Output>& outputs = tape.output_list();
   for (std::size_t i = 0; i < outputs.size(); ++i) doutputs[i] = outputs[i].reg < 0 ? 0.0 : d[outputs[i].reg];
 }
 
-std::vector<char> calc_input_dependence(const Program& program) {
+std::vector<char> calc_input_dependence(const Tape& tape) {
   // Backwards from the outputs: a register is needed when an output or a needed register reads it.
-  const std::size_t registers = static_cast<std::size_t>(program.registers());
+  const std::size_t registers = static_cast<std::size_t>(tape.registers());
   std::vector<char> needed(registers, 0);
-  for (const Output& o : program.output_list())
+  for (const Output& o : tape.output_list())
     if (o.reg >= 0) needed[static_cast<std::size_t>(o.reg)] = 1;
-  const std::vector<Instruction>& code = program.code();
-  const std::size_t first = static_cast<std::size_t>(program.inputs());
+  const std::vector<Instruction>& code = tape.code();
+  const std::size_t first = static_cast<std::size_t>(tape.inputs());
   for (std::size_t j = code.size(); j-- > 0;) {
     const Instruction& in = code[j];
     if (in.op == Op::nop) {

@@ -1,4 +1,4 @@
-// The tangent mode of straight-line programs (model/program_tangent.hpp): every op's derivative
+// The tangent mode of straight-line programs (model/tape_tangent.hpp): every op's derivative
 // against Richardson-extrapolated central differences of the program itself, the exact derivative
 // of a small polynomial, and the structural input dependence.
 #include <gtest/gtest.h>
@@ -6,17 +6,17 @@
 #include <cmath>
 #include <vector>
 
-#include "nhdyn/model/program.hpp"
-#include "nhdyn/model/program_tangent.hpp"
+#include "nhdyn/model/tape.hpp"
+#include "nhdyn/model/tape_tangent.hpp"
 
 namespace nhdyn {
 namespace {
 
 // A program of two coordinates (inputs t, q0, q1, v0, v1) with one output per op, each applied to
 // values where it is smooth: u = 0.3 + 0.2 sin-free mix of the inputs keeps asin/acos/log defined.
-Program every_op_program() {
-  Program p(2);
-  const int t = Program::time_register(), q0 = p.coordinate_register(0), q1 = p.coordinate_register(1),
+Tape every_op_tape() {
+  Tape p(2);
+  const int t = Tape::time_register(), q0 = p.coordinate_register(0), q1 = p.coordinate_register(1),
             v0 = p.velocity_register(0), v1 = p.velocity_register(1);
   const int u = p.push(Op::mulk_add, q0, p.push(Op::mul_k, q1, 0, 0, 0.1), 0, 0.2);  // 0.2 q0 + 0.1 q1
   const int w = p.push(Op::add_k, p.push(Op::mul, v0, t), 0, 0, 1.5);                 // v0 t + 1.5
@@ -38,14 +38,14 @@ Program every_op_program() {
   return p;
 }
 
-std::vector<double> outputs_at(const Program& p, const std::vector<double>& x) {
+std::vector<double> outputs_at(const Tape& p, const std::vector<double>& x) {
   std::vector<double> registers(static_cast<std::size_t>(p.registers())), out(static_cast<std::size_t>(p.outputs()));
   p.run(x[0], &x[1], &x[3], registers.data(), out.data());
   return out;
 }
 
 TEST(ProgramTangent, EveryOpAgreesWithRichardsonDifferences) {
-  const Program p = every_op_program();
+  const Tape p = every_op_tape();
   const std::vector<double> x = {0.4, 0.9, -0.7, 1.1, -0.6};  // t, q0, q1, v0, v1
   std::vector<double> values(static_cast<std::size_t>(p.registers())), tangents(values.size());
   p.execute(x[0], &x[1], &x[3], values.data());
@@ -69,7 +69,7 @@ TEST(ProgramTangent, EveryOpAgreesWithRichardsonDifferences) {
 
 TEST(ProgramTangent, PolynomialIsExact) {
   // y = q0^2 q1 + 3 v1: dy = 2 q0 q1 dq0 + q0^2 dq1 + 3 dv1.
-  Program p(2);
+  Tape p(2);
   const int q0 = p.coordinate_register(0), q1 = p.coordinate_register(1), v1 = p.velocity_register(1);
   p.add_output(p.push(Op::mulk_add, v1, p.push(Op::mul, p.push(Op::square, q0), q1), 0, 3.0));
   const double q[2] = {1.25, -0.5}, v[2] = {0.0, 2.0};
@@ -82,7 +82,7 @@ TEST(ProgramTangent, PolynomialIsExact) {
 }
 
 TEST(ProgramTangent, InputDependenceIsStructural) {
-  Program p(3);
+  Tape p(3);
   const int q0 = p.coordinate_register(0), q2 = p.coordinate_register(2), v1 = p.velocity_register(1);
   const int unused = p.push(Op::sin, p.coordinate_register(1));  // computed, but no output reads it
   (void)unused;

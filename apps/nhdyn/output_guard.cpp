@@ -1,4 +1,4 @@
-#include "outputs.hpp"
+#include "output_guard.hpp"
 
 #include <signal.h>
 #include <unistd.h>

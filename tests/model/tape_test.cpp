@@ -1,8 +1,8 @@
 // Straight-line programs: every instruction against the std:: function it stands for, the
-// validation of operands, the sincos companion, ProgramEvaluator's layout of the terms, its
+// validation of operands, the sincos companion, TapeEvaluator's layout of the terms, its
 // prepared programs against the programs as given (to the bit), and a run that allocates nothing
 // (counted at malloc, as in tests/formulation/allocation_test.cpp).
-#include "nhdyn/model/program.hpp"
+#include "nhdyn/model/tape.hpp"
 
 #include <gtest/gtest.h>
 
@@ -86,19 +86,19 @@ namespace nhdyn {
 namespace {
 
 // Runs `program` at (t, q, v) and returns its outputs.
-std::vector<double> run(const Program& program, double t, const std::vector<double>& q, const std::vector<double>& v) {
+std::vector<double> run(const Tape& program, double t, const std::vector<double>& q, const std::vector<double>& v) {
   std::vector<double> registers(static_cast<std::size_t>(program.registers()));
   std::vector<double> outputs(static_cast<std::size_t>(program.outputs()));
   program.run(t, q.data(), v.data(), registers.data(), outputs.data());
   return outputs;
 }
 
-TEST(Program, InputsAreRegistersAndConstantsAreOutputs) {
-  Program p(2);
+TEST(Tape, InputsAreRegistersAndConstantsAreOutputs) {
+  Tape p(2);
   EXPECT_EQ(p.inputs(), 5);
   EXPECT_EQ(p.registers(), 5);
   EXPECT_FALSE(p.reads_time());
-  p.add_output(Program::time_register());
+  p.add_output(Tape::time_register());
   p.add_output(p.coordinate_register(1));
   EXPECT_FALSE(p.reads_velocities());
   p.add_output(p.velocity_register(0));
@@ -115,9 +115,9 @@ TEST(Program, InputsAreRegistersAndConstantsAreOutputs) {
   EXPECT_THROW(p.velocity_register(-1), std::invalid_argument);
 }
 
-TEST(Program, EveryInstructionMatchesTheStandardLibrary) {
+TEST(Tape, EveryInstructionMatchesTheStandardLibrary) {
   const double x = 0.37, y = -1.9, z = 2.6, k = 1.75;
-  Program p(3);
+  Tape p(3);
   const int a = p.coordinate_register(0);
   const int b = p.coordinate_register(1);
   const int c = p.coordinate_register(2);
@@ -177,8 +177,8 @@ TEST(Program, EveryInstructionMatchesTheStandardLibrary) {
   EXPECT_FALSE(p.reads_velocities());
 }
 
-TEST(Program, SincosWritesTwoRegistersAndItsCompanionIsSkipped) {
-  Program p(1);
+TEST(Tape, SincosWritesTwoRegistersAndItsCompanionIsSkipped) {
+  Tape p(1);
   const int x = p.coordinate_register(0);
   const int sc = p.push(Op::sincos, x);
   EXPECT_EQ(sc, 3);
@@ -190,8 +190,8 @@ TEST(Program, SincosWritesTwoRegistersAndItsCompanionIsSkipped) {
   EXPECT_NE(p.describe().find("r3, r4 = sincos q0"), std::string::npos) << p.describe();
 }
 
-TEST(Program, RefusesOperandsNotYetWritten) {
-  Program p(2);
+TEST(Tape, RefusesOperandsNotYetWritten) {
+  Tape p(2);
   const int x = p.coordinate_register(0);
   EXPECT_THROW(p.push(Op::add, x, 5), std::invalid_argument);
   EXPECT_THROW(p.push(Op::neg, -1), std::invalid_argument);
@@ -208,9 +208,9 @@ TEST(Program, RefusesOperandsNotYetWritten) {
 // A 2-coordinate system: A = diag(m, m q0^2), Q = (-k q0, 0), G = (m q0 v1^2, -2 m q0 v0 v1),
 // one constraint q0' sin(q1) - q1' = 0 at velocity level, given as b = (sin q1, -1),
 // b0 = q0' q1' cos(q1); D = (1, sin q1); energy m/2 (v0^2 + q0^2 v1^2) + k/2 q0^2.
-ModelPrograms polar_programs(double m, double k) {
-  ModelPrograms p{Program(2), std::nullopt, Program(2), Program(2), std::nullopt, std::nullopt, std::nullopt};
-  Program& t = p.terms;
+ModelTapes polar_programs(double m, double k) {
+  ModelTapes p{Tape(2), std::nullopt, Tape(2), Tape(2), std::nullopt, std::nullopt, std::nullopt};
+  Tape& t = p.terms;
   const int q0 = t.coordinate_register(0), q1 = t.coordinate_register(1);
   const int v0 = t.velocity_register(0), v1 = t.velocity_register(1);
   const int zero = t.push_constant(0.0);
@@ -233,16 +233,16 @@ ModelPrograms polar_programs(double m, double k) {
   t.add_constant_output(-1.0);
   t.add_output(t.push(Op::mul, t.push(Op::mul, v0, v1), sc + 1));
 
-  Program d(2);
+  Tape d(2);
   d.add_constant_output(1.0);
   d.add_output(d.push(Op::sin, d.coordinate_register(1)));
   p.complement = d;
 
-  Program& f = p.velocity_residual;
+  Tape& f = p.velocity_residual;
   f.add_output(f.push(Op::sub, f.push(Op::mul, f.velocity_register(0), f.push(Op::sin, f.coordinate_register(1))),
                       f.velocity_register(1)));
 
-  Program e(2);
+  Tape e(2);
   const int x = e.coordinate_register(0), u = e.velocity_register(0), w = e.velocity_register(1);
   const int T = e.push(Op::mul_k, e.push(Op::muladd, e.push(Op::square, x), e.push(Op::square, w), e.push(Op::square, u)),
                        0, 0, 0.5 * m);
@@ -251,12 +251,12 @@ ModelPrograms polar_programs(double m, double k) {
   return p;
 }
 
-TEST(ProgramEvaluator, FillsTheTermsInTheirLayout) {
+TEST(TapeEvaluator, FillsTheTermsInTheirLayout) {
   const double m = 1.3, k = 2.1;
-  const ProgramEvaluator evaluator(2, 1, polar_programs(m, k));
+  const TapeEvaluator evaluator(2, 1, polar_programs(m, k));
   EXPECT_TRUE(evaluator.has_complement());
   EXPECT_TRUE(evaluator.has_energy());
-  EXPECT_EQ(evaluator.scratch_size(), static_cast<std::size_t>(evaluator.programs().terms.registers()));
+  EXPECT_EQ(evaluator.scratch_size(), static_cast<std::size_t>(evaluator.tapes().terms.registers()));
   const double q[2] = {0.8, -0.4}, v[2] = {0.3, 1.7};
   std::vector<double> scratch(evaluator.scratch_size());
   double A[4], Q[2], G[2], b[2], b0[1], D[2], f[1];
@@ -281,26 +281,26 @@ TEST(ProgramEvaluator, FillsTheTermsInTheirLayout) {
                    0.5 * m * (v[0] * v[0] + q[0] * q[0] * v[1] * v[1]) + 0.5 * k * q[0] * q[0]);
 }
 
-TEST(ProgramEvaluator, RefusesProgramsOfTheWrongShape) {
-  ModelPrograms p = polar_programs(1.0, 1.0);
-  EXPECT_THROW(ProgramEvaluator(2, 0, p), std::invalid_argument);  // terms outputs for s = 1
-  EXPECT_THROW(ProgramEvaluator(3, 1, p), std::invalid_argument);  // programs read 2 coordinates
-  ModelPrograms bad_position = polar_programs(1.0, 1.0);
+TEST(TapeEvaluator, RefusesProgramsOfTheWrongShape) {
+  ModelTapes p = polar_programs(1.0, 1.0);
+  EXPECT_THROW(TapeEvaluator(2, 0, p), std::invalid_argument);  // terms outputs for s = 1
+  EXPECT_THROW(TapeEvaluator(3, 1, p), std::invalid_argument);  // programs read 2 coordinates
+  ModelTapes bad_position = polar_programs(1.0, 1.0);
   bad_position.position_residual.add_output(bad_position.position_residual.velocity_register(0));
-  EXPECT_THROW(ProgramEvaluator(2, 1, bad_position), std::invalid_argument);
-  ModelPrograms bad_energy = polar_programs(1.0, 1.0);
+  EXPECT_THROW(TapeEvaluator(2, 1, bad_position), std::invalid_argument);
+  ModelTapes bad_energy = polar_programs(1.0, 1.0);
   bad_energy.energy->add_constant_output(0.0);
-  EXPECT_THROW(ProgramEvaluator(2, 1, bad_energy), std::invalid_argument);
+  EXPECT_THROW(TapeEvaluator(2, 1, bad_energy), std::invalid_argument);
 }
 
 // A program for n >= 2 coordinates whose `outputs` outputs cycle through registers of every kind
-// that ProgramEvaluator prepares apart: a parameter-only subexpression (sqrt(2) * 1.3, folded), the
+// that TapeEvaluator prepares apart: a parameter-only subexpression (sqrt(2) * 1.3, folded), the
 // instructions with a constant operand that become immediates, a register output twice, one that
 // later instructions read too, a sincos (or, without the math library, a square and a cube), the
 // inputs t and q', a constant output; and an instruction no output needs.
-Program mixed_program(int n, int outputs, bool library) {
-  Program p(n);
-  const int t = Program::time_register(), q0 = p.coordinate_register(0), q1 = p.coordinate_register(1);
+Tape mixed_program(int n, int outputs, bool library) {
+  Tape p(n);
+  const int t = Tape::time_register(), q0 = p.coordinate_register(0), q1 = p.coordinate_register(1);
   const int v0 = p.velocity_register(0), v1 = p.velocity_register(1);
   const int c = p.push_constant(1.3);
   const int pm = p.push(Op::mul, p.push(Op::sqrt, p.push_constant(2.0)), c);
@@ -331,15 +331,15 @@ Program mixed_program(int n, int outputs, bool library) {
   return p;
 }
 
-TEST(ProgramEvaluator, PreparedProgramsGiveTheSameBitsAsTheirPrograms) {
+TEST(TapeEvaluator, PreparedProgramsGiveTheSameBitsAsTheirPrograms) {
   for (const int n : {2, 3, 5})  // sizes fixed at compile time (n <= 4) or not
     for (const bool library : {true, false}) {
       const int s = 1;
-      ModelPrograms programs{mixed_program(n, n * n + 2 * n + s * n + s, library),
-                             mixed_program(n, (n - s) * n, library), Program(n), Program(n), std::nullopt, std::nullopt, std::nullopt};
+      ModelTapes programs{mixed_program(n, n * n + 2 * n + s * n + s, library),
+                             mixed_program(n, (n - s) * n, library), Tape(n), Tape(n), std::nullopt, std::nullopt, std::nullopt};
       programs.velocity_residual = mixed_program(n, 1, library);
-      const ProgramEvaluator evaluator(n, s, programs);
-      const Program& terms = evaluator.programs().terms;
+      const TapeEvaluator evaluator(n, s, programs);
+      const Tape& terms = evaluator.tapes().terms;
       std::vector<double> q(static_cast<std::size_t>(n)), v(static_cast<std::size_t>(n));
       for (const double state : {0.7, -1.3, 0.0}) {
         for (int i = 0; i < n; ++i) {
@@ -370,16 +370,16 @@ TEST(ProgramEvaluator, PreparedProgramsGiveTheSameBitsAsTheirPrograms) {
     }
 }
 
-TEST(ProgramEvaluator, ComputesParameterOnlySubexpressionsOnce) {
+TEST(TapeEvaluator, ComputesParameterOnlySubexpressionsOnce) {
   // A(1, 1) = q0 * (sqrt(2) * m) and Q(0) = sqrt(2) * m; everything else constant.
   const double m = 1.3;
-  ModelPrograms programs{Program(2), std::nullopt, Program(2), Program(2), std::nullopt, std::nullopt, std::nullopt};
-  Program& p = programs.terms;
+  ModelTapes programs{Tape(2), std::nullopt, Tape(2), Tape(2), std::nullopt, std::nullopt, std::nullopt};
+  Tape& p = programs.terms;
   const int zero = p.push_constant(0.0);
   const int sm = p.push(Op::mul, p.push(Op::sqrt, p.push_constant(2.0)), p.push_constant(m));
   const int a11 = p.push(Op::mul, p.coordinate_register(0), sm);
   for (const int reg : {zero, zero, zero, a11, sm, zero, zero, zero, zero, zero, zero}) p.add_output(reg);
-  const ProgramEvaluator evaluator(2, 1, programs);
+  const TapeEvaluator evaluator(2, 1, programs);
   EXPECT_EQ(evaluator.terms_operations(), 1) << p.describe();  // k * q0, k folded, into A directly
   const std::vector<double> q{0.7, -0.2}, v{0.3, 0.4};
   const std::vector<double> expected = run(p, 0.0, q, v);
@@ -391,11 +391,11 @@ TEST(ProgramEvaluator, ComputesParameterOnlySubexpressionsOnce) {
   EXPECT_EQ(got[4], std::sqrt(2.0) * m);
 }
 
-TEST(ProgramEvaluator, AProductUnderAConstantFactorIsOneStep) {
+TEST(TapeEvaluator, AProductUnderAConstantFactorIsOneStep) {
   // k = sqrt(2) m, a parameter stage: k (q0 q1), k (q0 v1) + v0, v1 - k q1 and k (q1 q1) + q0
   // cost one step each (mulk, mulk_muladd, mulk_add, mulk_muladd), rounding as the program does.
-  ModelPrograms programs{Program(2), std::nullopt, Program(2), Program(2), std::nullopt, std::nullopt, std::nullopt};
-  Program& p = programs.terms;
+  ModelTapes programs{Tape(2), std::nullopt, Tape(2), Tape(2), std::nullopt, std::nullopt, std::nullopt};
+  Tape& p = programs.terms;
   const int q0 = p.coordinate_register(0), q1 = p.coordinate_register(1);
   const int v0 = p.velocity_register(0), v1 = p.velocity_register(1);
   const int k = p.push(Op::mul, p.push(Op::sqrt, p.push_constant(2.0)), p.push_constant(1.3));
@@ -407,7 +407,7 @@ TEST(ProgramEvaluator, AProductUnderAConstantFactorIsOneStep) {
   const int e = p.push(Op::mul, k, shared);
   const int f = p.push(Op::add, shared, v1);
   for (const int reg : {a, b, c, d, e, f, a, b, c, d, e}) p.add_output(reg);
-  const ProgramEvaluator evaluator(2, 1, programs);
+  const TapeEvaluator evaluator(2, 1, programs);
   // The four, then q0 v0, k (q0 v0) and q0 v0 + v1, then a clone for each further output (5).
   EXPECT_EQ(evaluator.terms_operations(), 4 + 3 + 5) << p.describe();
   std::vector<double> scratch(evaluator.scratch_size());
@@ -425,18 +425,18 @@ TEST(ProgramEvaluator, AProductUnderAConstantFactorIsOneStep) {
   }
 }
 
-TEST(ProgramEvaluator, RunsWithoutAllocating) {
+TEST(TapeEvaluator, RunsWithoutAllocating) {
   Model model;
   model.name = "polar";
   model.coordinates = {"r", "theta"};
   model.constraints = {{"c", ConstraintLevel::velocity, "r' sin(theta) - theta' = 0"}};
   model.q0 = Vector::Constant(2, 0.5);
   model.v0 = Vector::Constant(2, 0.25);
-  model.evaluator = std::make_shared<ProgramEvaluator>(2, 1, polar_programs(1.0, 2.0));
+  model.evaluator = std::make_shared<TapeEvaluator>(2, 1, polar_programs(1.0, 2.0));
   Data data = make_data(model);
   const double q[2] = {0.8, -0.4}, v[2] = {0.3, 1.7};
   std::vector<double> outputs(16);
-  const Program& terms = static_cast<const ProgramEvaluator&>(*model.evaluator).programs().terms;
+  const Tape& terms = static_cast<const TapeEvaluator&>(*model.evaluator).tapes().terms;
   ASSERT_EQ(compute_terms(model, data, 0.0, q, v), Status::ok);
   g_allocations = 0;
   g_counting = true;
