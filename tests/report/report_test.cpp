@@ -724,32 +724,55 @@ TEST(ContactScene, BowlIsAMeshOfItsSphereAroundTheMotion) {
   }
 }
 
+// examples/ball_over_bump.toml with `from` replaced by `to`, written as NAME.toml and run for 0.2 s
+// with --html: its spec, its page and the terrain's mesh at full precision from the page's frames.
+struct BumpVariant {
+  bool ran = false;
+  std::string err;
+  nhdyn::symbolic::Spec spec;
+  std::string page;
+  nhdyn::SceneMesh terrain;
+};
+
+BumpVariant run_bump_variant(const fs::path& dir, const std::string& from, const std::string& to, const std::string& name) {
+  BumpVariant v;
+  std::string text = nhdyn::read_model_text(example("ball_over_bump.toml"));
+  if (text.find(from) == std::string::npos) {
+    v.err = "no '" + from + "' in ball_over_bump.toml";
+    return v;
+  }
+  text.replace(text.find(from), from.size(), to);
+  const fs::path model = dir / (name + ".toml"), csv = dir / (name + ".csv"), html = dir / (name + ".html");
+  std::ofstream(model) << text;
+  std::string out;
+  if (run("simulate " + model.string() + " --t-end 0.2 -o " + csv.string() + " --html " + html.string() + " -q", out,
+          v.err, dir) != 0)
+    return v;
+  v.page = nhdyn::test::read_text(html);
+  v.spec = nhdyn::load_model_file(model);
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(v.spec);
+  const int index = find_shape(scene, VisualKind::terrain, "ball");
+  if (index < 0) {
+    v.err = "no terrain in the scene";
+    return v;
+  }
+  v.terrain = nhdyn::calc_scene_meshes(scene, spec_parameters(v.spec), report_scene_values(v.page),
+                                       static_cast<std::size_t>(report_scene_stride(v.page)),
+                                       v.spec.name)[static_cast<std::size_t>(index)];
+  v.ran = true;
+  return v;
+}
+
 // A terrain undefined over part of the drawn box (sqrt(X + 0.1), a term too small to move the
 // ball, is not real for X < -0.1, inside the box's margin): no triangle there, rather than a
 // ground drawn at 0; every triangle's vertices are finite and the terrain's value.
 TEST_F(Cli, TerrainUndefinedInPartOfTheBoxIsLeftOutThere) {
-  std::string text = nhdyn::read_model_text(example("ball_over_bump.toml"));
-  const std::string terrain = "terrain = \"H*exp(-(X^2 + Y^2)/w^2)\"";
-  ASSERT_NE(text.find(terrain), std::string::npos);
-  text.replace(text.find(terrain), terrain.size(), "terrain = \"H*exp(-(X^2 + Y^2)/w^2) + 1e-12*sqrt(X + 0.1)\"");
-  const fs::path model = dir / "half.toml";
-  std::ofstream(model) << text;
-  std::string out, err;
-  const fs::path csv = dir / "half.csv", html = dir / "half.html";
-  ASSERT_EQ(run("simulate " + model.string() + " --t-end 0.2 -o " + csv.string() + " --html " +
-                    html.string() + " -q",
-                out, err, dir),
-            0)
-      << err;
-  const std::string page = nhdyn::test::read_text(html);
-  const nhdyn::symbolic::Spec spec = nhdyn::load_model_file(model);
-  const double H = parameter(spec, "H"), w = parameter(spec, "w");
-  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
-  const int index = find_shape(scene, VisualKind::terrain, "ball");
-  ASSERT_GE(index, 0);
-  const nhdyn::SceneMesh mesh = nhdyn::calc_scene_meshes(scene, spec_parameters(spec), report_scene_values(page),
-                                                         static_cast<std::size_t>(report_scene_stride(page)),
-                                                         spec.name)[static_cast<std::size_t>(index)];
+  const BumpVariant v = run_bump_variant(dir, "terrain = \"H*exp(-(X^2 + Y^2)/w^2)\"",
+                                         "terrain = \"H*exp(-(X^2 + Y^2)/w^2) + 1e-12*sqrt(X + 0.1)\"", "half");
+  ASSERT_TRUE(v.ran) << v.err;
+  const std::string& page = v.page;
+  const nhdyn::SceneMesh& mesh = v.terrain;
+  const double H = parameter(v.spec, "H"), w = parameter(v.spec, "w");
   int undefined = 0;
   for (std::size_t k = 0; k < mesh.vertices.size(); k += 3) undefined += !std::isfinite(mesh.vertices[k + 2]);
   EXPECT_GT(undefined, 0) << "the box reaches X < -0.1";
@@ -768,28 +791,12 @@ TEST_F(Cli, TerrainUndefinedInPartOfTheBoxIsLeftOutThere) {
 // four times the shape's half extent (its mesh's), 4 r = 0.2 m, as for the closed-form ball,
 // not a length of 1 m.
 TEST_F(Cli, TerrainUnderAnImplicitShapeHasTheShapesMargin) {
-  std::string text = nhdyn::read_model_text(example("ball_over_bump.toml"));
-  const std::string sphere = "shape = { sphere = \"r\" }";
-  ASSERT_NE(text.find(sphere), std::string::npos);
-  text.replace(text.find(sphere), sphere.size(), "shape = { surface = \"X^2 + Y^2 + Z^2 - r^2\" }");
-  const fs::path model = dir / "implicit.toml";
-  std::ofstream(model) << text;
-  std::string out, err;
-  const fs::path csv = dir / "implicit.csv", html = dir / "implicit.html";
-  ASSERT_EQ(run("simulate " + model.string() + " --t-end 0.2 -o " + csv.string() + " --html " + html.string() + " -q",
-                out, err, dir),
-            0)
-      << err;
-  const std::string page = nhdyn::test::read_text(html);
-  const nhdyn::symbolic::Spec spec = nhdyn::load_model_file(model);
-  const double r = parameter(spec, "r");
-  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
-  const int index = find_shape(scene, VisualKind::terrain, "ball");
-  ASSERT_GE(index, 0);
-  const nhdyn::SceneMesh mesh = nhdyn::calc_scene_meshes(scene, spec_parameters(spec), report_scene_values(page),
-                                                         static_cast<std::size_t>(report_scene_stride(page)),
-                                                         spec.name)[static_cast<std::size_t>(index)];
-  const nhdyn::CsvTable table = nhdyn::load_csv(csv);
+  const BumpVariant v =
+      run_bump_variant(dir, "shape = { sphere = \"r\" }", "shape = { surface = \"X^2 + Y^2 + Z^2 - r^2\" }", "implicit");
+  ASSERT_TRUE(v.ran) << v.err;
+  const nhdyn::SceneMesh& mesh = v.terrain;
+  const double r = parameter(v.spec, "r");
+  const nhdyn::CsvTable table = nhdyn::load_csv(dir / "implicit.csv");
   const int X = table.column("ball_X");
   ASSERT_GE(X, 0);
   double lo = 1e300, hi = -1e300, path_lo = 1e300, path_hi = -1e300;
