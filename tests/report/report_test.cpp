@@ -47,7 +47,7 @@ std::vector<double> run_scene(const nhdyn::symbolic::VisualScene& scene, const n
                               const std::vector<double>& q, const std::vector<double>& v) {
   std::vector<double> values;
   for (const auto& p : spec.parameters) values.push_back(p.value);
-  const nhdyn::Tape program = scene.program.bind(values.data(), values.size());
+  const nhdyn::Tape program = scene.tape.bind(values.data(), values.size());
   std::vector<double> registers(static_cast<std::size_t>(program.registers()));
   std::vector<double> out(static_cast<std::size_t>(program.outputs()));
   program.run(t, q.data(), v.data(), registers.data(), out.data());
@@ -260,7 +260,7 @@ points = [{ name = "p", position = ["x + h", "y - h^2"], radius = "h/10" }]
   EXPECT_DOUBLE_EQ(nhdyn::calc_scene_sizes(scene, model.parameters, model.name)[0].size[0], h / 10);
   std::vector<double> values;
   for (const nhdyn::Parameter& p : model.parameters) values.push_back(p.value);
-  const nhdyn::Tape program = scene.program.bind(values.data(), values.size());
+  const nhdyn::Tape program = scene.tape.bind(values.data(), values.size());
   std::vector<double> registers(static_cast<std::size_t>(program.registers())), out(3);
   const double q[2] = {0.25, -0.75}, v[2] = {0, 0};
   program.run(0.0, q, v, registers.data(), out.data());
@@ -695,7 +695,7 @@ TEST(ContactScene, BowlIsAMeshOfItsSphereAroundTheMotion) {
   std::vector<double> values;
   std::vector<double> parameters;
   for (const nhdyn::Parameter& p : model.parameters) parameters.push_back(p.value);
-  const nhdyn::Tape program = scene.program.bind(parameters.data(), parameters.size());
+  const nhdyn::Tape program = scene.tape.bind(parameters.data(), parameters.size());
   std::vector<double> registers(static_cast<std::size_t>(program.registers())), out(static_cast<std::size_t>(program.outputs()));
   std::vector<std::array<double, 3>> contact;
   for (const double angle : {0.0, 0.2, -0.3}) {

@@ -128,7 +128,7 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
   const int n = model.n();
   const int s = model.s();
   w.failed_contact = -1;
-  w.program.run(data.t, data.q.data(), data.v.data(), w.registers.data(), w.outputs.data());
+  w.tape.run(data.t, data.q.data(), data.v.data(), w.registers.data(), w.outputs.data());
   if (!w.velocity_residuals.empty())
     model.evaluator->velocity_residual(data.t, data.q.data(), data.v.data(), data.scratch.data(),
                                        w.velocity_residuals.data());

@@ -712,7 +712,7 @@ void append_scene_shapes(std::string& data, const ReportInput& input, const Fram
   const symbolic::VisualScene& scene = *input.scene;
   const std::vector<SceneSize> sizes = calc_scene_sizes(scene, input.parameters, input.model);
   const std::vector<double> parameter_values = parameter_values_for(scene, input.parameters, input.model);
-  const Tape program = scene.program.bind(parameter_values.data(), parameter_values.size());
+  const Tape program = scene.tape.bind(parameter_values.data(), parameter_values.size());
   const int n = program.coordinates();
   if (n != static_cast<int>(input.coordinates.size()))
     throw InputError(fmt::format("the scene of '{}' has {} coordinates, the run {}", input.model, n,

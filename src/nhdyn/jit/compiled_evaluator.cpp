@@ -403,8 +403,8 @@ std::string model_source(const TapeEvaluator& base, const Model& model) {
   for (int i = 0; i < kRowTapes; ++i)
     if (const Tape* program = row_tape(base.parametric_tapes(), i))
       source += make_tape_source(kRowTapeNames[i], *program);
-  if (model.contact_forces) source += make_tape_source("contact", model.contact_forces->program);
-  if (!model.outputs.list.empty()) source += make_tape_source("outputs", model.outputs.program);
+  if (model.contact_forces) source += make_tape_source("contact", model.contact_forces->tape);
+  if (!model.outputs.list.empty()) source += make_tape_source("outputs", model.outputs.tape);
   return source;
 }
 

@@ -207,9 +207,9 @@ ContactForceData make_contact_force_data(const Model& model) {
   w.active = true;
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
-  w.program = c.program.reads_parameters() ? c.program.bind(values.data(), values.size()) : c.program;
-  w.registers.assign(static_cast<std::size_t>(w.program.registers()), 0.0);
-  w.outputs.assign(static_cast<std::size_t>(w.program.outputs()), 0.0);
+  w.tape = c.tape.reads_parameters() ? c.tape.bind(values.data(), values.size()) : c.tape;
+  w.registers.assign(static_cast<std::size_t>(w.tape.registers()), 0.0);
+  w.outputs.assign(static_cast<std::size_t>(w.tape.outputs()), 0.0);
   if (c.native) {
     w.stage.assign(c.native->stage_size() + 1, 0.0);  // + 1: data() of an empty stage
     c.native->stage(values.data(), w.stage.data());
@@ -234,7 +234,7 @@ void compute_contact_forces(const Model& model, Data& data) {
   if (c.native)
     c.native->run(w.stage.data(), data.t, data.q.data(), data.v.data(), w.outputs.data());
   else
-    w.program.run(data.t, data.q.data(), data.v.data(), w.registers.data(), w.outputs.data());
+    w.tape.run(data.t, data.q.data(), data.v.data(), w.registers.data(), w.outputs.data());
   const double* o = w.outputs.data();
   assemble(c, o, data.qdd.data(), data.R.data(), w.M, w.rhs);
   if (c.single_wheel) {
@@ -332,11 +332,11 @@ void analyse_contact_forces(const Model& model, ContactForceModel& c) {
   {
     std::vector<double> values;
     for (const Parameter& p : model.parameters) values.push_back(p.value);
-    w.program = c.program.reads_parameters() ? c.program.bind(values.data(), values.size()) : c.program;
-    w.registers.assign(static_cast<std::size_t>(w.program.registers()), 0.0);
-    w.outputs.assign(static_cast<std::size_t>(w.program.outputs()), 0.0);
+    w.tape = c.tape.reads_parameters() ? c.tape.bind(values.data(), values.size()) : c.tape;
+    w.registers.assign(static_cast<std::size_t>(w.tape.registers()), 0.0);
+    w.outputs.assign(static_cast<std::size_t>(w.tape.outputs()), 0.0);
   }
-  w.program.run(t, q.data(), v.data(), w.registers.data(), w.outputs.data());
+  w.tape.run(t, q.data(), v.data(), w.registers.data(), w.outputs.data());
   const double* o = w.outputs.data();
   bool finite = qdd.allFinite();
   for (double x : w.outputs) finite = finite && std::isfinite(x);

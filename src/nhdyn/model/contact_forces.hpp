@@ -87,8 +87,8 @@ struct ContactForceModel {
   // Per reported contact (in the order of `contacts` that are reported), one flag per component
   // (at its first_value): whether the model determines that component (else it is NaN).
   std::vector<char> determined;
-  Tape program;             // parametric: reads the model's parameters (bound by make_data)
-  // `program` compiled (jit::make_compiled), run in its place when set; null for the interpreter.
+  Tape tape;                // parametric: reads the model's parameters (bound by make_data)
+  // `tape` compiled (jit::make_compiled), run in its place when set; null for the interpreter.
   std::shared_ptr<const NativeTape> native;
   // What loading found about the forces not determined, one line each (empty when all are).
   std::vector<std::string> notes;
@@ -110,7 +110,7 @@ struct ContactForceModel {
 struct ContactForceData {
   bool active = false;       // the model has contact forces
   std::vector<double> stage; // ContactForceModel::native's parameter stage (empty without it)
-  Tape program;           // ContactForceModel::program bound to the model's parameter values
+  Tape tape;              // ContactForceModel::tape bound to the model's parameter values
   std::vector<double> registers;
   std::vector<double> outputs;
   Matrix M;                  // rows() x columns(), the stacked system, moment rows divided by L

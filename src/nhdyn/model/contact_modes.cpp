@@ -23,9 +23,9 @@ ContactModeData make_contact_mode_data(const Model& model) {
   w.active = true;
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
-  w.program = c.program.reads_parameters() ? c.program.bind(values.data(), values.size()) : c.program;
-  w.registers.assign(static_cast<std::size_t>(w.program.registers()), 0.0);
-  w.outputs.assign(static_cast<std::size_t>(w.program.outputs()), 0.0);
+  w.tape = c.tape.reads_parameters() ? c.tape.bind(values.data(), values.size()) : c.tape;
+  w.registers.assign(static_cast<std::size_t>(w.tape.registers()), 0.0);
+  w.outputs.assign(static_cast<std::size_t>(w.tape.outputs()), 0.0);
   const std::size_t m = c.contacts.size();
   w.mode.assign(m, ContactMode::rolling);
   w.direction.assign(m, {1.0, 0.0});

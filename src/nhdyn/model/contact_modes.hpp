@@ -54,7 +54,7 @@ struct ContactModeModel {
   // Per contact, kOutputs values in (t, q): mu_s, mu_k, e (restitution), n (3, world, unit), t1 (3),
   // t2 (3) (the tangent directions of the no-slip rows, world, not necessarily unit: row a is
   // t_a . (v_P - v_ground)). Parametric: bound by make_contact_mode_data.
-  Tape program;
+  Tape tape;
   static constexpr int kOutputs = 12;
 };
 
@@ -64,7 +64,7 @@ struct ContactModeModel {
 // workspace may be resized (the only allocation).
 struct ContactModeData {
   bool active = false;
-  Tape program;                 // ContactModeModel::program bound to the parameter values
+  Tape tape;                    // ContactModeModel::tape bound to the parameter values
   std::vector<double> registers, outputs;
   std::vector<ContactMode> mode;   // per contact
   // Per contact, the slip direction carried through the sliding mode (unit, in the basis of the

@@ -16,9 +16,9 @@ OutputData make_output_data(const Model& model) {
   if (model.outputs.list.empty()) return d;
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
-  const Tape& program = model.outputs.program;
-  d.program = program.reads_parameters() ? program.bind(values.data(), values.size()) : program;
-  d.registers.assign(static_cast<std::size_t>(d.program.registers()), 0.0);
+  const Tape& tape = model.outputs.tape;
+  d.tape = tape.reads_parameters() ? tape.bind(values.data(), values.size()) : tape;
+  d.registers.assign(static_cast<std::size_t>(d.tape.registers()), 0.0);
   if (model.outputs.native) {
     d.stage.assign(model.outputs.native->stage_size() + 1, 0.0);  // + 1: data() of an empty stage
     model.outputs.native->stage(values.data(), d.stage.data());
@@ -42,7 +42,7 @@ void compute_outputs(const Model& model, Data& data) {
   if (model.outputs.native)
     model.outputs.native->run(o.stage.data(), data.t, o.x.data(), o.xd.data(), o.values.data());
   else
-    o.program.run(data.t, o.x.data(), o.xd.data(), o.registers.data(), o.values.data());
+    o.tape.run(data.t, o.x.data(), o.xd.data(), o.registers.data(), o.values.data());
 }
 
 }  // namespace nhdyn

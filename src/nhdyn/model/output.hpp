@@ -35,18 +35,18 @@ struct DerivedOutput {
 struct ModelOutputs {
   std::vector<DerivedOutput> list;  // in column order
   // One output per entry of `list`, in the dynamics layout (2n coordinates: [q; q''], [q'; R]);
-  // reads the model's parameters (bind before running). Empty program when `list` is.
-  Tape program = Tape();
-  // `program` compiled (jit::make_compiled), run in its place when set; null for the interpreter.
+  // reads the model's parameters (bind before running). Empty tape when `list` is.
+  Tape tape = Tape();
+  // `tape` compiled (jit::make_compiled), run in its place when set; null for the interpreter.
   std::shared_ptr<const NativeTape> native;
   int count() const { return static_cast<int>(list.size()); }
 };
 
 // The evaluation state of the outputs for one Data (make_output_data, from make_data).
 struct OutputData {
-  Tape program = Tape();    // ModelOutputs::program bound to the parameter values
+  Tape tape = Tape();       // ModelOutputs::tape bound to the parameter values
   std::vector<double> x, xd;       // 2n each: [q; q''] and [q'; R] (pack_dynamics_inputs)
-  std::vector<double> registers;   // program.registers()
+  std::vector<double> registers;   // tape.registers()
   std::vector<double> stage;       // ModelOutputs::native's parameter stage (empty without it)
   Vector values;                   // one per output (compute_outputs)
 };

@@ -198,10 +198,10 @@ void compile_contact_forces(const Spec& spec, Model& model) {
                    c.hand_constraints == 0 && c.balance_rows.front() && in.contacts.front().system == 0;
   std::vector<std::string> what(outputs.size());
   for (std::size_t i = 0; i < what.size(); ++i) what[i] = fmt::format("contact forces: output {}", i);
-  c.program = compile_expressions(spec, outputs, what);
-  if (c.program.outputs() != c.outputs())
+  c.tape = compile_expressions(spec, outputs, what);
+  if (c.tape.outputs() != c.outputs())
     throw ModelError(fmt::format("model '{}': the contact-force program has {} outputs, expected {} (a bug)",
-                                 spec.name, c.program.outputs(), c.outputs()));
+                                 spec.name, c.tape.outputs(), c.outputs()));
   analyse_contact_forces(model, c);
   model.contact_forces = std::move(out);
 }

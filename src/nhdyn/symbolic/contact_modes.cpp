@@ -141,7 +141,7 @@ void compile_contact_modes(const Spec& spec, Model& model) {
     for (int i = 0; i < ContactModeModel::kOutputs; ++i)
       what.push_back(fmt::format("contact '{}': mode output {}", m.name, i));
   }
-  out->program = compile_expressions(spec, outputs, what);
+  out->tape = compile_expressions(spec, outputs, what);
   model.contact_modes = std::move(out);
 }
 

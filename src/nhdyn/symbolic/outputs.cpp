@@ -138,7 +138,7 @@ void compile_outputs(const Spec& spec, Model& model) {
     expressions.push_back(o.expression);
     what.push_back(fmt::format("{}output '{}'", o.where.describe().empty() ? "" : o.where.describe() + ": ", o.name));
   }
-  model.outputs.program = compile_dynamics_tape(spec, expressions, what);
+  model.outputs.tape = compile_dynamics_tape(spec, expressions, what);
 }
 
 }  // namespace nhdyn::symbolic

@@ -300,7 +300,7 @@ VisualScene compile_visual(const Spec& spec) {
     offset += visual_outputs(item.kind);
     scene.shapes.push_back(shape);
   }
-  scene.program = positions.take();
+  scene.tape = positions.take();
   scene.sizes = sizes.take();
   return scene;
 }

@@ -2,7 +2,7 @@
 // [visual] table (hand-written models: spheres and segments whose ends are expressions in t, the
 // coordinates and the parameters) and its multibody description (bodies, wheels, frames) become
 // VisualItems of the Spec; compile_visual() turns them into two straight-line Programs
-// (model/tape.hpp) that read the parameters, like the model's own programs: `program`, whose
+// (model/tape.hpp) that read the parameters, like the model's own tapes: `tape`, whose
 // outputs, run on a row of results (t, q, q'), are every position and orientation the scene
 // needs, and `sizes`, which reads the parameters only (radii, masses, inertias). Parameters are
 // data (docs/design.md): io/report.hpp binds both to the values of the run's Model, so a
@@ -73,7 +73,7 @@ struct SpecVisual {
 };
 
 // A shape of the compiled scene. Its outputs start at `offset` in the outputs of
-// VisualScene::program: sphere, track, terrain and surface 3 (centre; a contact point), segment 6
+// VisualScene::tape: sphere, track, terrain and surface 3 (centre; a contact point), segment 6
 // (both ends), wheel, body, frame, ellipsoid, torus and solid 12 (origin, then R row-major); its
 // sizes at `size_offset` in those of VisualScene::sizes: sphere and wheel 1 (radius), body 10
 // (mass, then the inertia about the centre of mass in the frame's axes, 9 row-major), ellipsoid 3
@@ -95,7 +95,7 @@ struct VisualShape {
 
 struct VisualScene {
   std::vector<VisualShape> shapes;
-  Tape program;  // inputs t, q, q'; reads the parameters; outputs as the shapes say
+  Tape tape;  // inputs t, q, q'; reads the parameters; outputs as the shapes say
   Tape sizes;    // no coordinate input; reads the parameters only; outputs as the shapes say
   std::vector<std::string> parameters;  // the names the programs' `parameter` instructions index
   bool planar = false;
