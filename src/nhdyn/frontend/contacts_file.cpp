@@ -96,7 +96,6 @@ class ContactReader {
     return text;
   }
 
- private:
   // friction = mu or ["mu_s", "mu_k"], unilateral, restitution, mode (docs/contact-modes.md), as
   // texts for symbolic::parse_contact_mode.
   void read_modes(const toml::table& table, const std::string& what, symbolic::ContactText& text) const {
@@ -122,6 +121,8 @@ class ContactReader {
     if (const toml::node* mode = table.get("mode"))
       text.modes.emplace_back("mode", string_of(*mode, what + ": mode", "mode = \"sliding\""));
   }
+
+ private:
 
   // shape = { sphere = "r" }: the one key that names a registered shape, and that shape's options.
   void read_shape(const toml::node& node, const std::string& what, symbolic::ContactText& text) const {
@@ -201,6 +202,69 @@ const std::vector<std::string>& contact_keys() {
   static const std::vector<std::string> keys = {"name",     "body",       "shape",       "centre", "ground",
                                                 "rolling",  "friction",   "unilateral",  "restitution", "mode"};
   return keys;
+}
+
+const std::vector<std::string>& contact_mode_keys() {
+  static const std::vector<std::string> keys = {"friction", "unilateral", "restitution", "mode"};
+  return keys;
+}
+
+bool has_contact_mode_keys(const toml::table& table) {
+  for (const std::string& key : contact_mode_keys())
+    if (table.get(key) != nullptr) return true;
+  return false;
+}
+
+void load_wheel_contact(const toml::table& table, const WheelEntry& wheel, symbolic::MultibodyBuilder& multibody,
+                        const TomlLocator& at) {
+  const ContactReader reader(at);
+  symbolic::ContactText text;
+  text.where = at(table);
+  text.shape_where = text.where;
+  text.name = wheel.name;
+  text.body = wheel.body;
+  // The wheel's rim: a thin disk of its radius about its axle, centred on the body frame's origin
+  // (the centre a [[wheels]] entry has), rolling without slip or spin limit as the wheel does.
+  text.shape = "disk";
+  text.sizes = {wheel.radius};
+  text.shape_options.emplace_back("axis", wheel.axis);
+  // The wheel's plane passes through the world origin as the contact's plane does; its normal
+  // (or, without one, the opposite of gravity) is the plane's.
+  text.ground.key = "plane";
+  if (wheel.normal) text.ground.value.assign(wheel.normal->begin(), wheel.normal->end());
+  const toml::node* normal = table.get("normal");
+  text.ground.where = normal != nullptr ? at(*normal) : text.where;
+  text.ground_where = text.ground.where;
+  text.rolling = "rolling";
+  reader.read_modes(table, fmt::format("wheel '{}'", wheel.name), text);
+  multibody.contact(text);
+}
+
+void refuse_knife_edge_modes(const toml::node& knives, const TomlLocator& at) {
+  const toml::array* array = knives.as_array();
+  if (array == nullptr) return;
+  std::size_t index = 0;
+  for (const toml::node& element : *array) {
+    ++index;
+    const toml::table* table = element.as_table();
+    if (table == nullptr) continue;
+    std::string name = fmt::format("[[knife_edges]] entry {}", index);
+    if (const toml::node* n = table->get("name"); n != nullptr && n->is_string())
+      name = fmt::format("knife edge '{}'", n->as_string()->get());
+    for (const std::string& key : contact_mode_keys()) {
+      const toml::node* value = table->get(key);
+      if (value == nullptr) continue;
+      const std::string place = at(*value).describe();
+      throw ModelError(fmt::format(
+          "{}{}: '{}' is not a key of a knife edge: a knife edge only forbids its point's velocity across the "
+          "blade, and its model has no normal force (the frames or other contacts carry the weight), so Coulomb's "
+          "bound mu N on the side force, a lift-off at N = 0 and an impact at touchdown are not defined for it "
+          "(docs/contact-modes.md, \"Knife edges\"). Remove the key (the blade then never skids); for a runner "
+          "that may skid or lift off, write the body that touches the ground as a [[contacts]] entry (or a "
+          "[[wheels]] entry) with the friction, unilateral, restitution and mode keys, its height a coordinate",
+          place.empty() ? "" : place + ": ", name, key));
+    }
+  }
 }
 
 void load_contacts(const toml::node& contacts, symbolic::MultibodyBuilder& multibody, symbolic::SpecVisual& visual,

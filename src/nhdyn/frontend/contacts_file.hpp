@@ -1,11 +1,15 @@
 // The [[contacts]] array of a model file (docs/multibody.md, "Rolling bodies"): reads each entry's
 // TOML (name, body, shape, centre, ground, rolling) into a symbolic::ContactText, hands it to the
-// multibody builder, and adds the shape's drawing to the scene. The shapes and grounds are those
+// multibody builder, and adds the shape's drawing to the scene. Also the contact modes' keys of
+// the other helpers (docs/contact-modes.md): a [[wheels]] entry with them is read as the
+// [[contacts]] disk it is; a [[knife_edges]] entry with them is refused. The shapes and grounds are those
 // registered in symbolic/contact_shapes.cpp and symbolic/rolling_contact.cpp: this file lists none.
 // Called by the model-file loader (model_file.cpp) before MultibodyBuilder::apply().
 #pragma once
 
+#include <array>
 #include <functional>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,5 +38,33 @@ const std::vector<std::string>& contact_keys();
 void load_contacts(const toml::node& contacts, symbolic::MultibodyBuilder& multibody, symbolic::SpecVisual& visual,
                    const std::vector<std::pair<std::string, symbolic::PlacedFrame>>& body_frames,
                    const TomlLocator& at);
+
+// The keys that give a contact its modes (friction, unilateral, restitution, mode), which
+// [[contacts]] and [[wheels]] entries take (docs/contact-modes.md).
+const std::vector<std::string>& contact_mode_keys();
+
+// Whether `table` has any of contact_mode_keys().
+bool has_contact_mode_keys(const toml::table& table);
+
+// A [[wheels]] entry as the model-file loader read it (the texts as written).
+struct WheelEntry {
+  std::string name, body, axis, radius;
+  std::optional<std::array<std::string, 3>> normal;  // the plane's normal; none: opposite to gravity
+};
+
+// A [[wheels]] entry `table` with mode keys, handed to `multibody` as the [[contacts]] entry it
+// is: shape = { disk = radius, axis = axis } on `body` (centred on its frame's origin), ground =
+// { plane = normal } (or the default plane), rolling = "rolling", and the entry's mode keys, read
+// and checked as a contact's. So it has the contact's constraints (NAME_contact, NAME_roll1,
+// NAME_roll2), columns and switch events. The scene's drawing stays the loader's (the wheel's).
+// Throws ModelError naming file:line for a mode key of the wrong type and whatever the builder
+// refuses.
+void load_wheel_contact(const toml::table& table, const WheelEntry& wheel, symbolic::MultibodyBuilder& multibody,
+                        const TomlLocator& at);
+
+// Refuses the mode keys on [[knife_edges]] entries (`knives`, the array as written; anything else
+// is left for the loader's own checks): a knife edge's planar model has no normal force for
+// Coulomb's law to bound (docs/contact-modes.md). The ModelError names the key's file:line.
+void refuse_knife_edge_modes(const toml::node& knives, const TomlLocator& at);
 
 }  // namespace nhdyn

@@ -57,7 +57,9 @@ const std::vector<std::string> top_level_keys = {
 const std::vector<std::string> frame_keys = {"name", "parent", "translation", "rotations", "quaternion"};
 const std::vector<std::string> point_keys = {"name", "frame", "position"};
 const std::vector<std::string> body_keys = {"name", "frame", "mass", "com", "inertia"};
-const std::vector<std::string> wheel_keys = {"name", "body", "axis", "radius", "normal"};
+// A wheel's mode keys (friction, ...) make it the [[contacts]] disk it is (contacts_file.hpp).
+const std::vector<std::string> wheel_keys = {"name",     "body",       "axis",        "radius", "normal",
+                                             "friction", "unilateral", "restitution", "mode"};
 const std::vector<std::string> knife_edge_keys = {"name", "point", "axis", "normal"};
 const std::vector<std::string> surface_keys = {"name", "point", "surface"};
 const std::vector<std::string> curve_keys = {"name", "point", "surfaces"};
@@ -1164,8 +1166,13 @@ void load_wheels(LoadContext& cx, const toml::table& root, SpecBuilder& builder,
           c.string_of(c.member(*table, "wheels", "axis", "axis = \"y\""), what + ": axis", "axis = \"y\"");
       const std::string radius = c.number_or_expression(c.member(*table, "wheels", "radius", "radius = \"r\""),
                                                         what + ": radius", "radius = \"r\"");
-      scene.mb.rolling_wheel(name, body, axis, radius, c.optional_triple(*table, "normal", what + ": normal"),
-                             c.at(*table));
+      const std::optional<symbolic::Triple> normal = c.optional_triple(*table, "normal", what + ": normal");
+      if (has_contact_mode_keys(*table))
+        // A wheel that may slide or lift off: the contact modes are the [[contacts]] machinery's.
+        load_wheel_contact(*table, {name, body, axis, radius, normal}, scene.mb,
+                           [&c](const toml::node& node) { return c.at(node); });
+      else
+        scene.mb.rolling_wheel(name, body, axis, radius, normal, c.at(*table));
       // The scene draws the wheel's body as a disk of the wheel's radius about its axle.
       for (const auto& [body_name, placed] : scene.body_frames)
         if (body_name == body) {
@@ -1181,7 +1188,8 @@ void load_wheels(LoadContext& cx, const toml::table& root, SpecBuilder& builder,
 // [[knife_edges]]: a point that moves only along its blade.
 void load_knife_edges(LoadContext& cx, const toml::table& root, MultibodySections& scene) {
   const Cursor& c = cx.cursor;
-  if (const toml::node* knives = root.get("knife_edges"))
+  if (const toml::node* knives = root.get("knife_edges")) {
+    refuse_knife_edge_modes(*knives, [&c](const toml::node& node) { return c.at(node); });
     for (const toml::table* table : c.tables_of(*knives, "knife_edges", knife_edge_keys)) {
       const std::string name = c.name_of(*table, "knife_edges");
       const std::string what = fmt::format("knife edge '{}'", name);
@@ -1192,6 +1200,7 @@ void load_knife_edges(LoadContext& cx, const toml::table& root, MultibodySection
           c.string_of(c.member(*table, "knife_edges", "axis", "axis = \"x\""), what + ": axis", "axis = \"x\""),
           c.optional_triple(*table, "normal", what + ": normal"), c.at(*table));
     }
+  }
 }
 
 // [[surfaces]]: a point held on a fixed surface.
