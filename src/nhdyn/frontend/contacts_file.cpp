@@ -256,12 +256,12 @@ void refuse_knife_edge_modes(const toml::node& knives, const TomlLocator& at) {
       if (value == nullptr) continue;
       const std::string place = at(*value).describe();
       throw ModelError(fmt::format(
-          "{}{}: '{}' is not a key of a knife edge: a knife edge only forbids its point's velocity across the "
-          "blade, and its model has no normal force (the frames or other contacts carry the weight), so Coulomb's "
-          "bound mu N on the side force, a lift-off at N = 0 and an impact at touchdown are not defined for it "
-          "(docs/contact-modes.md, \"Knife edges\"). Remove the key (the blade then never skids); for a runner "
-          "that may skid or lift off, write the body that touches the ground as a [[contacts]] entry (or a "
-          "[[wheels]] entry) with the friction, unilateral, restitution and mode keys, its height a coordinate",
+          "{}{}: '{}' is not a key of a knife edge: its constraint forbids the blade's sideways velocity and "
+          "carries no normal force of its own (what holds the blade on the plane is the model's coordinates), so "
+          "Coulomb's bound mu N, a lift-off at N = 0 and an impact at touchdown are not defined for it "
+          "(docs/contact-modes.md, \"Knife edges\"). Remove the key (the blade then holds as it does without it); for a runner that may "
+          "skid or lift off, model what touches the ground as a [[wheels]] or [[contacts]] entry with this key, its "
+          "height among the coordinates (a knife edge is a wheel whose spin has no inertia)",
           place.empty() ? "" : place + ": ", name, key));
     }
   }

@@ -1,0 +1,280 @@
+// The contact modes' keys (friction, unilateral, restitution, mode) on [[wheels]] and
+// [[knife_edges]] entries (docs/contact-modes.md, "Wheels and knife edges"). A wheel with any of
+// them is read as the [[contacts]] disk it is: the same constraints (NAME_contact, NAME_roll1,
+// NAME_roll2), the same contact modes and columns, and accelerations equal to the last bit at
+// random states, on the default plane and on a tilted plane given by the wheel's `normal`. A wheel
+// without them keeps its own rows (NAME_slip1, NAME_slip2), and its accelerations and reactions
+// agree with the disk contact's to round-off (the two differ in how the rim's |a x n| is written
+// only). Bad values are refused naming file:line; a knife edge refuses the keys, naming the key's
+// place and why.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "multibody/multibody_support.hpp"
+#include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/frontend/model_file.hpp"
+#include "nhdyn/model/contact_forces.hpp"
+#include "nhdyn/model/contact_modes.hpp"
+#include "support/text.hpp"
+
+// A namespace of its own: the unity build joins this file with the other multibody tests.
+namespace nhdyn::wheel_modes_test {
+namespace {
+
+using multibody_test::dynamics_at;
+using multibody_test::uniform;
+
+// A thin disk whose centre (x, y, z) is free, turned by z-x-y angles (so it may leave the ground);
+// `helper` is appended: a [[wheels]] or a [[contacts]] entry.
+std::string disk_with(const std::string& helper) {
+  return R"(name = "disk"
+coordinates = ["x", "y", "z", "psi", "theta", "phi"]
+gravity = [0, 0, "-g"]
+
+[parameters]
+m = 0.5
+r = 0.2
+g = 9.81
+mu = 0.5
+a = 0.3
+
+[[frames]]
+name = "disk"
+translation = ["x", "y", "z"]
+rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
+
+[[bodies]]
+name = "disk"
+frame = "disk"
+mass = "m"
+inertia = ["m*r^2/4", "m*r^2/2", "m*r^2/4"]
+
+[initial]
+position = { x = 0, y = 0, z = "r", psi = 0, theta = 0, phi = 0 }
+)" + helper;
+}
+
+const std::string kWheel = "\n[[wheels]]\nname = \"disk\"\nbody = \"disk\"\naxis = \"y\"\nradius = \"r\"\n";
+const std::string kContact =
+    "\n[[contacts]]\nname = \"disk\"\nbody = \"disk\"\nshape = { disk = \"r\", axis = \"y\" }\n";
+const std::string kModes = "friction = \"mu\"\nunilateral = true\nrestitution = 0.5\n";
+
+std::vector<std::string> constraint_names(const Model& model) {
+  std::vector<std::string> names;
+  for (const Constraint& c : model.constraints) names.push_back(c.name);
+  return names;
+}
+
+std::vector<std::string> output_names(const Model& model) {
+  std::vector<std::string> names;
+  for (const DerivedOutput& o : model.outputs.list) names.push_back(o.name);
+  return names;
+}
+
+// q'' and R of the Do Sanh form at (q, v), as one vector.
+std::vector<double> solution_at(const Model& model, const std::vector<double>& q, const std::vector<double>& v) {
+  const Data data = dynamics_at(model, q, v);
+  std::vector<double> out(data.qdd.data(), data.qdd.data() + data.qdd.size());
+  out.insert(out.end(), data.R.data(), data.R.data() + data.R.size());
+  return out;
+}
+
+// Random states with |theta| < 1.2 (the disk not flat); not on the ground: the equations are
+// compared, not a motion.
+void random_state(std::mt19937& rng, std::vector<double>& q, std::vector<double>& v) {
+  q = {uniform(rng, -2, 2), uniform(rng, -2, 2), uniform(rng, 0.05, 0.3),
+       uniform(rng, -3, 3), uniform(rng, -1.2, 1.2), uniform(rng, -3, 3)};
+  v.resize(6);
+  for (double& x : v) x = uniform(rng, -3, 3);
+}
+
+// The largest |a - b| over the largest |b| (relative to the solution's scale).
+double relative_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  double diff = 0.0, scale = 0.0;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    diff = std::max(diff, std::abs(a[i] - b[i]));
+    scale = std::max(scale, std::abs(b[i]));
+  }
+  return diff / scale;
+}
+
+TEST(WheelModes, AWheelWithoutTheKeysKeepsItsOwnRows) {
+  const Model wheel = load_model_text(disk_with(kWheel), "wheel.toml");
+  EXPECT_EQ(constraint_names(wheel), (std::vector<std::string>{"disk_contact", "disk_slip1", "disk_slip2"}));
+  EXPECT_EQ(wheel.contact_modes, nullptr);
+}
+
+// Without the keys: the same motion as the disk contact, whose rows are rotated alike and whose
+// rim is written without the wheel's simplification (round-off apart).
+TEST(WheelModes, AWheelWithoutTheKeysMovesAsItsDiskContact) {
+  const Model wheel = load_model_text(disk_with(kWheel), "wheel.toml");
+  const Model contact = load_model_text(disk_with(kContact), "contact.toml");
+  ASSERT_EQ(contact.s(), 3);
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 10; ++trial) {
+    std::vector<double> q, v;
+    random_state(rng, q, v);
+    EXPECT_LT(relative_difference(solution_at(wheel, q, v), solution_at(contact, q, v)), 1e-12) << "trial " << trial;
+  }
+}
+
+// With the keys: the wheel is the disk contact, exactly (same text into the same builder).
+void expect_same_model(const std::string& wheel_entry, const std::string& contact_entry) {
+  const Model wheel = load_model_text(disk_with(wheel_entry), "wheel.toml");
+  const Model contact = load_model_text(disk_with(contact_entry), "contact.toml");
+  EXPECT_EQ(constraint_names(wheel), (std::vector<std::string>{"disk_contact", "disk_roll1", "disk_roll2"}));
+  EXPECT_EQ(constraint_names(wheel), constraint_names(contact));
+  ASSERT_NE(wheel.contact_modes, nullptr);
+  ASSERT_NE(contact.contact_modes, nullptr);
+  ASSERT_EQ(wheel.contact_modes->contacts.size(), 1u);
+  EXPECT_EQ(wheel.contact_modes->contacts[0].name, "disk");
+  EXPECT_TRUE(wheel.contact_modes->contacts[0].friction);
+  EXPECT_TRUE(wheel.contact_modes->contacts[0].unilateral);
+  EXPECT_EQ(contact_force_columns(wheel), contact_force_columns(contact));
+  EXPECT_EQ(output_names(wheel), output_names(contact));
+  EXPECT_EQ(output_names(wheel).front(), "disk_X");  // the contact point, as a contact has it
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 10; ++trial) {
+    std::vector<double> q, v;
+    random_state(rng, q, v);
+    EXPECT_EQ(solution_at(wheel, q, v), solution_at(contact, q, v)) << "trial " << trial;
+  }
+}
+
+TEST(WheelModes, AWheelWithTheKeysIsItsDiskContact) {
+  expect_same_model(kWheel + kModes, kContact + kModes);
+}
+
+// The wheel's normal is the contact's plane (through the origin, as both are): a plane tilted by
+// a about y, not normal to gravity.
+TEST(WheelModes, TheWheelsNormalIsTheContactsPlane) {
+  const std::string normal = "normal = [\"sin(a)\", 0, \"cos(a)\"]\n";
+  expect_same_model(kWheel + normal + kModes,
+                    kContact + "ground = { plane = [\"sin(a)\", 0, \"cos(a)\"] }\n" + kModes);
+  // Without the keys the wheel on that plane moves as the disk contact on it too.
+  const Model wheel = load_model_text(disk_with(kWheel + normal), "wheel.toml");
+  const Model contact =
+      load_model_text(disk_with(kContact + "ground = { plane = [\"sin(a)\", 0, \"cos(a)\"] }\n"), "contact.toml");
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 5; ++trial) {
+    std::vector<double> q, v;
+    random_state(rng, q, v);
+    EXPECT_LT(relative_difference(solution_at(wheel, q, v), solution_at(contact, q, v)), 1e-12) << "trial " << trial;
+  }
+}
+
+TEST(WheelModes, EachKeyAloneMakesTheWheelAContact) {
+  for (const std::string key : {"friction = 0.3\n", "unilateral = true\n", "restitution = 0\n", "mode = \"rolling\"\n"}) {
+    const Model wheel = load_model_text(disk_with(kWheel + key), "wheel.toml");
+    EXPECT_EQ(constraint_names(wheel), (std::vector<std::string>{"disk_contact", "disk_roll1", "disk_roll2"})) << key;
+    EXPECT_NE(wheel.contact_modes, nullptr) << key;
+  }
+}
+
+// The message loading `text` as wheel.toml throws ("" if none).
+std::string error_of(const std::string& text) {
+  try {
+    load_model_text(text, "wheel.toml");
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// "wheel.toml:LINE:" for the line of `text` that starts with `line_start` (the last such line).
+std::string place_of(const std::string& text, const std::string& line_start) {
+  int line = 0, found = 0;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    ++line;
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    if (text.compare(at, line_start.size(), line_start) == 0) found = line;
+    at = end + 1;
+  }
+  EXPECT_GT(found, 0) << line_start;
+  return "wheel.toml:" + std::to_string(found) + ":";
+}
+
+void expect_refused(const std::string& entry, const std::string& line_start, const std::vector<std::string>& parts) {
+  const std::string text = disk_with(entry);
+  const std::string message = error_of(text);
+  ASSERT_FALSE(message.empty()) << "no error for:\n" << entry;
+  EXPECT_TRUE(message.starts_with(place_of(text, line_start))) << message;
+  for (const std::string& part : parts) EXPECT_TRUE(test::contains(message, part)) << message << "\n  lacks: " << part;
+}
+
+TEST(WheelModes, BadValuesOnAWheelAreRefusedWithTheirPlace) {
+  // Type errors name the key's line; the values the contact checks name the entry's.
+  expect_refused(kWheel + "unilateral = \"yes\"\n", "unilateral", {"wheel 'disk': unilateral must be true or false"});
+  expect_refused(kWheel + "friction = [0.1, 0.2, 0.3]\n", "friction", {"friction must be one coefficient or two"});
+  expect_refused(kWheel + "mode = 1\n", "mode", {"wheel 'disk': mode must be a string"});
+  expect_refused(kWheel + "friction = -0.1\n", "[[wheels]]", {"contact 'disk'", "friction", "-0.1", ">= 0"});
+  expect_refused(kWheel + "friction = [0.2, 0.3]\n", "[[wheels]]", {"mu_s = 0.2 below mu_k = 0.3"});
+  expect_refused(kWheel + "restitution = 1.5\n", "[[wheels]]", {"restitution", "between 0"});
+  expect_refused(kWheel + "mode = \"hover\"\n", "[[wheels]]", {"unknown mode 'hover'"});
+  expect_refused(kWheel + "mode = \"sliding\"\n", "[[wheels]]", {"mode = \"sliding\" needs a friction coefficient"});
+  expect_refused(kWheel + "friction = 0.3\nmode = \"free\"\n", "[[wheels]]", {"mode = \"free\" needs unilateral = true"});
+  expect_refused(kWheel + "frictoin = 0.3\n", "frictoin", {"unknown key 'frictoin'", "did you mean 'friction'"});
+}
+
+// A Chaplygin sleigh: x, y, theta keep it flat; the blade at the frame's origin.
+std::string sled_with(const std::string& key) {
+  return R"(name = "sled"
+coordinates = ["x", "y", "theta"]
+gravity = [0, 0, "-g"]
+
+[parameters]
+m = 2.0
+a = 0.3
+g = 9.81
+
+[[frames]]
+name = "sled"
+translation = ["x", "y", 0]
+rotations = [["z", "theta"]]
+
+[[points]]
+name = "blade"
+frame = "sled"
+
+[[bodies]]
+name = "sled"
+frame = "sled"
+mass = "m"
+com = ["a", 0, 0]
+inertia = [0.05, 0.1, 0.1]
+
+[[knife_edges]]
+name = "blade"
+point = "blade"
+axis = "x"
+)" + key + R"(
+[initial]
+position = { x = 0, y = 0, theta = 0 }
+velocity = { x = 1, theta = 0.5 }
+)";
+}
+
+TEST(WheelModes, AKnifeEdgeRefusesTheKeysSayingWhy) {
+  EXPECT_EQ(error_of(sled_with("")), "");
+  for (const std::string key : {"friction", "unilateral", "restitution", "mode"}) {
+    const std::string value = key == "unilateral" ? "true" : key == "mode" ? "\"sliding\"" : "0.3";
+    const std::string text = sled_with(key + " = " + value + "\n");
+    const std::string message = error_of(text);
+    // The key's own line and column: the value after "KEY = ".
+    EXPECT_TRUE(message.starts_with(place_of(text, key) + std::to_string(key.size() + 4) + ": knife edge 'blade': '" +
+                                    key + "' is not a key of a knife edge"))
+        << message;
+    for (const char* part : {"no normal force", "mu N", "docs/contact-modes.md", "Remove the key", "[[wheels]]"})
+      EXPECT_TRUE(test::contains(message, part)) << message << "\n  lacks: " << part;
+  }
+}
+
+}  // namespace
+}  // namespace nhdyn::wheel_modes_test
