@@ -42,7 +42,6 @@ m = 0.5
 r = 0.2
 g = 9.81
 mu = 0.5
-a = 0.3
 
 [[frames]]
 name = "disk"
@@ -152,21 +151,36 @@ TEST(WheelModes, AWheelWithTheKeysIsItsDiskContact) {
 }
 
 // The wheel's normal is the contact's plane (through the origin, as both are): a plane tilted by
-// a about y, not normal to gravity.
+// atan(3/4) about y, not normal to gravity.
 TEST(WheelModes, TheWheelsNormalIsTheContactsPlane) {
-  const std::string normal = "normal = [\"sin(a)\", 0, \"cos(a)\"]\n";
+  const std::string normal = "normal = [3, 0, 4]\n";  // not of unit length: normalized as the contact's
   expect_same_model(kWheel + normal + kModes,
-                    kContact + "ground = { plane = [\"sin(a)\", 0, \"cos(a)\"] }\n" + kModes);
+                    kContact + "ground = { plane = [3, 0, 4] }\n" + kModes);
   // Without the keys the wheel on that plane moves as the disk contact on it too.
   const Model wheel = load_model_text(disk_with(kWheel + normal), "wheel.toml");
   const Model contact =
-      load_model_text(disk_with(kContact + "ground = { plane = [\"sin(a)\", 0, \"cos(a)\"] }\n"), "contact.toml");
+      load_model_text(disk_with(kContact + "ground = { plane = [3, 0, 4] }\n"), "contact.toml");
   std::mt19937 rng(3);
   for (int trial = 0; trial < 5; ++trial) {
     std::vector<double> q, v;
     random_state(rng, q, v);
     EXPECT_LT(relative_difference(solution_at(wheel, q, v), solution_at(contact, q, v)), 1e-12) << "trial " << trial;
   }
+}
+
+// Drawn as a wheel, as without the keys, with the contact point's track a contact has.
+TEST(WheelModes, AWheelWithTheKeysIsDrawnAsAWheelWithItsTrack) {
+  const auto kinds = [](const std::string& text) {
+    std::vector<std::string> out;
+    for (const symbolic::VisualItem& item : load_model_string(text, "wheel.toml").visual.items) {
+      if (item.kind == symbolic::VisualKind::wheel) out.push_back("wheel " + item.name);
+      if (item.kind == symbolic::VisualKind::track) out.push_back("track " + item.name);
+    }
+    std::sort(out.begin(), out.end());  // the scene's order does not matter
+    return out;
+  };
+  EXPECT_EQ(kinds(disk_with(kWheel)), (std::vector<std::string>{"wheel disk"}));
+  EXPECT_EQ(kinds(disk_with(kWheel + kModes)), (std::vector<std::string>{"track disk", "wheel disk"}));
 }
 
 TEST(WheelModes, EachKeyAloneMakesTheWheelAContact) {

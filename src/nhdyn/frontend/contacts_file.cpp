@@ -196,6 +196,24 @@ class ContactReader {
   const TomlLocator& at_;
 };
 
+// The ground where it is not the plane's grid, and the contact point's path on it: the
+// contact's outputs NAME_X, NAME_Y, NAME_Z.
+void add_ground_drawing(const symbolic::ContactText& text, const symbolic::ParsedContact& parsed,
+                        symbolic::SpecVisual& visual) {
+  const std::vector<std::string> point = {text.name + "_X", text.name + "_Y", text.name + "_Z"};
+  std::vector<symbolic::VisualItem> ground;
+  if (std::optional<symbolic::VisualItem> drawn = parsed.ground.type->drawing(parsed)) ground.push_back(std::move(*drawn));
+  symbolic::VisualItem track;
+  track.kind = symbolic::VisualKind::track;
+  ground.push_back(std::move(track));
+  for (symbolic::VisualItem& item : ground) {
+    item.name = text.name;
+    item.where = text.where.describe();
+    item.at_outputs = point;
+    visual.items.push_back(std::move(item));
+  }
+}
+
 }  // namespace
 
 const std::vector<std::string>& contact_keys() {
@@ -216,7 +234,7 @@ bool has_contact_mode_keys(const toml::table& table) {
 }
 
 void load_wheel_contact(const toml::table& table, const WheelEntry& wheel, symbolic::MultibodyBuilder& multibody,
-                        const TomlLocator& at) {
+                        symbolic::SpecVisual& visual, const TomlLocator& at) {
   const ContactReader reader(at);
   symbolic::ContactText text;
   text.where = at(table);
@@ -238,6 +256,8 @@ void load_wheel_contact(const toml::table& table, const WheelEntry& wheel, symbo
   text.rolling = "rolling";
   reader.read_modes(table, fmt::format("wheel '{}'", wheel.name), text);
   multibody.contact(text);
+  // The body is drawn as a wheel by the loader; the contact point's track is the contact's.
+  if (const symbolic::ParsedContact* parsed = multibody.parsed_contact(text.name)) add_ground_drawing(text, *parsed, visual);
 }
 
 void refuse_knife_edge_modes(const toml::node& knives, const TomlLocator& at) {
@@ -294,20 +314,7 @@ void load_contacts(const toml::node& contacts, symbolic::MultibodyBuilder& multi
         for (unsigned j = 0; j < 3; ++j) item.other.push_back(frame.rotation(i, j));
       visual.items.push_back(std::move(item));
     }
-    // The ground where it is not the plane's grid, and the contact point's path on it: the
-    // contact's outputs NAME_X, NAME_Y, NAME_Z.
-    const std::vector<std::string> point = {text.name + "_X", text.name + "_Y", text.name + "_Z"};
-    std::vector<symbolic::VisualItem> ground;
-    if (std::optional<symbolic::VisualItem> drawn = parsed->ground.type->drawing(*parsed)) ground.push_back(std::move(*drawn));
-    symbolic::VisualItem track;
-    track.kind = symbolic::VisualKind::track;
-    ground.push_back(std::move(track));
-    for (symbolic::VisualItem& item : ground) {
-      item.name = text.name;
-      item.where = text.where.describe();
-      item.at_outputs = point;
-      visual.items.push_back(std::move(item));
-    }
+    add_ground_drawing(text, *parsed, visual);
   }
 }
 

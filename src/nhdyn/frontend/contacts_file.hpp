@@ -56,11 +56,12 @@ struct WheelEntry {
 // is: shape = { disk = radius, axis = axis } on `body` (centred on its frame's origin), ground =
 // { plane = normal } (or the default plane), rolling = "rolling", and the entry's mode keys, read
 // and checked as a contact's. So it has the contact's constraints (NAME_contact, NAME_roll1,
-// NAME_roll2), columns and switch events. The scene's drawing stays the loader's (the wheel's).
-// Throws ModelError naming file:line for a mode key of the wrong type and whatever the builder
-// refuses.
+// NAME_roll2), columns and switch events. The body's drawing stays the loader's (a wheel); the
+// contact adds to `visual` what a [[contacts]] entry adds besides its shape (the contact point's
+// track). Throws ModelError naming file:line for a mode key of the wrong type and whatever the
+// builder refuses.
 void load_wheel_contact(const toml::table& table, const WheelEntry& wheel, symbolic::MultibodyBuilder& multibody,
-                        const TomlLocator& at);
+                        symbolic::SpecVisual& visual, const TomlLocator& at);
 
 // Refuses the mode keys on [[knife_edges]] entries (`knives`, the array as written; anything else
 // is left for the loader's own checks): a knife edge's planar model has no normal force for

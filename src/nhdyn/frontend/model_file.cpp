@@ -1169,7 +1169,7 @@ void load_wheels(LoadContext& cx, const toml::table& root, SpecBuilder& builder,
       const std::optional<symbolic::Triple> normal = c.optional_triple(*table, "normal", what + ": normal");
       if (has_contact_mode_keys(*table))
         // A wheel that may slide or lift off: the contact modes are the [[contacts]] machinery's.
-        load_wheel_contact(*table, {name, body, axis, radius, normal}, scene.mb,
+        load_wheel_contact(*table, {name, body, axis, radius, normal}, scene.mb, scene.visual,
                            [&c](const toml::node& node) { return c.at(node); });
       else
         scene.mb.rolling_wheel(name, body, axis, radius, normal, c.at(*table));
