@@ -1,9 +1,8 @@
-// A [[wheels]] entry with the contact modes' keys end to end (docs/contact-modes.md, "Wheels and
-// knife edges"): examples/rolling_disk_hop_wheel.toml, the hopping disk of rolling_disk_hop.toml
-// written as a wheel, gives the same CSV and the same FILE-events.csv, byte for byte after the
-// provenance header (which names the file), and prints the same touchdowns; so does the disk
-// released on the floor, which slips (disk_slip). A bad value on the wheel exits 2 naming
-// file:line.
+// A [[wheels]] entry with the contact modes' keys end to end (docs/contact-modes.md, "Wheels"):
+// examples/rolling_disk_hop_wheel.toml, the hopping disk of rolling_disk_hop.toml written as a
+// wheel, gives the same CSV and the same FILE-events.csv, byte for byte after the provenance
+// header (which names the file), and prints the same touchdowns; so does the disk released on the
+// floor, which slips (disk_slip). A bad value on the wheel exits 2 naming file:line.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -54,8 +53,11 @@ std::vector<std::string> event_lines(const std::string& out) {
 
 // Runs the wheel and the contact form with `options`; both succeed with the same rows and events.
 void expect_same_runs(const fs::path& dir, const std::string& options, const std::vector<std::string>& events) {
-  const auto wheel = run_nhdyn("simulate '" + example("rolling_disk_hop_wheel.toml") + "' " + options + " -o w.csv", dir);
-  const auto contact = run_nhdyn("simulate '" + example("rolling_disk_hop.toml") + "' " + options + " -o c.csv", dir);
+  const auto run = [&](const std::string& file, const std::string& csv) {
+    return run_nhdyn("simulate '" + example(file) + "' " + options + " -o " + csv, dir);
+  };
+  const auto wheel = run("rolling_disk_hop_wheel.toml", "w.csv");
+  const auto contact = run("rolling_disk_hop.toml", "c.csv");
   ASSERT_EQ(wheel.exit_code, 0) << wheel.out;
   ASSERT_EQ(contact.exit_code, 0) << contact.out;
   EXPECT_EQ(event_lines(wheel.out), event_lines(contact.out));

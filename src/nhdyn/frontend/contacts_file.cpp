@@ -123,7 +123,6 @@ class ContactReader {
   }
 
  private:
-
   // shape = { sphere = "r" }: the one key that names a registered shape, and that shape's options.
   void read_shape(const toml::node& node, const std::string& what, symbolic::ContactText& text) const {
     const std::string example = "shape = { sphere = \"r\" } or { ellipsoid = [\"a\", \"b\", \"c\"] }";
@@ -257,7 +256,8 @@ void load_wheel_contact(const toml::table& table, const WheelEntry& wheel, symbo
   reader.read_modes(table, fmt::format("wheel '{}'", wheel.name), text);
   multibody.contact(text);
   // The body is drawn as a wheel by the loader; the contact point's track is the contact's.
-  if (const symbolic::ParsedContact* parsed = multibody.parsed_contact(text.name)) add_ground_drawing(text, *parsed, visual);
+  if (const symbolic::ParsedContact* parsed = multibody.parsed_contact(text.name))
+    add_ground_drawing(text, *parsed, visual);
 }
 
 void refuse_knife_edge_modes(const toml::node& knives, const TomlLocator& at) {
@@ -279,9 +279,10 @@ void refuse_knife_edge_modes(const toml::node& knives, const TomlLocator& at) {
           "{}{}: '{}' is not a key of a knife edge: its constraint forbids the blade's sideways velocity and "
           "carries no normal force of its own (what holds the blade on the plane is the model's coordinates), so "
           "Coulomb's bound mu N, a lift-off at N = 0 and an impact at touchdown are not defined for it "
-          "(docs/contact-modes.md, \"Knife edges\"). Remove the key (the blade then holds as it does without it); for a runner that may "
-          "skid or lift off, model what touches the ground as a [[wheels]] or [[contacts]] entry with this key, its "
-          "height among the coordinates (a knife edge is a wheel whose spin has no inertia)",
+          "(docs/contact-modes.md, \"Knife edges\"). Remove the key (the blade then holds as it does without "
+          "it); for a runner that may skid or lift off, model what touches the ground as a [[wheels]] or "
+          "[[contacts]] entry with this key, its height among the coordinates (a knife edge is a wheel whose spin "
+          "has no inertia)",
           place.empty() ? "" : place + ": ", name, key));
     }
   }

@@ -2,8 +2,9 @@
 // TOML (name, body, shape, centre, ground, rolling) into a symbolic::ContactText, hands it to the
 // multibody builder, and adds the shape's drawing to the scene. Also the contact modes' keys of
 // the other helpers (docs/contact-modes.md): a [[wheels]] entry with them is read as the
-// [[contacts]] disk it is; a [[knife_edges]] entry with them is refused. The shapes and grounds are those
-// registered in symbolic/contact_shapes.cpp and symbolic/rolling_contact.cpp: this file lists none.
+// [[contacts]] disk it is; a [[knife_edges]] entry with them is refused. The shapes and grounds
+// are those registered in symbolic/contact_shapes.cpp and symbolic/rolling_contact.cpp: this file
+// lists none.
 // Called by the model-file loader (model_file.cpp) before MultibodyBuilder::apply().
 #pragma once
 
