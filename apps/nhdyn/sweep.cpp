@@ -15,7 +15,6 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "output_guard.hpp"
 #include "nhdyn/analysis/sweep.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
@@ -24,6 +23,7 @@
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/xy_plot.hpp"
 #include "nhdyn/model/parameters.hpp"
+#include "run_files.hpp"
 
 namespace nhdyn::cli {
 namespace {
@@ -175,7 +175,7 @@ void print_sweep(const Sweep& sweep, const Model& base, const SweepArgs& args, c
 }
 
 int run_sweep(const SweepArgs& args) {
-  protect_model_file(args.model);
+  RunFiles files(args.model);
   SweepOptions options;
   options.parameter = args.param;
   options.from = args.from;
@@ -206,20 +206,19 @@ int run_sweep(const SweepArgs& args) {
   namespace fs = std::filesystem;
   const fs::path table_path =
       args.output.empty() ? fs::path("results") / (make_file_name(base.name + "-sweep-" + args.param) + ".csv") : fs::path(args.output);
-  make_parent_directory(table_path);
   fs::path crossings_path = table_path;
   crossings_path.replace_filename(table_path.stem().string() + "-crossings.csv");
-  check_command_paths(args.model,
-                      {{table_path, "the eigenvalue CSV"}, {crossings_path, "the crossings CSV"}, {args.plot, "--plot"}});
-  check_plot_possible(args.plot);
-  AtomicFile table(table_path);  // both files can be written: checked before any work
-  AtomicFile crossings_file(crossings_path);
+  files.output(table_path, "the eigenvalue CSV", Folder::make);
+  files.output(crossings_path, "the crossings CSV");
+  files.plot(args.plot);
+  files.check();
+  AtomicFile& table = files.open(table_path);  // both files can be written: checked before any work
+  AtomicFile& crossings_file = files.open(crossings_path);
 
   const Sweep sweep = calc_eigenvalue_sweep(model_at, options);
 
   write_sweep_tables(sweep, base, source, args, table, crossings_file);
-  table.commit();
-  crossings_file.commit();
+  files.commit();
 
   if (!args.plot.empty()) plot_sweep(sweep, base, args);
   if (!args.quiet) print_sweep(sweep, base, args, table_path, crossings_path);
