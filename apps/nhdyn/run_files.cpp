@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <stdlib.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <system_error>
@@ -91,16 +92,22 @@ void RunFiles::check() {
   for (const Listed& out : listed_)
     if (out.kind == Kind::plot) require_plot_possible(out.path);
   // A plot or a page is written by its own writer after the run: its directory is proved
-  // writable now by a temporary file that is removed unused. Those whose folder must exist first,
-  // so that a refused run makes no folder (results/ included).
+  // writable now by a temporary file that is removed unused. Those in a folder nobody makes are
+  // probed first, so that a refused run makes no folder (results/ included); those in a folder
+  // made here (a study's plot beside its table in out/), once it is made.
+  std::vector<fs::path> made;
   for (const Listed& out : listed_)
-    if (out.kind != Kind::output && out.folder == Folder::must_exist)
-      probes_.push_back(std::make_unique<AtomicFile>(out.path));
+    if (out.folder == Folder::make) made.push_back(out.path.parent_path().lexically_normal());
+  const auto in_made_folder = [&made](const Listed& out) {
+    return out.folder == Folder::make ||
+           std::find(made.begin(), made.end(), out.path.parent_path().lexically_normal()) != made.end();
+  };
+  for (const Listed& out : listed_)
+    if (out.kind != Kind::output && !in_made_folder(out)) probes_.push_back(std::make_unique<AtomicFile>(out.path));
   for (const Listed& out : listed_)
     if (out.folder == Folder::make) make_folder_of(out.path, out.role);
   for (const Listed& out : listed_)
-    if (out.kind != Kind::output && out.folder == Folder::make)
-      probes_.push_back(std::make_unique<AtomicFile>(out.path));
+    if (out.kind != Kind::output && in_made_folder(out)) probes_.push_back(std::make_unique<AtomicFile>(out.path));
 }
 
 AtomicFile& RunFiles::open(const fs::path& path) {
