@@ -313,9 +313,9 @@ AtomicFile& open_batch_files(RunFiles& files, const BatchArgs& args, const std::
   return files.open(dir / "summary.csv");  // checks the directory is writable before any run
 }
 
-// --threads: 0 is every core; more than the machine runs is capped, with a note.
-void check_batch_threads(int threads) {
-  if (threads < 0) throw InputError(fmt::format("--threads {}: give 0 (every core) or a positive number", threads));
+// --threads: 0 is every core (checked by the library); more than the machine runs is capped, with a note.
+void note_batch_threads(int threads) {
+  check_batch_threads(threads);
   if (threads > max_batch_threads())
     fmt::print(stderr, "nhdyn: note: --threads {}: this machine has {} cores; using at most {} threads\n", threads,
                std::max(1U, std::thread::hardware_concurrency()), max_batch_threads());
@@ -359,7 +359,7 @@ std::string summary_header(const std::string& provenance, const std::vector<std:
 int run_batch(const BatchArgs& args) {
   if (args.grids.empty() == args.runs_csv.empty())
     throw InputError("give the runs either as --grid NAME=FROM:TO:COUNT (repeatable) or as --runs FILE.csv");
-  check_batch_threads(args.threads);
+  note_batch_threads(args.threads);
   RunFiles files(args.model);
   const ParameterOverrides overrides = batch_overrides(args.sets);
   const ModelSource source = read_model_source(args.model);

@@ -42,8 +42,9 @@ std::function<int()> add_report_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing");
   return [args] {
-    if (args->max_frames < 2)
-      throw InputError(fmt::format("--max-frames {}: give at least 2", args->max_frames));
+    ReportOptions options;
+    options.max_frames = args->max_frames;
+    check_report_options(options);  // before any work
     // Every file of the run, checked together before any work (run_files.hpp); an unwritable -o is
     // refused here.
     RunFiles files(args->model);
@@ -62,8 +63,6 @@ std::function<int()> add_report_command(CLI::App& app) {
     check_report_columns(table.header, make_result_columns(resolved.model), args->csv, resolved.model.name);
     check_report_times(table, args->csv);  // finite and never decreasing
     files.commit();  // nothing of its own to commit: the report's writer writes it whole
-    ReportOptions options;
-    options.max_frames = args->max_frames;
     const std::string notice = write_model_report(resolved.model, resolved.description.get(), table,
                        fmt::format("{}: {}", resolved.model.name, args->csv), {{"results", args->csv}}, args->output,
                        options);

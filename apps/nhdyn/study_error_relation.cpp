@@ -19,6 +19,7 @@
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/io/xy_plot.hpp"
+#include "nhdyn/studies/run_times.hpp"
 #include "nhdyn/studies/error_relation.hpp"
 #include "run_files.hpp"
 #include "study.hpp"
@@ -161,7 +162,7 @@ int run_error_relation(const ErrorRelationArgs& args) {
   for (const std::string& i : args.integrators) options.integrators.push_back(parse_integrator(i));
   options.t_end = args.t_end.value_or(0.0);
   options.output_step = args.output_step.value_or(0.0);
-  check_study_times(model, args.t_end, args.output_step);
+  check_study_run_times(model, args.t_end, args.output_step);  // the library's check, before any file
 
   namespace fs = std::filesystem;
   const fs::path table_path = args.output;

@@ -18,6 +18,7 @@
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/xy_plot.hpp"
+#include "nhdyn/studies/run_times.hpp"
 #include "nhdyn/studies/tracking.hpp"
 #include "run_files.hpp"
 #include "study.hpp"
@@ -136,7 +137,7 @@ int run_tracking(const TrackingArgs& args) {
   options.integrator = parse_integrator(args.integrator);
   options.t_end = args.t_end.value_or(0.0);
   options.output_step = args.output_step.value_or(0.0);
-  check_study_times(model, args.t_end, args.output_step);
+  check_study_run_times(model, args.t_end, args.output_step);  // the library's check, before any file
 
   namespace fs = std::filesystem;
   const fs::path table_path = args.output;
