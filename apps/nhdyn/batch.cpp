@@ -321,18 +321,6 @@ void note_batch_threads(int threads) {
                std::max(1U, std::thread::hardware_concurrency()), max_batch_threads());
 }
 
-// --set NAME=VALUE, each given to every run.
-ParameterOverrides batch_overrides(const std::vector<std::string>& sets) {
-  ParameterOverrides overrides;
-  for (const std::string& set : sets) {
-    const std::size_t eq = set.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError(fmt::format("--set '{}': write it as NAME=VALUE, e.g. --set a=0.3", set));
-    overrides.emplace_back(set.substr(0, eq), set.substr(eq + 1));
-  }
-  return overrides;
-}
-
 // The summary's provenance and column names: the run, its varied names, its outcome, its final
 // state and residuals.
 std::string summary_header(const std::string& provenance, const std::vector<std::string>& names, const Model& base) {
@@ -343,6 +331,31 @@ std::string summary_header(const std::string& provenance, const std::vector<std:
   for (const std::string& c : base.coordinates) header += "," + csv_text(c + "'");
   header += ",max_residual_pos,max_residual_vel,max_residual_acc,message\n";
   return header;
+}
+
+// The options of every run: the model's, the command line's overrides, the file's [[events]];
+// checked whole before any file is made.
+BatchOptions make_batch_options(const Model& base, const BatchArgs& args) {
+  BatchOptions options;
+  options.simulation = make_simulation_options(run_options_with(base, args));
+  options.simulation.events = base.events;  // the file's [[events]], as simulate and Python's batch honour them
+  options.threads = args.threads;
+  options.keep_trajectories = args.write_runs;
+  check_simulation_options(base, options.simulation);
+  return options;
+}
+
+// summary.csv: its provenance and header, then one line per run. Returns how many runs failed.
+long write_summary(AtomicFile& summary, const std::string& provenance, const std::vector<std::string>& names,
+                   const std::vector<std::vector<double>>& table, const std::vector<BatchResult>& results,
+                   const Model& base) {
+  summary.write(summary_header(provenance, names, base));
+  long failed = 0;
+  for (std::size_t r = 0; r < results.size(); ++r) {
+    failed += results[r].ok ? 0 : 1;
+    summary.write(summary_line(r, table[r], results[r], base));
+  }
+  return failed;
 }
 
 // An interrupted batch writes nothing: the staged run files and the summary's temporary go, and
@@ -361,20 +374,14 @@ int run_batch(const BatchArgs& args) {
     throw InputError("give the runs either as --grid NAME=FROM:TO:COUNT (repeatable) or as --runs FILE.csv");
   note_batch_threads(args.threads);
   RunFiles files(args.model);
-  const ParameterOverrides overrides = batch_overrides(args.sets);
+  const ParameterOverrides overrides = parse_parameter_sets(args.sets);  // each given to every run
   const ModelSource source = read_model_source(args.model);
   const Model base = load_model(source, overrides);
   std::vector<std::string> names;
   std::vector<std::vector<double>> table;
   make_run_table(args, names, table);
 
-  const RunOptions run = run_options_with(base, args);
-  BatchOptions options;
-  options.simulation = make_simulation_options(run);
-  options.simulation.events = base.events;  // the file's [[events]], as simulate and Python's batch honour them
-  options.threads = args.threads;
-  options.keep_trajectories = args.write_runs;
-  check_simulation_options(base, options.simulation);
+  BatchOptions options = make_batch_options(base, args);
 
   namespace fs = std::filesystem;
   const fs::path dir(args.output);
@@ -419,12 +426,7 @@ int run_batch(const BatchArgs& args) {
   const std::vector<BatchResult> results = simulate_batch(runs, options);
   if (const int sig = batch_signal.load()) exit_interrupted(sig, files);
 
-  summary.write(summary_header(summary_provenance, names, base));
-  long failed = 0;
-  for (std::size_t r = 0; r < results.size(); ++r) {
-    failed += results[r].ok ? 0 : 1;
-    summary.write(summary_line(r, table[r], results[r], base));
-  }
+  const long failed = write_summary(summary, summary_provenance, names, table, results, base);
   files.commit();  // the run files moved into place, then the summary
   print_batch_outcome(args, base, results, failed, dir);
   return failed > 0 ? 1 : 0;
