@@ -45,16 +45,6 @@ std::filesystem::path reactions_plot_path(const std::filesystem::path& plot) {
   return out;
 }
 
-// The options' values, checked before the model file is read.
-void check_spread_masses_options(const SpreadMassesOptions& options) {
-  for (double ratio : options.ratios)
-    if (!(ratio > 0.0 && std::isfinite(ratio)))
-      throw InputError(fmt::format("--ratios: {} is not a positive number; give ratios such as 1,1e6,1e12", ratio));
-  if (options.samples < 1) throw InputError(fmt::format("--samples {}: give at least 1 state per ratio", options.samples));
-  if (options.digits < 20)
-    throw InputError(fmt::format("--digits {}: the reference needs 20 digits or more (default 50)", options.digits));
-}
-
 // One CSV row per ratio: the ratio, cond(A), the reference's error, then each formulation's errors.
 void write_spread_masses_rows(const SpreadMasses& study, CsvWriter& csv) {
   std::vector<double> row;
@@ -142,7 +132,7 @@ int run_spread_masses(const SpreadMassesArgs& args) {
   options.samples = args.samples;
   options.digits = args.digits;
   options.parameter = args.parameter;
-  check_spread_masses_options(options);
+  check_spread_masses_options(options);  // the library's check, before the model file is read
   const ModelSource source = read_model_source(args.model);
   const auto description = load_description(source, parse_parameter_sets(args.sets));
 
