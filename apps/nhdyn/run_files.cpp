@@ -139,6 +139,13 @@ void RunFiles::write_now(const fs::path& path, const std::string& text) {
   file.commit();
 }
 
+fs::path RunFiles::write_scratch(const std::string& name, const std::string& text) {
+  const fs::path path = fs::temp_directory_path() / name;
+  scratch_.emplace_back(path, register_temporary_file(path));  // first: a signal while writing removes it too
+  write_now(path, text);
+  return path;
+}
+
 void RunFiles::commit() {
   if (!staging_.empty()) {
     std::error_code ec;
@@ -164,6 +171,12 @@ void RunFiles::discard() {
     fs::remove_all(staging_, ec);
     staging_.clear();
   }
+  for (const auto& [path, slot] : scratch_) {
+    std::error_code ec;
+    fs::remove(path, ec);
+    release_temporary_file(slot);
+  }
+  scratch_.clear();
 }
 
 void check_plot_columns(const std::string& plot, const std::vector<std::string>& columns,

@@ -27,6 +27,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "nhdyn/io/atomic_file.hpp"
@@ -86,6 +87,10 @@ class RunFiles {
   // Writes `text` to `path` (a listed output) whole and at once, whatever happens to the rest:
   // the .partial.csv of a failed run.
   void write_now(const std::filesystem::path& path, const std::string& text);
+  // A file of the run's own, not an output (the data sweep's plot is drawn from): `text` written
+  // to `name` in the temporary directory, removed when the RunFiles goes and by the handler of an
+  // interrupted run. Returns its path.
+  std::filesystem::path write_scratch(const std::string& name, const std::string& text);
 
   // The run succeeded: the staged files moved into their folder, then every opened file renamed
   // into place in the order opened; the plots' and pages' probes are released so that their
@@ -116,6 +121,7 @@ class RunFiles {
   std::vector<std::function<void()>> commits_;  // in the order opened
   std::vector<std::unique_ptr<AtomicFile>> probes_;
   std::filesystem::path staging_, staging_target_;
+  std::vector<std::pair<std::filesystem::path, int>> scratch_;  // path, slot in the table of temporaries
 };
 
 // --plot-columns: refused without --plot (InputError saying to give both), and each name checked

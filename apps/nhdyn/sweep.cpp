@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <system_error>
 #include <memory>
 #include <string>
 #include <utility>
@@ -94,37 +93,30 @@ void write_sweep_tables(const Sweep& sweep, const Model& base, const ModelSource
 
 // --plot: the real parts and the |imaginary parts| each sorted at every value: the k-th largest of
 // continuous functions is continuous, so the curves have no jumps where the CSV's order (by real
-// part) swaps the imaginary parts. Its data go to a temporary file.
-void plot_sweep(const Sweep& sweep, const Model& base, const SweepArgs& args) {
-  namespace fs = std::filesystem;
+// part) swaps the imaginary parts. Its data go to a scratch file of the run's (run_files.hpp).
+void plot_sweep(const Sweep& sweep, const Model& base, const SweepArgs& args, RunFiles& files) {
   const std::size_t k = sweep.state.size();
-  const fs::path data = fs::temp_directory_path() /
-                        fmt::format(".nhdyn-sweep-{}-{}.csv", ::getpid(), fs::path(args.plot).stem().string());
-  {
-    std::string plot_text = args.param;
-    for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",re_{}", i);
-    for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",absim_{}", i);
-    plot_text += "\n";
-    for (const SweepPoint& p : sweep.points) {
-      std::vector<double> re, im;
-      for (const std::complex<double>& e : p.eigenvalues) {
-        re.push_back(e.real());
-        im.push_back(std::abs(e.imag()));
-      }
-      std::sort(re.rbegin(), re.rend());
-      std::sort(im.rbegin(), im.rend());
-      plot_text += fmt::format("{:.17g}", p.value);
-      for (double x : re) plot_text += fmt::format(",{:.17g}", x);
-      for (double x : im) plot_text += fmt::format(",{:.17g}", x);
-      plot_text += "\n";
+  std::string plot_text = args.param;
+  for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",re_{}", i);
+  for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",absim_{}", i);
+  plot_text += "\n";
+  for (const SweepPoint& p : sweep.points) {
+    std::vector<double> re, im;
+    for (const std::complex<double>& e : p.eigenvalues) {
+      re.push_back(e.real());
+      im.push_back(std::abs(e.imag()));
     }
-    AtomicFile plot_data(data);
-    plot_data.write(plot_text);
-    plot_data.commit();
+    std::sort(re.rbegin(), re.rend());
+    std::sort(im.rbegin(), im.rend());
+    plot_text += fmt::format("{:.17g}", p.value);
+    for (double x : re) plot_text += fmt::format(",{:.17g}", x);
+    for (double x : im) plot_text += fmt::format(",{:.17g}", x);
+    plot_text += "\n";
   }
   XyPlotRequest request;
   request.title = fmt::format("{}: eigenvalues of the linearization against {}", base.name, args.param);
-  request.csv = data;
+  request.csv = files.write_scratch(
+      fmt::format(".nhdyn-sweep-{}-{}.csv", ::getpid(), std::filesystem::path(args.plot).stem().string()), plot_text);
   request.x = args.param;
   for (std::size_t i = 1; i <= k; ++i) {
     request.y.push_back(fmt::format("re_{}", i));
@@ -138,15 +130,7 @@ void plot_sweep(const Sweep& sweep, const Model& base, const SweepArgs& args) {
   request.y_label = "eigenvalues [1/s]: real parts and |imaginary parts|";
   request.log_x = false;
   request.log_y = false;
-  try {
-    write_xy_plot(request, args.plot);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(data, ignored);
-    throw;
-  }
-  std::error_code ignored;
-  fs::remove(data, ignored);
+  write_xy_plot(request, args.plot);
 }
 
 // The summary on standard output: the range, each crossing, and where the files went.
@@ -220,7 +204,7 @@ int run_sweep(const SweepArgs& args) {
   write_sweep_tables(sweep, base, source, args, table, crossings_file);
   files.commit();
 
-  if (!args.plot.empty()) plot_sweep(sweep, base, args);
+  if (!args.plot.empty()) plot_sweep(sweep, base, args, files);
   if (!args.quiet) print_sweep(sweep, base, args, table_path, crossings_path);
   return 0;
 }
