@@ -51,13 +51,13 @@ py::array_t<double> stack(const std::vector<BatchResult>& results, std::size_t r
                                      static_cast<py::ssize_t>(width)});
 }
 
-// threads=: a non-negative int (not a bool, a float or a string), at most what a C int holds.
+// threads=: an int (not a bool, a float or a string), brought within what a C int holds.
 int thread_count(const py::object& value) {
   if (!py::isinstance<py::int_>(value) || py::isinstance<py::bool_>(value))
     throw InputError(fmt::format("threads = {}: give a whole number (0: every core)", std::string(py::repr(value))));
   const auto big = value.cast<py::int_>();
-  if (big < py::int_(0)) throw InputError(fmt::format("threads = {}: give 0 (every core) or a positive number",
-                                                       std::string(py::str(value))));
+  // A negative count is refused by simulate_batch (check_batch_threads), in the library's words.
+  if (big < py::int_(0)) return big < py::int_(-(1 << 20)) ? -(1 << 20) : big.cast<int>();
   if (big > py::int_(1 << 20)) return 1 << 20;  // capped by batch_threads anyway
   return big.cast<int>();
 }
@@ -72,6 +72,7 @@ void bind_batch(py::module_& m) {
       [](const std::vector<ModelPtr>& models, const py::object& q0, const py::object& v0, const py::object& threads_arg,
          bool keep_trajectories, const py::kwargs& kwargs) {
         const int threads = thread_count(threads_arg);
+        check_batch_threads(threads);  // before any work, in the library's words
         if (models.empty()) throw InputError("simulate_batch: no runs (give at least one parameter value or initial state)");
         const int n = models.front()->n();
         for (const ModelPtr& model : models)

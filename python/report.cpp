@@ -43,7 +43,9 @@ void bind_report(py::module_& m) {
         if (rows.ndim() != 2 || rows.shape(1) != static_cast<py::ssize_t>(names.size()))
           throw InputError(fmt::format("report: expected rows x {} values, got {} dimensions", names.size(),
                                        rows.ndim()));
-        if (max_frames < 2) throw InputError(fmt::format("max_frames={}: give at least 2", max_frames));
+        ReportOptions options;
+        options.max_frames = max_frames;
+        check_report_options(options);  // before the model is loaded, in the library's words
         const LoadedModel loaded = load_model_described(source, to_overrides(overrides));
         CsvTable table;
         table.header = names;
@@ -51,8 +53,6 @@ void bind_report(py::module_& m) {
         table.rows.resize(static_cast<std::size_t>(rows.shape(0)));
         for (py::ssize_t i = 0; i < rows.shape(0); ++i)
           table.rows[static_cast<std::size_t>(i)].assign(rows.data(i, 0), rows.data(i, 0) + rows.shape(1));
-        ReportOptions options;
-        options.max_frames = max_frames;
         py::gil_scoped_release release;
         return write_model_report(loaded.model, loaded.description.get(), table, title, extra, path, options);
       },

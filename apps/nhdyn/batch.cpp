@@ -5,14 +5,11 @@
 // a velocity. Runs that fail are reported in the summary; the others are kept (exit 1 if any failed).
 #include <fmt/format.h>
 #include <signal.h>
-#include <stdlib.h>
 #include <unistd.h>
 
 #include <atomic>
-#include <cerrno>
 #include <cmath>
 #include <csignal>
-#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -21,6 +18,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "run_files.hpp"
 #include "run_overrides.hpp"
 #include "nhdyn/analysis/batch.hpp"
 #include "nhdyn/analysis/run_options.hpp"
@@ -31,7 +29,6 @@
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/results.hpp"
-#include "nhdyn/io/run_paths.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
 
 namespace nhdyn::cli {
@@ -247,23 +244,6 @@ const char* signal_name(int sig) {
   }
 }
 
-// A directory inside the output directory where the run files are written while the batch runs;
-// moved into place at the end, removed whole on failure or interruption.
-struct StagingDirectory {
-  std::filesystem::path path;
-  explicit StagingDirectory(const std::filesystem::path& dir) {
-    std::string pattern = (dir / ".nhdyn-batch-XXXXXX").string();
-    if (::mkdtemp(pattern.data()) == nullptr)
-      throw FileError(fmt::format("-o {}: cannot create a working directory there ({}); check its permissions",
-                                  dir.string(), std::strerror(errno)));
-    path = pattern;
-  }
-  ~StagingDirectory() {
-    std::error_code ec;
-    std::filesystem::remove_all(path, ec);
-  }
-};
-
 std::string summary_line(std::size_t r, const std::vector<double>& values, const BatchResult& res, const Model& base) {
   std::string line = std::to_string(r);
   for (double value : values) line += fmt::format(",{}", value);
@@ -320,47 +300,25 @@ std::vector<BatchRun> make_runs(const BatchArgs& args, const ModelSource& source
 }
 
 // Every input (the model file, the --runs table) checked against every output the batch may write
-// (summary.csv, run_N.csv), by name, link or inode, before any run (io/run_paths.hpp).
-void check_batch_paths(const BatchArgs& args, const std::filesystem::path& dir, std::size_t runs, int digits) {
-  namespace fs = std::filesystem;
-  RunPaths paths;
-  if (fs::is_regular_file(args.model)) paths.input(args.model, "the model file");
-  if (!args.runs_csv.empty()) paths.input(args.runs_csv, "--runs");
-  paths.output(dir / "summary.csv", "the summary");
-  paths.check();
-  if (!args.write_runs) return;
-  for (std::size_t r = 0; r < runs; ++r) {
-    const fs::path run = dir / fmt::format("run_{:0{}}.csv", r, digits);
-    for (const std::string& input : {args.model, args.runs_csv}) {
-      if (input.empty() || !fs::exists(input)) continue;
-      std::error_code ec;
-      if (fs::equivalent(input, run, ec) ||
-          (!fs::exists(run) && fs::weakly_canonical(fs::absolute(input)) == fs::weakly_canonical(fs::absolute(run))))
-        throw FileError(fmt::format("refusing to write '{}' (--write-runs): it is '{}', an input of this run; give "
-                                    "another output directory with -o",
-                                    run.string(), input));
-    }
-  }
+// (summary.csv, run_N.csv), by name, link or inode, before any run (run_files.hpp); the output
+// folder made, and the summary opened in it.
+AtomicFile& open_batch_files(RunFiles& files, const BatchArgs& args, const std::filesystem::path& dir,
+                             std::size_t runs, int digits) {
+  files.input(args.runs_csv, "--runs");
+  files.output(dir / "summary.csv", "the summary", Folder::make);
+  if (args.write_runs)
+    files.numbered_outputs(runs, [dir, digits](std::size_t r) { return dir / fmt::format("run_{:0{}}.csv", r, digits); },
+                           "--write-runs");
+  files.check();
+  return files.open(dir / "summary.csv");  // checks the directory is writable before any run
 }
 
-// --threads: 0 is every core; more than the machine runs is capped, with a note.
-void check_batch_threads(int threads) {
-  if (threads < 0) throw InputError(fmt::format("--threads {}: give 0 (every core) or a positive number", threads));
+// --threads: 0 is every core (checked by the library); more than the machine runs is capped, with a note.
+void note_batch_threads(int threads) {
+  check_batch_threads(threads);
   if (threads > max_batch_threads())
     fmt::print(stderr, "nhdyn: note: --threads {}: this machine has {} cores; using at most {} threads\n", threads,
                std::max(1U, std::thread::hardware_concurrency()), max_batch_threads());
-}
-
-// --set NAME=VALUE, each given to every run.
-ParameterOverrides batch_overrides(const std::vector<std::string>& sets) {
-  ParameterOverrides overrides;
-  for (const std::string& set : sets) {
-    const std::size_t eq = set.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw InputError(fmt::format("--set '{}': write it as NAME=VALUE, e.g. --set a=0.3", set));
-    overrides.emplace_back(set.substr(0, eq), set.substr(eq + 1));
-  }
-  return overrides;
 }
 
 // The summary's provenance and column names: the run, its varied names, its outcome, its final
@@ -375,21 +333,36 @@ std::string summary_header(const std::string& provenance, const std::vector<std:
   return header;
 }
 
-// The run files, staged while the runs ended, moved into the output directory.
-void move_run_files(const std::filesystem::path& staged, const std::filesystem::path& dir) {
-  std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(staged)) {
-    std::filesystem::rename(entry.path(), dir / entry.path().filename(), ec);
-    if (ec)
-      throw FileError(fmt::format("cannot move {} into {}: {}", entry.path().string(), dir.string(), ec.message()));
+// The options of every run: the model's, the command line's overrides, the file's [[events]];
+// checked whole before any file is made.
+BatchOptions make_batch_options(const Model& base, const BatchArgs& args) {
+  BatchOptions options;
+  options.simulation = make_simulation_options(run_options_with(base, args));
+  options.simulation.events = base.events;  // the file's [[events]], as simulate and Python's batch honour them
+  options.threads = args.threads;
+  options.keep_trajectories = args.write_runs;
+  check_simulation_options(base, options.simulation);
+  return options;
+}
+
+// summary.csv: its provenance and header, then one line per run. Returns how many runs failed.
+long write_summary(AtomicFile& summary, const std::string& provenance, const std::vector<std::string>& names,
+                   const std::vector<std::vector<double>>& table, const std::vector<BatchResult>& results,
+                   const Model& base) {
+  summary.write(summary_header(provenance, names, base));
+  long failed = 0;
+  for (std::size_t r = 0; r < results.size(); ++r) {
+    failed += results[r].ok ? 0 : 1;
+    summary.write(summary_line(r, table[r], results[r], base));
   }
+  return failed;
 }
 
 // An interrupted batch writes nothing: the staged run files and the summary's temporary go, and
 // the process ends as the signal would have ended it.
-[[noreturn]] void exit_interrupted(int sig, std::optional<StagingDirectory>& staging) {
-  staging.reset();
-  remove_temporary_files();  // the summary's temporary (_exit runs no destructor)
+[[noreturn]] void exit_interrupted(int sig, RunFiles& files) {
+  files.discard();           // the staged run files and the summary's temporary (_exit runs no destructor)
+  remove_temporary_files();  // and any other file under way
   fmt::print(stderr, "\nnhdyn: batch interrupted by {}; nothing was written (no summary, no run files)\n",
              signal_name(sig));
   std::signal(sig, SIG_DFL);
@@ -399,33 +372,26 @@ void move_run_files(const std::filesystem::path& staged, const std::filesystem::
 int run_batch(const BatchArgs& args) {
   if (args.grids.empty() == args.runs_csv.empty())
     throw InputError("give the runs either as --grid NAME=FROM:TO:COUNT (repeatable) or as --runs FILE.csv");
-  check_batch_threads(args.threads);
-  const ParameterOverrides overrides = batch_overrides(args.sets);
+  note_batch_threads(args.threads);
+  RunFiles files(args.model);
+  const ParameterOverrides overrides = parse_parameter_sets(args.sets);  // each given to every run
   const ModelSource source = read_model_source(args.model);
   const Model base = load_model(source, overrides);
   std::vector<std::string> names;
   std::vector<std::vector<double>> table;
   make_run_table(args, names, table);
 
-  const RunOptions run = run_options_with(base, args);
-  BatchOptions options;
-  options.simulation = make_simulation_options(run);
-  options.simulation.events = base.events;  // the file's [[events]], as simulate and Python's batch honour them
-  options.threads = args.threads;
-  options.keep_trajectories = args.write_runs;
-  check_simulation_options(base, options.simulation);
+  BatchOptions options = make_batch_options(base, args);
 
   namespace fs = std::filesystem;
   const fs::path dir(args.output);
   const int digits = static_cast<int>(std::to_string(std::max<std::size_t>(table.size(), 1) - 1).size());
-  check_batch_paths(args, dir, table.size(), digits);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir))
-    throw FileError(fmt::format("-o {}: cannot create the output directory ({}); give another with -o", args.output,
-                                ec ? ec.message() : "not a directory"));
-  AtomicFile summary(dir / "summary.csv");  // checks the directory is writable before any run
+  // From the first file made in the output folder on, a signal ends the batch through its own
+  // handlers (every signal of kBatchSignals, all files removed, "nothing was written").
+  install_batch_signal_handlers();
+  AtomicFile& summary = open_batch_files(files, args, dir, table.size(), digits);
   const std::vector<BatchRun> runs = make_runs(args, source, overrides, base, names, table);
+  if (const int sig = batch_signal.load()) exit_interrupted(sig, files);
   // Every file says what made it (io/provenance.hpp): the summary the batch's model and options
   // and its table of runs; each run's file that run's parameters and initial state, as simulate's.
   const auto batch_provenance = [&](const Model& model) {
@@ -447,29 +413,21 @@ int run_batch(const BatchArgs& args) {
 
   // Each run's file is written as soon as the run ends (not kept in memory), into a staging
   // directory; the files are moved into place when every run has ended and been written.
-  std::optional<StagingDirectory> staging;
   if (args.write_runs) {
-    staging.emplace(dir);
-    options.on_result = [&](std::size_t r, BatchResult& result) {
+    const fs::path staging = files.staging_folder(dir, "-o");
+    options.on_result = [&, staging](std::size_t r, BatchResult& result) {
       if (result.trajectory.rows() > 0)
-        write_run_file(staging->path / fmt::format("run_{:0{}}.csv", r, digits), *runs[r].model, result.trajectory,
+        write_run_file(staging / fmt::format("run_{:0{}}.csv", r, digits), *runs[r].model, result.trajectory,
                        run_provenance(r));
       result.trajectory = Trajectory{};
     };
   }
-  install_batch_signal_handlers();
   options.keep_going = [] { return batch_signal.load() == 0; };
   const std::vector<BatchResult> results = simulate_batch(runs, options);
-  if (const int sig = batch_signal.load()) exit_interrupted(sig, staging);
+  if (const int sig = batch_signal.load()) exit_interrupted(sig, files);
 
-  summary.write(summary_header(summary_provenance, names, base));
-  long failed = 0;
-  for (std::size_t r = 0; r < results.size(); ++r) {
-    failed += results[r].ok ? 0 : 1;
-    summary.write(summary_line(r, table[r], results[r], base));
-  }
-  if (staging) move_run_files(staging->path, dir);
-  summary.commit();
+  const long failed = write_summary(summary, summary_provenance, names, table, results, base);
+  files.commit();  // the run files moved into place, then the summary
   print_batch_outcome(args, base, results, failed, dir);
   return failed > 0 ? 1 : 0;
 }

@@ -5,9 +5,9 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "output_guard.hpp"
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/frontend/describe.hpp"
+#include "run_files.hpp"
 
 namespace nhdyn::cli {
 
@@ -25,12 +25,13 @@ std::function<int()> add_codegen_command(CLI::App& app) {
   cmd->add_option("--namespace", args->namespace_name, "C++ namespace of the generated code")->capture_default_str();
   cmd->add_option("--set", args->sets, "Set a parameter, NAME=EXPR: a number or an expression in numbers, pi, e and the other parameters (repeatable)");
   return [args] {
-    protect_model_file(args->model);
-    check_command_paths(args->model, {{args->output, "-o"}});
-    AtomicFile file(args->output);  // refuses an unwritable path before deriving
+    RunFiles files(args->model);
+    files.output(args->output, "-o");
+    files.check();
+    AtomicFile& file = files.open(args->output);  // refuses an unwritable path before deriving
     const auto description = load_description(read_model_source(args->model), parse_parameter_sets(args->sets));
     file.write(generate_model_code(*description, args->namespace_name));
-    file.commit();
+    files.commit();
     fmt::print("nhdyn codegen {}: wrote {} (make_{}_model())\n", description_name(*description), args->output,
                model_code_identifier(*description));
     return 0;

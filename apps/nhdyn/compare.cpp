@@ -11,7 +11,6 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "output_guard.hpp"
 #include "nhdyn/analysis/comparison.hpp"
 #include "nhdyn/analysis/exact_solution.hpp"
 #include "nhdyn/core/error.hpp"
@@ -22,6 +21,7 @@
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
+#include "run_files.hpp"
 
 namespace nhdyn::cli {
 namespace {
@@ -223,7 +223,7 @@ void print_comparison(const CompareArgs& args, const Model& model, const Compari
 }
 
 int run_compare(const CompareArgs& args) {
-  protect_model_file(args.model);
+  RunFiles files(args.model);
   const ModelSource source = read_model_source(args.model);
   const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
   std::string notice;
@@ -238,16 +238,18 @@ int run_compare(const CompareArgs& args) {
 
   namespace fs = std::filesystem;
   const fs::path table_path = args.output.empty() ? fs::path("results") / (make_file_name(model.name) + "-compare.csv") : fs::path(args.output);
-  if (args.output.empty()) make_parent_directory(table_path);
   fs::path series_path = table_path;
   series_path.replace_filename(table_path.stem().string() + "-series.csv");
-  check_command_paths(args.model, {{table_path, "the table CSV"}, {series_path, "the series CSV"}, {args.plot, "--plot"}});
-  check_plot_possible(args.plot);
-  AtomicFile table(table_path);  // both paths are checked before any run
+  files.output(table_path, "the table CSV", args.output.empty() ? Folder::make : Folder::must_exist);
+  files.output(series_path, "the series CSV");
+  files.plot(args.plot);
+  files.check();
   const std::vector<std::string> columns = series_columns(model, options);
   check_plot_columns(args.plot, columns, args.plot_columns);
   const std::string provenance = compare_provenance(model, source, args, methods, options);
-  CsvWriter series(series_path, columns, provenance);
+  // Both opened (so both paths proved writable) before any run; they appear only on commit.
+  CsvWriter& series = files.open_csv(series_path, columns, provenance);
+  AtomicFile& table = files.open(table_path);
 
   warn_stop_events(model, options.run.t_end);
   const Comparison result = compare_formulations(model, options);
@@ -257,8 +259,7 @@ int run_compare(const CompareArgs& args) {
       fmt::print(stderr, "nhdyn: warning ({}, {}): {}\n", formulation_name(r.which.method), integrator_name(r.which.integrator), w);
   table.write(format_table(provenance, result));
   write_series(series, model, result);
-  series.commit();
-  table.commit();
+  files.commit();  // a case that failed is a row of the table: the files are kept, and the exit code says it
   if (!args.plot.empty()) plot_comparison(args, model, options, series_path);
   if (!args.quiet) print_comparison(args, model, options, result, table_path, series_path);
   for (const ComparisonResult& r : result.results)

@@ -14,8 +14,8 @@
 
 #include "commands.hpp"
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/symbolic/chain.hpp"
+#include "run_files.hpp"
 
 namespace nhdyn::cli {
 namespace {
@@ -172,9 +172,11 @@ std::function<int()> add_example_command(CLI::App& app) {
       fmt::print("{}", text);
       return 0;
     }
-    AtomicFile file(args->output);
-    file.write(text);
-    file.commit();
+    RunFiles files("");  // no input: the example is written from its parameters
+    files.output(args->output, "-o");
+    files.check();
+    files.open(args->output).write(text);
+    files.commit();
     return 0;
   };
 }

@@ -9,13 +9,13 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "output_guard.hpp"
 #include "nhdyn/analysis/linearization.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/atomic_file.hpp"
+#include "run_files.hpp"
 
 namespace nhdyn::cli {
 namespace {
@@ -35,11 +35,13 @@ std::string join_names(const std::vector<std::string>& names) {
 }
 
 int run_linearize(const LinearizeArgs& args) {
-  protect_model_file(args.model);
-  check_command_paths(args.model, {{args.output, "-o"}});
+  RunFiles files(args.model);
   const ModelSource source = read_model_source(args.model);
   const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
   const Model& model = resolved.model;
+  files.output(args.output, "-o", Folder::make);
+  files.check();
+  AtomicFile* file = args.output.empty() ? nullptr : &files.open(args.output);  // writable: checked before any work
   LinearizationOptions options;
   options.cyclic = args.cyclic;
   options.independent = args.independent;
@@ -47,9 +49,7 @@ int run_linearize(const LinearizeArgs& args) {
   options.steady_tolerance = args.tolerance;
   const Linearization l = calc_linearization(model, options);
 
-  if (!args.output.empty()) {
-    make_parent_directory(args.output);
-    AtomicFile file(args.output);
+  if (file) {
     std::vector<std::pair<std::string, std::string>> given;
     if (!args.cyclic.empty()) given.emplace_back("cyclic", join(args.cyclic, ","));
     if (!args.independent.empty()) given.emplace_back("independent", join(args.independent, ","));
@@ -59,8 +59,8 @@ int run_linearize(const LinearizeArgs& args) {
     text += "index,real,imag\n";
     for (std::size_t i = 0; i < l.eigenvalues.size(); ++i)
       text += fmt::format("{},{:.17g},{:.17g}\n", i + 1, l.eigenvalues[i].real(), l.eigenvalues[i].imag());
-    file.write(text);
-    file.commit();
+    file->write(text);
+    files.commit();
   }
 
   fmt::print("nhdyn linearize {}: about the steady motion at t0 = {:g}\n", model.name, model.t0);

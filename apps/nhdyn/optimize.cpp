@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "output_guard.hpp"
 #include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/frontend/load_model.hpp"
@@ -22,10 +21,10 @@
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/io/report.hpp"
 #include "nhdyn/io/results.hpp"
-#include "nhdyn/io/run_paths.hpp"
 #include "nhdyn/model/output.hpp"
 #include "nhdyn/model/terms.hpp"
 #include "nhdyn/optimize/solve.hpp"
+#include "run_files.hpp"
 
 namespace nhdyn::cli {
 namespace {
@@ -135,33 +134,44 @@ CsvTable optimum_table(const OptimalControlProblem& problem, const OptimizeResul
   return table;
 }
 
+// The report of the optimal motion (--html), from the optimum's points in a simulation's columns.
+std::string write_optimum_report(const OptimizeArgs& args, const LoadedModel& loaded,
+                                 const OptimalControlProblem& problem, const OptimizeResult& result) {
+  ReportOptions report_options;
+  for (const OptimizeControl& c : problem.controls) report_options.controls.push_back("u_" + c.name);
+  return write_model_report(
+      problem.model, loaded.description.get(), optimum_table(problem, result),
+      fmt::format("{}: optimal program, {} nodes, {}", problem.model.name, problem.nodes,
+                  collocation_method_name(problem.method)),
+      {{"status", fmt::format("{} ({})", nlp_status_name(result.solver.status), result.solver.message)},
+       {"iterations", fmt::format("{}", result.solver.iterations)},
+       {"objective", fmt::format("{:.10g}", result.objective)},
+       {"replay difference", result.replayed ? fmt::format("{:.3e}", result.replay_difference) : "none"},
+       {"results", args.output}},
+      args.html, report_options);
+}
+
 int run_optimize(const OptimizeArgs& args) {
-  protect_model_file(args.model);
+  RunFiles files(args.model);
   const ModelSource source = read_model_source(args.model);
   const LoadedModel loaded = load_model_described(source, parse_parameter_sets(args.sets));
   if (!args.html.empty() && args.output.empty())
     throw InputError("--html reports the CSV of -o: give -o FILE.csv too");
-  {
-    // Every file of the command, checked together before the solve (io/run_paths.hpp).
-    RunPaths paths;
-    if (fs::is_regular_file(args.model)) paths.input(args.model, "the model file");
-    if (!args.output.empty()) {
-      paths.output(args.output, "-o");
-      paths.output(partial_path(args.output), "the partial-results file");
-    }
-    if (!args.plot.empty()) paths.output(args.plot, "--plot");
-    if (!args.html.empty()) paths.output(args.html, "--html");
-    paths.check();
-  }
+  if (!args.plot.empty() && args.output.empty()) throw InputError("--plot draws the CSV of -o: give -o FILE.csv too");
+  // Every file of the command, checked together before the solve (run_files.hpp); their folders
+  // are made, and -o opened, so that an unwritable path never costs a solve.
+  files.output(args.output, "-o", Folder::make);
+  if (!args.output.empty()) files.output(partial_path(args.output), "the partial-results file", Folder::make);
+  files.plot(args.plot, "--plot", Folder::make);
+  files.page(args.html, "--html", Folder::make);
+  files.check();
+  AtomicFile* csv = args.output.empty() ? nullptr : &files.open(args.output);
   const OptimalControlProblem problem = load_optimal_control_problem(source, loaded);
   OptimizeOptions options;
   options.nlp.tolerance = args.tolerance;
   options.nlp.constraint_tolerance = args.tolerance;
   options.nlp.max_iterations = args.max_iterations;
   options.guess = args.guess;
-  if (!args.output.empty()) make_parent_directory(args.output);
-  if (!args.plot.empty()) make_parent_directory(args.plot);
-  if (!args.html.empty()) make_parent_directory(args.html);
   const OptimizeResult result = solve_optimal_control(problem, options);
   // A build without IPOPT: bad input is still reported as such (the transcription checks it
   // before the solver is called), then the command says how to get IPOPT.
@@ -169,43 +179,27 @@ int run_optimize(const OptimizeArgs& args) {
   fmt::print("{}", format_optimize_summary(problem, result));
   const std::string table = format_table(optimize_columns(problem), optimize_rows(problem, result));
   if (!result.converged()) {
-    if (!args.output.empty()) {
-      const fs::path partial = partial_path(args.output);
-      AtomicFile file(partial);
-      file.write(fmt::format("# nhdyn optimize: IPOPT stopped ({}: {}); the last iterate\n",
-                             nlp_status_name(result.solver.status), result.solver.message) +
-                 table);
-      file.commit();
-      fmt::print("last iterate -> {}\n", partial.string());
+    if (csv) {
+      // -o is left as it was; the last iterate goes beside it.
+      files.write_now(partial_path(args.output),
+                      fmt::format("# nhdyn optimize: IPOPT stopped ({}: {}); the last iterate\n",
+                                  nlp_status_name(result.solver.status), result.solver.message) +
+                          table);
+      fmt::print("last iterate -> {}\n", partial_path(args.output).string());
     }
     fmt::print(stderr, "nhdyn: error: IPOPT did not converge: {} ({})\n", nlp_status_name(result.solver.status),
                result.solver.message);
     return 1;
   }
-  if (!args.output.empty()) {
-    AtomicFile file(args.output);
-    file.write(table);
-    file.commit();
-    fmt::print("results -> {}\n", args.output);
-  }
+  if (csv) csv->write(table);
+  files.commit();
+  if (csv) fmt::print("results -> {}\n", args.output);
   if (!args.plot.empty()) {
-    if (args.output.empty()) throw InputError("--plot draws the CSV of -o: give -o FILE.csv too");
     write_plot_of(problem, args.output, args.plot);
     fmt::print("plot -> {}\n", args.plot);
   }
   if (!args.html.empty()) {
-    ReportOptions report_options;
-    for (const OptimizeControl& c : problem.controls) report_options.controls.push_back("u_" + c.name);
-    const std::string notice = write_model_report(
-        problem.model, loaded.description.get(), optimum_table(problem, result),
-        fmt::format("{}: optimal program, {} nodes, {}", problem.model.name, problem.nodes,
-                    collocation_method_name(problem.method)),
-        {{"status", fmt::format("{} ({})", nlp_status_name(result.solver.status), result.solver.message)},
-         {"iterations", fmt::format("{}", result.solver.iterations)},
-         {"objective", fmt::format("{:.10g}", result.objective)},
-         {"replay difference", result.replayed ? fmt::format("{:.3e}", result.replay_difference) : "none"},
-         {"results", args.output}},
-        args.html, report_options);
+    const std::string notice = write_optimum_report(args, loaded, problem, result);
     fmt::print("report -> {}{}\n", args.html, notice.empty() ? "" : "\nnote: " + notice);
   }
   return 0;

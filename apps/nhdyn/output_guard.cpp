@@ -9,10 +9,7 @@
 #include <cstring>
 #include <system_error>
 
-#include "nhdyn/core/error.hpp"
 #include "nhdyn/io/atomic_file.hpp"
-#include "nhdyn/io/plot.hpp"
-#include "nhdyn/io/run_paths.hpp"
 
 namespace nhdyn::cli {
 namespace {
@@ -86,42 +83,6 @@ extern "C" void on_interrupt(int signal_number) {
 }
 
 }  // namespace
-
-void protect_model_file(const std::string& model) {
-  std::error_code ec;
-  if (std::filesystem::is_regular_file(model, ec)) protect_input(model);
-}
-
-void check_command_paths(const std::string& model,
-                         const std::vector<std::pair<std::filesystem::path, std::string>>& outputs) {
-  RunPaths paths;
-  std::error_code ec;
-  if (std::filesystem::is_regular_file(model, ec)) paths.input(model, "the model file");
-  for (const auto& [path, role] : outputs) paths.output(path, role);
-  paths.check();
-}
-
-void make_parent_directory(const std::filesystem::path& file) {
-  if (!file.has_parent_path()) return;
-  std::error_code ignored;
-  std::filesystem::create_directories(file.parent_path(), ignored);
-}
-
-void check_plot_possible(const std::string& plot) {
-  if (plot.empty()) return;
-  require_not_input(resolve_links(plot), plot);
-  if (!gnuplot_available())
-    throw FileError("--plot needs gnuplot, which is not installed: install it (apt-get install gnuplot-nox) "
-                    "or run without --plot");
-}
-
-void check_plot_columns(const std::string& plot, const std::vector<std::string>& columns,
-                        const std::vector<std::string>& chosen) {
-  if (chosen.empty()) return;
-  if (plot.empty())
-    throw InputError("--plot-columns chooses what --plot draws; give --plot FILE.png too, or leave --plot-columns out");
-  require_plot_columns(columns, chosen);
-}
 
 void install_interrupt_handlers() {
   struct sigaction action{};

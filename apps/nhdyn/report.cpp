@@ -14,10 +14,9 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/frontend/provenance.hpp"
-#include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/report.hpp"
-#include "nhdyn/io/run_paths.hpp"
+#include "run_files.hpp"
 
 namespace nhdyn::cli {
 
@@ -43,17 +42,15 @@ std::function<int()> add_report_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing");
   return [args] {
-    if (args->max_frames < 2)
-      throw InputError(fmt::format("--max-frames {}: give at least 2", args->max_frames));
-    {
-      // Every file of the run, checked together before any work (io/run_paths.hpp).
-      RunPaths paths;
-      paths.input(args->csv, "the result CSV");
-      if (std::filesystem::is_regular_file(args->model)) paths.input(args->model, "the model file");
-      paths.output(args->output, "-o");
-      paths.check();
-    }
-    std::optional<AtomicFile> probe(args->output);  // an unwritable path is refused before any work
+    ReportOptions options;
+    options.max_frames = args->max_frames;
+    check_report_options(options);  // before any work
+    // Every file of the run, checked together before any work (run_files.hpp); an unwritable -o is
+    // refused here.
+    RunFiles files(args->model);
+    files.input(args->csv, "the result CSV");
+    files.page(args->output, "-o");
+    files.check();
     const CsvTable table = load_csv(args->csv);
     // A CSV with its provenance (io/provenance.hpp) names its model's hash and its parameters as
     // run: the model must be that one, and the run's values are applied before any --set.
@@ -65,9 +62,7 @@ std::function<int()> add_report_command(CLI::App& app) {
     const LoadedModel resolved = load_model_described(source, overrides);
     check_report_columns(table.header, make_result_columns(resolved.model), args->csv, resolved.model.name);
     check_report_times(table, args->csv);  // finite and never decreasing
-    probe.reset();
-    ReportOptions options;
-    options.max_frames = args->max_frames;
+    files.commit();  // nothing of its own to commit: the report's writer writes it whole
     const std::string notice = write_model_report(resolved.model, resolved.description.get(), table,
                        fmt::format("{}: {}", resolved.model.name, args->csv), {{"results", args->csv}}, args->output,
                        options);

@@ -15,7 +15,6 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "output_guard.hpp"
 #include "nhdyn/analysis/run_options.hpp"
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
@@ -24,7 +23,6 @@
 #include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
-#include "nhdyn/io/run_paths.hpp"
 #include "nhdyn/io/report.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
@@ -32,6 +30,7 @@
 #include "nhdyn/model/initial_values.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "progress.hpp"
+#include "run_files.hpp"
 #include "run_overrides.hpp"
 
 namespace nhdyn::cli {
@@ -154,7 +153,6 @@ void write_events_file(AtomicFile& file, const Model& model, const SimulationSum
     text += '\n';
   }
   file.write(text);
-  file.commit();
 }
 
 // A device or pipe as the CSV (/dev/stdout) has no place beside it for companion files.
@@ -196,57 +194,46 @@ SimulationOptions make_run_options(const Model& model, const SimulateArgs& args)
   return options;
 }
 
-// A run's files: the CSV, its companions (FILE-events.csv, FILE.partial.csv), the plot and the
-// report. Opened (or probed) before the first step, committed after the last.
-struct RunFiles {
+// Where a run's rows go: the CSV and its companions (FILE-events.csv, FILE.partial.csv), with
+// the files of the run (run_files.hpp) that hold them until the run has succeeded.
+struct RunOutput {
   std::filesystem::path csv, events, partial;
   bool companions = false;  // the CSV is a regular file, with a place beside it
-  std::optional<AtomicFile> plot_probe, html_probe, events_file;
-  std::optional<CsvWriter> writer;
+  CsvWriter* writer = nullptr;
+  AtomicFile* events_file = nullptr;  // opened when the run has events or contact modes
   std::vector<double> kept;  // every row, for FILE.partial.csv if the run fails
 };
 
-// Every file of the run checked together (io/run_paths.hpp), then opened, before any work: a bad
-// path never costs a run.
-void open_run_files(RunFiles& files, const SimulateArgs& args, const Model& model, const SimulationOptions& options,
-                    const ResultColumns& columns, const std::string& provenance) {
+// Every file of the run listed and checked together (run_files.hpp), then opened, before any
+// work: a bad path never costs a run.
+RunOutput open_run_files(RunFiles& files, const SimulateArgs& args, const Model& model,
+                         const SimulationOptions& options, const ResultColumns& columns,
+                         const std::string& provenance) {
   namespace fs = std::filesystem;
   check_plot_columns(args.plot, columns.all, args.plot_columns);
+  RunOutput out;
   const bool default_csv = args.output.empty();
-  files.csv = default_csv ? fs::path("results") / (make_file_name(model.name) + ".csv") : fs::path(args.output);
-  files.events = companion(files.csv, "-events.csv");
-  files.partial = companion(files.csv, ".partial.csv");
-  files.companions = is_regular_target(files.csv);
+  out.csv = default_csv ? fs::path("results") / (make_file_name(model.name) + ".csv") : fs::path(args.output);
+  out.events = companion(out.csv, "-events.csv");
+  out.partial = companion(out.csv, ".partial.csv");
+  out.companions = is_regular_target(out.csv);
   // Contacts with modes write their switches in the events file too (docs/contact-modes.md).
-  const bool events_file = files.companions && (!options.events.empty() || model.contact_modes);
-  {
-    RunPaths paths;
-    if (fs::is_regular_file(args.model)) paths.input(args.model, "the model file");
-    paths.output(files.csv, "the CSV output");
-    if (events_file) paths.output(files.events, "the events file");
-    if (files.companions) paths.output(files.partial, "the partial-results file");
-    if (!args.plot.empty()) paths.output(args.plot, "--plot");
-    if (!args.html.empty()) paths.output(args.html, "--html");
-    paths.check();
-  }
-  check_plot_possible(args.plot);
-  if (!args.plot.empty()) files.plot_probe.emplace(args.plot);  // checks the plot's directory now; removed unused
-  if (default_csv) {
-    // The default place is ours to create; a path the user names must already be writable.
-    std::error_code ec;
-    fs::create_directories(files.csv.parent_path(), ec);
-    if (ec)
-      throw FileError(fmt::format("cannot create the directory '{}' for the results: {}; give another path with -o",
-                                  files.csv.parent_path().string(), ec.message()));
-  }
-  if (!args.html.empty()) files.html_probe.emplace(args.html);  // checks the report's directory now; removed unused
-  files.writer.emplace(files.csv, columns.all, provenance);  // refuses an unwritable path before any step
-  if (events_file) files.events_file.emplace(files.events);
+  const bool events_file = out.companions && (!options.events.empty() || model.contact_modes);
+  // The default place is ours to create; a path the user names must already be writable.
+  files.output(out.csv, "the CSV output", default_csv ? Folder::make : Folder::must_exist);
+  if (events_file) files.output(out.events, "the events file");
+  if (out.companions) files.output(out.partial, "the partial-results file");
+  files.plot(args.plot);
+  files.page(args.html, "--html");
+  files.check();
+  out.writer = &files.open_csv(out.csv, columns.all, provenance);  // refuses an unwritable path before any step
+  if (events_file) out.events_file = &files.open(out.events);
+  return out;
 }
 
 // Integrates, writing each row to the CSV (and keeping it for FILE.partial.csv) as it comes.
 SimulationSummary run_to_files(const Model& model, const SimulationOptions& options, const ResultColumns& columns,
-                               RunFiles& files) {
+                               RunOutput& files) {
   std::vector<double> row;
   row.reserve(columns.all.size());
   ProgressBar progress(model.t0, options.t_end);
@@ -262,23 +249,22 @@ SimulationSummary run_to_files(const Model& model, const SimulationOptions& opti
 
 // A failed run: the reason, and the rows up to the failure in FILE.partial.csv (the CSV itself is
 // never committed). Returns the exit code.
-int report_failure(const Model& model, const SimulationSummary& summary, const RunFiles& files,
+int report_failure(const Model& model, const SimulationSummary& summary, const RunOutput& out, RunFiles& files,
                    const ResultColumns& columns, const std::string& provenance) {
   fmt::print(stderr, "nhdyn: simulation of '{}' failed at t = {:.6g}: {}\n", model.name, summary.t_reached,
              summary.message);
-  if (!files.companions) {
-    fmt::print(stderr, "nhdyn: no results written ({} is left as it was)\n", files.csv.string());
+  if (!out.companions) {
+    fmt::print(stderr, "nhdyn: no results written ({} is left as it was)\n", out.csv.string());
     return 1;
   }
   std::string reason = fmt::format("# nhdyn: simulation of '{}' failed at t = {:.6g}: {}", model.name,
                                    summary.t_reached, summary.message);
   for (char& c : reason)
     if (c == '\n' || c == '\r') c = ' ';
-  AtomicFile partial(files.partial);
-  partial.write(reason + "\n" + provenance + csv_line(columns.all) + format_rows(files.kept, columns.all.size()));
-  partial.commit();
+  files.write_now(out.partial,
+                  reason + "\n" + provenance + csv_line(columns.all) + format_rows(out.kept, columns.all.size()));
   fmt::print(stderr, "nhdyn: the {} rows up to the failure are in {} ({} is left as it was)\n", summary.outputs,
-             files.partial.string(), files.csv.string());
+             out.partial.string(), out.csv.string());
   return 1;
 }
 
@@ -341,24 +327,23 @@ void plot_run(const SimulateArgs& args, const LoadedModel& resolved, const Model
 // drawn from them. Returns the report's notice, if any.
 std::string commit_run(const SimulateArgs& args, const LoadedModel& resolved, const Model& model,
                        const SimulationOptions& options, const ResultColumns& columns,
-                       const SimulationSummary& summary, const std::string& provenance, RunFiles& files) {
-  files.writer->commit();
-  if (files.events_file) write_events_file(*files.events_file, model, summary, provenance);
-  files.plot_probe.reset();
-  if (!args.plot.empty()) plot_run(args, resolved, model, options, columns, summary, files.csv);
-  files.html_probe.reset();
+                       const SimulationSummary& summary, const std::string& provenance, const RunOutput& out,
+                       RunFiles& files) {
+  if (out.events_file) write_events_file(*out.events_file, model, summary, provenance);
+  files.commit();
+  if (!args.plot.empty()) plot_run(args, resolved, model, options, columns, summary, out.csv);
   if (args.html.empty()) return {};
   return write_model_report(
-      model, resolved.description.get(), load_csv(files.csv), run_title(model, options),
+      model, resolved.description.get(), load_csv(out.csv), run_title(model, options),
       {{"steps", fmt::format("{} (rejected {})", summary.stats.steps, summary.stats.rejected_steps)},
        {"right-hand sides", fmt::format("{}", summary.stats.rhs_evaluations)},
-       {"results", files.csv.string()}},
+       {"results", out.csv.string()}},
       args.html);
 }
 
 // The summary on standard output: the run's choices, then each group's lines (analysis/simulation_summary.hpp).
 void print_summary(const SimulateArgs& args, const Model& model, const SimulationOptions& options,
-                   const SimulationSummary& summary, const RunFiles& files, const std::string& html_notice) {
+                   const SimulationSummary& summary, const RunOutput& files, const std::string& html_notice) {
   const bool adaptive = options.integrator.kind != IntegratorKind::rk4;
   fmt::print("nhdyn simulate {}: method {} ({}), integrator {}{}\n", model.name,
              formulation_name(options.formulation.method),
@@ -386,7 +371,7 @@ void print_summary(const SimulateArgs& args, const Model& model, const Simulatio
 }
 
 int run_simulate(const SimulateArgs& args) {
-  protect_model_file(args.model);
+  RunFiles files(args.model);
   const ModelSource source = read_model_source(args.model);
   const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
   const Model model = prepare_model(resolved, args);
@@ -394,15 +379,14 @@ int run_simulate(const SimulateArgs& args) {
   const ResultColumns columns = make_result_columns(model);
   // Every file of the run says where it came from (io/provenance.hpp).
   const std::string provenance = format_provenance(make_provenance(model, source, options, args.evaluator));
-  RunFiles files;
-  open_run_files(files, args, model, options, columns, provenance);
-  const SimulationSummary summary = run_to_files(model, options, columns, files);
+  RunOutput out = open_run_files(files, args, model, options, columns, provenance);
+  const SimulationSummary summary = run_to_files(model, options, columns, out);
   // The run's warnings (the constraint watch's, analysis/constraint_watch.hpp), whatever the outcome.
   for (const std::string& w : summary.warnings) fmt::print(stderr, "nhdyn: warning: {}\n", w);
   for (const std::string& w : summary.events.unmet_stops) fmt::print(stderr, "nhdyn: warning: {}\n", w);
-  if (summary.status != Status::ok) return report_failure(model, summary, files, columns, provenance);
-  const std::string html_notice = commit_run(args, resolved, model, options, columns, summary, provenance, files);
-  if (!args.quiet) print_summary(args, model, options, summary, files, html_notice);
+  if (summary.status != Status::ok) return report_failure(model, summary, out, files, columns, provenance);
+  const std::string html_notice = commit_run(args, resolved, model, options, columns, summary, provenance, out, files);
+  if (!args.quiet) print_summary(args, model, options, summary, out, html_notice);
   return 0;
 }
 

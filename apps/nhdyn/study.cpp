@@ -1,23 +1,14 @@
 // `nhdyn study NAME`: the command that holds the studies (study.hpp); each study is a subcommand
 // defined in its own file.
-#include <fmt/format.h>
 
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "commands.hpp"
-#include "nhdyn/core/error.hpp"
 #include "study.hpp"
 
 namespace nhdyn::cli {
-
-void check_study_times(const Model& model, const std::optional<double>& t_end, const std::optional<double>& output_step) {
-  if (t_end && !(*t_end > model.t0))
-    throw InputError(fmt::format("--t-end {} must be after the initial time {}", *t_end, model.t0));
-  if (output_step && !(*output_step > 0.0))
-    throw InputError(fmt::format("--output-step {} must be positive", *output_step));
-}
 
 std::filesystem::path by_tolerance_path(const std::filesystem::path& table) {
   std::filesystem::path series = table;

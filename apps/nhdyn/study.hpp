@@ -6,7 +6,6 @@
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <functional>
-#include <optional>
 
 #include "nhdyn/model/model.hpp"
 
@@ -21,9 +20,6 @@ std::function<int()> add_spread_masses_study(CLI::App& study);
 // tolerances and feedback gains (docs/studies/tracking.md).
 std::function<int()> add_tracking_study(CLI::App& study);
 
-// The run length the tolerance studies take: --t-end after the model's initial time and a
-// positive --output-step, when given; throws InputError naming the value.
-void check_study_times(const Model& model, const std::optional<double>& t_end, const std::optional<double>& output_step);
 // Where a tolerance study writes its series beside its table: TABLE.csv -> TABLE-by-tolerance.csv.
 std::filesystem::path by_tolerance_path(const std::filesystem::path& table);
 

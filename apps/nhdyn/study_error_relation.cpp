@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "output_guard.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/frontend/load_model.hpp"
@@ -20,7 +19,9 @@
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/io/xy_plot.hpp"
+#include "nhdyn/studies/run_times.hpp"
 #include "nhdyn/studies/error_relation.hpp"
+#include "run_files.hpp"
 #include "study.hpp"
 
 namespace nhdyn::cli {
@@ -149,7 +150,7 @@ std::string error_relation_provenance(const Model& model, const ModelSource& sou
 }
 
 int run_error_relation(const ErrorRelationArgs& args) {
-  protect_model_file(args.model);
+  RunFiles files(args.model);
   const ModelSource source = read_model_source(args.model);
   const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
   const Model& model = resolved.model;
@@ -161,15 +162,15 @@ int run_error_relation(const ErrorRelationArgs& args) {
   for (const std::string& i : args.integrators) options.integrators.push_back(parse_integrator(i));
   options.t_end = args.t_end.value_or(0.0);
   options.output_step = args.output_step.value_or(0.0);
-  check_study_times(model, args.t_end, args.output_step);
+  check_study_run_times(model, args.t_end, args.output_step);  // the library's check, before any file
 
   namespace fs = std::filesystem;
   const fs::path table_path = args.output;
   const fs::path series_path = by_tolerance_path(table_path);
-  check_command_paths(args.model,
-                      {{table_path, "the table CSV"}, {series_path, "the by-tolerance CSV"}, {args.plot, "--plot"}});
-  make_parent_directory(table_path);
-  check_plot_possible(args.plot);
+  files.output(table_path, "the table CSV", Folder::make);
+  files.output(series_path, "the by-tolerance CSV");
+  files.plot(args.plot);
+  files.check();
   if (options.formulations.empty()) options.formulations = calc_study_formulations(model);
   const bool pos = model.position_constraints() > 0;
   const bool vel = model.velocity_constraints() > 0;
@@ -181,15 +182,14 @@ int run_error_relation(const ErrorRelationArgs& args) {
       if (pos) columns.push_back("residual_pos_" + run_label(f, i));
     }
   // Both files are opened (and so checked writable) before the runs; they appear only on commit.
-  AtomicFile table(table_path);
   const std::string provenance = error_relation_provenance(model, source, options, args);
-  CsvWriter series(series_path, columns, provenance);
+  CsvWriter& series = files.open_csv(series_path, columns, provenance);
+  AtomicFile& table = files.open(table_path);
 
   const ErrorRelation study = study_error_relation(model, options);
   write_series(study, pos, vel, series);
   table.write(table_text(study, provenance, args.atol_factor));
-  series.commit();
-  table.commit();
+  files.commit();
 
   if (!args.plot.empty()) plot_error_relation(study, model, vel, series_path, args.plot);
   if (!args.quiet) print_error_relation(study, model, args, pos, vel, table_path, series_path);

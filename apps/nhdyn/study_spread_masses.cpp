@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "output_guard.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/frontend/describe.hpp"
@@ -21,6 +20,7 @@
 #include "nhdyn/io/plot.hpp"
 #include "nhdyn/io/xy_plot.hpp"
 #include "nhdyn/studies/spread_masses.hpp"
+#include "run_files.hpp"
 #include "study.hpp"
 
 namespace nhdyn::cli {
@@ -43,16 +43,6 @@ std::filesystem::path reactions_plot_path(const std::filesystem::path& plot) {
   std::filesystem::path out = plot;
   out.replace_filename(plot.stem().string() + "-reactions" + plot.extension().string());
   return out;
-}
-
-// The options' values, checked before the model file is read.
-void check_spread_masses_options(const SpreadMassesOptions& options) {
-  for (double ratio : options.ratios)
-    if (!(ratio > 0.0 && std::isfinite(ratio)))
-      throw InputError(fmt::format("--ratios: {} is not a positive number; give ratios such as 1,1e6,1e12", ratio));
-  if (options.samples < 1) throw InputError(fmt::format("--samples {}: give at least 1 state per ratio", options.samples));
-  if (options.digits < 20)
-    throw InputError(fmt::format("--digits {}: the reference needs 20 digits or more (default 50)", options.digits));
 }
 
 // One CSV row per ratio: the ratio, cond(A), the reference's error, then each formulation's errors.
@@ -135,24 +125,23 @@ void print_spread_masses(const SpreadMasses& study, const std::filesystem::path&
 }
 
 int run_spread_masses(const SpreadMassesArgs& args) {
-  protect_model_file(args.model);
+  RunFiles files(args.model);
   // Options first, so that a bad value is reported before the model file is read.
   SpreadMassesOptions options;
   options.ratios = args.ratios;
   options.samples = args.samples;
   options.digits = args.digits;
   options.parameter = args.parameter;
-  check_spread_masses_options(options);
+  check_spread_masses_options(options);  // the library's check, before the model file is read
   const ModelSource source = read_model_source(args.model);
   const auto description = load_description(source, parse_parameter_sets(args.sets));
 
   namespace fs = std::filesystem;
   const fs::path table_path = args.output;
-  check_command_paths(args.model, {{table_path, "the table CSV"},
-                                   {args.plot, "--plot"},
-                                   {args.plot.empty() ? fs::path() : reactions_plot_path(args.plot), "the reactions plot"}});
-  make_parent_directory(table_path);
-  check_plot_possible(args.plot);
+  files.output(table_path, "the table CSV", Folder::make);
+  files.plot(args.plot);
+  files.plot(args.plot.empty() ? fs::path() : reactions_plot_path(args.plot), "the reactions plot");
+  files.check();
 
   // Every formulation the model allows, named before the run so that the CSV (its columns) is
   // opened, and its directory proved writable, before anything is computed.
@@ -183,11 +172,11 @@ int run_spread_masses(const SpreadMassesArgs& args) {
        {"samples", fmt::format("{}", options.samples)},
        {"digits", fmt::format("{}", options.digits)},
        {"formulations", join(labels, ",")}}));
-  CsvWriter csv(table_path, columns, provenance);
+  CsvWriter& csv = files.open_csv(table_path, columns, provenance);
 
   const SpreadMasses study = study_spread_masses(description_spec(*description), options);
   write_spread_masses_rows(study, csv);
-  csv.commit();
+  files.commit();
 
   if (!args.plot.empty()) plot_spread_masses(study, table_path, qdd_columns, R_columns, args.plot);
   if (!args.quiet) print_spread_masses(study, table_path, args.plot);

@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "output_guard.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/frontend/load_model.hpp"
@@ -19,7 +18,9 @@
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/xy_plot.hpp"
+#include "nhdyn/studies/run_times.hpp"
 #include "nhdyn/studies/tracking.hpp"
+#include "run_files.hpp"
 #include "study.hpp"
 
 namespace nhdyn::cli {
@@ -125,7 +126,7 @@ void print_tracking(const Tracking& study, const Model& model, const TrackingArg
 }
 
 int run_tracking(const TrackingArgs& args) {
-  protect_model_file(args.model);
+  RunFiles files(args.model);
   const ModelSource source = read_model_source(args.model);
   const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
   const Model& model = resolved.model;
@@ -136,15 +137,15 @@ int run_tracking(const TrackingArgs& args) {
   options.integrator = parse_integrator(args.integrator);
   options.t_end = args.t_end.value_or(0.0);
   options.output_step = args.output_step.value_or(0.0);
-  check_study_times(model, args.t_end, args.output_step);
+  check_study_run_times(model, args.t_end, args.output_step);  // the library's check, before any file
 
   namespace fs = std::filesystem;
   const fs::path table_path = args.output;
   const fs::path series_path = by_tolerance_path(table_path);
-  check_command_paths(args.model,
-                      {{table_path, "the table CSV"}, {series_path, "the by-tolerance CSV"}, {args.plot, "--plot"}});
-  make_parent_directory(table_path);
-  check_plot_possible(args.plot);
+  files.output(table_path, "the table CSV", Folder::make);
+  files.output(series_path, "the by-tolerance CSV");
+  files.plot(args.plot);
+  files.check();
   // The residual the plot and the by-tolerance CSV use: position level when a program has one.
   bool pos = false;
   for (const ProgramConstraint& p : model.program_constraints) pos = pos || p.level == ConstraintLevel::position;
@@ -153,14 +154,13 @@ int run_tracking(const TrackingArgs& args) {
     columns.push_back("error_gain_" + gain_label(gain));
     columns.push_back("residual_gain_" + gain_label(gain));
   }
-  AtomicFile table(table_path);
   const std::string provenance = tracking_provenance(model, source, options, args);
-  CsvWriter series(series_path, columns, provenance);
+  CsvWriter& series = files.open_csv(series_path, columns, provenance);
+  AtomicFile& table = files.open(table_path);
 
   const Tracking study = study_tracking(model, options);
   table.write(write_tracking_series(study, pos, provenance, args.atol_factor, series));
-  series.commit();
-  table.commit();
+  files.commit();
 
   if (!args.plot.empty()) plot_tracking(study, model, pos, series_path, args.plot);
 

@@ -8,14 +8,12 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <system_error>
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "commands.hpp"
-#include "output_guard.hpp"
 #include "nhdyn/analysis/sweep.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
@@ -24,6 +22,7 @@
 #include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/xy_plot.hpp"
 #include "nhdyn/model/parameters.hpp"
+#include "run_files.hpp"
 
 namespace nhdyn::cli {
 namespace {
@@ -94,37 +93,30 @@ void write_sweep_tables(const Sweep& sweep, const Model& base, const ModelSource
 
 // --plot: the real parts and the |imaginary parts| each sorted at every value: the k-th largest of
 // continuous functions is continuous, so the curves have no jumps where the CSV's order (by real
-// part) swaps the imaginary parts. Its data go to a temporary file.
-void plot_sweep(const Sweep& sweep, const Model& base, const SweepArgs& args) {
-  namespace fs = std::filesystem;
+// part) swaps the imaginary parts. Its data go to a scratch file of the run's (run_files.hpp).
+void plot_sweep(const Sweep& sweep, const Model& base, const SweepArgs& args, RunFiles& files) {
   const std::size_t k = sweep.state.size();
-  const fs::path data = fs::temp_directory_path() /
-                        fmt::format(".nhdyn-sweep-{}-{}.csv", ::getpid(), fs::path(args.plot).stem().string());
-  {
-    std::string plot_text = args.param;
-    for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",re_{}", i);
-    for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",absim_{}", i);
-    plot_text += "\n";
-    for (const SweepPoint& p : sweep.points) {
-      std::vector<double> re, im;
-      for (const std::complex<double>& e : p.eigenvalues) {
-        re.push_back(e.real());
-        im.push_back(std::abs(e.imag()));
-      }
-      std::sort(re.rbegin(), re.rend());
-      std::sort(im.rbegin(), im.rend());
-      plot_text += fmt::format("{:.17g}", p.value);
-      for (double x : re) plot_text += fmt::format(",{:.17g}", x);
-      for (double x : im) plot_text += fmt::format(",{:.17g}", x);
-      plot_text += "\n";
+  std::string plot_text = args.param;
+  for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",re_{}", i);
+  for (std::size_t i = 1; i <= k; ++i) plot_text += fmt::format(",absim_{}", i);
+  plot_text += "\n";
+  for (const SweepPoint& p : sweep.points) {
+    std::vector<double> re, im;
+    for (const std::complex<double>& e : p.eigenvalues) {
+      re.push_back(e.real());
+      im.push_back(std::abs(e.imag()));
     }
-    AtomicFile plot_data(data);
-    plot_data.write(plot_text);
-    plot_data.commit();
+    std::sort(re.rbegin(), re.rend());
+    std::sort(im.rbegin(), im.rend());
+    plot_text += fmt::format("{:.17g}", p.value);
+    for (double x : re) plot_text += fmt::format(",{:.17g}", x);
+    for (double x : im) plot_text += fmt::format(",{:.17g}", x);
+    plot_text += "\n";
   }
   XyPlotRequest request;
   request.title = fmt::format("{}: eigenvalues of the linearization against {}", base.name, args.param);
-  request.csv = data;
+  request.csv = files.write_scratch(
+      fmt::format(".nhdyn-sweep-{}-{}.csv", ::getpid(), std::filesystem::path(args.plot).stem().string()), plot_text);
   request.x = args.param;
   for (std::size_t i = 1; i <= k; ++i) {
     request.y.push_back(fmt::format("re_{}", i));
@@ -138,15 +130,7 @@ void plot_sweep(const Sweep& sweep, const Model& base, const SweepArgs& args) {
   request.y_label = "eigenvalues [1/s]: real parts and |imaginary parts|";
   request.log_x = false;
   request.log_y = false;
-  try {
-    write_xy_plot(request, args.plot);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(data, ignored);
-    throw;
-  }
-  std::error_code ignored;
-  fs::remove(data, ignored);
+  write_xy_plot(request, args.plot);
 }
 
 // The summary on standard output: the range, each crossing, and where the files went.
@@ -175,7 +159,7 @@ void print_sweep(const Sweep& sweep, const Model& base, const SweepArgs& args, c
 }
 
 int run_sweep(const SweepArgs& args) {
-  protect_model_file(args.model);
+  RunFiles files(args.model);
   SweepOptions options;
   options.parameter = args.param;
   options.from = args.from;
@@ -206,22 +190,21 @@ int run_sweep(const SweepArgs& args) {
   namespace fs = std::filesystem;
   const fs::path table_path =
       args.output.empty() ? fs::path("results") / (make_file_name(base.name + "-sweep-" + args.param) + ".csv") : fs::path(args.output);
-  make_parent_directory(table_path);
   fs::path crossings_path = table_path;
   crossings_path.replace_filename(table_path.stem().string() + "-crossings.csv");
-  check_command_paths(args.model,
-                      {{table_path, "the eigenvalue CSV"}, {crossings_path, "the crossings CSV"}, {args.plot, "--plot"}});
-  check_plot_possible(args.plot);
-  AtomicFile table(table_path);  // both files can be written: checked before any work
-  AtomicFile crossings_file(crossings_path);
+  files.output(table_path, "the eigenvalue CSV", Folder::make);
+  files.output(crossings_path, "the crossings CSV");
+  files.plot(args.plot);
+  files.check();
+  AtomicFile& table = files.open(table_path);  // both files can be written: checked before any work
+  AtomicFile& crossings_file = files.open(crossings_path);
 
   const Sweep sweep = calc_eigenvalue_sweep(model_at, options);
 
   write_sweep_tables(sweep, base, source, args, table, crossings_file);
-  table.commit();
-  crossings_file.commit();
+  files.commit();
 
-  if (!args.plot.empty()) plot_sweep(sweep, base, args);
+  if (!args.plot.empty()) plot_sweep(sweep, base, args, files);
   if (!args.quiet) print_sweep(sweep, base, args, table_path, crossings_path);
   return 0;
 }

@@ -86,6 +86,7 @@ _PYTHON_TERMS = {
     "--set": "m.parameters[NAME] = value", "--initial": "q0/qd0", "--threads": "threads",
     "--cyclic": "cyclic=[...]", "--independent": "independent=[...]", "--speeds": "speeds=[...]",
     "--from": "values[0]", "--to": "values[-1]", "--steps": "len(values)", "--guess": "guess",
+    "--max-frames": "max_frames",
 }
 _OPTION = re.compile(r"--[a-z][a-z-]*[a-z]")
 # "max_steps (--max-steps)" names the keyword twice once translated.

@@ -83,6 +83,12 @@ int max_batch_threads() {
   return std::max(8, 4 * std::max(cores, 1));
 }
 
+void check_batch_threads(int threads) {
+  if (threads < 0)
+    throw InputError(
+        fmt::format("the number of threads (--threads) = {} must be 0 (every core) or a positive number", threads));
+}
+
 int batch_threads(int threads, std::size_t runs) {
   int count = threads > 0 ? std::min(threads, max_batch_threads()) : static_cast<int>(std::thread::hardware_concurrency());
   count = std::max(count, 1);
@@ -133,6 +139,7 @@ void run_one(const BatchRun& run, const BatchOptions& options, BatchResult& resu
 }  // namespace
 
 std::vector<BatchResult> simulate_batch(const std::vector<BatchRun>& runs, const BatchOptions& options) {
+  check_batch_threads(options.threads);
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const BatchRun& run = runs[i];
     if (!run.model) throw InputError(fmt::format("batch run {} has no model", i));

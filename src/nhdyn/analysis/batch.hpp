@@ -84,6 +84,10 @@ struct BatchResult {
 // The most threads a batch uses: four per core (at least 8). A CPU-bound run gains nothing from
 // more, and tens of thousands of threads exhaust the system's limits.
 int max_batch_threads();
+// The one check of a batch's thread count, for the command line (--threads) and Python (threads=)
+// alike: throws InputError unless `threads` is 0 (every core) or positive. simulate_batch calls it;
+// a caller may call it first to refuse the value before any work.
+void check_batch_threads(int threads);
 // The number of threads a batch of `runs` runs uses for `threads` (0 = every core), at least 1,
 // at most max_batch_threads() and `runs`. Fewer run when the system refuses to create a thread.
 int batch_threads(int threads, std::size_t runs);
@@ -95,7 +99,8 @@ std::vector<std::string> format_batch_unmet_stops(const std::vector<std::vector<
 
 // Runs every member; result i belongs to runs[i], whatever the number of threads (the results do
 // not depend on it: each run is the same sequential computation). Throws InputError only for
-// options that no run could use (a run without a model, an initial state of the wrong size);
+// options that no run could use (a run without a model, an initial state of the wrong size, a
+// negative thread count);
 // everything specific to a run ends up in its result.
 std::vector<BatchResult> simulate_batch(const std::vector<BatchRun>& runs, const BatchOptions& options);
 

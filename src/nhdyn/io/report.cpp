@@ -524,6 +524,13 @@ std::string write_model_report(const Model& model, const symbolic::Spec* spec, c
   return write_model_report(model, &description, table, title, extra, path, options);
 }
 
+void check_report_options(const ReportOptions& options) {
+  if (options.max_frames < 2)
+    throw InputError(fmt::format("the report's max_frames (--max-frames) = {} must be at least 2 (the first and the "
+                                 "last row)",
+                                 options.max_frames));
+}
+
 std::vector<std::size_t> report_frames(std::size_t rows, int max_frames) {
   std::vector<std::size_t> out;
   if (rows == 0) return out;
@@ -913,6 +920,7 @@ std::string write_report(const ReportInput& input, const std::filesystem::path& 
 std::string write_model_report(const Model& model, const symbolic::ModelDescription* description, const CsvTable& table, const std::string& title,
                         const std::vector<std::pair<std::string, std::string>>& extra,
                         const std::filesystem::path& path, const ReportOptions& options) {
+  check_report_options(options);
   ReportInput input;
   input.title = title;
   input.model = model.name;

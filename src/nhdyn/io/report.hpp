@@ -64,6 +64,11 @@ struct ReportOptions {
   std::vector<std::string> controls;
 };
 
+// The one check of ReportOptions, for the command line (--max-frames) and Python (max_frames=)
+// alike: InputError unless max_frames >= 2 (the first and the last row). write_model_report calls
+// it; a caller may call it first to refuse the value before any work.
+void check_report_options(const ReportOptions& options);
+
 // Throws InputError when `header` is not the column layout `expected` (make_result_columns of the
 // model): the message names the first column that differs, its position and what the model
 // expects there, with the CSV's name `csv` and the model's name.

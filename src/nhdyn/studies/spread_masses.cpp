@@ -70,17 +70,23 @@ std::vector<SpreadMassesState> make_spread_masses_states(const symbolic::Spec& s
   return states;
 }
 
-SpreadMasses study_spread_masses(const symbolic::Spec& spec, const SpreadMassesOptions& options) {
-  if (options.ratios.empty()) throw InputError("the spread-masses study needs at least one mass ratio");
+void check_spread_masses_options(const SpreadMassesOptions& options) {
+  if (options.ratios.empty()) throw InputError("the spread-masses study needs at least one mass ratio (--ratios)");
   for (double ratio : options.ratios)
     if (!(ratio > 0.0 && std::isfinite(ratio)))
-      throw InputError(fmt::format("mass ratio {} is not a positive number; give ratios such as 1,1e6,1e12", ratio));
+      throw InputError(
+          fmt::format("--ratios: mass ratio {} is not a positive number; give ratios such as 1,1e6,1e12", ratio));
   if (options.samples < 1)
-    throw InputError(fmt::format("{} samples: the study needs at least one state per ratio", options.samples));
+    throw InputError(fmt::format("--samples {0}: {0} samples are too few; the study needs at least 1 state per ratio",
+                                 options.samples));
   if (options.digits < 20)
-    throw InputError(fmt::format("{} digits is too few for a reference to double precision; ask for 20 or more "
-                                 "(50 is the default)",
+    throw InputError(fmt::format("--digits {0}: {0} digits is too few for a reference to double precision; ask for 20 "
+                                 "or more (50 is the default)",
                                  options.digits));
+}
+
+SpreadMasses study_spread_masses(const symbolic::Spec& spec, const SpreadMassesOptions& options) {
+  check_spread_masses_options(options);
   check_parameter(spec, options.parameter);
 
   const symbolic::Derivation derivation = symbolic::derive(spec);

@@ -78,9 +78,15 @@ struct SpreadMasses {
 std::vector<SpreadMassesState> make_spread_masses_states(const symbolic::Spec& spec, const std::string& parameter,
                                                          int samples);
 
-// Throws InputError naming the value at fault: no ratio, a ratio <= 0 or not finite, samples < 1,
-// digits < 20, a model without the parameter, an analytic complement for a model without one;
-// ModelError when the reference system is singular at a state.
+// The one check of the study's ratios, samples and digits, for the command line and a C++ caller
+// alike (its messages name the command line's options): InputError naming the value at fault for
+// no ratio, a ratio <= 0 or not finite, samples < 1, digits < 20. study_spread_masses calls it; a
+// caller may call it first to refuse the value before any work.
+void check_spread_masses_options(const SpreadMassesOptions& options);
+
+// Throws InputError naming the value at fault (check_spread_masses_options; a model without the
+// parameter; an analytic complement for a model without one); ModelError when the reference
+// system is singular at a state.
 SpreadMasses study_spread_masses(const symbolic::Spec& spec, const SpreadMassesOptions& options);
 
 }  // namespace nhdyn
