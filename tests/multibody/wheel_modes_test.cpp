@@ -20,6 +20,7 @@
 #include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/contact_modes.hpp"
+#include "support/models.hpp"
 #include "support/text.hpp"
 
 // A namespace of its own: the unity build joins this file with the other multibody tests.
@@ -239,42 +240,11 @@ TEST(WheelModes, BadValuesOnAWheelAreRefusedWithTheirPlace) {
   expect_refused(kWheel + "frictoin = 0.3\n", "frictoin", {"unknown key 'frictoin'", "did you mean 'friction'"});
 }
 
-// A Chaplygin sleigh: x, y, theta keep it flat; the blade at the frame's origin.
+// The Chaplygin sleigh of tests/support/models.hpp with KEY added to its [[knife_edges]] entry.
 std::string sled_with(const std::string& key) {
-  return R"(name = "sled"
-coordinates = ["x", "y", "theta"]
-gravity = [0, 0, "-g"]
-
-[parameters]
-m = 2.0
-a = 0.3
-g = 9.81
-
-[[frames]]
-name = "sled"
-translation = ["x", "y", 0]
-rotations = [["z", "theta"]]
-
-[[points]]
-name = "blade"
-frame = "sled"
-
-[[bodies]]
-name = "sled"
-frame = "sled"
-mass = "m"
-com = ["a", 0, 0]
-inertia = [0.05, 0.1, 0.1]
-
-[[knife_edges]]
-name = "blade"
-point = "blade"
-axis = "x"
-)" + key + R"(
-[initial]
-position = { x = 0, y = 0, theta = 0 }
-velocity = { x = 1, theta = 0.5 }
-)";
+  std::string text = test::kFlatSledBodies;
+  text.insert(text.find("\n[initial]") + 1, key);
+  return text;
 }
 
 TEST(WheelModes, AKnifeEdgeRefusesTheKeysSayingWhy) {
