@@ -215,14 +215,17 @@ void add_ground_drawing(const symbolic::ContactText& text, const symbolic::Parse
 
 }  // namespace
 
-const std::vector<std::string>& contact_keys() {
-  static const std::vector<std::string> keys = {"name",     "body",       "shape",       "centre", "ground",
-                                                "rolling",  "friction",   "unilateral",  "restitution", "mode"};
+const std::vector<std::string>& contact_mode_keys() {
+  static const std::vector<std::string> keys = {"friction", "unilateral", "restitution", "mode"};
   return keys;
 }
 
-const std::vector<std::string>& contact_mode_keys() {
-  static const std::vector<std::string> keys = {"friction", "unilateral", "restitution", "mode"};
+const std::vector<std::string>& contact_keys() {
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> all = {"name", "body", "shape", "centre", "ground", "rolling"};
+    all.insert(all.end(), contact_mode_keys().begin(), contact_mode_keys().end());
+    return all;
+  }();
   return keys;
 }
 

@@ -57,9 +57,13 @@ const std::vector<std::string> top_level_keys = {
 const std::vector<std::string> frame_keys = {"name", "parent", "translation", "rotations", "quaternion"};
 const std::vector<std::string> point_keys = {"name", "frame", "position"};
 const std::vector<std::string> body_keys = {"name", "frame", "mass", "com", "inertia"};
-// A wheel's mode keys (friction, ...) make it the [[contacts]] disk it is (contacts_file.hpp).
-const std::vector<std::string> wheel_keys = {"name",     "body",       "axis",        "radius", "normal",
-                                             "friction", "unilateral", "restitution", "mode"};
+// A wheel's mode keys (contact_mode_keys(): friction, ...) make it the [[contacts]] disk it is
+// (contacts_file.hpp).
+const std::vector<std::string> wheel_keys = [] {
+  std::vector<std::string> keys = {"name", "body", "axis", "radius", "normal"};
+  keys.insert(keys.end(), contact_mode_keys().begin(), contact_mode_keys().end());
+  return keys;
+}();
 const std::vector<std::string> knife_edge_keys = {"name", "point", "axis", "normal"};
 const std::vector<std::string> surface_keys = {"name", "point", "surface"};
 const std::vector<std::string> curve_keys = {"name", "point", "surfaces"};
