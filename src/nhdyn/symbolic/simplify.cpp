@@ -26,9 +26,34 @@ std::size_t size_of(const ex& e) {
   return n;
 }
 
-// Bottom-up: every function argument is simplified on its own; tan and tanh become quotients.
+// A half-integer power of a quotient with a number above or below the line, (n / d)^k, split into
+// n^k d^-k with that number made positive: sqrt(-1/P) becomes (-P)^(-1/2). Valid because the
+// root is real (its argument positive: mechanics takes square roots of lengths), so the number and
+// the other side share a sign. Without it GiNaC's normal() writes a root of a quotient as
+// (b/a)^x and keeps both that and a^-x as separate unknowns; on such a mixture its gcd fails,
+// depending on its term order ("heur_gcd: not an integer polynomial"), i.e. in some runs only.
+ex split_root(const ex& base, const GiNaC::numeric& k) {
+  const ex nd = base.numer_denom();
+  ex n = nd.op(0), d = nd.op(1);
+  const bool numeric_above = GiNaC::is_a<GiNaC::numeric>(n);
+  if (!(numeric_above || GiNaC::is_a<GiNaC::numeric>(d))) return GiNaC::pow(base, k);
+  const GiNaC::numeric number = GiNaC::ex_to<GiNaC::numeric>(numeric_above ? n : d);
+  if (number.is_negative()) {
+    n = GiNaC::expand(-n);
+    d = GiNaC::expand(-d);
+  }
+  // Each side simplified on its own, so that a root of P and a root of 1/P share one form of P.
+  return GiNaC::pow(simplify(n), k) * GiNaC::pow(simplify(d), -k);
+}
+
+// Bottom-up: every function argument is simplified on its own; tan and tanh become quotients;
+// square roots of quotients are split (split_root).
 struct Rewrite : GiNaC::map_function {
   ex operator()(const ex& e) override {
+    if (GiNaC::is_a<GiNaC::power>(e) && GiNaC::is_a<GiNaC::numeric>(e.op(1))) {
+      const GiNaC::numeric k = GiNaC::ex_to<GiNaC::numeric>(e.op(1));
+      if (k.is_rational() && !k.is_integer() && k.denom() == 2) return split_root(simplify(e.op(0)), k);
+    }
     if (GiNaC::is_a<GiNaC::function>(e)) {
       struct Arguments : GiNaC::map_function {
         ex operator()(const ex& arg) override { return simplify(arg); }
