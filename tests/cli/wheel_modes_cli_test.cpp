@@ -98,4 +98,14 @@ TEST_F(CliWheelModes, ABadValueOnTheWheelExits2WithItsPlace) {
   EXPECT_FALSE(fs::exists(dir_ / "bad.csv"));
 }
 
+// Another method than sanh is refused as for a [[contacts]] entry, and the message says where the
+// keys to remove are: a wheel's are on its [[wheels]] entry.
+TEST_F(CliWheelModes, AnotherMethodIsRefusedNamingTheWheelsEntries) {
+  const auto run = run_nhdyn("simulate '" + example("rolling_disk_hop_wheel.toml") + "' --method lagrange -o l.csv", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_TRUE(contains(run.out, "--method lagrange cannot solve them")) << run.out;
+  EXPECT_TRUE(contains(run.out, "from the [[contacts]] and [[wheels]] entries to run --method lagrange")) << run.out;
+  EXPECT_FALSE(fs::exists(dir_ / "l.csv"));
+}
+
 }  // namespace

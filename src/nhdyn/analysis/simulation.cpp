@@ -326,7 +326,7 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
           "model '{}' has contacts that may slide or lift off (friction or unilateral, docs/contact-modes.md): "
           "--method {} cannot solve them (a sliding contact's friction is a reaction the Do Sanh form alone "
           "takes); use --method sanh (the default; method=\"sanh\" from Python), or remove friction and "
-          "unilateral from the [[contacts]] to run --method {}",
+          "unilateral (and restitution, mode) from the [[contacts]] and [[wheels]] entries to run --method {}",
           model.name, formulation_name(options.formulation.method), formulation_name(options.formulation.method)));
     const char* why = options.stabilization == Stabilization::projection
                           ? "no projection (the projection would hold a sliding contact's slip at zero)"
