@@ -22,7 +22,7 @@
 #include <sstream>
 #include <vector>
 
-#include "nhdyn/jit/source.hpp"
+#include "nhdyn/jit/detail/source.hpp"
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/tape.hpp"
 

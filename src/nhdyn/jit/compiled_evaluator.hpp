@@ -2,7 +2,7 @@
 // into machine code by the system's C++ compiler, loaded with dlopen and used in place of the
 // interpreter. This folder is the only place that runs a compiler or calls dlopen.
 //
-// The source (jit/source.hpp) is compiled into a shared object cached under
+// The source (jit/detail/source.hpp) is compiled into a shared object cached under
 // $XDG_CACHE_HOME/nhdyn (else ~/.cache/nhdyn), named by a hash of the source, the compiler (its
 // command and its --version) and the flags, so a second run of the same model loads it without
 // compiling, and a parameter change reuses it (parameters are data: the stage is recomputed).

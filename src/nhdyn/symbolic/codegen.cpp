@@ -12,7 +12,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/model/tape.hpp"
-#include "nhdyn/model/tape_printer.hpp"
+#include "nhdyn/model/detail/tape_printer.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 
 namespace nhdyn::symbolic {
@@ -111,7 +111,7 @@ std::string comment_text(const std::string& s) {
   return out;
 }
 
-// How codegen spells a program (model/tape_printer.hpp): its parameter stage is computed once
+// How codegen spells a tape (model/detail/tape_printer.hpp): its parameter stage is computed once
 // per parameter change, in the evaluator's constructor, into members named <prefix>rN_; the calls
 // compute the rest. Parameters read as p_.<field>; constants are declared where read, with
 // literals that read back to the same value.

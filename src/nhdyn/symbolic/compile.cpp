@@ -39,7 +39,7 @@
 #include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "nhdyn/symbolic/outputs.hpp"
-#include "nhdyn/symbolic/plain_words.hpp"
+#include "nhdyn/symbolic/detail/plain_words.hpp"
 
 namespace nhdyn::symbolic {
 namespace {

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/symbolic/plain_words.hpp"
+#include "nhdyn/symbolic/detail/plain_words.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 
 namespace nhdyn::symbolic {
