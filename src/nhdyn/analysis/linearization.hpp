@@ -35,7 +35,7 @@ struct LinearizationOptions {
 };
 
 enum class DerivativeMethod { tangent, richardson };
-// "exact (tangent mode of the compiled programs)" or "Richardson-extrapolated central differences".
+// "exact (tangent mode of the compiled tapes)" or "Richardson-extrapolated central differences".
 const char* derivative_method_name(DerivativeMethod method);
 
 struct Linearization {

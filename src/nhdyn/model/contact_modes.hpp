@@ -90,7 +90,7 @@ struct ContactModeData {
   std::vector<double> velocity_residuals;  // the model's velocity residuals (the slips are among them)
   std::vector<int> kept;                   // rows of b kept as constraints
   std::vector<int> gap_column;             // per contact: its gap row's column in reaction_rows, or -1
-  std::vector<std::array<double, 2>> tangent_length;  // per contact: |t1|, |t2| of the program's outputs
+  std::vector<std::array<double, 2>> tangent_length;  // per contact: |t1|, |t2| of the tape's outputs
   Matrix reaction_rows;                    // n x r, the reaction directions B~^T (columns)
   Matrix M;                                // n x n, [D A; b_kept]
   Vector rhs, multipliers;                 // n; r
