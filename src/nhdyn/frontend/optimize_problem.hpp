@@ -3,7 +3,7 @@
 // directions B(t, q, q'), an objective, boundary states, bounds and path constraints
 // (docs/derivations/optimal-programs.md, section 1). The expressions that read the controls (the
 // actuator forces B u, the integrand, the final-time term, the path constraints) are compiled into
-// straight-line programs over the "control layout": n + m coordinates [q; u] whose velocities are
+// tapes (straight-line code) over the "control layout": n + m coordinates [q; u] whose velocities are
 // [q'; 0], so that the tangent mode of model/detail/tape_tangent.hpp differentiates them in q, q', u
 // and t alike. The transcription and the solver (src/nhdyn/optimize/) read this struct only.
 //
