@@ -4,13 +4,13 @@
 //   compiled_terms/<model>/interpreted   the same call on the TapeEvaluator that compile_model
 //                                        makes from the hand-built Spec and Derivation
 //                                        (tests/codegen/hand_built_specs.hpp): one straight-line
-//                                        program for A, Q, G, b, b0, run by the interpreter
-//   compiled_terms/<model>/generated     the generated C++ of the same programs (tests/codegen/),
+//                                        tape for A, Q, G, b, b0, run by the interpreter
+//   compiled_terms/<model>/generated     the generated C++ of the same tapes (tests/codegen/),
 //                                        when its headers are on the include path; they carry the
 //                                        models' default parameter values, which change no
 //                                        operation count
 // and the cost of building the model from symbols:
-//   compile/<model>/compile_model        parameter substitution, CSE, programs, Model
+//   compile/<model>/compile_model        parameter substitution, CSE, tapes, Model
 //   compile/<model>/generate_code        the same, then printed as C++
 //   compile/<model>/derive_and_compile   from the Spec (SpecBuilder, as a model file makes it):
 //                                        derive() then compile_model()

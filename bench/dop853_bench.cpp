@@ -1,4 +1,4 @@
-// DOP853 against dopri5 (integrators/explicit_rk.hpp) on whole simulations, at the tolerances
+// DOP853 against dopri5 (integrators/detail/explicit_rk.hpp) on whole simulations, at the tolerances
 // where an 8th-order pair should pay:
 //   integrators/<model>/<integrator>/rtol_<r>/outputs_<k>
 // simulate() of <model> for 10 s, sanh with D from QR, atol = rtol / 100, k outputs (every

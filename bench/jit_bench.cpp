@@ -1,5 +1,5 @@
 // The compiled evaluator (jit/compiled_evaluator.hpp) against the interpreter, on the Whipple
-// bicycle (examples/whipple_bicycle.toml, n = 8, s = 5, a terms program of about 3900 operations):
+// bicycle (examples/whipple_bicycle.toml, n = 8, s = 5, a terms tape of about 3900 operations):
 //   jit/whipple_bicycle/terms/<evaluator>        one Evaluator::terms call (A, Q, G, b, b0)
 //   jit/whipple_bicycle/rhs/<evaluator>          one right-hand side: terms, then q'' by sanh with
 //                                                D from QR (compute_dynamics)

@@ -1,7 +1,7 @@
 // Cost of the linearization about a steady motion (analysis/linearization.hpp) on the upright
 // rolling disk (examples/rolling_disk_upright.toml, n = 5, s = 2, psi named cyclic):
-//   linearize/rolling_disk/tangent     derivatives by the tangent mode of the compiled programs
-//   linearize/rolling_disk/richardson  the same model behind a forwarding Evaluator (no programs),
+//   linearize/rolling_disk/tangent     derivatives by the tangent mode of the compiled tapes
+//   linearize/rolling_disk/richardson  the same model behind a forwarding Evaluator (no tapes),
 //                                      so that Richardson-extrapolated central differences are used
 // and of one point of a sweep, which also recompiles the model from its derivation:
 //   sweep_point/bicycle_linear         compile_model + linearize of examples/bicycle_linear.toml

@@ -24,9 +24,11 @@ install(TARGETS ${nhdyn_installed_targets} EXPORT nhdynTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 # optimize/ is not an installed module (its library links IPOPT, which the CLI and the Python
-# package carry): its headers stay out with it.
+# package carry): its headers stay out with it. Neither are the modules' detail/ folders: the
+# library's own headers, which no installed header includes (tests/layering checks it).
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/src/nhdyn DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
-        FILES_MATCHING PATTERN "*.hpp" PATTERN "resources" EXCLUDE PATTERN "optimize" EXCLUDE)
+        FILES_MATCHING PATTERN "*.hpp" PATTERN "resources" EXCLUDE PATTERN "optimize" EXCLUDE
+        PATTERN "detail" EXCLUDE)
 install(FILES ${NHDYN_GENERATED_INCLUDE_DIR}/nhdyn/core/version.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/nhdyn/core)
 
 set(nhdyn_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/nhdyn)

@@ -112,14 +112,14 @@ void RunFiles::check() {
 
 AtomicFile& RunFiles::open(const fs::path& path) {
   AtomicFile& file = files_.emplace_back(path);
-  commits_.push_back([&file] { file.commit(); });
+  opened_.push_back({[&file] { file.finish(); }, [&file] { file.publish(); }});
   return file;
 }
 
 CsvWriter& RunFiles::open_csv(const fs::path& path, const std::vector<std::string>& columns,
                               const std::string& preamble) {
   CsvWriter& table = tables_.emplace_back(path, columns, preamble);
-  commits_.push_back([&table] { table.commit(); });
+  opened_.push_back({[&table] { table.finish(); }, [&table] { table.publish(); }});
   return table;
 }
 
@@ -147,6 +147,8 @@ fs::path RunFiles::write_scratch(const std::string& name, const std::string& tex
 }
 
 void RunFiles::commit() {
+  // Everything that can fail for want of space first, for every file; the renames only then.
+  for (const Opened& file : opened_) file.finish();
   if (!staging_.empty()) {
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(staging_)) {
@@ -156,13 +158,13 @@ void RunFiles::commit() {
                                     ec.message()));
     }
   }
-  for (const std::function<void()>& commit : commits_) commit();
-  commits_.clear();
+  for (const Opened& file : opened_) file.publish();
+  opened_.clear();
   probes_.clear();
 }
 
 void RunFiles::discard() {
-  commits_.clear();
+  opened_.clear();
   probes_.clear();
   tables_.clear();
   files_.clear();

@@ -9,8 +9,10 @@
 //      link or inode: io/run_paths.hpp), the directories the command makes are made, gnuplot is
 //      there when a plot is asked for, and the directory of each plot and report is proved
 //      writable; then open() the tables, which writes them to temporaries beside their targets;
-//   3. commit() after a run that succeeded: every opened file renamed into place, in the order
-//      opened (batch's staged run files first). A RunFiles destroyed (or discard()ed) without
+//   3. commit() after a run that succeeded: every opened file finished first (flushed and closed:
+//      whatever can fail for want of space), then, only when all are, renamed into place in the
+//      order opened (batch's staged run files first), so that a disk full at the last file leaves
+//      none of them behind, not the first ones alone. A RunFiles destroyed (or discard()ed) without
 //      commit removes its temporaries and staging folder, so a refused, failed or interrupted run
 //      leaves nothing behind (the SIGINT/SIGTERM handler of output_guard.hpp removes the
 //      temporaries of a process that is killed mid-run).
@@ -92,9 +94,10 @@ class RunFiles {
   // interrupted run. Returns its path.
   std::filesystem::path write_scratch(const std::string& name, const std::string& text);
 
-  // The run succeeded: the staged files moved into their folder, then every opened file renamed
-  // into place in the order opened; the plots' and pages' probes are released so that their
-  // writers can write them.
+  // The run succeeded: every opened file finished (FileError, and no file renamed, when one of
+  // them cannot be written whole), then the staged files moved into their folder and every opened
+  // file renamed into place in the order opened; the plots' and pages' probes are released so
+  // that their writers can write them.
   void commit();
   // The run is abandoned now (a signal that will end the process with _exit, which runs no
   // destructor): every temporary and the staging folder removed.
@@ -118,7 +121,10 @@ class RunFiles {
   std::optional<Numbered> numbered_;
   std::deque<AtomicFile> files_;        // deque: references stay valid as files are added
   std::deque<CsvWriter> tables_;
-  std::vector<std::function<void()>> commits_;  // in the order opened
+  struct Opened {
+    std::function<void()> finish, publish;
+  };
+  std::vector<Opened> opened_;  // in the order opened
   std::vector<std::unique_ptr<AtomicFile>> probes_;
   std::filesystem::path staging_, staging_target_;
   std::vector<std::pair<std::filesystem::path, int>> scratch_;  // path, slot in the table of temporaries

@@ -35,7 +35,8 @@ logger = logging.getLogger(__name__)
 
 DOCS = Path(__file__).resolve().parent.parent
 REPOSITORY = DOCS.parent
-# The installed headers (cmake/install.cmake): src/nhdyn but optimize/ and resources/.
+# The installed headers (cmake/install.cmake): src/nhdyn but optimize/, resources/ and every
+# module's detail/ folder (the library's own headers).
 HEADERS_ROOT = REPOSITORY / "src"
 NOT_INSTALLED = ("nhdyn/optimize/", "nhdyn/io/resources/")
 
@@ -44,7 +45,7 @@ def installed_headers():
     headers = []
     for path in sorted((HEADERS_ROOT / "nhdyn").rglob("*.hpp")):
         name = path.relative_to(HEADERS_ROOT).as_posix()
-        if not name.startswith(NOT_INSTALLED):
+        if not name.startswith(NOT_INSTALLED) and "/detail/" not in name:
             headers.append(name)
     return headers
 

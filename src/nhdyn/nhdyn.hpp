@@ -6,10 +6,12 @@
 //
 // It includes no GiNaC and no SUNDIALS (tests/layering checks it): models come from the front door
 // (frontend/load_model.hpp) or from the built-in C++ models, and everything after is numeric. The
-// headers not listed here are the library's own: a kernel's helpers (formulation/small_dense.hpp,
-// model/tape_tangent.hpp, symbolic/occurrence.hpp and the like) and the symbolic front end
-// (symbolic/, for programs that build a Spec in C++: examples/appell_builder.cpp). docs/design.md,
-// "Architecture", shows where each part sits.
+// other headers of a module folder are public too and go deeper (one formulation's kernel,
+// formulation/sanh.hpp; the symbolic front end, symbolic/, for programs that build a Spec in C++:
+// examples/appell_builder.cpp). The headers of a module's detail/ folder are the library's own
+// (formulation/detail/small_dense.hpp, model/detail/tape_tangent.hpp, ...): not installed, and
+// refused in an application by tests/layering. docs/design.md, "Architecture", shows where each
+// part sits.
 #pragma once
 
 #include "nhdyn/core/error.hpp"             // InputError, FileError, ModelError

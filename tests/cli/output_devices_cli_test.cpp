@@ -65,5 +65,32 @@ TEST_F(OutputDevices, AnEmptyNameGetsTheDefaultFileName) {
   EXPECT_EQ(make_file_name("../../escape").find('/'), std::string::npos);
 }
 
+// A command's files appear together or not at all (apps/nhdyn/run_files.hpp): when the last one
+// cannot be written whole (here a link to /dev/full, a device written straight, which refuses
+// every byte with ENOSPC at its flush), the ones before it are not renamed into place either.
+TEST_F(OutputDevices, SimulateLeavesNoCsvWhenItsEventsFileIsFull) {
+  fs::create_symlink("/dev/full", dir_ / "run-events.csv");
+  const test::CliOutcome r = run_nhdyn("simulate appell.toml -q --t-end 0.1 --event half=t-0.05 -o run.csv", dir_);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_TRUE(contains(r.out, "writing 'run-events.csv' failed: No space left on device")) << r.out;
+  EXPECT_FALSE(fs::exists(dir_ / "run.csv")) << "the rows appeared without their events file";
+  for (const auto& e : fs::directory_iterator(dir_))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+  // With room for both, both appear.
+  fs::remove(dir_ / "run-events.csv");
+  const test::CliOutcome ok = run_nhdyn("simulate appell.toml -q --t-end 0.1 --event half=t-0.05 -o run.csv", dir_);
+  EXPECT_EQ(ok.exit_code, 0) << ok.out;
+  EXPECT_TRUE(fs::is_regular_file(dir_ / "run.csv") && fs::is_regular_file(dir_ / "run-events.csv")) << ok.out;
+}
+
+TEST_F(OutputDevices, CompareLeavesNoSeriesWhenItsTableIsFull) {
+  // compare finishes its series CSV first, then the table (-o), which cannot be written.
+  fs::create_symlink("/dev/full", dir_ / "table.csv");
+  const test::CliOutcome r = run_nhdyn("compare appell.toml -q --t-end 0.1 -o table.csv", dir_);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_TRUE(contains(r.out, "writing 'table.csv' failed: No space left on device")) << r.out;
+  EXPECT_FALSE(fs::exists(dir_ / "table-series.csv")) << "the series appeared without its table";
+}
+
 }  // namespace
 }  // namespace nhdyn

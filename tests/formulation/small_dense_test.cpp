@@ -1,4 +1,4 @@
-// The fixed-size kernels for small n (formulation/small_dense.hpp) against the dynamic Eigen
+// The fixed-size kernels for small n (formulation/detail/small_dense.hpp) against the dynamic Eigen
 // path, on random systems of every size they cover and a few beyond: same q'' and R, a D that
 // is an orthonormal basis of null(b), and the same verdict on dependent constraints and on a
 // singular stacked matrix. Each q'' is also checked against the constraints and the equations

@@ -12,9 +12,9 @@
 #include <random>
 #include <vector>
 
-#include "nhdyn/formulation/row_scaling.hpp"
+#include "nhdyn/formulation/detail/row_scaling.hpp"
 #include "nhdyn/formulation/sanh.hpp"
-#include "nhdyn/formulation/small_dense.hpp"
+#include "nhdyn/formulation/detail/small_dense.hpp"
 
 namespace nhdyn {
 namespace {

@@ -221,7 +221,7 @@ TEST(ChainSparsePath, UdwadiaKalabaAndNullspaceOfASparseModelRunDense) {
 }
 
 TEST(LinearizationSparsePath, AModelCompiledSparseLinearizesLikeTheDenseOne) {
-  // The upright rolling disk: its terms program compiled sparse gives its tangents in the
+  // The upright rolling disk: its terms tape compiled sparse gives its tangents in the
   // compressed layout (analysis/linearization.cpp scatters them).
   const symbolic::Spec spec = load_model_file(example_path("rolling_disk_upright.toml"));
   const Model dense = symbolic::compile_model(spec, symbolic::CompileOptions{symbolic::TermsLayout::dense});

@@ -2,7 +2,7 @@
 // rk4 converges with order 4 and hits output times with the promised steps, dopri5 meets its
 // tolerance at step ends and in its continuous extension, scales its error with the tolerance,
 // honours max_step and reports a singularity as step size underflow.
-#include "nhdyn/integrators/explicit_rk.hpp"
+#include "nhdyn/integrators/detail/explicit_rk.hpp"
 
 #include <gtest/gtest.h>
 

@@ -78,7 +78,7 @@ TEST(Events, ModelFileEventsThroughTheApi) {
   EXPECT_EQ(summary.events.stopped_by, 2);
   EXPECT_EQ(summary.t_reached, summary.events.crossings[2].t);
 
-  // Parameters are data: L = 0.5 moves the crossing to 0.25 s with the same compiled programs.
+  // Parameters are data: L = 0.5 moves the crossing to 0.25 s with the same compiled tapes.
   set_parameter(model, "L", 0.5);
   summary = simulate(model, options, [](const Data&) {});
   ASSERT_EQ(summary.status, Status::ok) << summary.message;

@@ -12,9 +12,12 @@
 //   - SUNDIALS, directly or through headers, is seen only inside src/nhdyn/integrators/sundials;
 //   - the umbrella header src/nhdyn/nhdyn.hpp (the public surface, for applications) may include
 //     every module's headers but sees neither GiNaC nor SUNDIALS, and no module includes it;
-//   - a header marked "// Internal:" in its opening comment is included only by the library and
-//     the tests, never by an application (the CLI, Python, examples, benchmarks, fuzzer) nor by
-//     the umbrella header.
+//   - a header of a module's detail/ folder (src/nhdyn/<module>/detail/) is internal: its opening
+//     comment says so in a line "// Internal: ...", and a header outside detail/ has no such line;
+//   - an internal header is included only by the library and the tests, never by an application
+//     (the CLI, Python, examples, benchmarks, fuzzer) nor by the umbrella header, and never by a
+//     header outside detail/ (detail/ is not installed: cmake/install.cmake), so the installed
+//     headers need none of it.
 // The checker itself is tested on small synthetic trees that break each rule once.
 #include <gtest/gtest.h>
 
@@ -299,6 +302,12 @@ struct SourceFile {
   std::vector<Include> includes;
   bool internal = false;  // "// Internal:" in the opening comment: not part of the public API
 };
+
+// Whether a path lies in a module's detail/ folder (src/nhdyn/<module>/detail/...): the library's
+// own headers and sources, not installed.
+bool in_detail(const std::string& path) {
+  return path.rfind("src/nhdyn/", 0) == 0 && path.find("/detail/") != std::string::npos;
+}
 using Tree = std::map<std::string, SourceFile>;  // path relative to the root -> file
 
 Tree scan(const fs::path& root) {
@@ -411,6 +420,14 @@ void check_includes(const Tree& tree, const Layers& layers,
                     const std::map<std::string, std::vector<std::string>>& test_links, Problems& problems) {
   std::set<std::string> reported;
   for (const auto& [path, file] : tree) {
+    if (fs::path(path).extension() == ".hpp" && starts_with(path, "src/nhdyn/")) {
+      if (in_detail(path) && !file.internal)
+        problems.push_back(path + ": a header of detail/ says in its opening comment that it is internal, in a "
+                                  "line \"// Internal: <who uses it>\"");
+      if (!in_detail(path) && file.internal)
+        problems.push_back(path + ": marked \"// Internal:\" but outside detail/: move it to its module's detail/ "
+                                  "folder (or drop the mark if it is public)");
+    }
     const Owner owner = owner_of(path, layers, test_links, problems, reported);
     if (owner.what == "unknown") continue;
     for (const Include& inc : file.includes) {
@@ -424,10 +441,15 @@ void check_includes(const Tree& tree, const Layers& layers,
                              ", the umbrella header for applications; include the module headers it needs");
         continue;
       }
-      const auto target = tree.find("src/" + inc.target);
-      if (target != tree.end() && target->second.internal && (application || path == kUmbrella))
+      const bool internal = in_detail("src/" + inc.target);
+      if (internal && (application || path == kUmbrella))
         problems.push_back(where + owner.what + " includes " + inc.target +
-                           ", a header marked internal to the library; use the public headers (nhdyn/nhdyn.hpp)");
+                           ", a header internal to the library (detail/); use the public headers (nhdyn/nhdyn.hpp)");
+      else if (internal && starts_with(path, "src/nhdyn/") && !in_detail(path) &&
+               fs::path(path).extension() == ".hpp")
+        problems.push_back(where + "the installed header " + path + " includes " + inc.target +
+                           ", which is internal and not installed (detail/); include it from a source file, or "
+                           "move the header to detail/ too");
       if (m.empty())
         problems.push_back(where + "includes " + inc.target + ", which is in no module of the layer table");
       else if (!owner.visible.count(m))
@@ -694,12 +716,26 @@ TEST_F(SyntheticTree, UmbrellaHeaderSeeingGinacIsReported) {
 }
 
 TEST_F(SyntheticTree, InternalHeaderInAnApplicationIsReported) {
-  write("src/nhdyn/model/detail.hpp", "// Kernels' helpers.\n// Internal: not for users.\n#pragma once\n");
-  write("src/nhdyn/model/m.cpp", "#include \"nhdyn/model/detail.hpp\"\n");
-  write("tests/model/detail_test.cpp", "#include \"nhdyn/model/detail.hpp\"\n");
+  write("src/nhdyn/model/detail/helpers.hpp", "// Kernels' helpers.\n// Internal: not for users.\n#pragma once\n");
+  write("src/nhdyn/model/m.cpp", "#include \"nhdyn/model/detail/helpers.hpp\"\n");
+  write("tests/model/detail_test.cpp", "#include \"nhdyn/model/detail/helpers.hpp\"\n");
   EXPECT_TRUE(check().empty()) << join(check());
-  write("apps/cli/peek.cpp", "#include \"nhdyn/model/detail.hpp\"\n");
+  write("apps/cli/peek.cpp", "#include \"nhdyn/model/detail/helpers.hpp\"\n");
   EXPECT_TRUE(one_problem(check(), {"apps/cli/peek.cpp:1", "internal"}));
+}
+
+TEST_F(SyntheticTree, InstalledHeaderIncludingDetailIsReported) {
+  write("src/nhdyn/model/detail/helpers.hpp", "// Kernels' helpers.\n// Internal: not for users.\n#pragma once\n");
+  write("src/nhdyn/model/m.hpp", "#include \"nhdyn/core/a.hpp\"\n#include \"nhdyn/model/detail/helpers.hpp\"\n");
+  EXPECT_TRUE(one_problem(check(), {"src/nhdyn/model/m.hpp:2", "installed header", "not installed"}));
+}
+
+TEST_F(SyntheticTree, InternalMarkAndDetailFolderGoTogether) {
+  write("src/nhdyn/model/detail/helpers.hpp", "// Kernels' helpers.\n#pragma once\n");
+  EXPECT_TRUE(one_problem(check(), {"src/nhdyn/model/detail/helpers.hpp", "// Internal:"}));
+  write("src/nhdyn/model/detail/helpers.hpp", "// Kernels' helpers.\n// Internal: for m.cpp.\n#pragma once\n");
+  write("src/nhdyn/model/loose.hpp", "// Kernels' helpers.\n// Internal: for m.cpp.\n#pragma once\n");
+  EXPECT_TRUE(one_problem(check(), {"src/nhdyn/model/loose.hpp", "outside detail/"}));
 }
 
 TEST_F(SyntheticTree, ModuleWithoutLineIsReported) {

@@ -5,7 +5,7 @@
 // 1e-9, and the weave and capsize speeds found by the sweep's root finding to 1e-13 against the
 // published 4.29238253634111 and 6.02426201538837 m/s. Nothing of the benchmark's linear equations
 // enters the model: it is the nonlinear bicycle from its bodies, wheels and rolling constraints,
-// differentiated exactly (tangent mode of the compiled programs).
+// differentiated exactly (tangent mode of the compiled tapes).
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>

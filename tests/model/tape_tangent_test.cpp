@@ -1,4 +1,4 @@
-// The tangent mode of straight-line programs (model/tape_tangent.hpp): every op's derivative
+// The tangent mode of tapes (straight-line code) (model/detail/tape_tangent.hpp): every op's derivative
 // against Richardson-extrapolated central differences of the program itself, the exact derivative
 // of a small polynomial, and the structural input dependence.
 #include <gtest/gtest.h>
@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "nhdyn/model/tape.hpp"
-#include "nhdyn/model/tape_tangent.hpp"
+#include "nhdyn/model/detail/tape_tangent.hpp"
 
 namespace nhdyn {
 namespace {

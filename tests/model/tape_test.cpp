@@ -1,6 +1,6 @@
-// Straight-line programs: every instruction against the std:: function it stands for, the
+// Tapes (straight-line code): every instruction against the std:: function it stands for, the
 // validation of operands, the sincos companion, TapeEvaluator's layout of the terms, its
-// prepared programs against the programs as given (to the bit), and a run that allocates nothing
+// prepared tapes against the tapes as given (to the bit), and a run that allocates nothing
 // (counted at malloc, as in tests/formulation/allocation_test.cpp).
 #include "nhdyn/model/tape.hpp"
 

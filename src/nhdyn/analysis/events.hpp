@@ -1,4 +1,4 @@
-// A model's events as the integrators see them (integrators/events.hpp): the programs g(t, q, q')
+// A model's events as the integrators see them (integrators/events.hpp): the tapes g(t, q, q')
 // (or of q'', R and the contact forces, solved at each evaluation) of model/event.hpp bound to the model's parameter values, evaluated on y = [q; q'], and the
 // check that refuses a run whose events cannot mean anything at its start (an event already at
 // zero, a stop condition already true). simulate() (simulation.hpp) uses them; the located
@@ -38,7 +38,7 @@ class ModelEventFunctions final : public EventFunctions {
   using Dynamics =
       std::function<Status(double t, const double* y, const double** qdd, const double** R, const double** F)>;
 
-  // Binds every event's program to the model's current parameter values (allocates; not in the
+  // Binds every event's tape to the model's current parameter values (allocates; not in the
   // time loop). `events` must outlive this object. Throws InputError when an event reads q'' or R
   // and no `dynamics` is given, or reads contact forces that `model` does not have.
   ModelEventFunctions(const Model& model, const std::vector<const Event*>& events, Handler handler,
@@ -82,9 +82,9 @@ class ModelEventFunctions final : public EventFunctions {
   bool needs_contact_forces_ = false;
   int contact_columns_ = 0;     // 6 per wheel and knife edge of the model
   // 2n (+ contact_columns_) each: the inputs [q; q''; F], [q'; R; 0] of the dynamics layout (and
-  // of the contact layout, whose programs read the forces after them).
+  // of the contact layout, whose tapes read the forces after them).
   std::vector<double> x_, xd_;
-  // Runs every program at (t, y) into g; solves the dynamics first when an event needs it.
+  // Runs every tape at (t, y) into g; solves the dynamics first when an event needs it.
   Status run_all(double t, const double* y, double* g);
   int stopped_by_ = -1;
 };

@@ -13,7 +13,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/model/tape.hpp"
-#include "nhdyn/model/tape_tangent.hpp"
+#include "nhdyn/model/detail/tape_tangent.hpp"
 
 namespace nhdyn {
 namespace {
@@ -21,7 +21,7 @@ namespace {
 using Index = Eigen::Index;
 
 // Everything the linearization differentiates, as one flat vector: the terms A (n x n,
-// col-major), Q, G, b (s x n, col-major), b0 — the order of the terms program's outputs — then
+// col-major), Q, G, b (s x n, col-major), b0 — the order of the terms tape's outputs — then
 // the position residuals phi (p) and the velocity residuals f (r).
 struct Layout {
   int n = 0, s = 0, p = 0, r = 0;
@@ -36,7 +36,7 @@ struct Layout {
   Index terms() const { return phi(); }
 };
 
-// The inputs are numbered as a program's registers: 0 is t, 1 + i is q_i, 1 + n + i is q'_i.
+// The inputs are numbered as a tape's registers: 0 is t, 1 + i is q_i, 1 + n + i is q'_i.
 class Differentiator {
  public:
   Differentiator(const Model& model, const Layout& layout, double t, const Vector& q, const Vector& v)
@@ -45,9 +45,9 @@ class Differentiator {
     scratch_.assign(model.evaluator->scratch_size(), 0.0);
     if (tapes_ != nullptr) {
       const ModelTapes& p = tapes_->tapes();
-      for (const Tape* program : {&p.terms, &p.position_residual, &p.velocity_residual}) {
-        values_.emplace_back(static_cast<std::size_t>(program->registers()), 0.0);
-        program->execute(t, q.data(), v.data(), values_.back().data());
+      for (const Tape* tape : {&p.terms, &p.position_residual, &p.velocity_residual}) {
+        values_.emplace_back(static_cast<std::size_t>(tape->registers()), 0.0);
+        tape->execute(t, q.data(), v.data(), values_.back().data());
       }
       std::size_t largest = 0;
       for (const std::vector<double>& r : values_) largest = std::max(largest, r.size());
@@ -85,7 +85,7 @@ class Differentiator {
         dv_(input - 1 - n) = 1.0;
       const ModelTapes& p = tapes_->tapes();
       if (const TermsSparsity* sparsity = tapes_->sparsity()) {
-        // A program compiled sparse writes only the nonzeros of A and b (model/sparsity.hpp):
+        // A tape compiled sparse writes only the nonzeros of A and b (model/sparsity.hpp):
         // its tangent comes in that layout and is scattered into the dense one of Layout.
         const int a_nz = sparsity->A.nonzeros(), b_nz = sparsity->b.nonzeros();
         sparse_tangent_.resize(static_cast<std::size_t>(a_nz + 2 * n + b_nz + layout_.s));
@@ -156,11 +156,11 @@ class Differentiator {
   std::vector<double> scratch_;
   std::vector<std::vector<double>> values_;
   std::vector<double> tangents_;
-  std::vector<double> sparse_tangent_;  // the tangent of a terms program compiled sparse
+  std::vector<double> sparse_tangent_;  // the tangent of a terms tape compiled sparse
   Vector dq_, dv_;
 };
 
-// Which inputs the terms and residuals depend on: structurally for compiled programs, else by
+// Which inputs the terms and residuals depend on: structurally for compiled tapes, else by
 // differences at the state and at two shifted values of the input (a hand-written model).
 std::vector<char> find_dependence(const Model& model, const Layout& layout, Differentiator& diff, const Vector& q,
                                   const Vector& v) {
@@ -168,7 +168,7 @@ std::vector<char> find_dependence(const Model& model, const Layout& layout, Diff
   std::vector<char> depends(static_cast<std::size_t>(1 + 2 * n), 0);
   if (const auto* pe = dynamic_cast<const TapeEvaluator*>(model.evaluator.get())) {
     const ModelTapes& p = pe->tapes();
-    // Time: any program. Coordinates: the terms and the velocity residuals only — a position
+    // Time: any tape. Coordinates: the terms and the velocity residuals only — a position
     // residual may depend on a coordinate whose gradient is constant (x - r theta), and what the
     // linearization needs of it, its gradient, is a row of b, which the terms carry.
     const std::vector<char> terms = calc_input_dependence(p.terms);
@@ -246,7 +246,7 @@ std::string join(const std::vector<std::string>& names) {
 }  // namespace
 
 const char* derivative_method_name(DerivativeMethod method) {
-  return method == DerivativeMethod::tangent ? "exact (tangent mode of the compiled programs)"
+  return method == DerivativeMethod::tangent ? "exact (tangent mode of the compiled tapes)"
                                              : "Richardson-extrapolated central differences (hand-written model)";
 }
 

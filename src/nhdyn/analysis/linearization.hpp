@@ -5,7 +5,7 @@
 // named) leave the state; the perturbations of the others obey the linearized constraints, from
 // which independent coordinates and speeds are chosen (pivoted QR, or named); the result is the
 // state matrix of (dq_ind, dq'_ind) and its eigenvalues. Derivatives are exact (tangent mode,
-// model/tape_tangent.hpp) for compiled models and Richardson-extrapolated central differences
+// model/detail/tape_tangent.hpp) for compiled models and Richardson-extrapolated central differences
 // for hand-written ones. sweep.hpp repeats it over a parameter.
 #pragma once
 
@@ -35,7 +35,7 @@ struct LinearizationOptions {
 };
 
 enum class DerivativeMethod { tangent, richardson };
-// "exact (tangent mode of the compiled programs)" or "Richardson-extrapolated central differences".
+// "exact (tangent mode of the compiled tapes)" or "Richardson-extrapolated central differences".
 const char* derivative_method_name(DerivativeMethod method);
 
 struct Linearization {

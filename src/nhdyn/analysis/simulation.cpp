@@ -8,7 +8,7 @@
 #include <cstring>
 #include <limits>
 
-#include "nhdyn/analysis/contact_switches.hpp"
+#include "nhdyn/analysis/detail/contact_switches.hpp"
 #include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
@@ -85,7 +85,7 @@ class MechanicalOde final : public OdeSystem {
 
   // The works: of the forces, the reactions, the explicit time dependence, and with contact modes
   // the friction's and the impacts' loss (model/contact_modes.hpp; the loss changes only at
-  // touchdowns, analysis/contact_switches.cpp).
+  // touchdowns, analysis/detail/contact_switches.cpp).
   int size() const override { return 2 * n_ + (balance_ ? kWorks : 0) + (friction_ ? 2 : 0); }
   int error_size() const override { return 2 * n_; }
 

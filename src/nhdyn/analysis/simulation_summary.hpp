@@ -97,7 +97,7 @@ struct SimulationSummary {
   EventSummary events;
   ConstraintWatchSummary watch;
   // The run's warnings in words, in time order: the constraint watch's (format_constraint_warning)
-  // and those of the contacts' mode switches (analysis/contact_switches.hpp).
+  // and those of the contacts' mode switches (analysis/detail/contact_switches.hpp).
   std::vector<std::string> warnings;
 };
 

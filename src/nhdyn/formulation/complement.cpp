@@ -6,7 +6,7 @@
 #include <string>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/formulation/small_dense.hpp"
+#include "nhdyn/formulation/detail/small_dense.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {

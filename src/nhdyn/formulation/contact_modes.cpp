@@ -7,7 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "nhdyn/formulation/row_scaling.hpp"
+#include "nhdyn/formulation/detail/row_scaling.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {

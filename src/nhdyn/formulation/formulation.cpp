@@ -4,7 +4,7 @@
 #include <string>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/core/finite.hpp"
+#include "nhdyn/core/detail/finite.hpp"
 #include "nhdyn/formulation/contact_modes.hpp"
 #include "nhdyn/formulation/lagrange.hpp"
 #include "nhdyn/formulation/nullspace.hpp"

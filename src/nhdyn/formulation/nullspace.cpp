@@ -1,7 +1,7 @@
 #include "nhdyn/formulation/nullspace.hpp"
 
 #include "nhdyn/formulation/complement.hpp"
-#include "nhdyn/formulation/small_dense.hpp"
+#include "nhdyn/formulation/detail/small_dense.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {

@@ -12,7 +12,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/formulation/complement.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
-#include "nhdyn/formulation/row_scaling.hpp"
+#include "nhdyn/formulation/detail/row_scaling.hpp"
 #include "nhdyn/formulation/sanh.hpp"
 #include "nhdyn/model/terms.hpp"
 

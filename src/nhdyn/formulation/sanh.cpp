@@ -5,8 +5,8 @@
 #include <limits>
 
 #include "nhdyn/formulation/complement.hpp"
-#include "nhdyn/formulation/row_scaling.hpp"
-#include "nhdyn/formulation/small_dense.hpp"
+#include "nhdyn/formulation/detail/row_scaling.hpp"
+#include "nhdyn/formulation/detail/small_dense.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {

@@ -1,7 +1,7 @@
 // The [optimize] reader: TOML in, an OptimalControlProblem out. Expressions are parsed by a
 // SpecBuilder whose coordinates are the model's followed by the controls (the control layout of
 // optimize_problem.hpp) and whose parameters are the model's, so that an unknown name gets the
-// builder's file:line:column message with the nearest known one, and the compiled programs read
+// builder's file:line:column message with the nearest known one, and the compiled tapes read
 // [q; u] and [q'; 0] as their coordinates and velocities.
 #include "nhdyn/frontend/optimize_problem.hpp"
 
@@ -532,7 +532,7 @@ OptimalControlProblem load_optimal_control_problem(const ModelSource& source, co
                                  "(docs/optimize.md)",
                                  source.builtin));
   if (dynamic_cast<const TapeEvaluator*>(loaded.model.evaluator.get()) == nullptr)
-    throw InputError("optimize needs the model's compiled programs (the interpreted evaluator): load it without "
+    throw InputError("optimize needs the model's compiled tapes (the interpreted evaluator): load it without "
                      "--compiled");
   SectionReader reader(source, loaded.model);
   return reader.read();

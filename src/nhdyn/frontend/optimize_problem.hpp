@@ -3,8 +3,8 @@
 // directions B(t, q, q'), an objective, boundary states, bounds and path constraints
 // (docs/derivations/optimal-programs.md, section 1). The expressions that read the controls (the
 // actuator forces B u, the integrand, the final-time term, the path constraints) are compiled into
-// straight-line programs over the "control layout": n + m coordinates [q; u] whose velocities are
-// [q'; 0], so that the tangent mode of model/tape_tangent.hpp differentiates them in q, q', u
+// tapes (straight-line code) over the "control layout": n + m coordinates [q; u] whose velocities are
+// [q'; 0], so that the tangent mode of model/detail/tape_tangent.hpp differentiates them in q, q', u
 // and t alike. The transcription and the solver (src/nhdyn/optimize/) read this struct only.
 //
 //     model file --load_model_described--> Model --load_optimal_control_problem--> OptimalControlProblem

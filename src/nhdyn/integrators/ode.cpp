@@ -7,7 +7,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/integrators/events.hpp"
-#include "nhdyn/integrators/explicit_rk.hpp"
+#include "nhdyn/integrators/detail/explicit_rk.hpp"
 #include "nhdyn/integrators/sundials/cvode.hpp"
 
 namespace nhdyn {

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -180,43 +181,59 @@ AtomicFile::AtomicFile(const fs::path& target) : target_(target) {
 }
 
 AtomicFile::~AtomicFile() {
-  if (file_) {
-    std::fclose(file_);
-    if (!temporary_.empty()) {
-      std::error_code ec;
-      std::filesystem::remove(temporary_, ec);
-      release_temporary_file(slot_);
-    }
-  }
+  if (file_) std::fclose(file_);
+  if (stage_ != Stage::published) remove_temporary();
+}
+
+void AtomicFile::remove_temporary() {
+  if (temporary_.empty()) return;
+  std::error_code ec;
+  std::filesystem::remove(temporary_, ec);
+  release_temporary_file(slot_);
+  temporary_.clear();
 }
 
 void AtomicFile::write(std::string_view bytes) {
   if (failed_ || !file_) return;
-  if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) failed_ = true;
+  if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) {
+    failed_ = true;
+    write_error_ = errno;
+  }
+}
+
+void AtomicFile::finish() {
+  if (stage_ != Stage::writing) throw std::logic_error(fmt::format("AtomicFile: '{}' was already finished", target_.string()));
+  int error = failed_ ? write_error_ : 0;
+  if (std::fflush(file_) != 0 && error == 0) error = errno;
+  if (std::fclose(file_) != 0 && error == 0) error = errno;
+  const bool ok = !failed_ && error == 0;
+  file_ = nullptr;
+  stage_ = Stage::finished;
+  if (ok) return;
+  if (temporary_.empty())
+    throw FileError(fmt::format("writing '{}' failed: {}", target_.string(), std::strerror(error)));
+  remove_temporary();
+  throw FileError(fmt::format("writing '{}' failed (disk full?); nothing was written", target_.string()));
+}
+
+void AtomicFile::publish() {
+  if (stage_ != Stage::finished)
+    throw std::logic_error(fmt::format("AtomicFile: '{}' published before finish() or twice", target_.string()));
+  stage_ = Stage::published;
+  if (temporary_.empty()) return;
+  std::error_code ec;
+  std::filesystem::rename(temporary_, resolved_, ec);
+  if (ec) {
+    remove_temporary();
+    throw FileError(fmt::format("cannot create '{}': {}", target_.string(), ec.message()));
+  }
+  release_temporary_file(slot_);
+  temporary_.clear();
 }
 
 void AtomicFile::commit() {
-  if (!file_) throw FileError(fmt::format("'{}' was already committed", target_.string()));
-  const bool flushed = std::fflush(file_) == 0;
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  if (temporary_.empty()) {
-    if (failed_ || !flushed || !closed)
-      throw FileError(fmt::format("writing '{}' failed: {}", target_.string(), std::strerror(errno)));
-    return;
-  }
-  std::error_code ec;
-  if (failed_ || !flushed || !closed) {
-    std::filesystem::remove(temporary_, ec);
-    release_temporary_file(slot_);
-    throw FileError(fmt::format("writing '{}' failed (disk full?); nothing was written", target_.string()));
-  }
-  std::filesystem::rename(temporary_, resolved_, ec);
-  release_temporary_file(slot_);
-  if (ec) {
-    std::filesystem::remove(temporary_, ec);
-    throw FileError(fmt::format("cannot create '{}': {}", target_.string(), ec.message()));
-  }
+  finish();
+  publish();
 }
 
 }  // namespace nhdyn

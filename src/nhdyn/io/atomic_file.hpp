@@ -2,6 +2,11 @@
 // never destroys what is not its own (docs/cli.md, "Output files"):
 // - output goes to a temporary file beside the target, renamed onto it by commit(); destroyed
 //   uncommitted (or the process interrupted: remove_temporary_files), the temporary is removed;
+// - commit() is two steps, finish() and publish(), for the writers of several files: finish()
+//   does all that can fail for want of space (flushing and closing the temporary), publish() only
+//   the rename, which within one directory fails only when the directory itself was changed
+//   meanwhile. Finishing every file before publishing any makes a group of files appear together
+//   or not at all when one of them cannot be written (apps/nhdyn/run_files.hpp);
 // - a symbolic link is written through to its target; a character device, pipe or socket is
 //   written straight (no temporary, no rename): /dev/stdout and a FIFO work as outputs;
 // - an existing file keeps its permission bits (its other hard links keep the old content: the
@@ -29,18 +34,32 @@ class AtomicFile {
   AtomicFile& operator=(const AtomicFile&) = delete;
 
   void write(std::string_view bytes);
-  // Flushes, closes and renames onto the target. Throws FileError if any write failed.
+  // The first step of commit: flushes and closes the temporary (or the device or pipe written
+  // straight). Throws FileError, the temporary removed, if a write, the flush or the close failed
+  // (disk full, file too large): nothing of this file appears. The target is not touched yet.
+  // Not synced to the disk (no fsync): a local file system reports a lack of space at the write,
+  // and a run's outputs are recomputed rather than recovered after a power loss.
+  void finish();
+  // The second step: renames the finished temporary onto the target (nothing for a device or
+  // pipe). Throws FileError if the rename fails (the directory changed since the temporary was
+  // made in it), the temporary then removed. Call after finish().
+  void publish();
+  // finish() then publish(): the file appears whole, or FileError.
   void commit();
 
   const std::filesystem::path& target() const { return target_; }
 
  private:
+  enum class Stage { writing, finished, published };
   std::filesystem::path target_;     // as the user named it (messages)
   std::filesystem::path resolved_;   // symbolic links followed: the file that is replaced
   std::filesystem::path temporary_;  // empty when writing straight to a device or pipe
   std::FILE* file_ = nullptr;
   int slot_ = -1;  // in the table of temporaries removed on interruption
-  bool failed_ = false;
+  Stage stage_ = Stage::writing;
+  bool failed_ = false;  // a write failed; write_error_ is its errno
+  int write_error_ = 0;
+  void remove_temporary();
 };
 
 // Registers `input` (a file the run reads) so that no AtomicFile, CSV or plot may replace it,

@@ -56,10 +56,15 @@ void CsvWriter::write_row(std::span<const double> values) {
   }
 }
 
-void CsvWriter::commit() {
+void CsvWriter::finish() {
   file_.write(buffer_);
   buffer_.clear();
-  file_.commit();
+  file_.finish();
+}
+
+void CsvWriter::commit() {
+  finish();
+  publish();
 }
 
 int CsvTable::column(const std::string& name) const {

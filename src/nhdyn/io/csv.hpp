@@ -24,6 +24,11 @@ class CsvWriter {
 
   void write_row(std::span<const double> values);  // values.size() must equal the column count
   void commit();                                  // the file appears whole, or FileError
+  // commit() in its two steps (AtomicFile::finish, publish), for a group of files that appear
+  // together: the rows written and the temporary closed (FileError if any of it failed), then the
+  // rename.
+  void finish();
+  void publish() { file_.publish(); }
   std::size_t columns() const { return columns_; }
 
  private:

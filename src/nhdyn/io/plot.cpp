@@ -16,8 +16,8 @@
 #include <system_error>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/io/gnuplot.hpp"
-#include "nhdyn/io/plot_csv.hpp"
+#include "nhdyn/io/detail/gnuplot.hpp"
+#include "nhdyn/io/detail/plot_csv.hpp"
 
 namespace nhdyn {
 namespace {

@@ -163,7 +163,7 @@ SceneSize equivalent_ellipsoid(double mass, const Eigen::Matrix3d& inertia) {
   return out;
 }
 
-// The run's values in the order the scene's programs read them; refused when the names differ (a
+// The run's values in the order the scene's tapes read them; refused when the names differ (a
 // scene compiled from another model than the run's).
 std::vector<double> parameter_values_for(const symbolic::VisualScene& scene, const std::vector<Parameter>& parameters,
                                          const std::string& model) {
@@ -227,7 +227,7 @@ std::vector<SceneSize> calc_scene_sizes(const symbolic::VisualScene& scene, cons
 
 namespace {
 
-// A bound field program (symbolic/visual.hpp) evaluated at points.
+// A bound field tape (symbolic/visual.hpp) evaluated at points.
 class Field {
  public:
   Field(const Tape& field, const std::vector<double>& parameters)
@@ -719,8 +719,8 @@ void append_scene_shapes(std::string& data, const ReportInput& input, const Fram
   const symbolic::VisualScene& scene = *input.scene;
   const std::vector<SceneSize> sizes = calc_scene_sizes(scene, input.parameters, input.model);
   const std::vector<double> parameter_values = parameter_values_for(scene, input.parameters, input.model);
-  const Tape program = scene.tape.bind(parameter_values.data(), parameter_values.size());
-  const int n = program.coordinates();
+  const Tape bound = scene.tape.bind(parameter_values.data(), parameter_values.size());
+  const int n = bound.coordinates();
   if (n != static_cast<int>(input.coordinates.size()))
     throw InputError(fmt::format("the scene of '{}' has {} coordinates, the run {}", input.model, n,
                                  input.coordinates.size()));
@@ -730,8 +730,8 @@ void append_scene_shapes(std::string& data, const ReportInput& input, const Fram
     vc.push_back(table.column(q + "'"));
   }
   std::vector<double> q(static_cast<std::size_t>(n)), v(static_cast<std::size_t>(n));
-  std::vector<double> registers(static_cast<std::size_t>(program.registers()));
-  std::vector<double> outputs(static_cast<std::size_t>(program.outputs()));
+  std::vector<double> registers(static_cast<std::size_t>(bound.registers()));
+  std::vector<double> outputs(static_cast<std::size_t>(bound.outputs()));
   std::vector<double> values;
   values.reserve(frames.size() * outputs.size());
   const int tc = table.column("t");
@@ -741,7 +741,7 @@ void append_scene_shapes(std::string& data, const ReportInput& input, const Fram
       q[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(qc[static_cast<std::size_t>(i)])];
       v[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(vc[static_cast<std::size_t>(i)])];
     }
-    program.run(row[static_cast<std::size_t>(tc)], q.data(), v.data(), registers.data(), outputs.data());
+    bound.run(row[static_cast<std::size_t>(tc)], q.data(), v.data(), registers.data(), outputs.data());
     require_finite_scene(scene, input, outputs, row[static_cast<std::size_t>(tc)], q, v);
     // A body is drawn along its principal axes: R E, E's columns the axes in the frame's components.
     for (std::size_t s = 0; s < scene.shapes.size(); ++s) {

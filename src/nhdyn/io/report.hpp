@@ -2,7 +2,7 @@
 // with a 3-D animation of the motion, the plots of the run with a cursor at the current time, the
 // summary and the model's equations rendered by KaTeX. Last stage of the pipeline, like the plots
 // (io/plot.hpp): it reads the rows of a finished run (CSV layout of io/results.hpp) and, for the
-// scene, the compiled visual programs of the model (symbolic/visual.hpp), which it binds to the
+// scene, the compiled visual tapes of the model (symbolic/visual.hpp), which it binds to the
 // run's parameter values (parameters are data: a --set changes the drawn sizes and positions
 // without recompiling anything) and runs on each row it shows. The JavaScript libraries (Debian's libjs-three and libjs-katex with its fonts) and
 // the page's own template (io/resources/) are embedded in the library at build time; docs/report.md
@@ -43,7 +43,7 @@ struct ReportInput {
   // drawn, and the page says the model has nothing to draw.
   const symbolic::VisualScene* scene = nullptr;
   // The run's parameter values, in the order of scene->parameters (Model::parameters): the scene's
-  // programs read them. Their names are checked against the scene's.
+  // tapes read them. Their names are checked against the scene's.
   std::vector<Parameter> parameters;
   std::optional<std::pair<std::string, std::string>> path;
   // The title of the panel of columns.actuators: program motion's actuator forces by default, an
@@ -127,7 +127,7 @@ std::vector<SceneSize> calc_scene_sizes(const symbolic::VisualScene& scene, cons
 // (R, r, 0); solid, track, terrain and surface (0, 0, 0), their extent being their mesh's or path's.)
 
 // The triangle meshes of the scene's solid, terrain and surface shapes for the given parameter
-// values, computed once per report from `values` (the scene program's outputs at the frames
+// values, computed once per report from `values` (the scene tape's outputs at the frames
 // drawn, `stride` per frame): a solid's zero set f = 0 in its frame's axes, sampled along 25 x 49
 // rays from its centre (f < 0 there; bisection to round-off), spread as the unit sphere stretched
 // by the shape's reach along each axis; a terrain's height h(X, Y) at the

@@ -22,7 +22,7 @@
 #include <sstream>
 #include <vector>
 
-#include "nhdyn/jit/source.hpp"
+#include "nhdyn/jit/detail/source.hpp"
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/tape.hpp"
 
@@ -228,13 +228,13 @@ std::string verify_entry(const fs::path& object, const fs::path& check, const st
 }
 
 
-using ProgramStage = void (*)(const double*, double*);
-using ProgramRun = void (*)(const double*, double, const double*, const double*, double*);
+using TapeStageFunction = void (*)(const double*, double*);
+using TapeRunFunction = void (*)(const double*, double, const double*, const double*, double*);
 
 // A tape of make_tape_source in a loaded object (the contact forces', the outputs').
-class CompiledProgram final : public NativeTape {
+class CompiledTape final : public NativeTape {
  public:
-  CompiledProgram(std::shared_ptr<const Library> library, StageSize size, ProgramStage stage, ProgramRun run)
+  CompiledTape(std::shared_ptr<const Library> library, StageSize size, TapeStageFunction stage, TapeRunFunction run)
       : library_(std::move(library)), size_(size), stage_(stage), run_(run) {}
   std::size_t stage_size() const override { return size_(); }
   void stage(const double* parameters, double* stage) const override { stage_(parameters, stage); }
@@ -245,23 +245,23 @@ class CompiledProgram final : public NativeTape {
  private:
   std::shared_ptr<const Library> library_;  // keeps the object loaded
   StageSize size_;
-  ProgramStage stage_;
-  ProgramRun run_;
+  TapeStageFunction stage_;
+  TapeRunFunction run_;
 };
 
-// The program NAME of the loaded object, or null when the object lacks it.
-std::shared_ptr<const NativeTape> native_program(const std::shared_ptr<const Library>& library,
+// The tape NAME of the loaded object, or null when the object lacks it.
+std::shared_ptr<const NativeTape> native_tape(const std::shared_ptr<const Library>& library,
                                                     const std::string& name) {
   const auto size = reinterpret_cast<StageSize>(dlsym(library->handle, ("nhdyn_jit_" + name + "_stage_size").c_str()));
-  const auto stage = reinterpret_cast<ProgramStage>(dlsym(library->handle, ("nhdyn_jit_" + name + "_stage").c_str()));
-  const auto run = reinterpret_cast<ProgramRun>(dlsym(library->handle, ("nhdyn_jit_" + name).c_str()));
+  const auto stage = reinterpret_cast<TapeStageFunction>(dlsym(library->handle, ("nhdyn_jit_" + name + "_stage").c_str()));
+  const auto run = reinterpret_cast<TapeRunFunction>(dlsym(library->handle, ("nhdyn_jit_" + name).c_str()));
   if (!size || !stage || !run) return nullptr;
-  return std::make_shared<CompiledProgram>(library, size, stage, run);
+  return std::make_shared<CompiledTape>(library, size, stage, run);
 }
 
-// The programs of an output row that the evaluator runs (the residuals, the energy, h and the
+// The tapes of an output row that the evaluator runs (the residuals, the energy, h and the
 // power), compiled when the model has them; null: the interpreter's.
-enum RowProgram { kPositionResidual, kVelocityResidual, kEnergy, kEnergyFunction, kPower, kRowTapes };
+enum RowTape { kPositionResidual, kVelocityResidual, kEnergy, kEnergyFunction, kPower, kRowTapes };
 const char* const kRowTapeNames[kRowTapes] = {"position_residual", "velocity_residual", "energy",
                                                     "energy_function", "power"};
 const Tape* row_tape(const ModelTapes& p, int which) {
@@ -274,13 +274,13 @@ const Tape* row_tape(const ModelTapes& p, int which) {
     default: return nullptr;
   }
 }
-using RowPrograms = std::array<std::shared_ptr<const NativeTape>, kRowTapes>;
+using RowTapes = std::array<std::shared_ptr<const NativeTape>, kRowTapes>;
 
-// The interpreter's evaluator with its terms, and the programs of a row, replaced by compiled ones.
+// The interpreter's evaluator with its terms, and the tapes of a row, replaced by compiled ones.
 class CompiledEvaluator final : public Evaluator {
  public:
   CompiledEvaluator(std::shared_ptr<const TapeEvaluator> base, std::shared_ptr<const Library> library,
-                    RowPrograms rows)
+                    RowTapes rows)
       : base_(std::move(base)), library_(std::move(library)), sparse_(base_->sparsity() != nullptr),
         rows_(std::move(rows)) {
     const std::vector<double>& p = base_->parameter_values();
@@ -378,7 +378,7 @@ class CompiledEvaluator final : public Evaluator {
   std::shared_ptr<const Library> library_;
   bool sparse_ = false;
   std::vector<double> stage_;  // what the terms read of the parameter stage (one spare entry)
-  RowPrograms rows_;
+  RowTapes rows_;
   std::array<std::vector<double>, kRowTapes> row_stages_;  // their parameter stages
 };
 
@@ -396,13 +396,13 @@ bool is_compiled(const Model& model) {
 
 namespace {
 
-// The C++ source of a model: its terms, and the programs of the output rows (a compiled model
+// The C++ source of a model: its terms, and the tapes of the output rows (a compiled model
 // computes its rows compiled too).
 std::string model_source(const TapeEvaluator& base, const Model& model) {
   std::string source = make_terms_source(base.parametric_tapes().terms, base.n(), base.s(), base.sparsity());
   for (int i = 0; i < kRowTapes; ++i)
-    if (const Tape* program = row_tape(base.parametric_tapes(), i))
-      source += make_tape_source(kRowTapeNames[i], *program);
+    if (const Tape* tape = row_tape(base.parametric_tapes(), i))
+      source += make_tape_source(kRowTapeNames[i], *tape);
   if (model.contact_forces) source += make_tape_source("contact", model.contact_forces->tape);
   if (!model.outputs.list.empty()) source += make_tape_source("outputs", model.outputs.tape);
   return source;
@@ -534,26 +534,26 @@ std::shared_ptr<Library> compile_entry(const std::string& source, const std::str
   return library;
 }
 
-// The model with the library's functions in place of its programs.
+// The model with the library's functions in place of its tapes.
 Model bind_library(const Model& model, std::shared_ptr<const TapeEvaluator> base, std::shared_ptr<Library> library,
                    const fs::path& object) {
   Model out = model;
   if (model.contact_forces) {
     auto contact = std::make_shared<ContactForceModel>(*model.contact_forces);
-    contact->native = native_program(library, "contact");
-    if (!contact->native) throw JitError(fmt::format("{} lacks the contact forces' program", object.string()));
+    contact->native = native_tape(library, "contact");
+    if (!contact->native) throw JitError(fmt::format("{} lacks the contact forces' tape", object.string()));
     out.contact_forces = std::move(contact);
   }
   if (!model.outputs.list.empty()) {
-    out.outputs.native = native_program(library, "outputs");
-    if (!out.outputs.native) throw JitError(fmt::format("{} lacks the outputs' program", object.string()));
+    out.outputs.native = native_tape(library, "outputs");
+    if (!out.outputs.native) throw JitError(fmt::format("{} lacks the outputs' tape", object.string()));
   }
-  RowPrograms rows;
+  RowTapes rows;
   for (int i = 0; i < kRowTapes; ++i) {
     if (!row_tape(base->parametric_tapes(), i)) continue;
-    rows[static_cast<std::size_t>(i)] = native_program(library, kRowTapeNames[i]);
+    rows[static_cast<std::size_t>(i)] = native_tape(library, kRowTapeNames[i]);
     if (!rows[static_cast<std::size_t>(i)])
-      throw JitError(fmt::format("{} lacks the program {}", object.string(), kRowTapeNames[i]));
+      throw JitError(fmt::format("{} lacks the tape {}", object.string(), kRowTapeNames[i]));
   }
   out.evaluator = std::make_shared<CompiledEvaluator>(std::move(base), std::move(library), std::move(rows));
   return out;
@@ -564,7 +564,7 @@ Model bind_library(const Model& model, std::shared_ptr<const TapeEvaluator> base
 Model make_compiled(const Model& model, const JitOptions& options, JitReport* report) {
   auto base = std::dynamic_pointer_cast<const TapeEvaluator>(model.evaluator);
   if (!base)
-    throw JitError(fmt::format("model '{}' has no compiled programs (a hand-written built-in model): nothing to "
+    throw JitError(fmt::format("model '{}' has no compiled tapes (a hand-written built-in model): nothing to "
                                "compile",
                                model.name));
   const bool sparse = base->sparsity() != nullptr;

@@ -1,8 +1,8 @@
-// The compiled evaluator: a model's terms program (the hot path of every right-hand side) turned
+// The compiled evaluator: a model's terms tape (the hot path of every right-hand side) turned
 // into machine code by the system's C++ compiler, loaded with dlopen and used in place of the
 // interpreter. This folder is the only place that runs a compiler or calls dlopen.
 //
-// The source (jit/source.hpp) is compiled into a shared object cached under
+// The source (jit/detail/source.hpp) is compiled into a shared object cached under
 // $XDG_CACHE_HOME/nhdyn (else ~/.cache/nhdyn), named by a hash of the source, the compiler (its
 // command and its --version) and the flags, so a second run of the same model loads it without
 // compiling, and a parameter change reuses it (parameters are data: the stage is recomputed).
@@ -12,10 +12,10 @@
 // altered or misplaced entry is removed and compiled again with a note (JitReport::note), never
 // loaded. An interrupted compile (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2) stops the
 // compiler's whole process group, removes its source, log and temporary object, and then lets the
-// signal take its course. The programs of an output row go into the same object, so a compiled
+// signal take its course. The tapes of an output row go into the same object, so a compiled
 // model computes its rows compiled too: the residuals, the energy, h and the power (the
-// evaluator's), the contact forces' and the derived outputs' programs (NativeTape, set on the
-// Model's ContactForceModel and ModelOutputs). The other programs (complement, solution, initial
+// evaluator's), the contact forces' and the derived outputs' tapes (NativeTape, set on the
+// Model's ContactForceModel and ModelOutputs). The other tapes (complement, solution, initial
 // state, program constraints) and the parameter handling stay with the interpreter, whose
 // TapeEvaluator the compiled evaluator wraps; so every formulation, the sparse path and
 // linearization's finite differences work unchanged.
@@ -47,7 +47,7 @@ inline constexpr std::array<EvaluatorChoiceInfo, 3> kEvaluatorChoices{
 // "interpreted" | "compiled" | "auto"; throws InputError naming the value otherwise.
 EvaluatorChoice parse_evaluator_choice(const std::string& text);
 
-// `auto` compiles a model whose terms program has at least this many operations (docs/design.md,
+// `auto` compiles a model whose terms tape has at least this many operations (docs/design.md,
 // "Compiled evaluator": below it the compile time is not won back in a typical run).
 inline constexpr int kAutoCompileFrom = 1000;
 
@@ -66,11 +66,11 @@ struct JitReport {
 
 // The model with its terms compiled, sharing everything else. Throws JitError naming the reason
 // (no compiler, a failed compile with its first error line, a failed dlopen, a model whose
-// evaluator is not a compiled program, e.g. a hand-written built-in).
+// evaluator is not a compiled tape, e.g. a hand-written built-in).
 Model make_compiled(const Model& model, const JitOptions& options = {}, JitReport* report = nullptr);
 
 // The model with the evaluator `choice` asks for: interpreted returns it unchanged; compiled
-// compiles it; automatic compiles when the terms program has kAutoCompileFrom operations or more.
+// compiles it; automatic compiles when the terms tape has kAutoCompileFrom operations or more.
 // A compile that fails (no compiler, a compile error, a failed dlopen, a hand-written model) never
 // fails the run: the interpreter is kept and a one-line notice written to `notice` (not printed:
 // the caller prints). make_compiled is the call that throws.

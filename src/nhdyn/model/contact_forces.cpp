@@ -108,7 +108,7 @@ Vector ideal_acceleration(const Matrix& A, const Vector& h, const Matrix& b, con
   return K.fullPivLu().solve(k).head(n);
 }
 
-// M and rhs from the program's outputs, q'' and R (docs/derivations/contact-forces.md step 6).
+// M and rhs from the tape's outputs, q'' and R (docs/derivations/contact-forces.md step 6).
 void assemble(const ContactForceModel& c, const double* o, const double* qdd, const double* R, Matrix& M,
               Vector& rhs) {
   const int n = c.n;

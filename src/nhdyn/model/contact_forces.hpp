@@ -1,13 +1,13 @@
 // Contact forces of a multibody model's wheels and knife edges, without multipliers: the method of
 // docs/derivations/contact-forces.md section 4 (b). The symbolic layer (symbolic/contact_forces.hpp)
-// compiles, at load, one straight-line program in (t, q, q') whose outputs are the columns of the
+// compiles, at load, one tape (straight-line code) in (t, q, q') whose outputs are the columns of the
 // stacked system (C1) + (C3) and the parts of its right-hand side; after each output row the kernel
 // compute_contact_forces assembles
 //
 //     M F = rhs,   M = [ J_1^T d ... ]      rhs = [ R                                     ]
 //                      [ E_1   d ... ]            [ K_S q'' + k_S   (one block per system) ]
 //
-// (the momentum balance is linear in q'': K_S and k_S come from the program) and solves it by least
+// (the momentum balance is linear in q'': K_S and k_S come from the tape) and solves it by least
 // squares with a rank-revealing QR, then splits each force into its normal, longitudinal and
 // lateral parts. Where the model does not determine a component (a statically indeterminate support,
 // or a body held by its coordinates in a direction no contact supports) the component is NaN, and
@@ -60,7 +60,7 @@ struct ContactForceContact {
   int first_value = 0;    // index of its first column in ContactForceData::values
 };
 
-// Frozen at load. The program's outputs, in this order:
+// Frozen at load. The tape's outputs, in this order:
 //   per unknown u:     n entries J^T d_u (its column of (C1)), then 6 entries E d_u (its column of
 //                      (C3): d_u and (P - O) x d_u / L), then 3 entries d_u (world components);
 //   per system S:      6 x n entries K_S (column-major), then 6 entries k_S: the momentum balance
@@ -97,7 +97,7 @@ struct ContactForceModel {
   int columns() const { return unknowns + hand_constraints; }
   int reported() const;
   int values() const;  // the number of result columns of the reported contacts
-  // Offsets of the program's outputs.
+  // Offsets of the tape's outputs.
   int unknown_offset(int u) const { return u * (n + 9); }
   int system_offset(int s) const { return unknowns * (n + 9) + s * (6 * n + 6); }
   int direction_offset(int reported_index) const { return system_offset(systems) + 9 * reported_index; }
@@ -128,7 +128,7 @@ struct ContactForceData {
 ContactForceData make_contact_force_data(const Model& model);
 
 // Requires the accelerations of the current state (Stage::acceleration: q'' and R in data).
-// Writes data.contact.values and data.contact.residual. Allocates nothing; cost: the program, one
+// Writes data.contact.values and data.contact.residual. Allocates nothing; cost: the tape, one
 // QR of a (n + 6 systems) x unknowns matrix (none for one wheel alone on one system: F is its
 // system's momentum balance). Throws std::logic_error when called before the accelerations.
 void compute_contact_forces(const Model& model, Data& data);

@@ -5,7 +5,7 @@
 // modes: rolling (its gap and no-slip rows are constraints, as without modes), sliding (the gap
 // row stays, the no-slip rows are dropped and Coulomb's friction -mu_k N e_s acts along them) and
 // free (all its rows dropped). The solve of each mode is formulation/contact_modes.hpp; the
-// switches between them are analysis/contact_switches.hpp.
+// switches between them are analysis/detail/contact_switches.hpp.
 //
 //     symbolic/contact_modes (compile_contact_modes) -> Model::contact_modes
 //         -> make_data (ContactModeData) -> compute_mode_acceleration -> CSV columns NAME_mode ...
@@ -60,7 +60,7 @@ struct ContactModeModel {
 
 // The mode of every contact and the results of the last solve (compute_mode_acceleration), with
 // the workspace of that solve. Sized by make_contact_mode_data (inactive for a model without
-// contact modes); the mode changes only at a switch (analysis/contact_switches.hpp), where the
+// contact modes); the mode changes only at a switch (analysis/detail/contact_switches.hpp), where the
 // workspace may be resized (the only allocation).
 struct ContactModeData {
   bool active = false;
@@ -90,7 +90,7 @@ struct ContactModeData {
   std::vector<double> velocity_residuals;  // the model's velocity residuals (the slips are among them)
   std::vector<int> kept;                   // rows of b kept as constraints
   std::vector<int> gap_column;             // per contact: its gap row's column in reaction_rows, or -1
-  std::vector<std::array<double, 2>> tangent_length;  // per contact: |t1|, |t2| of the program's outputs
+  std::vector<std::array<double, 2>> tangent_length;  // per contact: |t1|, |t2| of the tape's outputs
   Matrix reaction_rows;                    // n x r, the reaction directions B~^T (columns)
   Matrix M;                                // n x n, [D A; b_kept]
   Vector rhs, multipliers;                 // n; r
@@ -106,7 +106,7 @@ ContactModeData make_contact_mode_data(const Model& model);
 
 // The result columns of the contacts with modes: per contact NAME_mode, NAME_slip_speed,
 // NAME_slip_x, NAME_slip_y, NAME_slip_z, NAME_gap, then work_friction (the friction's work since
-// t0) and impact_loss (the energy the touchdowns took since t0, analysis/contact_switches.hpp). Empty for a model without contact modes. Appended after the contact forces
+// t0) and impact_loss (the energy the touchdowns took since t0, analysis/detail/contact_switches.hpp). Empty for a model without contact modes. Appended after the contact forces
 // (contact_forces.hpp).
 std::vector<std::string> contact_mode_columns(const Model& model);
 // Appends their values (after compute_mode_acceleration and record_contact_gaps); `work_friction`

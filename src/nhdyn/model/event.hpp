@@ -1,7 +1,7 @@
 // An event of a model: a function g(t, q, q') (or of q'', R and the contact forces too) whose crossings of zero a run locates and reports
 // (analysis/simulation.hpp), optionally ending the run there. Written in a model file as
 // [[events]] (docs/model-format.md) or on the command line (--stop-when, --event); compiled from
-// its expression by the symbolic layer (symbolic/events.hpp) into a straight-line program that
+// its expression by the symbolic layer (symbolic/events.hpp) into a tape (straight-line code) that
 // reads the model's parameters, so that --set and set_parameter apply to events too.
 #pragma once
 

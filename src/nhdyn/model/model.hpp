@@ -45,7 +45,8 @@ struct Constraint {
 
 // A program (docs/derivations/program-motion.md): a constraint the motion must follow that no
 // ideal contact enforces, realized by its actuator, a generalized force along the column B_j of the
-// actuator matrix with an unknown magnitude u_j. (Unrelated to the evaluator's compiled programs.)
+// actuator matrix with an unknown magnitude u_j. (The code the evaluator runs is a tape,
+// model/tape.hpp: "program" means this only.)
 struct ProgramConstraint {
   std::string name;
   ConstraintLevel level = ConstraintLevel::position;

@@ -2,13 +2,13 @@
 // the parameters (a model file's [outputs], and a multibody model's automatic positions and
 // velocities of its points and frame origins), each written as one more column of the results
 // after the standard ones (io/results.hpp). Compiled by the symbolic layer (symbolic/outputs.hpp)
-// into one straight-line program that reads the parameters, so --set applies to outputs too;
+// into one tape (straight-line code, model/tape.hpp) that reads the parameters, so --set applies to outputs too;
 // make_data binds it to the Model's parameter values, compute_outputs runs it after the dynamics.
 //
 //     [outputs] / multibody points --symbolic/outputs--> Model::outputs --make_data--> Data::outputs
 //                                                          --compute_outputs--> Data::outputs.values
 //
-// A program that reads q'' or R (an output's, or an event's, model/event.hpp) uses the "dynamics
+// A tape that reads q'' or R (an output's, or an event's, model/event.hpp) uses the "dynamics
 // layout" below: it is a Tape of 2n coordinates whose coordinate inputs are [q; q''] and whose
 // velocity inputs are [q'; R]. Its caller packs those from a solved state (pack_dynamics_inputs).
 #pragma once

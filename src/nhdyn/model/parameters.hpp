@@ -2,7 +2,7 @@
 // A parameter is either a base one (a number) or a derived one (an expression in numbers, the
 // constants pi and e, and other parameters, such as k = "4*m"), re-evaluated whenever a parameter
 // it uses changes. Setting a parameter re-binds the Model's Evaluator to the new values
-// (Evaluator::with_parameters: the compiled programs fold their parameter-only parts once, here,
+// (Evaluator::with_parameters: the compiled tapes fold their parameter-only parts once, here,
 // not at every call) and re-evaluates the initial state where it depends on the parameters.
 // No GiNaC: the expressions of parameter values have their own small evaluator, so that the
 // command line (`--set NAME=EXPR`) and the Python package use this without the symbolic layer.
@@ -64,7 +64,7 @@ double get_parameter(const Model& model, std::string_view name);
 // depends on the parameters (so set q0 and v0 after the parameters). Throws InputError for an
 // unknown name (naming the nearest known one), a value check_parameter_value refuses, or values
 // the model refuses (a sled with rho <= a); the model is then left unchanged. Cost: that of
-// preparing the compiled programs once (no symbolic work).
+// preparing the compiled tapes once (no symbolic work).
 void set_parameter(Model& model, std::string_view name, double value);
 // The same with an expression of numbers, constants and other parameters (`--set lambda=pi/10`).
 void set_parameter_expression(Model& model, std::string_view name, std::string_view expression);

@@ -357,7 +357,7 @@ void check_tape(const Tape& tape, const char* what, int n, int outputs) {
 
 namespace {
 
-ModelTapes bind_programs(const ModelTapes& parametric, const std::vector<double>& values) {
+ModelTapes bind_tapes(const ModelTapes& parametric, const std::vector<double>& values) {
   if (values.size() < static_cast<std::size_t>(parametric.parameters))
     throw std::invalid_argument("TapeEvaluator: " + std::to_string(values.size()) + " parameter values for " +
                                 std::to_string(parametric.parameters) + " parameters");
@@ -415,7 +415,7 @@ void TapeEvaluator::build() {
   if (n <= 0 || s < 0 || s >= n)
     throw std::invalid_argument("TapeEvaluator: needs 0 <= s < n, got n = " + std::to_string(n) +
                                 ", s = " + std::to_string(s));
-  tapes_ = bind_programs(*parametric_, parameters_);
+  tapes_ = bind_tapes(*parametric_, parameters_);
   std::size_t a_size = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
   std::size_t b_size = static_cast<std::size_t>(s) * static_cast<std::size_t>(n);
   if (tapes_.sparsity) {

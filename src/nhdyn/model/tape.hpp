@@ -1,4 +1,4 @@
-// Straight-line programs on doubles (tapes): the numeric form of a model compiled from symbols
+// Straight-line code on doubles (tapes): the numeric form of a model compiled from symbols
 // (symbolic/compile.hpp). A Tape is a flat array of instructions in single-assignment form with
 // no branches and no allocation when it runs, so its cost is one switch dispatch per run of
 // instructions of the same op, plus the arithmetic. Registers: r[0] = t, r[1 + i] = q_i,

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
-#include "nhdyn/core/finite.hpp"
+#include "nhdyn/core/detail/finite.hpp"
 
 namespace nhdyn {
 

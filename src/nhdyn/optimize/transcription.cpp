@@ -13,7 +13,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
-#include "nhdyn/model/tape_tangent.hpp"
+#include "nhdyn/model/detail/tape_tangent.hpp"
 
 namespace nhdyn {
 namespace {

@@ -14,7 +14,7 @@
 // Boundary values and bounds are bounds on the variables; a fixed final value that the constraints
 // determine from the other fixed final values is released (the rank rule of section 5, item 1). The objective is the quadrature (O8) of
 // the integrand plus the final term (or T for minimum time). Every derivative is exact: the
-// tangent mode of the compiled programs (model/tape_tangent.hpp), contracted as in (O5), (O7),
+// tangent mode of the compiled tapes (model/detail/tape_tangent.hpp), contracted as in (O5), (O7),
 // so that no derivative of D is needed; the Hessian of the Lagrangian from forward differences of
 // these exact first derivatives (section 8). Plain C++, no solver types.
 #pragma once

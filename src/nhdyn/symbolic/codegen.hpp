@@ -1,6 +1,6 @@
 // Code generation: a Spec and its Derivation printed as standalone C++ — a header that implements
 // nhdyn::Evaluator with straight-line code and a `make_<identifier>_model()` that fills the Model
-// as compile_model() does. The code is the compiled programs (model/tape.hpp) written out, one
+// as compile_model() does. The code is the compiled tapes (model/tape.hpp) written out, one
 // `const double rN = ...;` per instruction, so common subexpressions are shared exactly as in the
 // interpreted model and both round alike. The header includes "nhdyn/model/evaluator.hpp",
 // "nhdyn/model/model.hpp" and the standard library only (no GiNaC). The output is deterministic:

@@ -9,9 +9,9 @@
 // that a call costs what it cost when parameters were literals. Each expression is first translated into a canonical form of our own
 // (below: sorted operands, sums of canonical sign, every distinct subexpression one node), which
 // does not depend on GiNaC's internal term order or sign choices (they follow addresses, which
-// change from process to process); the program is emitted from that form, every subexpression
+// change from process to process); the tape is emitted from that form, every subexpression
 // once, so that a subexpression shared by several terms (sin(phi) in A, G, b, b0) is computed
-// once, and the program — its rounding, and the generated code printed from it — is the same in
+// once, and the tape — its rounding, and the generated code printed from it — is the same in
 // every process (docs/design.md, "Reproducibility").
 #include "nhdyn/symbolic/compile.hpp"
 
@@ -39,7 +39,7 @@
 #include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "nhdyn/symbolic/outputs.hpp"
-#include "nhdyn/symbolic/plain_words.hpp"
+#include "nhdyn/symbolic/detail/plain_words.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
@@ -185,7 +185,7 @@ class TapeCompiler {
   // An output that is NaN at every call (an expression that cannot be evaluated).
   void add_nan_output() { tape_.add_constant_output(std::numeric_limits<double>::quiet_NaN()); }
 
-  // The finished program, with each sin(x), cos(x) pair fused into one sincos.
+  // The finished tape, with each sin(x), cos(x) pair fused into one sincos.
   Tape finish() const { return fuse_sincos(tape_); }
 
  private:
@@ -287,7 +287,7 @@ class TapeCompiler {
 
   // The terms that differ only in their factors of parameters, c1 p1 s + c2 p2 s, merged into one,
   // (c1 p1 + c2 p2) s, whose coefficient the parameter stage computes; the terms of parameters only
-  // merged with the offset into one. The program then does per call what it did when parameters were
+  // merged with the offset into one. The tape then does per call what it did when parameters were
   // numbers in the expression (and a computer algebra system merged such terms): a derived inertia
   // matrix sums each product of sines and cosines over the bodies, each with its own parameters.
   std::vector<Scaled> merge_parameter_terms(std::vector<Scaled> terms, double& offset) {
@@ -786,7 +786,7 @@ class TapeCompiler {
     return tape_.push(Op::pow_k, emit(base), 0, 0, p);
   }
 
-  // Rewrites a program so that sin(x) and cos(x) of the same register become one sincos (one
+  // Rewrites a tape so that sin(x) and cos(x) of the same register become one sincos (one
   // call to the math library less when the compiler fuses them, and always one dispatch less).
   static Tape fuse_sincos(const Tape& in) {
     const std::vector<Instruction>& code = in.code();
@@ -1066,7 +1066,7 @@ void compile_residuals(const Spec& spec, const Derivation& derivation, ModelTape
 }
 
 // The energy and its balance (docs/derivations/energy-balance.md): h where it differs from E, and
-// the symbolic parts of the power where they are not zero (the power program runs at every
+// the symbolic parts of the power where they are not zero (the power tape runs at every
 // right-hand side of a run, so a conservative model has none).
 void compile_energy(const Spec& spec, const Derivation& derivation, ModelTapes& tapes) {
   if (!derivation.energy) return;
@@ -1096,7 +1096,7 @@ void compile_initial_state(const Spec& spec, ModelTapes& tapes) {
                                  spec.name, spec.q0.size(), spec.v0.size(), n));
   const auto q_name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
   // Checked here, symbolically (an initial value may use the parameters only); its values come
-  // from the initial-state program, which follows the parameters when they change.
+  // from the initial-state tape, which follows the parameters when they change.
   const GiNaC::lst values = spec.parameter_values();
   for (int i = 0; i < n; ++i) {
     initial_value(spec, values, spec.q0[static_cast<std::size_t>(i)], q_name(i));

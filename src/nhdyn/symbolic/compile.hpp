@@ -1,7 +1,7 @@
 // From symbols to numbers: compile a Spec and its Derivation into a frozen numeric Model whose
-// Evaluator runs straight-line programs (model/tape.hpp) — all the terms A, Q, G, b, b0 in one
-// program with common subexpressions shared, and D, the residuals and the energy in their own —
-// evaluated on doubles without allocation. The programs read the parameters, whose values the
+// Evaluator runs straight-line code (tapes, model/tape.hpp) — all the terms A, Q, G, b, b0 in one
+// tape with common subexpressions shared, and D, the residuals and the energy in their own —
+// evaluated on doubles without allocation. The tapes read the parameters, whose values the
 // Model holds: set_parameter (model/parameters.hpp) changes them without recompiling.
 #pragma once
 
@@ -14,7 +14,7 @@
 
 namespace nhdyn::symbolic {
 
-// How the terms program writes A and b: every entry (dense), or only the entries that are not
+// How the terms tape writes A and b: every entry (dense), or only the entries that are not
 // identically zero (sparse; the evaluator then also offers sparse_terms() for the sparse
 // formulations, formulation/sparse_sanh.hpp). `automatic` compiles sparse from kSparseFrom
 // coordinates on when at most a quarter of the entries of A and b are nonzero: a chain of a
@@ -31,10 +31,10 @@ struct CompileOptions {
 // InputError for a cyclic or unknown definition of a derived parameter.
 Model compile_model(const Spec& spec, const Derivation& derivation, const CompileOptions& options = {});
 
-// One expression of t, q, q' and the parameters of `spec` as a program with one output (events,
+// One expression of t, q, q' and the parameters of `spec` as a tape with one output (events,
 // symbolic/events.hpp); `what` names it in errors. Throws ModelError as compile_model does.
 Tape compile_expression(const Spec& spec, const GiNaC::ex& expression, const std::string& what);
-// Several expressions as one program, one output each, common subexpressions computed once
+// Several expressions as one tape, one output each, common subexpressions computed once
 // (outputs, contact forces); what[i] names expression i in messages.
 Tape compile_expressions(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
                             const std::vector<std::string>& what);

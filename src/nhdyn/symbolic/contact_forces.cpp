@@ -200,7 +200,7 @@ void compile_contact_forces(const Spec& spec, Model& model) {
   for (std::size_t i = 0; i < what.size(); ++i) what[i] = fmt::format("contact forces: output {}", i);
   c.tape = compile_expressions(spec, outputs, what);
   if (c.tape.outputs() != c.outputs())
-    throw ModelError(fmt::format("model '{}': the contact-force program has {} outputs, expected {} (a bug)",
+    throw ModelError(fmt::format("model '{}': the contact-force tape has {} outputs, expected {} (a bug)",
                                  spec.name, c.tape.outputs(), c.outputs()));
   analyse_contact_forces(model, c);
   model.contact_forces = std::move(out);

@@ -1,6 +1,6 @@
 // The symbolic half of the contact forces (docs/derivations/contact-forces.md section 4, method
 // (b)): what the multibody front end (multibody.hpp) knows about its bodies and contacts, kept in
-// the Spec, and its compilation at load into the program of model/contact_forces.hpp — the columns
+// the Spec, and its compilation at load into the tape of model/contact_forces.hpp — the columns
 // J^T d and E d of every unknown, the momentum balance of every connected system as K q'' + k, and
 // the directions n, e_long, e_lat of every wheel and knife edge — followed by the numeric check of
 // step 5 (analyse_contact_forces), which marks what the model does not determine.
@@ -96,7 +96,7 @@ void require_determined_contact_forces(const Spec& spec, const Model& model, con
                                        const std::string& where, const std::string& what);
 
 // Builds Model::contact_forces from spec.contact_forces (nothing when it is null or has no
-// contact): compiles the program, then checks it at a generic state (analyse_contact_forces).
+// contact): compiles the tape, then checks it at a generic state (analyse_contact_forces).
 // Called by compile_model once the evaluator exists.
 void compile_contact_forces(const Spec& spec, Model& model);
 

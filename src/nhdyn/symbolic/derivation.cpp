@@ -11,7 +11,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
-#include "nhdyn/symbolic/occurrence.hpp"
+#include "nhdyn/symbolic/detail/occurrence.hpp"
 #include "nhdyn/symbolic/rolling_contact.hpp"
 #include "nhdyn/symbolic/simplify.hpp"
 

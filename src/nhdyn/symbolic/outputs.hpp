@@ -1,12 +1,12 @@
 // Derived outputs from their expressions (model/output.hpp): a model file's [outputs] and a
 // multibody model's automatic point and frame positions and velocities (SpecBuilder::output) are
-// compiled into one straight-line program of Model::outputs, in the "dynamics layout": a program
+// compiled into one tape of Model::outputs, in the "dynamics layout": a tape
 // of 2n coordinates whose coordinate inputs are [q; q''] and velocity inputs [q'; R], so that an
 // expression may read the accelerations and the generalized reactions R_x of a solved state. The
 // parameters stay parameters (--set changes them without recompiling). Events whose expressions
 // read q'' or R (through an output) are compiled the same way (symbolic/events.cpp), and those that
 // read the contact forces in a layout with their columns too. Outputs may not read the contact
-// forces (their program's layout has no slots for them, and their columns are in the results
+// forces (their tape's layout has no slots for them, and their columns are in the results
 // already): compile_outputs refuses them.
 #pragma once
 
@@ -24,9 +24,9 @@ namespace nhdyn::symbolic {
 // Whether `e` contains an acceleration or a reaction of `spec`.
 bool reads_dynamics(const Spec& spec, const GiNaC::ex& e);
 
-// The expressions (in t, q, q', q'', R and the parameters of `spec`) as one program in the
+// The expressions (in t, q, q', q'', R and the parameters of `spec`) as one tape in the
 // dynamics layout, one output each; `what` names each in errors (ModelError). With `contact`
-// (the symbols of the contact-force columns, SpecContactForces::columns) the program is in the
+// (the symbols of the contact-force columns, SpecContactForces::columns) the tape is in the
 // contact layout (model/event.hpp): 2n + contact.size() coordinates, the values of those columns
 // after [q; q''] (and zeros after [q'; R]), so that an event may read NAME_N.
 Tape compile_dynamics_tape(const Spec& spec, const std::vector<GiNaC::ex>& expressions,
@@ -43,7 +43,7 @@ inline constexpr int kMaxAutomaticOutputItems = 32;
 void add_multibody_outputs(SpecBuilder& builder, const MultibodyBuilder& multibody, const std::vector<std::string>& frames,
                            const std::vector<std::string>& points);
 
-// Fills model.outputs from spec.outputs (an empty list and program when there are none).
+// Fills model.outputs from spec.outputs (an empty list and tape when there are none).
 void compile_outputs(const Spec& spec, Model& model);
 
 }  // namespace nhdyn::symbolic

@@ -17,8 +17,8 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/symbolic/contact_forces.hpp"
-#include "nhdyn/symbolic/occurrence.hpp"
-#include "nhdyn/symbolic/plain_words.hpp"
+#include "nhdyn/symbolic/detail/occurrence.hpp"
+#include "nhdyn/symbolic/detail/plain_words.hpp"
 #include "nhdyn/core/suggest.hpp"
 
 namespace nhdyn::symbolic {

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/symbolic/plain_words.hpp"
+#include "nhdyn/symbolic/detail/plain_words.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 
 namespace nhdyn::symbolic {
@@ -24,9 +24,9 @@ std::string text_of(const GiNaC::ex& e) {
 const char* kind_name(VisualKind kind) { return visual_kind_name(kind); }
 
 // Expressions of one spec into one Tape whose `parameter` instructions read the parameters in
-// the order of spec.parameters, so that the program follows the values of the run it draws. The
+// the order of spec.parameters, so that the tape follows the values of the run it draws. The
 // scene's expressions are short (a few positions and rotations), so this translation aims at being
-// plain rather than at the smallest program: a subexpression met twice is computed once. With
+// plain rather than at the smallest tape: a subexpression met twice is computed once. With
 // `parameters_only` (the sizes) t, the coordinates and the velocities are refused.
 class Emitter {
  public:

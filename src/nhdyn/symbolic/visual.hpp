@@ -97,7 +97,7 @@ struct VisualScene {
   std::vector<VisualShape> shapes;
   Tape tape;  // inputs t, q, q'; reads the parameters; outputs as the shapes say
   Tape sizes;    // no coordinate input; reads the parameters only; outputs as the shapes say
-  std::vector<std::string> parameters;  // the names the programs' `parameter` instructions index
+  std::vector<std::string> parameters;  // the names the tapes' `parameter` instructions index
   bool planar = false;
   bool ground = false;
   std::vector<bool> angles;  // per coordinate: it appears inside a trigonometric function (an angle)

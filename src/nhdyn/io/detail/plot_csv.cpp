@@ -1,6 +1,6 @@
 // Reading a plot's CSV (plot_csv.hpp): the header and first row through csv.hpp's record reader,
 // the row count from newlines (counted or sampled), the ranges by one streaming pass.
-#include "nhdyn/io/plot_csv.hpp"
+#include "nhdyn/io/detail/plot_csv.hpp"
 
 #include <fmt/format.h>
 

@@ -1,5 +1,5 @@
 // A Tape printed as straight-line C++: the one printer of the compiled evaluator's source
-// (jit/source.hpp) and of the headers `nhdyn codegen` writes (symbolic/codegen.hpp). Each
+// (jit/detail/source.hpp) and of the headers `nhdyn codegen` writes (symbolic/codegen.hpp). Each
 // instruction becomes `const double rN = <expression>;`, the expression read from the table of
 // operations (kOps in tape.hpp), so that the printed code does the tape's operations in its
 // order and rounds as the interpreter does (when compiled without contraction into fused
@@ -11,6 +11,7 @@
 // users differ only in spelling, given by a TapePrintStyle: how a double, a parameter and a
 // stored stage register are written, and whether constants are declared as registers or written
 // as literals where they are read.
+// Internal: used by jit/ and symbolic/codegen.cpp, not part of the public API (nhdyn/nhdyn.hpp).
 #pragma once
 
 #include <functional>

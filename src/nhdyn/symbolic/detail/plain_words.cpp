@@ -1,6 +1,6 @@
 // GiNaC's own words in an error ("power::eval(): division by zero") turned into ours: what
 // happened to the expression, for the messages of the model-file reader, compile and [visual].
-#include "nhdyn/symbolic/plain_words.hpp"
+#include "nhdyn/symbolic/detail/plain_words.hpp"
 
 #include <fmt/format.h>
 

@@ -15,7 +15,7 @@
 #include <limits>
 #include <utility>
 
-#include "nhdyn/formulation/row_scaling.hpp"
+#include "nhdyn/formulation/detail/row_scaling.hpp"
 
 namespace nhdyn::small {
 

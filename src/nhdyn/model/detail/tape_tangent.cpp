@@ -1,4 +1,4 @@
-#include "nhdyn/model/tape_tangent.hpp"
+#include "nhdyn/model/detail/tape_tangent.hpp"
 
 #include <cmath>
 #include <cstddef>

@@ -3,6 +3,7 @@
 // Every place that catches an exception of GiNaC while reading or evaluating the user's
 // expressions passes its what() through plain_words and adds the place (file:line:column, the
 // option) and the expression itself.
+// Internal: used by the symbolic front end's sources, not part of the public API (nhdyn/nhdyn.hpp).
 #pragma once
 
 #include <string>

@@ -4,8 +4,9 @@
 // called a well-posed system singular, or let a singular one of such rows pass. Written once here
 // for every solve of [D A; b]: the sanh formulation (sanh.cpp, and the fixed-size kernels of
 // small_dense.hpp), the program-motion solve (program_motion.cpp), the contact modes
-// (contact_modes.cpp) and the impulse at a touchdown (analysis/contact_switches.cpp). Plain double
+// (contact_modes.cpp) and the impulse at a touchdown (analysis/detail/contact_switches.cpp). Plain double
 // and templates only, so that the fixed-size kernels use it too; allocates nothing.
+// Internal: used by formulation/ and analysis/, not part of the public API (nhdyn/nhdyn.hpp).
 #pragma once
 
 #include <algorithm>

@@ -2,6 +2,7 @@
 // out-of-line loop per array; the kernels test several small arrays at every evaluation, so
 // they fold them into one sum: x * 0 is 0 for a finite x and NaN for NaN or +-inf, and a NaN
 // survives every addition. The caller names the culprit only when this test fails.
+// Internal: used by the kernels of model/ and formulation/, not part of the public API (nhdyn/nhdyn.hpp).
 #pragma once
 
 #include <Eigen/Core>

@@ -6,7 +6,7 @@
 // of a compiled model with it; docs/linearization.md gives the derivation it serves.
 // Also here: which inputs the outputs of a tape depend on at all (structurally), which
 // tells cyclic coordinates and explicit time dependence apart without evaluating anything.
-// Internal: used by analysis/linearization, not part of the public API (nhdyn/nhdyn.hpp).
+// Internal: used by analysis/linearization and optimize/transcription, not part of the public API (nhdyn/nhdyn.hpp).
 #pragma once
 
 #include <vector>

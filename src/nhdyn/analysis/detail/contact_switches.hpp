@@ -8,6 +8,7 @@
 //
 //     simulate -> choose_initial_contact_modes -> integrate_contact_modes
 //         -> integrate (one segment per mode set) -> ContactSwitches::on_event -> new modes
+// Internal: used by analysis/simulation.cpp, not part of the public API (nhdyn/nhdyn.hpp).
 #pragma once
 
 #include <array>

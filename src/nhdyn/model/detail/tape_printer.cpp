@@ -1,4 +1,4 @@
-#include "nhdyn/model/tape_printer.hpp"
+#include "nhdyn/model/detail/tape_printer.hpp"
 
 #include <fmt/format.h>
 

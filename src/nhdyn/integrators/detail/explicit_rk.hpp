@@ -7,6 +7,7 @@
 // choice for tight tolerances. The adaptive pairs share one driver; what differs (error
 // estimate, continuous extension, controller constants) is in the tableau. integrate()
 // (ode.hpp) checks its input and dispatches here; call that rather than these entry points.
+// Internal: integrate() is the public entry point (nhdyn/nhdyn.hpp).
 #pragma once
 
 #include <array>

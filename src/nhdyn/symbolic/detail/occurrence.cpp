@@ -1,4 +1,4 @@
-#include "nhdyn/symbolic/occurrence.hpp"
+#include "nhdyn/symbolic/detail/occurrence.hpp"
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "nhdyn/analysis/contact_switches.hpp"
+#include "nhdyn/analysis/detail/contact_switches.hpp"
 
 #include <fmt/format.h>
 
@@ -11,7 +11,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
-#include "nhdyn/formulation/row_scaling.hpp"
+#include "nhdyn/formulation/detail/row_scaling.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {
@@ -404,7 +404,7 @@ Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, b
     M.row(n - r + j) = data_.b.row(rows[static_cast<std::size_t>(j)]);
     rhs(n - r + j) = target[static_cast<std::size_t>(j)];
   }
-  // Rows in different units scaled exactly first, as every solve of [D A; b] (formulation/row_scaling.hpp).
+  // Rows in different units scaled exactly first, as every solve of [D A; b] (formulation/detail/row_scaling.hpp).
   scale_rows_by_powers_of_two(
       n, [&](int i) { return M.row(i).cwiseAbs().maxCoeff(); },
       [&](int i, int exponent) {

@@ -1,4 +1,4 @@
-#include "nhdyn/formulation/small_dense.hpp"
+#include "nhdyn/formulation/detail/small_dense.hpp"
 
 #include <utility>
 

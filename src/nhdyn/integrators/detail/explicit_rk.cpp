@@ -1,4 +1,4 @@
-#include "nhdyn/integrators/explicit_rk.hpp"
+#include "nhdyn/integrators/detail/explicit_rk.hpp"
 
 #include "nhdyn/integrators/events.hpp"
 

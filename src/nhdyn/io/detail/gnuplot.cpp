@@ -1,7 +1,7 @@
 // The gnuplot runner (gnuplot.hpp): posix_spawnp without a shell, stderr captured through a pipe,
 // the script and gnuplot's own output in exclusive temporary files beside the target, and the
 // finished picture committed through an AtomicFile.
-#include "nhdyn/io/gnuplot.hpp"
+#include "nhdyn/io/detail/gnuplot.hpp"
 
 #include <fcntl.h>
 #include <fmt/format.h>
