@@ -5,7 +5,7 @@
 // [[contacts]] disk it is; a [[knife_edges]] entry with them is refused. The shapes and grounds
 // are those registered in symbolic/contact_shapes.cpp and symbolic/rolling_contact.cpp: this file
 // lists none.
-// Called by the model-file loader (model_file.cpp) before MultibodyBuilder::apply().
+// Called by the model-file loader (model_file_multibody.cpp) before MultibodyBuilder::apply().
 #pragma once
 
 #include <array>

@@ -2,8 +2,8 @@
 // of rolling wheels, knife edges and points on surfaces from a description of frames, points and
 // bodies, and hands them to a SpecBuilder — from there on the model is derived and compiled like a
 // hand-written one (spec_builder.hpp -> derive -> compile_model). The model file's [[frames]],
-// [[points]], [[bodies]], gravity, [[wheels]], [[knife_edges]] and [[surfaces]] (frontend/model_file.cpp)
-// are a thin layer over this class. docs/multibody.md describes it for users;
+// [[points]], [[bodies]], gravity, [[wheels]], [[knife_edges]] and [[surfaces]]
+// (frontend/model_file_multibody.cpp) are a thin layer over this class. docs/multibody.md describes it for users;
 // docs/derivations/rolling-wheel.md derives what it writes.
 //
 // Frames: "ground" is the world frame. A frame is placed in its parent by a translation (in the
