@@ -85,9 +85,8 @@ symbolic::Spec load_sections(LoadContext& cx) {
   if (const toml::node* forces = root.get("forces")) load_forces(cx, *forces, builder);
   if (const toml::node* constraints = root.get("constraints")) load_constraints(cx, *constraints, builder);
   if (const toml::node* programs = root.get("programs")) load_programs(cx, *programs, builder);
-  symbolic::SpecVisual visual;
-  load_multibody(cx, root, builder, visual);
-  if (const toml::node* node = root.get("visual")) load_visual(cx, *node, builder, visual);
+  load_multibody(cx, root, builder);
+  if (const toml::node* node = root.get("visual")) load_visual(cx, *node, builder);
   load_complement(cx, root, builder);
   if (const toml::node* initial = root.get("initial")) load_initial(cx, *initial, builder);
   if (const toml::node* solution = root.get("solution")) load_solution(cx, *solution, builder);
@@ -98,7 +97,6 @@ symbolic::Spec load_sections(LoadContext& cx) {
   if (const toml::node* node = root.get("events")) events = load_events(cx, *node, builder);
   symbolic::Spec spec = builder.build();
   spec.events = std::move(events);
-  spec.visual = std::move(visual);
   // The definitions of derived parameters, which a --set of a parameter they use re-evaluates.
   for (symbolic::SpecParameter& p : spec.parameters)
     for (const Parameter& loaded : cx.parameter_values)

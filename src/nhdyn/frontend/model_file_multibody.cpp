@@ -39,13 +39,13 @@ const std::vector<std::string> visual_keys = {"points", "segments"};
 const std::vector<std::string> visual_point_keys = {"name", "position", "radius"};
 const std::vector<std::string> visual_segment_keys = {"name", "from", "to"};
 
-// What the multibody sections build together: the builder, the scene, and the names the
-// automatic outputs and the wheels' scene need.
+// What the multibody sections build together: the builders (the SpecBuilder holds the scene),
+// and the names the automatic outputs and the contacts' scene need.
 struct MultibodySections {
+  SpecBuilder& builder;
   symbolic::MultibodyBuilder& mb;
-  symbolic::SpecVisual& visual;
   std::vector<std::string> frame_names, point_names;                     // for the automatic outputs
-  std::vector<std::pair<std::string, symbolic::PlacedFrame>> body_frames;  // for the wheels' scene
+  std::vector<std::pair<std::string, symbolic::PlacedFrame>> body_frames;  // for the contacts' scene
 };
 
 // A multibody frame's origin and rotation as a scene item.
@@ -139,8 +139,7 @@ void load_frames(LoadContext& cx, const toml::table& root, MultibodySections& sc
         scene.mb.quaternion_frame(name, parent, translation, *quaternion, c.at(*table->get("quaternion")));
         cx.quaternion_coordinates.insert(cx.quaternion_coordinates.end(), quaternion->begin(), quaternion->end());
         scene.frame_names.push_back(name);
-        scene.visual.items.push_back(
-            frame_item(scene.mb.placed_frame(name), symbolic::VisualKind::frame, c.at(*table)));
+        scene.builder.visual_item(frame_item(scene.mb.placed_frame(name), symbolic::VisualKind::frame, c.at(*table)));
         continue;
       }
       std::vector<symbolic::FrameRotation> rotations;
@@ -160,7 +159,7 @@ void load_frames(LoadContext& cx, const toml::table& root, MultibodySections& sc
       }
       scene.mb.frame(name, parent, translation, rotations, c.at(*table));
       scene.frame_names.push_back(name);
-      scene.visual.items.push_back(frame_item(scene.mb.placed_frame(name), symbolic::VisualKind::frame, c.at(*table)));
+      scene.builder.visual_item(frame_item(scene.mb.placed_frame(name), symbolic::VisualKind::frame, c.at(*table)));
     }
 }
 
@@ -180,8 +179,8 @@ void load_points(LoadContext& cx, const toml::table& root, MultibodySections& sc
     }
 }
 
-// [[bodies]]: a mass and inertia on a frame, drawn as its ellipsoid of inertia.
-void load_bodies(LoadContext& cx, const toml::table& root, SpecBuilder& builder, MultibodySections& scene) {
+// [[bodies]]: a mass and inertia on a frame (the builder draws it as its ellipsoid of inertia).
+void load_bodies(LoadContext& cx, const toml::table& root, MultibodySections& scene) {
   const Cursor& c = cx.cursor;
   if (const toml::node* bodies = root.get("bodies"))
     for (const toml::table* table : c.tables_of(*bodies, "bodies", body_keys)) {
@@ -196,24 +195,13 @@ void load_bodies(LoadContext& cx, const toml::table& root, SpecBuilder& builder,
       const toml::node& inertia_node = c.member(
           *table, "bodies", "inertia", "inertia = [\"Ixx\", \"Iyy\", \"Izz\"] (principal moments) or a 3 x 3 array");
       const symbolic::InertiaText inertia = inertia_of(c, inertia_node, name);
-      scene.mb.body(name, frame, mass, com, inertia, c.at(*table));
-      // The scene's ellipsoid of the body: its centre of mass, moving with its frame.
-      symbolic::VisualItem item = frame_item(scene.mb.placed_frame(frame), symbolic::VisualKind::body, c.at(*table));
-      item.name = name;
-      item.size = builder.parse(mass, c.at(*table));
-      for (std::size_t i = 0; i < 3; ++i) {
-        for (std::size_t j = 0; j < 3; ++j) {
-          item.at[i] += item.other[3 * i + j] * builder.parse(com[j], c.at(*table));
-          item.inertia.push_back(builder.parse(inertia[i][j], c.at(*table)));
-        }
-      }
+      scene.mb.body(name, frame, mass, com, inertia, c.at(*table));  // drawn by the builder
       scene.body_frames.emplace_back(name, scene.mb.placed_frame(frame));
-      scene.visual.items.push_back(std::move(item));
     }
 }
 
-// [[wheels]]: thin wheels rolling on the ground, drawn as disks about their axles.
-void load_wheels(LoadContext& cx, const toml::table& root, SpecBuilder& builder, MultibodySections& scene) {
+// [[wheels]]: thin wheels rolling on the ground (the builder draws each as a disk about its axle).
+void load_wheels(LoadContext& cx, const toml::table& root, MultibodySections& scene) {
   const Cursor& c = cx.cursor;
   if (const toml::node* wheels = root.get("wheels"))
     for (const toml::table* table : c.tables_of(*wheels, "wheels", wheel_keys)) {
@@ -228,19 +216,10 @@ void load_wheels(LoadContext& cx, const toml::table& root, SpecBuilder& builder,
       const std::optional<symbolic::Triple> normal = c.optional_triple(*table, "normal", what + ": normal");
       if (has_contact_mode_keys(*table))
         // A wheel that may slide or lift off: the contact modes are the [[contacts]] machinery's.
-        load_wheel_contact(*table, {name, body, axis, radius, normal}, scene.mb, scene.visual,
+        load_wheel_contact(*table, {name, body, axis, radius, normal}, scene.mb, scene.builder,
                            [&c](const toml::node& node) { return c.at(node); });
       else
-        scene.mb.rolling_wheel(name, body, axis, radius, normal, c.at(*table));
-      // The scene draws the wheel's body as a disk of the wheel's radius about its axle.
-      for (const auto& [body_name, placed] : scene.body_frames)
-        if (body_name == body) {
-          symbolic::VisualItem item = frame_item(placed, symbolic::VisualKind::wheel, c.at(*table));
-          item.name = name;
-          item.size = builder.parse(radius, c.at(*table));
-          item.axis = axis == "x" ? 0 : axis == "y" ? 1 : 2;
-          scene.visual.items.push_back(std::move(item));
-        }
+        scene.mb.rolling_wheel(name, body, axis, radius, normal, c.at(*table));  // drawn by the builder
     }
 }
 
@@ -327,7 +306,7 @@ std::vector<GiNaC::ex> position_of(const Cursor& c, const toml::node& node, cons
 
 // ---- The multibody description (docs/multibody.md) ------------------------------------------
 
-void load_multibody(LoadContext& cx, const toml::table& root, SpecBuilder& builder, symbolic::SpecVisual& visual) {
+void load_multibody(LoadContext& cx, const toml::table& root, SpecBuilder& builder) {
   const Cursor& c = cx.cursor;
   bool any = false;
   for (const char* key :
@@ -335,19 +314,18 @@ void load_multibody(LoadContext& cx, const toml::table& root, SpecBuilder& build
     any = any || root.get(key) != nullptr;
   if (!any) return;
   symbolic::MultibodyBuilder mb(builder);
-  visual.ground = true;
-  MultibodySections scene{mb, visual, {}, {}, {}};
+  MultibodySections scene{builder, mb, {}, {}, {}};
   if (const toml::node* gravity = root.get("gravity"))
     mb.gravity(c.triple_of(*gravity, "gravity", "gravity = [0, 0, \"-g\"]"), c.at(*gravity));
   load_frames(cx, root, scene);
   load_points(cx, root, scene);
-  load_bodies(cx, root, builder, scene);
-  load_wheels(cx, root, builder, scene);
+  load_bodies(cx, root, scene);
+  load_wheels(cx, root, scene);
   load_knife_edges(cx, root, scene);
   load_surfaces(cx, root, scene);
   load_curves(cx, root, scene);
   if (const toml::node* contacts = root.get("contacts"))
-    load_contacts(*contacts, mb, visual, scene.body_frames, [&c](const toml::node& node) { return c.at(node); });
+    load_contacts(*contacts, mb, builder, scene.body_frames, [&c](const toml::node& node) { return c.at(node); });
   mb.apply();
   // Every point's and frame origin's world position and velocity as result columns.
   symbolic::add_multibody_outputs(builder, mb, scene.frame_names, scene.point_names);
@@ -355,7 +333,7 @@ void load_multibody(LoadContext& cx, const toml::table& root, SpecBuilder& build
 
 // ---- [visual]: what the report's scene draws of a hand-written model (docs/model-format.md) ----
 
-void load_visual(LoadContext& cx, const toml::node& node, SpecBuilder& builder, symbolic::SpecVisual& visual) {
+void load_visual(LoadContext& cx, const toml::node& node, SpecBuilder& builder) {
   const Cursor& c = cx.cursor;
   const toml::table& table =
       c.table_of(node, "visual", "[visual] followed by points = [{ name = \"particle\", position = [\"x\", \"y\"] }]");
@@ -375,7 +353,7 @@ void load_visual(LoadContext& cx, const toml::node& node, SpecBuilder& builder, 
         const std::string text = c.number_or_expression(*radius, what + ": radius", "radius = 0.05");
         item.size = c.located(*radius, [&] { return builder.parse(text, c.content_at(*radius)); });
       }
-      visual.items.push_back(std::move(item));
+      builder.visual_item(std::move(item));
     }
   if (const toml::node* segments = table.get("segments"))
     for (const toml::table* entry : c.tables_of(*segments, "visual.segments", visual_segment_keys)) {
@@ -388,9 +366,10 @@ void load_visual(LoadContext& cx, const toml::node& node, SpecBuilder& builder, 
                             builder, components);
       item.other = position_of(c, c.member(*entry, "visual.segments", "to", "to = [\"x + l*cos(phi)\", \"y\"]"),
                                what + ": to", builder, components);
-      visual.items.push_back(std::move(item));
+      builder.visual_item(std::move(item));
     }
-  visual.planar = components == 2 && !visual.ground;
+  const bool ground = builder.current().visual.ground;
+  builder.visual_scene(components == 2 && !ground, ground);
 }
 
 }  // namespace nhdyn::model_file

@@ -17,7 +17,6 @@
 namespace nhdyn::symbolic {
 class SpecBuilder;
 struct SpecEvent;
-struct SpecVisual;
 }  // namespace nhdyn::symbolic
 
 namespace nhdyn::model_file {
@@ -54,10 +53,10 @@ std::vector<symbolic::SpecEvent> load_events(LoadContext& cx, const toml::node& 
 // ---- The multibody description and the scene (model_file_multibody.cpp) -----------------
 
 // gravity, [[frames]], [[points]], [[bodies]], [[wheels]], [[knife_edges]], [[surfaces]],
-// [[curves]] and [[contacts]] (docs/multibody.md), through one MultibodyBuilder; nothing when
-// the file has none of them.
-void load_multibody(LoadContext& cx, const toml::table& root, SpecBuilder& builder, symbolic::SpecVisual& visual);
+// [[curves]] and [[contacts]] (docs/multibody.md), through one MultibodyBuilder, with their scene
+// (through the builders, onto the Spec's); nothing when the file has none of them.
+void load_multibody(LoadContext& cx, const toml::table& root, SpecBuilder& builder);
 // [visual]: the points and segments the report's scene draws of a hand-written model.
-void load_visual(LoadContext& cx, const toml::node& node, SpecBuilder& builder, symbolic::SpecVisual& visual);
+void load_visual(LoadContext& cx, const toml::node& node, SpecBuilder& builder);
 
 }  // namespace nhdyn::model_file

@@ -92,6 +92,20 @@ class SpecBuilder {
     spec_.contact_coordinates.push_back(std::move(added));
     return *this;
   }
+  // The report's 3-D scene (spec.visual, visual.hpp), filled by the front ends in the order the
+  // model gives its parts: an item drawn (the multibody builder draws its bodies and wheels; the
+  // model file adds its frames' axes, its contacts' shapes and its [visual] items).
+  SpecBuilder& visual_item(VisualItem item) {
+    spec_.visual.items.push_back(std::move(item));
+    return *this;
+  }
+  // Whether the scene is planar (every position has two components: the (x, y) plane, y up) and
+  // whether it is drawn over the ground's grid (a multibody model: set by MultibodyBuilder).
+  SpecBuilder& visual_scene(bool planar, bool ground) {
+    spec_.visual.planar = planar;
+    spec_.visual.ground = ground;
+    return *this;
+  }
   // A contact whose closed-form point may turn singular along the motion (spec.hpp).
   SpecBuilder& contact_watch(SpecContactWatch watch) {
     spec_.contact_watches.push_back(std::move(watch));
