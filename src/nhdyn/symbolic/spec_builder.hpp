@@ -153,4 +153,10 @@ class SpecBuilder {
   int coordinate_of(const std::string& name) const;  // -1 when not a coordinate
 };
 
+// SpecBuilder::parse_derived against `spec`, a spec already built (a model file's, kept in its
+// description: symbolic/description.hpp): t, q, q', q'', the reactions R_x, the parameters, every
+// output and the contact-force columns are known, each output replaced by its expression. For
+// the command line's events of a model file (symbolic/events.hpp); errors as parse_derived's.
+GiNaC::ex parse_derived(const Spec& spec, const std::string& text, const SourceLocation& where = {});
+
 }  // namespace nhdyn::symbolic
