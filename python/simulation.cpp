@@ -12,7 +12,7 @@
 #include "nhdyn/analysis/batch.hpp"
 #include "nhdyn/analysis/run_options.hpp"
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/symbolic/events.hpp"
+#include "nhdyn/frontend/events.hpp"
 
 namespace nhdyn::python {
 namespace {
@@ -106,7 +106,7 @@ SimulationOptions make_options(const Model& model, const py::dict& kwargs) {
   // The model's [[events]], then stop_when="abs(phi) > 1" (conditions) and events={"name": "expr"}.
   options.events = model.events;
   for (const std::string& condition : strings(kwargs, "stop_when"))
-    options.events.push_back(symbolic::make_stop_condition(model, condition));
+    options.events.push_back(make_stop_condition(model, condition));
   if (kwargs.contains("events") && !py::object(kwargs["events"]).is_none()) {
     std::map<std::string, std::string> events;
     try {
@@ -115,7 +115,7 @@ SimulationOptions make_options(const Model& model, const py::dict& kwargs) {
       throw InputError("events: expected a dict of names to expressions, e.g. events={\"bottom\": \"x\"}");
     }
     for (const auto& [name, expression] : events)
-      options.events.push_back(symbolic::make_record_event(model, name + "=" + expression));
+      options.events.push_back(make_record_event(model, name + "=" + expression));
   }
   check_simulation_options(model, options);
   return options;

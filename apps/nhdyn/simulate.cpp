@@ -19,6 +19,7 @@
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/frontend/describe.hpp"
+#include "nhdyn/frontend/events.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/csv.hpp"
@@ -28,7 +29,6 @@
 #include "nhdyn/jit/compiled_evaluator.hpp"
 #include "nhdyn/model/contact_modes.hpp"
 #include "nhdyn/model/initial_values.hpp"
-#include "nhdyn/symbolic/events.hpp"
 #include "progress.hpp"
 #include "run_files.hpp"
 #include "run_overrides.hpp"
@@ -174,8 +174,9 @@ Model prepare_model(const LoadedModel& resolved, const SimulateArgs& args) {
 }
 
 // The run's options: the model's, the command line's overrides, the file's [[events]] then the
-// command line's; checked whole before any file is opened.
-SimulationOptions make_run_options(const Model& model, const SimulateArgs& args) {
+// command line's (read against the loaded model's description, frontend/events.hpp); checked
+// whole before any file is opened.
+SimulationOptions make_run_options(const LoadedModel& resolved, const Model& model, const SimulateArgs& args) {
   SimulationOptions options = make_simulation_options(run_options_with(model, args));
   options.integrator.step = args.step;
   options.fix_initial = args.fix_initial;
@@ -186,9 +187,9 @@ SimulationOptions make_run_options(const Model& model, const SimulateArgs& args)
   if (args.max_steps) options.integrator.max_steps = *args.max_steps;  // checked by check_simulation_options
   options.events = model.events;
   for (const std::string& condition : args.stop_when)
-    options.events.push_back(symbolic::make_stop_condition(model, condition));
+    options.events.push_back(make_stop_condition(resolved, condition));
   for (const std::string& definition : args.events)
-    options.events.push_back(symbolic::make_record_event(model, definition));
+    options.events.push_back(make_record_event(resolved, definition));
   options.formulation.program_feedback = parse_program_feedback(args.program_feedback);
   check_simulation_options(model, options);
   return options;
@@ -375,7 +376,7 @@ int run_simulate(const SimulateArgs& args) {
   const ModelSource source = read_model_source(args.model);
   const LoadedModel resolved = load_model_described(source, parse_parameter_sets(args.sets));
   const Model model = prepare_model(resolved, args);
-  const SimulationOptions options = make_run_options(model, args);
+  const SimulationOptions options = make_run_options(resolved, model, args);
   const ResultColumns columns = make_result_columns(model);
   // Every file of the run says where it came from (io/provenance.hpp).
   const std::string provenance = format_provenance(make_provenance(model, source, options, args.evaluator));

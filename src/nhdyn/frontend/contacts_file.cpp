@@ -198,7 +198,7 @@ class ContactReader {
 // The ground where it is not the plane's grid, and the contact point's path on it: the
 // contact's outputs NAME_X, NAME_Y, NAME_Z.
 void add_ground_drawing(const symbolic::ContactText& text, const symbolic::ParsedContact& parsed,
-                        symbolic::SpecVisual& visual) {
+                        symbolic::SpecBuilder& builder) {
   const std::vector<std::string> point = {text.name + "_X", text.name + "_Y", text.name + "_Z"};
   std::vector<symbolic::VisualItem> ground;
   if (std::optional<symbolic::VisualItem> drawn = parsed.ground.type->drawing(parsed)) ground.push_back(std::move(*drawn));
@@ -209,7 +209,7 @@ void add_ground_drawing(const symbolic::ContactText& text, const symbolic::Parse
     item.name = text.name;
     item.where = text.where.describe();
     item.at_outputs = point;
-    visual.items.push_back(std::move(item));
+    builder.visual_item(std::move(item));
   }
 }
 
@@ -236,7 +236,7 @@ bool has_contact_mode_keys(const toml::table& table) {
 }
 
 void load_wheel_contact(const toml::table& table, const WheelEntry& wheel, symbolic::MultibodyBuilder& multibody,
-                        symbolic::SpecVisual& visual, const TomlLocator& at) {
+                        symbolic::SpecBuilder& builder, const TomlLocator& at) {
   const ContactReader reader(at);
   symbolic::ContactText text;
   text.where = at(table);
@@ -258,9 +258,10 @@ void load_wheel_contact(const toml::table& table, const WheelEntry& wheel, symbo
   text.rolling = "rolling";
   reader.read_modes(table, fmt::format("wheel '{}'", wheel.name), text);
   multibody.contact(text);
-  // The body is drawn as a wheel by the loader; the contact point's track is the contact's.
+  // The contact point's track is the contact's; the body is drawn as the wheel it is.
   if (const symbolic::ParsedContact* parsed = multibody.parsed_contact(text.name))
-    add_ground_drawing(text, *parsed, visual);
+    add_ground_drawing(text, *parsed, builder);
+  multibody.wheel_drawing(wheel.name, wheel.body, wheel.axis, wheel.radius, text.where);
 }
 
 void refuse_knife_edge_modes(const toml::node& knives, const TomlLocator& at) {
@@ -291,7 +292,7 @@ void refuse_knife_edge_modes(const toml::node& knives, const TomlLocator& at) {
   }
 }
 
-void load_contacts(const toml::node& contacts, symbolic::MultibodyBuilder& multibody, symbolic::SpecVisual& visual,
+void load_contacts(const toml::node& contacts, symbolic::MultibodyBuilder& multibody, symbolic::SpecBuilder& builder,
                    const std::vector<std::pair<std::string, symbolic::PlacedFrame>>& body_frames,
                    const TomlLocator& at) {
   const ContactReader reader(at);
@@ -316,9 +317,9 @@ void load_contacts(const toml::node& contacts, symbolic::MultibodyBuilder& multi
       item.at.assign(centre.begin(), centre.end());
       for (unsigned i = 0; i < 3; ++i)
         for (unsigned j = 0; j < 3; ++j) item.other.push_back(frame.rotation(i, j));
-      visual.items.push_back(std::move(item));
+      builder.visual_item(std::move(item));
     }
-    add_ground_drawing(text, *parsed, visual);
+    add_ground_drawing(text, *parsed, builder);
   }
 }
 

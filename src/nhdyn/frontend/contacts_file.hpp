@@ -1,11 +1,11 @@
 // The [[contacts]] array of a model file (docs/multibody.md, "Rolling bodies"): reads each entry's
 // TOML (name, body, shape, centre, ground, rolling) into a symbolic::ContactText, hands it to the
-// multibody builder, and adds the shape's drawing to the scene. Also the contact modes' keys of
+// multibody builder, and adds the shape's drawing to the scene (through the SpecBuilder). Also the contact modes' keys of
 // the other helpers (docs/contact-modes.md): a [[wheels]] entry with them is read as the
 // [[contacts]] disk it is; a [[knife_edges]] entry with them is refused. The shapes and grounds
 // are those registered in symbolic/contact_shapes.cpp and symbolic/rolling_contact.cpp: this file
 // lists none.
-// Called by the model-file loader (model_file.cpp) before MultibodyBuilder::apply().
+// Called by the model-file loader (model_file_multibody.cpp) before MultibodyBuilder::apply().
 #pragma once
 
 #include <array>
@@ -20,9 +20,9 @@
 // Declared only: this header stays free of GiNaC (tests/layering).
 namespace nhdyn::symbolic {
 class MultibodyBuilder;
+class SpecBuilder;
 struct PlacedFrame;
 struct SourceLocation;
-struct SpecVisual;
 }  // namespace nhdyn::symbolic
 
 namespace nhdyn {
@@ -33,10 +33,10 @@ using TomlLocator = std::function<symbolic::SourceLocation(const toml::node&)>;
 // The keys of a [[contacts]] entry, in the order docs/model-format.md lists them.
 const std::vector<std::string>& contact_keys();
 
-// Reads `contacts` (an array of tables) into `multibody`, and the drawing of each shape into
-// `visual`; `body_frames` are the bodies declared so far with their frames. Throws ModelError
-// naming file:line for wrong types and unknown keys, and whatever the builder refuses.
-void load_contacts(const toml::node& contacts, symbolic::MultibodyBuilder& multibody, symbolic::SpecVisual& visual,
+// Reads `contacts` (an array of tables) into `multibody`, and the drawing of each shape into the
+// scene of `builder`; `body_frames` are the bodies declared so far with their frames. Throws
+// ModelError naming file:line for wrong types and unknown keys, and whatever the builder refuses.
+void load_contacts(const toml::node& contacts, symbolic::MultibodyBuilder& multibody, symbolic::SpecBuilder& builder,
                    const std::vector<std::pair<std::string, symbolic::PlacedFrame>>& body_frames,
                    const TomlLocator& at);
 
@@ -57,12 +57,12 @@ struct WheelEntry {
 // is: shape = { disk = radius, axis = axis } on `body` (centred on its frame's origin), ground =
 // { plane = normal } (or the default plane), rolling = "rolling", and the entry's mode keys, read
 // and checked as a contact's. So it has the contact's constraints (NAME_contact, NAME_roll1,
-// NAME_roll2), columns and switch events. The body's drawing stays the loader's (a wheel); the
-// contact adds to `visual` what a [[contacts]] entry adds besides its shape (the contact point's
-// track). Throws ModelError naming file:line for a mode key of the wrong type and whatever the
-// builder refuses.
+// NAME_roll2), columns and switch events. The contact adds to the scene of `builder` what a
+// [[contacts]] entry adds besides its shape (the contact point's track), then the multibody
+// builder draws the body as the wheel it is (MultibodyBuilder::wheel_drawing). Throws ModelError
+// naming file:line for a mode key of the wrong type and whatever the builder refuses.
 void load_wheel_contact(const toml::table& table, const WheelEntry& wheel, symbolic::MultibodyBuilder& multibody,
-                        symbolic::SpecVisual& visual, const TomlLocator& at);
+                        symbolic::SpecBuilder& builder, const TomlLocator& at);
 
 // Refuses the mode keys on [[knife_edges]] entries (`knives`, the array as written; anything else
 // is left for the loader's own checks): a knife edge's planar model has no normal force for

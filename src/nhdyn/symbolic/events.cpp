@@ -5,6 +5,7 @@
 #include <cctype>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
@@ -48,10 +49,10 @@ SpecBuilder names_of(const Model& model) {
 // Reads `text` for the command-line option `option` (quoted in messages as `shown`): a parse error
 // becomes an InputError naming the option and the text as the user wrote it. `text` may be
 // `shown` with parts blanked out (so that columns stay those of `shown`).
-GiNaC::ex read_option(const SpecBuilder& builder, const std::string& option, const std::string& shown,
+GiNaC::ex read_option(const Spec& spec, const std::string& option, const std::string& shown,
                       const std::string& text) {
   try {
-    return builder.parse_derived(text);
+    return parse_derived(spec, text);
   } catch (const ModelError& e) {
     std::string message = e.what();
     const std::string blanked = fmt::format("\"{}\"", text);
@@ -92,7 +93,16 @@ void compile_events(const Spec& spec, Model& model) {
         finish(spec, model, e.expression, e.name, e.text, e.where.describe(), e.direction, e.action));
 }
 
-Event make_stop_condition(const Model& model, const std::string& condition) {
+namespace {
+
+// A --stop-when condition split at its comparison (checked): the sides, each with the other blanked
+// out so that columns stay those of the whole condition.
+struct StopComparison {
+  std::string lhs, rhs;
+  bool greater = false;
+};
+
+StopComparison split_stop_condition(const std::string& condition) {
   const std::string option = "--stop-when";
   // The comparison: one '<' or '>' (optionally followed by '=') outside parentheses.
   std::vector<std::size_t> found;
@@ -134,11 +144,15 @@ Event make_stop_condition(const Model& model, const std::string& condition) {
     throw InputError(fmt::format("{} \"{}\": the comparison '{}' needs an expression on each side, e.g. --stop-when "
                                  "\"abs(phi) > 1.2\"",
                                  option, condition, condition.substr(op, op_end - op)));
-  const SpecBuilder builder = names_of(model);
-  const GiNaC::ex left = read_option(builder, option, condition, lhs);
-  const GiNaC::ex right = read_option(builder, option, condition, rhs);
+  return {lhs, rhs, greater};
+}
+
+Event stop_event(const Spec& spec, const Model& model, const std::string& condition, const StopComparison& c) {
+  const std::string option = "--stop-when";
+  const GiNaC::ex left = read_option(spec, option, condition, c.lhs);
+  const GiNaC::ex right = read_option(spec, option, condition, c.rhs);
   try {
-    Event event = finish(builder.current(), model, greater ? left - right : right - left, condition, condition,
+    Event event = finish(spec, model, c.greater ? left - right : right - left, condition, condition,
                          fmt::format("{} \"{}\"", option, condition), EventDirection::rising, EventAction::stop);
     event.condition = true;
     return event;
@@ -147,7 +161,9 @@ Event make_stop_condition(const Model& model, const std::string& condition) {
   }
 }
 
-Event make_record_event(const Model& model, const std::string& definition) {
+// A --event definition split at its '=' (checked): the name, and the text with the name and '='
+// blanked (columns in messages are those of the whole option).
+std::pair<std::string, std::string> split_event_definition(const std::string& definition) {
   const std::string option = "--event";
   const std::size_t eq = definition.find('=');
   const auto identifier = [](const std::string& name) {
@@ -160,18 +176,46 @@ Event make_record_event(const Model& model, const std::string& definition) {
     throw InputError(fmt::format("{} \"{}\": expected NAME=EXPR, a name (letters, digits, _ and -) and the expression "
                                  "whose zero crossings to record, e.g. --event \"upright=phi\"",
                                  option, definition));
-  const std::string name = definition.substr(0, eq);
-  // The name and '=' blanked: columns in messages are those of the whole option.
   std::string text = definition;
   for (std::size_t i = 0; i <= eq; ++i) text[i] = ' ';
-  const SpecBuilder builder = names_of(model);
-  const GiNaC::ex g = read_option(builder, option, definition, text);
+  return {definition.substr(0, eq), text};
+}
+
+Event record_event_of(const Spec& spec, const Model& model, const std::string& definition, const std::string& name,
+                   const std::string& text) {
+  const std::string option = "--event";
+  const GiNaC::ex g = read_option(spec, option, definition, text);
   try {
-    return finish(builder.current(), model, g, name, definition.substr(eq + 1), fmt::format("{} \"{}\"", option, definition),
-                  EventDirection::both, EventAction::record);
+    return finish(spec, model, g, name, definition.substr(name.size() + 1),
+                  fmt::format("{} \"{}\"", option, definition), EventDirection::both, EventAction::record);
   } catch (const ModelError& e) {
     throw InputError(e.what());
   }
+}
+
+}  // namespace
+
+// The syntax is checked before the names are declared (a condition without a comparison is told
+// so whatever the model).
+Event make_stop_condition(const Model& model, const std::string& condition) {
+  const StopComparison c = split_stop_condition(condition);
+  const SpecBuilder builder = names_of(model);
+  return stop_event(builder.current(), model, condition, c);
+}
+
+Event make_stop_condition(const Spec& spec, const Model& model, const std::string& condition) {
+  return stop_event(spec, model, condition, split_stop_condition(condition));
+}
+
+Event make_record_event(const Model& model, const std::string& definition) {
+  const auto [name, text] = split_event_definition(definition);
+  const SpecBuilder builder = names_of(model);
+  return record_event_of(builder.current(), model, definition, name, text);
+}
+
+Event make_record_event(const Spec& spec, const Model& model, const std::string& definition) {
+  const auto [name, text] = split_event_definition(definition);
+  return record_event_of(spec, model, definition, name, text);
 }
 
 }  // namespace nhdyn::symbolic

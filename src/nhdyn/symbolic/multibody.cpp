@@ -87,9 +87,23 @@ std::array<double, 3> principal_moments(const double (&A)[3][3]) {
   return {e1, 3.0 * q - e1 - e3, e3};
 }
 
+// A frame's origin and rotation as an item of the scene (visual.hpp).
+VisualItem frame_item(const PlacedFrame& frame, VisualKind kind, const SourceLocation& where) {
+  VisualItem item;
+  item.kind = kind;
+  item.name = frame.name;
+  item.where = where.describe();
+  item.at.assign(frame.origin.begin(), frame.origin.end());
+  for (unsigned i = 0; i < 3; ++i)
+    for (unsigned j = 0; j < 3; ++j) item.other.push_back(frame.rotation(i, j));
+  return item;
+}
+
 }  // namespace
 
 MultibodyBuilder::MultibodyBuilder(SpecBuilder& builder) : builder_(builder) {
+  // A multibody model's scene stands on the ground's grid.
+  builder_.visual_scene(builder_.current().visual.planar, true);
   PlacedFrame ground;
   ground.name = "ground";
   ground.origin = {0, 0, 0};
@@ -353,6 +367,20 @@ MultibodyBuilder& MultibodyBuilder::body(const std::string& name, const std::str
                        "axes",
                        moments[0], moments[1], moments[2], moments[i], moments[(i + 1) % 3], moments[(i + 2) % 3]));
   }
+  // The scene's ellipsoid of the body: its centre of mass, moving with its frame. Its expressions
+  // are read again from the texts rather than taken from `b`: the scene's tape shares
+  // subexpressions by identity (symbolic/visual.cpp), and this is the drawing a model file has
+  // always had, to the last bit of the report's values.
+  VisualItem item = frame_item(frames_[static_cast<std::size_t>(b.frame)], VisualKind::body, where);
+  item.name = name;
+  item.size = builder_.parse(mass, where);
+  for (std::size_t i = 0; i < 3; ++i) {
+    for (std::size_t j = 0; j < 3; ++j) {
+      item.at[i] += item.other[3 * i + j] * builder_.parse(centre_of_mass[j], where);
+      item.inertia.push_back(builder_.parse(inertia[i][j], where));
+    }
+  }
+  builder_.visual_item(std::move(item));
   bodies_.push_back(std::move(b));
   return *this;
 }
@@ -392,6 +420,20 @@ MultibodyBuilder& MultibodyBuilder::rolling_wheel(const std::string& name, const
   if (normal) h.normal = parse(*normal, where, context + ": normal", false);
   helpers_.push_back(std::move(h));
   if (helpers_.back().normal) plane_normal(helpers_.back(), context);  // a zero normal is refused now
+  return wheel_drawing(name, body, axis, radius, std::move(where));
+}
+
+MultibodyBuilder& MultibodyBuilder::wheel_drawing(const std::string& name, const std::string& body,
+                                                  const std::string& axis, const std::string& radius,
+                                                  SourceLocation where) {
+  const int index = body_index(body, where, fmt::format("wheel '{}'", name));
+  VisualItem item =
+      frame_item(frames_[static_cast<std::size_t>(bodies_[static_cast<std::size_t>(index)].frame)], VisualKind::wheel,
+                 where);
+  item.name = name;
+  item.size = builder_.parse(radius, where);
+  item.axis = axis == "x" ? 0 : axis == "y" ? 1 : 2;
+  builder_.visual_item(std::move(item));
   return *this;
 }
 

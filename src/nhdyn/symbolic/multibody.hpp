@@ -2,8 +2,8 @@
 // of rolling wheels, knife edges and points on surfaces from a description of frames, points and
 // bodies, and hands them to a SpecBuilder — from there on the model is derived and compiled like a
 // hand-written one (spec_builder.hpp -> derive -> compile_model). The model file's [[frames]],
-// [[points]], [[bodies]], gravity, [[wheels]], [[knife_edges]] and [[surfaces]] (frontend/model_file.cpp)
-// are a thin layer over this class. docs/multibody.md describes it for users;
+// [[points]], [[bodies]], gravity, [[wheels]], [[knife_edges]] and [[surfaces]]
+// (frontend/model_file_multibody.cpp) are a thin layer over this class. docs/multibody.md describes it for users;
 // docs/derivations/rolling-wheel.md derives what it writes.
 //
 // Frames: "ground" is the world frame. A frame is placed in its parent by a translation (in the
@@ -16,6 +16,10 @@
 //
 // Every expression is text parsed by the SpecBuilder (its coordinates and parameters must be
 // declared first). Errors are ModelErrors that start with the SourceLocation given.
+//
+// The builder also fills the report's scene (visual.hpp) through the SpecBuilder, so that a model
+// built in C++ is drawn as the same model written in a file: the ground's grid, each body as its
+// ellipsoid of inertia and each wheel as a disk about its axle, in the order they are given.
 #pragma once
 
 #include <ginac/ginac.h>
@@ -82,7 +86,8 @@ class MultibodyBuilder {
                           SourceLocation where = {});
   // A rigid body moving with `frame`: mass, centre of mass (in the frame's axes) and inertia tensor
   // about the centre of mass in the frame's axes (symmetric, positive definite; all expressions in
-  // the parameters). Checked with the parameter values given so far.
+  // the parameters). Checked with the parameter values given so far. Drawn in the scene as its
+  // ellipsoid of inertia at its centre of mass, moving with its frame.
   MultibodyBuilder& body(const std::string& name, const std::string& frame, const std::string& mass,
                          const Triple& centre_of_mass, const InertiaText& inertia, SourceLocation where = {});
   // The gravitational acceleration vector in world components (parameters only), e.g. {0, 0, -g}.
@@ -92,10 +97,17 @@ class MultibodyBuilder {
   // its axle is the frame's `axis` ("x", "y" or "z"). The plane passes through the world origin
   // with the normal `normal` (world components, parameters only), or opposite to gravity when no
   // normal is given. Adds "<name>_contact" (position level, unless it holds identically) and
-  // "<name>_slip1", "<name>_slip2" (velocity level).
+  // "<name>_slip1", "<name>_slip2" (velocity level). Drawn as wheel_drawing() draws it.
   MultibodyBuilder& rolling_wheel(const std::string& name, const std::string& body, const std::string& axis,
                                   const std::string& radius, const std::optional<Triple>& normal = std::nullopt,
                                   SourceLocation where = {});
+  // Draws `body` in the scene as the wheel `name` (VisualKind::wheel): a disk of `radius` about
+  // its frame's `axis`, centred on the frame's origin. rolling_wheel() calls it; a front end that
+  // gives a wheel as the disk contact it is (contact(), for the contact modes' keys:
+  // frontend/contacts_file.hpp) calls it after contact(). Throws a ModelError naming `where` for a
+  // body not declared.
+  MultibodyBuilder& wheel_drawing(const std::string& name, const std::string& body, const std::string& axis,
+                                  const std::string& radius, SourceLocation where = {});
   // A knife edge at `point` along its frame's `axis`, on the plane of `normal` (default: opposite
   // to gravity): the velocity of the point across the blade within the plane vanishes. Adds one
   // velocity-level constraint called `name`.

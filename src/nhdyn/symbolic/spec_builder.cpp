@@ -1098,6 +1098,29 @@ std::map<std::string, GiNaC::symbol> derived_scope(const Spec& spec) {
   return scope;
 }
 
+// What parse_derived reads: `text` against `scope` (derived_scope), with the names in
+// `unavailable` refused with their reason, each output then replaced by its expression.
+GiNaC::ex read_derived(const Spec& spec, const std::string& text, const SourceLocation& where,
+                       const std::map<std::string, GiNaC::symbol>& scope,
+                       const std::map<std::string, std::string>& unavailable) {
+  const Site site{text, where, ""};
+  const GiNaC::ex value = read(spec, site, 0, text.size(), &scope, &unavailable).value;
+  if (spec.outputs.empty()) return value;
+  GiNaC::exmap outputs;
+  for (const SpecOutput& o : spec.outputs) outputs[o.symbol] = o.expression;
+  const GiNaC::ex written_out = value.subs(outputs);
+  std::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, double>> seen;
+  const double size = tree_size(written_out, seen);
+  if (size > kLargestDerived)
+    site.fail_whole(fmt::format("with the outputs it names written out, this expression has about {:.2g} operations "
+                                "(the limit is {:g}): outputs that each use the one above more than once grow "
+                                "exponentially down the chain, and compiling them would take minutes; name each "
+                                "output once per expression (e.g. b = \"a^2\" rather than \"a*a\"), or write the "
+                                "expression in t, q, q', q'', R_x and the parameters",
+                                size, kLargestDerived));
+  return written_out;
+}
+
 }  // namespace
 
 SpecBuilder& SpecBuilder::announce_outputs(std::vector<std::pair<std::string, SourceLocation>> names) {
@@ -1125,22 +1148,11 @@ GiNaC::ex SpecBuilder::parse_derived(const std::string& text, const SourceLocati
                           name, defining.empty() ? std::string("this one") : fmt::format("'{}'", defining),
                           place.empty() ? "" : " (at " + place + ")", name));
   }
-  const Site site{text, where, ""};
-  const GiNaC::ex value = read(spec_, site, 0, text.size(), &scope, &unavailable).value;
-  if (spec_.outputs.empty()) return value;
-  GiNaC::exmap outputs;
-  for (const SpecOutput& o : spec_.outputs) outputs[o.symbol] = o.expression;
-  const GiNaC::ex written_out = value.subs(outputs);
-  std::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, double>> seen;
-  const double size = tree_size(written_out, seen);
-  if (size > kLargestDerived)
-    site.fail_whole(fmt::format("with the outputs it names written out, this expression has about {:.2g} operations "
-                                "(the limit is {:g}): outputs that each use the one above more than once grow "
-                                "exponentially down the chain, and compiling them would take minutes; name each "
-                                "output once per expression (e.g. b = \"a^2\" rather than \"a*a\"), or write the "
-                                "expression in t, q, q', q'', R_x and the parameters",
-                                size, kLargestDerived));
-  return written_out;
+  return read_derived(spec_, text, where, scope, unavailable);
+}
+
+GiNaC::ex parse_derived(const Spec& spec, const std::string& text, const SourceLocation& where) {
+  return read_derived(spec, text, where, derived_scope(spec), {});
 }
 
 SpecBuilder& SpecBuilder::output(const std::string& name, const std::string& text, SourceLocation where) {

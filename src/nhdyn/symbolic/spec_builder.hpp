@@ -92,6 +92,20 @@ class SpecBuilder {
     spec_.contact_coordinates.push_back(std::move(added));
     return *this;
   }
+  // The report's 3-D scene (spec.visual, visual.hpp), filled by the front ends in the order the
+  // model gives its parts: an item drawn (the multibody builder draws its bodies and wheels; the
+  // model file adds its frames' axes, its contacts' shapes and its [visual] items).
+  SpecBuilder& visual_item(VisualItem item) {
+    spec_.visual.items.push_back(std::move(item));
+    return *this;
+  }
+  // Whether the scene is planar (every position has two components: the (x, y) plane, y up) and
+  // whether it is drawn over the ground's grid (a multibody model: set by MultibodyBuilder).
+  SpecBuilder& visual_scene(bool planar, bool ground) {
+    spec_.visual.planar = planar;
+    spec_.visual.ground = ground;
+    return *this;
+  }
   // A contact whose closed-form point may turn singular along the motion (spec.hpp).
   SpecBuilder& contact_watch(SpecContactWatch watch) {
     spec_.contact_watches.push_back(std::move(watch));
@@ -138,5 +152,11 @@ class SpecBuilder {
   std::vector<std::pair<std::string, SourceLocation>> announced_outputs_;  // announce_outputs()
   int coordinate_of(const std::string& name) const;  // -1 when not a coordinate
 };
+
+// SpecBuilder::parse_derived against `spec`, a spec already built (a model file's, kept in its
+// description: symbolic/description.hpp): t, q, q', q'', the reactions R_x, the parameters, every
+// output and the contact-force columns are known, each output replaced by its expression. For
+// the command line's events of a model file (symbolic/events.hpp); errors as parse_derived's.
+GiNaC::ex parse_derived(const Spec& spec, const std::string& text, const SourceLocation& where = {});
 
 }  // namespace nhdyn::symbolic
