@@ -8,7 +8,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
-#include "nhdyn/core/suggest.hpp"
+#include "nhdyn/core/detail/suggest.hpp"
 #include "nhdyn/symbolic/contact_shapes.hpp"
 #include "nhdyn/symbolic/multibody.hpp"
 #include "nhdyn/symbolic/rolling_contact.hpp"

@@ -23,7 +23,7 @@
 #include <toml++/toml.h>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/frontend/model_file_sections.hpp"
+#include "nhdyn/frontend/detail/model_file_sections.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/rolling_contact.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"

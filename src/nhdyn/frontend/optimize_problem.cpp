@@ -19,7 +19,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
-#include "nhdyn/core/suggest.hpp"
+#include "nhdyn/core/detail/suggest.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
 

@@ -14,7 +14,7 @@
 #include <utility>
 
 #include "nhdyn/core/error.hpp"
-#include "nhdyn/core/suggest.hpp"
+#include "nhdyn/core/detail/suggest.hpp"
 
 namespace nhdyn {
 namespace {

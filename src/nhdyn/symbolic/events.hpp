@@ -6,7 +6,7 @@
 // NaN by design, is refused here, before any run). A model file's are read against its own Spec,
 // the one kept in its description (frontend/events.hpp chooses); a model without one (built in,
 // or a Model alone) gives its names from the Model. The result is a model/event.hpp Event whose
-// program g reads the parameters, so --set applies to it. Errors are ModelError (a model file's,
+// tape g reads the parameters, so --set applies to it. Errors are ModelError (a model file's,
 // with file:line:column) or InputError (the command line's, naming the option, the column and the
 // nearest known name).
 #pragma once

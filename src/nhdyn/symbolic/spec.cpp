@@ -6,7 +6,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/model/parameters.hpp"
-#include "nhdyn/core/suggest.hpp"
+#include "nhdyn/core/detail/suggest.hpp"
 
 namespace nhdyn::symbolic {
 

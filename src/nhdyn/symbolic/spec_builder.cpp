@@ -19,7 +19,7 @@
 #include "nhdyn/symbolic/contact_forces.hpp"
 #include "nhdyn/symbolic/detail/occurrence.hpp"
 #include "nhdyn/symbolic/detail/plain_words.hpp"
-#include "nhdyn/core/suggest.hpp"
+#include "nhdyn/core/detail/suggest.hpp"
 
 namespace nhdyn::symbolic {
 namespace {

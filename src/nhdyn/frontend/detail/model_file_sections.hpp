@@ -11,7 +11,7 @@
 
 #include <toml++/toml.h>
 
-#include "nhdyn/frontend/model_file_cursor.hpp"
+#include "nhdyn/frontend/detail/model_file_cursor.hpp"
 
 // Declared only: this header stays free of GiNaC (tests/layering).
 namespace nhdyn::symbolic {

@@ -1,5 +1,6 @@
 // "Did you mean ...?": the nearest of a list of known names to a misspelt one, by edit distance.
 // Used in the error messages of the model-file loader, the symbolic front end and the parameters.
+// Internal: the messages of the model-file loader, the symbolic front end and the parameters.
 #pragma once
 
 #include <string>

@@ -12,7 +12,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/frontend/contacts_file.hpp"
-#include "nhdyn/frontend/model_file_sections.hpp"
+#include "nhdyn/frontend/detail/model_file_sections.hpp"
 #include "nhdyn/symbolic/multibody.hpp"
 #include "nhdyn/symbolic/outputs.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"

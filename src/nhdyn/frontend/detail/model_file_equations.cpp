@@ -14,9 +14,9 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
-#include "nhdyn/core/suggest.hpp"
+#include "nhdyn/core/detail/suggest.hpp"
 #include "nhdyn/formulation/formulation.hpp"
-#include "nhdyn/frontend/model_file_sections.hpp"
+#include "nhdyn/frontend/detail/model_file_sections.hpp"
 #include "nhdyn/integrators/ode.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"

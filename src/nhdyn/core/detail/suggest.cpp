@@ -1,4 +1,4 @@
-#include "nhdyn/core/suggest.hpp"
+#include "nhdyn/core/detail/suggest.hpp"
 
 #include <algorithm>
 

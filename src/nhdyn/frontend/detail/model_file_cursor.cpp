@@ -1,6 +1,6 @@
 // The model-file loader's reader (model_file_cursor.hpp): where each position of the file is,
 // and the type-checked accessors with their messages.
-#include "nhdyn/frontend/model_file_cursor.hpp"
+#include "nhdyn/frontend/detail/model_file_cursor.hpp"
 
 #include <fmt/format.h>
 
@@ -11,7 +11,7 @@
 #include <utility>
 
 #include "nhdyn/core/join.hpp"
-#include "nhdyn/core/suggest.hpp"
+#include "nhdyn/core/detail/suggest.hpp"
 #include "nhdyn/symbolic/multibody.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 
