@@ -87,7 +87,8 @@ std::array<double, 3> principal_moments(const double (&A)[3][3]) {
   return {e1, 3.0 * q - e1 - e3, e3};
 }
 
-// A frame's origin and rotation as an item of the scene (visual.hpp).
+}  // namespace
+
 VisualItem frame_item(const PlacedFrame& frame, VisualKind kind, const SourceLocation& where) {
   VisualItem item;
   item.kind = kind;
@@ -98,8 +99,6 @@ VisualItem frame_item(const PlacedFrame& frame, VisualKind kind, const SourceLoc
     for (unsigned j = 0; j < 3; ++j) item.other.push_back(frame.rotation(i, j));
   return item;
 }
-
-}  // namespace
 
 MultibodyBuilder::MultibodyBuilder(SpecBuilder& builder) : builder_(builder) {
   // A multibody model's scene stands on the ground's grid.

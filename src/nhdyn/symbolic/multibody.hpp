@@ -205,4 +205,8 @@ class MultibodyBuilder {
   bool applied_ = false;
 };
 
+// A frame's origin and rotation as an item of the scene (visual.hpp) of the given kind: how the
+// builder draws a body or a wheel, and the loader a frame's axes.
+VisualItem frame_item(const PlacedFrame& frame, VisualKind kind, const SourceLocation& where);
+
 }  // namespace nhdyn::symbolic

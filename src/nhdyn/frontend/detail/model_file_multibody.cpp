@@ -48,19 +48,6 @@ struct MultibodySections {
   std::vector<std::pair<std::string, symbolic::PlacedFrame>> body_frames;  // for the contacts' scene
 };
 
-// A multibody frame's origin and rotation as a scene item.
-symbolic::VisualItem frame_item(const symbolic::PlacedFrame& frame, symbolic::VisualKind kind,
-                                const SourceLocation& where) {
-  symbolic::VisualItem item;
-  item.kind = kind;
-  item.name = frame.name;
-  item.where = where.describe();
-  item.at.assign(frame.origin.begin(), frame.origin.end());
-  for (unsigned i = 0; i < 3; ++i)
-    for (unsigned j = 0; j < 3; ++j) item.other.push_back(frame.rotation(i, j));
-  return item;
-}
-
 // A frame's `rotations = "quaternion"` with `quaternion = ["e0", "e1", "e2", "e3"]`: the four
 // coordinates' names; nullopt for a frame turned by angles (docs/derivations/quaternion-frame.md).
 std::optional<std::array<std::string, 4>> quaternion_of(const Cursor& c, const toml::table& table,
@@ -139,7 +126,8 @@ void load_frames(LoadContext& cx, const toml::table& root, MultibodySections& sc
         scene.mb.quaternion_frame(name, parent, translation, *quaternion, c.at(*table->get("quaternion")));
         cx.quaternion_coordinates.insert(cx.quaternion_coordinates.end(), quaternion->begin(), quaternion->end());
         scene.frame_names.push_back(name);
-        scene.builder.visual_item(frame_item(scene.mb.placed_frame(name), symbolic::VisualKind::frame, c.at(*table)));
+        scene.builder.visual_item(
+            symbolic::frame_item(scene.mb.placed_frame(name), symbolic::VisualKind::frame, c.at(*table)));
         continue;
       }
       std::vector<symbolic::FrameRotation> rotations;
@@ -159,7 +147,8 @@ void load_frames(LoadContext& cx, const toml::table& root, MultibodySections& sc
       }
       scene.mb.frame(name, parent, translation, rotations, c.at(*table));
       scene.frame_names.push_back(name);
-      scene.builder.visual_item(frame_item(scene.mb.placed_frame(name), symbolic::VisualKind::frame, c.at(*table)));
+      scene.builder.visual_item(
+          symbolic::frame_item(scene.mb.placed_frame(name), symbolic::VisualKind::frame, c.at(*table)));
     }
 }
 
