@@ -1,8 +1,9 @@
 """Builds the Python package nhdyn with CMake, for `pip install .` and `python3 -m build --wheel`
 (pyproject.toml; docs/install.md, "pip").
 
-The pure-Python files come from python/nhdyn/; the compiled module nhdyn._nhdyn and the file that
-says which interpreter it was built for (_build_info.py) from a CMake build of the target
+The pure-Python files come from python/nhdyn/; the compiled module nhdyn._nhdyn, IPOPT's module
+libnhdyn_ipopt.so that Model.optimize loads, and the file that says which interpreter it was built
+for (_build_info.py) from a CMake build of the target
 nhdyn_python, configured with -DPYTHON_EXECUTABLE set to the interpreter running this build, so
 the wheel is for that interpreter (its tag says which, as does the build's output).
 
@@ -78,6 +79,9 @@ class CMakeBuild(build_ext):
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(built, target)
         shutil.copy2(package / "_build_info.py", target.parent / "_build_info.py")
+        # IPOPT's module, loaded from beside the compiled one by Model.optimize (a build without IPOPT has none).
+        if (package / "libnhdyn_ipopt.so").exists():
+            shutil.copy2(package / "libnhdyn_ipopt.so", target.parent / "libnhdyn_ipopt.so")
 
 
 cmake_build_dir().mkdir(parents=True, exist_ok=True)  # egg_info wants its base to exist

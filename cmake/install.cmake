@@ -2,6 +2,7 @@
 #   P/bin/nhdyn                                      the command line
 #   P/include/nhdyn/...                              the library's headers (and the generated version.hpp)
 #   P/lib/libnhdyn_*.a                               the library's modules, static
+#   P/lib/nhdyn/libnhdyn_ipopt.so                    IPOPT's module, loaded by `nhdyn optimize` alone
 #   P/lib/cmake/nhdyn/nhdynConfig.cmake (+Version)   find_package(nhdyn 0.2 CONFIG) -> nhdyn::nhdyn
 #   P/lib/pkgconfig/nhdyn.pc                         pkg-config --cflags --libs nhdyn
 #   P/lib/python3.X/site-packages/nhdyn              the Python package (the interpreter's layout: below)
@@ -52,6 +53,10 @@ install(FILES ${PROJECT_BINARY_DIR}/nhdyn.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}
 # --- The command line, its man page and its bash completion.
 if(TARGET nhdyn_cli)
   install(TARGETS nhdyn_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  # IPOPT's module, which `nhdyn optimize` loads from there (src/nhdyn/optimize/ipopt/solver_module.cpp).
+  if(TARGET nhdyn_ipopt_solver)
+    install(FILES $<TARGET_FILE:nhdyn_ipopt_solver> DESTINATION ${CMAKE_INSTALL_LIBDIR}/nhdyn)
+  endif()
   install(FILES ${PROJECT_SOURCE_DIR}/scripts/nhdyn.bash-completion DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions
           RENAME nhdyn)
   find_program(NHDYN_HELP2MAN help2man)

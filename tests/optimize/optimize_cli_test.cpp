@@ -3,10 +3,12 @@
 // (Hermite-Simpson exact, the trapezoidal J_N in closed form), the Brockett integrator's circle
 // (J = 2 pi a / T), the brachistochrone's cycloid, the motion `nhdyn simulate` computes under the
 // same force (the double integrator, parallel parking), and each refusal of bad input with its exit code.
+#include <dlfcn.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <algorithm>
@@ -548,6 +550,71 @@ TEST_F(OptimizeCli, BadInputExitsTwoNamingWhere) {
   const Outcome no_section = run_nhdyn("optimize " + example("sled.toml"), dir_);
   EXPECT_EQ(no_section.exit_code, 2) << no_section.out;
   EXPECT_NE(no_section.out.find("has no [optimize] section"), std::string::npos) << no_section.out;
+}
+
+// IPOPT is a module loaded when a program is first solved (src/nhdyn/optimize/ipopt/solver_module.cpp):
+// the dynamic loader's own account (LD_DEBUG=files lists every object it opens) shows that a
+// simulation opens none of IPOPT's libraries and that `optimize` does.
+TEST_F(OptimizeCli, IpoptIsLoadedByOptimizeAlone) {
+  // The loader's account of the processes of one run (the shell's and nhdyn's), written to files
+  // `prefix`.PID (LD_DEBUG_OUTPUT), read back together.
+  const auto opened = [&](const std::string& prefix) {
+    std::string text;
+    for (const auto& entry : fs::directory_iterator(dir_)) {
+      if (entry.path().filename().string().rfind(prefix + ".", 0) != 0) continue;
+      std::ifstream in(entry.path());
+      std::stringstream s;
+      s << in.rdbuf();
+      text += s.str();
+    }
+    return text;
+  };
+  ::setenv("LD_DEBUG", "files", 1);
+  ::setenv("LD_DEBUG_OUTPUT", (dir_ / "simulate").c_str(), 1);
+  const Outcome simulate = run_nhdyn("simulate " + example("sled.toml") + " --t-end 1 -o sled.csv", dir_);
+  ::setenv("LD_DEBUG_OUTPUT", (dir_ / "optimize").c_str(), 1);
+  const Outcome solve = optimize(example("double_integrator.toml") + " -o di.csv");
+  ::unsetenv("LD_DEBUG");
+  ::unsetenv("LD_DEBUG_OUTPUT");
+  SKIP_WITHOUT_IPOPT(solve);
+  ASSERT_EQ(simulate.exit_code, 0) << simulate.out;
+  ASSERT_EQ(solve.exit_code, 0) << solve.out;
+  const std::string by_simulate = opened("simulate"), by_optimize = opened("optimize");
+  // The loader lists what it opens (the C library at least): the check below can see a library.
+  ASSERT_NE(by_simulate.find("file=libc.so"), std::string::npos) << by_simulate;
+  EXPECT_EQ(by_simulate.find("ipopt"), std::string::npos) << by_simulate;
+  EXPECT_EQ(by_simulate.find("libdmumps"), std::string::npos) << by_simulate;
+  EXPECT_NE(by_optimize.find("libnhdyn_ipopt.so"), std::string::npos) << by_optimize;
+  EXPECT_NE(by_optimize.find("file=libipopt.so"), std::string::npos) << by_optimize;
+}
+
+// NHDYN_IPOPT_MODULE names the module to load: a path that does not exist, a file that is not a
+// shared object and a shared object that is not nhdyn's module are each refused by name, exit 2.
+TEST_F(OptimizeCli, ASolverModuleThatCannotBeUsedIsNamed) {
+  Dl_info libm{};
+  ASSERT_NE(::dladdr(reinterpret_cast<void*>(static_cast<double (*)(double)>(&::cos)), &libm), 0);
+  write("not_elf.so", "not a shared object\n");
+  const std::string missing = (dir_ / "missing.so").string(), not_elf = (dir_ / "not_elf.so").string();
+  const auto run_with = [&](const std::string& module) {
+    ::setenv("NHDYN_IPOPT_MODULE", module.c_str(), 1);
+    const Outcome run = optimize(example("double_integrator.toml") + " -o di.csv");
+    ::unsetenv("NHDYN_IPOPT_MODULE");
+    return run;
+  };
+  const Outcome none = run_with(missing);
+  SKIP_WITHOUT_IPOPT(none);
+  EXPECT_EQ(none.exit_code, 2) << none.out;
+  EXPECT_NE(none.out.find("NHDYN_IPOPT_MODULE names " + missing + ", which does not exist"), std::string::npos)
+      << none.out;
+  const Outcome garbage = run_with(not_elf);
+  EXPECT_EQ(garbage.exit_code, 2) << garbage.out;
+  EXPECT_NE(garbage.out.find("nhdyn's IPOPT module " + not_elf + " could not be loaded: "), std::string::npos)
+      << garbage.out;
+  const Outcome foreign = run_with(libm.dli_fname);
+  EXPECT_EQ(foreign.exit_code, 2) << foreign.out;
+  EXPECT_NE(foreign.out.find(std::string(libm.dli_fname) + " is not the IPOPT module of this nhdyn"), std::string::npos)
+      << foreign.out;
+  EXPECT_FALSE(fs::exists(dir_ / "di.csv"));
 }
 
 }  // namespace

@@ -3,6 +3,8 @@ CSV and summary on the Brockett integrator, against its closed form J = 2 pi a /
 parameters, and a solve that does not converge."""
 
 import math
+import subprocess
+import sys
 import warnings
 
 import numpy as np
@@ -71,3 +73,26 @@ def test_builtin_model_is_refused():
     m = nhdyn.load(next(iter(nhdyn.builtin_models())))
     with pytest.raises(nhdyn.InputError, match="model file"):
         m.optimize()
+
+
+def test_ipopt_is_mapped_by_optimize_alone(examples):
+    # IPOPT is a module the package loads when a program is first solved: importing nhdyn and
+    # simulating map none of its libraries (the process's own memory map says so), optimizing does.
+    code = """
+import sys, nhdyn
+def mapped():
+    maps = open("/proc/self/maps").read()
+    return "libnhdyn_ipopt.so" in maps, "libipopt.so" in maps
+nhdyn.load(sys.argv[1] + "/sled.toml").simulate(t_end=1)
+before = mapped()
+try:
+    nhdyn.load(sys.argv[1] + "/double_integrator.toml").optimize()
+except nhdyn.InputError as error:
+    print("error", error)
+    sys.exit(0)
+print(before, mapped())
+"""
+    run = subprocess.run([sys.executable, "-c", code, str(examples)], capture_output=True, text=True, check=True)
+    if run.stdout.startswith("error") and "built without IPOPT" in run.stdout:
+        pytest.skip(run.stdout)
+    assert run.stdout.strip() == "(False, False) (True, True)", run.stdout + run.stderr

@@ -1,6 +1,8 @@
 // solve_nlp (optimize/nlp.hpp) with IPOPT 3.11 (Debian coinor-libipopt-dev, MUMPS as its linear
 // solver): a TNLP adapter over Nlp, the options nhdyn sets, and IPOPT's return status in nhdyn's
-// words. The only file that includes IPOPT's headers (src/nhdyn/CMakeLists.txt, optimize/ipopt).
+// words. The only file that includes IPOPT's headers (src/nhdyn/CMakeLists.txt, optimize/ipopt),
+// and the whole of the module libnhdyn_ipopt.so, which solver_module.cpp loads when a program is
+// first solved: its two entry points (solver_module.hpp) are all it exports.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -10,6 +12,7 @@
 #include <IpSolveStatistics.hpp>
 #include <IpTNLP.hpp>
 
+#include "nhdyn/optimize/ipopt/solver_module.hpp"
 #include "nhdyn/optimize/nlp.hpp"
 
 namespace nhdyn {
@@ -93,11 +96,7 @@ NlpStatus status_of(Ipopt::ApplicationReturnStatus s, std::string& message) {
   }
 }
 
-}  // namespace
-
-bool nlp_solver_available() { return true; }
-
-NlpResult solve_nlp(Nlp& nlp, const NlpOptions& options) {
+NlpResult solve(Nlp& nlp, const NlpOptions& options) {
   const bool hessian = options.hessian == NlpHessian::program && nlp.hessian_nonzeros() >= 0;
   Ipopt::SmartPtr<Adapter> adapter = new Adapter(nlp, hessian);
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
@@ -123,4 +122,17 @@ NlpResult solve_nlp(Nlp& nlp, const NlpOptions& options) {
   return result;
 }
 
+}  // namespace
 }  // namespace nhdyn
+
+// The module's entry points (solver_module.hpp), the only symbols it exports (the target builds with
+// hidden visibility).
+extern "C" __attribute__((visibility("default"))) const char* nhdyn_ipopt_interface() {
+  return nhdyn::ipopt_module::kInterface;
+}
+
+extern "C" __attribute__((visibility("default"))) void nhdyn_ipopt_solve(nhdyn::Nlp& nlp,
+                                                                        const nhdyn::NlpOptions& options,
+                                                                        nhdyn::NlpResult& result) {
+  result = nhdyn::solve(nlp, options);
+}
