@@ -16,6 +16,7 @@
 #include "nhdyn/symbolic/multibody.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
 #include "nhdyn/symbolic/visual.hpp"
+#include "support/models.hpp"
 
 // A namespace of its own: the unity build joins this file with the other multibody tests.
 namespace nhdyn::builder_scene_test {
@@ -26,35 +27,8 @@ using multibody_test::uniform;
 
 // A thin disk whose centre (x, y, z) is free, turned by z-x-y angles, rolling on the ground with
 // its axle along its frame's y axis; in a model file, and through the C++ API.
-const std::string kDisk = R"(name = "disk"
-coordinates = ["x", "y", "z", "psi", "theta", "phi"]
-gravity = [0, 0, "-g"]
-
-[parameters]
-m = 0.5
-r = 0.2
-g = 9.81
-
-[[frames]]
-name = "disk"
-translation = ["x", "y", "z"]
-rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
-
-[[bodies]]
-name = "disk"
-frame = "disk"
-mass = "m"
-inertia = ["m*r^2/4", "m*r^2/2", "m*r^2/4"]
-
-[[wheels]]
-name = "rim"
-body = "disk"
-axis = "y"
-radius = "r"
-
-[initial]
-position = { x = 0, y = 0, z = "r", psi = 0, theta = 0, phi = 0 }
-)";
+const std::string kRim = "\n[[wheels]]\nname = \"rim\"\nbody = \"disk\"\naxis = \"y\"\nradius = \"r\"\n";
+const std::string kDisk = test::free_disk_text("disk", "", kRim);
 
 symbolic::Spec disk_from_cpp() {
   symbolic::SpecBuilder b("disk");
@@ -149,8 +123,7 @@ TEST(BuilderScene, TheFilesSceneKeepsTheOrderOfItsSections) {
 // MultibodyBuilder::wheel_drawing), after its contact point's track.
 TEST(BuilderScene, AWheelGivenAsAContactIsDrawnAsTheSameWheel) {
   const symbolic::Spec plain = load_model_string(kDisk, "disk.toml");
-  std::string with_mode = kDisk;
-  with_mode.insert(with_mode.find("\n[initial]"), "friction = 0.5\n");
+  const std::string with_mode = test::free_disk_text("disk", "", kRim + "friction = 0.5\n");
   const symbolic::Spec contact = load_model_string(with_mode, "disk.toml");
   const symbolic::VisualItem* a = find(plain, symbolic::VisualKind::wheel);
   const symbolic::VisualItem* b = find(contact, symbolic::VisualKind::wheel);

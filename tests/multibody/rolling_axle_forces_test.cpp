@@ -17,6 +17,7 @@
 #include "multibody/multibody_support.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/model/contact_forces.hpp"
+#include "support/models.hpp"
 
 namespace nhdyn::multibody_test {
 namespace {
@@ -26,35 +27,12 @@ constexpr double kR = 0.2;  // the disk's radius
 // A thin disk whose centre is at (x, y, z), turned by z-x-y angles, rolling on z = 0: as a
 // [[wheels]] entry (`helper` "wheel") or a [[contacts]] disk ("rolling" or "rubber").
 std::string angle_disk_text(const std::string& helper) {
-  std::string text = R"(
-name = "disk-angles"
-coordinates = ["x", "y", "z", "psi", "theta", "phi"]
-gravity = [0, 0, "-g"]
-
-[parameters]
-m = 0.5
-r = 0.2
-g = 9.81
-
-[[frames]]
-name = "disk"
-translation = ["x", "y", "z"]
-rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
-
-[[bodies]]
-name = "disk"
-frame = "disk"
-mass = "m"
-inertia = ["m*r^2/4", "m*r^2/2", "m*r^2/4"]
-
-[initial]
-position = { x = 0, y = 0, z = "r", psi = 0, theta = 0, phi = 0 }
-)";
-  if (helper == "wheel") text += "\n[[wheels]]\nname = \"disk\"\nbody = \"disk\"\naxis = \"y\"\nradius = \"r\"\n";
-  else
-    text += "\n[[contacts]]\nname = \"disk\"\nbody = \"disk\"\nshape = { disk = \"r\", axis = \"y\" }\nrolling = \"" +
-            helper + "\"\n";
-  return text;
+  if (helper == "wheel") {
+    return test::free_disk_text("disk-angles", "", "\n[[wheels]]\nname = \"disk\"\nbody = \"disk\"\naxis = \"y\"\nradius = \"r\"\n");
+  }
+  return test::free_disk_text("disk-angles", "",
+                              "\n[[contacts]]\nname = \"disk\"\nbody = \"disk\"\nshape = { disk = \"r\", axis = \"y\" }\n"
+                              "rolling = \"" + helper + "\"\n");
 }
 
 // The same disk turned by the quaternion e.

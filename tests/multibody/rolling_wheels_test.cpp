@@ -14,6 +14,7 @@
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/results.hpp"
+#include "support/models.hpp"
 
 namespace nhdyn {
 namespace {
@@ -120,34 +121,10 @@ TEST(RollingWheels, DiskRollsDownAnInclineWithItsRadius) { check_incline(R"toml(
 // A uniform disk of radius r, centre (x, y, z), heading psi, tilt theta about the heading's x axis,
 // spin phi about the axle y: the frames of examples/rolling_disk_bodies.toml with the centre's
 // height held by the contact condition instead of placed.
-constexpr const char* disk_model = R"toml(name = "disk"
-coordinates = ["x", "y", "z", "psi", "theta", "phi"]
-gravity = [0, 0, "-g"]
-
-[parameters]
-m = 0.5
-r = 0.2
-g = 9.81
-w = 6.0
-theta0 = 0.3
-Omega = 2.0
-
-[[frames]]
-name = "disk"
-translation = ["x", "y", "z"]
-rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
-
-[[bodies]]
-name = "disk"
-frame = "disk"
-mass = "m"
-inertia = ["m*r^2/4", "m*r^2/2", "m*r^2/4"]
-
-[[contacts]]
-name = "disk"
-body = "disk"
-shape = { disk = "r", axis = "y" }
-)toml";
+const std::string disk_model =
+    test::free_disk_text("disk", "w = 6.0\ntheta0 = 0.3\nOmega = 2.0\n",
+                         "\n[[contacts]]\nname = \"disk\"\nbody = \"disk\"\nshape = { disk = \"r\", axis = \"y\" }\n",
+                         "velocity = { x = \"r*w\", phi = \"w\" }\n");
 
 // A wheel (mass 0.5, moments Ia about its axle y and Id about a diameter) with the frames of
 // examples/rolling_disk_bodies.toml but its centre's height held by the contact condition, started
@@ -193,11 +170,7 @@ velocity = { x = )toml" + number(V) + ", psi = " + number(Omega) + ", phi = " + 
 // (examples/rolling_disk_upright.toml), so about it the linearization has the pair
 // +-i sqrt((4/5)(3 w^2 - g/r)) and zeros; below w^2 = g/(3 r) the pair is real.
 TEST(RollingWheels, UprightDiskTiltFrequencyMatchesTheClosedForm) {
-  const std::string text = std::string(disk_model) + R"toml(
-[initial]
-position = { x = 0, y = 0, z = "r", psi = 0, theta = 0, phi = 0 }
-velocity = { x = "r*w", phi = "w" }
-)toml";
+  const std::string& text = disk_model;
   for (const double w : {6.0, 2.0}) {
     const Model model = load_model_text(text, "<disk>", {{"w", w}});
     LinearizationOptions options;

@@ -32,32 +32,7 @@ using multibody_test::uniform;
 
 // A thin disk whose centre (x, y, z) is free, turned by z-x-y angles (so it may leave the ground);
 // `helper` is appended: a [[wheels]] or a [[contacts]] entry.
-std::string disk_with(const std::string& helper) {
-  return R"(name = "disk"
-coordinates = ["x", "y", "z", "psi", "theta", "phi"]
-gravity = [0, 0, "-g"]
-
-[parameters]
-m = 0.5
-r = 0.2
-g = 9.81
-mu = 0.5
-
-[[frames]]
-name = "disk"
-translation = ["x", "y", "z"]
-rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
-
-[[bodies]]
-name = "disk"
-frame = "disk"
-mass = "m"
-inertia = ["m*r^2/4", "m*r^2/2", "m*r^2/4"]
-
-[initial]
-position = { x = 0, y = 0, z = "r", psi = 0, theta = 0, phi = 0 }
-)" + helper;
-}
+std::string disk_with(const std::string& helper) { return test::free_disk_text("disk", "mu = 0.5\n", helper); }
 
 const std::string kWheel = "\n[[wheels]]\nname = \"disk\"\nbody = \"disk\"\naxis = \"y\"\nradius = \"r\"\n";
 const std::string kContact =

@@ -2,6 +2,8 @@
 // that shows one behaviour, described where it is defined.
 #pragma once
 
+#include <string>
+
 namespace nhdyn::test {
 
 // A Chaplygin sleigh built from frames (x, y, theta keep it flat on the plane): its blade's normal
@@ -58,5 +60,37 @@ velocity = "y' - tan(phi)*x'"
 position = { x = 0, y = 0, phi = 0 }
 velocity = { x = 1, y = 0, phi = 1 }
 )";
+
+// A thin disk (m = 0.5, r = 0.2, g = 9.81, the moments of a uniform disk) whose centre (x, y, z)
+// is free, turned by z-x-y angles (psi, theta, phi) with its axle along its frame's y axis, named
+// `name`; `parameters` adds lines to [parameters], `entries` follows the body (the [[wheels]] or
+// [[contacts]] entry that puts it on the ground), and [initial] starts it upright at the origin,
+// its centre at height r, with `initial` added (a velocity = { ... } line).
+inline std::string free_disk_text(const std::string& name, const std::string& parameters, const std::string& entries,
+                                  const std::string& initial = "") {
+  return "name = \"" + name + R"toml("
+coordinates = ["x", "y", "z", "psi", "theta", "phi"]
+gravity = [0, 0, "-g"]
+
+[parameters]
+m = 0.5
+r = 0.2
+g = 9.81
+)toml" + parameters + R"toml(
+[[frames]]
+name = "disk"
+translation = ["x", "y", "z"]
+rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
+
+[[bodies]]
+name = "disk"
+frame = "disk"
+mass = "m"
+inertia = ["m*r^2/4", "m*r^2/2", "m*r^2/4"]
+)toml" + entries + R"toml(
+[initial]
+position = { x = 0, y = 0, z = "r", psi = 0, theta = 0, phi = 0 }
+)toml" + initial;
+}
 
 }  // namespace nhdyn::test
