@@ -7,6 +7,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/core/detail/suggest.hpp"
+#include "nhdyn/symbolic/detail/chain_rule.hpp"
 
 namespace nhdyn::symbolic {
 
@@ -23,7 +24,12 @@ void throw_model_error(const SourceLocation& where, const std::string& context, 
   throw ModelError((location.empty() ? "" : location + ": ") + (context.empty() ? "" : context + ": ") + problem);
 }
 
-SymbolTable::SymbolTable() : t_("t") { by_name_.emplace("t", t_); }
+SymbolTable::SymbolTable() : t_("t") {
+  // Before any expression of the model is built: GiNaC then differentiates its functions without
+  // an exception per call (detail/chain_rule.hpp).
+  detail::install_chain_rule();
+  by_name_.emplace("t", t_);
+}
 
 int SymbolTable::add_coordinate(const std::string& name) {
   q_.emplace_back(name);
