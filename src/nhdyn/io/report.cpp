@@ -722,9 +722,10 @@ std::vector<double> turned_angles(const symbolic::VisualShape& plane, const std:
     const double w = rate(t, 0.0);
     if (!std::isfinite(w))
       throw InputError(fmt::format("{}{}contact '{}' of '{}': its ground's angular_velocity is {} at t = {:.6g}: the "
-                                   "scene cannot turn the table, so the report is not written; write a rate defined "
-                                   "at every time of the run",
-                                   plane.where, plane.where.empty() ? "" : ": ", plane.name, model, w, t));
+                                   "table's angle in the scene is the integral of the rate from t = 0, so the report "
+                                   "is not written; write a rate defined from t = 0 to the end of the run",
+                                   plane.where, plane.where.empty() ? "" : ": ", plane.name, model,
+                                   std::isnan(w) ? std::string("NaN") : fmt::format("{}", w), t));
     return w;
   };
   double longest = 0.0;
