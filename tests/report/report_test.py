@@ -142,6 +142,18 @@ def check_report(browser, html, shape, label, screenshots, follows=False):
     check(browser.errors() == [], f"{label}: no console error after moving the slider ({browser.errors()[:3]})")
 
 
+def screens_at(browser, shape, fractions):
+    """The canvas's pixels at each fraction of the run, with its rectangle and where shape `shape` is
+    drawn on the page."""
+    out = []
+    for fraction in fractions:
+        browser.evaluate(f"nhdyn.setFrame(Math.round({fraction} * (nhdyn.frames - 1)))")
+        where = browser.evaluate(f"nhdyn.screen({shape})")
+        rect, rows, _ = canvas_pixels(browser)
+        out.append((rows, rect, where))
+    return out
+
+
 def check_contacts(browser, html, label, kinds):
     """A page of [[contacts]]: no console error, the shapes and grounds of `kinds` in its scene, and the
     first contact shape drawn where the camera projects it at two times, turning between them."""
@@ -151,14 +163,11 @@ def check_contacts(browser, html, label, kinds):
     present = browser.evaluate("NHDYN.scene.shapes.map(s => s.kind)")
     check(all(k in present for k in kinds), f"{label}: the scene has {kinds} ({present})")
     shape = browser.evaluate("NHDYN.scene.shapes.findIndex(s => s.body)")
-    screens = []
-    for fraction in (0.2, 0.7):
-        browser.evaluate(f"nhdyn.setFrame(Math.round({fraction} * (nhdyn.frames - 1)))")
-        where = browser.evaluate(f"nhdyn.screen({shape})")
-        rect, rows, _ = canvas_pixels(browser)
+    fractions = (0.2, 0.7)
+    screens = screens_at(browser, shape, fractions)
+    for (rows, rect, where), fraction in zip(screens, fractions):
         check(coloured_near(rows, rect, where, 20) > 100,
               f"{label}: the shape is drawn at {where[0]:.0f}, {where[1]:.0f} ({fraction:.0%} of the run)")
-        screens.append((rows, rect, where))
     (a, rect, where), (b, _, _) = screens
     check(changed_near(a, b, rect, where, 20) > 20, f"{label}: the drawing changed where the shape was")
     check(browser.errors() == [], f"{label}: no console error after moving ({browser.errors()[:3]})")
@@ -172,13 +181,7 @@ def check_turntable(browser, html, label):
     check(browser.evaluate("NHDYN.scene.shapes.filter(s => s.kind === 'plane' && s.turns).length") == 1,
           f"{label}: one turning plane in the scene")
     ball = browser.evaluate("NHDYN.scene.shapes.findIndex(s => s.body)")
-    screens = []
-    for fraction in (0.2, 0.5):
-        browser.evaluate(f"nhdyn.setFrame(Math.round({fraction} * (nhdyn.frames - 1)))")
-        where = browser.evaluate(f"nhdyn.screen({ball})")
-        rect, rows, _ = canvas_pixels(browser)
-        screens.append((rows, where))
-    (a, p), (b, q) = screens
+    (a, rect, p), (b, _, q) = screens_at(browser, ball, (0.2, 0.5))
     far = 0
     for y in range(len(a)):
         for x in range(len(a[0])):
