@@ -305,12 +305,23 @@
       if (s.axis === 1) inner.rotation.x = Math.PI / 2;
       group.add(inner);
       o.object = group;
+      // The wheel's tilted plane, when it has one (a [[wheels]] entry with a `normal` drawn as its
+      // contact's plane, of the same name): its normal is the wheel's up.
+      const ground = S.shapes.find((p) => p.kind === "plane" && p.name === s.name);
       const points = new Float32Array(frames * 3);
       for (let f = 0; f < frames; ++f) {
         const c = [value(f, s.offset), value(f, s.offset + 1), value(f, s.offset + 2)];
         const a = [value(f, s.offset + 3 + s.axis), value(f, s.offset + 6 + s.axis), value(f, s.offset + 9 + s.axis)];
         // The contact point: the lowest point of the rim, c - r d with d the unit vector of the
-        // vertical (up, +z or -z) within the wheel's plane.
+        // vertical (up, +z or -z; the plane's normal n) within the wheel's plane.
+        if (ground) {
+          const n = [value(f, ground.offset + 5), value(f, ground.offset + 8), value(f, ground.offset + 11)];
+          const na = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
+          const d = [n[0] - na * a[0], n[1] - na * a[1], n[2] - na * a[2]];
+          const norm = Math.hypot(d[0], d[1], d[2]) || 1;
+          for (let k = 0; k < 3; ++k) points[3 * f + k] = c[k] - (r * d[k]) / norm;
+          continue;
+        }
         let d = [-a[2] * a[0], -a[2] * a[1], 1 - a[2] * a[2]];
         const norm = Math.hypot(d[0], d[1], d[2]) || 1;
         for (let k = 0; k < 3; ++k) points[3 * f + k] = c[k] - (upward * r * d[k]) / norm;
