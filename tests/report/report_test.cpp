@@ -4,6 +4,7 @@
 // reproducible, and bad input (a [visual] table that cannot be drawn, a CSV of another model, an
 // --html path that cannot be written, a model with nothing to draw). The page in a browser is
 // tests/report/report_test.py.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -14,6 +15,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -899,6 +901,181 @@ TEST(ContactScene, TorusHasTheRunsRadiiAboutItsAxle) {
   EXPECT_EQ(nhdyn::calc_scene_sizes(scene, model.parameters, model.name)[static_cast<std::size_t>(torus)].size,
             (std::array<double, 3>{0.3, parameter(spec, "r"), 0.0}));
   EXPECT_GE(find_shape(scene, VisualKind::track, "tyre"), 0);
+}
+
+// ---- Plane grounds: a tilted plane in its own axes, a turntable turned through its angle ----
+
+// docs/gallery/ball_on_incline.toml, its plane's normal written with length 2 (the scene
+// normalizes it), run for 1.2 s with --html: the page has one plane, at the origin, whose third
+// axis is (-sin alpha, 0, cos alpha) on every frame, its axes orthonormal; the ball's centre is r
+// above that plane all along, on the closed form's parabola C(0) + u0 t e_y + 5/14 g sin(alpha)
+// t^2 d, d = (-cos alpha, 0, -sin alpha) down the slope.
+TEST_F(Cli, InclineIsDrawnInItsOwnPlaneUnderTheBall) {
+  std::string text = nhdyn::test::read_text(fs::path(NHDYN_SOURCE_DIR) / "docs" / "gallery" / "ball_on_incline.toml");
+  const std::string written = R"m(plane = ["-sin(alpha)", 0, "cos(alpha)"])m";
+  ASSERT_NE(text.find(written), std::string::npos);
+  text.replace(text.find(written), written.size(), R"m(plane = ["-2*sin(alpha)", 0, "2*cos(alpha)"])m");
+  std::ofstream(dir / "incline.toml") << text;
+  const fs::path csv = dir / "incline.csv", html = dir / "incline.html";
+  const nhdyn::test::CliOutcome run = nhdyn::test::run_nhdyn(
+      "simulate incline.toml --t-end 1.2 -q -o " + csv.string() + " --html " + html.string(), dir);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const std::string page = nhdyn::test::read_text(html);
+  const nhdyn::CsvTable table = nhdyn::load_csv(csv);
+  const ReportShape plane = report_shape(page, "plane", "ball"), ball = report_shape(page, "ellipsoid", "ball");
+  ASSERT_GE(plane.offset, 0) << "no plane in the page";
+  ASSERT_GE(ball.offset, 0);
+  const std::size_t first = page.find("{\"kind\":\"plane\"");
+  EXPECT_EQ(page.find("{\"kind\":\"plane\"", first + 1), std::string::npos) << "the plane is drawn once";
+  EXPECT_EQ(page.find("\"turns\""), std::string::npos) << "a fixed plane does not turn";
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_string(text, "incline.toml");
+  const double alpha = parameter(spec, "alpha"), r = parameter(spec, "r"), g = parameter(spec, "g"),
+               u0 = parameter(spec, "u0");
+  const std::array<double, 3> n = {-std::sin(alpha), 0.0, std::cos(alpha)}, d = {-std::cos(alpha), 0.0, -std::sin(alpha)};
+  const std::vector<double> values = report_scene_values(page);
+  const std::size_t stride = static_cast<std::size_t>(report_scene_stride(page));
+  ASSERT_EQ(values.size(), table.rows.size() * stride);
+  for (std::size_t f = 0; f < table.rows.size(); ++f) {
+    const double* o = values.data() + f * stride + plane.offset;
+    const double* R = o + 3;
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(o[k], 0.0);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(R[3 * i + 2], n[static_cast<std::size_t>(i)], 1e-6) << "frame " << f;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        const double dot = R[i] * R[j] + R[3 + i] * R[3 + j] + R[6 + i] * R[6 + j];
+        EXPECT_NEAR(dot, i == j ? 1.0 : 0.0, 2e-6) << "columns " << i << ", " << j;
+      }
+    const double* C = values.data() + f * stride + ball.offset;
+    EXPECT_NEAR(R[2] * C[0] + R[5] * C[1] + R[8] * C[2], r, 1e-5) << "the ball is on the drawn plane, frame " << f;
+    const double t = table.rows[f][0], down = 5.0 / 14 * g * std::sin(alpha) * t * t;
+    const std::array<double, 3> expected = {r * n[0] + down * d[0], u0 * t, r * n[2] + down * d[2]};
+    for (std::size_t k = 0; k < 3; ++k)
+      EXPECT_NEAR(C[k], expected[k], 1e-5 * std::max(1.0, std::abs(expected[k]))) << "frame " << f << ", component " << k;
+  }
+}
+
+// Several contacts on one plane draw it once; a level plane that does not turn is the scene's
+// grid in z = 0, and is drawn as a plane item only beside a tilted one (the page then draws no
+// other grid); a scene whose grounds are all level draws none (its report as before).
+TEST(ContactScene, EachGroundPlaneIsDrawnOnce) {
+  std::string text = R"m(name = "three-balls"
+coordinates = ["x1", "y1", "z1", "a1", "b1", "c1", "x2", "y2", "z2", "a2", "b2", "c2", "x3", "y3", "z3", "a3", "b3", "c3"]
+gravity = [0, 0, "-g"]
+
+[parameters]
+m = 0.1
+r = 0.05
+g = 9.81
+alpha = 0.3
+)m";
+  const char* const grounds[3] = {R"m(ground = { plane = ["-sin(alpha)", 0, "cos(alpha)"] })m",
+                                  R"m(ground = { plane = ["-sin(alpha)", 0, "cos(alpha)"] })m", R"m(ground = "plane")m"};
+  for (int k = 1; k <= 3; ++k)
+    text += fmt::format(R"m(
+[[frames]]
+name = "ball{0}"
+translation = ["x{0}", "y{0}", "z{0}"]
+rotations = [["x", "a{0}"], ["y", "b{0}"], ["z", "c{0}"]]
+
+[[bodies]]
+name = "ball{0}"
+frame = "ball{0}"
+mass = "m"
+inertia = ["2/5*m*r^2", "2/5*m*r^2", "2/5*m*r^2"]
+
+[[contacts]]
+name = "ball{0}"
+body = "ball{0}"
+shape = {{ sphere = "r" }}
+{1}
+)m",
+                        k, grounds[k - 1]);
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_string(text, "three.toml");
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  std::vector<std::string> planes;
+  for (const nhdyn::symbolic::VisualShape& shape : scene.shapes)
+    if (shape.kind == VisualKind::plane) planes.push_back(shape.name);
+  EXPECT_EQ(planes, (std::vector<std::string>{"ball1", "ball3"}));
+  const std::vector<double> out = run_scene(scene, spec, 0.0, std::vector<double>(18, 0.0), std::vector<double>(18, 0.0));
+  const double* level = out.data() + scene.shapes[static_cast<std::size_t>(find_shape(scene, VisualKind::plane, "ball3"))].offset;
+  EXPECT_EQ(std::vector<double>(level, level + 12), (std::vector<double>{0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1}));
+
+  for (const char* const level_only : {"rattleback.toml", "rolling_disk_hop_wheel.toml"}) {
+    const nhdyn::symbolic::VisualScene flat = nhdyn::symbolic::compile_visual(nhdyn::load_model_file(example(level_only)));
+    for (const nhdyn::symbolic::VisualShape& shape : flat.shapes) EXPECT_NE(shape.kind, VisualKind::plane) << level_only;
+  }
+}
+
+// examples/ball_on_turntable.toml with `from` replaced by `to` (nothing replaced when empty), run
+// for 1 s with --html from `dir`.
+struct TurntableRun {
+  nhdyn::test::CliOutcome run;
+  std::string page;
+  nhdyn::CsvTable table;
+};
+TurntableRun run_turntable(const fs::path& dir, const std::vector<std::pair<std::string, std::string>>& edits) {
+  std::string text = nhdyn::test::read_text(example("ball_on_turntable.toml"));
+  for (const auto& [from, to] : edits) {
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+  }
+  std::ofstream(dir / "table.toml") << text;
+  TurntableRun out;
+  out.run = nhdyn::test::run_nhdyn("simulate table.toml --t-end 1.2 -q -o table.csv --html table.html", dir);
+  if (out.run.exit_code == 0) {
+    out.page = nhdyn::test::read_text(dir / "table.html");
+    out.table = nhdyn::load_csv(dir / "table.csv");
+  }
+  return out;
+}
+
+// The table's angle at two frames: theta = atan2 of its first axis (R's first column, its normal
+// being z), against the integral of its rate from 0: Omega t for the example's constant rate,
+// Omega sin t for the rate Omega cos t; the normal stays (0, 0, 1).
+void check_table_angle(const TurntableRun& turntable, const std::function<double(double)>& angle) {
+  ASSERT_EQ(turntable.run.exit_code, 0) << turntable.run.out;
+  const std::string& page = turntable.page;
+  const ReportShape plane = report_shape(page, "plane", "ball");
+  ASSERT_GE(plane.offset, 0) << "no plane in the page";
+  EXPECT_NE(page.find("\"turns\":true", page.find("{\"kind\":\"plane\"")), std::string::npos);
+  const std::vector<double> values = report_scene_values(page);
+  const std::size_t stride = static_cast<std::size_t>(report_scene_stride(page));
+  ASSERT_EQ(values.size(), turntable.table.rows.size() * stride);
+  for (const std::size_t f : {std::size_t{30}, std::size_t{110}}) {
+    const double t = turntable.table.rows.at(f)[0];
+    const double* R = values.data() + f * stride + plane.offset + 3;
+    const double theta = std::atan2(R[3], R[0]);
+    EXPECT_NEAR(std::remainder(theta - angle(t), 2 * M_PI), 0.0, 2e-5) << "t = " << t;
+    EXPECT_NEAR(R[8], 1.0, 1e-12);
+    EXPECT_NEAR(R[2], 0.0, 1e-12);
+    EXPECT_NEAR(R[5], 0.0, 1e-12);
+  }
+}
+
+TEST_F(Cli, TurntableTurnsThroughTheIntegralOfItsRate) {
+  const double Omega = 3.0;
+  check_table_angle(run_turntable(dir, {}), [&](double t) { return Omega * t; });
+  // Omega cos t: the same at t = 0, where the initial velocities are written for Omega.
+  check_table_angle(run_turntable(dir, {{"angular_velocity = \"Omega\"", "angular_velocity = \"Omega*cos(t)\""}}),
+                    [&](double t) { return Omega * std::sin(t); });
+}
+
+// A rate that the run never evaluates undefined (before a start at t0 = 1), while the table's
+// angle integrates it from 0: the report is refused naming the contact and the time, and not
+// written.
+TEST_F(Cli, TurntableRateUndefinedBeforeTheRunIsRefused) {
+  const TurntableRun turntable = run_turntable(
+      dir, {{"angular_velocity = \"Omega\"", "angular_velocity = \"Omega + 0.001*sqrt(t - 0.5)\""},
+            {"[initial]\n", "[initial]\nt0 = 1\n"},
+            {"a = \"(Omega*x0 - u0)/r\"", "a = \"((Omega + 0.001*sqrt(0.5))*x0 - u0)/r\""}});
+  EXPECT_EQ(turntable.run.exit_code, 2) << turntable.run.out;
+  EXPECT_TRUE(nhdyn::test::contains(turntable.run.out, "table.toml:")) << turntable.run.out;
+  EXPECT_TRUE(nhdyn::test::contains(turntable.run.out, "contact 'ball' of 'ball-on-turntable': its ground's "
+                                                       "angular_velocity is NaN at t = "))
+      << turntable.run.out;
+  EXPECT_TRUE(nhdyn::test::contains(turntable.run.out, "the integral of the rate from t = 0")) << turntable.run.out;
+  EXPECT_FALSE(fs::exists(dir / "table.html"));
 }
 
 }  // namespace

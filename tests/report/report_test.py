@@ -142,6 +142,18 @@ def check_report(browser, html, shape, label, screenshots, follows=False):
     check(browser.errors() == [], f"{label}: no console error after moving the slider ({browser.errors()[:3]})")
 
 
+def screens_at(browser, shape, fractions):
+    """The canvas's pixels at each fraction of the run, with its rectangle and where shape `shape` is
+    drawn on the page."""
+    out = []
+    for fraction in fractions:
+        browser.evaluate(f"nhdyn.setFrame(Math.round({fraction} * (nhdyn.frames - 1)))")
+        where = browser.evaluate(f"nhdyn.screen({shape})")
+        rect, rows, _ = canvas_pixels(browser)
+        out.append((rows, rect, where))
+    return out
+
+
 def check_contacts(browser, html, label, kinds):
     """A page of [[contacts]]: no console error, the shapes and grounds of `kinds` in its scene, and the
     first contact shape drawn where the camera projects it at two times, turning between them."""
@@ -151,17 +163,33 @@ def check_contacts(browser, html, label, kinds):
     present = browser.evaluate("NHDYN.scene.shapes.map(s => s.kind)")
     check(all(k in present for k in kinds), f"{label}: the scene has {kinds} ({present})")
     shape = browser.evaluate("NHDYN.scene.shapes.findIndex(s => s.body)")
-    screens = []
-    for fraction in (0.2, 0.7):
-        browser.evaluate(f"nhdyn.setFrame(Math.round({fraction} * (nhdyn.frames - 1)))")
-        where = browser.evaluate(f"nhdyn.screen({shape})")
-        rect, rows, _ = canvas_pixels(browser)
+    fractions = (0.2, 0.7)
+    screens = screens_at(browser, shape, fractions)
+    for (rows, rect, where), fraction in zip(screens, fractions):
         check(coloured_near(rows, rect, where, 20) > 100,
               f"{label}: the shape is drawn at {where[0]:.0f}, {where[1]:.0f} ({fraction:.0%} of the run)")
-        screens.append((rows, rect, where))
     (a, rect, where), (b, _, _) = screens
     check(changed_near(a, b, rect, where, 20) > 20, f"{label}: the drawing changed where the shape was")
     check(browser.errors() == [], f"{label}: no console error after moving ({browser.errors()[:3]})")
+
+
+def check_turntable(browser, html, label):
+    """A turntable's page: its plane turns, so that between two times the drawing changes far from
+    the ball too (the table's grid, spokes and coloured sector), not only where the ball was."""
+    browser.events.clear()
+    browser.open("file://" + os.path.abspath(html) + "#paused")
+    check(browser.evaluate("NHDYN.scene.shapes.filter(s => s.kind === 'plane' && s.turns).length") == 1,
+          f"{label}: one turning plane in the scene")
+    ball = browser.evaluate("NHDYN.scene.shapes.findIndex(s => s.body)")
+    (a, rect, p), (b, _, q) = screens_at(browser, ball, (0.2, 0.5))
+    far = 0
+    for y in range(len(a)):
+        for x in range(len(a[0])):
+            near_ball = any((x + rect[0] - w[0]) ** 2 + (y + rect[1] - w[1]) ** 2 < 60 ** 2 for w in (p, q))
+            if not near_ball and sum(abs(u - v) for u, v in zip(a[y][x], b[y][x])) > 60:
+                far += 1
+    check(far > 2000, f"{label}: the drawing changed at {far} pixels away from the ball (the table turned)")
+    check(browser.errors() == [], f"{label}: no console error ({browser.errors()[:3]})")
 
 
 def main():
@@ -185,6 +213,9 @@ def main():
     bowl = os.path.join(WORK, "ball_in_bowl.html")
     run("simulate", os.path.join(SOURCE, "examples/ball_in_bowl.toml"), "--t-end", "1.6", "--set", "x0=0.15", "-q",
         "-o", os.path.join(WORK, "bowl.csv"), "--html", bowl)
+    turntable = os.path.join(WORK, "ball_on_turntable.html")
+    run("simulate", os.path.join(SOURCE, "examples/ball_on_turntable.toml"), "--t-end", "2", "-q",
+        "-o", os.path.join(WORK, "turntable.csv"), "--html", turntable)
     size = os.path.getsize(bicycle)
     check(size < 5e6, f"whipple_bicycle: a 10 s run at 100 frames/s gives a page of {size / 1e6:.2f} MB (< 5 MB)")
     try:
@@ -206,6 +237,7 @@ def main():
         check("Constraint disk_slip1, given at velocity level" in text and "disk\\_slip" not in text,
               f"rolling_disk_bodies: a constraint's name reads as written, without TeX escapes ({text[:120]!r})")
         check_contacts(browser, bowl, "ball_in_bowl", ["ellipsoid", "surface", "track"])
+        check_turntable(browser, turntable, "ball_on_turntable")
         browser.events.clear()
         browser.open("file://" + os.path.abspath(bicycle) + "#paused")
         check(browser.evaluate("nhdyn.frames") == 1001, "whipple_bicycle: all 1001 rows shown")

@@ -195,20 +195,22 @@ class ContactReader {
   const TomlLocator& at_;
 };
 
-// The ground where it is not the plane's grid, and the contact point's path on it: the
-// contact's outputs NAME_X, NAME_Y, NAME_Z.
+// The ground (a plane's axes and rate, a terrain's or a surface's mesh about the contact point),
+// and the contact point's path on it: the contact's outputs NAME_X, NAME_Y, NAME_Z.
 void add_ground_drawing(const symbolic::ContactText& text, const symbolic::ParsedContact& parsed,
-                        symbolic::SpecBuilder& builder) {
+                        const symbolic::MultibodyBuilder& multibody, symbolic::SpecBuilder& builder) {
   const std::vector<std::string> point = {text.name + "_X", text.name + "_Y", text.name + "_Z"};
   std::vector<symbolic::VisualItem> ground;
-  if (std::optional<symbolic::VisualItem> drawn = parsed.ground.type->drawing(parsed)) ground.push_back(std::move(*drawn));
+  if (std::optional<symbolic::VisualItem> drawn =
+          parsed.ground.type->drawing(parsed, builder.current(), multibody.gravity_vector()))
+    ground.push_back(std::move(*drawn));
   symbolic::VisualItem track;
   track.kind = symbolic::VisualKind::track;
   ground.push_back(std::move(track));
   for (symbolic::VisualItem& item : ground) {
     item.name = text.name;
     item.where = text.where.describe();
-    item.at_outputs = point;
+    if (item.at.empty()) item.at_outputs = point;
     builder.visual_item(std::move(item));
   }
 }
@@ -260,7 +262,7 @@ void load_wheel_contact(const toml::table& table, const WheelEntry& wheel, symbo
   multibody.contact(text);
   // The contact point's track is the contact's; the body is drawn as the wheel it is.
   if (const symbolic::ParsedContact* parsed = multibody.parsed_contact(text.name))
-    add_ground_drawing(text, *parsed, builder);
+    add_ground_drawing(text, *parsed, multibody, builder);
   multibody.wheel_drawing(wheel.name, wheel.body, wheel.axis, wheel.radius, text.where);
 }
 
@@ -319,7 +321,7 @@ void load_contacts(const toml::node& contacts, symbolic::MultibodyBuilder& multi
         for (unsigned j = 0; j < 3; ++j) item.other.push_back(frame.rotation(i, j));
       builder.visual_item(std::move(item));
     }
-    add_ground_drawing(text, *parsed, builder);
+    add_ground_drawing(text, *parsed, multibody, builder);
   }
 }
 

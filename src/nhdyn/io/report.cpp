@@ -711,8 +711,54 @@ void require_finite_scene(const symbolic::VisualScene& scene, const ReportInput&
   }
 }
 
+// The angle a turntable has turned through at each of `times` (ascending): theta(t), the integral
+// of its rate from 0 to t, by Gauss-Legendre's three points on pieces of at most 1/4096 of the
+// largest |t| (exact to round-off for a rate polynomial in t of degree up to 5, a constant
+// Omega giving Omega t). Throws InputError naming the plane when the rate is not finite.
+std::vector<double> turned_angles(const symbolic::VisualShape& plane, const std::vector<double>& parameters,
+                                  const std::vector<double>& times, const std::string& model) {
+  Field rate(plane.field, parameters);
+  const auto at = [&](double t) {
+    const double w = rate(t, 0.0);
+    if (!std::isfinite(w))
+      throw InputError(fmt::format("{}{}contact '{}' of '{}': its ground's angular_velocity is {} at t = {:.6g}: the "
+                                   "table's angle in the scene is the integral of the rate from t = 0, so the report "
+                                   "is not written; write a rate defined from t = 0 to the end of the run",
+                                   plane.where, plane.where.empty() ? "" : ": ", plane.name, model,
+                                   std::isnan(w) ? std::string("NaN") : fmt::format("{}", w), t));
+    return w;
+  };
+  double longest = 0.0;
+  for (const double t : times) longest = std::max(longest, std::abs(t));
+  const double piece = longest / 4096;
+  const double node = std::sqrt(0.6);
+  std::vector<double> out;
+  double angle = 0.0, from = 0.0;
+  for (const double to : times) {
+    const int pieces = piece > 0.0 ? std::max(1, static_cast<int>(std::ceil(std::abs(to - from) / piece))) : 1;
+    const double h = (to - from) / pieces;
+    for (int k = 0; k < pieces; ++k) {
+      const double mid = from + (k + 0.5) * h;
+      angle += h / 2 * (5.0 / 9 * at(mid - node * h / 2) + 8.0 / 9 * at(mid) + 5.0 / 9 * at(mid + node * h / 2));
+    }
+    out.push_back(angle);
+    from = to;
+  }
+  return out;
+}
+
+// A turning plane's axes at `angle` about its normal: R Rz(angle), R row-major (columns t1, t2, n).
+void turn_plane(double* R, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  for (int i = 0; i < 3; ++i) {
+    const double t1 = R[3 * i], t2 = R[3 * i + 1];
+    R[3 * i] = c * t1 + s * t2;
+    R[3 * i + 1] = -s * t1 + c * t2;
+  }
+}
+
 // The scene of a model with shapes: each shape's kind, size and place at every frame drawn (a
-// body along its principal axes).
+// body along its principal axes, a turntable turned through its angle).
 void append_scene_shapes(std::string& data, const ReportInput& input, const FrameColumns& column) {
   const CsvTable& table = column.table;
   const std::vector<std::size_t>& frames = column.frames;
@@ -735,8 +781,14 @@ void append_scene_shapes(std::string& data, const ReportInput& input, const Fram
   std::vector<double> values;
   values.reserve(frames.size() * outputs.size());
   const int tc = table.column("t");
-  for (const std::size_t f : frames) {
-    const std::vector<double>& row = table.rows[f];
+  std::vector<double> times;
+  for (const std::size_t f : frames) times.push_back(table.rows[f][static_cast<std::size_t>(tc)]);
+  std::vector<std::vector<double>> angles(scene.shapes.size());  // per turning plane, per frame
+  for (std::size_t s = 0; s < scene.shapes.size(); ++s)
+    if (scene.shapes[s].kind == symbolic::VisualKind::plane && scene.shapes[s].field.outputs() > 0)
+      angles[s] = turned_angles(scene.shapes[s], parameter_values, times, input.model);
+  for (std::size_t frame = 0; frame < frames.size(); ++frame) {
+    const std::vector<double>& row = table.rows[frames[frame]];
     for (int i = 0; i < n; ++i) {
       q[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(qc[static_cast<std::size_t>(i)])];
       v[static_cast<std::size_t>(i)] = row[static_cast<std::size_t>(vc[static_cast<std::size_t>(i)])];
@@ -754,6 +806,8 @@ void append_scene_shapes(std::string& data, const ReportInput& input, const Fram
           for (int k = 0; k < 3; ++k) RE[static_cast<std::size_t>(3 * i + j)] += R[3 * i + k] * E[static_cast<std::size_t>(3 * k + j)];
       std::copy(RE.begin(), RE.end(), R);
     }
+    for (std::size_t s = 0; s < scene.shapes.size(); ++s)
+      if (!angles[s].empty()) turn_plane(outputs.data() + scene.shapes[s].offset + 3, angles[s][frame]);
     values.insert(values.end(), outputs.begin(), outputs.end());
   }
   const std::vector<SceneMesh> meshes = calc_scene_meshes(scene, input.parameters, values, outputs.size(), input.model);
@@ -769,6 +823,7 @@ void append_scene_shapes(std::string& data, const ReportInput& input, const Fram
       data += ",\"body\":";
       append_string(data, shape.body);
     }
+    if (shape.kind == symbolic::VisualKind::plane && shape.field.outputs() > 0) data += ",\"turns\":true";
     if (!meshes[s].vertices.empty()) {
       data += ",\"mesh\":{\"v\":";
       append_numbers(data, meshes[s].vertices);

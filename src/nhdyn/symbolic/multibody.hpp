@@ -92,6 +92,9 @@ class MultibodyBuilder {
                          const Triple& centre_of_mass, const InertiaText& inertia, SourceLocation where = {});
   // The gravitational acceleration vector in world components (parameters only), e.g. {0, 0, -g}.
   MultibodyBuilder& gravity(const Triple& g, SourceLocation where = {});
+  // The gravity given so far (none before gravity()): a contact's plane without a normal is
+  // normal to it.
+  const std::optional<Vector3>& gravity_vector() const { return gravity_; }
 
   // A thin wheel of `radius` that rolls without slipping: the body's frame origin is its centre,
   // its axle is the frame's `axis` ("x", "y" or "z"). The plane passes through the world origin

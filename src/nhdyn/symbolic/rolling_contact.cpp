@@ -9,6 +9,7 @@
 #include <exception>
 #include <limits>
 #include <sstream>
+#include <tuple>
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
@@ -214,14 +215,39 @@ class PlaneGround final : public ContactGround {
     out.gap = dot(n, C) - s.reach;
     out.ground_omega = scale(c.ground.angular_velocity, n);
     out.ground_velocity = cross(out.ground_omega, out.point);
-    const int k = contact_least_aligned_axis(n, spec);
-    const GiNaC::ex nk = n[static_cast<std::size_t>(k)];
-    out.tangent1 = scale(1 / GiNaC::sqrt(simplify(1 - nk * nk)), subtract(unit(k), scale(nk, n)));
-    for (GiNaC::ex& e : out.tangent1) e = simplify(e);
-    out.tangent2 = cross(n, out.tangent1);
-    for (GiNaC::ex& e : out.tangent2) e = simplify(e);
+    std::tie(out.tangent1, out.tangent2) = plane_tangents(n, spec);
     if (c.shape->implicit()) implicit_shape_rows(c, F, out.tangent1, out.tangent2, out);
     return out;
+  }
+  // The plane's own axes (t1, t2, n) at the origin; a turntable's turning is its rate, integrated
+  // by the report (io/report.hpp). The level plane that does not turn is the scene's grid in z = 0:
+  // compile_visual leaves it to that grid unless another plane is drawn.
+  std::optional<VisualItem> drawing(const ParsedContact& c, const Spec& spec,
+                                    const std::optional<Vector3>& gravity) const override {
+    // Without a normal or a gravity the contact itself is refused (make_rolling_contact).
+    if (!c.ground.normal && !gravity) return std::nullopt;
+    const Vector3 n = ground_plane_normal(c.ground, spec, gravity, fmt::format("contact '{}'", c.name));
+    const auto [t1, t2] = plane_tangents(n, spec);
+    VisualItem item;
+    item.kind = VisualKind::plane;
+    item.at = {0, 0, 0};
+    for (std::size_t i = 0; i < 3; ++i) item.other.insert(item.other.end(), {t1[i], t2[i], n[i]});
+    item.field = c.ground.angular_velocity;
+    item.field_variables = {spec.symbols.time()};
+    return item;
+  }
+
+ private:
+  // Unit tangents of the plane of unit normal n: t1 from the world axis least aligned with n,
+  // t2 = n x t1 (the directions of the no-slip rows, and the axes of the plane's drawing).
+  static std::pair<Vector3, Vector3> plane_tangents(const Vector3& n, const Spec& spec) {
+    const int k = contact_least_aligned_axis(n, spec);
+    const GiNaC::ex nk = n[static_cast<std::size_t>(k)];
+    Vector3 t1 = scale(1 / GiNaC::sqrt(simplify(1 - nk * nk)), subtract(unit(k), scale(nk, n)));
+    for (GiNaC::ex& e : t1) e = simplify(e);
+    Vector3 t2 = cross(n, t1);
+    for (GiNaC::ex& e : t2) e = simplify(e);
+    return {t1, t2};
   }
 };
 
@@ -283,7 +309,7 @@ class SurfaceGround final : public ContactGround {
     out.variables = {X, Y, Z};
   }
   // The zero set of g, sampled along rays from the sphere's centre (every ray meets it once).
-  std::optional<VisualItem> drawing(const ParsedContact& c) const override {
+  std::optional<VisualItem> drawing(const ParsedContact& c, const Spec&, const std::optional<Vector3>&) const override {
     VisualItem item;
     item.kind = VisualKind::surface;
     item.sizes = {c.shape->length(c.values), c.ground.centre_x, c.ground.centre_y, c.ground.centre_z};
@@ -371,7 +397,7 @@ class TerrainGround final : public ContactGround {
     out.written = h;
     out.variables = {X, Y};
   }
-  std::optional<VisualItem> drawing(const ParsedContact& c) const override {
+  std::optional<VisualItem> drawing(const ParsedContact& c, const Spec&, const std::optional<Vector3>&) const override {
     VisualItem item;
     item.kind = VisualKind::terrain;
     item.sizes = {c.shape->length(c.values)};

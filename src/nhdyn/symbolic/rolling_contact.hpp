@@ -160,9 +160,12 @@ class ContactGround {
                       const std::optional<Vector3>& gravity, const std::string& context) const = 0;
   // How the report's scene draws the ground of `contact` (symbolic/visual.hpp): a terrain's
   // height field, a surface's zero set, each near the contact point's path (the loader fills
-  // at_outputs with NAME_X, NAME_Y, NAME_Z); nothing for a plane, which the scene's ground grid
-  // shows.
-  virtual std::optional<VisualItem> drawing(const ParsedContact&) const { return std::nullopt; }
+  // at_outputs with NAME_X, NAME_Y, NAME_Z, for an item whose `at` it leaves empty); a plane's
+  // axes and a turntable's rate (`gravity` gives the normal of a plane that has none). Throws as
+  // touch() for a plane whose normal is zero.
+  virtual std::optional<VisualItem> drawing(const ParsedContact&, const Spec&, const std::optional<Vector3>&) const {
+    return std::nullopt;
+  }
 };
 
 const std::vector<const ContactGround*>& contact_grounds();

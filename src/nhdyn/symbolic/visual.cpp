@@ -10,6 +10,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/symbolic/detail/plain_words.hpp"
+#include "nhdyn/symbolic/simplify.hpp"
 #include "nhdyn/symbolic/spec.hpp"
 
 namespace nhdyn::symbolic {
@@ -213,6 +214,7 @@ const char* visual_kind_name(VisualKind kind) {
     case VisualKind::track: return "track";
     case VisualKind::terrain: return "terrain";
     case VisualKind::surface: return "surface";
+    case VisualKind::plane: return "plane";
   }
   return "?";
 }
@@ -233,6 +235,38 @@ std::optional<std::vector<GiNaC::ex>> output_expressions(const Spec& spec, const
   return out;
 }
 
+// A plane item whose normal (R's third column) is +-z and that does not turn: the plane z = 0,
+// which the scene's grid draws.
+bool level_and_fixed(const VisualItem& plane) {
+  return plane.other.size() == 9 && symbolic::is_zero(plane.other[2]) && symbolic::is_zero(plane.other[5]) &&
+         symbolic::is_zero(plane.other[8] * plane.other[8] - 1) && symbolic::is_zero(plane.field);
+}
+
+bool same_plane(const VisualItem& a, const VisualItem& b) {
+  if (a.other.size() != b.other.size()) return false;
+  for (std::size_t i = 0; i < a.other.size(); ++i)
+    if (!symbolic::is_zero(a.other[i] - b.other[i])) return false;
+  return symbolic::is_zero(a.field - b.field);
+}
+
+// The items drawn, in their order: each distinct plane once, and no plane at all when every one is
+// level and fixed (the grid in z = 0 shows it, as in a scene without plane items).
+std::vector<const VisualItem*> drawn_items(const SpecVisual& visual) {
+  const bool planes = std::any_of(visual.items.begin(), visual.items.end(), [](const VisualItem& item) {
+    return item.kind == VisualKind::plane && !level_and_fixed(item);
+  });
+  std::vector<const VisualItem*> out;
+  for (const VisualItem& item : visual.items) {
+    if (item.kind == VisualKind::plane &&
+        (!planes || std::any_of(out.begin(), out.end(), [&](const VisualItem* drawn) {
+          return drawn->kind == VisualKind::plane && same_plane(*drawn, item);
+        })))
+      continue;
+    out.push_back(&item);
+  }
+  return out;
+}
+
 }  // namespace
 
 VisualScene compile_visual(const Spec& spec) {
@@ -248,7 +282,8 @@ VisualScene compile_visual(const Spec& spec) {
 
   Emitter positions(spec, false), sizes(spec, true);
   int offset = 0, size_offset = 0;
-  for (const VisualItem& written : spec.visual.items) {
+  for (const VisualItem* drawn : drawn_items(spec.visual)) {
+    const VisualItem& written = *drawn;
     VisualItem resolved;
     if (!written.at_outputs.empty()) {
       std::optional<std::vector<GiNaC::ex>> at = output_expressions(spec, written);
@@ -296,6 +331,11 @@ VisualScene compile_visual(const Spec& spec) {
       Emitter field(spec, item.field_variables);
       field.output(item.field, item, "surface");
       shape.field = field.take();
+    }
+    if (item.kind == VisualKind::plane && !symbolic::is_zero(item.field)) {
+      Emitter rate(spec, item.field_variables);
+      rate.output(item.field, item, "rate");
+      shape.field = rate.take();
     }
     offset += visual_outputs(item.kind);
     scene.shapes.push_back(shape);

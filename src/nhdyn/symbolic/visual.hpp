@@ -37,6 +37,7 @@ enum class VisualKind {
   track,      // a contact point's path over the ground (a line through its positions)
   terrain,    // a terrain Z = h(X, Y): a height-field mesh over the region its contact point covers
   surface,    // a fixed ground surface g(X, Y, Z) = 0: a mesh of its zero set near its contact point
+  plane,      // a plane ground through the origin, tilted or turning (a turntable): a grid in its axes
 };
 
 // One item of the scene, symbolic. Positions are world components (x, y, z); expressions may use
@@ -44,9 +45,10 @@ enum class VisualKind {
 struct VisualItem {
   VisualKind kind = VisualKind::sphere;
   std::string name;
-  std::vector<GiNaC::ex> at;     // sphere: centre; segment: first end; wheel, body, frame: origin (3)
+  std::vector<GiNaC::ex> at;     // sphere: centre; segment: first end; wheel, body, frame, plane: origin (3)
   std::vector<GiNaC::ex> other;  // segment: second end (3); wheel, body, frame: rotation R (9, row-major:
-                                 // frame components -> world components)
+                                 // frame components -> world components); plane: its axes t1, t2, n
+                                 // as the columns of R, n its unit normal
   GiNaC::ex size = 0;            // sphere, wheel: radius; segment: 0 (a line); body: its mass
   std::vector<GiNaC::ex> inertia;  // body: inertia about the centre of mass in the frame's axes (9, row-major)
   int axis = 1;                  // wheel, torus: the axle, 0, 1 or 2 for the frame's x, y or z axis
@@ -57,7 +59,8 @@ struct VisualItem {
   std::vector<GiNaC::ex> sizes;
   // solid, terrain, surface: the function whose zero set is drawn (terrain: the height h) in the
   // symbols `field_variables` (solid: 3, the frame's axes about `at`; terrain: 2, X and Y;
-  // surface: 3, world X, Y, Z) and the parameters.
+  // surface: 3, world X, Y, Z) and the parameters. plane: the turntable's rate Omega about n, in
+  // the time (one field variable, t) and the parameters; 0 for a fixed plane.
   GiNaC::ex field = 0;
   std::vector<GiNaC::ex> field_variables;
   // track, terrain, surface: `at` is the value of these three outputs of the spec (a contact
@@ -69,16 +72,18 @@ struct VisualItem {
 struct SpecVisual {
   std::vector<VisualItem> items;
   bool planar = false;  // every position has two components: the scene is the (x, y) plane, y up
-  bool ground = false;  // a multibody model: the ground plane z = 0 is drawn with a grid
+  bool ground = false;  // a multibody model: the ground plane z = 0 is drawn with a grid (unless a
+                        // plane item draws the grounds, see compile_visual)
 };
 
 // A shape of the compiled scene. Its outputs start at `offset` in the outputs of
 // VisualScene::tape: sphere, track, terrain and surface 3 (centre; a contact point), segment 6
-// (both ends), wheel, body, frame, ellipsoid, torus and solid 12 (origin, then R row-major); its
+// (both ends), wheel, body, frame, ellipsoid, torus, solid and plane 12 (origin, then R row-major;
+// a plane's R is its axes at rest, which the report turns by the angle of its rate); its
 // sizes at `size_offset` in those of VisualScene::sizes: sphere and wheel 1 (radius), body 10
 // (mass, then the inertia about the centre of mass in the frame's axes, 9 row-major), ellipsoid 3
 // (semi-axes), torus 2 (R, r), terrain 1 (a length), surface 4 (a length, a point inside), segment,
-// frame, track and solid none.
+// frame, track, solid and plane none.
 struct VisualShape {
   VisualKind kind = VisualKind::sphere;
   std::string name;
@@ -89,7 +94,9 @@ struct VisualShape {
   std::vector<std::string> expressions;  // the text of each of its outputs (at, then other), for messages
   std::string body;   // a contact's shape: the body it is the shape of (drawn instead of its ellipsoid)
   // solid, terrain, surface: the function drawn, its inputs the field variables in the places of
-  // the coordinates (Tape::coordinate_register(i)); reads the parameters (bind them).
+  // the coordinates (Tape::coordinate_register(i)); reads the parameters (bind them). plane: its
+  // rate Omega(t), t in the place of coordinate 0; a tape without outputs for a plane that does
+  // not turn.
   Tape field;
 };
 
@@ -105,7 +112,10 @@ struct VisualScene {
 
 // Compiles the spec's visual items with the parameters left symbolic, in the order of
 // spec.parameters (that of Model::parameters); an empty spec.visual gives a scene without shapes
-// (the report then draws the path). Cost: one pass over the expressions. Throws ModelError naming
+// (the report then draws the path). Plane items are grounds: one is kept per distinct plane (the
+// same axes and rate; several contacts on one incline draw it once), and none when every one is
+// level (its normal +-z) and fixed, as the scene's grid in z = 0 draws that plane; a scene with a
+// plane item draws no other grid. Cost: one pass over the expressions. Throws ModelError naming
 // the item and its place when a size depends on t, the coordinates or the velocities, or an
 // expression cannot be evaluated. The values of the sizes (a radius must be positive) are checked
 // when they are known, by the report.

@@ -40,7 +40,7 @@
   el("option", { value: "-1", text: "whole motion" }, follow);
   el("option", { value: "-2", text: "follow the bodies" }, follow);
   // Kinds that are not a moving thing to follow: axes, a contact point's path, a ground.
-  const fixedKinds = ["frame", "track", "terrain", "surface"];
+  const fixedKinds = ["frame", "track", "terrain", "surface", "plane"];
   D.scene.shapes.forEach((s, i) => {
     if (!fixedKinds.includes(s.kind)) el("option", { value: String(i), text: "follow " + s.name }, follow);
   });
@@ -80,6 +80,7 @@
     }
   };
   for (const s of S.shapes) {
+    if (s.kind === "plane") continue;  // a ground plane's origin is not a place the motion goes
     const r = reach(s);
     for (let f = 0; f < frames; ++f) {
       grow(value(f, s.offset), value(f, s.offset + 1), value(f, s.offset + 2), r);
@@ -95,7 +96,7 @@
   const points = (f) => {
     const out = [];
     for (const s of S.shapes) {
-      if (s.kind === "frame") continue;
+      if (s.kind === "frame" || s.kind === "plane") continue;
       const r = reach(s);
       for (const k of s.kind === "segment" ? [0, 3] : [0]) {
         const b = s.offset + k;
@@ -153,7 +154,8 @@
   sun.position.set(1, -2, 3 * upward);
   scene.add(sun);
 
-  // The ground (multibody) or the plane of a planar scene: a grid in z = 0, 1-2-5 spacing.
+  // The ground (multibody) or the plane of a planar scene: a grid in z = 0, 1-2-5 spacing; a
+  // contact's tilted plane: the same grid in the plane's axes (below, "plane").
   const niceStep = (span) => {
     const p = Math.pow(10, Math.floor(Math.log10(span)));
     const m = span / p;
@@ -165,18 +167,20 @@
     else geometry.addAttribute("position", attribute);
   };
   // Two grids: one for the whole motion, a finer one for the view that follows (at most 600 lines
-  // each way: a coarser step beyond).
-  const makeGrid = (view) => {
+  // each way: a coarser step beyond). (cu, cv) is the middle of the motion in the grid's plane,
+  // w its height along the plane's normal.
+  const makeGrid = (view, cu, cv, w) => {
     const reach = extent * 0.75 + view;
     let step = niceStep(view / 8);
     if ((2 * reach) / step > 600) {  // the next 1-2-5 step at or above 2 reach / 600
       step = niceStep((2 * reach) / 600);
       if (step < (2 * reach) / 600) step = niceStep(step * 2.6);
     }
-    // Lines x = const and y = const in the plane z = 0, drawn directly (no rotated GridHelper).
+    // Lines x = const and y = const in the plane z = 0 (of the grid's axes), drawn directly (no
+    // rotated GridHelper).
     const count = Math.ceil(reach / step);
-    const cx = Math.round(centre.x / step) * step, cy = Math.round(centre.y / step) * step;
-    const z = S.planar ? -1e-3 * near : 0, span = count * step;
+    const cx = Math.round(cu / step) * step, cy = Math.round(cv / step) * step;
+    const z = w, span = count * step;
     const minor = [], major = [];
     // Each line in pieces: a piece with an end behind the camera (the view that follows looks
     // along the ground) is not drawn by every WebGL implementation, so the pieces are short.
@@ -195,11 +199,64 @@
       setPositions(geometry, new Float32Array(lines));
       grid.add(new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ color: colour })));
     }
-    scene.add(grid);
     return grid;
   };
-  const wideGrid = makeGrid(extent);
-  const nearGrid = near < extent / 3 ? makeGrid(near) : wideGrid;
+  // The grids whose visibility follows the view: [whole motion, follow] pairs (one object when the
+  // two views have the same scale).
+  const grids = [];
+  const gridPair = (cu, cv, w, parent) => {
+    const wide = makeGrid(extent, cu, cv, w);
+    const close = near < extent / 3 ? makeGrid(near, cu, cv, w) : wide;
+    parent.add(wide);
+    if (close !== wide) parent.add(close);
+    grids.push([wide, close]);
+  };
+  // The scene's contact planes (a tilted plane, a turntable) draw the grounds when there are any;
+  // else the grid of z = 0 does (symbolic/visual.hpp: a level fixed plane is that grid).
+  if (!S.shapes.some((s) => s.kind === "plane")) gridPair(centre.x, centre.y, S.planar ? -1e-3 * near : 0, scene);
+  // A turntable: a translucent disk about its axis (the origin, along its normal) that holds every
+  // place the shapes pass through, its grid, rim and twelve spokes, and a coloured sector on its
+  // first axis, so that its turning shows.
+  const turntable = (s) => {
+    const b = s.offset;
+    const n = [value(0, b + 5), value(0, b + 8), value(0, b + 11)];
+    let rho = 0;
+    for (let f = 0; f < frames; f += Math.max(1, Math.floor(frames / 200)))
+      for (const p of points(f)) {
+        const along = p[0] * n[0] + p[1] * n[1] + p[2] * n[2];
+        const d = Math.hypot(p[0] - along * n[0], p[1] - along * n[1], p[2] - along * n[2]);
+        if (isFinite(d)) rho = Math.max(rho, d);
+      }
+    rho = 1.15 * Math.max(rho, size, 1e-3);
+    const table = new THREE.Group();
+    const disk = new THREE.Mesh(new Circle(rho, 96), new THREE.MeshLambertMaterial({
+      color: 0xa8c8a0, side: THREE.DoubleSide, transparent: true, opacity: 0.35, depthWrite: false }));
+    table.add(disk);
+    const sector = new THREE.Mesh(new Circle(rho, 8, -Math.PI / 24, Math.PI / 12), new THREE.MeshLambertMaterial({
+      color: 0xff7f0e, side: THREE.DoubleSide, transparent: true, opacity: 0.45, depthWrite: false }));
+    table.add(sector);
+    const step = niceStep(rho / 4), count = Math.ceil(rho / step);
+    const minor = [], major = [];
+    for (let i = -count; i <= count; ++i) {  // chords x = const and y = const of the disk
+      const x = i * step, half = Math.sqrt(Math.max(0, rho * rho - x * x));
+      if (!(half > 0)) continue;
+      minor.push(x, -half, 0, x, half, 0, -half, x, 0, half, x, 0);
+    }
+    for (let k = 0; k < 96; ++k) {  // the rim
+      const a = (2 * Math.PI * k) / 96, c = (2 * Math.PI * (k + 1)) / 96;
+      major.push(rho * Math.cos(a), rho * Math.sin(a), 0, rho * Math.cos(c), rho * Math.sin(c), 0);
+    }
+    for (let k = 0; k < 12; ++k) {  // the spokes
+      const a = (2 * Math.PI * k) / 12;
+      major.push(0, 0, 0, rho * Math.cos(a), rho * Math.sin(a), 0);
+    }
+    for (const [lines, colour] of [[minor, 0xbbbbbb], [major, 0x777777]]) {
+      const geometry = new THREE.BufferGeometry();
+      setPositions(geometry, new Float32Array(lines));
+      table.add(new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ color: colour })));
+    }
+    return table;
+  };
 
   const colours = [0x1f77b4, 0xd62728, 0x2ca02c, 0xff7f0e, 0x9467bd, 0x8c564b, 0xe377c2, 0x17becf];
   const material = (i, opacity) => new THREE.MeshLambertMaterial({
@@ -248,12 +305,23 @@
       if (s.axis === 1) inner.rotation.x = Math.PI / 2;
       group.add(inner);
       o.object = group;
+      // The wheel's tilted plane, when it has one (a [[wheels]] entry with a `normal` drawn as its
+      // contact's plane, of the same name): its normal is the wheel's up.
+      const ground = S.shapes.find((p) => p.kind === "plane" && p.name === s.name);
       const points = new Float32Array(frames * 3);
       for (let f = 0; f < frames; ++f) {
         const c = [value(f, s.offset), value(f, s.offset + 1), value(f, s.offset + 2)];
         const a = [value(f, s.offset + 3 + s.axis), value(f, s.offset + 6 + s.axis), value(f, s.offset + 9 + s.axis)];
         // The contact point: the lowest point of the rim, c - r d with d the unit vector of the
-        // vertical (up, +z or -z) within the wheel's plane.
+        // vertical (up, +z or -z; the plane's normal n) within the wheel's plane.
+        if (ground) {
+          const n = [value(f, ground.offset + 5), value(f, ground.offset + 8), value(f, ground.offset + 11)];
+          const na = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
+          const d = [n[0] - na * a[0], n[1] - na * a[1], n[2] - na * a[2]];
+          const norm = Math.hypot(d[0], d[1], d[2]) || 1;
+          for (let k = 0; k < 3; ++k) points[3 * f + k] = c[k] - (r * d[k]) / norm;
+          continue;
+        }
         let d = [-a[2] * a[0], -a[2] * a[1], 1 - a[2] * a[2]];
         const norm = Math.hypot(d[0], d[1], d[2]) || 1;
         for (let k = 0; k < 3; ++k) points[3 * f + k] = c[k] - (upward * r * d[k]) / norm;
@@ -339,6 +407,19 @@
         group.add(new THREE.LineSegments(wire, new THREE.LineBasicMaterial({ color: 0x6f8f68, transparent: true, opacity: 0.5 })));
         o.object = group;
       }
+    } else if (s.kind === "plane") {
+      // A contact's plane in its own axes (t1, t2, n: its frame, placed on each frame as the
+      // others are): the grid about the middle of the motion in the plane, or a turntable.
+      const group = new THREE.Group();
+      if (s.turns) {
+        group.add(turntable(s));
+      } else {
+        const b = s.offset;
+        const t1 = [value(0, b + 3), value(0, b + 6), value(0, b + 9)], t2 = [value(0, b + 4), value(0, b + 7), value(0, b + 10)];
+        gridPair(centre.x * t1[0] + centre.y * t1[1] + centre.z * t1[2], centre.x * t2[0] + centre.y * t2[1] + centre.z * t2[2],
+                 0, group);
+      }
+      o.object = group;
     } else if (s.kind === "track") {
       // The contact point's path over the ground (the contact's NAME_X, NAME_Y, NAME_Z).
       const points = new Float32Array(frames * 3);
@@ -548,8 +629,10 @@
     const f = api.frame;
     const chosen = Number(follow.value);
     viewWidth = chosen === -1 ? extent : near;
-    wideGrid.visible = chosen === -1 || wideGrid === nearGrid;
-    nearGrid.visible = chosen !== -1 || wideGrid === nearGrid;
+    for (const [wide, close] of grids) {
+      wide.visible = chosen === -1 || wide === close;
+      close.visible = chosen !== -1 || wide === close;
+    }
     orbit.distance = distance(viewWidth) * zoom;
     if (chosen >= 0) {
       const b = S.shapes[chosen].offset;
