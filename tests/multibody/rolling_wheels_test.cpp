@@ -72,8 +72,16 @@ position = { x = ")toml" +
 // from the centre to the contact (R + r
 // for the torus: the tube's radius adds to the rim's), and turns at phi' = s' / rho; the ground
 // pushes N = m g cos(alpha) and holds the wheel back with m g sin(alpha) k / (1 + k), k = J/(m rho^2).
-void check_incline(const std::string& shape, const std::string& reach_text, double rho) {
-  const Model model = load_model_text(incline_model(shape, reach_text));
+// With `level_in_file`, the file says alpha = 0 (a level plane, its normal along z) and --set's
+// value makes it the incline: the plane must follow the parameter.
+void check_incline(const std::string& shape, const std::string& reach_text, double rho, bool level_in_file = false) {
+  std::string text = incline_model(shape, reach_text);
+  if (level_in_file) {
+    const std::size_t at = text.find("alpha = 0.4");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, 11, "alpha = 0.0");
+  }
+  const Model model = level_in_file ? load_model_text(text, "<incline>", {{"alpha", 0.4}}) : load_model_text(text);
   const double m = 2.0, J = 0.07, g = 9.81, alpha = 0.4;
   const double k = J / (m * rho * rho), a = g * std::sin(alpha) / (1 + k);
   const double x0 = rho * std::sin(alpha), z0 = rho * std::cos(alpha);
@@ -117,6 +125,11 @@ TEST(RollingWheels, TorusRollsDownAnInclineWithTheOuterRadius) {
 }
 
 TEST(RollingWheels, DiskRollsDownAnInclineWithItsRadius) { check_incline(R"toml({ disk = "R", axis = "y" })toml", "R", 0.3); }
+
+// The plane's normal written in a parameter, axis-aligned at the file's value: --set tilts it.
+TEST(RollingWheels, SetTiltsAPlaneThatIsLevelInTheFile) {
+  check_incline(R"toml({ disk = "R", axis = "y" })toml", "R", 0.3, true);
+}
 
 // A uniform disk of radius r, centre (x, y, z), heading psi, tilt theta about the heading's x axis,
 // spin phi about the axle y: the frames of examples/rolling_disk_bodies.toml with the centre's

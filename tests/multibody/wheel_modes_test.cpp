@@ -146,6 +146,22 @@ TEST(WheelModes, TheWheelsNormalIsTheContactsPlane) {
   }
 }
 
+// A wheel's normal written in a parameter that makes it vertical at the file's value: --set tilts
+// the plane (the normal is not frozen to the axis it has at the file's values). The wheel so tilted
+// moves as the wheel on the plane [3, 0, 4] (alpha = atan(3/4)).
+TEST(WheelModes, SetTiltsAWheelsPlaneThatIsLevelInTheFile) {
+  const std::string normal = "normal = [\"sin(alpha)\", 0, \"cos(alpha)\"]\n";
+  const Model level = load_model_text(test::free_disk_text("disk", "mu = 0.5\nalpha = 0.0\n", kWheel + normal),
+                                      "level.toml", {{"alpha", std::atan(0.75)}});
+  const Model tilted = load_model_text(disk_with(kWheel + "normal = [3, 0, 4]\n"), "tilted.toml");
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 5; ++trial) {
+    std::vector<double> q, v;
+    random_state(rng, q, v);
+    EXPECT_LT(relative_difference(solution_at(level, q, v), solution_at(tilted, q, v)), 1e-12) << "trial " << trial;
+  }
+}
+
 // The tilted wheel's derivation takes square roots of quotients; GiNaC's gcd once failed on them in
 // some loads only, as its term order varies between loads (symbolic/simplify.cpp, split_root).
 // Loaded again and again, it loads every time, to the same equations.

@@ -532,9 +532,11 @@ Vector3 MultibodyBuilder::plane_normal(const Helper& helper, const std::string& 
          helper.normal ? "the plane's normal is the zero vector; give a nonzero normal, e.g. [0, 0, 1]"
                        : "the gravity vector is zero, so it defines no contact plane; give the plane's normal, e.g. "
                          "normal = [0, 0, 1]");
-  // An axis-aligned normal is kept exact (+-x, +-y, +-z); others are normalized symbolically.
+  // A normal along an axis as written (its other two components zero, not only at the file's
+  // parameter values: --set may change them) is kept exact (+-x, +-y, +-z); others are normalized
+  // symbolically, so that the plane follows the parameters.
   for (std::size_t i = 0; i < 3; ++i)
-    if (std::fabs(value[i]) == length) return scale(value[i] > 0 ? 1 : -1, unit(static_cast<int>(i)));
+    if (n[(i + 1) % 3].is_zero() && n[(i + 2) % 3].is_zero()) return scale(value[i] > 0 ? 1 : -1, unit(static_cast<int>(i)));
   const GiNaC::ex norm = GiNaC::sqrt(simplify(dot(n, n)));
   return {n[0] / norm, n[1] / norm, n[2] / norm};
 }
