@@ -5,9 +5,11 @@
 // The reference of both: the interpreter's prepared terms (constants folded, steps fused and
 // reordered, model/tape.hpp) equal their program run instruction by instruction, to the bit.
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <cstdlib>
@@ -19,8 +21,10 @@
 #include <vector>
 
 #include "nhdyn/analysis/residuals.hpp"
+#include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/io/results.hpp"
 #include "nhdyn/jit/compiled_evaluator.hpp"
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/data.hpp"
@@ -283,6 +287,76 @@ TEST_F(Jit, AMissingCompilerIsAnErrorOfMakeCompiledAndTheInterpreterWithANoticeF
     EXPECT_NE(notice.find("/nonexistent/c++"), std::string::npos) << notice;
     EXPECT_EQ(notice.find('\n'), std::string::npos) << "one line";
   }
+}
+
+// The processors this process may run on.
+int processors() {
+  cpu_set_t cpus;
+  return sched_getaffinity(0, sizeof cpus, &cpus) == 0 ? CPU_COUNT(&cpus) : 1;
+}
+
+// `auto` on a cold cache: the model runs on the interpreter while the compile goes on, and switches
+// to the compiled code once it is loaded. The run below waits at its 20th row until then, so the
+// switch falls mid-run; every row (q, q', q'', R, residuals, energy, contact forces) equals the
+// interpreter's run to the bit, before and after it. The object is then in the cache for the
+// next `auto`, which loads it at once.
+TEST_F(Jit, AutoOnAColdCacheStartsInterpretedAndSwitchesMidRunToTheSameNumbers) {
+  const Model model = load_model(example("whipple_bicycle.toml"));
+  const Model automatic = with_evaluator(model, EvaluatorChoice::automatic, nullptr, options_);
+  if (processors() < 2) {  // the compile would take the run's processor: the interpreter stays
+    EXPECT_EQ(background_state(automatic), BackgroundState::none);
+    GTEST_SKIP() << "one processor available: auto keeps the interpreter";
+  }
+  ASSERT_EQ(background_state(automatic), BackgroundState::compiling);  // the compile takes seconds
+  EXPECT_FALSE(is_compiled(automatic));
+  SimulationOptions run;
+  run.t_end = 2.0;
+  run.output_step = 0.01;
+  const auto rows_of = [&](const Model& m, bool wait_at_row_20) {
+    std::vector<std::vector<double>> rows;
+    std::vector<double> row;
+    simulate(m, run, [&](const Data& data) {
+      if (wait_at_row_20 && rows.size() == 20) {
+        EXPECT_EQ(background_state(m), BackgroundState::compiling) << "switched before the wait";
+        for (int i = 0; i < 6000 && background_state(m) == BackgroundState::compiling; ++i)
+          std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        EXPECT_EQ(background_state(m), BackgroundState::switched);
+      }
+      fill_result_row(m, data, row);
+      rows.push_back(row);
+    });
+    return rows;
+  };
+  const std::vector<std::vector<double>> interpreted = rows_of(model, false), switched = rows_of(automatic, true);
+  ASSERT_EQ(switched.size(), interpreted.size());
+  ASSERT_EQ(interpreted.size(), 201u);
+  for (std::size_t r = 0; r < interpreted.size(); ++r)
+    for (std::size_t c = 0; c < interpreted[r].size(); ++c)
+      ASSERT_EQ(std::memcmp(&switched[r][c], &interpreted[r][c], sizeof(double)), 0)
+          << "row " << r << ", column " << c << ": " << switched[r][c] << " against " << interpreted[r][c];
+  JitReport again;
+  EXPECT_TRUE(is_compiled(with_evaluator(model, EvaluatorChoice::automatic, nullptr, options_, &again)));
+  EXPECT_FALSE(again.compiled) << "loaded from the cache";
+}
+
+// A run that ends before the background compile does not wait for it: the compile is stopped when
+// the model goes, and leaves no temporary (source, log, partial object) in the cache.
+TEST_F(Jit, AutoStopsAnUnfinishedCompileAndLeavesNothingBehind) {
+  const Model model = load_model(example("whipple_bicycle.toml"));
+  {
+    const Model automatic = with_evaluator(model, EvaluatorChoice::automatic, nullptr, options_);
+    if (processors() < 2) GTEST_SKIP() << "one processor available: auto keeps the interpreter";
+    ASSERT_EQ(background_state(automatic), BackgroundState::compiling);
+    // Until the compiler has written its source, there is nothing to remove: wait for it.
+    bool source = false;
+    for (int i = 0; i < 500 && !source; ++i) {
+      for (const auto& entry : fs::directory_iterator(dir_)) source = source || entry.path().extension() == ".cpp";
+      if (!source) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ASSERT_TRUE(source) << "the compile did not start";
+  }
+  for (const auto& entry : fs::directory_iterator(dir_))
+    ADD_FAILURE() << "left behind: " << entry.path();
 }
 
 TEST_F(Jit, AutoLeavesSmallModelsToTheInterpreter) {

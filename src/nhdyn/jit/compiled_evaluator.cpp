@@ -3,6 +3,7 @@
 #include <dlfcn.h>
 #include <fcntl.h>
 #include <pthread.h>
+#include <sched.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -19,7 +20,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include "nhdyn/jit/detail/source.hpp"
@@ -92,8 +95,10 @@ class HeldSignals {
 // Runs argv (searched in PATH) with stdout and stderr to `log`, in its own process group; returns
 // its exit code, or -1 with errno's text in `error` when it cannot start. A stopping signal sent
 // to this process meanwhile (HeldSignals must be in force) ends the whole group (the compiler
-// driver and its cc1plus, as, ld), waits for it and returns -2 with the signal in `caught`.
-int run(const std::vector<std::string>& argv, const fs::path& log, std::string& error, int& caught) {
+// driver and its cc1plus, as, ld), waits for it and returns -2 with the signal in `caught`; so does
+// `cancel` turning true (a background compile no longer wanted), returning -3.
+int run(const std::vector<std::string>& argv, const fs::path& log, std::string& error, int& caught,
+        const std::atomic<bool>* cancel = nullptr) {
   caught = 0;
   std::vector<char*> args;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
@@ -128,16 +133,18 @@ int run(const std::vector<std::string>& argv, const fs::path& log, std::string& 
       error = std::strerror(errno);
       return -1;
     }
-    const timespec wait{0, 20'000'000};
+    // A compile nobody waits for is checked more often: the run that cancels it waits for this.
+    const timespec wait{0, cancel != nullptr ? 2'000'000 : 20'000'000};
     const int sig = sigtimedwait(&held, nullptr, &wait);
-    if (sig > 0) {
-      caught = sig;
+    const bool cancelled = cancel != nullptr && cancel->load();
+    if (sig > 0 || cancelled) {
+      caught = sig > 0 ? sig : 0;
       ::kill(-pid, SIGTERM);  // the driver removes its own temporaries on SIGTERM
-      for (int i = 0; i < 250 && waitpid(pid, &status, WNOHANG) == 0; ++i) ::usleep(20'000);
+      for (int i = 0; i < 2500 && waitpid(pid, &status, WNOHANG) == 0; ++i) ::usleep(2'000);
       ::kill(-pid, SIGKILL);  // whatever is left of the group after 5 s
       while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
       }
-      return -2;
+      return sig > 0 ? -2 : -3;
     }
   }
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
@@ -465,7 +472,7 @@ std::shared_ptr<Library> load_cached(const fs::path& object, const fs::path& che
 // temporary is removed on failure or interruption.
 std::shared_ptr<Library> compile_entry(const std::string& source, const std::string& compiler, const fs::path& dir,
                                        const std::string& key, const std::string& suffix, const Model& model,
-                                       bool sparse, JitReport* report) {
+                                       bool sparse, JitReport* report, const std::atomic<bool>* cancel) {
   const fs::path object = dir / (key + ".so");
   const fs::path check = dir / (key + ".so.check");
   const fs::path source_file = dir / (key + "-" + suffix + ".cpp");
@@ -492,15 +499,16 @@ std::shared_ptr<Library> compile_entry(const std::string& source, const std::str
   argv.insert(argv.end(), kFlags.begin(), kFlags.end());
   argv.insert(argv.end(), {"-o", temporary.string(), source_file.string()});
   const auto start = std::chrono::steady_clock::now();
-  const int status = run(argv, log, error, caught);
+  const int status = run(argv, log, error, caught, cancel);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const std::string output = status == -2 ? std::string() : read_file(log);
+  const std::string output = status == -2 || status == -3 ? std::string() : read_file(log);
   if (status != 0) {
     remove_all();
     if (caught) {
       held.release_and_raise(caught);
       throw JitError("the compile was interrupted");
     }
+    if (status == -3) throw JitError("the compile was cancelled");
     throw JitError(status < 0 ? fmt::format("the C++ compiler '{}' cannot be run ({})", compiler, error)
                               : fmt::format("the C++ compiler '{}' failed on model '{}': {}", compiler, model.name,
                                             first_error(output)));
@@ -561,7 +569,22 @@ Model bind_library(const Model& model, std::shared_ptr<const TapeEvaluator> base
 
 }  // namespace
 
-Model make_compiled(const Model& model, const JitOptions& options, JitReport* report) {
+namespace {
+
+// The cache key of a model's source for a compiler: a hash of the source, the compiler's command
+// and --version, and the flags.
+std::string cache_key(const std::string& source, const std::string& compiler, const fs::path& dir) {
+  const std::string version = compiler_version(compiler, dir, unique_suffix());
+  std::string flags;
+  for (const std::string& f : kFlags) flags += f + " ";
+  const std::string identity = compiler + "\n" + version + "\n" + flags + "\n";
+  const std::uint64_t h1 = fnv1a(source, fnv1a(identity, 0xcbf29ce484222325ULL));
+  const std::uint64_t h2 = fnv1a(identity, fnv1a(source, 0x84222325cbf29ce4ULL));
+  return fmt::format("{:016x}{:016x}", h1, h2);
+}
+
+// make_compiled, stopped (JitError) when `cancel` turns true while the compiler runs.
+Model compile_model(const Model& model, const JitOptions& options, JitReport* report, const std::atomic<bool>* cancel) {
   auto base = std::dynamic_pointer_cast<const TapeEvaluator>(model.evaluator);
   if (!base)
     throw JitError(fmt::format("model '{}' has no compiled tapes (a hand-written built-in model): nothing to "
@@ -577,19 +600,164 @@ Model make_compiled(const Model& model, const JitOptions& options, JitReport* re
   if (ec) throw JitError(fmt::format("cannot create the cache directory {}: {}", dir.string(), ec.message()));
 
   const std::string suffix = unique_suffix();
-  const std::string version = compiler_version(compiler, dir, suffix);
-  std::string flags;
-  for (const std::string& f : kFlags) flags += f + " ";
-  const std::string identity = compiler + "\n" + version + "\n" + flags + "\n";
-  const std::uint64_t h1 = fnv1a(source, fnv1a(identity, 0xcbf29ce484222325ULL));
-  const std::uint64_t h2 = fnv1a(identity, fnv1a(source, 0x84222325cbf29ce4ULL));
-  const std::string key = fmt::format("{:016x}{:016x}", h1, h2);
+  const std::string key = cache_key(source, compiler, dir);
   const fs::path object = dir / (key + ".so");
   if (report) report->object = object.string();
 
   std::shared_ptr<Library> library = load_cached(object, dir / (key + ".so.check"), key, sparse, report);
-  if (!library) library = compile_entry(source, compiler, dir, key, suffix, model, sparse, report);
+  if (!library) library = compile_entry(source, compiler, dir, key, suffix, model, sparse, report, cancel);
   return bind_library(model, std::move(base), std::move(library), object);
+}
+
+}  // namespace
+
+Model make_compiled(const Model& model, const JitOptions& options, JitReport* report) {
+  return compile_model(model, options, report, nullptr);
+}
+
+namespace {
+
+// `auto` on a model not yet in the cache: a thread compiles it while the run goes on with the
+// interpreter, and the compiled evaluator is published once loaded. The compiled code does the
+// interpreter's operations in its order (no fused multiply-adds), so a run that switches part-way
+// gives the interpreter's numbers to the bit. Whoever holds the last reference (the run's end)
+// stops a compile still going (its compiler's process group ended, its files removed) instead of
+// waiting for it: a short run never waits for the compiler.
+class BackgroundCompile {
+ public:
+  BackgroundCompile(const Model& model, const JitOptions& options) {
+    worker_ = std::thread([this, model, options] {
+      try {
+        // The stopping signals stay with the threads that run the model (held here only, so that
+        // this thread's wait for the compiler does not take them).
+        HeldSignals held;
+        Model compiled = compile_model(model, options, nullptr, &cancel_);
+        compiled_ = compiled.evaluator;
+        state_.store(BackgroundState::switched, std::memory_order_release);
+      } catch (const std::exception& e) {
+        failure_ = e.what();
+        state_.store(BackgroundState::failed, std::memory_order_release);
+      }
+    });
+  }
+  ~BackgroundCompile() {
+    cancel_.store(true);
+    worker_.join();
+  }
+  BackgroundCompile(const BackgroundCompile&) = delete;
+  BackgroundCompile& operator=(const BackgroundCompile&) = delete;
+
+  // The compiled evaluator once it is there, else null.
+  const Evaluator* compiled() const {
+    return state_.load(std::memory_order_acquire) == BackgroundState::switched ? compiled_.get() : nullptr;
+  }
+  BackgroundState state() const { return state_.load(std::memory_order_acquire); }
+  std::string failure() const { return state() == BackgroundState::failed ? failure_ : std::string(); }
+
+ private:
+  std::atomic<bool> cancel_{false};
+  std::atomic<BackgroundState> state_{BackgroundState::compiling};
+  std::shared_ptr<const Evaluator> compiled_;  // written before state_ says switched
+  std::string failure_;                        // written before state_ says failed
+  std::thread worker_;                         // last: started once the rest is in place
+};
+
+// The interpreter's evaluator until the background compile is loaded, the compiled one after: for
+// the terms and for the tapes of a row that the compiled evaluator runs compiled (the rest is the
+// interpreter's in both). The contact forces' and the outputs' tapes stay interpreted.
+class BackgroundEvaluator final : public Evaluator {
+ public:
+  BackgroundEvaluator(std::shared_ptr<const TapeEvaluator> base, std::shared_ptr<const BackgroundCompile> compile)
+      : base_(std::move(base)), compile_(std::move(compile)) {}
+
+  const Evaluator& now() const {
+    const Evaluator* compiled = compile_->compiled();
+    return compiled != nullptr ? *compiled : *base_;
+  }
+  const BackgroundCompile& compile() const { return *compile_; }
+
+  // Other parameter values: the compiled evaluator's rebinding when it is there, else the
+  // interpreter's (which stays interpreted).
+  std::shared_ptr<const Evaluator> with_parameters(const double* values, std::size_t count) const override {
+    return now().with_parameters(values, count);
+  }
+  bool has_initial_state() const override { return base_->has_initial_state(); }
+  void initial_state(double* scratch, double* q0, double* v0) const override { base_->initial_state(scratch, q0, v0); }
+  std::size_t scratch_size() const override { return base_->scratch_size(); }
+  void terms(double t, const double* q, const double* v, double* scratch, const TermsOut& out) const override {
+    now().terms(t, q, v, scratch, out);
+  }
+  const TermsSparsity* sparsity() const override { return base_->sparsity(); }
+  void sparse_terms(double t, const double* q, const double* v, double* scratch, const TermsOut& out) const override {
+    now().sparse_terms(t, q, v, scratch, out);
+  }
+  bool has_complement() const override { return base_->has_complement(); }
+  void complement(double t, const double* q, const double* v, double* scratch, double* D) const override {
+    base_->complement(t, q, v, scratch, D);
+  }
+  void position_residual(double t, const double* q, double* scratch, double* phi) const override {
+    now().position_residual(t, q, scratch, phi);
+  }
+  void velocity_residual(double t, const double* q, const double* v, double* scratch, double* f) const override {
+    now().velocity_residual(t, q, v, scratch, f);
+  }
+  bool has_program_constraints() const override { return base_->has_program_constraints(); }
+  void program_constraint_terms(double t, const double* q, const double* v, double* scratch, double* b_p,
+                                double* b_p0, double* B) const override {
+    base_->program_constraint_terms(t, q, v, scratch, b_p, b_p0, B);
+  }
+  void program_constraint_position_residual(double t, const double* q, double* scratch, double* phi) const override {
+    base_->program_constraint_position_residual(t, q, scratch, phi);
+  }
+  void program_constraint_velocity_residual(double t, const double* q, const double* v, double* scratch,
+                                            double* f) const override {
+    base_->program_constraint_velocity_residual(t, q, v, scratch, f);
+  }
+  bool has_energy() const override { return base_->has_energy(); }
+  bool has_energy_balance() const override { return base_->has_energy_balance(); }
+  bool energy_function_is_energy() const override { return base_->energy_function_is_energy(); }
+  double energy_function(double t, const double* q, const double* v, double* scratch) const override {
+    return now().energy_function(t, q, v, scratch);
+  }
+  void power(double t, const double* q, const double* v, double* scratch, double* out) const override {
+    now().power(t, q, v, scratch, out);
+  }
+  double energy(double t, const double* q, const double* v, double* scratch) const override {
+    return now().energy(t, q, v, scratch);
+  }
+  bool has_solution() const override { return base_->has_solution(); }
+  void solution(double t, double* scratch, double* qva) const override { base_->solution(t, scratch, qva); }
+
+ private:
+  std::shared_ptr<const TapeEvaluator> base_;
+  std::shared_ptr<const BackgroundCompile> compile_;
+};
+
+// The compiled model when the cache holds its object, sound; else nullopt. Throws JitError when
+// the compiler cannot be run (its version is part of the key) or the cache cannot be made.
+std::optional<Model> cached_model(const Model& model, const JitOptions& options, JitReport* report) {
+  auto base = std::dynamic_pointer_cast<const TapeEvaluator>(model.evaluator);
+  if (!base) return std::nullopt;
+  std::string compiler = options.compiler.empty() ? env("NHDYN_CXX") : options.compiler;
+  if (compiler.empty()) compiler = "c++";
+  const fs::path dir = cache_directory(options);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw JitError(fmt::format("cannot create the cache directory {}: {}", dir.string(), ec.message()));
+  const std::string key = cache_key(model_source(*base, model), compiler, dir);
+  const fs::path object = dir / (key + ".so");
+  if (report) report->object = object.string();
+  std::shared_ptr<Library> library =
+      load_cached(object, dir / (key + ".so.check"), key, base->sparsity() != nullptr, report);
+  if (!library) return std::nullopt;
+  return bind_library(model, std::move(base), std::move(library), object);
+}
+
+}  // namespace
+
+BackgroundState background_state(const Model& model) {
+  const auto* background = dynamic_cast<const BackgroundEvaluator*>(model.evaluator.get());
+  return background != nullptr ? background->compile().state() : BackgroundState::none;
 }
 
 Model with_evaluator(const Model& model, EvaluatorChoice choice, std::string* notice, const JitOptions& options,
@@ -610,6 +778,20 @@ Model with_evaluator(const Model& model, EvaluatorChoice choice, std::string* no
   try {
     JitReport local;
     JitReport* made = report ? report : &local;
+    if (choice == EvaluatorChoice::automatic) {
+      // The compile would take the run's own processor: the interpreter alone is faster.
+      cpu_set_t cpus;
+      if (sched_getaffinity(0, sizeof cpus, &cpus) == 0 && CPU_COUNT(&cpus) < 2) return model;
+      // Cached: compiled at once. Else the run starts on the interpreter and switches when the
+      // compile that starts now is done (BackgroundCompile).
+      std::optional<Model> cached = cached_model(model, options, made);
+      if (!made->note.empty() && notice) *notice = made->note;
+      if (cached) return std::move(*cached);
+      Model out = model;
+      out.evaluator = std::make_shared<BackgroundEvaluator>(std::dynamic_pointer_cast<const TapeEvaluator>(model.evaluator),
+                                                            std::make_shared<const BackgroundCompile>(model, options));
+      return out;
+    }
     Model compiled = make_compiled(model, options, made);
     if (!made->note.empty() && notice) *notice = made->note;
     return compiled;

@@ -70,7 +70,10 @@ struct JitReport {
 Model make_compiled(const Model& model, const JitOptions& options = {}, JitReport* report = nullptr);
 
 // The model with the evaluator `choice` asks for: interpreted returns it unchanged; compiled
-// compiles it; automatic compiles when the terms tape has kAutoCompileFrom operations or more.
+// compiles it; automatic, for a terms tape of kAutoCompileFrom operations or more, loads the cached
+// object, or else starts compiling it in the background and returns at once, the model running on
+// the interpreter until the compiled object is loaded (BackgroundState), with the same results to
+// the bit; the compile is stopped, not waited for, when the model goes before it is done.
 // A compile that fails (no compiler, a compile error, a failed dlopen, a hand-written model) never
 // fails the run: the interpreter is kept and a one-line notice written to `notice` (not printed:
 // the caller prints). make_compiled is the call that throws.
@@ -79,5 +82,12 @@ Model with_evaluator(const Model& model, EvaluatorChoice choice, std::string* no
 
 // Whether the model's evaluator is a compiled one.
 bool is_compiled(const Model& model);
+
+// `auto` on a model the cache does not hold yet (with_evaluator): where its background compile
+// stands. none: the model's evaluator is not such a one (interpreted, compiled, or a model too
+// small to compile); compiling: the interpreter runs the model meanwhile; switched: the compiled
+// evaluator runs its terms and rows from now on; failed: the interpreter stays.
+enum class BackgroundState { none, compiling, switched, failed };
+BackgroundState background_state(const Model& model);
 
 }  // namespace nhdyn::jit
