@@ -274,8 +274,12 @@ std::vector<BatchRun> make_runs(const BatchArgs& args, const ModelSource& source
   std::vector<Model> models;
   if (!parameter_names.empty()) models = load_model_variants(source, overrides, parameter_names, parameter_values);
   // The compiled evaluator is made once; each variant rebinds it to its parameter values.
+  // `auto` waits for the compile here: a batch's many runs repay it, and its variants are rebound
+  // to the compiled object below.
   std::string notice;
-  const Model chosen = jit::with_evaluator(base, jit::parse_evaluator_choice(args.evaluator), &notice);
+  jit::JitOptions jit_options;
+  jit_options.background = false;
+  const Model chosen = jit::with_evaluator(base, jit::parse_evaluator_choice(args.evaluator), &notice, jit_options);
   if (!notice.empty()) fmt::print(stderr, "{}\n", notice);
   if (jit::is_compiled(chosen))
     for (Model& m : models) {

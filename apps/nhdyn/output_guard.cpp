@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "nhdyn/io/atomic_file.hpp"
+#include "nhdyn/jit/compiled_evaluator.hpp"
 
 namespace nhdyn::cli {
 namespace {
@@ -66,6 +67,7 @@ void append_time(char* buf, std::size_t size, std::size_t& len, double t) {
 
 extern "C" void on_interrupt(int signal_number) {
   remove_temporary_files();
+  jit::stop_background_compiles();  // --evaluator auto's compiler, in a process group of its own
   char message[256];
   std::size_t len = 0;
   append(message, sizeof message, len, "\nnhdyn: interrupted by ");

@@ -6,9 +6,11 @@
 // reordered, model/tape.hpp) equal their program run instruction by instruction, to the bit.
 #include <gtest/gtest.h>
 #include <sched.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -357,6 +359,24 @@ TEST_F(Jit, AutoStopsAnUnfinishedCompileAndLeavesNothingBehind) {
   }
   for (const auto& entry : fs::directory_iterator(dir_))
     ADD_FAILURE() << "left behind: " << entry.path();
+}
+
+// The files a compile of a process gone left behind (a run ended by a signal) are removed by the
+// next compile in the cache; those of a live process (this one) and the entries are kept.
+TEST_F(Jit, ACompileRemovesTheFilesOfCompilesWhoseProcessIsGone) {
+  pid_t gone = 4'000'000;  // above Linux's largest pid (4194304 is the limit; take one not running)
+  while (::kill(gone, 0) == 0 || errno != ESRCH) --gone;
+  fs::create_directories(dir_);
+  const std::string g = std::to_string(gone), me = std::to_string(::getpid());
+  const std::vector<std::string> orphans = {"0123abcd-" + g + "-1.cpp", "0123abcd-" + g + "-1.log",
+                                            "0123abcd.so.tmp-" + g + "-1", "0123abcd.so.check.tmp-" + g + "-1",
+                                            "version-" + g + "-7.log"};
+  const std::vector<std::string> kept = {"0123abcd-" + me + "-99.cpp", "0123abcd.so", "0123abcd.so.check"};
+  for (const std::string& name : orphans) std::ofstream(dir_ / name) << "x";
+  for (const std::string& name : kept) std::ofstream(dir_ / name) << "x";
+  make_compiled(load_model(example("knife_edge.toml")), options_);
+  for (const std::string& name : orphans) EXPECT_FALSE(fs::exists(dir_ / name)) << name;
+  for (const std::string& name : kept) EXPECT_TRUE(fs::exists(dir_ / name)) << name;
 }
 
 TEST_F(Jit, AutoLeavesSmallModelsToTheInterpreter) {

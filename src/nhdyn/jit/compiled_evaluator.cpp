@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <system_error>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -92,6 +93,32 @@ class HeldSignals {
   sigset_t old_{};
 };
 
+// The process groups of the background compilers running now (0: a free slot), for
+// stop_background_compiles, which a signal handler may call: lock-free atomics only.
+constexpr int kBackgroundSlots = 16;
+std::atomic<pid_t> background_groups[kBackgroundSlots];
+static_assert(std::atomic<pid_t>::is_always_lock_free);
+
+// Registers a background compiler's group for its lifetime (none when every slot is taken: it is
+// then stopped only by the run's end, as before).
+class BackgroundGroup {
+ public:
+  explicit BackgroundGroup(pid_t group) {
+    for (int i = 0; i < kBackgroundSlots && slot_ < 0; ++i) {
+      pid_t free = 0;
+      if (background_groups[i].compare_exchange_strong(free, group)) slot_ = i;
+    }
+  }
+  ~BackgroundGroup() {
+    if (slot_ >= 0) background_groups[slot_].store(0);
+  }
+  BackgroundGroup(const BackgroundGroup&) = delete;
+  BackgroundGroup& operator=(const BackgroundGroup&) = delete;
+
+ private:
+  int slot_ = -1;
+};
+
 // Runs argv (searched in PATH) with stdout and stderr to `log`, in its own process group; returns
 // its exit code, or -1 with errno's text in `error` when it cannot start. A stopping signal sent
 // to this process meanwhile (HeldSignals must be in force) ends the whole group (the compiler
@@ -126,6 +153,8 @@ int run(const std::vector<std::string>& argv, const fs::path& log, std::string& 
     return -1;
   }
   int status = 0;
+  std::optional<BackgroundGroup> registered;
+  if (cancel != nullptr) registered.emplace(pid);
   for (;;) {
     const pid_t done = waitpid(pid, &status, WNOHANG);
     if (done == pid) break;
@@ -440,6 +469,37 @@ std::string compiler_version(const std::string& compiler, const fs::path& dir, c
   return version;
 }
 
+// Removes the files that compiles of processes now gone left in the cache directory (a run ended by
+// a signal while its background compile ran): every temporary is named with its process's id,
+// unique_suffix(), as KEY-PID-N.cpp, KEY-PID-N.log, KEY.so.tmp-PID-N, KEY.so.check.tmp-PID-N or
+// version-PID-N.log.
+void remove_orphans(const fs::path& dir) {
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    std::size_t at = name.find(".tmp-");
+    if (at != std::string::npos) {
+      at += 5;
+    } else if ((at = name.rfind('-', name.rfind('-') - 1)) != std::string::npos &&
+               (name.size() > 4 && (name.ends_with(".cpp") || name.ends_with(".log")))) {
+      ++at;
+    } else {
+      continue;
+    }
+    const std::size_t dash = name.find('-', at);
+    if (dash == std::string::npos || dash == at) continue;
+    pid_t pid = 0;
+    bool digits = true;
+    for (std::size_t i = at; i < dash; ++i) {
+      if (name[i] < '0' || name[i] > '9') digits = false;
+      else pid = pid * 10 + (name[i] - '0');
+    }
+    if (!digits || pid <= 0 || pid == ::getpid()) continue;
+    if (::kill(pid, 0) != 0 && errno == ESRCH) fs::remove(it->path(), ec);
+    ec.clear();
+  }
+}
+
 // The cache entry `object` if it is there and sound, else null (a damaged entry is removed, and
 // the report's note says why).
 std::shared_ptr<Library> load_cached(const fs::path& object, const fs::path& check, const std::string& key,
@@ -494,6 +554,10 @@ std::shared_ptr<Library> compile_entry(const std::string& source, const std::str
       remove_all();
       throw JitError(fmt::format("cannot write {}", source_file.string()));
     }
+  }
+  if (cancel != nullptr && cancel->load()) {
+    remove_all();
+    throw JitError("the compile was cancelled");
   }
   std::vector<std::string> argv = {compiler};
   argv.insert(argv.end(), kFlags.begin(), kFlags.end());
@@ -598,6 +662,7 @@ Model compile_model(const Model& model, const JitOptions& options, JitReport* re
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw JitError(fmt::format("cannot create the cache directory {}: {}", dir.string(), ec.message()));
+  remove_orphans(dir);
 
   const std::string suffix = unique_suffix();
   const std::string key = cache_key(source, compiler, dir);
@@ -744,6 +809,7 @@ std::optional<Model> cached_model(const Model& model, const JitOptions& options,
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw JitError(fmt::format("cannot create the cache directory {}: {}", dir.string(), ec.message()));
+  remove_orphans(dir);
   const std::string key = cache_key(model_source(*base, model), compiler, dir);
   const fs::path object = dir / (key + ".so");
   if (report) report->object = object.string();
@@ -755,9 +821,22 @@ std::optional<Model> cached_model(const Model& model, const JitOptions& options,
 
 }  // namespace
 
+void stop_background_compiles() noexcept {
+  for (std::atomic<pid_t>& group : background_groups) {
+    const pid_t g = group.load();
+    if (g > 0) ::kill(-g, SIGKILL);
+  }
+}
+
 BackgroundState background_state(const Model& model) {
   const auto* background = dynamic_cast<const BackgroundEvaluator*>(model.evaluator.get());
   return background != nullptr ? background->compile().state() : BackgroundState::none;
+}
+
+std::string background_notice(const Model& model) {
+  const auto* background = dynamic_cast<const BackgroundEvaluator*>(model.evaluator.get());
+  if (background == nullptr || background->compile().state() != BackgroundState::failed) return "";
+  return fmt::format("nhdyn: notice: the model ran on the interpreter ({})", background->compile().failure());
 }
 
 Model with_evaluator(const Model& model, EvaluatorChoice choice, std::string* notice, const JitOptions& options,
@@ -778,18 +857,23 @@ Model with_evaluator(const Model& model, EvaluatorChoice choice, std::string* no
   try {
     JitReport local;
     JitReport* made = report ? report : &local;
-    if (choice == EvaluatorChoice::automatic) {
-      // The compile would take the run's own processor: the interpreter alone is faster.
-      cpu_set_t cpus;
-      if (sched_getaffinity(0, sizeof cpus, &cpus) == 0 && CPU_COUNT(&cpus) < 2) return model;
+    if (choice == EvaluatorChoice::automatic && options.background) {
       // Cached: compiled at once. Else the run starts on the interpreter and switches when the
       // compile that starts now is done (BackgroundCompile).
       std::optional<Model> cached = cached_model(model, options, made);
       if (!made->note.empty() && notice) *notice = made->note;
       if (cached) return std::move(*cached);
+      // The compile would take the run's own processor: the interpreter alone is faster.
+      cpu_set_t cpus;
+      if (sched_getaffinity(0, sizeof cpus, &cpus) == 0 && CPU_COUNT(&cpus) < 2) return model;
       Model out = model;
-      out.evaluator = std::make_shared<BackgroundEvaluator>(std::dynamic_pointer_cast<const TapeEvaluator>(model.evaluator),
-                                                            std::make_shared<const BackgroundCompile>(model, options));
+      try {
+        out.evaluator = std::make_shared<BackgroundEvaluator>(
+            std::dynamic_pointer_cast<const TapeEvaluator>(model.evaluator), std::make_shared<const BackgroundCompile>(model, options));
+      } catch (const std::system_error& e) {  // no thread to be had: the interpreter
+        if (notice) *notice = fmt::format("nhdyn: notice: using the interpreter (no thread to compile in: {})", e.what());
+        return model;
+      }
       return out;
     }
     Model compiled = make_compiled(model, options, made);

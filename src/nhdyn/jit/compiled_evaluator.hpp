@@ -54,6 +54,9 @@ inline constexpr int kAutoCompileFrom = 1000;
 struct JitOptions {
   std::string compiler;  // "" = $NHDYN_CXX, else "c++"
   std::string cache_dir;  // "" = $XDG_CACHE_HOME/nhdyn, else $HOME/.cache/nhdyn
+  // `auto` compiles a model the cache lacks in the background (with_evaluator); false: it waits
+  // for the compile, as a batch of many runs does, which repays it.
+  bool background = true;
 };
 
 // What make_compiled happened to do.
@@ -89,5 +92,14 @@ bool is_compiled(const Model& model);
 // evaluator runs its terms and rows from now on; failed: the interpreter stays.
 enum class BackgroundState { none, compiling, switched, failed };
 BackgroundState background_state(const Model& model);
+
+// Ends the process groups of the background compiles still running (SIGKILL), for a process about
+// to end on a signal: async-signal-safe, so a signal handler may call it (the CLI's do). Their
+// files are removed by the next compile in the same cache (a file of a process gone is an orphan).
+void stop_background_compiles() noexcept;
+
+// Once the background compile failed (not stopped): the one-line notice the caller prints, as
+// with_evaluator's for a failed compile ("nhdyn: notice: using the interpreter (...)"); else "".
+std::string background_notice(const Model& model);
 
 }  // namespace nhdyn::jit
