@@ -312,66 +312,30 @@ const Tape* row_tape(const ModelTapes& p, int which) {
 }
 using RowTapes = std::array<std::shared_ptr<const NativeTape>, kRowTapes>;
 
-// The interpreter's evaluator with its terms, and the tapes of a row, replaced by compiled ones.
-class CompiledEvaluator final : public Evaluator {
+// The interpreter's evaluator behind another: every call forwarded to it. The compiled evaluators
+// derive from it and override what they run otherwise (the terms and the tapes of a row).
+class OverInterpreter : public Evaluator {
  public:
-  CompiledEvaluator(std::shared_ptr<const TapeEvaluator> base, std::shared_ptr<const Library> library,
-                    RowTapes rows)
-      : base_(std::move(base)), library_(std::move(library)), sparse_(base_->sparsity() != nullptr),
-        rows_(std::move(rows)) {
-    const std::vector<double>& p = base_->parameter_values();
-    stage_.assign(library_->stage_size() + 1, 0.0);
-    library_->stage(p.data(), stage_.data());
-    for (int i = 0; i < kRowTapes; ++i) {
-      if (!rows_[i]) continue;
-      row_stages_[i].assign(rows_[i]->stage_size() + 1, 0.0);  // + 1: data() of an empty stage
-      rows_[i]->stage(p.data(), row_stages_[i].data());
-    }
-  }
-
-  std::shared_ptr<const Evaluator> with_parameters(const double* values, std::size_t count) const override {
-    auto rebound = std::dynamic_pointer_cast<const TapeEvaluator>(base_->with_parameters(values, count));
-    if (!rebound) return nullptr;
-    return std::make_shared<CompiledEvaluator>(std::move(rebound), library_, rows_);
-  }
+  explicit OverInterpreter(std::shared_ptr<const TapeEvaluator> base) : base_(std::move(base)) {}
   bool has_initial_state() const override { return base_->has_initial_state(); }
-  void initial_state(double* scratch, double* q0, double* v0) const override {
-    base_->initial_state(scratch, q0, v0);
-  }
+  void initial_state(double* scratch, double* q0, double* v0) const override { base_->initial_state(scratch, q0, v0); }
   std::size_t scratch_size() const override { return base_->scratch_size(); }
-
-  void terms(double t, const double* q, const double* v, double* /*scratch*/, const TermsOut& out) const override {
-    if (sparse_) {
-      // The compiled code writes the nonzeros at their dense places; the rest is zero.
-      const std::size_t n = static_cast<std::size_t>(base_->n()), s = static_cast<std::size_t>(base_->s());
-      std::fill(out.A, out.A + n * n, 0.0);
-      std::fill(out.b, out.b + s * n, 0.0);
-      library_->terms_dense(stage_.data(), t, q, v, out.A, out.Q, out.G, out.b, out.b0);
-      return;
-    }
-    library_->terms(stage_.data(), t, q, v, out.A, out.Q, out.G, out.b, out.b0);
+  void terms(double t, const double* q, const double* v, double* scratch, const TermsOut& out) const override {
+    base_->terms(t, q, v, scratch, out);
   }
   const TermsSparsity* sparsity() const override { return base_->sparsity(); }
-  void sparse_terms(double t, const double* q, const double* v, double* /*scratch*/,
-                    const TermsOut& out) const override {
-    library_->terms(stage_.data(), t, q, v, out.A, out.Q, out.G, out.b, out.b0);
+  void sparse_terms(double t, const double* q, const double* v, double* scratch, const TermsOut& out) const override {
+    base_->sparse_terms(t, q, v, scratch, out);
   }
-
   bool has_complement() const override { return base_->has_complement(); }
   void complement(double t, const double* q, const double* v, double* scratch, double* D) const override {
     base_->complement(t, q, v, scratch, D);
   }
   void position_residual(double t, const double* q, double* scratch, double* phi) const override {
-    if (rows_[kPositionResidual])
-      rows_[kPositionResidual]->run(row_stages_[kPositionResidual].data(), t, q, nullptr, phi);
-    else
-      base_->position_residual(t, q, scratch, phi);
+    base_->position_residual(t, q, scratch, phi);
   }
   void velocity_residual(double t, const double* q, const double* v, double* scratch, double* f) const override {
-    if (rows_[kVelocityResidual])
-      rows_[kVelocityResidual]->run(row_stages_[kVelocityResidual].data(), t, q, v, f);
-    else
-      base_->velocity_residual(t, q, v, scratch, f);
+    base_->velocity_residual(t, q, v, scratch, f);
   }
   bool has_program_constraints() const override { return base_->has_program_constraints(); }
   void program_constraint_terms(double t, const double* q, const double* v, double* scratch, double* b_p,
@@ -388,6 +352,73 @@ class CompiledEvaluator final : public Evaluator {
   bool has_energy() const override { return base_->has_energy(); }
   bool has_energy_balance() const override { return base_->has_energy_balance(); }
   bool energy_function_is_energy() const override { return base_->energy_function_is_energy(); }
+  double energy_function(double t, const double* q, const double* v, double* scratch) const override {
+    return base_->energy_function(t, q, v, scratch);
+  }
+  void power(double t, const double* q, const double* v, double* scratch, double* out) const override {
+    base_->power(t, q, v, scratch, out);
+  }
+  double energy(double t, const double* q, const double* v, double* scratch) const override {
+    return base_->energy(t, q, v, scratch);
+  }
+  bool has_solution() const override { return base_->has_solution(); }
+  void solution(double t, double* scratch, double* qva) const override { base_->solution(t, scratch, qva); }
+
+ protected:
+  std::shared_ptr<const TapeEvaluator> base_;
+};
+
+// The interpreter's evaluator with its terms, and the tapes of a row, replaced by compiled ones.
+class CompiledEvaluator final : public OverInterpreter {
+ public:
+  CompiledEvaluator(std::shared_ptr<const TapeEvaluator> base, std::shared_ptr<const Library> library,
+                    RowTapes rows)
+      : OverInterpreter(std::move(base)), library_(std::move(library)), sparse_(base_->sparsity() != nullptr),
+        rows_(std::move(rows)) {
+    const std::vector<double>& p = base_->parameter_values();
+    stage_.assign(library_->stage_size() + 1, 0.0);
+    library_->stage(p.data(), stage_.data());
+    for (int i = 0; i < kRowTapes; ++i) {
+      if (!rows_[i]) continue;
+      row_stages_[i].assign(rows_[i]->stage_size() + 1, 0.0);  // + 1: data() of an empty stage
+      rows_[i]->stage(p.data(), row_stages_[i].data());
+    }
+  }
+
+  std::shared_ptr<const Evaluator> with_parameters(const double* values, std::size_t count) const override {
+    auto rebound = std::dynamic_pointer_cast<const TapeEvaluator>(base_->with_parameters(values, count));
+    if (!rebound) return nullptr;
+    return std::make_shared<CompiledEvaluator>(std::move(rebound), library_, rows_);
+  }
+
+  void terms(double t, const double* q, const double* v, double* /*scratch*/, const TermsOut& out) const override {
+    if (sparse_) {
+      // The compiled code writes the nonzeros at their dense places; the rest is zero.
+      const std::size_t n = static_cast<std::size_t>(base_->n()), s = static_cast<std::size_t>(base_->s());
+      std::fill(out.A, out.A + n * n, 0.0);
+      std::fill(out.b, out.b + s * n, 0.0);
+      library_->terms_dense(stage_.data(), t, q, v, out.A, out.Q, out.G, out.b, out.b0);
+      return;
+    }
+    library_->terms(stage_.data(), t, q, v, out.A, out.Q, out.G, out.b, out.b0);
+  }
+  void sparse_terms(double t, const double* q, const double* v, double* /*scratch*/,
+                    const TermsOut& out) const override {
+    library_->terms(stage_.data(), t, q, v, out.A, out.Q, out.G, out.b, out.b0);
+  }
+
+  void position_residual(double t, const double* q, double* scratch, double* phi) const override {
+    if (rows_[kPositionResidual])
+      rows_[kPositionResidual]->run(row_stages_[kPositionResidual].data(), t, q, nullptr, phi);
+    else
+      base_->position_residual(t, q, scratch, phi);
+  }
+  void velocity_residual(double t, const double* q, const double* v, double* scratch, double* f) const override {
+    if (rows_[kVelocityResidual])
+      rows_[kVelocityResidual]->run(row_stages_[kVelocityResidual].data(), t, q, v, f);
+    else
+      base_->velocity_residual(t, q, v, scratch, f);
+  }
   double energy_function(double t, const double* q, const double* v, double* scratch) const override {
     if (!rows_[kEnergyFunction]) return base_->energy_function(t, q, v, scratch);
     double h = 0.0;
@@ -406,11 +437,8 @@ class CompiledEvaluator final : public Evaluator {
     rows_[kEnergy]->run(row_stages_[kEnergy].data(), t, q, v, &e);
     return e;
   }
-  bool has_solution() const override { return base_->has_solution(); }
-  void solution(double t, double* scratch, double* qva) const override { base_->solution(t, scratch, qva); }
 
  private:
-  std::shared_ptr<const TapeEvaluator> base_;
   std::shared_ptr<const Library> library_;
   bool sparse_ = false;
   std::vector<double> stage_;  // what the terms read of the parameter stage (one spare entry)
@@ -730,10 +758,10 @@ class BackgroundCompile {
 // The interpreter's evaluator until the background compile is loaded, the compiled one after: for
 // the terms and for the tapes of a row that the compiled evaluator runs compiled (the rest is the
 // interpreter's in both). The contact forces' and the outputs' tapes stay interpreted.
-class BackgroundEvaluator final : public Evaluator {
+class BackgroundEvaluator final : public OverInterpreter {
  public:
   BackgroundEvaluator(std::shared_ptr<const TapeEvaluator> base, std::shared_ptr<const BackgroundCompile> compile)
-      : base_(std::move(base)), compile_(std::move(compile)) {}
+      : OverInterpreter(std::move(base)), compile_(std::move(compile)) {}
 
   const Evaluator& now() const {
     const Evaluator* compiled = compile_->compiled();
@@ -746,19 +774,11 @@ class BackgroundEvaluator final : public Evaluator {
   std::shared_ptr<const Evaluator> with_parameters(const double* values, std::size_t count) const override {
     return now().with_parameters(values, count);
   }
-  bool has_initial_state() const override { return base_->has_initial_state(); }
-  void initial_state(double* scratch, double* q0, double* v0) const override { base_->initial_state(scratch, q0, v0); }
-  std::size_t scratch_size() const override { return base_->scratch_size(); }
   void terms(double t, const double* q, const double* v, double* scratch, const TermsOut& out) const override {
     now().terms(t, q, v, scratch, out);
   }
-  const TermsSparsity* sparsity() const override { return base_->sparsity(); }
   void sparse_terms(double t, const double* q, const double* v, double* scratch, const TermsOut& out) const override {
     now().sparse_terms(t, q, v, scratch, out);
-  }
-  bool has_complement() const override { return base_->has_complement(); }
-  void complement(double t, const double* q, const double* v, double* scratch, double* D) const override {
-    base_->complement(t, q, v, scratch, D);
   }
   void position_residual(double t, const double* q, double* scratch, double* phi) const override {
     now().position_residual(t, q, scratch, phi);
@@ -766,21 +786,6 @@ class BackgroundEvaluator final : public Evaluator {
   void velocity_residual(double t, const double* q, const double* v, double* scratch, double* f) const override {
     now().velocity_residual(t, q, v, scratch, f);
   }
-  bool has_program_constraints() const override { return base_->has_program_constraints(); }
-  void program_constraint_terms(double t, const double* q, const double* v, double* scratch, double* b_p,
-                                double* b_p0, double* B) const override {
-    base_->program_constraint_terms(t, q, v, scratch, b_p, b_p0, B);
-  }
-  void program_constraint_position_residual(double t, const double* q, double* scratch, double* phi) const override {
-    base_->program_constraint_position_residual(t, q, scratch, phi);
-  }
-  void program_constraint_velocity_residual(double t, const double* q, const double* v, double* scratch,
-                                            double* f) const override {
-    base_->program_constraint_velocity_residual(t, q, v, scratch, f);
-  }
-  bool has_energy() const override { return base_->has_energy(); }
-  bool has_energy_balance() const override { return base_->has_energy_balance(); }
-  bool energy_function_is_energy() const override { return base_->energy_function_is_energy(); }
   double energy_function(double t, const double* q, const double* v, double* scratch) const override {
     return now().energy_function(t, q, v, scratch);
   }
@@ -790,11 +795,8 @@ class BackgroundEvaluator final : public Evaluator {
   double energy(double t, const double* q, const double* v, double* scratch) const override {
     return now().energy(t, q, v, scratch);
   }
-  bool has_solution() const override { return base_->has_solution(); }
-  void solution(double t, double* scratch, double* qva) const override { base_->solution(t, scratch, qva); }
 
  private:
-  std::shared_ptr<const TapeEvaluator> base_;
   std::shared_ptr<const BackgroundCompile> compile_;
 };
 
