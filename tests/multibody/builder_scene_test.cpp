@@ -7,6 +7,8 @@
 // a wheel too.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <random>
 #include <string>
 #include <vector>
@@ -117,6 +119,35 @@ TEST(BuilderScene, TheFilesSceneKeepsTheOrderOfItsSections) {
   for (const symbolic::VisualItem& item : file.visual.items) kinds.push_back(item.kind);
   EXPECT_EQ(kinds, (std::vector<symbolic::VisualKind>{symbolic::VisualKind::frame, symbolic::VisualKind::body,
                                                       symbolic::VisualKind::wheel}));
+}
+
+// A wheel's or a knife edge's own plane (`normal`) is drawn as the plane it is: a plane item whose
+// axes (t1, t2, n, as the columns of `other`) are orthonormal with n the given normal, normalized;
+// without a normal, no plane item (the report's z = 0 grid).
+TEST(BuilderScene, AWheelsAndAKnifeEdgesPlaneIsDrawnInItsAxes) {
+  const auto plane_axes = [](const std::string& text) {
+    const symbolic::Spec spec = load_model_string(text, "plane.toml");
+    const symbolic::VisualItem* plane = find(spec, symbolic::VisualKind::plane);
+    std::vector<double> axes;
+    if (plane == nullptr) return axes;
+    for (const GiNaC::ex& e : plane->other) axes.push_back(evaluate(spec, e, std::vector<double>(static_cast<std::size_t>(spec.n()), 0.1), std::vector<double>(static_cast<std::size_t>(spec.n()), 0.0)));
+    return axes;
+  };
+  const auto check = [](const std::vector<double>& axes, const std::array<double, 3>& n, const std::string& what) {
+    ASSERT_EQ(axes.size(), 9u) << what;
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(axes[static_cast<std::size_t>(3 * i + 2)], n[static_cast<std::size_t>(i)], 1e-15) << what;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        double dot = 0.0;
+        for (int i = 0; i < 3; ++i) dot += axes[static_cast<std::size_t>(3 * i + a)] * axes[static_cast<std::size_t>(3 * i + b)];
+        EXPECT_NEAR(dot, a == b ? 1.0 : 0.0, 1e-15) << what << " axes " << a << ", " << b;
+      }
+  };
+  check(plane_axes(test::free_disk_text("disk", "", kRim + "normal = [3, 0, 4]\n")), {0.6, 0.0, 0.8}, "wheel");
+  std::string sled = test::kFlatSledBodies;
+  sled.insert(sled.find("axis = \"x\"\n") + 11, "normal = [0, 1, 1]\n");
+  check(plane_axes(sled), {0.0, std::sqrt(0.5), std::sqrt(0.5)}, "knife edge");
+  EXPECT_TRUE(plane_axes(kDisk).empty()) << "a wheel on the default plane draws none";
 }
 
 // A wheel with a mode key is the disk contact it is, and still drawn as a wheel (by the builder,

@@ -396,6 +396,25 @@ void MultibodyBuilder::check_helper_name(const std::string& name, const SourceLo
   check_new(helpers_, name, "constraint helper", where);
 }
 
+namespace {
+std::pair<Vector3, Vector3> tangents(const Vector3& n, const Spec& spec);  // below
+
+// The drawing of a wheel's or a knife edge's own plane (their `normal`): the plane's axes t1, t2, n
+// at the origin, as a [[contacts]] plane ground draws itself (rolling_contact.cpp); the report
+// draws it in its own axes, and leaves a level one to its z = 0 grid (compile_visual).
+VisualItem plane_item(const Vector3& n, const Spec& spec, const std::string& name, const SourceLocation& where) {
+  const auto [t1, t2] = tangents(n, spec);
+  VisualItem item;
+  item.kind = VisualKind::plane;
+  item.name = name;
+  item.where = where.describe();
+  item.at = {0, 0, 0};
+  for (std::size_t i = 0; i < 3; ++i) item.other.insert(item.other.end(), {t1[i], t2[i], n[i]});
+  item.field_variables = {spec.symbols.time()};
+  return item;
+}
+}  // namespace
+
 MultibodyBuilder& MultibodyBuilder::rolling_wheel(const std::string& name, const std::string& body,
                                                   const std::string& axis, const std::string& radius,
                                                   const std::optional<Triple>& normal, SourceLocation where) {
@@ -418,7 +437,9 @@ MultibodyBuilder& MultibodyBuilder::rolling_wheel(const std::string& name, const
                                      r ? fmt::format("{}", *r) : "not a number"));
   if (normal) h.normal = parse(*normal, where, context + ": normal", false);
   helpers_.push_back(std::move(h));
-  if (helpers_.back().normal) plane_normal(helpers_.back(), context);  // a zero normal is refused now
+  if (helpers_.back().normal) {  // a zero normal is refused now; the plane is drawn
+    builder_.visual_item(plane_item(plane_normal(helpers_.back(), context), builder_.current(), name, where));
+  }
   return wheel_drawing(name, body, axis, radius, std::move(where));
 }
 
@@ -453,7 +474,8 @@ MultibodyBuilder& MultibodyBuilder::knife_edge(const std::string& name, const st
                                      axis));
   if (normal) h.normal = parse(*normal, where, context + ": normal", false);
   helpers_.push_back(std::move(h));
-  if (helpers_.back().normal) plane_normal(helpers_.back(), context);
+  if (helpers_.back().normal)
+    builder_.visual_item(plane_item(plane_normal(helpers_.back(), context), builder_.current(), name, where));
   return *this;
 }
 
