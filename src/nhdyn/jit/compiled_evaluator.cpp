@@ -663,6 +663,19 @@ Model bind_library(const Model& model, std::shared_ptr<const TapeEvaluator> base
 
 namespace {
 
+// The compiler to run and the cache directory, made (and rid of the files of compiles whose
+// process is gone).
+std::pair<std::string, fs::path> compiler_and_cache(const JitOptions& options) {
+  std::string compiler = options.compiler.empty() ? env("NHDYN_CXX") : options.compiler;
+  if (compiler.empty()) compiler = "c++";
+  fs::path dir = cache_directory(options);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw JitError(fmt::format("cannot create the cache directory {}: {}", dir.string(), ec.message()));
+  remove_orphans(dir);
+  return {compiler, dir};
+}
+
 // The cache key of a model's source for a compiler: a hash of the source, the compiler's command
 // and --version, and the flags.
 std::string cache_key(const std::string& source, const std::string& compiler, const fs::path& dir) {
@@ -684,13 +697,7 @@ Model compile_model(const Model& model, const JitOptions& options, JitReport* re
                                model.name));
   const bool sparse = base->sparsity() != nullptr;
   const std::string source = model_source(*base, model);
-  std::string compiler = options.compiler.empty() ? env("NHDYN_CXX") : options.compiler;
-  if (compiler.empty()) compiler = "c++";
-  const fs::path dir = cache_directory(options);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw JitError(fmt::format("cannot create the cache directory {}: {}", dir.string(), ec.message()));
-  remove_orphans(dir);
+  const auto [compiler, dir] = compiler_and_cache(options);
 
   const std::string suffix = unique_suffix();
   const std::string key = cache_key(source, compiler, dir);
@@ -805,13 +812,7 @@ class BackgroundEvaluator final : public OverInterpreter {
 std::optional<Model> cached_model(const Model& model, const JitOptions& options, JitReport* report) {
   auto base = std::dynamic_pointer_cast<const TapeEvaluator>(model.evaluator);
   if (!base) return std::nullopt;
-  std::string compiler = options.compiler.empty() ? env("NHDYN_CXX") : options.compiler;
-  if (compiler.empty()) compiler = "c++";
-  const fs::path dir = cache_directory(options);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw JitError(fmt::format("cannot create the cache directory {}: {}", dir.string(), ec.message()));
-  remove_orphans(dir);
+  const auto [compiler, dir] = compiler_and_cache(options);
   const std::string key = cache_key(model_source(*base, model), compiler, dir);
   const fs::path object = dir / (key + ".so");
   if (report) report->object = object.string();
