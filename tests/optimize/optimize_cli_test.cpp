@@ -610,6 +610,7 @@ TEST_F(OptimizeCli, ASolverModuleThatCannotBeUsedIsNamed) {
   EXPECT_EQ(garbage.exit_code, 2) << garbage.out;
   EXPECT_NE(garbage.out.find("nhdyn's IPOPT module " + not_elf + " could not be loaded: "), std::string::npos)
       << garbage.out;
+  EXPECT_NE(garbage.out.find("NHDYN_IPOPT_MODULE names it"), std::string::npos) << garbage.out;
   const Outcome foreign = run_with(libm.dli_fname);
   EXPECT_EQ(foreign.exit_code, 2) << foreign.out;
   EXPECT_NE(foreign.out.find(std::string(libm.dli_fname) + " is not the IPOPT module of this nhdyn"), std::string::npos)

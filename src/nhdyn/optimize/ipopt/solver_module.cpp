@@ -53,15 +53,17 @@ std::vector<std::string> candidates() {
   return paths;
 }
 
-Module load(const std::string& path) {
+// `named`: the path is NHDYN_IPOPT_MODULE's, so a path that is no module is the variable's fault.
+Module load(const std::string& path, bool named) {
   Module module;
   void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (handle == nullptr) {
     const char* why = dlerror();
-    module.error = fmt::format("nhdyn's IPOPT module {} could not be loaded: {}. `nhdyn optimize` needs IPOPT's "
-                               "libraries at run time: install coinor-libipopt-dev (sudo apt-get install "
-                               "coinor-libipopt-dev, or scripts/install-deps)",
-                               path, why != nullptr ? why : "unknown reason");
+    module.error = fmt::format(
+        "nhdyn's IPOPT module {} could not be loaded: {}. {}", path, why != nullptr ? why : "unknown reason",
+        named ? fmt::format("NHDYN_IPOPT_MODULE names it: set it to the path of {}, or unset it", ipopt_module::kFileName)
+              : "`nhdyn optimize` needs IPOPT's libraries at run time: install coinor-libipopt-dev (sudo apt-get "
+                "install coinor-libipopt-dev, or scripts/install-deps)");
     return module;
   }
   // Kept loaded for the life of the process: the solver may be called again.
@@ -86,11 +88,11 @@ Module find_and_load() {
                                  named, ipopt_module::kFileName);
       return module;
     }
-    return load(named);
+    return load(named, true);
   }
   const std::vector<std::string> paths = candidates();
   for (const std::string& path : paths) {
-    if (access(path.c_str(), F_OK) == 0) return load(path);
+    if (access(path.c_str(), F_OK) == 0) return load(path, false);
   }
   Module module;
   module.error = fmt::format("nhdyn's IPOPT module was not found (looked for {}): reinstall nhdyn, or set "
