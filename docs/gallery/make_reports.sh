@@ -19,7 +19,7 @@ runs=(
   "double_pendulum 5 3" "pendulum_cartesian 4 1" "rolling_disk_bodies 6 2" "whipple_bicycle 10 4"
   "rattleback 6 2.5" "chaplygin_ball 5 3" "ball_in_bowl 3 1.2 --set x0=0.03" "ball_over_bump 2 0.3"
   "tippe_top 3 2" "torus_wheel 6 1" "ball_on_incline 1.2 0.9" "ball_on_turntable 6 2.5"
-  "egg 4 1.5"
+  "egg 4 1.5" "ball_in_paraboloid 6 3"
 )
 for run in "${runs[@]}"; do
   read -r name t_end shot options <<<"$run"

@@ -726,6 +726,52 @@ TEST(ContactScene, BowlIsAMeshOfItsSphereAroundTheMotion) {
   }
 }
 
+// A ball in the elliptic paraboloid (a surface that is not a sphere): the bowl's mesh, sampled
+// over its tangent plane, lies on Z = X^2/(2 rho1) + Y^2/(2 rho2) to round-off and holds the
+// contact points.
+TEST(ContactScene, ParaboloidIsAMeshOfItsSurfaceAroundTheMotion) {
+  const nhdyn::symbolic::Spec spec = nhdyn::load_model_file(example("ball_in_paraboloid.toml"));
+  const nhdyn::Model model = nhdyn::symbolic::compile_model(spec);
+  const nhdyn::symbolic::VisualScene scene = nhdyn::symbolic::compile_visual(spec);
+  const int bowl = find_shape(scene, VisualKind::surface, "ball"), track = find_shape(scene, VisualKind::track, "ball");
+  ASSERT_GE(bowl, 0);
+  ASSERT_GE(track, 0);
+  const double rho1 = parameter(spec, "rho1"), rho2 = parameter(spec, "rho2"), r = parameter(spec, "r");
+  std::vector<double> parameters;
+  for (const nhdyn::Parameter& p : model.parameters) parameters.push_back(p.value);
+  const nhdyn::Tape program = scene.tape.bind(parameters.data(), parameters.size());
+  std::vector<double> registers(static_cast<std::size_t>(program.registers())), out(static_cast<std::size_t>(program.outputs()));
+  std::vector<double> values;
+  std::vector<std::array<double, 3>> contact;
+  // States on the contact: U on the bowl, the centre at r along its normal, the angles 0.
+  for (const auto& [X, Y] : std::vector<std::pair<double, double>>{{0.0, 0.0}, {0.05, -0.02}, {-0.03, 0.04}}) {
+    const double Z = X * X / (2 * rho1) + Y * Y / (2 * rho2);
+    const double nx = -X / rho1, ny = -Y / rho2, length = std::sqrt(nx * nx + ny * ny + 1);
+    const std::vector<double> q = {X + r * nx / length, Y + r * ny / length, Z + r / length, 0, 0, 0, X, Y, Z},
+                              v(q.size(), 0.0);
+    program.run(0.0, q.data(), v.data(), registers.data(), out.data());
+    values.insert(values.end(), out.begin(), out.end());
+    const double* p = out.data() + scene.shapes[static_cast<std::size_t>(track)].offset;
+    EXPECT_NEAR(p[0], X, 1e-15);
+    EXPECT_NEAR(p[2], Z, 1e-15);
+    contact.push_back({p[0], p[1], p[2]});
+  }
+  const nhdyn::SceneMesh mesh =
+      nhdyn::calc_scene_meshes(scene, model.parameters, values, out.size(), model.name)[static_cast<std::size_t>(bowl)];
+  ASSERT_FALSE(mesh.vertices.empty());
+  for (std::size_t k = 0; k < mesh.vertices.size(); k += 3) {
+    const double X = mesh.vertices[k], Y = mesh.vertices[k + 1];
+    EXPECT_NEAR(mesh.vertices[k + 2], X * X / (2 * rho1) + Y * Y / (2 * rho2), 1e-14);
+  }
+  for (const auto& p : contact) {
+    double nearest = 1e300;
+    for (std::size_t k = 0; k < mesh.vertices.size(); k += 3)
+      nearest = std::min(nearest, std::hypot(mesh.vertices[k] - p[0], mesh.vertices[k + 1] - p[1], mesh.vertices[k + 2] - p[2]));
+    EXPECT_LT(nearest, 0.02);
+  }
+  for (const int i : mesh.triangles) EXPECT_LT(static_cast<std::size_t>(3 * i), mesh.vertices.size());
+}
+
 // examples/ball_over_bump.toml with `from` replaced by `to`, written as NAME.toml and run for 0.2 s
 // with --html: its spec, its page and the terrain's mesh at full precision from the page's frames.
 struct BumpVariant {

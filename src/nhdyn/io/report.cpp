@@ -473,6 +473,83 @@ SceneMesh surface_mesh(Field& g, const symbolic::VisualShape& shape, const std::
   return mesh;
 }
 
+// The zero of g on the line p + s m nearest p (|s| up to 4 range, in both directions); NaN when
+// there is none.
+double line_zero(Field& g, const Point& p, const Point& m, double range) {
+  const auto at = [&](double s) { return g(p[0] + s * m[0], p[1] + s * m[1], p[2] + s * m[2]); };
+  const double g0 = at(0.0);
+  if (g0 == 0.0) return 0.0;
+  if (!std::isfinite(g0)) return std::nan("");
+  double previous = 0.0;
+  for (double s = 1e-3 * range; s <= 4.0 * range; previous = s, s *= 2.0)
+    for (const double sign : {1.0, -1.0}) {
+      const double far = at(sign * s);
+      if (!std::isfinite(far) || (far > 0.0) == (g0 > 0.0)) continue;
+      double lo = sign * previous, hi = sign * s;
+      for (int i = 0; i < 200 && std::abs(hi - lo) > 4 * std::numeric_limits<double>::epsilon() * std::abs(hi); ++i) {
+        const double mid = 0.5 * (lo + hi);
+        ((at(mid) > 0.0) == (g0 > 0.0) ? lo : hi) = mid;
+      }
+      return 0.5 * (lo + hi);
+    }
+  return std::nan("");
+}
+
+// A fixed surface that is not a sphere: its zero set over the tangent plane at the mean point of
+// the contact's path, the zero of g nearest each point of a square grid in that plane along the
+// plane's normal. The square holds the path and the margin; where a line meets no zero (the
+// surface turns away from the plane, as a closed bowl at its rim) the square is halved.
+SceneMesh patch_mesh(Field& g, const symbolic::VisualShape& shape, const std::string& model,
+                     const std::vector<Point>& path, double length) {
+  if (path.empty()) return {};
+  Point mean = {0.0, 0.0, 0.0};
+  for (const Point& p : path)
+    for (std::size_t k = 0; k < 3; ++k) mean[k] += p[k] / static_cast<double>(path.size());
+  const double h = 1e-6 * std::max({1.0, std::abs(mean[0]), std::abs(mean[1]), std::abs(mean[2])});
+  Point m;
+  for (std::size_t k = 0; k < 3; ++k) {
+    Point a = mean, b = mean;
+    a[k] += h;
+    b[k] -= h;
+    m[k] = (g(a[0], a[1], a[2]) - g(b[0], b[1], b[2])) / (2 * h);
+  }
+  const double norm = std::hypot(m[0], m[1], m[2]);
+  if (!(norm > 0.0) || !std::isfinite(norm))
+    mesh_failure(shape, model, "its gradient at the contact path's mean point is zero or not a number");
+  for (double& x : m) x /= norm;
+  const Point axis = std::abs(m[2]) < 0.9 ? Point{0.0, 0.0, 1.0} : Point{1.0, 0.0, 0.0};
+  Point e1 = {axis[1] * m[2] - axis[2] * m[1], axis[2] * m[0] - axis[0] * m[2], axis[0] * m[1] - axis[1] * m[0]};
+  const double n1 = std::hypot(e1[0], e1[1], e1[2]);
+  for (double& e : e1) e /= n1;
+  const Point e2 = {m[1] * e1[2] - m[2] * e1[1], m[2] * e1[0] - m[0] * e1[2], m[0] * e1[1] - m[1] * e1[0]};
+  double reach = 0.0;
+  for (const Point& p : path) {
+    const Point d = {p[0] - mean[0], p[1] - mean[1], p[2] - mean[2]};
+    reach = std::max({reach, std::abs(d[0] * e1[0] + d[1] * e1[1] + d[2] * e1[2]),
+                      std::abs(d[0] * e2[0] + d[1] * e2[1] + d[2] * e2[2])});
+  }
+  double half = reach + std::max(reach / 3.0, 4.0 * std::abs(length));
+  if (!(half > 0.0 && std::isfinite(half))) return {};
+  constexpr int n = 41;
+  for (int attempt = 0; attempt < 8; ++attempt, half /= 2) {
+    SceneMesh mesh;
+    bool whole = true;
+    for (int i = 0; i < n && whole; ++i)
+      for (int j = 0; j < n && whole; ++j) {
+        const double a = -half + 2 * half * i / (n - 1), b = -half + 2 * half * j / (n - 1);
+        const Point p = {mean[0] + a * e1[0] + b * e2[0], mean[1] + a * e1[1] + b * e2[1], mean[2] + a * e1[2] + b * e2[2]};
+        const double s = line_zero(g, p, m, half);
+        whole = std::isfinite(s);
+        mesh.vertices.insert(mesh.vertices.end(), {p[0] + s * m[0], p[1] + s * m[1], p[2] + s * m[2]});
+      }
+    if (!whole) continue;
+    grid_triangles(n, n, mesh.vertices, mesh.triangles);
+    mesh.rows = n;
+    return mesh;
+  }
+  mesh_failure(shape, model, "a line along its normal near the contact's path meets no point where its function is zero");
+}
+
 }  // namespace
 
 std::vector<SceneMesh> calc_scene_meshes(const symbolic::VisualScene& scene, const std::vector<Parameter>& parameters,
@@ -511,7 +588,8 @@ std::vector<SceneMesh> calc_scene_meshes(const symbolic::VisualScene& scene, con
     const double* x = size.data() + shape.size_offset;
     const double length = length_of(shape, x[0]);
     if (shape.kind == symbolic::VisualKind::terrain) out[s] = terrain_mesh(field, shape_path(shape, values, stride), length);
-    else out[s] = surface_mesh(field, shape, model, shape_path(shape, values, stride), length, {x[1], x[2], x[3]});
+    else if (x[4] != 0.0) out[s] = surface_mesh(field, shape, model, shape_path(shape, values, stride), length, {x[1], x[2], x[3]});
+    else out[s] = patch_mesh(field, shape, model, shape_path(shape, values, stride), length);
   }
   return out;
 }

@@ -52,6 +52,12 @@ bool contact_has_coordinates(const GiNaC::ex& e, const Spec& spec) {
   return false;
 }
 
+// A kink or a step (abs, csgn, step) anywhere in e: a ground or shape written with one has no
+// normal there.
+bool contact_not_smooth(const GiNaC::ex& e) {
+  return e.has(GiNaC::abs(GiNaC::wild())) || e.has(GiNaC::csgn(GiNaC::wild())) || e.has(GiNaC::step(GiNaC::wild()));
+}
+
 std::string contact_option_of(const KeyTexts& options, const std::string& key, const std::string& fallback) {
   for (const auto& [k, v] : options)
     if (k == key) return v;
@@ -143,14 +149,14 @@ std::vector<int> contact_coordinates(const std::string& names, std::size_t count
 // The coordinates that hold a contact point: those named by the `coordinates` key, or, without
 // it, new ones that nhdyn adds, named after the contact (added_contact_coordinates). `added` says
 // which.
-std::vector<int> contact_point_coordinates(const std::string& names, bool terrain, const ContactParsers& p,
+std::vector<int> contact_point_coordinates(const std::string& names, ContactPointOn on, const ContactParsers& p,
                                            const SourceLocation& where, const std::string& context,
                                            const std::string& what, const std::string& example, bool& added) {
-  const std::size_t count = terrain ? 2 : 3;
+  const std::size_t count = on == ContactPointOn::terrain ? 2 : 3;
   added = names.empty() && p.add_coordinate;
   if (!added) return contact_coordinates(names, count, *p.spec, where, context, what, example);
   std::vector<int> out;
-  for (const std::string& name : added_contact_coordinates(p.contact, terrain)) {
+  for (const std::string& name : added_contact_coordinates(p.contact, on)) {
     const Spec& spec = *p.spec;
     std::string taken;
     if (std::find(spec.coordinates.begin(), spec.coordinates.end(), name) != spec.coordinates.end())
@@ -191,8 +197,8 @@ class PlaneGround final : public ContactGround {
   std::string key() const override { return "plane"; }
   std::vector<std::string> options() const override { return {"angular_velocity"}; }
   std::string example() const override { return "ground = { plane = [0, 0, 1], angular_velocity = \"Omega\" }"; }
-  void parse(const GroundText& text, const ContactParsers& p, const std::string& context,
-             ParsedGround& out) const override {
+  void parse(const GroundText& text, const ContactParsers& p, const std::string& context, const ContactShape&,
+             const ShapeValues&, ParsedGround& out) const override {
     if (text.value.size() == 3)
       out.normal = Vector3{p.constant(text.value[0], text.where, context + ": plane normal"),
                            p.constant(text.value[1], text.where, context + ": plane normal"),
@@ -254,19 +260,23 @@ class PlaneGround final : public ContactGround {
   }
 };
 
-// A fixed surface g(X, Y, Z) = 0; so far a sphere (a quadratic whose Hessian is a positive or
-// negative multiple of the identity), on which a ball rolls inside or outside.
+// A fixed smooth surface g(X, Y, Z) = 0, the body on the side `side` names. A ball on a sphere
+// (g a quadratic whose Hessian is a nonzero multiple of the identity) has its contact point in
+// closed form (rolling-bodies.md section 3); any other shape or surface, or a ball on a sphere
+// given `coordinates`, has it held by three coordinates of the model (section 11).
 class SurfaceGround final : public ContactGround {
  public:
   std::string key() const override { return "surface"; }
-  std::vector<std::string> options() const override { return {"side"}; }
+  std::vector<std::string> options() const override { return {"side", "coordinates"}; }
   std::string example() const override {
     return "ground = { surface = \"X^2 + Y^2 + (Z - R)^2 - R^2\", side = \"inside\" }";
   }
-  void parse(const GroundText& text, const ContactParsers& p, const std::string& context,
-             ParsedGround& out) const override {
+  void parse(const GroundText& text, const ContactParsers& p, const std::string& context, const ContactShape& shape,
+             const ShapeValues& values, ParsedGround& out) const override {
+    const Spec& spec = *p.spec;
+    const std::string written = text.value.at(0);
     const GiNaC::symbol X("X"), Y("Y"), Z("Z");
-    const GiNaC::ex g = p.surface(text.value.at(0), Vector3{X, Y, Z}, text.where, context + ": surface").expand();
+    const GiNaC::ex g = p.surface(written, Vector3{X, Y, Z}, text.where, context + ": surface").expand();
     const std::string side = contact_option_of(text.options, "side", "");
     if (side != "inside" && side != "outside")
       throw_model_error(text.where, context,
@@ -275,19 +285,97 @@ class SurfaceGround final : public ContactGround {
                                      : fmt::format("unknown side '{}'; choose \"inside\" (the body is where g < 0) or "
                                                    "\"outside\" (where g > 0)",
                                                    side));
-    // g = alpha |X - K|^2 - alpha R^2: equal square terms, no products, degree 2.
-    const GiNaC::ex alpha = g.coeff(X, 2);
-    bool sphere = g.degree(X) == 2 && g.degree(Y) == 2 && g.degree(Z) == 2 && symbolic::is_zero(g.coeff(Y, 2) - alpha) &&
-                  symbolic::is_zero(g.coeff(Z, 2) - alpha) && !symbolic::is_zero(alpha);
-    for (const GiNaC::ex& cross_term : {g.coeff(X, 1).coeff(Y, 1), g.coeff(X, 1).coeff(Z, 1), g.coeff(Y, 1).coeff(Z, 1)})
-      sphere = sphere && symbolic::is_zero(cross_term);
-    const std::optional<double> a = sphere ? contact_number_of(alpha, *p.spec) : std::nullopt;
-    if (!sphere || !a || *a == 0.0)
+    if (contact_has_coordinates(g, spec))
       throw_model_error(text.where, context,
-                        fmt::format("the surface \"{}\" is not a sphere; so far a body rolls on a plane or a sphere "
-                                    "(written as a*(X - X0)^2 + a*(Y - Y0)^2 + a*(Z - Z0)^2 - a*R^2); other surfaces "
-                                    "and terrain are not yet supported",
-                                    text.value.at(0)));
+                        fmt::format("the surface \"{}\" depends on t or on a coordinate; a surface ground is fixed: "
+                                    "write it in X, Y, Z and the parameters",
+                                    written));
+    // Smooth: the contact's normal is grad g, and the equations take two more derivatives of it.
+    if (!g.has(X) && !g.has(Y) && !g.has(Z))
+      throw_model_error(text.where, context,
+                        fmt::format("the surface \"{}\" does not depend on X, Y or Z, so it is no surface; write "
+                                    "g(X, Y, Z) = 0, e.g. {}",
+                                    written, example()));
+    for (const GiNaC::ex& e : {g, g.diff(X), g.diff(Y), g.diff(Z)})
+      if (contact_not_smooth(e))
+        throw_model_error(text.where, context,
+                          fmt::format("the surface \"{}\" is not differentiable (it uses abs or a step): the contact's "
+                                      "normal and its derivatives must exist everywhere the body rolls; write a "
+                                      "smooth g, e.g. sqrt(X^2 + eps^2) for |X|",
+                                      written));
+    out.written = g;
+    out.variables = {X, Y, Z};
+    const std::string names = contact_option_of(text.options, "coordinates", "");
+    if (names.empty() && shape.ball_radius(values) && sphere(g, text, p, context, side, out)) return;
+    // The contact point U on the ground as coordinates (section 11); the body's side: g < 0 inside.
+    out.inside = side == "inside";
+    const std::vector<int> at = contact_point_coordinates(names, ContactPointOn::surface, p, text.where, context,
+                                                          "a surface ground", kCoordinatesExample, out.added);
+    for (std::size_t i = 0; i < 3; ++i) out.point[i] = at[i];
+    out.surface = g.subs(GiNaC::lst{X == spec.symbols.coordinate(at[0]), Y == spec.symbols.coordinate(at[1]),
+                                    Z == spec.symbols.coordinate(at[2])});
+  }
+  // A sphere's zero set sampled along rays from its centre (every ray meets it once); any other
+  // surface over its tangent plane at the contact path's mean point (the report, io/report.cpp).
+  std::optional<VisualItem> drawing(const ParsedContact& c, const Spec&, const std::optional<Vector3>&) const override {
+    VisualItem item;
+    item.kind = VisualKind::surface;
+    const bool rays = c.ground.point[0] < 0;
+    item.sizes = {c.shape->length(c.values), c.ground.centre_x, c.ground.centre_y, c.ground.centre_z, rays ? 1 : 0};
+    item.field = c.ground.written;
+    item.field_variables = c.ground.variables;
+    return item;
+  }
+  void check(const ParsedContact& c, const Spec& spec, const std::string& context) const override {
+    if (c.ground.point[0] >= 0) return;  // a ball flatter than the ground: checked at the start (SpecConvexity)
+    const double ball = contact_number_of(*c.shape->ball_radius(c.values), spec).value_or(0.0);
+    const double sphere = contact_number_of(c.ground.radius, spec).value_or(0.0);
+    if (c.ground.inside && !(ball < sphere))
+      throw_model_error(c.where, context,
+                        fmt::format("the ball (radius {:.6g}) is not smaller than the bowl (radius {:.6g}): it cannot "
+                                    "roll inside it with a single contact point; the ball's radius must be less than "
+                                    "the bowl's",
+                                    ball, sphere));
+  }
+  Touch touch(const ParsedContact& c, const PlacedFrame& F, const Spec& spec, const std::optional<Vector3>& gravity,
+              const std::string&) const override {
+    if (c.ground.point[0] >= 0) return located(c, F, spec, gravity);
+    Touch out;
+    const GiNaC::ex r = *c.shape->ball_radius(c.values);
+    const Vector3 K = {c.ground.centre_x, c.ground.centre_y, c.ground.centre_z};
+    const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
+    const Vector3 KC = subtract(C, K);
+    const GiNaC::ex distance = GiNaC::sqrt(dot(KC, KC));
+    // Inside, the normal out of the wall points to the sphere's centre; outside, away from it.
+    out.normal = scale((c.ground.inside ? -1 : 1) / distance, KC);
+    out.point = subtract(C, scale(r, out.normal));
+    out.gap = c.ground.inside ? c.ground.radius - r - distance : distance - c.ground.radius - r;
+    // Tangent rows e x (C - K) and (C - K) x (e x (C - K)), e the world axis least aligned with
+    // gravity (docs/derivations/rolling-bodies.md section 4.2).
+    const Vector3 e = unit(contact_least_aligned_axis(gravity ? *gravity : unit(2), spec));
+    out.tangent1 = cross(e, KC);
+    out.tangent2 = cross(KC, out.tangent1);
+    return out;
+  }
+
+ private:
+  static constexpr const char* kCoordinatesExample =
+      "ground = { surface = \"X^2/a^2 + Y^2/b^2 + (Z - c)^2/c^2 - 1\", side = \"inside\", coordinates = [\"gx\", "
+      "\"gy\", \"gz\"] }";
+
+  // g = alpha |X - K|^2 - alpha R^2 (equal square terms, no products, degree 2): fills the
+  // sphere's centre K and radius and returns true; false for any other g.
+  static bool sphere(const GiNaC::ex& g, const GroundText& text, const ContactParsers& p, const std::string& context,
+                     const std::string& side, ParsedGround& out) {
+    const GiNaC::ex X = out.variables[0], Y = out.variables[1], Z = out.variables[2];
+    const GiNaC::ex alpha = g.coeff(X, 2);
+    bool quadric = g.degree(X) == 2 && g.degree(Y) == 2 && g.degree(Z) == 2 &&
+                   symbolic::is_zero(g.coeff(Y, 2) - alpha) && symbolic::is_zero(g.coeff(Z, 2) - alpha) &&
+                   !symbolic::is_zero(alpha);
+    for (const GiNaC::ex& cross_term : {g.coeff(X, 1).coeff(Y, 1), g.coeff(X, 1).coeff(Z, 1), g.coeff(Y, 1).coeff(Z, 1)})
+      quadric = quadric && symbolic::is_zero(cross_term);
+    const std::optional<double> a = quadric ? contact_number_of(alpha, *p.spec) : std::nullopt;
+    if (!quadric || !a || *a == 0.0) return false;
     const GiNaC::ex zero = g.subs(GiNaC::lst{X == 0, Y == 0, Z == 0});
     out.centre_x = simplify(-g.coeff(X, 1).subs(GiNaC::lst{Y == 0, Z == 0}) / (2 * alpha));
     out.centre_y = simplify(-g.coeff(Y, 1).subs(GiNaC::lst{X == 0, Z == 0}) / (2 * alpha));
@@ -308,51 +396,47 @@ class SurfaceGround final : public ContactGround {
     out.radius = radius;
     // g < 0 is inside the sphere when alpha > 0.
     out.inside = (side == "inside") == (*a > 0.0);
-    out.written = g;
-    out.variables = {X, Y, Z};
+    return true;
   }
-  // The zero set of g, sampled along rays from the sphere's centre (every ray meets it once).
-  std::optional<VisualItem> drawing(const ParsedContact& c, const Spec&, const std::optional<Vector3>&) const override {
-    VisualItem item;
-    item.kind = VisualKind::surface;
-    item.sizes = {c.shape->length(c.values), c.ground.centre_x, c.ground.centre_y, c.ground.centre_z};
-    item.field = c.ground.written;
-    item.field_variables = c.ground.variables;
-    return item;
-  }
-  void check(const ParsedContact& c, const Spec& spec, const std::string& context) const override {
-    const std::optional<GiNaC::ex> r = c.shape->ball_radius(c.values);
-    if (!r)
-      throw_model_error(c.where, context,
-                        fmt::format("a {} on a curved surface is not yet supported (its contact point has no closed "
-                                    "form there); on a sphere only a ball rolls so far: shape = {{ sphere = \"r\" }}",
-                                    c.shape->key()));
-    const double ball = contact_number_of(*r, spec).value_or(0.0);
-    const double sphere = contact_number_of(c.ground.radius, spec).value_or(0.0);
-    if (c.ground.inside && !(ball < sphere))
-      throw_model_error(c.where, context,
-                        fmt::format("the ball (radius {:.6g}) is not smaller than the bowl (radius {:.6g}): it cannot "
-                                    "roll inside it with a single contact point; the ball's radius must be less than "
-                                    "the bowl's",
-                                    ball, sphere));
-  }
-  Touch touch(const ParsedContact& c, const PlacedFrame& F, const Spec& spec, const std::optional<Vector3>& gravity,
-              const std::string&) const override {
+
+  // The contact point U = (X, Y, Z) held by coordinates (rolling-bodies.md section 11):
+  // n = sigma grad g / |grad g|, tangents e x grad g and grad g x (e x grad g), B the body's
+  // support point along n; g(U) = 0 and the tangential components of B - U hold U.
+  static Touch located(const ParsedContact& c, const PlacedFrame& F, const Spec& spec,
+                       const std::optional<Vector3>& gravity) {
     Touch out;
-    const GiNaC::ex r = *c.shape->ball_radius(c.values);
-    const Vector3 K = {c.ground.centre_x, c.ground.centre_y, c.ground.centre_z};
-    const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
-    const Vector3 KC = subtract(C, K);
-    const GiNaC::ex distance = GiNaC::sqrt(dot(KC, KC));
-    // Inside, the normal out of the wall points to the sphere's centre; outside, away from it.
-    out.normal = scale((c.ground.inside ? -1 : 1) / distance, KC);
-    out.point = subtract(C, scale(r, out.normal));
-    out.gap = c.ground.inside ? c.ground.radius - r - distance : distance - c.ground.radius - r;
-    // Tangent rows e x (C - K) and (C - K) x (e x (C - K)), e the world axis least aligned with
-    // gravity (docs/derivations/rolling-bodies.md section 4.2).
+    const Vector3 U = {spec.symbols.coordinate(c.ground.point[0]), spec.symbols.coordinate(c.ground.point[1]),
+                       spec.symbols.coordinate(c.ground.point[2])};
+    Vector3 gradient;
+    for (std::size_t i = 0; i < 3; ++i) gradient[i] = c.ground.surface.diff(GiNaC::ex_to<GiNaC::symbol>(U[i]));
+    const GiNaC::ex length = GiNaC::sqrt(dot(gradient, gradient));
+    const int sigma = c.ground.inside ? -1 : 1;
+    out.normal = scale(sigma / length, gradient);
     const Vector3 e = unit(contact_least_aligned_axis(gravity ? *gravity : unit(2), spec));
-    out.tangent1 = cross(e, KC);
-    out.tangent2 = cross(KC, out.tangent1);
+    out.tangent1 = cross(e, gradient);
+    out.tangent2 = cross(gradient, out.tangent1);
+    const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
+    Vector3 body_point;
+    GiNaC::ex reach;
+    if (const std::optional<GiNaC::ex> r = c.shape->ball_radius(c.values)) {
+      body_point = subtract(C, scale(*r, out.normal));
+      reach = *r;
+    } else {
+      const ShapeSupport s = c.shape->support(c.values, multiply_transposed(F.rotation_numerator, out.normal),
+                                              F.rotation_denominator);
+      body_point = add(C, multiply(F.rotation, s.point));
+      reach = s.reach;
+    }
+    out.gap = dot(out.normal, subtract(C, U)) - reach;
+    const Vector3 apart = subtract(body_point, U);
+    out.locate = {{"_ground", c.ground.surface}, {"_at1", dot(out.tangent1, apart)}, {"_at2", dot(out.tangent2, apart)}};
+    // The ground rises along n by 1/2 w^T K w, K = -sigma H / |grad g| (a hollow where positive).
+    for (unsigned i = 0; i < 3; ++i)
+      for (unsigned j = 0; j < 3; ++j)
+        out.curvature(i, j) = -sigma * gradient[i].diff(GiNaC::ex_to<GiNaC::symbol>(U[j])) / length;
+    if (c.shape->implicit()) implicit_shape_rows(c, F, out.tangent1, out.tangent2, out);
+    // The force acts at the body's point, as on terrain (section 8).
+    out.point = body_point;
     return out;
   }
 };
@@ -368,8 +452,8 @@ class TerrainGround final : public ContactGround {
   std::string example() const override {
     return "ground = { terrain = \"0.05*sin(X)*cos(2*Y)\", coordinates = [\"u\", \"v\"] }";
   }
-  void parse(const GroundText& text, const ContactParsers& p, const std::string& context,
-             ParsedGround& out) const override {
+  void parse(const GroundText& text, const ContactParsers& p, const std::string& context, const ContactShape&,
+             const ShapeValues&, ParsedGround& out) const override {
     const Spec& spec = *p.spec;
     const std::string written = text.value.at(0);
     const GiNaC::symbol X("X"), Y("Y"), Z("Z");
@@ -387,13 +471,13 @@ class TerrainGround final : public ContactGround {
                                     written));
     // Smooth: the contact's normal is grad h, and the equations take two more derivatives of it.
     for (const GiNaC::ex& e : {h, h.diff(X), h.diff(Y)})
-      if (e.has(GiNaC::abs(GiNaC::wild())) || e.has(GiNaC::csgn(GiNaC::wild())) || e.has(GiNaC::step(GiNaC::wild())))
+      if (contact_not_smooth(e))
         throw_model_error(text.where, context,
                           fmt::format("the terrain \"{}\" is not differentiable (it uses abs): the contact's normal "
                                       "and its derivatives must exist everywhere the body rolls; write a smooth "
                                       "height, e.g. sqrt(X^2 + eps^2) for |X|",
                                       written));
-    const std::vector<int> at = contact_point_coordinates(contact_option_of(text.options, "coordinates", ""), true, p,
+    const std::vector<int> at = contact_point_coordinates(contact_option_of(text.options, "coordinates", ""), ContactPointOn::terrain, p,
                                                           text.where, context, "a terrain", example(), out.added);
     out.at = {at[0], at[1]};
     out.height = h.subs(GiNaC::lst{X == spec.symbols.coordinate(out.at[0]), Y == spec.symbols.coordinate(out.at[1])});
@@ -493,12 +577,12 @@ void parse_implicit_shape(const ContactText& text, const ContactParsers& p, cons
                                   "axes: write it in X, Y, Z (body axes) and the parameters",
                                   written));
   for (const GiNaC::ex& e : {f, f.diff(X), f.diff(Y), f.diff(Z)})
-    if (e.has(GiNaC::abs(GiNaC::wild())) || e.has(GiNaC::csgn(GiNaC::wild())))
+    if (contact_not_smooth(e))
       throw_model_error(text.shape_where, context,
                         fmt::format("the surface \"{}\" is not differentiable (it uses abs): its normal and curvature "
                                     "must exist at every point that may touch; write a smooth f",
                                     written));
-  const std::vector<int> at = contact_point_coordinates(contact_option_of(text.shape_options, "coordinates", ""), false,
+  const std::vector<int> at = contact_point_coordinates(contact_option_of(text.shape_options, "coordinates", ""), ContactPointOn::shape,
                                                         p, text.shape_where, context, "a surface shape",
                                                         find_contact_shape("surface")->example(), out.added);
   for (std::size_t i = 0; i < 3; ++i) {
@@ -573,7 +657,7 @@ ParsedContact parse_contact(const ContactText& text, const ContactParsers& parse
                         contact_unknown_key(fmt::format("key of a {} ground", ground->key()), option.first, ground_options));
   out.ground.type = ground;
   out.ground.where = text.ground.where;
-  ground->parse(text.ground, p, context + ": ground", out.ground);
+  ground->parse(text.ground, p, context + ": ground", shape, out.values, out.ground);
 
   if (text.rolling != "rolling" && text.rolling != "rubber")
     throw_model_error(text.where, context,
@@ -608,15 +692,25 @@ SpecConvexity convexity_check(const ParsedContact& c, const PlacedFrame& F, cons
   return check;
 }
 
-// The contact coordinates nhdyn adds, and where Newton starts (rolling-bodies.md section 10): on a
-// terrain below the centre; an implicit shape's point on its surface along -nu from its centre.
+// The contact coordinates nhdyn adds, and where Newton starts (rolling-bodies.md sections 10 and
+// 11): on a terrain below the centre; on a surface along grad F from the centre; an implicit
+// shape's point on its surface along -nu from its centre.
 SpecContactCoordinates added_coordinates(const ParsedContact& c, const PlacedFrame& F,
                                          const ContactGround::Touch& touch) {
   SpecContactCoordinates added;
   added.contact = c.name;
   added.where = c.where;
-  if (c.ground.added) {
-    const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
+  const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
+  if (c.ground.added && c.ground.point[0] >= 0) {
+    for (std::size_t i = 0; i < 3; ++i) {
+      added.coordinates.push_back(c.ground.point[i]);
+      added.start.push_back(0);
+      added.from.push_back(C[i]);
+      added.ground_point[i] = c.ground.point[i];
+    }
+    for (const char* suffix : {"_ground", "_at1", "_at2"}) added.constraints.push_back(c.name + suffix);
+    added.ground = c.ground.inside ? c.ground.surface : -c.ground.surface;
+  } else if (c.ground.added) {
     for (std::size_t i = 0; i < 2; ++i) {
       added.coordinates.push_back(c.ground.at[i]);
       added.constraints.push_back(fmt::format("{}_at{}", c.name, i + 1));
@@ -723,6 +817,17 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
                                fmt::format("contact '{}': no spin about the normal, n.(omega - omega_ground) = 0", c.name)});
   }
   if (c.shape->implicit()) out.convexity = convexity_check(c, F, touch);
+  // A ball on a surface held by coordinates: its curvature 1/r against the ground's (section 11).
+  const std::optional<GiNaC::ex> ball = c.shape->ball_radius(c.values);
+  if (ball && c.ground.point[0] >= 0) {
+    SpecConvexity check;
+    check.contact = c.name;
+    check.where = c.where;
+    check.normal = {touch.normal[0], touch.normal[1], touch.normal[2]};
+    for (unsigned i = 0; i < 3; ++i) check.body(i, i) = 1 / *ball;
+    check.ground = touch.curvature;
+    out.convexity = check;
+  }
   // 1 - (e . nu)^2 below 1e-4: the axle within 0.6 degree of the normal (rolling-bodies.md section 2).
   if (const std::optional<ContactShape::Singularity> singular =
           c.shape->singularity(c.values, multiply_transposed(F.rotation, touch.normal)))
@@ -795,9 +900,13 @@ void check_contact_convexity(const Spec& spec) {
 
 namespace nhdyn::symbolic {
 
-std::vector<std::string> added_contact_coordinates(const std::string& contact, bool terrain) {
-  if (terrain) return {contact + "_u", contact + "_v"};
-  return {contact + "_px", contact + "_py", contact + "_pz"};
+std::vector<std::string> added_contact_coordinates(const std::string& contact, ContactPointOn on) {
+  switch (on) {
+    case ContactPointOn::terrain: return {contact + "_u", contact + "_v"};
+    case ContactPointOn::shape: return {contact + "_px", contact + "_py", contact + "_pz"};
+    case ContactPointOn::surface: return {contact + "_gx", contact + "_gy", contact + "_gz"};
+  }
+  return {};
 }
 
 namespace {
@@ -814,11 +923,13 @@ double contact_value(const GiNaC::ex& e, const GiNaC::exmap& at) {
   }
 }
 
-// The point where the ray s d (s > 0) from the shape's centre leaves f < 0; NaN when f(0) is not
-// negative or f stays negative out to a huge distance.
-double ray_exit(const GiNaC::ex& f, const std::array<GiNaC::ex, 3>& y, const Eigen::Vector3d& d, GiNaC::exmap at) {
+// The point where the ray o + s d (s > 0) leaves f < 0, as s; NaN when f(o) is not negative or f
+// stays negative out to a huge distance. o is the shape's centre (0 in its own axes), or a point
+// in world axes for a ground.
+double ray_exit(const GiNaC::ex& f, const std::array<GiNaC::ex, 3>& y, const Eigen::Vector3d& d, GiNaC::exmap at,
+                const Eigen::Vector3d& o = Eigen::Vector3d::Zero()) {
   const auto value = [&](double s) {
-    for (int i = 0; i < 3; ++i) at[y[static_cast<std::size_t>(i)]] = GiNaC::numeric(s * d(i));
+    for (int i = 0; i < 3; ++i) at[y[static_cast<std::size_t>(i)]] = GiNaC::numeric(o(i) + s * d(i));
     return contact_value(f, at);
   };
   if (!(value(0.0) < 0.0)) return std::numeric_limits<double>::quiet_NaN();
@@ -833,6 +944,39 @@ double ray_exit(const GiNaC::ex& f, const std::array<GiNaC::ex, 3>& y, const Eig
     (value(middle) < 0.0 ? low : high) = middle;
   }
   return 0.5 * (low + high);
+}
+
+// Where a surface ground's contact point U starts (rolling-bodies.md section 11): where the line
+// from the shape's centre C along grad F(C) meets F = 0, F = -sigma g negative on the body's side
+// (along -grad F from a centre on the other side).
+Eigen::Vector3d ground_start(const Spec& spec, const SpecContactCoordinates& added, const GiNaC::exmap& at,
+                             const std::string& context) {
+  std::array<GiNaC::ex, 3> U;
+  for (std::size_t i = 0; i < 3; ++i) U[i] = spec.symbols.coordinate(added.ground_point[i]);
+  Eigen::Vector3d C, d;
+  for (int i = 0; i < 3; ++i) C(i) = contact_value(added.from[static_cast<std::size_t>(i)], at);
+  GiNaC::exmap here = at;
+  for (std::size_t i = 0; i < 3; ++i) here[U[i]] = GiNaC::numeric(C(static_cast<Eigen::Index>(i)));
+  const double F = contact_value(added.ground, here);
+  for (std::size_t i = 0; i < 3; ++i)
+    d(static_cast<Eigen::Index>(i)) = contact_value(added.ground.diff(GiNaC::ex_to<GiNaC::symbol>(U[i])), here);
+  if (!C.allFinite() || !std::isfinite(F))
+    throw_model_error(added.where, context,
+                      "cannot find the contact point on the ground at the start: the shape's centre or the surface "
+                      "g there is not a finite number; check the initial state");
+  if (F == 0.0) return C;
+  // A centre on the other side (its height not yet written: --fix-initial moves it afterwards)
+  // looks for the ground the other way.
+  const double sign = F < 0.0 ? 1.0 : -1.0;
+  d *= sign;
+  const double s = d.allFinite() && d.norm() > 0 ? ray_exit(sign * added.ground, U, d.normalized(), at, C)
+                                                   : std::numeric_limits<double>::quiet_NaN();
+  if (!std::isfinite(s))
+    throw_model_error(added.where, context,
+                      "cannot find the contact point on the ground at the start: the line from the shape's centre "
+                      "along the surface's steepest approach meets no point of g = 0; start the body nearer the "
+                      "ground, or name the contact point's coordinates and give their initial values");
+  return C + s * d.normalized();
 }
 
 const SpecConstraint& constraint_named(const Spec& spec, const std::string& name) {
@@ -860,11 +1004,19 @@ void solve_contact_coordinates(Spec& spec) {
         const double q = contact_value(spec.q0[i].subs(parameters), at);
         at[spec.symbols.coordinate(static_cast<int>(i))] = GiNaC::numeric(q);
       }
-    // The start: a terrain's point below the centre, then the shape's point along -nu.
+    // The start: a surface's point along the steepest approach from the centre, or a terrain's
+    // point below the centre; then the shape's point along -nu.
     Eigen::VectorXd x(k);
+    std::size_t first = 0;
+    if (!added.from.empty()) {
+      x.head(3) = ground_start(spec, added, at, context);
+      for (std::size_t i = 0; i < 3; ++i)
+        at[spec.symbols.coordinate(added.ground_point[i])] = GiNaC::numeric(x(static_cast<Eigen::Index>(i)));
+      first = 3;
+    }
     std::size_t ray_from = added.coordinates.size();
     if (!added.ray.empty()) ray_from -= 3;
-    for (std::size_t j = 0; j < ray_from; ++j) {
+    for (std::size_t j = first; j < ray_from; ++j) {
       x(static_cast<Eigen::Index>(j)) = contact_value(added.start[j], at);
       at[spec.symbols.coordinate(added.coordinates[j])] = GiNaC::numeric(x(static_cast<Eigen::Index>(j)));
     }

@@ -36,6 +36,7 @@ struct GroundText {
   std::vector<std::string> value;  // plane: the normal (3 expressions) or none; surface: g (one);
                                    // terrain: h (one)
   KeyTexts options;                // angular_velocity = "Omega", side = "inside", coordinates = "u, v"
+                                   // (terrain) or "gx, gy, gz" (surface)
                                    // (an array option's elements joined by ", ")
   SourceLocation where;
 };
@@ -61,12 +62,16 @@ struct ParsedGround {
   const ContactGround* type = nullptr;
   std::optional<Vector3> normal;    // plane: given (not yet normalized), else opposite to gravity
   GiNaC::ex angular_velocity = 0;   // plane: the turntable's rate Omega(t) about its normal
-  GiNaC::ex centre_x = 0, centre_y = 0, centre_z = 0;  // surface (a sphere): its centre K
-  GiNaC::ex radius = 0;             // surface: its radius R_g
-  bool inside = false;              // surface: the body is inside the sphere (a bowl)
+  GiNaC::ex centre_x = 0, centre_y = 0, centre_z = 0;  // surface (a sphere, closed form): its centre K
+  GiNaC::ex radius = 0;             // surface (a sphere, closed form): its radius R_g
+  bool inside = false;              // surface: the body is where g < 0 (a bowl)
   std::array<int, 2> at = {-1, -1};  // terrain: the coordinates holding the contact point's X and Y
   GiNaC::ex height = 0;             // terrain: h(X, Y) at X, Y = those coordinates
-  bool added = false;               // terrain: those coordinates were added by nhdyn (no `coordinates` key)
+  // surface, not a closed form (rolling-bodies.md section 11): the coordinates holding the contact
+  // point U on the ground (X, Y, Z), and g at U. Empty (-1) for a ball on a sphere in closed form.
+  std::array<int, 3> point = {-1, -1, -1};
+  GiNaC::ex surface = 0;
+  bool added = false;               // terrain, surface: those coordinates were added by nhdyn (no `coordinates` key)
   // terrain: h in `variables` X, Y; surface: g in X, Y, Z (world): what the report draws.
   GiNaC::ex written = 0;
   std::vector<GiNaC::ex> variables;
@@ -135,9 +140,10 @@ class ContactGround {
   virtual std::string key() const = 0;
   virtual std::vector<std::string> options() const = 0;
   virtual std::string example() const = 0;
-  // Reads the ground's value and options into `out` (out.type is set already).
+  // Reads the ground's value and options into `out` (out.type is set already); `shape` and
+  // `values` are the contact's shape, parsed before its ground.
   virtual void parse(const GroundText& text, const ContactParsers& parsers, const std::string& context,
-                     ParsedGround& out) const = 0;
+                     const ContactShape& shape, const ShapeValues& values, ParsedGround& out) const = 0;
   // Checks that `contact`'s shape may roll on this ground (a ball smaller than a bowl).
   virtual void check(const ParsedContact& contact, const Spec& spec, const std::string& context) const = 0;
   // The contact of the shape of `contact`, whose body moves with `frame`, on this ground
@@ -187,9 +193,14 @@ RollingContact make_rolling_contact(const ParsedContact& contact, const PlacedFr
 // the expressions do not evaluate to finite reals are left to the other checks.
 void check_contact_convexity(const Spec& spec);
 
-// The names nhdyn gives a contact point's coordinates when the contact names none: NAME_px,
-// NAME_py, NAME_pz for an implicit shape's point (body axes), NAME_u, NAME_v for a terrain's.
-std::vector<std::string> added_contact_coordinates(const std::string& contact, bool terrain);
+// What holds a contact point by coordinates of the model: a terrain (2: u, v), an implicit shape
+// (3: its point in body axes), a surface ground (3: the point on it, world).
+enum class ContactPointOn { terrain, shape, surface };
+
+// The names nhdyn gives a contact point's coordinates when the contact names none: NAME_u, NAME_v
+// on a terrain, NAME_px, NAME_py, NAME_pz for an implicit shape's point (body axes), NAME_gx,
+// NAME_gy, NAME_gz on a surface.
+std::vector<std::string> added_contact_coordinates(const std::string& contact, ContactPointOn on);
 
 // Sets spec.q0 and spec.v0 of the coordinates nhdyn added for contact points
 // (spec.contact_coordinates) from the rest of the initial state, at spec.t0 and the parameter

@@ -147,6 +147,12 @@ struct SpecContactCoordinates {
   std::vector<GiNaC::ex> ray;
   GiNaC::ex surface = 0;
   std::array<int, 3> point = {-1, -1, -1};  // the coordinates of y, when the ray is given
+  // A surface ground g(U) = 0 (rolling-bodies.md section 11): U, its first three coordinates,
+  // starts where the line from `from` (the shape's centre, world, in t and q) along grad F meets
+  // F = 0; F = -sigma g in U's coordinates, negative on the body's side (empty `from` when none).
+  std::vector<GiNaC::ex> from;
+  GiNaC::ex ground = 0;
+  std::array<int, 3> ground_point = {-1, -1, -1};
 };
 
 // A closed-form contact point that turns singular along the motion (a disk lying flat): a run

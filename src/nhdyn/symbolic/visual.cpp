@@ -196,7 +196,7 @@ int visual_sizes(VisualKind kind) {
     case VisualKind::body: return 10;
     case VisualKind::ellipsoid: return 3;
     case VisualKind::torus: return 2;
-    case VisualKind::surface: return 4;
+    case VisualKind::surface: return 5;
     default: return 0;
   }
 }

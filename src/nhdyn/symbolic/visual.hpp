@@ -54,8 +54,10 @@ struct VisualItem {
   int axis = 1;                  // wheel, torus: the axle, 0, 1 or 2 for the frame's x, y or z axis
   std::string where;             // "file:line:column" for messages
   // ellipsoid: the semi-axes (3); torus: the rim's radius and the tube's (2); terrain, surface: a
-  // length of the contact's shape (1), the margin of the region drawn, then (surface) a point from
-  // which every ray meets the surface once (3), where its mesh is sampled from. Parameters only.
+  // length of the contact's shape (1), the margin of the region drawn, then (surface) a point K
+  // (3) and 1 when every ray from K meets the surface once (a sphere's centre: its mesh is sampled
+  // along rays from K), 0 when the mesh is sampled over the tangent plane at the contact path's
+  // mean point instead (any other surface). Parameters only.
   std::vector<GiNaC::ex> sizes;
   // solid, terrain, surface: the function whose zero set is drawn (terrain: the height h) in the
   // symbols `field_variables` (solid: 3, the frame's axes about `at`; terrain: 2, X and Y;
@@ -82,7 +84,7 @@ struct SpecVisual {
 // a plane's R is its axes at rest, which the report turns by the angle of its rate); its
 // sizes at `size_offset` in those of VisualScene::sizes: sphere and wheel 1 (radius), body 10
 // (mass, then the inertia about the centre of mass in the frame's axes, 9 row-major), ellipsoid 3
-// (semi-axes), torus 2 (R, r), terrain 1 (a length), surface 4 (a length, a point inside), segment,
+// (semi-axes), torus 2 (R, r), terrain 1 (a length), surface 5 (a length, a point K, rays from K or not), segment,
 // frame, track, solid and plane none.
 struct VisualShape {
   VisualKind kind = VisualKind::sphere;

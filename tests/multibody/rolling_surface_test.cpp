@@ -1,0 +1,304 @@
+// Bodies rolling on a fixed surface g(X, Y, Z) = 0 whose contact point is held by three
+// coordinates (ground = { surface = ... } with any shape or any g, docs/derivations/rolling-bodies.md
+// section 11): against the closed forms (a ball on a sphere, a ball on an incline, an ellipsoid on
+// the plane), the elliptic paraboloid's two frequencies, the invariants in an ellipsoidal bowl,
+// and the refusals.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "nhdyn/analysis/linearization.hpp"
+#include "nhdyn/analysis/simulation.hpp"
+#include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/io/results.hpp"
+#include "support/text.hpp"
+
+namespace nhdyn {
+namespace {
+
+using test::example;
+using test::replace_once;
+
+int surface_column(const ResultColumns& columns, const std::string& name) {
+  for (std::size_t i = 0; i < columns.all.size(); ++i)
+    if (columns.all[i] == name) return static_cast<int>(i);
+  ADD_FAILURE() << "no column " << name;
+  return 0;
+}
+
+std::vector<std::vector<double>> surface_rows(const Model& model, const SimulationOptions& options,
+                                              SimulationSummary* summary = nullptr) {
+  std::vector<std::vector<double>> rows;
+  std::vector<double> row;
+  const SimulationSummary s = simulate(model, options, [&](const Data& data) {
+    fill_result_row(model, data, row);
+    rows.push_back(row);
+  });
+  if (summary) *summary = s;
+  return rows;
+}
+
+std::string surface_error(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected an error";
+  return "";
+}
+
+// The largest difference of the columns both tables have, by name, row by row.
+double largest_difference(const Model& a, const std::vector<std::vector<double>>& ra, const Model& b,
+                          const std::vector<std::vector<double>>& rb, const std::vector<std::string>& names) {
+  const ResultColumns ca = make_result_columns(a), cb = make_result_columns(b);
+  EXPECT_EQ(ra.size(), rb.size());
+  double worst = 0.0;
+  for (const std::string& name : names) {
+    const int i = surface_column(ca, name), j = surface_column(cb, name);
+    for (std::size_t k = 0; k < std::min(ra.size(), rb.size()); ++k)
+      worst = std::max(worst, std::abs(ra[k][static_cast<std::size_t>(i)] - rb[k][static_cast<std::size_t>(j)]));
+  }
+  return worst;
+}
+
+std::string text_of(const std::string& file) { return test::read_text(example(file)); }
+
+// The bowl of examples/ball_in_bowl.toml with `coordinates` given: the contact point held by
+// gx, gy, gz instead of the closed form. Every coordinate of the ball and its contact force agree.
+TEST(RollingSurface, BallOnASphereHeldByCoordinatesFollowsTheClosedForm) {
+  std::string text = text_of("ball_in_bowl.toml");
+  replace_once(text, R"(coordinates = ["x", "y", "z", "a", "b", "c"])",
+               R"(coordinates = ["x", "y", "z", "a", "b", "c", "gx", "gy", "gz"])");
+  replace_once(text, R"(side = "inside" })", R"(side = "inside", coordinates = ["gx", "gy", "gz"] })");
+  const Model closed = load_model(example("ball_in_bowl.toml"));
+  const Model located = load_model_text(text);
+  EXPECT_EQ(located.n(), closed.n() + 3);
+  SimulationOptions options;
+  options.t_end = 3.0;
+  options.output_step = 0.05;
+  options.integrator.rtol = 1e-11;
+  options.integrator.atol = 1e-13;
+  const auto a = surface_rows(closed, options);
+  options.fix_initial = true;  // gx, gy, gz are written nowhere: moved onto the contact
+  SimulationSummary summary;
+  const auto b = surface_rows(located, options, &summary);
+  EXPECT_LT(largest_difference(closed, a, located, b, {"x", "y", "z", "a", "b", "c", "x'", "b'"}), 1e-9);
+  EXPECT_LT(largest_difference(closed, a, located, b, {"ball_N", "ball_Fx", "ball_Fz", "ball_X", "ball_Z"}), 1e-9);
+  // The contact point's coordinates are the closed form's contact point.
+  const ResultColumns columns = make_result_columns(located);
+  for (const auto& row : b) {
+    EXPECT_NEAR(row[static_cast<std::size_t>(surface_column(columns, "gx"))],
+                row[static_cast<std::size_t>(surface_column(columns, "ball_X"))], 1e-11);
+    EXPECT_NEAR(row[static_cast<std::size_t>(surface_column(columns, "gz"))],
+                row[static_cast<std::size_t>(surface_column(columns, "ball_Z"))], 1e-11);
+  }
+  EXPECT_LT(summary.energy.drift, 1e-11);
+}
+
+// g = Z - X tan(alpha), the body where g > 0: the incline of rolling-bodies.md (6.8); the ball
+// rolls down at 5/7 g sin(alpha), pressed by m g cos(alpha). nhdyn adds ball_gx, ball_gy, ball_gz.
+TEST(RollingSurface, BallOnAnInclineWrittenAsASurfaceRollsAtFiveSevenths) {
+  const Model model = load_model_text(R"toml(name = "ball-on-surface-incline"
+coordinates = ["x", "y", "z", "psi", "theta", "phi"]
+gravity = [0, 0, "-g"]
+
+[parameters]
+m = 1.5
+r = 0.1
+g = 9.81
+alpha = 0.3
+
+[[frames]]
+name = "ball"
+translation = ["x", "y", "z"]
+rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
+
+[[bodies]]
+name = "ball"
+frame = "ball"
+mass = "m"
+inertia = ["2/5*m*r^2", "2/5*m*r^2", "2/5*m*r^2"]
+
+[[contacts]]
+name = "ball"
+body = "ball"
+shape = { sphere = "r" }
+ground = { surface = "Z - X*tan(alpha)", side = "outside" }
+
+[initial]
+position = { x = "-r*sin(alpha)", y = 0, z = "r*cos(alpha)", psi = 0, theta = 0, phi = 0 }
+)toml");
+  const double m = 1.5, r = 0.1, g = 9.81, alpha = 0.3, a = 5.0 / 7.0 * g * std::sin(alpha);
+  ASSERT_EQ(model.n(), 9);
+  EXPECT_EQ(model.coordinates[6], "ball_gx");
+  const ResultColumns columns = make_result_columns(model);
+  const int N = surface_column(columns, "ball_N"), X = surface_column(columns, "ball_X"),
+            Z = surface_column(columns, "ball_Z"), Fx = surface_column(columns, "ball_Fx");
+  SimulationOptions options;
+  options.t_end = 1.0;
+  options.output_step = 0.05;
+  options.integrator.rtol = 1e-11;
+  options.integrator.atol = 1e-13;
+  std::vector<double> row;
+  int rows = 0;
+  simulate(model, options, [&](const Data& data) {
+    fill_result_row(model, data, row);
+    const auto at = [&](int i) { return row[static_cast<std::size_t>(i)]; };
+    const double t = data.t, s = a * t * t / 2;
+    EXPECT_NEAR(data.q(0), -r * std::sin(alpha) - s * std::cos(alpha), 1e-10) << t;
+    EXPECT_NEAR(data.q(2), r * std::cos(alpha) - s * std::sin(alpha), 1e-10) << t;
+    EXPECT_NEAR(data.q(6), -s * std::cos(alpha), 1e-10) << t;  // the contact point's X
+    EXPECT_NEAR(data.q(8), data.q(6) * std::tan(alpha), 1e-12);  // on the incline
+    EXPECT_NEAR(at(N), m * g * std::cos(alpha), 1e-10 * m * g);
+    EXPECT_NEAR(at(Fx), -m * a * std::cos(alpha), 1e-10 * m * g);
+    EXPECT_NEAR(at(Z), at(X) * std::tan(alpha), 1e-12);
+    ++rows;
+  });
+  EXPECT_EQ(rows, 21);
+}
+
+// examples/ball_in_paraboloid.toml at rest at the bottom: two frequencies,
+// omega_k^2 = g / ((1 + 2/5)(rho_k - r)) (rolling-bodies.md section 11, test iii); rolling in a
+// sphere of radius rho_k would give the same.
+TEST(RollingSurface, BallInAnEllipticParaboloidRocksAtItsTwoFrequencies) {
+  const Model model = load_model(example("ball_in_paraboloid.toml"), {{"vx", 0.0}, {"vy", 0.0}});
+  const double g = 9.81, r = 0.05, rho1 = 0.5, rho2 = 0.8;
+  const double w1 = std::sqrt(g / (1.4 * (rho1 - r))), w2 = std::sqrt(g / (1.4 * (rho2 - r)));
+  const Linearization l = calc_linearization(model);
+  std::vector<double> w;
+  for (const std::complex<double>& e : l.eigenvalues) {
+    EXPECT_LT(std::abs(e.real()), 1e-9) << e;
+    if (e.imag() > 1e-3) w.push_back(e.imag());
+  }
+  std::sort(w.begin(), w.end());
+  ASSERT_EQ(w.size(), 2u);
+  EXPECT_NEAR(w[0], w2, 1e-10 * w2);
+  EXPECT_NEAR(w[1], w1, 1e-10 * w1);
+}
+
+// The example as shipped: the ball's energy, the contact point on the paraboloid, and the
+// ball's centre at r along the bowl's normal from it.
+TEST(RollingSurface, BallInAnEllipticParaboloidKeepsItsEnergyAndItsContact) {
+  const Model model = load_model(example("ball_in_paraboloid.toml"));
+  const double r = 0.05, rho1 = 0.5, rho2 = 0.8;
+  const ResultColumns columns = make_result_columns(model);
+  const int X = surface_column(columns, "ball_X"), Y = surface_column(columns, "ball_Y"),
+            Z = surface_column(columns, "ball_Z"), N = surface_column(columns, "ball_N");
+  SimulationOptions options;
+  options.t_end = 6.0;
+  options.output_step = 0.02;
+  options.integrator.rtol = 1e-11;
+  options.integrator.atol = 1e-13;
+  SimulationSummary summary;
+  double farthest_x = 0.0, farthest_y = 0.0;
+  for (const auto& row : surface_rows(model, options, &summary)) {
+    const double px = row[static_cast<std::size_t>(X)], py = row[static_cast<std::size_t>(Y)],
+                 pz = row[static_cast<std::size_t>(Z)];
+    EXPECT_NEAR(pz, px * px / (2 * rho1) + py * py / (2 * rho2), 1e-12);
+    const double nx = -px / rho1, ny = -py / rho2, length = std::sqrt(nx * nx + ny * ny + 1);
+    EXPECT_NEAR(row[1] - px, r * nx / length, 1e-11);
+    EXPECT_NEAR(row[2] - py, r * ny / length, 1e-11);
+    EXPECT_NEAR(row[3] - pz, r / length, 1e-11);
+    EXPECT_GT(row[static_cast<std::size_t>(N)], 0.0);
+    farthest_x = std::max(farthest_x, std::abs(px));
+    farthest_y = std::max(farthest_y, std::abs(py));
+  }
+  // It went both ways: along X by about vx/omega_1, along Y by about vy/omega_2.
+  EXPECT_GT(farthest_x, 0.015);
+  EXPECT_GT(farthest_y, 0.012);
+  EXPECT_LT(summary.energy.drift, 1e-11);
+}
+
+// examples/ellipsoid_rocking.toml on the surface Z = 0 (g = Z, the body where g > 0) instead of
+// the plane: the same motion and contact force, the contact point held by coordinates.
+TEST(RollingSurface, EllipsoidOnTheSurfaceZFollowsTheEllipsoidOnThePlane) {
+  std::string text = text_of("ellipsoid_rocking.toml");
+  replace_once(text, R"(shape = { ellipsoid = ["a", "b", "c"] })",
+               "shape = { ellipsoid = [\"a\", \"b\", \"c\"] }\nground = { surface = \"Z\", side = \"outside\" }");
+  const Model plane = load_model(example("ellipsoid_rocking.toml"));
+  const Model surface = load_model_text(text);
+  EXPECT_EQ(surface.n(), plane.n() + 3);
+  SimulationOptions options;
+  options.t_end = 2.0;
+  options.output_step = 0.02;
+  options.integrator.rtol = 1e-11;
+  options.integrator.atol = 1e-13;
+  const auto a = surface_rows(plane, options);
+  const auto b = surface_rows(surface, options);
+  EXPECT_LT(largest_difference(plane, a, surface, b, {"x", "y", "z", "psi", "theta", "phi", "phi'"}), 1e-9);
+  EXPECT_LT(largest_difference(plane, a, surface, b, {"foot_N", "foot_Fx", "foot_Fy", "foot_X", "foot_Y"}), 1e-8);
+}
+
+// An ellipsoid rolling in an ellipsoidal bowl (no closed form on either side): the energy, the
+// contact point on the bowl, and the body's touching point there.
+TEST(RollingSurface, EllipsoidInAnEllipsoidalBowlKeepsItsEnergyAndItsContact) {
+  std::string text = text_of("ellipsoid_rocking.toml");
+  replace_once(text, R"(shape = { ellipsoid = ["a", "b", "c"] })",
+               "shape = { ellipsoid = [\"a\", \"b\", \"c\"] }\n"
+               "ground = { surface = \"X^2/A^2 + Y^2/B^2 + (Z - C)^2/C^2 - 1\", side = \"inside\" }");
+  replace_once(text, "[parameters]\n", "[parameters]\nA = 1.2\nB = 0.9\nC = 0.7\n");
+  replace_once(text, R"x(z = "sqrt(a^2*sin(tilt)^2 + c^2*cos(tilt)^2)", psi = 0, theta = 0,)x", "psi = 0.2, theta = 0.05,");
+  const Model model = load_model_text(text);
+  const ResultColumns columns = make_result_columns(model);
+  const int X = surface_column(columns, "foot_X"), Y = surface_column(columns, "foot_Y"),
+            Z = surface_column(columns, "foot_Z"), gx = surface_column(columns, "foot_gx"),
+            gz = surface_column(columns, "foot_gz");
+  SimulationOptions options;
+  options.t_end = 2.0;
+  options.output_step = 0.02;
+  options.integrator.rtol = 1e-11;
+  options.integrator.atol = 1e-13;
+  options.fix_initial = true;  // z left out: put onto the bowl
+  SimulationSummary summary;
+  double farthest = 0.0;
+  for (const auto& row : surface_rows(model, options, &summary)) {
+    const auto at = [&](int i) { return row[static_cast<std::size_t>(i)]; };
+    const double A = 1.2, B = 0.9, C = 0.7;
+    const double px = at(X), py = at(Y), pz = at(Z);
+    EXPECT_NEAR(px * px / (A * A) + py * py / (B * B) + (pz - C) * (pz - C) / (C * C), 1.0, 1e-11);
+    EXPECT_NEAR(at(gx), px, 1e-11);
+    EXPECT_NEAR(at(gz), pz, 1e-11);
+    farthest = std::max(farthest, std::abs(px));
+  }
+  ASSERT_TRUE(summary.initial_fix.has_value());
+  EXPECT_GT(farthest, 0.02);  // it rocked
+  EXPECT_LT(summary.energy.drift, 1e-10);
+}
+
+// Refusals, each naming the file's line and what to do.
+TEST(RollingSurface, BadSurfacesAreRefusedByName) {
+  const std::string base = text_of("ball_in_paraboloid.toml");
+  const std::string ground = R"(ground = { surface = "X^2/(2*rho1) + Y^2/(2*rho2) - Z", side = "inside" })";
+  const auto with = [&](const std::string& replacement) {
+    std::string text = base;
+    replace_once(text, ground, replacement);
+    return text;
+  };
+  std::string m = surface_error([&] { load_model_text(with(R"(ground = { surface = "abs(X)/rho1 - Z", side = "inside" })")); });
+  EXPECT_NE(m.find("is not differentiable"), std::string::npos) << m;
+  EXPECT_NE(m.find("contact 'ball'"), std::string::npos) << m;
+  m = surface_error([&] { load_model_text(with(R"(ground = { surface = "X^2 - Z + x", side = "inside" })")); });
+  EXPECT_NE(m.find("depends on t or on a coordinate"), std::string::npos) << m;
+  m = surface_error([&] { load_model_text(with(R"(ground = { surface = "rho1", side = "inside" })")); });
+  EXPECT_NE(m.find("does not depend on X, Y or Z"), std::string::npos) << m;
+  m = surface_error([&] {
+    load_model_text(with(R"(ground = { surface = "X^2 - Z", side = "inside", coordinates = ["x", "y"] })"));
+  });
+  EXPECT_NE(m.find("needs the 3 coordinates"), std::string::npos) << m;
+  m = surface_error([&] { load_model_text(with(R"(ground = { surface = "X^2 - Z" })")); });
+  EXPECT_NE(m.find("needs side"), std::string::npos) << m;
+  // A ball flatter than the hollow it starts in: the contact would not be unique.
+  m = surface_error([&] { load_model(example("ball_in_paraboloid.toml"), {{"r", 0.6}}); });
+  EXPECT_NE(m.find("flatter than the hollow"), std::string::npos) << m;
+  EXPECT_NE(m.find("ball_in_paraboloid.toml:"), std::string::npos) << m;
+  EXPECT_NE(m.find("-0.333333"), std::string::npos) << m;  // 1/r - 1/rho1
+}
+
+}  // namespace
+}  // namespace nhdyn
