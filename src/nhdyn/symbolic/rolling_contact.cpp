@@ -422,8 +422,12 @@ class SurfaceGround final : public ContactGround {
       body_point = subtract(C, scale(*r, out.normal));
       reach = *r;
     } else {
-      const ShapeSupport s = c.shape->support(c.values, multiply_transposed(F.rotation_numerator, out.normal),
-                                              F.rotation_denominator);
+      // The support mapping depends on the direction only: taken along sigma N^T grad g, whose
+      // length is s |grad g| (R = N / s), so that |grad g| stays out of the expressions that are
+      // differentiated twice (as on a plane, rolling-bodies.md section 2.1).
+      const ShapeSupport s = c.shape->support(c.values,
+                                              multiply_transposed(F.rotation_numerator, scale(sigma, gradient)),
+                                              F.rotation_denominator * length);
       body_point = add(C, multiply(F.rotation, s.point));
       reach = s.reach;
     }
