@@ -132,6 +132,18 @@ TEST_F(OptimizeCli, DoubleIntegratorHermiteSimpsonIsExact) {
   EXPECT_NEAR(summary_value(set.out, "objective"), 48.0, 1e-7) << set.out;
 }
 
+// IPOPT reads an options file ipopt.opt from the working directory unless told not to: one that
+// stops it after an iteration, or asks it to print, changes nothing (the options are nhdyn's).
+TEST_F(OptimizeCli, AnIpoptOptionsFileInTheWorkingDirectoryIsNotRead) {
+  write("ipopt.opt", "max_iter 1\nprint_level 5\n");
+  const Outcome run = optimize(example("sled_heading_optimal.toml") + " -o sled.csv");
+  SKIP_WITHOUT_IPOPT(run);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("status: solved"), std::string::npos) << run.out;
+  EXPECT_EQ(run.out.find("This is Ipopt"), std::string::npos) << run.out;
+  EXPECT_GT(summary_value(run.out, "iterations"), 1.0) << run.out;
+}
+
 TEST_F(OptimizeCli, DoubleIntegratorTrapezoidalMeetsItsDiscreteClosedForm) {
   // J_N = 12 d^2/T^3 N^3/((N - 1)(N^2 + N - 3)) (section 10.1): no other discretization meets it;
   // its error against 12 d^2/T^3 falls with order 2.

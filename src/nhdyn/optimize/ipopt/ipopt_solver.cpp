@@ -108,8 +108,15 @@ NlpResult solve(Nlp& nlp, const NlpOptions& options) {
   app->Options()->SetIntegerValue("max_iter", options.max_iterations);
   app->Options()->SetNumericValue("nlp_lower_bound_inf", -0.5 * kNlpInfinity);
   app->Options()->SetNumericValue("nlp_upper_bound_inf", 0.5 * kNlpInfinity);
+  // MUMPS's permutation to a heavy diagonal (its maximum weighted matching, ICNTL(6)) grew faster
+  // than the collocation's KKT matrix: 2.8x and 4.3x its time as the nodes doubled from 501 to
+  // 2001, most of the analysis; without it the analysis and the factorizations grow linearly
+  // (docs/performance.md, "The figures"). The scaling (ICNTL(8)) stays.
+  app->Options()->SetIntegerValue("mumps_permuting_scaling", 0);
   NlpResult result;
-  if (app->Initialize() != Ipopt::Solve_Succeeded) {
+  // No options file: the options are the ones above, whatever the working directory holds (an
+  // ipopt.opt there would change the results silently).
+  if (app->Initialize("") != Ipopt::Solve_Succeeded) {
     result.status = NlpStatus::failed;
     result.message = "IPOPT could not be initialized";
     return result;
