@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "nhdyn/formulation/detail/row_scaling.hpp"
+#include "nhdyn/formulation/sanh.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {
@@ -116,6 +117,54 @@ void scale_rows(ContactModeData& w) {
       });
 }
 
+// (S4) with D the last n - r columns of the orthogonal factor of B~^T (D B~^T = 0), the kept rows
+// in w.reaction_rows: q'' and R. With no row kept (a free body and nothing else) D is the
+// identity: A q'' = Q + G.
+Status mode_acceleration(const Model& model, Data& data, int r) {
+  const ContactModeModel& cm = *model.contact_modes;
+  ContactModeData& w = data.modes;
+  const int n = model.n();
+  const int k = n - r;
+  data.Q_full.resize(n, n);
+  data.hh_work.resize(n);
+  if (r == 0) data.Q_full.setIdentity();
+  else w.qr.compute(w.reaction_rows);
+  if (r > 0 && w.qr.rank() < r) {
+    for (std::size_t i = 0; i < cm.contacts.size(); ++i)
+      if (w.mode[i] == ContactMode::sliding)
+        return fail(data, cm, static_cast<int>(i),
+                    "the reaction directions of the sliding contact are dependent (its friction direction lies in "
+                    "the span of the other constraints)");
+    return record_failure(data, Status::dependent_constraints, "b");
+  }
+  if (r > 0) w.qr.householderQ().evalTo(data.Q_full, data.hh_work);
+  w.M.topRows(k).noalias() = data.Q_full.rightCols(k).transpose() * data.A;
+  w.rhs.head(k).noalias() = data.Q_full.rightCols(k).transpose() * (data.Q + data.G);
+  for (int j = 0; j < r; ++j) {
+    const int row = w.kept[static_cast<std::size_t>(j)];
+    w.M.row(k + j) = data.b.row(row);
+    w.rhs(k + j) = -data.b0(row);
+  }
+  scale_rows(w);
+  w.lu.compute(w.M);
+  const double rcond = w.lu.rcond();
+  if (!(rcond > 1e-14)) {
+    for (std::size_t i = 0; i < cm.contacts.size(); ++i)
+      if (w.mode[i] == ContactMode::sliding)
+        return fail(data, cm, static_cast<int>(i),
+                    fmt::format("the equations of its sliding are singular (Painleve's paradox: with mu_k = {:.6g} "
+                                "its normal force no longer decides its normal acceleration, "
+                                "docs/contact-modes.md); lower the friction coefficient",
+                                w.mu_k[i]));
+    return record_failure(data, Status::singular_system, "stacked matrix [D A; b] of the contact modes");
+  }
+  data.qdd = w.lu.solve(w.rhs);
+  data.R.noalias() = data.A * data.qdd;
+  data.R -= data.Q;
+  data.R -= data.G;
+  return Status::ok;
+}
+
 }  // namespace
 
 Status compute_mode_acceleration(const Model& model, Data& data) {
@@ -162,46 +211,19 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
           (w.mu_k[i] * w.sliding_direction[i][a] / lengths[i][a]) * data.b.row(c.roll[a]).transpose();
   }
 
-  // D: the last n - r columns of the orthogonal factor of B~^T (D B~^T = 0), then (S4). With no
-  // row kept (a free body and nothing else) D is the identity: A q'' = Q + G.
+  // Every contact rolling: the ordinary Do Sanh form with D from b (sanh.hpp), as cheap as the
+  // model without modes; B~ = b, whose QR below gives only the multipliers.
   const int k = n - r;
-  data.Q_full.resize(n, n);
-  data.hh_work.resize(n);
-  if (r == 0) data.Q_full.setIdentity();
-  else w.qr.compute(w.reaction_rows);
-  if (r > 0 && w.qr.rank() < r) {
-    for (std::size_t i = 0; i < cm.contacts.size(); ++i)
-      if (w.mode[i] == ContactMode::sliding)
-        return fail(data, cm, static_cast<int>(i),
-                    "the reaction directions of the sliding contact are dependent (its friction direction lies in "
-                    "the span of the other constraints)");
-    return record_failure(data, Status::dependent_constraints, "b");
+  const bool rolling = std::all_of(w.mode.begin(), w.mode.end(), [](ContactMode m) { return m == ContactMode::rolling; });
+  if (rolling && r > 0) {
+    const Status status = compute_sanh_acceleration(model, data, Complement::qr);
+    if (status != Status::ok) return status;
+    w.qr.compute(w.reaction_rows);
+    if (w.qr.rank() < r) return record_failure(data, Status::dependent_constraints, "b");
+  } else {
+    const Status status = mode_acceleration(model, data, r);
+    if (status != Status::ok) return status;
   }
-  if (r > 0) w.qr.householderQ().evalTo(data.Q_full, data.hh_work);
-  w.M.topRows(k).noalias() = data.Q_full.rightCols(k).transpose() * data.A;
-  w.rhs.head(k).noalias() = data.Q_full.rightCols(k).transpose() * (data.Q + data.G);
-  for (int j = 0; j < r; ++j) {
-    const int row = w.kept[static_cast<std::size_t>(j)];
-    w.M.row(k + j) = data.b.row(row);
-    w.rhs(k + j) = -data.b0(row);
-  }
-  scale_rows(w);
-  w.lu.compute(w.M);
-  const double rcond = w.lu.rcond();
-  if (!(rcond > 1e-14)) {
-    for (std::size_t i = 0; i < cm.contacts.size(); ++i)
-      if (w.mode[i] == ContactMode::sliding)
-        return fail(data, cm, static_cast<int>(i),
-                    fmt::format("the equations of its sliding are singular (Painleve's paradox: with mu_k = {:.6g} "
-                                "its normal force no longer decides its normal acceleration, "
-                                "docs/contact-modes.md); lower the friction coefficient",
-                                w.mu_k[i]));
-    return record_failure(data, Status::singular_system, "stacked matrix [D A; b] of the contact modes");
-  }
-  data.qdd = w.lu.solve(w.rhs);
-  data.R.noalias() = data.A * data.qdd;
-  data.R -= data.Q;
-  data.R -= data.G;
 
   // The multipliers, R = B~^T lambda (least squares through the same QR): N and F_t.
   if (r > 0) {
@@ -235,6 +257,7 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
     }
   }
   data.power_friction = w.power_friction;
+  std::copy(w.mode.begin(), w.mode.end(), w.solved.begin());
   return Status::ok;
 }
 

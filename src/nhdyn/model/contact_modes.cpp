@@ -28,6 +28,7 @@ ContactModeData make_contact_mode_data(const Model& model) {
   w.outputs.assign(static_cast<std::size_t>(w.tape.outputs()), 0.0);
   const std::size_t m = c.contacts.size();
   w.mode.assign(m, ContactMode::rolling);
+  w.solved.assign(m, ContactMode::free);
   w.direction.assign(m, {1.0, 0.0});
   w.mu_s.assign(m, 0.0);
   w.mu_k.assign(m, 0.0);

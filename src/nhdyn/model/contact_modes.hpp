@@ -67,6 +67,7 @@ struct ContactModeData {
   Tape tape;                    // ContactModeModel::tape bound to the parameter values
   std::vector<double> registers, outputs;
   std::vector<ContactMode> mode;   // per contact
+  std::vector<ContactMode> solved;  // the modes of the last compute_mode_acceleration that succeeded
   // Per contact, the slip direction carried through the sliding mode (unit, in the basis of the
   // unit tangents): e_s = s / |s| oriented like it, and the friction's direction where |s| is at
   // round-off (docs/derivations/contact-modes.md sections 5 and 6). Set at every switch into

@@ -140,10 +140,19 @@ Status ContactSwitches::evaluate(double t, const double* y, double* g) {
     if (status != Status::ok) return status;
   }
   const int n = model_.n();
-  const Status status = compute_dynamics(model_, data_, formulation_, t, y, y + n);
-  if (status != Status::ok) return status;
   const ContactModeModel& cm = *model_.contact_modes;
   ContactModeData& w = data_.modes;
+  // The integrator's last right-hand side is often this very state (the first stage of the next
+  // step, FSAL): solved in the same modes, every value below is already there. Only while every
+  // contact rolls, whose solve depends on the state alone (a sliding one also on its carried
+  // direction).
+  const bool rolling = std::all_of(w.mode.begin(), w.mode.end(), [](ContactMode m) { return m == ContactMode::rolling; });
+  const bool solved = rolling && data_.stage >= Stage::acceleration && w.solved == w.mode && data_.t == t &&
+                      std::equal(y, y + n, data_.q.data()) && std::equal(y + n, y + 2 * n, data_.v.data());
+  if (!solved) {
+    const Status status = compute_dynamics(model_, data_, formulation_, t, y, y + n);
+    if (status != Status::ok) return status;
+  }
   const bool any_free = std::find(w.mode.begin(), w.mode.end(), ContactMode::free) != w.mode.end();
   if (any_free) model_.evaluator->position_residual(t, y, data_.scratch.data(), data_.phi.data());
   for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
