@@ -271,6 +271,68 @@ TEST(RollingSurface, EllipsoidInAnEllipsoidalBowlKeepsItsEnergyAndItsContact) {
   EXPECT_LT(summary.energy.drift, 1e-10);
 }
 
+// The same bowl written at other scales, 1e4 g and 1e-6 g, and as a function with a root where
+// the ball never goes (not a polynomial): the same motion. The rows that hold the contact point
+// are in length units whatever g's scale (rolling-bodies.md section 11).
+TEST(RollingSurface, TheScaleAndTheFormOfGDoNotChangeTheMotion) {
+  const std::string base = text_of("ball_in_paraboloid.toml");
+  const std::string written = R"x(surface = "X^2/(2*rho1) + Y^2/(2*rho2) - Z")x";
+  SimulationOptions options;
+  options.t_end = 2.0;
+  options.output_step = 0.05;
+  options.integrator.rtol = 1e-11;
+  options.integrator.atol = 1e-13;
+  const Model reference = load_model(example("ball_in_paraboloid.toml"));
+  const auto a = surface_rows(reference, options);
+  for (const std::string& g : std::vector<std::string>{R"x(surface = "1e4*(X^2/(2*rho1) + Y^2/(2*rho2) - Z)")x",
+                                                       R"x(surface = "1e-6*(X^2/(2*rho1) + Y^2/(2*rho2) - Z)")x",
+                                                       R"x(surface = "(X^2/(2*rho1) + Y^2/(2*rho2) - Z)*sqrt(4 + X^2)")x"}) {
+    std::string text = base;
+    replace_once(text, written, g);
+    const Model model = load_model_text(text);
+    const auto b = surface_rows(model, options);
+    EXPECT_LT(largest_difference(reference, a, model, b, {"x", "y", "z", "a", "b", "c", "ball_N"}), 1e-9) << g;
+  }
+}
+
+// A ball rolling at the start, told to start sliding, on the plane written as a surface: no
+// direction of sliding is defined (rolling needs no friction), as on the plane itself.
+TEST(RollingSurface, StartingToSlideWhereRollingNeedsNoFrictionIsRefused) {
+  std::string text = text_of("ball_in_paraboloid.toml");
+  replace_once(text, R"(ground = { surface = "X^2/(2*rho1) + Y^2/(2*rho2) - Z", side = "inside" })",
+               "ground = { surface = \"Z\", side = \"outside\" }\nfriction = 0.3\nmode = \"sliding\"");
+  const Model model = load_model_text(text);
+  SimulationOptions options;
+  options.t_end = 0.5;
+  const std::string m = surface_error([&] { simulate(model, options, [](const Data&) {}); });
+  EXPECT_NE(m.find("no direction of sliding is defined"), std::string::npos) << m;
+}
+
+// A ball climbing an ellipsoidal bowl's wall to where its normal is horizontal along x, the axis
+// the rolling rows' directions are built from: the run ends there with the reason, not with a
+// ball falling through the bowl.
+TEST(RollingSurface, ANormalAlongTheTangentsAxisEndsTheRun) {
+  std::string text = text_of("ball_in_paraboloid.toml");
+  replace_once(text, R"(ground = { surface = "X^2/(2*rho1) + Y^2/(2*rho2) - Z", side = "inside" })",
+               R"(ground = { surface = "X^2/0.09 + Y^2/0.04 + (Z - 0.15)^2/0.0225 - 1", side = "inside" })");
+  // Rolling along x turns the ball about y without end: y first, so that its angles stay regular.
+  replace_once(text, R"(rotations = [["x", "a"], ["y", "b"], ["z", "c"]])", R"(rotations = [["y", "b"], ["x", "a"], ["z", "c"]])");
+  replace_once(text, R"(vx = { value = 0.08)", R"(vx = { value = 3.0)");
+  replace_once(text, R"(vy = { value = 0.05)", R"(vy = { value = 0.0)");
+  const Model model = load_model_text(text);
+  SimulationOptions options;
+  options.t_end = 1.0;
+  options.output_step = 0.01;
+  double last = 0.0;
+  const SimulationSummary summary = simulate(model, options, [&](const Data& data) { last = data.t; });
+  EXPECT_NE(summary.status, Status::ok);
+  EXPECT_NE(summary.message.find("the ground's normal turns along the world's x axis"), std::string::npos)
+      << summary.message;
+  EXPECT_NE(summary.message.find("1 - (e . n)^2 = "), std::string::npos) << summary.message;
+  EXPECT_GT(last, 0.05);
+  EXPECT_LT(last, 0.2);
+}
+
 // Refusals, each naming the file's line and what to do.
 TEST(RollingSurface, BadSurfacesAreRefusedByName) {
   const std::string base = text_of("ball_in_paraboloid.toml");

@@ -48,9 +48,8 @@ std::string singular_contact_message(const Model& model, double t, const double*
     double value = 0.0;
     measure.run(t, q, v, registers.data(), &value);
     if (value >= w.threshold) continue;
-    return fmt::format("{}contact '{}': {} (1 - (axle . normal)^2 = {:.3g}) at t = {:.6g}, where {}; the run stops "
-                       "there",
-                       w.where.empty() ? "" : w.where + ": ", w.contact, w.reason, value, t,
+    return fmt::format("{}contact '{}': {} ({} = {:.3g}) at t = {:.6g}, where {}; the run stops there",
+                       w.where.empty() ? "" : w.where + ": ", w.contact, w.reason, w.quantity, value, t,
                        describe_state(model, q, v));
   }
   return "";
@@ -81,7 +80,16 @@ class MechanicalOde final : public OdeSystem {
   MechanicalOde(const Model& model, Data& data, const FormulationOptions& options, const SimulationOptions& run,
                 SimulationSummary& summary, ConstraintWatch* watch)
       : model_(model), data_(data), options_(options), run_(run), summary_(summary), watch_(watch), n_(model.n()),
-        balance_(model.evaluator->has_energy_balance()), friction_(balance_ && model.contact_modes != nullptr) {}
+        balance_(model.evaluator->has_energy_balance()), friction_(balance_ && model.contact_modes != nullptr) {
+    std::vector<double> values;
+    for (const Parameter& p : model.parameters) values.push_back(p.value);
+    for (const ContactWatch& w : model.contact_watches)
+      if (w.every_step) {
+        singular_.push_back({w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure,
+                             w.threshold});
+        registers_.resize(std::max(registers_.size(), static_cast<std::size_t>(singular_.back().first.registers())));
+      }
+  }
 
   // The works: of the forces, the reactions, the explicit time dependence, and with contact modes
   // the friction's and the impacts' loss (model/contact_modes.hpp; the loss changes only at
@@ -109,6 +117,19 @@ class MechanicalOde final : public OdeSystem {
   static constexpr int kWorks = 3;
 
   StepEnd after_step(double t, double* y) override {
+    // A contact whose equations stay regular where it is not defined (a surface's tangents
+    // vanishing): ended at the step that reaches it, with the state for the message
+    // (singular_contact_message).
+    for (const auto& [measure, threshold] : singular_) {
+      double value = 0.0;
+      measure.run(t, y, y + n_, registers_.data(), &value);
+      if (value < threshold) {
+        data_.t = t;
+        std::memcpy(data_.q.data(), y, sizeof(double) * static_cast<std::size_t>(n_));
+        std::memcpy(data_.v.data(), y + n_, sizeof(double) * static_cast<std::size_t>(n_));
+        return {Status::singular_system, false};
+      }
+    }
     // The watch reads the terms Data holds, when they are those of the step's end (the last stage
     // of dopri5, evaluated there); b depends on t, q and, for constraints nonlinear in the
     // velocities, q'.
@@ -133,6 +154,8 @@ class MechanicalOde final : public OdeSystem {
   ConstraintWatch* watch_;  // null when the run does not watch
   int n_;
   bool balance_;
+  std::vector<std::pair<Tape, double>> singular_;  // the contact watches checked at every step, bound
+  std::vector<double> registers_;
   bool friction_;
 };
 

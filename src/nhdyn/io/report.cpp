@@ -495,6 +495,45 @@ double line_zero(Field& g, const Point& p, const Point& m, double range) {
   return std::nan("");
 }
 
+SceneMesh patch_mesh(Field& g, const symbolic::VisualShape& shape, const std::string& model,
+                     const std::vector<Point>& path, double length);
+
+// A fixed surface that is not a sphere: along rays from a point K where g < 0 (inside a bowl, or
+// inside the solid a hill is the top of), K below the mean of the contact's path along the
+// surface's normal by the path's extent (halved until g(K) < 0): from a point inside a convex
+// region every ray meets its boundary once, so that the cap covers the whole path, up a bowl's
+// wall too. Where that fails, over the tangent plane (patch_mesh).
+SceneMesh ground_mesh(Field& g, const symbolic::VisualShape& shape, const std::string& model,
+                      const std::vector<Point>& path, double length) {
+  if (path.empty()) return {};
+  Point mean = {0.0, 0.0, 0.0};
+  for (const Point& p : path)
+    for (std::size_t k = 0; k < 3; ++k) mean[k] += p[k] / static_cast<double>(path.size());
+  const double h = 1e-6 * std::max({1.0, std::abs(mean[0]), std::abs(mean[1]), std::abs(mean[2])});
+  Point m;
+  for (std::size_t k = 0; k < 3; ++k) {
+    Point a = mean, b = mean;
+    a[k] += h;
+    b[k] -= h;
+    m[k] = (g(a[0], a[1], a[2]) - g(b[0], b[1], b[2])) / (2 * h);
+  }
+  const double norm = std::hypot(m[0], m[1], m[2]);
+  double reach = 0.0;
+  for (const Point& p : path) reach = std::max(reach, std::hypot(p[0] - mean[0], p[1] - mean[1], p[2] - mean[2]));
+  double depth = std::max(reach, 4.0 * std::abs(length));
+  if (norm > 0.0 && std::isfinite(norm) && depth > 0.0 && std::isfinite(depth))
+    for (int attempt = 0; attempt < 30; ++attempt, depth /= 2) {
+      const Point K = {mean[0] - depth * m[0] / norm, mean[1] - depth * m[1] / norm, mean[2] - depth * m[2] / norm};
+      if (!(g(K[0], K[1], K[2]) < 0.0)) continue;
+      try {
+        return surface_mesh(g, shape, model, path, length, K);
+      } catch (const InputError&) {
+        break;
+      }
+    }
+  return patch_mesh(g, shape, model, path, length);
+}
+
 // A fixed surface that is not a sphere: its zero set over the tangent plane at the mean point of
 // the contact's path, the zero of g nearest each point of a square grid in that plane along the
 // plane's normal. The square holds the path and the margin; where a line meets no zero (the
@@ -553,7 +592,8 @@ SceneMesh patch_mesh(Field& g, const symbolic::VisualShape& shape, const std::st
 }  // namespace
 
 std::vector<SceneMesh> calc_scene_meshes(const symbolic::VisualScene& scene, const std::vector<Parameter>& parameters,
-                                         const std::vector<double>& values, std::size_t stride, const std::string& model) {
+                                         const std::vector<double>& values, std::size_t stride, const std::string& model,
+                                         std::vector<std::string>* notes) {
   const std::vector<double> parameter_values = parameter_values_for(scene, parameters, model);
   const Tape sizes = scene.sizes.bind(parameter_values.data(), parameter_values.size());
   std::vector<double> registers(static_cast<std::size_t>(sizes.registers()));
@@ -589,7 +629,16 @@ std::vector<SceneMesh> calc_scene_meshes(const symbolic::VisualScene& scene, con
     const double length = length_of(shape, x[0]);
     if (shape.kind == symbolic::VisualKind::terrain) out[s] = terrain_mesh(field, shape_path(shape, values, stride), length);
     else if (x[4] != 0.0) out[s] = surface_mesh(field, shape, model, shape_path(shape, values, stride), length, {x[1], x[2], x[3]});
-    else out[s] = patch_mesh(field, shape, model, shape_path(shape, values, stride), length);
+    else {
+      // A ground the report cannot sample is left undrawn, said in the page's note: the run and
+      // its other shapes stand.
+      try {
+        out[s] = ground_mesh(field, shape, model, shape_path(shape, values, stride), length);
+      } catch (const InputError& e) {
+        if (notes != nullptr)
+          notes->push_back(fmt::format("The ground of contact '{}' is not drawn: {}.", shape.name, e.what()));
+      }
+    }
   }
   return out;
 }
@@ -837,7 +886,8 @@ void turn_plane(double* R, double angle) {
 
 // The scene of a model with shapes: each shape's kind, size and place at every frame drawn (a
 // body along its principal axes, a turntable turned through its angle).
-void append_scene_shapes(std::string& data, const ReportInput& input, const FrameColumns& column) {
+void append_scene_shapes(std::string& data, const ReportInput& input, const FrameColumns& column,
+                         std::vector<std::string>& notes) {
   const CsvTable& table = column.table;
   const std::vector<std::size_t>& frames = column.frames;
   const symbolic::VisualScene& scene = *input.scene;
@@ -888,7 +938,8 @@ void append_scene_shapes(std::string& data, const ReportInput& input, const Fram
       if (!angles[s].empty()) turn_plane(outputs.data() + scene.shapes[s].offset + 3, angles[s][frame]);
     values.insert(values.end(), outputs.begin(), outputs.end());
   }
-  const std::vector<SceneMesh> meshes = calc_scene_meshes(scene, input.parameters, values, outputs.size(), input.model);
+  const std::vector<SceneMesh> meshes =
+      calc_scene_meshes(scene, input.parameters, values, outputs.size(), input.model, &notes);
   data += fmt::format("\"planar\":{},\"ground\":{},\"stride\":{},\"shapes\":[", scene.planar, scene.ground,
                       outputs.size());
   for (std::size_t s = 0; s < scene.shapes.size(); ++s) {
@@ -1013,9 +1064,11 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
   std::string note;
   const bool has_shapes = input.scene != nullptr && !input.scene->shapes.empty();
   data += ",\"scene\":{";
-  if (has_shapes)
-    append_scene_shapes(data, input, column);
-  else
+  if (has_shapes) {
+    std::vector<std::string> notes;
+    append_scene_shapes(data, input, column, notes);
+    note = fmt::format("{}", fmt::join(notes, " "));
+  } else
     note = append_scene_path(data, input, column);
   data += '}';
   if (frames.size() < table.rows.size())

@@ -133,16 +133,19 @@ std::vector<SceneSize> calc_scene_sizes(const symbolic::VisualScene& scene, cons
 // by the shape's reach along each axis; a terrain's height h(X, Y) at the
 // nodes of a grid of 49 x 49 (at most) over the region its contact point covers, widened by a
 // margin (a third of the region's width, at least four lengths of the shape); a surface's zero
-// set g = 0 along rays from the point inside it, over the cap that the contact point's
-// directions from there cover, widened by the same margin. Empty for the other kinds. Throws
-// InputError naming the contact when a solid's f is not negative at its centre or a ray meets no
-// zero of f or g.
+// set g = 0 along rays from the point inside it (a sphere's centre; for any other surface a
+// point where g < 0 below the mean of the contact's path along its normal), over the cap that
+// the contact point's directions from there cover, widened by the same margin, or else over its
+// tangent plane there. Empty for the other kinds, and for a surface that none of these draws
+// (then `notes`, when given, gets a sentence that says so). Throws InputError naming the contact
+// when a solid's f is not negative at its centre or a ray meets no zero of f or of a sphere's g.
 struct SceneMesh {
   std::vector<double> vertices;  // x, y, z per vertex (solid: the frame's axes; terrain, surface: world)
   std::vector<int> triangles;    // three vertex indices each, two per cell of the grid
   int rows = 0;                  // the vertices are a grid of `rows` rows, row-major (lines drawn along it)
 };
 std::vector<SceneMesh> calc_scene_meshes(const symbolic::VisualScene& scene, const std::vector<Parameter>& parameters,
-                                         const std::vector<double>& values, std::size_t stride, const std::string& model);
+                                         const std::vector<double>& values, std::size_t stride, const std::string& model,
+                                         std::vector<std::string>* notes = nullptr);
 
 }  // namespace nhdyn

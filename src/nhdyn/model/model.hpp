@@ -92,6 +92,8 @@ struct ContactWatch {
   Tape measure;
   double threshold = 0.0;
   std::string reason;
+  std::string quantity;     // what the measure is, for the message
+  bool every_step = false;  // checked at every accepted step (symbolic/spec.hpp, SpecContactWatch)
 };
 
 struct Model {

@@ -763,7 +763,7 @@ void MultibodyBuilder::add_contact(const Helper& h) {
   }
   if (contact.convexity) builder_.convexity(std::move(*contact.convexity));
   if (contact.added) builder_.contact_coordinates(std::move(*contact.added));
-  if (contact.watch) builder_.contact_watch(std::move(*contact.watch));
+  for (SpecContactWatch& watch : contact.watches) builder_.contact_watch(std::move(watch));
   contact.force.system = system_of(body.frame);
   contacts_.push_back(std::move(contact.force));
   if (h.mode) {

@@ -260,6 +260,31 @@ class PlaneGround final : public ContactGround {
   }
 };
 
+// |grad g| at the shape's centre where the run starts (the file's initial values and parameters),
+// g's scale as a number: 1 where that is not a positive number (a start written nowhere).
+double gradient_scale(const Vector3& gradient, const Vector3& U, const Vector3& C, const Spec& spec) {
+  try {
+    GiNaC::exmap at;
+    for (const GiNaC::ex& p : spec.parameter_values()) at[p.op(0)] = p.op(1);
+    at[spec.symbols.time()] = GiNaC::numeric(spec.t0);
+    for (std::size_t i = 0; i < spec.q0.size() && i < spec.coordinates.size(); ++i)
+      at[spec.symbols.coordinate(static_cast<int>(i))] = spec.q0[i];
+    GiNaC::exmap on = at;
+    for (std::size_t i = 0; i < 3; ++i) on[U[i]] = C[i].subs(at, GiNaC::subs_options::no_pattern).subs(at);
+    double sum = 0.0;
+    for (const GiNaC::ex& d : gradient) {
+      const GiNaC::ex v = d.subs(on, GiNaC::subs_options::no_pattern).subs(at).evalf();
+      if (!GiNaC::is_a<GiNaC::numeric>(v) || !GiNaC::ex_to<GiNaC::numeric>(v).is_real()) return 1.0;
+      const double x = GiNaC::ex_to<GiNaC::numeric>(v).to_double();
+      sum += x * x;
+    }
+    const double size = std::sqrt(sum);
+    return std::isfinite(size) && size > 0.0 ? size : 1.0;
+  } catch (const std::exception&) {
+    return 1.0;
+  }
+}
+
 // A fixed smooth surface g(X, Y, Z) = 0, the body on the side `side` names. A ball on a sphere
 // (g a quadratic whose Hessian is a nonzero multiple of the identity) has its contact point in
 // closed form (rolling-bodies.md section 3); any other shape or surface, or a ball on a sphere
@@ -368,6 +393,7 @@ class SurfaceGround final : public ContactGround {
   static bool sphere(const GiNaC::ex& g, const GroundText& text, const ContactParsers& p, const std::string& context,
                      const std::string& side, ParsedGround& out) {
     const GiNaC::ex X = out.variables[0], Y = out.variables[1], Z = out.variables[2];
+    if (!g.is_polynomial(GiNaC::lst{X, Y, Z})) return false;
     const GiNaC::ex alpha = g.coeff(X, 2);
     bool quadric = g.degree(X) == 2 && g.degree(Y) == 2 && g.degree(Z) == 2 &&
                    symbolic::is_zero(g.coeff(Y, 2) - alpha) && symbolic::is_zero(g.coeff(Z, 2) - alpha) &&
@@ -412,10 +438,21 @@ class SurfaceGround final : public ContactGround {
     const GiNaC::ex length = GiNaC::sqrt(dot(gradient, gradient));
     const int sigma = c.ground.inside ? -1 : 1;
     out.normal = scale(sigma / length, gradient);
-    const Vector3 e = unit(contact_least_aligned_axis(gravity ? *gravity : unit(2), spec));
-    out.tangent1 = cross(e, gradient);
-    out.tangent2 = cross(gradient, out.tangent1);
+    // Divided by g's scale (a number), so that the rows are about as large as lengths whatever
+    // the scale of g, without a root of |grad g| in the expressions that are differentiated twice.
     const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
+    const double size = gradient_scale(gradient, U, C, spec);
+    const int axis = contact_least_aligned_axis(gravity ? *gravity : unit(2), spec);
+    const Vector3 e = unit(axis);
+    out.tangent1 = scale(1 / GiNaC::numeric(size), cross(e, gradient));
+    out.tangent2 = scale(1 / GiNaC::numeric(size), cross(gradient, out.tangent1));
+    out.singular = std::make_pair(
+        dot(cross(e, gradient), cross(e, gradient)) / dot(gradient, gradient),
+        fmt::format("the ground's normal turns along the world's {} axis, where the two directions of its rolling rows "
+                    "(e x grad g and grad g x (e x grad g), e that axis) vanish; a bowl's wall or a hill's side steeper "
+                    "than that is not offered: keep the motion away from it, or turn the model so that gravity is "
+                    "along another axis",
+                    "xyz"[axis]));
     Vector3 body_point;
     GiNaC::ex reach;
     if (const std::optional<GiNaC::ex> r = c.shape->ball_radius(c.values)) {
@@ -433,7 +470,9 @@ class SurfaceGround final : public ContactGround {
     }
     out.gap = dot(out.normal, subtract(C, U)) - reach;
     const Vector3 apart = subtract(body_point, U);
-    out.locate = {{"_ground", c.ground.surface}, {"_at1", dot(out.tangent1, apart)}, {"_at2", dot(out.tangent2, apart)}};
+    // g over its scale: about U's distance from the surface, in length units whatever g's scale.
+    out.locate = {{"_ground", c.ground.surface / GiNaC::numeric(size)}, {"_at1", dot(out.tangent1, apart)},
+                  {"_at2", dot(out.tangent2, apart)}};
     // The ground rises along n by 1/2 w^T K w, K = -sigma H / |grad g| (a hollow where positive).
     for (unsigned i = 0; i < 3; ++i)
       for (unsigned j = 0; j < 3; ++j)
@@ -835,7 +874,10 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
   // 1 - (e . nu)^2 below 1e-4: the axle within 0.6 degree of the normal (rolling-bodies.md section 2).
   if (const std::optional<ContactShape::Singularity> singular =
           c.shape->singularity(c.values, multiply_transposed(F.rotation, touch.normal)))
-    out.watch = SpecContactWatch{c.name, c.where, singular->measure, 1e-4, singular->reason};
+    out.watches.push_back(SpecContactWatch{c.name, c.where, singular->measure, 1e-4, singular->reason});
+  if (touch.singular)
+    out.watches.push_back(
+        SpecContactWatch{c.name, c.where, touch.singular->first, 1e-4, touch.singular->second, "1 - (e . n)^2", true});
   if (c.ground.added || c.values.added) out.added = added_coordinates(c, F, touch);
   out.force = contact_force_point(c, F, touch, vP);
   return out;

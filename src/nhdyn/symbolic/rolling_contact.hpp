@@ -129,8 +129,9 @@ struct RollingContact {
   std::optional<SpecConvexity> convexity;  // an implicit shape: checked at the initial state
   // The contact point's coordinates that nhdyn added (no `coordinates` key): found at the start.
   std::optional<SpecContactCoordinates> added;
-  // A closed form that turns singular along the motion (a disk lying flat): watched by the run.
-  std::optional<SpecContactWatch> watch;
+  // What turns singular along the motion (a disk lying flat, a surface's normal along the axis its
+  // tangents are built from): watched by the run.
+  std::vector<SpecContactWatch> watches;
 };
 
 // A ground type: its key, the further keys of its table, and where a shape touches it.
@@ -161,6 +162,9 @@ class ContactGround {
     std::vector<std::pair<std::string, GiNaC::ex>> locate;
     // The ground's curvature along the normal, world axes (SpecConvexity::ground); zero for a plane.
     GiNaC::matrix curvature = GiNaC::matrix(3, 3);
+    // Where the tangents vanish along the motion: a measure positive where they are defined and
+    // the reason for the message that ends a run where it falls below 1e-4 (none when they never do).
+    std::optional<std::pair<GiNaC::ex, std::string>> singular;
   };
   virtual Touch touch(const ParsedContact& contact, const PlacedFrame& frame, const Spec& spec,
                       const std::optional<Vector3>& gravity, const std::string& context) const = 0;

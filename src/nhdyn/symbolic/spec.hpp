@@ -163,6 +163,10 @@ struct SpecContactWatch {
   GiNaC::ex measure;
   double threshold = 0.0;
   std::string reason;
+  std::string quantity = "1 - (axle . normal)^2";  // what the measure is, in the message
+  // Checked at every accepted step, ending the run there (exit 1), rather than only where a run
+  // fails: for a singularity that does not make the equations fail (a surface's tangents vanish).
+  bool every_step = false;
 };
 
 struct Spec {

@@ -89,7 +89,9 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
     if (mode == ContactMode::sliding) {
       if (slip > floor) {
         w.direction[i] = {rolling.slip[i][0] / slip, rolling.slip[i][1] / slip};
-      } else if (norm2(rolling.friction[i]) > 0.0) {
+      } else if (norm2(rolling.friction[i]) > 1e-12 * std::abs(rolling.normal_force[i])) {
+        // (Friction at round-off relative to N, as a contact whose point is held by coordinates
+        // gives where rolling needs none, defines no direction either.)
         w.direction[i] = onset_direction(rolling, i);
       } else {
         throw ModelError(fmt::format("{}: contact '{}' is given mode = \"sliding\", but at t0 it does not slip and "
