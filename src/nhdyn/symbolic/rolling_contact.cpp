@@ -1009,7 +1009,8 @@ Eigen::Vector3d ground_start(const Spec& spec, const SpecContactCoordinates& add
   if (!C.allFinite() || !std::isfinite(F))
     throw_model_error(added.where, context,
                       "cannot find the contact point on the ground at the start: the shape's centre or the surface "
-                      "g there is not a finite number; check the initial state");
+                      "g there is not a finite number; check the initial state and the parameters g uses (a "
+                      "division by zero, a root of a negative number)");
   if (F == 0.0) return C;
   // A centre on the other side (its height not yet written: --fix-initial moves it afterwards)
   // looks for the ground the other way.
