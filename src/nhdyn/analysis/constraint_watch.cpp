@@ -121,9 +121,11 @@ ConstraintWatch make_constraint_watch(const Model& model, const Data& data, std:
   watch.warnings.reserve(static_cast<std::size_t>(s) + 1);
   watch.conditioning = !data.sparse && s > 0;
   if (watch.conditioning) {
-    // D is there, k x n, for the formulations that solve with it (sanh, nullspace).
+    // D is there, k x n, for the formulations that solve with it (sanh, nullspace). Not with
+    // contact modes: the rows their solve keeps change with the modes, and D is the ordinary
+    // form's only while every contact rolls (formulation/contact_modes.hpp); b alone is watched.
     watch.stacked = method && (*method == Formulation::sanh || *method == Formulation::nullspace) && data.D.rows() == k &&
-                    data.D.cols() == n;
+                    data.D.cols() == n && !data.modes.active;
     const int watched = watch.stacked ? n : s;
     watch.rows = Matrix::Zero(watched, n);
     watch.rows_t = Matrix::Zero(n, watched);
