@@ -355,6 +355,12 @@ TEST(RollingSurface, BadSurfacesAreRefusedByName) {
   EXPECT_NE(m.find("needs the 3 coordinates"), std::string::npos) << m;
   m = surface_error([&] { load_model_text(with(R"(ground = { surface = "X^2 - Z" })")); });
   EXPECT_NE(m.find("needs side"), std::string::npos) << m;
+  // An empty list of coordinates is not the key left out (which would add them).
+  m = surface_error([&] {
+    load_model_text(with(R"(ground = { surface = "X^2 - Z", side = "inside", coordinates = [] })"));
+  });
+  EXPECT_NE(m.find("ground.coordinates = [] is empty"), std::string::npos) << m;
+  EXPECT_NE(m.find("contact 'ball'"), std::string::npos) << m;
   // A ball flatter than the hollow it starts in: the contact would not be unique.
   m = surface_error([&] { load_model(example("ball_in_paraboloid.toml"), {{"r", 0.6}}); });
   EXPECT_NE(m.find("flatter than the hollow"), std::string::npos) << m;

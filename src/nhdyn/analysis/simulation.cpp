@@ -98,7 +98,10 @@ class MechanicalOde final : public OdeSystem {
   int error_size() const override { return 2 * n_; }
 
   Status rhs(double t, const double* y, double* ydot) override {
+    // The stages want q'' alone: contact values wait for the switches and rows that read them.
+    data_.modes.defer_forces = true;
     const Status status = compute_dynamics(model_, data_, options_, t, y, y + n_);
+    data_.modes.defer_forces = false;
     if (status != Status::ok) return status;
     std::memcpy(ydot, y + n_, sizeof(double) * static_cast<std::size_t>(n_));
     std::memcpy(ydot + n_, data_.qdd.data(), sizeof(double) * static_cast<std::size_t>(n_));

@@ -165,6 +165,9 @@ Status mode_acceleration(const Model& model, Data& data, int r) {
   return Status::ok;
 }
 
+// Defined below the entry points it serves.
+Status solve_modes(const Model& model, Data& data, bool rolling, bool forces_only = false);
+
 }  // namespace
 
 Status compute_mode_acceleration(const Model& model, Data& data) {
@@ -172,11 +175,39 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
     throw std::logic_error("compute_mode_acceleration: call compute_terms first for the current state");
   if (data.sparse || !model.contact_modes)
     throw std::logic_error("compute_mode_acceleration: contact modes are solved on the dense path of a model that has them");
+  ContactModeData& w = data.modes;
+  w.failed_contact = -1;
+  w.forces_current = false;
+  const bool rolling = std::all_of(w.mode.begin(), w.mode.end(), [](ContactMode m) { return m == ContactMode::rolling; });
+  if (rolling && w.defer_forces && model.s() > 0) {
+    // Every contact rolling: the ordinary Do Sanh form with D from b (sanh.hpp), as cheap as the
+    // model without modes; no friction works.
+    const Status status = compute_sanh_acceleration(model, data, Complement::qr);
+    if (status != Status::ok) return status;
+    data.power_friction = w.power_friction = 0.0;
+    std::copy(w.mode.begin(), w.mode.end(), w.solved.begin());
+    return Status::ok;
+  }
+  return solve_modes(model, data, rolling);
+}
+
+Status compute_mode_forces(const Model& model, Data& data) {
+  ContactModeData& w = data.modes;
+  if (w.forces_current) return Status::ok;
+  if (data.stage < Stage::acceleration || w.solved != w.mode)
+    throw std::logic_error("compute_mode_forces: call compute_mode_acceleration first for the current state and modes");
+  return solve_modes(model, data, true, true);
+}
+
+namespace {
+
+// The contact values and, unless `forces_only` (q'' and R already solved with every contact
+// rolling), the solve itself.
+Status solve_modes(const Model& model, Data& data, bool rolling, bool forces_only) {
   const ContactModeModel& cm = *model.contact_modes;
   ContactModeData& w = data.modes;
   const int n = model.n();
   const int s = model.s();
-  w.failed_contact = -1;
   w.tape.run(data.t, data.q.data(), data.v.data(), w.registers.data(), w.outputs.data());
   if (!w.velocity_residuals.empty())
     model.evaluator->velocity_residual(data.t, data.q.data(), data.v.data(), data.scratch.data(),
@@ -214,10 +245,11 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
   // Every contact rolling: the ordinary Do Sanh form with D from b (sanh.hpp), as cheap as the
   // model without modes; B~ = b, whose QR below gives only the multipliers.
   const int k = n - r;
-  const bool rolling = std::all_of(w.mode.begin(), w.mode.end(), [](ContactMode m) { return m == ContactMode::rolling; });
   if (rolling && r > 0) {
-    const Status status = compute_sanh_acceleration(model, data, Complement::qr);
-    if (status != Status::ok) return status;
+    if (!forces_only) {
+      const Status status = compute_sanh_acceleration(model, data, Complement::qr);
+      if (status != Status::ok) return status;
+    }
     w.qr.compute(w.reaction_rows);
     if (w.qr.rank() < r) return record_failure(data, Status::dependent_constraints, "b");
   } else {
@@ -258,7 +290,9 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
   }
   data.power_friction = w.power_friction;
   std::copy(w.mode.begin(), w.mode.end(), w.solved.begin());
+  w.forces_current = true;
   return Status::ok;
 }
 
+}  // namespace
 }  // namespace nhdyn

@@ -24,6 +24,12 @@ namespace nhdyn {
 // matrix B~^T (r kept rows) and one LU of n x n. Allocates only when the number of kept rows
 // changed since the last call (a switch). A singular system (Painleve's paradox, section 3.3 of
 // the derivation) returns Status::singular_system with data.failed_quantity naming the contact.
+// With data.modes.defer_forces set and every contact rolling, writes q'' and R only (the
+// ordinary sanh solve) and leaves the contact values to compute_mode_forces.
 Status compute_mode_acceleration(const Model& model, Data& data);
+
+// The contact values of the last compute_mode_acceleration when it deferred them (nothing when
+// they are current): one QR of b^T for the multipliers. Requires that solve's state in data.
+Status compute_mode_forces(const Model& model, Data& data);
 
 }  // namespace nhdyn

@@ -49,12 +49,20 @@ class ContactReader {
   std::vector<std::string> texts_of(const toml::node& node, const std::string& what, const std::string& example) const {
     std::vector<std::string> out;
     if (const auto* array = node.as_array()) {
+      // An empty list is not the key left out (a surface's `coordinates = []` would add them).
+      if (array->empty())
+        fail(node, fmt::format("{} = [] is empty: give its values, e.g. {}, or leave the key out", what, example));
       for (std::size_t i = 0; i < array->size(); ++i)
         out.push_back(text_of(*array->get(i), fmt::format("{}[{}]", what, i + 1), example));
       return out;
     }
     out.push_back(text_of(node, what, example));
     return out;
+  }
+
+  // The example an option's message shows: a list of names for `coordinates`.
+  static std::string option_example(const std::string& key, const std::string& otherwise) {
+    return key == "coordinates" ? "[\"gx\", \"gy\", \"gz\"]" : otherwise;
   }
 
   void check_keys(const toml::table& table, const std::vector<std::string>& keys, const std::string& where) const {
@@ -153,7 +161,7 @@ class ContactReader {
     for (auto&& [key, value] : *table) {
       const std::string k(key.str());
       if (k == text.shape) continue;
-      text.shape_options.emplace_back(k, join(texts_of(value, fmt::format("{}: shape.{}", what, k), "\"y\""), ", "));
+      text.shape_options.emplace_back(k, join(texts_of(value, fmt::format("{}: shape.{}", what, k), option_example(k, "\"y\"")), ", "));
     }
   }
 
@@ -188,7 +196,7 @@ class ContactReader {
     for (auto&& [key, value] : *table) {
       const std::string k(key.str());
       if (k == text.ground.key) continue;
-      text.ground.options.emplace_back(k, join(texts_of(value, fmt::format("{}: ground.{}", what, k), "\"Omega\""), ", "));
+      text.ground.options.emplace_back(k, join(texts_of(value, fmt::format("{}: ground.{}", what, k), option_example(k, "\"Omega\"")), ", "));
     }
   }
 

@@ -12,6 +12,7 @@
 #include <optional>
 #include <sstream>
 #include <string_view>
+#include <utility>
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/atomic_file.hpp"
@@ -498,14 +499,9 @@ double line_zero(Field& g, const Point& p, const Point& m, double range) {
 SceneMesh patch_mesh(Field& g, const symbolic::VisualShape& shape, const std::string& model,
                      const std::vector<Point>& path, double length);
 
-// A fixed surface that is not a sphere: along rays from a point K where g < 0 (inside a bowl, or
-// inside the solid a hill is the top of), K below the mean of the contact's path along the
-// surface's normal by the path's extent (halved until g(K) < 0): from a point inside a convex
-// region every ray meets its boundary once, so that the cap covers the whole path, up a bowl's
-// wall too. Where that fails, over the tangent plane (patch_mesh).
-SceneMesh ground_mesh(Field& g, const symbolic::VisualShape& shape, const std::string& model,
-                      const std::vector<Point>& path, double length) {
-  if (path.empty()) return {};
+// The mean point of a contact's path and g's gradient there (central differences): where the
+// drawing of a fixed surface starts.
+std::pair<Point, Point> path_mean_and_gradient(Field& g, const std::vector<Point>& path) {
   Point mean = {0.0, 0.0, 0.0};
   for (const Point& p : path)
     for (std::size_t k = 0; k < 3; ++k) mean[k] += p[k] / static_cast<double>(path.size());
@@ -517,6 +513,18 @@ SceneMesh ground_mesh(Field& g, const symbolic::VisualShape& shape, const std::s
     b[k] -= h;
     m[k] = (g(a[0], a[1], a[2]) - g(b[0], b[1], b[2])) / (2 * h);
   }
+  return {mean, m};
+}
+
+// A fixed surface that is not a sphere: along rays from a point K where g < 0 (inside a bowl, or
+// inside the solid a hill is the top of), K below the mean of the contact's path along the
+// surface's normal by the path's extent (halved until g(K) < 0): from a point inside a convex
+// region every ray meets its boundary once, so that the cap covers the whole path, up a bowl's
+// wall too. Where that fails, over the tangent plane (patch_mesh).
+SceneMesh ground_mesh(Field& g, const symbolic::VisualShape& shape, const std::string& model,
+                      const std::vector<Point>& path, double length) {
+  if (path.empty()) return {};
+  const auto [mean, m] = path_mean_and_gradient(g, path);
   const double norm = std::hypot(m[0], m[1], m[2]);
   double reach = 0.0;
   for (const Point& p : path) reach = std::max(reach, std::hypot(p[0] - mean[0], p[1] - mean[1], p[2] - mean[2]));
@@ -541,17 +549,7 @@ SceneMesh ground_mesh(Field& g, const symbolic::VisualShape& shape, const std::s
 SceneMesh patch_mesh(Field& g, const symbolic::VisualShape& shape, const std::string& model,
                      const std::vector<Point>& path, double length) {
   if (path.empty()) return {};
-  Point mean = {0.0, 0.0, 0.0};
-  for (const Point& p : path)
-    for (std::size_t k = 0; k < 3; ++k) mean[k] += p[k] / static_cast<double>(path.size());
-  const double h = 1e-6 * std::max({1.0, std::abs(mean[0]), std::abs(mean[1]), std::abs(mean[2])});
-  Point m;
-  for (std::size_t k = 0; k < 3; ++k) {
-    Point a = mean, b = mean;
-    a[k] += h;
-    b[k] -= h;
-    m[k] = (g(a[0], a[1], a[2]) - g(b[0], b[1], b[2])) / (2 * h);
-  }
+  auto [mean, m] = path_mean_and_gradient(g, path);
   const double norm = std::hypot(m[0], m[1], m[2]);
   if (!(norm > 0.0) || !std::isfinite(norm))
     mesh_failure(shape, model, "its gradient at the contact path's mean point is zero or not a number");

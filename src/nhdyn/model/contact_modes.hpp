@@ -68,6 +68,12 @@ struct ContactModeData {
   std::vector<double> registers, outputs;
   std::vector<ContactMode> mode;   // per contact
   std::vector<ContactMode> solved;  // the modes of the last compute_mode_acceleration that succeeded
+  // While every contact rolls, q'' is the ordinary Do Sanh solve and the contact values below
+  // (N, F_t, the slips) are wanted only where the switches are watched and rows written, not at
+  // every stage of a step: an integrator's right-hand side sets defer_forces around its solve, and
+  // forces_current says whether they belong to the last solve (compute_mode_forces completes them).
+  bool defer_forces = false;
+  bool forces_current = false;
   // Per contact, the slip direction carried through the sliding mode (unit, in the basis of the
   // unit tangents): e_s = s / |s| oriented like it, and the friction's direction where |s| is at
   // round-off (docs/derivations/contact-modes.md sections 5 and 6). Set at every switch into

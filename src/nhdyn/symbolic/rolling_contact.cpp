@@ -10,6 +10,7 @@
 #include <limits>
 #include <sstream>
 #include <tuple>
+#include <utility>
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
@@ -174,6 +175,17 @@ std::vector<int> contact_point_coordinates(const std::string& names, ContactPoin
     out.push_back(p.add_coordinate(name, where));
   }
   return out;
+}
+
+// The body's point whose outward normal is -n, and its reach along n from the shape's centre C
+// (world): for a ball C - r n directly, without R R^T; otherwise the shape's support point along
+// `direction` (body axes, of length `length`: the support mapping reads the direction only, so
+// that a ground may pass an unnormalized one and keep a root out of what is differentiated).
+std::pair<Vector3, GiNaC::ex> body_support(const ParsedContact& c, const PlacedFrame& F, const Vector3& C,
+                                           const Vector3& normal, const Vector3& direction, const GiNaC::ex& length) {
+  if (const std::optional<GiNaC::ex> r = c.shape->ball_radius(c.values)) return {subtract(C, scale(*r, normal)), *r};
+  const ShapeSupport s = c.shape->support(c.values, direction, length);
+  return {add(C, multiply(F.rotation, s.point)), s.reach};
 }
 
 // The rows that hold an implicit shape's contact point y (body axes) where the ground's normal is
@@ -453,21 +465,12 @@ class SurfaceGround final : public ContactGround {
                     "than that is not offered: keep the motion away from it, or turn the model so that gravity is "
                     "along another axis",
                     "xyz"[axis]));
-    Vector3 body_point;
-    GiNaC::ex reach;
-    if (const std::optional<GiNaC::ex> r = c.shape->ball_radius(c.values)) {
-      body_point = subtract(C, scale(*r, out.normal));
-      reach = *r;
-    } else {
-      // The support mapping depends on the direction only: taken along sigma N^T grad g, whose
-      // length is s |grad g| (R = N / s), so that |grad g| stays out of the expressions that are
-      // differentiated twice (as on a plane, rolling-bodies.md section 2.1).
-      const ShapeSupport s = c.shape->support(c.values,
-                                              multiply_transposed(F.rotation_numerator, scale(sigma, gradient)),
-                                              F.rotation_denominator * length);
-      body_point = add(C, multiply(F.rotation, s.point));
-      reach = s.reach;
-    }
+    // The support point along sigma N^T grad g, whose length is s |grad g| (R = N / s), so that
+    // |grad g| stays out of the expressions that are differentiated twice (as on a plane,
+    // rolling-bodies.md section 2.1).
+    const auto [body_point, reach] =
+        body_support(c, F, C, out.normal, multiply_transposed(F.rotation_numerator, scale(sigma, gradient)),
+                     F.rotation_denominator * length);
     out.gap = dot(out.normal, subtract(C, U)) - reach;
     const Vector3 apart = subtract(body_point, U);
     // g over its scale: about U's distance from the surface, in length units whatever g's scale.
@@ -550,19 +553,9 @@ class TerrainGround final : public ContactGround {
     out.tangent1 = {1, 0, hu};
     out.tangent2 = {0, 1, hv};
     const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
-    // The body's point whose outward normal is -n (section 2, with n the terrain's normal at P);
-    // for a ball C - r n directly, without R R^T.
-    Vector3 body_point;
-    GiNaC::ex reach;
-    if (const std::optional<GiNaC::ex> r = c.shape->ball_radius(c.values)) {
-      body_point = subtract(C, scale(*r, out.normal));
-      reach = *r;
-    } else {
-      const ShapeSupport s = c.shape->support(c.values, multiply_transposed(F.rotation_numerator, out.normal),
-                                              F.rotation_denominator);
-      body_point = add(C, multiply(F.rotation, s.point));
-      reach = s.reach;
-    }
+    // The body's point whose outward normal is -n (section 2, with n the terrain's normal at P).
+    const auto [body_point, reach] = body_support(
+        c, F, C, out.normal, multiply_transposed(F.rotation_numerator, out.normal), F.rotation_denominator);
     out.gap = dot(out.normal, subtract(C, ground_point)) - reach;
     const Vector3 apart = subtract(body_point, ground_point);
     out.locate = {{"_at1", dot(out.tangent1, apart)}, {"_at2", dot(out.tangent2, apart)}};

@@ -10,6 +10,7 @@
 #include <Eigen/QR>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/formulation/contact_modes.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
 #include "nhdyn/formulation/detail/row_scaling.hpp"
 #include "nhdyn/model/terms.hpp"
@@ -153,6 +154,9 @@ Status ContactSwitches::evaluate(double t, const double* y, double* g) {
                       std::equal(y, y + n, data_.q.data()) && std::equal(y + n, y + 2 * n, data_.v.data());
   if (!solved) {
     const Status status = compute_dynamics(model_, data_, formulation_, t, y, y + n);
+    if (status != Status::ok) return status;
+  } else {
+    const Status status = compute_mode_forces(model_, data_);
     if (status != Status::ok) return status;
   }
   const bool any_free = std::find(w.mode.begin(), w.mode.end(), ContactMode::free) != w.mode.end();
