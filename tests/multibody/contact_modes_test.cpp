@@ -202,6 +202,79 @@ TEST(ContactModes, DiskAndHoopThrownSlidingStickAtTheirClosedFormTimes) {
   }
 }
 
+// docs/derivations/contact-modes.md section 5, (O1): an upright thin disk at rest on the floor,
+// pushed at its centre by P = (Px, Py) (along its rolling direction x and across it, y), with too
+// little friction to roll. Its contact point responds to a tangential push F with S F, S =
+// diag(3/m, 5/m) (the axle's and a diameter's inertia, m r^2/2 and m r^2/4), and the normal does not
+// couple to it, so the friction at the onset is -mu N e with e = (kappa I + mu N S)^-1 sigma_f,
+// sigma_f = P / m, kappa > 0 making e a unit vector: neither the direction of P (45 degrees
+// here) nor the direction opposite to the friction rolling needs, (1, 0.6) for P = (3, 3) N
+// (31 degrees, the isotropic rule (O2)).
+TEST(ContactModes, UprightDiskPushedObliquelyStartsSlidingInTheAnisotropicOnsetDirection) {
+  const std::string text = R"toml(
+name = "disk-pushed"
+coordinates = ["x", "y", "z", "psi", "theta", "phi"]
+gravity = [0, 0, "-g"]
+[parameters]
+m = 0.5
+r = 0.2
+g = 9.81
+mu = 0.1
+Px = 3
+Py = 3
+[[frames]]
+name = "heading"
+translation = ["x", "y", "z"]
+rotations = [["z", "psi"]]
+[[frames]]
+name = "lean"
+parent = "heading"
+rotations = [["x", "theta"]]
+[[frames]]
+name = "disk"
+parent = "lean"
+rotations = [["y", "phi"]]
+[[bodies]]
+name = "disk"
+frame = "disk"
+mass = "m"
+inertia = ["m*r^2/4", "m*r^2/2", "m*r^2/4"]
+[[contacts]]
+name = "rim"
+body = "disk"
+shape = { disk = "r", axis = "y" }
+friction = "mu"
+[forces]
+x = "Px"
+y = "Py"
+[initial]
+position = { x = 0, y = 0, z = "r", psi = 0, theta = 0, phi = 0 }
+)toml";
+  const Model model = load_model_text(text, "disk.toml");
+  const double m = 0.5, g = 9.81, mu = 0.1, P = 3.0;
+  const double sigma_f[2] = {P / m, P / m}, S[2] = {3 / m, 5 / m}, muN = mu * m * g;
+  // kappa by bisection on |e(kappa)| = 1 (|e| falls as kappa grows).
+  const auto e_of = [&](double kappa, int i) { return sigma_f[i] / (kappa + muN * S[i]); };
+  double lo = 0.0, hi = 100.0;
+  for (int n = 0; n < 200; ++n) {
+    const double mid = 0.5 * (lo + hi);
+    (std::hypot(e_of(mid, 0), e_of(mid, 1)) > 1.0 ? lo : hi) = mid;
+  }
+  const double e[2] = {e_of(lo, 0), e_of(lo, 1)};
+  const ModeRun r = run_modes(model, 0.05);
+  ASSERT_FALSE(r.rows.empty());
+  EXPECT_EQ(r.at(0, "rim_mode"), 1.0);  // sliding from t0
+  // The friction at t0 is -mu N e: along -x (Flong) and -y (Flat) for the upright disk heading x.
+  const double F[2] = {r.at(0, "rim_Fx"), r.at(0, "rim_Fy")};
+  EXPECT_NEAR(std::hypot(F[0], F[1]), muN, 1e-9);
+  EXPECT_NEAR(-F[0] / muN, e[0], 1e-8);
+  EXPECT_NEAR(-F[1] / muN, e[1], 1e-8);
+  // And the slip grows along e (s = kappa e t + O(t^2)).
+  const double s[2] = {r.at(1, "rim_slip_x"), r.at(1, "rim_slip_y")};
+  EXPECT_NEAR(std::atan2(s[1], s[0]), std::atan2(e[1], e[0]), 1e-2);
+  EXPECT_GT(std::abs(std::atan2(e[1], e[0]) - std::atan2(0.6, 1.0)), 0.1);  // not (O2)
+}
+
 // A solid cylinder released at rest on an incline of angle alpha (gravity tilted, the plane
 // z = 0): it slides from the start iff tan(alpha) > 3 mu (section 10.3), with x'' = g (sin(alpha) -
 // mu cos(alpha)) and never sticks; below that it rolls at x'' = 2 g sin(alpha) / 3.

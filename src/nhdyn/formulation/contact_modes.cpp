@@ -47,7 +47,7 @@ void contact_kinematics(const ContactModeModel& cm, Data& data, std::vector<std:
     w.slip_world[i] = world;
     const double speed = std::hypot(w.slip[i][0], w.slip[i][1]);
     std::array<double, 2> e = w.direction[i];
-    if (speed > floor) {
+    if (speed > floor && static_cast<int>(i) != w.onset_trial) {
       e = {w.slip[i][0] / speed, w.slip[i][1] / speed};
       // Continued through zero: oriented like the carried direction (section 6), so that the
       // friction stays smooth within the step that holds the stick and s . e_s falls through 0.

@@ -73,6 +73,9 @@ struct ContactModeData {
   // every stage of a step: an integrator's right-hand side sets defer_forces around its solve, and
   // forces_current says whether they belong to the last solve (compute_mode_forces completes them).
   bool defer_forces = false;
+  // A contact whose sliding solve takes its carried direction whatever its slip (the trials of its
+  // onset direction, analysis/detail/contact_switches.cpp), or -1.
+  int onset_trial = -1;
   bool forces_current = false;
   // Per contact, the slip direction carried through the sliding mode (unit, in the basis of the
   // unit tangents): e_s = s / |s| oriented like it, and the friction's direction where |s| is at

@@ -5,6 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include <Eigen/LU>
 #include <Eigen/QR>
@@ -28,14 +32,129 @@ double slip_floor(const Data& data) { return 1e-10 * (1.0 + data.v.lpNorm<Eigen:
 
 double norm2(const std::array<double, 2>& x) { return std::hypot(x[0], x[1]); }
 
-// The direction of the friction at the onset of slip (docs/derivations/contact-modes.md (O2)):
-// opposite to the friction that rolling needs, F_roll, read from data.modes after a solve with
-// the contact rolling. For an isotropic contact (a ball, a body whose contact point responds alike
-// to every tangential push) this is exact; (O1) and (O3) for the others are not implemented yet.
-std::array<double, 2> onset_direction(const ContactModeData& w, std::size_t i) {
-  const double size = norm2(w.friction[i]);
-  if (!(size > 0.0)) return w.direction[i];
-  return {-w.friction[i][0] / size, -w.friction[i][1] / size};
+// The direction of the friction at the onset of slip (docs/derivations/contact-modes.md section
+// 5): the unit e (unit tangent basis) along which the slip acceleration sigma(e) of the sliding
+// mode, with the friction -mu_k N e, points: e x sigma(e) = 0, e . sigma(e) > 0 (O3). That is (O1)
+// for a contact whose N does not depend on the friction, and the direction opposite to the
+// friction rolling needs, F_roll, for an isotropic one (O2, a ball). Each trial e is one solve of
+// the sliding mode, whose slip is zero here (the carried direction serves it): sigma is its rows
+// of b times q'' plus b0. The circle is scanned at kScan points placed so that (O2) lies midway
+// between two, and every change of sign of e x sigma with e . sigma > 0 is bisected. Leaves
+// contact i's mode and carried direction as found; `why` says what failed (no direction, or more
+// than one: a non-uniqueness like Painleve's).
+constexpr int kScan = 48;
+
+struct Onset {
+  bool ok = false;
+  std::array<double, 2> e{1.0, 0.0};
+  std::string why;
+  std::optional<std::array<double, 2>> nearest;  // when several: the one nearest (O2)
+};
+
+Onset onset_direction(const Model& model, Data& data, const FormulationOptions& formulation, std::size_t i, double t,
+                      const double* q, const double* v) {
+  ContactModeData& w = data.modes;
+  const ContactModeContact& c = model.contact_modes->contacts[i];
+  const ContactMode mode = w.mode[i];
+  const std::array<double, 2> carried = w.direction[i];
+  Onset out;
+  w.mode[i] = ContactMode::rolling;
+  if (compute_dynamics(model, data, formulation, t, q, v) != Status::ok) {
+    w.mode[i] = mode;
+    out.why = "the rolling mode has no solution there";
+    return out;
+  }
+  const std::array<double, 2> rolling = w.friction[i];
+  const double size = norm2(rolling);
+  if (!(size > 0.0)) {
+    w.mode[i] = mode;
+    return {true, carried, "", std::nullopt};
+  }
+  const double beta0 = std::atan2(-rolling[1], -rolling[0]);
+  // e x sigma and e . sigma over |sigma|, and |sigma|, at angle beta; NaN where the sliding mode
+  // has no solution.
+  struct Trial {
+    double cross = std::numeric_limits<double>::quiet_NaN(), dot = 0.0, size = 0.0;
+  };
+  w.mode[i] = ContactMode::sliding;
+  w.onset_trial = static_cast<int>(i);  // the trial direction even where the slip is above round-off
+  const auto trial = [&](double beta) {
+    const std::array<double, 2> e = {std::cos(beta), std::sin(beta)};
+    w.direction[i] = e;
+    Trial out;
+    if (compute_dynamics(model, data, formulation, t, q, v) != Status::ok) return out;
+    std::array<double, 2> sigma;
+    for (std::size_t a = 0; a < 2; ++a) {
+      const auto row = static_cast<Eigen::Index>(c.roll[a]);
+      sigma[a] = (data.b.row(row).dot(data.qdd) + data.b0(row)) / w.tangent_length[i][a];
+    }
+    out.size = norm2(sigma);
+    if (!(out.size > 0.0)) return Trial{0.0, 0.0, 0.0};
+    out.dot = (e[0] * sigma[0] + e[1] * sigma[1]) / out.size;
+    out.cross = (e[0] * sigma[1] - e[1] * sigma[0]) / out.size;
+    return out;
+  };
+  constexpr double kStep = 2.0 * std::numbers::pi / kScan;
+  std::vector<double> roots;
+  double beta_a = beta0 - 0.5 * kStep;
+  Trial at_a = trial(beta_a);
+  double largest = 0.0;  // the scale of sigma over the circle
+  std::vector<std::pair<double, double>> brackets;
+  for (int k = 0; k < kScan; ++k) {
+    const double beta_b = beta_a + kStep;
+    const Trial at_b = trial(beta_b);
+    if (std::isfinite(at_b.size)) largest = std::max(largest, at_b.size);
+    if (std::isfinite(at_a.cross) && std::isfinite(at_b.cross) && (at_a.cross > 0.0) != (at_b.cross > 0.0))
+      brackets.emplace_back(beta_a, at_a.cross);
+    beta_a = beta_b;
+    at_a = at_b;
+  }
+  for (const auto& [start, cross_start] : brackets) {
+    double lo = start, hi = start + kStep, cross_lo = cross_start;
+    for (int n = 0; n < 48; ++n) {
+      const double mid = 0.5 * (lo + hi);
+      const Trial at = trial(mid);
+      if (!std::isfinite(at.cross)) break;
+      if (at.size <= 1e-9 * largest) {  // sigma = 0 (below)
+        lo = hi = mid;
+        break;
+      }
+      if ((at.cross > 0.0) == (cross_lo > 0.0)) {
+        lo = mid;
+        cross_lo = at.cross;
+      } else {
+        hi = mid;
+      }
+    }
+    const double root = 0.5 * (lo + hi);
+    // A root with the slip growing along e, not a pole of N(e) (where sigma grows without bound
+    // and turns over). At the onset itself, |F_roll| = mu_s N and mu_k = mu_s, sigma vanishes at
+    // the root (the slip grows at second order): its direction is the limit of the roots just past
+    // the onset, this one.
+    const Trial at = trial(root);
+    if ((std::abs(at.cross) < 1e-6 && at.dot > 0.0) || at.size <= 1e-9 * largest) roots.push_back(root);
+  }
+  w.onset_trial = -1;
+  w.mode[i] = mode;
+  w.direction[i] = carried;
+  if (roots.size() == 1) return {true, {std::cos(roots[0]), std::sin(roots[0])}, "", std::nullopt};
+  if (roots.size() > 1) {
+    const auto distance = [&](double beta) { return std::abs(std::remainder(beta - beta0, 2.0 * std::numbers::pi)); };
+    const double nearest = *std::min_element(roots.begin(), roots.end(),
+                                             [&](double a, double b) { return distance(a) < distance(b); });
+    out.nearest = std::array<double, 2>{std::cos(nearest), std::sin(nearest)};
+  }
+  out.why = roots.empty() ? "no direction of sliding makes the slip grow along it"
+                          : fmt::format("{} directions of sliding make the slip grow along them (the slip's onset is not "
+                                        "unique, as in Painleve's paradox)",
+                                        roots.size());
+  return out;
+}
+
+std::string onset_failure(const ContactModeContact& c, double t, const std::string& why) {
+  return fmt::format("contact '{}' starts to slip at t = {:.12g}, but {} (docs/derivations/contact-modes.md section 5, "
+                     "(O3)); the run ends here with its results so far",
+                     c.name, t, why);
 }
 
 // Painleve's paradox is watched on w_eff relative to its frictionless part (section 3.8): the run
@@ -93,7 +212,13 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
       } else if (norm2(rolling.friction[i]) > 1e-12 * std::abs(rolling.normal_force[i])) {
         // (Friction at round-off relative to N, as a contact whose point is held by coordinates
         // gives where rolling needs none, defines no direction either.)
-        w.direction[i] = onset_direction(rolling, i);
+        const Onset onset = onset_direction(model, data, formulation, i, t0, q0.data(), v0.data());
+        if (!onset.ok)
+          throw ModelError(fmt::format("{}: contact '{}' starts sliding at t0, but {} (docs/derivations/"
+                                       "contact-modes.md section 5); start it in another mode (mode = \"rolling\" "
+                                       "or \"free\")",
+                                       c.where, c.name, onset.why));
+        w.direction[i] = onset.e;
       } else {
         throw ModelError(fmt::format("{}: contact '{}' is given mode = \"sliding\", but at t0 it does not slip and "
                                      "rolling needs no friction there, so no direction of sliding is defined; "
@@ -233,11 +358,7 @@ std::string ContactSwitches::switch_contact(int contact, int slot, double t, con
   }
   if (before == ContactMode::rolling) {
     // Slip starts: the friction that rolling needs leaves the cone; it slides opposite to it.
-    if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
-    w.direction[i] = onset_direction(w, i);
-    w.mode[i] = ContactMode::sliding;
-    if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
-    if (!check_sliding(contact, t)) return "";
+    if (!start_sliding(contact, t, y, y + model_.n())) return "";
     return c.name + "_slip";
   }
   // The slip reached 0: stick if rolling is consistent and inside the cone, else lift off or slide
@@ -250,23 +371,27 @@ std::string ContactSwitches::switch_contact(int contact, int slot, double t, con
     return c.name + "_liftoff";
   }
   if (norm2(w.friction[i]) <= w.mu_s[i] * std::abs(N)) return c.name + "_stick";
-  w.direction[i] = onset_direction(w, i);
-  w.mode[i] = ContactMode::sliding;
-  if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
-  if (!check_sliding(contact, t)) return "";
+  if (!start_sliding(contact, t, y, y + model_.n())) return "";
   return c.name + "_slip";
 }
 
 void ContactSwitches::hold_row(double t, const double* y) {
   held_y_.assign(y, y + size_);
   held_t_ = t;
+  held_direction_ = data_.modes.direction;
   held_ = true;
 }
 
 Status ContactSwitches::flush_row() {
   if (!held_) return Status::ok;
   held_ = false;
-  return output_ ? (*output_)(held_t_, held_y_.data()) : Status::ok;
+  if (!output_) return Status::ok;
+  // The row as it was when held: a sliding contact whose slip is still at round-off there (its
+  // start) takes the direction carried then, not the one the next step has carried on to.
+  std::swap(data_.modes.direction, held_direction_);
+  const Status status = (*output_)(held_t_, held_y_.data());
+  std::swap(data_.modes.direction, held_direction_);
+  return status;
 }
 
 Status ContactSwitches::flush_row_after_failure() {
@@ -334,6 +459,25 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
   switched_ = true;
   const Status status = handler_(event, t, switch_y_.data());
   return status == Status::ok ? Status::stopped : status;
+}
+
+bool ContactSwitches::start_sliding(int contact, double t, const double* q, const double* v) {
+  const auto i = static_cast<std::size_t>(contact);
+  ContactModeData& w = data_.modes;
+  const Onset onset = onset_direction(model_, data_, formulation_, i, t, q, v);
+  // Several directions: the one nearest (O2) tells whether the sliding is in Painleve's paradox
+  // (the message that says which modes are consistent); else the onset is not unique.
+  if (!onset.ok && !onset.nearest) {
+    accumulation_ = onset_failure(model_.contact_modes->contacts[i], t, onset.why);
+    return false;
+  }
+  w.direction[i] = onset.ok ? onset.e : *onset.nearest;
+  w.mode[i] = ContactMode::sliding;
+  if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return false;
+  if (!check_sliding(contact, t)) return false;
+  if (onset.ok) return true;
+  accumulation_ = onset_failure(model_.contact_modes->contacts[i], t, onset.why);
+  return false;
 }
 
 bool ContactSwitches::check_sliding(int contact, double t) {
@@ -556,10 +700,7 @@ std::string ContactSwitches::touchdown(int contact, double t) {
   }
   if (c.unilateral && w.normal_force[i] < 0.0) w.mode[i] = ContactMode::free;
   else if (c.friction && norm2(w.friction[i]) > w.mu_s[i] * std::abs(w.normal_force[i])) {
-    w.direction[i] = onset_direction(w, i);
-    w.mode[i] = ContactMode::sliding;
-    if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return "";
-    if (!check_sliding(contact, t)) return "";
+    if (!start_sliding(contact, t, q, v)) return "";
   }
   return name;
 }

@@ -95,6 +95,10 @@ class ContactSwitches final : public EventFunctions {
   // Where a sliding mode starts, after compute_dynamics in it: false (with the message in
   // accumulation_) when the contact is in Painleve's paradox (w_eff <= 0, section 3.8).
   bool check_sliding(int contact, double t);
+  // Starts `contact` sliding at (t, q, v) in its onset direction (section 5, (O3)), then
+  // check_sliding: false (with the message in accumulation_) when no single direction is
+  // consistent or the sliding is in Painleve's paradox.
+  bool start_sliding(int contact, double t, const double* q, const double* v);
 
   const Model& model_;
   Data& data_;
@@ -120,6 +124,7 @@ class ContactSwitches final : public EventFunctions {
   bool held_ = false;  // a row of an output time not yet written
   double held_t_ = 0.0;
   std::vector<double> held_y_;
+  std::vector<std::array<double, 2>> held_direction_;  // the carried slip directions then
 };
 
 // Integrates as integrate() does, through any number of switches: each switch ends a segment,
