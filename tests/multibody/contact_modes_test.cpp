@@ -103,6 +103,41 @@ TEST(ContactModes, BallThrownSlidingSticksAtTheClosedFormTimeAndRollsAtFiveSeven
   EXPECT_NEAR(r.summary.energy.change, -m * v0 * v0 / 7, 1e-12);
 }
 
+// docs/derivations/contact-modes.md 3.6: a bilateral contact slides with Coulomb's friction of
+// |N|. The ball thrown sliding (mu = 0.25, v0 = 3 m/s) is pulled up at its centre by k t, k = 2
+// N/s: N = m g - k t changes sign at t = m g / k = 0.4905 s (an event NAME_reversal, the mode
+// stays sliding), and the centre decelerates at mu |g - k t / m| throughout, the friction doing
+// negative work: x'(t) = v0 - mu integral_0^t |g - k s / m| ds.
+TEST(ContactModes, BilateralContactSlidesWithTheFrictionOfAbsNAcrossTheSignChangeOfN) {
+  std::string text = nhdyn::test::read_text(example("ball_thrown_sliding.toml"));
+  nhdyn::test::replace_once(text, "[initial]", "[forces]\nz = \"k*t\"\n[initial]");
+  nhdyn::test::replace_once(text, "[parameters]", "[parameters]\nk = 2.0");
+  const Model model = load_model_text(text, "pulled.toml");
+  const double m = mode_parameter(model, "m"), g = mode_parameter(model, "g"), mu = mode_parameter(model, "mu");
+  const double v0 = mode_parameter(model, "v0"), k = 2.0, t_end = 0.8;
+  const ModeRun r = run_modes(model, t_end);
+  ASSERT_EQ(r.summary.events.crossings.size(), 1u);
+  EXPECT_EQ(r.summary.events.crossings[0].name, "ball_reversal");
+  const double t_star = m * g / k;
+  EXPECT_NEAR(r.summary.events.crossings[0].t, t_star, 1e-12);
+  const auto speed = [&](double t) {
+    const double a = std::min(t, t_star);
+    double integral = g * a - k * a * a / (2 * m);
+    if (t > t_star) integral += k * (t * t - t_star * t_star) / (2 * m) - g * (t - t_star);
+    return v0 - mu * integral;
+  };
+  for (std::size_t i = 0; i < r.rows.size(); ++i) {
+    const double t = r.rows[i][0];
+    EXPECT_NEAR(r.at(i, "x'"), speed(t), 1e-11) << "t = " << t;
+    EXPECT_EQ(r.at(i, "ball_mode"), 1.0) << "t = " << t;
+    EXPECT_NEAR(r.at(i, "ball_N"), m * g - k * t, 1e-11) << "t = " << t;
+    EXPECT_NEAR(r.at(i, "ball_Fx"), -mu * std::abs(m * g - k * t), 1e-11) << "t = " << t;
+  }
+  EXPECT_NEAR(speed(t_end), 2.15904875, 1e-12);  // the integral by hand
+  EXPECT_LT(r.at(r.rows.size() - 1, "work_friction"), 0.0);
+  EXPECT_LT(r.summary.energy.balance_error, 1e-11);
+}
+
 // A switch located within round-off of an output time: one row stands for that time, and it is the
 // switch's row, with the mode after it, on whichever side of the output time the switch falls.
 // v0 puts t* = 2 v0 / (7 mu g) on the output time 0.35; its last bits move t* across it.

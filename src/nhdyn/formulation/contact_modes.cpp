@@ -239,7 +239,7 @@ Status solve_modes(const Model& model, Data& data, bool rolling, bool forces_onl
     if (w.mode[i] != ContactMode::sliding || gap_column[i] < 0) continue;
     for (std::size_t a = 0; a < 2; ++a)
       w.reaction_rows.col(gap_column[i]) -=
-          (w.mu_k[i] * w.sliding_direction[i][a] / lengths[i][a]) * data.b.row(c.roll[a]).transpose();
+          (w.mu_k[i] * w.normal_sign[i] * w.sliding_direction[i][a] / lengths[i][a]) * data.b.row(c.roll[a]).transpose();
   }
 
   // Every contact rolling: the ordinary Do Sanh form with D from b (sanh.hpp), as cheap as the
@@ -275,7 +275,8 @@ Status solve_modes(const Model& model, Data& data, bool rolling, bool forces_onl
     const double N = w.multipliers(gap_column[i]);
     w.normal_force[i] = N;
     if (w.mode[i] == ContactMode::sliding) {
-      for (std::size_t a = 0; a < 2; ++a) w.friction[i][a] = -w.mu_k[i] * N * w.sliding_direction[i][a];
+      for (std::size_t a = 0; a < 2; ++a)
+        w.friction[i][a] = -w.mu_k[i] * w.normal_sign[i] * N * w.sliding_direction[i][a];
       // -mu_k |N| |s| = F_t . s, the dissipation (section 8).
       w.friction_power[i] = w.friction[i][0] * w.slip[i][0] + w.friction[i][1] * w.slip[i][1];
       w.power_friction += w.friction_power[i];

@@ -30,6 +30,7 @@ ContactModeData make_contact_mode_data(const Model& model) {
   w.mode.assign(m, ContactMode::rolling);
   w.solved.assign(m, ContactMode::free);
   w.direction.assign(m, {1.0, 0.0});
+  w.normal_sign.assign(m, 1.0);
   w.mu_s.assign(m, 0.0);
   w.mu_k.assign(m, 0.0);
   w.restitution.assign(m, 0.0);

@@ -82,6 +82,10 @@ struct ContactModeData {
   // round-off (docs/derivations/contact-modes.md sections 5 and 6). Set at every switch into
   // sliding and after every accepted step.
   std::vector<std::array<double, 2>> direction;
+  // Per contact, the sign of N carried through the sliding mode (+1, or -1 while a bilateral
+  // contact's ground pulls): Coulomb's friction is -mu_k |N| e_s, so the sliding reaction is
+  // N (n - mu_k sign(N) e_s) (docs/derivations/contact-modes.md 3.6). Flipped where N crosses 0.
+  std::vector<double> normal_sign;
   // --- results of compute_mode_acceleration, per contact ---
   std::vector<double> mu_s, mu_k, restitution;
   std::vector<double> normal_force;        // N [N]: positive when the ground pushes (0 when free)

@@ -66,6 +66,8 @@ Onset onset_direction(const Model& model, Data& data, const FormulationOptions& 
   }
   const std::array<double, 2> rolling = w.friction[i];
   const double size = norm2(rolling);
+  // A bilateral contact whose ground pulls slides with the friction of |N| (3.6).
+  w.normal_sign[i] = !c.unilateral && w.normal_force[i] < 0.0 ? -1.0 : 1.0;
   if (!(size > 0.0)) {
     w.mode[i] = mode;
     return {true, carried, "", std::nullopt};
@@ -209,6 +211,7 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
     if (mode == ContactMode::sliding) {
       if (slip > floor) {
         w.direction[i] = {rolling.slip[i][0] / slip, rolling.slip[i][1] / slip};
+        w.normal_sign[i] = !c.unilateral && rolling.normal_force[i] < 0.0 ? -1.0 : 1.0;
       } else if (norm2(rolling.friction[i]) > 1e-12 * std::abs(rolling.normal_force[i])) {
         // (Friction at round-off relative to N, as a contact whose point is held by coordinates
         // gives where rolling needs none, defines no direction either.)
@@ -229,6 +232,18 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
     w.mode[i] = mode;
   }
   if (compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok) throw_at_start(model, data);
+  for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
+    // A bilateral contact sliding with the sign of N that rolling has: the sliding one decides (3.6).
+    const ContactModeContact& c = cm.contacts[i];
+    if (c.unilateral || w.mode[i] != ContactMode::sliding || !(w.normal_sign[i] * w.normal_force[i] < 0.0)) continue;
+    w.normal_sign[i] = -w.normal_sign[i];
+    if (compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok) throw_at_start(model, data);
+    if (w.normal_sign[i] * w.normal_force[i] < 0.0)
+      throw ModelError(fmt::format("{}: contact '{}' starts sliding, but neither sign of its normal force is consistent "
+                                   "(docs/derivations/contact-modes.md 3.6); start it in another mode (mode = "
+                                   "\"rolling\")",
+                                   c.where, c.name));
+  }
   for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
     const ContactModeContact& c = cm.contacts[i];
     if (painleve(w, i))
@@ -297,7 +312,7 @@ Status ContactSwitches::evaluate(double t, const double* y, double* g) {
         if (c.friction) gi[1] = w.mu_s[i] * (c.unilateral ? N : std::abs(N)) - norm2(w.friction[i]);
         break;
       case ContactMode::sliding:
-        if (c.unilateral) gi[0] = N;
+        gi[0] = c.unilateral ? N : w.normal_sign[i] * N;  // lift-off, or a bilateral N changing sign
         gi[1] = w.slip[i][0] * w.direction[i][0] + w.slip[i][1] * w.direction[i][1];
         gi[2] = w.w_eff[i] - kPainleve * w.lambda_nn[i];  // Painleve (section 3.8)
         break;
@@ -311,6 +326,8 @@ Status ContactSwitches::evaluate(double t, const double* y, double* g) {
       if (w.mode[i] == ContactMode::free && w.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)] >= 0.0)
         gi[0] = std::max(gi[0], std::numeric_limits<double>::min());
       if (w.mode[i] == ContactMode::sliding) gi[1] = std::max(gi[1], std::numeric_limits<double>::min());
+      if (w.mode[i] == ContactMode::sliding && !c.unilateral)  // N's zero after a reversal
+        gi[0] = std::max(gi[0], std::numeric_limits<double>::min());
     }
   }
   return Status::ok;
@@ -321,6 +338,14 @@ std::string ContactSwitches::switch_contact(int contact, int slot, double t, con
   const ContactModeContact& c = model_.contact_modes->contacts[i];
   ContactModeData& w = data_.modes;
   const ContactMode before = w.mode[i];
+  if (slot == 0 && before == ContactMode::sliding && !c.unilateral) {
+    // A bilateral contact sliding on while its N changes sign: the friction of |N| turns with it
+    // (docs/derivations/contact-modes.md 3.6); the mode stays.
+    w.normal_sign[i] = -w.normal_sign[i];
+    if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return "";
+    if (!check_sliding(contact, t)) return "";
+    return c.name + "_reversal";
+  }
   if (slot == 0 && before != ContactMode::free) {
     // From rolling, N can reach 0 while the friction rolling needs does not (a contact without
     // friction limit): free, the contact then starts with g'' = -Lambda_nt F_t, which is < 0 for a
@@ -482,6 +507,22 @@ bool ContactSwitches::start_sliding(int contact, double t, const double* q, cons
 
 bool ContactSwitches::check_sliding(int contact, double t) {
   const auto i = static_cast<std::size_t>(contact);
+  ContactModeData& w = data_.modes;
+  const ContactModeContact& c = model_.contact_modes->contacts[i];
+  if (!c.unilateral && w.normal_sign[i] * w.normal_force[i] < 0.0) {
+    // The sign taken from rolling is not the sliding one: slide with the other (3.6).
+    w.normal_sign[i] = -w.normal_sign[i];
+    const Vector q = data_.q, v = data_.v;
+    if (compute_dynamics(model_, data_, formulation_, t, q.data(), v.data()) != Status::ok) return false;
+    if (w.normal_sign[i] * w.normal_force[i] < 0.0) {
+      accumulation_ = fmt::format("contact '{}' starts to slide at t = {:.12g}, but neither sign of its normal force is "
+                                  "consistent (N = {:.6g} N when the friction takes the other): as in Painleve's "
+                                  "paradox (docs/derivations/contact-modes.md 3.6); the run ends here with its "
+                                  "results so far",
+                                  c.name, t, w.normal_force[i]);
+      return false;
+    }
+  }
   if (!painleve(data_.modes, i)) return true;
   accumulation_ = painleve_message(model_.contact_modes->contacts[i], data_.modes, i, t) +
                   "; the run ends here with its results so far";
@@ -692,6 +733,7 @@ std::string ContactSwitches::touchdown(int contact, double t) {
   const double slip = norm2(w.slip[i]);
   if (c.friction && slip > slip_floor(data_)) {
     w.direction[i] = {w.slip[i][0] / slip, w.slip[i][1] / slip};
+    w.normal_sign[i] = 1.0;  // a touchdown is unilateral
     w.mode[i] = ContactMode::sliding;
     if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return "";
     if (!check_sliding(contact, t)) return "";
