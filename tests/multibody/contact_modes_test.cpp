@@ -138,6 +138,30 @@ TEST(ContactModes, BilateralContactSlidesWithTheFrictionOfAbsNAcrossTheSignChang
   EXPECT_LT(r.summary.energy.balance_error, 1e-11);
 }
 
+// A ball dropped into the bowl of examples/ball_in_bowl.toml, whose orientation is three angles:
+// rolling on, its middle angle reaches -270 degrees (gimbal lock) at t = 1.0817, where the run
+// ends; the message names the cause found at that state (A nearly singular), not the row written
+// before it.
+TEST(ContactModes, ABallWhoseAnglesReachGimbalLockEndsTheRunNamingIt) {
+  std::string text = nhdyn::test::read_text(example("ball_in_bowl.toml"));
+  nhdyn::test::replace_once(text, "rolling = \"rolling\"\n",
+                            "rolling = \"rolling\"\nfriction = [0.105, 0.1]\nunilateral = true\nmode = \"free\"\n");
+  nhdyn::test::replace_once(text, "z = \"Rb - sqrt", "z = \"0.05 + Rb - sqrt");
+  nhdyn::test::replace_once(text, "x0 = { value = 0.01", "x0 = { value = 0.15");
+  const Model model = load_model_text(text, "thrown.toml");
+  SimulationOptions options;
+  options.t_end = 2.0;
+  options.output_step = 0.01;
+  options.integrator.rtol = 1e-11;
+  options.integrator.atol = 1e-13;
+  const SimulationSummary summary = simulate(model, options, [](const Data&) {});
+  ASSERT_NE(summary.status, Status::ok);
+  EXPECT_NEAR(summary.t_reached, 1.0817, 1e-3) << summary.message;
+  EXPECT_NE(summary.message.find("A is nearly singular there"), std::string::npos) << summary.message;
+  EXPECT_NE(summary.message.find("gimbal lock"), std::string::npos) << summary.message;
+  EXPECT_NE(summary.message.find("rotations = \"quaternion\""), std::string::npos) << summary.message;
+}
+
 // A switch located within round-off of an output time: one row stands for that time, and it is the
 // switch's row, with the mode after it, on whichever side of the output time the switch falls.
 // v0 puts t* = 2 v0 / (7 mu g) on the output time 0.35; its last bits move t* across it.

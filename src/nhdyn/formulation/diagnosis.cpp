@@ -229,7 +229,22 @@ std::string explain_singular_with_regular_parts(const Model& model, const Data& 
                        "precision resolves beside the constraints' rows; write the model in units that bring "
                        "its masses and inertias within about 1e12 of each other",
                        head, smallest, largest);
-  if (data.failed_quantity.find("[D A; b]") != std::string::npos)
+  // A nearly singular A passes the Cholesky test: the coordinates near a singular point of the
+  // kinetic energy, such as three angles at gimbal lock (a ball rolling in a bowl on Euler angles).
+  if (!data.sparse && data.A.rows() == n) {
+    // On A with its diagonal scaled to 1 (D^-1/2 A D^-1/2), so that units and mass ratios do not
+    // count, only how nearly dependent its columns are.
+    const Vector scale = data.A.diagonal().cwiseMax(std::numeric_limits<double>::min()).cwiseSqrt().cwiseInverse();
+    const double rcond = Eigen::LLT<Matrix>(scale.asDiagonal() * data.A * scale.asDiagonal()).rcond();
+    if (rcond < 1e-8)
+      return fmt::format("the {} is singular at t = {:.6g}, and A is nearly singular there (reciprocal condition "
+                         "number {:.3g}; b has full rank): the coordinates are near a point where they stop "
+                         "describing the motion, such as three angles at gimbal lock (a body's middle angle at "
+                         "+-90 degrees); write the orientation as a quaternion (rotations = \"quaternion\", "
+                         "docs/multibody.md) or choose angles regular along the motion",
+                         data.failed_quantity, data.failed_t, rcond);
+  }
+  if (data.failed_quantity.find("[D A; b]") != std::string::npos && model.evaluator->has_complement())
     return head + "; this points to a D that is not a complement of b";
   return head + "; the constraints and the inertia are nearly dependent there: check the model's constraints "
                 "and masses at that state";

@@ -428,7 +428,16 @@ Status ContactSwitches::flush_row_after_failure() {
   const Status failure = data_.status;
   const std::string quantity = data_.failed_quantity;
   const int contact = data_.modes.failed_contact;
+  // And the terms there, which the diagnosis of a singular system reads (formulation/diagnosis.hpp).
+  const Matrix A = data_.A, b = data_.b, D = data_.D;
+  const Vector b0 = data_.b0, Q = data_.Q, G = data_.G;
   const Status status = flush_row();
+  data_.A = A;
+  data_.b = b;
+  data_.D = D;
+  data_.b0 = b0;
+  data_.Q = Q;
+  data_.G = G;
   data_.t = t;
   data_.q = q;
   data_.v = v;
