@@ -238,6 +238,32 @@ TEST_F(CliEvents, SameInputSameBytes) {
   EXPECT_EQ(read_text(dir_ / "a-events.csv"), read_text(dir_ / "b-events.csv"));
 }
 
+// A run whose steps no longer advance (here a spring of 1e12 N/m under dopri5 over 100 s; a
+// solution running into a singularity it cannot pass does the same) ends at the first check, after
+// 1e5 steps, saying what the pace would need, not after the whole step budget.
+TEST_F(CliEvents, ARunThatStallsEndsWhenItsPaceCannotReachTheEnd) {
+  std::ofstream(dir_ / "stiff.toml") << R"toml(name = "stiff-spring"
+coordinates = ["x"]
+kinetic_energy = "m/2 * x'^2"
+potential_energy = "k/2 * x^2"
+[parameters]
+m = 1.0
+k = 1e12
+[initial]
+position = { x = 1e-6 }
+velocity = { x = 0 }
+[simulation]
+t_end = 100
+output_step = 10
+)toml";
+  const EventsOutcome run = nhdyn("simulate stiff.toml --max-steps 1000000 -o s.csv");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("dopri5: the integration stalls at t = 0.00"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("its last 100000 steps advanced t by"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("try cvode-bdf"), std::string::npos) << run.err;
+  EXPECT_TRUE(fs::exists(dir_ / "s.partial.csv"));
+}
+
 TEST_F(CliEvents, AFailedRunKeepsItsRowsInAPartialFile) {
   const EventsOutcome run = nhdyn("simulate " + examples + "pendulum_cartesian.toml --max-steps 40 -o p.csv");
   EXPECT_EQ(run.exit_code, 1) << run.err;

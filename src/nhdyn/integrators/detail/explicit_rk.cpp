@@ -115,6 +115,30 @@ IntegrationResult budget_exhausted(std::string_view method, long max_steps, doub
   return result;
 }
 
+// Steps that no longer advance: every kStallSteps steps (accepted + rejected) the pace of the
+// last ones is projected to the end; a run that at that pace would need more than kStallFactor
+// times the steps its budget has left ends there. A solution running into a singularity it cannot
+// pass (a square root of a quantity that falls to 0, a surface that ends) shrinks its steps
+// without limit but slowly enough to grind through the budget for many minutes before saying so.
+constexpr long kStallSteps = 100000;
+constexpr double kStallFactor = 10.0;
+
+IntegrationResult stalled(std::string_view method, double t, double advanced, double needed, long max_steps,
+                          const IntegratorStats& stats) {
+  IntegrationResult result;
+  result.status = Status::too_many_steps;
+  result.t_reached = t;
+  result.stats = stats;
+  result.message = fmt::format(
+      "{}: the integration stalls at t = {}: its last {} steps advanced t by {:.3g}, a pace that needs about {:.3g} "
+      "steps to the end, more than {} times what is left of the budget of {}; the solution is probably singular "
+      "there (a square root or a logarithm of a quantity that reaches 0, a surface or a constraint that ends, a "
+      "denominator that vanishes), or too stiff for an explicit integrator (try cvode-bdf): check the model at that "
+      "state, or raise max_steps to go on",
+      method, t, kStallSteps, advanced, needed, kStallFactor, max_steps);
+  return result;
+}
+
 IntegrationResult stopped_at(double t, const IntegratorStats& stats) {
   IntegrationResult result;
   result.status = Status::stopped;
@@ -514,9 +538,18 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
   double err_old = 1e-4;  // Hairer's FACOLD: the previous accepted error, floored
   bool last_rejected = false;
   bool last_error_finite = true;
+  double stall_t = t;  // t at the last stall check
+  long stall_next = run.stats.steps + run.stats.rejected_steps + kStallSteps;
   for (;;) {
     if (run.stats.steps + run.stats.rejected_steps >= options.max_steps)
       return budget_exhausted(method, options.max_steps, t, run.stats);
+    if (const long used = run.stats.steps + run.stats.rejected_steps; used >= stall_next) {
+      const double needed = (t_end - t) / (t - stall_t) * static_cast<double>(kStallSteps);
+      if (!(needed <= kStallFactor * static_cast<double>(options.max_steps - used)))
+        return stalled(method, t, t - stall_t, needed, options.max_steps, run.stats);
+      stall_t = t;
+      stall_next = used + kStallSteps;
+    }
     if (!(h >= 16.0 * eps * std::max(std::abs(t), std::numeric_limits<double>::min())))
       return step_size_failure(method, last_error_finite, t, h, run.stats);
     // Reaching t_end within 1% of a step is done in that step; stretching the last step a little
