@@ -361,6 +361,15 @@ TEST(RollingSurface, BadSurfacesAreRefusedByName) {
   });
   EXPECT_NE(m.find("ground.coordinates = [] is empty"), std::string::npos) << m;
   EXPECT_NE(m.find("contact 'ball'"), std::string::npos) << m;
+  // The wrong side: the start's gap of about -2 r is explained by the side.
+  m = surface_error([&] {
+    const Model model = load_model_text(with(R"(ground = { surface = "X^2/(2*rho1) + Y^2/(2*rho2) - Z", side = "outside" })"));
+    SimulationOptions options;
+    options.t_end = 0.1;
+    simulate(model, options, [](const Data&) {});
+  });
+  EXPECT_NE(m.find("ball_contact (position level): residual -0.1"), std::string::npos) << m;
+  EXPECT_NE(m.find("the body is where g > 0 (side = \"outside\")"), std::string::npos) << m;
   // A ball flatter than the hollow it starts in: the contact would not be unique.
   m = surface_error([&] { load_model(example("ball_in_paraboloid.toml"), {{"r", 0.6}}); });
   EXPECT_NE(m.find("flatter than the hollow"), std::string::npos) << m;

@@ -817,10 +817,18 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
                         fmt::format("the body can never touch the ground: the gap between them is the constant {}; "
                                     "place the body's frame so that it touches the ground",
                                     contact_printed(gap)));
+    // A surface's side decides which way the gap is measured: a body on the other side starts
+    // with a gap of about minus twice its size.
+    const std::string side =
+        c.ground.type->key() == "surface"
+            ? fmt::format("; the body is where g {} 0 (side = \"{}\"): a gap of about minus twice the body's size "
+                          "says it is on the other side",
+                          c.ground.inside ? "<" : ">", c.ground.inside ? "inside" : "outside")
+            : "";
     out.constraints.push_back({c.name + "_contact", ConstraintLevel::position, gap,
                                fmt::format("contact '{}': the gap between the body and the ground = 0 (its position residual is the "
-                                           "gap, in length units; --fix-initial moves the body onto the ground)",
-                                           c.name)});
+                                           "gap, in length units; --fix-initial moves the body onto the ground{})",
+                                           c.name, side)});
   }
   // The contact point's coordinates on the ground, where they are coordinates (section 8).
   for (const auto& [suffix, row] : touch.locate)

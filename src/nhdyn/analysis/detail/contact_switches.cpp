@@ -382,7 +382,7 @@ std::string ContactSwitches::switch_contact(int contact, int slot, double t, con
     return "";
   }
   if (before == ContactMode::rolling) {
-    // Slip starts: the friction that rolling needs leaves the cone; it slides opposite to it.
+    // Slip starts: the friction that rolling needs leaves the cone; it slides in the onset direction.
     if (!start_sliding(contact, t, y, y + model_.n())) return "";
     return c.name + "_slip";
   }
