@@ -15,6 +15,7 @@
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/model/parameters.hpp"
+#include "support/models.hpp"
 #include "support/text.hpp"
 
 namespace nhdyn {
@@ -270,34 +271,7 @@ TEST(ContactModes, DiskAndHoopThrownSlidingStickAtTheirClosedFormTimes) {
 // here) nor the direction opposite to the friction rolling needs, (1, 0.6) for P = (3, 3) N
 // (31 degrees, the isotropic rule (O2)).
 TEST(ContactModes, UprightDiskPushedObliquelyStartsSlidingInTheAnisotropicOnsetDirection) {
-  const std::string text = R"toml(
-name = "disk-pushed"
-coordinates = ["x", "y", "z", "psi", "theta", "phi"]
-gravity = [0, 0, "-g"]
-[parameters]
-m = 0.5
-r = 0.2
-g = 9.81
-mu = 0.1
-Px = 3
-Py = 3
-[[frames]]
-name = "heading"
-translation = ["x", "y", "z"]
-rotations = [["z", "psi"]]
-[[frames]]
-name = "lean"
-parent = "heading"
-rotations = [["x", "theta"]]
-[[frames]]
-name = "disk"
-parent = "lean"
-rotations = [["y", "phi"]]
-[[bodies]]
-name = "disk"
-frame = "disk"
-mass = "m"
-inertia = ["m*r^2/4", "m*r^2/2", "m*r^2/4"]
+  const std::string text = nhdyn::test::free_disk_text("disk-pushed", "mu = 0.1\nPx = 3\nPy = 3\n", R"toml(
 [[contacts]]
 name = "rim"
 body = "disk"
@@ -306,9 +280,7 @@ friction = "mu"
 [forces]
 x = "Px"
 y = "Py"
-[initial]
-position = { x = 0, y = 0, z = "r", psi = 0, theta = 0, phi = 0 }
-)toml";
+)toml");
   const Model model = load_model_text(text, "disk.toml");
   const double m = 0.5, g = 9.81, mu = 0.1, P = 3.0;
   const double sigma_f[2] = {P / m, P / m}, S[2] = {3 / m, 5 / m}, muN = mu * m * g;
