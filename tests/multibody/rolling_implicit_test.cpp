@@ -229,5 +229,43 @@ TEST(RollingImplicit, FlatterThanTheTerrainsHollowIsRefused) {
   EXPECT_NO_THROW(load_model_text(text, "e.toml", {{"tilt", 0.0}}));
 }
 
+// A shape convex at the start but not everywhere: X^2/a^2 + Y^4/b^4 + Z^2/c^2 = 1 is flat along Y
+// where Y = 0. Released tilted about x, its contact point swings through Y = 0: the run ends as it
+// gets there, naming the shape (on the plane, the hollow's message would be the wrong cause). Near
+// the bottom the curvatures are kappa_X = c/a^2 and kappa_Y = 6 c Y^2/b^4 (f's Hessian over
+// |grad f| = 2/c), so the measure 4 kappa_X kappa_Y/(kappa_X + kappa_Y)^2 falls below 1e-4 at
+// |Y| = b^2/a sqrt(1e-4/24) to first order.
+TEST(RollingImplicit, AShapeThatStopsBeingConvexAlongTheRunEndsItThere) {
+  std::string text = ellipsoid_example_text();
+  replace_once(text, "shape = { ellipsoid = [\"a\", \"b\", \"c\"] }",
+               "shape = { surface = \"X^2/a^2 + Y^4/b^4 + Z^2/c^2 - 1\" }");
+  replace_once(text, "z = \"sqrt(a^2*sin(tilt)^2 + c^2*cos(tilt)^2)\", psi = 0, theta = 0, phi = \"tilt\"",
+               "psi = 0, theta = \"tilt\", phi = 0");
+  const Model model = load_model_text(text, "q.toml");
+  SimulationOptions options;
+  options.t_end = 1.0;
+  options.output_step = 0.005;
+  options.fix_initial = true;  // z onto the plane, and the contact point's coordinates
+  const int py = implicit_column(model, "foot_py");
+  std::vector<double> row;
+  std::vector<double> ys;
+  const SimulationSummary summary = simulate(model, options, [&](const Data& data) {
+    fill_result_row(model, data, row);
+    ys.push_back(row[static_cast<std::size_t>(py)]);
+  });
+  EXPECT_EQ(summary.status, Status::singular_system) << summary.message;
+  expect_parts(summary.message, {"q.toml:", "contact 'foot': the shape is no longer strictly convex at its contact point",
+                                 "det K_shape / (tr K_shape / 2)^2 on the tangent plane = "});
+  const std::size_t at = summary.message.find("foot_py = ");
+  ASSERT_NE(at, std::string::npos) << summary.message;
+  const double a = 0.2, b = 0.15, limit = b * b / a * std::sqrt(1e-4 / 24);
+  const double stopped = std::abs(std::stod(summary.message.substr(at + 10)));
+  EXPECT_LT(stopped, 1.05 * limit) << summary.message;
+  EXPECT_GT(stopped, 0.95 * limit) << summary.message;
+  ASSERT_GT(ys.size(), 2u);
+  EXPECT_GT(std::abs(ys.front()), 0.1 * b);  // started well off Y = 0, every row on the same side
+  for (double y : ys) EXPECT_GT(y * ys.front(), stopped * std::abs(ys.front()));
+}
+
 }  // namespace
 }  // namespace nhdyn

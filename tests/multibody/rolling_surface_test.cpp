@@ -333,6 +333,70 @@ TEST(RollingSurface, ANormalAlongTheTangentsAxisEndsTheRun) {
   EXPECT_LT(last, 0.2);
 }
 
+// A ball rolling up the quartic hollow Z = X^4 / L^3, flat at the bottom (the start's check
+// passes) and more curved than the ball higher up: the run ends where the hollow's curvature
+// k(X) = Z'' / (1 + Z'^2)^(3/2) reaches 1/r, naming the contact, not with a step-size underflow or
+// a ball cutting into the wall; slower, the ball turns back below that point and runs to the end.
+TEST(RollingSurface, AHollowMoreCurvedThanTheBallMetAlongTheRunEndsItThere) {
+  std::string text = text_of("ball_in_paraboloid.toml");
+  replace_once(text, R"(ground = { surface = "X^2/(2*rho1) + Y^2/(2*rho2) - Z", side = "inside" })",
+               R"(ground = { surface = "X^4/L^3 - Z", side = "inside" })");
+  replace_once(text, "[parameters]\n", "[parameters]\nL = 0.1\n");
+  replace_once(text, R"(vy = { value = 0.05)", R"(vy = { value = 0.0)");
+  const double L = 0.1, r = 0.05;
+  // The hollow's curvature at X, and X* where it equals 1/r (it grows with X up to past X*).
+  const auto curvature = [&](double X) {
+    const double slope = 4 * X * X * X / (L * L * L), second = 12 * X * X / (L * L * L);
+    return second / std::pow(1 + slope * slope, 1.5);
+  };
+  double lo = 0.0, hi = 0.06;
+  for (int i = 0; i < 100; ++i) (curvature(0.5 * (lo + hi)) < 1 / r ? lo : hi) = 0.5 * (lo + hi);
+  const double X_star = 0.5 * (lo + hi);
+  ASSERT_GT(curvature(0.9 * X_star), 0.0);
+  ASSERT_LT(curvature(0.9 * X_star), 1 / r);
+
+  SimulationOptions options;
+  options.t_end = 1.0;
+  options.output_step = 0.001;
+  {
+    std::string fast = text;
+    replace_once(fast, R"(vx = { value = 0.08)", R"(vx = { value = 1.0)");
+    const Model model = load_model_text(fast);
+    const int gx = surface_column(make_result_columns(model), "ball_gx");
+    SimulationSummary summary;
+    const auto rows = surface_rows(model, options, &summary);
+    EXPECT_EQ(summary.status, Status::singular_system) << summary.message;
+    EXPECT_NE(summary.message.find("contact 'ball': the ground's hollow is as curved as the shape here"),
+              std::string::npos)
+        << summary.message;
+    EXPECT_NE(summary.message.find("det(K_shape - K_ground) / (tr K_shape / 2)^2 on the tangent plane = "),
+              std::string::npos)
+        << summary.message;
+    // Stopped where 1 - r k < 1e-4 (the ground is flat along Y): the contact point X, which the
+    // message's state gives, within about 1e-4 of X* (k'(X) X / k is about 2 there).
+    const std::size_t at = summary.message.find("ball_gx = ");
+    ASSERT_NE(at, std::string::npos) << summary.message;
+    const double stopped = std::stod(summary.message.substr(at + 10));
+    EXPECT_GT(stopped, (1 - 2e-4) * X_star) << summary.message;
+    EXPECT_LT(stopped, X_star) << summary.message;
+    ASSERT_FALSE(rows.empty());
+    for (const auto& row : rows) EXPECT_LT(row[static_cast<std::size_t>(gx)], stopped);
+  }
+  {
+    std::string slow = text;
+    replace_once(slow, R"(vx = { value = 0.08)", R"(vx = { value = 0.1)");
+    const Model model = load_model_text(slow);
+    const int gx = surface_column(make_result_columns(model), "ball_gx");
+    SimulationSummary summary;
+    double farthest = 0.0;
+    for (const auto& row : surface_rows(model, options, &summary))
+      farthest = std::max(farthest, row[static_cast<std::size_t>(gx)]);
+    EXPECT_EQ(summary.status, Status::ok) << summary.message;
+    EXPECT_GT(farthest, 0.3 * X_star);
+    EXPECT_LT(farthest, 0.9 * X_star);
+  }
+}
+
 // Refusals, each naming the file's line and what to do.
 TEST(RollingSurface, BadSurfacesAreRefusedByName) {
   const std::string base = text_of("ball_in_paraboloid.toml");

@@ -728,6 +728,56 @@ SpecConvexity convexity_check(const ParsedContact& c, const PlacedFrame& F, cons
   return check;
 }
 
+// The determinant and the trace of a symmetric K restricted to the plane normal to n (n not
+// necessarily unit): n^T adj(K) n / |n|^2 and tr K - n^T K n / |n|^2, the product and the sum of
+// the principal curvatures when K is a curvature matrix (rolling-bodies.md section 9.1).
+std::pair<GiNaC::ex, GiNaC::ex> tangent_determinant_and_trace(const GiNaC::matrix& K, const Vector3& n) {
+  const auto minor = [&](unsigned i, unsigned j) {  // the 2x2 minor without row i and column j
+    const unsigned r0 = i == 0 ? 1 : 0, r1 = i == 2 ? 1 : 2, c0 = j == 0 ? 1 : 0, c1 = j == 2 ? 1 : 2;
+    return K(r0, c0) * K(r1, c1) - K(r0, c1) * K(r1, c0);
+  };
+  GiNaC::ex adjugate = 0, along = 0;
+  for (unsigned i = 0; i < 3; ++i)
+    for (unsigned j = 0; j < 3; ++j) {
+      adjugate += n[i] * n[j] * ((i + j) % 2 == 0 ? 1 : -1) * minor(j, i);
+      along += n[i] * K(i, j) * n[j];
+    }
+  const GiNaC::ex nn = dot(n, n);
+  return {adjugate / nn, K(0, 0) + K(1, 1) + K(2, 2) - along / nn};
+}
+
+// The start's convexity check carried along the motion (SpecContactWatch, checked at every
+// accepted step): the shape's curvature less the ground's on the tangent plane, as
+// det(K_shape - K_ground) / (tr K_shape / 2)^2 there, which is (1 - r k1)(1 - r k2) for a ball of
+// radius r on a ground of principal curvatures k1, k2, and falls to 0 where the ground's hollow
+// becomes as curved as the shape (past it the contact is not unique and the motion not the body's);
+// for an implicit shape also its own det K / (tr K / 2)^2, 0 where it stops being strictly convex.
+std::vector<SpecContactWatch> convexity_watches(const SpecConvexity& check, bool own) {
+  const Vector3 n = {check.normal[0], check.normal[1], check.normal[2]};
+  const auto [body_det, body_trace] = tangent_determinant_and_trace(check.body, n);
+  const GiNaC::ex scale = body_trace * body_trace / 4;
+  const GiNaC::matrix relative = check.body.sub(check.ground);
+  std::vector<SpecContactWatch> watches;
+  // The shape's own first: on a plane (K = 0) the two are the same measure, and the cause is the shape.
+  if (own)
+    watches.push_back(SpecContactWatch{
+        check.contact, check.where, body_det / scale, 1e-4,
+        "the shape is no longer strictly convex at its contact point (a principal curvature reaches 0): it would roll "
+        "on a point that is not its lowest; write a strictly convex f",
+        "det K_shape / (tr K_shape / 2)^2 on the tangent plane", true});
+  bool flat = true;
+  for (unsigned i = 0; i < 3; ++i)
+    for (unsigned j = 0; j < 3; ++j) flat = flat && check.ground(i, j).is_zero();
+  if (!flat)
+    watches.push_back(SpecContactWatch{
+        check.contact, check.where, tangent_determinant_and_trace(relative, n).first / scale, 1e-4,
+        "the ground's hollow is as curved as the shape here (the shape's principal curvatures less the ground's "
+        "reach 0): the contact is no longer a single point, and the motion past it is not the body's; use a more "
+        "curved shape or a smoother ground",
+        "det(K_shape - K_ground) / (tr K_shape / 2)^2 on the tangent plane", true});
+  return watches;
+}
+
 // The contact coordinates nhdyn adds, and where Newton starts (rolling-bodies.md sections 10 and
 // 11): on a terrain below the centre; on a surface along grad F from the centre; an implicit
 // shape's point on its surface along -nu from its centre.
@@ -872,6 +922,9 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
     check.ground = touch.curvature;
     out.convexity = check;
   }
+  if (out.convexity)
+    for (SpecContactWatch& watch : convexity_watches(*out.convexity, c.shape->implicit()))
+      out.watches.push_back(std::move(watch));
   // 1 - (e . nu)^2 below 1e-4: the axle within 0.6 degree of the normal (rolling-bodies.md section 2).
   if (const std::optional<ContactShape::Singularity> singular =
           c.shape->singularity(c.values, multiply_transposed(F.rotation, touch.normal)))

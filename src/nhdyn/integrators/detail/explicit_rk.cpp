@@ -82,37 +82,32 @@ bool all_finite(const double* y, int n) {
   return true;
 }
 
-IntegrationResult rhs_failure(std::string_view method, Status status, double t_fail,
-                              double t_reached, const IntegratorStats& stats) {
+// The result of a run that ends at t_reached with `status` and `message`.
+IntegrationResult ended(Status status, double t_reached, const IntegratorStats& stats, std::string message = {}) {
   IntegrationResult result;
   result.status = status;
   result.t_reached = t_reached;
   result.stats = stats;
-  result.message = fmt::format("{}: the right-hand side failed at t = {}: {}", method, t_fail,
-                               describe(status));
+  result.message = std::move(message);
   return result;
 }
 
+IntegrationResult rhs_failure(std::string_view method, Status status, double t_fail,
+                              double t_reached, const IntegratorStats& stats) {
+  return ended(status, t_reached, stats,
+               fmt::format("{}: the right-hand side failed at t = {}: {}", method, t_fail, describe(status)));
+}
+
 IntegrationResult step_end_failure(std::string_view method, Status status, double t, const IntegratorStats& stats) {
-  IntegrationResult result;
-  result.status = status;
-  result.t_reached = t;
-  result.stats = stats;
-  result.message = fmt::format("{}: after the step to t = {}: {}", method, t, describe(status));
-  return result;
+  return ended(status, t, stats, fmt::format("{}: after the step to t = {}: {}", method, t, describe(status)));
 }
 
 IntegrationResult budget_exhausted(std::string_view method, long max_steps, double t,
                                    const IntegratorStats& stats) {
-  IntegrationResult result;
-  result.status = Status::too_many_steps;
-  result.t_reached = t;
-  result.stats = stats;
-  result.message = fmt::format(
-      "{}: the budget of {} steps (accepted + rejected) was used up at t = {}; raise max_steps or "
-      "loosen the tolerances",
-      method, max_steps, t);
-  return result;
+  return ended(Status::too_many_steps, t, stats,
+               fmt::format("{}: the budget of {} steps (accepted + rejected) was used up at t = {}; raise max_steps "
+                           "or loosen the tolerances",
+                           method, max_steps, t));
 }
 
 // Steps that no longer advance: every kStallSteps steps (accepted + rejected) the pace of the
@@ -125,27 +120,18 @@ constexpr double kStallFactor = 10.0;
 
 IntegrationResult stalled(std::string_view method, double t, double advanced, double needed, long max_steps,
                           const IntegratorStats& stats) {
-  IntegrationResult result;
-  result.status = Status::too_many_steps;
-  result.t_reached = t;
-  result.stats = stats;
-  result.message = fmt::format(
-      "{}: the integration stalls at t = {}: its last {} steps advanced t by {:.3g}, a pace that needs about {:.3g} "
-      "steps to the end, more than {} times what is left of the budget of {}; the solution is probably singular "
-      "there (a square root or a logarithm of a quantity that reaches 0, a surface or a constraint that ends, a "
-      "denominator that vanishes), or too stiff for an explicit integrator (try cvode-bdf): check the model at that "
-      "state, or raise max_steps to go on",
-      method, t, kStallSteps, advanced, needed, kStallFactor, max_steps);
-  return result;
+  return ended(
+      Status::too_many_steps, t, stats,
+      fmt::format(
+          "{}: the integration stalls at t = {}: its last {} steps advanced t by {:.3g}, a pace that needs about "
+          "{:.3g} steps to the end, more than {} times what is left of the budget of {}; the solution is probably "
+          "singular there (a square root or a logarithm of a quantity that reaches 0, a surface or a constraint that "
+          "ends, a denominator that vanishes), or too stiff for an explicit integrator (try cvode-bdf): check the "
+          "model at that state, or raise max_steps to go on",
+          method, t, kStallSteps, advanced, needed, kStallFactor, max_steps));
 }
 
-IntegrationResult stopped_at(double t, const IntegratorStats& stats) {
-  IntegrationResult result;
-  result.status = Status::stopped;
-  result.t_reached = t;
-  result.stats = stats;
-  return result;
-}
+IntegrationResult stopped_at(double t, const IntegratorStats& stats) { return ended(Status::stopped, t, stats); }
 
 // RMS norm of v / (atol + rtol |w|), the weights of Hairer's initial step heuristic.
 double weighted_rms(const double* v, const double* w, int n, double rtol, double atol) {
