@@ -88,16 +88,21 @@ TEST(RollingTerrainCli, StartOffTheTerrainGivesTheGap) {
   EXPECT_NE(fixed.out.find("    z = 0.1 (changed by +0.1), was 0"), std::string::npos) << fixed.out;
 }
 
-TEST(RollingTerrainCli, BallAsCurvedAsAHollowIsSingular) {
+TEST(RollingTerrainCli, BallAsCurvedAsAHollowIsRefused) {
   // In a hollow Z = -h, whose bottom has the radius of curvature w^2 / (2 H) = 0.9 m, a ball of
-  // that radius touches along a whole cap: the contact point is not unique, the constraints leave
-  // u', v' free, and they have no inertia.
-  expect_terrain_refused(simulate_bump("hollow", {{kBumpTerrain, "terrain = \"-H*exp(-(X^2 + Y^2)/w^2)\""},
-                                          {"r = { value = 0.05", "r = { value = 0.9"},
-                                          {"z = \"H + r\"", "z = \"-H + r\""},
-                                          {"u = \"V*w^2/(w^2 + 2*H*r)\"", "u = 0"}}),
-                 {"the constraints do not fix the velocities", "a motion of u, v has no kinetic energy",
-                  "[D A; b] is singular", "contact point is unique"});
+  // that radius touches along a whole cap: the contact point is not unique (the constraints would
+  // leave u', v' free, with no inertia). The start's check names both curvatures, 1/r = 1.11111
+  // and the ball's less the hollow's, 0; a ball of 1 m is flatter still (-0.111111).
+  const auto hollow = [&](const std::string& name, const std::string& r) {
+    return simulate_bump(name, {{kBumpTerrain, "terrain = \"-H*exp(-(X^2 + Y^2)/w^2)\""},
+                                {"r = { value = 0.05", "r = { value = " + r},
+                                {"z = \"H + r\"", "z = \"-H + r\""},
+                                {"u = \"V*w^2/(w^2 + 2*H*r)\"", "u = 0"}});
+  };
+  expect_terrain_refused(hollow("hollow", "0.9"), {"bump.toml:", "contact 'ball'", "flatter than the hollow",
+                                                   "1.11111 and 1.11111"});
+  expect_terrain_refused(hollow("hollow_flatter", "1.0"),
+                         {"contact 'ball'", "flatter than the hollow", "-0.111111 and -0.111111"});
 }
 
 }  // namespace

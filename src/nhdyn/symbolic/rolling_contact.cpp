@@ -911,9 +911,10 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
                                fmt::format("contact '{}': no spin about the normal, n.(omega - omega_ground) = 0", c.name)});
   }
   if (c.shape->implicit()) out.convexity = convexity_check(c, F, touch);
-  // A ball on a surface held by coordinates: its curvature 1/r against the ground's (section 11).
+  // A ball on a surface or a terrain held by coordinates: its curvature 1/r against the ground's
+  // (sections 8 and 11).
   const std::optional<GiNaC::ex> ball = c.shape->ball_radius(c.values);
-  if (ball && c.ground.point[0] >= 0) {
+  if (ball && (c.ground.point[0] >= 0 || c.ground.at[0] >= 0)) {
     SpecConvexity check;
     check.contact = c.name;
     check.where = c.where;
