@@ -149,6 +149,7 @@ void add_run(py::dict& d, const SimulationSummary& s) {
   d["steps"] = s.stats.steps;
   d["rejected_steps"] = s.stats.rejected_steps;
   d["rhs_evaluations"] = s.stats.rhs_evaluations;
+  d["stiff_steps"] = s.stats.stiff_steps;  // IntegratorStats: held by stability (dopri5, dop853)
   d["outputs"] = s.outputs;
   d["wall_time"] = s.wall_time;
 }
@@ -166,6 +167,7 @@ void add_watch_warnings(py::dict& d, const SimulationSummary& s) {
   py::list warnings;
   for (const std::string& w : s.warnings) warnings.append(w);
   d["warnings"] = warnings;
+  d["stiffness"] = s.stiffness;  // raised as nhdyn.StiffnessWarning
   py::list watch;
   for (const ConstraintWarning& w : s.watch.warnings) {
     py::dict item;

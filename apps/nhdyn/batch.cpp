@@ -136,6 +136,12 @@ void print_batch_outcome(const BatchArgs& args, const Model& base, const std::ve
       for (const std::string& w : results[r].summary.warnings) fmt::print(stderr, "nhdyn: warning: run {}: {}\n", r, w);
   }
   if (warned > 1) fmt::print(stderr, "nhdyn: warning: {} of {} runs had constraint-watch warnings\n", warned, results.size());
+  // A stiff stretch (analysis/simulation_summary.hpp): the first run's words and how many runs had one.
+  std::size_t stiff = 0;
+  for (std::size_t r = 0; r < results.size(); ++r)
+    if (!results[r].summary.stiffness.empty() && stiff++ == 0)
+      fmt::print(stderr, "nhdyn: warning: run {}: {}\n", r, results[r].summary.stiffness);
+  if (stiff > 1) fmt::print(stderr, "nhdyn: warning: {} of {} runs were stiff\n", stiff, results.size());
   // A stop condition that never held, in simulate's words, once with the runs it names.
   std::vector<std::vector<std::string>> unmet(results.size());
   for (std::size_t r = 0; r < results.size(); ++r) unmet[r] = results[r].summary.events.unmet_stops;

@@ -254,9 +254,13 @@ int run_compare(const CompareArgs& args) {
   warn_stop_events(model, options.run.t_end);
   const Comparison result = compare_formulations(model, options);
   // The constraint watch's warnings (analysis/constraint_watch.hpp), per case, whatever -q says.
-  for (const ComparisonResult& r : result.results)
+  for (const ComparisonResult& r : result.results) {
     for (const std::string& w : r.summary.warnings)
       fmt::print(stderr, "nhdyn: warning ({}, {}): {}\n", formulation_name(r.which.method), integrator_name(r.which.integrator), w);
+    if (!r.summary.stiffness.empty())
+      fmt::print(stderr, "nhdyn: warning ({}, {}): {}\n", formulation_name(r.which.method),
+                 integrator_name(r.which.integrator), r.summary.stiffness);
+  }
   table.write(format_table(provenance, result));
   write_series(series, model, result);
   files.commit();  // a case that failed is a row of the table: the files are kept, and the exit code says it

@@ -385,6 +385,7 @@ int run_simulate(const SimulateArgs& args) {
   // The run's warnings (the constraint watch's, analysis/constraint_watch.hpp), whatever the outcome.
   for (const std::string& w : summary.warnings) fmt::print(stderr, "nhdyn: warning: {}\n", w);
   for (const std::string& w : summary.events.unmet_stops) fmt::print(stderr, "nhdyn: warning: {}\n", w);
+  if (!summary.stiffness.empty()) fmt::print(stderr, "nhdyn: warning: {}\n", summary.stiffness);
   // `auto`'s background compile, failed during the run (a compile error): said as before the run.
   if (const std::string notice = jit::background_notice(model); !notice.empty()) fmt::print(stderr, "{}\n", notice);
   if (summary.status != Status::ok) return report_failure(model, summary, out, files, columns, provenance);

@@ -149,7 +149,7 @@ def _check_t_eval(t_eval, t0, t_end):
 
 __all__ = [
     "__version__", "Error", "InputError", "ModelError", "FileError", "SimulationError", "ConstraintWarning",
-    "StopConditionWarning",
+    "StopConditionWarning", "StiffnessWarning",
     "load", "loads", "builtin_models", "Model", "Result", "Optimum", "Equations", "Linearization", "Sweep",
     "BatchResult", "simulate_batch", "from_sympy", "from_sympy_mechanics",
 ]
@@ -163,10 +163,20 @@ class ConstraintWarning(UserWarning):
     numbers. Filter with warnings.simplefilter("error", nhdyn.ConstraintWarning) to make it fatal."""
 
 
+class StiffnessWarning(UserWarning):
+    """A run whose explicit integrator (dopri5, dop853) spent most of its steps held by its
+    stability rather than its accuracy (Hairer's stiffness test; docs/cli.md, "--max-steps"): the
+    result is right but an implicit integrator (integrator="cvode-bdf") takes far fewer steps.
+    Result.summary["stiffness"] has the words; summary["stiff_steps"] the count."""
+
+
 def _warn_constraints(model_name, summary, stacklevel, run=None):
     where = "" if run is None else " (run {})".format(run)
     for text in summary.get("warnings", []):
         warnings.warn("nhdyn: {}{}: {}".format(model_name, where, text), ConstraintWarning, stacklevel=stacklevel + 1)
+    if summary.get("stiffness"):
+        warnings.warn("nhdyn: {}{}: {}".format(model_name, where, summary["stiffness"]), StiffnessWarning,
+                      stacklevel=stacklevel + 1)
 
 
 class StopConditionWarning(UserWarning):

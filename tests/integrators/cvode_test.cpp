@@ -103,6 +103,34 @@ TEST(CvodeBdf, StiffRelaxationTakesFarFewerRhsEvaluationsThanDopri5) {
       << bdf.stats.rhs_evaluations << " vs " << dopri.stats.rhs_evaluations;
 }
 
+// Hairer's stiffness test in the explicit pairs (IntegratorStats::stiff_steps, stiff_from): on the
+// relaxation above |lambda| = 1000 holds dopri5's steps just under 3.25e-3 and dop853's just under
+// 6.1e-3 (within 20 % of the stability bound), so most steps are counted stiff, from early on; the oscillator (|lambda| = 1, steps of about 0.1 at
+// this tolerance, h |lambda| far inside both bounds) has none.
+TEST(StiffnessTest, TheExplicitPairsCountTheStepsThatStabilityHeld) {
+  const double y0[1] = {1.0};
+  const std::vector<double> times = linspace(0.0, 10.0, 101);
+  for (IntegratorKind kind : {IntegratorKind::dopri5, IntegratorKind::dop853}) {
+    FastRelaxation system;
+    const IntegrationResult stiff = integrate(system, tolerances(kind, 1e-6, 1e-8), 0.0, y0, times,
+                                              [](double, const double*) { return Status::ok; });
+    ASSERT_EQ(stiff.status, Status::ok) << stiff.message;
+    const double bound = kind == IntegratorKind::dopri5 ? 3.25 : 6.1;
+    // About 10 / (bound / 1000) accepted steps, at least half of them near the bound.
+    EXPECT_GT(stiff.stats.steps, 0.8 * 10.0 / (bound / 1000.0));
+    EXPECT_GT(2 * stiff.stats.stiff_steps, stiff.stats.steps) << stiff.stats.stiff_steps << " of " << stiff.stats.steps;
+    EXPECT_LT(stiff.stats.stiff_from, 0.5);
+
+    Oscillator calm;
+    const double start[2] = {1.0, 0.0};
+    const IntegrationResult smooth = integrate(calm, tolerances(kind, 1e-6, 1e-8), 0.0, start, times,
+                                               [](double, const double*) { return Status::ok; });
+    ASSERT_EQ(smooth.status, Status::ok) << smooth.message;
+    EXPECT_EQ(smooth.stats.stiff_steps, 0);
+    EXPECT_TRUE(std::isnan(smooth.stats.stiff_from));
+  }
+}
+
 // Robertson's chemical kinetics, the classic stiff test (Hairer-Wanner II, IV.1).
 class Robertson : public OdeSystem {
  public:

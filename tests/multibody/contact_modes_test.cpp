@@ -432,6 +432,36 @@ TEST(ContactModes, BallOnASphereLiftsOffAtTenSeventeenthsOrSlipsFirst) {
   EXPECT_NEAR(sphere_angle(r.summary.events.crossings[1]), hi, 1e-7);
   EXPECT_LT(r.at(r.rows.size() - 1, "work_friction"), 0.0);
   EXPECT_LT(r.summary.energy.balance_error, 1e-9);
+  // With one coefficient the slip grows from 0 as t^2 and its direction is stiff while it is small:
+  // dopri5 spends most of its steps there, and the run says so, from the slip's onset.
+  const std::string& stiff = r.summary.stiffness;
+  EXPECT_NE(stiff.find("the run is stiff from t = "), std::string::npos) << stiff;
+  EXPECT_NE(stiff.find("--integrator cvode-bdf"), std::string::npos) << stiff;
+  EXPECT_NE(stiff.find("a single friction coefficient"), std::string::npos) << stiff;
+  EXPECT_GT(2 * r.summary.stats.stiff_steps, r.summary.stats.steps);
+  EXPECT_GE(r.summary.stats.stiff_from, r.summary.events.crossings[0].t);
+  EXPECT_LT(r.summary.stats.stiff_from, r.summary.events.crossings[0].t + 1e-3);
+  // Two coefficients: the slip grows as t from the onset, no stiff stretch and no warning.
+  std::string two = text;
+  two.replace(two.find("friction = 0.3\n"), 15, "friction = [0.3, 0.25]\n");
+  const ModeRun r2 = run_modes(load_model_text(two, "sphere2.toml"), 3.1);
+  ASSERT_EQ(r2.summary.events.crossings.size(), 2u);
+  EXPECT_EQ(r2.summary.stiffness, "");
+  EXPECT_LT(10 * r2.summary.stats.steps, r.summary.stats.steps);
+}
+
+// After lift-off the ball flies away from the sphere: its rolling rows, dropped, have tangents
+// (C - K) x ... that grow with the distance, by 5e4 over 10 s. The constraint watch compares only
+// the rows the modes keep, so the free flight makes no warning (it made one on ball_roll2).
+TEST(ContactModes, TheConstraintWatchLeavesTheRowsOfAFreeContactAlone) {
+  const Model model = load_model(example("ball_on_sphere.toml"));
+  const ModeRun r = run_modes(model, 10.0);
+  ASSERT_EQ(r.summary.status, Status::ok) << r.summary.message;
+  ASSERT_EQ(r.summary.events.crossings.size(), 1u);
+  EXPECT_EQ(r.at(r.rows.size() - 1, "ball_mode"), 2.0);  // free
+  EXPECT_GT(r.at(r.rows.size() - 1, "ball_gap"), 100.0);
+  EXPECT_TRUE(r.summary.warnings.empty()) << r.summary.warnings.front();
+  EXPECT_LT(r.summary.watch.largest_row_factor, 10.0);
 }
 
 // A ball dropped from h0 onto the plane (unilateral, Newton's restitution e, no friction limit:

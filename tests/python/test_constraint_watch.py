@@ -63,3 +63,21 @@ def test_batch_warns_once_per_run():
     texts = [str(w.message) for w in caught if issubclass(w.category, nhdyn.ConstraintWarning)]
     assert len(texts) == 2 and "(run 0)" in texts[0] and "(run 1)" in texts[1]
     assert all(len(s["constraint_warnings"]) == 1 for s in b.summaries)
+
+
+def test_a_stiff_stretch_is_a_stiffness_warning_not_a_constraint_warning(examples):
+    # The sled speeds up down the slope and the rate at which its heading follows its velocity
+    # grows with the speed: from about 20 s on, dopri5's steps are held by its stability. The
+    # run says so as a StiffnessWarning (the result is right, only slow); cvode-bdf is not held.
+    m = nhdyn.load(examples / "sled.toml")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", nhdyn.ConstraintWarning)
+        with pytest.warns(nhdyn.StiffnessWarning, match=r"the run is stiff from t = 20\.\d+: .*--integrator cvode-bdf"):
+            r = m.simulate(t_end=100)
+    assert r.summary["warnings"] == []
+    assert 2 * r.summary["stiff_steps"] > r.summary["steps"] > 1000
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", nhdyn.StiffnessWarning)
+        bdf = m.simulate(t_end=100, integrator="cvode-bdf")
+    assert bdf.summary["stiffness"] == "" and bdf.summary["stiff_steps"] == 0
+    assert 5 * bdf.summary["steps"] < r.summary["steps"]

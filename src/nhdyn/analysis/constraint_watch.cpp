@@ -119,6 +119,7 @@ ConstraintWatch make_constraint_watch(const Model& model, const Data& data, std:
   watch.norm = Vector::Zero(s);
   watch.warned.assign(static_cast<std::size_t>(s) + 1, 0);
   watch.warnings.reserve(static_cast<std::size_t>(s) + 1);
+  watch.in_use.assign(static_cast<std::size_t>(s), 1);
   watch.conditioning = !data.sparse && s > 0;
   if (watch.conditioning) {
     // D is there, k x n, for the formulations that solve with it (sanh, nullspace). Not with
@@ -136,13 +137,41 @@ ConstraintWatch make_constraint_watch(const Model& model, const Data& data, std:
   return watch;
 }
 
+namespace {
+
+// The rows of b the contacts' current modes keep (ConstraintWatch::in_use); true when all are.
+bool mark_rows_in_use(const Model& model, const Data& data, ConstraintWatch& watch) {
+  if (!model.contact_modes || !data.modes.active) return true;
+  std::fill(watch.in_use.begin(), watch.in_use.end(), 1);
+  bool all = true;
+  const auto drop = [&](int row) {
+    if (row < 0) return;
+    watch.in_use[static_cast<std::size_t>(row)] = 0;
+    all = false;
+  };
+  const std::vector<ContactModeContact>& contacts = model.contact_modes->contacts;
+  for (std::size_t c = 0; c < contacts.size() && c < data.modes.mode.size(); ++c) {
+    const ContactMode mode = data.modes.mode[c];
+    if (mode == ContactMode::rolling) continue;
+    drop(contacts[c].roll[0]);
+    drop(contacts[c].roll[1]);
+    drop(contacts[c].spin);
+    if (mode == ContactMode::free) drop(contacts[c].gap);
+  }
+  return all;
+}
+
+}  // namespace
+
 void compute_constraint_watch(const Model& model, const Data& data, ConstraintWatch& watch) {
   const int s = model.s();
   if (s == 0) return;
   ++watch.states;
   row_norms(data, watch.norm);
+  const bool all_in_use = mark_rows_in_use(model, data, watch);
   Eigen::Index last = 0;
-  if (watch.conditioning) watch.condition = stacked_condition(model, data, watch, last);
+  if (watch.conditioning && (all_in_use || !watch.started))
+    watch.condition = stacked_condition(model, data, watch, last);
   if (!watch.started) {
     // The reference: a row that is zero or not finite here was refused before the run began.
     watch.started = true;
@@ -152,13 +181,13 @@ void compute_constraint_watch(const Model& model, const Data& data, ConstraintWa
   }
   for (int i = 0; i < s; ++i) {
     const double initial = watch.initial_norm(i);
-    if (!(initial > 0.0) || !std::isfinite(initial)) continue;
+    if (!(initial > 0.0) || !std::isfinite(initial) || !watch.in_use[static_cast<std::size_t>(i)]) continue;
     const double factor = change_factor(initial, watch.norm(i));
     watch.largest_row_factor = std::max(watch.largest_row_factor, factor);
     if (factor >= watch.threshold)
       record(watch, i, i, WatchMeasure::row_norm, data.t, initial, watch.norm(i), factor);
   }
-  if (watch.conditioning && watch.initial_condition > 0.0 && std::isfinite(watch.initial_condition)) {
+  if (watch.conditioning && all_in_use && watch.initial_condition > 0.0 && std::isfinite(watch.initial_condition)) {
     // Only growth counts: a matrix better conditioned than at the start is no trouble.
     const double factor = std::isfinite(watch.condition) ? watch.condition / watch.initial_condition : kInfinity;
     watch.largest_condition_factor = std::max(watch.largest_condition_factor, factor);

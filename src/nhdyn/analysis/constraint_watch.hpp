@@ -85,6 +85,11 @@ struct ConstraintWatch {
   Vector unit;                              // workspace of the bound, (rows watched)
   long states = 0;                          // states watched
   long estimates = 0;                       // of them, those whose conditioning was estimated
+  // With contact modes: the rows of b the current modes keep (a sliding contact drops its no-slip
+  // rows, a free one all its rows; model/contact_modes.hpp). A dropped row constrains nothing, so
+  // its norm is not compared (a ball flying away from a sphere stretches its rolling rows'
+  // unnormalized tangents), and the conditioning is watched only while every row is kept. s flags.
+  std::vector<char> in_use;
 };
 
 // The watch for a run of `model` on `data` (its path, dense or sparse) with the formulation
@@ -94,7 +99,8 @@ ConstraintWatch make_constraint_watch(const Model& model, const Data& data, std:
 
 // Watches the state held in data (b, and on the dense path D and A, after compute_acceleration):
 // the first call sets the reference, every later one compares with it and records a warning the
-// first time a constraint's measure passes the threshold. Allocates nothing.
+// first time a constraint's measure passes the threshold; with contact modes, only the rows the
+// current modes keep. Allocates nothing.
 void compute_constraint_watch(const Model& model, const Data& data, ConstraintWatch& watch);
 
 // One warning in words: the constraint by name, the measure, t, the factor, and what to do.

@@ -55,6 +55,24 @@ std::string singular_contact_message(const Model& model, double t, const double*
   return "";
 }
 
+// A run whose explicit integrator spent a large share of its steps held by stability, not accuracy
+// (IntegratorStats::stiff_steps, Hairer's test): at least 1000 steps and a quarter of all. "" when
+// not, or for the other integrators.
+std::string stiffness_warning(const Model& model, const IntegratorOptions& integrator, const IntegratorStats& stats) {
+  if (std::isnan(stats.stiff_from) || stats.stiff_steps < std::max(1000L, stats.steps / 4)) return "";
+  bool friction = false;
+  if (model.contact_modes)
+    for (const ContactModeContact& c : model.contact_modes->contacts) friction = friction || c.friction;
+  return fmt::format(
+      "the run is stiff from t = {:.6g}: {} of its {} steps were as short as the stability of {} requires, not as its "
+      "accuracy does; an implicit integrator takes far fewer steps there: --integrator cvode-bdf{}",
+      stats.stiff_from, stats.stiff_steps, stats.steps, integrator_name(integrator.kind),
+      friction ? ". A contact that starts to slide with a single friction coefficient makes such a stretch (its slip "
+                 "grows from 0 as t^2, and its direction is stiff while the slip is small); friction = [mu_s, mu_k] "
+                 "with mu_k < mu_s does not"
+               : "");
+}
+
 // Outputs beyond this many rows are refused: at ~100 bytes a row that is a 10 GB file.
 constexpr double kMaxOutputs = 1e8;
 
@@ -617,6 +635,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.watch.warnings = watch.warnings;
   for (const ConstraintWarning& w : watch.warnings) summary.warnings.push_back(format_constraint_warning(model, w));
   summary.warnings.insert(summary.warnings.end(), switches.warnings().begin(), switches.warnings().end());
+  summary.stiffness = stiffness_warning(model, options.integrator, summary.stats);
   summary.watch.largest_row_factor = watch.largest_row_factor;
   summary.watch.largest_condition_factor = watch.largest_condition_factor;
   summary.watch.watched_states = watch.states;

@@ -99,6 +99,10 @@ struct SimulationSummary {
   // The run's warnings in words, in time order: the constraint watch's (format_constraint_warning)
   // and those of the contacts' mode switches (analysis/detail/contact_switches.hpp).
   std::vector<std::string> warnings;
+  // A stiff stretch of an explicit integrator's run in words (IntegratorStats::stiff_steps, with
+  // the integrator to take instead); "" when the run had none. Kept apart from `warnings`: the
+  // result is right, only slow.
+  std::string stiffness;
 };
 
 // The lines `nhdyn simulate` prints after a run, one function per group, each line indented by two

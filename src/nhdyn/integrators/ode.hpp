@@ -6,6 +6,7 @@
 
 #include <array>
 #include <functional>
+#include <limits>
 #include <span>
 #include <string_view>
 #include <string>
@@ -84,6 +85,21 @@ struct IntegratorStats {
   long steps = 0;             // accepted steps
   long rejected_steps = 0;    // rejected by the error test (adaptive) or failed (CVODE)
   long rhs_evaluations = 0;   // calls of OdeSystem::rhs, including those for Jacobians
+  // dopri5, dop853: the accepted steps whose size the method's stability bounded rather than its
+  // accuracy (Hairer's test: h |lambda| near the stability boundary, |lambda| estimated from two
+  // stages at t + h), and the first t where 15 of them came nearly in a row (NaN if never): a stiff
+  // stretch, which an implicit method (cvode-bdf) crosses in far fewer steps.
+  long stiff_steps = 0;
+  double stiff_from = std::numeric_limits<double>::quiet_NaN();
+
+  // The counts of a run made of several integrations (contact modes' segments, restarts).
+  void add(const IntegratorStats& later) {
+    steps += later.steps;
+    rejected_steps += later.rejected_steps;
+    rhs_evaluations += later.rhs_evaluations;
+    stiff_steps += later.stiff_steps;
+    if (stiff_from != stiff_from) stiff_from = later.stiff_from;  // NaN: none yet
+  }
 };
 
 struct IntegrationResult {

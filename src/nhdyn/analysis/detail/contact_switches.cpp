@@ -778,9 +778,7 @@ IntegrationResult integrate_contact_modes(OdeSystem& ode, const IntegratorOption
     if (const Status status = failed ? switches.flush_row_after_failure() : switches.flush_row();
         status != Status::ok && result.status == Status::ok)
       result.status = status;
-    total.steps += result.stats.steps;
-    total.rejected_steps += result.stats.rejected_steps;
-    total.rhs_evaluations += result.stats.rhs_evaluations;
+    total.add(result.stats);
     result.stats = total;
     if (result.status == Status::stopped && switches.switched()) {
       switches.clear();

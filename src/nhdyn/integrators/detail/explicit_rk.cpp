@@ -30,6 +30,8 @@ class Stepper {
   double* k(int i) { return k_[static_cast<std::size_t>(i)].data(); }
   const double* k(int i) const { return k_[static_cast<std::size_t>(i)].data(); }
   double* scratch() { return y_stage_.data(); }
+  // After step(): the state of the last stage before the FSAL one.
+  const double* scratch_view() const { return y_stage_.data(); }
 
   // The FSAL stage of one step is the first of the next: swapping the buffers saves a copy.
   void reuse_last_stage() { std::swap(k_.front(), k_.back()); }
@@ -174,6 +176,44 @@ template <class Tableau>
 constexpr bool error_uses_last_stage = true;
 template <>
 constexpr bool error_uses_last_stage<rk::DormandPrince853> = false;
+
+// Hairer's stiffness test (DOPRI5 and DOP853, "the problem seems to become stiff"): the last two
+// stages of a step are both at t + h, so h |f(t + h, y1) - f(t + h, y_s)| / |y1 - y_s| estimates
+// h |lambda| for the dominant eigenvalue of the Jacobian; near the method's stability bound the
+// step size is held by stability, not by accuracy. Hairer counts the steps beyond the bound; the
+// step-size controller keeps h |lambda| just inside it (about 0.83 of it for dopri5 and 0.95 for
+// dop853 on y' = -1000 y), so a step within 20 % of the bound counts here (accuracy alone gives
+// far smaller h |lambda| at any usual tolerance). 15 such steps with fewer than 6 others between
+// them make a stiff stretch; its first step's t is reported (IntegratorStats::stiff_from).
+struct StiffnessTest {
+  int stiff = 0;  // stiff steps in the current stretch
+  int calm = 0;   // other steps since the last stiff one
+  double stretch_from = 0.0;
+
+  template <class Tableau>
+  void after_accepted_step(const Stepper<Tableau>& stepper, const double* y1, int n, double t, double h,
+                           IntegratorStats& stats) {
+    static_assert(Tableau::c[Tableau::stages - 2] == 1.0 && Tableau::c[Tableau::stages - 1] == 1.0,
+                  "the test compares the two last stages, both at t + h");
+    const double* ys = stepper.scratch_view();
+    const double* fs = stepper.k(Tableau::stages - 2);
+    const double* f1 = stepper.k(Tableau::stages - 1);
+    double num = 0.0, den = 0.0;
+    for (int i = 0; i < n; ++i) {
+      num += (f1[i] - fs[i]) * (f1[i] - fs[i]);
+      den += (y1[i] - ys[i]) * (y1[i] - ys[i]);
+    }
+    if (!(den > 0.0) || !std::isfinite(num)) return;
+    if (h * std::sqrt(num / den) > 0.8 * Tableau::stability_bound) {
+      ++stats.stiff_steps;
+      calm = 0;
+      if (stiff++ == 0) stretch_from = t;
+      if (stiff == 15 && std::isnan(stats.stiff_from)) stats.stiff_from = stretch_from;
+    } else if (++calm == 6) {
+      stiff = 0;
+    }
+  }
+};
 
 // The weighted RMS norm of the error estimate of the step (t, y) -> (t + h, y1), weights
 // atol + rtol max(|y|, |y1|); the step is accepted when it is at most 1. Dormand-Prince 5(4):
@@ -381,6 +421,7 @@ struct AdaptiveRun {
   std::optional<EventTracker> tracker;  // with events only
   std::vector<EventTracker::Crossing> crossings;
   std::size_t next = 0;  // the first output time not yet written
+  StiffnessTest stiffness;
 };
 
 // Before the first step from t: the event tracker started, f(t, y) in the first stage and the
@@ -577,6 +618,14 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
 
     const double t_new = last ? t_end : t + h;
     bool last_stage_ready = error_uses_last_stage<Tableau>;
+    // The FSAL stage, which the next step needs anyway, for the stiffness test.
+    if (!last_stage_ready) {
+      ++run.stats.rhs_evaluations;
+      status = system.rhs(t_new, run.y1.data(), run.stepper.k(Tableau::stages - 1));
+      if (status != Status::ok) return rhs_failure(method, status, t_new, t, run.stats);
+      last_stage_ready = true;
+    }
+    run.stiffness.after_accepted_step(run.stepper, run.y1.data(), system.error_size(), t, h, run.stats);
     // Events: a change of sign of some g between the step's ends is located on the step's
     // continuous extension (events.hpp), before after_step moves the end state.
     bool crossed = false;

@@ -50,6 +50,8 @@ struct DormandPrince54 {
   static constexpr double fac_min = 0.2;
   static constexpr double fac_max = 10.0;
   static constexpr double safety = 0.9;
+  // Where the stability region meets the negative real axis, for the stiffness test (DOPRI5's 3.25).
+  static constexpr double stability_bound = 3.25;
   static constexpr std::array<double, stages> c{{0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0}};
   static constexpr std::array<std::array<double, stages>, stages> a{{
       {{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}},
@@ -94,6 +96,7 @@ struct DormandPrince853 {
   static constexpr double fac_min = 0.333;
   static constexpr double fac_max = 6.0;
   static constexpr double safety = 0.9;
+  static constexpr double stability_bound = 6.1;  // DOP853's, for the stiffness test
   static constexpr std::array<double, stages> c{
       {0.0, 0.526001519587677318785587544488e-01, 0.789002279381515978178381316732e-01,
        0.118350341907227396726757197510, 0.281649658092772603273242802490,
