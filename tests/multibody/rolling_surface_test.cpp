@@ -5,6 +5,8 @@
 // and the refusals.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -395,6 +397,28 @@ TEST(RollingSurface, AHollowMoreCurvedThanTheBallMetAlongTheRunEndsItThere) {
     EXPECT_GT(farthest, 0.3 * X_star);
     EXPECT_LT(farthest, 0.9 * X_star);
   }
+}
+
+// The closed-form ellipsoid is held against the bowl's curvature as a ball is: at its lowest
+// point (0, 0, -c) its principal curvatures are c/a^2 = 2.5 and c/b^2 = 4.44444 (a = 0.2,
+// b = 0.15, c = 0.1); the ellipsoidal bowl X^2/A^2 + Y^2/B^2 + (Z - C)^2/C^2 = 1 has C/A^2 and
+// C/B^2 at its bottom. With A = B = C = 0.3 (3.33333 both) the ellipsoid is flatter along x and
+// the start is refused naming both; with the example's bowl of the test above it is not.
+TEST(RollingSurface, AnEllipsoidFlatterThanItsBowlIsRefusedWithBothCurvatures) {
+  const auto in_bowl = [&](double A, double B, double C) {
+    std::string text = text_of("ellipsoid_rocking.toml");
+    replace_once(text, R"(shape = { ellipsoid = ["a", "b", "c"] })",
+                 "shape = { ellipsoid = [\"a\", \"b\", \"c\"] }\n"
+                 "ground = { surface = \"X^2/A^2 + Y^2/B^2 + (Z - C)^2/C^2 - 1\", side = \"inside\" }");
+    replace_once(text, "[parameters]\n",
+                 fmt::format("[parameters]\nA = {}\nB = {}\nC = {}\n", A, B, C));
+    return text;
+  };
+  const std::string m = surface_error([&] { load_model_text(in_bowl(0.3, 0.3, 0.3), "bowl.toml", {{"tilt", 0.0}}); });
+  for (const std::string part : {"bowl.toml:", "contact 'foot'", "flatter than the hollow", "2.5 and 4.44444",
+                                 "-0.833333 and 1.11111"})
+    EXPECT_NE(m.find(part), std::string::npos) << m << "\n  lacks: " << part;
+  EXPECT_NO_THROW(load_model_text(in_bowl(1.2, 0.9, 0.7), "bowl.toml", {{"tilt", 0.0}}));
 }
 
 // Refusals, each naming the file's line and what to do.

@@ -32,6 +32,11 @@ class Sphere final : public ContactShape {
     return {scale(-v.sizes[0] / length, nu), v.sizes[0]};
   }
   std::optional<GiNaC::ex> ball_radius(const ShapeValues& v) const override { return v.sizes[0]; }
+  std::optional<GiNaC::matrix> curvature(const ShapeValues& v, const Vector3&, const GiNaC::ex&) const override {
+    GiNaC::matrix K(3, 3);
+    for (unsigned i = 0; i < 3; ++i) K(i, i) = 1 / v.sizes[0];
+    return K;
+  }
   VisualItem drawing(const ShapeValues& v) const override { return drawn(VisualKind::ellipsoid, {v.sizes[0], v.sizes[0], v.sizes[0]}); }
 };
 
@@ -48,6 +53,16 @@ class Ellipsoid final : public ContactShape {
                              v.sizes[2] * v.sizes[2] * nu[2]};
     const GiNaC::ex root = GiNaC::sqrt(dot(nu, Minv_nu));
     return {scale(-1 / root, Minv_nu), root / length};
+  }
+  // f = y^T M y - 1: H = 2 M and grad f = 2 M y*, of length |nu| / sqrt(nu^T M^{-1} nu) at y*, so
+  // K = M sqrt(nu^T M^{-1} nu) / length.
+  std::optional<GiNaC::matrix> curvature(const ShapeValues& v, const Vector3& nu, const GiNaC::ex& length) const override {
+    GiNaC::ex quadratic = 0;
+    for (std::size_t i = 0; i < 3; ++i) quadratic += v.sizes[i] * v.sizes[i] * nu[i] * nu[i];
+    const GiNaC::ex factor = GiNaC::sqrt(quadratic) / length;
+    GiNaC::matrix K(3, 3);
+    for (unsigned i = 0; i < 3; ++i) K(i, i) = factor / (v.sizes[i] * v.sizes[i]);
+    return K;
   }
   GiNaC::ex length(const ShapeValues& v) const override { return v.sizes[0]; }
   VisualItem drawing(const ShapeValues& v) const override { return drawn(VisualKind::ellipsoid, v.sizes); }

@@ -61,6 +61,14 @@ class ContactShape {
   virtual bool implicit() const { return false; }
   // The radius when the shape is a ball (the only shape offered on curved grounds so far).
   virtual std::optional<GiNaC::ex> ball_radius(const ShapeValues&) const { return std::nullopt; }
+  // The shape's curvature matrix (body axes) at its support point y*(nu) for nu / length: the
+  // Hessian of a defining f over |grad f| there, positive along the directions the surface bends
+  // away from the ground (docs/derivations/rolling-bodies.md sections 9 and 11), which the
+  // convexity check holds against a curved ground's. Nothing for a shape without one (a disk's
+  // rim, a torus) or an implicit shape (whose check uses its f).
+  virtual std::optional<GiNaC::matrix> curvature(const ShapeValues&, const Vector3&, const GiNaC::ex&) const {
+    return std::nullopt;
+  }
   // The size of the shape for the moment rows of the contact-force solve (a length).
   virtual GiNaC::ex length(const ShapeValues& values) const { return values.sizes.front(); }
   // Where the closed-form contact point is singular along the motion: a measure that is positive

@@ -911,18 +911,19 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
                                fmt::format("contact '{}': no spin about the normal, n.(omega - omega_ground) = 0", c.name)});
   }
   if (c.shape->implicit()) out.convexity = convexity_check(c, F, touch);
-  // A ball on a surface or a terrain held by coordinates: its curvature 1/r against the ground's
-  // (sections 8 and 11).
-  const std::optional<GiNaC::ex> ball = c.shape->ball_radius(c.values);
-  if (ball && (c.ground.point[0] >= 0 || c.ground.at[0] >= 0)) {
-    SpecConvexity check;
-    check.contact = c.name;
-    check.where = c.where;
-    check.normal = {touch.normal[0], touch.normal[1], touch.normal[2]};
-    for (unsigned i = 0; i < 3; ++i) check.body(i, i) = 1 / *ball;
-    check.ground = touch.curvature;
-    out.convexity = check;
-  }
+  // A closed-form shape (a ball, an ellipsoid) on a surface or a terrain held by coordinates: its
+  // curvature at the support point against the ground's (sections 8 and 11).
+  const Vector3 nu = multiply_transposed(F.rotation, touch.normal);
+  if (!c.shape->implicit() && (c.ground.point[0] >= 0 || c.ground.at[0] >= 0))
+    if (const std::optional<GiNaC::matrix> K = c.shape->curvature(c.values, nu, GiNaC::sqrt(dot(nu, nu)))) {
+      SpecConvexity check;
+      check.contact = c.name;
+      check.where = c.where;
+      check.normal = {touch.normal[0], touch.normal[1], touch.normal[2]};
+      check.body = F.rotation.mul(*K).mul(F.rotation.transpose());
+      check.ground = touch.curvature;
+      out.convexity = check;
+    }
   if (out.convexity)
     for (SpecContactWatch& watch : convexity_watches(*out.convexity, c.shape->implicit()))
       out.watches.push_back(std::move(watch));
