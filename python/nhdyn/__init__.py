@@ -164,8 +164,8 @@ class ConstraintWarning(UserWarning):
 
 
 class StiffnessWarning(UserWarning):
-    """A run whose explicit integrator (dopri5, dop853) spent most of its steps held by its
-    stability rather than its accuracy (Hairer's stiffness test; docs/cli.md, "--max-steps"): the
+    """A run whose explicit integrator (dopri5, dop853) spent many of its steps (at least 1000 and a
+    quarter of all) held by its stability rather than its accuracy (Hairer's stiffness test; docs/cli.md, "--max-steps"): the
     result is right but an implicit integrator (integrator="cvode-bdf") takes far fewer steps.
     Result.summary["stiffness"] has the words; summary["stiff_steps"] the count."""
 

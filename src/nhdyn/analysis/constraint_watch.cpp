@@ -10,6 +10,7 @@ namespace nhdyn {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // The row norms of b into `out` (s), from the dense b or, on the sparse path, from b_sparse's
 // columns: O(nonzeros).
@@ -170,24 +171,34 @@ void compute_constraint_watch(const Model& model, const Data& data, ConstraintWa
   row_norms(data, watch.norm);
   const bool all_in_use = mark_rows_in_use(model, data, watch);
   Eigen::Index last = 0;
-  if (watch.conditioning && (all_in_use || !watch.started))
-    watch.condition = stacked_condition(model, data, watch, last);
+  const bool conditioned = watch.conditioning && all_in_use;
+  if (conditioned) watch.condition = stacked_condition(model, data, watch, last);
   if (!watch.started) {
-    // The reference: a row that is zero or not finite here was refused before the run began.
+    // The reference: a row that is zero or not finite here was refused before the run began. A
+    // row a contact's mode drops (and the conditioning while one is dropped) takes its reference
+    // at the first state that keeps it (NaN until then).
     watch.started = true;
-    watch.initial_norm = watch.norm;
-    watch.initial_condition = watch.condition;
+    for (int i = 0; i < s; ++i)
+      watch.initial_norm(i) = watch.in_use[static_cast<std::size_t>(i)] ? watch.norm(i) : kNaN;
+    watch.initial_condition = conditioned ? watch.condition : kNaN;
     return;
   }
   for (int i = 0; i < s; ++i) {
+    if (!watch.in_use[static_cast<std::size_t>(i)]) continue;
+    if (std::isnan(watch.initial_norm(i))) {
+      watch.initial_norm(i) = watch.norm(i);
+      continue;
+    }
     const double initial = watch.initial_norm(i);
-    if (!(initial > 0.0) || !std::isfinite(initial) || !watch.in_use[static_cast<std::size_t>(i)]) continue;
+    if (!(initial > 0.0) || !std::isfinite(initial)) continue;
     const double factor = change_factor(initial, watch.norm(i));
     watch.largest_row_factor = std::max(watch.largest_row_factor, factor);
     if (factor >= watch.threshold)
       record(watch, i, i, WatchMeasure::row_norm, data.t, initial, watch.norm(i), factor);
   }
-  if (watch.conditioning && all_in_use && watch.initial_condition > 0.0 && std::isfinite(watch.initial_condition)) {
+  if (conditioned && std::isnan(watch.initial_condition)) {
+    watch.initial_condition = watch.condition;
+  } else if (conditioned && watch.initial_condition > 0.0 && std::isfinite(watch.initial_condition)) {
     // Only growth counts: a matrix better conditioned than at the start is no trouble.
     const double factor = std::isfinite(watch.condition) ? watch.condition / watch.initial_condition : kInfinity;
     watch.largest_condition_factor = std::max(watch.largest_condition_factor, factor);

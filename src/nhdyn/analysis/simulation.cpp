@@ -37,12 +37,32 @@ std::string non_finite_message(const std::string& kind, const std::string& where
                      where.empty() ? "" : where + ": ", kind, name, expression, text, t, state);
 }
 
+// The index of the contact `name` among the contacts with modes (model/contact_modes.hpp), or -1.
+int mode_contact_index(const Model& model, const std::string& name) {
+  if (!model.contact_modes) return -1;
+  const std::vector<ContactModeContact>& contacts = model.contact_modes->contacts;
+  for (std::size_t i = 0; i < contacts.size(); ++i)
+    if (contacts[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+// Whether a contact's watch applies in its current mode (ContactWatch::touching_only, free_only):
+// in the air a convexity describes no touching body, and the free flight's watch no contact.
+bool watched_in_mode(const Data& data, int mode_contact, bool touching_only, bool free_only) {
+  const bool free = mode_contact >= 0 && data.modes.active &&
+                    data.modes.mode[static_cast<std::size_t>(mode_contact)] == ContactMode::free;
+  return free ? !touching_only : !free_only;
+}
+
 // The contact whose closed-form point is singular at (t, q, v) (model.hpp, ContactWatch: a disk
-// lying flat), as the message of the run that failed there; "" when none is.
-std::string singular_contact_message(const Model& model, double t, const double* q, const double* v) {
+// lying flat), as the message of the run that failed there; "" when none is. A measure that is not
+// a number counts as singular.
+std::string singular_contact_message(const Model& model, const Data& data, double t, const double* q,
+                                     const double* v) {
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
   for (const ContactWatch& w : model.contact_watches) {
+    if (!watched_in_mode(data, mode_contact_index(model, w.contact), w.touching_only, w.free_only)) continue;
     const Tape measure = w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure;
     std::vector<double> registers(static_cast<std::size_t>(measure.registers()));
     double value = 0.0;
@@ -57,20 +77,26 @@ std::string singular_contact_message(const Model& model, double t, const double*
 
 // A run whose explicit integrator spent a large share of its steps held by stability, not accuracy
 // (IntegratorStats::stiff_steps, Hairer's test): at least 1000 steps and a quarter of all. "" when
-// not, or for the other integrators.
-std::string stiffness_warning(const Model& model, const IntegratorOptions& integrator, const IntegratorStats& stats) {
-  if (std::isnan(stats.stiff_from) || stats.stiff_steps < std::max(1000L, stats.steps / 4)) return "";
-  bool friction = false;
+// not, or for the other integrators. The friction's sentence only where a contact with friction
+// has a single coefficient (mu_k = mu_s, the last values `data` holds).
+std::string stiffness_warning(const Model& model, const Data& data, const IntegratorOptions& integrator,
+                              const IntegratorStats& stats) {
+  if (stats.stiff_steps < std::max(1000L, stats.steps / 4)) return "";
+  bool single = false;
   if (model.contact_modes)
-    for (const ContactModeContact& c : model.contact_modes->contacts) friction = friction || c.friction;
+    for (std::size_t c = 0; c < model.contact_modes->contacts.size(); ++c)
+      single = single || (model.contact_modes->contacts[c].friction && c < data.modes.mu_s.size() &&
+                          data.modes.mu_s[c] == data.modes.mu_k[c]);
+  // A run of many short segments (contact modes switching) may never hold 15 stiff steps in a row.
+  const std::string from = std::isnan(stats.stiff_from) ? "" : fmt::format(" from t = {:.6g}", stats.stiff_from);
   return fmt::format(
-      "the run is stiff from t = {:.6g}: {} of its {} steps were as short as the stability of {} requires, not as its "
-      "accuracy does; an implicit integrator takes far fewer steps there: --integrator cvode-bdf{}",
-      stats.stiff_from, stats.stiff_steps, stats.steps, integrator_name(integrator.kind),
-      friction ? ". A contact that starts to slide with a single friction coefficient makes such a stretch (its slip "
-                 "grows from 0 as t^2, and its direction is stiff while the slip is small); friction = [mu_s, mu_k] "
-                 "with mu_k < mu_s does not"
-               : "");
+      "the run is stiff{}: {} of its {} steps were as short as the stability of {} requires, not as its accuracy "
+      "does; an implicit integrator takes far fewer steps there: --integrator cvode-bdf{}",
+      from, stats.stiff_steps, stats.steps, integrator_name(integrator.kind),
+      single ? ". A contact that starts to slide with a single friction coefficient makes such a stretch (its slip "
+               "grows from 0 as t^2, and its direction is stiff while the slip is small); friction = [mu_s, mu_k] "
+               "with mu_k < mu_s does not"
+             : "");
 }
 
 // Outputs beyond this many rows are refused: at ~100 bytes a row that is a 10 GB file.
@@ -104,8 +130,8 @@ class MechanicalOde final : public OdeSystem {
     for (const ContactWatch& w : model.contact_watches)
       if (w.every_step) {
         singular_.push_back({w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure,
-                             w.threshold});
-        registers_.resize(std::max(registers_.size(), static_cast<std::size_t>(singular_.back().first.registers())));
+                             w.threshold, mode_contact_index(model, w.contact), w.touching_only, w.free_only});
+        registers_.resize(std::max(registers_.size(), static_cast<std::size_t>(singular_.back().measure.registers())));
       }
   }
 
@@ -141,10 +167,11 @@ class MechanicalOde final : public OdeSystem {
     // A contact whose equations stay regular where it is not defined (a surface's tangents
     // vanishing): ended at the step that reaches it, with the state for the message
     // (singular_contact_message).
-    for (const auto& [measure, threshold] : singular_) {
+    for (const EveryStepWatch& w : singular_) {
+      if (!watched_in_mode(data_, w.mode_contact, w.touching_only, w.free_only)) continue;
       double value = 0.0;
-      measure.run(t, y, y + n_, registers_.data(), &value);
-      if (value < threshold) {
+      w.measure.run(t, y, y + n_, registers_.data(), &value);
+      if (!(value >= w.threshold)) {
         data_.t = t;
         std::memcpy(data_.q.data(), y, sizeof(double) * static_cast<std::size_t>(n_));
         std::memcpy(data_.v.data(), y + n_, sizeof(double) * static_cast<std::size_t>(n_));
@@ -175,7 +202,13 @@ class MechanicalOde final : public OdeSystem {
   ConstraintWatch* watch_;  // null when the run does not watch
   int n_;
   bool balance_;
-  std::vector<std::pair<Tape, double>> singular_;  // the contact watches checked at every step, bound
+  struct EveryStepWatch {
+    Tape measure;
+    double threshold;
+    int mode_contact;  // the contact's index among those with modes, or -1
+    bool touching_only, free_only;
+  };
+  std::vector<EveryStepWatch> singular_;  // the contact watches checked at every step, bound
   std::vector<double> registers_;
   bool friction_;
 };
@@ -556,7 +589,7 @@ std::string explain_run_failure(const Model& model, const Data& data, const Mode
   }
   if (!output_message.empty()) message = output_message;
   // A contact point that is not defined there says so, rather than the equations' symptom of it.
-  if (const std::string singular = singular_contact_message(model, data.t, data.q.data(), data.v.data());
+  if (const std::string singular = singular_contact_message(model, data, data.t, data.q.data(), data.v.data());
       !singular.empty())
     message = singular;
   if (message.empty()) message = fmt::format("{} at t = {:.6g}", describe(status), result.t_reached);
@@ -635,7 +668,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.watch.warnings = watch.warnings;
   for (const ConstraintWarning& w : watch.warnings) summary.warnings.push_back(format_constraint_warning(model, w));
   summary.warnings.insert(summary.warnings.end(), switches.warnings().begin(), switches.warnings().end());
-  summary.stiffness = stiffness_warning(model, options.integrator, summary.stats);
+  summary.stiffness = stiffness_warning(model, data, options.integrator, summary.stats);
   summary.watch.largest_row_factor = watch.largest_row_factor;
   summary.watch.largest_condition_factor = watch.largest_condition_factor;
   summary.watch.watched_states = watch.states;

@@ -94,6 +94,8 @@ struct ContactWatch {
   std::string reason;
   std::string quantity;     // what the measure is, for the message
   bool every_step = false;  // checked at every accepted step (symbolic/spec.hpp, SpecContactWatch)
+  bool touching_only = false;  // checked only while the contact touches (contact modes)
+  bool free_only = false;      // checked only while the contact is free
 };
 
 struct Model {

@@ -750,8 +750,11 @@ std::pair<GiNaC::ex, GiNaC::ex> tangent_determinant_and_trace(const GiNaC::matri
 // accepted step): the shape's curvature less the ground's on the tangent plane, as
 // det(K_shape - K_ground) / (tr K_shape / 2)^2 there, which is (1 - r k1)(1 - r k2) for a ball of
 // radius r on a ground of principal curvatures k1, k2, and falls to 0 where the ground's hollow
-// becomes as curved as the shape (past it the contact is not unique and the motion not the body's);
-// for an implicit shape also its own det K / (tr K / 2)^2, 0 where it stops being strictly convex.
+// becomes as curved as the shape (past it the contact is not unique and the motion not the body's).
+// Where both principal differences cross 0 together (an isotropic hollow) the determinant only
+// touches 0, so its trace tr(K_shape - K_ground) / tr K_shape is watched too: it turns negative
+// there. For an implicit shape also its own det K / (tr K / 2)^2, 0 where it stops being strictly
+// convex, and not a number where both its curvatures vanish (which ends the run as well).
 std::vector<SpecContactWatch> convexity_watches(const SpecConvexity& check, bool own) {
   const Vector3 n = {check.normal[0], check.normal[1], check.normal[2]};
   const auto [body_det, body_trace] = tangent_determinant_and_trace(check.body, n);
@@ -764,17 +767,22 @@ std::vector<SpecContactWatch> convexity_watches(const SpecConvexity& check, bool
         check.contact, check.where, body_det / scale, 1e-4,
         "the shape is no longer strictly convex at its contact point (a principal curvature reaches 0): it would roll "
         "on a point that is not its lowest; write a strictly convex f",
-        "det K_shape / (tr K_shape / 2)^2 on the tangent plane", true});
+        "det K_shape / (tr K_shape / 2)^2 on the tangent plane", true, true});
   bool flat = true;
   for (unsigned i = 0; i < 3; ++i)
     for (unsigned j = 0; j < 3; ++j) flat = flat && check.ground(i, j).is_zero();
-  if (!flat)
-    watches.push_back(SpecContactWatch{
-        check.contact, check.where, tangent_determinant_and_trace(relative, n).first / scale, 1e-4,
+  if (!flat) {
+    const std::string reason =
         "the ground's hollow is as curved as the shape here (the shape's principal curvatures less the ground's "
         "reach 0): the contact is no longer a single point, and the motion past it is not the body's; use a more "
-        "curved shape or a smoother ground",
-        "det(K_shape - K_ground) / (tr K_shape / 2)^2 on the tangent plane", true});
+        "curved shape or a smoother ground";
+    const auto [relative_det, relative_trace] = tangent_determinant_and_trace(relative, n);
+    watches.push_back(SpecContactWatch{check.contact, check.where, relative_det / scale, 1e-4, reason,
+                                       "det(K_shape - K_ground) / (tr K_shape / 2)^2 on the tangent plane", true,
+                                       true});
+    watches.push_back(SpecContactWatch{check.contact, check.where, relative_trace / body_trace, 1e-4, reason,
+                                       "tr(K_shape - K_ground) / tr K_shape on the tangent plane", true, true});
+  }
   return watches;
 }
 
@@ -920,13 +928,33 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
       check.contact = c.name;
       check.where = c.where;
       check.normal = {touch.normal[0], touch.normal[1], touch.normal[2]};
-      check.body = F.rotation.mul(*K).mul(F.rotation.transpose());
+      // A ball's I / r is the same in every axes: not turned, so that its watch stays short.
+      check.body = c.shape->ball_radius(c.values) ? *K : F.rotation.mul(*K).mul(F.rotation.transpose());
       check.ground = touch.curvature;
       out.convexity = check;
     }
   if (out.convexity)
     for (SpecContactWatch& watch : convexity_watches(*out.convexity, c.shape->implicit()))
       out.watches.push_back(std::move(watch));
+  // A ball in the air over a ground held by coordinates (contact modes, free): the ground's point
+  // below its centre, which measures the gap, is the nearest one only while the centre is nearer
+  // than the ground's radii of curvature there (r + gap < 1/k): the ball's curvature 1/r becomes
+  // 1/(r + gap) in the same measures (rolling-bodies.md section 11).
+  if (out.convexity && c.shape->ball_radius(c.values)) {
+    const GiNaC::ex reach = *c.shape->ball_radius(c.values) + touch.gap;
+    SpecConvexity flying = *out.convexity;
+    for (unsigned i = 0; i < 3; ++i) flying.body(i, i) = 1 / reach;
+    const std::string reason =
+        "the ball flies farther from the ground than the ground's radius of curvature below it, where the ground's "
+        "point below the ball (which measures the gap) is no longer the nearest one and nhdyn cannot follow the flight "
+        "over this ground; a ground in closed form (a plane, a sphere) has no such limit";
+    const Vector3 n = {touch.normal[0], touch.normal[1], touch.normal[2]};
+    const auto [det, trace] = tangent_determinant_and_trace(flying.body.sub(flying.ground), n);
+    out.watches.push_back(SpecContactWatch{c.name, c.where, det * reach * reach, 1e-4, reason,
+                                           "(1 - (r + gap) k1)(1 - (r + gap) k2)", true, false, true});
+    out.watches.push_back(SpecContactWatch{c.name, c.where, trace * reach / 2, 1e-4, reason,
+                                           "(2 - (r + gap)(k1 + k2)) / 2", true, false, true});
+  }
   // 1 - (e . nu)^2 below 1e-4: the axle within 0.6 degree of the normal (rolling-bodies.md section 2).
   if (const std::optional<ContactShape::Singularity> singular =
           c.shape->singularity(c.values, multiply_transposed(F.rotation, touch.normal)))

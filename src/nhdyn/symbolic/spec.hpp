@@ -167,6 +167,10 @@ struct SpecContactWatch {
   // Checked at every accepted step, ending the run there (exit 1), rather than only where a run
   // fails: for a singularity that does not make the equations fail (a surface's tangents vanish).
   bool every_step = false;
+  // With contact modes: checked only while the contact touches (rolling or sliding: its convexity),
+  // or only while it is free (in the air: the point below it); neither: in every mode.
+  bool touching_only = false;
+  bool free_only = false;
 };
 
 struct Spec {

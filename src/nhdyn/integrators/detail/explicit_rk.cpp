@@ -422,7 +422,16 @@ struct AdaptiveRun {
   std::vector<EventTracker::Crossing> crossings;
   std::size_t next = 0;  // the first output time not yet written
   StiffnessTest stiffness;
+  bool stiffness_pending = false;  // the accepted step's stiffness test waits for its FSAL stage
 };
+
+// The stiffness test of the accepted step (t, h) once its FSAL stage at y1 is ready, once a step.
+template <class Tableau>
+void test_stiffness(AdaptiveRun<Tableau>& run, double t, double h, bool last_stage_ready) {
+  if (!run.stiffness_pending || !last_stage_ready) return;
+  run.stiffness_pending = false;
+  run.stiffness.after_accepted_step(run.stepper, run.y1.data(), run.system.error_size(), t, h, run.stats);
+}
 
 // Before the first step from t: the event tracker started, f(t, y) in the first stage and the
 // first step size h (the given one, or Hairer's estimate). A failure is the run's result.
@@ -508,7 +517,8 @@ std::optional<IntegrationResult> inside_step(AdaptiveRun<Tableau>& run, double t
 // At the end t_new of an accepted step: after_step on the end state (the events restarted
 // if it changed it), the FSAL stage of the state the next step starts from, the output at t_new.
 template <class Tableau>
-std::optional<IntegrationResult> end_step(AdaptiveRun<Tableau>& run, double t_new, bool last_stage_ready) {
+std::optional<IntegrationResult> end_step(AdaptiveRun<Tableau>& run, double t, double h, double t_new,
+                                          bool last_stage_ready) {
   if (run.tracker) run.tracker->advance();
   const StepEnd end = run.system.after_step(t_new, run.y1.data());
   if (end.status != Status::ok) return step_end_failure(run.method, end.status, t_new, run.stats);
@@ -523,6 +533,8 @@ std::optional<IntegrationResult> end_step(AdaptiveRun<Tableau>& run, double t_ne
     const Status status = run.system.rhs(t_new, run.y1.data(), run.stepper.k(Tableau::stages - 1));
     if (status != Status::ok) return rhs_failure(run.method, status, t_new, t_new, run.stats);
   }
+  // A changed state's FSAL stage is not the step's: the test is left out for that step.
+  test_stiffness(run, t, h, !end.changed);
   if (run.next < run.output_times.size() && run.output_times[run.next] == t_new) {
     if (run.output(t_new, run.y1.data()) == Status::stopped) return stopped_at(t_new, run.stats);
     ++run.next;
@@ -618,14 +630,10 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
 
     const double t_new = last ? t_end : t + h;
     bool last_stage_ready = error_uses_last_stage<Tableau>;
-    // The FSAL stage, which the next step needs anyway, for the stiffness test.
-    if (!last_stage_ready) {
-      ++run.stats.rhs_evaluations;
-      status = system.rhs(t_new, run.y1.data(), run.stepper.k(Tableau::stages - 1));
-      if (status != Status::ok) return rhs_failure(method, status, t_new, t, run.stats);
-      last_stage_ready = true;
-    }
-    run.stiffness.after_accepted_step(run.stepper, run.y1.data(), system.error_size(), t, h, run.stats);
+    // The stiffness test needs the FSAL stage at y1: dopri5's error estimate has it already; DOP853
+    // evaluates it for an output inside the step or in end_step, and the test waits for it there.
+    run.stiffness_pending = true;
+    test_stiffness(run, t, h, last_stage_ready);
     // Events: a change of sign of some g between the step's ends is located on the step's
     // continuous extension (events.hpp), before after_step moves the end state.
     bool crossed = false;
@@ -633,9 +641,11 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
       status = run.tracker->check(t_new, run.y1.data(), crossed);
       if (status != Status::ok) return rhs_failure(method, status, t_new, t, run.stats);
     }
-    if (crossed || (run.next < output_times.size() && output_times[run.next] < t_new))
+    if (crossed || (run.next < output_times.size() && output_times[run.next] < t_new)) {
       if (auto stop = inside_step(run, t, h, t_new, crossed, last_stage_ready)) return *std::move(stop);
-    if (auto stop = end_step(run, t_new, last_stage_ready)) return *std::move(stop);
+      test_stiffness(run, t, h, last_stage_ready);
+    }
+    if (auto stop = end_step(run, t, h, t_new, last_stage_ready)) return *std::move(stop);
 
     std::swap(run.y, run.y1);
     run.stepper.reuse_last_stage();
