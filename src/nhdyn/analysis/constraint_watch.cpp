@@ -143,21 +143,14 @@ namespace {
 // The rows of b the contacts' current modes keep (ConstraintWatch::in_use); true when all are.
 bool mark_rows_in_use(const Model& model, const Data& data, ConstraintWatch& watch) {
   if (!model.contact_modes || !data.modes.active) return true;
-  std::fill(watch.in_use.begin(), watch.in_use.end(), 1);
-  bool all = true;
-  const auto drop = [&](int row) {
-    if (row < 0) return;
-    watch.in_use[static_cast<std::size_t>(row)] = 0;
-    all = false;
-  };
   const std::vector<ContactModeContact>& contacts = model.contact_modes->contacts;
-  for (std::size_t c = 0; c < contacts.size() && c < data.modes.mode.size(); ++c) {
-    const ContactMode mode = data.modes.mode[c];
-    if (mode == ContactMode::rolling) continue;
-    drop(contacts[c].roll[0]);
-    drop(contacts[c].roll[1]);
-    drop(contacts[c].spin);
-    if (mode == ContactMode::free) drop(contacts[c].gap);
+  bool all = true;
+  for (int row = 0; row < model.s(); ++row) {
+    bool kept = true;
+    for (std::size_t c = 0; c < contacts.size() && kept; ++c)
+      kept = !contact_mode_drops_row(contacts[c], data.modes.mode[c], row);
+    watch.in_use[static_cast<std::size_t>(row)] = kept;
+    all = all && kept;
   }
   return all;
 }

@@ -20,12 +20,6 @@ namespace {
 // sliding mode near s = 0").
 double slip_floor(const Data& data) { return 1e-10 * (1.0 + data.v.lpNorm<Eigen::Infinity>()); }
 
-bool dropped(const ContactModeContact& c, ContactMode mode, int row) {
-  if (mode == ContactMode::rolling) return false;
-  if (row == c.roll[0] || row == c.roll[1] || row == c.spin) return true;
-  return mode == ContactMode::free && row == c.gap;
-}
-
 // Per contact: mu, the unit tangents' lengths, the slip, and for a sliding contact e_s.
 void contact_kinematics(const ContactModeModel& cm, Data& data, std::vector<std::array<double, 2>>& lengths) {
   ContactModeData& w = data.modes;
@@ -219,7 +213,7 @@ Status solve_modes(const Model& model, Data& data, bool rolling, bool forces_onl
   w.kept.clear();
   for (int row = 0; row < s; ++row) {
     bool keep = true;
-    for (std::size_t i = 0; i < cm.contacts.size() && keep; ++i) keep = !dropped(cm.contacts[i], w.mode[i], row);
+    for (std::size_t i = 0; i < cm.contacts.size() && keep; ++i) keep = !contact_mode_drops_row(cm.contacts[i], w.mode[i], row);
     if (keep) w.kept.push_back(row);
   }
   const int r = static_cast<int>(w.kept.size());

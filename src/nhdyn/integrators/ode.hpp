@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <span>
@@ -98,7 +99,7 @@ struct IntegratorStats {
     rejected_steps += later.rejected_steps;
     rhs_evaluations += later.rhs_evaluations;
     stiff_steps += later.stiff_steps;
-    if (stiff_from != stiff_from) stiff_from = later.stiff_from;  // NaN: none yet
+    if (std::isnan(stiff_from)) stiff_from = later.stiff_from;
   }
 };
 

@@ -86,15 +86,19 @@ void append_contact_mode_values(const Data& data, std::vector<double>& row) {
   row.push_back(data.impact_loss);
 }
 
+bool contact_mode_drops_row(const ContactModeContact& c, ContactMode mode, int row) {
+  if (mode == ContactMode::rolling || row < 0) return false;
+  if (row == c.roll[0] || row == c.roll[1] || row == c.spin) return true;
+  return mode == ContactMode::free && row == c.gap;
+}
+
 bool contact_mode_drops(const Model& model, const Data& data, const std::string& constraint) {
   if (!model.contact_modes || !data.modes.active) return false;
   const std::vector<ContactModeContact>& contacts = model.contact_modes->contacts;
-  for (std::size_t i = 0; i < contacts.size(); ++i) {
-    const ContactModeContact& c = contacts[i];
-    const ContactMode mode = data.modes.mode[i];
-    if (mode == ContactMode::rolling) continue;
-    for (int row : {c.roll[0], c.roll[1], c.spin, mode == ContactMode::free ? c.gap : -1})
-      if (row >= 0 && model.constraints[static_cast<std::size_t>(row)].name == constraint) return true;
+  for (int row = 0; row < model.s(); ++row) {
+    if (model.constraints[static_cast<std::size_t>(row)].name != constraint) continue;
+    for (std::size_t i = 0; i < contacts.size(); ++i)
+      if (contact_mode_drops_row(contacts[i], data.modes.mode[i], row)) return true;
   }
   return false;
 }

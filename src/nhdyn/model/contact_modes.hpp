@@ -136,5 +136,9 @@ void record_contact_gaps(const Model& model, Data& data);
 
 // Whether the constraint called `constraint` is a row that its contact's current mode drops.
 bool contact_mode_drops(const Model& model, const Data& data, const std::string& constraint);
+// Whether contact c in `mode` drops the row `row` of b (a constraint index): sliding drops its
+// no-slip rows and its spin row, free also its gap; rolling none. The one rule the mode solve, the
+// residuals and the constraint watch share.
+bool contact_mode_drops_row(const ContactModeContact& c, ContactMode mode, int row);
 
 }  // namespace nhdyn

@@ -189,6 +189,7 @@ struct StiffnessTest {
   int stiff = 0;  // stiff steps in the current stretch
   int calm = 0;   // other steps since the last stiff one
   double stretch_from = 0.0;
+  bool pending = false;  // the accepted step's test waits for its FSAL stage
 
   template <class Tableau>
   void after_accepted_step(const Stepper<Tableau>& stepper, const double* y1, int n, double t, double h,
@@ -422,14 +423,13 @@ struct AdaptiveRun {
   std::vector<EventTracker::Crossing> crossings;
   std::size_t next = 0;  // the first output time not yet written
   StiffnessTest stiffness;
-  bool stiffness_pending = false;  // the accepted step's stiffness test waits for its FSAL stage
 };
 
 // The stiffness test of the accepted step (t, h) once its FSAL stage at y1 is ready, once a step.
 template <class Tableau>
 void test_stiffness(AdaptiveRun<Tableau>& run, double t, double h, bool last_stage_ready) {
-  if (!run.stiffness_pending || !last_stage_ready) return;
-  run.stiffness_pending = false;
+  if (!run.stiffness.pending || !last_stage_ready) return;
+  run.stiffness.pending = false;
   run.stiffness.after_accepted_step(run.stepper, run.y1.data(), run.system.error_size(), t, h, run.stats);
 }
 
@@ -632,7 +632,7 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
     bool last_stage_ready = error_uses_last_stage<Tableau>;
     // The stiffness test needs the FSAL stage at y1: dopri5's error estimate has it already; DOP853
     // evaluates it for an output inside the step or in end_step, and the test waits for it there.
-    run.stiffness_pending = true;
+    run.stiffness.pending = true;
     test_stiffness(run, t, h, last_stage_ready);
     // Events: a change of sign of some g between the step's ends is located on the step's
     // continuous extension (events.hpp), before after_step moves the end state.
