@@ -128,9 +128,11 @@ asan: deps
 	cd $(SAN_BUILD) && $(SANITIZER_ENV) ctest --output-on-failure -j $(JOBS) $(if $(ASAN_SKIP_NAMES),-E '$(ASAN_SKIP_NAMES)')
 
 # Reuses build-asan when it was made with clang-14 (make asan), else configures build-fuzz.
+# FUZZ_FLAGS: libFuzzer flags (CI gives -seed=1, so that its run tries the same inputs every time).
 FUZZ_RUNS ?= 5000
+FUZZ_FLAGS ?=
 fuzz:
-	NHDYN_FUZZ_BUILD=$(if $(HAVE_CLANG),$(CURDIR)/$(SAN_BUILD),$(CURDIR)/build-fuzz) sh fuzz/run $(FUZZ_RUNS)
+	NHDYN_FUZZ_BUILD=$(if $(HAVE_CLANG),$(CURDIR)/$(SAN_BUILD),$(CURDIR)/build-fuzz) sh fuzz/run $(FUZZ_RUNS) $(FUZZ_FLAGS)
 
 clean:
 	rm -rf $(BUILD) $(SAN_BUILD) build-fuzz results

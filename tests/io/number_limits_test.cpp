@@ -1,7 +1,7 @@
 // Inputs that used to end in an internal error or a hang now get a user error naming what is
 // wrong (the CLI's exit 2), at once: a subnormal parameter value or literal (CLN's "floating
 // point underflow", Tape::push's powi), and a product of powers of sums that multiplied out
-// has millions of terms (minutes in expand). Timed loosely (a hang is minutes; the refusal is
+// has millions of terms (minutes in expand) or thousands (seconds). Timed loosely (a hang is minutes; the refusal is
 // milliseconds), so that the test fails on a hang, not on a slow machine.
 #include <gtest/gtest.h>
 
@@ -56,6 +56,19 @@ TEST(NumberLimits, AProductOfPowersOfSumsIsRefusedAtOnce) {
   const std::string m = refusal(oscillator("(x'^2+y'^2+z'^2)*(1+(x+y+z)^2)^32", "0", "1"), seconds);
   EXPECT_NE(m.find("multiplied out"), std::string::npos) << m;
   EXPECT_LT(seconds, 5.0);
+}
+
+// (x + y + z + m)^20 multiplies out to 1771 terms and T to about 5300: seconds of derivation
+// (15 s in a release build for the sled's T times (x + y + phi + a)^30), refused at the 1000-term
+// limit; a power of a sum of 138 terms loads.
+TEST(NumberLimits, APowerOfASumOfThousandsOfTermsIsRefused) {
+  double seconds = 0;
+  const std::string m = refusal(oscillator("(x'^2+y'^2+z'^2)*(3+(x+y+z+m)^20)", "0", "1"), seconds);
+  EXPECT_NE(m.find("multiplied out, this expression could have about 5.3e+03 terms (the limit is 1000)"),
+            std::string::npos)
+      << m;
+  EXPECT_LT(seconds, 5.0);
+  EXPECT_EQ(refusal(oscillator("(x'^2+y'^2+z'^2)*(3+(x+y+z)^8)", "0", "1"), seconds), "");
 }
 
 }  // namespace
