@@ -1,7 +1,8 @@
 // Events (events.hpp) on problems whose crossings are known in closed form: the zeros of cos t
 // found by every integrator that locates events, to round-off for the explicit pairs on their
 // continuous extensions; the direction filter; several crossings in one step reported in time
-// order; a stop that ends the run at the crossing; rk4 refused; Brent's method on its own.
+// order; a stop that ends the run at the crossing; a dip through zero and back inside one step,
+// found when the event may dip; rk4 refused; Brent's method on its own.
 #include "nhdyn/integrators/events.hpp"
 
 #include <gtest/gtest.h>
@@ -151,6 +152,75 @@ TEST(Events, StopEndsTheRunAtTheCrossing) {
     ASSERT_EQ(events.hits.size(), 2u);
     EXPECT_EQ(result.t_reached, events.hits[1].t);
     EXPECT_NEAR(result.t_reached, 1.5 * pi, 1e-6);
+  }
+}
+
+// y' = 1 from 0: the error estimate is zero, so each step is ten times the last, and one of
+// them spans t = 1 ... 10. g = (y - 5)^2 - a^2 dips below zero between 5 - a and 5 + a inside it,
+// positive at both its ends: seen only when the event may dip (EventFunctions::may_dip).
+class Uniform : public OdeSystem {
+ public:
+  int size() const override { return 1; }
+  Status rhs(double /*t*/, const double* /*y*/, double* ydot) override {
+    ydot[0] = 1.0;
+    return Status::ok;
+  }
+};
+
+class Dip : public EventFunctions {
+ public:
+  Dip(CrossingDirection direction, double a2, bool may_dip) : direction_(direction), a2_(a2), may_dip_(may_dip) {}
+  int count() const override { return 1; }
+  CrossingDirection direction(int) const override { return direction_; }
+  Status evaluate(double, const double* y, double* g) override {
+    g[0] = (y[0] - 5.0) * (y[0] - 5.0) - a2_;
+    return Status::ok;
+  }
+  Status on_event(int, double t, const double*) override {
+    hits.push_back(t);
+    return Status::ok;
+  }
+  bool may_dip(int) const override { return may_dip_; }
+  std::vector<double> hits;
+
+ private:
+  CrossingDirection direction_;
+  double a2_;
+  bool may_dip_;
+};
+
+TEST(Events, ADipInsideOneStepIsFoundWhenTheEventMayDip) {
+  for (IntegratorKind kind :
+       {IntegratorKind::dopri5, IntegratorKind::dop853, IntegratorKind::cvode_adams, IntegratorKind::cvode_bdf}) {
+    const auto dip_run = [&](Dip& dip) {
+      Uniform uniform;
+      IntegratorOptions options;
+      options.kind = kind;
+      const double y0[1] = {0.0};
+      const std::vector<double> times = {0.0, 10.0};
+      const IntegrationResult result =
+          integrate(uniform, options, 0.0, y0, times, [](double, const double*) { return Status::ok; }, &dip);
+      EXPECT_EQ(result.status, Status::ok) << result.message;
+      return result.stats.steps;
+    };
+    const std::string name(integrator_name(kind));
+    Dip unseen(CrossingDirection::falling, 0.01, false);
+    const long steps = dip_run(unseen);
+    EXPECT_TRUE(unseen.hits.empty()) << name << ": the steps are too long to see it without may_dip";
+    EXPECT_LT(steps, 20) << name;
+    Dip falling(CrossingDirection::falling, 0.01, true);
+    dip_run(falling);
+    ASSERT_EQ(falling.hits.size(), 1u) << name;
+    EXPECT_NEAR(falling.hits[0], 4.9, 1e-12) << name;
+    Dip both(CrossingDirection::both, 0.01, true);
+    dip_run(both);
+    ASSERT_EQ(both.hits.size(), 2u) << name;
+    EXPECT_NEAR(both.hits[0], 4.9, 1e-12) << name;
+    EXPECT_NEAR(both.hits[1], 5.1, 1e-12) << name;
+    // A near miss (the minimum 1e-4 above zero) is no crossing.
+    Dip miss(CrossingDirection::both, -1e-4, true);
+    dip_run(miss);
+    EXPECT_TRUE(miss.hits.empty()) << name << ": " << miss.hits.front();
   }
 }
 

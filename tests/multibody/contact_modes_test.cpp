@@ -450,6 +450,53 @@ TEST(ContactModes, BallOnASphereLiftsOffAtTenSeventeenthsOrSlipsFirst) {
   EXPECT_LT(10 * r2.summary.stats.steps, r.summary.stats.steps);
 }
 
+// A ball dropped from 40 m onto ball_on_sphere's sphere (R = 1, r = 0.1) at x = 0.3: it falls
+// freely and its centre reaches R + r where z = sqrt((R + r)^2 - x^2), at t* = sqrt(2 (40 - z) / g).
+// Free flight is a polynomial, so the integrator's steps are long (about 1 s): the ball crosses the
+// sphere within one of them, the gap positive at both ends, and the touchdown is found only by
+// looking inside the step (EventFunctions::may_dip), with every integrator that locates events
+// (CVODE's root finding sees sign changes only). A ball dropped at x = 1.15 passes the sphere
+// 0.05 from it: no touchdown, its gap never below 0.05.
+TEST(ContactModes, ABallFallingPastASphereWithinOneStepTouchesDownOnIt) {
+  const auto dropped = [](double x) {
+    std::string text = test::read_text(example("ball_on_sphere.toml"));
+    const std::string start = "position = { x = \"(R + r)*sin(theta0)\", y = 0, z = \"(R + r)*cos(theta0)\"";
+    text.replace(text.find(start), start.size(), fmt::format("position = {{ x = {}, y = 0, z = 40", x));
+    return load_model_text(text, "drop.toml");
+  };
+  const double g = 9.81, x = 0.3;
+  const double t_star = std::sqrt(2 * (40 - std::sqrt(1.1 * 1.1 - x * x)) / g);
+  for (const IntegratorKind integrator :
+       {IntegratorKind::dopri5, IntegratorKind::dop853, IntegratorKind::cvode_bdf, IntegratorKind::cvode_adams}) {
+    const bool explicit_rk = integrator == IntegratorKind::dopri5 || integrator == IntegratorKind::dop853;
+    SimulationOptions options;
+    options.t_end = 4.0;
+    options.output_step = 0.5;
+    options.integrator.kind = integrator;
+    options.integrator.rtol = 1e-10;
+    options.integrator.atol = 1e-12;
+    const SimulationSummary summary = simulate(dropped(x), options, [](const Data&) {});
+    ASSERT_EQ(summary.status, Status::ok) << summary.message;
+    ASSERT_GE(summary.events.crossings.size(), 1u);
+    const EventRecord& touchdown = summary.events.crossings[0];
+    EXPECT_EQ(touchdown.name, "ball_touchdown");
+    // BDF's interpolating polynomial is of lower order than the explicit methods' extensions.
+    EXPECT_NEAR(touchdown.t, t_star, explicit_rk ? 1e-9 : 1e-8);
+    EXPECT_NEAR(std::hypot(touchdown.q[0], touchdown.q[1], touchdown.q[2]), 1.1, explicit_rk ? 1e-9 : 1e-7);
+    // Long steps: the touchdown was inside one of them, not at a step's end.
+    if (explicit_rk) {
+      EXPECT_LT(summary.stats.steps, 40);
+    }
+  }
+  const Model past = dropped(1.15);
+  const ModeRun r = run_modes(past, 4.0);
+  EXPECT_TRUE(r.summary.events.crossings.empty()) << r.summary.events.crossings[0].name;
+  double lowest = 1e300;
+  for (std::size_t i = 0; i < r.rows.size(); ++i) lowest = std::min(lowest, r.at(i, "ball_gap"));
+  EXPECT_GT(lowest, 0.05 - 1e-9);
+  EXPECT_LT(lowest, 0.06);  // the rows every 0.01 s pass near the closest point
+}
+
 // After lift-off the ball flies away from the sphere: its rolling rows, dropped, have tangents
 // (C - K) x ... that grow with the distance, by 5e4 over 10 s. The constraint watch compares only
 // the rows the modes keep, so the free flight makes no warning (it made one on ball_roll2).

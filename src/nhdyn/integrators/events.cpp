@@ -1,6 +1,7 @@
 #include "nhdyn/integrators/events.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -87,14 +88,18 @@ Status find_root(const std::function<Status(double x, double& fx)>& f, double a,
   return Status::ok;
 }
 
-EventTracker::EventTracker(EventFunctions& events, int n)
+EventTracker::EventTracker(EventFunctions& events, int n, double rtol, double atol)
     : events_(events),
+      rtol_(rtol),
+      atol_(atol),
       m_(events.count()),
       sign_(static_cast<std::size_t>(m_), 0),
       g_end_(static_cast<std::size_t>(m_), 0.0),
       g_(static_cast<std::size_t>(m_), 0.0),
-      y_(static_cast<std::size_t>(n), 0.0) {
+      y_(static_cast<std::size_t>(n), 0.0),
+      g_start_(static_cast<std::size_t>(m_), 0.0) {
   crossed_.reserve(static_cast<std::size_t>(m_));
+  dips_.reserve(static_cast<std::size_t>(m_));
 }
 
 Status EventTracker::restart(double t, const double* y) {
@@ -104,6 +109,7 @@ Status EventTracker::restart(double t, const double* y) {
     const int s = sign_of(g_[i]);
     if (s != 0) sign_[i] = s;  // a zero keeps the side it was reached from
   }
+  g_start_ = g_;
   return Status::ok;
 }
 
@@ -123,8 +129,39 @@ Status EventTracker::check(double t1, const double* y1, bool& crossed) {
     if (direction == CrossingDirection::falling && rising) continue;
     crossed_.push_back(i);
   }
-  crossed = !crossed_.empty();
+  collect_dips();
+  crossed = !crossed_.empty() || !dips_.empty();
   return Status::ok;
+}
+
+Status EventTracker::check_dips(double t1, const double* y1, bool& dipped) {
+  dipped = false;
+  crossed_.clear();
+  const Status status = events_.evaluate(t1, y1, g_end_.data());
+  if (status != Status::ok) return status;
+  collect_dips();
+  dipped = !dips_.empty();
+  return Status::ok;
+}
+
+bool EventTracker::any_may_dip() const {
+  for (int i = 0; i < m_; ++i)
+    if (events_.may_dip(i)) return true;
+  return false;
+}
+
+void EventTracker::collect_dips() {
+  dips_.clear();
+  for (int i = 0; i < m_; ++i) {
+    const std::size_t k = static_cast<std::size_t>(i);
+    const int before = sign_[k];
+    if (before == 0 || sign_of(g_end_[k]) != before || !events_.may_dip(i)) continue;
+    const CrossingDirection direction = events_.direction(i);
+    // A dip from the positive side crosses falling, from the negative side rising.
+    if (direction == CrossingDirection::rising && before > 0) continue;
+    if (direction == CrossingDirection::falling && before < 0) continue;
+    dips_.push_back(i);
+  }
 }
 
 Status EventTracker::value(int i, double t, double h, double theta, const Interpolant& interpolate, double& g) {
@@ -136,8 +173,102 @@ Status EventTracker::value(int i, double t, double h, double theta, const Interp
   return status;
 }
 
+Status EventTracker::find_dip(int i, double t, double h, const Interpolant& interpolate, double& theta,
+                              double& theta_back) {
+  theta = theta_back = -1.0;
+  const std::size_t k = static_cast<std::size_t>(i);
+  const double side = sign_[k];
+  // f = g_i seen from the side it kept: positive at both ends, a dip is where it turns negative.
+  const auto f = [&](double x, double& fx) {
+    const Status status = value(i, t, h, x, interpolate, fx);
+    fx *= side;
+    return status;
+  };
+  const double f0 = side * g_start_[k], f1 = side * g_end_[k];
+  // A dip counts when g goes below zero by more than the interpolant may be off by, ten times
+  // the tolerances on the state (a gap that opens from zero at a lift-off has values of either
+  // sign of that size near its start), or round-off on g's size at the ends.
+  interpolate(0.0, y_.data());
+  double size = 0.0;
+  for (const double v : y_) size = std::max(size, std::abs(v));
+  const double depth = std::max(1e-9 * std::max(std::abs(f0), std::abs(f1)), 10.0 * (atol_ + rtol_ * size));
+  // The slopes at the ends, by differences over a small fraction of the step: a minimum inside
+  // needs f falling at the start and rising at the end. (A function that rises, then falls, dips
+  // and rises again within one step has three extrema there; the error control keeps a step far
+  // shorter than that on a gap, which changes with the bodies' motion.)
+  constexpr double kDelta = 1e-4;
+  double fa = 0.0, fb = 0.0;
+  Status status = f(kDelta, fa);
+  if (status != Status::ok) return status;
+  if (!(fa < f0)) return Status::ok;
+  status = f(1.0 - kDelta, fb);
+  if (status != Status::ok) return status;
+  if (!(fb < f1)) return Status::ok;
+  // Samples to bracket the smallest value: a narrow dip between wide samples shows as a smaller
+  // sample next to it, since the gap falls towards the dip and rises after it.
+  constexpr int kSamples = 8;
+  std::array<double, kSamples + 1> fs{};
+  fs[0] = f0;
+  fs[kSamples] = f1;
+  int lowest = 0;
+  for (int j = 1; j < kSamples; ++j) {
+    status = f(static_cast<double>(j) / kSamples, fs[static_cast<std::size_t>(j)]);
+    if (status != Status::ok) return status;
+    if (fs[static_cast<std::size_t>(j)] < fs[static_cast<std::size_t>(lowest)]) lowest = j;
+  }
+  // The first sample below zero: the crossing is between it and the one before.
+  for (int j = 1; j < kSamples; ++j) {
+    if (fs[static_cast<std::size_t>(j)] < -depth) {
+      lowest = j;
+      break;
+    }
+  }
+  double left = std::max(lowest - 1, 0) / static_cast<double>(kSamples);
+  double right = std::min(lowest + 1, kSamples) / static_cast<double>(kSamples);
+  double f_left = fs[static_cast<std::size_t>(std::max(lowest - 1, 0))];
+  double below = static_cast<double>(lowest) / kSamples, f_below = fs[static_cast<std::size_t>(lowest)];
+  // Golden sections on [left, right] towards the minimum until a value below zero, or until the
+  // bracket is 1e-9 of the step wide: a graze shallower than that is not worth a switch.
+  constexpr double kGolden = 0.3819660112501051;  // (3 - sqrt 5) / 2
+  double a = left, b = right;
+  double x = below, fx = f_below;
+  for (int iteration = 0; iteration < 100 && !(fx < -depth) && b - a > 1e-9; ++iteration) {
+    // The next point in the larger part of [a, b] around x.
+    const double u = (x - a > b - x) ? x - kGolden * (x - a) : x + kGolden * (b - x);
+    double fu = 0.0;
+    status = f(u, fu);
+    if (status != Status::ok) return status;
+    if (fu < fx) {
+      if (u < x) b = x;
+      else a = x;
+      x = u;
+      fx = fu;
+    } else {
+      if (u < x) a = u;
+      else b = u;
+    }
+  }
+  if (!(fx < -depth)) return Status::ok;  // the gap narrows inside the step but stays open
+  below = x;
+  f_below = fx;
+  // Where f first reaches zero: between the last point before the dip where it was positive and
+  // the point found in it. left is such a point (a sample before the lowest one, or the start).
+  if (!(f_left > 0.0)) return Status::ok;
+  status = find_root(f, left, f_left, below, f_below, theta);
+  if (status != Status::ok || events_.direction(i) != CrossingDirection::both) return status;
+  // And where it comes back, between the dip and the step's end, for an event that admits both.
+  return find_root(f, below, f_below, 1.0, f1, theta_back);
+}
+
 Status EventTracker::locate(double t, double h, const Interpolant& interpolate, std::vector<Crossing>& out) {
   out.clear();
+  for (int i : dips_) {
+    double theta = -1.0, theta_back = -1.0;
+    const Status status = find_dip(i, t, h, interpolate, theta, theta_back);
+    if (status != Status::ok) return status;
+    if (theta >= 0.0) out.push_back({i, t + theta * h, theta});
+    if (theta_back >= 0.0) out.push_back({i, theta_back >= 1.0 ? t + h : t + theta_back * h, theta_back});
+  }
   for (int i : crossed_) {
     const std::size_t k = static_cast<std::size_t>(i);
     double g0 = 0.0;
@@ -181,6 +312,7 @@ Status EventTracker::locate(double t, double h, const Interpolant& interpolate, 
 }
 
 void EventTracker::advance() {
+  g_start_ = g_end_;
   for (std::size_t i = 0; i < g_end_.size(); ++i) {
     const int s = sign_of(g_end_[i]);
     // Landing exactly on zero passes to the other side: the next step starts from there.

@@ -3,6 +3,8 @@
 // each g_i between the ends of every accepted step and then locate the root on the step's own
 // interpolating polynomial to round-off (Brent's method in the step's fraction theta); CVODE uses
 // its own root finding (CVodeRootInit). Several crossings in one step are reported in time order.
+// A g that may cross zero and come back within one step (a gap: EventFunctions::may_dip) is also
+// searched for a minimum inside each step, by every integrator.
 // rk4 has no continuous extension: integrate() refuses events with it.
 // Like the rest of integrators/, this knows nothing of mechanics: the simulation driver
 // (analysis/simulation.hpp) turns the model's event expressions into an EventFunctions.
@@ -32,6 +34,11 @@ class EventFunctions {
   // (crossings at the same time in index order), with the state y(t) there. Return
   // Status::stopped to end the run at t, Status::ok to go on; any other status fails the run.
   virtual Status on_event(int i, double t, const double* y) = 0;
+  // Whether g_i may cross zero and come back inside one step, on the same side at both ends (a
+  // gap that closes and opens again within a step too long for it: a body in flight passing
+  // through another in one step). The integrators then also look for such a dip in every step
+  // (EventTracker::locate). Default: no.
+  virtual bool may_dip(int /*i*/) const { return false; }
 };
 
 // The sign bookkeeping and root location shared by the explicit integrators: the sign of each g_i
@@ -46,14 +53,22 @@ class EventTracker {
     double theta = 0.0;  // (t - step start) / h as found: evaluate the interpolant here, not at t
   };
 
-  EventTracker(EventFunctions& events, int n);
+  // n: the size of the state; rtol, atol: the integrator's tolerances on it, below which a dip of
+  // a g that may dip is not told from the interpolant's error.
+  EventTracker(EventFunctions& events, int n, double rtol = 0.0, double atol = 0.0);
 
   // g at the start of the run (or after the state was changed by OdeSystem::after_step).
   Status restart(double t, const double* y);
-  // Evaluates g at the step end (t1, y1) and says whether some g_i changed sign since the
-  // step's start in a direction its event admits (then locate() is due). Does not update the
-  // signs: call advance() once the step is done.
+  // Evaluates g at the step end (t1, y1) and says whether locate() is due: some g_i changed sign
+  // since the step's start in a direction its event admits, or one that may dip (may_dip) kept
+  // the side from which its event admits a crossing. Does not update the signs: call advance()
+  // once the step is done.
   Status check(double t1, const double* y1, bool& crossed);
+  // The same for the g_i that may dip only, for an integrator that finds sign changes by itself
+  // (CVODE): then locate() looks for dips alone.
+  Status check_dips(double t1, const double* y1, bool& dipped);
+  // Whether some g_i may dip (EventFunctions::may_dip): else check_dips is never due.
+  bool any_may_dip() const;
   // y(theta) on a step (t, y) -> (t + h, y1), theta in [0, 1]: writes n values.
   using Interpolant = std::function<void(double theta, double* y)>;
   // For each crossing found by check(), the time of the root of g_i(t + theta h, y(theta)) for
@@ -61,6 +76,12 @@ class EventTracker {
   // precision in theta (a few dozen evaluations of the interpolant and g per crossing). A sign
   // change by a jump of g (|g| at the located point above 1e-3 of its size at the ends: a pole,
   // a wrap-around) is not a crossing: it is counted in jumps() and left out.
+  // A g_i that may dip and kept its side: if its slopes at the step's ends point to a minimum
+  // inside (falling at the start, rising at the end, from the side kept), the minimum is sought
+  // on the interpolant (samples, then golden sections), and where g_i passes zero on the way
+  // down is a crossing like any other (and on the way back, for an event of both directions).
+  // A dip shallower than ten times the tolerances on the state is not told from the
+  // interpolant's error and is left out.
   Status locate(double t, double h, const Interpolant& interpolate, std::vector<Crossing>& out);
   // The step is taken: the signs at its end become those of the next step's start.
   void advance();
@@ -74,14 +95,23 @@ class EventTracker {
  private:
   // g_i at time t + theta h on the interpolant.
   Status value(int i, double t, double h, double theta, const Interpolant& interpolate, double& g);
+  // dips_: the g_i that may dip and kept the side they may cross from, by g_end_.
+  void collect_dips();
+  // For a g_i in dips_: the fraction theta of the step where it first reaches zero inside a dip,
+  // or -1 when the step holds none; and theta_back where it comes back, for an event that admits
+  // both directions (else -1).
+  Status find_dip(int i, double t, double h, const Interpolant& interpolate, double& theta, double& theta_back);
 
   EventFunctions& events_;
+  double rtol_, atol_;
   int m_;
   std::vector<int> sign_;        // sign of g_i at the step's start (last nonzero); 0 if never nonzero
   std::vector<double> g_end_;    // g at the step's end, from check()
   std::vector<double> g_;        // scratch for evaluate()
   std::vector<double> y_;        // scratch state on the interpolant
+  std::vector<double> g_start_;  // g at the step's start
   std::vector<int> crossed_;     // indices that crossed in the step
+  std::vector<int> dips_;        // indices that may dip and kept the side they may cross from
   int jumps_ = 0;
   double first_jump_t_ = 0.0;
 };

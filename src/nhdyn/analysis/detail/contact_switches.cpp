@@ -277,6 +277,13 @@ CrossingDirection ContactSwitches::direction(int i) const {
   return i < user_count_ ? user_->direction(i) : CrossingDirection::falling;
 }
 
+bool ContactSwitches::may_dip(int i) const {
+  if (i < user_count_) return user_->may_dip(i);
+  const int contact = (i - user_count_) / kSlots;
+  const int slot = (i - user_count_) % kSlots;
+  return slot == 0 && data_.modes.mode[static_cast<std::size_t>(contact)] == ContactMode::free;
+}
+
 Status ContactSwitches::evaluate(double t, const double* y, double* g) {
   if (user_) {
     const Status status = user_->evaluate(t, y, g);

@@ -61,6 +61,9 @@ class ContactSwitches final : public EventFunctions {
   CrossingDirection direction(int i) const override;
   Status evaluate(double t, const double* y, double* g) override;
   Status on_event(int i, double t, const double* y) override;
+  // A free contact's gap: a body in flight can pass through the ground's edge or a sphere within
+  // one long step, the gap positive at both ends.
+  bool may_dip(int i) const override;
 
   // After integrate() returned Status::stopped: whether a switch ended the segment, and where.
   bool switched() const { return switched_; }

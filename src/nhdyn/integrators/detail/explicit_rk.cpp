@@ -438,7 +438,7 @@ void test_stiffness(AdaptiveRun<Tableau>& run, double t, double h, bool last_sta
 template <class Tableau>
 std::optional<IntegrationResult> start_adaptive(AdaptiveRun<Tableau>& run, double t, double hmax, double& h) {
   if (run.events != nullptr && run.events->count() > 0) {
-    run.tracker.emplace(*run.events, run.n);
+    run.tracker.emplace(*run.events, run.n, run.options.rtol, run.options.atol);
     run.crossings.reserve(static_cast<std::size_t>(run.events->count()));
     const Status status = run.tracker->restart(t, run.y.data());
     if (status != Status::ok) return rhs_failure(run.method, status, t, t, run.stats);

@@ -227,6 +227,10 @@ struct CvodeRun {
   IntegrationResult result;
   double t = 0.0;        // where the solution is known
   std::size_t next = 0;  // the first output time not yet written
+  // Dips of the event functions that may dip (EventFunctions::may_dip): CVODE's root finding sees
+  // only the sign changes between its steps' ends, this the minima inside them.
+  std::optional<EventTracker> dips;
+  std::vector<EventTracker::Crossing> crossings;
 
   // The run's result: its status, message and counters, reached at t.
   IntegrationResult finish(Status status, std::string message) {
@@ -285,6 +289,48 @@ std::optional<IntegrationResult> handle_roots(CvodeRun& run, double t_new) {
   return std::nullopt;
 }
 
+// After a step from run.t to t_new: the dips of the event functions that may dip, looked for on
+// CVODE's interpolating polynomial; each found is handled as a root (the outputs before it, then
+// on_event with the state there).
+std::optional<IntegrationResult> handle_dips(CvodeRun& run, double t_new) {
+  if (!run.dips) return std::nullopt;
+  void* mem = run.objects.cvode.get();
+  bool dipped = false;
+  Status status = run.dips->check_dips(t_new, N_VGetArrayPointer(run.objects.y.get()), dipped);
+  if (status == Status::ok && dipped) {
+    const double t = run.t, h = t_new - run.t;
+    N_Vector y_dky = run.objects.y_dky.get();
+    bool interpolated = true;
+    status = run.dips->locate(
+        t, h,
+        [&](double theta, double* out) {
+          interpolated = interpolated && CVodeGetDky(mem, theta >= 1.0 ? t_new : t + theta * h, 0, y_dky) == CV_SUCCESS;
+          std::copy(N_VGetArrayPointer(y_dky), N_VGetArrayPointer(y_dky) + N_VGetLength(y_dky), out);
+        },
+        run.crossings);
+    if (!interpolated)
+      return run.finish(Status::integrator_failure, fmt::format("{}: interpolation inside the step from t = {} failed: {}",
+                                                                run.method, t, run.state.cvode_message));
+    for (const EventTracker::Crossing& crossing : run.crossings) {
+      if (auto stop = write_outputs_before(run, crossing.t)) return stop;
+      if (CVodeGetDky(mem, crossing.t, 0, y_dky) != CV_SUCCESS)
+        return run.finish(Status::integrator_failure, fmt::format("{}: interpolation at t = {} failed: {}", run.method,
+                                                                  crossing.t, run.state.cvode_message));
+      const Status event_status = run.events->on_event(crossing.index, crossing.t, N_VGetArrayPointer(y_dky));
+      if (event_status == Status::ok) continue;
+      run.t = crossing.t;
+      if (event_status == Status::stopped) return run.finish(Status::stopped, {});
+      return run.finish(event_status, fmt::format("{}: at the event at t = {}: {}", run.method, run.t,
+                                                  describe(event_status)));
+    }
+  }
+  if (status != Status::ok)
+    return run.finish(status, fmt::format("{}: the event functions failed at t = {}: {}", run.method, t_new,
+                                          describe(status)));
+  run.dips->advance();
+  return std::nullopt;
+}
+
 // After after_step changed the state: CVODE starts again from it (its counters banked first,
 // since re-initialization resets them).
 std::optional<IntegrationResult> restart(CvodeRun& run, double t_end) {
@@ -308,7 +354,7 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
                                   const OutputFn& output, EventFunctions* events) {
   const std::string_view method = integrator_name(options.kind);
   const int n = system.size();
-  CvodeRun run{method, options, output_times, output, events, {}, {}, {}, {}, {}, t0, 0};
+  CvodeRun run{method, options, output_times, output, events, {}, {}, {}, {}, {}, t0, 0, {}, {}};
   run.result.t_reached = t0;
   if (output_times.empty()) return run.result;
 
@@ -334,6 +380,14 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
   }
   void* mem = run.objects.cvode.get();
   double* y_data = N_VGetArrayPointer(run.objects.y.get());
+  if (events != nullptr && events->count() > 0) {
+    run.dips.emplace(*events, n, options.rtol, options.atol);
+    if (!run.dips->any_may_dip()) {
+      run.dips.reset();
+    } else if (const Status status = run.dips->restart(t0, y0); status != Status::ok) {
+      return run.finish(status, fmt::format("{}: the event functions failed at t = {}: {}", method, t0, describe(status)));
+    }
+  }
 
   for (;;) {
     const Counters current = read_counters(mem);
@@ -368,6 +422,7 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
     // Outputs inside the step come from CVODE's interpolating polynomial, valid until the
     // re-initialization below; after_step acts at the step end, so an output there sees the
     // state it leaves.
+    if (auto stop = handle_dips(run, t_new)) return *std::move(stop);
     if (auto stop = write_outputs_before(run, t_new)) return *std::move(stop);
     run.t = t_new;
     const StepEnd end = system.after_step(run.t, y_data);
@@ -386,8 +441,12 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
                         fmt::format("{}: step size underflow at t = {} (h = {}): the solution may be "
                                     "singular there, or the tolerances too tight",
                                     method, run.t, h_next));
-    if (end.changed)
+    if (end.changed) {
       if (auto failure = restart(run, t_end)) return *std::move(failure);
+      if (run.dips && run.dips->restart(run.t, y_data) != Status::ok)
+        return run.finish(Status::integrator_failure,
+                          fmt::format("{}: the event functions failed at t = {}", method, run.t));
+    }
   }
   return run.finish(Status::ok, {});
 }
