@@ -461,6 +461,85 @@ TEST(RollingSurface, AnEllipsoidFlatterThanItsBowlIsRefusedWithBothCurvatures) {
   EXPECT_EQ(summary.status, Status::ok) << summary.message;
 }
 
+// A torus (R = 0.3, tube r = 0.05, axle y) in a spherical bowl of radius Rb: upright, its
+// curvatures at the bottom are 1/(R + r) = 2.85714 along the rim and 1/r = 20 across (section 11),
+// so a bowl of 0.34 (2.94118) is refused with -0.0840336 and 17.0588 left, one of 1 is accepted.
+// Leaned by 0.5 in a bowl of 0.4 it starts (k_t = c / (R + r c) = 2.552, c = cos 0.5) and leans
+// further as it falls, until k_t reaches 1/Rb: the run ends there, and the measure it names is
+// (k_t - 1/Rb)(1/r - 1/Rb) / ((k_t + 1/r) / 2)^2 computed from the state it names.
+TEST(RollingSurface, ATorusFlatterThanItsBowlIsRefusedAtTheStartAndStoppedAlongTheRun) {
+  const auto torus = [](double Rb, double lean) {
+    return fmt::format(R"toml(name = "torus-in-bowl"
+coordinates = ["x", "y", "z", "psi", "theta", "phi"]
+gravity = [0, 0, "-g"]
+
+[parameters]
+m = 2.0
+J = 0.07
+K = 0.05
+R = 0.3
+r = 0.05
+g = 9.81
+Rb = {}
+lean = {}
+
+[[frames]]
+name = "wheel"
+translation = ["x", "y", "z"]
+rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
+
+[[bodies]]
+name = "wheel"
+frame = "wheel"
+mass = "m"
+inertia = ["K", "J", "K"]
+
+[[contacts]]
+name = "tyre"
+body = "wheel"
+shape = {{ torus = ["R", "r"], axis = "y" }}
+ground = {{ surface = "X^2 + Y^2 + (Z - Rb)^2 - Rb^2", side = "inside" }}
+
+[initial]
+position = {{ x = 0, y = "-R*sin(lean)", z = "R*cos(lean) + r", psi = 0, theta = "lean", phi = 0 }}
+)toml",
+                       Rb, lean);
+  };
+  const std::string m = surface_error([&] { load_model_text(torus(0.34, 0.0), "torus.toml"); });
+  for (const std::string part : {"torus.toml:", "contact 'tyre'", "flatter than the hollow", "2.85714 and 20",
+                                 "-0.0840336 and 17.0588"})
+    EXPECT_NE(m.find(part), std::string::npos) << m << "\n  lacks: " << part;
+  SimulationOptions options;
+  options.t_end = 0.5;
+  options.output_step = 0.01;
+  SimulationSummary summary;
+  surface_rows(load_model_text(torus(1.0, 0.0), "torus.toml"), options, &summary);
+  EXPECT_EQ(summary.status, Status::ok) << summary.message;
+
+  surface_rows(load_model_text(torus(0.4, 0.5), "torus.toml"), options, &summary);
+  ASSERT_NE(summary.status, Status::ok);
+  const std::string& stop = summary.message;
+  EXPECT_NE(stop.find("the ground's hollow is as curved as the shape here"), std::string::npos) << stop;
+  const auto named = [&](const std::string& key) {
+    const std::size_t at = stop.find(key + " = ");
+    EXPECT_NE(at, std::string::npos) << key << " in " << stop;
+    return at == std::string::npos ? 0.0 : std::stod(stop.substr(at + key.size() + 3));
+  };
+  const double theta = named("theta"), gy = named("tyre_gy"), gz = named("tyre_gz");
+  const double Rb = 0.4, R = 0.3, r = 0.05;
+  // The bowl's inward unit normal at the contact point, and the axle (0, cos theta, sin theta).
+  const double nx = 0.0, ny = -gy / Rb, nz = (Rb - gz) / Rb;
+  const double en = std::cos(theta) * ny + std::sin(theta) * nz;
+  const double c = std::sqrt(1.0 - en * en / (nx * nx + ny * ny + nz * nz));
+  const double k_t = c / (R + r * c);
+  const double measure = (k_t - 1 / Rb) * (1 / r - 1 / Rb) / std::pow((k_t + 1 / r) / 2, 2);
+  const std::size_t at = stop.find("on the tangent plane = ");
+  ASSERT_NE(at, std::string::npos) << stop;
+  EXPECT_NEAR(std::stod(stop.substr(at + 23)), measure, 2e-5) << stop;
+  EXPECT_LT(measure, 1e-4);
+  EXPECT_GT(theta, 0.53);  // leaned further than at the start
+}
+
 // Refusals, each naming the file's line and what to do.
 TEST(RollingSurface, BadSurfacesAreRefusedByName) {
   const std::string base = text_of("ball_in_paraboloid.toml");

@@ -64,8 +64,8 @@ class ContactShape {
   // The shape's curvature matrix (body axes) at its support point y*(nu) for nu / length: the
   // Hessian of a defining f over |grad f| there, positive along the directions the surface bends
   // away from the ground (docs/derivations/rolling-bodies.md sections 9 and 11), which the
-  // convexity check holds against a curved ground's. Nothing for a shape without one (a disk's
-  // rim, a torus) or an implicit shape (whose check uses its f).
+  // convexity check holds against a curved ground's. Nothing for a shape without one (a disk,
+  // infinitely curved across its rim) or an implicit shape (whose check uses its f).
   virtual std::optional<GiNaC::matrix> curvature(const ShapeValues&, const Vector3&, const GiNaC::ex&) const {
     return std::nullopt;
   }
