@@ -178,86 +178,97 @@ Status EventTracker::find_dip(int i, double t, double h, const Interpolant& inte
   theta = theta_back = -1.0;
   const std::size_t k = static_cast<std::size_t>(i);
   const double side = sign_[k];
-  // f = g_i seen from the side it kept: positive at both ends, a dip is where it turns negative.
+  // f = g_i seen from the side it starts on: positive at the start, a dip is where it turns negative.
   const auto f = [&](double x, double& fx) {
     const Status status = value(i, t, h, x, interpolate, fx);
     fx *= side;
     return status;
   };
-  const double f0 = side * g_start_[k], f1 = side * g_end_[k];
-  // A dip counts when g goes below zero by more than the interpolant may be off by, ten times
-  // the tolerances on the state (a gap that opens from zero at a lift-off has values of either
-  // sign of that size near its start), or round-off on g's size at the ends.
-  interpolate(0.0, y_.data());
-  double size = 0.0;
-  for (const double v : y_) size = std::max(size, std::abs(v));
-  const double depth = std::max(1e-9 * std::max(std::abs(f0), std::abs(f1)), 10.0 * (atol_ + rtol_ * size));
-  // The slopes at the ends, by differences over a small fraction of the step: a minimum inside
-  // needs f falling at the start and rising at the end. (A function that rises, then falls, dips
-  // and rises again within one step has three extrema there; the error control keeps a step far
-  // shorter than that on a gap, which changes with the bodies' motion.)
+  // Samples of the whole step: a free flight is a polynomial, so one step may hold a climb, the
+  // top and the fall onto the ground (or a body's turns): no shape of f is assumed. Where the
+  // samples rise and fall more than a few times (a body turning several times in one step) they
+  // are refined until they resolve it.
+  std::vector<double>& fs = samples_;
+  int count = 16;
+  for (;;) {
+    fs.assign(static_cast<std::size_t>(count) + 1, 0.0);
+    fs.front() = side * g_start_[k];
+    fs.back() = side * g_end_[k];
+    for (int j = 1; j < count; ++j) {
+      const Status status = f(static_cast<double>(j) / count, fs[static_cast<std::size_t>(j)]);
+      if (status != Status::ok) return status;
+    }
+    int turns = 0;
+    for (int j = 1; j < count; ++j) {
+      const double before = fs[static_cast<std::size_t>(j)] - fs[static_cast<std::size_t>(j - 1)];
+      const double after = fs[static_cast<std::size_t>(j + 1)] - fs[static_cast<std::size_t>(j)];
+      if ((before < 0.0) != (after < 0.0)) ++turns;
+    }
+    if (turns <= 4 || count >= 512) break;
+    count *= 4;
+  }
+  const auto at = [&](int j) { return static_cast<double>(j) / count; };
+  const auto sample = [&](int j) { return fs[static_cast<std::size_t>(j)]; };
+  const double f0 = sample(0), f1 = sample(count);
+  const auto [low, high] = std::minmax_element(fs.begin(), fs.end());
+  // A dip counts when f goes below zero by more than the interpolant may be off by on f's own
+  // size, the tolerances (right after a lift-off, where f opens from zero, the interpolant has
+  // values of either sign far below that), and more than 1e-7 of how much f changes over the step.
+  const double scale = std::max(std::abs(f0), std::abs(f1));
+  const double depth = std::max({atol_ + rtol_ * scale, 1e-7 * (*high - *low), 1e-12 * scale});
+  // The slopes at the ends, where a minimum may hide between the end and the next sample.
   constexpr double kDelta = 1e-4;
-  double fa = 0.0, fb = 0.0;
-  Status status = f(kDelta, fa);
-  if (status != Status::ok) return status;
-  if (!(fa < f0)) return Status::ok;
-  status = f(1.0 - kDelta, fb);
-  if (status != Status::ok) return status;
-  if (!(fb < f1)) return Status::ok;
-  // Samples to bracket the smallest value: a narrow dip between wide samples shows as a smaller
-  // sample next to it, since the gap falls towards the dip and rises after it.
-  constexpr int kSamples = 8;
-  std::array<double, kSamples + 1> fs{};
-  fs[0] = f0;
-  fs[kSamples] = f1;
-  int lowest = 0;
-  for (int j = 1; j < kSamples; ++j) {
-    status = f(static_cast<double>(j) / kSamples, fs[static_cast<std::size_t>(j)]);
-    if (status != Status::ok) return status;
-    if (fs[static_cast<std::size_t>(j)] < fs[static_cast<std::size_t>(lowest)]) lowest = j;
-  }
-  // The first sample below zero: the crossing is between it and the one before.
-  for (int j = 1; j < kSamples; ++j) {
-    if (fs[static_cast<std::size_t>(j)] < -depth) {
-      lowest = j;
-      break;
-    }
-  }
-  double left = std::max(lowest - 1, 0) / static_cast<double>(kSamples);
-  double right = std::min(lowest + 1, kSamples) / static_cast<double>(kSamples);
-  double f_left = fs[static_cast<std::size_t>(std::max(lowest - 1, 0))];
-  double below = static_cast<double>(lowest) / kSamples, f_below = fs[static_cast<std::size_t>(lowest)];
-  // Golden sections on [left, right] towards the minimum until a value below zero, or until the
-  // bracket is 1e-9 of the step wide: a graze shallower than that is not worth a switch.
+  const auto falls_from_start = [&]() {
+    double fa = 0.0;
+    return f(kDelta / count, fa) == Status::ok && fa < f0;
+  };
+  const auto rises_to_end = [&]() {
+    double fb = 0.0;
+    return f(1.0 - kDelta / count, fb) == Status::ok && fb < f1;
+  };
   constexpr double kGolden = 0.3819660112501051;  // (3 - sqrt 5) / 2
-  double a = left, b = right;
-  double x = below, fx = f_below;
-  for (int iteration = 0; iteration < 100 && !(fx < -depth) && b - a > 1e-9; ++iteration) {
-    // The next point in the larger part of [a, b] around x.
-    const double u = (x - a > b - x) ? x - kGolden * (x - a) : x + kGolden * (b - x);
-    double fu = 0.0;
-    status = f(u, fu);
-    if (status != Status::ok) return status;
-    if (fu < fx) {
-      if (u < x) b = x;
-      else a = x;
-      x = u;
-      fx = fu;
-    } else {
-      if (u < x) a = u;
-      else b = u;
+  // Each local minimum of the samples, in time order: the first that holds a dip gives the crossing.
+  for (int j = 0; j <= count; ++j) {
+    const bool minimum = (j == 0 || sample(j) <= sample(j - 1)) && (j == count || sample(j) <= sample(j + 1));
+    if (!minimum) continue;
+    if (j == 0 && !falls_from_start()) continue;
+    // The end of a step where g changed sign is the sign change itself, which locate() finds as
+    // before; only a dip before it is this search's.
+    if (j == count && (f1 < 0.0 || !rises_to_end())) continue;
+    // Golden sections around the sample towards the minimum, until a value below -depth or a
+    // bracket 1e-9 of the step wide: a graze shallower than that is not worth a switch.
+    double a = at(std::max(j - 1, 0)), b = at(std::min(j + 1, count));
+    double x = at(j), fx = sample(j);
+    for (int iteration = 0; iteration < 100 && !(fx < -depth) && b - a > 1e-9; ++iteration) {
+      const double u = (x - a > b - x) ? x - kGolden * (x - a) : x + kGolden * (b - x);
+      double fu = 0.0;
+      const Status status = f(u, fu);
+      if (status != Status::ok) return status;
+      if (fu < fx) {
+        if (u < x) b = x;
+        else a = x;
+        x = u;
+        fx = fu;
+      } else {
+        if (u < x) a = u;
+        else b = u;
+      }
     }
+    if (!(fx < -depth)) continue;  // f narrows there but stays positive
+    // Where f first reaches zero: between the last sample before x where it is positive (the
+    // step's start at worst, where it is) and x; and, for an event of both directions, where it
+    // comes back: between x and the first sample after it where it is positive (the end at worst).
+    int left = std::min(static_cast<int>(std::floor(x * count)), count);
+    if (at(left) >= x) --left;
+    while (left > 0 && !(sample(left) > 0.0)) --left;
+    Status status = find_root(f, at(left), sample(left), x, fx, theta);
+    if (status != Status::ok || events_.direction(i) != CrossingDirection::both) return status;
+    int right = std::max(static_cast<int>(std::ceil(x * count)), 0);
+    if (at(right) <= x) ++right;
+    while (right < count && !(sample(right) > 0.0)) ++right;
+    return find_root(f, x, fx, at(right), sample(right), theta_back);
   }
-  if (!(fx < -depth)) return Status::ok;  // the gap narrows inside the step but stays open
-  below = x;
-  f_below = fx;
-  // Where f first reaches zero: between the last point before the dip where it was positive and
-  // the point found in it. left is such a point (a sample before the lowest one, or the start).
-  if (!(f_left > 0.0)) return Status::ok;
-  status = find_root(f, left, f_left, below, f_below, theta);
-  if (status != Status::ok || events_.direction(i) != CrossingDirection::both) return status;
-  // And where it comes back, between the dip and the step's end, for an event that admits both.
-  return find_root(f, below, f_below, 1.0, f1, theta_back);
+  return Status::ok;
 }
 
 Status EventTracker::locate(double t, double h, const Interpolant& interpolate, std::vector<Crossing>& out) {
@@ -271,6 +282,18 @@ Status EventTracker::locate(double t, double h, const Interpolant& interpolate, 
   }
   for (int i : crossed_) {
     const std::size_t k = static_cast<std::size_t>(i);
+    // A g that may dip can have gone through zero and back before the sign change at the end:
+    // the first crossing is the one found by the same search (the end being one of its minima).
+    if (events_.may_dip(i)) {
+      double theta = -1.0, theta_back = -1.0;
+      const Status status = find_dip(i, t, h, interpolate, theta, theta_back);
+      if (status != Status::ok) return status;
+      if (theta >= 0.0) {
+        out.push_back({i, t + theta * h, theta});
+        if (theta_back >= 0.0) out.push_back({i, theta_back >= 1.0 ? t + h : t + theta_back * h, theta_back});
+        continue;
+      }
+    }
     double g0 = 0.0;
     Status status = value(i, t, h, 0.0, interpolate, g0);
     if (status != Status::ok) return status;

@@ -53,8 +53,8 @@ class EventTracker {
     double theta = 0.0;  // (t - step start) / h as found: evaluate the interpolant here, not at t
   };
 
-  // n: the size of the state; rtol, atol: the integrator's tolerances on it, below which a dip of
-  // a g that may dip is not told from the interpolant's error.
+  // n: the size of the state; rtol, atol: the integrator's tolerances, from which a dip of a g
+  // that may dip is told from the interpolant's error.
   EventTracker(EventFunctions& events, int n, double rtol = 0.0, double atol = 0.0);
 
   // g at the start of the run (or after the state was changed by OdeSystem::after_step).
@@ -76,12 +76,14 @@ class EventTracker {
   // precision in theta (a few dozen evaluations of the interpolant and g per crossing). A sign
   // change by a jump of g (|g| at the located point above 1e-3 of its size at the ends: a pole,
   // a wrap-around) is not a crossing: it is counted in jumps() and left out.
-  // A g_i that may dip and kept its side: if its slopes at the step's ends point to a minimum
-  // inside (falling at the start, rising at the end, from the side kept), the minimum is sought
-  // on the interpolant (samples, then golden sections), and where g_i passes zero on the way
-  // down is a crossing like any other (and on the way back, for an event of both directions).
-  // A dip shallower than ten times the tolerances on the state is not told from the
-  // interpolant's error and is left out.
+  // A g_i that may dip and kept its side: sampled across the step on the interpolant (16 samples,
+  // more where it turns often), each local minimum of the samples followed by golden sections, and
+  // where g_i first passes zero on the way down to a dip is a crossing like any other (and on the
+  // way back, for an event of both directions). A dip shallower than the tolerances on g's size
+  // (atol + rtol |g|), or than 1e-7 of its change over the step, is not told from the interpolant's error
+  // and is left out. A g that may dip and changed sign over the step is searched the same way, so
+  // that a dip before the change gives the first crossing (for an event of both directions, the
+  // dip's two crossings; a third, the change at the end, is then not reported).
   Status locate(double t, double h, const Interpolant& interpolate, std::vector<Crossing>& out);
   // The step is taken: the signs at its end become those of the next step's start.
   void advance();
@@ -112,6 +114,7 @@ class EventTracker {
   std::vector<double> g_start_;  // g at the step's start
   std::vector<int> crossed_;     // indices that crossed in the step
   std::vector<int> dips_;        // indices that may dip and kept the side they may cross from
+  std::vector<double> samples_;  // scratch for find_dip
   int jumps_ = 0;
   double first_jump_t_ = 0.0;
 };
