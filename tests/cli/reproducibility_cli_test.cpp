@@ -191,6 +191,13 @@ TEST_F(Reproducible, BicycleEquations) {
   }
 }
 
+// A ground held by coordinates divides its rows by |grad g| at the start: as a float, that factor
+// combined with the exact coefficients in GiNaC's order of the process ("-1.0 ball_gx" in one run,
+// "-ball_gx" in another); it is an exact rational (rolling_contact.cpp, exact_scale).
+TEST_F(Reproducible, BallInAParaboloidEquations) {
+  expect_same_bytes({"equations", example("ball_in_paraboloid.toml")}, "");
+}
+
 // The 50-digit reference's own error estimate (a column of the CSV): its terms summed in GiNaC's
 // order at 50 digits parted in the last digits from run to run, before they were summed with
 // guard digits and rounded (symbolic/precise_reference.cpp).

@@ -397,13 +397,12 @@ void MultibodyBuilder::check_helper_name(const std::string& name, const SourceLo
 }
 
 namespace {
-std::pair<Vector3, Vector3> tangents(const Vector3& n, const Spec& spec);  // below
 
 // The drawing of a wheel's or a knife edge's own plane (their `normal`): the plane's axes t1, t2, n
 // at the origin, as a [[contacts]] plane ground draws itself (rolling_contact.cpp); the report
 // draws it in its own axes, and leaves a level one to its z = 0 grid (compile_visual).
 VisualItem plane_item(const Vector3& n, const Spec& spec, const std::string& name, const SourceLocation& where) {
-  const auto [t1, t2] = tangents(n, spec);
+  const auto [t1, t2] = plane_tangents(n, spec);
   VisualItem item;
   item.kind = VisualKind::plane;
   item.name = name;
@@ -565,26 +564,6 @@ Vector3 MultibodyBuilder::plane_normal(const Helper& helper, const std::string& 
 
 namespace {
 
-// An orthonormal basis t1, t2 of the plane with unit normal n: t1 from the world axis least aligned
-// with n (the first of ties), t2 = n x t1.
-std::pair<Vector3, Vector3> tangents(const Vector3& n, const Spec& spec) {
-  int k = 0;
-  double smallest = 2.0;
-  for (int i = 0; i < 3; ++i) {
-    const double v = std::fabs(value_of(n[static_cast<std::size_t>(i)], spec).value_or(1.0));
-    if (v < smallest - 1e-15) {
-      smallest = v;
-      k = i;
-    }
-  }
-  const GiNaC::ex nk = n[static_cast<std::size_t>(k)];
-  Vector3 t1 = subtract(unit(k), scale(nk, n));
-  const GiNaC::ex length = GiNaC::sqrt(simplify(1 - nk * nk));
-  t1 = {simplify(t1[0] / length), simplify(t1[1] / length), simplify(t1[2] / length)};
-  const Vector3 t2 = cross(n, t1);
-  return {t1, {simplify(t2[0]), simplify(t2[1]), simplify(t2[2])}};
-}
-
 // For an expression too large for simplify(): whether it is zero at a few fixed, generic points
 // (coordinates and t in [-1, 1], the parameters at their values): |e| <= 1e-12 at each.
 bool vanishes_at_sample_points(const GiNaC::ex& e, const Spec& spec) {
@@ -645,7 +624,7 @@ void MultibodyBuilder::add_wheel(const Helper& h) {
   }
   // The material point at P: v_C + omega x (P - C); its two components along the plane vanish.
   const Vector3 vP = add(time_derivative(C, spec.symbols), cross(F.omega, CP));
-  const auto [t1, t2] = tangents(n, spec);
+  const auto [t1, t2] = plane_tangents(n, spec);
   int k = 0;
   for (const Vector3& tk : {t1, t2}) {
     const GiNaC::ex slip = simplify_moderate(dot(tk, vP));

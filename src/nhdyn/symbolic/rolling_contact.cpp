@@ -79,6 +79,20 @@ int contact_least_aligned_axis(const Vector3& direction, const Spec& spec) {
   return k;
 }
 
+}  // namespace
+
+std::pair<Vector3, Vector3> plane_tangents(const Vector3& n, const Spec& spec) {
+  const int k = contact_least_aligned_axis(n, spec);
+  const GiNaC::ex nk = n[static_cast<std::size_t>(k)];
+  Vector3 t1 = scale(1 / GiNaC::sqrt(simplify(1 - nk * nk)), subtract(unit(k), scale(nk, n)));
+  for (GiNaC::ex& e : t1) e = simplify(e);
+  Vector3 t2 = cross(n, t1);
+  for (GiNaC::ex& e : t2) e = simplify(e);
+  return {t1, t2};
+}
+
+namespace {
+
 // The unit normal of a plane ground: the given one, else opposite to gravity.
 Vector3 ground_plane_normal(const ParsedGround& ground, const Spec& spec, const std::optional<Vector3>& gravity,
                      const std::string& context) {
@@ -257,20 +271,35 @@ class PlaneGround final : public ContactGround {
     item.field_variables = {spec.symbols.time()};
     return item;
   }
-
- private:
-  // Unit tangents of the plane of unit normal n: t1 from the world axis least aligned with n,
-  // t2 = n x t1 (the directions of the no-slip rows, and the axes of the plane's drawing).
-  static std::pair<Vector3, Vector3> plane_tangents(const Vector3& n, const Spec& spec) {
-    const int k = contact_least_aligned_axis(n, spec);
-    const GiNaC::ex nk = n[static_cast<std::size_t>(k)];
-    Vector3 t1 = scale(1 / GiNaC::sqrt(simplify(1 - nk * nk)), subtract(unit(k), scale(nk, n)));
-    for (GiNaC::ex& e : t1) e = simplify(e);
-    Vector3 t2 = cross(n, t1);
-    for (GiNaC::ex& e : t2) e = simplify(e);
-    return {t1, t2};
-  }
 };
+
+// A positive scale as an exact rational: between 1e-3 and 1e3 the nearest with a denominator up
+// to 10^6 (continued fractions: within about 1e-12 of it, and short to print: 1, 19/25), else the
+// double's own binary value. A float in the derived expressions would combine with their exact
+// coefficients in GiNaC's term order, which changes from process to process: the equations
+// printed "-1.0 x" in one run and "-x" in another.
+GiNaC::numeric exact_scale(double value) {
+  if (!(value > 0.0) || !std::isfinite(value)) return GiNaC::numeric(1);
+  if (value >= 1e-3 && value <= 1e3) {
+    long p0 = 0, q0 = 1, p1 = 1, q1 = 0;  // the convergents before the current one
+    double x = value;
+    for (int i = 0; i < 40; ++i) {
+      const double a = std::floor(x);
+      const long p2 = static_cast<long>(a) * p1 + p0, q2 = static_cast<long>(a) * q1 + q0;
+      if (q2 > 1000000) break;
+      p0 = p1;
+      q0 = q1;
+      p1 = p2;
+      q1 = q2;
+      if (std::abs(static_cast<double>(p1) / static_cast<double>(q1) - value) <= 1e-15 * value || x - a < 1e-9) break;
+      x = 1.0 / (x - a);
+    }
+    if (q1 > 0 && p1 > 0) return GiNaC::numeric(p1) / GiNaC::numeric(q1);
+  }
+  int exponent = 0;
+  const double mantissa = std::frexp(value, &exponent);  // value = mantissa 2^exponent, mantissa in [1/2, 1)
+  return GiNaC::numeric(static_cast<long>(std::ldexp(mantissa, 53))) * GiNaC::numeric(2).power(exponent - 53);
+}
 
 // |grad g| at the shape's centre where the run starts (the file's initial values and parameters),
 // g's scale as a number: 1 where that is not a positive number (a start written nowhere).
@@ -453,11 +482,11 @@ class SurfaceGround final : public ContactGround {
     // Divided by g's scale (a number), so that the rows are about as large as lengths whatever
     // the scale of g, without a root of |grad g| in the expressions that are differentiated twice.
     const Vector3 C = add(F.origin, multiply(F.rotation, c.centre));
-    const double size = gradient_scale(gradient, U, C, spec);
+    const GiNaC::numeric size = exact_scale(gradient_scale(gradient, U, C, spec));
     const int axis = contact_least_aligned_axis(gravity ? *gravity : unit(2), spec);
     const Vector3 e = unit(axis);
-    out.tangent1 = scale(1 / GiNaC::numeric(size), cross(e, gradient));
-    out.tangent2 = scale(1 / GiNaC::numeric(size), cross(gradient, out.tangent1));
+    out.tangent1 = scale(1 / size, cross(e, gradient));
+    out.tangent2 = scale(1 / size, cross(gradient, out.tangent1));
     out.singular = std::make_pair(
         dot(cross(e, gradient), cross(e, gradient)) / dot(gradient, gradient),
         fmt::format("the ground's normal turns along the world's {} axis, where the two directions of its rolling rows "
@@ -474,7 +503,7 @@ class SurfaceGround final : public ContactGround {
     out.gap = dot(out.normal, subtract(C, U)) - reach;
     const Vector3 apart = subtract(body_point, U);
     // g over its scale: about U's distance from the surface, in length units whatever g's scale.
-    out.locate = {{"_ground", c.ground.surface / GiNaC::numeric(size)}, {"_at1", dot(out.tangent1, apart)},
+    out.locate = {{"_ground", c.ground.surface / size}, {"_at1", dot(out.tangent1, apart)},
                   {"_at2", dot(out.tangent2, apart)}};
     // The ground rises along n by 1/2 w^T K w, K = -sigma H / |grad g| (a hollow where positive).
     for (unsigned i = 0; i < 3; ++i)

@@ -190,6 +190,12 @@ ParsedContact parse_contact(const ContactText& text, const ContactParsers& parse
 RollingContact make_rolling_contact(const ParsedContact& contact, const PlacedFrame& frame, const Spec& spec,
                                     const std::optional<Vector3>& gravity);
 
+// Unit tangents of the plane of unit normal n: t1 from the world axis least aligned with n (at
+// the parameters' values; the first of ties), t2 = n x t1. The directions of the no-slip rows of
+// every contact on a plane ([[contacts]], [[wheels]], [[knife_edges]]) and the axes of the plane's
+// drawing.
+std::pair<Vector3, Vector3> plane_tangents(const Vector3& n, const Spec& spec);
+
 // Throws ModelError when an implicit shape is not convex toward the ground where the run starts
 // (spec.t0, spec.q0 with the parameter values), or is flatter than a hollow of the terrain there
 // (the contact would not be unique): names the contact, where it was written, the principal
