@@ -129,7 +129,7 @@ Status EventTracker::check(double t1, const double* y1, bool& crossed) {
     if (direction == CrossingDirection::falling && rising) continue;
     crossed_.push_back(i);
   }
-  collect_dips();
+  collect_dips(false);
   crossed = !crossed_.empty() || !dips_.empty();
   return Status::ok;
 }
@@ -139,7 +139,7 @@ Status EventTracker::check_dips(double t1, const double* y1, bool& dipped) {
   crossed_.clear();
   const Status status = events_.evaluate(t1, y1, g_end_.data());
   if (status != Status::ok) return status;
-  collect_dips();
+  collect_dips(true);
   dipped = !dips_.empty();
   return Status::ok;
 }
@@ -150,12 +150,13 @@ bool EventTracker::any_may_dip() const {
   return false;
 }
 
-void EventTracker::collect_dips() {
+void EventTracker::collect_dips(bool with_changes) {
   dips_.clear();
   for (int i = 0; i < m_; ++i) {
     const std::size_t k = static_cast<std::size_t>(i);
     const int before = sign_[k];
-    if (before == 0 || sign_of(g_end_[k]) != before || !events_.may_dip(i)) continue;
+    if (before == 0 || !events_.may_dip(i)) continue;
+    if (!with_changes && sign_of(g_end_[k]) != before) continue;
     const CrossingDirection direction = events_.direction(i);
     // A dip from the positive side crosses falling, from the negative side rising.
     if (direction == CrossingDirection::rising && before > 0) continue;
@@ -198,14 +199,19 @@ Status EventTracker::find_dip(int i, double t, double h, const Interpolant& inte
       const Status status = f(static_cast<double>(j) / count, fs[static_cast<std::size_t>(j)]);
       if (status != Status::ok) return status;
     }
-    int turns = 0;
-    for (int j = 1; j < count; ++j) {
-      const double before = fs[static_cast<std::size_t>(j)] - fs[static_cast<std::size_t>(j - 1)];
-      const double after = fs[static_cast<std::size_t>(j + 1)] - fs[static_cast<std::size_t>(j)];
-      if ((before < 0.0) != (after < 0.0)) ++turns;
+    // Turns counted on changes above the tolerances on f's size, so that round-off on a gap that
+    // does not change (a body held still by its other contacts) does not count.
+    const double noise = atol_ + (rtol_ + 1e-12) * std::max(std::abs(fs.front()), std::abs(fs.back()));
+    int turns = 0, last = 0;
+    for (int j = 1; j <= count; ++j) {
+      const double change = fs[static_cast<std::size_t>(j)] - fs[static_cast<std::size_t>(j - 1)];
+      if (!(std::abs(change) > noise)) continue;
+      const int sign = change > 0.0 ? 1 : -1;
+      if (last != 0 && sign != last) ++turns;
+      last = sign;
     }
     if (turns <= 4 || count >= 512) break;
-    count *= 4;
+    count = std::min(count * 4, 512);
   }
   const auto at = [&](int j) { return static_cast<double>(j) / count; };
   const auto sample = [&](int j) { return fs[static_cast<std::size_t>(j)]; };
@@ -229,7 +235,9 @@ Status EventTracker::find_dip(int i, double t, double h, const Interpolant& inte
   constexpr double kGolden = 0.3819660112501051;  // (3 - sqrt 5) / 2
   // Each local minimum of the samples, in time order: the first that holds a dip gives the crossing.
   for (int j = 0; j <= count; ++j) {
-    const bool minimum = (j == 0 || sample(j) <= sample(j - 1)) && (j == count || sample(j) <= sample(j + 1));
+    // A valley: below the sample before it by more than depth (a flat stretch, or round-off on
+    // one, is no valley and costs no search), and not above the one after it.
+    const bool minimum = (j == 0 || sample(j) < sample(j - 1) - depth) && (j == count || sample(j) <= sample(j + 1));
     if (!minimum) continue;
     if (j == 0 && !falls_from_start()) continue;
     // The end of a step where g changed sign is the sign change itself, which locate() finds as
@@ -266,6 +274,7 @@ Status EventTracker::find_dip(int i, double t, double h, const Interpolant& inte
     int right = std::max(static_cast<int>(std::ceil(x * count)), 0);
     if (at(right) <= x) ++right;
     while (right < count && !(sample(right) > 0.0)) ++right;
+    if (!(sample(right) > 0.0)) return Status::ok;  // it does not come back within the step
     return find_root(f, x, fx, at(right), sample(right), theta_back);
   }
   return Status::ok;

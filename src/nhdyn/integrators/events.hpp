@@ -65,7 +65,7 @@ class EventTracker {
   // once the step is done.
   Status check(double t1, const double* y1, bool& crossed);
   // The same for the g_i that may dip only, for an integrator that finds sign changes by itself
-  // (CVODE): then locate() looks for dips alone.
+  // (CVODE): then locate() looks for dips alone, also before a sign change at (t1, y1).
   Status check_dips(double t1, const double* y1, bool& dipped);
   // Whether some g_i may dip (EventFunctions::may_dip): else check_dips is never due.
   bool any_may_dip() const;
@@ -97,8 +97,9 @@ class EventTracker {
  private:
   // g_i at time t + theta h on the interpolant.
   Status value(int i, double t, double h, double theta, const Interpolant& interpolate, double& g);
-  // dips_: the g_i that may dip and kept the side they may cross from, by g_end_.
-  void collect_dips();
+  // dips_: the g_i that may dip and start on the side they may cross from, by g_end_: those that
+  // kept it, and with_changes those that left it too.
+  void collect_dips(bool with_changes);
   // For a g_i in dips_: the fraction theta of the step where it first reaches zero inside a dip,
   // or -1 when the step holds none; and theta_back where it comes back, for an event that admits
   // both directions (else -1).

@@ -273,9 +273,10 @@ class PlaneGround final : public ContactGround {
   }
 };
 
-// A positive scale as an exact rational: between 1e-3 and 1e3 the nearest with a denominator up
-// to 10^6 (continued fractions: within about 1e-12 of it, and short to print: 1, 19/25), else the
-// double's own binary value. A float in the derived expressions would combine with their exact
+// A positive scale as an exact rational: between 1e-3 and 1e3 a convergent of its continued
+// fraction with a denominator up to 10^6 (short to print: 1, 19/25; within 1e-15 of it where one
+// is, and within about 1e-6 at worst, for a value just off a simple fraction: the scale only
+// normalizes rows), else the double's own binary value. A float in the derived expressions would combine with their exact
 // coefficients in GiNaC's term order, which changes from process to process: the equations
 // printed "-1.0 x" in one run and "-x" in another.
 GiNaC::numeric exact_scale(double value) {

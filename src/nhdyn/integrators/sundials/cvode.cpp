@@ -231,6 +231,7 @@ struct CvodeRun {
   // only the sign changes between its steps' ends, this the minima inside them.
   std::optional<EventTracker> dips;
   std::vector<EventTracker::Crossing> crossings;
+  double dips_t = 0.0;  // where the dips were last looked for up to
 
   // The run's result: its status, message and counters, reached at t.
   IntegrationResult finish(Status status, std::string message) {
@@ -289,16 +290,18 @@ std::optional<IntegrationResult> handle_roots(CvodeRun& run, double t_new) {
   return std::nullopt;
 }
 
-// After a step from run.t to t_new: the dips of the event functions that may dip, looked for on
-// CVODE's interpolating polynomial; each found is handled as a root (the outputs before it, then
-// on_event with the state there).
+// Up to t_new (a step's end, or a root CVODE returned at inside it, y the state there): the dips
+// of the event functions that may dip since they were last looked for, on CVODE's interpolating
+// polynomial, before any root CVODE found (its root finding sees sign changes only, and takes any
+// of the roots of a gap that dipped and came back before changing sign); each found is handled as
+// a root (the outputs before it, then on_event with the state there).
 std::optional<IntegrationResult> handle_dips(CvodeRun& run, double t_new) {
   if (!run.dips) return std::nullopt;
   void* mem = run.objects.cvode.get();
   bool dipped = false;
   Status status = run.dips->check_dips(t_new, N_VGetArrayPointer(run.objects.y.get()), dipped);
-  if (status == Status::ok && dipped) {
-    const double t = run.t, h = t_new - run.t;
+  if (status == Status::ok && dipped && t_new > run.dips_t) {
+    const double t = run.dips_t, h = t_new - run.dips_t;
     N_Vector y_dky = run.objects.y_dky.get();
     bool interpolated = true;
     status = run.dips->locate(
@@ -328,6 +331,7 @@ std::optional<IntegrationResult> handle_dips(CvodeRun& run, double t_new) {
     return run.finish(status, fmt::format("{}: the event functions failed at t = {}: {}", run.method, t_new,
                                           describe(status)));
   run.dips->advance();
+  run.dips_t = t_new;
   return std::nullopt;
 }
 
@@ -387,6 +391,7 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
     } else if (const Status status = run.dips->restart(t0, y0); status != Status::ok) {
       return run.finish(status, fmt::format("{}: the event functions failed at t = {}: {}", method, t0, describe(status)));
     }
+    run.dips_t = t0;
   }
 
   for (;;) {
@@ -415,6 +420,7 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
     }
 
     if (flag == CV_ROOT_RETURN) {
+      if (auto stop = handle_dips(run, t_new)) return *std::move(stop);
       if (auto stop = handle_roots(run, t_new)) return *std::move(stop);
       continue;
     }
@@ -446,6 +452,7 @@ IntegrationResult integrate_cvode(OdeSystem& system, const IntegratorOptions& op
       if (run.dips && run.dips->restart(run.t, y_data) != Status::ok)
         return run.finish(Status::integrator_failure,
                           fmt::format("{}: the event functions failed at t = {}", method, run.t));
+      run.dips_t = run.t;
     }
   }
   return run.finish(Status::ok, {});
