@@ -126,18 +126,6 @@ std::string csv_line(const std::vector<std::string>& cells) {
   return line + "\n";
 }
 
-// The rows of a run kept in memory as well as in the CSV's temporary file, so that a failed run
-// can leave them in FILE.partial.csv with the reason first (the CSV itself is never committed).
-// Numbers are printed as CsvWriter prints them: the shortest form that reads back the same.
-std::string format_rows(const std::vector<double>& values, std::size_t columns) {
-  std::string out;
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    fmt::format_to(std::back_inserter(out), "{}", values[i]);
-    out += (i + 1) % columns == 0 ? '\n' : ',';
-  }
-  return out;
-}
-
 // FILE-events.csv: the run's provenance, then one row per located crossing, name, t, q, q'.
 void write_events_file(AtomicFile& file, const Model& model, const SimulationSummary& summary,
                        const std::string& provenance) {
@@ -202,7 +190,6 @@ struct RunOutput {
   bool companions = false;  // the CSV is a regular file, with a place beside it
   CsvWriter* writer = nullptr;
   AtomicFile* events_file = nullptr;  // opened when the run has events or contact modes
-  std::vector<double> kept;  // every row, for FILE.partial.csv if the run fails
 };
 
 // Every file of the run listed and checked together (run_files.hpp), then opened, before any
@@ -232,7 +219,8 @@ RunOutput open_run_files(RunFiles& files, const SimulateArgs& args, const Model&
   return out;
 }
 
-// Integrates, writing each row to the CSV (and keeping it for FILE.partial.csv) as it comes.
+// Integrates, writing each row to the CSV as it comes (a failed run's FILE.partial.csv is read back
+// from the CSV's temporary: no copy of the rows is kept).
 SimulationSummary run_to_files(const Model& model, const SimulationOptions& options, const ResultColumns& columns,
                                RunOutput& files) {
   std::vector<double> row;
@@ -241,7 +229,6 @@ SimulationSummary run_to_files(const Model& model, const SimulationOptions& opti
   const SimulationSummary summary = simulate(model, options, [&](const Data& data) {
     fill_result_row(model, data, row);
     files.writer->write_row(row);
-    if (files.companions) files.kept.insert(files.kept.end(), row.begin(), row.end());
     progress.update(data.t);
   });
   progress.finish();
@@ -250,8 +237,7 @@ SimulationSummary run_to_files(const Model& model, const SimulationOptions& opti
 
 // A failed run: the reason, and the rows up to the failure in FILE.partial.csv (the CSV itself is
 // never committed). Returns the exit code.
-int report_failure(const Model& model, const SimulationSummary& summary, const RunOutput& out, RunFiles& files,
-                   const ResultColumns& columns, const std::string& provenance) {
+int report_failure(const Model& model, const SimulationSummary& summary, const RunOutput& out, RunFiles& files) {
   fmt::print(stderr, "nhdyn: simulation of '{}' failed at t = {:.6g}: {}\n", model.name, summary.t_reached,
              summary.message);
   if (!out.companions) {
@@ -262,8 +248,7 @@ int report_failure(const Model& model, const SimulationSummary& summary, const R
                                    summary.t_reached, summary.message);
   for (char& c : reason)
     if (c == '\n' || c == '\r') c = ' ';
-  files.write_now(out.partial,
-                  reason + "\n" + provenance + csv_line(columns.all) + format_rows(out.kept, columns.all.size()));
+  files.write_now(out.partial, reason + "\n" + out.writer->written());
   fmt::print(stderr, "nhdyn: the {} rows up to the failure are in {} ({} is left as it was)\n", summary.outputs,
              out.partial.string(), out.csv.string());
   return 1;
@@ -388,7 +373,7 @@ int run_simulate(const SimulateArgs& args) {
   if (!summary.stiffness.empty()) fmt::print(stderr, "nhdyn: warning: {}\n", summary.stiffness);
   // `auto`'s background compile, failed during the run (a compile error): said as before the run.
   if (const std::string notice = jit::background_notice(model); !notice.empty()) fmt::print(stderr, "{}\n", notice);
-  if (summary.status != Status::ok) return report_failure(model, summary, out, files, columns, provenance);
+  if (summary.status != Status::ok) return report_failure(model, summary, out, files);
   const std::string html_notice = commit_run(args, resolved, model, options, columns, summary, provenance, out, files);
   if (!args.quiet) print_summary(args, model, options, summary, out, html_notice);
   return 0;

@@ -87,6 +87,29 @@ TEST_F(AtomicFileSteps, FinishLeavesTheTargetAloneAndPublishRenames) {
   EXPECT_THROW(file.publish(), std::logic_error);
 }
 
+// What a failed run leaves in FILE.partial.csv: the table's bytes so far, read back from its
+// temporary (the rows still in the writer's buffer included), while the target keeps its content.
+TEST_F(AtomicFileSteps, TheBytesWrittenSoFarAreReadBackFromTheTemporary) {
+  const fs::path target = dir_ / "t.csv";
+  std::ofstream(target) << "old\n";
+  nhdyn::CsvWriter table(target, {"t", "x"}, "# made by a test\n");
+  const std::vector<double> row = {0.5, -1e-300};
+  table.write_row(row);
+  EXPECT_EQ(table.written(), "# made by a test\nt,x\n0.5,-1e-300\n");
+  for (int i = 0; i < 3000; ++i) table.write_row(row);  // past the writer's 32 KiB buffer
+  const std::string text = table.written();
+  EXPECT_EQ(text.size(), 21U + 3001U * 12U);  // the preamble and header, 3001 rows
+  EXPECT_EQ(text.substr(text.size() - 24), "0.5,-1e-300\n0.5,-1e-300\n");
+  EXPECT_EQ(read(target), "old\n");
+  table.finish();
+  table.publish();
+  EXPECT_EQ(read(target), text);
+  nhdyn::AtomicFile finished(dir_ / "u.txt");
+  finished.write("x");
+  finished.finish();
+  EXPECT_EQ(finished.written(), "");
+}
+
 TEST_F(AtomicFileSteps, AFinishedFileNotPublishedLeavesNothing) {
   {
     nhdyn::AtomicFile file(dir_ / "a.txt");

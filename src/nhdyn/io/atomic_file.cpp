@@ -201,6 +201,18 @@ void AtomicFile::write(std::string_view bytes) {
   }
 }
 
+std::string AtomicFile::written() const {
+  if (!file_ || temporary_.empty() || std::fflush(file_) != 0) return {};
+  std::FILE* in = std::fopen(temporary_.c_str(), "rb");
+  if (!in) return {};
+  std::string bytes;
+  std::array<char, 1 << 16> chunk;
+  std::size_t n = 0;
+  while ((n = std::fread(chunk.data(), 1, chunk.size(), in)) > 0) bytes.append(chunk.data(), n);
+  std::fclose(in);
+  return bytes;
+}
+
 void AtomicFile::finish() {
   if (stage_ != Stage::writing) throw std::logic_error(fmt::format("AtomicFile: '{}' was already finished", target_.string()));
   int error = failed_ ? write_error_ : 0;

@@ -34,6 +34,10 @@ class AtomicFile {
   AtomicFile& operator=(const AtomicFile&) = delete;
 
   void write(std::string_view bytes);
+  // The bytes written so far, read back from the temporary (flushed first): what a run that failed
+  // leaves of its table in a file of its own (FILE.partial.csv) without keeping a copy in memory.
+  // Empty for a device or pipe written straight, and after finish().
+  std::string written() const;
   // The first step of commit: flushes and closes the temporary (or the device or pipe written
   // straight). Throws FileError, the temporary removed, if a write, the flush or the close failed
   // (disk full, file too large): nothing of this file appears. The target is not touched yet.

@@ -56,6 +56,12 @@ void CsvWriter::write_row(std::span<const double> values) {
   }
 }
 
+std::string CsvWriter::written() {
+  file_.write(buffer_);
+  buffer_.clear();
+  return file_.written();
+}
+
 void CsvWriter::finish() {
   file_.write(buffer_);
   buffer_.clear();

@@ -24,6 +24,8 @@ class CsvWriter {
 
   void write_row(std::span<const double> values);  // values.size() must equal the column count
   void commit();                                  // the file appears whole, or FileError
+  // The preamble, header and rows written so far, as the file holds them (AtomicFile::written).
+  std::string written();
   // commit() in its two steps (AtomicFile::finish, publish), for a group of files that appear
   // together: the rows written and the temporary closed (FileError if any of it failed), then the
   // rename.
