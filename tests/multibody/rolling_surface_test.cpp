@@ -540,6 +540,84 @@ position = {{ x = 0, y = "-R*sin(lean)", z = "R*cos(lean) + r", psi = 0, theta =
   EXPECT_GT(theta, 0.53);  // leaned further than at the start
 }
 
+// A thin disk (R = 0.3, axle y) in a spherical bowl of radius Rb: infinitely curved across its
+// rim, so only the rim's curvature along it counts, |e x n| / R (section 11; the torus's with no
+// tube). Upright it is 1/R = 3.33333 against the bowl's 1/Rb: a bowl of 0.29 (3.44828) is refused
+// naming both, one of 1 is accepted. Leaned by 0.5 in a bowl of 0.36 it starts (c / R = 2.92526,
+// c = cos 0.5, against 2.77778), leans further as it falls, and the run ends where c / R reaches
+// 1/Rb, with the measure 1 - R / (Rb c) computed from the state it names.
+TEST(RollingSurface, ADiskWhoseRimIsFlatterThanItsBowlIsRefusedAtTheStartAndStoppedAlongTheRun) {
+  const auto disk = [](double Rb, double lean) {
+    return fmt::format(R"toml(name = "disk-in-bowl"
+coordinates = ["x", "y", "z", "psi", "theta", "phi"]
+gravity = [0, 0, "-g"]
+
+[parameters]
+m = 2.0
+J = 0.09
+K = 0.045
+R = 0.3
+g = 9.81
+Rb = {}
+lean = {}
+
+[[frames]]
+name = "wheel"
+translation = ["x", "y", "z"]
+rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
+
+[[bodies]]
+name = "wheel"
+frame = "wheel"
+mass = "m"
+inertia = ["K", "J", "K"]
+
+[[contacts]]
+name = "rim"
+body = "wheel"
+shape = {{ disk = "R", axis = "y" }}
+ground = {{ surface = "X^2 + Y^2 + (Z - Rb)^2 - Rb^2", side = "inside" }}
+
+[initial]
+position = {{ x = 0, y = "-R*sin(lean)", z = "R*cos(lean)", psi = 0, theta = "lean", phi = 0 }}
+)toml",
+                       Rb, lean);
+  };
+  const std::string m = surface_error([&] { load_model_text(disk(0.29, 0.0), "disk.toml"); });
+  for (const std::string part : {"disk.toml:", "contact 'rim'", "the disk's rim is flatter than the hollow",
+                                 "curvature is 3.33333", "the ground's 3.44828"})
+    EXPECT_NE(m.find(part), std::string::npos) << m << "\n  lacks: " << part;
+  SimulationOptions options;
+  options.t_end = 0.5;
+  options.output_step = 0.01;
+  SimulationSummary summary;
+  surface_rows(load_model_text(disk(1.0, 0.0), "disk.toml"), options, &summary);
+  EXPECT_EQ(summary.status, Status::ok) << summary.message;
+
+  surface_rows(load_model_text(disk(0.36, 0.5), "disk.toml"), options, &summary);
+  ASSERT_NE(summary.status, Status::ok);
+  const std::string& stop = summary.message;
+  EXPECT_NE(stop.find("the ground's hollow is as curved as the disk's rim here"), std::string::npos) << stop;
+  const auto named = [&](const std::string& key) {
+    const std::size_t at = stop.find(key + " = ");
+    EXPECT_NE(at, std::string::npos) << key << " in " << stop;
+    return at == std::string::npos ? 0.0 : std::stod(stop.substr(at + key.size() + 3));
+  };
+  const double theta = named("theta"), gx = named("rim_gx"), gy = named("rim_gy"), gz = named("rim_gz");
+  const double Rb = 0.36, R = 0.3;
+  // The bowl's inward unit normal at the contact point, and the axle (sin psi ..., here psi stays
+  // 0 by symmetry: (0, cos theta, sin theta)).
+  const double nx = -gx / Rb, ny = -gy / Rb, nz = (Rb - gz) / Rb;
+  const double en = std::cos(theta) * ny + std::sin(theta) * nz;
+  const double c = std::sqrt(1.0 - en * en / (nx * nx + ny * ny + nz * nz));
+  const double measure = 1 - R / (Rb * c);
+  const std::size_t at = stop.find("along the rim = ");
+  ASSERT_NE(at, std::string::npos) << stop;
+  EXPECT_NEAR(std::stod(stop.substr(at + 16)), measure, 2e-5) << stop;
+  EXPECT_LT(measure, 1e-4);
+  EXPECT_GT(theta, 0.55);  // leaned further than at the start
+}
+
 // Refusals, each naming the file's line and what to do.
 TEST(RollingSurface, BadSurfacesAreRefusedByName) {
   const std::string base = text_of("ball_in_paraboloid.toml");

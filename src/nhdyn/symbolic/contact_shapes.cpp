@@ -86,6 +86,12 @@ class Disk final : public ContactShape {
     return Singularity{1 - along * along, "the disk lies flat: its axle is along the ground's normal, where every point of "
                                           "its rim is lowest and the contact point is not defined"};
   }
+  // The rim circle's curvature along t = e x nu at its lowest point, |e x nu| / (R |nu|): the
+  // torus's with no tube (docs/derivations/rolling-bodies.md section 11).
+  std::optional<Rim> rim(const ShapeValues& v, const Vector3& nu, const GiNaC::ex& length) const override {
+    const GiNaC::ex en = nu[static_cast<std::size_t>(v.axis)];
+    return Rim{cross(unit(v.axis), nu), GiNaC::sqrt(length * length - en * en) / (v.sizes[0] * length)};
+  }
   VisualItem drawing(const ShapeValues& v) const override {
     VisualItem item = drawn(VisualKind::wheel, {});
     item.size = v.sizes[0];

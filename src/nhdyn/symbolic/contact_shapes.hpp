@@ -65,10 +65,19 @@ class ContactShape {
   // Hessian of a defining f over |grad f| there, positive along the directions the surface bends
   // away from the ground (docs/derivations/rolling-bodies.md sections 9 and 11), which the
   // convexity check holds against a curved ground's. Nothing for a shape without one (a disk,
-  // infinitely curved across its rim) or an implicit shape (whose check uses its f).
+  // infinitely curved across its rim: rim() below) or an implicit shape (whose check uses its f).
   virtual std::optional<GiNaC::matrix> curvature(const ShapeValues&, const Vector3&, const GiNaC::ex&) const {
     return std::nullopt;
   }
+  // A shape curved toward the ground along one direction only, infinitely across it (a thin disk:
+  // its rim): that direction at the support point y*(nu) for nu / length (body axes, any length)
+  // and the curvature along it, which the convexity check holds against the ground's along the
+  // same direction (docs/derivations/rolling-bodies.md section 11). Nothing for other shapes.
+  struct Rim {
+    Vector3 tangent;
+    GiNaC::ex curvature;
+  };
+  virtual std::optional<Rim> rim(const ShapeValues&, const Vector3&, const GiNaC::ex&) const { return std::nullopt; }
   // The size of the shape for the moment rows of the contact-force solve (a length).
   virtual GiNaC::ex length(const ShapeValues& values) const { return values.sizes.front(); }
   // Where the closed-form contact point is singular along the motion: a measure that is positive

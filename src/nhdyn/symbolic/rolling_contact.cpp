@@ -787,6 +787,20 @@ std::pair<GiNaC::ex, GiNaC::ex> tangent_determinant_and_trace(const GiNaC::matri
 // convex, and not a number where both its curvatures vanish (which ends the run as well).
 std::vector<SpecContactWatch> convexity_watches(const SpecConvexity& check, bool own) {
   const Vector3 n = {check.normal[0], check.normal[1], check.normal[2]};
+  // A thin disk: its rim's curvature along t against the ground's, 1 - k_ground(t) / k_rim, 1 on a
+  // plane and 0 where the hollow is as curved as the rim (the disk touches it at two points).
+  if (!check.rim.empty()) {
+    const Vector3 t = {check.rim[0], check.rim[1], check.rim[2]};
+    GiNaC::ex along = 0;
+    for (unsigned i = 0; i < 3; ++i)
+      for (unsigned j = 0; j < 3; ++j) along += t[i] * check.ground(i, j) * t[j];
+    return {SpecContactWatch{
+        check.contact, check.where, 1 - along / dot(t, t) / check.rim_curvature, 1e-4,
+        "the ground's hollow is as curved as the disk's rim here (along the rim the ground bends as much as the "
+        "rim does): the disk touches the ground at more than one point, and the motion past it is not the body's; "
+        "use a smaller disk or a smoother ground",
+        "1 - k_ground / k_rim along the rim", true, true}};
+  }
   const auto [body_det, body_trace] = tangent_determinant_and_trace(check.body, n);
   const GiNaC::ex scale = body_trace * body_trace / 4;
   const GiNaC::matrix relative = check.body.sub(check.ground);
@@ -949,10 +963,11 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
                                fmt::format("contact '{}': no spin about the normal, n.(omega - omega_ground) = 0", c.name)});
   }
   if (c.shape->implicit()) out.convexity = convexity_check(c, F, touch);
-  // A closed-form shape (a ball, an ellipsoid) on a surface or a terrain held by coordinates: its
-  // curvature at the support point against the ground's (sections 8 and 11).
+  // A closed-form shape (a ball, an ellipsoid, a torus) on a surface or a terrain held by
+  // coordinates: its curvature at the support point against the ground's; a thin disk's along its
+  // rim (sections 8 and 11).
   const Vector3 nu = multiply_transposed(F.rotation, touch.normal);
-  if (!c.shape->implicit() && (c.ground.point[0] >= 0 || c.ground.at[0] >= 0))
+  if (!c.shape->implicit() && (c.ground.point[0] >= 0 || c.ground.at[0] >= 0)) {
     if (const std::optional<GiNaC::matrix> K = c.shape->curvature(c.values, nu, GiNaC::sqrt(dot(nu, nu)))) {
       SpecConvexity check;
       check.contact = c.name;
@@ -962,7 +977,18 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
       check.body = c.shape->ball_radius(c.values) ? *K : F.rotation.mul(*K).mul(F.rotation.transpose());
       check.ground = touch.curvature;
       out.convexity = check;
+    } else if (const std::optional<ContactShape::Rim> rim = c.shape->rim(c.values, nu, GiNaC::sqrt(dot(nu, nu)))) {
+      SpecConvexity check;
+      check.contact = c.name;
+      check.where = c.where;
+      check.normal = {touch.normal[0], touch.normal[1], touch.normal[2]};
+      const Vector3 t = multiply(F.rotation, rim->tangent);
+      check.rim = {t[0], t[1], t[2]};
+      check.rim_curvature = rim->curvature;
+      check.ground = touch.curvature;
+      out.convexity = check;
     }
+  }
   if (out.convexity)
     for (SpecContactWatch& watch : convexity_watches(*out.convexity, c.shape->implicit()))
       out.watches.push_back(std::move(watch));
@@ -1026,6 +1052,23 @@ void check_contact_convexity(const Spec& spec) {
     }
     if (!ok || !(n.norm() > 0)) continue;
     n.normalize();
+    const std::string context = fmt::format("contact '{}'", check.contact);
+    if (!check.rim.empty()) {
+      // A thin disk: the ground's curvature along the rim, t^T K t / |t|^2, below the rim's.
+      Eigen::Vector3d t;
+      double rim = 0;
+      for (int i = 0; i < 3 && ok; ++i) ok = value(check.rim[static_cast<std::size_t>(i)], t(i));
+      if (!ok || !value(check.rim_curvature, rim) || !(t.norm() > 0) || !(rim > 0)) continue;
+      const double along = t.dot(ground * t) / t.squaredNorm();
+      if (!(rim - along > 1e-12 * rim))
+        throw_model_error(check.where, context, fmt::format(
+            "the disk's rim is flatter than the hollow of the ground at the initial contact point, so the contact is "
+            "not unique: along the rim the rim's curvature is {:.6g} (|e x n| / r, e the axle) and the ground's "
+            "{:.6g} (it must be smaller). Use a smaller disk, a smoother ground, or start where the ground's hollow "
+            "is shallower",
+            rim, along));
+      continue;
+    }
     // An orthonormal basis E of the tangent plane; the curvatures are the eigenvalues of E^T K E.
     Eigen::Vector3d e1 = n.unitOrthogonal();
     Eigen::Matrix<double, 3, 2> E;
@@ -1037,7 +1080,6 @@ void check_contact_convexity(const Spec& spec) {
     const Eigen::Vector2d own = curvatures(body), relative = curvatures(body - ground);
     // Relative to the shape's own size: a curvature 1e-12 of its largest counts as flat.
     const double small = 1e-12 * std::max(own.cwiseAbs().maxCoeff(), 1e-300);
-    const std::string context = fmt::format("contact '{}'", check.contact);
     if (!(own(0) > small))
       throw_model_error(check.where, context, fmt::format(
           "the shape is not strictly convex toward the ground at the initial contact point: its "

@@ -127,6 +127,10 @@ struct SpecConvexity {
   std::vector<GiNaC::ex> normal;                  // n, unit (3)
   GiNaC::matrix body = GiNaC::matrix(3, 3);
   GiNaC::matrix ground = GiNaC::matrix(3, 3);     // zero for a plane
+  // A thin disk (ContactShape::rim): its rim's direction at the contact point (world axes, any
+  // length; empty for other shapes) and its curvature along it, which stand for `body`.
+  std::vector<GiNaC::ex> rim;
+  GiNaC::ex rim_curvature;
 };
 
 // Coordinates that the multibody front end added for a contact point ([[contacts]] without
