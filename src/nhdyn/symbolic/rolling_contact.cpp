@@ -830,6 +830,35 @@ std::vector<SpecContactWatch> convexity_watches(const SpecConvexity& check, bool
   return watches;
 }
 
+// What the start checks and the run watches of the shape's convexity against the ground's
+// (sections 9 and 11): an implicit shape's from its f; a closed-form shape (a ball, an ellipsoid, a
+// torus) on a surface or a terrain held by coordinates, its curvature at the support point; a thin
+// disk's along its rim. Nothing on a plane for a closed-form shape (convex by construction).
+std::optional<SpecConvexity> shape_convexity(const ParsedContact& c, const PlacedFrame& F,
+                                             const ContactGround::Touch& touch) {
+  if (c.shape->implicit()) return convexity_check(c, F, touch);
+  if (c.ground.point[0] < 0 && c.ground.at[0] < 0) return std::nullopt;
+  SpecConvexity check;
+  check.contact = c.name;
+  check.where = c.where;
+  check.normal = {touch.normal[0], touch.normal[1], touch.normal[2]};
+  check.ground = touch.curvature;
+  const Vector3 nu = multiply_transposed(F.rotation, touch.normal);
+  const GiNaC::ex length = GiNaC::sqrt(dot(nu, nu));
+  if (const std::optional<GiNaC::matrix> K = c.shape->curvature(c.values, nu, length)) {
+    // A ball's I / r is the same in every axes: not turned, so that its watch stays short.
+    check.body = c.shape->ball_radius(c.values) ? *K : F.rotation.mul(*K).mul(F.rotation.transpose());
+    return check;
+  }
+  if (const std::optional<ContactShape::Rim> rim = c.shape->rim(c.values, nu, length)) {
+    const Vector3 t = multiply(F.rotation, rim->tangent);
+    check.rim = {t[0], t[1], t[2]};
+    check.rim_curvature = rim->curvature;
+    return check;
+  }
+  return std::nullopt;
+}
+
 // The contact coordinates nhdyn adds, and where Newton starts (rolling-bodies.md sections 10 and
 // 11): on a terrain below the centre; on a surface along grad F from the centre; an implicit
 // shape's point on its surface along -nu from its centre.
@@ -962,33 +991,7 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
     out.constraints.push_back({c.name + "_spin", ConstraintLevel::velocity, spin,
                                fmt::format("contact '{}': no spin about the normal, n.(omega - omega_ground) = 0", c.name)});
   }
-  if (c.shape->implicit()) out.convexity = convexity_check(c, F, touch);
-  // A closed-form shape (a ball, an ellipsoid, a torus) on a surface or a terrain held by
-  // coordinates: its curvature at the support point against the ground's; a thin disk's along its
-  // rim (sections 8 and 11).
-  const Vector3 nu = multiply_transposed(F.rotation, touch.normal);
-  if (!c.shape->implicit() && (c.ground.point[0] >= 0 || c.ground.at[0] >= 0)) {
-    if (const std::optional<GiNaC::matrix> K = c.shape->curvature(c.values, nu, GiNaC::sqrt(dot(nu, nu)))) {
-      SpecConvexity check;
-      check.contact = c.name;
-      check.where = c.where;
-      check.normal = {touch.normal[0], touch.normal[1], touch.normal[2]};
-      // A ball's I / r is the same in every axes: not turned, so that its watch stays short.
-      check.body = c.shape->ball_radius(c.values) ? *K : F.rotation.mul(*K).mul(F.rotation.transpose());
-      check.ground = touch.curvature;
-      out.convexity = check;
-    } else if (const std::optional<ContactShape::Rim> rim = c.shape->rim(c.values, nu, GiNaC::sqrt(dot(nu, nu)))) {
-      SpecConvexity check;
-      check.contact = c.name;
-      check.where = c.where;
-      check.normal = {touch.normal[0], touch.normal[1], touch.normal[2]};
-      const Vector3 t = multiply(F.rotation, rim->tangent);
-      check.rim = {t[0], t[1], t[2]};
-      check.rim_curvature = rim->curvature;
-      check.ground = touch.curvature;
-      out.convexity = check;
-    }
-  }
+  out.convexity = shape_convexity(c, F, touch);
   if (out.convexity)
     for (SpecContactWatch& watch : convexity_watches(*out.convexity, c.shape->implicit()))
       out.watches.push_back(std::move(watch));
