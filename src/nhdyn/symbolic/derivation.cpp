@@ -282,7 +282,7 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
     for (const auto& [j, entry] : row) {
       if (entry.is_zero()) continue;
       const auto uj = static_cast<unsigned>(j);
-      b(r, uj) = tidy(entry);
+      b(r, uj) = smaller_form(entry);
       zero = zero && b(r, uj).is_zero();
     }
     if (zero)
@@ -296,7 +296,7 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
                                            c.level == ConstraintLevel::position   ? "the coordinates"
                                            : c.level == ConstraintLevel::velocity ? "the velocities"
                                                                                   : "the accelerations"));
-    b0_out(r, 0) = tidy(b0);
+    b0_out(r, 0) = smaller_form(b0);
   }
 
 }

@@ -973,7 +973,7 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
   int k = 0;
   for (const Vector3& t : {touch.tangent1, touch.tangent2}) {
     ++k;
-    const GiNaC::ex row = simplify_moderate(dot(t, relative));
+    const GiNaC::ex row = smaller_form(dot(t, relative));
     if (row.is_zero())
       throw_model_error(c.where, context,
                         fmt::format("the contact point's velocity along the ground (direction {}) is zero whatever "

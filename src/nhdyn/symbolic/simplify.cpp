@@ -333,6 +333,28 @@ std::size_t capped_size(const ex& e, std::size_t limit) {
 
 }  // namespace
 
+namespace {
+
+// The symbols and functions written in the tree, each occurrence counted, and numbers not: a
+// measure of size that GiNaC's sign choices (x - y in one process, -(y - x) in another: the -1 is
+// a number) do not change.
+std::size_t symbol_count(const ex& e, std::size_t limit) {
+  if (GiNaC::is_a<GiNaC::numeric>(e)) return 0;
+  if (GiNaC::is_a<GiNaC::symbol>(e)) return 1;
+  std::size_t n = GiNaC::is_a<GiNaC::function>(e) ? 1 : 0;
+  for (std::size_t i = 0; i < e.nops() && n <= limit; ++i) n += symbol_count(e.op(i), limit - n);
+  return n;
+}
+
+}  // namespace
+
+GiNaC::ex smaller_form(const GiNaC::ex& e) {
+  const GiNaC::ex simplified = simplify_moderate(e);
+  if (simplified.is_equal(e)) return e;
+  const std::size_t derived = symbol_count(e, kSimplifyLimit);
+  return derived < symbol_count(simplified, derived) ? e : simplified;
+}
+
 GiNaC::ex simplify_moderate(const GiNaC::ex& e) {
   if (capped_size(e, kSimplifyLimit) > kSimplifyLimit) return e;
   return simplify(e);

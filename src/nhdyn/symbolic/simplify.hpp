@@ -34,6 +34,13 @@ GiNaC::matrix simplify(const GiNaC::matrix& m);
 inline constexpr std::size_t kSimplifyLimit = 1000;
 GiNaC::ex simplify_moderate(const GiNaC::ex& e);
 
+// simplify_moderate(e), or e as it is where that is smaller, counted in the symbols and functions
+// written (numbers not): the rows of a rolling contact and their derivatives, which normal()
+// would multiply out (a ball's rolling rows on a sphere: 3.6 times the operations). Both forms
+// compile to the same tape in every process (the compiler fixes the signs GiNaC chooses by its term
+// order, compile.cpp), and the count does not see those signs, so the choice is the same too.
+GiNaC::ex smaller_form(const GiNaC::ex& e);
+
 // True when simplify(e) is 0; false when it is not or when simplify() cannot tell. Call it as
 // symbolic::is_zero: argument-dependent lookup also finds GiNaC::is_zero, which only tests whether
 // the expression is literally the number 0.
