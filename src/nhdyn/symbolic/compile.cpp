@@ -384,6 +384,53 @@ class TapeCompiler {
     return {sign, intern(std::move(n))};
   }
 
+  // The factors of a product with the powers of one base merged, S^p S^q = S^(p + q): GiNaC merges
+  // them only where the base is written alike, and it writes a sum's sign by its term order, which
+  // changes from process to process, so one process holds S^(1/2) (-S) and another -S^(3/2). Here
+  // the sign has gone to the coefficient `c`: a factor S (exponent 1) and a power (e S)^p with
+  // e = +-1 merge into e (e S)^(p + 1), powers of the same signed base add their exponents. Factors
+  // whose exponents add to 0 drop out.
+  std::vector<int> merge_powers(std::vector<int> factors, double& c) {
+    struct Power {
+      Scaled base;
+      double p;
+    };
+    std::vector<Power> powers;
+    bool merged = false;
+    for (int f : factors) {
+      const Node& n = node(f);
+      const bool number_power = n.kind == Kind::power && n.items.size() == 1;
+      Power x = number_power ? Power{n.items[0], n.exponent} : Power{{1.0, f}, 1.0};
+      bool done = false;
+      for (Power& y : powers) {
+        if (y.base.id != x.base.id) continue;
+        if (same_bits(y.base.c, x.base.c)) {
+          y.p += x.p;
+        } else if (x.p == 1.0 && same_bits(x.base.c, 1.0) && std::abs(y.base.c) == 1.0) {
+          c *= y.base.c;  // S (e S)^p = e (e S)^(p + 1)
+          y.p += 1.0;
+        } else if (y.p == 1.0 && same_bits(y.base.c, 1.0) && std::abs(x.base.c) == 1.0) {
+          c *= x.base.c;
+          y = {x.base, x.p + 1.0};
+        } else {
+          continue;
+        }
+        done = merged = true;
+        break;
+      }
+      if (!done) powers.push_back(x);
+    }
+    if (!merged) return factors;
+    std::vector<int> out;
+    for (const Power& x : powers) {
+      if (x.p == 0.0) continue;
+      const Scaled f = make_power(x.base, x.p);
+      c *= f.c;
+      if (f.id != kOne) out.push_back(f.id);
+    }
+    return out;
+  }
+
   // c * the product of the factors (nodes), sorted.
   Scaled make_mul(std::vector<int> factors, double c) {
     if (c == 0.0) return {0.0, kOne};
@@ -471,7 +518,9 @@ class TapeCompiler {
           factors.push_back(f.id);
         }
       }
-      return make_mul(std::move(factors), product_of(std::move(numbers)));
+      double c = product_of(std::move(numbers));
+      factors = merge_powers(std::move(factors), c);
+      return make_mul(std::move(factors), c);
     }
     if (GiNaC::is_exactly_a<GiNaC::power>(e)) {
       const Scaled base = canonical(e.op(0));

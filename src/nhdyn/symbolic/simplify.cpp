@@ -338,10 +338,28 @@ namespace {
 // The symbols and functions written in the tree, each occurrence counted, and numbers not: a
 // measure of size that GiNaC's sign choices (x - y in one process, -(y - x) in another: the -1 is
 // a number) do not change.
+// In a product, the powers of one base count the base once: GiNaC merges S^(1/2) (-S) into
+// -S^(3/2) in the processes where it writes -S as S, and the compiler merges them in every one
+// (compile.cpp, merge_powers), so the count must not see the difference either.
 std::size_t symbol_count(const ex& e, std::size_t limit) {
   if (GiNaC::is_a<GiNaC::numeric>(e)) return 0;
   if (GiNaC::is_a<GiNaC::symbol>(e)) return 1;
   std::size_t n = GiNaC::is_a<GiNaC::function>(e) ? 1 : 0;
+  if (GiNaC::is_a<GiNaC::mul>(e)) {
+    std::vector<std::string> bases;  // each base's key, the same for S and -S
+    for (std::size_t i = 0; i < e.nops() && n <= limit; ++i) {
+      const ex& f = e.op(i);
+      const bool power = GiNaC::is_a<GiNaC::power>(f);
+      const ex& base = power ? f.op(0) : f;
+      if (power) n += symbol_count(f.op(1), limit - n);
+      std::string key = canonical_key(base);
+      if (GiNaC::is_a<GiNaC::add>(base)) key = std::min(key, canonical_key(GiNaC::expand(-base)));
+      if (std::find(bases.begin(), bases.end(), key) != bases.end()) continue;
+      bases.push_back(std::move(key));
+      n += symbol_count(base, limit - n);
+    }
+    return n;
+  }
   for (std::size_t i = 0; i < e.nops() && n <= limit; ++i) n += symbol_count(e.op(i), limit - n);
   return n;
 }

@@ -35,10 +35,13 @@ inline constexpr std::size_t kSimplifyLimit = 1000;
 GiNaC::ex simplify_moderate(const GiNaC::ex& e);
 
 // simplify_moderate(e), or e as it is where that is smaller, counted in the symbols and functions
-// written (numbers not): the rows of a rolling contact and their derivatives, which normal()
-// would multiply out (a ball's rolling rows on a sphere: 3.6 times the operations). Both forms
-// compile to the same tape in every process (the compiler fixes the signs GiNaC chooses by its term
-// order, compile.cpp), and the count does not see those signs, so the choice is the same too.
+// written (numbers not; the powers of one base in a product counting it once): the rows of a
+// rolling contact and their derivatives, which normal() would multiply out (a ball's rolling rows
+// on a sphere: 3.6 times the operations). GiNaC writes an unsimplified expression by its term
+// order, which changes from process to process, in two ways that matter: the sign of a sum (x - y
+// in one process, -(y - x) in another; the -1 is a number) and, through it, whether S^(1/2) (-S) is
+// merged into -S^(3/2). The count sees neither, and the compiler undoes both (compile.cpp), so the
+// choice and the tape are the same in every process.
 GiNaC::ex smaller_form(const GiNaC::ex& e);
 
 // True when simplify(e) is 0; false when it is not or when simplify() cannot tell. Call it as
