@@ -543,9 +543,9 @@ position = {{ x = 0, y = "-R*sin(lean)", z = "R*cos(lean) + r", psi = 0, theta =
 // A thin disk (R = 0.3, axle y) in a spherical bowl of radius Rb: infinitely curved across its
 // rim, so only the rim's curvature along it counts, |e x n| / R (section 11; the torus's with no
 // tube). Upright it is 1/R = 3.33333 against the bowl's 1/Rb: a bowl of 0.29 (3.44828) is refused
-// naming both, one of 1 is accepted. Leaned by 0.5 in a bowl of 0.36 it starts (c / R = 2.92526,
+// naming both, one of 1 is accepted. Leaned by 0.5 in a bowl of 0.36 it starts (c / R = 2.92528,
 // c = cos 0.5, against 2.77778), leans further as it falls, and the run ends where c / R reaches
-// 1/Rb, with the measure 1 - R / (Rb c) computed from the state it names.
+// 1/Rb, with the measure it names equal to the closed form from the state it names.
 TEST(RollingSurface, ADiskWhoseRimIsFlatterThanItsBowlIsRefusedAtTheStartAndStoppedAlongTheRun) {
   const auto disk = [](double Rb, double lean) {
     return fmt::format(R"toml(name = "disk-in-bowl"
@@ -603,19 +603,42 @@ position = {{ x = 0, y = "-R*sin(lean)", z = "R*cos(lean)", psi = 0, theta = "le
     EXPECT_NE(at, std::string::npos) << key << " in " << stop;
     return at == std::string::npos ? 0.0 : std::stod(stop.substr(at + key.size() + 3));
   };
-  const double theta = named("theta"), gx = named("rim_gx"), gy = named("rim_gy"), gz = named("rim_gz");
+  const double x = named("x"), y = named("y"), z = named("z"), theta = named("theta");
+  const double px = named("rim_gx"), py = named("rim_gy"), pz = named("rim_gz");
   const double Rb = 0.36, R = 0.3;
-  // The bowl's inward unit normal at the contact point, and the axle (sin psi ..., here psi stays
-  // 0 by symmetry: (0, cos theta, sin theta)).
-  const double nx = -gx / Rb, ny = -gy / Rb, nz = (Rb - gz) / Rb;
-  const double en = std::cos(theta) * ny + std::sin(theta) * nz;
-  const double c = std::sqrt(1.0 - en * en / (nx * nx + ny * ny + nz * nz));
-  const double measure = 1 - R / (Rb * c);
+  // In a sphere the contact point P is the rim point farthest from the sphere's centre O, at the
+  // distance s + R, s = d_perp . (P - C) / R the part of d = C - O in the disk's plane along the
+  // way to P; the ground's normal there makes c = (s + R) / Rb with that plane, so
+  // 1 - R / (Rb c) = s / (s + R): 0 where O is on the axle line and the whole rim lies on the
+  // sphere, negative past it. The axle is (0, cos theta, sin theta): psi stays 0 by symmetry.
+  const double ey = std::cos(theta), ez = std::sin(theta);
+  const double dx = x, dy = y, dz = z - Rb;
+  const double along = dy * ey + dz * ez;
+  const double qx = dx, qy = dy - along * ey, qz = dz - along * ez;  // d_perp
+  const double sp = (qx * (px - x) + qy * (py - y) + qz * (pz - z)) / R;
+  const double measure = sp / (sp + R);
   const std::size_t at = stop.find("along the rim = ");
   ASSERT_NE(at, std::string::npos) << stop;
   EXPECT_NEAR(std::stod(stop.substr(at + 16)), measure, 2e-5) << stop;
   EXPECT_LT(measure, 1e-4);
+  EXPECT_NEAR(std::hypot(px - x, py - y, pz - z), R, 1e-5);  // P on the rim (the state printed to 6 digits)
   EXPECT_GT(theta, 0.55);  // leaned further than at the start
+
+  // A paraboloid curved 1/a along x (the rim's direction at the bottom) and 1/b across: the disk
+  // leaned by 0.5 (rim curvature cos(0.5) / R = 2.92528) is refused where 1/a = 4, and accepted
+  // with a and b swapped (0.5 along the rim; the 4 across it does not count).
+  const auto paraboloid = [&](double a, double b) {
+    std::string text = disk(1.0, 0.5);
+    replace_once(text, R"(ground = { surface = "X^2 + Y^2 + (Z - Rb)^2 - Rb^2", side = "inside" })",
+                 fmt::format(R"(ground = {{ surface = "X^2/(2*{}) + Y^2/(2*{}) - Z", side = "inside" }})", a, b));
+    return text;
+  };
+  const std::string refused = surface_error([&] { load_model_text(paraboloid(0.25, 2.0), "disk.toml"); });
+  for (const std::string part : {"the disk's rim is flatter than the hollow", "curvature is 2.92528", "the ground's 4 "})
+    EXPECT_NE(refused.find(part), std::string::npos) << refused << "\n  lacks: " << part;
+  options.t_end = 0.05;
+  surface_rows(load_model_text(paraboloid(2.0, 0.25), "disk.toml"), options, &summary);
+  EXPECT_EQ(summary.status, Status::ok) << summary.message;
 }
 
 // Refusals, each naming the file's line and what to do.

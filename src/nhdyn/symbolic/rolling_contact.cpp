@@ -797,8 +797,8 @@ std::vector<SpecContactWatch> convexity_watches(const SpecConvexity& check, bool
     return {SpecContactWatch{
         check.contact, check.where, 1 - along / dot(t, t) / check.rim_curvature, 1e-4,
         "the ground's hollow is as curved as the disk's rim here (along the rim the ground bends as much as the "
-        "rim does): the disk touches the ground at more than one point, and the motion past it is not the body's; "
-        "use a smaller disk or a smoother ground",
+        "rim does): past this point the rim would dip into the ground beside the contact point, and the motion is "
+        "not the body's; use a smaller disk or a smoother ground",
         "1 - k_ground / k_rim along the rim", true, true}};
   }
   const auto [body_det, body_trace] = tangent_determinant_and_trace(check.body, n);
