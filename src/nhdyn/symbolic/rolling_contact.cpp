@@ -941,7 +941,7 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
   out.tangent2 = touch.tangent2;
 
   // The contact condition: the gap, zero when touching (rolling-bodies.md section 4.1).
-  const GiNaC::ex gap = simplify_moderate(touch.gap);
+  const GiNaC::ex gap = smaller_form(touch.gap);
   if (!gap.is_zero()) {
     if (!contact_has_coordinates(gap, spec))
       throw_model_error(c.where, context,
@@ -963,7 +963,7 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
   }
   // The contact point's coordinates on the ground, where they are coordinates (section 8).
   for (const auto& [suffix, row] : touch.locate)
-    out.constraints.push_back({c.name + suffix, ConstraintLevel::position, simplify_moderate(row),
+    out.constraints.push_back({c.name + suffix, ConstraintLevel::position, smaller_form(row),
                                fmt::format("contact '{}': the contact point is where the body's normal is opposite "
                                            "to the ground's ({})",
                                            c.name, suffix.substr(1))});

@@ -346,16 +346,24 @@ std::size_t symbol_count(const ex& e, std::size_t limit) {
   if (GiNaC::is_a<GiNaC::symbol>(e)) return 1;
   std::size_t n = GiNaC::is_a<GiNaC::function>(e) ? 1 : 0;
   if (GiNaC::is_a<GiNaC::mul>(e)) {
-    std::vector<std::string> bases;  // each base's key, the same for S and -S
+    // Only sums can stand twice (as S and -S): GiNaC merges other equal bases itself.
+    const auto sum_base = [](const ex& f) {
+      const ex& base = GiNaC::is_a<GiNaC::power>(f) ? f.op(0) : f;
+      return GiNaC::is_a<GiNaC::add>(base);
+    };
+    std::size_t sums = 0;
+    for (std::size_t i = 0; i < e.nops(); ++i) sums += sum_base(e.op(i)) ? 1 : 0;
+    std::vector<std::string> bases;  // each sum base's key, the same for S and -S
     for (std::size_t i = 0; i < e.nops() && n <= limit; ++i) {
       const ex& f = e.op(i);
       const bool power = GiNaC::is_a<GiNaC::power>(f);
       const ex& base = power ? f.op(0) : f;
       if (power) n += symbol_count(f.op(1), limit - n);
-      std::string key = canonical_key(base);
-      if (GiNaC::is_a<GiNaC::add>(base)) key = std::min(key, canonical_key(GiNaC::expand(-base)));
-      if (std::find(bases.begin(), bases.end(), key) != bases.end()) continue;
-      bases.push_back(std::move(key));
+      if (sums > 1 && sum_base(f)) {
+        std::string key = std::min(canonical_key(base), canonical_key(GiNaC::expand(-base)));
+        if (std::find(bases.begin(), bases.end(), key) != bases.end()) continue;
+        bases.push_back(std::move(key));
+      }
       n += symbol_count(base, limit - n);
     }
     return n;
