@@ -1,10 +1,11 @@
 // The shapes a rolling body may have ([[contacts]] of a model file, docs/multibody.md): one type
-// per shape, registered once in the table of contact_shapes.cpp. A shape knows the key that names
-// it in `shape = { KEY = ... }`, how many sizes that key takes and which further keys it has, and
-// its geometry: the support mapping y*(nu), the point of the shape lowest along a unit direction
-// nu (body axes), and the reach rho(nu) = -nu . y*(nu) (docs/derivations/rolling-bodies.md
-// section 2). The rolling-contact builder (rolling_contact.hpp), the loader and the scene go
-// through this table; none of them lists shapes.
+// per shape, each in a file of its own (shapes/), registered once in the table of
+// contact_shapes.cpp. A shape knows the key that names it in `shape = { KEY = ... }`, how many
+// sizes that key takes and which further keys it has, and its geometry: the support mapping
+// y*(nu), the point of the shape lowest along a unit direction nu (body axes), and the reach
+// rho(nu) = -nu . y*(nu) (docs/derivations/rolling-bodies.md section 2). The rolling-contact
+// builder (rolling_contact.hpp), the loader and the scene go through this table; none of them
+// lists shapes.
 #pragma once
 
 #include <ginac/ginac.h>
