@@ -1,6 +1,7 @@
 // A convex body rolling on a ground ([[contacts]] of a model file, docs/multibody.md): the
-// description as the user wrote it (ContactText), the grounds (one type each, registered once in
-// rolling_contact.cpp, as the shapes are in contact_shapes.cpp), and what the multibody builder
+// description as the user wrote it (ContactText), the grounds (one type each in grounds/,
+// registered once in rolling_contact.cpp, as the shapes are in shapes/ and contact_shapes.cpp), and
+// what the multibody builder
 // adds for one contact: the contact condition (the gap), the rolling constraints, the no-spin
 // constraint of rubber rolling, the contact point, and the contact-force description.
 // docs/derivations/rolling-bodies.md derives every expression here.
