@@ -9,23 +9,11 @@
 #include "nhdyn/model/contact_modes.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 #include "nhdyn/symbolic/contact_forces.hpp"
+#include "nhdyn/symbolic/detail/contact_geometry.hpp"
 #include "nhdyn/symbolic/rolling_contact.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
-
-// The value at the parameter values, or nullopt when it is not a finite real number.
-std::optional<double> mode_number_of(const GiNaC::ex& e, const Spec& spec) {
-  try {
-    const GiNaC::ex v = e.subs(spec.parameter_values()).evalf();
-    if (!GiNaC::is_a<GiNaC::numeric>(v) || !GiNaC::ex_to<GiNaC::numeric>(v).is_real()) return std::nullopt;
-    const double d = GiNaC::ex_to<GiNaC::numeric>(v).to_double();
-    if (!std::isfinite(d)) return std::nullopt;
-    return d;
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-}
 
 std::string value_text(const std::optional<double>& v) { return v ? fmt::format("{:.6g}", *v) : "not a number"; }
 
@@ -43,7 +31,7 @@ std::optional<SpecContactMode> parse_contact_mode(const ContactText& text, const
     if (key == "friction" || key == "mu_s" || key == "mu_k") {
       const std::string what = key == "friction" ? "friction" : key == "mu_s" ? "friction[1] (mu_s)" : "friction[2] (mu_k)";
       const GiNaC::ex mu = p.constant(value, text.where, context + ": " + what);
-      const std::optional<double> v = mode_number_of(mu, *p.spec);
+      const std::optional<double> v = contact_number_of(mu, *p.spec);
       if (!v || *v < 0.0)
         throw_model_error(text.where, context,
                           fmt::format("{} = \"{}\" is {}; a Coulomb friction coefficient is a number >= 0 (e.g. "
@@ -57,7 +45,7 @@ std::optional<SpecContactMode> parse_contact_mode(const ContactText& text, const
       out.unilateral = value == "true";
     } else if (key == "restitution") {
       out.restitution = p.constant(value, text.where, context + ": restitution");
-      const std::optional<double> v = mode_number_of(out.restitution, *p.spec);
+      const std::optional<double> v = contact_number_of(out.restitution, *p.spec);
       if (!v || *v < 0.0 || *v > 1.0)
         throw_model_error(text.where, context,
                           fmt::format("restitution = \"{}\" is {}; Newton's coefficient of restitution is between 0 "
@@ -68,7 +56,7 @@ std::optional<SpecContactMode> parse_contact_mode(const ContactText& text, const
     }
   }
   if (two) {
-    const std::optional<double> s = mode_number_of(out.mu_s, *p.spec), k = mode_number_of(out.mu_k, *p.spec);
+    const std::optional<double> s = contact_number_of(out.mu_s, *p.spec), k = contact_number_of(out.mu_k, *p.spec);
     if (s && k && *s < *k)
       throw_model_error(text.where, context,
                         fmt::format("friction = [mu_s, mu_k] has mu_s = {:.6g} below mu_k = {:.6g}; the static "
