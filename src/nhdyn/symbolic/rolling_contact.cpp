@@ -541,7 +541,15 @@ std::vector<std::string> added_contact_coordinates(const std::string& contact, C
 namespace {
 
 // A numeric value, NaN when `e` is not a finite real number once everything is substituted.
+// The values in `at` are exact (exact_double) and the evaluation carries 40 digits, so that the
+// rounding of GiNaC's sums, taken in its term order (which changes from process to process), stays
+// far below a double's: the contact point found at the start is the same in every process.
 double contact_value(const GiNaC::ex& e, const GiNaC::exmap& at) {
+  struct Digits {
+    long saved = GiNaC::Digits;
+    Digits() { GiNaC::Digits = 40; }
+    ~Digits() { GiNaC::Digits = saved; }
+  } digits;
   try {
     const GiNaC::ex x = e.subs(at, GiNaC::subs_options::no_pattern).evalf();
     if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real())
@@ -558,7 +566,7 @@ double contact_value(const GiNaC::ex& e, const GiNaC::exmap& at) {
 double ray_exit(const GiNaC::ex& f, const std::array<GiNaC::ex, 3>& y, const Eigen::Vector3d& d, GiNaC::exmap at,
                 const Eigen::Vector3d& o = Eigen::Vector3d::Zero()) {
   const auto value = [&](double s) {
-    for (int i = 0; i < 3; ++i) at[y[static_cast<std::size_t>(i)]] = GiNaC::numeric(o(i) + s * d(i));
+    for (int i = 0; i < 3; ++i) at[y[static_cast<std::size_t>(i)]] = exact_double(o(i) + s * d(i));
     return contact_value(f, at);
   };
   if (!(value(0.0) < 0.0)) return std::numeric_limits<double>::quiet_NaN();
@@ -585,7 +593,7 @@ Eigen::Vector3d ground_start(const Spec& spec, const SpecContactCoordinates& add
   Eigen::Vector3d C, d;
   for (int i = 0; i < 3; ++i) C(i) = contact_value(added.from[static_cast<std::size_t>(i)], at);
   GiNaC::exmap here = at;
-  for (std::size_t i = 0; i < 3; ++i) here[U[i]] = GiNaC::numeric(C(static_cast<Eigen::Index>(i)));
+  for (std::size_t i = 0; i < 3; ++i) here[U[i]] = exact_double(C(static_cast<Eigen::Index>(i)));
   const double F = contact_value(added.ground, here);
   for (std::size_t i = 0; i < 3; ++i)
     d(static_cast<Eigen::Index>(i)) = contact_value(added.ground.diff(GiNaC::ex_to<GiNaC::symbol>(U[i])), here);
@@ -609,6 +617,19 @@ Eigen::Vector3d ground_start(const Spec& spec, const SpecContactCoordinates& add
   return C + s * d.normalized();
 }
 
+// The parameters' values exact (a value given as a double is its binary value), as every number
+// put into the expressions evaluated by contact_value.
+GiNaC::lst exact_parameter_values(const Spec& spec) {
+  GiNaC::lst out;
+  for (const GiNaC::ex& p : spec.parameter_values()) {
+    const GiNaC::ex& value = p.op(1);
+    const bool inexact = GiNaC::is_a<GiNaC::numeric>(value) && !GiNaC::ex_to<GiNaC::numeric>(value).is_rational() &&
+                         GiNaC::ex_to<GiNaC::numeric>(value).is_real();
+    out.append(p.op(0) == (inexact ? GiNaC::ex(exact_double(GiNaC::ex_to<GiNaC::numeric>(value).to_double())) : value));
+  }
+  return out;
+}
+
 const SpecConstraint& constraint_named(const Spec& spec, const std::string& name) {
   for (const SpecConstraint& c : spec.constraints)
     if (c.name == name) return c;
@@ -619,7 +640,7 @@ const SpecConstraint& constraint_named(const Spec& spec, const std::string& name
 
 void solve_contact_coordinates(Spec& spec) {
   if (spec.contact_coordinates.empty()) return;
-  const GiNaC::lst parameters = spec.parameter_values();
+  const GiNaC::lst parameters = exact_parameter_values(spec);
   for (const SpecContactCoordinates& added : spec.contact_coordinates) {
     const std::string context = fmt::format("contact '{}'", added.contact);
     const auto k = static_cast<Eigen::Index>(added.coordinates.size());
@@ -628,11 +649,11 @@ void solve_contact_coordinates(Spec& spec) {
     // Everything else at its initial value (numbers: the parameters substituted).
     GiNaC::exmap at;
     for (const GiNaC::ex& p : parameters) at[p.op(0)] = p.op(1);
-    at[spec.symbols.time()] = GiNaC::numeric(spec.t0);
+    at[spec.symbols.time()] = exact_double(spec.t0);
     for (std::size_t i = 0; i < spec.coordinates.size(); ++i)
       if (!unknown[i]) {
         const double q = contact_value(spec.q0[i].subs(parameters), at);
-        at[spec.symbols.coordinate(static_cast<int>(i))] = GiNaC::numeric(q);
+        at[spec.symbols.coordinate(static_cast<int>(i))] = exact_double(q);
       }
     // The start: a surface's point along the steepest approach from the centre, or a terrain's
     // point below the centre; then the shape's point along -nu.
@@ -641,14 +662,14 @@ void solve_contact_coordinates(Spec& spec) {
     if (!added.from.empty()) {
       x.head(3) = ground_start(spec, added, at, context);
       for (std::size_t i = 0; i < 3; ++i)
-        at[spec.symbols.coordinate(added.ground_point[i])] = GiNaC::numeric(x(static_cast<Eigen::Index>(i)));
+        at[spec.symbols.coordinate(added.ground_point[i])] = exact_double(x(static_cast<Eigen::Index>(i)));
       first = 3;
     }
     std::size_t ray_from = added.coordinates.size();
     if (!added.ray.empty()) ray_from -= 3;
     for (std::size_t j = first; j < ray_from; ++j) {
       x(static_cast<Eigen::Index>(j)) = contact_value(added.start[j], at);
-      at[spec.symbols.coordinate(added.coordinates[j])] = GiNaC::numeric(x(static_cast<Eigen::Index>(j)));
+      at[spec.symbols.coordinate(added.coordinates[j])] = exact_double(x(static_cast<Eigen::Index>(j)));
     }
     if (!added.ray.empty()) {
       Eigen::Vector3d d;
@@ -674,7 +695,7 @@ void solve_contact_coordinates(Spec& spec) {
       for (std::size_t j = 0; j < added.coordinates.size(); ++j) jacobian[r].push_back(rows[r].diff(symbol(j)));
     const auto set_x = [&] {
       for (std::size_t j = 0; j < added.coordinates.size(); ++j)
-        at[spec.symbols.coordinate(added.coordinates[j])] = GiNaC::numeric(x(static_cast<Eigen::Index>(j)));
+        at[spec.symbols.coordinate(added.coordinates[j])] = exact_double(x(static_cast<Eigen::Index>(j)));
     };
     Eigen::VectorXd r(static_cast<Eigen::Index>(rows.size()));
     const auto residual = [&] {

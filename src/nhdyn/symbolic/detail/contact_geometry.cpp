@@ -225,8 +225,13 @@ GiNaC::numeric exact_scale(double value) {
     }
     if (q1 > 0 && p1 > 0) return GiNaC::numeric(p1) / GiNaC::numeric(q1);
   }
+  return exact_double(value);
+}
+
+GiNaC::numeric exact_double(double value) {
+  if (value == 0.0 || !std::isfinite(value)) return GiNaC::numeric(0);
   int exponent = 0;
-  const double mantissa = std::frexp(value, &exponent);  // value = mantissa 2^exponent, mantissa in [1/2, 1)
+  const double mantissa = std::frexp(value, &exponent);  // value = mantissa 2^exponent, |mantissa| in [1/2, 1)
   return GiNaC::numeric(static_cast<long>(std::ldexp(mantissa, 53))) * GiNaC::numeric(2).power(exponent - 53);
 }
 

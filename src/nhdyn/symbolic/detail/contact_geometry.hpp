@@ -72,6 +72,11 @@ void implicit_shape_rows(const ParsedContact& c, const PlacedFrame& F, const Vec
 // process: the equations printed "-1.0 x" in one run and "-x" in another.
 GiNaC::numeric exact_scale(double value);
 
+// The double's own binary value as an exact rational (0 for a value that is not finite): a number
+// put into an expression that GiNaC then evaluates in its term order, so that the order does not
+// reach the result (a float would round differently from process to process).
+GiNaC::numeric exact_double(double value);
+
 // |grad g| at the shape's centre where the run starts (the file's initial values and parameters),
 // g's scale as a number: 1 where that is not a positive number (a start written nowhere).
 double gradient_scale(const Vector3& gradient, const Vector3& U, const Vector3& C, const Spec& spec);
