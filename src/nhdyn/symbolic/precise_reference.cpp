@@ -9,21 +9,10 @@
 #include <utility>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/symbolic/detail/digits_scope.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
-
-// GiNaC::Digits is global: set it for one computation and put it back, even on a throw.
-class DigitsScope {
- public:
-  explicit DigitsScope(long digits) : saved_(GiNaC::Digits) { GiNaC::Digits = digits; }
-  ~DigitsScope() { GiNaC::Digits = saved_; }
-  DigitsScope(const DigitsScope&) = delete;
-  DigitsScope& operator=(const DigitsScope&) = delete;
-
- private:
-  long saved_;
-};
 
 std::string to_text(const GiNaC::ex& e) {
   std::ostringstream out;

@@ -19,6 +19,7 @@
 #include "nhdyn/symbolic/simplify.hpp"
 
 #include "nhdyn/symbolic/detail/contact_geometry.hpp"
+#include "nhdyn/symbolic/detail/digits_scope.hpp"
 #include "nhdyn/symbolic/detail/grounds.hpp"
 
 namespace nhdyn::symbolic {
@@ -545,11 +546,7 @@ namespace {
 // rounding of GiNaC's sums, taken in its term order (which changes from process to process), stays
 // far below a double's: the contact point found at the start is the same in every process.
 double contact_value(const GiNaC::ex& e, const GiNaC::exmap& at) {
-  struct Digits {
-    long saved = GiNaC::Digits;
-    Digits() { GiNaC::Digits = 40; }
-    ~Digits() { GiNaC::Digits = saved; }
-  } digits;
+  const DigitsScope digits(40);
   try {
     const GiNaC::ex x = e.subs(at, GiNaC::subs_options::no_pattern).evalf();
     if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real())

@@ -331,10 +331,6 @@ std::size_t capped_size(const ex& e, std::size_t limit) {
   return n;
 }
 
-}  // namespace
-
-namespace {
-
 // The symbols and functions written in the tree, each occurrence counted, and numbers not: a
 // measure of size that GiNaC's sign choices (x - y in one process, -(y - x) in another: the -1 is
 // a number) do not change.

@@ -1,5 +1,6 @@
 // The helpers of the rolling-contact builder that its grounds share (detail/contact_geometry.hpp).
 #include "nhdyn/symbolic/detail/contact_geometry.hpp"
+#include "nhdyn/symbolic/precise_reference.hpp"
 
 #include <fmt/format.h>
 
@@ -228,12 +229,7 @@ GiNaC::numeric exact_scale(double value) {
   return exact_double(value);
 }
 
-GiNaC::numeric exact_double(double value) {
-  if (value == 0.0 || !std::isfinite(value)) return GiNaC::numeric(0);
-  int exponent = 0;
-  const double mantissa = std::frexp(value, &exponent);  // value = mantissa 2^exponent, |mantissa| in [1/2, 1)
-  return GiNaC::numeric(static_cast<long>(std::ldexp(mantissa, 53))) * GiNaC::numeric(2).power(exponent - 53);
-}
+GiNaC::numeric exact_double(double value) { return std::isfinite(value) ? exact_rational(value) : GiNaC::numeric(0); }
 
 // |grad g| at the shape's centre where the run starts (the file's initial values and parameters),
 // g's scale as a number: 1 where that is not a positive number (a start written nowhere).

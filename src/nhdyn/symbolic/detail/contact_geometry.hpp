@@ -72,7 +72,8 @@ void implicit_shape_rows(const ParsedContact& c, const PlacedFrame& F, const Vec
 // process: the equations printed "-1.0 x" in one run and "-x" in another.
 GiNaC::numeric exact_scale(double value);
 
-// The double's own binary value as an exact rational (0 for a value that is not finite): a number
+// The double's own binary value as an exact rational (exact_rational of precise_reference.hpp; 0
+// for a value that is not finite, where a search has failed and says so itself): a number
 // put into an expression that GiNaC then evaluates in its term order, so that the order does not
 // reach the result (a float would round differently from process to process).
 GiNaC::numeric exact_double(double value);
