@@ -56,21 +56,23 @@ double energy_error(const SimulationSummary& s) {
   return s.energy.has_balance ? s.energy.balance_error : s.energy.drift;
 }
 
-// The methods compared: those asked for, except that programs are solved by sanh alone: by default
-// it is then the one method compared, with a note; another one asked for by name is refused.
+// The methods compared: those asked for, except that programs and contacts that may slide or lift
+// off are solved by sanh alone: by default it is then the one method compared, with a note; another
+// one asked for by name is refused.
 std::vector<std::string> compared_methods(const Model& model, const CompareArgs& args) {
   std::vector<std::string> methods = args.methods;
-  if (model.m() > 0) {
+  if (model.m() > 0 || model.contact_modes) {
+    const char* what = model.m() > 0 ? "programs ([[programs]])" : "contacts that may slide or lift off (friction or "
+                                                                   "unilateral, docs/contact-modes.md)";
     for (const std::string& m : methods)
       if (args.methods_given && parse_formulation(m) != Formulation::sanh)
-        throw InputError(fmt::format("--methods {}: model '{}' has programs ([[programs]]), which only the sanh "
-                                     "formulation solves; give --methods sanh (and --integrators to compare "
-                                     "integrators)",
-                                     m, model.name));
+        throw InputError(fmt::format("--methods {}: model '{}' has {}, which only the sanh formulation solves; give "
+                                     "--methods sanh (and --integrators to compare integrators)",
+                                     m, model.name, what));
     if (!args.methods_given) {
       methods = {"sanh"};
-      fmt::print(stderr, "nhdyn: note: model '{}' has programs, which only sanh solves: comparing sanh alone "
-                         "(--integrators compares integrators)\n", model.name);
+      fmt::print(stderr, "nhdyn: note: model '{}' has {}, which only sanh solves: comparing sanh alone "
+                         "(--integrators compares integrators)\n", model.name, what);
     }
   }
   // A name given twice would give two runs of one case and two columns of one name.

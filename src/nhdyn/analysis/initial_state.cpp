@@ -14,6 +14,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
+#include "nhdyn/model/contact_modes.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {
@@ -36,6 +37,23 @@ std::vector<int> rows_at(const Model& model, ConstraintLevel level, bool program
     for (int j = 0; j < model.m(); ++j)
       if (lives_at(model.program_constraints[static_cast<std::size_t>(j)].level, level)) rows.push_back(model.s() + j);
   return rows;
+}
+
+// Whether constraint `row` belongs to a contact whose given mode at t0 (`mode` of [[contacts]])
+// drops it: --fix-initial leaves a free contact's gap and a sliding one's slip as written.
+bool dropped_at_start(const Model& model, int row) {
+  if (!model.contact_modes || row >= model.s()) return false;
+  for (const ContactModeContact& c : model.contact_modes->contacts)
+    if (c.initial >= 0 && contact_mode_drops_row(c, static_cast<ContactMode>(c.initial), row)) return true;
+  return false;
+}
+
+// Whether some contact's mode at t0 is given.
+bool modes_given(const Model& model) {
+  if (!model.contact_modes) return false;
+  for (const ContactModeContact& c : model.contact_modes->contacts)
+    if (c.initial >= 0) return true;
+  return false;
 }
 
 // The residual of those rows, in that order.
@@ -152,7 +170,9 @@ void fix_keeping_written(const Model& model, Data& data, double t, double tolera
         free.push_back(i);
         free_names.push_back(value_name(model, i, level));
       }
-    const std::vector<int> all = rows_at(model, level, true);
+    std::vector<int> all = rows_at(model, level, true);
+    all.erase(std::remove_if(all.begin(), all.end(), [&model](int row) { return dropped_at_start(model, row); }),
+              all.end());
     // The constraints and programs none of the free values enter cannot be mended by moving them.
     std::vector<int> movable, fixed_rows;
     if (!all.empty()) {
@@ -276,8 +296,9 @@ InitialFix fix_free_initial_values(const Model& model, Data& data, double t, con
                                    double tolerance, int max_iterations) {
   const auto any = [](const std::vector<bool>& flags) { return std::find(flags.begin(), flags.end(), true) != flags.end(); };
   // The projection knows the constraints only: a model with programs takes the restricted Newton
-  // steps, every value free when none is written (the same smallest inertia-weighted change).
-  if (!any(model.q0_written) && !any(model.v0_written) && model.m() == 0)
+  // steps, every value free when none is written (the same smallest inertia-weighted change); so
+  // does a model whose contacts' modes at t0 are given, which drop some rows.
+  if (!any(model.q0_written) && !any(model.v0_written) && model.m() == 0 && !modes_given(model))
     return fix_initial_state(model, data, t, q, v, tolerance, max_iterations);
   InitialFix fix;
   fix.q = q;

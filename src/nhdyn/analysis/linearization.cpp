@@ -582,6 +582,7 @@ void reduce_to_independent(const Model& model, const LinearizationOptions& optio
 
 Linearization calc_linearization(const Model& model, const LinearizationOptions& options) {
   check_model_shape(model);
+  require_fewer_constraints(model, "a linearization");
   if (model.m() > 0)
     throw InputError(fmt::format("model '{}' has programs ([[programs]]); linearization does not take their actuator "
                                  "forces into account: remove the programs to linearize the free system",

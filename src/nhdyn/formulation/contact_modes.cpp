@@ -173,7 +173,7 @@ Status compute_mode_acceleration(const Model& model, Data& data) {
   w.failed_contact = -1;
   w.forces_current = false;
   const bool rolling = std::all_of(w.mode.begin(), w.mode.end(), [](ContactMode m) { return m == ContactMode::rolling; });
-  if (rolling && w.defer_forces && model.s() > 0) {
+  if (rolling && w.defer_forces && model.s() > 0 && model.s() < model.n()) {
     // Every contact rolling: the ordinary Do Sanh form with D from b (sanh.hpp), as cheap as the
     // model without modes; no friction works.
     const Status status = compute_sanh_acceleration(model, data, Complement::qr);
@@ -217,6 +217,19 @@ Status solve_modes(const Model& model, Data& data, bool rolling, bool forces_onl
     if (keep) w.kept.push_back(row);
   }
   const int r = static_cast<int>(w.kept.size());
+  if (r >= n) {
+    // Contacts held together that leave the body no freedom (s >= n, constraints_always_held):
+    // the Do Sanh form has no k = n - r > 0 rows of D to give the motion.
+    std::string touching;
+    for (std::size_t i = 0; i < cm.contacts.size(); ++i)
+      if (w.mode[i] != ContactMode::free) touching += (touching.empty() ? "'" : ", '") + cm.contacts[i].name + "'";
+    return fail(data, cm, -1,
+                fmt::format("the contacts {} held together keep {} constraint rows on {} coordinates: the body "
+                            "would be wedged with no freedom of motion, which the equations of motion cannot carry "
+                            "(docs/contact-modes.md, \"More contacts than freedom\"); start one of them free "
+                            "(mode = \"free\"), or remove one",
+                            touching, r, n));
+  }
   if (w.reaction_rows.cols() != r) {
     w.reaction_rows.resize(n, r);
     w.multipliers.resize(r);

@@ -266,6 +266,8 @@ std::string explain_failure(const Model& model, const Data& data) {
       if (data.failed_quantity.rfind("program matrix", 0) == 0) return explain_program_failure(model, data);
       if (data.failed_quantity.rfind("contact '", 0) == 0)  // formulation/contact_modes.cpp
         return fmt::format("{} at t = {:.6g}", data.failed_quantity, data.failed_t);
+      if (data.failed_quantity.rfind("the contacts '", 0) == 0)  // the same, contacts held together
+        return fmt::format("at t = {:.6g}, {}", data.failed_t, data.failed_quantity);
       if (data.failed_quantity == "complement D")
         return fmt::format("the model's complement D is not a complement of b at t = {:.6g}: the largest "
                            "|D_i . b_j| / (|D_i| |b_j|) is {:.3g} (D b^T must be 0); the rows of D must span "
@@ -285,6 +287,7 @@ std::string explain_failure(const Model& model, const Data& data) {
 }
 
 Status check_terms(const Model& model, Data& data) {
+  if (model.s() >= model.n()) return Status::ok;
   if (!a_is_positive_definite(model, data)) {
     // A singular A is judged on the constraints, so dependent constraints are the first thing to say.
     if (model.s() > 0 && b_is_rank_deficient(model, data))

@@ -17,7 +17,8 @@ std::string explain_failure(const Model& model, const Data& data);
 
 // Checks the terms in data (after compute_terms): A symmetric positive definite, or, where it is
 // singular, positive definite on the velocities the constraints allow ([D A; b] regular), and b
-// of full row rank. Returns the first problem found, recording it in data, or Status::ok.
+// of full row rank. Returns the first problem found, recording it in data, or Status::ok. A model
+// with s >= n (contacts never all held) is checked by its mode solve, on the rows its modes keep.
 Status check_terms(const Model& model, Data& data);
 
 // compute_terms at (t, q, v) then check_terms; throws ModelError with explain_failure's words.

@@ -8,6 +8,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "nhdyn/model/contact_modes.hpp"
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/model/model.hpp"
 
@@ -221,6 +222,13 @@ ContactForceData make_contact_force_data(const Model& model) {
   w.misfit = Vector::Zero(c.rows());
   w.qr = Eigen::ColPivHouseholderQR<Matrix>(c.rows(), c.columns());
   w.values = Vector::Constant(c.values(), kNaN);
+  for (const ContactForceContact& contact : c.contacts) {
+    int index = -1;
+    if (model.contact_modes)
+      for (std::size_t i = 0; i < model.contact_modes->contacts.size(); ++i)
+        if (model.contact_modes->contacts[i].name == contact.name) index = static_cast<int>(i);
+    w.mode_contact.push_back(index);
+  }
   return w;
 }
 
@@ -237,6 +245,15 @@ void compute_contact_forces(const Model& model, Data& data) {
     w.tape.run(data.t, data.q.data(), data.v.data(), w.registers.data(), w.outputs.data());
   const double* o = w.outputs.data();
   assemble(c, o, data.qdd.data(), data.R.data(), w.M, w.rhs);
+  Eigen::Index solved = c.columns();  // the columns solved for: all but a free contact's
+  if (data.modes.active)
+    for (std::size_t i = 0; i < c.contacts.size(); ++i) {
+      const int m = w.mode_contact[i];
+      if (m < 0 || data.modes.mode[static_cast<std::size_t>(m)] != ContactMode::free) continue;
+      w.M.middleCols(c.contacts[i].first_unknown, c.contacts[i].unknowns).setZero();
+      solved -= c.contacts[i].unknowns;
+    }
+  bool determined = true;
   if (c.single_wheel) {
     // One wheel supports the only system: F = sum_B m_B (a_B - g), its first balance rows.
     w.x = w.rhs.segment(c.n, 3);
@@ -248,10 +265,22 @@ void compute_contact_forces(const Model& model, Data& data) {
     w.qr.matrixQR().topLeftCorner(rank, rank).triangularView<Eigen::Upper>().solveInPlace(w.work.head(rank));
     w.x.setZero();
     for (Eigen::Index i = 0; i < rank; ++i) w.x(w.qr.colsPermutation().indices()(i)) = w.work(i);
+    // The load's analysis (ContactForceModel::determined) holds every contact at once, which a
+    // model with s >= n never does: its rows are judged here, on the contacts touching.
+    determined = model.s() < model.n() || rank == solved;
   }
   w.misfit.noalias() = w.M * w.x;
   w.misfit -= w.rhs;
-  const double scale = w.rhs.norm();
+  double scale = w.rhs.norm();
+  if (solved < c.columns()) {
+    // A free contact's body may be in flight, its balance m (a - g) = 0 a difference of round-offs:
+    // measured against the balance's own terms k_S (weight and inertia), not against that.
+    double terms = 0.0;
+    for (int sys = 0; sys < c.systems; ++sys)
+      if (c.balance_rows[static_cast<std::size_t>(sys)])
+        for (int r = 0; r < 6; ++r) terms = std::hypot(terms, o[c.system_offset(sys) + 6 * c.n + r]);
+    scale = std::max(scale, terms);
+  }
   w.residual = scale > 0.0 ? w.misfit.norm() / scale : w.misfit.norm();
   int index = 0;
   for (const ContactForceContact& contact : c.contacts) {
@@ -270,7 +299,7 @@ void compute_contact_forces(const Model& model, Data& data) {
         const double* e = basis + 3 * (k - 3);
         out[j] = e[0] * F[0] + e[1] * F[1] + e[2] * F[2];
       }
-      if (!c.determined[static_cast<std::size_t>(contact.first_value) + j]) out[j] = kNaN;
+      if (!c.determined[static_cast<std::size_t>(contact.first_value) + j] || !determined) out[j] = kNaN;
     }
     ++index;
   }
@@ -300,6 +329,9 @@ void analyse_contact_forces(const Model& model, ContactForceModel& c) {
   const int n = model.n();
   const int s = model.s();
   c.determined.assign(static_cast<std::size_t>(c.values()), 1);
+  // Contacts never all held (s >= n) have no state with every row held to check: each row is
+  // judged on the contacts touching there (compute_contact_forces).
+  if (s >= n) return;
   // A generic admissible state near the initial one: shifted by fixed amounts (the same model gives
   // the same verdict), then moved onto the constraints (step 5); failing that the start itself when
   // it is on them. With neither, nothing is checked: a verdict off the constraints can be wrong.

@@ -119,6 +119,9 @@ struct ContactForceData {
   Vector work;               // rows(), Q^T rhs
   Vector misfit;             // rows(), M F - rhs
   Eigen::ColPivHouseholderQR<Matrix> qr;
+  // Per contact of ContactForceModel::contacts: its index among the contacts with modes
+  // (contact_modes.hpp), or -1. A free contact's unknowns are zero, not solved for.
+  std::vector<int> mode_contact;
   // Results: per reported contact, its components (Fx, Fy, Fz [N] world, N, Flong, Flat [N],
   // Mspin [N m]); NaN where not determined (ContactForceModel::determined).
   Vector values;
@@ -131,6 +134,9 @@ ContactForceData make_contact_force_data(const Model& model);
 // Writes data.contact.values and data.contact.residual. Allocates nothing; cost: the tape, one
 // QR of a (n + 6 systems) x unknowns matrix (none for one wheel alone on one system: F is its
 // system's momentum balance). Throws std::logic_error when called before the accelerations.
+// With contact modes, the unknowns of the free contacts are 0; in a model with s >= n (contacts
+// never all held, whose forces the load does not analyse) the forces of a state where the touching
+// contacts share the load in a way the balance does not fix are NaN.
 void compute_contact_forces(const Model& model, Data& data);
 
 // The CSV columns: NAME_Fx, NAME_Fy, NAME_Fz, NAME_N, NAME_Flong, NAME_Flat per reported wheel or

@@ -27,7 +27,12 @@ ContactModeData make_contact_mode_data(const Model& model) {
   w.registers.assign(static_cast<std::size_t>(w.tape.registers()), 0.0);
   w.outputs.assign(static_cast<std::size_t>(w.tape.outputs()), 0.0);
   const std::size_t m = c.contacts.size();
+  // The modes a fresh Data solves in, before a run chooses them from the state
+  // (choose_initial_contact_modes): rolling, or free where the model file says so (a contact that
+  // starts away from the ground; with more contact rows than coordinates, all rolling is no motion).
   w.mode.assign(m, ContactMode::rolling);
+  for (std::size_t i = 0; i < m; ++i)
+    if (model.contact_modes->contacts[i].initial == static_cast<int>(ContactMode::free)) w.mode[i] = ContactMode::free;
   w.solved.assign(m, ContactMode::free);
   w.direction.assign(m, {1.0, 0.0});
   w.normal_sign.assign(m, 1.0);
@@ -90,6 +95,19 @@ bool contact_mode_drops_row(const ContactModeContact& c, ContactMode mode, int r
   if (mode == ContactMode::rolling || row < 0) return false;
   if (row == c.roll[0] || row == c.roll[1] || row == c.spin) return true;
   return mode == ContactMode::free && row == c.gap;
+}
+
+int constraints_always_held(const Model& model) {
+  if (!model.contact_modes) return model.s();
+  int held = 0;
+  for (int row = 0; row < model.s(); ++row) {
+    bool dropped = false;
+    for (const ContactModeContact& c : model.contact_modes->contacts)
+      dropped = dropped || (c.unilateral && contact_mode_drops_row(c, ContactMode::free, row)) ||
+                (c.friction && contact_mode_drops_row(c, ContactMode::sliding, row));
+    held += dropped ? 0 : 1;
+  }
+  return held;
 }
 
 bool contact_mode_drops(const Model& model, const Data& data, const std::string& constraint) {

@@ -134,6 +134,12 @@ void append_contact_mode_values(const Data& data, std::vector<double>& row);
 // slip of a free one are motion, not constraint error; they have their own columns).
 void record_contact_gaps(const Model& model, Data& data);
 
+// The constraints that hold in every mode of the model's contacts: s less the rows some mode can
+// drop (free drops a unilateral contact's rows, sliding a contact with friction's no-slip and spin
+// rows). A model may have s >= n when this is below n (docs/contact-modes.md, "More contacts than
+// freedom"): the solve then refuses a set of modes that keeps n rows or more.
+int constraints_always_held(const Model& model);
+
 // Whether the constraint called `constraint` is a row that its contact's current mode drops.
 bool contact_mode_drops(const Model& model, const Data& data, const std::string& constraint);
 // Whether contact c in `mode` drops the row `row` of b (a constraint index): sliding drops its

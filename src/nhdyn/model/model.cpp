@@ -6,6 +6,7 @@
 #include <set>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/model/contact_modes.hpp"
 
 namespace nhdyn {
 
@@ -32,13 +33,26 @@ int Model::velocity_programs() const {
   }));
 }
 
+void require_fewer_constraints(const Model& model, const std::string& what) {
+  if (model.s() < model.n()) return;
+  throw InputError(fmt::format(
+      "model '{}' has {} constraints on {} coordinates, which its contacts' modes never hold all at once "
+      "(docs/contact-modes.md, \"More contacts than freedom\"); {} holds every constraint, which leaves no motion: "
+      "simulate the model instead, or remove a contact",
+      model.name, model.s(), model.n(), what));
+}
+
 void check_model_shape(const Model& model) {
   const std::string who = fmt::format("model '{}'", model.name);
   if (model.n() == 0) throw ModelError(who + ": it has no coordinates");
-  if (model.s() >= model.n())
-    throw ModelError(fmt::format("{}: {} constraints on {} coordinates leave no freedom of motion; "
-                                 "a model needs fewer constraints than coordinates",
-                                 who, model.s(), model.n()));
+  if (const int held = constraints_always_held(model); held >= model.n())
+    throw ModelError(held == model.s()
+                         ? fmt::format("{}: {} constraints on {} coordinates leave no freedom of motion; "
+                                       "a model needs fewer constraints than coordinates",
+                                       who, model.s(), model.n())
+                         : fmt::format("{}: {} constraints on {} coordinates, {} of them held whatever the contacts' "
+                                       "modes, leave no freedom of motion; fewer than n must hold at any time",
+                                       who, model.s(), model.n(), held));
   if (!model.evaluator) throw ModelError(who + ": it has no evaluator");
   if (model.q0.size() != model.n() || model.v0.size() != model.n())
     throw ModelError(fmt::format("{}: initial state has {} coordinates and {} velocities, expected {}",

@@ -134,7 +134,10 @@ struct Model {
 
   int n() const { return static_cast<int>(coordinates.size()); }
   int s() const { return static_cast<int>(constraints.size()); }
-  int k() const { return n() - s(); }
+  // k = n - s, the degrees of freedom with every constraint held; 0 for a model with s >= n, whose
+  // contacts are never all held (contact_modes.hpp, constraints_always_held): its solve keeps the
+  // rows of the contacts' current modes.
+  int k() const { return n() > s() ? n() - s() : 0; }
   int m() const { return static_cast<int>(program_constraints.size()); }
   // Number of constraints given at position level, and at position or velocity level.
   int position_constraints() const;
@@ -146,5 +149,10 @@ struct Model {
 
 // Checks the dimensions and names of a model before use; throws ModelError naming what is wrong.
 void check_model_shape(const Model& model);
+
+// Throws InputError when the model declares as many constraints as coordinates or more (s >= n,
+// allowed for contacts that are never all held, contact_modes.hpp): `what` (a linearization,
+// generated code, an optimization) holds every constraint at once, which leaves no motion.
+void require_fewer_constraints(const Model& model, const std::string& what);
 
 }  // namespace nhdyn

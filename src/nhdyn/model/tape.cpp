@@ -412,8 +412,8 @@ std::shared_ptr<const Evaluator> TapeEvaluator::with_parameters(const double* va
 
 void TapeEvaluator::build() {
   const int n = n_, s = s_;
-  if (n <= 0 || s < 0 || s >= n)
-    throw std::invalid_argument("TapeEvaluator: needs 0 <= s < n, got n = " + std::to_string(n) +
+  if (n <= 0 || s < 0)  // s >= n is allowed: contacts that are never all held (Model::k())
+    throw std::invalid_argument("TapeEvaluator: needs n > 0 and s >= 0, got n = " + std::to_string(n) +
                                 ", s = " + std::to_string(s));
   tapes_ = bind_tapes(*parametric_, parameters_);
   std::size_t a_size = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);

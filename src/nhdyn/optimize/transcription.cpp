@@ -24,6 +24,7 @@ double nlp_bound(double b) { return std::isfinite(b) ? b : (b > 0 ? kNlpInfinity
 
 Transcription::Transcription(const OptimalControlProblem& problem) : problem_(problem) {
   const Model& model = problem_.model;
+  require_fewer_constraints(model, "optimize");
   const auto* programs = dynamic_cast<const TapeEvaluator*>(model.evaluator.get());
   if (programs == nullptr) throw InputError("optimize needs a model compiled from a model file");
   if (programs->sparsity() != nullptr)

@@ -474,6 +474,7 @@ std::string generate_code(const Spec& spec, const Derivation& derivation, const 
 
   // The generated code writes every entry of A and b (dense outputs).
   const Model model = compile_model(spec, derivation, CompileOptions{TermsLayout::dense});
+  require_fewer_constraints(model, "the generated code");
   if (model.m() > 0)
     throw InputError(fmt::format("codegen: model '{}' has programs ([[programs]]), which generated code does not "
                                  "carry yet; run it through the interpreted evaluator (nhdyn simulate)",

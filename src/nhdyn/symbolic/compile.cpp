@@ -1006,10 +1006,10 @@ void compile_program_constraints(const Spec& spec, const Derivation& derivation,
 void check_derivation(const Spec& spec, const Derivation& derivation) {
   const int n = spec.n(), s = spec.s();
   if (n == 0) throw ModelError(fmt::format("model '{}' has no coordinates", spec.name));
-  if (s >= n)
-    throw ModelError(fmt::format("model '{}' has {} constraints for {} coordinates; it needs fewer constraints "
-                                 "than coordinates",
-                                 spec.name, s, n));
+  if (constraints_always_held(spec) >= n)
+    throw ModelError(fmt::format("model '{}' has {} constraints for {} coordinates, {} of them held whatever the "
+                                 "contacts' modes; fewer than n must hold at any time",
+                                 spec.name, s, n, constraints_always_held(spec)));
   if (spec.symbols.coordinates() != n)
     throw ModelError(fmt::format("model '{}': {} coordinates, but {} in the symbol table", spec.name, n,
                                  spec.symbols.coordinates()));

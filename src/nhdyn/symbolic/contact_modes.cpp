@@ -82,6 +82,18 @@ std::optional<SpecContactMode> parse_contact_mode(const ContactText& text, const
   return out;
 }
 
+int constraints_always_held(const Spec& spec) {
+  int held = spec.s();
+  if (!spec.contact_forces) return held;
+  for (const SpecContactMode& m : spec.contact_forces->modes)
+    for (const SpecConstraint& c : spec.constraints) {
+      const bool sliding_drops = c.name == m.name + "_roll1" || c.name == m.name + "_roll2" || c.name == m.name + "_spin";
+      const bool free_drops = sliding_drops || c.name == m.name + "_contact";
+      if ((m.friction && sliding_drops) || (m.unilateral && free_drops)) --held;
+    }
+  return held;
+}
+
 void compile_contact_modes(const Spec& spec, Model& model) {
   if (!spec.contact_forces || spec.contact_forces->modes.empty()) return;
   auto out = std::make_shared<ContactModeModel>();

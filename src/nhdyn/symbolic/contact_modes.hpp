@@ -41,6 +41,13 @@ struct SpecContactMode {
 // none of them (the contact rolls for ever, as before). Throws ModelError naming file:line.
 std::optional<SpecContactMode> parse_contact_mode(const ContactText& text, const ContactParsers& parsers);
 
+// The constraints that hold in every mode of the model's contacts: s less the rows some mode can
+// drop (a unilateral contact's gap, no-slip and spin rows; a contact with friction alone its
+// no-slip and spin rows). A model may declare n or more constraints when fewer than n always hold
+// (a ball that rolls off a sphere onto a floor: two contacts never held at once); its modes then
+// keep fewer than n rows at a time, or the run stops and says which contacts held together.
+int constraints_always_held(const Spec& spec);
+
 // Builds Model::contact_modes from spec.contact_forces->modes (nothing when there are none).
 // Throws ModelError naming the contact when its gap is not a constraint row (a body held on the
 // ground by its coordinates cannot lift off or carry its normal force in the equations). Called

@@ -12,6 +12,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/symbolic/detail/occurrence.hpp"
+#include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/rolling_contact.hpp"
 #include "nhdyn/symbolic/simplify.hpp"
 
@@ -505,8 +506,10 @@ Derivation derive(const Spec& spec) {
   const int n = spec.n(), s = spec.s();
   const std::string model = fmt::format("{}model '{}': ", prefix(spec.where), spec.name);
   if (n == 0) throw ModelError(model + "no coordinates");
-  if (s >= n)
-    throw ModelError(model + fmt::format("{} constraints for {} coordinates: there must be fewer (s < n)", s, n));
+  if (constraints_always_held(spec) >= n)
+    throw ModelError(model + fmt::format("{} constraints for {} coordinates, {} of them held whatever the contacts' "
+                                         "modes: fewer than n must hold at any time",
+                                         s, n, constraints_always_held(spec)));
   const auto name = [&](int i) { return spec.coordinates[static_cast<std::size_t>(i)]; };
 
   const GiNaC::ex& T = spec.kinetic_energy;

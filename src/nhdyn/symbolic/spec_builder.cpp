@@ -17,6 +17,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/symbolic/contact_forces.hpp"
+#include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/detail/occurrence.hpp"
 #include "nhdyn/symbolic/detail/plain_words.hpp"
 #include "nhdyn/core/detail/suggest.hpp"
@@ -1195,10 +1196,24 @@ Spec SpecBuilder::build() const {
   if (n == 0) fail(spec_.where, context, "no coordinates are declared");
   if (spec_.kinetic_energy.is_zero())
     fail(spec_.where, context, "missing kinetic energy T (it defines the inertia matrix A = d2T/dq'2)");
-  if (s >= n)
+  if (const int held = constraints_always_held(spec_); held >= n)
     fail(spec_.where, context,
-         fmt::format("{} constraints for {} coordinates: there must be fewer constraints than coordinates (s < n)",
-                     s, n));
+         held == s ? fmt::format("{} constraints for {} coordinates: there must be fewer constraints than coordinates "
+                                 "(s < n)",
+                                 s, n)
+                   : fmt::format("{} constraints for {} coordinates, {} of them held whatever the contacts' modes: "
+                                 "fewer than n must hold at any time (s < n, or contacts that lift off or slide, "
+                                 "docs/contact-modes.md)",
+                                 s, n, held));
+  // With s >= n (contacts never all held) the model's own degrees of freedom change with the
+  // modes: what is chosen for k = n - s of them has no meaning.
+  if (s >= n && (spec_.m() > 0 || !spec_.independent.empty() || spec_.complement))
+    fail(spec_.m() > 0 ? spec_.programs.front().constraint.where : spec_.where, context,
+         fmt::format("{} constraints for {} coordinates: {} need{} fewer constraints than coordinates (s < n), "
+                     "whatever the contacts' modes",
+                     s, n,
+                     spec_.m() > 0 ? "programs" : !spec_.independent.empty() ? "independent coordinates" : "a complement D",
+                     spec_.m() > 0 || !spec_.independent.empty() ? "" : "s"));
   const int k = n - s;
   if (spec_.m() > k) {
     const SpecProgram& extra = spec_.programs[static_cast<std::size_t>(k)];

@@ -182,6 +182,13 @@ std::string painleve_message(const ContactModeContact& c, const ContactModeData&
                      c.name, t, w.mu_k[i], w.w_eff[i], w.lambda_nn[i], N, nu0, kind);
 }
 
+// Whether contact c starts free whatever the dynamics: given mode = "free", or unilateral with
+// its gap open (above 1e-9 m).
+bool starts_free(const ContactModeContact& c, double gap) {
+  if (c.initial >= 0) return c.initial == static_cast<int>(ContactMode::free);
+  return c.unilateral && gap > 1e-9;
+}
+
 void throw_at_start(const Model& model, const Data& data) {
   throw ModelError(fmt::format("model '{}': at the initial state: {}", model.name, explain_failure(model, data)));
 }
@@ -193,10 +200,16 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
   if (!data.modes.active || !model.contact_modes) return;
   const ContactModeModel& cm = *model.contact_modes;
   ContactModeData& w = data.modes;
-  std::fill(w.mode.begin(), w.mode.end(), ContactMode::rolling);
-  if (compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok) throw_at_start(model, data);
   if (model.position_constraints() > 0)
     model.evaluator->position_residual(t0, q0.data(), data.scratch.data(), data.phi.data());
+  // The contacts that start free say so without the dynamics: given mode = "free", or unilateral
+  // and off the ground. The others' rolling forces are those with these free (a body with more
+  // contact rows than coordinates can hold only some of its contacts at once).
+  for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
+    const ContactModeContact& c = cm.contacts[i];
+    w.mode[i] = starts_free(c, data.phi(c.gap_position)) ? ContactMode::free : ContactMode::rolling;
+  }
+  if (compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok) throw_at_start(model, data);
   const double floor = slip_floor(data);
   const ContactModeData rolling = w;  // the rolling forces and slips of every contact
   for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
@@ -206,7 +219,7 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
     const bool cone_violated = c.friction && norm2(rolling.friction[i]) > rolling.mu_s[i] * std::abs(rolling.normal_force[i]);
     ContactMode mode = ContactMode::rolling;
     if (c.initial >= 0) mode = static_cast<ContactMode>(c.initial);
-    else if (c.unilateral && gap > 1e-9) mode = ContactMode::free;
+    else if (starts_free(c, gap)) mode = ContactMode::free;
     else if (c.friction && (slip > floor || cone_violated)) mode = ContactMode::sliding;
     if (mode == ContactMode::sliding) {
       if (slip > floor) {
