@@ -57,23 +57,130 @@ bool watched_in_mode(const Data& data, int mode_contact, bool touching_only, boo
 // The contact whose closed-form point is singular at (t, q, v) (model.hpp, ContactWatch: a disk
 // lying flat), as the message of the run that failed there; "" when none is. A measure that is not
 // a number counts as singular.
-std::string singular_contact_message(const Model& model, const Data& data, double t, const double* q,
-                                     const double* v) {
+// Watch `w`'s measure at (t, q, v), bound to the model's parameter values. Cold path: allocates.
+double watch_measure(const Model& model, const ContactWatch& w, double t, const double* q, const double* v) {
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
+  const Tape measure = w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure;
+  std::vector<double> registers(static_cast<std::size_t>(measure.registers()));
+  double value = 0.0;
+  measure.run(t, q, v, registers.data(), &value);
+  return value;
+}
+
+std::string watch_message(const Model& model, const ContactWatch& w, double value, double t, const double* q,
+                          const double* v) {
+  return fmt::format("{}contact '{}': {} ({} = {:.3g}) at t = {:.6g}, where {}; the run stops there",
+                     w.where.empty() ? "" : w.where + ": ", w.contact, w.reason, w.quantity, value, t,
+                     describe_state(model, q, v));
+}
+
+std::string singular_contact_message(const Model& model, const Data& data, double t, const double* q,
+                                     const double* v) {
   for (const ContactWatch& w : model.contact_watches) {
     if (!watched_in_mode(data, mode_contact_index(model, w.contact), w.touching_only, w.free_only)) continue;
-    const Tape measure = w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure;
-    std::vector<double> registers(static_cast<std::size_t>(measure.registers()));
-    double value = 0.0;
-    measure.run(t, q, v, registers.data(), &value);
+    const double value = watch_measure(model, w, t, q, v);
     if (value >= w.threshold) continue;
-    return fmt::format("{}contact '{}': {} ({} = {:.3g}) at t = {:.6g}, where {}; the run stops there",
-                       w.where.empty() ? "" : w.where + ": ", w.contact, w.reason, w.quantity, value, t,
-                       describe_state(model, q, v));
+    return watch_message(model, w, value, t, q, v);
   }
   return "";
 }
+
+// The contact watches checked along the run (ContactWatch::every_step), bound to the parameter
+// values: at every accepted step's end (after_step: every integrator), and, for an integrator that
+// locates events, as events falling through their thresholds, so that the run stops where a
+// measure reaches its limit and not at the end of the step past it. Forwards the run's own events
+// (`user`, may be null) as its first ones.
+class WatchedEvents final : public EventFunctions {
+ public:
+  WatchedEvents(const Model& model, Data& data)
+      : data_(data), n_(model.n()), fired_y_(static_cast<std::size_t>(2 * model.n()), 0.0) {
+    std::vector<double> values;
+    for (const Parameter& p : model.parameters) values.push_back(p.value);
+    for (std::size_t i = 0; i < model.contact_watches.size(); ++i) {
+      const ContactWatch& w = model.contact_watches[i];
+      if (!w.every_step) continue;
+      watches_.push_back({w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure,
+                          w.threshold, mode_contact_index(model, w.contact), w.touching_only, w.free_only,
+                          static_cast<int>(i)});
+      registers_.resize(std::max(registers_.size(), static_cast<std::size_t>(watches_.back().measure.registers())));
+    }
+  }
+
+  bool empty() const { return watches_.empty(); }
+  void set_user(EventFunctions* user) {
+    user_ = user;
+    user_count_ = user ? user->count() : 0;
+  }
+  int count() const override { return user_count_ + static_cast<int>(watches_.size()); }
+  CrossingDirection direction(int i) const override {
+    return i < user_count_ ? user_->direction(i) : CrossingDirection::falling;
+  }
+  bool may_dip(int i) const override { return i < user_count_ && user_->may_dip(i); }
+  // A watch out of its mode is +1 (no crossing); a measure that is not a number counts as below
+  // its threshold (-1): the step's end finds it (check), as it finds a jump.
+  Status evaluate(double t, const double* y, double* g) override {
+    if (user_) {
+      const Status status = user_->evaluate(t, y, g);
+      if (status != Status::ok) return status;
+    }
+    for (std::size_t k = 0; k < watches_.size(); ++k) {
+      const Watch& w = watches_[k];
+      double& gk = g[static_cast<std::size_t>(user_count_) + k];
+      if (!watched_in_mode(data_, w.mode_contact, w.touching_only, w.free_only)) {
+        gk = 1.0;
+        continue;
+      }
+      double value = 0.0;
+      w.measure.run(t, y, y + n_, registers_.data(), &value);
+      gk = std::isfinite(value) ? value - w.threshold : -1.0;
+    }
+    return Status::ok;
+  }
+  Status on_event(int i, double t, const double* y) override {
+    if (i < user_count_) return user_->on_event(i, t, y);
+    return stop(watches_[static_cast<std::size_t>(i - user_count_)].index, t, y);
+  }
+  // At a step's end: the first watch below its threshold ends the run there.
+  Status check(double t, const double* y) {
+    for (const Watch& w : watches_) {
+      if (!watched_in_mode(data_, w.mode_contact, w.touching_only, w.free_only)) continue;
+      double value = 0.0;
+      w.measure.run(t, y, y + n_, registers_.data(), &value);
+      if (!(value >= w.threshold)) return stop(w.index, t, y);
+    }
+    return Status::ok;
+  }
+  // The watch (index in Model::contact_watches) that ended the run, or -1; where, and the state
+  // y = [q; q'] there.
+  int fired() const { return fired_; }
+  double fired_t() const { return fired_t_; }
+  const double* fired_y() const { return fired_y_.data(); }
+
+ private:
+  struct Watch {
+    Tape measure;
+    double threshold;
+    int mode_contact;  // the contact's index among those with modes, or -1
+    bool touching_only, free_only;
+    int index;         // in Model::contact_watches
+  };
+  Status stop(int index, double t, const double* y) {
+    fired_ = index;
+    fired_t_ = t;
+    std::memcpy(fired_y_.data(), y, sizeof(double) * fired_y_.size());
+    return Status::singular_system;
+  }
+  Data& data_;
+  EventFunctions* user_ = nullptr;
+  int user_count_ = 0;
+  int n_;
+  std::vector<Watch> watches_;
+  std::vector<double> registers_;
+  int fired_ = -1;
+  double fired_t_ = 0.0;
+  std::vector<double> fired_y_;
+};
 
 // A run whose explicit integrator spent a large share of its steps held by stability, not accuracy
 // (IntegratorStats::stiff_steps, Hairer's test): at least 1000 steps and a quarter of all. "" when
@@ -122,18 +229,10 @@ StepEnd project(const Model& model, Data& data, const ProjectionOptions& options
 class MechanicalOde final : public OdeSystem {
  public:
   MechanicalOde(const Model& model, Data& data, const FormulationOptions& options, const SimulationOptions& run,
-                SimulationSummary& summary, ConstraintWatch* watch)
-      : model_(model), data_(data), options_(options), run_(run), summary_(summary), watch_(watch), n_(model.n()),
-        balance_(model.evaluator->has_energy_balance()), friction_(balance_ && model.contact_modes != nullptr) {
-    std::vector<double> values;
-    for (const Parameter& p : model.parameters) values.push_back(p.value);
-    for (const ContactWatch& w : model.contact_watches)
-      if (w.every_step) {
-        singular_.push_back({w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure,
-                             w.threshold, mode_contact_index(model, w.contact), w.touching_only, w.free_only});
-        registers_.resize(std::max(registers_.size(), static_cast<std::size_t>(singular_.back().measure.registers())));
-      }
-  }
+                SimulationSummary& summary, ConstraintWatch* watch, WatchedEvents& watched)
+      : model_(model), data_(data), options_(options), run_(run), summary_(summary), watch_(watch), watched_(watched),
+        n_(model.n()), balance_(model.evaluator->has_energy_balance()),
+        friction_(balance_ && model.contact_modes != nullptr) {}
 
   // The works: of the forces, the reactions, the explicit time dependence, and with contact modes
   // the friction's and the impacts' loss (model/contact_modes.hpp; the loss changes only at
@@ -165,19 +264,9 @@ class MechanicalOde final : public OdeSystem {
 
   StepEnd after_step(double t, double* y) override {
     // A contact whose equations stay regular where it is not defined (a surface's tangents
-    // vanishing): ended at the step that reaches it, with the state for the message
-    // (singular_contact_message).
-    for (const EveryStepWatch& w : singular_) {
-      if (!watched_in_mode(data_, w.mode_contact, w.touching_only, w.free_only)) continue;
-      double value = 0.0;
-      w.measure.run(t, y, y + n_, registers_.data(), &value);
-      if (!(value >= w.threshold)) {
-        data_.t = t;
-        std::memcpy(data_.q.data(), y, sizeof(double) * static_cast<std::size_t>(n_));
-        std::memcpy(data_.v.data(), y + n_, sizeof(double) * static_cast<std::size_t>(n_));
-        return {Status::singular_system, false};
-      }
-    }
+    // vanishing): located as an event where the integrator can, else ended at the step that
+    // reaches it, with the state for the message (WatchedEvents).
+    if (const Status status = watched_.check(t, y); status != Status::ok) return {status, false};
     // The watch reads the terms Data holds, when they are those of the step's end (the last stage
     // of dopri5, evaluated there); b depends on t, q and, for constraints nonlinear in the
     // velocities, q'.
@@ -200,16 +289,9 @@ class MechanicalOde final : public OdeSystem {
   const SimulationOptions& run_;
   SimulationSummary& summary_;
   ConstraintWatch* watch_;  // null when the run does not watch
+  WatchedEvents& watched_;
   int n_;
   bool balance_;
-  struct EveryStepWatch {
-    Tape measure;
-    double threshold;
-    int mode_contact;  // the contact's index among those with modes, or -1
-    bool touching_only, free_only;
-  };
-  std::vector<EveryStepWatch> singular_;  // the contact watches checked at every step, bound
-  std::vector<double> registers_;
   bool friction_;
 };
 
@@ -576,7 +658,8 @@ void note_unmet_stops(const Model& model, const std::vector<const Event*>& event
 
 // The message of a run that failed, in the most telling words there are.
 std::string explain_run_failure(const Model& model, const Data& data, const ModelEventFunctions& event_functions,
-                                const IntegrationResult& result, const std::string& output_message, Status status) {
+                                const WatchedEvents& watched, const IntegrationResult& result,
+                                const std::string& output_message, Status status) {
   // The kernels recorded the details of a failed evaluation in data; prefer those words.
   std::string message = data.status != Status::ok ? explain_failure(model, data) : result.message;
   // An event not finite at its latest evaluation ended the run, unless the dynamics failed after it.
@@ -588,6 +671,12 @@ std::string explain_run_failure(const Model& model, const Data& data, const Mode
                                  describe_state(model, bad_event.y.data(), bad_event.y.data() + model.n()));
   }
   if (!output_message.empty()) message = output_message;
+  // A contact watch that ended the run (located at its threshold, or at the step past it).
+  if (watched.fired() >= 0 && status == Status::singular_system) {
+    const ContactWatch& w = model.contact_watches[static_cast<std::size_t>(watched.fired())];
+    const double t = watched.fired_t(), *q = watched.fired_y(), *v = watched.fired_y() + model.n();
+    return watch_message(model, w, watch_measure(model, w, t, q, v), t, q, v);
+  }
   // A contact point that is not defined there says so, rather than the equations' symptom of it.
   if (const std::string singular = singular_contact_message(model, data, data.t, data.q.data(), data.v.data());
       !singular.empty())
@@ -619,7 +708,8 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   FormulationOptions formulation = options.formulation;
   formulation.baumgarte.enabled = options.stabilization == Stabilization::baumgarte;
   ConstraintWatch watch = make_constraint_watch(model, data, options.formulation.method, options.watch_factor);
-  MechanicalOde ode(model, data, formulation, options, summary, options.watch_constraints ? &watch : nullptr);
+  WatchedEvents watched(model, data);
+  MechanicalOde ode(model, data, formulation, options, summary, options.watch_constraints ? &watch : nullptr, watched);
   const auto states = static_cast<std::size_t>(ode.size());
   std::vector<double> y0(states, 0.0);  // the work starts at 0
   std::copy(q0.data(), q0.data() + n, y0.begin());
@@ -637,10 +727,16 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
     return Status::ok;
   }, event_dynamics(model, data, formulation));
   event_functions.require_valid_start(model.t0, y0.data());
+  // What the integrator locates: the run's events, and the contact watches where it can.
+  EventFunctions* located = events.empty() ? nullptr : &event_functions;
+  if (!watched.empty() && supports_events(options.integrator.kind)) {
+    watched.set_user(located);
+    located = &watched;
+  }
 
   const auto start = std::chrono::steady_clock::now();
   // Contacts that may slide or lift off: the run goes on through their switches (contact_switches.hpp).
-  ContactSwitches switches(model, data, formulation, static_cast<int>(states), events.empty() ? nullptr : &event_functions,
+  ContactSwitches switches(model, data, formulation, static_cast<int>(states), located,
                            [&](const std::string& name, double t, const double* y) -> Status {
                              if (output(t, y) == Status::stopped) return recorder.failure();
                              auto at = std::find(summary.events.names.begin(), summary.events.names.end(), name);
@@ -652,7 +748,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   const IntegrationResult result =
       model.contact_modes ? integrate_contact_modes(ode, options.integrator, model.t0, y0.data(), times, output, switches)
                           : integrate(ode, options.integrator, model.t0, y0.data(), times, output,
-                                      events.empty() ? nullptr : &event_functions);
+                                      located);
   summary.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.status = recorder.failure() != Status::ok ? recorder.failure() : result.status;
   summary.events.stopped_by = event_functions.stopped_by();
@@ -673,7 +769,8 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.watch.largest_condition_factor = watch.largest_condition_factor;
   summary.watch.watched_states = watch.states;
   if (summary.status != Status::ok)
-    summary.message = explain_run_failure(model, data, event_functions, result, recorder.message(), summary.status);
+    summary.message = explain_run_failure(model, data, event_functions, watched, result, recorder.message(),
+                                          summary.status);
   return summary;
 }
 
