@@ -224,10 +224,10 @@ Status solve_modes(const Model& model, Data& data, bool rolling, bool forces_onl
     for (std::size_t i = 0; i < cm.contacts.size(); ++i)
       if (w.mode[i] != ContactMode::free) touching += (touching.empty() ? "'" : ", '") + cm.contacts[i].name + "'";
     return fail(data, cm, -1,
-                fmt::format("the contacts {} held together keep {} constraint rows on {} coordinates: the body "
-                            "would be wedged with no freedom of motion, which the equations of motion cannot carry "
-                            "(docs/contact-modes.md, \"More contacts than freedom\"); start one of them free "
-                            "(mode = \"free\"), or remove one",
+                fmt::format("the contacts {} held together keep {} constraint rows on {} coordinates, which leaves "
+                            "the Do Sanh form no row of D (it needs fewer independent rows than coordinates): the body "
+                            "is wedged, or held by dependent rows (docs/contact-modes.md, \"More contacts than "
+                            "freedom\"); start one of them free (mode = \"free\"), or remove one",
                             touching, r, n));
   }
   if (w.reaction_rows.cols() != r) {

@@ -453,7 +453,7 @@ void TapeEvaluator::build() {
     throw std::invalid_argument("TapeEvaluator: more residuals than constraints");
 
   const int m = tapes_.program_constraints;
-  if (m < 0 || m > n - s || (m > 0) != tapes_.program_constraint_terms.has_value() ||
+  if (m < 0 || m > std::max(n - s, 0) || (m > 0) != tapes_.program_constraint_terms.has_value() ||
       (m > 0) != tapes_.program_constraint_position_residual.has_value() ||
       (m > 0) != tapes_.program_constraint_velocity_residual.has_value())
     throw std::invalid_argument("TapeEvaluator: " + std::to_string(m) +

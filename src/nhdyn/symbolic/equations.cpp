@@ -517,7 +517,7 @@ struct Content {
   std::optional<GiNaC::matrix> D;
   // too_large: the terms are too large to look for a partition symbolically (entries of more than
   // kSimplifyLimit nodes; the Whipple bicycle).
-  enum class Origin { analytic, independent, none_constraints, fallback, unavailable, too_large } origin =
+  enum class Origin { analytic, independent, none_constraints, fallback, unavailable, too_large, modes } origin =
       Origin::unavailable;
   std::vector<std::string> independent;  // names, for independent and fallback
   std::optional<GiNaC::matrix> A0, C;
@@ -621,6 +621,8 @@ Content make_content(const Spec& spec, const Derivation& d) {
         if (std::find(spec.independent.begin(), spec.independent.end(), name) != spec.independent.end())
           c.independent.push_back(name);
     }
+  } else if (s >= n) {
+    c.origin = Content::Origin::modes;  // contacts never all held: a D for each set of modes, in the run
   } else if (s == 0) {
     c.origin = Content::Origin::none_constraints;
     with_d.D = GiNaC::ex_to<GiNaC::matrix>(GiNaC::unit_matrix(static_cast<unsigned>(n)));
@@ -705,8 +707,10 @@ std::string format_text(const Spec& spec, const Content& c) {
   const EquationPrinter p(spec, EquationFormat::text);
   const int n = spec.n(), s = spec.s(), k = n - s;
   std::string out = fmt::format("Model {}{}\n", spec.name, spec.description.empty() ? "" : ": " + spec.description);
-  out += fmt::format("  q = ({}); n = {} coordinates, s = {} constraint{}, k = n - s = {}\n",
-                     join(spec.coordinates, ", "), n, s, s == 1 ? "" : "s", k);
+  out += s >= n ? fmt::format("  q = ({}); n = {} coordinates, s = {} constraint{}, never all held (contact modes)\n",
+                              join(spec.coordinates, ", "), n, s, s == 1 ? "" : "s")
+                : fmt::format("  q = ({}); n = {} coordinates, s = {} constraint{}, k = n - s = {}\n",
+                              join(spec.coordinates, ", "), n, s, s == 1 ? "" : "s", k);
   if (!spec.parameters.empty()) out += "  parameters: " + parameter_list(spec) + "\n";
 
   out += "\nKinetic energy\n  T = " + p.expression(c.T) + "\n";
@@ -766,8 +770,16 @@ std::string format_text(const Spec& spec, const Content& c) {
                          "a partition symbolically; the solver chooses D numerically at each step\n",
                          kSimplifyLimit, kPartitionNodeLimit);
       break;
+    case Content::Origin::modes:
+      out += fmt::format("Complement D: none for all {} rows at once (s >= n: the contacts are never all held); the run "
+                         "keeps the rows of the contacts touching, r < n, and takes D (n - r rows) for them "
+                         "(docs/contact-modes.md, \"More contacts than freedom\")\n",
+                         s);
+      break;
   }
-  if (!c.D || !c.A0 || !c.C) {
+  if (c.origin == Content::Origin::modes) {
+    // Nothing reduced to show: the reduced system changes with the modes.
+  } else if (!c.D || !c.A0 || !c.C) {
     out += fmt::format("Reduced inertia A0 = D A and reduced forces C = D (Q + G): unavailable without D; add "
                        "`independent = [...]` with k = {} coordinate names to the model\n",
                        k);
@@ -885,8 +897,14 @@ std::string format_latex(const Spec& spec, const Content& c) {
                             "nodes, or $b$ of more than {} in all) to look for a partition symbolically.",
                             kSimplifyLimit, kPartitionNodeLimit);
       break;
+    case Content::Origin::modes:
+      heading = "No complement $D$ for all the rows at once ($s \\ge n$: the contacts are never all held); the run "
+                "keeps the rows of the contacts touching and takes $D$ for them.";
+      break;
   }
-  if (!c.D || !c.A0 || !c.C) {
+  if (c.origin == Content::Origin::modes) {
+    rows.push_back("\\intertext{" + heading + "}");
+  } else if (!c.D || !c.A0 || !c.C) {
     rows.push_back("\\intertext{" + heading +
                    fmt::format(" $A_0 = D A$ and $C = D (Q + G)$ are unavailable without $D$; add "
                                "\\texttt{{independent = [...]}} with $k = {}$ coordinate names to the model.}}",

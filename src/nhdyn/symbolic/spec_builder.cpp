@@ -1214,7 +1214,7 @@ Spec SpecBuilder::build() const {
                      s, n,
                      spec_.m() > 0 ? "programs" : !spec_.independent.empty() ? "independent coordinates" : "a complement D",
                      spec_.m() > 0 || !spec_.independent.empty() ? "" : "s"));
-  const int k = n - s;
+  const int k = std::max(n - s, 0);
   if (spec_.m() > k) {
     const SpecProgram& extra = spec_.programs[static_cast<std::size_t>(k)];
     fail(extra.constraint.where, context,

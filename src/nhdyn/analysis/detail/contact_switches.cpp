@@ -205,9 +205,18 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
   // The contacts that start free say so without the dynamics: given mode = "free", or unilateral
   // and off the ground. The others' rolling forces are those with these free (a body with more
   // contact rows than coordinates can hold only some of its contacts at once).
+  if (!w.velocity_residuals.empty())
+    model.evaluator->velocity_residual(t0, q0.data(), v0.data(), data.scratch.data(), w.velocity_residuals.data());
   for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
     const ContactModeContact& c = cm.contacts[i];
     w.mode[i] = starts_free(c, data.phi(c.gap_position)) ? ContactMode::free : ContactMode::rolling;
+    // Free on the ground and moving into it: an impact at t0, which no event would find.
+    const double gap = data.phi(c.gap_position), rate = w.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)];
+    if (w.mode[i] == ContactMode::free && gap <= 1e-9 && rate < -slip_floor(data))
+      throw ModelError(fmt::format("{}: contact '{}' is given mode = \"free\", but at t0 it touches the ground (gap "
+                                   "{:.6g} m) and moves into it ({:.6g} m/s): a free start needs the gap open or "
+                                   "opening; start it higher, or rolling (mode = \"rolling\", or leave the key out)",
+                                   c.where, c.name, gap + 0.0, rate));
   }
   if (compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok) throw_at_start(model, data);
   const double floor = slip_floor(data);
@@ -343,7 +352,8 @@ Status ContactSwitches::evaluate(double t, const double* y, double* g) {
     // leaves with, so that a flight or a slide shorter than the integrator's first step is still
     // seen to end (section 4: "the touchdown event must ignore the zero it starts on").
     if (t == start_t_) {
-      if (w.mode[i] == ContactMode::free && w.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)] >= 0.0)
+      if (w.mode[i] == ContactMode::free && static_cast<int>(i) != grazed_ &&
+          w.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)] >= 0.0)
         gi[0] = std::max(gi[0], std::numeric_limits<double>::min());
       if (w.mode[i] == ContactMode::sliding) gi[1] = std::max(gi[1], std::numeric_limits<double>::min());
       if (w.mode[i] == ContactMode::sliding && !c.unilateral)  // N's zero after a reversal
@@ -480,6 +490,18 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
   if (i < user_count_) return user_->on_event(i, t, y);
   const int contact = (i - user_count_) / kSlots;
   const int slot = (i - user_count_) % kSlots;
+  if (slot == 0 && data_.modes.mode[static_cast<std::size_t>(contact)] == ContactMode::free && grazes(contact, t, y)) {
+    // No touchdown: the contact stays free and leaves. The segment restarts there without a row,
+    // its gap taken as it is (not as a fresh lift-off's), so that an integrator that locates roots
+    // itself (CVODE) does not meet the same zero again at once.
+    std::copy(y, y + size_, switch_y_.begin());
+    switch_t_ = t;
+    start_t_ = t;
+    grazed_ = contact;
+    switched_ = true;
+    return Status::stopped;
+  }
+  grazed_ = -1;
   ++switch_count_;
   same_time_ = switch_count_ > 1 && std::abs(t - last_switch_t_) <= 64 * std::numeric_limits<double>::epsilon() *
                                                                           std::max(1.0, std::abs(t))
@@ -511,8 +533,53 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
   switch_t_ = t;
   start_t_ = t;
   switched_ = true;
-  const Status status = handler_(event, t, switch_y_.data());
-  return status == Status::ok ? Status::stopped : status;
+  // Other contacts touching at this instant, moving into their grounds: their touchdowns now, one
+  // after the other, each with the modes the ones before left; then the row, with the state after
+  // all of them, and an event record each.
+  std::vector<std::string> events{event};
+  for (std::size_t k = 0; k < data_.modes.mode.size(); ++k) {
+    const int next = closing_contact(t);
+    if (next < 0) break;
+    ++switch_count_;
+    const std::vector<double> before = switch_y_;
+    events.push_back(switch_contact(next, 0, t, before.data()));
+    if (events.back().empty()) {
+      if (accumulation_.empty())
+        accumulation_ = fmt::format("contact '{}': the equations could not be solved at its touchdown at t = {:.9g}: {}",
+                                    model_.contact_modes->contacts[static_cast<std::size_t>(next)].name, t,
+                                    data_.status != Status::ok ? explain_failure(model_, data_) : "");
+      return Status::integrator_failure;
+    }
+  }
+  for (const std::string& name : events)
+    if (const Status status = handler_(name, t, switch_y_.data()); status != Status::ok) return status;
+  return Status::stopped;
+}
+
+int ContactSwitches::closing_contact(double t) {
+  const ContactModeModel& cm = *model_.contact_modes;
+  ContactModeData& w = data_.modes;
+  const int n = model_.n();
+  const double* q = switch_y_.data();
+  const double* v = q + n;
+  if (model_.position_constraints() > 0)
+    model_.evaluator->position_residual(t, q, data_.scratch.data(), data_.phi.data());
+  if (!w.velocity_residuals.empty())
+    model_.evaluator->velocity_residual(t, q, v, data_.scratch.data(), w.velocity_residuals.data());
+  double scale = 1.0;
+  for (int j = 0; j < n; ++j) scale = std::max(scale, std::abs(q[j]));
+  const double touching = 64 * std::numeric_limits<double>::epsilon() * scale;
+  double largest_rate = 0.0;
+  for (int j = 0; j < n; ++j) largest_rate = std::max(largest_rate, std::abs(v[j]));
+  const double closing = 1e-10 * (1.0 + largest_rate);  // slip_floor's scale, at this state
+  for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
+    const ContactModeContact& c = cm.contacts[i];
+    if (w.mode[i] != ContactMode::free) continue;
+    if (data_.phi(c.gap_position) <= touching &&
+        w.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)] < -closing)
+      return static_cast<int>(i);
+  }
+  return -1;
 }
 
 bool ContactSwitches::start_sliding(int contact, double t, const double* q, const double* v) {
@@ -617,10 +684,20 @@ Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, b
     }
   }
   Eigen::ColPivHouseholderQR<Matrix> qr(Bt);
-  if (qr.rank() < r || gap_column < 0) {
-    out.failure = fmt::format("contact '{}' touches down at t = {:.9g} where the constraints after the impact are "
-                              "dependent; the run ends here with its results so far",
-                              c.name, t);
+  if (qr.rank() < r || r >= n || gap_column < 0) {
+    // Name the contacts held through the impact: with two of them on one body (a ball rolling
+    // into a wall) their rows may be dependent, or as many as the coordinates.
+    std::string held;
+    for (std::size_t j = 0; j < cm.contacts.size(); ++j)
+      if (j == i || w.mode[j] != ContactMode::free)
+        held += fmt::format("{}'{}' ({})", held.empty() ? "" : ", ", cm.contacts[j].name,
+                            j == i ? (sliding ? "sliding" : "touching down") : contact_mode_name(w.mode[j]));
+    out.failure = fmt::format(
+        "contact '{}' touches down at t = {:.9g}, where the contacts held through the impact, {}, keep {} constraint "
+        "rows of rank {} on {} coordinates: the impact's equations in the Do Sanh form need fewer rows than "
+        "coordinates, and independent ones (docs/contact-modes.md, \"More contacts than freedom\"); the run ends "
+        "here with its results so far",
+        c.name, t, held, r, static_cast<int>(qr.rank()), n);
     return out;
   }
   const Matrix Qf = qr.householderQ();
@@ -658,6 +735,41 @@ Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, b
                                 : (roll_column[a] >= 0 ? Pi(roll_column[a]) * w.tangent_length[i][a] : 0.0);
   out.ok = true;
   return out;
+}
+
+bool ContactSwitches::settle_others(int contact, double t, const double* q, const double* v) {
+  ContactModeData& w = data_.modes;
+  const ContactModeModel& cm = *model_.contact_modes;
+  std::vector<std::size_t> sliding;
+  for (std::size_t j = 0; j < cm.contacts.size(); ++j)
+    if (static_cast<int>(j) != contact && w.mode[j] == ContactMode::sliding) sliding.push_back(j);
+  if (sliding.empty()) return true;
+  if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return false;
+  std::vector<std::size_t> stopped;
+  for (std::size_t j : sliding) {
+    const double slip = norm2(w.slip[j]);
+    if (slip > slip_floor(data_)) {
+      w.direction[j] = {w.slip[j][0] / slip, w.slip[j][1] / slip};
+    } else {
+      w.mode[j] = ContactMode::rolling;
+      stopped.push_back(j);
+    }
+  }
+  if (stopped.empty()) return true;
+  if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return false;
+  for (std::size_t j : stopped)
+    if (norm2(w.friction[j]) > w.mu_s[j] * std::abs(w.normal_force[j]) &&
+        !start_sliding(static_cast<int>(j), t, q, v))
+      return false;
+  return true;
+}
+
+bool ContactSwitches::grazes(int contact, double t, const double* y) {
+  const ContactModeContact& c = model_.contact_modes->contacts[static_cast<std::size_t>(contact)];
+  if (compute_dynamics(model_, data_, formulation_, t, y, y + model_.n()) != Status::ok) return false;
+  const double approach = data_.modes.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)];
+  const double acceleration = data_.b.row(c.gap).dot(data_.qdd) + data_.b0(c.gap);  // the free gap's g''
+  return approach >= -slip_floor(data_) && acceleration > 0.0;
 }
 
 std::string ContactSwitches::touchdown(int contact, double t) {
@@ -753,7 +865,7 @@ std::string ContactSwitches::touchdown(int contact, double t) {
   const std::string name = c.name + "_touchdown";
   if (e > 0.0 && -e * vn > slip_floor(data_)) {
     w.mode[i] = c.unilateral ? ContactMode::free : ContactMode::rolling;
-    return name;
+    return settle_others(contact, t, q, v) ? name : "";
   }
   // The contact stays closed: the mode as at the start (section 7, "After the impact"): sliding
   // if it slips after the impact, else rolling if inside the cone, free if it would pull.
@@ -767,13 +879,13 @@ std::string ContactSwitches::touchdown(int contact, double t) {
     if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return "";
     if (!check_sliding(contact, t)) return "";
     if (c.unilateral && w.normal_force[i] < 0.0) w.mode[i] = ContactMode::free;
-    return name;
+    return settle_others(contact, t, q, v) ? name : "";
   }
   if (c.unilateral && w.normal_force[i] < 0.0) w.mode[i] = ContactMode::free;
   else if (c.friction && norm2(w.friction[i]) > w.mu_s[i] * std::abs(w.normal_force[i])) {
     if (!start_sliding(contact, t, q, v)) return "";
   }
-  return name;
+  return settle_others(contact, t, q, v) ? name : "";
 }
 
 IntegrationResult integrate_contact_modes(OdeSystem& ode, const IntegratorOptions& options, double t0,

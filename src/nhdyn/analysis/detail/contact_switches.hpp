@@ -91,6 +91,20 @@ class ContactSwitches final : public EventFunctions {
   std::string switch_contact(int contact, int slot, double t, const double* y);
   // The impact of a touchdown (section 7): the velocities of switch_y_ after it, and the mode.
   std::string touchdown(int contact, double t);
+  // Whether a free contact's gap crossing 0 at (t, y) is no impact: it meets the ground with no
+  // approach speed (the gap's rate within the integration error) while accelerating away from it.
+  // Just after a lift-off the gap sits at the integration error, and an integrator whose first
+  // steps are shorter than the time it needs to rise above that (CVODE) sees it cross 0 there.
+  bool grazes(int contact, double t, const double* y);
+  // After `contact`'s impact at (t, q, v): every other sliding contact slides along its slip after
+  // the impulse (which may have turned or reversed it), or sticks where the impulse stopped it
+  // (sliding on in its onset direction if sticking needs more than mu_s N). False (with the message
+  // in accumulation_) when that fails.
+  bool settle_others(int contact, double t, const double* q, const double* v);
+  // A free contact that touches its ground at (t, switch_y_) moving into it, or -1: two gaps that
+  // close at one instant, or one that this switch's impulse closed. The event that finds a
+  // touchdown needs the gap positive where the segment starts; such a contact's gap is not.
+  int closing_contact(double t);
   // (I1)-(I2) for `contact` with the velocities v before, after compute_dynamics there: sticking
   // (its no-slip rows target 0), or sliding along `direction` (unit tangent basis) with mu_k.
   Impulse solve_impulse(int contact, double t, const double* v, bool sliding,
@@ -118,6 +132,7 @@ class ContactSwitches final : public EventFunctions {
   int same_time_ = 0;       // successive switches without progress in t
   double last_switch_t_ = 0.0;
   double start_t_ = -HUGE_VAL;  // the time the current segment started at (the last switch)
+  int grazed_ = -1;  // the contact whose graze (grazes) restarted the current segment, or -1
   std::vector<double> last_touchdown_;  // per contact: the times of its last two touchdowns
   std::vector<double> previous_touchdown_;
   std::vector<long> touchdowns_;
