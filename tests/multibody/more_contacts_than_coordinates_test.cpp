@@ -287,6 +287,21 @@ TEST(MoreContactsThanCoordinates, ASlidingContactTakesTheSlipThatAnotherContacts
   EXPECT_NEAR(r.at(last, "x'"), -5 * e * vb / 7, 1e-9);
   EXPECT_LE(r.at(last, "work_friction"), 0.0);
   EXPECT_LT(r.summary.energy.balance_error, 1e-12);
+  // Plastic at the wall (e = 0): the impulse stops the ball and its spin, the floor's slip with
+  // them, and the floor sticks there: an event of its own at the same time (it went from sliding
+  // to rolling with no row that said so).
+  const std::string plastic = floor_and_wall("friction = 0.1\n", "restitution = 0\nmode = \"free\"\n",
+                                             "position = { x = -0.5, y = 0, z = \"r\", a = 0, b = 0, c = 0 }\n"
+                                             "velocity = { x = 2, y = 0, z = 0, a = 0, b = 0, c = 0 }");
+  const FloorRun p = run(load_model_text(plastic, "plastic.toml"), 1.0);
+  ASSERT_EQ(p.summary.status, Status::ok) << p.summary.message;
+  ASSERT_EQ(p.summary.events.crossings.size(), 2u);
+  EXPECT_EQ(p.summary.events.crossings[0].name, "wall_touchdown");
+  EXPECT_EQ(p.summary.events.crossings[1].name, "floor_stick");
+  EXPECT_EQ(p.summary.events.crossings[1].t, p.summary.events.crossings[0].t);
+  EXPECT_NEAR(p.at(p.rows.size() - 1, "x'"), 0.0, 1e-12);
+  EXPECT_NEAR(p.at(p.rows.size() - 1, "b'"), 0.0, 1e-10);
+  EXPECT_EQ(p.at(p.rows.size() - 1, "floor_mode"), 0.0);
 }
 
 // Both gaps closing at one instant (the ball thrown into the corner, frictionless, e = 1/2 at

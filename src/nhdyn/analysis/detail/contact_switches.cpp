@@ -189,6 +189,34 @@ bool starts_free(const ContactModeContact& c, double gap) {
   return c.unilateral && gap > 1e-9;
 }
 
+// When every touching contact rolling is no motion (more contact rows than coordinates, a ball on
+// a floor against a wall), the contacts with friction that slip at t0 slide from the start: their
+// no-slip rows are dropped before the first solve. True when the solve then succeeds.
+bool slide_the_slipping(const Model& model, Data& data, const FormulationOptions& formulation, double t0,
+                        const Vector& q0, const Vector& v0) {
+  const ContactModeModel& cm = *model.contact_modes;
+  ContactModeData& w = data.modes;
+  const double floor = slip_floor(data);
+  bool any = false;
+  for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
+    const ContactModeContact& c = cm.contacts[i];
+    if (w.mode[i] != ContactMode::rolling || !c.friction || c.initial == static_cast<int>(ContactMode::rolling))
+      continue;
+    const double s1 = w.velocity_residuals[static_cast<std::size_t>(c.roll_velocity[0])];
+    const double s2 = w.velocity_residuals[static_cast<std::size_t>(c.roll_velocity[1])];
+    if (std::hypot(s1, s2) <= floor) continue;
+    w.mode[i] = ContactMode::sliding;
+    any = true;
+  }
+  if (!any || compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok) return false;
+  // The slips are the state's; the friction of each now opposes its own.
+  for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
+    const double slip = norm2(w.slip[i]);
+    if (w.mode[i] == ContactMode::sliding && slip > 0.0) w.direction[i] = {w.slip[i][0] / slip, w.slip[i][1] / slip};
+  }
+  return compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) == Status::ok;
+}
+
 void throw_at_start(const Model& model, const Data& data) {
   throw ModelError(fmt::format("model '{}': at the initial state: {}", model.name, explain_failure(model, data)));
 }
@@ -218,7 +246,9 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
                                    "opening; start it higher, or rolling (mode = \"rolling\", or leave the key out)",
                                    c.where, c.name, gap + 0.0, rate));
   }
-  if (compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok) throw_at_start(model, data);
+  if (compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok &&
+      !slide_the_slipping(model, data, formulation, t0, q0, v0))
+    throw_at_start(model, data);
   const double floor = slip_floor(data);
   const ContactModeData rolling = w;  // the rolling forces and slips of every contact
   for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
@@ -523,6 +553,7 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
     return Status::integrator_failure;
   }
   std::copy(y, y + size_, switch_y_.begin());  // a touchdown changes its velocities
+  settled_.clear();
   const std::string event = switch_contact(contact, slot, t, y);
   if (event.empty()) {
     if (accumulation_.empty())
@@ -537,13 +568,18 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
   // after the other, each with the modes the ones before left; then the row, with the state after
   // all of them, and an event record each.
   std::vector<std::string> events{event};
+  events.insert(events.end(), settled_.begin(), settled_.end());
+  settled_.clear();
   for (std::size_t k = 0; k < data_.modes.mode.size(); ++k) {
     const int next = closing_contact(t);
     if (next < 0) break;
     ++switch_count_;
     const std::vector<double> before = switch_y_;
-    events.push_back(switch_contact(next, 0, t, before.data()));
-    if (events.back().empty()) {
+    const std::string also = switch_contact(next, 0, t, before.data());
+    events.push_back(also);
+    events.insert(events.end(), settled_.begin(), settled_.end());
+    settled_.clear();
+    if (also.empty()) {
       if (accumulation_.empty())
         accumulation_ = fmt::format("contact '{}': the equations could not be solved at its touchdown at t = {:.9g}: {}",
                                     model_.contact_modes->contacts[static_cast<std::size_t>(next)].name, t,
@@ -757,10 +793,13 @@ bool ContactSwitches::settle_others(int contact, double t, const double* q, cons
   }
   if (stopped.empty()) return true;
   if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return false;
-  for (std::size_t j : stopped)
-    if (norm2(w.friction[j]) > w.mu_s[j] * std::abs(w.normal_force[j]) &&
-        !start_sliding(static_cast<int>(j), t, q, v))
-      return false;
+  for (std::size_t j : stopped) {
+    if (norm2(w.friction[j]) > w.mu_s[j] * std::abs(w.normal_force[j])) {
+      if (!start_sliding(static_cast<int>(j), t, q, v)) return false;
+      continue;
+    }
+    settled_.push_back(cm.contacts[j].name + "_stick");  // an event row of its own, at the same time
+  }
   return true;
 }
 
