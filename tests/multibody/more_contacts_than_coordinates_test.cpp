@@ -15,6 +15,7 @@
 #include "nhdyn/analysis/linearization.hpp"
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/events.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/integrators/ode.hpp"
 #include "nhdyn/frontend/model_file.hpp"
@@ -352,6 +353,30 @@ TEST(MoreContactsThanCoordinates, AFreeStartOnTheGroundMovingIntoItIsRefused) {
                                          "(gap 0 m) and moves into it (-1 m/s)"),
               std::string::npos)
         << e.what();
+  }
+}
+
+// A stop condition that an impact makes true (the floor's normal force past m g / 2, the speed
+// past 1.6 m/s, both only after the landing) crosses at the impact itself, where the state jumps:
+// no step sees it, and the run went on to its end warning that it never became true.
+TEST(MoreContactsThanCoordinates, AStopConditionThatAnImpactMakesTrueStopsTheRunThere) {
+  const Model model = load_model(example("ball_off_sphere_onto_floor.toml"));
+  for (const std::string condition : {"floor_N > 0.5", "x' > 1.6"}) {
+    SimulationOptions options;
+    options.t_end = 4.0;
+    options.output_step = 0.01;
+    options.integrator.rtol = 1e-10;
+    options.integrator.atol = 1e-12;
+    options.events.push_back(make_stop_condition(model, condition));
+    double last_t = 0.0;
+    const SimulationSummary summary = simulate(model, options, [&](const Data& data) { last_t = data.t; });
+    ASSERT_EQ(summary.status, Status::ok) << summary.message;
+    EXPECT_EQ(summary.events.stopped_by, 0) << condition;
+    ASSERT_EQ(summary.events.crossings.size(), 3u) << condition;
+    EXPECT_EQ(summary.events.crossings[1].name, "floor_touchdown");
+    EXPECT_EQ(summary.events.crossings[2].t, summary.events.crossings[1].t) << condition;
+    EXPECT_EQ(summary.t_reached, summary.events.crossings[1].t) << condition;
+    EXPECT_EQ(last_t, summary.events.crossings[1].t) << condition;
   }
 }
 

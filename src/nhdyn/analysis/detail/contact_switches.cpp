@@ -319,6 +319,8 @@ ContactSwitches::ContactSwitches(const Model& model, Data& data, const Formulati
   last_touchdown_.assign(m, -HUGE_VAL);
   previous_touchdown_.assign(m, -HUGE_VAL);
   touchdowns_.assign(m, 0);
+  user_before_.assign(static_cast<std::size_t>(user_count_), 0.0);
+  user_after_.assign(static_cast<std::size_t>(user_count_), 0.0);
 }
 
 int ContactSwitches::count() const {
@@ -554,6 +556,8 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
   }
   std::copy(y, y + size_, switch_y_.begin());  // a touchdown changes its velocities
   settled_.clear();
+  // The run's own events before the switch, to find those its jump carries across zero.
+  const bool user_before = user_ && user_->evaluate(t, y, user_before_.data()) == Status::ok;
   const std::string event = switch_contact(contact, slot, t, y);
   if (event.empty()) {
     if (accumulation_.empty())
@@ -589,6 +593,20 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
   }
   for (const std::string& name : events)
     if (const Status status = handler_(name, t, switch_y_.data()); status != Status::ok) return status;
+  // A run's event whose function the switch's jump carries across zero (an impact that makes a
+  // contact force or a speed pass a stop condition's bound) crosses there: no integrator step
+  // would see it, the next segment starting on the other side.
+  if (user_before && user_->evaluate(t, switch_y_.data(), user_after_.data()) == Status::ok)
+    for (int k = 0; k < user_count_; ++k) {
+      const double before = user_before_[static_cast<std::size_t>(k)], after = user_after_[static_cast<std::size_t>(k)];
+      const CrossingDirection d = user_->direction(k);
+      const bool rising = before < 0.0 && after > 0.0, falling = before > 0.0 && after < 0.0;
+      if (!(d == CrossingDirection::rising ? rising : d == CrossingDirection::falling ? falling : rising || falling))
+        continue;
+      const Status status = user_->on_event(k, t, switch_y_.data());
+      if (status == Status::stopped) switched_ = false;  // the run ends here, as planned
+      if (status != Status::ok) return status;
+    }
   return Status::stopped;
 }
 

@@ -134,6 +134,7 @@ class ContactSwitches final : public EventFunctions {
   double start_t_ = -HUGE_VAL;  // the time the current segment started at (the last switch)
   int grazed_ = -1;  // the contact whose graze (grazes) restarted the current segment, or -1
   std::vector<std::string> settled_;  // NAME_stick of the contacts another's impact stopped (settle_others)
+  std::vector<double> user_before_, user_after_;  // the run's own events across a switch
   std::vector<double> last_touchdown_;  // per contact: the times of its last two touchdowns
   std::vector<double> previous_touchdown_;
   std::vector<long> touchdowns_;
