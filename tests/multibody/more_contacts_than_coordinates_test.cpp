@@ -5,6 +5,7 @@
 // contact point), the contact forces of the contacts touching, and what is refused: contacts
 // held together that wedge the body, rows held in every mode that reach n, and the analyses that
 // hold every row at once. Also compare on a run with switch rows (they come between output times).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -265,44 +266,42 @@ unilateral = true
 }
 
 // A ball slid without spin along a rough floor (mu = 0.1) into the wall, which holds it without
-// slip (no friction limit) and returns it at e = 1/2: before the wall its speed falls as v0 - mu g t
-// while the friction spins it up; the wall's impulse reverses v_x to -e v_b and, holding the
-// contact point, stops the spin (the floor keeps v_z = 0). The floor's friction then opposes the
-// new slip (it used to keep the direction of the old one and push: the energy grew), and the ball
-// rolls back at 5/7 of -e v_b, 2 e v_b / (7 mu g) after the impact.
+// slip (no friction limit) and returns it at e = 1/2. Before the wall its speed falls as
+// v0 - mu g t while the friction spins it up (omega = 5 mu g t / (2 r)). The wall's impulse
+// reverses v_x to -e v_b and, stopping its contact point, takes the spin's part k r omega / (1 + k)
+// as an upward speed: held, the floor would have to pull the ball down (it did), so it lifts off
+// there. The ball flies 2 v_z / g, lands sliding (the sticking impulse is outside the cone: the
+// landing takes mu V off v_x's magnitude and mu V (1 + k) / k off the slip), and the floor's
+// friction opposes the slip left (it used to keep the direction of the slip before the wall and
+// push: the energy grew) until it sticks, 2 |s| / (7 mu g) later, at v_x - mu g that time.
 TEST(MoreContactsThanCoordinates, ASlidingContactTakesTheSlipThatAnotherContactsImpactLeaves) {
   const std::string text = floor_and_wall("friction = 0.1\n", "restitution = 0.5\nmode = \"free\"\n",
                                           "position = { x = -0.5, y = 0, z = \"r\", a = 0, b = 0, c = 0 }\n"
                                           "velocity = { x = 2, y = 0, z = 0, a = 0, b = 0, c = 0 }");
   const FloorRun r = run(load_model_text(text, "wall.toml"), 2.0);
   ASSERT_EQ(r.summary.status, Status::ok) << r.summary.message;
-  const double mu = 0.1, g = 9.81, v0 = 2.0, e = 0.5;
+  const double mu = 0.1, g = 9.81, v0 = 2.0, e = 0.5, k = 0.4, rr = 0.1;
   const double tw = (v0 - std::sqrt(v0 * v0 - 2 * mu * g * 0.4)) / (mu * g);  // the centre 0.4 on, at x = -r
-  const double vb = v0 - mu * g * tw;
-  ASSERT_EQ(r.summary.events.crossings.size(), 2u);
-  EXPECT_EQ(r.summary.events.crossings[0].name, "wall_touchdown");
+  const double vb = v0 - mu * g * tw, wb = 5 * mu * g * tw / (2 * rr);
+  const double vx = -e * vb, vz = k * rr * wb / (1 + k), w = vz / rr;  // after the wall
+  const double tl = tw + 2 * vz / g;                                   // the landing
+  const double slip = std::abs(vx - rr * w) - mu * vz * (1 + k) / k;   // after the landing
+  const double vl = vx + mu * vz, ts = tl + 2 * slip / (7 * mu * g);
+  std::vector<std::string> names;
+  for (const EventRecord& c : r.summary.events.crossings) names.push_back(c.name);
+  ASSERT_EQ(names, (std::vector<std::string>{"wall_touchdown", "floor_liftoff", "floor_touchdown", "floor_stick"}));
   EXPECT_NEAR(r.summary.events.crossings[0].t, tw, 1e-9);
-  EXPECT_EQ(r.summary.events.crossings[1].name, "floor_stick");
-  EXPECT_NEAR(r.summary.events.crossings[1].t, tw + 2 * e * vb / (7 * mu * g), 1e-8);
+  EXPECT_EQ(r.summary.events.crossings[1].t, r.summary.events.crossings[0].t);
+  EXPECT_NEAR(r.summary.events.crossings[1].v[0], vx, 1e-10);
+  EXPECT_NEAR(r.summary.events.crossings[1].v[2], vz, 1e-10);
+  EXPECT_NEAR(r.summary.events.crossings[1].v[4], w, 1e-9);  // b' = omega_y
+  EXPECT_NEAR(r.summary.events.crossings[2].t, tl, 1e-9);
+  EXPECT_NEAR(r.summary.events.crossings[2].v[0], vl, 1e-9);
+  EXPECT_NEAR(r.summary.events.crossings[3].t, ts, 1e-8);
   const std::size_t last = r.rows.size() - 1;
-  EXPECT_NEAR(r.at(last, "x'"), -5 * e * vb / 7, 1e-9);
+  EXPECT_NEAR(r.at(last, "x'"), vl + mu * g * (ts - tl), 1e-8);
   EXPECT_LE(r.at(last, "work_friction"), 0.0);
   EXPECT_LT(r.summary.energy.balance_error, 1e-12);
-  // Plastic at the wall (e = 0): the impulse stops the ball and its spin, the floor's slip with
-  // them, and the floor sticks there: an event of its own at the same time (it went from sliding
-  // to rolling with no row that said so).
-  const std::string plastic = floor_and_wall("friction = 0.1\n", "restitution = 0\nmode = \"free\"\n",
-                                             "position = { x = -0.5, y = 0, z = \"r\", a = 0, b = 0, c = 0 }\n"
-                                             "velocity = { x = 2, y = 0, z = 0, a = 0, b = 0, c = 0 }");
-  const FloorRun p = run(load_model_text(plastic, "plastic.toml"), 1.0);
-  ASSERT_EQ(p.summary.status, Status::ok) << p.summary.message;
-  ASSERT_EQ(p.summary.events.crossings.size(), 2u);
-  EXPECT_EQ(p.summary.events.crossings[0].name, "wall_touchdown");
-  EXPECT_EQ(p.summary.events.crossings[1].name, "floor_stick");
-  EXPECT_EQ(p.summary.events.crossings[1].t, p.summary.events.crossings[0].t);
-  EXPECT_NEAR(p.at(p.rows.size() - 1, "x'"), 0.0, 1e-12);
-  EXPECT_NEAR(p.at(p.rows.size() - 1, "b'"), 0.0, 1e-10);
-  EXPECT_EQ(p.at(p.rows.size() - 1, "floor_mode"), 0.0);
 }
 
 // Both gaps closing at one instant (the ball thrown into the corner, frictionless, e = 1/2 at
@@ -337,6 +336,33 @@ TEST(MoreContactsThanCoordinates, TwoTouchdownsAtOneInstantAreBothTaken) {
   EXPECT_NE(p.summary.message.find("'floor' (rolling), 'wall' (touching down), keep 6 constraint rows of rank 5 on 6"),
             std::string::npos)
       << p.summary.message;
+}
+
+// A ball sliding without friction along the floor at 3 m/s into a dome (a sphere of radius 1
+// centred 0.9 below the floor), frictionless too, e = 1/2. The dome's impulse along its normal n
+// lifts the ball: held through the impact, the floor would have to pull it down (it did: the ball
+// left at (1.5, 0)). It leaves instead, with its own NAME_liftoff, and the ball flies off at
+// v - (1 + e)(v . n) n.
+TEST(MoreContactsThanCoordinates, AContactThatWouldPullThroughAnotherContactsImpactLeavesTheGround) {
+  std::string text = floor_and_wall("friction = 0\n", "friction = 0\nrestitution = 0.5\nmode = \"free\"\n",
+                                    "position = { x = 0.9, y = 0, z = \"r\", a = 0, b = 0, c = 0 }\n"
+                                    "velocity = { x = -3, y = 0, z = 0, a = 0, b = 0, c = 0 }");
+  text = replaced(text, "ground = { plane = [-1, 0, 0] }",
+                  "ground = { surface = \"X^2 + Y^2 + (Z + 0.9)^2 - 1\", side = \"outside\" }");
+  const FloorRun r = run(load_model_text(text, "dome.toml"), 0.3);
+  ASSERT_EQ(r.summary.status, Status::ok) << r.summary.message;
+  const double xc = std::sqrt(1.1 * 1.1 - 1.0);  // the centre where it meets the dome, at z = r
+  std::string names;
+  for (const EventRecord& e : r.summary.events.crossings) names += fmt::format(" {} {}", e.name, e.t);
+  ASSERT_EQ(r.summary.events.crossings.size(), 2u) << names;
+  EXPECT_EQ(r.summary.events.crossings[0].name, "wall_touchdown");
+  EXPECT_NEAR(r.summary.events.crossings[0].t, (0.9 - xc) / 3, 1e-10);
+  EXPECT_EQ(r.summary.events.crossings[1].name, "floor_liftoff");
+  EXPECT_EQ(r.summary.events.crossings[1].t, r.summary.events.crossings[0].t);
+  const double nx = xc / 1.1, nz = 1.0 / 1.1, vn = -3 * nx;
+  EXPECT_NEAR(r.summary.events.crossings[1].v[0], -3 - 1.5 * vn * nx, 1e-10);
+  EXPECT_NEAR(r.summary.events.crossings[1].v[2], -1.5 * vn * nz, 1e-10);
+  EXPECT_EQ(r.at(r.rows.size() - 1, "floor_mode"), 2.0);
 }
 
 // A contact given mode = "free" that touches its ground at t0 moving into it would pass through:

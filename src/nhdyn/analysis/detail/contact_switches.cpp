@@ -784,6 +784,12 @@ Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, b
   const Vector impulse = data_.A * (out.v - v_before);
   const Vector Pi = qr.solve(impulse);
   out.normal = Pi(gap_column);
+  const double largest = Pi.size() > 0 ? Pi.cwiseAbs().maxCoeff() : 0.0;
+  for (int j = 0; j < r && out.pulling < 0; ++j)
+    for (std::size_t o = 0; o < cm.contacts.size(); ++o)
+      if (o != i && cm.contacts[o].unilateral && rows[static_cast<std::size_t>(j)] == cm.contacts[o].gap &&
+          Pi(j) < -1e-10 * largest)
+        out.pulling = static_cast<int>(o);
   for (std::size_t a = 0; a < 2; ++a)
     out.tangential[a] = sliding ? -w.mu_k[i] * out.normal * direction[a]
                                 : (roll_column[a] >= 0 ? Pi(roll_column[a]) * w.tangent_length[i][a] : 0.0);
@@ -859,45 +865,53 @@ std::string ContactSwitches::touchdown(int contact, double t) {
   const double e = w.restitution[i];
   const double vn = w.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)];
   const std::array<double, 2> slip_before = w.slip[i];
-  // Coulomb at the impulse level (section 7, "Which impulse"): sticking if inside the cone.
-  Impulse impulse = solve_impulse(contact, t, v, false, {0.0, 0.0});
-  if (!impulse.ok) {
-    accumulation_ = impulse.failure;
-    return "";
-  }
-  if (c.friction && norm2(impulse.tangential) > w.mu_s[i] * impulse.normal) {
-    std::array<double, 2> direction{0.0, 0.0};
-    const double slip = norm2(slip_before);
-    if (slip > slip_floor(data_)) direction = {slip_before[0] / slip, slip_before[1] / slip};
-    else {
-      const double size = norm2(impulse.tangential);
-      if (!(size > 0.0)) {
-        // Outside the cone only because the sticking impulse pulls (normal <= 0), with no
-        // tangential part and no slip: no direction to slide in, and no impact law holds.
-        accumulation_ = fmt::format(
-            "contact '{}' touches down at t = {:.9g} with a sticking impulse that pulls (normal impulse {:.6g} N s) "
-            "and no slip to slide along: no impact law of this model is consistent there "
-            "(docs/derivations/contact-modes.md section 7). The run ends here with its results so far",
-            c.name, t, impulse.normal);
-        return "";
-      }
-      direction = {-impulse.tangential[0] / size, -impulse.tangential[1] / size};
-    }
-    impulse = solve_impulse(contact, t, v, true, direction);
+  // Another unilateral contact that would pull through the impact leaves the ground at it
+  // (its own NAME_liftoff at the same time), and the impulse is solved again without it.
+  Impulse impulse;
+  for (std::size_t released = 0;; ++released) {
+    // Coulomb at the impulse level (section 7, "Which impulse"): sticking if inside the cone.
+    impulse = solve_impulse(contact, t, v, false, {0.0, 0.0});
     if (!impulse.ok) {
       accumulation_ = impulse.failure;
       return "";
     }
-    if (!(impulse.normal > 0.0)) {
-      accumulation_ = fmt::format(
-          "contact '{}' touches down at t = {:.9g} sliding (the sticking impulse is outside the friction cone) in "
-          "Painleve's paradox: with mu_k = {:.6g} the impulse along n - mu_k e_s would have to pull (normal impulse "
-          "{:.6g} N s), w_eff <= 0 (docs/derivations/contact-modes.md 3.8); no impact law of this model is "
-          "consistent there. The run ends here with its results so far; lower the friction coefficient",
-          c.name, t, w.mu_k[i], impulse.normal);
-      return "";
+    if (c.friction && norm2(impulse.tangential) > w.mu_s[i] * impulse.normal) {
+      std::array<double, 2> direction{0.0, 0.0};
+      const double slip = norm2(slip_before);
+      if (slip > slip_floor(data_)) direction = {slip_before[0] / slip, slip_before[1] / slip};
+      else {
+        const double size = norm2(impulse.tangential);
+        if (!(size > 0.0)) {
+          // Outside the cone only because the sticking impulse pulls (normal <= 0), with no
+          // tangential part and no slip: no direction to slide in, and no impact law holds.
+          accumulation_ = fmt::format(
+              "contact '{}' touches down at t = {:.9g} with a sticking impulse that pulls (normal impulse {:.6g} N s) "
+              "and no slip to slide along: no impact law of this model is consistent there "
+              "(docs/derivations/contact-modes.md section 7). The run ends here with its results so far",
+              c.name, t, impulse.normal);
+          return "";
+        }
+        direction = {-impulse.tangential[0] / size, -impulse.tangential[1] / size};
+      }
+      impulse = solve_impulse(contact, t, v, true, direction);
+      if (!impulse.ok) {
+        accumulation_ = impulse.failure;
+        return "";
+      }
+      if (!(impulse.normal > 0.0)) {
+        accumulation_ = fmt::format(
+            "contact '{}' touches down at t = {:.9g} sliding (the sticking impulse is outside the friction cone) in "
+            "Painleve's paradox: with mu_k = {:.6g} the impulse along n - mu_k e_s would have to pull (normal impulse "
+            "{:.6g} N s), w_eff <= 0 (docs/derivations/contact-modes.md 3.8); no impact law of this model is "
+            "consistent there. The run ends here with its results so far; lower the friction coefficient",
+            c.name, t, w.mu_k[i], impulse.normal);
+        return "";
+      }
+      w.direction[i] = direction;
     }
-    w.direction[i] = direction;
+    if (impulse.pulling < 0 || released >= cm.contacts.size()) break;
+    w.mode[static_cast<std::size_t>(impulse.pulling)] = ContactMode::free;
+    settled_.push_back(cm.contacts[static_cast<std::size_t>(impulse.pulling)].name + "_liftoff");
   }
   const Evaluator& ev = *model_.evaluator;
   const bool balance = ev.has_energy_balance() && size_ > 2 * n + 4;

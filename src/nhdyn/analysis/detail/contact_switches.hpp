@@ -44,6 +44,8 @@ struct Impulse {
   Vector v;
   double normal = 0.0;
   std::array<double, 2> tangential{0.0, 0.0};
+  // Another unilateral contact held through the impact whose normal impulse would pull, or -1.
+  int pulling = -1;
   std::string failure;  // why not, when !ok
 };
 
