@@ -227,7 +227,7 @@ Status solve_modes(const Model& model, Data& data, bool rolling, bool forces_onl
                 fmt::format("the contacts {} held together keep {} constraint rows on {} coordinates, which leaves "
                             "the Do Sanh form no row of D (it needs fewer independent rows than coordinates): the body "
                             "is wedged, or held by dependent rows (docs/contact-modes.md, \"More contacts than "
-                            "freedom\"); start one of them free (mode = \"free\"), or remove one",
+                            "freedom\"); start one of them free (a unilateral one, mode = \"free\"), or remove one",
                             touching, r, n));
   }
   if (w.reaction_rows.cols() != r) {
