@@ -365,6 +365,43 @@ TEST(MoreContactsThanCoordinates, AContactThatWouldPullThroughAnotherContactsImp
   EXPECT_EQ(r.at(r.rows.size() - 1, "floor_mode"), 2.0);
 }
 
+// A ball rolling at 2 m/s into a frictionless wall (friction = 0, e = 1/2) on a floor that holds it
+// without slip: the wall takes no tangential impulse, so it keeps only its gap row through the
+// impact (with its no-slip rows too, the six rows had rank 5 and the run ended). The ball rolls
+// back at -e v0, the floor's impulse turning its spin to match, b' = -e v0 / r.
+TEST(MoreContactsThanCoordinates, ARollingBallBouncesOffAFrictionlessWall) {
+  const std::string text = floor_and_wall("", "friction = 0\nrestitution = 0.5\nmode = \"free\"\n",
+                                          "position = { x = -0.5, y = 0, z = \"r\", a = 0, b = 0, c = 0 }\n"
+                                          "velocity = { x = 2, y = 0, z = 0, a = 0, b = 20, c = 0 }");
+  const FloorRun r = run(load_model_text(text, "frictionless.toml"), 1.0);
+  ASSERT_EQ(r.summary.status, Status::ok) << r.summary.message;
+  ASSERT_EQ(r.summary.events.crossings.size(), 1u);
+  EXPECT_EQ(r.summary.events.crossings[0].name, "wall_touchdown");
+  EXPECT_NEAR(r.summary.events.crossings[0].t, 0.2, 1e-10);  // the centre 0.4 on at 2 m/s
+  const std::size_t last = r.rows.size() - 1;
+  EXPECT_NEAR(r.at(last, "x'"), -1.0, 1e-10);
+  EXPECT_NEAR(r.at(last, "b'"), -10.0, 1e-9);
+  EXPECT_NEAR(r.at(last, "floor_N"), 0.981, 1e-10);
+}
+
+// A ball given mode = "free" at rest on the floor: the gap starts at 0 and closes as gravity pulls
+// the ball down (it passed through the floor, no event). The touchdown is at once, with no speed
+// to take, and the ball rests with N = m g.
+TEST(MoreContactsThanCoordinates, AFreeContactAtRestOnItsGroundTouchesDownAtOnce) {
+  const std::string text = floor_and_wall("mode = \"free\"\n", "mode = \"free\"\n",
+                                          "position = { x = -1, y = 0, z = \"r\", a = 0, b = 0, c = 0 }\n"
+                                          "velocity = { x = 0, y = 0, z = 0, a = 0, b = 0, c = 0 }");
+  const FloorRun r = run(load_model_text(text, "rest.toml"), 0.5);
+  ASSERT_EQ(r.summary.status, Status::ok) << r.summary.message;
+  ASSERT_EQ(r.summary.events.crossings.size(), 1u);
+  EXPECT_EQ(r.summary.events.crossings[0].name, "floor_touchdown");
+  EXPECT_LT(r.summary.events.crossings[0].t, 1e-12);
+  const std::size_t last = r.rows.size() - 1;
+  EXPECT_NEAR(r.at(last, "z"), 0.1, 1e-12);
+  EXPECT_NEAR(r.at(last, "floor_N"), 0.981, 1e-12);
+  EXPECT_EQ(r.at(last, "floor_mode"), 0.0);
+}
+
 // A contact given mode = "free" that touches its ground at t0 moving into it would pass through:
 // no event finds a touchdown whose gap starts at 0. Refused, with the gap and the speed.
 TEST(MoreContactsThanCoordinates, AFreeStartOnTheGroundMovingIntoItIsRefused) {

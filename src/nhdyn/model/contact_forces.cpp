@@ -283,8 +283,12 @@ void compute_contact_forces(const Model& model, Data& data) {
   }
   w.residual = scale > 0.0 ? w.misfit.norm() / scale : w.misfit.norm();
   int index = 0;
-  for (const ContactForceContact& contact : c.contacts) {
+  for (std::size_t k = 0; k < c.contacts.size(); ++k) {
+    const ContactForceContact& contact = c.contacts[k];
     if (!contact.reported) continue;
+    // A free contact's force is 0 whatever the others share (its unknowns were not solved for).
+    const int m = w.mode_contact[k];
+    const bool is_free = data.modes.active && m >= 0 && data.modes.mode[static_cast<std::size_t>(m)] == ContactMode::free;
     double F[3];
     force_of(c, contact, o, w.x.data(), F);
     const double* basis = o + c.direction_offset(index);
@@ -299,7 +303,7 @@ void compute_contact_forces(const Model& model, Data& data) {
         const double* e = basis + 3 * (k - 3);
         out[j] = e[0] * F[0] + e[1] * F[1] + e[2] * F[2];
       }
-      if (!c.determined[static_cast<std::size_t>(contact.first_value) + j] || !determined) out[j] = kNaN;
+      if (!c.determined[static_cast<std::size_t>(contact.first_value) + j] || (!determined && !is_free)) out[j] = kNaN;
     }
     ++index;
   }

@@ -246,9 +246,11 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
                                    "opening; start it higher, or rolling (mode = \"rolling\", or leave the key out)",
                                    c.where, c.name, gap + 0.0, rate));
   }
-  if (compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok &&
-      !slide_the_slipping(model, data, formulation, t0, q0, v0))
-    throw_at_start(model, data);
+  if (compute_dynamics(model, data, formulation, t0, q0.data(), v0.data()) != Status::ok) {
+    // The first failure is the one to report when sliding the slipping contacts does not help.
+    const std::string first = fmt::format("model '{}': at the initial state: {}", model.name, explain_failure(model, data));
+    if (!slide_the_slipping(model, data, formulation, t0, q0, v0)) throw ModelError(first);
+  }
   const double floor = slip_floor(data);
   const ContactModeData rolling = w;  // the rolling forces and slips of every contact
   for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
@@ -383,9 +385,12 @@ Status ContactSwitches::evaluate(double t, const double* y, double* g) {
     // from where it rises: that zero is not a crossing, and the sign it starts with is the one it
     // leaves with, so that a flight or a slide shorter than the integrator's first step is still
     // seen to end (section 4: "the touchdown event must ignore the zero it starts on").
+    // A gap at rest there (its rate within the integration error) is as good as opening: one that
+    // then closes is a touchdown, found as g falls from this positive start (a body set down free
+    // on its ground, or released by another contact's impulse, would else pass through it).
     if (t == start_t_) {
       if (w.mode[i] == ContactMode::free && static_cast<int>(i) != grazed_ &&
-          w.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)] >= 0.0)
+          w.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)] >= -slip_floor(data_))
         gi[0] = std::max(gi[0], std::numeric_limits<double>::min());
       if (w.mode[i] == ContactMode::sliding) gi[1] = std::max(gi[1], std::numeric_limits<double>::min());
       if (w.mode[i] == ContactMode::sliding && !c.unilateral)  // N's zero after a reversal
@@ -526,6 +531,17 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
     // No touchdown: the contact stays free and leaves. The segment restarts there without a row,
     // its gap taken as it is (not as a fresh lift-off's), so that an integrator that locates roots
     // itself (CVODE) does not meet the same zero again at once.
+    // Counted as switches are, so that grazes that keep coming back end the run rather than hang it.
+    ++switch_count_;
+    same_graze_ = t == last_graze_t_ ? same_graze_ + 1 : 0;
+    last_graze_t_ = t;
+    if (same_graze_ > kMaxSameTime || switch_count_ > kMaxSwitches) {
+      accumulation_ = fmt::format("contact '{}' grazed its ground {} times at t = {:.9g} ({} switches in the run): no "
+                                  "consistent mode; the run ends here with its results so far",
+                                  model_.contact_modes->contacts[static_cast<std::size_t>(contact)].name,
+                                  same_graze_ + 1, t, switch_count_);
+      return Status::integrator_failure;
+    }
     std::copy(y, y + size_, switch_y_.begin());
     switch_t_ = t;
     start_t_ = t;
@@ -574,7 +590,10 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
   std::vector<std::string> events{event};
   events.insert(events.end(), settled_.begin(), settled_.end());
   settled_.clear();
-  for (std::size_t k = 0; k < data_.modes.mode.size(); ++k) {
+  // Only an impulse makes another free gap's rate jump: after a touchdown, not after a lift-off or
+  // a slip (where a free gap at the drift's level is no contact closing).
+  const bool impact = event.size() > 10 && event.compare(event.size() - 10, 10, "_touchdown") == 0;
+  for (std::size_t k = 0; impact && k < data_.modes.mode.size(); ++k) {
     const int next = closing_contact(t);
     if (next < 0) break;
     ++switch_count_;
@@ -639,6 +658,12 @@ int ContactSwitches::closing_contact(double t) {
 bool ContactSwitches::start_sliding(int contact, double t, const double* q, const double* v) {
   const auto i = static_cast<std::size_t>(contact);
   ContactModeData& w = data_.modes;
+  if (frictionless(i)) {
+    // No friction force: the direction of sliding takes no part in the equations.
+    w.direction[i] = {1.0, 0.0};
+    w.mode[i] = ContactMode::sliding;
+    return compute_dynamics(model_, data_, formulation_, t, q, v) == Status::ok && check_sliding(contact, t);
+  }
   const Onset onset = onset_direction(model_, data_, formulation_, i, t, q, v);
   // Several directions: the one nearest (O2) tells whether the sliding is in Painleve's paradox
   // (the message that says which modes are consistent); else the onset is not unique.
@@ -800,11 +825,32 @@ Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, b
 bool ContactSwitches::settle_others(int contact, double t, const double* q, const double* v) {
   ContactModeData& w = data_.modes;
   const ContactModeModel& cm = *model_.contact_modes;
-  std::vector<std::size_t> sliding;
+  std::vector<std::size_t> sliding, rolling;
   for (std::size_t j = 0; j < cm.contacts.size(); ++j)
     if (static_cast<int>(j) != contact && w.mode[j] == ContactMode::sliding) sliding.push_back(j);
-  if (sliding.empty()) return true;
+    else if (static_cast<int>(j) != contact && w.mode[j] == ContactMode::rolling &&
+             (cm.contacts[j].unilateral || cm.contacts[j].friction))
+      rolling.push_back(j);
+  if (sliding.empty() && rolling.empty()) return true;
   if (compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return false;
+  // A rolling contact that the impact leaves pulling lifts off; one that needs more friction than
+  // its cone gives slips: each with its event at this time (the next segment would start past the
+  // crossing that finds it).
+  bool changed = false;
+  for (std::size_t j : rolling) {
+    const ContactModeContact& o = cm.contacts[j];
+    if (o.unilateral && w.normal_force[j] < -1e-10 * (1.0 + data_.R.lpNorm<Eigen::Infinity>())) {
+      w.mode[j] = ContactMode::free;
+      settled_.push_back(o.name + "_liftoff");
+      changed = true;
+    } else if (o.friction && norm2(w.friction[j]) > w.mu_s[j] * std::abs(w.normal_force[j]) * (1.0 + 1e-12)) {
+      if (!start_sliding(static_cast<int>(j), t, q, v)) return false;
+      settled_.push_back(o.name + "_slip");
+      changed = true;
+    }
+  }
+  if (changed && compute_dynamics(model_, data_, formulation_, t, q, v) != Status::ok) return false;
+  if (sliding.empty()) return true;
   std::vector<std::size_t> stopped;
   for (std::size_t j : sliding) {
     const double slip = norm2(w.slip[j]);
@@ -870,15 +916,18 @@ std::string ContactSwitches::touchdown(int contact, double t) {
   Impulse impulse;
   for (std::size_t released = 0;; ++released) {
     // Coulomb at the impulse level (section 7, "Which impulse"): sticking if inside the cone.
-    impulse = solve_impulse(contact, t, v, false, {0.0, 0.0});
-    if (!impulse.ok) {
+    // A frictionless contact (friction = 0) takes no tangential impulse: straight to the sliding one,
+    // which keeps its gap row alone (the sticking one would hold its no-slip rows too).
+    impulse = frictionless(i) ? Impulse{} : solve_impulse(contact, t, v, false, {0.0, 0.0});
+    if (!frictionless(i) && !impulse.ok) {
       accumulation_ = impulse.failure;
       return "";
     }
-    if (c.friction && norm2(impulse.tangential) > w.mu_s[i] * impulse.normal) {
+    if (frictionless(i) || (c.friction && norm2(impulse.tangential) > w.mu_s[i] * impulse.normal)) {
       std::array<double, 2> direction{0.0, 0.0};
       const double slip = norm2(slip_before);
       if (slip > slip_floor(data_)) direction = {slip_before[0] / slip, slip_before[1] / slip};
+      else if (frictionless(i)) direction = {1.0, 0.0};
       else {
         const double size = norm2(impulse.tangential);
         if (!(size > 0.0)) {
@@ -898,6 +947,14 @@ std::string ContactSwitches::touchdown(int contact, double t) {
         accumulation_ = impulse.failure;
         return "";
       }
+      if (!(impulse.normal > 0.0) && frictionless(i)) {
+        accumulation_ = fmt::format("contact '{}' touches down at t = {:.9g} with an impulse that would have to pull "
+                                    "(normal impulse {:.6g} N s): no impact law of this model is consistent there "
+                                    "(docs/derivations/contact-modes.md section 7). The run ends here with its "
+                                    "results so far",
+                                    c.name, t, impulse.normal);
+        return "";
+      }
       if (!(impulse.normal > 0.0)) {
         accumulation_ = fmt::format(
             "contact '{}' touches down at t = {:.9g} sliding (the sticking impulse is outside the friction cone) in "
@@ -909,7 +966,14 @@ std::string ContactSwitches::touchdown(int contact, double t) {
       }
       w.direction[i] = direction;
     }
-    if (impulse.pulling < 0 || released >= cm.contacts.size()) break;
+    if (impulse.pulling < 0) break;
+    if (released >= cm.contacts.size()) {
+      accumulation_ = fmt::format("contact '{}' touches down at t = {:.9g}, and releasing the contacts whose impulse "
+                                  "would pull leaves one that still pulls ('{}'): no impact law of this model is "
+                                  "consistent there; the run ends here with its results so far",
+                                  c.name, t, cm.contacts[static_cast<std::size_t>(impulse.pulling)].name);
+      return "";
+    }
     w.mode[static_cast<std::size_t>(impulse.pulling)] = ContactMode::free;
     settled_.push_back(cm.contacts[static_cast<std::size_t>(impulse.pulling)].name + "_liftoff");
   }
@@ -970,6 +1034,7 @@ IntegrationResult integrate_contact_modes(OdeSystem& ode, const IntegratorOption
   // Each output time's row waits for the next call (ContactSwitches::hold_row): a switch found
   // within round-off after it replaces it.
   switches.set_output(&output);
+  switches.start(t0);
   const OutputFn held = [&switches](double time, const double* state) {
     const Status status = switches.flush_row();
     if (status == Status::ok) switches.hold_row(time, state);

@@ -72,6 +72,8 @@ class ContactSwitches final : public EventFunctions {
   double switch_t() const { return switch_t_; }
   const std::vector<double>& switch_y() const { return switch_y_; }
   void clear() { switched_ = false; }
+  // The run's start t0 is the first segment's: its free contacts' gaps start as a switch's do.
+  void start(double t0) { start_t_ = t0; }
   // Set when the switches accumulate (Zeno or no consistent mode): the message ending the run.
   const std::string& accumulation() const { return accumulation_; }
   long switches() const { return switch_count_; }
@@ -103,6 +105,11 @@ class ContactSwitches final : public EventFunctions {
   // (sliding on in its onset direction if sticking needs more than mu_s N). False (with the message
   // in accumulation_) when that fails.
   bool settle_others(int contact, double t, const double* q, const double* v);
+  // Whether contact i has friction = 0 (mu_s = mu_k = 0, the values of the last solve): it slides
+  // with no friction force, so no direction of sliding matters.
+  bool frictionless(std::size_t i) const {
+    return model_.contact_modes->contacts[i].friction && data_.modes.mu_s[i] == 0.0 && data_.modes.mu_k[i] == 0.0;
+  }
   // A free contact that touches its ground at (t, switch_y_) moving into it, or -1: two gaps that
   // close at one instant, or one that this switch's impulse closed. The event that finds a
   // touchdown needs the gap positive where the segment starts; such a contact's gap is not.
@@ -135,6 +142,8 @@ class ContactSwitches final : public EventFunctions {
   double last_switch_t_ = 0.0;
   double start_t_ = -HUGE_VAL;  // the time the current segment started at (the last switch)
   int grazed_ = -1;  // the contact whose graze (grazes) restarted the current segment, or -1
+  double last_graze_t_ = -HUGE_VAL;
+  int same_graze_ = 0;  // grazes at last_graze_t_ before the last
   std::vector<std::string> settled_;  // NAME_stick of the contacts another's impact stopped (settle_others)
   std::vector<double> user_before_, user_after_;  // the run's own events across a switch
   std::vector<double> last_touchdown_;  // per contact: the times of its last two touchdowns
