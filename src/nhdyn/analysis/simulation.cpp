@@ -58,7 +58,7 @@ bool watched_in_mode(const Data& data, int mode_contact, bool touching_only, boo
 // lying flat), as the message of the run that failed there; "" when none is. A measure that is not
 // a number counts as singular.
 // Watch `w`'s measure at (t, q, v), bound to the model's parameter values. Cold path: allocates.
-double watch_measure(const Model& model, const ContactWatch& w, double t, const double* q, const double* v) {
+double calc_watch_measure(const Model& model, const ContactWatch& w, double t, const double* q, const double* v) {
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
   const Tape measure = w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure;
@@ -79,7 +79,7 @@ std::string singular_contact_message(const Model& model, const Data& data, doubl
                                      const double* v) {
   for (const ContactWatch& w : model.contact_watches) {
     if (!watched_in_mode(data, mode_contact_index(model, w.contact), w.touching_only, w.free_only)) continue;
-    const double value = watch_measure(model, w, t, q, v);
+    const double value = calc_watch_measure(model, w, t, q, v);
     if (value >= w.threshold) continue;
     return watch_message(model, w, value, t, q, v);
   }
@@ -675,7 +675,7 @@ std::string explain_run_failure(const Model& model, const Data& data, const Mode
   if (watched.fired() >= 0 && status == Status::singular_system) {
     const ContactWatch& w = model.contact_watches[static_cast<std::size_t>(watched.fired())];
     const double t = watched.fired_t(), *q = watched.fired_y(), *v = watched.fired_y() + model.n();
-    return watch_message(model, w, watch_measure(model, w, t, q, v), t, q, v);
+    return watch_message(model, w, calc_watch_measure(model, w, t, q, v), t, q, v);
   }
   // A contact point that is not defined there says so, rather than the equations' symptom of it.
   if (const std::string singular = singular_contact_message(model, data, data.t, data.q.data(), data.v.data());

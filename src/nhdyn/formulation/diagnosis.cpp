@@ -91,10 +91,26 @@ std::string explain_inertia_sparse(const Model& model, const Data& data) {
       data.t, smallest, largest, asymmetry, model.n());
 }
 
+// The rows of b a failed solve held: with contact modes those its modes kept (with s >= n the
+// full b is never of rank s, whatever the state), else all of them; and b restricted to them.
+std::vector<int> held_rows(const Model& model, const Data& data) {
+  if (data.modes.active && !data.modes.kept.empty()) return data.modes.kept;
+  std::vector<int> rows;
+  for (int i = 0; i < model.s(); ++i) rows.push_back(i);
+  return rows;
+}
+
+Matrix rows_of_b(const Data& data, const std::vector<int>& rows) {
+  Matrix b(static_cast<Eigen::Index>(rows.size()), data.b.cols());
+  for (std::size_t k = 0; k < rows.size(); ++k) b.row(static_cast<Eigen::Index>(k)) = data.b.row(rows[k]);
+  return b;
+}
+
 // Singular values of b and, for each small one, the constraints taking part in the dependency.
 std::string explain_dependent_constraints(const Model& model, const Data& data) {
   if (sparse_checks(model, data)) return explain_dependent_constraints_sparse(model, data);
-  Eigen::JacobiSVD<Matrix> svd(data.b, Eigen::ComputeFullU);
+  const std::vector<int> rows = held_rows(model, data);
+  Eigen::JacobiSVD<Matrix> svd(rows_of_b(data, rows), Eigen::ComputeFullU);
   const Vector& sv = svd.singularValues();
   const double largest = sv.size() > 0 ? sv(0) : 0.0;
   const double smallest = sv.size() > 0 ? sv(sv.size() - 1) : 0.0;
@@ -102,9 +118,9 @@ std::string explain_dependent_constraints(const Model& model, const Data& data) 
   for (Eigen::Index j = 0; j < sv.size(); ++j) {
     if (sv(j) > kRankTolerance * largest && largest > 0.0) continue;
     // A left singular vector with a small singular value combines rows of b to (almost) zero.
-    for (int i = 0; i < model.s(); ++i)
-      if (std::abs(svd.matrixU()(i, j)) > 1e-8) {
-        const Constraint& c = model.constraints[static_cast<std::size_t>(i)];
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      if (std::abs(svd.matrixU()(static_cast<Eigen::Index>(k), j)) > 1e-8) {
+        const Constraint& c = model.constraints[static_cast<std::size_t>(rows[k])];
         if (involved.find("'" + c.name + "'") == std::string::npos)
           involved += (involved.empty() ? "" : ", ") + ("'" + c.name + "'") +
                       (c.where.empty() ? "" : " (" + c.where + ")");
@@ -113,9 +129,11 @@ std::string explain_dependent_constraints(const Model& model, const Data& data) 
   const double condition = smallest > 0.0 ? largest / smallest : std::numeric_limits<double>::infinity();
   return fmt::format(
       "the constraints {} are dependent or conflicting at t = {:.6g}: the constraint matrix b has "
-      "rank below s = {} (condition estimate {:.3g}). Remove or rewrite a redundant constraint, or "
+      "rank below {} = {} (condition estimate {:.3g}). Remove or rewrite a redundant constraint, or "
       "check that the state does not sit on a singular configuration of the constraints.",
-      involved.empty() ? std::string("(all)") : involved, data.t, model.s(), condition);
+      involved.empty() ? std::string("(all)") : involved, data.t,
+      rows.size() == static_cast<std::size_t>(model.s()) ? "s" : "the rows the contacts' modes keep", rows.size(),
+      condition);
 }
 
 // A singular A whose null directions the constraints do not all remove: the coordinates moving
@@ -168,7 +186,9 @@ std::string explain_inertia(const Model& model, const Data& data) {
 bool b_is_rank_deficient(const Model& model, const Data& data) {
   if (model.s() == 0) return false;
   if (sparse_checks(model, data)) return calc_sparse_rank(data).rank < model.s();
-  Eigen::JacobiSVD<Matrix> svd(data.b);
+  const std::vector<int> rows = held_rows(model, data);
+  if (rows.size() > static_cast<std::size_t>(model.n())) return true;
+  Eigen::JacobiSVD<Matrix> svd(rows_of_b(data, rows));
   const Vector& sv = svd.singularValues();
   return !(sv(sv.size() - 1) > kRankTolerance * sv(0));
 }

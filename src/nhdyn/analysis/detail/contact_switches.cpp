@@ -259,8 +259,12 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
     const double slip = norm2(rolling.slip[i]);
     const bool cone_violated = c.friction && norm2(rolling.friction[i]) > rolling.mu_s[i] * std::abs(rolling.normal_force[i]);
     ContactMode mode = ContactMode::rolling;
+    // A unilateral contact that carries no load at t0 (N at round-off below 0: a ball resting
+    // against a wall) starts free, not refused as pulling.
+    const bool unloaded = c.unilateral && rolling.normal_force[i] < 0.0 &&
+                          rolling.normal_force[i] >= -1e-10 * (1.0 + data.R.lpNorm<Eigen::Infinity>());
     if (c.initial >= 0) mode = static_cast<ContactMode>(c.initial);
-    else if (starts_free(c, gap)) mode = ContactMode::free;
+    else if (starts_free(c, gap) || unloaded) mode = ContactMode::free;
     else if (c.friction && (slip > floor || cone_violated)) mode = ContactMode::sliding;
     if (mode == ContactMode::sliding) {
       if (slip > floor) {
