@@ -39,18 +39,26 @@ std::vector<int> rows_at(const Model& model, ConstraintLevel level, bool program
   return rows;
 }
 
-// Whether constraint `row` belongs to a contact whose given mode at t0 (`mode` of [[contacts]])
-// drops it: --fix-initial leaves a free contact's gap and a sliding one's slip as written.
-bool dropped_at_start(const Model& model, int row) {
+// Whether constraint `row` belongs to a contact that starts in a mode that drops it: its given
+// `mode` (a free contact's gap and a sliding one's slip are motion, not constraint error), or, in a
+// model whose contacts are never all held (s >= n), a unilateral contact whose gap `phi` (the
+// position residuals at the start) is open, as the run starts it free.
+bool dropped_at_start(const Model& model, int row, const Vector& phi) {
   if (!model.contact_modes || row >= model.s()) return false;
-  for (const ContactModeContact& c : model.contact_modes->contacts)
+  for (const ContactModeContact& c : model.contact_modes->contacts) {
     if (c.initial >= 0 && contact_mode_drops_row(c, static_cast<ContactMode>(c.initial), row)) return true;
+    if (c.initial < 0 && model.s() >= model.n() && c.unilateral && c.gap_position < phi.size() &&
+        phi(c.gap_position) > 1e-9 && contact_mode_drops_row(c, ContactMode::free, row))
+      return true;
+  }
   return false;
 }
 
-// Whether some contact's mode at t0 is given.
+// Whether some contact starts in a mode the model decides alone: a given one, or any in a model
+// whose contacts are never all held.
 bool modes_given(const Model& model) {
   if (!model.contact_modes) return false;
+  if (model.s() >= model.n()) return true;
   for (const ContactModeContact& c : model.contact_modes->contacts)
     if (c.initial >= 0) return true;
   return false;
@@ -171,7 +179,8 @@ void fix_keeping_written(const Model& model, Data& data, double t, double tolera
         free_names.push_back(value_name(model, i, level));
       }
     std::vector<int> all = rows_at(model, level, true);
-    all.erase(std::remove_if(all.begin(), all.end(), [&model](int row) { return dropped_at_start(model, row); }),
+    const Vector phi = residual(model, data, t, fix.q, fix.v, ConstraintLevel::position);
+    all.erase(std::remove_if(all.begin(), all.end(), [&](int row) { return dropped_at_start(model, row, phi); }),
               all.end());
     // The constraints and programs none of the free values enter cannot be mended by moving them.
     std::vector<int> movable, fixed_rows;
