@@ -44,14 +44,21 @@ struct FloorRun {
   }
 };
 
+// The runs' options: the example's tolerances.
+SimulationOptions run_options(double t_end, double output_step, IntegratorKind integrator = IntegratorKind::dopri5) {
+  SimulationOptions options;
+  options.t_end = t_end;
+  options.output_step = output_step;
+  options.integrator.kind = integrator;
+  options.integrator.rtol = 1e-10;
+  options.integrator.atol = 1e-12;
+  return options;
+}
+
 FloorRun run(const Model& model, double t_end) {
   FloorRun out;
   out.columns = make_result_columns(model);
-  SimulationOptions options;
-  options.t_end = t_end;
-  options.output_step = 0.01;
-  options.integrator.rtol = 1e-10;
-  options.integrator.atol = 1e-12;
+  const SimulationOptions options = run_options(t_end, 0.01);
   out.summary = simulate(model, options, [&](const Data& data) {
     std::vector<double> row;
     fill_result_row(model, data, row);
@@ -162,12 +169,7 @@ TEST(MoreContactsThanCoordinates, EveryIntegratorLandsTheBallAtTheClosedFormSpee
   const double k = 0.4, c = 2 * std::cos(1e-3) / (3 + k), vL = std::sqrt(9.81 * 1.1 * c);
   for (const IntegratorKind integrator :
        {IntegratorKind::dopri5, IntegratorKind::dop853, IntegratorKind::cvode_bdf, IntegratorKind::cvode_adams}) {
-    SimulationOptions options;
-    options.t_end = 4.0;
-    options.output_step = 0.5;
-    options.integrator.kind = integrator;
-    options.integrator.rtol = 1e-10;
-    options.integrator.atol = 1e-12;
+    const SimulationOptions options = run_options(4.0, 0.5, integrator);
     double last_vx = 0.0;
     const SimulationSummary summary =
         simulate(model, options, [&](const Data& data) { last_vx = data.v(0); });
@@ -185,12 +187,7 @@ TEST(MoreContactsThanCoordinates, EveryIntegratorLandsTheBallAtTheClosedFormSpee
   const auto angle = [](const EventRecord& e) { return std::atan2(e.q[0], e.q[2] - 1.5) * 180 / M_PI; };
   for (const IntegratorKind integrator :
        {IntegratorKind::dopri5, IntegratorKind::dop853, IntegratorKind::cvode_bdf, IntegratorKind::cvode_adams}) {
-    SimulationOptions options;
-    options.t_end = 4.0;
-    options.output_step = 0.5;
-    options.integrator.kind = integrator;
-    options.integrator.rtol = 1e-10;
-    options.integrator.atol = 1e-12;
+    const SimulationOptions options = run_options(4.0, 0.5, integrator);
     const SimulationSummary summary = simulate(friction, options, [](const Data&) {});
     ASSERT_EQ(summary.status, Status::ok) << integrator_name(integrator) << ": " << summary.message;
     std::vector<std::string> names;
@@ -437,11 +434,7 @@ TEST(MoreContactsThanCoordinates, AFreeStartOnTheGroundMovingIntoItIsRefused) {
 TEST(MoreContactsThanCoordinates, AStopConditionThatAnImpactMakesTrueStopsTheRunThere) {
   const Model model = load_model(example("ball_off_sphere_onto_floor.toml"));
   for (const std::string condition : {"floor_N > 0.5", "x' > 1.6"}) {
-    SimulationOptions options;
-    options.t_end = 4.0;
-    options.output_step = 0.01;
-    options.integrator.rtol = 1e-10;
-    options.integrator.atol = 1e-12;
+    SimulationOptions options = run_options(4.0, 0.01);
     options.events.push_back(make_stop_condition(model, condition));
     double last_t = 0.0;
     const SimulationSummary summary = simulate(model, options, [&](const Data& data) { last_t = data.t; });
@@ -463,22 +456,14 @@ TEST(MoreContactsThanCoordinates, FixInitialLeavesTheRowsOfContactsThatStartFree
   const std::string no_mode = replaced(floor_example(), "mode = \"free\"\n", "");
   for (const auto& [text, events] : {std::pair{floor_example(), 2u}, std::pair{no_mode, 2u}}) {
     const Model model = load_model_text(text, "fix.toml");
-    SimulationOptions options;
-    options.t_end = 4.0;
-    options.output_step = 0.5;
-    options.integrator.rtol = 1e-10;
-    options.integrator.atol = 1e-12;
+    SimulationOptions options = run_options(4.0, 0.5);
     options.fix_initial = true;
     const SimulationSummary summary = simulate(model, options, [](const Data&) {});
     ASSERT_EQ(summary.status, Status::ok) << summary.message;
     EXPECT_EQ(summary.events.crossings.size(), events);
   }
   const Model sliding = load_model(example("ball_thrown_sliding.toml"));
-  SimulationOptions options;
-  options.t_end = 1.0;
-  options.output_step = 0.1;
-  options.integrator.rtol = 1e-10;
-  options.integrator.atol = 1e-12;
+  SimulationOptions options = run_options(1.0, 0.1);
   options.fix_initial = true;
   double v_end = 0.0;
   const SimulationSummary summary = simulate(sliding, options, [&](const Data& data) { v_end = data.v(0); });
