@@ -446,6 +446,15 @@ TEST(MoreContactsThanCoordinates, AStopConditionThatAnImpactMakesTrueStopsTheRun
     EXPECT_EQ(summary.t_reached, summary.events.crossings[1].t) << condition;
     EXPECT_EQ(last_t, summary.events.crossings[1].t) << condition;
   }
+  // A record event crossing at the same jump is recorded too, the stop after it.
+  SimulationOptions options = run_options(4.0, 0.01);
+  options.events.push_back(make_stop_condition(model, "x' > 1.6"));
+  options.events.push_back(make_record_event(model, "fast=x' - 1.7"));
+  const SimulationSummary summary = simulate(model, options, [](const Data&) {});
+  ASSERT_EQ(summary.status, Status::ok) << summary.message;
+  std::vector<std::string> names;
+  for (const EventRecord& e : summary.events.crossings) names.push_back(e.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"ball_liftoff", "floor_touchdown", "x' > 1.6", "fast"}));
 }
 
 // --fix-initial moves only the values the model file leaves free onto the rows that hold at the

@@ -619,6 +619,8 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
   // A run's event whose function the switch's jump carries across zero (an impact that makes a
   // contact force or a speed pass a stop condition's bound) crosses there: no integrator step
   // would see it, the next segment starting on the other side.
+  // Every one is recorded, a stop among them ending the run after them.
+  bool stop = false;
   if (user_before && user_->evaluate(t, switch_y_.data(), user_after_.data()) == Status::ok)
     for (int k = 0; k < user_count_; ++k) {
       const double before = user_before_[static_cast<std::size_t>(k)], after = user_after_[static_cast<std::size_t>(k)];
@@ -627,9 +629,10 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
       if (!(d == CrossingDirection::rising ? rising : d == CrossingDirection::falling ? falling : rising || falling))
         continue;
       const Status status = user_->on_event(k, t, switch_y_.data());
-      if (status == Status::stopped) switched_ = false;  // the run ends here, as planned
-      if (status != Status::ok) return status;
+      if (status == Status::stopped) stop = true;
+      else if (status != Status::ok) return status;
     }
+  if (stop) switched_ = false;  // the run ends here, as planned
   return Status::stopped;
 }
 
