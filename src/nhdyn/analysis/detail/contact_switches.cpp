@@ -888,6 +888,85 @@ bool ContactSwitches::grazes(int contact, double t, const double* y) {
   return approach >= -slip_floor(data_) && acceleration > 0.0;
 }
 
+// The impulse of `contact`'s touchdown at (t, v), after compute_dynamics there in the modes before
+// (section 7, "Which impulse"): sticking if inside the cone, else sliding along the slip before it
+// (`slip_before`); another unilateral contact that would pull through the impact leaves the ground
+// at it (its own NAME_liftoff at the same time), and the impulse is solved again without it. False,
+// with the message in accumulation_, when no impact law of the model is consistent there.
+bool ContactSwitches::impact_impulse(int contact, double t, const double* v,
+                                     const std::array<double, 2>& slip_before, Impulse& impulse) {
+  const auto i = static_cast<std::size_t>(contact);
+  const ContactModeModel& cm = *model_.contact_modes;
+  const ContactModeContact& c = cm.contacts[i];
+  ContactModeData& w = data_.modes;
+  // Another unilateral contact that would pull through the impact leaves the ground at it
+  // (its own NAME_liftoff at the same time), and the impulse is solved again without it.
+  for (std::size_t released = 0;; ++released) {
+    // Coulomb at the impulse level (section 7, "Which impulse"): sticking if inside the cone.
+    // A frictionless contact (friction = 0) takes no tangential impulse: straight to the sliding one,
+    // which keeps its gap row alone (the sticking one would hold its no-slip rows too).
+    impulse = frictionless(i) ? Impulse{} : solve_impulse(contact, t, v, false, {0.0, 0.0});
+    if (!frictionless(i) && !impulse.ok) {
+      accumulation_ = impulse.failure;
+      return false;
+    }
+    if (frictionless(i) || (c.friction && norm2(impulse.tangential) > w.mu_s[i] * impulse.normal)) {
+      std::array<double, 2> direction{0.0, 0.0};
+      const double slip = norm2(slip_before);
+      if (slip > slip_floor(data_)) direction = {slip_before[0] / slip, slip_before[1] / slip};
+      else if (frictionless(i)) direction = {1.0, 0.0};
+      else {
+        const double size = norm2(impulse.tangential);
+        if (!(size > 0.0)) {
+          // Outside the cone only because the sticking impulse pulls (normal <= 0), with no
+          // tangential part and no slip: no direction to slide in, and no impact law holds.
+          accumulation_ = fmt::format(
+              "contact '{}' touches down at t = {:.9g} with a sticking impulse that pulls (normal impulse {:.6g} N s) "
+              "and no slip to slide along: no impact law of this model is consistent there "
+              "(docs/derivations/contact-modes.md section 7). The run ends here with its results so far",
+              c.name, t, impulse.normal);
+          return false;
+        }
+        direction = {-impulse.tangential[0] / size, -impulse.tangential[1] / size};
+      }
+      impulse = solve_impulse(contact, t, v, true, direction);
+      if (!impulse.ok) {
+        accumulation_ = impulse.failure;
+        return false;
+      }
+      if (!(impulse.normal > 0.0) && frictionless(i)) {
+        accumulation_ = fmt::format("contact '{}' touches down at t = {:.9g} with an impulse that would have to pull "
+                                    "(normal impulse {:.6g} N s): no impact law of this model is consistent there "
+                                    "(docs/derivations/contact-modes.md section 7). The run ends here with its "
+                                    "results so far",
+                                    c.name, t, impulse.normal);
+        return false;
+      }
+      if (!(impulse.normal > 0.0)) {
+        accumulation_ = fmt::format(
+            "contact '{}' touches down at t = {:.9g} sliding (the sticking impulse is outside the friction cone) in "
+            "Painleve's paradox: with mu_k = {:.6g} the impulse along n - mu_k e_s would have to pull (normal impulse "
+            "{:.6g} N s), w_eff <= 0 (docs/derivations/contact-modes.md 3.8); no impact law of this model is "
+            "consistent there. The run ends here with its results so far; lower the friction coefficient",
+            c.name, t, w.mu_k[i], impulse.normal);
+        return false;
+      }
+      w.direction[i] = direction;
+    }
+    if (impulse.pulling < 0) break;
+    if (released >= cm.contacts.size()) {
+      accumulation_ = fmt::format("contact '{}' touches down at t = {:.9g}, and releasing the contacts whose impulse "
+                                  "would pull leaves one that still pulls ('{}'): no impact law of this model is "
+                                  "consistent there; the run ends here with its results so far",
+                                  c.name, t, cm.contacts[static_cast<std::size_t>(impulse.pulling)].name);
+      return false;
+    }
+    w.mode[static_cast<std::size_t>(impulse.pulling)] = ContactMode::free;
+    settled_.push_back(cm.contacts[static_cast<std::size_t>(impulse.pulling)].name + "_liftoff");
+  }
+  return true;
+}
+
 std::string ContactSwitches::touchdown(int contact, double t) {
   const auto i = static_cast<std::size_t>(contact);
   const ContactModeModel& cm = *model_.contact_modes;
@@ -918,72 +997,8 @@ std::string ContactSwitches::touchdown(int contact, double t) {
   const double e = w.restitution[i];
   const double vn = w.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)];
   const std::array<double, 2> slip_before = w.slip[i];
-  // Another unilateral contact that would pull through the impact leaves the ground at it
-  // (its own NAME_liftoff at the same time), and the impulse is solved again without it.
   Impulse impulse;
-  for (std::size_t released = 0;; ++released) {
-    // Coulomb at the impulse level (section 7, "Which impulse"): sticking if inside the cone.
-    // A frictionless contact (friction = 0) takes no tangential impulse: straight to the sliding one,
-    // which keeps its gap row alone (the sticking one would hold its no-slip rows too).
-    impulse = frictionless(i) ? Impulse{} : solve_impulse(contact, t, v, false, {0.0, 0.0});
-    if (!frictionless(i) && !impulse.ok) {
-      accumulation_ = impulse.failure;
-      return "";
-    }
-    if (frictionless(i) || (c.friction && norm2(impulse.tangential) > w.mu_s[i] * impulse.normal)) {
-      std::array<double, 2> direction{0.0, 0.0};
-      const double slip = norm2(slip_before);
-      if (slip > slip_floor(data_)) direction = {slip_before[0] / slip, slip_before[1] / slip};
-      else if (frictionless(i)) direction = {1.0, 0.0};
-      else {
-        const double size = norm2(impulse.tangential);
-        if (!(size > 0.0)) {
-          // Outside the cone only because the sticking impulse pulls (normal <= 0), with no
-          // tangential part and no slip: no direction to slide in, and no impact law holds.
-          accumulation_ = fmt::format(
-              "contact '{}' touches down at t = {:.9g} with a sticking impulse that pulls (normal impulse {:.6g} N s) "
-              "and no slip to slide along: no impact law of this model is consistent there "
-              "(docs/derivations/contact-modes.md section 7). The run ends here with its results so far",
-              c.name, t, impulse.normal);
-          return "";
-        }
-        direction = {-impulse.tangential[0] / size, -impulse.tangential[1] / size};
-      }
-      impulse = solve_impulse(contact, t, v, true, direction);
-      if (!impulse.ok) {
-        accumulation_ = impulse.failure;
-        return "";
-      }
-      if (!(impulse.normal > 0.0) && frictionless(i)) {
-        accumulation_ = fmt::format("contact '{}' touches down at t = {:.9g} with an impulse that would have to pull "
-                                    "(normal impulse {:.6g} N s): no impact law of this model is consistent there "
-                                    "(docs/derivations/contact-modes.md section 7). The run ends here with its "
-                                    "results so far",
-                                    c.name, t, impulse.normal);
-        return "";
-      }
-      if (!(impulse.normal > 0.0)) {
-        accumulation_ = fmt::format(
-            "contact '{}' touches down at t = {:.9g} sliding (the sticking impulse is outside the friction cone) in "
-            "Painleve's paradox: with mu_k = {:.6g} the impulse along n - mu_k e_s would have to pull (normal impulse "
-            "{:.6g} N s), w_eff <= 0 (docs/derivations/contact-modes.md 3.8); no impact law of this model is "
-            "consistent there. The run ends here with its results so far; lower the friction coefficient",
-            c.name, t, w.mu_k[i], impulse.normal);
-        return "";
-      }
-      w.direction[i] = direction;
-    }
-    if (impulse.pulling < 0) break;
-    if (released >= cm.contacts.size()) {
-      accumulation_ = fmt::format("contact '{}' touches down at t = {:.9g}, and releasing the contacts whose impulse "
-                                  "would pull leaves one that still pulls ('{}'): no impact law of this model is "
-                                  "consistent there; the run ends here with its results so far",
-                                  c.name, t, cm.contacts[static_cast<std::size_t>(impulse.pulling)].name);
-      return "";
-    }
-    w.mode[static_cast<std::size_t>(impulse.pulling)] = ContactMode::free;
-    settled_.push_back(cm.contacts[static_cast<std::size_t>(impulse.pulling)].name + "_liftoff");
-  }
+  if (!impact_impulse(contact, t, v, slip_before, impulse)) return "";
   const Evaluator& ev = *model_.evaluator;
   const bool balance = ev.has_energy_balance() && size_ > 2 * n + 4;
   const double h_before = balance ? ev.energy_function(t, q, v, data_.scratch.data()) : 0.0;

@@ -95,6 +95,9 @@ class ContactSwitches final : public EventFunctions {
   std::string switch_contact(int contact, int slot, double t, const double* y);
   // The impact of a touchdown (section 7): the velocities of switch_y_ after it, and the mode.
   std::string touchdown(int contact, double t);
+  // Its impulse (touchdown's first half); false with the message in accumulation_.
+  bool impact_impulse(int contact, double t, const double* v, const std::array<double, 2>& slip_before,
+                      Impulse& impulse);
   // Whether a free contact's gap crossing 0 at (t, y) is no impact: it meets the ground with no
   // approach speed (the gap's rate within the integration error) while accelerating away from it.
   // Just after a lift-off the gap sits at the integration error, and an integrator whose first
