@@ -485,6 +485,71 @@ TEST(MoreContactsThanCoordinates, FixInitialLeavesTheRowsOfContactsThatStartFree
   EXPECT_NEAR(v_end, 5 * v0 / 7, 1e-9);  // section 10.1: the slip kept, the ball rolls at 5 v0 / 7
 }
 
+// A dumbbell (a rod along x with a ball of radius r at each end, I = 2/5 m r^2 about the rod)
+// pushed sideways at v on a floor with mu = 0.3, both ends given mode = "sliding": rolling both
+// would be six rows on its six coordinates, and the start was refused as wedged. The ends slide
+// from the start (their no-slip rows dropped) and the dumbbell behaves as a ball (k = 2/5): both
+// stick at 2 v / (7 mu g) at 5 v / 7. Rolling on both ends is then six rows of rank 5 (it could
+// roll about its rod): the run ends there naming both.
+TEST(MoreContactsThanCoordinates, ADumbbellStartedSlidingOnBothEndsSlidesUntilItSticks) {
+  const std::string text = R"toml(name = "dumbbell"
+coordinates = ["x", "y", "z", "a", "b", "c"]
+gravity = [0, 0, "-g"]
+
+[parameters]
+m = 1.0
+r = 0.1
+L = 0.5
+g = 9.81
+
+[[frames]]
+name = "bar"
+translation = ["x", "y", "z"]
+rotations = [["z", "c"], ["y", "b"], ["x", "a"]]
+
+[[bodies]]
+name = "bar"
+frame = "bar"
+mass = "m"
+inertia = ["2/5*m*r^2", "m*L^2", "m*L^2"]
+
+[[contacts]]
+name = "left"
+body = "bar"
+shape = { sphere = "r" }
+centre = ["-L", 0, 0]
+ground = "plane"
+unilateral = true
+friction = 0.3
+mode = "sliding"
+
+[[contacts]]
+name = "right"
+body = "bar"
+shape = { sphere = "r" }
+centre = ["L", 0, 0]
+ground = "plane"
+unilateral = true
+friction = 0.3
+mode = "sliding"
+
+[initial]
+position = { x = 0, y = 0, z = "r", a = 0, b = 0, c = 0 }
+velocity = { x = 0, y = 1, z = 0, a = 0, b = 0, c = 0 }
+)toml";
+  const Model model = load_model_text(text, "dumbbell.toml");
+  ASSERT_EQ(model.s(), 6);
+  double last_vy = 0.0;
+  const SimulationSummary summary = simulate(model, run_options(1.0, 0.01), [&](const Data& data) { last_vy = data.v(1); });
+  const double t_stick = 2 * 1.0 / (7 * 0.3 * 9.81);
+  ASSERT_NE(summary.status, Status::ok);
+  EXPECT_NEAR(summary.t_reached, t_stick, 1e-8) << summary.message;
+  EXPECT_NE(summary.message.find("the contacts 'left', 'right' held together keep 6 constraint rows on 6 coordinates"),
+            std::string::npos)
+      << summary.message;
+  EXPECT_NEAR(last_vy, 5.0 / 7.0, 1e-8);
+}
+
 // A linearization holds every constraint at once: for s >= n it says why it cannot, by name.
 TEST(MoreContactsThanCoordinates, ALinearizationIsRefusedWithTheReason) {
   const Model model = load_model(example("ball_off_sphere_onto_floor.toml"));
