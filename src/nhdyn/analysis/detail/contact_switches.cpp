@@ -28,7 +28,9 @@ constexpr int kMaxSameTime = 8;         // successive switches without progress 
 
 // The slip below which a contact is taken not to slip (the integration error of its velocity
 // constraint, not a motion): as in formulation/contact_modes.cpp.
-double slip_floor(const Data& data) { return 1e-10 * (1.0 + data.v.lpNorm<Eigen::Infinity>()); }
+// Of the velocities v; slip_floor(data) of those Data holds.
+double slip_floor(const Eigen::Ref<const Vector>& v) { return 1e-10 * (1.0 + v.lpNorm<Eigen::Infinity>()); }
+double slip_floor(const Data& data) { return slip_floor(data.v); }
 
 double norm2(const std::array<double, 2>& x) { return std::hypot(x[0], x[1]); }
 
@@ -576,6 +578,10 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
   }
   std::copy(y, y + size_, switch_y_.begin());  // a touchdown changes its velocities
   settled_.clear();
+  // Only an impulse makes another free gap's rate jump: after a touchdown (a free contact's gap
+  // reaching 0), not after a lift-off or a slip, where a free gap at the drift's level is no
+  // contact closing.
+  const bool impact = slot == 0 && data_.modes.mode[static_cast<std::size_t>(contact)] == ContactMode::free;
   // The run's own events before the switch, to find those its jump carries across zero.
   const bool user_before = user_ && user_->evaluate(t, y, user_before_.data()) == Status::ok;
   const std::string event = switch_contact(contact, slot, t, y);
@@ -594,9 +600,6 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
   std::vector<std::string> events{event};
   events.insert(events.end(), settled_.begin(), settled_.end());
   settled_.clear();
-  // Only an impulse makes another free gap's rate jump: after a touchdown, not after a lift-off or
-  // a slip (where a free gap at the drift's level is no contact closing).
-  const bool impact = event.size() > 10 && event.compare(event.size() - 10, 10, "_touchdown") == 0;
   for (std::size_t k = 0; impact && k < data_.modes.mode.size(); ++k) {
     const int next = closing_contact(t);
     if (next < 0) break;
@@ -649,9 +652,7 @@ int ContactSwitches::closing_contact(double t) {
   double scale = 1.0;
   for (int j = 0; j < n; ++j) scale = std::max(scale, std::abs(q[j]));
   const double touching = 64 * std::numeric_limits<double>::epsilon() * scale;
-  double largest_rate = 0.0;
-  for (int j = 0; j < n; ++j) largest_rate = std::max(largest_rate, std::abs(v[j]));
-  const double closing = 1e-10 * (1.0 + largest_rate);  // slip_floor's scale, at this state
+  const double closing = slip_floor(Eigen::Map<const Vector>(v, n));  // at this state, not Data's
   for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
     const ContactModeContact& c = cm.contacts[i];
     if (w.mode[i] != ContactMode::free) continue;
