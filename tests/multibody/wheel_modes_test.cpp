@@ -5,7 +5,9 @@
 // and on a tilted plane given by the wheel's `normal`. A wheel without them keeps its own rows
 // (NAME_slip1, NAME_slip2), and its accelerations and reactions agree with the disk contact's to
 // round-off (the two differ only in how the rim's |a x n| is written). Bad values are refused
-// naming file:line; a knife edge refuses the keys, naming the key's place and why.
+// naming file:line; a knife edge refuses the keys, naming the key's place and why. The Whipple
+// bicycle written with disk contacts is the bicycle of wheels, and friction on a wheel that its
+// coordinates hold on the ground is refused saying that it needs its height.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -267,6 +269,66 @@ TEST(WheelModes, AKnifeEdgeRefusesTheKeysSayingWhy) {
                                     key + "' is not a key of a knife edge"))
         << message;
     for (const char* part : {"no normal force", "mu N", "docs/contact-modes.md", "Remove the key", "[[wheels]]"})
+      EXPECT_TRUE(test::contains(message, part)) << message << "\n  lacks: " << part;
+  }
+}
+
+// The Whipple bicycle of examples/whipple_bicycle.toml, its two [[wheels]] entries written as the
+// [[contacts]] disks they are, `rear_keys` added to the rear one. Its coordinates hold the rear
+// wheel on the ground (the rear frame's height is no coordinate), so that disk's gap, rR cos(phi) -
+// rR sqrt(cos(phi)^2), is zero in every position without simplifying to 0.
+std::string bicycle_text() { return test::read_text(test::example("whipple_bicycle.toml")); }
+
+std::string bicycle_of_disks(const std::string& rear_keys) {
+  std::string text = bicycle_text();
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+  };
+  replace("[[wheels]]\nname = \"rear\"\nbody = \"rear_wheel\"\naxis = \"y\"\nradius = \"rR\"\n",
+          "[[contacts]]\nname = \"rear\"\nbody = \"rear_wheel\"\nshape = { disk = \"rR\", axis = \"y\" }\n" + rear_keys);
+  replace("[[wheels]]\nname = \"front\"\nbody = \"front_wheel\"\naxis = \"y\"\nradius = \"rF\"\n",
+          "[[contacts]]\nname = \"front\"\nbody = \"front_wheel\"\nshape = { disk = \"rF\", axis = \"y\" }\n");
+  return text;
+}
+
+// A gap that vanishes in every position adds no row, as a wheel's contact does not: the bicycle of
+// disk contacts has the rows of the bicycle of wheels (it was refused, its rear_contact a zero row
+// of b), and the same q'' and R at random states.
+TEST(WheelModes, TheBicycleOfDiskContactsIsTheBicycleOfWheels) {
+  const Model wheels = load_model_text(bicycle_text(), "wheels.toml");
+  const Model disks = load_model_text(bicycle_of_disks(""), "disks.toml");
+  EXPECT_EQ(constraint_names(wheels),
+            (std::vector<std::string>{"rear_slip1", "rear_slip2", "front_contact", "front_slip1", "front_slip2"}));
+  EXPECT_EQ(constraint_names(disks),
+            (std::vector<std::string>{"rear_roll1", "rear_roll2", "front_contact", "front_roll1", "front_roll2"}));
+  std::mt19937 rng(17);
+  for (int trial = 0; trial < 10; ++trial) {
+    // x, y, psi, phi, theta, delta, thetaR, thetaF: leaning, steered and pitched within a bicycle's range.
+    const std::vector<double> q = {uniform(rng, -2, 2),     uniform(rng, -2, 2),     uniform(rng, -3, 3),
+                                   uniform(rng, -0.6, 0.6), uniform(rng, -0.2, 0.2), uniform(rng, -0.8, 0.8),
+                                   uniform(rng, -3, 3),     uniform(rng, -3, 3)};
+    std::vector<double> v(8);
+    for (double& x : v) x = uniform(rng, -3, 3);
+    EXPECT_LT(relative_difference(solution_at(disks, q, v), solution_at(wheels, q, v)), 1e-12) << "trial " << trial;
+  }
+}
+
+// Friction needs the gap's row (the normal force is its multiplier): where the coordinates hold the
+// wheel on the ground, the run is refused at the entry, saying which coordinate to add.
+TEST(WheelModes, FrictionOnAWheelTheCoordinatesHoldOnTheGroundIsRefusedSayingWhatToAdd) {
+  for (const bool as_wheel : {true, false}) {
+    std::string text = as_wheel ? bicycle_text() : bicycle_of_disks("friction = 0.8\n");
+    if (as_wheel) text.insert(text.find("radius = \"rR\"\n") + 14, "friction = 0.8\n");
+    const std::string entry = as_wheel ? "[[wheels]]" : "[[contacts]]";
+    const std::size_t at = text.find(entry);
+    ASSERT_NE(at, std::string::npos);
+    const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
+    const std::string message = error_of(text);
+    EXPECT_TRUE(message.starts_with("wheel.toml:" + std::to_string(line) + ":1: contact 'rear'")) << message;
+    for (const std::string part : {"friction and unilateral need the contact's gap as a constraint",
+                                   "its gap is zero for every position", "its height"})
       EXPECT_TRUE(test::contains(message, part)) << message << "\n  lacks: " << part;
   }
 }

@@ -367,7 +367,9 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
 
   // The contact condition: the gap, zero when touching (rolling-bodies.md section 4.1).
   const GiNaC::ex gap = smaller_form(touch.gap);
-  if (!gap.is_zero()) {
+  // A gap that holds in every position (the coordinates eliminate the height, as a bicycle's
+  // do) adds no row: it would be a zero row of b.
+  if (!contact_vanishes_identically(gap, spec)) {
     if (!contact_has_coordinates(gap, spec))
       throw_model_error(c.where, context,
                         fmt::format("the body can never touch the ground: the gap between them is the constant {}; "

@@ -54,6 +54,26 @@ bool contact_has_coordinates(const GiNaC::ex& e, const Spec& spec) {
   return false;
 }
 
+bool contact_vanishes_identically(const GiNaC::ex& e, const Spec& spec) {
+  if (e.is_zero()) return true;
+  if (!contact_has_coordinates(e, spec)) return false;  // a constant: its message is the caller's
+  for (int sample = 0; sample < 3; ++sample) {
+    GiNaC::lst values = spec.parameter_values();
+    values.append(spec.symbols.time() == 0.1 * (sample + 1));
+    for (int i = 0; i < spec.n(); ++i)
+      values.append(spec.symbols.coordinate(i) == std::sin(1.7 * (i + 1) + 2.3 * sample));
+    try {
+      const GiNaC::ex v = e.subs(values).evalf();
+      if (!GiNaC::is_a<GiNaC::numeric>(v) || !GiNaC::ex_to<GiNaC::numeric>(v).is_real() ||
+          std::abs(GiNaC::ex_to<GiNaC::numeric>(v).to_double()) > 1e-12)
+        return false;
+    } catch (const std::exception&) {
+      return false;
+    }
+  }
+  return true;
+}
+
 // A kink or a step (abs, csgn, step) anywhere in e: a ground or shape written with one has no
 // normal there.
 bool contact_not_smooth(const GiNaC::ex& e) {
