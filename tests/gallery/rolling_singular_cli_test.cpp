@@ -1,7 +1,9 @@
 // A closed-form contact point that turns singular along the run (docs/multibody.md, "Rolling
 // bodies"): a thin disk released leaning far falls flat, where its contact point (the lowest point
 // of the rim) is not defined. The run stops there with exit code 1 and a message naming the
-// contact, the time and the reason; the rows before are in the partial file, with no NaN.
+// contact, the time and the reason; the rows before are in the partial file, with no NaN. The same
+// disk as a [[wheels]] entry, whose rim is written with |axle x normal| = cos(theta) (no root that
+// could fail), stops where that falls through 1e-2: before, it rolled on through the plane, exit 0.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -70,6 +72,42 @@ TEST(RollingSingularCli, DiskFallingFlatStopsNamingTheContact) {
     for (const double value : row) EXPECT_TRUE(std::isfinite(value));
   // Falling: the lean grows toward pi/2 (flat) and the last row is close to it.
   EXPECT_GT(partial.rows.back()[static_cast<std::size_t>(theta)], 1.5);
+}
+
+// The same disk as a [[wheels]] entry.
+std::string falling_wheel() {
+  std::string text = kFallingDisk;
+  const std::string contact = "[[contacts]]\nname = \"wheel\"\nbody = \"disk\"\nshape = { disk = \"r\", axis = \"y\" }\n";
+  const std::size_t at = text.find(contact);
+  EXPECT_NE(at, std::string::npos);
+  if (at != std::string::npos)
+    text.replace(at, contact.size(), "[[wheels]]\nname = \"wheel\"\nbody = \"disk\"\naxis = \"y\"\nradius = \"r\"\n");
+  return text;
+}
+
+TEST(RollingSingularCli, WheelFallingFlatStopsWhereItsAxleMeetsTheNormal) {
+  const fs::path dir = fs::temp_directory_path() / "nhdyn_rolling_flat_wheel";
+  fs::create_directories(dir);
+  fs::remove(dir / "o.csv");
+  fs::remove(dir / "o.partial.csv");
+  std::ofstream(dir / "flat.toml") << falling_wheel();
+  const nhdyn::test::CliOutcome outcome = nhdyn::test::run_nhdyn("simulate flat.toml -o o.csv", dir);
+  EXPECT_EQ(outcome.exit_code, 1) << outcome.out;
+  EXPECT_NE(outcome.out.find("flat.toml:22:1: contact 'wheel': the wheel lies flat"), std::string::npos) << outcome.out;
+  EXPECT_NE(outcome.out.find("(|axle x normal| = 0.01) at t = 0.139"), std::string::npos) << outcome.out;
+  // Located where cos(theta) = 0.01: theta = acos(0.01) = 1.5608 as printed (6 digits).
+  EXPECT_NE(outcome.out.find("theta = 1.5608,"), std::string::npos) << outcome.out;
+  EXPECT_FALSE(fs::exists(dir / "o.csv"));
+  const nhdyn::CsvTable partial = nhdyn::load_csv(dir / "o.partial.csv");
+  ASSERT_GE(partial.rows.size(), 10u);
+  const int theta = partial.column("theta");
+  const int z = partial.column("z");
+  for (const auto& row : partial.rows) {
+    for (const double value : row) EXPECT_TRUE(std::isfinite(value));
+    // Never through the plane: the centre stays at r cos(theta) >= 0, theta below pi/2.
+    EXPECT_LT(row[static_cast<std::size_t>(theta)], std::acos(0.01) + 1e-9);
+    EXPECT_GT(row[static_cast<std::size_t>(z)], 0.0);
+  }
 }
 
 }  // namespace

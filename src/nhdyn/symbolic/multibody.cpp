@@ -605,11 +605,26 @@ void MultibodyBuilder::add_wheel(const Helper& h) {
   if (symbolic::is_zero(squared))
     throw_model_error(h.where, context, "the axle is always normal to the plane (the wheel lies flat): it cannot roll");
   GiNaC::ex length = GiNaC::sqrt(squared);
+  bool signed_length = false;
   if (GiNaC::is_a<GiNaC::power>(squared) && squared.op(1) == 2) {
     const std::optional<double> u = value_of(squared.op(0), spec, true);
-    if (u && *u != 0.0) length = *u > 0 ? squared.op(0) : -squared.op(0);
+    if (u && *u != 0.0) {
+      length = *u > 0 ? squared.op(0) : -squared.op(0);
+      signed_length = true;
+    }
   }
   const Vector3 CP = scale(h.radius / length, subtract(scale(an, a), n));  // P - C
+  // Where the wheel lies flat (a.n = +-1) every point of its rim is lowest: the run stops there, as
+  // a disk contact's does (rolling-bodies.md section 2), at every step. Written as +-u, |a x n|
+  // makes nothing fail there and the wheel would roll on through the plane; u itself changes sign
+  // there, so its fall through 1e-2 (the axle within 0.6 degree of the normal) is located even by
+  // a step that passes the flat position (1 - (a.n)^2 = u^2 only touches 0).
+  const std::string flat = "the wheel lies flat: its axle is along the plane's normal, where every point of its rim "
+                           "is lowest and the contact point is not defined";
+  if (signed_length)
+    builder_.contact_watch(SpecContactWatch{h.name, h.where, length, 1e-2, flat, "|axle x normal|", true});
+  else
+    builder_.contact_watch(SpecContactWatch{h.name, h.where, 1 - an * an, 1e-4, flat, "1 - (axle . normal)^2", true});
   const Vector3 P = add(C, CP);
 
   const GiNaC::ex contact = simplify_moderate(dot(n, P));
