@@ -1,9 +1,10 @@
 // A closed-form contact point that turns singular along the run (docs/multibody.md, "Rolling
 // bodies"): a thin disk released leaning far falls flat, where its contact point (the lowest point
 // of the rim) is not defined. The run stops there with exit code 1 and a message naming the
-// contact, the time and the reason; the rows before are in the partial file, with no NaN. The same
-// disk as a [[wheels]] entry, whose rim is written with |axle x normal| = cos(theta) (no root that
-// could fail), stops where that falls through 1e-2: before, it rolled on through the plane, exit 0.
+// contact, the time and the reason; the rows before are in the partial file, with no NaN. Its rim
+// is written with |axle x normal| = cos(theta), no root that could fail, so the run stops where that
+// falls through 0.01, located at every step; the same disk as a [[wheels]] entry likewise (before,
+// the wheel rolled on through the plane, exit 0).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -52,26 +53,38 @@ t_end = 1
 output_step = 0.01
 )toml";
 
-TEST(RollingSingularCli, DiskFallingFlatStopsNamingTheContact) {
-  const fs::path dir = fs::temp_directory_path() / "nhdyn_rolling_flat";
+// The run of `text` as flat.toml stops where the disk's |axle x normal| = cos(theta) falls through
+// 0.01 (located: theta = acos(0.01) = 1.5608 as printed), naming the entry and the reason, with the
+// rows before in the partial file: finite, theta below the stop, the centre above the plane.
+void expect_stops_flat(const std::string& text, const std::string& folder, const std::string& reason) {
+  const fs::path dir = fs::temp_directory_path() / folder;
   fs::create_directories(dir);
   fs::remove(dir / "o.csv");
   fs::remove(dir / "o.partial.csv");
-  std::ofstream(dir / "flat.toml") << kFallingDisk;
+  std::ofstream(dir / "flat.toml") << text;
   const nhdyn::test::CliOutcome outcome = nhdyn::test::run_nhdyn("simulate flat.toml -o o.csv", dir);
   EXPECT_EQ(outcome.exit_code, 1) << outcome.out;
-  EXPECT_NE(outcome.out.find("flat.toml:22:1: contact 'wheel': the disk lies flat"), std::string::npos) << outcome.out;
-  EXPECT_NE(outcome.out.find("its axle is along the ground's normal"), std::string::npos) << outcome.out;
-  EXPECT_NE(outcome.out.find("at t = 0.14"), std::string::npos) << outcome.out;
+  EXPECT_NE(outcome.out.find("flat.toml:22:1: contact 'wheel': " + reason), std::string::npos) << outcome.out;
+  EXPECT_NE(outcome.out.find("(|axle x normal| = 0.01) at t = 0.139"), std::string::npos) << outcome.out;
+  EXPECT_NE(outcome.out.find("theta = 1.5608,"), std::string::npos) << outcome.out;
   EXPECT_EQ(outcome.out.find("not a complement"), std::string::npos) << outcome.out;  // not the equations' symptom
   EXPECT_FALSE(fs::exists(dir / "o.csv"));
   const nhdyn::CsvTable partial = nhdyn::load_csv(dir / "o.partial.csv");
   ASSERT_GE(partial.rows.size(), 10u);
   const int theta = partial.column("theta");
-  for (const auto& row : partial.rows)
+  const int z = partial.column("z");
+  for (const auto& row : partial.rows) {
     for (const double value : row) EXPECT_TRUE(std::isfinite(value));
+    EXPECT_LT(row[static_cast<std::size_t>(theta)], std::acos(0.01) + 1e-9);
+    EXPECT_GT(row[static_cast<std::size_t>(z)], 0.0);
+  }
   // Falling: the lean grows toward pi/2 (flat) and the last row is close to it.
   EXPECT_GT(partial.rows.back()[static_cast<std::size_t>(theta)], 1.5);
+}
+
+TEST(RollingSingularCli, DiskFallingFlatStopsNamingTheContact) {
+  expect_stops_flat(kFallingDisk, "nhdyn_rolling_flat",
+                    "the disk lies flat: its axle is along the ground's normal, where every point of its rim is lowest");
 }
 
 // The same disk as a [[wheels]] entry.
@@ -86,28 +99,8 @@ std::string falling_wheel() {
 }
 
 TEST(RollingSingularCli, WheelFallingFlatStopsWhereItsAxleMeetsTheNormal) {
-  const fs::path dir = fs::temp_directory_path() / "nhdyn_rolling_flat_wheel";
-  fs::create_directories(dir);
-  fs::remove(dir / "o.csv");
-  fs::remove(dir / "o.partial.csv");
-  std::ofstream(dir / "flat.toml") << falling_wheel();
-  const nhdyn::test::CliOutcome outcome = nhdyn::test::run_nhdyn("simulate flat.toml -o o.csv", dir);
-  EXPECT_EQ(outcome.exit_code, 1) << outcome.out;
-  EXPECT_NE(outcome.out.find("flat.toml:22:1: contact 'wheel': the wheel lies flat"), std::string::npos) << outcome.out;
-  EXPECT_NE(outcome.out.find("(|axle x normal| = 0.01) at t = 0.139"), std::string::npos) << outcome.out;
-  // Located where cos(theta) = 0.01: theta = acos(0.01) = 1.5608 as printed (6 digits).
-  EXPECT_NE(outcome.out.find("theta = 1.5608,"), std::string::npos) << outcome.out;
-  EXPECT_FALSE(fs::exists(dir / "o.csv"));
-  const nhdyn::CsvTable partial = nhdyn::load_csv(dir / "o.partial.csv");
-  ASSERT_GE(partial.rows.size(), 10u);
-  const int theta = partial.column("theta");
-  const int z = partial.column("z");
-  for (const auto& row : partial.rows) {
-    for (const double value : row) EXPECT_TRUE(std::isfinite(value));
-    // Never through the plane: the centre stays at r cos(theta) >= 0, theta below pi/2.
-    EXPECT_LT(row[static_cast<std::size_t>(theta)], std::acos(0.01) + 1e-9);
-    EXPECT_GT(row[static_cast<std::size_t>(z)], 0.0);
-  }
+  expect_stops_flat(falling_wheel(), "nhdyn_rolling_flat_wheel",
+                    "the wheel lies flat: its axle is along the plane's normal, where every point of its rim is lowest");
 }
 
 }  // namespace

@@ -156,6 +156,8 @@ ParsedContact parse_contact(const ContactText& text, const ContactParsers& parse
                                   "spin about the normal)",
                                   text.rolling));
   out.rubber = text.rolling == "rubber";
+  out.unilateral = std::find(text.modes.begin(), text.modes.end(), KeyTexts::value_type{"unilateral", "true"}) !=
+                   text.modes.end();
   ground->check(out, *p.spec, context);
   return out;
 }
@@ -442,9 +444,15 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
                                            "(2 - (r + gap)(k1 + k2)) / 2", true, false, true});
   }
   // 1 - (e . nu)^2 below 1e-4: the axle within 0.6 degree of the normal (rolling-bodies.md section 2).
+  // Where |e x nu| is written +-u (touch.signed_roots), u's fall through 1e-2, at every step: the
+  // equations do not fail there (u changes sign, 1 - (e . nu)^2 = u^2 only touches 0).
   if (const std::optional<ContactShape::Singularity> singular =
-          c.shape->singularity(c.values, multiply_transposed(F.rotation, touch.normal)))
-    out.watches.push_back(SpecContactWatch{c.name, c.where, singular->measure, 1e-4, singular->reason});
+          c.shape->singularity(c.values, multiply_transposed(F.rotation, touch.normal))) {
+    if (touch.signed_roots.empty())
+      out.watches.push_back(SpecContactWatch{c.name, c.where, singular->measure, 1e-4, singular->reason});
+    for (const GiNaC::ex& u : touch.signed_roots)
+      out.watches.push_back(SpecContactWatch{c.name, c.where, u, 1e-2, singular->reason, "|axle x normal|", true});
+  }
   if (touch.singular)
     out.watches.push_back(
         SpecContactWatch{c.name, c.where, touch.singular->first, 1e-4, touch.singular->second, "1 - (e . n)^2", true});

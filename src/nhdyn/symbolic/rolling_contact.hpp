@@ -88,6 +88,9 @@ struct ParsedContact {
   Vector3 centre = {0, 0, 0};  // the shape's centre in the body frame's axes
   ParsedGround ground;
   bool rubber = false;
+  // unilateral = true: the body may leave the ground and tumble in the air, where a disk's |e x nu|
+  // takes both signs (its contact point keeps the root; grounds/plane.cpp).
+  bool unilateral = false;
   SourceLocation where;
 };
 
@@ -166,6 +169,10 @@ class ContactGround {
     // Where the tangents vanish along the motion: a measure positive where they are defined and
     // the reason for the message that ends a run where it falls below 1e-4 (none when they never do).
     std::optional<std::pair<GiNaC::ex, std::string>> singular;
+    // Roots of perfect squares that the contact point writes as +-u (contact_roots_of_squares):
+    // each is positive where the shape's contact point is defined and changes sign where it is
+    // singular (a disk's |e x nu| where it lies flat), so the run watches it at every step.
+    std::vector<GiNaC::ex> signed_roots;
   };
   virtual Touch touch(const ParsedContact& contact, const PlacedFrame& frame, const Spec& spec,
                       const std::optional<Vector3>& gravity, const std::string& context) const = 0;

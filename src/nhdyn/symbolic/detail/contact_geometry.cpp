@@ -74,6 +74,29 @@ bool contact_vanishes_identically(const GiNaC::ex& e, const Spec& spec) {
   return true;
 }
 
+GiNaC::ex contact_roots_of_squares(const GiNaC::ex& e, const Spec& spec, std::vector<GiNaC::ex>& roots) {
+  struct Roots : GiNaC::map_function {
+    const Spec& spec;
+    std::vector<GiNaC::ex>& roots;
+    Roots(const Spec& s, std::vector<GiNaC::ex>& r) : spec(s), roots(r) {}
+    GiNaC::ex operator()(const GiNaC::ex& x) override {
+      const GiNaC::ex mapped = x.map(*this);
+      if (!GiNaC::is_a<GiNaC::power>(mapped) || !GiNaC::is_a<GiNaC::numeric>(mapped.op(1))) return mapped;
+      const GiNaC::numeric k = GiNaC::ex_to<GiNaC::numeric>(mapped.op(1));
+      if (!k.is_rational() || k.is_integer() || k.denom() != 2) return mapped;
+      const GiNaC::ex squared = simplify(mapped.op(0));
+      if (!GiNaC::is_a<GiNaC::power>(squared) || !squared.op(1).is_equal(2)) return mapped;
+      const std::optional<double> u = contact_number_of(squared.op(0), spec, true);
+      if (!u || *u == 0.0) return mapped;
+      const GiNaC::ex root = *u > 0 ? squared.op(0) : -squared.op(0);
+      if (std::none_of(roots.begin(), roots.end(), [&](const GiNaC::ex& r) { return r.is_equal(root); }))
+        roots.push_back(root);
+      return GiNaC::pow(root, k * 2);
+    }
+  } map(spec, roots);
+  return map(e);
+}
+
 // A kink or a step (abs, csgn, step) anywhere in e: a ground or shape written with one has no
 // normal there.
 bool contact_not_smooth(const GiNaC::ex& e) {

@@ -31,6 +31,15 @@ bool contact_has_coordinates(const GiNaC::ex& e, const Spec& spec);
 // is such a zero that simplify() leaves as it is.
 bool contact_vanishes_identically(const GiNaC::ex& e, const Spec& spec);
 
+// e with every root of a perfect square, sqrt(u^2) (and its odd powers), written as +-u with the
+// sign u has at the reference configuration (coordinates and t at 0, the parameters at their
+// values); each such +-u is added to `roots` (once). |u| = +-u while u keeps its sign, and where
+// it is 0 the shape's closed-form contact point is singular anyway (a disk lying flat), which the
+// run watches through `roots` (rolling_contact.cpp). Roots of other arguments, and of a u that is
+// 0 or not a number there, stay. A disk on a plane in angles, |e x nu| = sqrt(1 - sin(theta)^2)
+// = cos(theta), keeps no root in what is differentiated twice: the form a [[wheels]] entry has.
+GiNaC::ex contact_roots_of_squares(const GiNaC::ex& e, const Spec& spec, std::vector<GiNaC::ex>& roots);
+
 // A kink or a step (abs, csgn, step) anywhere in e: a ground or shape written with one has no
 // normal there.
 bool contact_not_smooth(const GiNaC::ex& e);

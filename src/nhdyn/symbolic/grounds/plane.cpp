@@ -43,7 +43,15 @@ class PlaneGround final : public ContactGround {
     // differentiated twice stay polynomial inside the root (rolling-bodies.md section 2.1).
     const Vector3 nu = multiply_transposed(F.rotation_numerator, n);
     const Vector3 nu_s = {simplify_moderate(nu[0]), simplify_moderate(nu[1]), simplify_moderate(nu[2])};
-    const ShapeSupport s = c.shape->support(c.values, nu_s, F.rotation_denominator);
+    ShapeSupport s = c.shape->support(c.values, nu_s, F.rotation_denominator);
+    // A disk's |e x nu| in angles is often a perfect square's root, sqrt(cos(theta)^2): written
+    // cos(theta), as a [[wheels]] entry writes it (docs/derivations/rolling-wheel.md), for a body
+    // that stays on the plane. One that may lift off keeps the root: in the air it may turn over,
+    // and its gap is z - r |cos(theta)| whatever its lean.
+    if (!c.unilateral) {
+      for (GiNaC::ex& x : s.point) x = contact_roots_of_squares(x, spec, out.signed_roots);
+      s.reach = contact_roots_of_squares(s.reach, spec, out.signed_roots);
+    }
     out.point = add(C, multiply(F.rotation, s.point));
     out.normal = n;
     out.gap = dot(n, C) - s.reach;
