@@ -107,19 +107,19 @@ TEST(MultibodyBadInput, MassNotPositive) {
 
 TEST(MultibodyBadInput, WheelWithoutContactPlane) {
   // No gravity and no normal.
-  expect_error(replaced("gravity = [0, 0, \"-g\"]\n", ""), {"disk.toml:", "wheel 'disk'", "no contact plane", "normal"});
+  expect_error(replaced("gravity = [0, 0, \"-g\"]\n", ""), {"disk.toml:31:1:", "wheel 'disk'", "no ground plane", "normal = [0, 0, 1]"});
   // A zero normal.
   expect_error(replaced("radius = \"r\"", "radius = \"r\"\nnormal = [0, 0, 0]"),
-               {"disk.toml:32:", "wheel 'disk'", "zero vector"});
+               {"disk.toml:37:10:", "wheel 'disk'", "zero vector"});  // at the key
   // Zero gravity and no normal.
   expect_error(replaced("gravity = [0, 0, \"-g\"]", "gravity = [0, 0, 0]"),
-               {"disk.toml:32:", "wheel 'disk'", "gravity vector is zero"});
+               {"disk.toml:32:", "wheel 'disk'", "gravity vector is zero", "normal = [0, 0, 1]"});
 }
 
 TEST(MultibodyBadInput, RotationAboutAnUnknownAxis) {
   expect_error(replaced("rotations = [[\"x\", \"theta\"]]", "rotations = [[\"w\", \"theta\"]]"),
                {"disk.toml:18:", "frame 'lean'", "rotation 1", "unknown axis 'w'", "\"x\", \"y\" or \"z\""});
-  expect_error(replaced("axis = \"y\"", "axis = \"q\""), {"disk.toml:32:", "wheel 'disk'", "unknown axle axis 'q'"});
+  expect_error(replaced("axis = \"y\"", "axis = \"q\""), {"disk.toml:32:", "wheel 'disk'", "unknown axis 'q'", "the axle is the \"x\", \"y\" or \"z\" axis"});
 }
 
 TEST(MultibodyBadInput, UnknownNamesSuggestTheNearest) {
@@ -171,7 +171,7 @@ TEST(MultibodyBadInput, VelocitiesInPlacementsAndCoordinatesInConstants) {
 TEST(MultibodyBadInput, AWheelThatCannotTouchThePlane) {
   // The heading frame floats 1 m above the ground: n.P = 1 whatever the coordinates.
   expect_error(replaced("translation = [\"x\", \"y\", 0]", "translation = [\"x\", \"y\", 1]"),
-               {"disk.toml:32:", "wheel 'disk'", "never touch the plane"});
+               {"disk.toml:32:", "wheel 'disk'", "can never touch the ground", "the constant 1"});
 }
 
 }  // namespace

@@ -117,13 +117,15 @@ TEST(BuilderScene, TheFilesSceneKeepsTheOrderOfItsSections) {
   const symbolic::Spec file = load_model_string(kDisk, "disk.toml");
   std::vector<symbolic::VisualKind> kinds;
   for (const symbolic::VisualItem& item : file.visual.items) kinds.push_back(item.kind);
+  // The wheel is the disk contact it is: its plane and its contact point's track, then the wheel.
   EXPECT_EQ(kinds, (std::vector<symbolic::VisualKind>{symbolic::VisualKind::frame, symbolic::VisualKind::body,
+                                                      symbolic::VisualKind::plane, symbolic::VisualKind::track,
                                                       symbolic::VisualKind::wheel}));
 }
 
 // A wheel's or a knife edge's own plane (`normal`) is drawn as the plane it is: a plane item whose
 // axes (t1, t2, n, as the columns of `other`) are orthonormal with n the given normal, normalized;
-// without a normal, no plane item (the report's z = 0 grid).
+// a wheel without a normal draws the level plane (which the report shows as its z = 0 grid).
 TEST(BuilderScene, AWheelsAndAKnifeEdgesPlaneIsDrawnInItsAxes) {
   const auto plane_axes = [](const std::string& text) {
     const symbolic::Spec spec = load_model_string(text, "plane.toml");
@@ -147,7 +149,8 @@ TEST(BuilderScene, AWheelsAndAKnifeEdgesPlaneIsDrawnInItsAxes) {
   std::string sled = test::kFlatSledBodies;
   sled.insert(sled.find("axis = \"x\"\n") + 11, "normal = [0, 1, 1]\n");
   check(plane_axes(sled), {0.0, std::sqrt(0.5), std::sqrt(0.5)}, "knife edge");
-  EXPECT_TRUE(plane_axes(kDisk).empty()) << "a wheel on the default plane draws none";
+  // On the default plane: the level plane opposite to gravity (the report draws it as its grid of z = 0).
+  check(plane_axes(kDisk), {0.0, 0.0, 1.0}, "wheel on the default plane");
 }
 
 // A wheel with a mode key is the disk contact it is, and still drawn as a wheel (by the builder,

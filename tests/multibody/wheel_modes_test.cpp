@@ -180,7 +180,7 @@ TEST(WheelModes, TheTiltedWheelLoadsEveryTime) {
   }
 }
 
-// Drawn as a wheel, as without the keys, with the contact point's track a contact has.
+// Drawn as a wheel with the contact point's track a contact has, with the keys or without.
 TEST(WheelModes, AWheelWithTheKeysIsDrawnAsAWheelWithItsTrack) {
   const auto kinds = [](const std::string& text) {
     std::vector<std::string> out;
@@ -191,7 +191,7 @@ TEST(WheelModes, AWheelWithTheKeysIsDrawnAsAWheelWithItsTrack) {
     std::sort(out.begin(), out.end());  // the scene's order does not matter
     return out;
   };
-  EXPECT_EQ(kinds(disk_with(kWheel)), (std::vector<std::string>{"wheel disk"}));
+  EXPECT_EQ(kinds(disk_with(kWheel)), (std::vector<std::string>{"track disk", "wheel disk"}));
   EXPECT_EQ(kinds(disk_with(kWheel + kModes)), (std::vector<std::string>{"track disk", "wheel disk"}));
 }
 

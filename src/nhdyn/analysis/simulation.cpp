@@ -70,8 +70,8 @@ double calc_watch_measure(const Model& model, const ContactWatch& w, double t, c
 
 std::string watch_message(const Model& model, const ContactWatch& w, double value, double t, const double* q,
                           const double* v) {
-  return fmt::format("{}contact '{}': {} ({} = {:.3g}) at t = {:.6g}, where {}; the run stops there",
-                     w.where.empty() ? "" : w.where + ": ", w.contact, w.reason, w.quantity, value, t,
+  return fmt::format("{}{} '{}': {} ({} = {:.3g}) at t = {:.6g}, where {}; the run stops there",
+                     w.where.empty() ? "" : w.where + ": ", w.entry, w.contact, w.reason, w.quantity, value, t,
                      describe_state(model, q, v));
 }
 

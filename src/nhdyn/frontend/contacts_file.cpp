@@ -266,6 +266,11 @@ void load_wheel_contact(const toml::table& table, const WheelEntry& wheel, symbo
   text.ground.where = normal != nullptr ? at(*normal) : text.where;
   text.ground_where = text.ground.where;
   text.rolling = "rolling";
+  // Without the mode keys the wheel keeps the names its no-slip rows have always had; its messages
+  // say what the entry is and name its keys.
+  if (!has_contact_mode_keys(table)) text.no_slip_suffix = "_slip";
+  text.entry = "wheel";
+  text.size_keys = {"radius"};
   reader.read_modes(table, fmt::format("wheel '{}'", wheel.name), text);
   multibody.contact(text);
   // The contact point's track is the contact's; the body is drawn as the wheel it is.

@@ -96,6 +96,7 @@ struct ContactWatch {
   bool every_step = false;  // checked at every accepted step (symbolic/spec.hpp, SpecContactWatch)
   bool touching_only = false;  // checked only while the contact touches (contact modes)
   bool free_only = false;      // checked only while the contact is free
+  std::string entry = "contact";  // what the message calls it ("wheel" for a [[wheels]] entry)
 };
 
 struct Model {

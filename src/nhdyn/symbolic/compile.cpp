@@ -1190,9 +1190,9 @@ void compile_contact_coordinates(const Spec& spec, Model& model) {
   }
   for (const SpecContactWatch& w : spec.contact_watches)
     model.contact_watches.push_back({w.contact, w.where.describe(),
-                                     compile_expression(spec, w.measure, fmt::format("contact '{}'", w.contact)),
+                                     compile_expression(spec, w.measure, fmt::format("{} '{}'", w.entry, w.contact)),
                                      w.threshold, w.reason, w.quantity, w.every_step, w.touching_only,
-                                     w.free_only});
+                                     w.free_only, w.entry});
 }
 
 }  // namespace

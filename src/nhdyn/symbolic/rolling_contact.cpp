@@ -88,7 +88,7 @@ void parse_implicit_shape(const ContactText& text, const ContactParsers& p, cons
 ParsedContact parse_contact(const ContactText& text, const ContactParsers& parsers) {
   ContactParsers p = parsers;
   p.contact = text.name;
-  const std::string context = fmt::format("contact '{}'", text.name);
+  const std::string context = fmt::format("{} '{}'", text.entry, text.name);
   ParsedContact out;
   out.name = text.name;
   out.where = text.where;
@@ -107,7 +107,8 @@ ParsedContact parse_contact(const ContactText& text, const ContactParsers& parse
                                   join(names), shape.example(), text.sizes.size()));
   if (shape.implicit()) parse_implicit_shape(text, p, context, out.values);
   for (std::size_t i = 0; i < text.sizes.size() && !shape.implicit(); ++i) {
-    const std::string what = fmt::format("{}: {} {}", context, shape.key(), names[i]);
+    const std::string what = i < text.size_keys.size() ? fmt::format("{}: {}", context, text.size_keys[i])
+                                                       : fmt::format("{}: {} {}", context, shape.key(), names[i]);
     const GiNaC::ex size = p.constant(text.sizes[i], text.shape_where, what);
     const std::optional<double> v = contact_number_of(size, *p.spec);
     if (!v || !(*v > 0.0))
@@ -148,6 +149,7 @@ ParsedContact parse_contact(const ContactText& text, const ContactParsers& parse
                         contact_unknown_key(fmt::format("key of a {} ground", ground->key()), option.first, ground_options));
   out.ground.type = ground;
   out.ground.where = text.ground.where;
+  if (text.entry == "wheel") out.ground.normal_example = "normal = [0, 0, 1]";
   ground->parse(text.ground, p, context + ": ground", shape, out.values, out.ground);
 
   if (text.rolling != "rolling" && text.rolling != "rubber")
@@ -156,6 +158,8 @@ ParsedContact parse_contact(const ContactText& text, const ContactParsers& parse
                                   "spin about the normal)",
                                   text.rolling));
   out.rubber = text.rolling == "rubber";
+  out.no_slip_suffix = text.no_slip_suffix;
+  out.entry = text.entry;
   out.unilateral = std::find(text.modes.begin(), text.modes.end(), KeyTexts::value_type{"unilateral", "true"}) !=
                    text.modes.end();
   ground->check(out, *p.spec, context);
@@ -358,7 +362,7 @@ ContactPoint contact_force_point(const ParsedContact& c, const PlacedFrame& F, c
 
 RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F, const Spec& spec,
                                     const std::optional<Vector3>& gravity) {
-  const std::string context = fmt::format("contact '{}'", c.name);
+  const std::string context = fmt::format("{} '{}'", c.entry, c.name);
   const ContactGround::Touch touch = c.ground.type->touch(c, F, spec, gravity, context);
   RollingContact out;
   out.point = touch.point;
@@ -386,16 +390,16 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
                           c.ground.inside ? "<" : ">", c.ground.inside ? "inside" : "outside")
             : "";
     out.constraints.push_back({c.name + "_contact", ConstraintLevel::position, gap,
-                               fmt::format("contact '{}': the gap between the body and the ground = 0 (its position residual is the "
+                               fmt::format("{}: the gap between the body and the ground = 0 (its position residual is the "
                                            "gap, in length units; --fix-initial moves the body onto the ground{})",
-                                           c.name, side)});
+                                           context, side)});
   }
   // The contact point's coordinates on the ground, where they are coordinates (section 8).
   for (const auto& [suffix, row] : touch.locate)
     out.constraints.push_back({c.name + suffix, ConstraintLevel::position, smaller_form(row),
-                               fmt::format("contact '{}': the contact point is where the body's normal is opposite "
+                               fmt::format("{}: the contact point is where the body's normal is opposite "
                                            "to the ground's ({})",
-                                           c.name, suffix.substr(1))});
+                                           context, suffix.substr(1))});
   // Rolling: the material point of the body at P has the ground's velocity there (section 4.2).
   const Vector3 vP = add(time_derivative(F.origin, spec.symbols), cross(F.omega, subtract(touch.point, F.origin)));
   const Vector3 relative = subtract(vP, touch.ground_velocity);
@@ -408,8 +412,8 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
                         fmt::format("the contact point's velocity along the ground (direction {}) is zero whatever "
                                     "the velocities: the body's frame cannot move there, so it has nothing to roll on",
                                     k));
-    out.constraints.push_back({fmt::format("{}_roll{}", c.name, k), ConstraintLevel::velocity, row,
-                               fmt::format("contact '{}': no slip, t{}.(v_P - v_ground) = 0", c.name, k)});
+    out.constraints.push_back({fmt::format("{}{}{}", c.name, c.no_slip_suffix, k), ConstraintLevel::velocity, row,
+                               fmt::format("{}: no slip, t{}.(v_P - v_ground) = 0", context, k)});
   }
   if (c.rubber) {
     const GiNaC::ex spin = simplify_moderate(dot(touch.normal, subtract(F.omega, touch.ground_omega)));
@@ -418,7 +422,7 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
                         "the body cannot spin about the contact normal in these coordinates, so rubber rolling adds "
                         "nothing: write rolling = \"rolling\"");
     out.constraints.push_back({c.name + "_spin", ConstraintLevel::velocity, spin,
-                               fmt::format("contact '{}': no spin about the normal, n.(omega - omega_ground) = 0", c.name)});
+                               fmt::format("{}: no spin about the normal, n.(omega - omega_ground) = 0", context)});
   }
   out.convexity = shape_convexity(c, F, touch);
   if (out.convexity)
@@ -456,6 +460,7 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
   if (touch.singular)
     out.watches.push_back(
         SpecContactWatch{c.name, c.where, touch.singular->first, 1e-4, touch.singular->second, "1 - (e . n)^2", true});
+  for (SpecContactWatch& watch : out.watches) watch.entry = c.entry;
   if (c.ground.added || c.values.added) out.added = added_coordinates(c, F, touch);
   out.force = contact_force_point(c, F, touch, vP);
   return out;

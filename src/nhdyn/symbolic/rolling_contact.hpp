@@ -53,6 +53,13 @@ struct ContactText {
   GroundText ground;
   std::string rolling = "rolling";  // "rolling" or "rubber"
   KeyTexts modes;                   // friction (or mu_s, mu_k), unilateral, restitution, mode (contact_modes.hpp)
+  // The no-slip rows are NAME + this + 1 and 2: "_roll"; a [[wheels]] entry without the contact
+  // modes' keys keeps its rows' names, "_slip" (docs/multibody.md).
+  std::string no_slip_suffix = "_roll";
+  // What the messages call the entry ("contact 'NAME'"; "wheel" for a [[wheels]] entry), and the
+  // names of its sizes where they are keys of their own (a wheel's "radius"; empty: the shape's).
+  std::string entry = "contact";
+  std::vector<std::string> size_keys;
   SourceLocation where, shape_where, ground_where;
 };
 
@@ -66,6 +73,8 @@ struct ParsedGround {
   GiNaC::ex centre_x = 0, centre_y = 0, centre_z = 0;  // surface (a sphere, closed form): its centre K
   GiNaC::ex radius = 0;             // surface (a sphere, closed form): its radius R_g
   bool inside = false;              // surface: the body is where g < 0 (a bowl)
+  // plane: how the entry writes a normal, for the messages (a [[wheels]] entry: normal = [...]).
+  std::string normal_example = "ground = { plane = [0, 0, 1] }";
   std::array<int, 2> at = {-1, -1};  // terrain: the coordinates holding the contact point's X and Y
   GiNaC::ex height = 0;             // terrain: h(X, Y) at X, Y = those coordinates
   // surface, not a closed form (rolling-bodies.md section 11): the coordinates holding the contact
@@ -91,6 +100,8 @@ struct ParsedContact {
   // unilateral = true: the body may leave the ground and tumble in the air, where a disk's |e x nu|
   // takes both signs (its contact point keeps the root; grounds/plane.cpp).
   bool unilateral = false;
+  std::string no_slip_suffix = "_roll";  // ContactText::no_slip_suffix
+  std::string entry = "contact";         // ContactText::entry
   SourceLocation where;
 };
 

@@ -175,6 +175,7 @@ struct SpecContactWatch {
   // or only while it is free (in the air: the point below it); neither: in every mode.
   bool touching_only = false;
   bool free_only = false;
+  std::string entry = "contact";  // what the message calls it: "contact 'NAME'", "wheel 'NAME'"
 };
 
 struct Spec {

@@ -203,12 +203,9 @@ void load_wheels(LoadContext& cx, const toml::table& root, MultibodySections& sc
       const std::string radius = c.number_or_expression(c.member(*table, "wheels", "radius", "radius = \"r\""),
                                                         what + ": radius", "radius = \"r\"");
       const std::optional<symbolic::Triple> normal = c.optional_triple(*table, "normal", what + ": normal");
-      if (has_contact_mode_keys(*table))
-        // A wheel that may slide or lift off: the contact modes are the [[contacts]] machinery's.
-        load_wheel_contact(*table, {name, body, axis, radius, normal}, scene.mb, scene.builder,
-                           [&c](const toml::node& node) { return c.at(node); });
-      else
-        scene.mb.rolling_wheel(name, body, axis, radius, normal, c.at(*table));  // drawn by the builder
+      // The [[contacts]] disk the wheel is, with its modes when it has the keys.
+      load_wheel_contact(*table, {name, body, axis, radius, normal}, scene.mb, scene.builder,
+                         [&c](const toml::node& node) { return c.at(node); });
     }
 }
 

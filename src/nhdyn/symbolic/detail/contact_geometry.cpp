@@ -131,16 +131,18 @@ Vector3 ground_plane_normal(const ParsedGround& ground, const Spec& spec, const 
   else if (gravity) n = scale(-1, *gravity);
   else
     throw_model_error(ground.where, context,
-                      "no ground plane: give its normal, ground = { plane = [0, 0, 1] }, or a gravity vector, whose "
-                      "opposite is then the normal");
+                      fmt::format("no ground plane: give its normal, {}, or a gravity vector, whose opposite is then "
+                                  "the normal",
+                                  ground.normal_example));
   std::array<double, 3> value{};
   for (std::size_t i = 0; i < 3; ++i) value[i] = contact_number_of(n[i], spec).value_or(0.0);
   const double length = std::sqrt(value[0] * value[0] + value[1] * value[1] + value[2] * value[2]);
   if (!(length > 0.0))
     throw_model_error(ground.where, context,
                       ground.normal ? "the plane's normal is the zero vector; give a nonzero normal, e.g. [0, 0, 1]"
-                                    : "the gravity vector is zero, so it defines no ground plane; give its normal, "
-                                      "ground = { plane = [0, 0, 1] }");
+                                    : fmt::format("the gravity vector is zero, so it defines no ground plane; give its "
+                                                  "normal, {}",
+                                                  ground.normal_example));
   // A normal along an axis as written (its other two components zero, not only at the file's
   // parameter values: --set may change them) is kept exact (+-x, +-y, +-z); others are normalized
   // symbolically, so that the plane follows the parameters.

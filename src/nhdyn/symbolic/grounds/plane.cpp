@@ -68,7 +68,7 @@ class PlaneGround final : public ContactGround {
                                     const std::optional<Vector3>& gravity) const override {
     // Without a normal or a gravity the contact itself is refused (make_rolling_contact).
     if (!c.ground.normal && !gravity) return std::nullopt;
-    const Vector3 n = ground_plane_normal(c.ground, spec, gravity, fmt::format("contact '{}'", c.name));
+    const Vector3 n = ground_plane_normal(c.ground, spec, gravity, fmt::format("{} '{}'", c.entry, c.name));
     const auto [t1, t2] = plane_tangents(n, spec);
     VisualItem item;
     item.kind = VisualKind::plane;
