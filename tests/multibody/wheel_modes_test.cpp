@@ -4,7 +4,7 @@
 // NAME_roll2), contact modes, columns and accelerations at random states, on the default plane
 // and on a tilted plane given by the wheel's `normal`. A wheel without them keeps its own rows
 // (NAME_slip1, NAME_slip2), and its accelerations and reactions agree with the disk contact's to
-// round-off (the two differ only in how the rim's |a x n| is written). Bad values are refused
+// round-off (a wheel is the disk contact, with its rows' names). Bad values are refused
 // naming file:line; a knife edge refuses the keys, naming the key's place and why. The Whipple
 // bicycle written with disk contacts is the bicycle of wheels, and friction on a wheel that its
 // coordinates hold on the ground is refused saying that it needs its height.

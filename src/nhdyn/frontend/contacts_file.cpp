@@ -248,29 +248,13 @@ bool has_contact_mode_keys(const toml::table& table) {
 void load_wheel_contact(const toml::table& table, const WheelEntry& wheel, symbolic::MultibodyBuilder& multibody,
                         symbolic::SpecBuilder& builder, const TomlLocator& at) {
   const ContactReader reader(at);
-  symbolic::ContactText text;
-  text.where = at(table);
-  text.shape_where = text.where;
-  text.name = wheel.name;
-  text.body = wheel.body;
-  // The wheel's rim: a thin disk of its radius about its axle, centred on the body frame's origin
-  // (the centre a [[wheels]] entry has), rolling without slip or spin limit as the wheel does.
-  text.shape = "disk";
-  text.sizes = {wheel.radius};
-  text.shape_options.emplace_back("axis", wheel.axis);
-  // The wheel's plane passes through the world origin as the contact's plane does; its normal
-  // (or, without one, the opposite of gravity) is the plane's.
-  text.ground.key = "plane";
-  if (wheel.normal) text.ground.value.assign(wheel.normal->begin(), wheel.normal->end());
-  const toml::node* normal = table.get("normal");
-  text.ground.where = normal != nullptr ? at(*normal) : text.where;
-  text.ground_where = text.ground.where;
-  text.rolling = "rolling";
-  // Without the mode keys the wheel keeps the names its no-slip rows have always had; its messages
-  // say what the entry is and name its keys.
-  if (!has_contact_mode_keys(table)) text.no_slip_suffix = "_slip";
-  text.entry = "wheel";
-  text.size_keys = {"radius"};
+  symbolic::ContactText text =
+      symbolic::wheel_contact_text(wheel.name, wheel.body, wheel.axis, wheel.radius, wheel.normal, at(table));
+  // A normal's messages name its key's place.
+  if (const toml::node* normal = table.get("normal")) text.ground.where = text.ground_where = at(*normal);
+  // With the mode keys the no-slip rows take a contact's names, NAME_roll1 and NAME_roll2, which
+  // the contact modes use (docs/contact-modes.md, "Wheels").
+  if (has_contact_mode_keys(table)) text.no_slip_suffix = "_roll";
   reader.read_modes(table, fmt::format("wheel '{}'", wheel.name), text);
   multibody.contact(text);
   // The contact point's track is the contact's; the body is drawn as the wheel it is.

@@ -53,11 +53,10 @@ struct WheelEntry {
   std::optional<std::array<std::string, 3>> normal;  // the plane's normal; none: opposite to gravity
 };
 
-// A [[wheels]] entry `table` with mode keys, handed to `multibody` as the [[contacts]] entry it
-// is: shape = { disk = radius, axis = axis } on `body` (centred on its frame's origin), ground =
-// { plane = normal } (or the default plane), rolling = "rolling", and the entry's mode keys, read
-// and checked as a contact's. So it has the contact's constraints (NAME_contact, NAME_roll1,
-// NAME_roll2), columns and switch events. The contact adds to the scene of `builder` what a
+// A [[wheels]] entry `table`, handed to `multibody` as the [[contacts]] entry it is
+// (symbolic::wheel_contact_text: a disk on the plane) with the entry's mode keys, read and checked
+// as a contact's. So it has the contact's constraints (NAME_contact, NAME_slip1, NAME_slip2; with
+// a mode key NAME_roll1, NAME_roll2), columns and switch events. The contact adds to the scene of `builder` what a
 // [[contacts]] entry adds besides its shape (the contact point's track), then the multibody
 // builder draws the body as the wheel it is (MultibodyBuilder::wheel_drawing). Throws ModelError
 // naming file:line for a mode key of the wrong type and whatever the builder refuses.

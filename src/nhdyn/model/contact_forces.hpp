@@ -29,8 +29,10 @@ namespace nhdyn {
 struct Model;
 struct Data;
 
-// rolling: a convex body of [[contacts]] (docs/derivations/rolling-bodies.md).
-enum class ContactKind { wheel, knife_edge, surface, curve, rolling };
+// What a contact of the load is: a knife edge; a point held on a surface or curve ([[surfaces]],
+// [[curves]]: unknowns only, no columns); rolling: a convex body of [[contacts]]
+// (docs/derivations/rolling-bodies.md), a [[wheels]] entry among them (the disk it is).
+enum class ContactKind { knife_edge, surface, curve, rolling };
 
 // An output component of a reported contact: the world force, its parts along the ground's normal
 // n and (wheels, knife edges, rolling bodies with an axle) e_long, e_lat, and the spin moment about
@@ -38,8 +40,8 @@ enum class ContactKind { wheel, knife_edge, surface, curve, rolling };
 enum class ContactComponent { Fx, Fy, Fz, N, Flong, Flat, Mspin };
 inline constexpr int kContactComponentKinds = 7;
 const char* contact_component_name(ContactComponent component);  // "Fx", ..., "Mspin"
-// The columns of a contact, in order: a wheel or knife edge Fx, Fy, Fz, N, Flong, Flat; a rolling
-// body Fx, Fy, Fz, N, then Flong, Flat when its shape has an axle (`axle`: a disk, a torus), then
+// The columns of a contact, in order: a knife edge Fx, Fy, Fz, N, Flong, Flat; a rolling body Fx,
+// Fy, Fz, N, then Flong, Flat when its shape has an axle (`axle`: a disk, a wheel, a torus), then
 // Mspin with `spin` (rubber rolling).
 std::vector<ContactComponent> contact_components(ContactKind kind, bool spin, bool axle = false);
 
@@ -48,8 +50,8 @@ std::vector<ContactComponent> contact_components(ContactKind kind, bool spin, bo
 // knife edge: along the plane's normal n and across the blade e_lat).
 struct ContactForceContact {
   std::string name;
-  ContactKind kind = ContactKind::wheel;
-  bool reported = false;  // wheels and knife edges get columns; surfaces and curves are unknowns only
+  ContactKind kind = ContactKind::rolling;
+  bool reported = false;  // rolling bodies and knife edges get columns; surfaces and curves are unknowns only
   int first_unknown = 0;  // index of its first unknown among all unknowns
   int unknowns = 3;
   int system = 0;         // the connected system it supports

@@ -80,7 +80,7 @@ void append_contact_unknowns(const SpecContactForces& in, const SymbolTable& sym
     ContactForceContact contact;
     contact.name = p.name;
     contact.kind = p.kind;
-    contact.reported = p.kind == ContactKind::wheel || p.kind == ContactKind::knife_edge || p.kind == ContactKind::rolling;
+    contact.reported = p.kind == ContactKind::knife_edge || p.kind == ContactKind::rolling;
     contact.first_unknown = c.unknowns;
     contact.unknowns = static_cast<int>(p.directions.size()) + (p.spin ? 1 : 0);
     contact.system = std::max(p.system, 0);
@@ -185,7 +185,7 @@ void compile_contact_forces(const Spec& spec, Model& model) {
   for (int s = 0; s < c.systems; ++s) append_system_balance(in, symbols, per_length, n, s, outputs);
   // Per reported contact: n, e_long, e_lat.
   for (const ContactPoint& p : in.contacts) {
-    if (p.kind != ContactKind::wheel && p.kind != ContactKind::knife_edge && p.kind != ContactKind::rolling) continue;
+    if (p.kind != ContactKind::knife_edge && p.kind != ContactKind::rolling) continue;
     append(outputs, p.normal);
     append(outputs, p.longitudinal);
     append(outputs, p.lateral);
@@ -194,11 +194,10 @@ void compile_contact_forces(const Spec& spec, Model& model) {
     const std::vector<GiNaC::ex> row = b_row(spec, *con);
     outputs.insert(outputs.end(), row.begin(), row.end());
   }
-  // The shortcut needs the force's three world components as the only unknowns: a wheel, or a
-  // rolling contact without a spin moment (rubber).
+  // The shortcut needs the force's three world components as the only unknowns: a rolling
+  // contact (a wheel is one) without a spin moment (rubber).
   const ContactForceContact& only = c.contacts.front();
-  c.single_wheel = c.systems == 1 && c.contacts.size() == 1 &&
-                   (only.kind == ContactKind::wheel || (only.kind == ContactKind::rolling && only.unknowns == 3)) &&
+  c.single_wheel = c.systems == 1 && c.contacts.size() == 1 && only.kind == ContactKind::rolling && only.unknowns == 3 &&
                    c.hand_constraints == 0 && c.balance_rows.front() && in.contacts.front().system == 0;
   std::vector<std::string> what(outputs.size());
   for (std::size_t i = 0; i < what.size(); ++i) what[i] = fmt::format("contact forces: output {}", i);

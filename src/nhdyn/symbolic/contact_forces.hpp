@@ -35,7 +35,7 @@ struct ContactBody {
 // normal n and e_long, e_lat.
 struct ContactPoint {
   std::string name;
-  ContactKind kind = ContactKind::wheel;
+  ContactKind kind = ContactKind::rolling;
   Vector3 point;
   Vector3 velocity;
   std::vector<Vector3> directions;

@@ -14,6 +14,7 @@
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/symbolic/simplify.hpp"
 #include "nhdyn/core/detail/suggest.hpp"
+#include "nhdyn/symbolic/detail/contact_geometry.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
@@ -38,14 +39,6 @@ std::string printed(const GiNaC::ex& e) {
   std::ostringstream out;
   out << e;
   return out.str();
-}
-
-// Whether simplify_moderate() simplified `e` (it is small enough).
-bool capped_size_below(const GiNaC::ex& e) {
-  std::size_t count = 0;
-  for (GiNaC::const_preorder_iterator it = e.preorder_begin(); it != e.preorder_end(); ++it)
-    if (++count > kSimplifyLimit) return false;
-  return true;
 }
 
 // The value of an expression with the parameters set (and, at the reference configuration, every
@@ -414,30 +407,39 @@ VisualItem plane_item(const Vector3& n, const Spec& spec, const std::string& nam
 }
 }  // namespace
 
+ContactText wheel_contact_text(const std::string& name, const std::string& body, const std::string& axis,
+                               const std::string& radius, const std::optional<Triple>& normal, SourceLocation where) {
+  ContactText text;
+  text.where = where;
+  text.shape_where = where;
+  text.name = name;
+  text.body = body;
+  // The wheel's rim: a thin disk of its radius about its axle, centred on the body frame's origin,
+  // rolling without slip or spin limit on the plane through the world origin whose normal is
+  // `normal` (or, without one, the opposite of gravity).
+  text.shape = "disk";
+  text.sizes = {radius};
+  text.shape_options.emplace_back("axis", axis);
+  text.ground.key = "plane";
+  if (normal) text.ground.value.assign(normal->begin(), normal->end());
+  text.ground.where = where;
+  text.ground_where = where;
+  text.rolling = "rolling";
+  text.no_slip_suffix = "_slip";
+  text.entry = "wheel";
+  text.size_keys = {"radius"};
+  return text;
+}
+
 MultibodyBuilder& MultibodyBuilder::rolling_wheel(const std::string& name, const std::string& body,
                                                   const std::string& axis, const std::string& radius,
                                                   const std::optional<Triple>& normal, SourceLocation where) {
-  const std::string context = fmt::format("wheel '{}'", name);
-  check_helper_name(name, where);
-  Helper h;
-  h.kind = Helper::Kind::wheel;
-  h.name = name;
-  h.where = where;
-  h.index = body_index(body, where, context);
-  h.axis = axis_index(axis);
-  if (h.axis < 0)
-    throw_model_error(where, context, fmt::format("unknown axle axis '{}'; the axle is the \"x\", \"y\" or \"z\" axis of the "
-                                     "wheel body's frame",
-                                     axis));
-  h.radius = parse(radius, where, context + ": radius", false);
-  const std::optional<double> r = value_of(h.radius, builder_.current());
-  if (!r || !(*r > 0.0))
-    throw_model_error(where, context, fmt::format("the radius \"{}\" must be positive, but it is {}", radius,
-                                     r ? fmt::format("{}", *r) : "not a number"));
-  if (normal) h.normal = parse(*normal, where, context + ": normal", false);
-  helpers_.push_back(std::move(h));
-  if (helpers_.back().normal) {  // a zero normal is refused now; the plane is drawn
-    builder_.visual_item(plane_item(plane_normal(helpers_.back(), context), builder_.current(), name, where));
+  contact(wheel_contact_text(name, body, axis, radius, normal, where));
+  if (normal) {  // a tilted plane is drawn in its axes; the level one is the report's grid
+    const ParsedContact* parsed = parsed_contact(name);
+    builder_.visual_item(plane_item(ground_plane_normal(parsed->ground, builder_.current(), gravity_,
+                                                        fmt::format("wheel '{}'", name)),
+                                    builder_.current(), name, where));
   }
   return wheel_drawing(name, body, axis, radius, std::move(where));
 }
@@ -562,109 +564,6 @@ Vector3 MultibodyBuilder::plane_normal(const Helper& helper, const std::string& 
   return {n[0] / norm, n[1] / norm, n[2] / norm};
 }
 
-namespace {
-
-// For an expression too large for simplify(): whether it is zero at a few fixed, generic points
-// (coordinates and t in [-1, 1], the parameters at their values): |e| <= 1e-12 at each.
-bool vanishes_at_sample_points(const GiNaC::ex& e, const Spec& spec) {
-  if (capped_size_below(e)) return false;  // small ones were simplified: not zero
-  for (int sample = 0; sample < 3; ++sample) {
-    GiNaC::lst values = spec.parameter_values();
-    values.append(spec.symbols.time() == 0.1 * (sample + 1));
-    for (int i = 0; i < spec.n(); ++i)
-      values.append(spec.symbols.coordinate(i) == std::sin(1.7 * (i + 1) + 2.3 * sample));
-    const GiNaC::ex v = e.subs(values).evalf();
-    if (!GiNaC::is_a<GiNaC::numeric>(v) || !GiNaC::ex_to<GiNaC::numeric>(v).is_real() ||
-        std::abs(GiNaC::ex_to<GiNaC::numeric>(v).to_double()) > 1e-12)
-      return false;
-  }
-  return true;
-}
-
-bool has_coordinates(const GiNaC::ex& e, const Spec& spec) {
-  if (e.has(spec.symbols.time())) return true;
-  for (int i = 0; i < spec.n(); ++i)
-    if (e.has(spec.symbols.coordinate(i))) return true;
-  return false;
-}
-
-}  // namespace
-
-void MultibodyBuilder::add_wheel(const Helper& h) {
-  const std::string context = fmt::format("wheel '{}'", h.name);
-  const Spec& spec = builder_.current();
-  const Body& body = bodies_[static_cast<std::size_t>(h.index)];
-  const PlacedFrame& F = frames_[static_cast<std::size_t>(body.frame)];
-  const Vector3 n = plane_normal(h, context);
-  const Vector3& C = F.origin;
-  const Vector3 a = column(F.rotation, h.axis);
-  const GiNaC::ex an = dot(a, n);
-  // |a x n| = sqrt(1 - (a.n)^2); a perfect square u^2 gives u with its sign at the reference
-  // configuration (docs/derivations/rolling-wheel.md).
-  const GiNaC::ex squared = simplify(1 - an * an);
-  if (symbolic::is_zero(squared))
-    throw_model_error(h.where, context, "the axle is always normal to the plane (the wheel lies flat): it cannot roll");
-  GiNaC::ex length = GiNaC::sqrt(squared);
-  bool signed_length = false;
-  if (GiNaC::is_a<GiNaC::power>(squared) && squared.op(1) == 2) {
-    const std::optional<double> u = value_of(squared.op(0), spec, true);
-    if (u && *u != 0.0) {
-      length = *u > 0 ? squared.op(0) : -squared.op(0);
-      signed_length = true;
-    }
-  }
-  const Vector3 CP = scale(h.radius / length, subtract(scale(an, a), n));  // P - C
-  // Where the wheel lies flat (a.n = +-1) every point of its rim is lowest: the run stops there, as
-  // a disk contact's does (rolling-bodies.md section 2), at every step. Written as +-u, |a x n|
-  // makes nothing fail there and the wheel would roll on through the plane; u itself changes sign
-  // there, so its fall through 1e-2 (the axle within 0.6 degree of the normal) is located even by
-  // a step that passes the flat position (1 - (a.n)^2 = u^2 only touches 0).
-  const std::string flat = "the wheel lies flat: its axle is along the plane's normal, where every point of its rim "
-                           "is lowest and the contact point is not defined";
-  if (signed_length)
-    builder_.contact_watch(SpecContactWatch{h.name, h.where, length, 1e-2, flat, "|axle x normal|", true});
-  else
-    builder_.contact_watch(SpecContactWatch{h.name, h.where, 1 - an * an, 1e-4, flat, "1 - (axle . normal)^2", true});
-  const Vector3 P = add(C, CP);
-
-  const GiNaC::ex contact = simplify_moderate(dot(n, P));
-  if (!contact.is_zero() && !vanishes_at_sample_points(contact, spec)) {
-    if (!has_coordinates(contact, spec))
-      throw_model_error(h.where, context,
-           fmt::format("the wheel can never touch the plane: the height of its lowest point above the plane is the "
-                       "constant {}; place the wheel's frame so that it touches the plane",
-                       printed(contact)));
-    builder_.constraint(h.name + "_contact", ConstraintLevel::position, contact,
-                        fmt::format("wheel '{}': lowest point on the plane, n.P = 0", h.name), h.where);
-  }
-  // The material point at P: v_C + omega x (P - C); its two components along the plane vanish.
-  const Vector3 vP = add(time_derivative(C, spec.symbols), cross(F.omega, CP));
-  const auto [t1, t2] = plane_tangents(n, spec);
-  int k = 0;
-  for (const Vector3& tk : {t1, t2}) {
-    const GiNaC::ex slip = simplify_moderate(dot(tk, vP));
-    ++k;
-    if (slip.is_zero())
-      throw_model_error(h.where, context,
-           fmt::format("the contact point's velocity along the plane (direction {}) is zero whatever the "
-                       "velocities: the wheel's frame cannot move, so it has nothing to roll on",
-                       k));
-    builder_.constraint(fmt::format("{}_slip{}", h.name, k), ConstraintLevel::velocity, slip,
-                        fmt::format("wheel '{}': no slip, t{}.v_P = 0", h.name, k), h.where);
-  }
-  // The contact force's unknowns are its world components; e_long = (a x n)/|a x n|.
-  ContactPoint point;
-  point.name = h.name;
-  point.kind = ContactKind::wheel;
-  point.point = P;
-  point.velocity = vP;
-  point.directions = {unit(0), unit(1), unit(2)};
-  point.normal = n;
-  point.longitudinal = scale(1 / length, cross(a, n));
-  point.lateral = cross(n, point.longitudinal);
-  point.system = system_of(body.frame);
-  contacts_.push_back(std::move(point));
-}
 
 void MultibodyBuilder::add_knife_edge(const Helper& h) {
   const std::string context = fmt::format("knife edge '{}'", h.name);
@@ -826,7 +725,6 @@ void MultibodyBuilder::apply() {
   const std::size_t first_helper = builder_.current().constraints.size();
   for (const Helper& h : helpers_) {
     switch (h.kind) {
-      case Helper::Kind::wheel: add_wheel(h); break;
       case Helper::Kind::knife_edge: add_knife_edge(h); break;
       case Helper::Kind::contact: add_contact(h); break;
       case Helper::Kind::surface:
@@ -861,7 +759,7 @@ void MultibodyBuilder::apply() {
   record_contact_forces(*record);
   std::vector<ReportedContact> reported;  // the wheels, knife edges and rolling bodies, whose columns events may name
   for (const ContactPoint& c : record->contacts)
-    if (c.kind == ContactKind::wheel || c.kind == ContactKind::knife_edge || c.kind == ContactKind::rolling)
+    if (c.kind == ContactKind::knife_edge || c.kind == ContactKind::rolling)
       reported.emplace_back(c.name, contact_components(c.kind, c.spin, c.axle));
   record->columns = make_contact_force_symbols(reported);
   record->modes = modes_;
@@ -906,7 +804,6 @@ void MultibodyBuilder::record_contact_forces(SpecContactForces& record) const {
   if (gravity_) record.gravity = *gravity_;
   double largest = 0.0;  // L, the scale of the moment rows: the largest wheel radius
   for (const Helper& h : helpers_) {
-    if (h.kind == Helper::Kind::wheel) largest = std::max(largest, value_of(h.radius, builder_.current()).value_or(0.0));
     if (h.kind == Helper::Kind::contact)
       largest = std::max(largest, value_of(h.contact->shape->length(h.contact->values), builder_.current()).value_or(0.0));
   }

@@ -66,6 +66,14 @@ struct PlacedFrame {
   SourceLocation where;
 };
 
+// A [[wheels]] entry as the [[contacts]] entry it is: shape = { disk = radius, axis = axis } on
+// `body` (centred on its frame's origin), ground = { plane = normal } (without one, the plane
+// normal to gravity), rolling = "rolling"; its no-slip rows named NAME_slip1, NAME_slip2 and its
+// messages "wheel 'NAME'" with the key `radius` (docs/multibody.md).
+ContactText wheel_contact_text(const std::string& name, const std::string& body, const std::string& axis,
+                               const std::string& radius, const std::optional<Triple>& normal,
+                               SourceLocation where = {});
+
 class MultibodyBuilder {
  public:
   // Coordinates and parameters must already be declared on `builder`, which must outlive this.
@@ -99,16 +107,16 @@ class MultibodyBuilder {
   // A thin wheel of `radius` that rolls without slipping: the body's frame origin is its centre,
   // its axle is the frame's `axis` ("x", "y" or "z"). The plane passes through the world origin
   // with the normal `normal` (world components, parameters only), or opposite to gravity when no
-  // normal is given. Adds "<name>_contact" (position level, unless it holds identically) and
-  // "<name>_slip1", "<name>_slip2" (velocity level). Drawn as wheel_drawing() draws it.
+  // normal is given. It is the disk contact of wheel_contact_text() (contact()): adds
+  // "<name>_contact" (position level, unless it holds identically) and "<name>_slip1",
+  // "<name>_slip2" (velocity level). Drawn as wheel_drawing() draws it.
   MultibodyBuilder& rolling_wheel(const std::string& name, const std::string& body, const std::string& axis,
                                   const std::string& radius, const std::optional<Triple>& normal = std::nullopt,
                                   SourceLocation where = {});
   // Draws `body` in the scene as the wheel `name` (VisualKind::wheel): a disk of `radius` about
-  // its frame's `axis`, centred on the frame's origin. rolling_wheel() calls it; a front end that
-  // gives a wheel as the disk contact it is (contact(), for the contact modes' keys:
-  // frontend/contacts_file.hpp) calls it after contact(). Throws a ModelError naming `where` for a
-  // body not declared.
+  // its frame's `axis`, centred on the frame's origin. rolling_wheel() calls it after contact(), as
+  // the model file's [[wheels]] loader does (frontend/contacts_file.hpp). Throws a ModelError
+  // naming `where` for a body not declared.
   MultibodyBuilder& wheel_drawing(const std::string& name, const std::string& body, const std::string& axis,
                                   const std::string& radius, SourceLocation where = {});
   // A knife edge at `point` along its frame's `axis`, on the plane of `normal` (default: opposite
@@ -161,7 +169,7 @@ class MultibodyBuilder {
   // A helper's constraints, computed in apply() (the plane's default normal needs the gravity,
   // which may come later).
   struct Helper {
-    enum class Kind { wheel, knife_edge, surface, curve, contact } kind;
+    enum class Kind { knife_edge, surface, curve, contact } kind;
     std::string name;
     int index = -1;          // body (wheel) or point
     int axis = 0;
@@ -189,7 +197,6 @@ class MultibodyBuilder {
   GiNaC::ex parse_surface(const std::string& text, const Vector3& at, const SourceLocation& where,
                           const std::string& context) const;
   Vector3 plane_normal(const Helper& helper, const std::string& context) const;
-  void add_wheel(const Helper& helper);
   void add_knife_edge(const Helper& helper);
   void add_contact(const Helper& helper);
   // The bodies and contacts for the contact forces (symbolic/contact_forces.hpp), onto the builder.
@@ -201,7 +208,7 @@ class MultibodyBuilder {
   std::vector<Point> points_;
   std::vector<Body> bodies_;
   std::vector<Helper> helpers_;
-  std::vector<ContactPoint> contacts_;  // filled by add_wheel, add_knife_edge and apply()
+  std::vector<ContactPoint> contacts_;  // filled by add_knife_edge and apply()
   std::vector<SpecContactMode> modes_;  // the contacts with modes, filled by add_contact
   std::optional<Vector3> gravity_;
   SourceLocation gravity_where_;
