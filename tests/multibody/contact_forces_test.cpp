@@ -72,7 +72,7 @@ TEST(ContactForces, RollingDiskMatchesTheCentreOfMassBalanceAtRandomStates) {
   const Model model = load_model(example("rolling_disk_bodies.toml"));
   ASSERT_TRUE(model.contact_forces);
   EXPECT_TRUE(model.contact_forces->notes.empty()) << model.contact_forces->notes.front();
-  EXPECT_TRUE(model.contact_forces->single_wheel);
+  EXPECT_TRUE(model.contact_forces->single_contact);
   const double m = parameter(model, "m"), r = parameter(model, "r"), g = parameter(model, "g");
   std::mt19937 rng(15);
   for (int trial = 0; trial < 20; ++trial) {

@@ -252,9 +252,6 @@ void load_wheel_contact(const toml::table& table, const WheelEntry& wheel, symbo
       symbolic::wheel_contact_text(wheel.name, wheel.body, wheel.axis, wheel.radius, wheel.normal, at(table));
   // A normal's messages name its key's place.
   if (const toml::node* normal = table.get("normal")) text.ground.where = text.ground_where = at(*normal);
-  // With the mode keys the no-slip rows take a contact's names, NAME_roll1 and NAME_roll2, which
-  // the contact modes use (docs/contact-modes.md, "Wheels").
-  if (has_contact_mode_keys(table)) text.no_slip_suffix = "_roll";
   reader.read_modes(table, fmt::format("wheel '{}'", wheel.name), text);
   multibody.contact(text);
   // The contact point's track is the contact's; the body is drawn as the wheel it is.

@@ -254,8 +254,8 @@ void compute_contact_forces(const Model& model, Data& data) {
       solved -= c.contacts[i].unknowns;
     }
   bool determined = true;
-  if (c.single_wheel) {
-    // One wheel supports the only system: F = sum_B m_B (a_B - g), its first balance rows.
+  if (c.single_contact) {
+    // One contact supports the only system: F = sum_B m_B (a_B - g), its first balance rows.
     w.x = w.rhs.segment(c.n, 3);
   } else {
     w.qr.compute(w.M);

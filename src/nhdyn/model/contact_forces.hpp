@@ -79,9 +79,9 @@ struct ContactForceModel {
   std::vector<ContactForceContact> contacts;
   std::vector<int> unknown_system;  // system of each unknown
   std::vector<std::string> system_names;  // the frame below ground that each system hangs from
-  // One wheel alone on the only system, with nothing else: F is its momentum balance (step 7's
-  // shortcut), no solve.
-  bool single_wheel = false;
+  // One rolling contact (a wheel, a ball, ...) alone on the only system, with nothing else and
+  // no spin moment: F is its momentum balance (step 7's shortcut), no solve.
+  bool single_contact = false;
   // Whether the balance rows (C3) of each system enter M: false when the system's balance is not
   // consistent with (C1) (a body held by its coordinates) or the model has forces or energies the
   // bodies do not describe.

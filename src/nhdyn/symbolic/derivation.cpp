@@ -522,6 +522,7 @@ Derivation derive(const Spec& spec) {
     throw ModelError(model + fmt::format("the potential energy V contains the velocity {}'", name(i)));
   require_at_most_quadratic(spec, model);
   check_contact_convexity(spec);  // an implicit rolling shape must be convex where the run starts
+  check_contact_watches_at_start(spec);  // a wheel neither flat nor turned over where it starts
 
   Derivation d;
   std::vector<GiNaC::ex> Tv;

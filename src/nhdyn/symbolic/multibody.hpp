@@ -171,9 +171,8 @@ class MultibodyBuilder {
   struct Helper {
     enum class Kind { knife_edge, surface, curve, contact } kind;
     std::string name;
-    int index = -1;          // body (wheel) or point
+    int index = -1;          // the point (knife edge, surface, curve)
     int axis = 0;
-    GiNaC::ex radius;
     std::optional<Vector3> normal;
     std::vector<GiNaC::ex> surfaces;
     std::shared_ptr<const ParsedContact> contact;  // a rolling body

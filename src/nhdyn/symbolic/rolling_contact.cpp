@@ -158,7 +158,8 @@ ParsedContact parse_contact(const ContactText& text, const ContactParsers& parse
                                   "spin about the normal)",
                                   text.rolling));
   out.rubber = text.rolling == "rubber";
-  out.no_slip_suffix = text.no_slip_suffix;
+  // The contact modes find the no-slip rows as NAME_roll1, NAME_roll2 (contact_modes.cpp).
+  out.no_slip_suffix = text.modes.empty() ? text.no_slip_suffix : "_roll";
   out.entry = text.entry;
   out.unilateral = std::find(text.modes.begin(), text.modes.end(), KeyTexts::value_type{"unilateral", "true"}) !=
                    text.modes.end();
@@ -452,10 +453,12 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
   // equations do not fail there (u changes sign, 1 - (e . nu)^2 = u^2 only touches 0).
   if (const std::optional<ContactShape::Singularity> singular =
           c.shape->singularity(c.values, multiply_transposed(F.rotation, touch.normal))) {
-    if (touch.signed_roots.empty())
-      out.watches.push_back(SpecContactWatch{c.name, c.where, singular->measure, 1e-4, singular->reason});
-    for (const GiNaC::ex& u : touch.signed_roots)
-      out.watches.push_back(SpecContactWatch{c.name, c.where, u, 1e-2, singular->reason, "|axle x normal|", true});
+    out.watches.push_back(SpecContactWatch{c.name, c.where, singular->measure, 1e-4, singular->reason});
+    for (const GiNaC::ex& u : touch.signed_roots) {
+      SpecContactWatch watch{c.name, c.where, u, 1e-2, singular->reason, "|axle x normal|", true};
+      watch.signed_root = true;
+      out.watches.push_back(std::move(watch));
+    }
   }
   if (touch.singular)
     out.watches.push_back(
@@ -464,6 +467,37 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
   if (c.ground.added || c.values.added) out.added = added_coordinates(c, F, touch);
   out.force = contact_force_point(c, F, touch, vP);
   return out;
+}
+
+void check_contact_watches_at_start(const Spec& spec) {
+  GiNaC::lst at = spec.parameter_values();
+  at.append(spec.symbols.time() == GiNaC::numeric(spec.t0));
+  for (std::size_t i = 0; i < spec.coordinates.size() && i < spec.q0.size(); ++i)
+    at.append(spec.symbols.coordinate(static_cast<int>(i)) == spec.q0[i].subs(spec.parameter_values()));
+  for (const SpecContactWatch& w : spec.contact_watches) {
+    if (!w.signed_root) continue;
+    double value = 0.0;
+    try {
+      const GiNaC::ex x = w.measure.subs(at).evalf();
+      if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real()) continue;
+      value = GiNaC::ex_to<GiNaC::numeric>(x).to_double();
+    } catch (const std::exception&) {
+      continue;
+    }
+    if (value >= w.threshold) continue;
+    const std::string context = fmt::format("{} '{}'", w.entry, w.contact);
+    if (value > -w.threshold)
+      throw_model_error(w.where, context,
+                        fmt::format("{} at the start ({} = {:.3g}, below {}); start it leaning less", w.reason,
+                                    w.quantity, value, w.threshold));
+    throw_model_error(w.where, context,
+                      fmt::format("at the start the wheel is turned past lying flat from its reference configuration "
+                                  "(every coordinate 0): its rim's {} is written as {}, with the sign it has there, "
+                                  "and is {:.3g} at the start, where that rim point is the highest, not the lowest. "
+                                  "Start the wheel on the side of lying flat that its reference configuration is on, "
+                                  "or place its frames so that it stands upright where the coordinates are 0",
+                                  w.quantity, contact_printed(w.measure), value));
+  }
 }
 
 void check_contact_convexity(const Spec& spec) {

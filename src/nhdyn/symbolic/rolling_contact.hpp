@@ -54,7 +54,8 @@ struct ContactText {
   std::string rolling = "rolling";  // "rolling" or "rubber"
   KeyTexts modes;                   // friction (or mu_s, mu_k), unilateral, restitution, mode (contact_modes.hpp)
   // The no-slip rows are NAME + this + 1 and 2: "_roll"; a [[wheels]] entry without the contact
-  // modes' keys keeps its rows' names, "_slip" (docs/multibody.md).
+  // modes' keys keeps its rows' names, "_slip" (docs/multibody.md). With modes they are "_roll"
+  // whatever this says (the contact modes find them by that name).
   std::string no_slip_suffix = "_roll";
   // What the messages call the entry ("contact 'NAME'"; "wheel" for a [[wheels]] entry), and the
   // names of its sizes where they are keys of their own (a wheel's "radius"; empty: the shape's).
@@ -221,6 +222,13 @@ std::pair<Vector3, Vector3> plane_tangents(const Vector3& n, const Spec& spec);
 // curvatures found and what to do (docs/derivations/rolling-bodies.md section 9). States where
 // the expressions do not evaluate to finite reals are left to the other checks.
 void check_contact_convexity(const Spec& spec);
+
+// Throws ModelError when a wheel's |axle x normal|, written +-u with the sign u has at the
+// reference configuration (SpecContactWatch::signed_root), is below its threshold where the run
+// starts: the wheel lies flat there, or stands turned past lying flat from its reference
+// configuration, where its rim's lowest point as written is the highest. Names the wheel, where
+// it was written, the value and what to do.
+void check_contact_watches_at_start(const Spec& spec);
 
 // What holds a contact point by coordinates of the model: a terrain (2: u, v), an implicit shape
 // (3: its point in body axes), a surface ground (3: the point on it, world).

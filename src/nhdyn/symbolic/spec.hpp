@@ -176,6 +176,9 @@ struct SpecContactWatch {
   bool touching_only = false;
   bool free_only = false;
   std::string entry = "contact";  // what the message calls it: "contact 'NAME'", "wheel 'NAME'"
+  // The measure is a wheel's |axle x normal| written +-u (contact_geometry.hpp): the load refuses
+  // a start where it is below its threshold (check_contact_watches_at_start).
+  bool signed_root = false;
 };
 
 struct Spec {

@@ -26,9 +26,9 @@ std::string contact_printed(const GiNaC::ex& e);
 bool contact_has_coordinates(const GiNaC::ex& e, const Spec& spec);
 
 // Whether e, which depends on the coordinates or t, is zero for every state: 0 as written, or zero
-// at three fixed generic points (coordinates in [-1, 1], t in (0, 1), the parameters at their
-// values). A disk's gap in coordinates that eliminate its height, rR cos(phi) - rR sqrt(cos(phi)^2),
-// is such a zero that simplify() leaves as it is.
+// to round-off of its terms' sizes at three fixed generic points (coordinates in [-1, 1], t in
+// (0, 1), the parameters at their values). A disk's gap in coordinates that eliminate its height,
+// rR cos(phi) - rR sqrt(cos(phi)^2), is such a zero that simplify() leaves as it is.
 bool contact_vanishes_identically(const GiNaC::ex& e, const Spec& spec);
 
 // e with every root of a perfect square, sqrt(u^2) (and its odd powers), written as +-u with the

@@ -43,12 +43,23 @@ class PlaneGround final : public ContactGround {
     // differentiated twice stay polynomial inside the root (rolling-bodies.md section 2.1).
     const Vector3 nu = multiply_transposed(F.rotation_numerator, n);
     const Vector3 nu_s = {simplify_moderate(nu[0]), simplify_moderate(nu[1]), simplify_moderate(nu[2])};
+    if (c.values.axis >= 0) {
+      // A disk or torus whose axle is along the normal in every position has no lowest rim point
+      // anywhere: |e x nu|^2 = |nu|^2 - (e . nu)^2 is 0 whatever the coordinates.
+      const GiNaC::ex along = nu_s[static_cast<std::size_t>(c.values.axis)];
+      if (symbolic::is_zero(F.rotation_denominator * F.rotation_denominator - along * along))
+        throw_model_error(c.where, context,
+                          "the axle is along the plane's normal in every position: the disk lies flat whatever the "
+                          "coordinates, so it has no lowest rim point to roll on; give as `axis` the axle of the "
+                          "body's frame that is parallel to the plane when the wheel stands");
+    }
     ShapeSupport s = c.shape->support(c.values, nu_s, F.rotation_denominator);
-    // A disk's |e x nu| in angles is often a perfect square's root, sqrt(cos(theta)^2): written
-    // cos(theta), as a [[wheels]] entry writes it (docs/derivations/rolling-wheel.md), for a body
-    // that stays on the plane. One that may lift off keeps the root: in the air it may turn over,
-    // and its gap is z - r |cos(theta)| whatever its lean.
-    if (!c.unilateral) {
+    // A wheel's |e x nu| in angles is often a perfect square's root, sqrt(cos(theta)^2): written
+    // cos(theta) (docs/derivations/rolling-wheel.md), for a wheel that stays on the plane. One that
+    // may lift off keeps the root (in the air it may turn over: its gap is z - r |cos(theta)|
+    // whatever its lean), and so does a [[contacts]] disk, which may start on either side of its
+    // reference configuration.
+    if (c.entry == "wheel" && !c.unilateral) {
       for (GiNaC::ex& x : s.point) x = contact_roots_of_squares(x, spec, out.signed_roots);
       s.reach = contact_roots_of_squares(s.reach, spec, out.signed_roots);
     }
