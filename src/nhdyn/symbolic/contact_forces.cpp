@@ -196,9 +196,9 @@ void compile_contact_forces(const Spec& spec, Model& model) {
   }
   // The shortcut needs the force's three world components as the only unknowns: a rolling
   // contact (a wheel is one) without a spin moment (rubber).
-  const ContactForceContact& only = c.contacts.front();
-  c.single_contact = c.systems == 1 && c.contacts.size() == 1 && only.kind == ContactKind::rolling && only.unknowns == 3 &&
-                   c.hand_constraints == 0 && c.balance_rows.front() && in.contacts.front().system == 0;
+  c.single_contact = c.systems == 1 && c.contacts.size() == 1 && c.contacts.front().kind == ContactKind::rolling &&
+                     c.contacts.front().unknowns == 3 && c.hand_constraints == 0 && c.balance_rows.front() &&
+                     in.contacts.front().system == 0;
   std::vector<std::string> what(outputs.size());
   for (std::size_t i = 0; i < what.size(); ++i) what[i] = fmt::format("contact forces: output {}", i);
   c.tape = compile_expressions(spec, outputs, what);

@@ -71,7 +71,7 @@ struct SpecContactForces {
   // unknowns like a hand-written constraint's, but they act on no body, so the momentum balance stays.
   std::vector<std::string> internal;
   bool other_energy = false;              // T or V written by hand besides the bodies'
-  double length = 1.0;                    // L [m], the largest wheel radius (or 1)
+  double length = 1.0;                    // L [m], the largest contact's size (a wheel's radius; or 1)
   // The columns of the reported contacts as symbols (make_contact_force_symbols), for the
   // expressions of events; outputs may not read them (they are computed before the forces).
   std::vector<ContactForceSymbol> columns;

@@ -757,7 +757,7 @@ void MultibodyBuilder::apply() {
   for (std::size_t i = first_helper; i < constraints.size(); ++i) record->generated.push_back(constraints[i].name);
   record->internal = std::move(unit_norms);
   record_contact_forces(*record);
-  std::vector<ReportedContact> reported;  // the wheels, knife edges and rolling bodies, whose columns events may name
+  std::vector<ReportedContact> reported;  // the knife edges and rolling bodies (wheels among them), whose columns events may name
   for (const ContactPoint& c : record->contacts)
     if (c.kind == ContactKind::knife_edge || c.kind == ContactKind::rolling)
       reported.emplace_back(c.name, contact_components(c.kind, c.spin, c.axle));
@@ -802,7 +802,7 @@ void MultibodyBuilder::record_contact_forces(SpecContactForces& record) const {
     record.contacts.push_back(std::move(c));
   }
   if (gravity_) record.gravity = *gravity_;
-  double largest = 0.0;  // L, the scale of the moment rows: the largest wheel radius
+  double largest = 0.0;  // L, the scale of the moment rows: the largest contact's size
   for (const Helper& h : helpers_) {
     if (h.kind == Helper::Kind::contact)
       largest = std::max(largest, value_of(h.contact->shape->length(h.contact->values), builder_.current()).value_or(0.0));
