@@ -168,6 +168,12 @@ TEST(MultibodyBadInput, VelocitiesInPlacementsAndCoordinatesInConstants) {
   expect_error(replaced("radius = \"r\"", "radius = \"r*theta\""), {"disk.toml:32:", "radius", "coordinate 'theta'"});
 }
 
+// A coordinate in a wheel's normal: named at the key, in the wheel's words (a wheel has no ground key).
+TEST(MultibodyBadInput, ACoordinateInAWheelsNormal) {
+  expect_error(replaced("radius = \"r\"", "radius = \"r\"\nnormal = [0, \"theta\", 1]"),
+               {"disk.toml:37:10:", "wheel 'disk': plane normal:", "depends on the coordinate 'theta'"});
+}
+
 TEST(MultibodyBadInput, AWheelThatCannotTouchThePlane) {
   // The heading frame floats 1 m above the ground: n.P = 1 whatever the coordinates.
   expect_error(replaced("translation = [\"x\", \"y\", 0]", "translation = [\"x\", \"y\", 1]"),

@@ -150,7 +150,8 @@ ParsedContact parse_contact(const ContactText& text, const ContactParsers& parse
   out.ground.type = ground;
   out.ground.where = text.ground.where;
   if (text.entry == "wheel") out.ground.normal_example = "normal = [0, 0, 1]";
-  ground->parse(text.ground, p, context + ": ground", shape, out.values, out.ground);
+  // A wheel has no `ground` key: its plane's messages name the wheel (and point at its `normal`).
+  ground->parse(text.ground, p, text.entry == "wheel" ? context : context + ": ground", shape, out.values, out.ground);
 
   if (text.rolling != "rolling" && text.rolling != "rubber")
     throw_model_error(text.where, context,
