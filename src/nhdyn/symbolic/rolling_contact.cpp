@@ -470,54 +470,60 @@ RollingContact make_rolling_contact(const ParsedContact& c, const PlacedFrame& F
   return out;
 }
 
-void check_contact_watches_at_start(const Spec& spec) {
-  GiNaC::lst at = spec.parameter_values();
-  at.append(spec.symbols.time() == GiNaC::numeric(spec.t0));
-  for (std::size_t i = 0; i < spec.coordinates.size() && i < spec.q0.size(); ++i)
-    at.append(spec.symbols.coordinate(static_cast<int>(i)) == spec.q0[i].subs(spec.parameter_values()));
-  for (const SpecContactWatch& w : spec.contact_watches) {
-    if (!w.signed_root) continue;
-    double value = 0.0;
-    try {
-      const GiNaC::ex x = w.measure.subs(at).evalf();
-      if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real()) continue;
-      value = GiNaC::ex_to<GiNaC::numeric>(x).to_double();
-    } catch (const std::exception&) {
-      continue;
-    }
-    if (value >= w.threshold) continue;
-    const std::string context = fmt::format("{} '{}'", w.entry, w.contact);
-    if (value > -w.threshold)
-      throw_model_error(w.where, context,
-                        fmt::format("{} at the start ({} = {:.3g}, below {}); start it leaning less", w.reason,
-                                    w.quantity, value, w.threshold));
-    throw_model_error(w.where, context,
-                      fmt::format("at the start the wheel is turned past lying flat from its reference configuration "
-                                  "(every coordinate 0): its rim's {} is written as {}, with the sign it has there, "
-                                  "and is {:.3g} at the start, where that rim point is the highest, not the lowest. "
-                                  "Start the wheel on the side of lying flat that its reference configuration is on, "
-                                  "or place its frames so that it stands upright where the coordinates are 0",
-                                  w.quantity, contact_printed(w.measure), value));
-  }
-}
+namespace {
 
-void check_contact_convexity(const Spec& spec) {
-  if (spec.convexity.empty()) return;
-  const GiNaC::lst values = spec.parameter_values();
-  GiNaC::exmap at;
-  at[spec.symbols.time()] = GiNaC::numeric(spec.t0);
-  for (std::size_t i = 0; i < spec.coordinates.size(); ++i)
-    if (i < spec.q0.size()) at[spec.symbols.coordinate(static_cast<int>(i))] = spec.q0[i].subs(values);
-  const auto value = [&](const GiNaC::ex& e, double& out) {
+// Values of expressions in t and q where the run starts (spec.t0, spec.q0 at the parameter values):
+// what the start checks below judge.
+class StartValues {
+ public:
+  explicit StartValues(const Spec& spec) : values_(spec.parameter_values()) {
+    at_[spec.symbols.time()] = GiNaC::numeric(spec.t0);
+    for (std::size_t i = 0; i < spec.coordinates.size(); ++i)
+      if (i < spec.q0.size()) at_[spec.symbols.coordinate(static_cast<int>(i))] = spec.q0[i].subs(values_);
+  }
+  // False where e is not a finite real number there (left to the other checks).
+  bool operator()(const GiNaC::ex& e, double& out) const {
     try {
-      const GiNaC::ex x = e.subs(at, GiNaC::subs_options::no_pattern).subs(values).subs(values).evalf();
+      const GiNaC::ex x = e.subs(at_, GiNaC::subs_options::no_pattern).subs(values_).subs(values_).evalf();
       if (!GiNaC::is_a<GiNaC::numeric>(x) || !GiNaC::ex_to<GiNaC::numeric>(x).is_real()) return false;
       out = GiNaC::ex_to<GiNaC::numeric>(x).to_double();
       return std::isfinite(out);
     } catch (const std::exception&) {
       return false;
     }
-  };
+  }
+
+ private:
+  GiNaC::lst values_;
+  GiNaC::exmap at_;
+};
+
+}  // namespace
+
+void check_contact_watches_at_start(const Spec& spec) {
+  const StartValues value(spec);
+  for (const SpecContactWatch& w : spec.contact_watches) {
+    double measure = 0.0;
+    if (!w.signed_root || !value(w.measure, measure)) continue;
+    if (measure >= w.threshold) continue;
+    const std::string context = fmt::format("{} '{}'", w.entry, w.contact);
+    if (measure > -w.threshold)
+      throw_model_error(w.where, context,
+                        fmt::format("{} at the start ({} = {:.3g}, below {}); start it leaning less", w.reason,
+                                    w.quantity, measure, w.threshold));
+    throw_model_error(w.where, context,
+                      fmt::format("at the start the wheel is turned past lying flat from its reference configuration "
+                                  "(every coordinate 0): its rim's {} is written as {}, with the sign it has there, "
+                                  "and is {:.3g} at the start, where that rim point is the highest, not the lowest. "
+                                  "Start the wheel on the side of lying flat that its reference configuration is on, "
+                                  "or place its frames so that it stands upright where the coordinates are 0",
+                                  w.quantity, contact_printed(w.measure), measure));
+  }
+}
+
+void check_contact_convexity(const Spec& spec) {
+  if (spec.convexity.empty()) return;
+  const StartValues value(spec);
   for (const SpecConvexity& check : spec.convexity) {
     Eigen::Vector3d n;
     Eigen::Matrix3d body, ground;
