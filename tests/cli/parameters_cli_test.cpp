@@ -72,6 +72,29 @@ TEST(ParametersCli, RefusalsSayWhatIsWrong) {
   EXPECT_TRUE(has(broken, "rho > a")) << broken.output;
 }
 
+// A contact's size or a body's mass that a --set makes negative is refused at the line that
+// writes it (the load judged the file's values only, and a ball of radius -0.1 ran with exit 0),
+// and the run writes nothing.
+TEST(ParametersCli, SizesAndMassesMadeNegativeAreRefusedAtTheirLine) {
+  const fs::path dir = scratch_dir();
+  const std::string out = (dir / "out.csv").string();
+  const ParametersRun radius = run("simulate '" + example("ball_in_bowl.toml") + "' --set r=-0.1 -q -o '" + out + "'");
+  EXPECT_EQ(radius.code, 2) << radius.output;
+  EXPECT_TRUE(has(radius, "ball_in_bowl.toml:38:") && has(radius, "contact 'ball': sphere r") &&
+              has(radius, "\"r\" must be positive, but it is -0.1"))
+      << radius.output;
+  const ParametersRun wheel = run("simulate '" + example("whipple_bicycle.toml") + "' --set rR=-1 -q -o '" + out + "'");
+  EXPECT_EQ(wheel.code, 2) << wheel.output;
+  EXPECT_TRUE(has(wheel, "wheel 'rear': radius") && has(wheel, "\"rR\" must be positive, but it is -1")) << wheel.output;
+  const ParametersRun mass = run("simulate '" + example("ball_in_bowl.toml") + "' --set m=0 -q -o '" + out + "'");
+  EXPECT_EQ(mass.code, 2) << mass.output;
+  EXPECT_TRUE(has(mass, "body 'ball': mass") && has(mass, "\"m\" must be positive, but it is 0")) << mass.output;
+  EXPECT_FALSE(fs::exists(out));
+  const ParametersRun fine = run("simulate '" + example("ball_in_bowl.toml") + "' --set r=0.04 --t-end 0.01 -q -o '" + out + "'");
+  EXPECT_EQ(fine.code, 0) << fine.output;
+  fs::remove_all(dir);
+}
+
 TEST(ParametersCli, DerivedParameterOfAFileFollowsItsBase) {
   const fs::path dir = scratch_dir();
   const fs::path file = dir / "spring.toml";

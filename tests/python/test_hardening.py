@@ -184,3 +184,15 @@ def test_messages_name_the_python_keyword_not_the_command_line_option(oscillator
     message = str(caught.value)
     assert expected in message, message
     assert "--" not in message, message
+
+
+def test_a_size_or_mass_set_negative_is_refused_and_the_model_kept(examples):
+    m = nhdyn.load(examples / "ball_in_bowl.toml")
+    radius = m.parameters["r"]
+    with pytest.raises(nhdyn.InputError, match=r"ball_in_bowl.toml:38:.*contact 'ball': sphere r: \"r\" must be positive, but it is -0.1"):
+        m.parameters["r"] = -0.1
+    assert m.parameters["r"] == radius
+    with pytest.raises(nhdyn.InputError, match=r"body 'ball': mass: \"m\" must be positive"):
+        nhdyn.simulate_batch(m, parameters={"m": [1.0, -1.0]}, t_end=0.01)
+    m.parameters["r"] = 0.04  # a positive one is taken
+    assert m.parameters["r"] == 0.04

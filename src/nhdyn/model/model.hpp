@@ -99,6 +99,17 @@ struct ContactWatch {
   std::string entry = "contact";  // what the message calls it ("wheel" for a [[wheels]] entry)
 };
 
+// A value the model file gives that must be positive (a contact's size, a body's mass), in the
+// parameters (`value`, one output: bind it). The load judges it at the file's values; a change of
+// the parameters (--set, set_parameter) is refused where it makes one zero or negative
+// (parameters.hpp, check_positive_values), rather than running a ball of negative radius.
+struct PositiveValue {
+  std::string where;  // file:line
+  std::string what;   // "contact 'ball': sphere r"
+  std::string text;   // as written: "r"
+  Tape value;
+};
+
 struct Model {
   std::string name;
   std::string description;
@@ -116,6 +127,7 @@ struct Model {
   std::vector<bool> q0_written, v0_written;
   std::vector<ContactCoordinates> contact_coordinates;  // found at the start of every run
   std::vector<ContactWatch> contact_watches;            // a failed run looks at them
+  std::vector<PositiveValue> positive_values;           // judged at each change of the parameters
   SimulationDefaults defaults;
   std::optional<PlanarPath> path;
   // Immutable and bound to the values of `parameters`: Model copies (one per thread) share it

@@ -359,6 +359,7 @@ void bind(Model& model, std::vector<Parameter> parameters) {
   std::vector<double> values;
   values.reserve(parameters.size());
   for (const Parameter& p : parameters) values.push_back(p.value);
+  check_positive_values(model, parameters);
   std::shared_ptr<const Evaluator> evaluator = model.evaluator->with_parameters(values.data(), values.size());
   if (!evaluator)
     throw InputError(fmt::format("model '{}': its evaluator computes with fixed parameters and cannot take new values "
@@ -376,6 +377,23 @@ void bind(Model& model, std::vector<Parameter> parameters) {
 }
 
 }  // namespace
+
+void check_positive_values(const Model& model, const std::vector<Parameter>& parameters) {
+  if (model.positive_values.empty()) return;
+  std::vector<double> values;
+  values.reserve(parameters.size());
+  for (const Parameter& p : parameters) values.push_back(p.value);
+  for (const PositiveValue& check : model.positive_values) {
+    const Tape tape = check.value.reads_parameters() ? check.value.bind(values.data(), values.size()) : check.value;
+    std::vector<double> registers(static_cast<std::size_t>(tape.registers()));
+    double value = 0.0;
+    tape.run(model.t0, model.q0.data(), model.v0.data(), registers.data(), &value);
+    if (value > 0.0 && std::isfinite(value)) continue;
+    throw InputError(fmt::format("{}{}: \"{}\" must be positive, but it is {:.6g} with the parameters set; give "
+                                 "values that keep it positive",
+                                 check.where.empty() ? "" : check.where + ": ", check.what, check.text, value));
+  }
+}
 
 void set_parameter(Model& model, std::string_view name, double value) {
   std::vector<Parameter> parameters = model.parameters;

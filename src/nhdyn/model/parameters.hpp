@@ -71,6 +71,10 @@ void set_parameter_expression(Model& model, std::string_view name, std::string_v
 // Each "NAME=EXPR" of `sets` in turn (the command line's --set), then one re-binding.
 void apply_parameter_sets(Model& model, const std::vector<std::string>& sets);
 
+// Throws InputError, naming the file's line, the entry and its text, where one of
+// model.positive_values is not positive at `parameters` (a --set r=-0.1 of a ball's radius).
+void check_positive_values(const Model& model, const std::vector<Parameter>& parameters);
+
 // Re-binds `model`'s evaluator to the values of model.parameters (after re-evaluating the derived
 // ones) and re-evaluates its initial state; what set_parameter does after changing a value.
 void rebind_parameters(Model& model);

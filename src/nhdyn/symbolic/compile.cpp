@@ -1193,6 +1193,8 @@ void compile_contact_coordinates(const Spec& spec, Model& model) {
                                      compile_expression(spec, w.measure, fmt::format("{} '{}'", w.entry, w.contact)),
                                      w.threshold, w.reason, w.quantity, w.every_step, w.touching_only,
                                      w.free_only, w.entry});
+  for (const SpecPositive& v : spec.positive_values)
+    model.positive_values.push_back({v.where.describe(), v.what, v.text, compile_expression(spec, v.value, v.what)});
 }
 
 }  // namespace
@@ -1235,6 +1237,7 @@ Model compile_model(const Spec& spec, const Derivation& derivation, const Compil
   compile_contact_modes(spec, model);
   compile_events(spec, model);
   check_model_shape(model);
+  check_positive_values(model, model.parameters);  // after a --set (the load judged the file's values)
   return model;
 }
 

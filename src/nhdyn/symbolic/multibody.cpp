@@ -316,6 +316,7 @@ MultibodyBuilder& MultibodyBuilder::body(const std::string& name, const std::str
   if (!m || !(*m > 0.0))
     throw_model_error(where, context + ": mass",
          fmt::format("the mass \"{}\" must be a positive number, but it is {}", mass, m ? fmt::format("{}", *m) : "not a number"));
+  builder_.positive_value(SpecPositive{where, context + ": mass", mass, b.mass});
   b.com = parse(centre_of_mass, where, context + ": centre of mass", false);
   b.inertia = GiNaC::matrix(3, 3);
   double I[3][3];
@@ -657,6 +658,7 @@ void MultibodyBuilder::add_contact(const Helper& h) {
   if (contact.convexity) builder_.convexity(std::move(*contact.convexity));
   if (contact.added) builder_.contact_coordinates(std::move(*contact.added));
   for (SpecContactWatch& watch : contact.watches) builder_.contact_watch(std::move(watch));
+  for (const SpecPositive& size : h.contact->positive) builder_.positive_value(size);
   contact.force.system = system_of(body.frame);
   contacts_.push_back(std::move(contact.force));
   if (h.mode) {

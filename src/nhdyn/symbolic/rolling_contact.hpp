@@ -95,6 +95,7 @@ struct ParsedContact {
   int body = -1;
   const ContactShape* shape = nullptr;
   ShapeValues values;
+  std::vector<SpecPositive> positive;  // its sizes, judged again when the parameters change
   Vector3 centre = {0, 0, 0};  // the shape's centre in the body frame's axes
   ParsedGround ground;
   bool rubber = false;

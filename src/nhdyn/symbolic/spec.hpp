@@ -181,6 +181,17 @@ struct SpecContactWatch {
   bool signed_root = false;
 };
 
+// A value the file gives that must be positive (a contact's size, a body's mass): the load judges
+// it at the file's values, and the model keeps it (Model::positive_values) to judge it again
+// whenever the parameters change (--set, set_parameter), where a negative radius would otherwise
+// run.
+struct SpecPositive {
+  SourceLocation where;
+  std::string what;  // what the message names: "contact 'ball': sphere r"
+  std::string text;  // as written: "r"
+  GiNaC::ex value;   // in the parameters
+};
+
 struct Spec {
   std::string name;
   std::string description;
@@ -203,6 +214,7 @@ struct Spec {
   std::vector<bool> q0_written, v0_written;
   std::vector<SpecContactCoordinates> contact_coordinates;  // found at the start, not written
   std::vector<SpecContactWatch> contact_watches;  // checked where a run fails (model.hpp)
+  std::vector<SpecPositive> positive_values;      // judged again at each change of the parameters
   // Optional exact motion q(t) from the initial state, n expressions in t and the parameters
   // (empty when the model gives none); compare --reference analytic measures runs against it.
   std::vector<GiNaC::ex> solution;

@@ -111,6 +111,11 @@ class SpecBuilder {
     spec_.contact_watches.push_back(std::move(watch));
     return *this;
   }
+  // A value that must stay positive whatever the parameters become (spec.hpp).
+  SpecBuilder& positive_value(SpecPositive value) {
+    spec_.positive_values.push_back(std::move(value));
+    return *this;
+  }
   // Derived outputs (docs/model-format.md, [outputs]; symbolic/outputs.hpp): a named expression
   // in t, q, q', q'', the reactions R_x, the parameters and the outputs declared before it, that
   // becomes a column of the results. Its name must be a new name (not a coordinate, parameter,
