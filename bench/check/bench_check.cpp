@@ -19,6 +19,13 @@
 //                                        small model, whose right-hand side is cheapest
 //   bicycle_watch_on_vs_off_compiled     the bicycle's 10 s run as above (1001 rows, compiled
 //                                        evaluator, nothing written), with the watch over without
+//   rattleback_rhs_compiled_vs_hand_written   one right-hand side of examples/rattleback.toml
+//                                        (compute_dynamics, compiled) over the same equations written
+//                                        by hand (check/rattleback_stacked.hpp: the same coordinates,
+//                                        A, b, b0, Q + G by vector mechanics, an analytic D, a fixed-
+//                                        size 6 x 6 LU), at the example's start; the two q'' are
+//                                        compared first (1e-12)
+//   rattleback_rhs_interpreted_vs_hand_written  the same, interpreted
 // The compiled object comes from the compiled evaluator's cache ($XDG_CACHE_HOME/nhdyn), so only
 // the first run on a machine pays the compiler.
 //   nhdyn_bench_check EXAMPLES_DIR [PAIRS [FILTER]]   (PAIRS: pairs per ratio, default 7; FILTER:
@@ -45,6 +52,7 @@
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/model/output.hpp"
+#include "rattleback_stacked.hpp"
 
 namespace {
 
@@ -101,7 +109,7 @@ void rhs_loop(const Model& model, Data& data, long calls) {
   const FormulationOptions options{Formulation::sanh, Complement::qr};
   for (long i = 0; i < calls; ++i) {
     if (compute_dynamics(model, data, options, 0.0, model.q0.data(), model.v0.data()) != Status::ok) {
-      std::fprintf(stderr, "bench-check: compute_dynamics failed on the bicycle\n");
+      std::fprintf(stderr, "bench-check: compute_dynamics failed on %s\n", model.name.c_str());
       std::exit(1);
     }
   }
@@ -142,6 +150,27 @@ void run_watched(const Model& model, double t_end, double output_step, double rt
   const SimulationSummary summary = simulate(model, options, [](const Data&) {});
   if (summary.status != Status::ok) {
     std::fprintf(stderr, "bench-check: the run of %s failed: %s\n", model.name.c_str(), summary.message.c_str());
+    std::exit(1);
+  }
+}
+
+// The hand-written rattleback at the model's start, `calls` times; first (check) its q'' against
+// nhdyn's, so that the yardstick cannot drift from the model.
+void hand_written_loop(const Model& model, long calls, bool check) {
+  const bench::RattlebackParameters p;
+  bench::Vector6 qdd, reaction;
+  for (long i = 0; i < calls; ++i)
+    if (!bench::rattleback_stacked(p, model.q0.data(), model.v0.data(), qdd, reaction)) {
+      std::fprintf(stderr, "bench-check: the hand-written rattleback is singular at the start\n");
+      std::exit(1);
+    }
+  if (!check) return;
+  Data data = make_data(model);
+  if (compute_dynamics(model, data, {Formulation::sanh, Complement::qr}, 0.0, model.q0.data(), model.v0.data()) !=
+          Status::ok ||
+      !((data.qdd - qdd).norm() <= 1e-12 * (1.0 + qdd.norm()))) {
+    std::fprintf(stderr, "bench-check: the hand-written rattleback's q'' differs from nhdyn's by %g\n",
+                 (data.qdd - qdd).norm());
     std::exit(1);
   }
 }
@@ -216,6 +245,15 @@ int main(int argc, char** argv) {
          [&] { run_watched(sled, 200.0, 0.1, 1e-8, 1e-10, false); });
     pair("bicycle_watch_on_vs_off_compiled", pairs, [&] { run_watched(compiled, 10.0, 0.01, 1e-10, 1e-12, true); },
          [&] { run_watched(compiled, 10.0, 0.01, 1e-10, 1e-12, false); });
+
+    const Model rattleback = load_model((examples / "rattleback.toml").string());
+    const Model rattleback_compiled = jit::make_compiled(rattleback);
+    hand_written_loop(rattleback, 1, true);
+    Data dr = make_data(rattleback), drc = make_data(rattleback_compiled);
+    pair("rattleback_rhs_compiled_vs_hand_written", pairs, [&] { rhs_loop(rattleback_compiled, drc, 50000); },
+         [&] { hand_written_loop(rattleback, 50000, false); });
+    pair("rattleback_rhs_interpreted_vs_hand_written", pairs, [&] { rhs_loop(rattleback, dr, 50000); },
+         [&] { hand_written_loop(rattleback, 50000, false); });
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench-check: %s\n", e.what());
     return 1;

@@ -69,20 +69,24 @@ bool null_space_basis(const double* b, double* D) {
         for (int i = j + 1; i < N; ++i) w[i] -= d * v[i];
       }
     }
-    // Column s + r of Q = H_1 ... H_s e_{s+r}: apply the reflectors from the last to the first.
-    for (int r = 0; r < K; ++r) {
-      std::array<double, N> y{};
-      y[S + r] = 1.0;
-      for (int j = S - 1; j >= 0; --j) {
-        const double* v = bt.data() + N * j;
-        double d = y[j];
-        for (int i = j + 1; i < N; ++i) d += v[i] * y[i];
+    // Column s + r of Q = H_1 ... H_s e_{s+r}: the reflectors applied from the last to the first,
+    // each to the k columns in turn, so that the k independent chains of dependent operations
+    // overlap (the same operations as one column after the other, in a different order).
+    std::array<double, N * K> y{};
+    for (int r = 0; r < K; ++r) y[S + r + N * r] = 1.0;
+    for (int j = S - 1; j >= 0; --j) {
+      const double* v = bt.data() + N * j;
+      for (int r = 0; r < K; ++r) {
+        double* yr = y.data() + N * r;
+        double d = yr[j];
+        for (int i = j + 1; i < N; ++i) d += v[i] * yr[i];
         d *= tau[j];
-        y[j] -= d;
-        for (int i = j + 1; i < N; ++i) y[i] -= d * v[i];
+        yr[j] -= d;
+        for (int i = j + 1; i < N; ++i) yr[i] -= d * v[i];
       }
-      for (int i = 0; i < N; ++i) D[r + K * i] = y[i];
     }
+    for (int r = 0; r < K; ++r)
+      for (int i = 0; i < N; ++i) D[r + K * i] = y[i + N * r];
     return true;
   }
 }
@@ -105,13 +109,18 @@ bool eliminate(std::array<double, N * N>& M, std::array<double, N>& r) {
     largest = std::max(largest, std::abs(pivot));
     smallest = std::min(smallest, std::abs(pivot));
     if (pivot == 0.0) return false;
-    for (int i = c + 1; i < N; ++i) {
-      // A division, not a product with 1/pivot: a row equal to the pivot row then has l = 1
-      // exactly and cancels to zero, so that dependent rows are found singular as Eigen finds them.
-      const double l = M[i + N * c] / pivot;
-      for (int j = c + 1; j < N; ++j) M[i + N * j] -= l * M[c + N * j];
-      r[i] -= l * r[c];
+    // A division, not a product with 1/pivot: a row equal to the pivot row then has l = 1 exactly
+    // and cancels to zero, so that dependent rows are found singular as Eigen finds them. The
+    // multipliers are kept in the pivot's column, and the update runs down the columns (storage
+    // order): the same operations as row by row, in an order the compiler vectorizes.
+    double* l = M.data() + N * c;
+    for (int i = c + 1; i < N; ++i) l[i] /= pivot;
+    for (int j = c + 1; j < N; ++j) {
+      double* column = M.data() + N * j;
+      const double above = column[c];
+      for (int i = c + 1; i < N; ++i) column[i] -= l[i] * above;
     }
+    for (int i = c + 1; i < N; ++i) r[i] -= l[i] * r[c];
   }
   return smallest > largest * kEps * N;
 }
