@@ -8,6 +8,8 @@
 #
 # Defaults: build, N = 100 1000 10000. Target (issue 12): N = 10 000 in 10 s or less.
 set -eu
+# A first run's figures: the derivation made at every load (the cache of derived models off).
+export NHDYN_DERIVATION_CACHE=off
 build=${1:-build}
 [ $# -ge 1 ] && shift
 sizes=${*:-100 1000 10000}

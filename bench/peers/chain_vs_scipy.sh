@@ -9,6 +9,8 @@
 #
 # Defaults: build, 1, N = 10 30 100 300 1000. Uses /usr/bin/python3 (python3-scipy, python3-numpy).
 set -eu
+# A first run's figures: the derivation made at every load (the cache of derived models off).
+export NHDYN_DERIVATION_CACHE=off
 build=${1:-build}
 t_end=${2:-1}
 [ $# -ge 2 ] && shift 2 || shift $#

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/frontend/detail/derivation_cache.hpp"
 #include "nhdyn/frontend/model_file.hpp"
 #include "nhdyn/io/results.hpp"
 #include "nhdyn/model/builtin.hpp"
@@ -46,6 +47,14 @@ symbolic::Spec load_spec(const ModelSource& source, const ParameterOverrides& ov
   // The contact points nhdyn added, found again at the parameters set here.
   if (!overrides.empty()) symbolic::solve_contact_coordinates(spec);
   return spec;
+}
+
+// The description of a model file's model, with the store that keeps its derivation between
+// processes (detail/derivation_cache.hpp).
+std::shared_ptr<const symbolic::ModelDescription> describe(const ModelSource& source,
+                                                           const ParameterOverrides& overrides) {
+  return std::make_shared<const symbolic::ModelDescription>(
+      load_spec(source, overrides), detail::make_derivation_store(source.text, override_sets(overrides)));
 }
 
 // A built-in model has no Spec: refused with the path of its model file (and, when `what` is
@@ -86,7 +95,7 @@ LoadedModel load_model_described(const ModelSource& source, const ParameterOverr
     apply_parameter_sets(model, override_sets(overrides));  // parameters are data: no recompilation
     return {std::move(model), nullptr};
   }
-  auto description = std::make_shared<const symbolic::ModelDescription>(load_spec(source, overrides));
+  auto description = describe(source, overrides);
   Model model = description->compile();
   make_result_columns(model);  // refuses a derived output named like another column, at load time
   return {std::move(model), std::move(description)};
@@ -99,7 +108,7 @@ LoadedModel load_model_argument(const std::string& source, const std::vector<std
 std::shared_ptr<const symbolic::ModelDescription> load_description(const ModelSource& source,
                                                                    const ParameterOverrides& overrides) {
   require_file(source);
-  return std::make_shared<const symbolic::ModelDescription>(load_spec(source, overrides));
+  return describe(source, overrides);
 }
 
 Model load_model(const ModelSource& source, const ParameterOverrides& overrides) {

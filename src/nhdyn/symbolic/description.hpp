@@ -13,8 +13,10 @@
 // throws (a [visual] size that depends on q) leaves nothing cached and throws again next time.
 #pragma once
 
+#include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 
 #include "nhdyn/model/model.hpp"
 #include "nhdyn/symbolic/compile.hpp"
@@ -24,15 +26,34 @@
 
 namespace nhdyn::symbolic {
 
+// Where a derivation is kept between loads of the same model (frontend/detail/derivation_cache.hpp:
+// a file in the user's cache). Without one, every load derives.
+class DerivationStore {
+ public:
+  virtual ~DerivationStore() = default;
+  // The bytes kept for this model (archive_derivation), if any.
+  virtual std::optional<std::string> read() const = 0;
+  // Whether a derivation that took `seconds` for `coordinates` coordinates is worth keeping
+  // (asked before it is archived: the archive costs time too).
+  virtual bool wants(double seconds, int coordinates) const = 0;
+  // Keeps them for the next load; a store that cannot write keeps nothing and says nothing.
+  virtual void write(const std::string& bytes) const = 0;
+};
+
 class ModelDescription {
  public:
-  explicit ModelDescription(Spec spec) : spec_(std::move(spec)) {}
+  explicit ModelDescription(Spec spec, std::shared_ptr<const DerivationStore> store = nullptr)
+      : spec_(std::move(spec)), store_(std::move(store)) {}
   ModelDescription(const ModelDescription&) = delete;
   ModelDescription& operator=(const ModelDescription&) = delete;
 
   const Spec& spec() const { return spec_; }
   // derive(spec()), the first call derives (its cost: docs/performance.md), later ones return it.
+  // With a store, the first call reads the derivation kept there instead when the store has one
+  // that reads back (derivation_archive.hpp), and keeps the one it derives otherwise.
   const Derivation& derivation() const;
+  // Whether derivation() read its derivation from the store (false before the first call).
+  bool derivation_was_stored() const { return read_from_store_; }
   // compile_visual(spec()), compiled on first use; throws as compile_visual.
   const VisualScene& scene() const;
   // compile_model(spec(), derivation(), options): the derivation is the one kept here.
@@ -40,6 +61,8 @@ class ModelDescription {
 
  private:
   Spec spec_;
+  std::shared_ptr<const DerivationStore> store_;
+  mutable bool read_from_store_ = false;
   mutable std::once_flag derived_;
   mutable std::optional<Derivation> derivation_;
   mutable std::once_flag drawn_;

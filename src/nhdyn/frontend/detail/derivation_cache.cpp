@@ -1,0 +1,191 @@
+#include "nhdyn/frontend/detail/derivation_cache.hpp"
+
+#include <dlfcn.h>
+#include <elf.h>
+#include <link.h>
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <optional>
+#include <sstream>
+#include <system_error>
+
+#include "nhdyn/symbolic/description.hpp"
+
+namespace nhdyn::detail {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kHeader = "nhdyn-derivation-cache 1";
+
+std::uint64_t fnv1a(const std::string& s, std::uint64_t h) {
+  for (unsigned char ch : s) {
+    h ^= ch;
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+std::string env(const char* name) {
+  const char* value = std::getenv(name);
+  return value ? value : "";
+}
+
+std::optional<fs::path> cache_directory() {
+  const std::string xdg = env("XDG_CACHE_HOME");
+  if (!xdg.empty()) return fs::path(xdg) / "nhdyn" / "derivations";
+  const std::string home = env("HOME");
+  if (home.empty()) return std::nullopt;
+  return fs::path(home) / ".cache" / "nhdyn" / "derivations";
+}
+
+void trim(const fs::path& dir);
+
+// The file's whole content: the header, the key's length and the key, then the archive.
+class FileStore final : public symbolic::DerivationStore {
+ public:
+  FileStore(fs::path file, std::string key, bool always)
+      : file_(std::move(file)), key_(std::move(key)), always_(always) {}
+
+  // A derivation that took at least 1 ms per coordinate: a model with rolling contacts or a
+  // long chain of frames (the bicycle, 70 ms per coordinate; the rattleback, 8) reads back in a
+  // fraction of that, while a large model of simple bodies (the 1000-body chain, 0.1 ms per
+  // coordinate) derives about as fast as its archive is written and read, and writing it would
+  // slow its first run by a fifth.
+  bool wants(double seconds, int coordinates) const override {
+    return always_ || seconds >= 1e-3 * std::max(coordinates, 1);
+  }
+
+  std::optional<std::string> read() const override {
+    std::ifstream in(file_, std::ios::binary);
+    if (!in) return std::nullopt;
+    std::string line;
+    std::size_t size = 0;
+    if (!std::getline(in, line) || line != kHeader || !(in >> size) || in.get() != '\n' || size != key_.size())
+      return std::nullopt;
+    std::string key(size, '\0');
+    if (!in.read(key.data(), static_cast<std::streamsize>(size)) || key != key_) return std::nullopt;
+    std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    std::error_code error;
+    fs::last_write_time(file_, fs::file_time_type::clock::now(), error);  // used: the last to go
+    return bytes;
+  }
+
+  void write(const std::string& bytes) const override {
+    static std::atomic<unsigned> counter{0};
+    std::error_code error;
+    fs::create_directories(file_.parent_path(), error);
+    if (error) return;
+    const fs::path temporary =
+        file_.parent_path() / fmt::format(".{}.{}-{}.tmp", file_.filename().string(), ::getpid(), counter++);
+    {
+      std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+      out << kHeader << '\n' << key_.size() << '\n' << key_ << bytes;
+      out.flush();
+      if (!out) {
+        fs::remove(temporary, error);
+        return;
+      }
+    }
+    fs::rename(temporary, file_, error);
+    if (error) fs::remove(temporary, error);
+    trim(file_.parent_path());
+  }
+
+ private:
+  fs::path file_;
+  std::string key_;
+  bool always_;
+};
+
+// At most kMostFiles derivations: beyond, the least recently used go (a shell loop over --set
+// values makes one file per value).
+constexpr std::size_t kMostFiles = 200;
+
+void trim(const fs::path& dir) {
+  std::error_code error;
+  std::vector<std::pair<fs::file_time_type, fs::path>> files;
+  for (fs::directory_iterator it(dir, error), end; !error && it != end; it.increment(error))
+    if (it->path().extension() == ".derivation") {
+      const fs::file_time_type time = fs::last_write_time(it->path(), error);
+      if (!error) files.emplace_back(time, it->path());
+    }
+  if (files.size() <= kMostFiles) return;
+  std::sort(files.begin(), files.end());
+  for (std::size_t i = 0; i < files.size() - kMostFiles * 3 / 4; ++i) fs::remove(files[i].second, error);
+}
+
+// dl_iterate_phdr's walk: the object whose loaded segments hold `address`, and its build-id note.
+struct BuildIdSearch {
+  std::uintptr_t address = 0;
+  std::string id;
+};
+
+int find_build_id(dl_phdr_info* info, std::size_t, void* data) {
+  auto* search = static_cast<BuildIdSearch*>(data);
+  bool holds = false;
+  for (int i = 0; i < info->dlpi_phnum && !holds; ++i) {
+    const ElfW(Phdr)& p = info->dlpi_phdr[i];
+    const std::uintptr_t start = info->dlpi_addr + p.p_vaddr;
+    holds = p.p_type == PT_LOAD && search->address >= start && search->address < start + p.p_memsz;
+  }
+  if (!holds) return 0;
+  for (int i = 0; i < info->dlpi_phnum; ++i) {
+    const ElfW(Phdr)& p = info->dlpi_phdr[i];
+    if (p.p_type != PT_NOTE) continue;
+    const auto* at = reinterpret_cast<const unsigned char*>(info->dlpi_addr + p.p_vaddr);
+    const unsigned char* end = at + p.p_memsz;
+    while (at + sizeof(ElfW(Nhdr)) <= end) {
+      ElfW(Nhdr) note;
+      std::memcpy(&note, at, sizeof note);
+      const unsigned char* name = at + sizeof note;
+      const unsigned char* desc = name + ((note.n_namesz + 3) & ~3U);
+      if (desc + note.n_descsz > end) break;
+      if (note.n_type == NT_GNU_BUILD_ID && note.n_namesz == 4 && std::memcmp(name, "GNU", 4) == 0) {
+        for (unsigned k = 0; k < note.n_descsz; ++k) search->id += fmt::format("{:02x}", desc[k]);
+        return 1;
+      }
+      at = desc + ((note.n_descsz + 3) & ~3U);
+    }
+  }
+  return 1;  // the object, without a build-id
+}
+
+}  // namespace
+
+std::string build_identity() {
+  static const std::string id = [] {
+    BuildIdSearch search;
+    search.address = reinterpret_cast<std::uintptr_t>(&find_build_id);
+    dl_iterate_phdr(find_build_id, &search);
+    return search.id;
+  }();
+  return id;
+}
+
+std::shared_ptr<const symbolic::DerivationStore> make_derivation_store(const std::string& text,
+                                                                       const std::vector<std::string>& sets) {
+  const std::string setting = env("NHDYN_DERIVATION_CACHE");
+  if (setting == "off" || setting == "0") return nullptr;
+  const std::string id = build_identity();
+  const std::optional<fs::path> dir = cache_directory();
+  if (id.empty() || !dir) return nullptr;
+  std::string key = "build " + id + "\n";
+  for (const std::string& set : sets) key += "set " + set + "\n";
+  key += "text\n" + text;
+  const std::string name = fmt::format("{:016x}{:016x}.derivation", fnv1a(key, 0xcbf29ce484222325ULL),
+                                       fnv1a(key, 0x84222325cbf29ce4ULL));
+  return std::make_shared<FileStore>(*dir / name, std::move(key), setting == "always");
+}
+
+}  // namespace nhdyn::detail

@@ -1,0 +1,213 @@
+#include "nhdyn/symbolic/derivation_archive.hpp"
+
+#include <cstdint>
+#include <cstdio>
+#include <set>
+#include <sstream>
+#include <unordered_set>
+
+namespace nhdyn::symbolic {
+namespace {
+
+constexpr const char* kMagic = "nhdyn-derivation-archive 2";
+
+// Every field as a sequence: a 1 x (1 + length) GiNaC matrix whose first entry is the length.
+// A matrix, not GiNaC's lst (a linked list, whose hash the archive takes of every node by op(i),
+// in quadratic time) nor exprseq (which libginac cannot read back). A matrix field is the
+// sequence {rows, cols, entries by row}; an ExMatrix keeps the entries it set, as {rows, cols,
+// r, c, entry, r, c, entry, ...}; an optional is a sequence of none or one.
+GiNaC::ex sequence(const std::vector<GiNaC::ex>& items) {
+  GiNaC::matrix m(1, static_cast<unsigned>(items.size() + 1));
+  m(0, 0) = static_cast<long>(items.size());
+  for (std::size_t i = 0; i < items.size(); ++i) m(0, static_cast<unsigned>(i + 1)) = items[i];
+  return m;
+}
+
+GiNaC::ex pack(const GiNaC::matrix& m) {
+  std::vector<GiNaC::ex> out{m.rows(), m.cols()};
+  for (unsigned r = 0; r < m.rows(); ++r)
+    for (unsigned c = 0; c < m.cols(); ++c) out.push_back(m(r, c));
+  return sequence(out);
+}
+
+GiNaC::ex pack(const ExMatrix& m) {
+  std::vector<GiNaC::ex> out{m.rows(), m.cols()};
+  for (unsigned c = 0; c < m.cols(); ++c)
+    for (const auto& [r, entry] : m.column(c)) {
+      out.push_back(r);
+      out.push_back(c);
+      out.push_back(entry);
+    }
+  return sequence(out);
+}
+
+GiNaC::ex pack(const std::vector<GiNaC::ex>& v) { return sequence(v); }
+
+GiNaC::ex pack(const std::optional<GiNaC::ex>& e) {
+  return e ? sequence({*e}) : sequence({});
+}
+
+// Two FNV-1a hashes of `bytes` (128 bits, hex): what tells a whole archive from a damaged one.
+std::string checksum(const std::string& bytes) {
+  std::uint64_t h1 = 0xcbf29ce484222325ULL, h2 = 0x84222325cbf29ce4ULL;
+  for (unsigned char ch : bytes) {
+    h1 = (h1 ^ ch) * 0x100000001b3ULL;
+    h2 = (h2 ^ ch) * 0x100000001b3ULL;
+  }
+  char text[33];
+  std::snprintf(text, sizeof text, "%016llx%016llx", static_cast<unsigned long long>(h1),
+                static_cast<unsigned long long>(h2));
+  return text;
+}
+
+// Unpacking throws std::runtime_error on a shape that is not one pack() writes.
+unsigned count(const GiNaC::ex& e) {
+  if (!GiNaC::is_a<GiNaC::numeric>(e) || !GiNaC::ex_to<GiNaC::numeric>(e).is_nonneg_integer())
+    throw std::runtime_error("a size is not a whole number");
+  return static_cast<unsigned>(GiNaC::ex_to<GiNaC::numeric>(e).to_int());
+}
+
+// A sequence's elements.
+std::vector<GiNaC::ex> as_list(const GiNaC::ex& e) {
+  if (!GiNaC::is_a<GiNaC::matrix>(e)) throw std::runtime_error("not a sequence");
+  const GiNaC::matrix& m = GiNaC::ex_to<GiNaC::matrix>(e);
+  if (m.rows() != 1 || m.cols() < 1 || count(m(0, 0)) + 1 != m.cols()) throw std::runtime_error("not a sequence");
+  std::vector<GiNaC::ex> items;
+  items.reserve(m.cols() - 1);
+  for (unsigned i = 1; i < m.cols(); ++i) items.push_back(m(0, i));
+  return items;
+}
+
+GiNaC::matrix unpack_matrix(const GiNaC::ex& e) {
+  const std::vector<GiNaC::ex> l = as_list(e);
+  if (l.size() < 2) throw std::runtime_error("a matrix without its size");
+  const unsigned rows = count(l[0]), cols = count(l[1]);
+  if (l.size() != 2 + static_cast<std::size_t>(rows) * cols) throw std::runtime_error("a matrix of the wrong size");
+  GiNaC::matrix m(rows, cols);
+  for (unsigned r = 0; r < rows; ++r)
+    for (unsigned c = 0; c < cols; ++c) m(r, c) = l[2 + static_cast<std::size_t>(r) * cols + c];
+  return m;
+}
+
+ExMatrix unpack_ex_matrix(const GiNaC::ex& e) {
+  const std::vector<GiNaC::ex> l = as_list(e);
+  if (l.size() < 2 || (l.size() - 2) % 3 != 0) throw std::runtime_error("a sparse matrix of the wrong shape");
+  ExMatrix m(count(l[0]), count(l[1]));
+  for (std::size_t i = 2; i < l.size(); i += 3) {
+    const unsigned r = count(l[i]), c = count(l[i + 1]);
+    if (r >= m.rows() || c >= m.cols()) throw std::runtime_error("an entry outside its matrix");
+    m(r, c) = l[i + 2];
+  }
+  return m;
+}
+
+std::vector<GiNaC::ex> unpack_vector(const GiNaC::ex& e) { return as_list(e); }
+
+std::optional<GiNaC::ex> unpack_optional(const GiNaC::ex& e) {
+  const std::vector<GiNaC::ex> l = as_list(e);
+  if (l.size() > 1) throw std::runtime_error("an optional of more than one");
+  return l.size() == 1 ? std::optional<GiNaC::ex>(l[0]) : std::nullopt;
+}
+
+// The names of the symbols in `e`, each shared subexpression visited once.
+using Seen = std::unordered_set<GiNaC::ex, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
+
+void collect_symbols(const GiNaC::ex& e, Seen& seen, std::set<std::string>& names) {
+  if (e.nops() > 0 && !seen.insert(e).second) return;
+  if (GiNaC::is_a<GiNaC::symbol>(e)) {
+    names.insert(GiNaC::ex_to<GiNaC::symbol>(e).get_name());
+    return;
+  }
+  for (std::size_t i = 0; i < e.nops(); ++i) collect_symbols(e.op(i), seen, names);
+}
+
+// The fields in one order, as (name, packed expression).
+std::vector<std::pair<const char*, GiNaC::ex>> fields(const Derivation& d) {
+  return {{"A", pack(d.A)},
+          {"Q", pack(d.Q)},
+          {"G", pack(d.G)},
+          {"b", pack(d.b)},
+          {"b0", pack(d.b0)},
+          {"D", d.D ? sequence({pack(*d.D)}) : sequence({})},
+          {"phi", pack(d.phi)},
+          {"f", pack(d.f)},
+          {"b_p", pack(d.b_p)},
+          {"b_p0", pack(d.b_p0)},
+          {"B", pack(d.B)},
+          {"phi_p", pack(d.phi_p)},
+          {"f_p", pack(d.f_p)},
+          {"energy", pack(d.energy)},
+          {"energy_function", pack(d.energy_function)},
+          {"power_forces", d.power_forces},
+          {"power_time", d.power_time},
+          {"conservative", GiNaC::numeric(d.conservative ? 1 : 0)}};
+}
+
+}  // namespace
+
+std::string archive_derivation(const Derivation& derivation) {
+  GiNaC::archive archive;
+  Seen seen;
+  std::set<std::string> names;
+  for (const auto& [name, e] : fields(derivation)) {
+    collect_symbols(e, seen, names);
+    archive.archive_ex(e, name);
+  }
+  std::ostringstream body;
+  body << names.size() << '\n';
+  for (const std::string& name : names) body << name << '\n';
+  body << archive;
+  return std::string(kMagic) + "\n" + checksum(body.str()) + "\n" + body.str();
+}
+
+std::optional<Derivation> unarchive_derivation(const std::string& bytes, const SymbolTable& symbols) {
+  try {
+    // GiNaC's reader trusts its input (a count altered in a damaged file can make it read on
+    // forever), so the bytes are checked whole before it sees them.
+    const std::string magic = std::string(kMagic) + "\n";
+    if (bytes.compare(0, magic.size(), magic) != 0) return std::nullopt;
+    const std::size_t end = bytes.find('\n', magic.size());
+    if (end == std::string::npos) return std::nullopt;
+    const std::string body = bytes.substr(end + 1);
+    if (bytes.compare(magic.size(), end - magic.size(), checksum(body)) != 0) return std::nullopt;
+    std::istringstream in(body);
+    std::string line;
+    std::size_t n = 0;
+    if (!(in >> n) || !std::getline(in, line) || !line.empty() || n > bytes.size()) return std::nullopt;
+    GiNaC::lst known;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!std::getline(in, line)) return std::nullopt;
+      const std::optional<GiNaC::symbol> s = symbols.find(line);
+      if (!s) return std::nullopt;  // a symbol of another model: reading would make a new one
+      known.append(*s);
+    }
+    GiNaC::archive archive;
+    in >> archive;
+    if (!in) return std::nullopt;
+    const auto read = [&](const char* name) { return archive.unarchive_ex(known, name); };
+    Derivation d;
+    d.A = unpack_ex_matrix(read("A"));
+    d.Q = unpack_matrix(read("Q"));
+    d.G = unpack_matrix(read("G"));
+    d.b = unpack_ex_matrix(read("b"));
+    d.b0 = unpack_matrix(read("b0"));
+    if (const std::vector<GiNaC::ex> D = as_list(read("D")); D.size() == 1) d.D = unpack_matrix(D[0]);
+    d.phi = unpack_vector(read("phi"));
+    d.f = unpack_vector(read("f"));
+    d.b_p = unpack_matrix(read("b_p"));
+    d.b_p0 = unpack_matrix(read("b_p0"));
+    d.B = unpack_matrix(read("B"));
+    d.phi_p = unpack_vector(read("phi_p"));
+    d.f_p = unpack_vector(read("f_p"));
+    d.energy = unpack_optional(read("energy"));
+    d.energy_function = unpack_optional(read("energy_function"));
+    d.power_forces = read("power_forces");
+    d.power_time = read("power_time");
+    d.conservative = !read("conservative").is_zero();
+    return d;
+  } catch (const std::exception&) {
+    return std::nullopt;  // not an archive GiNaC reads, or not of this shape
+  }
+}
+
+}  // namespace nhdyn::symbolic

@@ -1,0 +1,24 @@
+// A Derivation as bytes and back (GiNaC's archive format), so that a model loaded again need not
+// be derived again (frontend/derivation_cache.hpp keeps the bytes between processes). Reading
+// links every symbol to the one of the Spec's SymbolTable with its name, so that the expressions
+// read are the ones derive() made: compile_model turns them into the same tapes, and a run from a
+// derivation read back gives the same bytes as one from a derivation just made.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "nhdyn/symbolic/derivation.hpp"
+#include "nhdyn/symbolic/spec.hpp"
+
+namespace nhdyn::symbolic {
+
+// The bytes of `derivation`: a checksum, the names of the symbols it uses, then GiNaC's archive.
+std::string archive_derivation(const Derivation& derivation);
+
+// The derivation of `bytes`, its symbols those of `symbols`; std::nullopt when the bytes are not
+// a whole derivation archive (damaged or cut short: the checksum) or use a symbol `symbols` does
+// not know (a derivation of another model).
+std::optional<Derivation> unarchive_derivation(const std::string& bytes, const SymbolTable& symbols);
+
+}  // namespace nhdyn::symbolic

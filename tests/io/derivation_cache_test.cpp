@@ -1,0 +1,214 @@
+// The derivation kept between processes (symbolic/derivation_archive.hpp,
+// frontend/detail/derivation_cache.hpp): a derivation read back equals the one derived, entry by
+// entry, and compiles to a model that computes the same numbers to the bit; bytes of another model
+// or damaged bytes are refused; the cache file is used on the second load of the same text and
+// --set values, not on another, and is replaced when it does not read back.
+#include <gtest/gtest.h>
+
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "nhdyn/formulation/formulation.hpp"
+#include "nhdyn/frontend/detail/derivation_cache.hpp"
+#include "nhdyn/frontend/load_model.hpp"
+#include "nhdyn/frontend/model_file.hpp"
+#include "nhdyn/model/data.hpp"
+#include "nhdyn/symbolic/compile.hpp"
+#include "nhdyn/symbolic/description.hpp"
+#include "nhdyn/symbolic/derivation_archive.hpp"
+#include "support/text.hpp"
+
+namespace nhdyn {
+namespace {
+
+namespace fs = std::filesystem;
+using symbolic::Derivation;
+
+void expect_same(const GiNaC::matrix& a, const GiNaC::matrix& b, const std::string& what) {
+  ASSERT_EQ(a.rows(), b.rows()) << what;
+  ASSERT_EQ(a.cols(), b.cols()) << what;
+  for (unsigned r = 0; r < a.rows(); ++r)
+    for (unsigned c = 0; c < a.cols(); ++c) EXPECT_TRUE(a(r, c).is_equal(b(r, c))) << what << "(" << r << ", " << c << ")";
+}
+
+void expect_same(const std::vector<GiNaC::ex>& a, const std::vector<GiNaC::ex>& b, const std::string& what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(a[i].is_equal(b[i])) << what << "[" << i << "]";
+}
+
+// The numbers a model computes at its start: q'' and the reactions.
+std::vector<double> start_numbers(const Model& model) {
+  Data data = make_data(model);
+  EXPECT_EQ(compute_dynamics(model, data, {}, model.t0, model.q0.data(), model.v0.data()), Status::ok) << model.name;
+  std::vector<double> out(data.qdd.data(), data.qdd.data() + data.qdd.size());
+  out.insert(out.end(), data.R.data(), data.R.data() + data.R.size());
+  return out;
+}
+
+TEST(DerivationArchive, ReadsBackEveryEntryAndComputesTheSameNumbers) {
+  for (const char* file : {"whipple_bicycle.toml", "rattleback.toml", "ball_in_bowl.toml", "sled.toml",
+                           "bicycle_roll_program.toml", "ball_off_sphere_onto_floor.toml"}) {
+    SCOPED_TRACE(file);
+    const symbolic::Spec spec = load_model_file(test::example(file));
+    const Derivation d = symbolic::derive(spec);
+    const std::optional<Derivation> back = symbolic::unarchive_derivation(symbolic::archive_derivation(d), spec.symbols);
+    ASSERT_TRUE(back.has_value());
+    expect_same(d.A.dense(), back->A.dense(), "A");
+    expect_same(d.b.dense(), back->b.dense(), "b");
+    for (unsigned c = 0; c < d.A.cols(); ++c) EXPECT_EQ(d.A.column(c).size(), back->A.column(c).size());
+    expect_same(d.Q, back->Q, "Q");
+    expect_same(d.G, back->G, "G");
+    expect_same(d.b0, back->b0, "b0");
+    expect_same(d.b_p, back->b_p, "b_p");
+    expect_same(d.b_p0, back->b_p0, "b_p0");
+    expect_same(d.B, back->B, "B");
+    expect_same(d.phi, back->phi, "phi");
+    expect_same(d.f, back->f, "f");
+    expect_same(d.phi_p, back->phi_p, "phi_p");
+    expect_same(d.f_p, back->f_p, "f_p");
+    EXPECT_EQ(d.D.has_value(), back->D.has_value());
+    ASSERT_EQ(d.energy.has_value(), back->energy.has_value());
+    if (d.energy) {
+      EXPECT_TRUE(d.energy->is_equal(*back->energy));
+    }
+    EXPECT_EQ(d.energy_function.has_value(), back->energy_function.has_value());
+    EXPECT_TRUE(d.power_forces.is_equal(back->power_forces));
+    EXPECT_TRUE(d.power_time.is_equal(back->power_time));
+    EXPECT_EQ(d.conservative, back->conservative);
+    // The same tapes: the same numbers to the bit.
+    EXPECT_EQ(start_numbers(symbolic::compile_model(spec, d)), start_numbers(symbolic::compile_model(spec, *back)));
+  }
+}
+
+TEST(DerivationArchive, RefusesAnotherModelsAndDamagedBytes) {
+  const symbolic::Spec bicycle = load_model_file(test::example("whipple_bicycle.toml"));
+  const symbolic::Spec sled = load_model_file(test::example("sled.toml"));
+  const std::string bytes = symbolic::archive_derivation(symbolic::derive(bicycle));
+  // The sled's table knows none of the bicycle's coordinates.
+  EXPECT_FALSE(symbolic::unarchive_derivation(bytes, sled.symbols).has_value());
+  EXPECT_FALSE(symbolic::unarchive_derivation(bytes.substr(0, bytes.size() / 2), bicycle.symbols).has_value());
+  EXPECT_FALSE(symbolic::unarchive_derivation("", bicycle.symbols).has_value());
+  std::string altered = bytes;
+  altered[altered.size() / 2] ^= 0x5a;
+  // One byte altered anywhere is refused by the checksum (GiNaC's reader, given it, could read on
+  // forever or make another expression).
+  EXPECT_FALSE(symbolic::unarchive_derivation(altered, bicycle.symbols).has_value());
+  altered = bytes;
+  altered.back() ^= 0x01;
+  EXPECT_FALSE(symbolic::unarchive_derivation(altered, bicycle.symbols).has_value());
+  EXPECT_TRUE(symbolic::unarchive_derivation(bytes, bicycle.symbols).has_value());
+}
+
+// A cache directory of the test's own, set for the process while the test runs.
+class CacheDirectory {
+ public:
+  CacheDirectory() : dir_(fs::temp_directory_path() / ("nhdyn-derivation-cache-" + std::to_string(::getpid()))) {
+    fs::remove_all(dir_);
+    const char* old = std::getenv("XDG_CACHE_HOME");
+    old_ = old ? std::optional<std::string>(old) : std::nullopt;
+    ::setenv("XDG_CACHE_HOME", dir_.c_str(), 1);
+    // Every derivation kept, however fast this machine derives it (the default keeps the costly ones).
+    ::setenv("NHDYN_DERIVATION_CACHE", "always", 1);
+  }
+  ~CacheDirectory() {
+    if (old_)
+      ::setenv("XDG_CACHE_HOME", old_->c_str(), 1);
+    else
+      ::unsetenv("XDG_CACHE_HOME");
+    ::unsetenv("NHDYN_DERIVATION_CACHE");
+    fs::remove_all(dir_);
+  }
+  const fs::path& root() const { return dir_; }
+  std::vector<fs::path> files() const {
+    std::vector<fs::path> out;
+    if (fs::exists(dir_ / "nhdyn" / "derivations"))
+      for (const auto& entry : fs::directory_iterator(dir_ / "nhdyn" / "derivations")) out.push_back(entry.path());
+    return out;
+  }
+
+ private:
+  fs::path dir_;
+  std::optional<std::string> old_;
+};
+
+bool stored(const LoadedModel& loaded) { return loaded.description->derivation_was_stored(); }
+
+TEST(DerivationCache, TheSecondLoadReadsTheDerivationAndComputesTheSame) {
+  if (detail::build_identity().empty()) GTEST_SKIP() << "this build has no GNU build-id: no derivation cache";
+  const CacheDirectory cache;
+  const ModelSource source = read_model_source(test::example("rattleback.toml"));
+  const LoadedModel first = load_model_described(source, {});
+  EXPECT_FALSE(stored(first));
+  ASSERT_EQ(cache.files().size(), 1U);
+  const LoadedModel second = load_model_described(source, {});
+  EXPECT_TRUE(stored(second));
+  EXPECT_EQ(start_numbers(first.model), start_numbers(second.model));
+  // Another --set value is another key (the derivation's checks use the values).
+  const LoadedModel other = load_model_described(source, {{"spin", -4.0}});
+  EXPECT_FALSE(stored(other));
+  EXPECT_EQ(cache.files().size(), 2U);
+  // Another text is another key, even with the same name.
+  const ModelSource changed = model_source_from_text(source.text + "\n# a comment\n", source.file_name);
+  EXPECT_FALSE(stored(load_model_described(changed, {})));
+}
+
+TEST(DerivationCache, ADamagedFileIsDerivedAgainAndReplaced) {
+  if (detail::build_identity().empty()) GTEST_SKIP() << "this build has no GNU build-id: no derivation cache";
+  const CacheDirectory cache;
+  const ModelSource source = read_model_source(test::example("ball_in_bowl.toml"));
+  const LoadedModel first = load_model_described(source, {});
+  ASSERT_EQ(cache.files().size(), 1U);
+  const fs::path file = cache.files().front();
+  std::string bytes;
+  {
+    std::ifstream in(file, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  for (const std::string& damaged : {bytes.substr(0, bytes.size() / 2), std::string("not a cache file\n")}) {
+    std::ofstream(file, std::ios::binary | std::ios::trunc) << damaged;
+    const LoadedModel again = load_model_described(source, {});
+    EXPECT_FALSE(stored(again));
+    EXPECT_EQ(start_numbers(first.model), start_numbers(again.model));
+    EXPECT_TRUE(stored(load_model_described(source, {})));  // replaced by a good one
+  }
+}
+
+// A cache of many files (a shell loop over --set values) keeps the 150 most recently used of them
+// once it holds more than 200, the one just written among them.
+TEST(DerivationCache, ManyFilesAreTrimmedToTheMostRecentlyUsed) {
+  if (detail::build_identity().empty()) GTEST_SKIP() << "this build has no GNU build-id: no derivation cache";
+  const CacheDirectory cache;
+  const fs::path dir = cache.root() / "nhdyn" / "derivations";
+  fs::create_directories(dir);
+  const auto old = fs::file_time_type::clock::now() - std::chrono::hours(1);
+  for (int i = 0; i < 210; ++i) {
+    const fs::path file = dir / ("old" + std::to_string(i) + ".derivation");
+    std::ofstream(file) << "old";
+    fs::last_write_time(file, old + std::chrono::seconds(i));
+  }
+  std::ofstream(dir / "notes.txt") << "not a derivation: left alone";
+  const LoadedModel loaded = load_model_described(read_model_source(test::example("sled.toml")), {});
+  const std::vector<fs::path> files = cache.files();
+  EXPECT_EQ(files.size(), 151U);  // 150 derivations and the notes
+  EXPECT_TRUE(fs::exists(dir / "notes.txt"));
+  EXPECT_FALSE(fs::exists(dir / "old0.derivation"));
+  EXPECT_TRUE(fs::exists(dir / "old209.derivation"));
+  EXPECT_TRUE(stored(load_model_described(read_model_source(test::example("sled.toml")), {})));
+}
+
+TEST(DerivationCache, OffMeansNoFile) {
+  const CacheDirectory cache;
+  ::setenv("NHDYN_DERIVATION_CACHE", "off", 1);
+  const LoadedModel loaded = load_model_described(read_model_source(test::example("sled.toml")), {});
+  EXPECT_FALSE(stored(loaded));
+  EXPECT_TRUE(cache.files().empty());
+}
+
+}  // namespace
+}  // namespace nhdyn
