@@ -877,8 +877,8 @@ TEST(CliKnownDefects, UnknownSubcommandIsNamed) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// docs/cli.md: every line of its ```sh blocks runs, in a fresh directory per block, with
-// `nhdyn` on PATH, and ends with the exit code its trailing `# exit N` comment gives (0 if none).
+// docs/cli.md: every line of its ```sh blocks runs, in a fresh directory per block holding only
+// `examples` (a link to the source tree's examples/), with `nhdyn` on PATH, and ends with the exit code its trailing `# exit N` comment gives (0 if none).
 
 struct DocExample {
   int line;             // in docs/cli.md
@@ -934,6 +934,7 @@ TEST(CliDocs, EveryExampleInCliMdRunsAsDocumented) {
     if (ex.block != block) {
       if (dir) EXPECT_NO_TEMPORARIES(dir->path());
       dir.emplace();
+      fs::create_directory_symlink(fs::path(NHDYN_SOURCE_DIR) / "examples", dir->path() / "examples");
       block = ex.block;
     }
     if (contains(ex.command, "--plot") && !gnuplot_available()) continue;
