@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -57,7 +58,7 @@ TEST(DerivationArchive, ReadsBackEveryEntryAndComputesTheSameNumbers) {
     SCOPED_TRACE(file);
     const symbolic::Spec spec = load_model_file(test::example(file));
     const Derivation d = symbolic::derive(spec);
-    const std::optional<Derivation> back = symbolic::unarchive_derivation(symbolic::archive_derivation(d), spec.symbols);
+    const std::optional<Derivation> back = symbolic::unarchive_derivation(symbolic::archive_derivation(d), spec);
     ASSERT_TRUE(back.has_value());
     expect_same(d.A.dense(), back->A.dense(), "A");
     expect_same(d.b.dense(), back->b.dense(), "b");
@@ -91,18 +92,29 @@ TEST(DerivationArchive, RefusesAnotherModelsAndDamagedBytes) {
   const symbolic::Spec sled = load_model_file(test::example("sled.toml"));
   const std::string bytes = symbolic::archive_derivation(symbolic::derive(bicycle));
   // The sled's table knows none of the bicycle's coordinates.
-  EXPECT_FALSE(symbolic::unarchive_derivation(bytes, sled.symbols).has_value());
-  EXPECT_FALSE(symbolic::unarchive_derivation(bytes.substr(0, bytes.size() / 2), bicycle.symbols).has_value());
-  EXPECT_FALSE(symbolic::unarchive_derivation("", bicycle.symbols).has_value());
+  EXPECT_FALSE(symbolic::unarchive_derivation(bytes, sled).has_value());
+  EXPECT_FALSE(symbolic::unarchive_derivation(bytes.substr(0, bytes.size() / 2), bicycle).has_value());
+  EXPECT_FALSE(symbolic::unarchive_derivation("", bicycle).has_value());
   std::string altered = bytes;
   altered[altered.size() / 2] ^= 0x5a;
   // One byte altered anywhere is refused by the checksum (GiNaC's reader, given it, could read on
   // forever or make another expression).
-  EXPECT_FALSE(symbolic::unarchive_derivation(altered, bicycle.symbols).has_value());
+  EXPECT_FALSE(symbolic::unarchive_derivation(altered, bicycle).has_value());
   altered = bytes;
   altered.back() ^= 0x01;
-  EXPECT_FALSE(symbolic::unarchive_derivation(altered, bicycle.symbols).has_value());
-  EXPECT_TRUE(symbolic::unarchive_derivation(bytes, bicycle.symbols).has_value());
+  EXPECT_FALSE(symbolic::unarchive_derivation(altered, bicycle).has_value());
+  EXPECT_TRUE(symbolic::unarchive_derivation(bytes, bicycle).has_value());
+}
+
+// A derivation of a model with other sizes is refused even where every symbol it names is known.
+TEST(DerivationArchive, RefusesADerivationOfOtherSizes) {
+  const std::string two = "name = \"two\"\ncoordinates = [\"x\", \"y\"]\nkinetic_energy = \"x'^2/2 + y'^2/2\"\n";
+  const std::string three =
+      "name = \"three\"\ncoordinates = [\"x\", \"y\", \"z\"]\nkinetic_energy = \"x'^2/2 + y'^2/2 + z'^2/2\"\n";
+  const symbolic::Spec a = load_model_string(two, "two.toml"), b = load_model_string(three, "three.toml");
+  const std::string bytes = symbolic::archive_derivation(symbolic::derive(a));
+  EXPECT_TRUE(symbolic::unarchive_derivation(bytes, a).has_value());
+  EXPECT_FALSE(symbolic::unarchive_derivation(bytes, b).has_value());
 }
 
 // A cache directory of the test's own, set for the process while the test runs.
@@ -112,6 +124,8 @@ class CacheDirectory {
     fs::remove_all(dir_);
     const char* old = std::getenv("XDG_CACHE_HOME");
     old_ = old ? std::optional<std::string>(old) : std::nullopt;
+    const char* setting = std::getenv("NHDYN_DERIVATION_CACHE");
+    old_setting_ = setting ? std::optional<std::string>(setting) : std::nullopt;
     ::setenv("XDG_CACHE_HOME", dir_.c_str(), 1);
     // Every derivation kept, however fast this machine derives it (the default keeps the costly ones).
     ::setenv("NHDYN_DERIVATION_CACHE", "always", 1);
@@ -121,7 +135,10 @@ class CacheDirectory {
       ::setenv("XDG_CACHE_HOME", old_->c_str(), 1);
     else
       ::unsetenv("XDG_CACHE_HOME");
-    ::unsetenv("NHDYN_DERIVATION_CACHE");
+    if (old_setting_)
+      ::setenv("NHDYN_DERIVATION_CACHE", old_setting_->c_str(), 1);
+    else
+      ::unsetenv("NHDYN_DERIVATION_CACHE");
     fs::remove_all(dir_);
   }
   const fs::path& root() const { return dir_; }
@@ -134,7 +151,7 @@ class CacheDirectory {
 
  private:
   fs::path dir_;
-  std::optional<std::string> old_;
+  std::optional<std::string> old_, old_setting_;
 };
 
 bool stored(const LoadedModel& loaded) { return loaded.description->derivation_was_stored(); }
@@ -204,10 +221,49 @@ TEST(DerivationCache, ManyFilesAreTrimmedToTheMostRecentlyUsed) {
 
 TEST(DerivationCache, OffMeansNoFile) {
   const CacheDirectory cache;
-  ::setenv("NHDYN_DERIVATION_CACHE", "off", 1);
-  const LoadedModel loaded = load_model_described(read_model_source(test::example("sled.toml")), {});
-  EXPECT_FALSE(stored(loaded));
-  EXPECT_TRUE(cache.files().empty());
+  for (const char* off : {"off", "OFF", "0", "false", "No"}) {
+    ::setenv("NHDYN_DERIVATION_CACHE", off, 1);
+    const LoadedModel loaded = load_model_described(read_model_source(test::example("sled.toml")), {});
+    EXPECT_FALSE(stored(loaded)) << off;
+    EXPECT_TRUE(cache.files().empty()) << off;
+  }
+}
+
+// What sits at the file's place and is not a file is passed by, never opened: a named pipe (whose
+// opening waits for a writer) or a link to /dev/zero (a line without end); the model derives.
+TEST(DerivationCache, APipeOrADeviceAtTheFilesPlaceIsPassedBy) {
+  if (detail::build_identity().empty()) GTEST_SKIP() << "this build has no GNU build-id: no derivation cache";
+  const CacheDirectory cache;
+  const ModelSource source = read_model_source(test::example("ball_in_bowl.toml"));
+  const LoadedModel first = load_model_described(source, {});
+  ASSERT_EQ(cache.files().size(), 1U);
+  const fs::path file = cache.files().front();
+  fs::remove(file);
+  ASSERT_EQ(::mkfifo(file.c_str(), 0600), 0);
+  const LoadedModel piped = load_model_described(source, {});
+  EXPECT_FALSE(stored(piped));
+  EXPECT_EQ(start_numbers(first.model), start_numbers(piped.model));
+  fs::remove(file);
+  fs::create_symlink("/dev/zero", file);
+  const LoadedModel zero = load_model_described(source, {});
+  EXPECT_FALSE(stored(zero));
+  EXPECT_EQ(start_numbers(first.model), start_numbers(zero.model));
+}
+
+// The temporary file of a writer that died before its rename (SIGKILL) goes once an hour old;
+// a younger one (a writer at work) stays.
+TEST(DerivationCache, TemporariesOfDeadWritersGo) {
+  if (detail::build_identity().empty()) GTEST_SKIP() << "this build has no GNU build-id: no derivation cache";
+  const CacheDirectory cache;
+  const fs::path dir = cache.root() / "nhdyn" / "derivations";
+  fs::create_directories(dir);
+  const fs::path dead = dir / ".0123.derivation.999-0.tmp", live = dir / ".4567.derivation.998-0.tmp";
+  std::ofstream(dead) << "half";
+  std::ofstream(live) << "half";
+  fs::last_write_time(dead, fs::file_time_type::clock::now() - std::chrono::hours(2));
+  load_model_described(read_model_source(test::example("ball_in_bowl.toml")), {});
+  EXPECT_FALSE(fs::exists(dead));
+  EXPECT_TRUE(fs::exists(live));
 }
 
 }  // namespace

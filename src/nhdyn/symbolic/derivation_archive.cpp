@@ -6,6 +6,9 @@
 #include <sstream>
 #include <unordered_set>
 
+#include <cln/version.h>
+#include <ginac/version.h>
+
 namespace nhdyn::symbolic {
 namespace {
 
@@ -160,7 +163,14 @@ std::string archive_derivation(const Derivation& derivation) {
   return std::string(kMagic) + "\n" + checksum(body.str()) + "\n" + body.str();
 }
 
-std::optional<Derivation> unarchive_derivation(const std::string& bytes, const SymbolTable& symbols) {
+std::string derivation_engine() {
+  return "GiNaC " + std::to_string(GiNaC::version_major) + "." + std::to_string(GiNaC::version_minor) + "." +
+         std::to_string(GiNaC::version_micro) + ", CLN " + std::to_string(cln::version_major) + "." +
+         std::to_string(cln::version_minor) + "." + std::to_string(cln::version_patchlevel);
+}
+
+std::optional<Derivation> unarchive_derivation(const std::string& bytes, const Spec& spec) {
+  const SymbolTable& symbols = spec.symbols;
   try {
     // GiNaC's reader trusts its input (a count altered in a damaged file can make it read on
     // forever), so the bytes are checked whole before it sees them.
@@ -172,10 +182,10 @@ std::optional<Derivation> unarchive_derivation(const std::string& bytes, const S
     if (bytes.compare(magic.size(), end - magic.size(), checksum(body)) != 0) return std::nullopt;
     std::istringstream in(body);
     std::string line;
-    std::size_t n = 0;
-    if (!(in >> n) || !std::getline(in, line) || !line.empty() || n > bytes.size()) return std::nullopt;
+    std::size_t named = 0;
+    if (!(in >> named) || !std::getline(in, line) || !line.empty() || named > bytes.size()) return std::nullopt;
     GiNaC::lst known;
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < named; ++i) {
       if (!std::getline(in, line)) return std::nullopt;
       const std::optional<GiNaC::symbol> s = symbols.find(line);
       if (!s) return std::nullopt;  // a symbol of another model: reading would make a new one
@@ -204,6 +214,15 @@ std::optional<Derivation> unarchive_derivation(const std::string& bytes, const S
     d.power_forces = read("power_forces");
     d.power_time = read("power_time");
     d.conservative = !read("conservative").is_zero();
+    const auto n = static_cast<unsigned>(spec.n()), s = static_cast<unsigned>(spec.s()),
+               m = static_cast<unsigned>(spec.m());
+    const auto sized = [](const GiNaC::matrix& x, unsigned rows, unsigned cols) {
+      return x.rows() == rows && x.cols() == cols;
+    };
+    if (d.A.rows() != n || d.A.cols() != n || d.b.rows() != s || d.b.cols() != n || !sized(d.Q, n, 1) ||
+        !sized(d.G, n, 1) || !sized(d.b0, s, 1) || (d.D && d.D->cols() != n) || d.b_p.rows() != m ||
+        (m > 0 && d.b_p.cols() != n) || d.b_p0.rows() != m || d.B.cols() != m || (m > 0 && d.B.rows() != n))
+      return std::nullopt;  // made for a model of other sizes
     return d;
   } catch (const std::exception&) {
     return std::nullopt;  // not an archive GiNaC reads, or not of this shape

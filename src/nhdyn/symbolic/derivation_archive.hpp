@@ -16,9 +16,14 @@ namespace nhdyn::symbolic {
 // The bytes of `derivation`: a checksum, the names of the symbols it uses, then GiNaC's archive.
 std::string archive_derivation(const Derivation& derivation);
 
+// The libraries that make and read a derivation, as they are loaded: "GiNaC 1.8.6, CLN 1.3.6".
+std::string derivation_engine();
+
 // The derivation of `bytes`, its symbols those of `symbols`; std::nullopt when the bytes are not
 // a whole derivation archive (damaged or cut short: the checksum) or use a symbol `symbols` does
-// not know (a derivation of another model).
-std::optional<Derivation> unarchive_derivation(const std::string& bytes, const SymbolTable& symbols);
+// not know or has other sizes (a derivation of another model).
+// Its matrices must have the sizes of `spec` (n coordinates, s constraints, m programs), whose
+// symbol table it reads with.
+std::optional<Derivation> unarchive_derivation(const std::string& bytes, const Spec& spec);
 
 }  // namespace nhdyn::symbolic

@@ -10,7 +10,7 @@ const Derivation& ModelDescription::derivation() const {
   std::call_once(derived_, [this] {
     if (store_)
       if (const std::optional<std::string> bytes = store_->read())
-        if (std::optional<Derivation> kept = unarchive_derivation(*bytes, spec_.symbols)) {
+        if (std::optional<Derivation> kept = unarchive_derivation(*bytes, spec_)) {
           derivation_ = std::move(kept);
           read_from_store_ = true;
           return;

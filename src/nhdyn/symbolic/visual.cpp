@@ -1,5 +1,7 @@
 #include "nhdyn/symbolic/visual.hpp"
 
+#include "nhdyn/symbolic/compile.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -33,7 +35,7 @@ class Emitter {
  public:
   Emitter(const Spec& spec, bool parameters_only)
       : tape_(parameters_only ? 0 : spec.n(), static_cast<int>(spec.parameters.size())),
-        parameters_only_(parameters_only) {
+        parameters_only_(parameters_only), spec_(parameters_only ? nullptr : &spec) {
     for (std::size_t i = 0; i < spec.parameters.size(); ++i)
       parameters_.emplace(spec.symbols.parameter(spec.parameters[i].name), static_cast<int>(i));
     variables_.emplace(spec.symbols.time(), parameters_only ? -1 : Tape::time_register());
@@ -65,6 +67,10 @@ class Emitter {
     item_ = &item;
     what_ = what;
     const GiNaC::ex value = numeric_form(e);
+    if (spec_) {
+      checked_.push_back(e);
+      whats_.emplace_back(what);
+    }
     if (GiNaC::is_exactly_a<GiNaC::numeric>(value)) {
       tape_.add_constant_output(number(value, e));
       return;
@@ -72,7 +78,13 @@ class Emitter {
     tape_.add_output(emit(value, e));
   }
 
-  Tape take() { return std::move(tape_); }
+  // The positions' tape comes from the model's own compiler (compile.hpp), whose canonical form
+  // orders every sum and product by a key of our own: emitted in GiNaC's order, which follows
+  // where libginac is loaded, the scene's numbers differed in the last bits from run to run (a
+  // report of the rattleback was not the same file twice). The walk above still checks every
+  // expression, with the scene's messages. The sizes and fields keep this emitter's tape: numbers
+  // of the parameters and of the field's variables, which no run-to-run test has caught differing.
+  Tape take() { return spec_ ? compile_expressions(*spec_, checked_, whats_) : std::move(tape_); }
 
  private:
   // Numbers, pi and exact fractions as doubles; the parameters stay symbols.
@@ -155,6 +167,9 @@ class Emitter {
 
   Tape tape_;
   bool parameters_only_ = false;
+  const Spec* spec_ = nullptr;
+  std::vector<GiNaC::ex> checked_;
+  std::vector<std::string> whats_;
   const VisualItem* item_ = nullptr;
   const char* what_ = "";
   std::map<GiNaC::ex, int, GiNaC::ex_is_less> parameters_;  // parameter symbol -> its index

@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
+#include <chrono>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -19,6 +21,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "nhdyn/symbolic/derivation_archive.hpp"
 #include "nhdyn/symbolic/description.hpp"
 
 namespace nhdyn::detail {
@@ -27,6 +30,8 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kHeader = "nhdyn-derivation-cache 1";
+// No derivation is near this (the 1000-body chain's is 1.7 MB); a larger file is not one.
+constexpr std::uintmax_t kLargestFile = std::uintmax_t{256} << 20;
 
 std::uint64_t fnv1a(const std::string& s, std::uint64_t h) {
   for (unsigned char ch : s) {
@@ -43,9 +48,10 @@ std::string env(const char* name) {
 
 std::optional<fs::path> cache_directory() {
   const std::string xdg = env("XDG_CACHE_HOME");
-  if (!xdg.empty()) return fs::path(xdg) / "nhdyn" / "derivations";
+  // The XDG Base Directory rules: a relative path there is ignored.
+  if (!xdg.empty() && fs::path(xdg).is_absolute()) return fs::path(xdg) / "nhdyn" / "derivations";
   const std::string home = env("HOME");
-  if (home.empty()) return std::nullopt;
+  if (home.empty() || !fs::path(home).is_absolute()) return std::nullopt;
   return fs::path(home) / ".cache" / "nhdyn" / "derivations";
 }
 
@@ -67,16 +73,16 @@ class FileStore final : public symbolic::DerivationStore {
   }
 
   std::optional<std::string> read() const override {
+    // A regular file (after links) of a sane size, nothing else: opening a named pipe waits for a
+    // writer, and /dev/zero has no end to read to.
+    std::error_code error;
+    if (!fs::is_regular_file(file_, error) || fs::file_size(file_, error) > kLargestFile || error) return std::nullopt;
     std::ifstream in(file_, std::ios::binary);
     if (!in) return std::nullopt;
-    std::string line;
-    std::size_t size = 0;
-    if (!std::getline(in, line) || line != kHeader || !(in >> size) || in.get() != '\n' || size != key_.size())
-      return std::nullopt;
-    std::string key(size, '\0');
-    if (!in.read(key.data(), static_cast<std::streamsize>(size)) || key != key_) return std::nullopt;
+    const std::string header = std::string(kHeader) + "\n" + std::to_string(key_.size()) + "\n" + key_;
+    std::string head(header.size(), '\0');
+    if (!in.read(head.data(), static_cast<std::streamsize>(head.size())) || head != header) return std::nullopt;
     std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    std::error_code error;
     fs::last_write_time(file_, fs::file_time_type::clock::now(), error);  // used: the last to go
     return bytes;
   }
@@ -112,14 +118,22 @@ class FileStore final : public symbolic::DerivationStore {
 // values makes one file per value).
 constexpr std::size_t kMostFiles = 200;
 
+// Also removes the temporary files of writers that died before their rename (SIGKILL, a crash),
+// once they are an hour old: no live writer takes that long.
 void trim(const fs::path& dir) {
   std::error_code error;
   std::vector<std::pair<fs::file_time_type, fs::path>> files;
-  for (fs::directory_iterator it(dir, error), end; !error && it != end; it.increment(error))
-    if (it->path().extension() == ".derivation") {
-      const fs::file_time_type time = fs::last_write_time(it->path(), error);
-      if (!error) files.emplace_back(time, it->path());
-    }
+  const fs::file_time_type stale = fs::file_time_type::clock::now() - std::chrono::hours(1);
+  for (fs::directory_iterator it(dir, error), end; !error && it != end; it.increment(error)) {
+    const std::string name = it->path().filename().string();
+    std::error_code ignored;
+    const fs::file_time_type time = fs::last_write_time(it->path(), ignored);
+    if (ignored) continue;
+    if (it->path().extension() == ".derivation")
+      files.emplace_back(time, it->path());
+    else if (name.starts_with(".") && name.ends_with(".tmp") && time < stale)
+      fs::remove(it->path(), ignored);
+  }
   if (files.size() <= kMostFiles) return;
   std::sort(files.begin(), files.end());
   for (std::size_t i = 0; i < files.size() - kMostFiles * 3 / 4; ++i) fs::remove(files[i].second, error);
@@ -175,12 +189,15 @@ std::string build_identity() {
 
 std::shared_ptr<const symbolic::DerivationStore> make_derivation_store(const std::string& text,
                                                                        const std::vector<std::string>& sets) {
-  const std::string setting = env("NHDYN_DERIVATION_CACHE");
-  if (setting == "off" || setting == "0") return nullptr;
+  std::string setting = env("NHDYN_DERIVATION_CACHE");
+  for (char& c : setting) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (setting == "off" || setting == "0" || setting == "false" || setting == "no") return nullptr;
   const std::string id = build_identity();
   const std::optional<fs::path> dir = cache_directory();
   if (id.empty() || !dir) return nullptr;
-  std::string key = "build " + id + "\n";
+  // The build, and the libraries that derive (GiNaC and CLN are shared: an upgrade of them is
+  // another derivation).
+  std::string key = "build " + id + "\nengine " + symbolic::derivation_engine() + "\n";
   for (const std::string& set : sets) key += "set " + set + "\n";
   key += "text\n" + text;
   const std::string name = fmt::format("{:016x}{:016x}.derivation", fnv1a(key, 0xcbf29ce484222325ULL),
