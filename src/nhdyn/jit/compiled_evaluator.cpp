@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "nhdyn/jit/detail/source.hpp"
+#include "nhdyn/core/detail/hash.hpp"
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/tape.hpp"
 
@@ -41,14 +42,6 @@ namespace fs = std::filesystem;
 // multiply-add (the interpreter rounds twice; so must the compiled code).
 const std::vector<std::string> kFlags = {"-std=c++17", "-O2", "-fPIC", "-shared", "-ffp-contract=off",
                                          "-fno-math-errno"};
-
-std::uint64_t fnv1a(const std::string& s, std::uint64_t h) {
-  for (unsigned char ch : s) {
-    h ^= ch;
-    h *= 0x100000001b3ULL;
-  }
-  return h;
-}
 
 std::string env(const char* name) {
   const char* value = std::getenv(name);
@@ -249,7 +242,7 @@ std::shared_ptr<Library> load(const fs::path& path, bool sparse, std::string& er
 // The check file beside a cached object: its key, size and two hashes of its bytes.
 std::string entry_check(const std::string& key, const std::string& bytes) {
   return fmt::format("nhdyn compiled model\nkey {}\nsize {}\nhash {:016x}{:016x}\n", key, bytes.size(),
-                     fnv1a(bytes, 0xcbf29ce484222325ULL), fnv1a(bytes, 0x84222325cbf29ce4ULL));
+                     fnv1a(bytes, kFnvOffset), fnv1a(bytes, kFnvOtherOffset));
 }
 
 // "" when `object` is whole and belongs to `key` by its check file; else what is wrong.
@@ -683,8 +676,8 @@ std::string cache_key(const std::string& source, const std::string& compiler, co
   std::string flags;
   for (const std::string& f : kFlags) flags += f + " ";
   const std::string identity = compiler + "\n" + version + "\n" + flags + "\n";
-  const std::uint64_t h1 = fnv1a(source, fnv1a(identity, 0xcbf29ce484222325ULL));
-  const std::uint64_t h2 = fnv1a(identity, fnv1a(source, 0x84222325cbf29ce4ULL));
+  const std::uint64_t h1 = fnv1a(source, fnv1a(identity, kFnvOffset));
+  const std::uint64_t h2 = fnv1a(identity, fnv1a(source, kFnvOtherOffset));
   return fmt::format("{:016x}{:016x}", h1, h2);
 }
 

@@ -9,6 +9,8 @@
 #include <cln/version.h>
 #include <ginac/version.h>
 
+#include "nhdyn/core/detail/hash.hpp"
+
 namespace nhdyn::symbolic {
 namespace {
 
@@ -52,14 +54,9 @@ GiNaC::ex pack(const std::optional<GiNaC::ex>& e) {
 
 // Two FNV-1a hashes of `bytes` (128 bits, hex): what tells a whole archive from a damaged one.
 std::string checksum(const std::string& bytes) {
-  std::uint64_t h1 = 0xcbf29ce484222325ULL, h2 = 0x84222325cbf29ce4ULL;
-  for (unsigned char ch : bytes) {
-    h1 = (h1 ^ ch) * 0x100000001b3ULL;
-    h2 = (h2 ^ ch) * 0x100000001b3ULL;
-  }
   char text[33];
-  std::snprintf(text, sizeof text, "%016llx%016llx", static_cast<unsigned long long>(h1),
-                static_cast<unsigned long long>(h2));
+  std::snprintf(text, sizeof text, "%016llx%016llx", static_cast<unsigned long long>(fnv1a(bytes, kFnvOffset)),
+                static_cast<unsigned long long>(fnv1a(bytes, kFnvOtherOffset)));
   return text;
 }
 

@@ -21,6 +21,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "nhdyn/core/detail/hash.hpp"
 #include "nhdyn/symbolic/derivation_archive.hpp"
 #include "nhdyn/symbolic/description.hpp"
 
@@ -32,14 +33,6 @@ namespace fs = std::filesystem;
 constexpr const char* kHeader = "nhdyn-derivation-cache 1";
 // No derivation is near this (the 1000-body chain's is 1.7 MB); a larger file is not one.
 constexpr std::uintmax_t kLargestFile = std::uintmax_t{256} << 20;
-
-std::uint64_t fnv1a(const std::string& s, std::uint64_t h) {
-  for (unsigned char ch : s) {
-    h ^= ch;
-    h *= 0x100000001b3ULL;
-  }
-  return h;
-}
 
 std::string env(const char* name) {
   const char* value = std::getenv(name);
@@ -200,8 +193,8 @@ std::shared_ptr<const symbolic::DerivationStore> make_derivation_store(const std
   std::string key = "build " + id + "\nengine " + symbolic::derivation_engine() + "\n";
   for (const std::string& set : sets) key += "set " + set + "\n";
   key += "text\n" + text;
-  const std::string name = fmt::format("{:016x}{:016x}.derivation", fnv1a(key, 0xcbf29ce484222325ULL),
-                                       fnv1a(key, 0x84222325cbf29ce4ULL));
+  const std::string name = fmt::format("{:016x}{:016x}.derivation", fnv1a(key, kFnvOffset),
+                                       fnv1a(key, kFnvOtherOffset));
   return std::make_shared<FileStore>(*dir / name, std::move(key), setting == "always");
 }
 
