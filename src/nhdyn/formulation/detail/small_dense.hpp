@@ -151,8 +151,8 @@ bool solve_stacked(const double* A, const double* Q, const double* G, const doub
   }
   // Rows in very different units scaled first, as factor_equilibrated does (row_scaling.hpp).
   std::array<double, N> row{};
-  for (int i = 0; i < N; ++i)
-    for (int c = 0; c < N; ++c) row[i] = std::max(row[i], std::abs(M[i + N * c]));
+  for (int c = 0; c < N; ++c)  // down each column (storage order): the same maxima, vectorized
+    for (int i = 0; i < N; ++i) row[i] = std::max(row[i], std::abs(M[i + N * c]));
   scale_rows_by_powers_of_two(
       N, [&](int i) { return row[i]; },
       [&](int i, int exponent) {
