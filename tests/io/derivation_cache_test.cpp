@@ -219,6 +219,27 @@ TEST(DerivationCache, ManyFilesAreTrimmedToTheMostRecentlyUsed) {
   EXPECT_TRUE(stored(load_model_described(read_model_source(test::example("sled.toml")), {})));
 }
 
+// By default a costly derivation is kept from its model's second load: the first leaves a mark
+// only (a model loaded once pays no archive), the second writes, the third reads.
+TEST(DerivationCache, ByDefaultTheSecondLoadKeepsAndTheThirdReads) {
+  if (detail::build_identity().empty()) GTEST_SKIP() << "this build has no GNU build-id: no derivation cache";
+  const CacheDirectory cache;
+  ::unsetenv("NHDYN_DERIVATION_CACHE");
+  const ModelSource source = read_model_source(test::example("rattleback.toml"));
+  const auto count = [&](const char* extension) {
+    int k = 0;
+    for (const fs::path& f : cache.files()) k += f.extension() == extension;
+    return k;
+  };
+  EXPECT_FALSE(stored(load_model_described(source, {})));
+  EXPECT_EQ(count(".seen"), 1);
+  EXPECT_EQ(count(".derivation"), 0);
+  EXPECT_FALSE(stored(load_model_described(source, {})));
+  EXPECT_EQ(count(".seen"), 0);
+  EXPECT_EQ(count(".derivation"), 1);
+  EXPECT_TRUE(stored(load_model_described(source, {})));
+}
+
 TEST(DerivationCache, OffMeansNoFile) {
   const CacheDirectory cache;
   for (const char* off : {"off", "OFF", "0", "false", "No"}) {

@@ -56,13 +56,21 @@ class FileStore final : public symbolic::DerivationStore {
   FileStore(fs::path file, std::string key, bool always)
       : file_(std::move(file)), key_(std::move(key)), always_(always) {}
 
-  // A derivation that took at least 1 ms per coordinate: a model with rolling contacts or a
-  // long chain of frames (the bicycle, 70 ms per coordinate; the rattleback, 8) reads back in a
-  // fraction of that, while a large model of simple bodies (the 1000-body chain, 0.1 ms per
-  // coordinate) derives about as fast as its archive is written and read, and writing it would
-  // slow its first run by a fifth.
+  // A derivation that took at least 1 ms per coordinate, at its second load: a model with rolling
+  // contacts or a long chain of frames (the bicycle, 70 ms per coordinate; the rattleback, 8)
+  // reads back in a fraction of that, while a large model of simple bodies (the 1000-body chain,
+  // 0.1 ms per coordinate) derives about as fast as its archive is written and read. Writing the
+  // archive costs a first load too (the bicycle's, a fifth), so the first load of a model leaves
+  // only a mark (an empty NAME.seen) and the second one writes: a model loaded once pays nothing,
+  // one loaded again reads its derivation from the third load on.
   bool wants(double seconds, int coordinates) const override {
-    return always_ || seconds >= 1e-3 * std::max(coordinates, 1);
+    if (always_) return true;
+    if (seconds < 1e-3 * std::max(coordinates, 1)) return false;
+    std::error_code error;
+    if (fs::is_regular_file(mark(), error)) return true;
+    fs::create_directories(file_.parent_path(), error);
+    if (!error) std::ofstream(mark(), std::ios::binary | std::ios::trunc);
+    return false;
   }
 
   std::optional<std::string> read() const override {
@@ -98,17 +106,23 @@ class FileStore final : public symbolic::DerivationStore {
     }
     fs::rename(temporary, file_, error);
     if (error) fs::remove(temporary, error);
+    fs::remove(mark(), error);
     trim(file_.parent_path());
   }
 
  private:
+  fs::path mark() const {
+    fs::path seen = file_;
+    return seen.replace_extension(".seen");
+  }
+
   fs::path file_;
   std::string key_;
   bool always_;
 };
 
-// At most kMostFiles derivations: beyond, the least recently used go (a shell loop over --set
-// values makes one file per value).
+// At most kMostFiles derivations and marks (NAME.seen): beyond, the least recently used go (a
+// shell loop over --set values makes one file per value).
 constexpr std::size_t kMostFiles = 200;
 
 // Also removes the temporary files of writers that died before their rename (SIGKILL, a crash),
@@ -122,7 +136,7 @@ void trim(const fs::path& dir) {
     std::error_code ignored;
     const fs::file_time_type time = fs::last_write_time(it->path(), ignored);
     if (ignored) continue;
-    if (it->path().extension() == ".derivation")
+    if (it->path().extension() == ".derivation" || it->path().extension() == ".seen")
       files.emplace_back(time, it->path());
     else if (name.starts_with(".") && name.ends_with(".tmp") && time < stale)
       fs::remove(it->path(), ignored);

@@ -6,7 +6,8 @@
 // in full before the derivation is read, so that a hash collision or another build's file is never
 // used. Written to a temporary file and renamed into place: a reader never sees half a file. A
 // file that does not read back is derived again and replaced. Only derivations that cost more than
-// reading them back are kept (FileStore::wants: at least 1 ms per coordinate).
+// reading them back are kept (FileStore::wants: at least 1 ms per coordinate), and only from their
+// second load (the first leaves a mark, NAME.seen): a model loaded once pays no archive.
 // NHDYN_DERIVATION_CACHE=off turns it off, =always keeps every derivation; a build without a GNU
 // build-id (its identity) or without a cache directory has none.
 // Internal: frontend/load_model.cpp (and tests/io/derivation_cache_test.cpp).
