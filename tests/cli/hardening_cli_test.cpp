@@ -148,10 +148,11 @@ TEST_F(Hardening, DamagedCompiledModelCacheIsRebuilt) {
   fs::copy_file(fs::path(other.string() + ".check"), fs::path(sled_object.string() + ".check"),
                 fs::copy_options::overwrite_existing);
   damaged_run("another model's object and check file");
-  // No temporary, source or log is left.
+  // No temporary, source or log is left (the cache of derived models, which the loads may fill,
+  // has its own folder there).
   for (const auto& entry : fs::directory_iterator(cache)) {
     const std::string name = entry.path().filename().string();
-    EXPECT_TRUE(name.ends_with(".so") || name.ends_with(".so.check")) << name;
+    EXPECT_TRUE(name.ends_with(".so") || name.ends_with(".so.check") || name == "derivations") << name;
   }
 }
 
@@ -171,8 +172,12 @@ TEST_F(Hardening, InterruptedCompileLeavesNothing) {
     EXPECT_EQ(r.code, 128 + sig) << r.err;
     EXPECT_TRUE(cache_entries(dir_ / "cache" / "nhdyn", ".cpp").empty());
     EXPECT_TRUE(cache_entries(dir_ / "cache" / "nhdyn", ".log").empty());
+    // Nothing of the compile: the one entry a run may leave there is the cache of derived models
+    // (docs/cli.md), which its load may fill and the compile does not touch.
     if (fs::exists(dir_ / "cache" / "nhdyn")) {
-      EXPECT_TRUE(fs::is_empty(dir_ / "cache" / "nhdyn")) << "signal " << sig;
+      for (const auto& entry : fs::directory_iterator(dir_ / "cache" / "nhdyn")) {
+        EXPECT_EQ(entry.path().filename(), "derivations") << "signal " << sig << ": " << entry.path();
+      }
     }
     EXPECT_FALSE(fs::exists(dir_ / "out.csv"));
     // No process still runs the slow compiler (its path is unique to this test).
