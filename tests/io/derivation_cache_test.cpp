@@ -250,6 +250,29 @@ TEST(DerivationCache, OffMeansNoFile) {
   }
 }
 
+// A relative XDG_CACHE_HOME is ignored, as the XDG Base Directory rules say: the cache goes under
+// $HOME/.cache, never into a folder of the current directory.
+TEST(DerivationCache, ARelativeXdgCacheHomeIsIgnored) {
+  if (detail::build_identity().empty()) GTEST_SKIP() << "this build has no GNU build-id: no derivation cache";
+  const CacheDirectory cache;  // restores XDG_CACHE_HOME and NHDYN_DERIVATION_CACHE after
+  const char* home = std::getenv("HOME");
+  const std::optional<std::string> old_home = home ? std::optional<std::string>(home) : std::nullopt;
+  const fs::path fake_home = cache.root() / "home";
+  ::setenv("HOME", fake_home.c_str(), 1);
+  ::setenv("XDG_CACHE_HOME", "relative-cache", 1);
+  const fs::path here = fs::current_path();
+  fs::create_directories(cache.root() / "work");
+  fs::current_path(cache.root() / "work");
+  load_model_described(read_model_source(test::example("sled.toml")), {});
+  fs::current_path(here);
+  if (old_home)
+    ::setenv("HOME", old_home->c_str(), 1);
+  else
+    ::unsetenv("HOME");
+  EXPECT_FALSE(fs::exists(cache.root() / "work" / "relative-cache"));
+  EXPECT_TRUE(fs::exists(fake_home / ".cache" / "nhdyn" / "derivations"));
+}
+
 // What sits at the file's place and is not a file is passed by, never opened: a named pipe (whose
 // opening waits for a writer) or a link to /dev/zero (a line without end); the model derives.
 TEST(DerivationCache, APipeOrADeviceAtTheFilesPlaceIsPassedBy) {
