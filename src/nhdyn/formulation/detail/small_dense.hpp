@@ -93,17 +93,38 @@ bool null_space_basis(const double* b, double* D) {
 
 // Gaussian elimination with partial pivoting of the N x N matrix M (column-major) and its right-
 // hand side r, in place; false when a pivot is zero or the smallest is round-off of the largest.
+// Every loop has bounds known at compile time and is unrolled, and the pivot row is exchanged by
+// selects rather than by an index known only at run time: every entry has a fixed place, so the
+// compiler keeps the matrix in registers (an exchange through a run-time index stored entries one
+// by one that the next column's update then loaded two at a time, which stalls the load).
 template <int N>
-bool eliminate(std::array<double, N * N>& M, std::array<double, N>& r) {
+[[gnu::always_inline]] inline bool eliminate(std::array<double, N * N>& M, std::array<double, N>& r) {
   double largest = 0.0;
   double smallest = std::numeric_limits<double>::infinity();
+#pragma GCC unroll 8
   for (int c = 0; c < N; ++c) {
     int p = c;
-    for (int i = c + 1; i < N; ++i)
-      if (std::abs(M[i + N * c]) > std::abs(M[p + N * c])) p = i;
-    if (p != c) {
-      for (int j = c; j < N; ++j) std::swap(M[c + N * j], M[p + N * j]);
-      std::swap(r[c], r[p]);
+    double best = std::abs(M[c + N * c]);
+#pragma GCC unroll 8
+    for (int i = c + 1; i < N; ++i) {
+      const double candidate = std::abs(M[i + N * c]);
+      if (candidate > best) {
+        best = candidate;
+        p = i;
+      }
+    }
+#pragma GCC unroll 8
+    for (int i = c + 1; i < N; ++i) {
+      const bool exchange = p == i;
+#pragma GCC unroll 8
+      for (int j = c; j < N; ++j) {
+        const double top = M[c + N * j], other = M[i + N * j];
+        M[c + N * j] = exchange ? other : top;
+        M[i + N * j] = exchange ? top : other;
+      }
+      const double top = r[c], other = r[i];
+      r[c] = exchange ? other : top;
+      r[i] = exchange ? top : other;
     }
     const double pivot = M[c + N * c];
     largest = std::max(largest, std::abs(pivot));
@@ -111,16 +132,17 @@ bool eliminate(std::array<double, N * N>& M, std::array<double, N>& r) {
     if (pivot == 0.0) return false;
     // A division, not a product with 1/pivot: a row equal to the pivot row then has l = 1 exactly
     // and cancels to zero, so that dependent rows are found singular as Eigen finds them. The
-    // multipliers are kept in the pivot's column, and the update runs down the columns (storage
-    // order): the same operations as row by row, in an order the compiler vectorizes.
-    double* l = M.data() + N * c;
-    for (int i = c + 1; i < N; ++i) l[i] /= pivot;
+    // multipliers are kept in the pivot's column.
+#pragma GCC unroll 8
+    for (int i = c + 1; i < N; ++i) M[i + N * c] /= pivot;
+#pragma GCC unroll 8
     for (int j = c + 1; j < N; ++j) {
-      double* column = M.data() + N * j;
-      const double above = column[c];
-      for (int i = c + 1; i < N; ++i) column[i] -= l[i] * above;
+      const double above = M[c + N * j];
+#pragma GCC unroll 8
+      for (int i = c + 1; i < N; ++i) M[i + N * j] -= M[i + N * c] * above;
     }
-    for (int i = c + 1; i < N; ++i) r[i] -= l[i] * r[c];
+#pragma GCC unroll 8
+    for (int i = c + 1; i < N; ++i) r[i] -= M[i + N * c] * r[c];
   }
   return smallest > largest * kEps * N;
 }
@@ -161,16 +183,22 @@ bool solve_stacked(const double* A, const double* Q, const double* G, const doub
       });
   const bool regular = eliminate<N>(M, r);
   if (!regular) return false;
+  // In a local array, not through the output pointer, which may alias the inputs as far as the
+  // compiler knows: each entry would be stored and loaded again by the next row.
+  std::array<double, N> x;
+#pragma GCC unroll 8
   for (int i = N - 1; i >= 0; --i) {
     double acc = r[i];
-    for (int j = i + 1; j < N; ++j) acc -= M[i + N * j] * qdd[j];
-    qdd[i] = acc / M[i + N * i];
+#pragma GCC unroll 8
+    for (int j = i + 1; j < N; ++j) acc -= M[i + N * j] * x[j];
+    x[i] = acc / M[i + N * i];
   }
   for (int i = 0; i < N; ++i) {
     double acc = -h[i];
-    for (int j = 0; j < N; ++j) acc += A[i + N * j] * qdd[j];
+    for (int j = 0; j < N; ++j) acc += A[i + N * j] * x[j];
     R[i] = acc;
   }
+  std::copy(x.begin(), x.end(), qdd);
   return true;
 }
 
