@@ -26,6 +26,14 @@
 //                                        size 6 x 6 LU), at the example's start; the two q'' are
 //                                        compared first (1e-12)
 //   rattleback_rhs_interpreted_vs_hand_written  the same, interpreted
+//   sled_dopri5_vs_hand_written          simulate() 200 s of examples/sled.toml (dopri5 at rtol 1e-8,
+//                                        atol 1e-10, first step 1e-3, 2 rows, nothing written, the
+//                                        default options otherwise: the constraint watch on) over
+//                                        the same integration written by hand (check/sled_by_hand.hpp:
+//                                        the stacked 3 x 3 system written out, a Dormand-Prince 5(4)
+//                                        loop for 6 doubles); the step counts and final states are
+//                                        compared first
+//   sled_dop853_vs_hand_written          the same with dop853 (Dormand-Prince 8(5,3)) on both sides
 // The compiled object comes from the compiled evaluator's cache ($XDG_CACHE_HOME/nhdyn), so only
 // the first run on a machine pays the compiler.
 //   nhdyn_bench_check EXAMPLES_DIR [PAIRS [FILTER]]   (PAIRS: pairs per ratio, default 7; FILTER:
@@ -53,6 +61,7 @@
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/model/output.hpp"
 #include "rattleback_stacked.hpp"
+#include "sled_by_hand.hpp"
 
 namespace {
 
@@ -175,6 +184,67 @@ void hand_written_loop(const Model& model, long calls, bool check) {
   }
 }
 
+// The sled's run by simulate() (the user's path, 2 rows) and by hand, with the same first step.
+constexpr double kSledEnd = 200.0, kSledRtol = 1e-8, kSledAtol = 1e-10, kSledFirstStep = 1e-3;
+
+SimulationSummary run_sled(const Model& sled, IntegratorKind kind, Eigen::VectorXd* last_state = nullptr) {
+  SimulationOptions options;
+  options.t_end = kSledEnd;
+  options.output_step = kSledEnd;
+  options.formulation = {Formulation::sanh, Complement::qr};
+  options.integrator.kind = kind;
+  options.integrator.rtol = kSledRtol;
+  options.integrator.atol = kSledAtol;
+  options.integrator.step = kSledFirstStep;
+  const SimulationSummary summary = simulate(sled, options, [&](const Data& data) {
+    if (last_state != nullptr) {
+      last_state->resize(data.q.size() + data.v.size());
+      *last_state << data.q, data.v;
+    }
+  });
+  if (summary.status != Status::ok) {
+    std::fprintf(stderr, "bench-check: the sled's run failed: %s\n", summary.message.c_str());
+    std::exit(1);
+  }
+  return summary;
+}
+
+template <class Tableau>
+bench::ByHandRun run_sled_by_hand(const Model& sled) {
+  bench::SledState y0{};
+  for (int i = 0; i < 3; ++i) {
+    y0[static_cast<std::size_t>(i)] = sled.q0[i];
+    y0[static_cast<std::size_t>(i + 3)] = sled.v0[i];
+  }
+  return bench::integrate_sled_by_hand<Tableau>(bench::SledByHand{}, y0, kSledEnd, kSledFirstStep, kSledRtol,
+                                                 kSledAtol);
+}
+
+// The yardstick must be the same run: the same steps, the same final state (to the tolerances'
+// level: the two evaluate the same equations in a different order).
+template <class Tableau>
+void check_sled_by_hand(const Model& sled, IntegratorKind kind, const char* name) {
+  Eigen::VectorXd last;
+  const SimulationSummary summary = run_sled(sled, kind, &last);
+  const bench::ByHandRun by_hand = run_sled_by_hand<Tableau>(sled);
+  double difference = 0.0;
+  for (int i = 0; i < 3; ++i)
+    difference = std::max({difference, std::abs(last[i] - by_hand.y[static_cast<std::size_t>(i)]),
+                           std::abs(last[i + 3] - by_hand.y[static_cast<std::size_t>(i + 3)])});
+  // A step whose error estimate is within round-off of 1 may be taken on one side and rejected on
+  // the other (the two sum the same terms in another order): the counts agree to 1 %.
+  const auto near = [](long x, long y) { return std::abs(x - y) <= 2 + std::max(x, y) / 100; };
+  if (!near(summary.stats.steps, by_hand.steps) || !near(summary.stats.rejected_steps, by_hand.rejected) ||
+      !(difference <= 1e-6)) {
+    std::fprintf(stderr,
+                 "bench-check: %s: simulate() took %ld steps (%ld rejected), the hand-written run %ld (%ld); "
+                 "final states differ by %g\n",
+                 name, summary.stats.steps, summary.stats.rejected_steps, by_hand.steps, by_hand.rejected,
+                 difference);
+    std::exit(1);
+  }
+}
+
 // FILTER "breakdown": what one output row of the bicycle costs, kernel by kernel (CPU time per
 // call, microseconds), the way simulate() computes a row: for finding where the time goes.
 void breakdown(const Model& model, const char* label) {
@@ -254,6 +324,15 @@ int main(int argc, char** argv) {
          [&] { hand_written_loop(rattleback, 50000, false); });
     pair("rattleback_rhs_interpreted_vs_hand_written", pairs, [&] { rhs_loop(rattleback, dr, 50000); },
          [&] { hand_written_loop(rattleback, 50000, false); });
+
+    const auto sled_pair = [&](const char* name, IntegratorKind kind, auto tableau) {
+      using Tableau = decltype(tableau);
+      if (std::string(name).find(filter) == std::string::npos) return;
+      check_sled_by_hand<Tableau>(sled, kind, name);
+      pair(name, pairs, [&] { run_sled(sled, kind); }, [&] { run_sled_by_hand<Tableau>(sled); });
+    };
+    sled_pair("sled_dopri5_vs_hand_written", IntegratorKind::dopri5, rk::DormandPrince54{});
+    sled_pair("sled_dop853_vs_hand_written", IntegratorKind::dop853, rk::DormandPrince853{});
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench-check: %s\n", e.what());
     return 1;
