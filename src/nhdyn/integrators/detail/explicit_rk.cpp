@@ -62,14 +62,24 @@ class Stepper {
 
  private:
   // target = y + h sum_{j < count} w_j k_j, skipping the zeros that sparse tableaus are full of.
+  // Each entry's sum is formed in a register, in the order of j, and stored once: the same
+  // additions as adding one stage after another to the whole target, without storing and loading
+  // the target again for every stage.
   void combine(const std::array<double, Tableau::stages>& w, int count, const double* y, double h,
                double* target) const {
-    std::copy(y, y + n_, target);
+    std::array<double, Tableau::stages> coef;
+    std::array<const double*, Tableau::stages> stage;
+    int used = 0;
     for (int j = 0; j < count; ++j) {
       if (w[static_cast<std::size_t>(j)] == 0.0) continue;
-      const double coef = h * w[static_cast<std::size_t>(j)];
-      const double* kj = k(j);
-      for (int i = 0; i < n_; ++i) target[i] += coef * kj[i];
+      coef[static_cast<std::size_t>(used)] = h * w[static_cast<std::size_t>(j)];
+      stage[static_cast<std::size_t>(used)] = k(j);
+      ++used;
+    }
+    for (int i = 0; i < n_; ++i) {
+      double sum = y[i];
+      for (int j = 0; j < used; ++j) sum += coef[static_cast<std::size_t>(j)] * stage[static_cast<std::size_t>(j)][i];
+      target[i] = sum;
     }
   }
 
