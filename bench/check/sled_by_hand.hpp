@@ -114,7 +114,8 @@ ByHandRun integrate_sled_by_hand(const SledByHand& sled, const SledState& y0, do
       h /= std::min(1.0 / Tableau::fac_min, fac11 / Tableau::safety);
       continue;
     }
-    const double fac = std::clamp(fac11 / std::pow(err_old, Tableau::beta) / Tableau::safety,
+    const double memory = Tableau::beta == 0.0 ? 1.0 : std::pow(err_old, Tableau::beta);
+    const double fac = std::clamp(fac11 / memory / Tableau::safety,
                                   1.0 / Tableau::fac_max, 1.0 / Tableau::fac_min);
     double h_new = h / fac;
     err_old = std::max(err, 1e-4);

@@ -585,6 +585,9 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
   if (auto failure = start_adaptive(run, t, hmax, h)) return *std::move(failure);
 
   double err_old = 1e-4;  // Hairer's FACOLD: the previous accepted error, floored
+  // err_old^beta, the PI controller's memory, computed once when err_old changes (beta = 0 for
+  // DOP853, where it is 1).
+  double err_old_beta = beta == 0.0 ? 1.0 : std::pow(err_old, beta);
   bool last_rejected = false;
   bool last_error_finite = true;
   double stall_t = t;  // t at the last stall check
@@ -629,10 +632,10 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
       continue;
     }
 
-    const double fac =
-        std::clamp(fac11 / std::pow(err_old, beta) / safety, 1.0 / fac_max, 1.0 / fac_min);
+    const double fac = std::clamp(fac11 / err_old_beta / safety, 1.0 / fac_max, 1.0 / fac_min);
     double h_new = h / fac;
     err_old = std::max(err, 1e-4);
+    if constexpr (beta != 0.0) err_old_beta = std::pow(err_old, beta);
     // Right after a rejection, growing the step again invites another one.
     if (last_rejected) h_new = std::min(h_new, h);
     last_rejected = false;
