@@ -42,43 +42,77 @@ class Stepper {
   // where the rhs failed.
   Status step(OdeSystem& system, double t, const double* y, double h, double* y1,
               IntegratorStats& stats, double& t_fail, bool evaluate_last = true) {
-    constexpr int s_count = Tableau::stages;
-    for (int s = 1; s < s_count; ++s) {
-      // With FSAL the last row of a equals b, so the last stage state is y1 itself.
-      double* target = (Tableau::fsal && s == s_count - 1) ? y1 : y_stage_.data();
-      combine(Tableau::a[static_cast<std::size_t>(s)], s, y, h, target);
-      if (Tableau::fsal && s == s_count - 1 && !evaluate_last) break;
-      const double ts = t + Tableau::c[static_cast<std::size_t>(s)] * h;
-      ++stats.rhs_evaluations;
-      const Status status = system.rhs(ts, target, k(s));
-      if (status != Status::ok) {
-        t_fail = ts;
-        return status;
-      }
+    Status status = Status::ok;
+    // Stages 2..s, each with its row of the tableau known at compile time (see combine).
+    [&]<int... S>(std::integer_sequence<int, S...>) {
+      (void)(stage<S + 1>(system, t, y, h, y1, stats, t_fail, evaluate_last, status) && ...);
+    }(std::make_integer_sequence<int, Tableau::stages - 1>{});
+    if constexpr (!Tableau::fsal) {
+      if (status == Status::ok) combine<Tableau::stages>(y, h, y1);
     }
-    if constexpr (!Tableau::fsal) combine(Tableau::b, s_count, y, h, y1);
-    return Status::ok;
+    return status;
   }
 
  private:
-  // target = y + h sum_{j < count} w_j k_j, skipping the zeros that sparse tableaus are full of.
-  // Each entry's sum is formed in a register, in the order of j, and stored once: the same
-  // additions as adding one stage after another to the whole target, without storing and loading
-  // the target again for every stage.
-  void combine(const std::array<double, Tableau::stages>& w, int count, const double* y, double h,
-               double* target) const {
-    std::array<double, Tableau::stages> coef;
-    std::array<const double*, Tableau::stages> stage;
-    int used = 0;
-    for (int j = 0; j < count; ++j) {
-      if (w[static_cast<std::size_t>(j)] == 0.0) continue;
-      coef[static_cast<std::size_t>(used)] = h * w[static_cast<std::size_t>(j)];
-      stage[static_cast<std::size_t>(used)] = k(j);
-      ++used;
+  // Stage `s`: its state, then f there into k(s); false when the step goes no further (the FSAL
+  // stage left to the caller, or a failed rhs with `status` and t_fail set).
+  template <int s>
+  bool stage(OdeSystem& system, double t, const double* y, double h, double* y1, IntegratorStats& stats,
+             double& t_fail, bool evaluate_last, Status& status) {
+    constexpr bool last = Tableau::fsal && s == Tableau::stages - 1;
+    // With FSAL the last row of a equals b, so the last stage state is y1 itself.
+    double* target = last ? y1 : y_stage_.data();
+    combine<s>(y, h, target);
+    if (last && !evaluate_last) return false;
+    const double ts = t + Tableau::c[static_cast<std::size_t>(s)] * h;
+    ++stats.rhs_evaluations;
+    status = system.rhs(ts, target, k(s));
+    if (status != Status::ok) {
+      t_fail = ts;
+      return false;
+    }
+    return true;
+  }
+
+  // Row `row` of the tableau: a's, or b for row = stages.
+  template <int row>
+  static constexpr const std::array<double, Tableau::stages>& weights() {
+    if constexpr (row < Tableau::stages) return Tableau::a[static_cast<std::size_t>(row)];
+    else return Tableau::b;
+  }
+
+  // The stages whose weights in row `row` are not zero, at compile time: the sparse tableaus are
+  // full of zeros.
+  template <int row>
+  static constexpr auto nonzero_weights() {
+    constexpr const std::array<double, Tableau::stages>& w = weights<row>();
+    std::array<int, Tableau::stages> stages{};
+    int count = 0;
+    for (int j = 0; j < row && j < Tableau::stages; ++j)
+      if (w[static_cast<std::size_t>(j)] != 0.0) stages[static_cast<std::size_t>(count++)] = j;
+    return std::pair{stages, count};
+  }
+
+  // target = y + h sum_j w_j k_j over row `row`'s nonzero weights. Each entry's sum is formed in a
+  // register, in the order of j, and stored once: the same additions as adding one stage after
+  // another to the whole target, without storing and loading the target for every stage; with
+  // the weights known at compile time the sum over j is unrolled.
+  template <int row>
+  void combine(const double* y, double h, double* target) const {
+    constexpr auto nonzero = nonzero_weights<row>();
+    constexpr int used = nonzero.second;
+    constexpr const std::array<double, Tableau::stages>& w = weights<row>();
+    std::array<double, used> coef;
+    std::array<const double*, used> from;
+    for (int m = 0; m < used; ++m) {
+      const std::size_t j = static_cast<std::size_t>(nonzero.first[static_cast<std::size_t>(m)]);
+      coef[static_cast<std::size_t>(m)] = h * w[j];
+      from[static_cast<std::size_t>(m)] = k_[j].data();
     }
     for (int i = 0; i < n_; ++i) {
       double sum = y[i];
-      for (int j = 0; j < used; ++j) sum += coef[static_cast<std::size_t>(j)] * stage[static_cast<std::size_t>(j)][i];
+#pragma GCC unroll 16
+      for (int m = 0; m < used; ++m) sum += coef[static_cast<std::size_t>(m)] * from[static_cast<std::size_t>(m)][i];
       target[i] = sum;
     }
   }
