@@ -370,6 +370,40 @@ TEST(TapeEvaluator, PreparedProgramsGiveTheSameBitsAsTheirPrograms) {
     }
 }
 
+// The tapes run beside the evaluator at every row (contact forces, derived outputs, contact modes)
+// are PreparedTapes: the same bits as the tape as given, with the steps no output needs left out.
+TEST(PreparedTape, GivesTheSameBitsAsItsTapeInFewerSteps) {
+  for (const int n : {2, 5})
+    for (const bool library : {true, false}) {
+      const Tape tape = mixed_program(n, 17, library);
+      const PreparedTape prepared(tape);
+      EXPECT_EQ(prepared.outputs(), tape.outputs());
+      EXPECT_EQ(prepared.registers(), tape.registers());
+      std::vector<double> q(static_cast<std::size_t>(n)), v(static_cast<std::size_t>(n));
+      for (const double state : {0.7, -1.3, 0.0}) {
+        for (int i = 0; i < n; ++i) {
+          q[static_cast<std::size_t>(i)] = state * (1.0 + 0.25 * i);
+          v[static_cast<std::size_t>(i)] = state - 0.5 * i;
+        }
+        const std::vector<double> expected = run(tape, 0.25 * state, q, v);
+        std::vector<double> registers(static_cast<std::size_t>(prepared.registers())), got(expected.size(), -7.0);
+        prepared.run(0.25 * state, q.data(), v.data(), registers.data(), got.data());
+        EXPECT_EQ(std::memcmp(got.data(), expected.data(), got.size() * sizeof(double)), 0) << "n = " << n;
+      }
+    }
+  // q0 * (sqrt(2) * 1.3) and a sine no output needs: one step (and the nop that ends them).
+  Tape small(1);
+  const int k = small.push(Op::mul, small.push(Op::sqrt, small.push_constant(2.0)), small.push_constant(1.3));
+  small.add_output(small.push(Op::mul, small.coordinate_register(0), k));
+  small.push(Op::sin, small.coordinate_register(0));
+  EXPECT_EQ(PreparedTape(small).steps.size(), 2u) << small.describe();
+  Tape parametric(2, 1);
+  parametric.add_output(parametric.push(Op::mul, parametric.push_parameter(0), parametric.coordinate_register(0)));
+  EXPECT_THROW(PreparedTape{parametric}, std::logic_error);
+  const double value = 3.0;
+  EXPECT_NO_THROW(PreparedTape{parametric.bind(&value, 1)});
+}
+
 TEST(TapeEvaluator, ComputesParameterOnlySubexpressionsOnce) {
   // A(1, 1) = q0 * (sqrt(2) * m) and Q(0) = sqrt(2) * m; everything else constant.
   const double m = 1.3;

@@ -112,7 +112,7 @@ struct ContactForceModel {
 struct ContactForceData {
   bool active = false;       // the model has contact forces
   std::vector<double> stage; // ContactForceModel::native's parameter stage (empty without it)
-  Tape tape;              // ContactForceModel::tape bound to the model's parameter values
+  PreparedTape tape;      // ContactForceModel::tape bound to the model's parameter values, prepared
   std::vector<double> registers;
   std::vector<double> outputs;
   Matrix M;                  // rows() x columns(), the stacked system, moment rows divided by L

@@ -64,7 +64,7 @@ struct ContactModeModel {
 // workspace may be resized (the only allocation).
 struct ContactModeData {
   bool active = false;
-  Tape tape;                    // ContactModeModel::tape bound to the parameter values
+  PreparedTape tape;            // ContactModeModel::tape bound to the parameter values, prepared
   std::vector<double> registers, outputs;
   std::vector<ContactMode> mode;   // per contact
   std::vector<ContactMode> solved;  // the modes of the last compute_mode_acceleration that succeeded

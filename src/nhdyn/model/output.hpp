@@ -44,7 +44,7 @@ struct ModelOutputs {
 
 // The evaluation state of the outputs for one Data (make_output_data, from make_data).
 struct OutputData {
-  Tape tape = Tape();       // ModelOutputs::tape bound to the parameter values
+  PreparedTape tape;        // ModelOutputs::tape bound to the parameter values, prepared
   std::vector<double> x, xd;       // 2n each: [q; q''] and [q'; R] (pack_dynamics_inputs)
   std::vector<double> registers;   // tape.registers()
   std::vector<double> stage;       // ModelOutputs::native's parameter stage (empty without it)

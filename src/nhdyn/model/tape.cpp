@@ -707,7 +707,9 @@ void fuse_products(std::vector<Step>& steps, const std::vector<std::vector<Want>
 
 }  // namespace
 
-TapeEvaluator::Prepared TapeEvaluator::prepare(const Tape& tape, const std::vector<int>& sizes) {
+PreparedTape PreparedTape::prepare(const Tape& tape, const std::vector<int>& sizes) {
+  if (tape.reads_parameters())
+    throw std::logic_error("PreparedTape: the tape reads parameters; prepare the tape bind() returns");
   const int inputs = tape.inputs();
   const std::size_t registers = static_cast<std::size_t>(tape.registers());
   const auto at = [](int reg) { return static_cast<std::size_t>(reg); };
@@ -716,7 +718,9 @@ TapeEvaluator::Prepared TapeEvaluator::prepare(const Tape& tape, const std::vect
   std::vector<Step> steps = fold_constants(tape, known, value);
 
   // The outputs: constants into the image, the others wanted from their registers.
-  Prepared p;
+  PreparedTape p;
+  p.n_ = tape.coordinates();
+  p.registers_ = tape.registers();
   std::vector<std::vector<Want>> wants(registers);
   const std::vector<Output>& outputs = tape.output_list();
   std::size_t j = 0;
@@ -889,19 +893,23 @@ void TapeEvaluator::sparse_terms(double t, const double* q, const double* v, dou
   sparse_function_(*this, t, q, v, scratch, out);
 }
 
+void PreparedTape::run(double t, const double* q, const double* v, double* registers, double* outputs) const {
+  load_inputs(reads, static_cast<std::size_t>(n_), t, q, v, registers);
+  const std::size_t m = image.size();
+  for (std::size_t i = 0; i < m; ++i) outputs[i] = image[i];
+  double* arrays[2];
+  arrays[0] = registers;
+  store_fence();
+  arrays[1] = outputs;
+  if (calls)
+    run_steps<true>(steps.data(), arrays);
+  else
+    run_steps<false>(steps.data(), arrays);
+}
+
 void TapeEvaluator::run(const Prepared& p, double t, const double* q, const double* v, double* scratch,
                            double* out) const {
-  load_inputs(p.reads, static_cast<std::size_t>(n_), t, q, v, scratch);
-  const std::size_t m = p.image.size();
-  for (std::size_t i = 0; i < m; ++i) out[i] = p.image[i];
-  double* arrays[2];
-  arrays[0] = scratch;
-  store_fence();
-  arrays[1] = out;
-  if (p.calls)
-    run_steps<true>(p.steps.data(), arrays);
-  else
-    run_steps<false>(p.steps.data(), arrays);
+  p.run(t, q, v, scratch, out);
 }
 
 void TapeEvaluator::complement(double t, const double* q, const double* v, double* scratch, double* D) const {

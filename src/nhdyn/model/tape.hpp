@@ -221,6 +221,36 @@ class Tape {
   bool reads_[3] = {false, false, false};  // t, q, q'
 };
 
+// A tape ready to run, prepared from a tape whose parameters are bound (Tape::bind) as
+// TapeEvaluator prepares its own (below: constants folded, products fused, dead steps left out,
+// steps grouped by op): the same values to the bit, in fewer steps. Its steps write destination 0
+// (the registers) or 1 + i (the i-th output array), end with a nop, and every output has its place
+// in `image` (its constant, 0 where a step writes it), copied before the steps run. The tapes run
+// at every output row beside the evaluator's (contact forces, derived outputs) are run this way.
+class PreparedTape {
+ public:
+  PreparedTape() = default;
+  // `tape`, whose outputs fill one array. Throws std::logic_error for a tape that reads parameters.
+  explicit PreparedTape(const Tape& tape) : PreparedTape(prepare(tape, {tape.outputs()})) {}
+  // `tape`, whose outputs fill arrays of the given sizes one after the other.
+  static PreparedTape prepare(const Tape& tape, const std::vector<int>& sizes);
+
+  int outputs() const { return static_cast<int>(image.size()); }
+  int registers() const { return registers_; }
+  // Tape::run's inputs and outputs (one output array): `registers` holds registers() doubles.
+  // Allocates nothing.
+  void run(double t, const double* q, const double* v, double* registers, double* outputs) const;
+
+  std::vector<Step> steps;
+  bool calls = false;                     // a step calls the math library
+  bool reads[3] = {false, false, false};  // t, q, q'
+  std::vector<double> image;
+
+ private:
+  int n_ = 0;
+  int registers_ = 0;
+};
+
 // The tapes of a compiled model, with the output each must have (n coordinates, s
 // constraints, p of them at position level, r = number at position or velocity level). Each may
 // read the model's parameters (in the order of Model::parameters).
@@ -324,17 +354,8 @@ class TapeEvaluator final : public Evaluator {
   void solution(double t, double* scratch, double* qva) const override;
 
  private:
-  // A tape ready to run: its steps (destination 0 the registers, 1 + i the i-th output array),
-  // ended by a nop, the inputs they read, and every output as an image (constants, 0 where a
-  // step writes) that is copied before the steps run.
-  struct Prepared {
-    std::vector<Step> steps;
-    bool calls = false;                     // a step calls the math library
-    bool reads[3] = {false, false, false};  // t, q, q'
-    std::vector<double> image;
-  };
-  // Prepares `tape`, whose outputs fill arrays of the given sizes one after the other.
-  static Prepared prepare(const Tape& tape, const std::vector<int>& sizes);
+  using Prepared = PreparedTape;
+  static Prepared prepare(const Tape& tape, const std::vector<int>& sizes) { return PreparedTape::prepare(tape, sizes); }
 
   // The whole terms() call, with the sizes fixed at compile time for n <= 4 (terms_fixed) or not:
   // the input copies and the image copies then become a few moves instead of loops.
