@@ -413,7 +413,9 @@ class CompiledEvaluator final : public OverInterpreter {
       base_->velocity_residual(t, q, v, scratch, f);
   }
   double energy_function(double t, const double* q, const double* v, double* scratch) const override {
-    if (!rows_[kEnergyFunction]) return base_->energy_function(t, q, v, scratch);
+    // Without a tape of its own h is E (T = T2): the compiled energy, not the interpreter's.
+    if (!rows_[kEnergyFunction]) return base_->energy_function_is_energy() ? energy(t, q, v, scratch)
+                                                                           : base_->energy_function(t, q, v, scratch);
     double h = 0.0;
     rows_[kEnergyFunction]->run(row_stages_[kEnergyFunction].data(), t, q, v, &h);
     return h;
