@@ -15,7 +15,7 @@
 #include <array>
 #include <cmath>
 
-#include "nhdyn/integrators/detail/explicit_rk.hpp"
+#include "nhdyn/integrators/tableaus.hpp"
 
 namespace nhdyn::bench {
 
