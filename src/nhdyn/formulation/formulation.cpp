@@ -69,7 +69,9 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
   }
   if (options.baumgarte.enabled) data.b0 = data.b0_model;
   if (status != Status::ok) return status;
-  if (accumulate_non_finite(accumulate_non_finite(0.0, data.qdd), data.R) != 0.0) {
+  const double acc = data.pair_non_finite ? data.pair_non_finite(data.qdd.data(), data.R.data())
+                                           : accumulate_non_finite(accumulate_non_finite(0.0, data.qdd), data.R);
+  if (acc != 0.0) {
     if (!data.qdd.allFinite()) return record_failure(data, Status::non_finite, "accelerations q''");
     return record_failure(data, Status::non_finite, "reactions R");
   }

@@ -1,5 +1,7 @@
 #include "nhdyn/model/data.hpp"
 
+#include "nhdyn/core/detail/finite.hpp"
+
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -385,6 +387,10 @@ Data make_data(const Model& model, const DataOptions& options) {
   d.is_dependent.assign(static_cast<std::size_t>(n), 0);
   d.contact = make_contact_force_data(model);
   d.modes = make_contact_mode_data(model);
+  if (!sparse) {
+    d.terms_non_finite = find_terms_non_finite(n, s);
+    d.pair_non_finite = find_pair_non_finite(n);
+  }
   if (const int m = model.m(); m > 0) {
     ProgramMotionData& w = d.motion;
     w.b_p = Matrix::Zero(m, n);

@@ -44,15 +44,21 @@ Status compute_terms(const Model& model, Data& data, double t, const double* q, 
     model.evaluator->terms(t, data.q.data(), data.v.data(), data.scratch.data(),
                            TermsOut{data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data()});
   ++data.term_evaluations;
-  double acc = accumulate_non_finite(0.0, data.q);
-  acc = accumulate_non_finite(acc, data.v);
-  acc = accumulate_non_finite(acc, data.A);
-  acc = accumulate_non_finite(acc, data.Q);
-  acc = accumulate_non_finite(acc, data.G);
-  acc = accumulate_non_finite(acc, data.b);
-  acc = accumulate_non_finite(acc, data.b0);
-  acc = accumulate_non_finite(acc, data.A_sparse.valuePtr(), data.A_sparse.nonZeros());
-  acc = accumulate_non_finite(acc, data.b_sparse.valuePtr(), data.b_sparse.nonZeros());
+  double acc = 0.0;
+  if (data.terms_non_finite) {
+    acc = data.terms_non_finite(data.q.data(), data.v.data(), data.A.data(), data.Q.data(), data.G.data(),
+                                data.b.data(), data.b0.data());
+  } else {
+    acc = accumulate_non_finite(acc, data.q);
+    acc = accumulate_non_finite(acc, data.v);
+    acc = accumulate_non_finite(acc, data.A);
+    acc = accumulate_non_finite(acc, data.Q);
+    acc = accumulate_non_finite(acc, data.G);
+    acc = accumulate_non_finite(acc, data.b);
+    acc = accumulate_non_finite(acc, data.b0);
+    acc = accumulate_non_finite(acc, data.A_sparse.valuePtr(), data.A_sparse.nonZeros());
+    acc = accumulate_non_finite(acc, data.b_sparse.valuePtr(), data.b_sparse.nonZeros());
+  }
   if (acc != 0.0) {
     if (!data.q.allFinite()) return record_failure(data, Status::non_finite, "coordinates q");
     if (!data.v.allFinite()) return record_failure(data, Status::non_finite, "velocities q'");
