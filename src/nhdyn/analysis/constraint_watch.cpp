@@ -16,13 +16,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // columns: O(nonzeros).
 void row_norms(const Data& data, Vector& out) {
   if (!data.sparse) {
-    const Eigen::Index s = out.size(), n = data.b.cols();
-    const double* b = data.b.data();
-    for (Eigen::Index i = 0; i < s; ++i) {
-      double sum = 0.0;
-      for (Eigen::Index c = 0; c < n; ++c) sum += b[i + s * c] * b[i + s * c];
-      out(i) = std::sqrt(sum);
-    }
+    for (Eigen::Index i = 0; i < out.size(); ++i) out(i) = data.b.row(i).norm();
     return;
   }
   out.setZero();
@@ -63,40 +57,16 @@ double stacked_condition(const Model& model, const Data& data, ConstraintWatch& 
   const int k = model.k();
   const int s = model.s();
   Matrix& rows = watch.rows;
-  // Plain loops over the column-major storage: this runs at every accepted step, and at the sizes
-  // of most models Eigen's expressions of dynamic size cost more in dispatch than in arithmetic.
-  const Eigen::Index m = rows.rows(), n = rows.cols(), top = m - s;
-  double* M = rows.data();
-  const double* estimated = watch.estimated_rows.data();
-  if (watch.stacked && k > 0) {
-    const double* D = data.D.data();
-    const double* A = data.A.data();
-    for (Eigen::Index c = 0; c < n; ++c)
-      for (Eigen::Index i = 0; i < k; ++i) {
-        double acc = 0.0;
-        for (Eigen::Index l = 0; l < n; ++l) acc += D[i + k * l] * A[l + n * c];
-        M[i + m * c] = acc;
-      }
-  }
-  const double* b = data.b.data();
-  for (Eigen::Index c = 0; c < n; ++c)
-    for (Eigen::Index i = 0; i < s; ++i) M[top + i + m * c] = b[i + s * c];
+  if (watch.stacked && k > 0) rows.topRows(k).noalias() = data.D * data.A;
+  rows.bottomRows(s) = data.b;
+  const Eigen::Index top = rows.rows() - s;
   double moved = 0.0;  // ||M - M at the last estimate||_F^2, in the same pass as the scaling
-  for (Eigen::Index i = 0; i < m; ++i) {
+  for (Eigen::Index i = 0; i < rows.rows(); ++i) {
     // The rows of b have their norms in watch.norm already.
-    double norm = 0.0;
-    if (i < top) {
-      for (Eigen::Index c = 0; c < n; ++c) norm += M[i + m * c] * M[i + m * c];
-      norm = std::sqrt(norm);
-    } else {
-      norm = watch.norm(i - top);
-    }
+    const double norm = i < top ? rows.row(i).norm() : watch.norm(i - top);
     if (!std::isfinite(norm)) return kInfinity;
-    for (Eigen::Index c = 0; c < n; ++c) {
-      if (norm > 0.0) M[i + m * c] /= norm;
-      const double d = M[i + m * c] - estimated[i + m * c];
-      moved += d * d;
-    }
+    if (norm > 0.0) rows.row(i) /= norm;
+    moved += (rows.row(i) - watch.estimated_rows.row(i)).squaredNorm();
   }
   if (moved <= watch.reuse_radius * watch.reuse_radius && watch.reuse_radius > 0.0) {
     last = watch.last_pivot;
@@ -108,16 +78,16 @@ double stacked_condition(const Model& model, const Data& data, ConstraintWatch& 
   const Matrix& R = watch.qr.matrixQR();
   double largest = 0.0;
   double smallest = kInfinity;
-  const Eigen::Index pivots = std::min(R.rows(), R.cols());
-  for (Eigen::Index i = 0; i < pivots; ++i) {
+  const Eigen::Index m = std::min(R.rows(), R.cols());
+  for (Eigen::Index i = 0; i < m; ++i) {
     const double d = std::abs(R(i, i));
     largest = std::max(largest, d);
     smallest = std::min(smallest, d);
   }
-  last = watch.qr.colsPermutation().indices()(pivots - 1);
+  last = watch.qr.colsPermutation().indices()(m - 1);
   watch.last_pivot = last;
   watch.estimated_rows = rows;
-  watch.reuse_radius = smallest > 0.0 ? kConditioningReuse * smallest_singular_value_bound(R, pivots, watch.unit) : 0.0;
+  watch.reuse_radius = smallest > 0.0 ? kConditioningReuse * smallest_singular_value_bound(R, m, watch.unit) : 0.0;
   if (!(smallest > 0.0)) return kInfinity;
   return largest / smallest;
 }
