@@ -396,7 +396,12 @@ TEST(PreparedTape, GivesTheSameBitsAsItsTapeInFewerSteps) {
   const int k = small.push(Op::mul, small.push(Op::sqrt, small.push_constant(2.0)), small.push_constant(1.3));
   small.add_output(small.push(Op::mul, small.coordinate_register(0), k));
   small.push(Op::sin, small.coordinate_register(0));
-  EXPECT_EQ(PreparedTape(small).steps.size(), 2u) << small.describe();
+  EXPECT_EQ(PreparedTape(small).steps(), 1) << small.describe();
+  // A default one has no outputs and runs (nothing).
+  const PreparedTape empty;
+  double registers[1] = {0.0};
+  empty.run(0.0, nullptr, nullptr, registers, nullptr);
+  EXPECT_EQ(empty.outputs(), 0);
   Tape parametric(2, 1);
   parametric.add_output(parametric.push(Op::mul, parametric.push_parameter(0), parametric.coordinate_register(0)));
   EXPECT_THROW(PreparedTape{parametric}, std::logic_error);

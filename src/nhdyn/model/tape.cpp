@@ -512,10 +512,10 @@ void TapeEvaluator::build() {
                          {tapes_.program_constraint_velocity_residual->outputs()});
   }
   if (tapes_.sparsity) {
-    terms_function_ = terms_.calls ? &terms_scatter<true> : &terms_scatter<false>;
-    sparse_function_ = terms_.calls ? &terms_any<true> : &terms_any<false>;
+    terms_function_ = terms_.calls_ ? &terms_scatter<true> : &terms_scatter<false>;
+    sparse_function_ = terms_.calls_ ? &terms_any<true> : &terms_any<false>;
   } else {
-    terms_function_ = terms_.calls ? choose_terms<true>(n, s) : choose_terms<false>(n, s);
+    terms_function_ = terms_.calls_ ? choose_terms<true>(n, s) : choose_terms<false>(n, s);
   }
 }
 
@@ -719,6 +719,7 @@ PreparedTape PreparedTape::prepare(const Tape& tape, const std::vector<int>& siz
 
   // The outputs: constants into the image, the others wanted from their registers.
   PreparedTape p;
+  p.steps_.clear();
   p.n_ = tape.coordinates();
   p.registers_ = tape.registers();
   std::vector<std::vector<Want>> wants(registers);
@@ -728,7 +729,7 @@ PreparedTape PreparedTape::prepare(const Tape& tape, const std::vector<int>& siz
     for (int i = 0; i < sizes[array]; ++i, ++j) {
       const Output& o = outputs[j];
       const bool constant = o.reg < 0 || known[at(o.reg)];
-      p.image.push_back(o.reg < 0 ? o.value : constant ? value[at(o.reg)] : 0.0);
+      p.image_.push_back(o.reg < 0 ? o.value : constant ? value[at(o.reg)] : 0.0);
       if (!constant) wants[at(o.reg)].push_back(Want{static_cast<int>(array) + 1, i});
     }
 
@@ -742,20 +743,20 @@ PreparedTape PreparedTape::prepare(const Tape& tape, const std::vector<int>& siz
   const int n = tape.coordinates();
   const auto note_read = [&p, n](int reg) {
     if (reg == 0)
-      p.reads[0] = true;
+      p.reads_[0] = true;
     else if (reg <= n)
-      p.reads[1] = true;
+      p.reads_[1] = true;
     else if (reg <= 2 * n)
-      p.reads[2] = true;
+      p.reads_[2] = true;
   };
   const auto place = [&p, &note_read](const Step& step, int dest, int to) {
     Step x = step;
     x.dest = static_cast<std::uint8_t>(dest);
     x.to = to;
-    p.steps.push_back(x);
+    p.steps_.push_back(x);
     const int operands[3] = {x.a, x.b, x.c};
     for (int k = 0; k < operand_count(x.op); ++k) note_read(operands[k]);
-    p.calls = p.calls || calls_library(x.op);
+    p.calls_ = p.calls_ || calls_library(x.op);
   };
   const auto copy = [&place](int reg, const Want& w) {
     place(Step{Op::mul_k, 0, 0, reg, 0, 0, 1.0}, w.array, w.index);
@@ -781,8 +782,8 @@ PreparedTape PreparedTape::prepare(const Tape& tape, const std::vector<int>& siz
     }
     for (std::size_t w = first; w < want.size(); ++w) place(step, want[w].array, want[w].index);
   }
-  p.steps = schedule(p.steps, registers);
-  p.steps.push_back(Step{});
+  p.steps_ = schedule(p.steps_, registers);
+  p.steps_.push_back(Step{});
   return p;
 }
 
@@ -821,29 +822,29 @@ template <int N, int S, bool Calls>
 void TapeEvaluator::terms_fixed(const TapeEvaluator& self, double t, const double* q, const double* v,
                                    double* scratch, const TermsOut& out) {
   const Prepared& p = self.terms_;
-  load_inputs(p.reads, N, t, q, v, scratch);
-  const double* image = p.image.data();
+  load_inputs(p.reads_, N, t, q, v, scratch);
+  const double* image = p.image_.data();
   copy_fixed<N * N>(image, out.A);
   copy_fixed<N>(image + N * N, out.Q);
   copy_fixed<N>(image + N * N + N, out.G);
   copy_fixed<S * N>(image + N * N + 2 * N, out.b);
   copy_fixed<S>(image + N * N + 2 * N + S * N, out.b0);
-  run_steps<Calls>(p.steps.data(), TermsArrays(scratch, out).arrays);
+  run_steps<Calls>(p.steps_.data(), TermsArrays(scratch, out).arrays);
 }
 
 template <bool Calls>
 void TapeEvaluator::terms_any(const TapeEvaluator& self, double t, const double* q, const double* v,
                                  double* scratch, const TermsOut& out) {
   const Prepared& p = self.terms_;
-  load_inputs(p.reads, static_cast<std::size_t>(self.n_), t, q, v, scratch);
+  load_inputs(p.reads_, static_cast<std::size_t>(self.n_), t, q, v, scratch);
   const TermsArrays arrays(scratch, out);
-  const double* image = p.image.data();
+  const double* image = p.image_.data();
   for (int a = 0; a < 5; ++a) {
     const std::size_t size = self.terms_sizes_[a];
     for (std::size_t i = 0; i < size; ++i) arrays.arrays[a + 1][i] = image[i];
     image += size;
   }
-  run_steps<Calls>(p.steps.data(), arrays.arrays);
+  run_steps<Calls>(p.steps_.data(), arrays.arrays);
 }
 
 template <bool Calls>
@@ -894,17 +895,17 @@ void TapeEvaluator::sparse_terms(double t, const double* q, const double* v, dou
 }
 
 void PreparedTape::run(double t, const double* q, const double* v, double* registers, double* outputs) const {
-  load_inputs(reads, static_cast<std::size_t>(n_), t, q, v, registers);
-  const std::size_t m = image.size();
-  for (std::size_t i = 0; i < m; ++i) outputs[i] = image[i];
+  load_inputs(reads_, static_cast<std::size_t>(n_), t, q, v, registers);
+  const std::size_t m = image_.size();
+  for (std::size_t i = 0; i < m; ++i) outputs[i] = image_[i];
   double* arrays[2];
   arrays[0] = registers;
   store_fence();
   arrays[1] = outputs;
-  if (calls)
-    run_steps<true>(steps.data(), arrays);
+  if (calls_)
+    run_steps<true>(steps_.data(), arrays);
   else
-    run_steps<false>(steps.data(), arrays);
+    run_steps<false>(steps_.data(), arrays);
 }
 
 void TapeEvaluator::run(const Prepared& p, double t, const double* q, const double* v, double* scratch,
@@ -930,7 +931,7 @@ void TapeEvaluator::program_constraint_terms(double t, const double* q, const do
                                                 double* b_p, double* b_p0, double* B) const {
   if (!tapes_.program_constraint_terms) return;
   const Prepared& p = program_terms_;
-  load_inputs(p.reads, static_cast<std::size_t>(n_), t, q, v, scratch);
+  load_inputs(p.reads_, static_cast<std::size_t>(n_), t, q, v, scratch);
   double* arrays[4];
   arrays[0] = scratch;
   store_fence();
@@ -939,15 +940,15 @@ void TapeEvaluator::program_constraint_terms(double t, const double* q, const do
   arrays[2] = b_p0;
   store_fence();
   arrays[3] = B;
-  const double* image = p.image.data();
+  const double* image = p.image_.data();
   for (int a = 0; a < 3; ++a) {
     for (std::size_t i = 0; i < program_sizes_[a]; ++i) arrays[a + 1][i] = image[i];
     image += program_sizes_[a];
   }
-  if (p.calls)
-    run_steps<true>(p.steps.data(), arrays);
+  if (p.calls_)
+    run_steps<true>(p.steps_.data(), arrays);
   else
-    run_steps<false>(p.steps.data(), arrays);
+    run_steps<false>(p.steps_.data(), arrays);
 }
 
 void TapeEvaluator::program_constraint_position_residual(double t, const double* q, double* scratch,

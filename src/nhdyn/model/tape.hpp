@@ -229,24 +229,27 @@ class Tape {
 // at every output row beside the evaluator's (contact forces, derived outputs) are run this way.
 class PreparedTape {
  public:
+  // A tape without outputs: run() writes nothing.
   PreparedTape() = default;
   // `tape`, whose outputs fill one array. Throws std::logic_error for a tape that reads parameters.
   explicit PreparedTape(const Tape& tape) : PreparedTape(prepare(tape, {tape.outputs()})) {}
   // `tape`, whose outputs fill arrays of the given sizes one after the other.
   static PreparedTape prepare(const Tape& tape, const std::vector<int>& sizes);
 
-  int outputs() const { return static_cast<int>(image.size()); }
+  int outputs() const { return static_cast<int>(image_.size()); }
   int registers() const { return registers_; }
+  // The number of steps run() runs (a sincos counts one).
+  int steps() const { return static_cast<int>(steps_.size()) - 1; }
   // Tape::run's inputs and outputs (one output array): `registers` holds registers() doubles.
   // Allocates nothing.
   void run(double t, const double* q, const double* v, double* registers, double* outputs) const;
 
-  std::vector<Step> steps;
-  bool calls = false;                     // a step calls the math library
-  bool reads[3] = {false, false, false};  // t, q, q'
-  std::vector<double> image;
-
  private:
+  friend class TapeEvaluator;  // runs the steps into its own output arrays (the terms' five)
+  std::vector<Step> steps_{Step{}};        // ended by a nop
+  bool calls_ = false;                     // a step calls the math library
+  bool reads_[3] = {false, false, false};  // t, q, q'
+  std::vector<double> image_;
   int n_ = 0;
   int registers_ = 0;
 };
@@ -324,7 +327,7 @@ class TapeEvaluator final : public Evaluator {
   bool has_initial_state() const override { return tapes_.initial_state.has_value(); }
   void initial_state(double* scratch, double* q0, double* v0) const override;
   // Number of operations the prepared terms run per call (a sincos counts one).
-  int terms_operations() const { return static_cast<int>(terms_.steps.size()) - 1; }
+  int terms_operations() const { return terms_.steps(); }
 
   std::size_t scratch_size() const override { return scratch_; }
   // The Evaluator interface; each call runs one tape and writes its outputs. A sparse terms
