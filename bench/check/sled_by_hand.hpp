@@ -7,7 +7,8 @@
 // events, no checks: what a user who writes the sled's integration by hand would run. It is the
 // yardstick of bench-check's `sled_dopri5_vs_hand_written` and `sled_dop853_vs_hand_written`, which
 // time `simulate()` of the model file against it; both start with the same first step and take the
-// same steps (the bench compares the step counts and the final states before timing).
+// same steps (the bench compares the step counts, to 1 %: a step whose error estimate is within
+// round-off of 1 may go either way, and the final states before timing).
 #pragma once
 
 #include <Eigen/Dense>
