@@ -458,6 +458,38 @@ void derive_complement(const Spec& spec, const std::string& model, Derivation& d
   }
 }
 
+// The degree of `e` as a homogeneous polynomial in the velocities `v` (the few a term contains),
+// whatever its other factors; -1 when it is not one (a velocity inside a function, a root or a
+// denominator, or a sum of terms of unlike degrees). Degree 0 means that e contains no velocity.
+int velocity_degree(const GiNaC::ex& e, const std::vector<GiNaC::ex>& v) {
+  if (GiNaC::is_exactly_a<GiNaC::symbol>(e))
+    return std::any_of(v.begin(), v.end(), [&](const GiNaC::ex& x) { return x.is_equal(e); }) ? 1 : 0;
+  if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) return 0;
+  const bool sum = GiNaC::is_exactly_a<GiNaC::add>(e), product = GiNaC::is_exactly_a<GiNaC::mul>(e);
+  if (GiNaC::is_exactly_a<GiNaC::power>(e)) {
+    const int base = velocity_degree(e.op(0), v);
+    if (base < 0) return -1;
+    const GiNaC::ex& k = e.op(1);
+    if (GiNaC::is_exactly_a<GiNaC::numeric>(k) && k.info(GiNaC::info_flags::nonnegint))
+      return base * GiNaC::ex_to<GiNaC::numeric>(k).to_int();
+    return base == 0 && velocity_degree(k, v) == 0 ? 0 : -1;
+  }
+  int out = 0;
+  for (std::size_t i = 0; i < e.nops(); ++i) {
+    const int d = velocity_degree(e.op(i), v);
+    if (d < 0) return -1;
+    if (product) {
+      out += d;
+    } else if (sum) {
+      if (i > 0 && d != out) return -1;
+      out = d;
+    } else if (d != 0) {
+      return -1;  // a velocity inside a function's argument
+    }
+  }
+  return out;
+}
+
 // The energy balance (docs/derivations/energy-balance.md). Simplifying a sum costs more than
 // linearly in its number of terms (every trigonometric argument is reduced across all of them):
 // a large model's expressions are kept as written, which computes the same values.
@@ -479,6 +511,15 @@ void derive_energy_balance(const Spec& spec, const SplitSum& Ts, Derivation& d) 
   bool h_is_energy = true;
   for (std::size_t j = 0; j < Ts.terms.size(); ++j) {
     const GiNaC::ex& term = Ts.terms[j];
+    // A term that is a homogeneous quadratic in the velocities needs no check: Euler's identity
+    // holds for it as polynomials, which expand() below would confirm at great cost for the
+    // nested products of a multibody model's rotations (two fifths of the bicycle's start-up).
+    std::vector<GiNaC::ex> velocities;
+    for (int i : Ts.occurrences[j].v) velocities.push_back(v(i));
+    if (!velocities.empty() && velocity_degree(term, velocities) == 2) {
+      h_terms.push_back(term);
+      continue;
+    }
     GiNaC::ex rate = 0;
     for (int i : Ts.occurrences[j].v) rate += v(i) * term.diff(v(i));
     // Expanding settles the usual term (a polynomial in the velocities) at a small fraction of
