@@ -7,8 +7,8 @@
 
 #include <ginac/ginac.h>
 
-#include <map>
 #include <set>
+#include <unordered_map>
 #include <vector>
 
 #include "nhdyn/symbolic/spec.hpp"
@@ -34,7 +34,12 @@ class SymbolIndex {
 
  private:
   enum class Kind { time, q, v, a };
-  std::map<GiNaC::ex, std::pair<Kind, int>, GiNaC::ex_is_less> index_;
+  struct Entry {
+    GiNaC::ex symbol;
+    Kind kind;
+    int i;
+  };
+  std::unordered_multimap<unsigned, Entry> index_;  // by the symbol's GiNaC hash
 };
 
 }  // namespace nhdyn::symbolic
