@@ -148,16 +148,18 @@ class TapeCompiler {
  public:
   explicit TapeCompiler(const Spec& spec)
       : spec_(spec), tape_(spec.n(), static_cast<int>(spec.parameters.size())) {
-    for (std::size_t i = 0; i < spec.parameters.size(); ++i)
-      parameters_.emplace(spec.symbols.parameter(spec.parameters[i].name), static_cast<int>(i));
     const SymbolTable& symbols = spec.symbols;
-    variables_.emplace(symbols.time(), Tape::time_register());
+    inputs_.reserve(2 * static_cast<std::size_t>(symbols.coordinates()) + spec.parameters.size() + 1);
+    for (std::size_t i = 0; i < spec.parameters.size(); ++i)
+      add_input(spec.symbols.parameter(spec.parameters[i].name), -1, static_cast<int>(i));
+    add_input(symbols.time(), Tape::time_register(), -1);
     for (int i = 0; i < symbols.coordinates(); ++i) {
-      variables_.emplace(symbols.coordinate(i), tape_.coordinate_register(i));
-      variables_.emplace(symbols.velocity(i), tape_.velocity_register(i));
+      add_input(symbols.coordinate(i), tape_.coordinate_register(i), -1);
+      add_input(symbols.velocity(i), tape_.velocity_register(i), -1);
     }
     nodes_.emplace_back();  // kOne
     nodes_.back().key = 1;
+    same_key_.push_back(-1);
   }
 
   // Compiles `e` (parameters still symbolic) into the next output; `what` names it in errors.
@@ -207,12 +209,18 @@ class TapeCompiler {
     h = mix(h, hash_double(n.exponent));
     for (const Scaled& item : n.items) h = mix(mix(h, hash_double(item.c)), node(item.id).key);
     n.key = h;
-    std::vector<int>& candidates = by_key_[h];
-    for (int id : candidates)
-      if (shallow_equal(node(id), n)) return id;
+    const auto [first, fresh] = by_key_.try_emplace(h, static_cast<int>(nodes_.size()));
+    if (!fresh) {
+      for (int id = first->second; id >= 0; id = same_key_[static_cast<std::size_t>(id)])
+        if (shallow_equal(node(id), n)) return id;
+    }
     nodes_.push_back(std::move(n));
     const int id = static_cast<int>(nodes_.size()) - 1;
-    candidates.push_back(id);
+    same_key_.push_back(-1);
+    if (!fresh) {  // the chain of nodes with this key: the new one first
+      same_key_.back() = first->second;
+      first->second = id;
+    }
     return id;
   }
 
@@ -475,8 +483,10 @@ class TapeCompiler {
     const auto found = translated_.find(key);
     if (found != translated_.end()) return found->second.second;
     const Scaled s = translate(e);
-    // The node itself is kept in the memo so that its address cannot be reused by another.
-    translated_.emplace(key, std::make_pair(e, s));
+    // The node itself is kept in the memo so that its address cannot be reused by another. A node
+    // held by `e` alone (the temporary c x that op() makes of a sum's term with a coefficient) can
+    // never be met again: it is not kept.
+    if (key->get_refcount() > 1) translated_.emplace(key, std::make_pair(e, s));
     return s;
   }
 
@@ -545,13 +555,15 @@ class TapeCompiler {
     Node n;
     n.kind = Kind::symbol;
     n.name = x.get_name();
-    const auto variable = variables_.find(x);
-    const auto parameter = parameters_.find(x);
-    if (variable != variables_.end()) {
-      n.input = variable->second;
+    const Input* found = nullptr;
+    const auto [begin, end] = inputs_.equal_range(x.gethash());
+    for (auto it = begin; it != end && found == nullptr; ++it)
+      if (it->second.symbol.is_equal(x)) found = &it->second;
+    if (found != nullptr && found->input >= 0) {
+      n.input = found->input;
       n.parameters_only = false;
-    } else if (parameter != parameters_.end()) {
-      n.parameter = parameter->second;
+    } else if (found != nullptr) {
+      n.parameter = found->parameter;
     } else {
       for (int i = 0; i < spec_.symbols.coordinates(); ++i)
         if (x.is_equal(spec_.symbols.acceleration(i)))
@@ -890,14 +902,27 @@ class TapeCompiler {
   }
 
   const Spec& spec_;
-  std::map<GiNaC::ex, int, GiNaC::ex_is_less> parameters_;  // parameter symbol -> its index
-  std::map<GiNaC::ex, int, GiNaC::ex_is_less> variables_;   // t, q, q' -> input register
+  // t, q, q' -> input register, parameter symbol -> its index; found by the symbol's GiNaC hash
+  // (from its serial number, the same in every copy), then by equality.
+  struct Input {
+    GiNaC::ex symbol;
+    int input = -1;
+    int parameter = -1;
+  };
+  std::unordered_multimap<unsigned, Input> inputs_;
+  void add_input(const GiNaC::symbol& x, int input, int parameter) {
+    inputs_.emplace(x.gethash(), Input{x, input, parameter});
+  }
   std::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, Scaled>> translated_;
   std::deque<Node> nodes_;  // a deque: references stay valid while nodes are added
-  std::unordered_map<std::uint64_t, std::vector<int>> by_key_;
+  std::unordered_map<std::uint64_t, int> by_key_;  // key -> the last node made with it
+  std::vector<int> same_key_;                       // per node: the one made before it with its key, or -1
   Tape tape_;
-  std::map<MemoKey, int> memo_;
-  std::map<std::uint64_t, int> constants_;  // by the bits of the value
+  struct MemoHash {
+    std::size_t operator()(const MemoKey& k) const { return mix(static_cast<std::uint64_t>(k.first), k.second); }
+  };
+  std::unordered_map<MemoKey, int, MemoHash> memo_;
+  std::unordered_map<std::uint64_t, int> constants_;  // by the bits of the value
   std::string what_;
   GiNaC::ex original_;
 };
