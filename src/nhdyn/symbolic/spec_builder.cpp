@@ -783,22 +783,17 @@ SpecBuilder& SpecBuilder::force(const std::string& coordinate, const std::string
   return *this;
 }
 
-namespace {
-
-void check_constraint_name(const Spec& spec, const std::string& name, const SourceLocation& where) {
+void SpecBuilder::check_constraint_name(const std::string& name, const SourceLocation& where) const {
   const std::string context = fmt::format("constraint '{}'", name);
   if (name.empty() || !std::isalpha(static_cast<unsigned char>(name[0])) ||
       !std::all_of(name.begin(), name.end(), [](char c) { return identifier_char(c) || c == '-'; }))
     fail(where, context, "not a valid constraint name: use letters, digits, '_' and '-', starting with a letter");
-  for (const SpecConstraint& c : spec.constraints)
-    if (c.name == name) {
-      const std::string at = c.where.describe();
-      fail(where, context, fmt::format("duplicated constraint name '{}'{}", name,
-                                       at.empty() ? "" : " (first given at " + at + ")"));
-    }
+  if (const auto found = constraint_by_name_.find(name); found != constraint_by_name_.end()) {
+    const std::string at = spec_.constraints[found->second].where.describe();
+    fail(where, context, fmt::format("duplicated constraint name '{}'{}", name,
+                                     at.empty() ? "" : " (first given at " + at + ")"));
+  }
 }
-
-}  // namespace
 
 SpecBuilder& SpecBuilder::add_energies(const GiNaC::ex& kinetic, const GiNaC::ex& potential) {
   spec_.kinetic_energy += kinetic;
@@ -808,7 +803,7 @@ SpecBuilder& SpecBuilder::add_energies(const GiNaC::ex& kinetic, const GiNaC::ex
 
 SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel level, const GiNaC::ex& expression,
                                      const std::string& text, SourceLocation where) {
-  check_constraint_name(spec_, name, where);
+  check_constraint_name(name, where);
   const int n = spec_.n();
   bool velocities = false, accelerations = false;
   for (int i = 0; i < n; ++i) {
@@ -822,6 +817,7 @@ SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel le
     fail(where, fmt::format("constraint '{}'", name),
          "the expression does not match the level it is given at (position: no velocities; velocity: some "
          "velocity, no acceleration; acceleration: some acceleration)");
+  constraint_by_name_.emplace(name, spec_.constraints.size());
   spec_.constraints.push_back({name, level, expression, text, std::move(where)});
   return *this;
 }
@@ -829,7 +825,7 @@ SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel le
 SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel level, const std::string& text,
                                      SourceLocation where) {
   const std::string context = fmt::format("constraint '{}'", name);
-  check_constraint_name(spec_, name, where);
+  check_constraint_name(name, where);
   const Site site{text, where, context};
   // `lhs = rhs` is read as lhs - rhs = 0.
   Parsed parsed;
@@ -871,6 +867,7 @@ SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel le
                               velocities ? "velocity" : "position"));
       break;
   }
+  constraint_by_name_.emplace(name, spec_.constraints.size());
   spec_.constraints.push_back({name, level, parsed.value, text, std::move(where)});
   return *this;
 }
