@@ -299,7 +299,11 @@ class Reader {
       table[internal_name(o.name)] = o.kind == SymbolKind::constant ? GiNaC::ex(GiNaC::Pi) : GiNaC::ex(o.symbol);
     Parsed parsed;
     try {
-      GiNaC::parser parser(table, /*strict=*/true);
+      // One parser per thread, given each expression's table: making a parser copies GiNaC's
+      // table of functions, which cost as much as reading a short expression (a chain's 6000
+      // initial values).
+      thread_local GiNaC::parser parser(GiNaC::symtab(), /*strict=*/true);
+      parser.get_syms() = std::move(table);
       parsed.value = parser(out_);
     } catch (const std::exception& e) {
       site_.fail_at(tokens_.front().begin, plain_words(e.what()));
@@ -560,58 +564,54 @@ class Reader {
 // kinetic energy, potential or constraint of mechanics needs them.
 constexpr long kLargestExponent = 64;
 
-bool has_huge_exponent(const GiNaC::ex& e) {
-  if (GiNaC::is_a<GiNaC::power>(e)) {
-    const GiNaC::ex exponent = e.op(1);
-    if (GiNaC::is_a<GiNaC::numeric>(exponent) &&
-        GiNaC::abs(GiNaC::ex_to<GiNaC::numeric>(exponent)) > GiNaC::numeric(kLargestExponent))
-      return true;
-  }
-  for (std::size_t i = 0; i < e.nops(); ++i)
-    if (has_huge_exponent(e.op(i))) return true;
-  return false;
-}
+// What read() measures of an expression, in one walk: a walk per measure, and largest_expansion's
+// walk of every subtree again at each level, cost a tenth of reading a long kinetic energy.
+struct Measures {
+  bool huge_exponent = false;  // a number exponent larger than kLargestExponent in magnitude
+  // The number of terms that multiplying out the expression can produce (an upper bound: a sum's
+  // terms add, a product's multiply, (t terms)^n gives at most C(n + t - 1, t - 1)); function
+  // arguments and the bases of non-integer powers are atoms here and measured on their own.
+  double terms = 1.0;
+  double largest = 1.0;  // the largest `terms` of the expression and of its subexpressions
+  std::size_t nodes = 1;
+};
 
-// The number of terms that multiplying out `e` can produce (an upper bound: a sum's terms add, a
-// product's multiply, (t terms)^n gives at most C(n + t - 1, t - 1)); function arguments and the
-// bases of non-integer powers are atoms here and measured on their own by largest_expansion.
-double expanded_terms(const GiNaC::ex& e) {
-  if (GiNaC::is_a<GiNaC::add>(e)) {
-    double sum = 0.0;
-    for (std::size_t i = 0; i < e.nops(); ++i) sum += expanded_terms(e.op(i));
-    return sum;
+Measures measure(const GiNaC::ex& e) {
+  Measures out;
+  const bool sum = GiNaC::is_exactly_a<GiNaC::add>(e), product = GiNaC::is_exactly_a<GiNaC::mul>(e);
+  const bool power = GiNaC::is_exactly_a<GiNaC::power>(e);
+  const bool number_exponent = power && GiNaC::is_exactly_a<GiNaC::numeric>(e.op(1));
+  const bool integer_power = number_exponent && GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_integer();
+  if (number_exponent && GiNaC::abs(GiNaC::ex_to<GiNaC::numeric>(e.op(1))) > GiNaC::numeric(kLargestExponent))
+    out.huge_exponent = true;
+  // The subexpressions whose own expansion counts: those of sums, products, powers and functions.
+  const bool inner = sum || product || power || GiNaC::is_a<GiNaC::function>(e);
+  double base_terms = 1.0;
+  out.terms = sum ? 0.0 : 1.0;
+  double largest = 0.0;
+  for (std::size_t i = 0; i < e.nops(); ++i) {
+    const Measures m = measure(e.op(i));
+    out.huge_exponent = out.huge_exponent || m.huge_exponent;
+    out.nodes += m.nodes;
+    if (inner) largest = std::max(largest, m.largest);
+    if (sum) out.terms += m.terms;
+    if (product) out.terms *= m.terms;
+    if (i == 0) base_terms = m.terms;
   }
-  if (GiNaC::is_a<GiNaC::mul>(e)) {
-    double product = 1.0;
-    for (std::size_t i = 0; i < e.nops(); ++i) product *= expanded_terms(e.op(i));
-    return std::min(product, 1e300);
-  }
-  if (GiNaC::is_a<GiNaC::power>(e) && GiNaC::is_a<GiNaC::numeric>(e.op(1)) &&
-      GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_integer()) {
-    const double t = expanded_terms(e.op(0));
+  if (product) out.terms = std::min(out.terms, 1e300);
+  if (integer_power && !out.huge_exponent) {  // refused when huge, whatever it measures
+    const double t = base_terms;
     const double n = std::min(std::abs(GiNaC::ex_to<GiNaC::numeric>(e.op(1)).to_double()), 1e6);
-    if (t <= 1.0) return 1.0;
-    // C(n + t - 1, t - 1) through lgamma, capped: only its order of magnitude matters.
-    const double log_terms = std::lgamma(n + t) - std::lgamma(n + 1.0) - std::lgamma(t);
-    return log_terms > 690.0 ? 1e300 : std::exp(log_terms);
+    if (t <= 1.0) {
+      out.terms = 1.0;
+    } else {
+      // C(n + t - 1, t - 1) through lgamma, capped: only its order of magnitude matters.
+      const double log_terms = std::lgamma(n + t) - std::lgamma(n + 1.0) - std::lgamma(t);
+      out.terms = log_terms > 690.0 ? 1e300 : std::exp(log_terms);
+    }
   }
-  return 1.0;
-}
-
-double largest_expansion(const GiNaC::ex& e) {
-  double largest = expanded_terms(e);
-  const bool atom = GiNaC::is_a<GiNaC::function>(e) ||
-                    (GiNaC::is_a<GiNaC::power>(e) && !(GiNaC::is_a<GiNaC::numeric>(e.op(1)) &&
-                                                       GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_integer()));
-  if (atom || GiNaC::is_a<GiNaC::add>(e) || GiNaC::is_a<GiNaC::mul>(e) || GiNaC::is_a<GiNaC::power>(e))
-    for (std::size_t i = 0; i < e.nops(); ++i) largest = std::max(largest, largest_expansion(e.op(i)));
-  return largest;
-}
-
-std::size_t node_count(const GiNaC::ex& e) {
-  std::size_t n = 1;
-  for (std::size_t i = 0; i < e.nops(); ++i) n += node_count(e.op(i));
-  return n;
+  out.largest = std::max(out.terms, largest);
+  return out;
 }
 
 // The derivation multiplies expressions out (expand, normal), and its time grows faster than the
@@ -626,12 +626,13 @@ Parsed read(const Spec& spec, const Site& site, std::size_t begin, std::size_t e
             const std::map<std::string, GiNaC::symbol>* scope = nullptr,
             const std::map<std::string, std::string>* unavailable = nullptr) {
   Parsed parsed = Reader(site, spec, lex(site, begin, end), scope, unavailable).read();
-  if (has_huge_exponent(parsed.value))
+  const Measures measures = measure(parsed.value);
+  if (measures.huge_exponent)
     site.fail_whole(fmt::format("an exponent larger than {} in magnitude; nhdyn expands powers symbolically, "
                                 "so rewrite the expression (e.g. with exp and log) or use a smaller power",
                                 kLargestExponent));
-  const double terms = largest_expansion(parsed.value);
-  if (terms > kLargestExpansion + 10.0 * static_cast<double>(node_count(parsed.value)))
+  const double terms = measures.largest;
+  if (terms > kLargestExpansion + 10.0 * static_cast<double>(measures.nodes))
     site.fail_whole(fmt::format("multiplied out, this expression could have about {:.2g} terms (the limit is {:g}): "
                                 "nhdyn expands products and powers of sums symbolically, which takes seconds at a few thousand terms "
                                 "and minutes beyond; "
