@@ -245,8 +245,12 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
                                                name(o.a.front())));
         // phi' = phi_q q' + phi_t; phi'' = b q'' + b0 with b = phi_q and
         // b0 = (d/dq (phi_q q')) q' + 2 phi_qt q' + phi_tt, the q''-free part of d/dt phi'.
-        const GiNaC::ex phidot = convective_derivative(e, symbols, index);
-        for (int j : o.q) row.emplace_back(j, e.diff(q(j)));
+        // phidot as convective_derivative(e) builds it, from the partial derivatives of the row.
+        GiNaC::ex phidot = o.time ? e.diff(symbols.time()) : GiNaC::ex(0);
+        for (int j : o.q) {
+          row.emplace_back(j, e.diff(q(j)));
+          phidot += row.back().second * symbols.velocity(j);
+        }
         b0 = convective_derivative(phidot, symbols, index);
         phi.push_back(e);
         f.push_back(tidy(phidot));
