@@ -82,7 +82,7 @@ enum class SymbolKind { time, constant, coordinate, velocity, acceleration, para
 struct Occurrence {
   SymbolKind kind;
   std::string name;  // as written, e.g. "x'"
-  GiNaC::symbol symbol;
+  GiNaC::ex symbol;
   std::size_t position;  // byte offset in the text
 };
 
@@ -296,7 +296,7 @@ class Reader {
     // a model quadratic in its number of coordinates.
     GiNaC::symtab table;
     for (const Occurrence& o : symbols_)
-      table[internal_name(o.name)] = o.kind == SymbolKind::constant ? GiNaC::ex(GiNaC::Pi) : GiNaC::ex(o.symbol);
+      table[internal_name(o.name)] = o.kind == SymbolKind::constant ? GiNaC::ex(GiNaC::Pi) : o.symbol;
     Parsed parsed;
     try {
       // One parser per thread, given each expression's table: making a parser copies GiNaC's
@@ -500,7 +500,8 @@ class Reader {
         out_ += internal_name(name);
         return;
       }
-      std::optional<GiNaC::symbol> symbol = spec_.symbols.find(name);
+      std::optional<GiNaC::ex> symbol;
+      if (const GiNaC::ex* held = spec_.symbols.expression_of(name)) symbol = *held;
       if (!symbol && scope_ != nullptr) {
         const auto found = scope_->find(name);
         if (found != scope_->end()) symbol = found->second;
@@ -544,7 +545,7 @@ class Reader {
                                                                    std::string(static_cast<std::size_t>(token.primes), '\''))));
     }
     symbols_.push_back({token.primes == 1 ? SymbolKind::velocity : SymbolKind::acceleration, written,
-                        *spec_.symbols.find(written), token.begin});
+                        *spec_.symbols.expression_of(written), token.begin});
     out_ += internal_name(written);
   }
 
