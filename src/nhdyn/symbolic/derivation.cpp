@@ -11,6 +11,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
+#include "nhdyn/symbolic/detail/derivative.hpp"
 #include "nhdyn/symbolic/detail/occurrence.hpp"
 #include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/rolling_contact.hpp"
@@ -35,8 +36,8 @@ std::string printed(const GiNaC::ex& e) {
 // coordinates that e contains are differentiated by.
 GiNaC::ex convective_derivative(const GiNaC::ex& e, const SymbolTable& symbols, const SymbolIndex& index) {
   const Contained o = index.find(e);
-  GiNaC::ex out = o.time ? e.diff(symbols.time()) : GiNaC::ex(0);
-  for (int i : o.q) out += e.diff(symbols.coordinate(i)) * symbols.velocity(i);
+  GiNaC::ex out = o.time ? detail::derivative(e, symbols.time()) : GiNaC::ex(0);
+  for (int i : o.q) out += detail::derivative(e, symbols.coordinate(i)) * symbols.velocity(i);
   return out;
 }
 
@@ -103,7 +104,7 @@ struct SplitSum {
   }
   GiNaC::ex diff(const std::vector<std::vector<int>>& with, int i, const GiNaC::symbol& x) const {
     GiNaC::ex out = 0;
-    for (int j : with[static_cast<std::size_t>(i)]) out += terms[static_cast<std::size_t>(j)].diff(x);
+    for (int j : with[static_cast<std::size_t>(i)]) out += detail::derivative(terms[static_cast<std::size_t>(j)], x);
     return out;
   }
 };
@@ -246,9 +247,9 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
         // phi' = phi_q q' + phi_t; phi'' = b q'' + b0 with b = phi_q and
         // b0 = (d/dq (phi_q q')) q' + 2 phi_qt q' + phi_tt, the q''-free part of d/dt phi'.
         // phidot as convective_derivative(e) builds it, from the partial derivatives of the row.
-        GiNaC::ex phidot = o.time ? e.diff(symbols.time()) : GiNaC::ex(0);
+        GiNaC::ex phidot = o.time ? detail::derivative(e, symbols.time()) : GiNaC::ex(0);
         for (int j : o.q) {
-          row.emplace_back(j, e.diff(q(j)));
+          row.emplace_back(j, detail::derivative(e, q(j)));
           phidot += row.back().second * symbols.velocity(j);
         }
         b0 = convective_derivative(phidot, symbols, index);
@@ -261,7 +262,7 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
           throw ModelError(where + fmt::format(" is given at velocity level but contains the acceleration {}''",
                                                name(o.a.front())));
         // f' = (df/dq') q'' + (df/dq) q' + df/dt.
-        for (int j : o.v) row.emplace_back(j, e.diff(v(j)));
+        for (int j : o.v) row.emplace_back(j, detail::derivative(e, v(j)));
         b0 = convective_derivative(e, symbols, index);
         f.push_back(e);
         break;
@@ -270,12 +271,12 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
         involve = "the accelerations";
         GiNaC::lst at_rest;
         for (int j : o.a) {
-          row.emplace_back(j, e.diff(a(j)));
+          row.emplace_back(j, detail::derivative(e, a(j)));
           at_rest.append(a(j) == 0);
         }
         for (const auto& [i, entry] : row)
           for (int j : o.a)
-            if (!symbolic::is_zero(entry.diff(a(j))))
+            if (!symbolic::is_zero(detail::derivative(entry, a(j))))
               throw ModelError(where + fmt::format(" must be linear in the accelerations, but it is not linear in "
                                                    "{}'' (its derivative by {}'' depends on {}'')",
                                                    name(i), name(i), name(j)));
@@ -365,7 +366,7 @@ void derive_inertia(const Spec& spec, const SplitSum& Ts, const SymbolIndex& ind
     for (int jj : partners) {
       if (jj < i) continue;
       const auto uj = static_cast<unsigned>(jj);
-      const GiNaC::ex entry = tidy(Tv[ui].diff(v(jj)));
+      const GiNaC::ex entry = tidy(detail::derivative(Tv[ui], v(jj)));
       if (const Contained o = index.find(entry); !o.v.empty())
         throw ModelError(model + fmt::format("the kinetic energy T is not quadratic in the velocities: "
                                              "A = d2T/dq'2 depends on {}' (entry ({}, {}) is {})",
@@ -525,7 +526,7 @@ void derive_energy_balance(const Spec& spec, const SplitSum& Ts, Derivation& d) 
       continue;
     }
     GiNaC::ex rate = 0;
-    for (int i : Ts.occurrences[j].v) rate += v(i) * term.diff(v(i));
+    for (int i : Ts.occurrences[j].v) rate += v(i) * detail::derivative(term, v(i));
     // Expanding settles the usual term (a polynomial in the velocities) at a small fraction of
     // the cost of simplifying it, which matters for the thousands of terms of a long chain.
     const GiNaC::ex euler = (rate - 2 * term).expand();
@@ -541,7 +542,7 @@ void derive_energy_balance(const Spec& spec, const SplitSum& Ts, Derivation& d) 
   for (std::size_t i = 0; i < spec.forces.size(); ++i)
     if (!symbolic::is_zero(spec.forces[i])) power_forces += spec.forces[i] * v(static_cast<int>(i));
   d.power_forces = tidy(power_forces);
-  d.power_time = tidy(V.diff(t) - T.diff(t));
+  d.power_time = tidy(detail::derivative(V, t) - detail::derivative(T, t));
   d.conservative = symbolic::is_zero(d.power_forces) && symbolic::is_zero(d.power_time);
 }
 

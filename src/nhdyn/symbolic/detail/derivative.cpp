@@ -1,0 +1,66 @@
+// GiNaC's derivative without the terms that are 0 (derivative.hpp).
+#include "nhdyn/symbolic/detail/derivative.hpp"
+
+#include <utility>
+
+namespace nhdyn::symbolic::detail {
+namespace {
+
+using GiNaC::ex;
+
+// The pairs and the number of a sum or a product, and a product's split of a factor into a pair:
+// protected members of GiNaC's classes, which a derived class may name.
+struct Sequence : GiNaC::expairseq {
+  static const GiNaC::epvector& pairs(const ex& e) { return GiNaC::ex_to<GiNaC::expairseq>(e).*(&Sequence::seq); }
+  static const ex& number(const ex& e) { return GiNaC::ex_to<GiNaC::expairseq>(e).*(&Sequence::overall_coeff); }
+};
+struct Product : GiNaC::mul {
+  static GiNaC::expair split(const ex& product, const ex& factor) {
+    return (GiNaC::ex_to<GiNaC::mul>(product).*(&Product::split_ex_to_pair))(factor);
+  }
+};
+
+bool contains(const ex& e, const GiNaC::symbol& s) {
+  if (GiNaC::is_exactly_a<GiNaC::add>(e) || GiNaC::is_exactly_a<GiNaC::mul>(e)) {
+    for (const GiNaC::expair& p : Sequence::pairs(e))
+      if (contains(p.rest, s)) return true;
+    return false;  // the coefficients and the number are numbers
+  }
+  const std::size_t n = e.nops();
+  if (n == 0) return e.is_equal(s);
+  for (std::size_t i = 0; i < n; ++i)
+    if (contains(e.op(i), s)) return true;
+  return false;
+}
+
+}  // namespace
+
+ex derivative(const ex& e, const GiNaC::symbol& s) {
+  if (!contains(e, s)) return 0;
+  if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
+    // add::derivative: each term's rest differentiated, with its coefficient.
+    GiNaC::epvector terms;
+    terms.reserve(Sequence::pairs(e).size());
+    for (const GiNaC::expair& p : Sequence::pairs(e)) terms.push_back(GiNaC::expair(derivative(p.rest, s), p.coeff));
+    return GiNaC::dynallocate<GiNaC::add>(std::move(terms));
+  }
+  if (GiNaC::is_exactly_a<GiNaC::mul>(e)) {
+    // mul::derivative: the product with each factor in turn replaced by its derivative, here only
+    // the factors that contain s (the others' products are 0 and drop out of the sum).
+    const GiNaC::epvector& factors = Sequence::pairs(e);
+    GiNaC::exvector terms;
+    GiNaC::epvector product = factors;
+    for (std::size_t i = 0; i < factors.size(); ++i) {
+      const GiNaC::expair& f = factors[i];
+      if (!contains(f.rest, s)) continue;
+      GiNaC::expair d = Product::split(e, GiNaC::pow(f.rest, f.coeff - 1) * derivative(f.rest, s));
+      d.swap(product[i]);
+      terms.push_back(GiNaC::dynallocate<GiNaC::mul>(product, Sequence::number(e) * f.coeff));
+      d.swap(product[i]);
+    }
+    return GiNaC::dynallocate<GiNaC::add>(terms);
+  }
+  return e.diff(s);
+}
+
+}  // namespace nhdyn::symbolic::detail
