@@ -934,8 +934,9 @@ void check_size(const Spec& spec, const char* what, const Matrix& m, int rows, i
                                  m.rows(), m.cols(), rows, cols));
 }
 
-// The value of an initial condition once the parameters are set.
-double initial_value(const Spec& spec, const GiNaC::lst& values, const GiNaC::ex& e, const std::string& what) {
+// An initial condition must be a real number once the parameters are set.
+void require_initial_value(const Spec& spec, const GiNaC::lst& values, const GiNaC::ex& e, const std::string& what) {
+  if (GiNaC::is_exactly_a<GiNaC::numeric>(e) && GiNaC::ex_to<GiNaC::numeric>(e).is_real()) return;  // a number
   GiNaC::ex value;
   try {
     value = e.subs(values, GiNaC::subs_options::no_pattern).evalf();
@@ -947,7 +948,6 @@ double initial_value(const Spec& spec, const GiNaC::lst& values, const GiNaC::ex
     throw ModelError(fmt::format("model '{}': the initial value of {} = {} is not a real number once the "
                                  "parameters are set (it is {}); initial values may use the parameters only",
                                  spec.name, what, to_text(e), to_text(value)));
-  return GiNaC::ex_to<GiNaC::numeric>(value).to_double();
 }
 
 int coordinate_index(const Spec& spec, const std::string& name, const char* what) {
@@ -1173,8 +1173,8 @@ void compile_initial_state(const Spec& spec, ModelTapes& tapes) {
   // from the initial-state tape, which follows the parameters when they change.
   const GiNaC::lst values = spec.parameter_values();
   for (int i = 0; i < n; ++i) {
-    initial_value(spec, values, spec.q0[static_cast<std::size_t>(i)], q_name(i));
-    initial_value(spec, values, spec.v0[static_cast<std::size_t>(i)], q_name(i) + "'");
+    require_initial_value(spec, values, spec.q0[static_cast<std::size_t>(i)], q_name(i));
+    require_initial_value(spec, values, spec.v0[static_cast<std::size_t>(i)], q_name(i) + "'");
   }
   TapeCompiler initial(spec);
   for (int i = 0; i < n; ++i) initial.add_output(spec.q0[static_cast<std::size_t>(i)], "initial " + q_name(i));

@@ -292,12 +292,23 @@ class Reader {
       if (next.kind == TokenKind::close) site_.fail_at(next.begin, "syntax error: unmatched ')'");
       unexpected(next);
     }
+    Parsed parsed;
+    // A lone name or a zero (most of a large model's initial values) is what GiNaC's parser
+    // would make of it: the symbol (or pi) itself, the number 0.
+    if (out_ == "0" || (symbols_.size() == 1 && out_ == internal_name(symbols_.front().name))) {
+      if (out_ == "0")
+        parsed.value = 0;
+      else
+        parsed.value = symbols_.front().kind == SymbolKind::constant ? GiNaC::ex(GiNaC::Pi) : symbols_.front().symbol;
+      parsed.symbols = std::move(symbols_);
+      parsed.present = symbols_of(parsed.value);
+      return parsed;
+    }
     // Only the names the text uses: a table of every symbol per expression would make reading
     // a model quadratic in its number of coordinates.
     GiNaC::symtab table;
     for (const Occurrence& o : symbols_)
       table[internal_name(o.name)] = o.kind == SymbolKind::constant ? GiNaC::ex(GiNaC::Pi) : o.symbol;
-    Parsed parsed;
     try {
       // One parser per thread, given each expression's table: making a parser copies GiNaC's
       // table of functions, which cost as much as reading a short expression (a chain's 6000
