@@ -13,6 +13,7 @@
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/symbolic/detail/derivative.hpp"
 #include "nhdyn/symbolic/detail/occurrence.hpp"
+#include "nhdyn/symbolic/detail/pairs.hpp"
 #include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/rolling_contact.hpp"
 #include "nhdyn/symbolic/simplify.hpp"
@@ -163,12 +164,48 @@ void require_complement_at_initial_state(const Spec& spec, const GiNaC::matrix& 
         where, k + s, n, sigma(sigma.size() - 1), sigma(0), k));
 }
 
+// The degree of `e` as a polynomial in the velocities, whatever its other factors; -1 when a
+// velocity stands elsewhere than in sums, products and powers with a whole exponent (in a
+// function's argument, a root, a denominator). GiNaC's degree() after q' -> lambda q' is at most
+// this (it reads the same structure; terms may cancel).
+int polynomial_velocity_degree(const GiNaC::ex& e, const SymbolIndex& index) {
+  if (GiNaC::is_exactly_a<GiNaC::symbol>(e)) return index.is_velocity(e) ? 1 : 0;
+  if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) return 0;
+  const bool sum = GiNaC::is_exactly_a<GiNaC::add>(e);
+  if (sum || GiNaC::is_exactly_a<GiNaC::mul>(e)) {
+    int out = 0;
+    for (const GiNaC::expair& p : detail::Pairs::of(e)) {
+      int d = polynomial_velocity_degree(p.rest, index);
+      if (d < 0) return -1;
+      if (!sum && d > 0) {  // a factor rest^k
+        if (!p.coeff.info(GiNaC::info_flags::nonnegint)) return -1;
+        d *= GiNaC::ex_to<GiNaC::numeric>(p.coeff).to_int();
+      }
+      out = sum ? std::max(out, d) : out + d;
+    }
+    return out;
+  }
+  if (GiNaC::is_exactly_a<GiNaC::power>(e)) {
+    const int base = polynomial_velocity_degree(e.op(0), index);
+    if (base < 0) return -1;
+    if (GiNaC::is_exactly_a<GiNaC::numeric>(e.op(1)) && e.op(1).info(GiNaC::info_flags::nonnegint))
+      return base * GiNaC::ex_to<GiNaC::numeric>(e.op(1)).to_int();
+    return base == 0 && polynomial_velocity_degree(e.op(1), index) == 0 ? 0 : -1;
+  }
+  for (std::size_t i = 0; i < e.nops(); ++i)
+    if (polynomial_velocity_degree(e.op(i), index) != 0) return -1;
+  return 0;
+}
+
 // A kinetic energy of degree above 2 in the velocities is refused before its Hessian is formed:
 // for a power such as (x'^2 + y'^2 + x + y)^40 the Hessian takes minutes to expand. degree() reads
 // the unexpanded expression (a power's degree is its base's times the exponent), and a numeric
 // third difference of T(lambda q') at a rational point confirms it, so that terms that cancel
 // once multiplied out are not refused.
-void require_at_most_quadratic(const Spec& spec, const std::string& model) {
+void require_at_most_quadratic(const Spec& spec, const SymbolIndex& index, const std::string& model) {
+  // What the test below concludes for a polynomial of degree 2 or less, without the substitution
+  // into all of T (a fortieth of a long chain's start-up).
+  if (const int d = polynomial_velocity_degree(spec.kinetic_energy, index); d >= 0 && d <= 2) return;
   const SymbolTable& symbols = spec.symbols;
   const GiNaC::symbol lambda("velocity_scale");
   GiNaC::exmap scaled;
@@ -566,7 +603,7 @@ Derivation derive(const Spec& spec) {
     throw ModelError(model + "the kinetic and potential energies may not contain accelerations");
   if (const int i = Vs.first(&Contained::v); i >= 0)
     throw ModelError(model + fmt::format("the potential energy V contains the velocity {}'", name(i)));
-  require_at_most_quadratic(spec, model);
+  require_at_most_quadratic(spec, index, model);
   check_contact_convexity(spec);  // an implicit rolling shape must be convex where the run starts
   check_contact_watches_at_start(spec);  // a wheel neither flat nor turned over where it starts
 

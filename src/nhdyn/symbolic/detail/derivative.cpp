@@ -3,17 +3,15 @@
 
 #include <utility>
 
+#include "nhdyn/symbolic/detail/pairs.hpp"
+
 namespace nhdyn::symbolic::detail {
 namespace {
 
 using GiNaC::ex;
 
-// The pairs and the number of a sum or a product, and a product's split of a factor into a pair:
-// protected members of GiNaC's classes, which a derived class may name.
-struct Sequence : GiNaC::expairseq {
-  static const GiNaC::epvector& pairs(const ex& e) { return GiNaC::ex_to<GiNaC::expairseq>(e).*(&Sequence::seq); }
-  static const ex& number(const ex& e) { return GiNaC::ex_to<GiNaC::expairseq>(e).*(&Sequence::overall_coeff); }
-};
+// A product's split of a factor into a pair: a protected member of GiNaC's class, which a derived
+// class may name.
 struct Product : GiNaC::mul {
   static GiNaC::expair split(const ex& product, const ex& factor) {
     return (GiNaC::ex_to<GiNaC::mul>(product).*(&Product::split_ex_to_pair))(factor);
@@ -22,7 +20,7 @@ struct Product : GiNaC::mul {
 
 bool contains(const ex& e, const GiNaC::symbol& s) {
   if (GiNaC::is_exactly_a<GiNaC::add>(e) || GiNaC::is_exactly_a<GiNaC::mul>(e)) {
-    for (const GiNaC::expair& p : Sequence::pairs(e))
+    for (const GiNaC::expair& p : Pairs::of(e))
       if (contains(p.rest, s)) return true;
     return false;  // the coefficients and the number are numbers
   }
@@ -40,14 +38,14 @@ ex derivative(const ex& e, const GiNaC::symbol& s) {
   if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
     // add::derivative: each term's rest differentiated, with its coefficient.
     GiNaC::epvector terms;
-    terms.reserve(Sequence::pairs(e).size());
-    for (const GiNaC::expair& p : Sequence::pairs(e)) terms.push_back(GiNaC::expair(derivative(p.rest, s), p.coeff));
+    terms.reserve(Pairs::of(e).size());
+    for (const GiNaC::expair& p : Pairs::of(e)) terms.push_back(GiNaC::expair(derivative(p.rest, s), p.coeff));
     return GiNaC::dynallocate<GiNaC::add>(std::move(terms));
   }
   if (GiNaC::is_exactly_a<GiNaC::mul>(e)) {
     // mul::derivative: the product with each factor in turn replaced by its derivative, here only
     // the factors that contain s (the others' products are 0 and drop out of the sum).
-    const GiNaC::epvector& factors = Sequence::pairs(e);
+    const GiNaC::epvector& factors = Pairs::of(e);
     GiNaC::exvector terms;
     GiNaC::epvector product = factors;
     for (std::size_t i = 0; i < factors.size(); ++i) {
@@ -55,10 +53,17 @@ ex derivative(const ex& e, const GiNaC::symbol& s) {
       if (!contains(f.rest, s)) continue;
       GiNaC::expair d = Product::split(e, GiNaC::pow(f.rest, f.coeff - 1) * derivative(f.rest, s));
       d.swap(product[i]);
-      terms.push_back(GiNaC::dynallocate<GiNaC::mul>(product, Sequence::number(e) * f.coeff));
+      terms.push_back(GiNaC::dynallocate<GiNaC::mul>(product, Pairs::number(e) * f.coeff));
       d.swap(product[i]);
     }
     return GiNaC::dynallocate<GiNaC::add>(terms);
+  }
+  if (GiNaC::is_exactly_a<GiNaC::power>(e) && GiNaC::is_exactly_a<GiNaC::numeric>(e.op(1))) {
+    // power::derivative for a number exponent r: D(b^r) = r b^(r - 1) D(b).
+    const ex& base = e.op(0);
+    const ex& r = e.op(1);
+    GiNaC::epvector factors{GiNaC::expair(base, r - 1), GiNaC::expair(derivative(base, s), 1)};
+    return GiNaC::dynallocate<GiNaC::mul>(std::move(factors), r);
   }
   return e.diff(s);
 }

@@ -10,8 +10,9 @@
 
 namespace nhdyn::symbolic::detail {
 
-// e.diff(s): sums and products by GiNaC's own rules (add::derivative, mul::derivative), without
-// the terms of the subexpressions that do not contain s, which are 0; everything else by GiNaC.
+// e.diff(s): sums, products and powers with a number exponent by GiNaC's own rules (add::, mul::
+// and power::derivative), without the terms of the subexpressions that do not contain s, which are
+// 0; everything else by GiNaC.
 // tests/symbolic/derivative_test.cpp compares the two.
 GiNaC::ex derivative(const GiNaC::ex& e, const GiNaC::symbol& s);
 

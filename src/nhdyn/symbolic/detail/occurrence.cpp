@@ -2,21 +2,18 @@
 
 #include <algorithm>
 
+#include "nhdyn/symbolic/detail/pairs.hpp"
+
 namespace nhdyn::symbolic {
 namespace {
 
-// The pairs of a sum or a product as GiNaC keeps them: op(i) would build c x for each term with a
-// coefficient and x^k for each factor with an exponent, a temporary per operand. The coefficients
-// and exponents are numbers, so the symbols are in the pairs' rests.
-struct Pairs : GiNaC::expairseq {
-  static const GiNaC::epvector& of(const GiNaC::ex& e) { return GiNaC::ex_to<GiNaC::expairseq>(e).*(&Pairs::seq); }
-};
-
 // Calls f on every leaf of e (symbols, numbers, constants), shared ones as often as they occur.
+// The pairs of sums and products are walked as GiNaC keeps them (detail/pairs.hpp): their
+// coefficients and exponents are numbers, so the symbols are in the rests.
 template <class F>
 void for_each_leaf(const GiNaC::ex& e, F& f) {
   if (GiNaC::is_exactly_a<GiNaC::add>(e) || GiNaC::is_exactly_a<GiNaC::mul>(e)) {
-    for (const GiNaC::expair& p : Pairs::of(e)) for_each_leaf(p.rest, f);
+    for (const GiNaC::expair& p : detail::Pairs::of(e)) for_each_leaf(p.rest, f);
     return;
   }
   const std::size_t n = e.nops();
@@ -55,21 +52,29 @@ SymbolIndex::SymbolIndex(const SymbolTable& symbols) {
   }
 }
 
+// By GiNaC's hash of a symbol (from its serial number, the same in every copy), then equality.
+const SymbolIndex::Entry* SymbolIndex::lookup(const GiNaC::ex& leaf) const {
+  const auto [begin, end] = index_.equal_range(leaf.gethash());
+  for (auto it = begin; it != end; ++it)
+    if (it->second.symbol.is_equal(leaf)) return &it->second;
+  return nullptr;
+}
+
+bool SymbolIndex::is_velocity(const GiNaC::ex& e) const {
+  const Entry* entry = lookup(e);
+  return entry != nullptr && entry->kind == Kind::v;
+}
+
 Contained SymbolIndex::find(const GiNaC::ex& e) const {
   Contained out;
   const auto record = [&](const GiNaC::ex& leaf) {
-    // By GiNaC's hash of a symbol (from its serial number, the same in every copy), then equality.
-    const auto [begin, end] = index_.equal_range(leaf.gethash());
-    for (auto it = begin; it != end; ++it) {
-      const Entry& entry = it->second;
-      if (!entry.symbol.is_equal(leaf)) continue;
-      switch (entry.kind) {
-        case Kind::time: out.time = true; break;
-        case Kind::q: out.q.push_back(entry.i); break;
-        case Kind::v: out.v.push_back(entry.i); break;
-        case Kind::a: out.a.push_back(entry.i); break;
-      }
-      return;
+    const Entry* entry = lookup(leaf);
+    if (entry == nullptr) return;
+    switch (entry->kind) {
+      case Kind::time: out.time = true; break;
+      case Kind::q: out.q.push_back(entry->i); break;
+      case Kind::v: out.v.push_back(entry->i); break;
+      case Kind::a: out.a.push_back(entry->i); break;
     }
   };
   for_each_leaf(e, record);

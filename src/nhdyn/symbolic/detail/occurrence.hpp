@@ -31,6 +31,8 @@ class SymbolIndex {
  public:
   explicit SymbolIndex(const SymbolTable& symbols);
   Contained find(const GiNaC::ex& e) const;
+  // True when `e` is one of the velocities.
+  bool is_velocity(const GiNaC::ex& e) const;
 
  private:
   enum class Kind { time, q, v, a };
@@ -40,6 +42,7 @@ class SymbolIndex {
     int i;
   };
   std::unordered_multimap<unsigned, Entry> index_;  // by the symbol's GiNaC hash
+  const Entry* lookup(const GiNaC::ex& leaf) const;
 };
 
 }  // namespace nhdyn::symbolic
