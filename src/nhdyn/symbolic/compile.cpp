@@ -39,6 +39,7 @@
 #include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "nhdyn/symbolic/outputs.hpp"
+#include "nhdyn/symbolic/detail/pairs.hpp"
 #include "nhdyn/symbolic/detail/plain_words.hpp"
 
 namespace nhdyn::symbolic {
@@ -495,42 +496,64 @@ class TapeCompiler {
     return numeric_value(x);
   }
 
+  // The term c x of a sum (x its pair's rest, c != 1): GiNaC's product of x and c, whose factors
+  // are x's (x a product, its number times c) or x itself.
+  Scaled term(const GiNaC::ex& x, const GiNaC::numeric& c) {
+    if (GiNaC::is_exactly_a<GiNaC::mul>(x))
+      return product(detail::Pairs::of(x), GiNaC::ex_to<GiNaC::numeric>(detail::Pairs::number(x)).mul(c));
+    return product(GiNaC::epvector{GiNaC::expair(x, 1)}, c);
+  }
+
+  // number * the product of the factors rest^exponent: each factor translated (a power for an
+  // exponent other than 1), the numbers multiplied in their own order, powers of a base merged.
+  Scaled product(const GiNaC::epvector& pairs, const GiNaC::numeric& number) {
+    std::vector<int> factors;
+    std::vector<double> numbers;
+    for (const GiNaC::expair& p : pairs) {
+      const Scaled f = p.coeff.is_equal(1) ? canonical(p.rest)
+                                           : make_power(canonical(p.rest), real_number(GiNaC::ex_to<GiNaC::numeric>(p.coeff)));
+      if (f.c != 1.0) numbers.push_back(f.c);
+      if (f.id == kOne) continue;
+      if (node(f.id).kind == Kind::mul) {
+        for (const Scaled& g : node(f.id).items) factors.push_back(g.id);
+      } else {
+        factors.push_back(f.id);
+      }
+    }
+    if (!number.is_equal(1)) {
+      const double x = real_number(number);
+      if (x != 1.0) numbers.push_back(x);
+    }
+    double c = product_of(std::move(numbers));
+    factors = merge_powers(std::move(factors), c);
+    return make_mul(std::move(factors), c);
+  }
+
+  // Sums and products are read from GiNaC's pairs (detail/pairs.hpp), not through op(), which
+  // builds a product c x for each term with a coefficient and a power x^k for each factor with an
+  // exponent: each is translated as translate() would translate that product or power.
   Scaled translate(const GiNaC::ex& e) {
     if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) return {real_number(GiNaC::ex_to<GiNaC::numeric>(e)), kOne};
-    if (GiNaC::is_a<GiNaC::symbol>(e)) return {1.0, symbol(GiNaC::ex_to<GiNaC::symbol>(e))};
-    if (GiNaC::is_exactly_a<GiNaC::constant>(e)) {
-      const GiNaC::ex value = e.evalf();
-      if (GiNaC::is_exactly_a<GiNaC::numeric>(value)) return {real_number(GiNaC::ex_to<GiNaC::numeric>(value)), kOne};
-      fail(fmt::format("contains the constant '{}', which has no numeric value", to_text(e)));
-    }
     if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
       std::vector<Scaled> terms;
       std::vector<double> numbers;
-      for (std::size_t i = 0; i < e.nops(); ++i) {
-        const Scaled t = canonical(e.op(i));
+      for (const GiNaC::expair& p : detail::Pairs::of(e)) {
+        const Scaled t = p.coeff.is_equal(1) ? canonical(p.rest) : term(p.rest, GiNaC::ex_to<GiNaC::numeric>(p.coeff));
         if (t.id == kOne)
           numbers.push_back(t.c);
         else
           terms.push_back(t);
       }
+      if (!detail::Pairs::number(e).is_zero()) numbers.push_back(translate(detail::Pairs::number(e)).c);
       return make_add(std::move(terms), sum(std::move(numbers)));
     }
-    if (GiNaC::is_exactly_a<GiNaC::mul>(e)) {
-      std::vector<int> factors;
-      std::vector<double> numbers;
-      for (std::size_t i = 0; i < e.nops(); ++i) {
-        const Scaled f = canonical(e.op(i));
-        if (f.c != 1.0) numbers.push_back(f.c);
-        if (f.id == kOne) continue;
-        if (node(f.id).kind == Kind::mul) {
-          for (const Scaled& g : node(f.id).items) factors.push_back(g.id);
-        } else {
-          factors.push_back(f.id);
-        }
-      }
-      double c = product_of(std::move(numbers));
-      factors = merge_powers(std::move(factors), c);
-      return make_mul(std::move(factors), c);
+    if (GiNaC::is_exactly_a<GiNaC::mul>(e))
+      return product(detail::Pairs::of(e), GiNaC::ex_to<GiNaC::numeric>(detail::Pairs::number(e)));
+    if (GiNaC::is_a<GiNaC::symbol>(e)) return {1.0, symbol(GiNaC::ex_to<GiNaC::symbol>(e))};
+    if (GiNaC::is_exactly_a<GiNaC::constant>(e)) {
+      const GiNaC::ex value = e.evalf();
+      if (GiNaC::is_exactly_a<GiNaC::numeric>(value)) return {real_number(GiNaC::ex_to<GiNaC::numeric>(value)), kOne};
+      fail(fmt::format("contains the constant '{}', which has no numeric value", to_text(e)));
     }
     if (GiNaC::is_exactly_a<GiNaC::power>(e)) {
       const Scaled base = canonical(e.op(0));
