@@ -31,10 +31,9 @@ bool contains(const ex& e, const GiNaC::symbol& s) {
   return false;
 }
 
-}  // namespace
-
-ex derivative(const ex& e, const GiNaC::symbol& s) {
-  if (!contains(e, s)) return 0;
+// The derivative of an expression that contains s (the factors of a product are tested before
+// they are differentiated, and not again here).
+ex derivative_of_container(const ex& e, const GiNaC::symbol& s) {
   if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
     // add::derivative: each term's rest differentiated, with its coefficient.
     GiNaC::epvector terms;
@@ -51,7 +50,7 @@ ex derivative(const ex& e, const GiNaC::symbol& s) {
     for (std::size_t i = 0; i < factors.size(); ++i) {
       const GiNaC::expair& f = factors[i];
       if (!contains(f.rest, s)) continue;
-      GiNaC::expair d = Product::split(e, GiNaC::pow(f.rest, f.coeff - 1) * derivative(f.rest, s));
+      GiNaC::expair d = Product::split(e, GiNaC::pow(f.rest, f.coeff - 1) * derivative_of_container(f.rest, s));
       d.swap(product[i]);
       terms.push_back(GiNaC::dynallocate<GiNaC::mul>(product, Pairs::number(e) * f.coeff));
       d.swap(product[i]);
@@ -62,10 +61,14 @@ ex derivative(const ex& e, const GiNaC::symbol& s) {
     // power::derivative for a number exponent r: D(b^r) = r b^(r - 1) D(b).
     const ex& base = e.op(0);
     const ex& r = e.op(1);
-    GiNaC::epvector factors{GiNaC::expair(base, r - 1), GiNaC::expair(derivative(base, s), 1)};
+    GiNaC::epvector factors{GiNaC::expair(base, r - 1), GiNaC::expair(derivative_of_container(base, s), 1)};
     return GiNaC::dynallocate<GiNaC::mul>(std::move(factors), r);
   }
   return e.diff(s);
 }
+
+}  // namespace
+
+ex derivative(const ex& e, const GiNaC::symbol& s) { return contains(e, s) ? derivative_of_container(e, s) : ex(0); }
 
 }  // namespace nhdyn::symbolic::detail
