@@ -229,7 +229,9 @@ ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool elim
     back.append(second[i] == g);
   }
   Freeze freeze;
-  ex q = GiNaC::expand(freeze(p).subs(to_symbols));
+  // no_pattern: the keys hold no wildcard, so a lookup per node finds them; GiNaC's default tries
+  // every key as a pattern at every node.
+  ex q = GiNaC::expand(freeze(p).subs(to_symbols, GiNaC::subs_options::no_pattern));
   for (std::size_t i = 0; i < families.size(); ++i) {
     const GiNaC::symbol& s = first[i];
     const GiNaC::symbol& c = second[i];
@@ -249,7 +251,7 @@ ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool elim
     }
     q = GiNaC::expand(reduced);
   }
-  return q.subs(back).subs(freeze.back);
+  return q.subs(back, GiNaC::subs_options::no_pattern).subs(freeze.back, GiNaC::subs_options::no_pattern);
 }
 
 // True when a power of a sine, cosine, sinh or cosh occurs anywhere in e (inside roots and
