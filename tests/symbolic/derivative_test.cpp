@@ -45,6 +45,9 @@ TEST(Derivative, IsGiNaCsDerivativeNodeForNode) {
     for (const GiNaC::symbol& s : {x, y, v, w, m}) {
       const ex ours = detail::derivative(e, s);
       EXPECT_TRUE(ours.is_equal(e.diff(s))) << "d/d" << s << " of " << e << ": " << ours << " vs " << e.diff(s);
+      if (e.has(s)) {
+        EXPECT_TRUE(detail::derivative_of_container(e, s).is_equal(e.diff(s))) << e << " by " << s;
+      }
     }
 }
 

@@ -37,8 +37,8 @@ std::string printed(const GiNaC::ex& e) {
 // coordinates that e contains are differentiated by.
 GiNaC::ex convective_derivative(const GiNaC::ex& e, const SymbolTable& symbols, const SymbolIndex& index) {
   const Contained o = index.find(e);
-  GiNaC::ex out = o.time ? detail::derivative(e, symbols.time()) : GiNaC::ex(0);
-  for (int i : o.q) out += detail::derivative(e, symbols.coordinate(i)) * symbols.velocity(i);
+  GiNaC::ex out = o.time ? detail::derivative_of_container(e, symbols.time()) : GiNaC::ex(0);
+  for (int i : o.q) out += detail::derivative_of_container(e, symbols.coordinate(i)) * symbols.velocity(i);
   return out;
 }
 
@@ -105,7 +105,8 @@ struct SplitSum {
   }
   GiNaC::ex diff(const std::vector<std::vector<int>>& with, int i, const GiNaC::symbol& x) const {
     GiNaC::ex out = 0;
-    for (int j : with[static_cast<std::size_t>(i)]) out += detail::derivative(terms[static_cast<std::size_t>(j)], x);
+    for (int j : with[static_cast<std::size_t>(i)])
+      out += detail::derivative_of_container(terms[static_cast<std::size_t>(j)], x);
     return out;
   }
 };
@@ -284,9 +285,9 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
         // phi' = phi_q q' + phi_t; phi'' = b q'' + b0 with b = phi_q and
         // b0 = (d/dq (phi_q q')) q' + 2 phi_qt q' + phi_tt, the q''-free part of d/dt phi'.
         // phidot as convective_derivative(e) builds it, from the partial derivatives of the row.
-        GiNaC::ex phidot = o.time ? detail::derivative(e, symbols.time()) : GiNaC::ex(0);
+        GiNaC::ex phidot = o.time ? detail::derivative_of_container(e, symbols.time()) : GiNaC::ex(0);
         for (int j : o.q) {
-          row.emplace_back(j, detail::derivative(e, q(j)));
+          row.emplace_back(j, detail::derivative_of_container(e, q(j)));
           phidot += row.back().second * symbols.velocity(j);
         }
         b0 = convective_derivative(phidot, symbols, index);
@@ -299,7 +300,7 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
           throw ModelError(where + fmt::format(" is given at velocity level but contains the acceleration {}''",
                                                name(o.a.front())));
         // f' = (df/dq') q'' + (df/dq) q' + df/dt.
-        for (int j : o.v) row.emplace_back(j, detail::derivative(e, v(j)));
+        for (int j : o.v) row.emplace_back(j, detail::derivative_of_container(e, v(j)));
         b0 = convective_derivative(e, symbols, index);
         f.push_back(e);
         break;

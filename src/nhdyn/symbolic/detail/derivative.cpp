@@ -31,8 +31,9 @@ bool contains(const ex& e, const GiNaC::symbol& s) {
   return false;
 }
 
-// The derivative of an expression that contains s (the factors of a product are tested before
-// they are differentiated, and not again here).
+}  // namespace
+
+// The factors of a product are tested before they are differentiated, and not again here.
 ex derivative_of_container(const ex& e, const GiNaC::symbol& s) {
   if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
     // add::derivative: each term's rest differentiated, with its coefficient.
@@ -66,8 +67,6 @@ ex derivative_of_container(const ex& e, const GiNaC::symbol& s) {
   }
   return e.diff(s);
 }
-
-}  // namespace
 
 ex derivative(const ex& e, const GiNaC::symbol& s) { return contains(e, s) ? derivative_of_container(e, s) : ex(0); }
 

@@ -15,5 +15,7 @@ namespace nhdyn::symbolic::detail {
 // 0; everything else by GiNaC.
 // tests/symbolic/derivative_test.cpp compares the two.
 GiNaC::ex derivative(const GiNaC::ex& e, const GiNaC::symbol& s);
+// The same for an `e` that contains s (a term listed as holding it): e is not searched for it first.
+GiNaC::ex derivative_of_container(const GiNaC::ex& e, const GiNaC::symbol& s);
 
 }  // namespace nhdyn::symbolic::detail
