@@ -39,6 +39,7 @@
 #include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "nhdyn/symbolic/outputs.hpp"
+#include "nhdyn/symbolic/detail/pairs.hpp"
 #include "nhdyn/symbolic/detail/plain_words.hpp"
 
 namespace nhdyn::symbolic {
@@ -148,16 +149,18 @@ class TapeCompiler {
  public:
   explicit TapeCompiler(const Spec& spec)
       : spec_(spec), tape_(spec.n(), static_cast<int>(spec.parameters.size())) {
-    for (std::size_t i = 0; i < spec.parameters.size(); ++i)
-      parameters_.emplace(spec.symbols.parameter(spec.parameters[i].name), static_cast<int>(i));
     const SymbolTable& symbols = spec.symbols;
-    variables_.emplace(symbols.time(), Tape::time_register());
+    inputs_.reserve(2 * static_cast<std::size_t>(symbols.coordinates()) + spec.parameters.size() + 1);
+    for (std::size_t i = 0; i < spec.parameters.size(); ++i)
+      add_input(spec.symbols.parameter(spec.parameters[i].name), -1, static_cast<int>(i));
+    add_input(symbols.time(), Tape::time_register(), -1);
     for (int i = 0; i < symbols.coordinates(); ++i) {
-      variables_.emplace(symbols.coordinate(i), tape_.coordinate_register(i));
-      variables_.emplace(symbols.velocity(i), tape_.velocity_register(i));
+      add_input(symbols.coordinate(i), tape_.coordinate_register(i), -1);
+      add_input(symbols.velocity(i), tape_.velocity_register(i), -1);
     }
     nodes_.emplace_back();  // kOne
     nodes_.back().key = 1;
+    same_key_.push_back(-1);
   }
 
   // Compiles `e` (parameters still symbolic) into the next output; `what` names it in errors.
@@ -207,12 +210,18 @@ class TapeCompiler {
     h = mix(h, hash_double(n.exponent));
     for (const Scaled& item : n.items) h = mix(mix(h, hash_double(item.c)), node(item.id).key);
     n.key = h;
-    std::vector<int>& candidates = by_key_[h];
-    for (int id : candidates)
-      if (shallow_equal(node(id), n)) return id;
+    const auto [first, fresh] = by_key_.try_emplace(h, static_cast<int>(nodes_.size()));
+    if (!fresh) {
+      for (int id = first->second; id >= 0; id = same_key_[static_cast<std::size_t>(id)])
+        if (shallow_equal(node(id), n)) return id;
+    }
     nodes_.push_back(std::move(n));
     const int id = static_cast<int>(nodes_.size()) - 1;
-    candidates.push_back(id);
+    same_key_.push_back(-1);
+    if (!fresh) {  // the chain of nodes with this key: the new one first
+      same_key_.back() = first->second;
+      first->second = id;
+    }
     return id;
   }
 
@@ -475,8 +484,10 @@ class TapeCompiler {
     const auto found = translated_.find(key);
     if (found != translated_.end()) return found->second.second;
     const Scaled s = translate(e);
-    // The node itself is kept in the memo so that its address cannot be reused by another.
-    translated_.emplace(key, std::make_pair(e, s));
+    // The node itself is kept in the memo so that its address cannot be reused by another. A node
+    // held by `e` alone (the temporary c x that op() makes of a sum's term with a coefficient) can
+    // never be met again: it is not kept.
+    if (key->get_refcount() > 1) translated_.emplace(key, std::make_pair(e, s));
     return s;
   }
 
@@ -485,42 +496,64 @@ class TapeCompiler {
     return numeric_value(x);
   }
 
+  // The term c x of a sum (x its pair's rest, c != 1): GiNaC's product of x and c, whose factors
+  // are x's (x a product, its number times c) or x itself.
+  Scaled term(const GiNaC::ex& x, const GiNaC::numeric& c) {
+    if (GiNaC::is_exactly_a<GiNaC::mul>(x))
+      return product(detail::Pairs::of(x), GiNaC::ex_to<GiNaC::numeric>(detail::Pairs::number(x)).mul(c));
+    return product(GiNaC::epvector{GiNaC::expair(x, 1)}, c);
+  }
+
+  // number * the product of the factors rest^exponent: each factor translated (a power for an
+  // exponent other than 1), the numbers multiplied in their own order, powers of a base merged.
+  Scaled product(const GiNaC::epvector& pairs, const GiNaC::numeric& number) {
+    std::vector<int> factors;
+    std::vector<double> numbers;
+    for (const GiNaC::expair& p : pairs) {
+      const Scaled f = p.coeff.is_equal(1) ? canonical(p.rest)
+                                           : make_power(canonical(p.rest), real_number(GiNaC::ex_to<GiNaC::numeric>(p.coeff)));
+      if (f.c != 1.0) numbers.push_back(f.c);
+      if (f.id == kOne) continue;
+      if (node(f.id).kind == Kind::mul) {
+        for (const Scaled& g : node(f.id).items) factors.push_back(g.id);
+      } else {
+        factors.push_back(f.id);
+      }
+    }
+    if (!number.is_equal(1)) {
+      const double x = real_number(number);
+      if (x != 1.0) numbers.push_back(x);
+    }
+    double c = product_of(std::move(numbers));
+    factors = merge_powers(std::move(factors), c);
+    return make_mul(std::move(factors), c);
+  }
+
+  // Sums and products are read from GiNaC's pairs (detail/pairs.hpp), not through op(), which
+  // builds a product c x for each term with a coefficient and a power x^k for each factor with an
+  // exponent: each is translated as translate() would translate that product or power.
   Scaled translate(const GiNaC::ex& e) {
     if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) return {real_number(GiNaC::ex_to<GiNaC::numeric>(e)), kOne};
-    if (GiNaC::is_a<GiNaC::symbol>(e)) return {1.0, symbol(GiNaC::ex_to<GiNaC::symbol>(e))};
-    if (GiNaC::is_exactly_a<GiNaC::constant>(e)) {
-      const GiNaC::ex value = e.evalf();
-      if (GiNaC::is_exactly_a<GiNaC::numeric>(value)) return {real_number(GiNaC::ex_to<GiNaC::numeric>(value)), kOne};
-      fail(fmt::format("contains the constant '{}', which has no numeric value", to_text(e)));
-    }
     if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
       std::vector<Scaled> terms;
       std::vector<double> numbers;
-      for (std::size_t i = 0; i < e.nops(); ++i) {
-        const Scaled t = canonical(e.op(i));
+      for (const GiNaC::expair& p : detail::Pairs::of(e)) {
+        const Scaled t = p.coeff.is_equal(1) ? canonical(p.rest) : term(p.rest, GiNaC::ex_to<GiNaC::numeric>(p.coeff));
         if (t.id == kOne)
           numbers.push_back(t.c);
         else
           terms.push_back(t);
       }
+      if (!detail::Pairs::number(e).is_zero()) numbers.push_back(translate(detail::Pairs::number(e)).c);
       return make_add(std::move(terms), sum(std::move(numbers)));
     }
-    if (GiNaC::is_exactly_a<GiNaC::mul>(e)) {
-      std::vector<int> factors;
-      std::vector<double> numbers;
-      for (std::size_t i = 0; i < e.nops(); ++i) {
-        const Scaled f = canonical(e.op(i));
-        if (f.c != 1.0) numbers.push_back(f.c);
-        if (f.id == kOne) continue;
-        if (node(f.id).kind == Kind::mul) {
-          for (const Scaled& g : node(f.id).items) factors.push_back(g.id);
-        } else {
-          factors.push_back(f.id);
-        }
-      }
-      double c = product_of(std::move(numbers));
-      factors = merge_powers(std::move(factors), c);
-      return make_mul(std::move(factors), c);
+    if (GiNaC::is_exactly_a<GiNaC::mul>(e))
+      return product(detail::Pairs::of(e), GiNaC::ex_to<GiNaC::numeric>(detail::Pairs::number(e)));
+    if (GiNaC::is_a<GiNaC::symbol>(e)) return {1.0, symbol(GiNaC::ex_to<GiNaC::symbol>(e))};
+    if (GiNaC::is_exactly_a<GiNaC::constant>(e)) {
+      const GiNaC::ex value = e.evalf();
+      if (GiNaC::is_exactly_a<GiNaC::numeric>(value)) return {real_number(GiNaC::ex_to<GiNaC::numeric>(value)), kOne};
+      fail(fmt::format("contains the constant '{}', which has no numeric value", to_text(e)));
     }
     if (GiNaC::is_exactly_a<GiNaC::power>(e)) {
       const Scaled base = canonical(e.op(0));
@@ -545,13 +578,15 @@ class TapeCompiler {
     Node n;
     n.kind = Kind::symbol;
     n.name = x.get_name();
-    const auto variable = variables_.find(x);
-    const auto parameter = parameters_.find(x);
-    if (variable != variables_.end()) {
-      n.input = variable->second;
+    const Input* found = nullptr;
+    const auto [begin, end] = inputs_.equal_range(x.gethash());
+    for (auto it = begin; it != end && found == nullptr; ++it)
+      if (it->second.symbol.is_equal(x)) found = &it->second;
+    if (found != nullptr && found->input >= 0) {
+      n.input = found->input;
       n.parameters_only = false;
-    } else if (parameter != parameters_.end()) {
-      n.parameter = parameter->second;
+    } else if (found != nullptr) {
+      n.parameter = found->parameter;
     } else {
       for (int i = 0; i < spec_.symbols.coordinates(); ++i)
         if (x.is_equal(spec_.symbols.acceleration(i)))
@@ -890,14 +925,27 @@ class TapeCompiler {
   }
 
   const Spec& spec_;
-  std::map<GiNaC::ex, int, GiNaC::ex_is_less> parameters_;  // parameter symbol -> its index
-  std::map<GiNaC::ex, int, GiNaC::ex_is_less> variables_;   // t, q, q' -> input register
+  // t, q, q' -> input register, parameter symbol -> its index; found by the symbol's GiNaC hash
+  // (from its serial number, the same in every copy), then by equality.
+  struct Input {
+    GiNaC::ex symbol;
+    int input = -1;
+    int parameter = -1;
+  };
+  std::unordered_multimap<unsigned, Input> inputs_;
+  void add_input(const GiNaC::symbol& x, int input, int parameter) {
+    inputs_.emplace(x.gethash(), Input{x, input, parameter});
+  }
   std::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, Scaled>> translated_;
   std::deque<Node> nodes_;  // a deque: references stay valid while nodes are added
-  std::unordered_map<std::uint64_t, std::vector<int>> by_key_;
+  std::unordered_map<std::uint64_t, int> by_key_;  // key -> the last node made with it
+  std::vector<int> same_key_;                       // per node: the one made before it with its key, or -1
   Tape tape_;
-  std::map<MemoKey, int> memo_;
-  std::map<std::uint64_t, int> constants_;  // by the bits of the value
+  struct MemoHash {
+    std::size_t operator()(const MemoKey& k) const { return mix(static_cast<std::uint64_t>(k.first), k.second); }
+  };
+  std::unordered_map<MemoKey, int, MemoHash> memo_;
+  std::unordered_map<std::uint64_t, int> constants_;  // by the bits of the value
   std::string what_;
   GiNaC::ex original_;
 };
@@ -909,8 +957,9 @@ void check_size(const Spec& spec, const char* what, const Matrix& m, int rows, i
                                  m.rows(), m.cols(), rows, cols));
 }
 
-// The value of an initial condition once the parameters are set.
-double initial_value(const Spec& spec, const GiNaC::lst& values, const GiNaC::ex& e, const std::string& what) {
+// An initial condition must be a real number once the parameters are set.
+void require_initial_value(const Spec& spec, const GiNaC::lst& values, const GiNaC::ex& e, const std::string& what) {
+  if (GiNaC::is_exactly_a<GiNaC::numeric>(e) && GiNaC::ex_to<GiNaC::numeric>(e).is_real()) return;  // a number
   GiNaC::ex value;
   try {
     value = e.subs(values, GiNaC::subs_options::no_pattern).evalf();
@@ -922,7 +971,6 @@ double initial_value(const Spec& spec, const GiNaC::lst& values, const GiNaC::ex
     throw ModelError(fmt::format("model '{}': the initial value of {} = {} is not a real number once the "
                                  "parameters are set (it is {}); initial values may use the parameters only",
                                  spec.name, what, to_text(e), to_text(value)));
-  return GiNaC::ex_to<GiNaC::numeric>(value).to_double();
 }
 
 int coordinate_index(const Spec& spec, const std::string& name, const char* what) {
@@ -1148,8 +1196,8 @@ void compile_initial_state(const Spec& spec, ModelTapes& tapes) {
   // from the initial-state tape, which follows the parameters when they change.
   const GiNaC::lst values = spec.parameter_values();
   for (int i = 0; i < n; ++i) {
-    initial_value(spec, values, spec.q0[static_cast<std::size_t>(i)], q_name(i));
-    initial_value(spec, values, spec.v0[static_cast<std::size_t>(i)], q_name(i) + "'");
+    require_initial_value(spec, values, spec.q0[static_cast<std::size_t>(i)], q_name(i));
+    require_initial_value(spec, values, spec.v0[static_cast<std::size_t>(i)], q_name(i) + "'");
   }
   TapeCompiler initial(spec);
   for (int i = 0; i < n; ++i) initial.add_output(spec.q0[static_cast<std::size_t>(i)], "initial " + q_name(i));

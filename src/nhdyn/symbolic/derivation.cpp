@@ -11,7 +11,9 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
+#include "nhdyn/symbolic/detail/derivative.hpp"
 #include "nhdyn/symbolic/detail/occurrence.hpp"
+#include "nhdyn/symbolic/detail/pairs.hpp"
 #include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/rolling_contact.hpp"
 #include "nhdyn/symbolic/simplify.hpp"
@@ -35,8 +37,8 @@ std::string printed(const GiNaC::ex& e) {
 // coordinates that e contains are differentiated by.
 GiNaC::ex convective_derivative(const GiNaC::ex& e, const SymbolTable& symbols, const SymbolIndex& index) {
   const Contained o = index.find(e);
-  GiNaC::ex out = o.time ? e.diff(symbols.time()) : GiNaC::ex(0);
-  for (int i : o.q) out += e.diff(symbols.coordinate(i)) * symbols.velocity(i);
+  GiNaC::ex out = o.time ? detail::derivative_of_container(e, symbols.time()) : GiNaC::ex(0);
+  for (int i : o.q) out += detail::derivative_of_container(e, symbols.coordinate(i)) * symbols.velocity(i);
   return out;
 }
 
@@ -103,7 +105,8 @@ struct SplitSum {
   }
   GiNaC::ex diff(const std::vector<std::vector<int>>& with, int i, const GiNaC::symbol& x) const {
     GiNaC::ex out = 0;
-    for (int j : with[static_cast<std::size_t>(i)]) out += terms[static_cast<std::size_t>(j)].diff(x);
+    for (int j : with[static_cast<std::size_t>(i)])
+      out += detail::derivative_of_container(terms[static_cast<std::size_t>(j)], x);
     return out;
   }
 };
@@ -162,12 +165,48 @@ void require_complement_at_initial_state(const Spec& spec, const GiNaC::matrix& 
         where, k + s, n, sigma(sigma.size() - 1), sigma(0), k));
 }
 
+// The degree of `e` as a polynomial in the velocities, whatever its other factors; -1 when a
+// velocity stands elsewhere than in sums, products and powers with a whole exponent (in a
+// function's argument, a root, a denominator). GiNaC's degree() after q' -> lambda q' is at most
+// this (it reads the same structure; terms may cancel).
+int polynomial_velocity_degree(const GiNaC::ex& e, const SymbolIndex& index) {
+  if (GiNaC::is_exactly_a<GiNaC::symbol>(e)) return index.is_velocity(e) ? 1 : 0;
+  if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) return 0;
+  const bool sum = GiNaC::is_exactly_a<GiNaC::add>(e);
+  if (sum || GiNaC::is_exactly_a<GiNaC::mul>(e)) {
+    int out = 0;
+    for (const GiNaC::expair& p : detail::Pairs::of(e)) {
+      int d = polynomial_velocity_degree(p.rest, index);
+      if (d < 0) return -1;
+      if (!sum && d > 0) {  // a factor rest^k
+        if (!p.coeff.info(GiNaC::info_flags::nonnegint)) return -1;
+        d *= GiNaC::ex_to<GiNaC::numeric>(p.coeff).to_int();
+      }
+      out = sum ? std::max(out, d) : out + d;
+    }
+    return out;
+  }
+  if (GiNaC::is_exactly_a<GiNaC::power>(e)) {
+    const int base = polynomial_velocity_degree(e.op(0), index);
+    if (base < 0) return -1;
+    if (GiNaC::is_exactly_a<GiNaC::numeric>(e.op(1)) && e.op(1).info(GiNaC::info_flags::nonnegint))
+      return base * GiNaC::ex_to<GiNaC::numeric>(e.op(1)).to_int();
+    return base == 0 && polynomial_velocity_degree(e.op(1), index) == 0 ? 0 : -1;
+  }
+  for (std::size_t i = 0; i < e.nops(); ++i)
+    if (polynomial_velocity_degree(e.op(i), index) != 0) return -1;
+  return 0;
+}
+
 // A kinetic energy of degree above 2 in the velocities is refused before its Hessian is formed:
 // for a power such as (x'^2 + y'^2 + x + y)^40 the Hessian takes minutes to expand. degree() reads
 // the unexpanded expression (a power's degree is its base's times the exponent), and a numeric
 // third difference of T(lambda q') at a rational point confirms it, so that terms that cancel
 // once multiplied out are not refused.
-void require_at_most_quadratic(const Spec& spec, const std::string& model) {
+void require_at_most_quadratic(const Spec& spec, const SymbolIndex& index, const std::string& model) {
+  // What the test below concludes for a polynomial of degree 2 or less, without the substitution
+  // into all of T (a fortieth of a long chain's start-up).
+  if (const int d = polynomial_velocity_degree(spec.kinetic_energy, index); d >= 0 && d <= 2) return;
   const SymbolTable& symbols = spec.symbols;
   const GiNaC::symbol lambda("velocity_scale");
   GiNaC::exmap scaled;
@@ -245,8 +284,12 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
                                                name(o.a.front())));
         // phi' = phi_q q' + phi_t; phi'' = b q'' + b0 with b = phi_q and
         // b0 = (d/dq (phi_q q')) q' + 2 phi_qt q' + phi_tt, the q''-free part of d/dt phi'.
-        const GiNaC::ex phidot = convective_derivative(e, symbols, index);
-        for (int j : o.q) row.emplace_back(j, e.diff(q(j)));
+        // phidot as convective_derivative(e) builds it, from the partial derivatives of the row.
+        GiNaC::ex phidot = o.time ? detail::derivative_of_container(e, symbols.time()) : GiNaC::ex(0);
+        for (int j : o.q) {
+          row.emplace_back(j, detail::derivative_of_container(e, q(j)));
+          phidot += row.back().second * symbols.velocity(j);
+        }
         b0 = convective_derivative(phidot, symbols, index);
         phi.push_back(e);
         f.push_back(tidy(phidot));
@@ -257,7 +300,7 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
           throw ModelError(where + fmt::format(" is given at velocity level but contains the acceleration {}''",
                                                name(o.a.front())));
         // f' = (df/dq') q'' + (df/dq) q' + df/dt.
-        for (int j : o.v) row.emplace_back(j, e.diff(v(j)));
+        for (int j : o.v) row.emplace_back(j, detail::derivative_of_container(e, v(j)));
         b0 = convective_derivative(e, symbols, index);
         f.push_back(e);
         break;
@@ -266,12 +309,12 @@ void constraint_rows(const Spec& spec, const std::vector<SpecConstraint>& constr
         involve = "the accelerations";
         GiNaC::lst at_rest;
         for (int j : o.a) {
-          row.emplace_back(j, e.diff(a(j)));
+          row.emplace_back(j, detail::derivative(e, a(j)));
           at_rest.append(a(j) == 0);
         }
         for (const auto& [i, entry] : row)
           for (int j : o.a)
-            if (!symbolic::is_zero(entry.diff(a(j))))
+            if (!symbolic::is_zero(detail::derivative(entry, a(j))))
               throw ModelError(where + fmt::format(" must be linear in the accelerations, but it is not linear in "
                                                    "{}'' (its derivative by {}'' depends on {}'')",
                                                    name(i), name(i), name(j)));
@@ -361,7 +404,7 @@ void derive_inertia(const Spec& spec, const SplitSum& Ts, const SymbolIndex& ind
     for (int jj : partners) {
       if (jj < i) continue;
       const auto uj = static_cast<unsigned>(jj);
-      const GiNaC::ex entry = tidy(Tv[ui].diff(v(jj)));
+      const GiNaC::ex entry = tidy(detail::derivative(Tv[ui], v(jj)));
       if (const Contained o = index.find(entry); !o.v.empty())
         throw ModelError(model + fmt::format("the kinetic energy T is not quadratic in the velocities: "
                                              "A = d2T/dq'2 depends on {}' (entry ({}, {}) is {})",
@@ -458,6 +501,38 @@ void derive_complement(const Spec& spec, const std::string& model, Derivation& d
   }
 }
 
+// The degree of `e` as a homogeneous polynomial in the velocities `v` (the few a term contains),
+// whatever its other factors; -1 when it is not one (a velocity inside a function, a root or a
+// denominator, or a sum of terms of unlike degrees). Degree 0 means that e contains no velocity.
+int velocity_degree(const GiNaC::ex& e, const std::vector<GiNaC::ex>& v) {
+  if (GiNaC::is_exactly_a<GiNaC::symbol>(e))
+    return std::any_of(v.begin(), v.end(), [&](const GiNaC::ex& x) { return x.is_equal(e); }) ? 1 : 0;
+  if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) return 0;
+  const bool sum = GiNaC::is_exactly_a<GiNaC::add>(e), product = GiNaC::is_exactly_a<GiNaC::mul>(e);
+  if (GiNaC::is_exactly_a<GiNaC::power>(e)) {
+    const int base = velocity_degree(e.op(0), v);
+    if (base < 0) return -1;
+    const GiNaC::ex& k = e.op(1);
+    if (GiNaC::is_exactly_a<GiNaC::numeric>(k) && k.info(GiNaC::info_flags::nonnegint))
+      return base * GiNaC::ex_to<GiNaC::numeric>(k).to_int();
+    return base == 0 && velocity_degree(k, v) == 0 ? 0 : -1;
+  }
+  int out = 0;
+  for (std::size_t i = 0; i < e.nops(); ++i) {
+    const int d = velocity_degree(e.op(i), v);
+    if (d < 0) return -1;
+    if (product) {
+      out += d;
+    } else if (sum) {
+      if (i > 0 && d != out) return -1;
+      out = d;
+    } else if (d != 0) {
+      return -1;  // a velocity inside a function's argument
+    }
+  }
+  return out;
+}
+
 // The energy balance (docs/derivations/energy-balance.md). Simplifying a sum costs more than
 // linearly in its number of terms (every trigonometric argument is reduced across all of them):
 // a large model's expressions are kept as written, which computes the same values.
@@ -479,8 +554,17 @@ void derive_energy_balance(const Spec& spec, const SplitSum& Ts, Derivation& d) 
   bool h_is_energy = true;
   for (std::size_t j = 0; j < Ts.terms.size(); ++j) {
     const GiNaC::ex& term = Ts.terms[j];
+    // A term that is a homogeneous quadratic in the velocities needs no check: Euler's identity
+    // holds for it as polynomials, which expand() below would confirm at great cost for the
+    // nested products of a multibody model's rotations (two fifths of the bicycle's start-up).
+    std::vector<GiNaC::ex> velocities;
+    for (int i : Ts.occurrences[j].v) velocities.push_back(v(i));
+    if (!velocities.empty() && velocity_degree(term, velocities) == 2) {
+      h_terms.push_back(term);
+      continue;
+    }
     GiNaC::ex rate = 0;
-    for (int i : Ts.occurrences[j].v) rate += v(i) * term.diff(v(i));
+    for (int i : Ts.occurrences[j].v) rate += v(i) * detail::derivative(term, v(i));
     // Expanding settles the usual term (a polynomial in the velocities) at a small fraction of
     // the cost of simplifying it, which matters for the thousands of terms of a long chain.
     const GiNaC::ex euler = (rate - 2 * term).expand();
@@ -496,7 +580,7 @@ void derive_energy_balance(const Spec& spec, const SplitSum& Ts, Derivation& d) 
   for (std::size_t i = 0; i < spec.forces.size(); ++i)
     if (!symbolic::is_zero(spec.forces[i])) power_forces += spec.forces[i] * v(static_cast<int>(i));
   d.power_forces = tidy(power_forces);
-  d.power_time = tidy(V.diff(t) - T.diff(t));
+  d.power_time = tidy(detail::derivative(V, t) - detail::derivative(T, t));
   d.conservative = symbolic::is_zero(d.power_forces) && symbolic::is_zero(d.power_time);
 }
 
@@ -520,7 +604,7 @@ Derivation derive(const Spec& spec) {
     throw ModelError(model + "the kinetic and potential energies may not contain accelerations");
   if (const int i = Vs.first(&Contained::v); i >= 0)
     throw ModelError(model + fmt::format("the potential energy V contains the velocity {}'", name(i)));
-  require_at_most_quadratic(spec, model);
+  require_at_most_quadratic(spec, index, model);
   check_contact_convexity(spec);  // an implicit rolling shape must be convex where the run starts
   check_contact_watches_at_start(spec);  // a wheel neither flat nor turned over where it starts
 

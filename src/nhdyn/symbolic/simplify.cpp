@@ -73,10 +73,69 @@ struct Fraction {
   ex denominator;
 };
 
+// An argument normal() leaves as it is: a symbol, an integer or a sum of integer multiples of
+// symbols (a rational multiple, x/2 + y, it would write as (x + 2 y)/2).
+bool is_plain_argument(const ex& a) {
+  const auto plain_term = [](const ex& t) {
+    if (GiNaC::is_exactly_a<GiNaC::symbol>(t)) return true;
+    if (GiNaC::is_exactly_a<GiNaC::numeric>(t)) return t.info(GiNaC::info_flags::integer);
+    return GiNaC::is_exactly_a<GiNaC::mul>(t) && t.nops() == 2 && GiNaC::is_exactly_a<GiNaC::symbol>(t.op(0)) &&
+           GiNaC::is_exactly_a<GiNaC::numeric>(t.op(1)) && t.op(1).info(GiNaC::info_flags::integer);
+  };
+  if (!GiNaC::is_exactly_a<GiNaC::add>(a)) return plain_term(a);
+  for (std::size_t i = 0; i < a.nops(); ++i)
+    if (!plain_term(a.op(i))) return false;
+  return true;
+}
+
+// A polynomial with rational coefficients in symbols and in calls (other than tan and tanh) of
+// plain arguments: no denominator, root or floating-point number. Its normal form is its
+// expansion, and simplify() leaves its function arguments as they are; the common entry of a
+// large model (m a cos(theta1) theta1', -sin(theta2) x2' theta2') is one, and expand() costs a
+// fraction of normal(), which replaces every call by a symbol and back and adds term by term.
+bool is_plain_polynomial(const ex& e) {
+  if (GiNaC::is_exactly_a<GiNaC::symbol>(e)) return true;
+  if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) return e.info(GiNaC::info_flags::rational);
+  if (GiNaC::is_exactly_a<GiNaC::power>(e))
+    return GiNaC::is_exactly_a<GiNaC::numeric>(e.op(1)) && e.op(1).info(GiNaC::info_flags::posint) &&
+           is_plain_polynomial(e.op(0));
+  if (GiNaC::is_exactly_a<GiNaC::add>(e) || GiNaC::is_exactly_a<GiNaC::mul>(e)) {
+    for (std::size_t i = 0; i < e.nops(); ++i)
+      if (!is_plain_polynomial(e.op(i))) return false;
+    return true;
+  }
+  if (GiNaC::is_exactly_a<GiNaC::function>(e)) {
+    if (is_function(e, "tan") || is_function(e, "tanh")) return false;
+    for (std::size_t i = 0; i < e.nops(); ++i)
+      if (!is_plain_argument(e.op(i))) return false;
+    return true;
+  }
+  return false;
+}
+
 // numerator / denominator, both expanded and coprime, with a unit fixed independently of GiNaC's
 // term order: the denominator has integer coefficients without common factor, and its first term
 // (by canonical_key) a positive coefficient.
-Fraction normal_fraction(const ex& e) {
+Fraction normal_fraction_of_any(const ex& e);
+
+// normal_fraction() of a plain polynomial.
+Fraction plain_fraction(const ex& e) {
+  // Build with -DNHDYN_CHECK_SIMPLIFY_SHORTCUT to compare with normal() on every call.
+  const Fraction out{GiNaC::expand(e), 1};
+#ifdef NHDYN_CHECK_SIMPLIFY_SHORTCUT
+  const Fraction full = normal_fraction_of_any(e);
+  if (!full.numerator.is_equal(out.numerator) || !full.denominator.is_equal(out.denominator)) {
+    std::cerr << "NORMAL SHORTCUT MISMATCH " << e << " : " << full.numerator << " / " << full.denominator
+              << " vs " << out.numerator << std::endl;
+    std::abort();
+  }
+#endif
+  return out;
+}
+
+Fraction normal_fraction(const ex& e) { return is_plain_polynomial(e) ? plain_fraction(e) : normal_fraction_of_any(e); }
+
+Fraction normal_fraction_of_any(const ex& e) {
   const ex nd = GiNaC::normal(e).numer_denom();
   ex n = GiNaC::expand(nd.op(0));
   ex d = GiNaC::expand(nd.op(1));
@@ -170,7 +229,9 @@ ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool elim
     back.append(second[i] == g);
   }
   Freeze freeze;
-  ex q = GiNaC::expand(freeze(p).subs(to_symbols));
+  // no_pattern: the keys hold no wildcard, so a lookup per node finds them; GiNaC's default tries
+  // every key as a pattern at every node.
+  ex q = GiNaC::expand(freeze(p).subs(to_symbols, GiNaC::subs_options::no_pattern));
   for (std::size_t i = 0; i < families.size(); ++i) {
     const GiNaC::symbol& s = first[i];
     const GiNaC::symbol& c = second[i];
@@ -190,7 +251,7 @@ ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool elim
     }
     q = GiNaC::expand(reduced);
   }
-  return q.subs(back).subs(freeze.back);
+  return q.subs(back, GiNaC::subs_options::no_pattern).subs(freeze.back, GiNaC::subs_options::no_pattern);
 }
 
 // True when a power of a sine, cosine, sinh or cosh occurs anywhere in e (inside roots and
@@ -295,23 +356,38 @@ ex reduced_form(const Fraction& base, std::vector<Family>& families) {
 GiNaC::ex simplify(const GiNaC::ex& e) {
   if (GiNaC::is_a<GiNaC::numeric>(e) || GiNaC::is_a<GiNaC::symbol>(e)) return e;
   Rewrite rewrite;
-  const Fraction base = normal_fraction(rewrite(e));
+  // A plain polynomial's function arguments are simplified already (is_plain_argument).
+  const Fraction base = is_plain_polynomial(e) ? plain_fraction(e) : normal_fraction(rewrite(e));
+#ifdef NHDYN_CHECK_SIMPLIFY_SHORTCUT
+  if (is_plain_polynomial(e)) {
+    const Fraction full = normal_fraction_of_any(rewrite(e));
+    if (!full.numerator.is_equal(base.numerator) || !full.denominator.is_equal(base.denominator)) {
+      std::cerr << "REWRITE SHORTCUT MISMATCH " << e << std::endl;
+      std::abort();
+    }
+  }
+#endif
   if (base.numerator.is_zero()) return 0;
-  std::vector<Family> families;
-  collect_families(base.numerator, families);
-  collect_families(base.denominator, families);
-  if (families.empty()) return assemble(base);
+  // Without a power of a family function the reduction gives back its input (the common entry of a
+  // large model), whatever the families are: they are collected only when there is one.
   if (!has_family_power(base.numerator) && !has_family_power(base.denominator)) {
     // Build with -DNHDYN_CHECK_SIMPLIFY_SHORTCUT to compare the shortcut with the full reduction on
     // every call (done over every example and `nhdyn equations` when the shortcut was added).
 #ifdef NHDYN_CHECK_SIMPLIFY_SHORTCUT
-    if (!reduced_form(base, families).is_equal(assemble(base))) {
+    std::vector<Family> families;
+    collect_families(base.numerator, families);
+    collect_families(base.denominator, families);
+    if (!families.empty() && !reduced_form(base, families).is_equal(assemble(base))) {
       std::cerr << "SHORTCUT MISMATCH " << e << " : " << reduced_form(base, families) << " vs " << assemble(base) << std::endl;
       std::abort();
     }
 #endif
     return assemble(base);
   }
+  std::vector<Family> families;
+  collect_families(base.numerator, families);
+  collect_families(base.denominator, families);
+  if (families.empty()) return assemble(base);
   return reduced_form(base, families);
 }
 

@@ -24,7 +24,7 @@ void throw_model_error(const SourceLocation& where, const std::string& context, 
   throw ModelError((location.empty() ? "" : location + ": ") + (context.empty() ? "" : context + ": ") + problem);
 }
 
-SymbolTable::SymbolTable() : t_("t") {
+SymbolTable::SymbolTable() : t_(GiNaC::symbol("t")) {
   // Before any expression of the model is built: GiNaC then differentiates its functions without
   // an exception per call (detail/chain_rule.hpp).
   detail::install_chain_rule();
@@ -32,10 +32,10 @@ SymbolTable::SymbolTable() : t_("t") {
 }
 
 int SymbolTable::add_coordinate(const std::string& name) {
-  q_.emplace_back(name);
-  v_.emplace_back(name + "'");
-  a_.emplace_back(name + "''");
-  r_.emplace_back("R_" + name);
+  q_.emplace_back(GiNaC::symbol(name));
+  v_.emplace_back(GiNaC::symbol(name + "'"));
+  a_.emplace_back(GiNaC::symbol(name + "''"));
+  r_.emplace_back(GiNaC::symbol("R_" + name));
   by_name_.emplace(name, q_.back());
   by_name_.emplace(name + "'", v_.back());
   by_name_.emplace(name + "''", a_.back());
@@ -44,12 +44,17 @@ int SymbolTable::add_coordinate(const std::string& name) {
 
 void SymbolTable::add_parameter(const std::string& name) { by_name_.emplace(name, GiNaC::symbol(name)); }
 
-const GiNaC::symbol& SymbolTable::parameter(const std::string& name) const { return by_name_.at(name); }
+const GiNaC::symbol& SymbolTable::parameter(const std::string& name) const { return symbol_of(by_name_.at(name)); }
 
 std::optional<GiNaC::symbol> SymbolTable::find(const std::string& name) const {
   const auto it = by_name_.find(name);
   if (it == by_name_.end()) return std::nullopt;
-  return it->second;
+  return symbol_of(it->second);
+}
+
+const GiNaC::ex* SymbolTable::expression_of(const std::string& name) const {
+  const auto it = by_name_.find(name);
+  return it == by_name_.end() ? nullptr : &it->second;
 }
 
 std::vector<std::string> SymbolTable::names() const {

@@ -41,30 +41,36 @@ struct SourceLocation {
 class SymbolTable {
  public:
   SymbolTable();
-  const GiNaC::symbol& time() const { return t_; }
+  // The symbols are kept on GiNaC's heap and handed out as references to those objects: an
+  // expression made from them holds the symbol itself, where one made from a symbol object of our
+  // own gets a copy of it (an allocation per use, and equal symbols that are not the same object).
+  const GiNaC::symbol& time() const { return symbol_of(t_); }
   // Adds a coordinate with its velocity and acceleration symbols; returns its index.
   int add_coordinate(const std::string& name);
   void add_parameter(const std::string& name);
   int coordinates() const { return static_cast<int>(q_.size()); }
-  const GiNaC::symbol& coordinate(int i) const { return q_[static_cast<std::size_t>(i)]; }
-  const GiNaC::symbol& velocity(int i) const { return v_[static_cast<std::size_t>(i)]; }
-  const GiNaC::symbol& acceleration(int i) const { return a_[static_cast<std::size_t>(i)]; }
+  const GiNaC::symbol& coordinate(int i) const { return symbol_of(q_[static_cast<std::size_t>(i)]); }
+  const GiNaC::symbol& velocity(int i) const { return symbol_of(v_[static_cast<std::size_t>(i)]); }
+  const GiNaC::symbol& acceleration(int i) const { return symbol_of(a_[static_cast<std::size_t>(i)]); }
   // The generalized reaction on coordinate i, "R_x" as the results name it: known only to the
   // expressions of outputs and events (SpecBuilder::parse_derived), not to T, V or constraints.
-  const GiNaC::symbol& reaction(int i) const { return r_[static_cast<std::size_t>(i)]; }
+  const GiNaC::symbol& reaction(int i) const { return symbol_of(r_[static_cast<std::size_t>(i)]); }
   const GiNaC::symbol& parameter(const std::string& name) const;  // throws std::out_of_range
   bool has(const std::string& name) const { return by_name_.count(name) > 0; }
   // The symbol called `name`, if any ("t", "x", "x'", "x''", a parameter).
   std::optional<GiNaC::symbol> find(const std::string& name) const;
+  // The same as the expression that holds it (nullptr when there is none): no copy of the symbol.
+  const GiNaC::ex* expression_of(const std::string& name) const;
   // Every known name, for suggestions in error messages.
   std::vector<std::string> names() const;
   // The parser's table: every name mapped to its symbol, plus the constant pi.
   GiNaC::symtab parser_table() const;
 
  private:
-  GiNaC::symbol t_;
-  std::vector<GiNaC::symbol> q_, v_, a_, r_;
-  std::map<std::string, GiNaC::symbol> by_name_;
+  static const GiNaC::symbol& symbol_of(const GiNaC::ex& e) { return GiNaC::ex_to<GiNaC::symbol>(e); }
+  GiNaC::ex t_;
+  std::vector<GiNaC::ex> q_, v_, a_, r_;
+  std::map<std::string, GiNaC::ex> by_name_;
 };
 
 struct SpecParameter {

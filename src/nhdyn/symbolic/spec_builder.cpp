@@ -82,7 +82,7 @@ enum class SymbolKind { time, constant, coordinate, velocity, acceleration, para
 struct Occurrence {
   SymbolKind kind;
   std::string name;  // as written, e.g. "x'"
-  GiNaC::symbol symbol;
+  GiNaC::ex symbol;
   std::size_t position;  // byte offset in the text
 };
 
@@ -292,14 +292,29 @@ class Reader {
       if (next.kind == TokenKind::close) site_.fail_at(next.begin, "syntax error: unmatched ')'");
       unexpected(next);
     }
+    Parsed parsed;
+    // A lone name or a zero (most of a large model's initial values) is what GiNaC's parser
+    // would make of it: the symbol (or pi) itself, the number 0.
+    if (out_ == "0" || (symbols_.size() == 1 && out_ == internal_name(symbols_.front().name))) {
+      if (out_ == "0")
+        parsed.value = 0;
+      else
+        parsed.value = symbols_.front().kind == SymbolKind::constant ? GiNaC::ex(GiNaC::Pi) : symbols_.front().symbol;
+      parsed.symbols = std::move(symbols_);
+      parsed.present = symbols_of(parsed.value);
+      return parsed;
+    }
     // Only the names the text uses: a table of every symbol per expression would make reading
     // a model quadratic in its number of coordinates.
     GiNaC::symtab table;
     for (const Occurrence& o : symbols_)
-      table[internal_name(o.name)] = o.kind == SymbolKind::constant ? GiNaC::ex(GiNaC::Pi) : GiNaC::ex(o.symbol);
-    Parsed parsed;
+      table[internal_name(o.name)] = o.kind == SymbolKind::constant ? GiNaC::ex(GiNaC::Pi) : o.symbol;
     try {
-      GiNaC::parser parser(table, /*strict=*/true);
+      // One parser per thread, given each expression's table: making a parser copies GiNaC's
+      // table of functions, which cost as much as reading a short expression (a chain's 6000
+      // initial values).
+      thread_local GiNaC::parser parser(GiNaC::symtab(), /*strict=*/true);
+      parser.get_syms() = std::move(table);
       parsed.value = parser(out_);
     } catch (const std::exception& e) {
       site_.fail_at(tokens_.front().begin, plain_words(e.what()));
@@ -496,7 +511,8 @@ class Reader {
         out_ += internal_name(name);
         return;
       }
-      std::optional<GiNaC::symbol> symbol = spec_.symbols.find(name);
+      std::optional<GiNaC::ex> symbol;
+      if (const GiNaC::ex* held = spec_.symbols.expression_of(name)) symbol = *held;
       if (!symbol && scope_ != nullptr) {
         const auto found = scope_->find(name);
         if (found != scope_->end()) symbol = found->second;
@@ -540,7 +556,7 @@ class Reader {
                                                                    std::string(static_cast<std::size_t>(token.primes), '\''))));
     }
     symbols_.push_back({token.primes == 1 ? SymbolKind::velocity : SymbolKind::acceleration, written,
-                        *spec_.symbols.find(written), token.begin});
+                        *spec_.symbols.expression_of(written), token.begin});
     out_ += internal_name(written);
   }
 
@@ -560,58 +576,54 @@ class Reader {
 // kinetic energy, potential or constraint of mechanics needs them.
 constexpr long kLargestExponent = 64;
 
-bool has_huge_exponent(const GiNaC::ex& e) {
-  if (GiNaC::is_a<GiNaC::power>(e)) {
-    const GiNaC::ex exponent = e.op(1);
-    if (GiNaC::is_a<GiNaC::numeric>(exponent) &&
-        GiNaC::abs(GiNaC::ex_to<GiNaC::numeric>(exponent)) > GiNaC::numeric(kLargestExponent))
-      return true;
-  }
-  for (std::size_t i = 0; i < e.nops(); ++i)
-    if (has_huge_exponent(e.op(i))) return true;
-  return false;
-}
+// What read() measures of an expression, in one walk: a walk per measure, and largest_expansion's
+// walk of every subtree again at each level, cost a tenth of reading a long kinetic energy.
+struct Measures {
+  bool huge_exponent = false;  // a number exponent larger than kLargestExponent in magnitude
+  // The number of terms that multiplying out the expression can produce (an upper bound: a sum's
+  // terms add, a product's multiply, (t terms)^n gives at most C(n + t - 1, t - 1)); function
+  // arguments and the bases of non-integer powers are atoms here and measured on their own.
+  double terms = 1.0;
+  double largest = 1.0;  // the largest `terms` of the expression and of its subexpressions
+  std::size_t nodes = 1;
+};
 
-// The number of terms that multiplying out `e` can produce (an upper bound: a sum's terms add, a
-// product's multiply, (t terms)^n gives at most C(n + t - 1, t - 1)); function arguments and the
-// bases of non-integer powers are atoms here and measured on their own by largest_expansion.
-double expanded_terms(const GiNaC::ex& e) {
-  if (GiNaC::is_a<GiNaC::add>(e)) {
-    double sum = 0.0;
-    for (std::size_t i = 0; i < e.nops(); ++i) sum += expanded_terms(e.op(i));
-    return sum;
+Measures measure(const GiNaC::ex& e) {
+  Measures out;
+  const bool sum = GiNaC::is_exactly_a<GiNaC::add>(e), product = GiNaC::is_exactly_a<GiNaC::mul>(e);
+  const bool power = GiNaC::is_exactly_a<GiNaC::power>(e);
+  const bool number_exponent = power && GiNaC::is_exactly_a<GiNaC::numeric>(e.op(1));
+  const bool integer_power = number_exponent && GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_integer();
+  if (number_exponent && GiNaC::abs(GiNaC::ex_to<GiNaC::numeric>(e.op(1))) > GiNaC::numeric(kLargestExponent))
+    out.huge_exponent = true;
+  // The subexpressions whose own expansion counts: those of sums, products, powers and functions.
+  const bool inner = sum || product || power || GiNaC::is_a<GiNaC::function>(e);
+  double base_terms = 1.0;
+  out.terms = sum ? 0.0 : 1.0;
+  double largest = 0.0;
+  for (std::size_t i = 0; i < e.nops(); ++i) {
+    const Measures m = measure(e.op(i));
+    out.huge_exponent = out.huge_exponent || m.huge_exponent;
+    out.nodes += m.nodes;
+    if (inner) largest = std::max(largest, m.largest);
+    if (sum) out.terms += m.terms;
+    if (product) out.terms *= m.terms;
+    if (i == 0) base_terms = m.terms;
   }
-  if (GiNaC::is_a<GiNaC::mul>(e)) {
-    double product = 1.0;
-    for (std::size_t i = 0; i < e.nops(); ++i) product *= expanded_terms(e.op(i));
-    return std::min(product, 1e300);
-  }
-  if (GiNaC::is_a<GiNaC::power>(e) && GiNaC::is_a<GiNaC::numeric>(e.op(1)) &&
-      GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_integer()) {
-    const double t = expanded_terms(e.op(0));
+  if (product) out.terms = std::min(out.terms, 1e300);
+  if (integer_power && !out.huge_exponent) {  // refused when huge, whatever it measures
+    const double t = base_terms;
     const double n = std::min(std::abs(GiNaC::ex_to<GiNaC::numeric>(e.op(1)).to_double()), 1e6);
-    if (t <= 1.0) return 1.0;
-    // C(n + t - 1, t - 1) through lgamma, capped: only its order of magnitude matters.
-    const double log_terms = std::lgamma(n + t) - std::lgamma(n + 1.0) - std::lgamma(t);
-    return log_terms > 690.0 ? 1e300 : std::exp(log_terms);
+    if (t <= 1.0) {
+      out.terms = 1.0;
+    } else {
+      // C(n + t - 1, t - 1) through lgamma, capped: only its order of magnitude matters.
+      const double log_terms = std::lgamma(n + t) - std::lgamma(n + 1.0) - std::lgamma(t);
+      out.terms = log_terms > 690.0 ? 1e300 : std::exp(log_terms);
+    }
   }
-  return 1.0;
-}
-
-double largest_expansion(const GiNaC::ex& e) {
-  double largest = expanded_terms(e);
-  const bool atom = GiNaC::is_a<GiNaC::function>(e) ||
-                    (GiNaC::is_a<GiNaC::power>(e) && !(GiNaC::is_a<GiNaC::numeric>(e.op(1)) &&
-                                                       GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_integer()));
-  if (atom || GiNaC::is_a<GiNaC::add>(e) || GiNaC::is_a<GiNaC::mul>(e) || GiNaC::is_a<GiNaC::power>(e))
-    for (std::size_t i = 0; i < e.nops(); ++i) largest = std::max(largest, largest_expansion(e.op(i)));
-  return largest;
-}
-
-std::size_t node_count(const GiNaC::ex& e) {
-  std::size_t n = 1;
-  for (std::size_t i = 0; i < e.nops(); ++i) n += node_count(e.op(i));
-  return n;
+  out.largest = std::max(out.terms, largest);
+  return out;
 }
 
 // The derivation multiplies expressions out (expand, normal), and its time grows faster than the
@@ -626,12 +638,13 @@ Parsed read(const Spec& spec, const Site& site, std::size_t begin, std::size_t e
             const std::map<std::string, GiNaC::symbol>* scope = nullptr,
             const std::map<std::string, std::string>* unavailable = nullptr) {
   Parsed parsed = Reader(site, spec, lex(site, begin, end), scope, unavailable).read();
-  if (has_huge_exponent(parsed.value))
+  const Measures measures = measure(parsed.value);
+  if (measures.huge_exponent)
     site.fail_whole(fmt::format("an exponent larger than {} in magnitude; nhdyn expands powers symbolically, "
                                 "so rewrite the expression (e.g. with exp and log) or use a smaller power",
                                 kLargestExponent));
-  const double terms = largest_expansion(parsed.value);
-  if (terms > kLargestExpansion + 10.0 * static_cast<double>(node_count(parsed.value)))
+  const double terms = measures.largest;
+  if (terms > kLargestExpansion + 10.0 * static_cast<double>(measures.nodes))
     site.fail_whole(fmt::format("multiplied out, this expression could have about {:.2g} terms (the limit is {:g}): "
                                 "nhdyn expands products and powers of sums symbolically, which takes seconds at a few thousand terms "
                                 "and minutes beyond; "
@@ -783,22 +796,17 @@ SpecBuilder& SpecBuilder::force(const std::string& coordinate, const std::string
   return *this;
 }
 
-namespace {
-
-void check_constraint_name(const Spec& spec, const std::string& name, const SourceLocation& where) {
+void SpecBuilder::check_constraint_name(const std::string& name, const SourceLocation& where) const {
   const std::string context = fmt::format("constraint '{}'", name);
   if (name.empty() || !std::isalpha(static_cast<unsigned char>(name[0])) ||
       !std::all_of(name.begin(), name.end(), [](char c) { return identifier_char(c) || c == '-'; }))
     fail(where, context, "not a valid constraint name: use letters, digits, '_' and '-', starting with a letter");
-  for (const SpecConstraint& c : spec.constraints)
-    if (c.name == name) {
-      const std::string at = c.where.describe();
-      fail(where, context, fmt::format("duplicated constraint name '{}'{}", name,
-                                       at.empty() ? "" : " (first given at " + at + ")"));
-    }
+  if (const auto found = constraint_by_name_.find(name); found != constraint_by_name_.end()) {
+    const std::string at = spec_.constraints[found->second].where.describe();
+    fail(where, context, fmt::format("duplicated constraint name '{}'{}", name,
+                                     at.empty() ? "" : " (first given at " + at + ")"));
+  }
 }
-
-}  // namespace
 
 SpecBuilder& SpecBuilder::add_energies(const GiNaC::ex& kinetic, const GiNaC::ex& potential) {
   spec_.kinetic_energy += kinetic;
@@ -808,7 +816,7 @@ SpecBuilder& SpecBuilder::add_energies(const GiNaC::ex& kinetic, const GiNaC::ex
 
 SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel level, const GiNaC::ex& expression,
                                      const std::string& text, SourceLocation where) {
-  check_constraint_name(spec_, name, where);
+  check_constraint_name(name, where);
   const int n = spec_.n();
   bool velocities = false, accelerations = false;
   for (int i = 0; i < n; ++i) {
@@ -822,6 +830,7 @@ SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel le
     fail(where, fmt::format("constraint '{}'", name),
          "the expression does not match the level it is given at (position: no velocities; velocity: some "
          "velocity, no acceleration; acceleration: some acceleration)");
+  constraint_by_name_.emplace(name, spec_.constraints.size());
   spec_.constraints.push_back({name, level, expression, text, std::move(where)});
   return *this;
 }
@@ -829,7 +838,7 @@ SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel le
 SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel level, const std::string& text,
                                      SourceLocation where) {
   const std::string context = fmt::format("constraint '{}'", name);
-  check_constraint_name(spec_, name, where);
+  check_constraint_name(name, where);
   const Site site{text, where, context};
   // `lhs = rhs` is read as lhs - rhs = 0.
   Parsed parsed;
@@ -871,6 +880,7 @@ SpecBuilder& SpecBuilder::constraint(const std::string& name, ConstraintLevel le
                               velocities ? "velocity" : "position"));
       break;
   }
+  constraint_by_name_.emplace(name, spec_.constraints.size());
   spec_.constraints.push_back({name, level, parsed.value, text, std::move(where)});
   return *this;
 }

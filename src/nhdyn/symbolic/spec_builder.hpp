@@ -154,6 +154,10 @@ class SpecBuilder {
   // The index of each coordinate by name: a lookup per initial value, force or solution, which a
   // linear search made quadratic in the number of coordinates (10 000 particles).
   std::unordered_map<std::string, int> coordinate_by_name_;
+  // The index of each constraint by name, for the check of duplicated names (quadratic in the
+  // number of constraints as a search of the list: 3000 for a 1000-body chain).
+  std::unordered_map<std::string, std::size_t> constraint_by_name_;
+  void check_constraint_name(const std::string& name, const SourceLocation& where) const;
   std::vector<std::pair<std::string, SourceLocation>> announced_outputs_;  // announce_outputs()
   int coordinate_of(const std::string& name) const;  // -1 when not a coordinate
 };

@@ -9,6 +9,7 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -214,7 +215,7 @@ void load_constraints(LoadContext& cx, const toml::node& node, SpecBuilder& buil
   const Cursor& c = cx.cursor;
   const toml::array& array =
       c.array_of(node, "constraints", "[[constraints]] followed by name = \"blade\" and velocity = \"...\"");
-  std::vector<std::pair<std::string, SourceLocation>> names;
+  std::unordered_map<std::string, SourceLocation> names;  // a search of a list is quadratic in their number
   int number = 0;
   for (const toml::node& element : array) {
     ++number;
@@ -232,12 +233,11 @@ void load_constraints(LoadContext& cx, const toml::node& node, SpecBuilder& buil
       name = c.string_of(*name_node, "name", "name = \"blade\"");
       name_at = c.at(*name_node);
     }
-    for (const auto& [other, other_at] : names)
-      if (other == name)
-        c.fail(name_at, fmt::format("constraint name '{}' is used twice (first at line {}); give each constraint "
-                                    "its own name",
-                                    name, other_at.line));
-    names.emplace_back(name, name_at);
+    if (const auto other = names.find(name); other != names.end())
+      c.fail(name_at, fmt::format("constraint name '{}' is used twice (first at line {}); give each constraint "
+                                  "its own name",
+                                  name, other->second.line));
+    names.emplace(name, name_at);
 
     const LevelEntry found = level_of(c, *table, element, "constraint", name);
     const toml::node* level_node = found.node;

@@ -2,15 +2,26 @@
 
 #include <algorithm>
 
+#include "nhdyn/symbolic/detail/pairs.hpp"
+
 namespace nhdyn::symbolic {
 namespace {
 
-void collect(const GiNaC::ex& e, SymbolSet& out) {
-  if (GiNaC::is_a<GiNaC::symbol>(e)) {
-    out.insert(e);
+// Calls f on every leaf of e (symbols, numbers, constants), shared ones as often as they occur.
+// The pairs of sums and products are walked as GiNaC keeps them (detail/pairs.hpp): their
+// coefficients and exponents are numbers, so the symbols are in the rests.
+template <class F>
+void for_each_leaf(const GiNaC::ex& e, F& f) {
+  if (GiNaC::is_exactly_a<GiNaC::add>(e) || GiNaC::is_exactly_a<GiNaC::mul>(e)) {
+    for (const GiNaC::expair& p : detail::Pairs::of(e)) for_each_leaf(p.rest, f);
     return;
   }
-  for (std::size_t i = 0; i < e.nops(); ++i) collect(e.op(i), out);
+  const std::size_t n = e.nops();
+  if (n == 0) {
+    f(e);
+    return;
+  }
+  for (std::size_t i = 0; i < n; ++i) for_each_leaf(e.op(i), f);
 }
 
 void sort_unique(std::vector<int>& indices) {
@@ -22,32 +33,51 @@ void sort_unique(std::vector<int>& indices) {
 
 SymbolSet symbols_of(const GiNaC::ex& e) {
   SymbolSet out;
-  collect(e, out);
+  const auto collect = [&](const GiNaC::ex& leaf) {
+    if (GiNaC::is_a<GiNaC::symbol>(leaf)) out.insert(leaf);
+  };
+  for_each_leaf(e, collect);
   return out;
 }
 
 SymbolIndex::SymbolIndex(const SymbolTable& symbols) {
-  index_.emplace(symbols.time(), std::make_pair(Kind::time, 0));
+  const auto add = [&](const GiNaC::symbol& x, Kind kind, int i) {
+    index_.emplace(x.gethash(), Entry{x, kind, i});
+  };
+  add(symbols.time(), Kind::time, 0);
   for (int i = 0; i < symbols.coordinates(); ++i) {
-    index_.emplace(symbols.coordinate(i), std::make_pair(Kind::q, i));
-    index_.emplace(symbols.velocity(i), std::make_pair(Kind::v, i));
-    index_.emplace(symbols.acceleration(i), std::make_pair(Kind::a, i));
+    add(symbols.coordinate(i), Kind::q, i);
+    add(symbols.velocity(i), Kind::v, i);
+    add(symbols.acceleration(i), Kind::a, i);
   }
+}
+
+// By GiNaC's hash of a symbol (from its serial number, the same in every copy), then equality.
+const SymbolIndex::Entry* SymbolIndex::lookup(const GiNaC::ex& leaf) const {
+  const auto [begin, end] = index_.equal_range(leaf.gethash());
+  for (auto it = begin; it != end; ++it)
+    if (it->second.symbol.is_equal(leaf)) return &it->second;
+  return nullptr;
+}
+
+bool SymbolIndex::is_velocity(const GiNaC::ex& e) const {
+  const Entry* entry = lookup(e);
+  return entry != nullptr && entry->kind == Kind::v;
 }
 
 Contained SymbolIndex::find(const GiNaC::ex& e) const {
   Contained out;
-  for (const GiNaC::ex& symbol : symbols_of(e)) {
-    const auto found = index_.find(symbol);
-    if (found == index_.end()) continue;
-    const auto [kind, i] = found->second;
-    switch (kind) {
+  const auto record = [&](const GiNaC::ex& leaf) {
+    const Entry* entry = lookup(leaf);
+    if (entry == nullptr) return;
+    switch (entry->kind) {
       case Kind::time: out.time = true; break;
-      case Kind::q: out.q.push_back(i); break;
-      case Kind::v: out.v.push_back(i); break;
-      case Kind::a: out.a.push_back(i); break;
+      case Kind::q: out.q.push_back(entry->i); break;
+      case Kind::v: out.v.push_back(entry->i); break;
+      case Kind::a: out.a.push_back(entry->i); break;
     }
-  }
+  };
+  for_each_leaf(e, record);
   sort_unique(out.q);
   sort_unique(out.v);
   sort_unique(out.a);

@@ -7,8 +7,8 @@
 
 #include <ginac/ginac.h>
 
-#include <map>
 #include <set>
+#include <unordered_map>
 #include <vector>
 
 #include "nhdyn/symbolic/spec.hpp"
@@ -31,10 +31,18 @@ class SymbolIndex {
  public:
   explicit SymbolIndex(const SymbolTable& symbols);
   Contained find(const GiNaC::ex& e) const;
+  // True when `e` is one of the velocities.
+  bool is_velocity(const GiNaC::ex& e) const;
 
  private:
   enum class Kind { time, q, v, a };
-  std::map<GiNaC::ex, std::pair<Kind, int>, GiNaC::ex_is_less> index_;
+  struct Entry {
+    GiNaC::ex symbol;
+    Kind kind;
+    int i;
+  };
+  std::unordered_multimap<unsigned, Entry> index_;  // by the symbol's GiNaC hash
+  const Entry* lookup(const GiNaC::ex& leaf) const;
 };
 
 }  // namespace nhdyn::symbolic
