@@ -10,6 +10,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/symbolic/compile.hpp"
+#include "nhdyn/symbolic/detail/derivative.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
@@ -22,7 +23,10 @@ Vector3 times(const GiNaC::matrix& I, const Vector3& w) {
   return out;
 }
 
-Vector3 diff(const Vector3& v, const GiNaC::symbol& x) { return {v[0].diff(x), v[1].diff(x), v[2].diff(x)}; }
+// By detail::derivative: GiNaC's derivative, 0 at once where a symbol does not occur.
+Vector3 diff(const Vector3& v, const GiNaC::symbol& x) {
+  return {detail::derivative(v[0], x), detail::derivative(v[1], x), detail::derivative(v[2], x)};
+}
 
 // d/dt of v(t, q, q') along the motion with q'' = 0: dv/dt + sum_i dv/dq_i q_i' (the part of the
 // acceleration that does not multiply q''; the rest is (dv/dq') q'').
@@ -37,9 +41,9 @@ std::vector<GiNaC::ex> b_row(const Spec& spec, const SpecConstraint& c) {
   std::vector<GiNaC::ex> row;
   for (int j = 0; j < spec.n(); ++j) {
     switch (c.level) {
-      case ConstraintLevel::position: row.push_back(c.expression.diff(spec.symbols.coordinate(j))); break;
-      case ConstraintLevel::velocity: row.push_back(c.expression.diff(spec.symbols.velocity(j))); break;
-      case ConstraintLevel::acceleration: row.push_back(c.expression.diff(spec.symbols.acceleration(j))); break;
+      case ConstraintLevel::position: row.push_back(detail::derivative(c.expression, spec.symbols.coordinate(j))); break;
+      case ConstraintLevel::velocity: row.push_back(detail::derivative(c.expression, spec.symbols.velocity(j))); break;
+      case ConstraintLevel::acceleration: row.push_back(detail::derivative(c.expression, spec.symbols.acceleration(j))); break;
     }
   }
   return row;
@@ -93,7 +97,7 @@ void append_contact_unknowns(const SpecContactForces& in, const SymbolTable& sym
         p.system >= 0 ? subtract(p.point, in.origins[static_cast<std::size_t>(p.system)]) : Vector3{0, 0, 0};
     for (const Vector3& d : p.directions) {
       const GiNaC::ex along = dot(p.velocity, d);
-      for (int j = 0; j < n; ++j) outputs.push_back(along.diff(symbols.velocity(j)));
+      for (int j = 0; j < n; ++j) outputs.push_back(detail::derivative(along, symbols.velocity(j)));
       if (p.system >= 0) {
         append(outputs, d);
         append(outputs, scale(per_length, cross(arm, d)));
@@ -107,7 +111,7 @@ void append_contact_unknowns(const SpecContactForces& in, const SymbolTable& sym
     if (p.spin) {
       // A pure moment M n: its column (d omega/d q')^T n in (C1), [0; n / L] in (C3), no force.
       const GiNaC::ex about = dot(p.omega, p.normal);
-      for (int j = 0; j < n; ++j) outputs.push_back(about.diff(symbols.velocity(j)));
+      for (int j = 0; j < n; ++j) outputs.push_back(detail::derivative(about, symbols.velocity(j)));
       for (int r = 0; r < 3; ++r) outputs.push_back(0);
       if (p.system >= 0) append(outputs, scale(per_length, p.normal));
       else append(outputs, Vector3{0, 0, 0});

@@ -1,5 +1,7 @@
 #include "nhdyn/symbolic/kinematics.hpp"
 
+#include "nhdyn/symbolic/detail/derivative.hpp"
+
 namespace nhdyn::symbolic {
 
 Vector3 add(const Vector3& a, const Vector3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
@@ -77,8 +79,10 @@ Vector3 column(const GiNaC::matrix& R, int axis) {
 }
 
 GiNaC::ex time_derivative(const GiNaC::ex& e, const SymbolTable& symbols) {
-  GiNaC::ex out = e.diff(symbols.time());
-  for (int i = 0; i < symbols.coordinates(); ++i) out += e.diff(symbols.coordinate(i)) * symbols.velocity(i);
+  // detail::derivative: GiNaC's derivative, 0 at once for the coordinates e does not contain.
+  GiNaC::ex out = detail::derivative(e, symbols.time());
+  for (int i = 0; i < symbols.coordinates(); ++i)
+    out += detail::derivative(e, symbols.coordinate(i)) * symbols.velocity(i);
   return out;
 }
 

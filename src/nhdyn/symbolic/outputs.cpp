@@ -54,7 +54,9 @@ Tape compile_dynamics_tape(const Spec& spec, const std::vector<GiNaC::ex>& expre
   }
   std::vector<GiNaC::ex> mapped;
   mapped.reserve(expressions.size());
-  for (const GiNaC::ex& e : expressions) mapped.push_back(e.subs(map));
+  // no_pattern: the keys are symbols, so a lookup per node finds them; GiNaC's default tries every
+  // key as a pattern at every node.
+  for (const GiNaC::ex& e : expressions) mapped.push_back(e.subs(map, GiNaC::subs_options::no_pattern));
   return compile_expressions(layout, mapped, what);
 }
 

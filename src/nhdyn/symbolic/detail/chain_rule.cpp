@@ -6,6 +6,8 @@
 #include <mutex>
 #include <vector>
 
+#include "nhdyn/symbolic/detail/derivative.hpp"
+
 namespace nhdyn::symbolic::detail {
 namespace {
 
@@ -33,9 +35,10 @@ ex d_cosh(const ex& x) { return GiNaC::sinh(x); }
 ex d_tanh(const ex& x) { return 1 - GiNaC::pow(GiNaC::tanh(x), 2); }
 
 // f(u)' = f'(u) u', and 0 (not f'(u) 0) when u does not depend on s, as GiNaC's own chain rule.
+// u' by derivative() (derivative.hpp): u.diff(s), the same expression, with less work.
 template <ex (*Partial)(const ex&)>
 ex chain_rule(const ex& u, const GiNaC::symbol& s) {
-  const ex du = u.diff(s);
+  const ex du = derivative(u, s);
   if (du.is_zero()) return ex();
   return Partial(u) * du;
 }
@@ -48,7 +51,7 @@ ex atan2_chain_rule(const ex& y, const ex& x, const GiNaC::symbol& s) {
   if (!GiNaC::is_exactly_a<GiNaC::function>(call)) return call.diff(s);
   ex result;
   for (unsigned i = 0; i < 2; ++i) {
-    const ex d = (i == 0 ? y : x).diff(s);
+    const ex d = derivative(i == 0 ? y : x, s);
     if (!d.is_zero()) result += FunctionTable::partial(GiNaC::ex_to<GiNaC::function>(call), i) * d;
   }
   return result;
