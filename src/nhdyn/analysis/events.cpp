@@ -37,7 +37,7 @@ ModelEventFunctions::ModelEventFunctions(const Model& model, const std::vector<c
                                    event->name));
     needs_dynamics_ = needs_dynamics_ || event->dynamics || event->contact_forces;
     needs_contact_forces_ = needs_contact_forces_ || event->contact_forces;
-    tapes_.push_back(event->g.reads_parameters() ? event->g.bind(values.data(), values.size()) : event->g);
+    tapes_.push_back(event->g.bind(values.data(), values.size()));
     registers = std::max(registers, tapes_.back().registers());
   }
   registers_.assign(static_cast<std::size_t>(registers), 0.0);

@@ -61,7 +61,7 @@ bool watched_in_mode(const Data& data, int mode_contact, bool touching_only, boo
 double calc_watch_measure(const Model& model, const ContactWatch& w, double t, const double* q, const double* v) {
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
-  const Tape measure = w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure;
+  const Tape measure = w.measure.bind(values.data(), values.size());
   std::vector<double> registers(static_cast<std::size_t>(measure.registers()));
   double value = 0.0;
   measure.run(t, q, v, registers.data(), &value);
@@ -100,7 +100,7 @@ class WatchedEvents final : public EventFunctions {
     for (std::size_t i = 0; i < model.contact_watches.size(); ++i) {
       const ContactWatch& w = model.contact_watches[i];
       if (!w.every_step) continue;
-      watches_.push_back({w.measure.reads_parameters() ? w.measure.bind(values.data(), values.size()) : w.measure,
+      watches_.push_back({w.measure.bind(values.data(), values.size()),
                           w.threshold, mode_contact_index(model, w.contact), w.touching_only, w.free_only,
                           static_cast<int>(i)});
       registers_.resize(std::max(registers_.size(), static_cast<std::size_t>(watches_.back().measure.registers())));

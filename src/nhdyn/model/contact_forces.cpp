@@ -208,7 +208,7 @@ ContactForceData make_contact_force_data(const Model& model) {
   w.active = true;
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
-  w.tape = PreparedTape(c.tape.reads_parameters() ? c.tape.bind(values.data(), values.size()) : c.tape);
+  w.tape = PreparedTape(c.tape.bind(values.data(), values.size()));
   w.registers.assign(static_cast<std::size_t>(w.tape.registers()), 0.0);
   w.outputs.assign(static_cast<std::size_t>(w.tape.outputs()), 0.0);
   if (c.native) {
@@ -368,7 +368,7 @@ void analyse_contact_forces(const Model& model, ContactForceModel& c) {
   {
     std::vector<double> values;
     for (const Parameter& p : model.parameters) values.push_back(p.value);
-    w.tape = PreparedTape(c.tape.reads_parameters() ? c.tape.bind(values.data(), values.size()) : c.tape);
+    w.tape = PreparedTape(c.tape.bind(values.data(), values.size()));
     w.registers.assign(static_cast<std::size_t>(w.tape.registers()), 0.0);
     w.outputs.assign(static_cast<std::size_t>(w.tape.outputs()), 0.0);
   }

@@ -23,7 +23,7 @@ ContactModeData make_contact_mode_data(const Model& model) {
   w.active = true;
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
-  w.tape = PreparedTape(c.tape.reads_parameters() ? c.tape.bind(values.data(), values.size()) : c.tape);
+  w.tape = PreparedTape(c.tape.bind(values.data(), values.size()));
   w.registers.assign(static_cast<std::size_t>(w.tape.registers()), 0.0);
   w.outputs.assign(static_cast<std::size_t>(w.tape.outputs()), 0.0);
   const std::size_t m = c.contacts.size();

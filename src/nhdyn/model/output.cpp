@@ -17,7 +17,7 @@ OutputData make_output_data(const Model& model) {
   std::vector<double> values;
   for (const Parameter& p : model.parameters) values.push_back(p.value);
   const Tape& tape = model.outputs.tape;
-  d.tape = PreparedTape(tape.reads_parameters() ? tape.bind(values.data(), values.size()) : tape);
+  d.tape = PreparedTape(tape.bind(values.data(), values.size()));
   d.registers.assign(static_cast<std::size_t>(d.tape.registers()), 0.0);
   if (model.outputs.native) {
     d.stage.assign(model.outputs.native->stage_size() + 1, 0.0);  // + 1: data() of an empty stage

@@ -384,7 +384,7 @@ void check_positive_values(const Model& model, const std::vector<Parameter>& par
   values.reserve(parameters.size());
   for (const Parameter& p : parameters) values.push_back(p.value);
   for (const PositiveValue& check : model.positive_values) {
-    const Tape tape = check.value.reads_parameters() ? check.value.bind(values.data(), values.size()) : check.value;
+    const Tape tape = check.value.bind(values.data(), values.size());
     std::vector<double> registers(static_cast<std::size_t>(tape.registers()));
     double value = 0.0;
     tape.run(model.t0, model.q0.data(), model.v0.data(), registers.data(), &value);

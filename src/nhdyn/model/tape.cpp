@@ -493,22 +493,22 @@ void TapeEvaluator::build() {
     scratch_ = std::max(scratch_, values_offset_ + a_size + b_size);
   }
 
-  terms_ = prepare(tapes_.terms, {static_cast<int>(a_size), n, n, static_cast<int>(b_size), s});
-  if (tapes_.complement) complement_ = prepare(*tapes_.complement, {(n - s) * n});
-  position_residual_ = prepare(tapes_.position_residual, {tapes_.position_residual.outputs()});
-  velocity_residual_ = prepare(tapes_.velocity_residual, {tapes_.velocity_residual.outputs()});
-  if (tapes_.energy) energy_ = prepare(*tapes_.energy, {1});
-  if (tapes_.energy_function) energy_function_ = prepare(*tapes_.energy_function, {1});
-  if (tapes_.power) power_ = prepare(*tapes_.power, {2});
-  if (tapes_.solution) solution_ = prepare(*tapes_.solution, {3 * n});
-  if (tapes_.initial_state) initial_state_ = prepare(*tapes_.initial_state, {2 * n});
+  terms_ = PreparedTape::prepare(tapes_.terms, {static_cast<int>(a_size), n, n, static_cast<int>(b_size), s});
+  if (tapes_.complement) complement_ = PreparedTape::prepare(*tapes_.complement, {(n - s) * n});
+  position_residual_ = PreparedTape::prepare(tapes_.position_residual, {tapes_.position_residual.outputs()});
+  velocity_residual_ = PreparedTape::prepare(tapes_.velocity_residual, {tapes_.velocity_residual.outputs()});
+  if (tapes_.energy) energy_ = PreparedTape::prepare(*tapes_.energy, {1});
+  if (tapes_.energy_function) energy_function_ = PreparedTape::prepare(*tapes_.energy_function, {1});
+  if (tapes_.power) power_ = PreparedTape::prepare(*tapes_.power, {2});
+  if (tapes_.solution) solution_ = PreparedTape::prepare(*tapes_.solution, {3 * n});
+  if (tapes_.initial_state) initial_state_ = PreparedTape::prepare(*tapes_.initial_state, {2 * n});
   if (m > 0) {
     program_sizes_[0] = program_sizes_[2] = static_cast<std::size_t>(m) * static_cast<std::size_t>(n);
     program_sizes_[1] = static_cast<std::size_t>(m);
-    program_terms_ = prepare(*tapes_.program_constraint_terms, {m * n, m, n * m});
-    program_phi_ = prepare(*tapes_.program_constraint_position_residual,
+    program_terms_ = PreparedTape::prepare(*tapes_.program_constraint_terms, {m * n, m, n * m});
+    program_phi_ = PreparedTape::prepare(*tapes_.program_constraint_position_residual,
                            {tapes_.program_constraint_position_residual->outputs()});
-    program_f_ = prepare(*tapes_.program_constraint_velocity_residual,
+    program_f_ = PreparedTape::prepare(*tapes_.program_constraint_velocity_residual,
                          {tapes_.program_constraint_velocity_residual->outputs()});
   }
   if (tapes_.sparsity) {
@@ -821,7 +821,7 @@ NHDYN_ALWAYS_INLINE void copy_fixed(const double* from, double* to) {
 template <int N, int S, bool Calls>
 void TapeEvaluator::terms_fixed(const TapeEvaluator& self, double t, const double* q, const double* v,
                                    double* scratch, const TermsOut& out) {
-  const Prepared& p = self.terms_;
+  const PreparedTape& p = self.terms_;
   load_inputs(p.reads_, N, t, q, v, scratch);
   const double* image = p.image_.data();
   copy_fixed<N * N>(image, out.A);
@@ -835,7 +835,7 @@ void TapeEvaluator::terms_fixed(const TapeEvaluator& self, double t, const doubl
 template <bool Calls>
 void TapeEvaluator::terms_any(const TapeEvaluator& self, double t, const double* q, const double* v,
                                  double* scratch, const TermsOut& out) {
-  const Prepared& p = self.terms_;
+  const PreparedTape& p = self.terms_;
   load_inputs(p.reads_, static_cast<std::size_t>(self.n_), t, q, v, scratch);
   const TermsArrays arrays(scratch, out);
   const double* image = p.image_.data();
@@ -908,29 +908,24 @@ void PreparedTape::run(double t, const double* q, const double* v, double* regis
     run_steps<false>(steps_.data(), arrays);
 }
 
-void TapeEvaluator::run(const Prepared& p, double t, const double* q, const double* v, double* scratch,
-                           double* out) const {
-  p.run(t, q, v, scratch, out);
-}
-
 void TapeEvaluator::complement(double t, const double* q, const double* v, double* scratch, double* D) const {
   if (!tapes_.complement) return;
-  run(complement_, t, q, v, scratch, D);
+  complement_.run(t, q, v, scratch, D);
 }
 
 void TapeEvaluator::position_residual(double t, const double* q, double* scratch, double* phi) const {
-  run(position_residual_, t, q, nullptr, scratch, phi);
+  position_residual_.run(t, q, nullptr, scratch, phi);
 }
 
 void TapeEvaluator::velocity_residual(double t, const double* q, const double* v, double* scratch,
                                          double* f) const {
-  run(velocity_residual_, t, q, v, scratch, f);
+  velocity_residual_.run(t, q, v, scratch, f);
 }
 
 void TapeEvaluator::program_constraint_terms(double t, const double* q, const double* v, double* scratch,
                                                 double* b_p, double* b_p0, double* B) const {
   if (!tapes_.program_constraint_terms) return;
-  const Prepared& p = program_terms_;
+  const PreparedTape& p = program_terms_;
   load_inputs(p.reads_, static_cast<std::size_t>(n_), t, q, v, scratch);
   double* arrays[4];
   arrays[0] = scratch;
@@ -954,26 +949,26 @@ void TapeEvaluator::program_constraint_terms(double t, const double* q, const do
 void TapeEvaluator::program_constraint_position_residual(double t, const double* q, double* scratch,
                                                             double* phi) const {
   if (!tapes_.program_constraint_position_residual) return;
-  run(program_phi_, t, q, nullptr, scratch, phi);
+  program_phi_.run(t, q, nullptr, scratch, phi);
 }
 
 void TapeEvaluator::program_constraint_velocity_residual(double t, const double* q, const double* v,
                                                             double* scratch, double* f) const {
   if (!tapes_.program_constraint_velocity_residual) return;
-  run(program_f_, t, q, v, scratch, f);
+  program_f_.run(t, q, v, scratch, f);
 }
 
 double TapeEvaluator::energy(double t, const double* q, const double* v, double* scratch) const {
   if (!tapes_.energy) return 0.0;
   double e = 0.0;
-  run(energy_, t, q, v, scratch, &e);
+  energy_.run(t, q, v, scratch, &e);
   return e;
 }
 
 double TapeEvaluator::energy_function(double t, const double* q, const double* v, double* scratch) const {
   if (!tapes_.energy_function) return energy(t, q, v, scratch);  // T = T2: h = E
   double h = 0.0;
-  run(energy_function_, t, q, v, scratch, &h);
+  energy_function_.run(t, q, v, scratch, &h);
   return h;
 }
 
@@ -982,18 +977,18 @@ void TapeEvaluator::power(double t, const double* q, const double* v, double* sc
     out[0] = out[1] = 0.0;
     return;
   }
-  run(power_, t, q, v, scratch, out);
+  power_.run(t, q, v, scratch, out);
 }
 
 void TapeEvaluator::solution(double t, double* scratch, double* qva) const {
   if (!tapes_.solution) return;
-  run(solution_, t, nullptr, nullptr, scratch, qva);
+  solution_.run(t, nullptr, nullptr, scratch, qva);
 }
 
 void TapeEvaluator::initial_state(double* scratch, double* q0, double* v0) const {
   if (!tapes_.initial_state) return;
   std::vector<double> out(2 * static_cast<std::size_t>(n_));
-  run(initial_state_, 0.0, nullptr, nullptr, scratch, out.data());
+  initial_state_.run(0.0, nullptr, nullptr, scratch, out.data());
   std::copy(out.begin(), out.begin() + n_, q0);
   std::copy(out.begin() + n_, out.end(), v0);
 }

@@ -193,7 +193,8 @@ class Tape {
   bool reads_parameters() const { return reads_parameters_; }
 
   // The tape with every `parameter` instruction replaced by the constant values[index]
-  // (`count` values, at least parameters()); register numbers and outputs stay as they are.
+  // (`count` values, at least parameters()); register numbers and outputs stay as they are. A
+  // tape that reads no parameter comes back as it is.
   Tape bind(const double* values, std::size_t count) const;
 
   // Runs the tape: q and v hold coordinates() values (v may be null when the tape reads no
@@ -357,8 +358,6 @@ class TapeEvaluator final : public Evaluator {
   void solution(double t, double* scratch, double* qva) const override;
 
  private:
-  using Prepared = PreparedTape;
-  static Prepared prepare(const Tape& tape, const std::vector<int>& sizes) { return PreparedTape::prepare(tape, sizes); }
 
   // The whole terms() call, with the sizes fixed at compile time for n <= 4 (terms_fixed) or not:
   // the input copies and the image copies then become a few moves instead of loops.
@@ -375,7 +374,6 @@ class TapeEvaluator final : public Evaluator {
                             double* scratch, const TermsOut& out);
   template <bool Calls>
   static TermsFunction choose_terms(int n, int s);
-  void run(const Prepared& p, double t, const double* q, const double* v, double* scratch, double* out) const;
 
   void build();
 
@@ -385,10 +383,10 @@ class TapeEvaluator final : public Evaluator {
   std::vector<double> parameters_;
   ModelTapes tapes_;  // *parametric_ bound to parameters_
   std::size_t scratch_ = 0;
-  Prepared terms_, complement_, position_residual_, velocity_residual_, energy_, solution_, initial_state_;
-  Prepared program_terms_, program_phi_, program_f_;  // program motion (empty without programs)
+  PreparedTape terms_, complement_, position_residual_, velocity_residual_, energy_, solution_, initial_state_;
+  PreparedTape program_terms_, program_phi_, program_f_;  // program motion (empty without programs)
   std::size_t program_sizes_[3] = {0, 0, 0};          // outputs of program_terms_: b_p, b_p0, B
-  Prepared energy_function_, power_;
+  PreparedTape energy_function_, power_;
   TermsFunction terms_function_ = nullptr;
   std::size_t terms_sizes_[5] = {0, 0, 0, 0, 0};  // outputs of terms: A, Q, G, b, b0 (nonzeros when sparse)
   std::size_t values_offset_ = 0;  // where terms_scatter keeps the nonzeros in scratch
