@@ -7,8 +7,13 @@
 #include <signal.h>
 #include <sys/resource.h>
 
+#include <fmt/format.h>
+
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -108,6 +113,99 @@ TEST_F(AtomicFileSteps, TheBytesWrittenSoFarAreReadBackFromTheTemporary) {
   finished.write("x");
   finished.finish();
   EXPECT_EQ(finished.written(), "");
+}
+
+// Rows of `columns` numbers of every kind: long fractions, integers, negative zero, the extremes,
+// subnormals, infinities and NaN, so that each row's text has its own length.
+std::vector<std::vector<double>> varied_rows(int rows, int columns) {
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const double special[] = {0.0, -0.0, 1.0, -70.0, 1e-300, 4.9e-324, std::numeric_limits<double>::max(),
+                            std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                            std::numeric_limits<double>::quiet_NaN(), 1e16, 1e-5, 0.0001, 123456789012345678.0};
+  std::vector<std::vector<double>> out(static_cast<std::size_t>(rows));
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < columns; ++c) {
+      const auto k = static_cast<std::size_t>(random() % 20);
+      out[static_cast<std::size_t>(r)].push_back(k < std::size(special) ? special[k]
+                                                                         : uniform(random) * std::pow(10.0, r % 40 - 20));
+    }
+  return out;
+}
+
+// The text of `rows` as a CSV under the header "a,b,...", each number as fmt prints it.
+std::string expected_text(const std::vector<std::vector<double>>& rows, const std::string& header) {
+  std::string text = header;
+  for (const std::vector<double>& row : rows) {
+    for (std::size_t i = 0; i < row.size(); ++i) text += (i ? "," : "") + fmt::format("{}", row[i]);
+    text += "\n";
+  }
+  return text;
+}
+
+TEST_F(AtomicFileSteps, ALongTableFormattedBesideTheRunHasTheBytesOfEachRowInOrder) {
+  // 4000 rows of 7 and one of 3000 columns (each past the first 32 KiB, where the formatting
+  // thread takes over, with blocks of one and of many rows), with the bytes read back in the
+  // middle of the run as a failed run reads them.
+  for (const int columns : {7, 3000}) {
+    const int rows = columns == 7 ? 4000 : 40;
+    const fs::path target = dir_ / "long.csv";
+    std::vector<std::string> names;
+    std::string header;
+    for (int c = 0; c < columns; ++c) {
+      names.push_back("c" + std::to_string(c));
+      header += (c ? "," : "") + names.back();
+    }
+    header += "\n";
+    const std::vector<std::vector<double>> table = varied_rows(rows, columns);
+    nhdyn::CsvWriter writer(target, names, "# preamble\n");
+    const std::vector<std::vector<double>> first(table.begin(), table.begin() + rows / 2);
+    for (const std::vector<double>& row : first) writer.write_row(row);
+    EXPECT_EQ(writer.written(), "# preamble\n" + expected_text(first, header)) << columns << " columns";
+    for (int r = rows / 2; r < rows; ++r) writer.write_row(table[static_cast<std::size_t>(r)]);
+    writer.commit();
+    const std::string text = read(target);
+    EXPECT_EQ(text, "# preamble\n" + expected_text(table, header)) << columns << " columns";
+    // And every finite number reads back to the same double.
+    const nhdyn::CsvTable back = nhdyn::load_csv(target);
+    ASSERT_EQ(back.rows.size(), table.size());
+    for (std::size_t r = 0; r < table.size(); ++r)
+      for (std::size_t c = 0; c < table[r].size(); ++c) {
+        if (!std::isfinite(table[r][c])) continue;
+        ASSERT_EQ(back.rows[r][c], table[r][c]) << "row " << r << " column " << c;
+      }
+  }
+}
+
+TEST_F(AtomicFileSteps, ALongTableNotCommittedLeavesNothingWhileItsRowsAreBeingFormatted) {
+  const fs::path target = dir_ / "long.csv";
+  std::ofstream(target) << "old\n";
+  {
+    nhdyn::CsvWriter writer(target, {"a", "b", "c"});
+    for (const std::vector<double>& row : varied_rows(20000, 3)) writer.write_row(row);
+  }  // destroyed without commit, blocks perhaps still with the formatting thread
+  EXPECT_EQ(entries(), std::vector<std::string>{"long.csv"});
+  EXPECT_EQ(read(target), "old\n");
+}
+
+TEST_F(AtomicFileSteps, ALongTableThatDoesNotFitFailsWholeAtItsFinish) {
+  // The formatting thread's writes pass the file-size limit: finish() reports it and nothing
+  // appears, as for a table written by the caller's thread.
+  const fs::path target = dir_ / "long.csv";
+  const std::vector<std::vector<double>> table = varied_rows(20000, 5);
+  nhdyn::CsvWriter writer(target, {"a", "b", "c", "d", "e"});
+  {
+    const FileSizeLimit limit(200000);
+    ASSERT_TRUE(limit.ok());
+    for (const std::vector<double>& row : table) writer.write_row(row);
+    try {
+      writer.finish();
+      ADD_FAILURE() << "a table past the file-size limit was finished";
+    } catch (const nhdyn::FileError& e) {
+      EXPECT_NE(std::string(e.what()).find("long.csv"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_TRUE(entries().empty());
 }
 
 TEST_F(AtomicFileSteps, AFinishedFileNotPublishedLeavesNothing) {

@@ -52,6 +52,8 @@ class AtomicFile {
   void commit();
 
   const std::filesystem::path& target() const { return target_; }
+  // Whether the target is a device or pipe written straight (no temporary file).
+  bool straight() const { return temporary_.empty(); }
 
  private:
   enum class Stage { writing, finished, published };

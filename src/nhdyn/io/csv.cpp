@@ -4,9 +4,13 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <condition_variable>
 #include <cstdlib>
+#include <exception>
 #include <fstream>
+#include <mutex>
 #include <sstream>
+#include <thread>
 
 #include "nhdyn/core/error.hpp"
 
@@ -25,6 +29,65 @@ std::string quote_if_needed(const std::string& name) {
 
 }  // namespace
 
+namespace {
+
+// Formatted text is written to the file in pieces of about this size; the first piece filled
+// starts the formatting thread (CsvWriter::Formatter).
+constexpr std::size_t kFlushBytes = std::size_t{1} << 15;
+// Numbers per block handed to the formatting thread (at least one row).
+constexpr std::size_t kBlockValues = std::size_t{1} << 13;
+
+// Appends `rows` rows of `columns` values to `text`, each value in its shortest round-trip form.
+void format_rows(const double* values, std::size_t rows, std::size_t columns, std::string& text) {
+  // Each value into a stack buffer first: appending through a back_inserter costs a capacity check
+  // per character, twice the formatting itself on an 89-column row.
+  char cell[40];  // the shortest round-trip form of a double takes at most 24 characters
+  for (std::size_t r = 0; r < rows; ++r) {
+    for (std::size_t i = 0; i < columns; ++i) {
+      if (i) text += ',';
+      char* end = fmt::format_to(cell, FMT_COMPILE("{}"), *values++);
+      text.append(cell, end);
+    }
+    text += '\n';
+  }
+}
+
+}  // namespace
+
+// The thread that formats and writes the blocks of rows write_row collects. One block is with it
+// at a time (`full`); the writer fills the next meanwhile and waits only when it has filled that
+// too: the memory stays two blocks, and the file gets the rows in their order.
+struct CsvWriter::Formatter {
+  std::mutex mutex;
+  std::condition_variable wake;  // the thread waits for a block or the stop
+  std::condition_variable idle;  // the writer waits for the thread to be done with its block
+  std::vector<double> block;     // the thread's, while `full`
+  bool full = false;
+  bool stop = false;
+  std::exception_ptr error;      // what formatting or writing threw, for the writer to rethrow
+  std::thread thread;
+
+  void run(AtomicFile& file, std::size_t columns) {
+    std::string text;
+    std::unique_lock lock(mutex);
+    for (;;) {
+      wake.wait(lock, [this] { return full || stop; });
+      if (!full) return;
+      lock.unlock();
+      try {
+        text.clear();
+        format_rows(block.data(), block.size() / columns, columns, text);
+        file.write(text);  // a failed write is kept by the file and reported by finish()
+      } catch (...) {
+        error = std::current_exception();
+      }
+      lock.lock();
+      full = false;
+      idle.notify_one();
+    }
+  }
+};
+
 CsvWriter::CsvWriter(const std::filesystem::path& target, const std::vector<std::string>& columns,
                      const std::string& preamble)
     : file_(target), columns_(columns.size()) {
@@ -35,36 +98,75 @@ CsvWriter::CsvWriter(const std::filesystem::path& target, const std::vector<std:
   }
   header += '\n';
   file_.write(header);
-  buffer_.reserve(1 << 16);
+  buffer_.reserve(2 * kFlushBytes);
+}
+
+CsvWriter::~CsvWriter() {
+  if (!formatter_) return;
+  {
+    const std::lock_guard lock(formatter_->mutex);
+    formatter_->stop = true;
+  }
+  formatter_->wake.notify_one();
+  formatter_->thread.join();
 }
 
 void CsvWriter::write_row(std::span<const double> values) {
   if (values.size() != columns_)
     throw std::logic_error(fmt::format("CsvWriter: a row of {} values for {} columns", values.size(), columns_));
-  // Each value into a stack buffer first: appending through a back_inserter costs a capacity check
-  // per character, twice the formatting itself on an 89-column row.
-  char cell[40];  // the shortest round-trip form of a double takes at most 24 characters
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    char* end = fmt::format_to(cell, FMT_COMPILE("{}"), values[i]);
-    if (i) buffer_ += ',';
-    buffer_.append(cell, end);
+  if (formatter_) {
+    block_.insert(block_.end(), values.begin(), values.end());
+    if (block_.size() >= kBlockValues) hand_over();
+    return;
   }
-  buffer_ += '\n';
-  if (buffer_.size() > (1 << 15)) {
+  format_rows(values.data(), 1, columns_, buffer_);
+  if (buffer_.size() > kFlushBytes) {
     file_.write(buffer_);
     buffer_.clear();
+    // A table this long goes on being formatted beside the run, where there is a core for it. A
+    // device or pipe is written by the caller's thread alone, as the caller's other output is.
+    if (!file_.straight() && columns_ > 0 && std::thread::hardware_concurrency() > 1) start_formatter();
   }
 }
 
-std::string CsvWriter::written() {
+void CsvWriter::start_formatter() {
+  formatter_ = std::make_unique<Formatter>();
+  block_.reserve(kBlockValues + columns_);
+  formatter_->block.reserve(kBlockValues + columns_);
+  formatter_->thread = std::thread([this] { formatter_->run(file_, columns_); });
+}
+
+void CsvWriter::hand_over() {
+  Formatter& f = *formatter_;
+  std::unique_lock lock(f.mutex);
+  f.idle.wait(lock, [&f] { return !f.full; });
+  if (f.error) std::rethrow_exception(f.error);
+  std::swap(f.block, block_);
+  block_.clear();
+  f.full = true;
+  lock.unlock();
+  f.wake.notify_one();
+}
+
+void CsvWriter::drain() {
+  if (formatter_) {
+    if (!block_.empty()) hand_over();
+    Formatter& f = *formatter_;
+    std::unique_lock lock(f.mutex);
+    f.idle.wait(lock, [&f] { return !f.full; });
+    if (f.error) std::rethrow_exception(f.error);
+  }
   file_.write(buffer_);
   buffer_.clear();
+}
+
+std::string CsvWriter::written() {
+  drain();
   return file_.written();
 }
 
 void CsvWriter::finish() {
-  file_.write(buffer_);
-  buffer_.clear();
+  drain();
   file_.finish();
 }
 
