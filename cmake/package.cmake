@@ -28,6 +28,6 @@ if(TARGET nhdyn_python)
 endif()
 set(CPACK_DEBIAN_PACKAGE_DEPENDS "${nhdyn_deb_depends}")
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS
-    "g++, gnuplot-nox, pkg-config, cmake, libeigen3-dev, libfmt-dev, libtomlplusplus-dev, libginac-dev, libcln-dev, libsundials-dev")
+    "g++, gnuplot-nox, pkg-config, cmake, libeigen3-dev, libfmt-dev, libtomlplusplus-dev, libginac-dev, libcln-dev, libsundials-dev, libsuitesparse-dev")
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS "python3-pandas, python3-matplotlib, python3-dask")
 include(CPack)

@@ -23,9 +23,9 @@ bool solve_partition(const Model& model, Data& data) {
       data.b_ind(data.b_sparse.innerIndexPtr()[m], jj) = b_values[m];
   }
   data.b_ind.col(k) = data.b0;
-  data.lu_dep->factorize(data.b_dep_sparse);
-  if (data.lu_dep->info() != Eigen::Success) return false;
-  data.X = data.lu_dep->solve(data.b_ind);
+  if (!data.lu_dep.factorize(data.b_dep_sparse)) return false;
+  data.X = data.b_ind;
+  data.lu_dep.solve_in_place(data.X);
   const double largest = data.X.leftCols(k).size() > 0 ? data.X.leftCols(k).cwiseAbs().maxCoeff() : 0.0;
   return largest <= kLargestX;  // false for NaN as well
 }

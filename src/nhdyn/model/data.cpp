@@ -145,7 +145,6 @@ Data make_sparse_data(const Model& model) {
     d.llt_k.compute(Matrix::Identity(k, k));  // sized; see make_dense_data
     d.b_ind = Matrix::Zero(s, k + 1);
     d.X = Matrix::Zero(s, k + 1);
-    d.lu_dep = std::make_unique<SparseLU>();
   } else {
     d.llt_a = std::make_unique<SparseLLT>();
     d.llt_a->analyzePattern(d.A_sparse);
@@ -270,8 +269,7 @@ void install_partition(const Model& model, Data& data, std::vector<int> dependen
   data.b_dep_source.resize(static_cast<std::size_t>(data.b_dep_sparse.nonZeros()));
   for (int m = 0; m < data.b_dep_sparse.nonZeros(); ++m)
     data.b_dep_source[static_cast<std::size_t>(m)] = static_cast<int>(data.b_dep_sparse.valuePtr()[m]);
-  data.lu_dep = std::make_unique<SparseLU>();
-  data.lu_dep->analyzePattern(data.b_dep_sparse);
+  data.lu_dep.analyze(data.b_dep_sparse);
 }
 
 // The independent coordinates that keep X = b_dep^-1 b_ind small: the first k pivots of a
@@ -316,8 +314,7 @@ bool choose_by_null_space(const Model& model, Data& data) {
   const double* values = data.b_sparse.valuePtr();
   double* dep_values = data.b_dep_sparse.valuePtr();
   for (std::size_t m = 0; m < data.b_dep_source.size(); ++m) dep_values[m] = values[data.b_dep_source[m]];
-  data.lu_dep->factorize(data.b_dep_sparse);
-  if (data.lu_dep->info() != Eigen::Success) {
+  if (!data.lu_dep.factorize(data.b_dep_sparse)) {
     install_partition(model, data, std::move(previous));
     return false;
   }

@@ -31,10 +31,10 @@
 #include "nhdyn/model/contact_modes.hpp"
 #include "nhdyn/model/model.hpp"
 #include "nhdyn/model/output.hpp"
+#include "nhdyn/model/sparse_lu.hpp"
 
 namespace nhdyn {
 
-using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 using SparseLU = Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>>;
 using SparseLLT = Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>;
 
@@ -233,7 +233,7 @@ struct Data {
   // --- sparse workspace (sparse path only; make_data analyses every pattern once) ---------------
   SparseMatrix b_dep_sparse;       // s x s, b(:, dependent), values gathered from b_sparse
   std::vector<int> b_dep_source;   // for each value of b_dep_sparse, its index among b_sparse's values
-  std::unique_ptr<SparseLU> lu_dep;    // b_dep_sparse (SparseLU cannot be moved: held by pointer)
+  SparseLuFactor lu_dep;           // b_dep_sparse (KLU: model/sparse_lu.hpp)
   std::unique_ptr<SparseLLT> llt_a;    // A_sparse, for a model without constraints (s = 0)
   SparseMatrix K_sparse;           // (n + s) x (n + s), [A b^T; b C] with C diagonal (0 for lagrange,
                                    // 1 on the rows a projection leaves out)

@@ -1,0 +1,47 @@
+// The sparse LU factorization of the sparse path's b_dep (formulation/sparse_sanh.hpp): a square
+// matrix whose pattern is fixed by the partition and whose values change at every right-hand side.
+// It is SuiteSparse's KLU, kept behind this class so that its headers stay in sparse_lu.cpp. KLU
+// analyses the pattern once (a block triangular form, then an ordering for each block: the chain's
+// 2998 x 2998 b_dep has 998 blocks), and after the first factorization each one reuses the pivot
+// order of the last factorization that searched for pivots (klu_refactor: no search, no
+// allocation, ten times faster than a supernodal LU that searches again). It searches again only
+// when the reused order has become poor: its smallest pivot against its largest fell a thousandfold
+// below what the search gave (docs/performance.md, "The sparse path").
+#pragma once
+
+#include <Eigen/SparseCore>
+#include <memory>
+
+#include "nhdyn/core/types.hpp"
+
+namespace nhdyn {
+
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+class SparseLuFactor {
+ public:
+  SparseLuFactor();
+  ~SparseLuFactor();
+  SparseLuFactor(SparseLuFactor&&) noexcept;
+  SparseLuFactor& operator=(SparseLuFactor&&) noexcept;
+
+  // The pattern of `m` (square, compressed), analysed; forgets any factorization.
+  void analyze(const SparseMatrix& m);
+  // The factorization of `m`, whose pattern is the analysed one. False when `m` is singular (a
+  // zero pivot even with a search for pivots).
+  bool factorize(const SparseMatrix& m);
+  // rhs := m^-1 rhs, every column, after a successful factorize.
+  void solve_in_place(Matrix& rhs);
+  // How many factorizations searched for pivots (the first after analyze, and each change of the
+  // pivot order), and how many reused the order: for tests and the performance page.
+  long pivoting_factorizations() const { return pivoting_; }
+  long reusing_factorizations() const { return reusing_; }
+
+ private:
+  struct State;  // KLU's objects (sparse_lu.cpp)
+  std::unique_ptr<State> state_;
+  long pivoting_ = 0;
+  long reusing_ = 0;
+};
+
+}  // namespace nhdyn
