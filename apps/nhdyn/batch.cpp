@@ -203,7 +203,8 @@ void make_run_table(const BatchArgs& args, std::vector<std::string>& names, std:
 // One run's rows as CSV, in the columns of `nhdyn simulate`.
 void write_run_file(const std::filesystem::path& path, const Model& model, const Trajectory& tr,
                     const std::string& provenance) {
-  CsvWriter writer(path, make_result_columns(model).all, provenance);
+  // Written on the batch's worker thread, every row there: the other workers have the other cores.
+  CsvWriter writer(path, make_result_columns(model).all, provenance, false);
   std::vector<double> row;
   const auto slice = [&row](const std::vector<double>& column, std::size_t k, std::size_t width) {
     row.insert(row.end(), column.begin() + static_cast<std::ptrdiff_t>(k * width),

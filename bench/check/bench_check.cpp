@@ -1,6 +1,7 @@
 // The in-process half of `make bench-check` (scripts/bench-check runs it and the whole-process
 // pairs): paired ratios of two jobs measured in one process, A B A B ..., each pair's ratio
-// taken from CPU time of this thread, so that the machine's speed (shared, noisy) divides out.
+// taken from the process's CPU time (every thread's), so that the machine's speed (shared, noisy)
+// divides out.
 // Prints one line per ratio:
 //   NAME median min max A_median_seconds B_median_seconds
 // The ratios (the names are those of bench/baselines):
@@ -259,7 +260,7 @@ void breakdown(const Model& model, const char* label) {
   const ResultColumns columns = make_result_columns(model);
   std::vector<double> row(columns.all.size());
   const fs::path csv = fs::temp_directory_path() / ("nhdyn-bench-check-" + std::to_string(::getpid()) + ".csv");
-  CsvWriter writer(csv, columns.all);
+  CsvWriter writer(csv, columns.all, {}, false);  // formatted here: what a row's text costs
   const long calls = 2000;
   auto per_call = [&](const char* what, const std::function<void()>& job) {
     job();

@@ -4,8 +4,12 @@
 // SIGXFSZ ignored) makes the kernel refuse the bytes past it with EFBIG, as a full disk refuses
 // them with ENOSPC, at the flush of the last buffered bytes.
 #include <gtest/gtest.h>
+#include <pthread.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <unistd.h>
+
+#include "support/address_sanitizer.hpp"
 
 #include <fmt/format.h>
 
@@ -144,11 +148,11 @@ std::string expected_text(const std::vector<std::vector<double>>& rows, const st
 }
 
 TEST_F(AtomicFileSteps, ALongTableFormattedBesideTheRunHasTheBytesOfEachRowInOrder) {
-  // 4000 rows of 7 and one of 3000 columns (each past the first 32 KiB, where the formatting
-  // thread takes over, with blocks of one and of many rows), with the bytes read back in the
-  // middle of the run as a failed run reads them.
+  // 12000 rows of 7 and 40 of 3000 columns (each past the first 256 KiB, where the formatting
+  // thread takes over, with blocks of many rows and of a few), with the bytes read back in the
+  // middle of the run, the thread at work, as a failed run reads them.
   for (const int columns : {7, 3000}) {
-    const int rows = columns == 7 ? 4000 : 40;
+    const int rows = columns == 7 ? 12000 : 40;
     const fs::path target = dir_ / "long.csv";
     std::vector<std::string> names;
     std::string header;
@@ -195,7 +199,7 @@ TEST_F(AtomicFileSteps, ALongTableThatDoesNotFitFailsWholeAtItsFinish) {
   const std::vector<std::vector<double>> table = varied_rows(20000, 5);
   nhdyn::CsvWriter writer(target, {"a", "b", "c", "d", "e"});
   {
-    const FileSizeLimit limit(200000);
+    const FileSizeLimit limit(600000);
     ASSERT_TRUE(limit.ok());
     for (const std::vector<double>& row : table) writer.write_row(row);
     try {
@@ -206,6 +210,58 @@ TEST_F(AtomicFileSteps, ALongTableThatDoesNotFitFailsWholeAtItsFinish) {
     }
   }
   EXPECT_TRUE(entries().empty());
+}
+
+// The process's virtual memory size now (VmSize of /proc/self/status), in bytes; 0 if unknown.
+rlim_t virtual_memory_size() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("VmSize:", 0) == 0) return static_cast<rlim_t>(std::stoull(line.substr(7))) * 1024;
+  return 0;
+}
+
+TEST_F(AtomicFileSteps, ALongTableIsFormattedOnTheCallersThreadWhereNoThreadCanStart) {
+#ifdef NHDYN_ADDRESS_SANITIZER
+  GTEST_SKIP() << "AddressSanitizer reserves more address space than the limit this test sets";
+#else
+  // An address-space limit a few megabytes above what the process uses leaves no room for a
+  // thread's stack (8 MiB): the writer formats every row itself, and the table is whole.
+  const fs::path target = dir_ / "long.csv";
+  const std::vector<std::vector<double>> table = varied_rows(30000, 2);
+  nhdyn::CsvWriter writer(target, {"a", "b"});
+  rlimit saved{};
+  ::getrlimit(RLIMIT_AS, &saved);
+  const rlim_t used = virtual_memory_size();
+  ASSERT_GT(used, 0U);
+  rlimit limit = saved;
+  limit.rlim_cur = used + (rlim_t{4} << 20);
+  ASSERT_EQ(::setrlimit(RLIMIT_AS, &limit), 0);
+  for (const std::vector<double>& row : table) writer.write_row(row);
+  ::setrlimit(RLIMIT_AS, &saved);
+  writer.commit();
+  EXPECT_EQ(read(target), expected_text(table, "a,b\n"));
+#endif
+}
+
+TEST_F(AtomicFileSteps, TheFormattingThreadLeavesTheStoppingSignalsToTheCaller) {
+  // A caller that holds SIGUSR1 (as a foreground compile holds the stopping signals) receives one
+  // sent to the process while the formatting thread lives: the thread blocks them all. Were it not
+  // to, the signal would be delivered to it and end the process.
+  const fs::path target = dir_ / "long.csv";
+  nhdyn::CsvWriter writer(target, {"a", "b", "c"});
+  for (const std::vector<double>& row : varied_rows(30000, 3)) writer.write_row(row);
+  sigset_t usr1, old;
+  sigemptyset(&usr1);
+  sigaddset(&usr1, SIGUSR1);
+  ASSERT_EQ(::pthread_sigmask(SIG_BLOCK, &usr1, &old), 0);
+  ASSERT_EQ(::kill(::getpid(), SIGUSR1), 0);
+  const timespec wait{2, 0};
+  const int received = ::sigtimedwait(&usr1, nullptr, &wait);
+  ::pthread_sigmask(SIG_SETMASK, &old, nullptr);
+  EXPECT_EQ(received, SIGUSR1);
+  writer.commit();
+  EXPECT_TRUE(fs::exists(target));
 }
 
 TEST_F(AtomicFileSteps, AFinishedFileNotPublishedLeavesNothing) {

@@ -10,8 +10,10 @@
 #include <fstream>
 #include <mutex>
 #include <sstream>
+#include <system_error>
 #include <thread>
 
+#include "nhdyn/core/detail/signals.hpp"
 #include "nhdyn/core/error.hpp"
 
 namespace nhdyn {
@@ -31,9 +33,12 @@ std::string quote_if_needed(const std::string& name) {
 
 namespace {
 
-// Formatted text is written to the file in pieces of about this size; the first piece filled
-// starts the formatting thread (CsvWriter::Formatter).
+// Formatted text is written to the file in pieces of about this size.
 constexpr std::size_t kFlushBytes = std::size_t{1} << 15;
+// A table that has passed this much text starts its formatting thread (CsvWriter::Formatter): by
+// then the thread's start and end (about 0.1 ms) cost a fifth of the formatting so far at most, and
+// a short table never pays them.
+constexpr std::size_t kBesideBytes = std::size_t{1} << 18;
 // Numbers per block handed to the formatting thread (at least one row).
 constexpr std::size_t kBlockValues = std::size_t{1} << 13;
 
@@ -89,8 +94,8 @@ struct CsvWriter::Formatter {
 };
 
 CsvWriter::CsvWriter(const std::filesystem::path& target, const std::vector<std::string>& columns,
-                     const std::string& preamble)
-    : file_(target), columns_(columns.size()) {
+                     const std::string& preamble, bool beside)
+    : file_(target), columns_(columns.size()), beside_(beside) {
   std::string header = preamble;
   for (std::size_t i = 0; i < columns.size(); ++i) {
     if (i) header += ',';
@@ -121,19 +126,30 @@ void CsvWriter::write_row(std::span<const double> values) {
   }
   format_rows(values.data(), 1, columns_, buffer_);
   if (buffer_.size() > kFlushBytes) {
+    text_written_ += buffer_.size();
     file_.write(buffer_);
     buffer_.clear();
-    // A table this long goes on being formatted beside the run, where there is a core for it. A
-    // device or pipe is written by the caller's thread alone, as the caller's other output is.
-    if (!file_.straight() && columns_ > 0 && std::thread::hardware_concurrency() > 1) start_formatter();
+    // A long table goes on being formatted beside the run, where there is a core for it. A device
+    // or pipe is written by the caller's thread alone, as the caller's other output is.
+    if (beside_ && text_written_ >= kBesideBytes && !file_.straight() && columns_ > 0 &&
+        std::thread::hardware_concurrency() > 1)
+      start_formatter();
   }
 }
 
 void CsvWriter::start_formatter() {
-  formatter_ = std::make_unique<Formatter>();
+  beside_ = false;  // one attempt: a thread refused (a limit on threads or memory) is not asked for again
+  auto formatter = std::make_unique<Formatter>();
   block_.reserve(kBlockValues + columns_);
-  formatter_->block.reserve(kBlockValues + columns_);
-  formatter_->thread = std::thread([this] { formatter_->run(file_, columns_); });
+  formatter->block.reserve(kBlockValues + columns_);
+  Formatter* f = formatter.get();
+  try {
+    formatter->thread = thread_without_stopping_signals([this, f] { f->run(file_, columns_); });
+  } catch (const std::system_error&) {
+    return;  // the rows go on being formatted on the caller's thread
+  }
+  formatter_ = std::move(formatter);
+  buffer_.shrink_to_fit();  // no longer used
 }
 
 void CsvWriter::hand_over() {

@@ -2,11 +2,12 @@
 // output time, written through an AtomicFile so that a failed run leaves no partial file.
 // Numbers are printed in the shortest form that reads back to the same double.
 //
-// A large table is formatted on a thread of its own: once the rows written pass the first 32 KB of
-// text (and the machine has a second core, and the target is a regular file), write_row only
-// copies the numbers into a block that the thread formats and writes while the run goes on. The
-// bytes are the same; the shortest form of a double costs about 35 ns, a third of an output row's
-// cost on a small model and a fifth of the 1000-body chain's whole run (docs/performance.md).
+// A long table is formatted on a thread of its own: once the rows written pass 256 KB of text (and
+// the machine has a second core, and the target is a regular file), write_row only copies the
+// numbers into a block that the thread formats and writes while the run goes on. The bytes are the
+// same; the shortest form of a double costs about 35 ns, a third of an output row's cost on a
+// small model (docs/performance.md). The thread holds no stopping signal (core/detail/signals.hpp);
+// where no thread can be started, the caller's thread formats every row as before.
 #pragma once
 
 #include <filesystem>
@@ -26,8 +27,10 @@ class CsvWriter {
   // Opens the temporary file at once (FileError if the target cannot be written) and writes the
   // header, after `preamble` (comment lines, each starting with '#' and ending in '\n': the
   // provenance header of io/provenance.hpp). Names containing a comma or a quote are quoted.
+  // `beside` false: every row formatted on the caller's thread (a writer among many busy threads,
+  // such as a batch's, gains nothing from one more).
   CsvWriter(const std::filesystem::path& target, const std::vector<std::string>& columns,
-            const std::string& preamble = {});
+            const std::string& preamble = {}, bool beside = true);
   ~CsvWriter();  // uncommitted: the formatting thread stopped, the temporary removed
   CsvWriter(const CsvWriter&) = delete;
   CsvWriter& operator=(const CsvWriter&) = delete;
@@ -53,6 +56,8 @@ class CsvWriter {
   std::size_t columns_;
   std::string buffer_;          // formatted rows not yet written to file_ (no formatter)
   std::vector<double> block_;   // rows not yet formatted (with a formatter)
+  std::size_t text_written_ = 0;  // bytes of rows written by the caller's thread
+  bool beside_;                 // a formatting thread may still be started
   std::unique_ptr<Formatter> formatter_;
 };
 

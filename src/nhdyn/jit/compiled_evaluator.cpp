@@ -28,6 +28,7 @@
 
 #include "nhdyn/jit/detail/source.hpp"
 #include "nhdyn/core/detail/hash.hpp"
+#include "nhdyn/core/detail/signals.hpp"
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/tape.hpp"
 
@@ -53,16 +54,6 @@ std::string read_file(const fs::path& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-// The catchable signals that end a process by default and that a user sends to stop a run: while
-// the compiler runs they are held, so that an interrupted compile can stop the compiler and
-// remove its files before the signal takes its course (docs/design.md, "Compiled evaluator").
-sigset_t stopping_signals() {
-  sigset_t set;
-  sigemptyset(&set);
-  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2}) sigaddset(&set, sig);
-  return set;
 }
 
 // Holds the stopping signals in this thread for its lifetime; release() lets them through again
