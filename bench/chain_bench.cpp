@@ -10,7 +10,7 @@
 //                                      udwadia-kalaba, nullspace/qr
 //   chain/solve/sparse/<form>/N        the same on the sparse path: sanh (block elimination on
 //                                      the partition, formulation/sparse_sanh.hpp) and lagrange
-//                                      (one SparseLU of the KKT matrix), Eigen's SparseLU both
+//                                      (one LU of the KKT matrix), KLU both (model/sparse_lu.hpp)
 //   chain/rhs/sparse/<form>/N          one whole right-hand side (compute_dynamics: terms and
 //                                      solve) at the initial state, what an integrator pays per
 //                                      stage; its growth from N = 100 to 1000 is the n^1.1 target

@@ -115,8 +115,7 @@ Status project_level(const Model& model, Data& data, double t, double* q, double
         data.projection_rows[static_cast<std::size_t>(i)] =
             belongs_to(model.constraints[static_cast<std::size_t>(i)].level, level) ? 1 : 0;
       fill_sparse_kkt(data, data.projection_rows.data());
-      data.lu_kkt_sparse->factorize(data.K_sparse);
-      singular = data.lu_kkt_sparse->info() != Eigen::Success;
+      singular = !data.lu_kkt_sparse.factorize(data.K_sparse);
     } else {
       data.K.setZero();
       data.K.topLeftCorner(n, n) = data.A;
@@ -144,9 +143,10 @@ Status project_level(const Model& model, Data& data, double t, double* q, double
           data.kkt_rhs(n + i) = -r(j) / scale(j);
           ++j;
         }
-      if (data.sparse)
-        data.kkt_sol = data.lu_kkt_sparse->solve(data.kkt_rhs);
-      else
+      if (data.sparse) {
+        data.kkt_sol = data.kkt_rhs;
+        data.lu_kkt_sparse.solve_in_place(data.kkt_sol);
+      } else
         data.kkt_sol = data.lu_kkt.solve(data.kkt_rhs);
       if (pass == 0) {
         double step = 0.0, size = 0.0;

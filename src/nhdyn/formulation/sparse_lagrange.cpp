@@ -31,10 +31,10 @@ Status compute_sparse_lagrange_acceleration(const Model& model, Data& data) {
   fill_sparse_kkt(data, nullptr);
   data.kkt_rhs.head(n) = data.Q + data.G;
   data.kkt_rhs.tail(s) = -data.b0;
-  data.lu_kkt_sparse->factorize(data.K_sparse);
-  if (data.lu_kkt_sparse->info() != Eigen::Success)
+  if (!data.lu_kkt_sparse.factorize(data.K_sparse))
     return record_failure(data, Status::singular_system, "KKT matrix [A b^T; b 0]");
-  data.kkt_sol = data.lu_kkt_sparse->solve(data.kkt_rhs);
+  data.kkt_sol = data.kkt_rhs;
+  data.lu_kkt_sparse.solve_in_place(data.kkt_sol);
   data.qdd = data.kkt_sol.head(n);
   data.lambda = -data.kkt_sol.tail(s);
   data.R.noalias() = data.b_sparse.transpose() * data.lambda;

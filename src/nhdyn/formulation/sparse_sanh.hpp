@@ -25,8 +25,9 @@ namespace nhdyn {
 // coordinates anew (compute_sparse_partition: allocates, counted in data.partition_changes) and
 // solves again. Status::dependent_constraints when b has rank below s, Status::singular_system
 // when b_dep stays singular, Status::inertia_not_positive_definite when D A D^T (or A, for s = 0)
-// is not positive definite. Allocates nothing else beyond SparseLU's factors (its numeric
-// factorization allocates them on every call; Eigen offers no way to reuse them).
+// is not positive definite. Allocates nothing else once the first factorization has sized KLU's
+// factors of b_dep (model/sparse_lu.hpp; a new search for pivots may size them again); for s = 0,
+// Eigen's SimplicialLLT allocates its factors at each call.
 Status compute_sparse_sanh_acceleration(const Model& model, Data& data);
 
 }  // namespace nhdyn

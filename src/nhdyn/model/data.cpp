@@ -168,8 +168,7 @@ Data make_sparse_data(const Model& model) {
     d.K_source.resize(static_cast<std::size_t>(d.K_sparse.nonZeros()));
     for (int m = 0; m < d.K_sparse.nonZeros(); ++m)
       d.K_source[static_cast<std::size_t>(m)] = static_cast<int>(d.K_sparse.valuePtr()[m]);
-    d.lu_kkt_sparse = std::make_unique<SparseLU>();
-    d.lu_kkt_sparse->analyzePattern(d.K_sparse);
+    d.lu_kkt_sparse.analyze(d.K_sparse);
   }
   return d;
 }
@@ -289,8 +288,7 @@ bool choose_by_null_space(const Model& model, Data& data) {
     const int source = data.K_source[m];
     k_values[m] = source == kKktDiagonal ? 0.0 : source >= 0 ? a_values[source] : b_values[~source];
   }
-  data.lu_kkt_sparse->factorize(data.K_sparse);
-  if (data.lu_kkt_sparse->info() != Eigen::Success) return false;
+  if (!data.lu_kkt_sparse.factorize(data.K_sparse)) return false;
   Matrix Z(k, n);
   Vector g(n), rhs = Vector::Zero(n + s);
   std::uint64_t state = 0x9e3779b97f4a7c15ULL;
@@ -300,7 +298,8 @@ bool choose_by_null_space(const Model& model, Data& data) {
       g(i) = static_cast<double>(state >> 11) * 0x1.0p-53 - 0.5;
     }
     rhs.head(n) = data.A_sparse * g;
-    const Vector sol = data.lu_kkt_sparse->solve(rhs);
+    Vector sol = rhs;
+    data.lu_kkt_sparse.solve_in_place(sol);
     if (!sol.allFinite()) return false;
     Z.row(r) = sol.head(n).transpose();
   }

@@ -19,7 +19,6 @@
 #include <Eigen/SVD>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
-#include <Eigen/SparseLU>
 #include <memory>
 #include <optional>
 #include <string>
@@ -35,7 +34,6 @@
 
 namespace nhdyn {
 
-using SparseLU = Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>>;
 using SparseLLT = Eigen::SimplicialLLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>;
 
 // The formulations (formulation/formulation.hpp says what each one solves, and kFormulations
@@ -238,7 +236,7 @@ struct Data {
   SparseMatrix K_sparse;           // (n + s) x (n + s), [A b^T; b C] with C diagonal (0 for lagrange,
                                    // 1 on the rows a projection leaves out)
   std::vector<int> K_source;       // each value of K_sparse: A's index (>= 0), ~b's index, or kKktDiagonal
-  std::unique_ptr<SparseLU> lu_kkt_sparse;  // K_sparse
+  SparseLuFactor lu_kkt_sparse;    // K_sparse (KLU: model/sparse_lu.hpp)
 };
 
 // The code in Data::K_source of a diagonal entry of the lower right block of K_sparse.

@@ -75,12 +75,11 @@ bool SparseLuFactor::factorize(const SparseMatrix& m) {
   return true;
 }
 
-void SparseLuFactor::solve_in_place(Matrix& rhs) {
-  if (!state_ || !state_->numeric || rhs.rows() != state_->size)
+void SparseLuFactor::solve_in_place(double* rhs, Eigen::Index rows, Eigen::Index columns) {
+  if (!state_ || !state_->numeric || rows != state_->size)
     throw std::logic_error("SparseLuFactor::solve_in_place: factorize a matrix of this size first");
-  if (rhs.cols() == 0) return;
-  klu_solve(state_->symbolic, state_->numeric, state_->size, static_cast<int>(rhs.cols()), rhs.data(),
-            &state_->common);
+  if (columns == 0) return;
+  klu_solve(state_->symbolic, state_->numeric, state_->size, static_cast<int>(columns), rhs, &state_->common);
 }
 
 }  // namespace nhdyn

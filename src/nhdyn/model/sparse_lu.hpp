@@ -1,5 +1,6 @@
-// The sparse LU factorization of the sparse path's b_dep (formulation/sparse_sanh.hpp): a square
-// matrix whose pattern is fixed by the partition and whose values change at every right-hand side.
+// The sparse LU factorizations of the sparse path: b_dep (formulation/sparse_sanh.hpp) and the KKT
+// matrix [A b^T; b C] (sparse_lagrange.hpp, the projection): square matrices whose pattern is fixed
+// and whose values change at every right-hand side.
 // It is SuiteSparse's KLU, kept behind this class so that its headers stay in sparse_lu.cpp. KLU
 // analyses the pattern once (a block triangular form, then an ordering for each block: the chain's
 // 2998 x 2998 b_dep has 998 blocks), and after the first factorization each one reuses the pivot
@@ -31,13 +32,15 @@ class SparseLuFactor {
   // zero pivot even with a search for pivots).
   bool factorize(const SparseMatrix& m);
   // rhs := m^-1 rhs, every column, after a successful factorize.
-  void solve_in_place(Matrix& rhs);
+  void solve_in_place(Matrix& rhs) { solve_in_place(rhs.data(), rhs.rows(), rhs.cols()); }
+  void solve_in_place(Vector& rhs) { solve_in_place(rhs.data(), rhs.rows(), 1); }
   // How many factorizations searched for pivots (the first after analyze, and each change of the
   // pivot order), and how many reused the order: for tests and the performance page.
   long pivoting_factorizations() const { return pivoting_; }
   long reusing_factorizations() const { return reusing_; }
 
  private:
+  void solve_in_place(double* rhs, Eigen::Index rows, Eigen::Index columns);
   struct State;  // KLU's objects (sparse_lu.cpp)
   std::unique_ptr<State> state_;
   long pivoting_ = 0;
