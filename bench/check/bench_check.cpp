@@ -36,6 +36,11 @@
 //                                        loop for 6 doubles); the step counts and final states are
 //                                        compared first
 //   sled_dop853_vs_hand_written          the same with dop853 (Dormand-Prince 8(5,3)) on both sides
+//   chain_rhs_sparse_vs_reference        one right-hand side of the 300-body chain (n = 900) on the
+//                                        sparse path (compute_dynamics, sparse sanh: KLU refactorizes
+//                                        b_dep in place), 100 times, over 20 hand-written sled
+//                                        integrations (dopri5): a fixed amount of hand-written work,
+//                                        so that a slower sparse path shows
 // The compiled object comes from the compiled evaluator's cache ($XDG_CACHE_HOME/nhdyn), so only
 // the first run on a machine pays the compiler.
 //   nhdyn_bench_check EXAMPLES_DIR [PAIRS [FILTER]]   (PAIRS: pairs per ratio, default 7; FILTER:
@@ -62,6 +67,8 @@
 #include "nhdyn/model/contact_forces.hpp"
 #include "nhdyn/model/data.hpp"
 #include "nhdyn/model/output.hpp"
+#include "nhdyn/symbolic/chain.hpp"
+#include "nhdyn/symbolic/compile.hpp"
 #include "rattleback_stacked.hpp"
 #include "sled_by_hand.hpp"
 
@@ -346,6 +353,24 @@ int main(int argc, char** argv) {
     };
     sled_pair("sled_dopri5_vs_hand_written", IntegratorKind::dopri5, rk::DormandPrince54{});
     sled_pair("sled_dop853_vs_hand_written", IntegratorKind::dop853, rk::DormandPrince853{});
+
+    // The sparse path: one right-hand side of the 300-body chain (n = 900, sparse sanh, KLU's LU of
+    // b_dep refactorized in place) against a fixed amount of hand-written work, as the loads are.
+    if (std::string("chain_rhs_sparse_vs_reference").find(filter) != std::string::npos) {
+      symbolic::ChainParameters chain_parameters;
+      chain_parameters.bodies = 300;
+      const Model chain = symbolic::compile_model(symbolic::make_chain_spec(chain_parameters),
+                                                  symbolic::CompileOptions{symbolic::TermsLayout::sparse});
+      Data dchain = make_data(chain);
+      if (!dchain.sparse) {
+        std::fprintf(stderr, "bench-check: the chain did not take the sparse path\n");
+        return 1;
+      }
+      pair("chain_rhs_sparse_vs_reference", pairs, [&] { rhs_loop(chain, dchain, 100); },
+           [&] {
+             for (int i = 0; i < kSledRuns; ++i) run_sled_by_hand<rk::DormandPrince54>(sled);
+           });
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench-check: %s\n", e.what());
     return 1;
