@@ -1,6 +1,7 @@
 #include "nhdyn/symbolic/simplify.hpp"
 
 #include <algorithm>
+#include <optional>
 #ifdef NHDYN_CHECK_SIMPLIFY_SHORTCUT
 #include <cstdlib>
 #include <iostream>
@@ -213,6 +214,68 @@ struct Freeze : GiNaC::map_function {
   }
 };
 
+// What one power of a family function becomes: x^2 -> square.
+struct Rule {
+  GiNaC::symbol x;
+  ex square;
+};
+
+// The factor x^k of a term with x^k -> x^(k mod 2) square^(k div 2) where a rule applies and k >= 2;
+// false when the factor is not what a term of an expanded polynomial in the symbols holds (a
+// rational number, or a symbol, call or frozen power to a nonnegative integer power).
+bool reduce_factor(const ex& f, const std::vector<Rule>& rules, ex& out, bool& changed) {
+  if (GiNaC::is_exactly_a<GiNaC::numeric>(f)) {
+    out = f;
+    return f.info(GiNaC::info_flags::rational);
+  }
+  const bool power = GiNaC::is_exactly_a<GiNaC::power>(f);
+  const ex& base = power ? f.op(0) : f;
+  if (!GiNaC::is_exactly_a<GiNaC::symbol>(base) && !GiNaC::is_a<GiNaC::function>(base)) return false;
+  if (power && !f.op(1).info(GiNaC::info_flags::nonnegint)) return false;
+  out = f;
+  if (!power || !GiNaC::is_exactly_a<GiNaC::symbol>(base)) return true;
+  const int k = GiNaC::ex_to<GiNaC::numeric>(f.op(1)).to_int();
+  for (const Rule& rule : rules) {
+    if (!base.is_equal(rule.x)) continue;
+    out = GiNaC::pow(rule.x, k % 2) * GiNaC::pow(rule.square, k / 2);
+    changed = true;
+    break;
+  }
+  return true;
+}
+
+// The rules applied to every term of the expanded polynomial q at once and the sum expanded once:
+// the polynomial of degree at most 1 in each x that the family-by-family reduction below reaches
+// (the remainder modulo the relations, which is unique: their leading powers x^2 share no symbol),
+// so expand() writes both alike. Empty when a term is not a product of the factors reduce_factor()
+// takes; in particular a floating-point coefficient, whose sums depend on the order of the
+// additions, leaves the reduction to the family-by-family one.
+std::optional<ex> reduce_terms(const ex& q, const std::vector<Rule>& rules) {
+  const bool sum = GiNaC::is_exactly_a<GiNaC::add>(q);
+  GiNaC::exvector terms;
+  terms.reserve(sum ? q.nops() : 1);
+  bool changed = false;
+  for (std::size_t i = 0; i < (sum ? q.nops() : 1); ++i) {
+    const ex& term = sum ? q.op(i) : q;
+    if (!GiNaC::is_exactly_a<GiNaC::mul>(term)) {
+      ex out;
+      if (!reduce_factor(term, rules, out, changed)) return std::nullopt;
+      terms.push_back(out);
+      continue;
+    }
+    GiNaC::exvector factors;
+    factors.reserve(term.nops());
+    for (std::size_t j = 0; j < term.nops(); ++j) {
+      ex out;
+      if (!reduce_factor(term.op(j), rules, out, changed)) return std::nullopt;
+      factors.push_back(out);
+    }
+    terms.push_back(GiNaC::mul(factors));
+  }
+  if (!changed) return q;
+  return GiNaC::expand(GiNaC::add(terms));
+}
+
 // Reduces a polynomial modulo the relations of the families: with s, c the two functions of a
 // family, eliminate_first replaces s^2 by 1 - c^2 (sinh^2 by cosh^2 - 1), otherwise c^2 by
 // 1 - s^2 (cosh^2 by 1 + sinh^2). The result has degree at most 1 in the eliminated function.
@@ -232,24 +295,29 @@ ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool elim
   // no_pattern: the keys hold no wildcard, so a lookup per node finds them; GiNaC's default tries
   // every key as a pattern at every node.
   ex q = GiNaC::expand(freeze(p).subs(to_symbols, GiNaC::subs_options::no_pattern));
+  std::vector<Rule> rules;
   for (std::size_t i = 0; i < families.size(); ++i) {
     const GiNaC::symbol& s = first[i];
     const GiNaC::symbol& c = second[i];
-    const GiNaC::symbol& x = eliminate_first ? s : c;  // the function whose square goes
-    ex square;                                         // what x^2 becomes
     if (!families[i].hyperbolic)
-      square = 1 - GiNaC::pow(eliminate_first ? c : s, 2);
+      rules.push_back({eliminate_first ? s : c, 1 - GiNaC::pow(eliminate_first ? c : s, 2)});
     else
-      square = eliminate_first ? GiNaC::pow(c, 2) - 1 : 1 + GiNaC::pow(s, 2);
-    const int degree = q.degree(x);
-    if (degree < 2 || q.ldegree(x) < 0) continue;
-    ex reduced = 0;
-    for (int k = 0; k <= degree; ++k) {
-      const ex coefficient = q.coeff(x, k);
-      if (coefficient.is_zero()) continue;
-      reduced += coefficient * GiNaC::pow(x, k % 2) * GiNaC::pow(square, k / 2);
+      rules.push_back({eliminate_first ? s : c, eliminate_first ? GiNaC::pow(c, 2) - 1 : 1 + GiNaC::pow(s, 2)});
+  }
+  if (const std::optional<ex> at_once = reduce_terms(q, rules)) {
+    q = *at_once;
+  } else {
+    for (const Rule& rule : rules) {
+      const int degree = q.degree(rule.x);
+      if (degree < 2 || q.ldegree(rule.x) < 0) continue;
+      ex reduced = 0;
+      for (int k = 0; k <= degree; ++k) {
+        const ex coefficient = q.coeff(rule.x, k);
+        if (coefficient.is_zero()) continue;
+        reduced += coefficient * GiNaC::pow(rule.x, k % 2) * GiNaC::pow(rule.square, k / 2);
+      }
+      q = GiNaC::expand(reduced);
     }
-    q = GiNaC::expand(reduced);
   }
   return q.subs(back, GiNaC::subs_options::no_pattern).subs(freeze.back, GiNaC::subs_options::no_pattern);
 }
