@@ -341,10 +341,21 @@ Fraction reduce(const Fraction& start, const std::vector<Family>& families, bool
   Fraction f = start;
   // Cancelling common factors cannot raise the degree in the eliminated function, so one round
   // usually suffices; a few more make sure a fixpoint is reached.
+  // normal_fraction() gives the same result for the same expression, and its result written as a
+  // quotient is usually its argument again: the round that confirms the fixpoint then hands it the
+  // argument of the round before, and takes that round's result instead of normalizing again.
+  ex argument;
+  Fraction result;
   for (int round = 0; round < 4; ++round) {
     const ex n = reduce_polynomial(f.numerator, families, eliminate_first);
     const ex d = reduce_polynomial(f.denominator, families, eliminate_first);
-    const Fraction next = normal_fraction(n / d);
+    const ex quotient = n / d;
+    const bool known = round > 0 && quotient.is_equal(argument);
+    if (!known) {
+      argument = quotient;
+      result = normal_fraction(quotient);
+    }
+    const Fraction next = result;
     const bool same = next.numerator.is_equal(f.numerator) && next.denominator.is_equal(f.denominator);
     f = next;
     if (same || f.numerator.is_zero()) break;
