@@ -265,12 +265,15 @@ std::optional<ex> reduce_terms(const ex& q, const std::vector<Rule>& rules) {
     }
     GiNaC::exvector factors;
     factors.reserve(term.nops());
+    bool term_changed = false;
     for (std::size_t j = 0; j < term.nops(); ++j) {
       ex out;
-      if (!reduce_factor(term.op(j), rules, out, changed)) return std::nullopt;
+      if (!reduce_factor(term.op(j), rules, out, term_changed)) return std::nullopt;
       factors.push_back(out);
     }
-    terms.push_back(GiNaC::mul(factors));
+    // A term without a square to replace is kept as the object it is: expand() knows it expanded.
+    terms.push_back(term_changed ? ex(GiNaC::mul(factors)) : term);
+    changed = changed || term_changed;
   }
   if (!changed) return q;
   return GiNaC::expand(GiNaC::add(terms));
