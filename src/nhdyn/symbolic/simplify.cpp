@@ -214,26 +214,26 @@ struct Freeze : GiNaC::map_function {
   }
 };
 
-// What one power of a family function becomes: x^2 -> square.
+// What one power of a family function becomes: x^2 -> square. x is the call itself, or the
+// symbol that stands for it.
 struct Rule {
-  GiNaC::symbol x;
+  ex x;
   ex square;
 };
 
 // The factor x^k of a term with x^k -> x^(k mod 2) square^(k div 2) where a rule applies and k >= 2;
-// false when the factor is not what a term of an expanded polynomial in the symbols holds (a
-// rational number, or a symbol, call or frozen power to a nonnegative integer power).
+// false when the factor is not what a term of an expanded polynomial holds (a rational number, a
+// symbol or call to a nonnegative integer power, or a power with another exponent, which the
+// reduction does not look into).
 bool reduce_factor(const ex& f, const std::vector<Rule>& rules, ex& out, bool& changed) {
-  if (GiNaC::is_exactly_a<GiNaC::numeric>(f)) {
-    out = f;
-    return f.info(GiNaC::info_flags::rational);
-  }
-  const bool power = GiNaC::is_exactly_a<GiNaC::power>(f);
-  const ex& base = power ? f.op(0) : f;
-  if (!GiNaC::is_exactly_a<GiNaC::symbol>(base) && !GiNaC::is_a<GiNaC::function>(base)) return false;
-  if (power && !f.op(1).info(GiNaC::info_flags::nonnegint)) return false;
   out = f;
-  if (!power || !GiNaC::is_exactly_a<GiNaC::symbol>(base)) return true;
+  if (GiNaC::is_exactly_a<GiNaC::numeric>(f)) return f.info(GiNaC::info_flags::rational);
+  if (GiNaC::is_exactly_a<GiNaC::symbol>(f) || GiNaC::is_a<GiNaC::function>(f)) return true;
+  if (!GiNaC::is_exactly_a<GiNaC::power>(f)) return false;
+  const ex& base = f.op(0);
+  if (!f.op(1).info(GiNaC::info_flags::integer)) return true;
+  if (!f.op(1).info(GiNaC::info_flags::nonnegint)) return false;
+  if (!GiNaC::is_exactly_a<GiNaC::symbol>(base) && !GiNaC::is_a<GiNaC::function>(base)) return false;
   const int k = GiNaC::ex_to<GiNaC::numeric>(f.op(1)).to_int();
   for (const Rule& rule : rules) {
     if (!base.is_equal(rule.x)) continue;
@@ -279,10 +279,9 @@ std::optional<ex> reduce_terms(const ex& q, const std::vector<Rule>& rules) {
   return GiNaC::expand(GiNaC::add(terms));
 }
 
-// Reduces a polynomial modulo the relations of the families: with s, c the two functions of a
-// family, eliminate_first replaces s^2 by 1 - c^2 (sinh^2 by cosh^2 - 1), otherwise c^2 by
-// 1 - s^2 (cosh^2 by 1 + sinh^2). The result has degree at most 1 in the eliminated function.
-ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool eliminate_first) {
+// reduce_polynomial() for any polynomial: its calls and roots replaced by symbols, expanded, reduced
+// and substituted back.
+ex reduce_polynomial_by_symbols(const ex& p, const std::vector<Family>& families, bool eliminate_first) {
   std::vector<GiNaC::symbol> first(families.size()), second(families.size());
   GiNaC::lst to_symbols, back;
   for (std::size_t i = 0; i < families.size(); ++i) {
@@ -323,6 +322,29 @@ ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool elim
     }
   }
   return q.subs(back, GiNaC::subs_options::no_pattern).subs(freeze.back, GiNaC::subs_options::no_pattern);
+}
+
+// Reduces a polynomial modulo the relations of the families: with s, c the two functions of a
+// family, eliminate_first replaces s^2 by 1 - c^2 (sinh^2 by cosh^2 - 1), otherwise c^2 by
+// 1 - s^2 (cosh^2 by 1 + sinh^2). The result has degree at most 1 in the eliminated function.
+// p is expanded (reduce() passes the parts of a normal fraction): its terms are reduced as they
+// are, on the calls themselves, which gives the polynomial that replacing the calls and roots by
+// symbols, expanding, reducing and substituting back gives (expand() of what is expanded already
+// writes it again, and the substitutions are undone one for one), and p itself where nothing is
+// reduced, without those passes over all of p.
+ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool eliminate_first) {
+  std::vector<Rule> on_calls;
+  for (const Family& family : families) {
+    const ex& u = family.argument;
+    const ex f = family.hyperbolic ? GiNaC::sinh(u) : GiNaC::sin(u);
+    const ex g = family.hyperbolic ? GiNaC::cosh(u) : GiNaC::cos(u);
+    if (!family.hyperbolic)
+      on_calls.push_back({eliminate_first ? f : g, 1 - GiNaC::pow(eliminate_first ? g : f, 2)});
+    else
+      on_calls.push_back({eliminate_first ? f : g, eliminate_first ? GiNaC::pow(g, 2) - 1 : 1 + GiNaC::pow(f, 2)});
+  }
+  if (const std::optional<ex> direct = reduce_terms(p, on_calls)) return *direct;
+  return reduce_polynomial_by_symbols(p, families, eliminate_first);
 }
 
 // True when a power of a sine, cosine, sinh or cosh occurs anywhere in e (inside roots and
