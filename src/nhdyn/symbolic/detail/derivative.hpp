@@ -26,7 +26,7 @@ GiNaC::ex derivative_of_container(const GiNaC::ex& e, const GiNaC::symbol& s);
 // an operation leaves as they are, so the rotations that a multibody T is built of stand in every
 // dT/dq'_i, and d/dq_j of each is taken for every i. The memo holds each object it has seen, so
 // that no other object can take its address while it lives, and so it holds memory: it lives for
-// a stage of the derivation or of the compilation, not longer. A memo made while another lives on
+// a stage of the multibody front end, the derivation or the compilation, not longer. A memo made while another lives on
 // the thread adds nothing: the first one serves both.
 class DerivativeMemo {
  public:
