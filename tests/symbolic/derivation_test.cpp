@@ -419,6 +419,20 @@ TEST(Simplify, TrigonometricIdentitiesReduceToZero) {
   EXPECT_EQ(canonical_key(simplify((u * c + 1) / c)), canonical_key(u + 1 / c));
 }
 
+// The reduction of sin^2 (or cos^2) works on every family and every power of a term at once when
+// the coefficients are rational, family by family otherwise (a float's sums depend on their order):
+// both reach the same remainder.
+TEST(Simplify, PowersOfSeveralFamiliesReduceTogether) {
+  const GiNaC::symbol x("x"), y("y"), z("z"), u("u");
+  const ex sx = GiNaC::sin(x), cx = GiNaC::cos(x), sy = GiNaC::sin(y), cy = GiNaC::cos(y);
+  const ex shz = GiNaC::sinh(z), chz = GiNaC::cosh(z);
+  const ex reduced = GiNaC::pow(1 - cx * cx, 2) * sy * (1 - cy * cy) * (chz * chz - 1);
+  EXPECT_TRUE(symbolic::is_zero(GiNaC::pow(sx, 4) * GiNaC::pow(sy, 3) * GiNaC::pow(shz, 2) - reduced));
+  EXPECT_TRUE(symbolic::is_zero(u * GiNaC::pow(sx, 5) / 3 - u * sx * GiNaC::pow(1 - cx * cx, 2) / 3));
+  EXPECT_TRUE(symbolic::is_zero(0.5 * GiNaC::pow(sx, 2) * GiNaC::pow(cy, 2) - 0.5 * (1 - cx * cx) * (1 - sy * sy)));
+  EXPECT_FALSE(symbolic::is_zero(GiNaC::pow(sx, 4) * GiNaC::pow(sy, 3) - GiNaC::pow(cx, 4) * GiNaC::pow(sy, 3)));
+}
+
 TEST(Simplify, ValueDoesNotDependOnSymbolCreationOrder) {
   // GiNaC orders terms (and picks the sign of a sum inside a product) by hashes of symbol serial
   // numbers; simplify()'s value must not depend on that. The printed form is checked to be

@@ -51,6 +51,25 @@ TEST(Derivative, IsGiNaCsDerivativeNodeForNode) {
     }
 }
 
+// With a memo, a subexpression shared by several expressions (as the parts of T are by its
+// derivatives) is differentiated once by each symbol: the expressions are GiNaC's all the same,
+// asked once or twice, and a memo made inside another leaves the outer one at work.
+TEST(Derivative, AMemoGivesTheSameExpressions) {
+  detail::install_chain_rule();
+  const GiNaC::symbol x("x"), y("y"), v("v"), m("m");
+  const ex shared = GiNaC::cos(x) * y * v - GiNaC::sin(x) * GiNaC::pow(x + y, 2);
+  const std::vector<ex> terms = {m * shared * v, GiNaC::pow(shared, 2) * y, shared + GiNaC::sqrt(1 + shared * x)};
+  const detail::DerivativeMemo memo;
+  for (int pass = 0; pass < 2; ++pass) {
+    const detail::DerivativeMemo inner;
+    for (const ex& e : terms)
+      for (const GiNaC::symbol& s : {x, y, v}) {
+        EXPECT_TRUE(detail::derivative(e, s).is_equal(e.diff(s))) << "d/d" << s << " of " << e;
+        EXPECT_TRUE(detail::derivative(e, s).is_equal(e.diff(s))) << "again, d/d" << s << " of " << e;
+      }
+  }
+}
+
 TEST(Derivative, LeavesADerivationAsGiNaCMadeIt) {
   // The sleigh of docs/gallery: T with products of sines and velocities, a velocity constraint.
   SpecBuilder b("sleigh");

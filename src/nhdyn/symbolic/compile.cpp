@@ -39,6 +39,7 @@
 #include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/events.hpp"
 #include "nhdyn/symbolic/outputs.hpp"
+#include "nhdyn/symbolic/detail/derivative.hpp"
 #include "nhdyn/symbolic/detail/pairs.hpp"
 #include "nhdyn/symbolic/detail/plain_words.hpp"
 
@@ -1249,6 +1250,8 @@ void compile_contact_coordinates(const Spec& spec, Model& model) {
 
 Model compile_model(const Spec& spec, const Derivation& derivation, const CompileOptions& options) {
   check_derivation(spec, derivation);
+  // The contact forces differentiate the same kinematics again and again (detail/derivative.hpp).
+  const detail::DerivativeMemo memo;
   const int n = spec.n(), s = spec.s();
   Model model;
   describe_model(spec, derivation, model);

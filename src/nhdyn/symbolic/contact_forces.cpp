@@ -11,6 +11,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 #include "nhdyn/symbolic/detail/derivative.hpp"
+#include "nhdyn/symbolic/detail/occurrence.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
@@ -226,8 +227,10 @@ std::vector<ContactForceSymbol> make_contact_force_symbols(const std::vector<Rep
 std::vector<int> contact_force_columns_in(const Spec& spec, const GiNaC::ex& e) {
   std::vector<int> found;
   if (!spec.contact_forces) return found;
+  // One walk for all the columns, not a has() per column: the same leaves.
+  const SymbolSet in = symbols_of(e);
   for (const ContactForceSymbol& c : spec.contact_forces->columns)
-    if (e.has(c.symbol)) found.push_back(c.column);
+    if (in.count(c.symbol) > 0) found.push_back(c.column);
   return found;
 }
 

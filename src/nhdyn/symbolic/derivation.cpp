@@ -610,8 +610,14 @@ Derivation derive(const Spec& spec) {
 
   Derivation d;
   std::vector<GiNaC::ex> Tv;
-  derive_inertia(spec, Ts, index, model, d, Tv);
-  derive_forces(spec, Ts, Vs, Tv, index, model, d);
+  {
+    // dT/dq'_i holds the parts of T that do not contain q'_i as they are, and they are
+    // differentiated again for A's entries and for G (detail/derivative.hpp, DerivativeMemo). The
+    // constraints' rows share little and are many in a large model: the memo would only grow.
+    const detail::DerivativeMemo memo;
+    derive_inertia(spec, Ts, index, model, d, Tv);
+    derive_forces(spec, Ts, Vs, Tv, index, model, d);
+  }
   // Every constraint at acceleration level, b q'' + b0 = 0 (docs/notation.md (2.5)).
   constraint_rows(spec, spec.constraints, "constraint", index, d.b, d.b0, d.phi, d.f);
   derive_programs(spec, index, d);

@@ -15,6 +15,7 @@
 #include "nhdyn/symbolic/simplify.hpp"
 #include "nhdyn/core/detail/suggest.hpp"
 #include "nhdyn/symbolic/detail/contact_geometry.hpp"
+#include "nhdyn/symbolic/detail/derivative.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
@@ -700,6 +701,8 @@ GiNaC::ex MultibodyBuilder::potential_energy() const {
 void MultibodyBuilder::apply() {
   if (applied_) throw ModelError("MultibodyBuilder::apply() was called twice; call it once, after everything else");
   applied_ = true;
+  // The contacts and energies differentiate the frames' kinematics again and again (detail/derivative.hpp).
+  const detail::DerivativeMemo memo;
   const bool other_energy =
       !builder_.current().kinetic_energy.is_zero() || !builder_.current().potential_energy.is_zero();
   builder_.add_energies(kinetic_energy(), potential_energy());

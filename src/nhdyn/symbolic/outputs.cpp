@@ -10,11 +10,15 @@
 #include "nhdyn/symbolic/compile.hpp"
 #include "nhdyn/symbolic/kinematics.hpp"
 
+#include "nhdyn/symbolic/detail/occurrence.hpp"
+
 namespace nhdyn::symbolic {
 
 bool reads_dynamics(const Spec& spec, const GiNaC::ex& e) {
+  // One walk for all the symbols, not a has() per symbol: the same leaves.
+  const SymbolSet in = symbols_of(e);
   for (int i = 0; i < spec.symbols.coordinates(); ++i)
-    if (e.has(spec.symbols.acceleration(i)) || e.has(spec.symbols.reaction(i))) return true;
+    if (in.count(spec.symbols.acceleration(i)) > 0 || in.count(spec.symbols.reaction(i)) > 0) return true;
   return false;
 }
 

@@ -1,6 +1,7 @@
 #include "nhdyn/symbolic/simplify.hpp"
 
 #include <algorithm>
+#include <optional>
 #ifdef NHDYN_CHECK_SIMPLIFY_SHORTCUT
 #include <cstdlib>
 #include <iostream>
@@ -213,10 +214,74 @@ struct Freeze : GiNaC::map_function {
   }
 };
 
-// Reduces a polynomial modulo the relations of the families: with s, c the two functions of a
-// family, eliminate_first replaces s^2 by 1 - c^2 (sinh^2 by cosh^2 - 1), otherwise c^2 by
-// 1 - s^2 (cosh^2 by 1 + sinh^2). The result has degree at most 1 in the eliminated function.
-ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool eliminate_first) {
+// What one power of a family function becomes: x^2 -> square. x is the call itself, or the
+// symbol that stands for it.
+struct Rule {
+  ex x;
+  ex square;
+};
+
+// The factor x^k of a term with x^k -> x^(k mod 2) square^(k div 2) where a rule applies and k >= 2;
+// false when the factor is not what a term of an expanded polynomial holds (a rational number, a
+// symbol or call to a nonnegative integer power, or a power with another exponent, which the
+// reduction does not look into).
+bool reduce_factor(const ex& f, const std::vector<Rule>& rules, ex& out, bool& changed) {
+  out = f;
+  if (GiNaC::is_exactly_a<GiNaC::numeric>(f)) return f.info(GiNaC::info_flags::rational);
+  if (GiNaC::is_exactly_a<GiNaC::symbol>(f) || GiNaC::is_a<GiNaC::function>(f)) return true;
+  if (!GiNaC::is_exactly_a<GiNaC::power>(f)) return false;
+  const ex& base = f.op(0);
+  if (!f.op(1).info(GiNaC::info_flags::integer)) return true;
+  if (!f.op(1).info(GiNaC::info_flags::nonnegint)) return false;
+  if (!GiNaC::is_exactly_a<GiNaC::symbol>(base) && !GiNaC::is_a<GiNaC::function>(base)) return false;
+  const int k = GiNaC::ex_to<GiNaC::numeric>(f.op(1)).to_int();
+  for (const Rule& rule : rules) {
+    if (!base.is_equal(rule.x)) continue;
+    out = GiNaC::pow(rule.x, k % 2) * GiNaC::pow(rule.square, k / 2);
+    changed = true;
+    break;
+  }
+  return true;
+}
+
+// The rules applied to every term of the expanded polynomial q at once and the sum expanded once:
+// the polynomial of degree at most 1 in each x that the family-by-family reduction below reaches
+// (the remainder modulo the relations, which is unique: their leading powers x^2 share no symbol),
+// so expand() writes both alike. Empty when a term is not a product of the factors reduce_factor()
+// takes; in particular a floating-point coefficient, whose sums depend on the order of the
+// additions, leaves the reduction to the family-by-family one.
+std::optional<ex> reduce_terms(const ex& q, const std::vector<Rule>& rules) {
+  const bool sum = GiNaC::is_exactly_a<GiNaC::add>(q);
+  GiNaC::exvector terms;
+  terms.reserve(sum ? q.nops() : 1);
+  bool changed = false;
+  for (std::size_t i = 0; i < (sum ? q.nops() : 1); ++i) {
+    const ex& term = sum ? q.op(i) : q;
+    if (!GiNaC::is_exactly_a<GiNaC::mul>(term)) {
+      ex out;
+      if (!reduce_factor(term, rules, out, changed)) return std::nullopt;
+      terms.push_back(out);
+      continue;
+    }
+    GiNaC::exvector factors;
+    factors.reserve(term.nops());
+    bool term_changed = false;
+    for (std::size_t j = 0; j < term.nops(); ++j) {
+      ex out;
+      if (!reduce_factor(term.op(j), rules, out, term_changed)) return std::nullopt;
+      factors.push_back(out);
+    }
+    // A term without a square to replace is kept as the object it is: expand() knows it expanded.
+    terms.push_back(term_changed ? ex(GiNaC::mul(factors)) : term);
+    changed = changed || term_changed;
+  }
+  if (!changed) return q;
+  return GiNaC::expand(GiNaC::add(terms));
+}
+
+// reduce_polynomial() for any polynomial: its calls and roots replaced by symbols, expanded, reduced
+// and substituted back.
+ex reduce_polynomial_by_symbols(const ex& p, const std::vector<Family>& families, bool eliminate_first) {
   std::vector<GiNaC::symbol> first(families.size()), second(families.size());
   GiNaC::lst to_symbols, back;
   for (std::size_t i = 0; i < families.size(); ++i) {
@@ -232,26 +297,54 @@ ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool elim
   // no_pattern: the keys hold no wildcard, so a lookup per node finds them; GiNaC's default tries
   // every key as a pattern at every node.
   ex q = GiNaC::expand(freeze(p).subs(to_symbols, GiNaC::subs_options::no_pattern));
+  std::vector<Rule> rules;
   for (std::size_t i = 0; i < families.size(); ++i) {
     const GiNaC::symbol& s = first[i];
     const GiNaC::symbol& c = second[i];
-    const GiNaC::symbol& x = eliminate_first ? s : c;  // the function whose square goes
-    ex square;                                         // what x^2 becomes
     if (!families[i].hyperbolic)
-      square = 1 - GiNaC::pow(eliminate_first ? c : s, 2);
+      rules.push_back({eliminate_first ? s : c, 1 - GiNaC::pow(eliminate_first ? c : s, 2)});
     else
-      square = eliminate_first ? GiNaC::pow(c, 2) - 1 : 1 + GiNaC::pow(s, 2);
-    const int degree = q.degree(x);
-    if (degree < 2 || q.ldegree(x) < 0) continue;
-    ex reduced = 0;
-    for (int k = 0; k <= degree; ++k) {
-      const ex coefficient = q.coeff(x, k);
-      if (coefficient.is_zero()) continue;
-      reduced += coefficient * GiNaC::pow(x, k % 2) * GiNaC::pow(square, k / 2);
+      rules.push_back({eliminate_first ? s : c, eliminate_first ? GiNaC::pow(c, 2) - 1 : 1 + GiNaC::pow(s, 2)});
+  }
+  if (const std::optional<ex> at_once = reduce_terms(q, rules)) {
+    q = *at_once;
+  } else {
+    for (const Rule& rule : rules) {
+      const int degree = q.degree(rule.x);
+      if (degree < 2 || q.ldegree(rule.x) < 0) continue;
+      ex reduced = 0;
+      for (int k = 0; k <= degree; ++k) {
+        const ex coefficient = q.coeff(rule.x, k);
+        if (coefficient.is_zero()) continue;
+        reduced += coefficient * GiNaC::pow(rule.x, k % 2) * GiNaC::pow(rule.square, k / 2);
+      }
+      q = GiNaC::expand(reduced);
     }
-    q = GiNaC::expand(reduced);
   }
   return q.subs(back, GiNaC::subs_options::no_pattern).subs(freeze.back, GiNaC::subs_options::no_pattern);
+}
+
+// Reduces a polynomial modulo the relations of the families: with s, c the two functions of a
+// family, eliminate_first replaces s^2 by 1 - c^2 (sinh^2 by cosh^2 - 1), otherwise c^2 by
+// 1 - s^2 (cosh^2 by 1 + sinh^2). The result has degree at most 1 in the eliminated function.
+// p is expanded (reduce() passes the parts of a normal fraction): its terms are reduced as they
+// are, on the calls themselves, which gives the polynomial that replacing the calls and roots by
+// symbols, expanding, reducing and substituting back gives (expand() of what is expanded already
+// writes it again, and the substitutions are undone one for one), and p itself where nothing is
+// reduced, without those passes over all of p.
+ex reduce_polynomial(const ex& p, const std::vector<Family>& families, bool eliminate_first) {
+  std::vector<Rule> on_calls;
+  for (const Family& family : families) {
+    const ex& u = family.argument;
+    const ex f = family.hyperbolic ? GiNaC::sinh(u) : GiNaC::sin(u);
+    const ex g = family.hyperbolic ? GiNaC::cosh(u) : GiNaC::cos(u);
+    if (!family.hyperbolic)
+      on_calls.push_back({eliminate_first ? f : g, 1 - GiNaC::pow(eliminate_first ? g : f, 2)});
+    else
+      on_calls.push_back({eliminate_first ? f : g, eliminate_first ? GiNaC::pow(g, 2) - 1 : 1 + GiNaC::pow(f, 2)});
+  }
+  if (const std::optional<ex> direct = reduce_terms(p, on_calls)) return *direct;
+  return reduce_polynomial_by_symbols(p, families, eliminate_first);
 }
 
 // True when a power of a sine, cosine, sinh or cosh occurs anywhere in e (inside roots and
@@ -273,10 +366,21 @@ Fraction reduce(const Fraction& start, const std::vector<Family>& families, bool
   Fraction f = start;
   // Cancelling common factors cannot raise the degree in the eliminated function, so one round
   // usually suffices; a few more make sure a fixpoint is reached.
+  // normal_fraction() gives the same result for the same expression, and its result written as a
+  // quotient is usually its argument again: the round that confirms the fixpoint then hands it the
+  // argument of the round before, and takes that round's result instead of normalizing again.
+  ex argument;
+  Fraction result;
   for (int round = 0; round < 4; ++round) {
     const ex n = reduce_polynomial(f.numerator, families, eliminate_first);
     const ex d = reduce_polynomial(f.denominator, families, eliminate_first);
-    const Fraction next = normal_fraction(n / d);
+    const ex quotient = n / d;
+    const bool known = round > 0 && quotient.is_equal(argument);
+    if (!known) {
+      argument = quotient;
+      result = normal_fraction(quotient);
+    }
+    const Fraction next = result;
     const bool same = next.numerator.is_equal(f.numerator) && next.denominator.is_equal(f.denominator);
     f = next;
     if (same || f.numerator.is_zero()) break;

@@ -1,6 +1,7 @@
 // GiNaC's derivative without the terms that are 0 (derivative.hpp).
 #include "nhdyn/symbolic/detail/derivative.hpp"
 
+#include <unordered_map>
 #include <utility>
 
 #include "nhdyn/symbolic/detail/pairs.hpp"
@@ -31,10 +32,17 @@ bool contains(const ex& e, const GiNaC::symbol& s) {
   return false;
 }
 
-}  // namespace
+// The memo of this thread while a DerivativeMemo lives, by the address of the object differentiated.
+struct Remembered {
+  ex e;  // the object differentiated, held so that its address stays its own
+  ex s;
+  ex derivative;
+};
+using Memo = std::unordered_multimap<const GiNaC::basic*, Remembered>;
+thread_local Memo* active_memo = nullptr;
 
-// The factors of a product are tested before they are differentiated, and not again here.
-ex derivative_of_container(const ex& e, const GiNaC::symbol& s) {
+// derivative_of_container() by the rules, without the memo.
+ex by_rules(const ex& e, const GiNaC::symbol& s) {
   if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
     // add::derivative: each term's rest differentiated, with its coefficient.
     GiNaC::epvector terms;
@@ -66,6 +74,35 @@ ex derivative_of_container(const ex& e, const GiNaC::symbol& s) {
     return GiNaC::dynallocate<GiNaC::mul>(std::move(factors), r);
   }
   return e.diff(s);
+}
+
+}  // namespace
+
+DerivativeMemo::DerivativeMemo() {
+  if (active_memo != nullptr) return;
+  active_memo = new Memo;
+  active_ = true;
+}
+
+DerivativeMemo::~DerivativeMemo() {
+  if (!active_) return;
+  delete active_memo;
+  active_memo = nullptr;
+}
+
+// The factors of a product are tested before they are differentiated, and not again here.
+ex derivative_of_container(const ex& e, const GiNaC::symbol& s) {
+  // A symbol's or a number's derivative costs less than looking it up. Only objects held more than
+  // once are remembered: one held by its parent alone comes again only with its parent, which the
+  // memo answers first where it is shared (a large model's many small terms would only fill it).
+  const GiNaC::basic* key = &GiNaC::ex_to<GiNaC::basic>(e);
+  if (active_memo == nullptr || e.nops() == 0 || key->get_refcount() < 2) return by_rules(e, s);
+  const auto [begin, end] = active_memo->equal_range(key);
+  for (auto it = begin; it != end; ++it)
+    if (it->second.s.is_equal(s)) return it->second.derivative;
+  const ex d = by_rules(e, s);
+  active_memo->emplace(key, Remembered{e, s, d});
+  return d;
 }
 
 ex derivative(const ex& e, const GiNaC::symbol& s) { return contains(e, s) ? derivative_of_container(e, s) : ex(0); }
