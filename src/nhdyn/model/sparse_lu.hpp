@@ -5,9 +5,10 @@
 // analyses the pattern once (a block triangular form, then an ordering for each block: the chain's
 // 2998 x 2998 b_dep has 998 blocks), and after the first factorization each one reuses the pivot
 // order of the last factorization that searched for pivots (klu_refactor: no search, no
-// allocation, ten times faster than a supernodal LU that searches again). It searches again only
-// when the reused order has become poor: its smallest pivot against its largest fell a thousandfold
-// below what the search gave (docs/performance.md, "The sparse path").
+// allocation, ten times faster than a supernodal LU that searches again). A search is partial
+// pivoting proper (each pivot the largest of its column), and it searches again as soon as the
+// reused order has become poorer: its pivot growth or the ratio of its smallest to its largest
+// pivot worse by half than what the search gave (docs/design.md, "The sparse path").
 #pragma once
 
 #include <Eigen/SparseCore>
