@@ -4,6 +4,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "nhdyn/symbolic/detail/kind.hpp"
 #include "nhdyn/symbolic/detail/pairs.hpp"
 
 namespace nhdyn::symbolic::detail {
@@ -20,11 +21,16 @@ struct Product : GiNaC::mul {
 };
 
 bool contains(const ex& e, const GiNaC::symbol& s) {
-  if (GiNaC::is_exactly_a<GiNaC::add>(e) || GiNaC::is_exactly_a<GiNaC::mul>(e)) {
+  const ExKind kind = kind_of(e);
+  if (kind == ExKind::add || kind == ExKind::mul) {
     for (const GiNaC::expair& p : Pairs::of(e))
       if (contains(p.rest, s)) return true;
     return false;  // the coefficients and the number are numbers
   }
+  // An object of another class than s's is not equal to it (basic::is_equal compares the classes
+  // first), and a number or a symbol has no operands.
+  if (kind == ExKind::numeric) return false;
+  if (kind == ExKind::symbol) return e.is_equal(s);
   const std::size_t n = e.nops();
   if (n == 0) return e.is_equal(s);
   for (std::size_t i = 0; i < n; ++i)
@@ -43,14 +49,15 @@ thread_local Memo* active_memo = nullptr;
 
 // derivative_of_container() by the rules, without the memo.
 ex by_rules(const ex& e, const GiNaC::symbol& s) {
-  if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
+  const ExKind kind = kind_of(e);
+  if (kind == ExKind::add) {
     // add::derivative: each term's rest differentiated, with its coefficient.
     GiNaC::epvector terms;
     terms.reserve(Pairs::of(e).size());
     for (const GiNaC::expair& p : Pairs::of(e)) terms.push_back(GiNaC::expair(derivative(p.rest, s), p.coeff));
     return GiNaC::dynallocate<GiNaC::add>(std::move(terms));
   }
-  if (GiNaC::is_exactly_a<GiNaC::mul>(e)) {
+  if (kind == ExKind::mul) {
     // mul::derivative: the product with each factor in turn replaced by its derivative, here only
     // the factors that contain s (the others' products are 0 and drop out of the sum).
     const GiNaC::epvector& factors = Pairs::of(e);
@@ -66,7 +73,7 @@ ex by_rules(const ex& e, const GiNaC::symbol& s) {
     }
     return GiNaC::dynallocate<GiNaC::add>(terms);
   }
-  if (GiNaC::is_exactly_a<GiNaC::power>(e) && GiNaC::is_exactly_a<GiNaC::numeric>(e.op(1))) {
+  if (kind == ExKind::power && kind_of(e.op(1)) == ExKind::numeric) {
     // power::derivative for a number exponent r: D(b^r) = r b^(r - 1) D(b).
     const ex& base = e.op(0);
     const ex& r = e.op(1);
