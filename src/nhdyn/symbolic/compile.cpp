@@ -25,6 +25,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <memory_resource>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -937,6 +938,9 @@ class TapeCompiler {
   }
 
   const Spec& spec_;
+  // The memory of the tables below, given back at once when the compiler ends: a large model's
+  // tables hold 10^5 entries each, allocated one by one and never erased.
+  std::pmr::monotonic_buffer_resource arena_;
   // t, q, q' -> input register, parameter symbol -> its index; found by the symbol's GiNaC hash
   // (from its serial number, the same in every copy), then by equality.
   struct Input {
@@ -948,16 +952,16 @@ class TapeCompiler {
   void add_input(const GiNaC::symbol& x, int input, int parameter) {
     inputs_.emplace(x.gethash(), Input{x, input, parameter});
   }
-  std::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, Scaled>> translated_;
+  std::pmr::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, Scaled>> translated_{&arena_};
   std::deque<Node> nodes_;  // a deque: references stay valid while nodes are added
-  std::unordered_map<std::uint64_t, int> by_key_;  // key -> the last node made with it
+  std::pmr::unordered_map<std::uint64_t, int> by_key_{&arena_};  // key -> the last node made with it
   std::vector<int> same_key_;                       // per node: the one made before it with its key, or -1
   Tape tape_;
   struct MemoHash {
     std::size_t operator()(const MemoKey& k) const { return mix(static_cast<std::uint64_t>(k.first), k.second); }
   };
-  std::unordered_map<MemoKey, int, MemoHash> memo_;
-  std::unordered_map<std::uint64_t, int> constants_;  // by the bits of the value
+  std::pmr::unordered_map<MemoKey, int, MemoHash> memo_{&arena_};
+  std::pmr::unordered_map<std::uint64_t, int> constants_{&arena_};  // by the bits of the value
   std::string what_;
   GiNaC::ex original_;
 };
