@@ -8,7 +8,6 @@
 #include <cstring>
 #include <functional>
 #include <iterator>
-#include <map>
 #include <memory>
 #include <queue>
 #include <stdexcept>
@@ -571,29 +570,34 @@ std::vector<Step> schedule(const std::vector<Step>& steps, std::size_t registers
   }
   // The ready steps, smallest first: all of them, and by run key. A step taken through its key
   // stays in `ready` until it comes to the top, where it is dropped.
+  // A key (two bytes) has its heap in ready_by_key at slot[key], made when a step of it is first ready.
   using Earliest = std::priority_queue<int, std::vector<int>, std::greater<int>>;
-  std::map<unsigned, Earliest> ready_by_key;
+  std::vector<int> slot(std::size_t{1} << 16, -1);
+  std::vector<Earliest> ready_by_key;
   Earliest ready;
   std::vector<char> taken(m, 0);
   const auto make_ready = [&](int i) {
     ready.push(i);
-    ready_by_key[run_key(&steps[at(i)])].push(i);
+    int& k = slot[run_key(&steps[at(i)])];
+    if (k < 0) {
+      k = static_cast<int>(ready_by_key.size());
+      ready_by_key.emplace_back();
+    }
+    ready_by_key[at(k)].push(i);
   };
   for (std::size_t i = 0; i < m; ++i)
     if (pending[i] == 0) make_ready(static_cast<int>(i));
   std::vector<Step> out;
   out.reserve(m);
-  unsigned key = ~0u;
+  unsigned key = ~0u;  // no step's key
   for (;;) {
     while (!ready.empty() && taken[at(ready.top())]) ready.pop();
     if (ready.empty()) break;
-    auto same = ready_by_key.find(key);
-    if (same == ready_by_key.end() || same->second.empty()) {
+    if (key >= slot.size() || slot[key] < 0 || ready_by_key[at(slot[key])].empty())
       key = run_key(&steps[at(ready.top())]);
-      same = ready_by_key.find(key);
-    }
-    const int i = same->second.top();
-    same->second.pop();
+    Earliest& same = ready_by_key[at(slot[key])];
+    const int i = same.top();
+    same.pop();
     taken[at(i)] = 1;
     out.push_back(steps[at(i)]);
     for (int e = first[at(i)]; e < first[at(i) + 1]; ++e)
