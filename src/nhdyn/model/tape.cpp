@@ -568,9 +568,10 @@ std::vector<Step> schedule(const std::vector<Step>& steps, std::size_t registers
     std::vector<int> fill(first.begin(), first.end() - 1);
     for (std::size_t e = 0; e < reader_of.size(); e += 2) next[at(fill[at(reader_of[e])]++)] = reader_of[e + 1];
   }
-  // The ready steps, smallest first: all of them, and by run key. A step taken through its key
-  // stays in `ready` until it comes to the top, where it is dropped.
-  // A key (two bytes) has its heap in ready_by_key at slot[key], made when a step of it is first ready.
+  // The ready steps, smallest first: all of them in `ready`, and those of each run key in their
+  // own heap, ready_by_key[slot[key]] (a key is two bytes; its heap is made when a step of it is
+  // first ready). A step taken through its key stays in `ready` until it comes to the top, where
+  // it is dropped.
   using Earliest = std::priority_queue<int, std::vector<int>, std::greater<int>>;
   std::vector<int> slot(std::size_t{1} << 16, -1);
   std::vector<Earliest> ready_by_key;
