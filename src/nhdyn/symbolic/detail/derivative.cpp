@@ -1,6 +1,7 @@
 // GiNaC's derivative without the terms that are 0 (derivative.hpp).
 #include "nhdyn/symbolic/detail/derivative.hpp"
 
+#include <memory_resource>
 #include <unordered_map>
 #include <utility>
 
@@ -44,7 +45,11 @@ struct Remembered {
   ex s;
   ex derivative;
 };
-using Memo = std::unordered_multimap<const GiNaC::basic*, Remembered>;
+// Its entries' memory is given back at once when it ends: it is only ever added to.
+struct Memo {
+  std::pmr::monotonic_buffer_resource arena;
+  std::pmr::unordered_multimap<const GiNaC::basic*, Remembered> entries{&arena};
+};
 thread_local Memo* active_memo = nullptr;
 
 // derivative_of_container() by the rules, without the memo.
@@ -104,11 +109,11 @@ ex derivative_of_container(const ex& e, const GiNaC::symbol& s) {
   // memo answers first where it is shared (a large model's many small terms would only fill it).
   const GiNaC::basic* key = &GiNaC::ex_to<GiNaC::basic>(e);
   if (active_memo == nullptr || e.nops() == 0 || key->get_refcount() < 2) return by_rules(e, s);
-  const auto [begin, end] = active_memo->equal_range(key);
+  const auto [begin, end] = active_memo->entries.equal_range(key);
   for (auto it = begin; it != end; ++it)
     if (it->second.s.is_equal(s)) return it->second.derivative;
   const ex d = by_rules(e, s);
-  active_memo->emplace(key, Remembered{e, s, d});
+  active_memo->entries.emplace(key, Remembered{e, s, d});
   return d;
 }
 
