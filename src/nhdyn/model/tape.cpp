@@ -6,10 +6,10 @@
 #include <cstddef>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <iterator>
-#include <map>
 #include <memory>
-#include <set>
+#include <queue>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -538,46 +538,71 @@ double fold(const Instruction& in, double a, double b, double c, double* cosine)
 // model's sums of products interleave mul, muladd and mulk_add step by step).
 std::vector<Step> schedule(const std::vector<Step>& steps, std::size_t registers) {
   const std::size_t m = steps.size();
+  const auto at = [](int i) { return static_cast<std::size_t>(i); };
+  // The steps that read each step's result, in tape order (next[first[i]] .. next[first[i + 1]]):
+  // counted, then filled, in one array rather than a vector per step.
   std::vector<int> writer(registers, -1);
   std::vector<int> pending(m, 0);
-  std::vector<std::vector<int>> next(m);
+  std::vector<int> reader_of;  // per operand read from a step: (writer, reader) pairs
+  reader_of.reserve(2 * m);
   for (std::size_t i = 0; i < m; ++i) {
     const Step& s = steps[i];
     const int operands[3] = {s.a, s.b, s.c};
     for (int k = 0; k < operand_count(s.op); ++k) {
-      const int w = writer[static_cast<std::size_t>(operands[k])];
+      const int w = writer[at(operands[k])];
       if (w < 0) continue;  // an input
-      next[static_cast<std::size_t>(w)].push_back(static_cast<int>(i));
+      reader_of.push_back(w);
+      reader_of.push_back(static_cast<int>(i));
       ++pending[i];
     }
     if (s.dest == 0) {
-      writer[static_cast<std::size_t>(s.to)] = static_cast<int>(i);
-      if (s.op == Op::sincos) writer[static_cast<std::size_t>(s.to) + 1] = static_cast<int>(i);
+      writer[at(s.to)] = static_cast<int>(i);
+      if (s.op == Op::sincos) writer[at(s.to) + 1] = static_cast<int>(i);
     }
   }
-  std::map<unsigned, std::set<int>> ready_by_key;
-  std::set<int> ready;
+  std::vector<int> first(m + 1, 0);
+  for (std::size_t e = 0; e < reader_of.size(); e += 2) ++first[at(reader_of[e]) + 1];
+  for (std::size_t i = 0; i < m; ++i) first[i + 1] += first[i];
+  std::vector<int> next(reader_of.size() / 2);
+  {
+    std::vector<int> fill(first.begin(), first.end() - 1);
+    for (std::size_t e = 0; e < reader_of.size(); e += 2) next[at(fill[at(reader_of[e])]++)] = reader_of[e + 1];
+  }
+  // The ready steps, smallest first: all of them in `ready`, and those of each run key in their
+  // own heap, ready_by_key[slot[key]] (a key is two bytes; its heap is made when a step of it is
+  // first ready). A step taken through its key stays in `ready` until it comes to the top, where
+  // it is dropped.
+  using Earliest = std::priority_queue<int, std::vector<int>, std::greater<int>>;
+  std::vector<int> slot(std::size_t{1} << 16, -1);
+  std::vector<Earliest> ready_by_key;
+  Earliest ready;
+  std::vector<char> taken(m, 0);
   const auto make_ready = [&](int i) {
-    ready.insert(i);
-    ready_by_key[run_key(&steps[static_cast<std::size_t>(i)])].insert(i);
+    ready.push(i);
+    int& k = slot[run_key(&steps[at(i)])];
+    if (k < 0) {
+      k = static_cast<int>(ready_by_key.size());
+      ready_by_key.emplace_back();
+    }
+    ready_by_key[at(k)].push(i);
   };
   for (std::size_t i = 0; i < m; ++i)
     if (pending[i] == 0) make_ready(static_cast<int>(i));
   std::vector<Step> out;
   out.reserve(m);
-  unsigned key = ~0u;
-  while (!ready.empty()) {
-    auto same = ready_by_key.find(key);
-    if (same == ready_by_key.end() || same->second.empty()) {
-      key = run_key(&steps[static_cast<std::size_t>(*ready.begin())]);
-      same = ready_by_key.find(key);
-    }
-    const int i = *same->second.begin();
-    same->second.erase(same->second.begin());
-    ready.erase(i);
-    out.push_back(steps[static_cast<std::size_t>(i)]);
-    for (int j : next[static_cast<std::size_t>(i)])
-      if (--pending[static_cast<std::size_t>(j)] == 0) make_ready(j);
+  unsigned key = ~0u;  // no step's key
+  for (;;) {
+    while (!ready.empty() && taken[at(ready.top())]) ready.pop();
+    if (ready.empty()) break;
+    if (key >= slot.size() || slot[key] < 0 || ready_by_key[at(slot[key])].empty())
+      key = run_key(&steps[at(ready.top())]);
+    Earliest& same = ready_by_key[at(slot[key])];
+    const int i = same.top();
+    same.pop();
+    taken[at(i)] = 1;
+    out.push_back(steps[at(i)]);
+    for (int e = first[at(i)]; e < first[at(i) + 1]; ++e)
+      if (--pending[at(next[at(e)])] == 0) make_ready(next[at(e)]);
   }
   return out;
 }

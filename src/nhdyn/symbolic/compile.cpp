@@ -25,6 +25,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <memory_resource>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -40,6 +41,7 @@
 #include "nhdyn/symbolic/events.hpp"
 #include "nhdyn/symbolic/outputs.hpp"
 #include "nhdyn/symbolic/detail/derivative.hpp"
+#include "nhdyn/symbolic/detail/kind.hpp"
 #include "nhdyn/symbolic/detail/pairs.hpp"
 #include "nhdyn/symbolic/detail/plain_words.hpp"
 
@@ -500,7 +502,7 @@ class TapeCompiler {
   // The term c x of a sum (x its pair's rest, c != 1): GiNaC's product of x and c, whose factors
   // are x's (x a product, its number times c) or x itself.
   Scaled term(const GiNaC::ex& x, const GiNaC::numeric& c) {
-    if (GiNaC::is_exactly_a<GiNaC::mul>(x))
+    if (detail::kind_of(x) == detail::ExKind::mul)
       return product(detail::Pairs::of(x), GiNaC::ex_to<GiNaC::numeric>(detail::Pairs::number(x)).mul(c));
     return product(GiNaC::epvector{GiNaC::expair(x, 1)}, c);
   }
@@ -534,45 +536,55 @@ class TapeCompiler {
   // builds a product c x for each term with a coefficient and a power x^k for each factor with an
   // exponent: each is translated as translate() would translate that product or power.
   Scaled translate(const GiNaC::ex& e) {
-    if (GiNaC::is_exactly_a<GiNaC::numeric>(e)) return {real_number(GiNaC::ex_to<GiNaC::numeric>(e)), kOne};
-    if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
-      std::vector<Scaled> terms;
-      std::vector<double> numbers;
-      for (const GiNaC::expair& p : detail::Pairs::of(e)) {
-        const Scaled t = p.coeff.is_equal(1) ? canonical(p.rest) : term(p.rest, GiNaC::ex_to<GiNaC::numeric>(p.coeff));
-        if (t.id == kOne)
-          numbers.push_back(t.c);
-        else
-          terms.push_back(t);
+    switch (detail::kind_of(e)) {
+      case detail::ExKind::numeric: return {real_number(GiNaC::ex_to<GiNaC::numeric>(e)), kOne};
+      case detail::ExKind::add: return sum_of(e);
+      case detail::ExKind::mul:
+        return product(detail::Pairs::of(e), GiNaC::ex_to<GiNaC::numeric>(detail::Pairs::number(e)));
+      case detail::ExKind::symbol: return {1.0, symbol(GiNaC::ex_to<GiNaC::symbol>(e))};
+      case detail::ExKind::constant: {
+        const GiNaC::ex value = e.evalf();
+        if (GiNaC::is_exactly_a<GiNaC::numeric>(value)) return {real_number(GiNaC::ex_to<GiNaC::numeric>(value)), kOne};
+        fail(fmt::format("contains the constant '{}', which has no numeric value", to_text(e)));
       }
-      if (!detail::Pairs::number(e).is_zero()) numbers.push_back(translate(detail::Pairs::number(e)).c);
-      return make_add(std::move(terms), sum(std::move(numbers)));
+      case detail::ExKind::power: return power_of(e);
+      case detail::ExKind::function: return function(e);
+      case detail::ExKind::other: break;
     }
-    if (GiNaC::is_exactly_a<GiNaC::mul>(e))
-      return product(detail::Pairs::of(e), GiNaC::ex_to<GiNaC::numeric>(detail::Pairs::number(e)));
+    // A subclass of symbol or function.
     if (GiNaC::is_a<GiNaC::symbol>(e)) return {1.0, symbol(GiNaC::ex_to<GiNaC::symbol>(e))};
-    if (GiNaC::is_exactly_a<GiNaC::constant>(e)) {
-      const GiNaC::ex value = e.evalf();
-      if (GiNaC::is_exactly_a<GiNaC::numeric>(value)) return {real_number(GiNaC::ex_to<GiNaC::numeric>(value)), kOne};
-      fail(fmt::format("contains the constant '{}', which has no numeric value", to_text(e)));
-    }
-    if (GiNaC::is_exactly_a<GiNaC::power>(e)) {
-      const Scaled base = canonical(e.op(0));
-      const GiNaC::ex exponent = e.op(1);
-      if (GiNaC::is_exactly_a<GiNaC::numeric>(exponent))
-        return make_power(base, real_number(GiNaC::ex_to<GiNaC::numeric>(exponent)));
-      const Scaled p = canonical(exponent);
-      if (p.id == kOne) return make_power(base, p.c);
-      Node n;
-      n.kind = Kind::power;
-      n.items = {base, p};
-      n.exponent = std::numeric_limits<double>::quiet_NaN();  // not a number exponent
-      n.parameters_only = node(base.id).parameters_only && node(p.id).parameters_only;
-      return {1.0, intern(std::move(n))};
-    }
     if (GiNaC::is_a<GiNaC::function>(e)) return function(e);
     fail(fmt::format("contains '{}' (a GiNaC {}), which is not a scalar expression the compiler handles",
                      to_text(e), GiNaC::ex_to<GiNaC::basic>(e).class_name()));
+  }
+
+  Scaled sum_of(const GiNaC::ex& e) {
+    std::vector<Scaled> terms;
+    std::vector<double> numbers;
+    for (const GiNaC::expair& p : detail::Pairs::of(e)) {
+      const Scaled t = p.coeff.is_equal(1) ? canonical(p.rest) : term(p.rest, GiNaC::ex_to<GiNaC::numeric>(p.coeff));
+      if (t.id == kOne)
+        numbers.push_back(t.c);
+      else
+        terms.push_back(t);
+    }
+    if (!detail::Pairs::number(e).is_zero()) numbers.push_back(translate(detail::Pairs::number(e)).c);
+    return make_add(std::move(terms), sum(std::move(numbers)));
+  }
+
+  Scaled power_of(const GiNaC::ex& e) {
+    const Scaled base = canonical(e.op(0));
+    const GiNaC::ex exponent = e.op(1);
+    if (GiNaC::is_exactly_a<GiNaC::numeric>(exponent))
+      return make_power(base, real_number(GiNaC::ex_to<GiNaC::numeric>(exponent)));
+    const Scaled p = canonical(exponent);
+    if (p.id == kOne) return make_power(base, p.c);
+    Node n;
+    n.kind = Kind::power;
+    n.items = {base, p};
+    n.exponent = std::numeric_limits<double>::quiet_NaN();  // not a number exponent
+    n.parameters_only = node(base.id).parameters_only && node(p.id).parameters_only;
+    return {1.0, intern(std::move(n))};
   }
 
   int symbol(const GiNaC::symbol& x) {
@@ -926,6 +938,9 @@ class TapeCompiler {
   }
 
   const Spec& spec_;
+  // The memory of the tables below, given back at once when the compiler ends: a large model's
+  // tables hold 10^5 entries each, allocated one by one and never erased.
+  std::pmr::monotonic_buffer_resource arena_;
   // t, q, q' -> input register, parameter symbol -> its index; found by the symbol's GiNaC hash
   // (from its serial number, the same in every copy), then by equality.
   struct Input {
@@ -937,16 +952,16 @@ class TapeCompiler {
   void add_input(const GiNaC::symbol& x, int input, int parameter) {
     inputs_.emplace(x.gethash(), Input{x, input, parameter});
   }
-  std::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, Scaled>> translated_;
+  std::pmr::unordered_map<const GiNaC::basic*, std::pair<GiNaC::ex, Scaled>> translated_{&arena_};
   std::deque<Node> nodes_;  // a deque: references stay valid while nodes are added
-  std::unordered_map<std::uint64_t, int> by_key_;  // key -> the last node made with it
+  std::pmr::unordered_map<std::uint64_t, int> by_key_{&arena_};  // key -> the last node made with it
   std::vector<int> same_key_;                       // per node: the one made before it with its key, or -1
   Tape tape_;
   struct MemoHash {
     std::size_t operator()(const MemoKey& k) const { return mix(static_cast<std::uint64_t>(k.first), k.second); }
   };
-  std::unordered_map<MemoKey, int, MemoHash> memo_;
-  std::unordered_map<std::uint64_t, int> constants_;  // by the bits of the value
+  std::pmr::unordered_map<MemoKey, int, MemoHash> memo_{&arena_};
+  std::pmr::unordered_map<std::uint64_t, int> constants_{&arena_};  // by the bits of the value
   std::string what_;
   GiNaC::ex original_;
 };

@@ -1,9 +1,11 @@
 // GiNaC's derivative without the terms that are 0 (derivative.hpp).
 #include "nhdyn/symbolic/detail/derivative.hpp"
 
+#include <memory_resource>
 #include <unordered_map>
 #include <utility>
 
+#include "nhdyn/symbolic/detail/kind.hpp"
 #include "nhdyn/symbolic/detail/pairs.hpp"
 
 namespace nhdyn::symbolic::detail {
@@ -20,11 +22,16 @@ struct Product : GiNaC::mul {
 };
 
 bool contains(const ex& e, const GiNaC::symbol& s) {
-  if (GiNaC::is_exactly_a<GiNaC::add>(e) || GiNaC::is_exactly_a<GiNaC::mul>(e)) {
+  const ExKind kind = kind_of(e);
+  if (kind == ExKind::add || kind == ExKind::mul) {
     for (const GiNaC::expair& p : Pairs::of(e))
       if (contains(p.rest, s)) return true;
     return false;  // the coefficients and the number are numbers
   }
+  // An object of another class than s's is not equal to it (basic::is_equal compares the classes
+  // first), and a number or a symbol has no operands.
+  if (kind == ExKind::numeric) return false;
+  if (kind == ExKind::symbol) return e.is_equal(s);
   const std::size_t n = e.nops();
   if (n == 0) return e.is_equal(s);
   for (std::size_t i = 0; i < n; ++i)
@@ -38,19 +45,24 @@ struct Remembered {
   ex s;
   ex derivative;
 };
-using Memo = std::unordered_multimap<const GiNaC::basic*, Remembered>;
+// Its entries' memory is given back at once when it ends: it is only ever added to.
+struct Memo {
+  std::pmr::monotonic_buffer_resource arena;
+  std::pmr::unordered_multimap<const GiNaC::basic*, Remembered> entries{&arena};
+};
 thread_local Memo* active_memo = nullptr;
 
 // derivative_of_container() by the rules, without the memo.
 ex by_rules(const ex& e, const GiNaC::symbol& s) {
-  if (GiNaC::is_exactly_a<GiNaC::add>(e)) {
+  const ExKind kind = kind_of(e);
+  if (kind == ExKind::add) {
     // add::derivative: each term's rest differentiated, with its coefficient.
     GiNaC::epvector terms;
     terms.reserve(Pairs::of(e).size());
     for (const GiNaC::expair& p : Pairs::of(e)) terms.push_back(GiNaC::expair(derivative(p.rest, s), p.coeff));
     return GiNaC::dynallocate<GiNaC::add>(std::move(terms));
   }
-  if (GiNaC::is_exactly_a<GiNaC::mul>(e)) {
+  if (kind == ExKind::mul) {
     // mul::derivative: the product with each factor in turn replaced by its derivative, here only
     // the factors that contain s (the others' products are 0 and drop out of the sum).
     const GiNaC::epvector& factors = Pairs::of(e);
@@ -66,7 +78,7 @@ ex by_rules(const ex& e, const GiNaC::symbol& s) {
     }
     return GiNaC::dynallocate<GiNaC::add>(terms);
   }
-  if (GiNaC::is_exactly_a<GiNaC::power>(e) && GiNaC::is_exactly_a<GiNaC::numeric>(e.op(1))) {
+  if (kind == ExKind::power && kind_of(e.op(1)) == ExKind::numeric) {
     // power::derivative for a number exponent r: D(b^r) = r b^(r - 1) D(b).
     const ex& base = e.op(0);
     const ex& r = e.op(1);
@@ -97,11 +109,11 @@ ex derivative_of_container(const ex& e, const GiNaC::symbol& s) {
   // memo answers first where it is shared (a large model's many small terms would only fill it).
   const GiNaC::basic* key = &GiNaC::ex_to<GiNaC::basic>(e);
   if (active_memo == nullptr || e.nops() == 0 || key->get_refcount() < 2) return by_rules(e, s);
-  const auto [begin, end] = active_memo->equal_range(key);
+  const auto [begin, end] = active_memo->entries.equal_range(key);
   for (auto it = begin; it != end; ++it)
     if (it->second.s.is_equal(s)) return it->second.derivative;
   const ex d = by_rules(e, s);
-  active_memo->emplace(key, Remembered{e, s, d});
+  active_memo->entries.emplace(key, Remembered{e, s, d});
   return d;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "nhdyn/symbolic/detail/kind.hpp"
 #include "nhdyn/symbolic/detail/pairs.hpp"
 
 namespace nhdyn::symbolic {
@@ -12,7 +13,8 @@ namespace {
 // coefficients and exponents are numbers, so the symbols are in the rests.
 template <class F>
 void for_each_leaf(const GiNaC::ex& e, F& f) {
-  if (GiNaC::is_exactly_a<GiNaC::add>(e) || GiNaC::is_exactly_a<GiNaC::mul>(e)) {
+  const detail::ExKind kind = detail::kind_of(e);
+  if (kind == detail::ExKind::add || kind == detail::ExKind::mul) {
     for (const GiNaC::expair& p : detail::Pairs::of(e)) for_each_leaf(p.rest, f);
     return;
   }
@@ -34,7 +36,9 @@ void sort_unique(std::vector<int>& indices) {
 SymbolSet symbols_of(const GiNaC::ex& e) {
   SymbolSet out;
   const auto collect = [&](const GiNaC::ex& leaf) {
-    if (GiNaC::is_a<GiNaC::symbol>(leaf)) out.insert(leaf);
+    const detail::ExKind kind = detail::kind_of(leaf);
+    if (kind == detail::ExKind::symbol || (kind == detail::ExKind::other && GiNaC::is_a<GiNaC::symbol>(leaf)))
+      out.insert(leaf);
   };
   for_each_leaf(e, collect);
   return out;
@@ -68,6 +72,7 @@ bool SymbolIndex::is_velocity(const GiNaC::ex& e) const {
 Contained SymbolIndex::find(const GiNaC::ex& e) const {
   Contained out;
   const auto record = [&](const GiNaC::ex& leaf) {
+    if (detail::kind_of(leaf) == detail::ExKind::numeric) return;  // equal to no symbol of the index
     const Entry* entry = lookup(leaf);
     if (entry == nullptr) return;
     switch (entry->kind) {
