@@ -29,10 +29,6 @@ std::string quote_if_needed(const std::string& name) {
   return out + "\"";
 }
 
-}  // namespace
-
-namespace {
-
 // Formatted text is written to the file in pieces of about this size.
 constexpr std::size_t kFlushBytes = std::size_t{1} << 15;
 // A table that has passed this much text starts its formatting thread (CsvWriter::Formatter): by
