@@ -16,7 +16,13 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // columns: O(nonzeros).
 void row_norms(const Data& data, Vector& out) {
   if (!data.sparse) {
-    for (Eigen::Index i = 0; i < out.size(); ++i) out(i) = data.b.row(i).norm();
+    const Eigen::Index s = out.size(), n = data.b.cols();
+    const double* b = data.b.data();
+    for (Eigen::Index i = 0; i < s; ++i) {
+      double sum = 0.0;
+      for (Eigen::Index c = 0; c < n; ++c) sum += b[i + s * c] * b[i + s * c];
+      out(i) = std::sqrt(sum);
+    }
     return;
   }
   out.setZero();
@@ -57,16 +63,43 @@ double stacked_condition(const Model& model, const Data& data, ConstraintWatch& 
   const int k = model.k();
   const int s = model.s();
   Matrix& rows = watch.rows;
-  if (watch.stacked && k > 0) rows.topRows(k).noalias() = data.D * data.A;
-  rows.bottomRows(s) = data.b;
-  const Eigen::Index top = rows.rows() - s;
+  // Plain loops over the column-major storage: this runs at every accepted step, and at the
+  // sizes where that matters (a few coordinates) Eigen's dynamic-size product and row
+  // expressions cost more in dispatch than in arithmetic.
+  const Eigen::Index n = rows.cols(), watched = rows.rows();
+  const Eigen::Index top = watched - s;
+  double* M = rows.data();
+  if (watch.stacked && k > 0) {
+    const double* D = data.D.data();
+    const double* A = data.A.data();
+    for (Eigen::Index c = 0; c < n; ++c)
+      for (Eigen::Index i = 0; i < k; ++i) {
+        double acc = 0.0;
+        for (Eigen::Index l = 0; l < n; ++l) acc += D[i + k * l] * A[l + n * c];
+        M[i + watched * c] = acc;
+      }
+  }
+  const double* b = data.b.data();
+  for (Eigen::Index c = 0; c < n; ++c)
+    for (Eigen::Index i = 0; i < s; ++i) M[top + i + watched * c] = b[i + s * c];
+  const double* estimated = watch.estimated_rows.data();
   double moved = 0.0;  // ||M - M at the last estimate||_F^2, in the same pass as the scaling
-  for (Eigen::Index i = 0; i < rows.rows(); ++i) {
+  for (Eigen::Index i = 0; i < watched; ++i) {
     // The rows of b have their norms in watch.norm already.
-    const double norm = i < top ? rows.row(i).norm() : watch.norm(i - top);
+    double norm = 0.0;
+    if (i < top) {
+      for (Eigen::Index c = 0; c < n; ++c) norm += M[i + watched * c] * M[i + watched * c];
+      norm = std::sqrt(norm);
+    } else {
+      norm = watch.norm(i - top);
+    }
     if (!std::isfinite(norm)) return kInfinity;
-    if (norm > 0.0) rows.row(i) /= norm;
-    moved += (rows.row(i) - watch.estimated_rows.row(i)).squaredNorm();
+    const double scale = norm > 0.0 ? norm : 1.0;
+    for (Eigen::Index c = 0; c < n; ++c) {
+      M[i + watched * c] /= scale;
+      const double d = M[i + watched * c] - estimated[i + watched * c];
+      moved += d * d;
+    }
   }
   if (moved <= watch.reuse_radius * watch.reuse_radius && watch.reuse_radius > 0.0) {
     last = watch.last_pivot;

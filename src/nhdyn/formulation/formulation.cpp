@@ -6,6 +6,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/detail/finite.hpp"
 #include "nhdyn/formulation/contact_modes.hpp"
+#include "nhdyn/formulation/detail/small_dense.hpp"
 #include "nhdyn/formulation/lagrange.hpp"
 #include "nhdyn/formulation/nullspace.hpp"
 #include "nhdyn/formulation/program_motion.hpp"
@@ -47,6 +48,25 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
     throw InputError("model '" + model.name + "' has programs ([[programs]]), which only the sanh formulation solves, "
                      "on the dense path (docs/derivations/program-motion.md); choose --method sanh");
   data.has_multipliers = false;
+  // The common small case in one fused kernel (small_dense.hpp's sanh_qr): the same operations
+  // and checks, in the same order, as the general path below.
+  if (options.method == Formulation::sanh && options.complement == Complement::qr && !options.baumgarte.enabled &&
+      !data.modes.active && !data.sparse && model.m() == 0 && data.small_kernels)
+    if (const small::Kernels* kernels = small::find_kernels(model.n(), model.s())) {
+      switch (kernels->sanh_qr(data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data(),
+                               data.D.data(), data.h.data(), data.qdd.data(), data.R.data())) {
+        case small::SanhResult::ok: break;
+        case small::SanhResult::dependent_constraints:
+          return record_failure(data, Status::dependent_constraints, "constraint matrix b");
+        case small::SanhResult::singular:
+          return record_failure(data, Status::singular_system, "stacked matrix [D A; b]");
+        case small::SanhResult::non_finite_qdd: return record_failure(data, Status::non_finite, "accelerations q''");
+        case small::SanhResult::non_finite_R: return record_failure(data, Status::non_finite, "reactions R");
+      }
+      data.stage = Stage::acceleration;
+      ++data.acceleration_solves;
+      return Status::ok;
+    }
   if (options.baumgarte.enabled) {
     compute_baumgarte_terms(model, data, options.baumgarte);
     data.b0_model = data.b0;

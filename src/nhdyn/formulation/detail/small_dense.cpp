@@ -9,7 +9,7 @@ namespace {
 template <int N, int... S>
 constexpr void fill_row(std::array<std::array<Kernels, kSmallMaxN + 1>, kSmallMaxN + 1>& table,
                         std::integer_sequence<int, S...>) {
-  ((table[N][S] = Kernels{&null_space_basis<N, S>, &solve_stacked<N, S>}), ...);
+  ((table[N][S] = Kernels{&null_space_basis<N, S>, &solve_stacked<N, S>, &sanh_qr<N, S>}), ...);
 }
 
 template <int... N>

@@ -98,7 +98,7 @@ bool null_space_basis(const double* b, double* D) {
 // compiler keeps the matrix in registers (an exchange through a run-time index stored entries one
 // by one that the next column's update then loaded two at a time, which stalls the load).
 template <int N>
-[[gnu::always_inline]] inline bool eliminate(std::array<double, N * N>& M, std::array<double, N>& r) {
+[[gnu::always_inline]] inline bool eliminate(std::array<double, N * N>& M, std::array<double, N>& r, std::array<double, N>& inverse) {
   double largest = 0.0;
   double smallest = std::numeric_limits<double>::infinity();
 #pragma GCC unroll 8
@@ -130,6 +130,7 @@ template <int N>
     largest = std::max(largest, std::abs(pivot));
     smallest = std::min(smallest, std::abs(pivot));
     if (pivot == 0.0) return false;
+    inverse[c] = 1.0 / pivot;
     // A division, not a product with 1/pivot: a row equal to the pivot row then has l = 1 exactly
     // and cancels to zero, so that dependent rows are found singular as Eigen finds them. The
     // multipliers are kept in the pivot's column.
@@ -181,7 +182,8 @@ bool solve_stacked(const double* A, const double* Q, const double* G, const doub
         for (int c = 0; c < N; ++c) M[i + N * c] = std::ldexp(M[i + N * c], -exponent);
         r[i] = std::ldexp(r[i], -exponent);
       });
-  const bool regular = eliminate<N>(M, r);
+  std::array<double, N> inverse;
+  const bool regular = eliminate<N>(M, r, inverse);
   if (!regular) return false;
   // In a local array, not through the output pointer, which may alias the inputs as far as the
   // compiler knows: each entry would be stored and loaded again by the next row.
@@ -191,7 +193,7 @@ bool solve_stacked(const double* A, const double* Q, const double* G, const doub
     double acc = r[i];
 #pragma GCC unroll 8
     for (int j = i + 1; j < N; ++j) acc -= M[i + N * j] * x[j];
-    x[i] = acc / M[i + N * i];
+    x[i] = i == N - 1 ? acc / M[i + N * i] : acc * inverse[i];
   }
   for (int i = 0; i < N; ++i) {
     double acc = -h[i];
@@ -200,6 +202,28 @@ bool solve_stacked(const double* A, const double* Q, const double* G, const doub
   }
   std::copy(x.begin(), x.end(), qdd);
   return true;
+}
+
+// What sanh_qr found: the first failure in the order the separate kernels and checks meet them.
+enum class SanhResult { ok, dependent_constraints, singular, non_finite_qdd, non_finite_R };
+
+// The sanh formulation with the QR complement in one call: null_space_basis, solve_stacked and
+// the finiteness test of q'' and R (core/detail/finite.hpp's sum of x * 0), as the separate
+// calls do them. One call instead of four lets D stay in registers between the two kernels and
+// saves the calls' fixed costs, which at n = 3 are a tenth of a right-hand side.
+template <int N, int S>
+SanhResult sanh_qr(const double* A, const double* Q, const double* G, const double* b, const double* b0,
+                   double* D, double* h, double* qdd, double* R) {
+  if (!null_space_basis<N, S>(b, D)) return SanhResult::dependent_constraints;
+  if (!solve_stacked<N, S>(A, Q, G, b, b0, D, h, qdd, R)) return SanhResult::singular;
+  double x = 0.0, y = 0.0;
+  for (int i = 0; i < N; ++i) {
+    x += qdd[i] * 0.0;
+    y += R[i] * 0.0;
+  }
+  if (x != 0.0) return SanhResult::non_finite_qdd;  // NaN != 0 too
+  if (y != 0.0) return SanhResult::non_finite_R;
+  return SanhResult::ok;
 }
 
 }  // namespace nhdyn::small
@@ -211,6 +235,8 @@ struct Kernels {
   bool (*null_space_basis)(const double* b, double* D);
   bool (*solve_stacked)(const double* A, const double* Q, const double* G, const double* b, const double* b0,
                         const double* D, double* h, double* qdd, double* R);
+  SanhResult (*sanh_qr)(const double* A, const double* Q, const double* G, const double* b, const double* b0,
+                        double* D, double* h, double* qdd, double* R);
 };
 
 // The kernels for n coordinates and s constraints, or nullptr when n > kSmallMaxN (the caller
