@@ -209,10 +209,11 @@ enum class SanhResult { ok, dependent_constraints, singular, non_finite_qdd, non
 
 // The sanh formulation with the QR complement in one call: null_space_basis, solve_stacked and
 // the finiteness test of q'' and R (core/detail/finite.hpp's sum of x * 0), as the separate
-// calls do them. One call instead of four lets D stay in registers between the two kernels and
-// saves the calls' fixed costs, which at n = 3 are a tenth of a right-hand side.
+// calls do them. One call instead of four, the two kernels inlined into it (flatten), lets D stay
+// in registers between them and saves the calls' fixed costs: at n = 3 a right-hand side 10 %
+// faster than the four calls.
 template <int N, int S>
-SanhResult sanh_qr(const double* A, const double* Q, const double* G, const double* b, const double* b0,
+[[gnu::flatten]] SanhResult sanh_qr(const double* A, const double* Q, const double* G, const double* b, const double* b0,
                    double* D, double* h, double* qdd, double* R) {
   if (!null_space_basis<N, S>(b, D)) return SanhResult::dependent_constraints;
   if (!solve_stacked<N, S>(A, Q, G, b, b0, D, h, qdd, R)) return SanhResult::singular;
