@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -35,11 +36,17 @@ TEST(FixedFinite, TermsTestFindsEveryNonFiniteValue) {
       std::size_t k = 0;
       for (std::vector<double>& a : arrays)
         for (double& x : a) x = finite_value(k++);
+      std::vector<double> q_out(un, -1.0), v_out(un, -1.0);
       const auto run = [&] {
         return test(arrays[0].data(), arrays[1].data(), arrays[2].data(), arrays[3].data(), arrays[4].data(),
-                    arrays[5].data(), arrays[6].data());
+                    arrays[5].data(), arrays[6].data(), q_out.data(), v_out.data());
       };
       EXPECT_EQ(run(), 0.0) << "n = " << n << ", s = " << s;
+      // The state is stored bit for bit (a -0.0 and a subnormal among its values).
+      for (std::size_t i = 0; i < un; ++i) {
+        EXPECT_EQ(std::memcmp(&q_out[i], &arrays[0][i], sizeof(double)), 0) << "q, n = " << n << ", i = " << i;
+        EXPECT_EQ(std::memcmp(&v_out[i], &arrays[1][i], sizeof(double)), 0) << "v, n = " << n << ", i = " << i;
+      }
       for (std::vector<double>& a : arrays)
         for (double& x : a) {
           const double kept = x;

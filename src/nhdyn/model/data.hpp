@@ -178,9 +178,10 @@ struct Data {
   // small_dense.hpp). Both paths compute the same values; tests clear it to compare them.
   bool small_kernels = true;
   // The fixed-size finiteness tests of the terms and of q'' and R (core/detail/finite.hpp), set
-  // by make_data on the dense path for n <= 8 and s <= n; null: the tests array by array.
+  // by make_data on the dense path for n <= 8 and s <= n; null: the tests array by array. The
+  // terms' test also stores the state (its last two arguments: q and q' here).
   double (*terms_non_finite)(const double*, const double*, const double*, const double*, const double*,
-                             const double*, const double*) = nullptr;
+                             const double*, const double*, double*, double*) = nullptr;
   double (*pair_non_finite)(const double*, const double*) = nullptr;
   // Whether compute_complement checks the model's analytic D against b at every evaluation
   // (formulation/complement.hpp): on in debug builds; release builds check D once, at loading.

@@ -13,12 +13,23 @@ inline void add_non_finite(double (&sum)[4], const double* x) {
   for (int i = 0; i < M; ++i) sum[i & 3] += x[i] * 0.0;
 }
 
+// Copies M values from x to `out` as it adds x * 0 (x and out may be the same array).
+template <int M>
+inline void copy_non_finite(double (&sum)[4], const double* x, double* out) {
+#pragma GCC unroll 64
+  for (int i = 0; i < M; ++i) {
+    const double value = x[i];
+    sum[i & 3] += value * 0.0;
+    out[i] = value;
+  }
+}
+
 template <int N, int S>
 double terms_non_finite(const double* q, const double* v, const double* A, const double* Q, const double* G,
-                        const double* b, const double* b0) {
+                        const double* b, const double* b0, double* q_out, double* v_out) {
   double sum[4] = {0.0, 0.0, 0.0, 0.0};
-  add_non_finite<N>(sum, q);
-  add_non_finite<N>(sum, v);
+  copy_non_finite<N>(sum, q, q_out);
+  copy_non_finite<N>(sum, v, v_out);
   add_non_finite<N * N>(sum, A);
   add_non_finite<N>(sum, Q);
   add_non_finite<N>(sum, G);

@@ -33,9 +33,11 @@ double accumulate_non_finite(double acc, const Eigen::DenseBase<Derived>& x) {
 // The same test of a small dense model's terms, q, q', A, Q, G, b and b0 together, with n and s
 // known at compile time: one call of unrolled code instead of seven loops, whose fixed costs were
 // most of the test at n = 3 (a third of a sled's right-hand side outside the solve). 0 when every
-// value is finite, NaN otherwise.
+// value is finite, NaN otherwise. It also copies q and q' to q_out and v_out (the same arrays or
+// apart): the state is stored where it is read for the test, without a call of memcpy for each.
 using TermsNonFinite = double (*)(const double* q, const double* v, const double* A, const double* Q,
-                                  const double* G, const double* b, const double* b0);
+                                  const double* G, const double* b, const double* b0, double* q_out,
+                                  double* v_out);
 // The test for n coordinates and s constraints, or nullptr beyond kFixedFiniteMaxN coordinates or
 // for s > n (the caller then tests array by array).
 inline constexpr int kFixedFiniteMaxN = 8;
