@@ -94,10 +94,9 @@ double stacked_condition(const Model& model, const Data& data, ConstraintWatch& 
       norm = watch.norm(i - top);
     }
     if (!std::isfinite(norm)) return kInfinity;
-    // One division a row: the scaled rows feed an estimate, where the last bit does not matter.
-    const double inverse = norm > 0.0 ? 1.0 / norm : 1.0;
+    const double scale = norm > 0.0 ? norm : 1.0;
     for (Eigen::Index c = 0; c < n; ++c) {
-      M[i + watched * c] *= inverse;
+      M[i + watched * c] /= scale;
       const double d = M[i + watched * c] - estimated[i + watched * c];
       moved += d * d;
     }
