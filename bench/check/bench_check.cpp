@@ -36,6 +36,7 @@
 //                                        loop for 6 doubles); the step counts and final states are
 //                                        compared first
 //   sled_dop853_vs_hand_written          the same with dop853 (Dormand-Prince 8(5,3)) on both sides
+//   sled_dopri5_compiled_vs_hand_written the dopri5 pair with the sled's terms compiled
 //   chain_rhs_sparse_vs_reference        one right-hand side of the 300-body chain (n = 900) on the
 //                                        sparse path (compute_dynamics, sparse sanh: KLU refactorizes
 //                                        b_dep in place), 100 times, over 20 hand-written sled
@@ -337,21 +338,24 @@ int main(int argc, char** argv) {
     pair("rattleback_rhs_interpreted_vs_hand_written", pairs, [&] { rhs_loop(rattleback, dr, 50000); },
          [&] { hand_written_loop(rattleback, 50000, false); });
 
-    const auto sled_pair = [&](const char* name, IntegratorKind kind, auto tableau) {
+    const auto sled_pair = [&](const char* name, const Model& model, IntegratorKind kind, auto tableau) {
       using Tableau = decltype(tableau);
       if (std::string(name).find(filter) == std::string::npos) return;
-      check_sled_by_hand<Tableau>(sled, kind, name);
+      check_sled_by_hand<Tableau>(model, kind, name);
       pair(
           name, pairs,
           [&] {
-            for (int i = 0; i < kSledRuns; ++i) run_sled(sled, kind);
+            for (int i = 0; i < kSledRuns; ++i) run_sled(model, kind);
           },
           [&] {
             for (int i = 0; i < kSledRuns; ++i) run_sled_by_hand<Tableau>(sled);
           });
     };
-    sled_pair("sled_dopri5_vs_hand_written", IntegratorKind::dopri5, rk::DormandPrince54{});
-    sled_pair("sled_dop853_vs_hand_written", IntegratorKind::dop853, rk::DormandPrince853{});
+    sled_pair("sled_dopri5_vs_hand_written", sled, IntegratorKind::dopri5, rk::DormandPrince54{});
+    sled_pair("sled_dop853_vs_hand_written", sled, IntegratorKind::dop853, rk::DormandPrince853{});
+    if (std::string("sled_dopri5_compiled_vs_hand_written").find(filter) != std::string::npos)
+      sled_pair("sled_dopri5_compiled_vs_hand_written", jit::make_compiled(sled), IntegratorKind::dopri5,
+                rk::DormandPrince54{});
 
     // The sparse path: one right-hand side of the 300-body chain (n = 900, sparse sanh, KLU's LU of
     // b_dep refactorized in place) against a fixed amount of hand-written work, as the loads are.
