@@ -7,6 +7,7 @@
 
 #include <random>
 #include <string>
+#include <utility>
 
 #include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/model/data.hpp"
@@ -104,6 +105,38 @@ TEST(SmallKernels, SingularStackedMatrixIsRefusedAsOnTheDynamicPath) {
     const Model model = testing::make_constant_model(sys.A, sys.Q, sys.b, sys.b0);
     EXPECT_EQ(solve(model, true, Complement::qr).status, Status::singular_system) << "n = " << n;
     EXPECT_EQ(solve(model, false, Complement::qr).status, Status::singular_system) << "n = " << n;
+  }
+}
+
+// The fused kernel (small_dense.hpp's sanh_qr) reports an overflow in q'' or in R as the
+// separate calls do: the same status and the same quantity named, on both paths.
+TEST(SmallKernels, OverflowInTheAccelerationsOrTheReactionsIsNamedAsOnTheDynamicPath) {
+  const auto failure = [](const Model& model, bool small) {
+    Data data = make_data(model);
+    data.small_kernels = small;
+    const Status status =
+        compute_dynamics(model, data, {Formulation::sanh, Complement::qr}, 0.0, model.q0.data(), model.v0.data());
+    return std::make_pair(status, data.failed_quantity);
+  };
+  // q'': the rows D A (of order 1e-300) are scaled up to meet b's, and D h = D Q (1e300) with them.
+  Matrix b(1, 2);
+  b << 1.0, 0.0;
+  Vector Q(2);
+  Q << 0.0, 1e300;
+  const Model tiny_masses = testing::make_constant_model(1e-300 * Matrix::Identity(2, 2), Q, b, Vector::Zero(1));
+  for (bool small : {true, false}) {
+    const auto [status, quantity] = failure(tiny_masses, small);
+    EXPECT_EQ(status, Status::non_finite) << small;
+    EXPECT_EQ(quantity, "accelerations q''") << small;
+  }
+  // R alone: b q'' = -b0 gives q''_0 = 1e10, finite, and A q'' = 1e310 overflows.
+  Vector b0(1);
+  b0 << -1e10;
+  const Model huge_masses = testing::make_constant_model(1e300 * Matrix::Identity(2, 2), Vector::Zero(2), b, b0);
+  for (bool small : {true, false}) {
+    const auto [status, quantity] = failure(huge_masses, small);
+    EXPECT_EQ(status, Status::non_finite) << small;
+    EXPECT_EQ(quantity, "reactions R") << small;
   }
 }
 
