@@ -3,8 +3,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace nhdyn {
 namespace {
@@ -58,14 +60,14 @@ double smallest_singular_value_bound(const Matrix& R, Eigen::Index m, Vector& un
   return std::isfinite(bound) ? bound : 0.0;
 }
 
-// The conditioning estimate of the row-scaled watched matrix and the index of its last pivot row.
-double stacked_condition(const Model& model, const Data& data, ConstraintWatch& watch, Eigen::Index& last) {
+// The watched rows (the stacked [D A; b], or b alone) scaled to unit norm into watch.rows, and
+// their squared distance from the rows of the last estimate; infinity when a row's norm is not
+// finite. Plain loops over the column-major storage: Eigen's dynamic-size product and row
+// expressions cost more in dispatch than in arithmetic at the sizes where a step is cheap.
+double scale_rows(const Model& model, const Data& data, ConstraintWatch& watch) {
   const int k = model.k();
   const int s = model.s();
   Matrix& rows = watch.rows;
-  // Plain loops over the column-major storage: this runs at every accepted step, and at the
-  // sizes where that matters (a few coordinates) Eigen's dynamic-size product and row
-  // expressions cost more in dispatch than in arithmetic.
   const Eigen::Index n = rows.cols(), watched = rows.rows();
   const Eigen::Index top = watched - s;
   double* M = rows.data();
@@ -83,7 +85,7 @@ double stacked_condition(const Model& model, const Data& data, ConstraintWatch& 
   for (Eigen::Index c = 0; c < n; ++c)
     for (Eigen::Index i = 0; i < s; ++i) M[top + i + watched * c] = b[i + s * c];
   const double* estimated = watch.estimated_rows.data();
-  double moved = 0.0;  // ||M - M at the last estimate||_F^2, in the same pass as the scaling
+  double moved = 0.0;
   for (Eigen::Index i = 0; i < watched; ++i) {
     // The rows of b have their norms in watch.norm already.
     double norm = 0.0;
@@ -100,6 +102,86 @@ double stacked_condition(const Model& model, const Data& data, ConstraintWatch& 
       const double d = M[i + watched * c] - estimated[i + watched * c];
       moved += d * d;
     }
+  }
+  return moved;
+}
+
+// The rows of the stacked [D A; b] (n x n, column-major, n and s known at compile time) scaled to
+// unit norm into `rows`, and their squared distance from the rows of the last estimate: the same
+// operations in the same order as scale_rows above, unrolled, for the small models whose steps
+// are cheapest (the sled's watch took a twentieth of its run with the loops above). Infinity when
+// a row's norm is not finite.
+template <int N, int S>
+double scaled_stacked_rows(const double* D, const double* A, const double* b, const double* b_norm,
+                           const double* estimated, double* rows) {
+  constexpr int K = N - S;
+  double moved = 0.0;
+  for (int i = 0; i < K; ++i) {
+    double row[N];
+    double norm = 0.0;
+    for (int c = 0; c < N; ++c) {
+      double acc = 0.0;
+      for (int l = 0; l < N; ++l) acc += D[i + K * l] * A[l + N * c];
+      row[c] = acc;
+    }
+    for (int c = 0; c < N; ++c) norm += row[c] * row[c];
+    norm = std::sqrt(norm);
+    if (!std::isfinite(norm)) return kInfinity;
+    const double scale = norm > 0.0 ? norm : 1.0;
+    for (int c = 0; c < N; ++c) {
+      rows[i + N * c] = row[c] / scale;
+      const double d = rows[i + N * c] - estimated[i + N * c];
+      moved += d * d;
+    }
+  }
+  for (int i = 0; i < S; ++i) {
+    const double norm = b_norm[i];
+    if (!std::isfinite(norm)) return kInfinity;
+    const double scale = norm > 0.0 ? norm : 1.0;
+    for (int c = 0; c < N; ++c) {
+      rows[K + i + N * c] = b[i + S * c] / scale;
+      const double d = rows[K + i + N * c] - estimated[K + i + N * c];
+      moved += d * d;
+    }
+  }
+  return moved;
+}
+
+using ScaledStackedRows = double (*)(const double*, const double*, const double*, const double*, const double*,
+                                     double*);
+constexpr int kFixedWatchMaxN = 8;
+
+template <int N, int... S>
+constexpr void fill_watch_row(std::array<std::array<ScaledStackedRows, kFixedWatchMaxN>, kFixedWatchMaxN + 1>& table,
+                              std::integer_sequence<int, S...>) {
+  ((table[N][S] = &scaled_stacked_rows<N, S>), ...);
+}
+
+// kScaledStackedRows[n][s] for 1 <= n <= 8 and 0 <= s < n (k >= 1); other entries null.
+template <int... N>
+constexpr std::array<std::array<ScaledStackedRows, kFixedWatchMaxN>, kFixedWatchMaxN + 1> make_watch_table(
+    std::integer_sequence<int, N...>) {
+  std::array<std::array<ScaledStackedRows, kFixedWatchMaxN>, kFixedWatchMaxN + 1> table{};
+  (fill_watch_row<N + 1>(table, std::make_integer_sequence<int, N + 1>{}), ...);
+  return table;
+}
+
+constexpr auto kScaledStackedRows = make_watch_table(std::make_integer_sequence<int, kFixedWatchMaxN>{});
+
+// The conditioning estimate of the row-scaled watched matrix and the index of its last pivot row.
+double stacked_condition(const Model& model, const Data& data, ConstraintWatch& watch, Eigen::Index& last) {
+  const int k = model.k();
+  const int s = model.s();
+  Matrix& rows = watch.rows;
+  const Eigen::Index n = rows.cols(), watched = rows.rows();
+  double moved = 0.0;  // ||M - M at the last estimate||_F^2, in the same pass as the scaling
+  if (watch.stacked && k > 0 && n <= kFixedWatchMaxN && watched == n) {
+    moved = kScaledStackedRows[static_cast<std::size_t>(n)][static_cast<std::size_t>(s)](
+        data.D.data(), data.A.data(), data.b.data(), watch.norm.data(), watch.estimated_rows.data(), rows.data());
+    if (moved == kInfinity) return kInfinity;
+  } else {
+    moved = scale_rows(model, data, watch);
+    if (moved == kInfinity) return kInfinity;
   }
   if (moved <= watch.reuse_radius * watch.reuse_radius && watch.reuse_radius > 0.0) {
     last = watch.last_pivot;
