@@ -4,17 +4,22 @@
 #include <cstdio>
 #include <set>
 #include <sstream>
+#include <stdexcept>
+#include <unordered_map>
 #include <unordered_set>
+#include <utility>
+#include <vector>
 
 #include <cln/version.h>
 #include <ginac/version.h>
 
 #include "nhdyn/core/detail/hash.hpp"
+#include "nhdyn/symbolic/detail/kind.hpp"
 
 namespace nhdyn::symbolic {
 namespace {
 
-constexpr const char* kMagic = "nhdyn-derivation-archive 2";
+constexpr const char* kMagic = "nhdyn-derivation-archive 3";
 
 // Every field as a sequence: a 1 x (1 + length) GiNaC matrix whose first entry is the length.
 // A matrix, not GiNaC's lst (a linked list, whose hash the archive takes of every node by op(i),
@@ -143,21 +148,129 @@ std::vector<std::pair<const char*, GiNaC::ex>> fields(const Derivation& d) {
           {"conservative", GiNaC::numeric(d.conservative ? 1 : 0)}};
 }
 
-}  // namespace
+// The shared subexpressions of a derivation written once each. GiNaC's archive_ex stores every
+// distinct subexpression once, but it walks the expression as a tree, visiting a subexpression
+// at each of its uses before it finds it stored: the bicycle's derivation, 3000 distinct nodes,
+// is a tree of 300 000, and archiving it took longer than deriving it. So every subexpression
+// used more than once becomes a definition, wild(i) in the expressions that use it (a wildcard:
+// a placeholder that archives as a number and cannot be a model's symbol), and the archive holds
+// the definitions, each over the wildcards of earlier ones, then the fields over them all. Reading
+// substitutes them back in order (SubstituteShared): GiNaC evaluates each rebuilt node, which gives
+// the node it was, since the derivation's expressions are evaluated already; archive_derivation
+// checks that on the expressions it writes and stores them whole if one came back otherwise.
+using ExMap = std::unordered_map<GiNaC::ex, GiNaC::ex, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
 
-std::string archive_derivation(const Derivation& derivation) {
-  GiNaC::archive archive;
-  Seen seen;
-  std::set<std::string> names;
-  for (const auto& [name, e] : fields(derivation)) {
-    collect_symbols(e, seen, names);
-    archive.archive_ex(e, name);
+class SharedSubexpressions {
+ public:
+  // Counts the uses of every subexpression under `e` (a use per parent, each node's children
+  // counted at its first use only).
+  void count_uses(const GiNaC::ex& e) {
+    if (e.nops() == 0) return;
+    auto [it, first] = uses_.try_emplace(e, 0u);
+    ++it->second;
+    if (!first) return;
+    for (std::size_t i = 0; i < e.nops(); ++i) count_uses(e.op(i));
   }
+
+  // `e` with every subexpression used more than once replaced by its wildcard, its definition
+  // (over the wildcards of its own shared parts) appended to definitions().
+  GiNaC::ex factor(const GiNaC::ex& e) {
+    if (e.nops() == 0) return e;
+    if (const auto it = factored_.find(e); it != factored_.end()) return it->second;
+    struct Factor : GiNaC::map_function {
+      SharedSubexpressions& self;
+      explicit Factor(SharedSubexpressions& s) : self(s) {}
+      GiNaC::ex operator()(const GiNaC::ex& x) override { return self.factor(x); }
+    } factor_children(*this);
+    GiNaC::ex out = e.map(factor_children);
+    // A sequence or a matrix stays itself: it is a field's shape, not an expression.
+    if (uses_[e] > 1 && !GiNaC::is_a<GiNaC::matrix>(e)) {
+      definitions_.push_back(out);
+      out = GiNaC::wild(static_cast<unsigned>(definitions_.size() - 1));
+    }
+    factored_.emplace(e, out);
+    return out;
+  }
+
+  const std::vector<GiNaC::ex>& definitions() const { return definitions_; }
+
+ private:
+  std::unordered_map<GiNaC::ex, unsigned, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> uses_;
+  ExMap factored_;
+  std::vector<GiNaC::ex> definitions_;
+};
+
+// `e` (as written: its shared parts wildcards, a tree without repeated parts) with each wildcard
+// replaced by the value of its label in `values`, every node rebuilt by GiNaC (map evaluates
+// it); throws std::runtime_error for a wildcard of label values.size() or more.
+class SubstituteShared final : public GiNaC::map_function {
+ public:
+  explicit SubstituteShared(const std::vector<GiNaC::ex>& values) : values_(values) {}
+  GiNaC::ex operator()(const GiNaC::ex& e) override {
+    if (e.nops() > 0) return e.map(*this);
+    // A leaf: its class by one look-up (detail/kind.hpp); a wildcard is among the others.
+    if (detail::kind_of(e) != detail::ExKind::other || !GiNaC::is_a<GiNaC::wildcard>(e)) return e;
+    const unsigned label = GiNaC::ex_to<GiNaC::wildcard>(e).get_label();
+    if (label >= values_.size()) throw std::runtime_error("a wildcard without its definition");
+    return values_[label];
+  }
+
+ private:
+  const std::vector<GiNaC::ex>& values_;
+};
+
+// The values of the wildcards of `definitions`, each over earlier ones only (throws
+// std::runtime_error on one that uses a later one).
+std::vector<GiNaC::ex> expand_shared(const std::vector<GiNaC::ex>& definitions) {
+  std::vector<GiNaC::ex> values;
+  values.reserve(definitions.size());
+  SubstituteShared substitute(values);
+  for (const GiNaC::ex& definition : definitions) values.push_back(substitute(definition));
+  return values;
+}
+
+GiNaC::ex substitute_shared(const GiNaC::ex& e, const std::vector<GiNaC::ex>& values) {
+  SubstituteShared substitute(values);
+  return substitute(e);
+}
+
+// The archive of `fields` over the definitions `shared` (empty: the fields whole).
+std::string archive_body(const std::vector<std::pair<const char*, GiNaC::ex>>& fields,
+                         const std::vector<GiNaC::ex>& shared, const std::set<std::string>& names) {
+  GiNaC::archive archive;
+  archive.archive_ex(sequence(shared), "shared");
+  for (const auto& [name, e] : fields) archive.archive_ex(e, name);
   std::ostringstream body;
   body << names.size() << '\n';
   for (const std::string& name : names) body << name << '\n';
   body << archive;
-  return std::string(kMagic) + "\n" + checksum(body.str()) + "\n" + body.str();
+  return body.str();
+}
+
+}  // namespace
+
+std::string archive_derivation(const Derivation& derivation) {
+  const std::vector<std::pair<const char*, GiNaC::ex>> whole = fields(derivation);
+  Seen seen;
+  std::set<std::string> names;
+  SharedSubexpressions shared;
+  for (const auto& [name, e] : whole) {
+    collect_symbols(e, seen, names);
+    shared.count_uses(e);
+  }
+  std::vector<std::pair<const char*, GiNaC::ex>> factored;
+  for (const auto& [name, e] : whole) factored.emplace_back(name, shared.factor(e));
+  // Substituting back must give every field as it is (see SharedSubexpressions).
+  bool exact = true;
+  try {
+    const std::vector<GiNaC::ex> values = expand_shared(shared.definitions());
+    for (std::size_t i = 0; i < whole.size() && exact; ++i)
+      exact = substitute_shared(factored[i].second, values).is_equal(whole[i].second);
+  } catch (const std::runtime_error&) {
+    exact = false;
+  }
+  const std::string body = exact ? archive_body(factored, shared.definitions(), names) : archive_body(whole, {}, names);
+  return std::string(kMagic) + "\n" + checksum(body) + "\n" + body;
 }
 
 std::string derivation_engine() {
@@ -191,7 +304,8 @@ std::optional<Derivation> unarchive_derivation(const std::string& bytes, const S
     GiNaC::archive archive;
     in >> archive;
     if (!in) return std::nullopt;
-    const auto read = [&](const char* name) { return archive.unarchive_ex(known, name); };
+    const std::vector<GiNaC::ex> values = expand_shared(as_list(archive.unarchive_ex(known, "shared")));
+    const auto read = [&](const char* name) { return substitute_shared(archive.unarchive_ex(known, name), values); };
     Derivation d;
     d.A = unpack_ex_matrix(read("A"));
     d.Q = unpack_matrix(read("Q"));
