@@ -57,10 +57,10 @@ class FileStore final : public symbolic::DerivationStore {
       : file_(std::move(file)), key_(std::move(key)), always_(always) {}
 
   // A derivation that took at least 1 ms per coordinate, at its second load: a model with rolling
-  // contacts or a long chain of frames (the bicycle, 70 ms per coordinate; the rattleback, 8)
+  // contacts or a long chain of frames (the bicycle, 11 ms per coordinate; the rattleback, 2.5)
   // reads back in a fraction of that, while a large model of simple bodies (the 1000-body chain,
-  // 0.1 ms per coordinate) derives about as fast as its archive is written and read. Writing the
-  // archive costs a first load too (the bicycle's, a fifth), so the first load of a model leaves
+  // 0.1 ms per coordinate) derives about as fast as its archive is read. Writing the archive costs
+  // a load too (the bicycle's, a seventh), so the first load of a model leaves
   // only a mark (an empty NAME.seen) and the second one writes: a model loaded once pays nothing,
   // one loaded again reads its derivation from the third load on.
   bool wants(double seconds, int coordinates) const override {
