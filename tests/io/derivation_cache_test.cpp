@@ -90,6 +90,28 @@ TEST(DerivationArchive, ReadsBackEveryEntryAndComputesTheSameNumbers) {
   }
 }
 
+// A derivation beyond what reading accepts is not stored at all (archive_derivation gives no
+// bytes): 1200 levels of nesting ((... (x + 1)^3 + 1)^3 ...), and a product whose factors share
+// one part, doubling 24 times (2^24 nodes counted as a tree, 48 distinct ones; GiNaC itself
+// walks such a product as a tree when it makes it, so the test keeps it near the limit of ten
+// million).
+TEST(DerivationArchive, StoresNothingBeyondWhatReadingAccepts) {
+  const symbolic::Spec spec = load_model_file(test::example("sled.toml"));
+  const Derivation made = symbolic::derive(spec);
+  ASSERT_FALSE(symbolic::archive_derivation(made).empty());
+  const GiNaC::symbol& x = spec.symbols.find("x").value();
+  Derivation deep = made;
+  GiNaC::ex nested = x;
+  for (int i = 0; i < 600; ++i) nested = GiNaC::pow(nested + 1, 3);
+  deep.Q(0, 0) = nested;
+  EXPECT_TRUE(symbolic::archive_derivation(deep).empty());
+  Derivation wide = made;
+  GiNaC::ex doubled = x;
+  for (int i = 0; i < 24; ++i) doubled = GiNaC::sin(doubled) * GiNaC::cos(doubled);
+  wide.Q(0, 0) = doubled;
+  EXPECT_TRUE(symbolic::archive_derivation(wide).empty());
+}
+
 TEST(DerivationArchive, RefusesAnotherModelsAndDamagedBytes) {
   const symbolic::Spec bicycle = load_model_file(test::example("whipple_bicycle.toml"));
   const symbolic::Spec sled = load_model_file(test::example("sled.toml"));

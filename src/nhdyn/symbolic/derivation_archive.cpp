@@ -72,6 +72,12 @@ unsigned count(const GiNaC::ex& e) {
   return static_cast<unsigned>(GiNaC::ex_to<GiNaC::numeric>(e).to_int());
 }
 
+// An entry where a scalar expression belongs (a matrix there is not one pack() writes).
+const GiNaC::ex& scalar(const GiNaC::ex& e) {
+  if (GiNaC::is_a<GiNaC::matrix>(e)) throw std::runtime_error("a matrix where an expression belongs");
+  return e;
+}
+
 // A sequence's elements.
 std::vector<GiNaC::ex> as_list(const GiNaC::ex& e) {
   if (!GiNaC::is_a<GiNaC::matrix>(e)) throw std::runtime_error("not a sequence");
@@ -90,7 +96,7 @@ GiNaC::matrix unpack_matrix(const GiNaC::ex& e) {
   if (l.size() != 2 + static_cast<std::size_t>(rows) * cols) throw std::runtime_error("a matrix of the wrong size");
   GiNaC::matrix m(rows, cols);
   for (unsigned r = 0; r < rows; ++r)
-    for (unsigned c = 0; c < cols; ++c) m(r, c) = l[2 + static_cast<std::size_t>(r) * cols + c];
+    for (unsigned c = 0; c < cols; ++c) m(r, c) = scalar(l[2 + static_cast<std::size_t>(r) * cols + c]);
   return m;
 }
 
@@ -101,17 +107,21 @@ ExMatrix unpack_ex_matrix(const GiNaC::ex& e) {
   for (std::size_t i = 2; i < l.size(); i += 3) {
     const unsigned r = count(l[i]), c = count(l[i + 1]);
     if (r >= m.rows() || c >= m.cols()) throw std::runtime_error("an entry outside its matrix");
-    m(r, c) = l[i + 2];
+    m(r, c) = scalar(l[i + 2]);
   }
   return m;
 }
 
-std::vector<GiNaC::ex> unpack_vector(const GiNaC::ex& e) { return as_list(e); }
+std::vector<GiNaC::ex> unpack_vector(const GiNaC::ex& e) {
+  std::vector<GiNaC::ex> l = as_list(e);
+  for (const GiNaC::ex& x : l) scalar(x);
+  return l;
+}
 
 std::optional<GiNaC::ex> unpack_optional(const GiNaC::ex& e) {
   const std::vector<GiNaC::ex> l = as_list(e);
   if (l.size() > 1) throw std::runtime_error("an optional of more than one");
-  return l.size() == 1 ? std::optional<GiNaC::ex>(l[0]) : std::nullopt;
+  return l.size() == 1 ? std::optional<GiNaC::ex>(scalar(l[0])) : std::nullopt;
 }
 
 // The names of the symbols in `e`, each shared subexpression visited once.
@@ -157,7 +167,7 @@ std::vector<std::pair<const char*, GiNaC::ex>> fields(const Derivation& d) {
 // the definitions, each over the wildcards of earlier ones, then the fields over them all. Reading
 // substitutes them back in order (SubstituteShared): GiNaC evaluates each rebuilt node, which gives
 // the node it was, since the derivation's expressions are evaluated already; archive_derivation
-// checks that on the expressions it writes and stores them whole if one came back otherwise.
+// checks that on the expressions it writes, and stores nothing if one came back otherwise.
 using ExMap = std::unordered_map<GiNaC::ex, GiNaC::ex, std::hash<GiNaC::ex>, GiNaC::ex_is_equal>;
 
 class SharedSubexpressions {
@@ -200,41 +210,111 @@ class SharedSubexpressions {
   std::vector<GiNaC::ex> definitions_;
 };
 
+// What reading trusts of an archive, whose bytes may have been made on purpose (the checksum is
+// against damage, not against a forger): a model file nests at most 256 levels (spec_builder.cpp)
+// and the derivations of the examples are 6 to 20 deep, with entries of up to 50 000 nodes
+// counted as a tree (the bicycle's); deeper or larger ones, which would take the compiler's
+// recursion past its stack or GiNaC's tree walks (its return_type follows a product's every
+// factor) into hours, are refused and derived again.
+constexpr unsigned kMaxDepth = 1024;
+constexpr double kMaxTreeSize = 1e7;
+
+// The depth and the size counted as a tree (each use of a shared part again) of an expression.
+struct Shape {
+  unsigned depth = 0;
+  double tree_size = 0.0;
+};
+
 // `e` (as written: its shared parts wildcards, a tree without repeated parts) with each wildcard
 // replaced by the value of its label in `values`, every node rebuilt by GiNaC (map evaluates
-// it); throws std::runtime_error for a wildcard of label values.size() or more.
+// it); shape() is then that of the result, from the shapes of the values. Throws
+// std::runtime_error for a wildcard of label values.size() or more, for a matrix below a node
+// that is not one (a field is a sequence of sequences, whose entries are scalar expressions), and
+// for an expression deeper or larger than kMaxDepth, kMaxTreeSize.
 class SubstituteShared final : public GiNaC::map_function {
  public:
-  explicit SubstituteShared(const std::vector<GiNaC::ex>& values) : values_(values) {}
+  SubstituteShared(const std::vector<GiNaC::ex>& values, const std::vector<Shape>& shapes)
+      : values_(values), shapes_(shapes) {}
+
+  GiNaC::ex substitute(const GiNaC::ex& e) {
+    Shape top;
+    children_ = &top;
+    const GiNaC::ex out = (*this)(e);
+    children_ = nullptr;
+    shape_ = top;
+    return out;
+  }
+  const Shape& shape() const { return shape_; }
+
   GiNaC::ex operator()(const GiNaC::ex& e) override {
-    if (e.nops() > 0) return e.map(*this);
-    // A leaf: its class by one look-up (detail/kind.hpp); a wildcard is among the others.
-    if (detail::kind_of(e) != detail::ExKind::other || !GiNaC::is_a<GiNaC::wildcard>(e)) return e;
-    const unsigned label = GiNaC::ex_to<GiNaC::wildcard>(e).get_label();
-    if (label >= values_.size()) throw std::runtime_error("a wildcard without its definition");
-    return values_[label];
+    Shape shape;
+    GiNaC::ex out = e;
+    // A node's class by one look-up (detail/kind.hpp); matrices and wildcards are among the others.
+    const bool other = detail::kind_of(e) == detail::ExKind::other;
+    const bool matrix = other && e.nops() > 0 && GiNaC::is_a<GiNaC::matrix>(e);
+    if (e.nops() > 0) {
+      if (matrix && scalars_above_ > 0) throw std::runtime_error("a matrix inside an expression");
+      Shape* const parent = children_;
+      children_ = &shape;  // the children's calls fold their shapes into this one
+      if (!matrix) ++scalars_above_;
+      out = e.map(*this);
+      if (!matrix) --scalars_above_;
+      children_ = parent;
+      shape.depth += 1;
+      shape.tree_size += 1.0;
+    } else if (other && GiNaC::is_a<GiNaC::wildcard>(e)) {
+      const unsigned label = GiNaC::ex_to<GiNaC::wildcard>(e).get_label();
+      if (label >= values_.size()) throw std::runtime_error("a wildcard without its definition");
+      out = values_[label];
+      shape = shapes_[label];
+    } else {
+      shape = {1, 1.0};
+    }
+    // The size of a scalar expression: a field's sequences hold all its entries.
+    if (shape.depth > kMaxDepth || (!matrix && !(shape.tree_size <= kMaxTreeSize)))
+      throw std::runtime_error("an expression deeper or larger than a derivation makes");
+    if (children_ != nullptr) {
+      children_->depth = std::max(children_->depth, shape.depth);
+      children_->tree_size += shape.tree_size;
+    }
+    return out;
   }
 
  private:
   const std::vector<GiNaC::ex>& values_;
+  const std::vector<Shape>& shapes_;
+  Shape* children_ = nullptr;
+  Shape shape_;
+  int scalars_above_ = 0;  // nodes above the current one that are not matrices
 };
 
-// The values of the wildcards of `definitions`, each over earlier ones only (throws
-// std::runtime_error on one that uses a later one).
-std::vector<GiNaC::ex> expand_shared(const std::vector<GiNaC::ex>& definitions) {
+// The values of the wildcards of `definitions` and their shapes, each over earlier ones only
+// (throws std::runtime_error on one that uses a later one, on one that is or holds a matrix, and
+// as SubstituteShared).
+struct Expanded {
   std::vector<GiNaC::ex> values;
-  values.reserve(definitions.size());
-  SubstituteShared substitute(values);
-  for (const GiNaC::ex& definition : definitions) values.push_back(substitute(definition));
-  return values;
+  std::vector<Shape> shapes;
+};
+
+Expanded expand_shared(const std::vector<GiNaC::ex>& definitions) {
+  Expanded out;
+  out.values.reserve(definitions.size());
+  out.shapes.reserve(definitions.size());
+  SubstituteShared substitute(out.values, out.shapes);
+  for (const GiNaC::ex& definition : definitions) {
+    if (GiNaC::is_a<GiNaC::matrix>(definition)) throw std::runtime_error("a definition that is a matrix");
+    out.values.push_back(substitute.substitute(definition));
+    out.shapes.push_back(substitute.shape());
+  }
+  return out;
 }
 
-GiNaC::ex substitute_shared(const GiNaC::ex& e, const std::vector<GiNaC::ex>& values) {
-  SubstituteShared substitute(values);
-  return substitute(e);
+GiNaC::ex substitute_shared(const GiNaC::ex& e, const Expanded& shared) {
+  SubstituteShared substitute(shared.values, shared.shapes);
+  return substitute.substitute(e);
 }
 
-// The archive of `fields` over the definitions `shared` (empty: the fields whole).
+// The archive of `fields` over the definitions `shared`.
 std::string archive_body(const std::vector<std::pair<const char*, GiNaC::ex>>& fields,
                          const std::vector<GiNaC::ex>& shared, const std::set<std::string>& names) {
   GiNaC::archive archive;
@@ -260,16 +340,16 @@ std::string archive_derivation(const Derivation& derivation) {
   }
   std::vector<std::pair<const char*, GiNaC::ex>> factored;
   for (const auto& [name, e] : whole) factored.emplace_back(name, shared.factor(e));
-  // Substituting back must give every field as it is (see SharedSubexpressions).
-  bool exact = true;
+  // Reading must give every field as it is (see SharedSubexpressions), within the limits reading
+  // keeps to; a derivation that would not is not stored.
   try {
-    const std::vector<GiNaC::ex> values = expand_shared(shared.definitions());
-    for (std::size_t i = 0; i < whole.size() && exact; ++i)
-      exact = substitute_shared(factored[i].second, values).is_equal(whole[i].second);
+    const Expanded values = expand_shared(shared.definitions());
+    for (std::size_t i = 0; i < whole.size(); ++i)
+      if (!substitute_shared(factored[i].second, values).is_equal(whole[i].second)) return {};
   } catch (const std::runtime_error&) {
-    exact = false;
+    return {};
   }
-  const std::string body = exact ? archive_body(factored, shared.definitions(), names) : archive_body(whole, {}, names);
+  const std::string body = archive_body(factored, shared.definitions(), names);
   return std::string(kMagic) + "\n" + checksum(body) + "\n" + body;
 }
 
@@ -304,7 +384,7 @@ std::optional<Derivation> unarchive_derivation(const std::string& bytes, const S
     GiNaC::archive archive;
     in >> archive;
     if (!in) return std::nullopt;
-    const std::vector<GiNaC::ex> values = expand_shared(as_list(archive.unarchive_ex(known, "shared")));
+    const Expanded values = expand_shared(as_list(archive.unarchive_ex(known, "shared")));
     const auto read = [&](const char* name) { return substitute_shared(archive.unarchive_ex(known, name), values); };
     Derivation d;
     d.A = unpack_ex_matrix(read("A"));
@@ -322,8 +402,8 @@ std::optional<Derivation> unarchive_derivation(const std::string& bytes, const S
     d.f_p = unpack_vector(read("f_p"));
     d.energy = unpack_optional(read("energy"));
     d.energy_function = unpack_optional(read("energy_function"));
-    d.power_forces = read("power_forces");
-    d.power_time = read("power_time");
+    d.power_forces = scalar(read("power_forces"));
+    d.power_time = scalar(read("power_time"));
     d.conservative = !read("conservative").is_zero();
     const auto n = static_cast<unsigned>(spec.n()), s = static_cast<unsigned>(spec.s()),
                m = static_cast<unsigned>(spec.m());

@@ -19,7 +19,8 @@ const Derivation& ModelDescription::derivation() const {
     const auto start = std::chrono::steady_clock::now();
     derivation_ = derive(spec_);
     const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
-    if (store_ && store_->wants(took.count(), spec_.n())) store_->write(archive_derivation(*derivation_));
+    if (store_ && store_->wants(took.count(), spec_.n()))
+      if (const std::string bytes = archive_derivation(*derivation_); !bytes.empty()) store_->write(bytes);
   });
   return *derivation_;
 }
