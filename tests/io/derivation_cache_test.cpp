@@ -11,10 +11,15 @@
 
 #include <chrono>
 #include <filesystem>
+#include <cstdio>
 #include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
 #include <iterator>
 #include <string>
 
+#include "nhdyn/core/detail/hash.hpp"
 #include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/frontend/detail/derivation_cache.hpp"
 #include "nhdyn/frontend/load_model.hpp"
@@ -110,6 +115,114 @@ TEST(DerivationArchive, StoresNothingBeyondWhatReadingAccepts) {
   for (int i = 0; i < 24; ++i) doubled = GiNaC::sin(doubled) * GiNaC::cos(doubled);
   wide.Q(0, 0) = doubled;
   EXPECT_TRUE(symbolic::archive_derivation(wide).empty());
+}
+
+// Bytes made on purpose to pass the checksum (the archive of the sled's derivation with one part
+// forged, its checksum computed again as archive_derivation does): each holds what the writer
+// never makes, and reading refuses it, where before a nested chain crashed the compiler and a
+// doubling product hung GiNaC.
+std::string forged(const symbolic::Spec& spec, const std::function<void(GiNaC::matrix& shared,
+                                                                         std::map<std::string, GiNaC::ex>& fields)>& change) {
+  const std::string bytes = symbolic::archive_derivation(symbolic::derive(spec));
+  std::istringstream in(bytes);
+  std::string magic, sum, line;
+  std::getline(in, magic);
+  std::getline(in, sum);
+  std::size_t named = 0;
+  in >> named;
+  std::getline(in, line);
+  std::vector<std::string> names(named);
+  GiNaC::lst known;
+  for (std::string& name : names) {
+    std::getline(in, name);
+    known.append(spec.symbols.find(name).value());
+  }
+  GiNaC::archive archive;
+  in >> archive;
+  GiNaC::matrix shared = GiNaC::ex_to<GiNaC::matrix>(archive.unarchive_ex(known, "shared"));
+  std::vector<std::string> order;
+  std::map<std::string, GiNaC::ex> fields;
+  for (unsigned i = 1; i < archive.num_expressions(); ++i) {
+    std::string name;
+    const GiNaC::ex e = archive.unarchive_ex(known, name, i);
+    order.push_back(name);
+    fields[name] = e;
+  }
+  change(shared, fields);
+  GiNaC::archive out;
+  out.archive_ex(shared, "shared");
+  for (const std::string& name : order) out.archive_ex(fields[name], name.c_str());
+  std::ostringstream body;
+  body << names.size() << '\n';
+  for (const std::string& name : names) body << name << '\n';
+  body << out;
+  char text[33];
+  std::snprintf(text, sizeof text, "%016llx%016llx", static_cast<unsigned long long>(fnv1a(body.str(), kFnvOffset)),
+                static_cast<unsigned long long>(fnv1a(body.str(), kFnvOtherOffset)));
+  return magic + "\n" + text + "\n" + body.str();
+}
+
+// The shared definitions {count, d0, d1, ...} with `more` appended.
+GiNaC::matrix with_definitions(const GiNaC::matrix& shared, const std::vector<GiNaC::ex>& more) {
+  GiNaC::matrix out(1, shared.cols() + static_cast<unsigned>(more.size()));
+  for (unsigned c = 1; c < shared.cols(); ++c) out(0, c) = shared(0, c);
+  for (std::size_t i = 0; i < more.size(); ++i) out(0, shared.cols() + static_cast<unsigned>(i)) = more[i];
+  out(0, 0) = static_cast<long>(out.cols() - 1);
+  return out;
+}
+
+TEST(DerivationArchive, RefusesBytesMadeToPassItsChecksum) {
+  const symbolic::Spec spec = load_model_file(test::example("sled.toml"));
+  const GiNaC::symbol x = spec.symbols.find("x").value();
+  // Unchanged, the bytes read back (the forging itself is sound).
+  EXPECT_TRUE(symbolic::unarchive_derivation(forged(spec, [](auto&, auto&) {}), spec).has_value());
+  const auto defined = [&](const GiNaC::matrix& shared) { return static_cast<unsigned>(shared.cols() - 1); };
+  // A definition that uses itself, and one that uses a later one.
+  EXPECT_FALSE(symbolic::unarchive_derivation(forged(spec, [&](GiNaC::matrix& shared, auto& fields) {
+    const unsigned k = defined(shared);
+    shared = with_definitions(shared, {GiNaC::sin(GiNaC::wild(k)) + x});
+    fields["power_time"] = GiNaC::wild(k);
+  }), spec).has_value());
+  EXPECT_FALSE(symbolic::unarchive_derivation(forged(spec, [&](GiNaC::matrix& shared, auto& fields) {
+    const unsigned k = defined(shared);
+    shared = with_definitions(shared, {GiNaC::sin(GiNaC::wild(k + 1)), GiNaC::cos(x)});
+    fields["power_time"] = GiNaC::wild(k);
+  }), spec).has_value());
+  // A wildcard with no definition.
+  EXPECT_FALSE(symbolic::unarchive_derivation(forged(spec, [&](auto&, auto& fields) {
+    fields["power_time"] = GiNaC::wild(1000000);
+  }), spec).has_value());
+  // A definition that is a matrix, in Q.
+  EXPECT_FALSE(symbolic::unarchive_derivation(forged(spec, [&](GiNaC::matrix& shared, auto& fields) {
+    const unsigned k = defined(shared);
+    shared = with_definitions(shared, {GiNaC::matrix(2, 2, GiNaC::lst{x, 1, 2, 3})});
+    GiNaC::matrix q = GiNaC::ex_to<GiNaC::matrix>(fields["Q"]);
+    q(0, 3) = GiNaC::wild(k);
+    fields["Q"] = q;
+  }), spec).has_value());
+  // A chain of 3000 definitions, each the sine of the last.
+  EXPECT_FALSE(symbolic::unarchive_derivation(forged(spec, [&](GiNaC::matrix& shared, auto& fields) {
+    const unsigned k = defined(shared);
+    std::vector<GiNaC::ex> chain{GiNaC::sin(x)};
+    for (unsigned i = 1; i < 3000; ++i) chain.push_back(GiNaC::sin(GiNaC::wild(k + i - 1)));
+    shared = with_definitions(shared, chain);
+    fields["power_time"] = GiNaC::wild(k + 2999);
+  }), spec).has_value());
+  // 60 definitions, each the product of the sine and the cosine of the last: 2^60 nodes as a tree.
+  EXPECT_FALSE(symbolic::unarchive_derivation(forged(spec, [&](GiNaC::matrix& shared, auto& fields) {
+    const unsigned k = defined(shared);
+    std::vector<GiNaC::ex> doubling{GiNaC::sin(x)};
+    for (unsigned i = 1; i < 60; ++i)
+      doubling.push_back(GiNaC::sin(GiNaC::wild(k + i - 1)) * GiNaC::cos(GiNaC::wild(k + i - 1)));
+    shared = with_definitions(shared, doubling);
+    fields["power_time"] = GiNaC::wild(k + 59);
+  }), spec).has_value());
+  // 2000 levels of nesting in a field itself, no definitions.
+  EXPECT_FALSE(symbolic::unarchive_derivation(forged(spec, [&](auto&, auto& fields) {
+    GiNaC::ex nested = x;
+    for (int i = 0; i < 1000; ++i) nested = GiNaC::pow(nested + 1, 3);
+    fields["power_time"] = nested;
+  }), spec).has_value());
 }
 
 TEST(DerivationArchive, RefusesAnotherModelsAndDamagedBytes) {

@@ -314,6 +314,58 @@ GiNaC::ex substitute_shared(const GiNaC::ex& e, const Expanded& shared) {
   return substitute.substitute(e);
 }
 
+// Whether GiNaC can read `archive` back: its reader recurses through the nodes, so a graph deeper
+// than a written derivation is (its shared parts stand for themselves: a few levels over the
+// expressions' own) would take it past its stack, and a cycle, which no writer makes, forever.
+// Walked here with a stack of our own, each node once.
+bool within_reach(const GiNaC::archive& archive) {
+  constexpr unsigned kMaxNodeDepth = kMaxDepth + 8;  // the sequences holding a field's entries
+  std::unordered_map<const GiNaC::archive_node*, unsigned> depth;  // 0 while being walked
+  GiNaC::archive_node::propinfovector properties;
+  struct Visit {
+    const GiNaC::archive_node* node;
+    std::vector<const GiNaC::archive_node*> children;
+    std::size_t next = 0;
+    unsigned deepest = 0;
+  };
+  std::vector<Visit> path;
+  const auto enter = [&](const GiNaC::archive_node& node) {
+    if (path.size() >= kMaxNodeDepth) return false;
+    depth.emplace(&node, 0u);
+    Visit visit{&node, {}};
+    node.get_properties(properties);
+    for (const auto& p : properties)
+      if (p.type == GiNaC::archive_node::PTYPE_NODE)
+        for (unsigned i = 0; i < p.count; ++i) visit.children.push_back(&node.find_ex_node(p.name, i));
+    path.push_back(std::move(visit));
+    return true;
+  };
+  for (unsigned e = 0; e < archive.num_expressions(); ++e) {
+    const GiNaC::archive_node& top = archive.get_top_node(e);
+    if (depth.count(&top) != 0) continue;
+    if (!enter(top)) return false;
+    while (!path.empty()) {
+      Visit& visit = path.back();
+      if (visit.next < visit.children.size()) {
+        const GiNaC::archive_node* child = visit.children[visit.next++];
+        if (const auto it = depth.find(child); it != depth.end()) {
+          if (it->second == 0) return false;  // on the path: a cycle
+          visit.deepest = std::max(visit.deepest, it->second);
+        } else if (!enter(*child)) {
+          return false;
+        }
+        continue;
+      }
+      const unsigned mine = visit.deepest + 1;  // the longest path below and through this node
+      if (mine > kMaxNodeDepth) return false;
+      depth[visit.node] = mine;
+      path.pop_back();
+      if (!path.empty()) path.back().deepest = std::max(path.back().deepest, mine);
+    }
+  }
+  return true;
+}
+
 // The archive of `fields` over the definitions `shared`.
 std::string archive_body(const std::vector<std::pair<const char*, GiNaC::ex>>& fields,
                          const std::vector<GiNaC::ex>& shared, const std::set<std::string>& names) {
@@ -383,7 +435,7 @@ std::optional<Derivation> unarchive_derivation(const std::string& bytes, const S
     }
     GiNaC::archive archive;
     in >> archive;
-    if (!in) return std::nullopt;
+    if (!in || !within_reach(archive)) return std::nullopt;
     const Expanded values = expand_shared(as_list(archive.unarchive_ex(known, "shared")));
     const auto read = [&](const char* name) { return substitute_shared(archive.unarchive_ex(known, name), values); };
     Derivation d;
