@@ -29,10 +29,12 @@ class OdeSystem {
   // Number of states.
   virtual int size() const = 0;
   // Number of leading states that the adaptive Runge-Kutta pairs' error norm and first-step
-  // heuristic weigh (all by default). The states past it are quadratures no other state depends
-  // on (the work of the forces, docs/derivations/energy-balance.md): integrated by the same method
-  // on the same steps, they do not choose the steps, so the other states are those of a run
-  // without them, to the bit. CVODE weighs every state.
+  // heuristic weigh (all by default). The states past it are quadratures no state depends on, not
+  // even their own (the work of the forces, docs/derivations/energy-balance.md): rhs() never reads
+  // them. Integrated by the same method on the same steps, they do not choose the steps, so the
+  // other states are those of a run without them, to the bit; the explicit Runge-Kutta methods
+  // form them only in the states they return (a stage's state holds the leading ones alone).
+  // CVODE weighs every state.
   virtual int error_size() const { return size(); }
   // ydot = f(t, y). Returns Status::ok or the reason the right-hand side cannot be evaluated;
   // an integrator stops at the first non-ok status and reports it.

@@ -19,11 +19,13 @@ namespace {
 constexpr double eps = std::numeric_limits<double>::epsilon();
 
 // One explicit Runge-Kutta step for any tableau. Owns the stage derivatives k_i and a scratch
-// state, allocated once per integrate() call.
+// state, allocated once per integrate() call. A stage's state holds only the `read` leading
+// states, those the right-hand side reads (OdeSystem::error_size: the states past them are
+// quadratures); the state a step returns, y1, holds them all.
 template <class Tableau>
 class Stepper {
  public:
-  explicit Stepper(int n) : n_(n), y_stage_(static_cast<std::size_t>(n)) {
+  Stepper(int n, int read) : n_(n), read_(read), y_stage_(static_cast<std::size_t>(n)) {
     for (std::vector<double>& k : k_) k.assign(static_cast<std::size_t>(n), 0.0);
   }
 
@@ -48,7 +50,7 @@ class Stepper {
       (void)(stage<S + 1>(system, t, y, h, y1, stats, t_fail, evaluate_last, status) && ...);
     }(std::make_integer_sequence<int, Tableau::stages - 1>{});
     if constexpr (!Tableau::fsal) {
-      if (status == Status::ok) combine<Tableau::stages>(y, h, y1);
+      if (status == Status::ok) combine<Tableau::stages>(y, h, y1, n_);
     }
     return status;
   }
@@ -62,7 +64,7 @@ class Stepper {
     constexpr bool last = Tableau::fsal && s == Tableau::stages - 1;
     // With FSAL the last row of a equals b, so the last stage state is y1 itself.
     double* target = last ? y1 : y_stage_.data();
-    combine<s>(y, h, target);
+    combine<s>(y, h, target, last ? n_ : read_);
     if (last && !evaluate_last) return false;
     const double ts = t + Tableau::c[static_cast<std::size_t>(s)] * h;
     ++stats.rhs_evaluations;
@@ -93,12 +95,12 @@ class Stepper {
     return std::pair{stages, count};
   }
 
-  // target = y + h sum_j w_j k_j over row `row`'s nonzero weights. Each entry's sum is formed in a
-  // register, in the order of j, and stored once: the same additions as adding one stage after
-  // another to the whole target, without storing and loading the target for every stage; with
-  // the weights known at compile time the sum over j is unrolled.
+  // target = y + h sum_j w_j k_j over row `row`'s nonzero weights, for the first `count` states.
+  // Each entry's sum is formed in a register, in the order of j, and stored once: the same
+  // additions as adding one stage after another to the whole target, without storing and loading
+  // the target for every stage; with the weights known at compile time the sum over j is unrolled.
   template <int row>
-  void combine(const double* y, double h, double* target) const {
+  void combine(const double* y, double h, double* target, int count) const {
     constexpr auto nonzero = nonzero_weights<row>();
     constexpr int used = nonzero.second;
     constexpr const std::array<double, Tableau::stages>& w = weights<row>();
@@ -109,7 +111,7 @@ class Stepper {
       coef[static_cast<std::size_t>(m)] = h * w[j];
       from[static_cast<std::size_t>(m)] = k_[j].data();
     }
-    for (int i = 0; i < n_; ++i) {
+    for (int i = 0; i < count; ++i) {
       double sum = y[i];
 #pragma GCC unroll 16
       for (int m = 0; m < used; ++m) sum += coef[static_cast<std::size_t>(m)] * from[static_cast<std::size_t>(m)][i];
@@ -118,6 +120,7 @@ class Stepper {
   }
 
   int n_;
+  int read_;
   std::vector<double> y_stage_;
   std::array<std::vector<double>, Tableau::stages> k_;
 };
@@ -324,7 +327,7 @@ template <>
 class ContinuousExtension<rk::DormandPrince54> {
  public:
   using Tableau = rk::DormandPrince54;
-  explicit ContinuousExtension(int n) : n_(n) {}
+  ContinuousExtension(int n, int /*read*/) : n_(n) {}
 
   Status prepare(OdeSystem& /*system*/, const Stepper<Tableau>& stepper, double /*t*/,
                  const double* y, const double* y1, double h, IntegratorStats& /*stats*/,
@@ -366,7 +369,8 @@ template <>
 class ContinuousExtension<rk::DormandPrince853> {
  public:
   using Tableau = rk::DormandPrince853;
-  explicit ContinuousExtension(int n) : n_(n), y_stage_(static_cast<std::size_t>(n)) {
+  // The extra stages' states hold the `read` leading states, as the Stepper's do.
+  ContinuousExtension(int n, int read) : n_(n), read_(read), y_stage_(static_cast<std::size_t>(n)) {
     for (std::vector<double>& k : extra_) k.assign(static_cast<std::size_t>(n), 0.0);
     for (std::vector<double>& r : r_) r.assign(static_cast<std::size_t>(n), 0.0);
   }
@@ -380,12 +384,12 @@ class ContinuousExtension<rk::DormandPrince853> {
     for (int s = 0; s < Tableau::extra_stages; ++s) {
       const std::array<double, Tableau::all_stages>& w =
           Tableau::a_extra[static_cast<std::size_t>(s)];
-      std::copy(y, y + n_, y_stage_.begin());
+      std::copy(y, y + read_, y_stage_.begin());
       for (int j = 0; j < Tableau::stages + s; ++j) {
         if (w[static_cast<std::size_t>(j)] == 0.0) continue;
         const double coef = h * w[static_cast<std::size_t>(j)];
         const double* kj = stage(j);
-        for (int i = 0; i < n_; ++i) y_stage_[static_cast<std::size_t>(i)] += coef * kj[i];
+        for (int i = 0; i < read_; ++i) y_stage_[static_cast<std::size_t>(i)] += coef * kj[i];
       }
       const double ts = t + Tableau::c_extra[static_cast<std::size_t>(s)] * h;
       ++stats.rhs_evaluations;
@@ -436,6 +440,7 @@ class ContinuousExtension<rk::DormandPrince853> {
 
  private:
   int n_;
+  int read_;
   std::vector<double> y_stage_;
   std::array<std::vector<double>, Tableau::extra_stages> extra_;
   std::array<std::vector<double>, 8> r_;  // r_0 = y, then r1..r7 above
@@ -448,7 +453,7 @@ struct AdaptiveRun {
               std::span<const double> output_times, const OutputFn& output, EventFunctions* events)
       : method(method), system(system), options(options), output_times(output_times), output(output), events(events),
         n(system.size()), y(y0, y0 + n), y1(static_cast<std::size_t>(n)), y_out(static_cast<std::size_t>(n)),
-        stepper(n), extension(n) {}
+        stepper(n, system.error_size()), extension(n, system.error_size()) {}
 
   std::string_view method;
   OdeSystem& system;
@@ -718,7 +723,7 @@ IntegrationResult integrate_rk4(OdeSystem& system, const IntegratorOptions& opti
 
   std::vector<double> y(y0, y0 + n);
   std::vector<double> y1(static_cast<std::size_t>(n));
-  Stepper<rk::ClassicRk4> stepper(n);
+  Stepper<rk::ClassicRk4> stepper(n, system.error_size());
   IntegratorStats stats;
 
   std::size_t next = 0;
