@@ -218,9 +218,14 @@ double dense_data_bytes(int n, int s, const DataOptions& options) {
 }
 
 double physical_memory_bytes() {
-  const long pages = sysconf(_SC_PHYS_PAGES);
-  const long page_size = sysconf(_SC_PAGESIZE);
-  return pages > 0 && page_size > 0 ? static_cast<double>(pages) * static_cast<double>(page_size) : 0.0;
+  // Asked once a process: each make_data wants it, and the question is a system call (sysinfo),
+  // a tenth of a small model's short run.
+  static const double bytes = [] {
+    const long pages = sysconf(_SC_PHYS_PAGES);
+    const long page_size = sysconf(_SC_PAGESIZE);
+    return pages > 0 && page_size > 0 ? static_cast<double>(pages) * static_cast<double>(page_size) : 0.0;
+  }();
+  return bytes;
 }
 
 void check_dense_memory(const Model& model, double available, const DataOptions& options) {
