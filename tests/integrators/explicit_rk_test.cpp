@@ -1,8 +1,11 @@
 // Exams for the explicit Runge-Kutta integrators: the tableaus satisfy the order conditions,
 // rk4 converges with order 4 and hits output times with the promised steps, dopri5 meets its
 // tolerance at step ends and in its continuous extension, scales its error with the tolerance,
-// honours max_step and reports a singularity as step size underflow.
+// honours max_step and reports a singularity as step size underflow; a quadrature past
+// error_size() leaves the other states as they were, to the bit.
 #include "nhdyn/integrators/detail/explicit_rk.hpp"
+
+#include "nhdyn/core/error.hpp"
 
 #include <gtest/gtest.h>
 
@@ -558,6 +561,96 @@ TEST(Dop853, SingularityGivesStepSizeUnderflow) {
                                              [](double, const double*) { return Status::ok; });
   EXPECT_EQ(result.status, Status::step_size_underflow) << result.message;
   EXPECT_NEAR(result.t_reached, 1.0, 1e-6);
+}
+
+// The oscillator with a quadrature past error_size(): W' = x'^2, W(0) = 0, so that
+// W(t) = t / 2 - sin(2 t) / 4. Its right-hand side never reads W (OdeSystem::error_size).
+class RkOscillatorWithWork : public OdeSystem {
+ public:
+  int size() const override { return 3; }
+  int error_size() const override { return 2; }
+  Status rhs(double /*t*/, const double* y, double* ydot) override {
+    ydot[0] = y[1];
+    ydot[1] = -y[0];
+    ydot[2] = y[1] * y[1];
+    return Status::ok;
+  }
+  StepEnd after_step(double t, double* /*y*/) override {
+    step_ends.push_back(t);
+    return {};
+  }
+  std::vector<double> step_ends;
+};
+
+// A quadrature formed only in the states a step returns changes nothing else: the same steps and
+// the same oscillator to the bit at every output (inside steps and at their ends), and W within
+// the tolerance of its closed form, for each explicit method.
+TEST(ExplicitRk, AQuadraturePastTheErrorSizeLeavesTheOtherStatesAsTheyWere) {
+  std::vector<double> times;
+  for (int k = 1; k <= 200; ++k) times.push_back(0.05 * k);
+  for (const IntegratorOptions& options : {rk4_options(0.01), dopri5_options(1e-10), dop853_options(1e-10)}) {
+    SCOPED_TRACE(integrator_name(options.kind));
+    RkOscillator plain;
+    RkOscillatorWithWork with_work;
+    std::vector<std::array<double, 2>> plain_states;
+    std::vector<std::array<double, 3>> work_states;
+    const double y0[3] = {1.0, 0.0, 0.0};
+    const IntegrationResult a = integrate(plain, options, 0.0, y0, times, [&](double, const double* y) {
+      plain_states.push_back({y[0], y[1]});
+      return Status::ok;
+    });
+    const IntegrationResult b = integrate(with_work, options, 0.0, y0, times, [&](double, const double* y) {
+      work_states.push_back({y[0], y[1], y[2]});
+      return Status::ok;
+    });
+    ASSERT_EQ(a.status, Status::ok) << a.message;
+    ASSERT_EQ(b.status, Status::ok) << b.message;
+    EXPECT_EQ(plain.step_ends, with_work.step_ends);
+    EXPECT_EQ(a.stats.rhs_evaluations, b.stats.rhs_evaluations);
+    ASSERT_EQ(plain_states.size(), times.size());
+    ASSERT_EQ(work_states.size(), times.size());
+    double worst = 0.0;
+    for (std::size_t i = 0; i < times.size(); ++i) {
+      EXPECT_EQ(plain_states[i][0], work_states[i][0]) << "t = " << times[i];
+      EXPECT_EQ(plain_states[i][1], work_states[i][1]) << "t = " << times[i];
+      const double t = times[i];
+      worst = std::max(worst, std::abs(work_states[i][2] - (t / 2 - std::sin(2 * t) / 4)));
+    }
+    // rk4 with h = 0.01 errs by about h^4 over t = 10; the adaptive pairs by their tolerance.
+    EXPECT_LT(worst, 1e-7);
+    EXPECT_GT(work_states.back()[2], 4.0);  // W(10) = 5 - sin(20) / 4 = 4.77...
+  }
+}
+
+// error_size() must lie in [1, size()]: the error norm divides by it, and the stages form that
+// many states.
+class RkBadErrorSize : public OdeSystem {
+ public:
+  explicit RkBadErrorSize(int weighed) : weighed_(weighed) {}
+  int size() const override { return 2; }
+  int error_size() const override { return weighed_; }
+  Status rhs(double /*t*/, const double* y, double* ydot) override {
+    ydot[0] = y[1];
+    ydot[1] = -y[0];
+    return Status::ok;
+  }
+
+ private:
+  int weighed_;
+};
+
+TEST(ExplicitRk, AnErrorSizeOutsideOneToTheStateCountIsRefused) {
+  for (int weighed : {0, -1, 3}) {
+    RkBadErrorSize system(weighed);
+    const double y0[2] = {1.0, 0.0};
+    const std::vector<double> times = {1.0};
+    try {
+      integrate(system, dopri5_options(1e-8), 0.0, y0, times, [](double, const double*) { return Status::ok; });
+      ADD_FAILURE() << "error_size " << weighed << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("error_size"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

@@ -25,6 +25,10 @@ void require_valid_input(const OdeSystem& system, const IntegratorOptions& optio
   const int n = system.size();
   if (n < 1)
     throw InputError(fmt::format("the system to integrate has {} states; it needs at least 1", n));
+  if (const int weighed = system.error_size(); weighed < 1 || weighed > n)
+    throw InputError(fmt::format("the system to integrate weighs {} of its {} states in the error norm "
+                                 "(error_size); it must weigh from 1 to all of them",
+                                 weighed, n));
   if (!std::isfinite(t0)) throw InputError(fmt::format("initial time t0 = {} is not finite", t0));
   for (int i = 0; i < n; ++i)
     if (!std::isfinite(y0[i]))

@@ -32,7 +32,7 @@ class Stepper {
   double* k(int i) { return k_[static_cast<std::size_t>(i)].data(); }
   const double* k(int i) const { return k_[static_cast<std::size_t>(i)].data(); }
   double* scratch() { return y_stage_.data(); }
-  // After step(): the state of the last stage before the FSAL one.
+  // After step(): the state of the last stage before the FSAL one, its first `read` entries.
   const double* scratch_view() const { return y_stage_.data(); }
 
   // The FSAL stage of one step is the first of the next: swapping the buffers saves a copy.
