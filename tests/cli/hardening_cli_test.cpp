@@ -103,6 +103,22 @@ TEST_F(Hardening, HugeThreadCountIsCapped) {
     EXPECT_FALSE(contains(entry.path().filename().string(), ".tmp")) << entry.path();
 }
 
+// A path that never ends (/dev/zero) was read into memory until the machine ran out: a model file
+// is read up to 256 MB, a CSV's line up to 64 MB, and a directory is named as one.
+TEST_F(Hardening, EndlessOrDirectoryInputsAreRefusedByName) {
+  const ProcessRun model = nhdyn({"simulate", "/dev/zero", "-o", "z.csv"});
+  EXPECT_EQ(model.code, 2) << model.err;
+  EXPECT_TRUE(contains(model.err, "/dev/zero: larger than 256 MB")) << model.err;
+  EXPECT_FALSE(fs::exists(dir_ / "z.csv"));
+  const ProcessRun runs = nhdyn({"batch", "sled.toml", "--runs", "/dev/zero", "--t-end", "0.1", "-o", "rb"});
+  EXPECT_EQ(runs.code, 2) << runs.err;
+  EXPECT_TRUE(contains(runs.err, "/dev/zero:1: a line longer than 64 MB")) << runs.err;
+  const ProcessRun folder = nhdyn({"batch", "sled.toml", "--runs", ".", "--t-end", "0.1", "-o", "rb"});
+  EXPECT_EQ(folder.code, 2) << folder.err;
+  EXPECT_TRUE(contains(folder.err, "'.' is a directory; expected a CSV file")) << folder.err;
+  EXPECT_FALSE(fs::exists(dir_ / "rb"));
+}
+
 // The shared objects (and their check files) in a cache directory, by extension.
 std::vector<fs::path> cache_entries(const fs::path& cache, const std::string& extension) {
   std::vector<fs::path> out;
@@ -148,6 +164,17 @@ TEST_F(Hardening, DamagedCompiledModelCacheIsRebuilt) {
   fs::copy_file(fs::path(other.string() + ".check"), fs::path(sled_object.string() + ".check"),
                 fs::copy_options::overwrite_existing);
   damaged_run("another model's object and check file");
+  // A named pipe in place of the object or of its check file (the read of either waited for a
+  // writer for ever), and a link to /dev/zero (whose read never ended).
+  const fs::path sled_check = sled_object.string() + ".check";
+  for (const fs::path& place : {sled_object, sled_check}) {
+    fs::remove(place);
+    ASSERT_EQ(::mkfifo(place.c_str(), 0644), 0);
+    damaged_run("a named pipe at " + place.filename().string());
+    fs::remove(place);
+    fs::create_symlink("/dev/zero", place);
+    damaged_run("a link to /dev/zero at " + place.filename().string());
+  }
   // No temporary, source or log is left (the cache of derived models, which the loads may fill,
   // has its own folder there).
   for (const auto& entry : fs::directory_iterator(cache)) {

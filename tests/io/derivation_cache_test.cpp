@@ -378,6 +378,32 @@ TEST(DerivationCache, ByDefaultTheSecondLoadKeepsAndTheThirdReads) {
   EXPECT_TRUE(stored(load_model_described(source, {})));
 }
 
+// The mark of a first load is made only where nothing is: a named pipe at its place (whose
+// opening for writing waits for a reader) and a dangling link (whose target the mark would create)
+// are left as they are, and the model loads.
+TEST(DerivationCache, APipeOrALinkAtTheMarksPlaceIsLeftAlone) {
+  if (detail::build_identity().empty()) GTEST_SKIP() << "this build has no GNU build-id: no derivation cache";
+  const CacheDirectory cache;
+  ::unsetenv("NHDYN_DERIVATION_CACHE");
+  const ModelSource source = read_model_source(test::example("rattleback.toml"));
+  const LoadedModel first = load_model_described(source, {});
+  ASSERT_EQ(cache.files().size(), 1U);
+  const fs::path mark = cache.files().front();
+  ASSERT_EQ(mark.extension(), ".seen");
+  fs::remove(mark);
+  ASSERT_EQ(::mkfifo(mark.c_str(), 0600), 0);
+  const LoadedModel piped = load_model_described(source, {});
+  EXPECT_FALSE(stored(piped));
+  EXPECT_EQ(start_numbers(first.model), start_numbers(piped.model));
+  EXPECT_TRUE(fs::is_fifo(mark));
+  fs::remove(mark);
+  const fs::path target = cache.root() / "elsewhere";
+  fs::create_symlink(target, mark);
+  const LoadedModel linked = load_model_described(source, {});
+  EXPECT_EQ(start_numbers(first.model), start_numbers(linked.model));
+  EXPECT_FALSE(fs::exists(target));
+}
+
 TEST(DerivationCache, OffMeansNoFile) {
   const CacheDirectory cache;
   for (const char* off : {"off", "OFF", "0", "false", "No"}) {

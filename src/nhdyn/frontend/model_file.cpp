@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -141,10 +142,19 @@ std::string read_model_text(const std::filesystem::path& path) {
     throw FileError(fmt::format("{}: cannot open the model file: {}", path.string(),
                                 error != 0 ? std::strerror(error) : "unknown error"));
   }
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Read up to a bound: a model file is text (the 10 000-body chain's is under 6 MB), and a device
+  // such as /dev/zero has no end to read to.
+  constexpr std::size_t kMaxModelFile = std::size_t{256} << 20;
+  std::string text;
+  std::array<char, 1 << 16> chunk;
+  while (in.read(chunk.data(), chunk.size()) || in.gcount() > 0) {
+    text.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxModelFile)
+      throw FileError(fmt::format("{}: larger than {} MB, which no model file is; is it the file you meant?",
+                                  path.string(), kMaxModelFile >> 20));
+  }
   if (in.bad()) throw FileError(fmt::format("{}: cannot read the model file", path.string()));
-  return text.str();
+  return text;
 }
 
 symbolic::Spec load_model_file(const std::filesystem::path& path) {

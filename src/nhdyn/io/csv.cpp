@@ -193,7 +193,35 @@ int CsvTable::column(const std::string& name) const {
   return -1;
 }
 
+namespace {
+
+// A line of a CSV longer than this is refused: a row of 10 000 bodies' states is a few MB, and
+// a file without line ends (a device such as /dev/zero) would otherwise be read into memory to
+// its end, which never comes.
+constexpr std::size_t kMaxCsvLine = std::size_t{64} << 20;
+
+// std::getline with that bound: the next line without its '\n', false at the end of the input.
+bool read_bounded_line(std::istream& in, std::string& line, const std::filesystem::path& path, long line_number) {
+  line.clear();
+  std::streambuf* buffer = in.rdbuf();
+  bool any = false;
+  for (int c = buffer->sbumpc(); c != std::char_traits<char>::eof(); c = buffer->sbumpc()) {
+    any = true;
+    if (c == '\n') return true;
+    line.push_back(static_cast<char>(c));
+    if (line.size() > kMaxCsvLine)
+      throw FileError(fmt::format("{}:{}: a line longer than {} MB; is '{}' a CSV file?", path.string(), line_number,
+                                  kMaxCsvLine >> 20, path.string()));
+  }
+  return any;
+}
+
+}  // namespace
+
 CsvTable load_csv(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw FileError(fmt::format("'{}' is a directory; expected a CSV file", path.string()));
   std::ifstream in(path);
   if (!in) throw FileError(fmt::format("cannot read '{}'", path.string()));
   CsvTable table;
@@ -202,7 +230,7 @@ CsvTable load_csv(const std::filesystem::path& path) {
   // Comment lines before the header (the reason line of nhdyn's own FILE.partial.csv) are skipped,
   // and a UTF-8 byte-order mark (spreadsheet exports) is not part of the first name.
   bool header = false;
-  while (std::getline(in, line)) {
+  while (read_bounded_line(in, line, path, line_number + 1)) {
     ++line_number;
     if (line_number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     if (!line.empty() && line[0] == '#') {
@@ -214,7 +242,7 @@ CsvTable load_csv(const std::filesystem::path& path) {
   }
   if (!header) throw FileError(fmt::format("'{}' is empty; expected a header row", path.string()));
   table.header = split_csv_record(line);
-  while (std::getline(in, line)) {
+  while (read_bounded_line(in, line, path, line_number + 1)) {
     ++line_number;
     if (line.empty()) continue;
     std::vector<double> row;

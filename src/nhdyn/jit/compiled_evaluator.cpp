@@ -24,6 +24,7 @@
 #include <system_error>
 #include <sstream>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "nhdyn/jit/detail/source.hpp"
@@ -236,11 +237,23 @@ std::string entry_check(const std::string& key, const std::string& bytes) {
                      fnv1a(bytes, kFnvOffset), fnv1a(bytes, kFnvOtherOffset));
 }
 
-// "" when `object` is whole and belongs to `key` by its check file; else what is wrong.
+// The largest cached object read (to hash it): a compiled model is far smaller, and a device or
+// a link to one in its place is never read to its end.
+constexpr std::uintmax_t kMaxObjectBytes = std::uintmax_t{1} << 30;
+constexpr std::uintmax_t kMaxCheckBytes = 4096;
+
+// "" when `object` is whole and belongs to `key` by its check file; else what is wrong. Only
+// regular files of a plausible size are read: a named pipe would block the read, a device never
+// end it.
 std::string verify_entry(const fs::path& object, const fs::path& check, const std::string& key) {
   std::error_code ec;
   if (!fs::exists(object, ec)) return "the object is missing";
   if (!fs::exists(check, ec)) return "its check file is missing";
+  for (const auto& [path, limit] : {std::pair{object, kMaxObjectBytes}, std::pair{check, kMaxCheckBytes}}) {
+    if (!fs::is_regular_file(path, ec)) return fmt::format("{} is not a regular file", path.filename().string());
+    const std::uintmax_t size = fs::file_size(path, ec);
+    if (ec || size > limit) return fmt::format("{} is larger than any cache entry", path.filename().string());
+  }
   const std::string expected = read_file(check);
   if (expected.find(fmt::format("key {}\n", key)) == std::string::npos) return "its check file names another model";
   if (entry_check(key, read_file(object)) != expected) return "the object is truncated or altered";

@@ -2,6 +2,7 @@
 
 #include <dlfcn.h>
 #include <elf.h>
+#include <fcntl.h>
 #include <link.h>
 #include <unistd.h>
 
@@ -69,7 +70,12 @@ class FileStore final : public symbolic::DerivationStore {
     std::error_code error;
     if (fs::is_regular_file(mark(), error)) return true;
     fs::create_directories(file_.parent_path(), error);
-    if (!error) std::ofstream(mark(), std::ios::binary | std::ios::trunc);
+    // Made only where nothing is: O_EXCL with O_NOFOLLOW opens no named pipe (which would wait
+    // for a reader), no device and no link's target.
+    if (!error) {
+      const int fd = ::open(mark().c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+      if (fd >= 0) ::close(fd);
+    }
     return false;
   }
 
