@@ -60,6 +60,29 @@ TEST(ParameterExpression, RefusesWhatItCannotRead) {
   EXPECT_TRUE(contains(error_of([&] { calc_parameter_expression("1e400", known); }), "too large"));
 }
 
+// 0^0 was 1 and 1/0 "too large, rescale the units": an undefined or infinite value of finite
+// operands is named where it happens, as in the model file's other expressions.
+TEST(ParameterExpression, UndefinedAndInfiniteOperationsAreNamed) {
+  const std::vector<Parameter> known{{"m", 2.0, "kg", ""}};
+  for (const char* text : {"0^0", "(1-1)^0", "(m-m)**0", "0^(m-2)"})
+    EXPECT_TRUE(contains(error_of([&] { calc_parameter_expression(text, known); }), "contains 0^0, which is undefined"))
+        << text;
+  EXPECT_TRUE(contains(error_of([&] { calc_parameter_expression("1/0", known); }), "it divides by zero (column 3)"));
+  EXPECT_TRUE(contains(error_of([&] { calc_parameter_expression("m/(m-2)", known); }), "it divides by zero"));
+  EXPECT_TRUE(contains(error_of([&] { calc_parameter_expression("0/0", known); }), "it divides by zero"));
+  EXPECT_TRUE(contains(error_of([&] { calc_parameter_expression("0^(-1)", known); }), "negative power divides by zero"));
+  EXPECT_TRUE(contains(error_of([&] { calc_parameter_expression("log(0)", known); }), "log(0) is infinite"));
+  EXPECT_TRUE(contains(error_of([&] { calc_parameter_expression("exp(1000)", known); }), "exp(1000) is infinite"));
+  EXPECT_TRUE(contains(error_of([&] { calc_parameter_expression("1e300/1e-300", known); }), "a quotient overflows"));
+  EXPECT_TRUE(contains(error_of([&] { calc_parameter_expression("10^400", known); }), "a power overflows"));
+  // Their neighbours that have a value keep it; names are still collected from any text.
+  EXPECT_EQ(calc_parameter_expression("0^2", known), 0.0);
+  EXPECT_EQ(calc_parameter_expression("m^0", known), 1.0);
+  EXPECT_EQ(calc_parameter_expression("0/m", known), 0.0);
+  EXPECT_EQ(calc_parameter_expression("log(1)", known), 0.0);
+  EXPECT_EQ(calc_expression_names("m/(m-m) + 0^0", known), std::vector<std::string>{"m"});
+}
+
 TEST(ParameterValue, SubnormalAndTooLargeAreNamed) {
   EXPECT_TRUE(contains(error_of([] { check_parameter_value("m", 1e-320); }), "subnormal"));
   EXPECT_TRUE(contains(error_of([] { check_parameter_value("k", 1e308); }), "too large"));

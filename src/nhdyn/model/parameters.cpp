@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cfloat>
 #include <cmath>
+#include <limits>
 #include <cstdlib>
 #include <functional>
 #include <memory>
@@ -62,6 +63,14 @@ class ExpressionParser {
                                  "parentheses, functions such as sin(x) or sqrt(x), pi, e and other parameters",
                                  shown, what, pos_ + 1));
   }
+  // An operation of finite operands whose value is infinite (1/0, log(0), exp(1000)): refused
+  // where the operation ends, saying which. (A NaN, sqrt(-1), is named by check_parameter_value.)
+  // Only when evaluating: collecting names, every value is a placeholder 0.
+  double defined(double value, const std::string& operation) const {
+    if (!evaluate_ || !std::isinf(value)) return value;
+    throw InputError(fmt::format("'{}' has no finite value: {} (column {}); write the value meant",
+                                 shorten(text_), operation, pos_));
+  }
   void skip_space() {
     while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
   }
@@ -90,8 +99,12 @@ class ExpressionParser {
       if (text_.substr(pos_, 2) == "**") return value;  // handled by power()
       if (accept("*"))
         value = value * unary();
-      else if (accept("/"))
-        value = value / unary();
+      else if (accept("/")) {
+        const double divisor = unary();
+        if (evaluate_ && divisor == 0.0 && std::isfinite(value))
+          defined(std::numeric_limits<double>::infinity(), "it divides by zero");
+        value = defined(value / divisor, "a quotient overflows");
+      }
       else
         return value;
     }
@@ -112,8 +125,12 @@ class ExpressionParser {
   }
   double power() {
     const double base = atom();
-    if (accept("^") || accept("**")) return std::pow(base, unary());
-    return base;
+    if (!accept("^") && !accept("**")) return base;
+    const double exponent = unary();
+    if (evaluate_ && base == 0.0 && exponent == 0.0)
+      throw InputError(fmt::format("'{}' contains 0^0, which is undefined: write 1 or 0 as meant", shorten(text_)));
+    return defined(std::pow(base, exponent),
+                   base == 0.0 && exponent < 0.0 ? "0 to a negative power divides by zero" : "a power overflows");
   }
   double atom() {
     skip_space();
@@ -188,7 +205,8 @@ class ExpressionParser {
     for (const auto& [known, f] : unary_functions)
       if (function == known) {
         if (args.size() != 1) fail(function + " takes one argument");
-        return f(args[0]);
+        const double value = f(args[0]);
+        return std::isfinite(args[0]) ? defined(value, fmt::format("{}({:g}) is infinite", function, args[0])) : value;
       }
     fail(fmt::format("'{}' is not a function this evaluator knows (sin, cos, tan, asin, acos, atan, atan2, sinh, "
                      "cosh, tanh, exp, log, sqrt, abs)",
