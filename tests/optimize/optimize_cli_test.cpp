@@ -562,6 +562,25 @@ TEST_F(OptimizeCli, BadInputExitsTwoNamingWhere) {
   const Outcome no_section = run_nhdyn("optimize " + example("sled.toml"), dir_);
   EXPECT_EQ(no_section.exit_code, 2) << no_section.out;
   EXPECT_NE(no_section.out.find("has no [optimize] section"), std::string::npos) << no_section.out;
+
+  // The solver's options, before any work: IPOPT dropped tol 0 and max_iter -5 for its defaults
+  // with a note of its own, and took --tolerance 1e300 to call the straight-line start solved.
+  for (const std::string tolerance : {"0", "-1e-8", "nan", "inf", "1e300", "0.02"}) {
+    const Outcome loose = run_nhdyn("optimize " + example("double_integrator.toml") + " -o t.csv --tolerance " + tolerance,
+                                    dir_);
+    EXPECT_EQ(loose.exit_code, 2) << tolerance << ": " << loose.out;
+    EXPECT_NE(loose.out.find("the optimizer's tolerance"), std::string::npos) << loose.out;
+    EXPECT_NE(loose.out.find("must be a number above 0 and at most 0.01"), std::string::npos) << loose.out;
+    EXPECT_FALSE(fs::exists(dir_ / "t.csv")) << tolerance;
+  }
+  for (const std::string budget : {"0", "-5"}) {
+    const Outcome none = run_nhdyn("optimize " + example("double_integrator.toml") + " -o i.csv --max-iterations " + budget,
+                                   dir_);
+    EXPECT_EQ(none.exit_code, 2) << budget << ": " << none.out;
+    EXPECT_NE(none.out.find("the optimizer's iteration budget " + budget + " must be at least 1"), std::string::npos)
+        << none.out;
+    EXPECT_FALSE(fs::exists(dir_ / "i.csv")) << budget;
+  }
 }
 
 // IPOPT is a module loaded when a program is first solved (src/nhdyn/optimize/ipopt/solver_module.cpp):

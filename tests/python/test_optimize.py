@@ -96,3 +96,15 @@ print(before, mapped())
     if run.stdout.startswith("error") and "built without IPOPT" in run.stdout:
         pytest.skip(run.stdout)
     assert run.stdout.strip() == "(False, False) (True, True)", run.stdout + run.stderr
+
+
+def test_solver_options_are_checked_before_any_work(examples):
+    # IPOPT dropped tol 0 and max_iter -5 for its defaults, and took tolerance 1e300 to call the
+    # straight-line start solved.
+    m = nhdyn.load(examples / "double_integrator.toml")
+    for tolerance in (0.0, -1e-8, math.nan, math.inf, 1e300, 0.02):
+        with pytest.raises(nhdyn.InputError, match="the optimizer's tolerance .* must be a number above 0 and at most"):
+            m.optimize(tolerance=tolerance)
+    for budget in (0, -5):
+        with pytest.raises(nhdyn.InputError, match=f"the optimizer's iteration budget {budget} must be at least 1"):
+            m.optimize(max_iterations=budget)

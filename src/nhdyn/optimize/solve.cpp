@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
@@ -69,9 +70,28 @@ void apply_guess(const Transcription& nlp, const std::filesystem::path& path, st
   }
 }
 
+// The solver's options, before any work: IPOPT takes only tol > 0 and max_iter >= 0, and drops
+// another value with a note of its own for its default; a tolerance above 1e-2 lets a start that
+// violates the boundary conditions and the dynamics by percents count as solved.
+constexpr double kLoosestTolerance = 1e-2;
+
+void check_nlp_options(const NlpOptions& options) {
+  for (const auto& [name, value] : {std::pair{"tolerance", options.tolerance},
+                                    std::pair{"constraint tolerance", options.constraint_tolerance}})
+    if (!(value > 0.0 && value <= kLoosestTolerance))
+      throw InputError(fmt::format("the optimizer's {} {} must be a number above 0 and at most {:g} (the default is "
+                                   "1e-8): a looser one accepts a start far from a solution as solved",
+                                   name, value, kLoosestTolerance));
+  if (options.max_iterations < 1)
+    throw InputError(fmt::format("the optimizer's iteration budget {} must be at least 1 (the default "
+                                 "is 3000)",
+                                 options.max_iterations));
+}
+
 }  // namespace
 
 OptimizeResult solve_optimal_control(const OptimalControlProblem& problem, const OptimizeOptions& options) {
+  check_nlp_options(options.nlp);
   Transcription nlp(problem);
   OptimizeResult result;
   result.notes = problem.warnings;
