@@ -18,11 +18,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Creates the directory that holds `file` (and its parents), or says why it cannot.
-void make_folder_of(const fs::path& file, const std::string& role) {
+// Creates the directory that holds `file` (and its parents), or says why it cannot; the folders
+// it made, the deepest first, are appended to `made`.
+void make_folder_of(const fs::path& file, const std::string& role, std::vector<fs::path>& made) {
   if (!file.has_parent_path()) return;
   std::error_code ec;
+  std::vector<fs::path> missing;
+  for (fs::path folder = file.parent_path(); !folder.empty() && !fs::exists(folder, ec); folder = folder.parent_path()) {
+    missing.push_back(folder);
+    if (folder == folder.parent_path()) break;
+  }
   fs::create_directories(file.parent_path(), ec);
+  if (!ec) made.insert(made.end(), missing.begin(), missing.end());
   std::error_code is_dir_ec;
   if (ec || !fs::is_directory(file.parent_path(), is_dir_ec))
     throw FileError(fmt::format("cannot create the directory '{}' for {} '{}' ({}); give another path",
@@ -105,7 +112,7 @@ void RunFiles::check() {
   for (const Listed& out : listed_)
     if (out.kind != Kind::output && !in_made_folder(out)) probes_.push_back(std::make_unique<AtomicFile>(out.path));
   for (const Listed& out : listed_)
-    if (out.folder == Folder::make) make_folder_of(out.path, out.role);
+    if (out.folder == Folder::make) make_folder_of(out.path, out.role, made_folders_);
   for (const Listed& out : listed_)
     if (out.kind != Kind::output && in_made_folder(out)) probes_.push_back(std::make_unique<AtomicFile>(out.path));
 }
@@ -161,6 +168,7 @@ void RunFiles::commit() {
   for (const Opened& file : opened_) file.publish();
   opened_.clear();
   probes_.clear();
+  made_folders_.clear();  // the run's now
 }
 
 void RunFiles::discard() {
@@ -179,6 +187,13 @@ void RunFiles::discard() {
     release_temporary_file(slot);
   }
   scratch_.clear();
+  // The folders check() made for a run that ends without its files, while they are empty (a
+  // failed run's FILE.partial.csv keeps its folder).
+  for (const fs::path& folder : made_folders_) {
+    std::error_code ec;
+    if (fs::is_empty(folder, ec) && !ec) fs::remove(folder, ec);
+  }
+  made_folders_.clear();
 }
 
 void check_plot_columns(const std::string& plot, const std::vector<std::string>& columns,

@@ -14,7 +14,8 @@
 //      order opened (batch's staged run files first), so that a disk full at the last file leaves
 //      none of them behind, not the first ones alone. A RunFiles destroyed (or discard()ed) without
 //      commit removes its temporaries and staging folder, so a refused, failed or interrupted run
-//      leaves nothing behind (the SIGINT/SIGTERM handler of output_guard.hpp removes the
+//      leaves nothing behind, not even the folders check() made for it while they are empty (the
+//      SIGINT/SIGTERM handler of output_guard.hpp removes the
 //      temporaries of a process that is killed mid-run).
 //
 // The library's pieces (AtomicFile, CsvWriter, RunPaths) stay in io/; this is the command line's
@@ -127,6 +128,7 @@ class RunFiles {
   std::vector<Opened> opened_;  // in the order opened
   std::vector<std::unique_ptr<AtomicFile>> probes_;
   std::filesystem::path staging_, staging_target_;
+  std::vector<std::filesystem::path> made_folders_;  // by check(), the deepest first; kept by commit()
   std::vector<std::pair<std::filesystem::path, int>> scratch_;  // path, slot in the table of temporaries
 };
 

@@ -294,6 +294,13 @@ TEST_F(Hardening, BatchTablesAreCheckedFirst) {
                                 quick);
   EXPECT_EQ(huge.code, 2) << huge.err;
   EXPECT_TRUE(contains(huge.err, "more than 10000000 runs")) << huge.err;
+  // A non-finite initial value is refused with the table, not run and blamed on the model.
+  write("initial.csv", "a,phi'(0)\n0.3,1\n0.4,inf\n");
+  const ProcessRun infinite = nhdyn({"batch", "sled.toml", "--runs", "initial.csv", "--t-end", "0.1", "-o", "out"});
+  EXPECT_EQ(infinite.code, 2) << infinite.err;
+  EXPECT_TRUE(contains(infinite.err, "batch run 1: the initial value phi'(0) = inf is not a finite number"))
+      << infinite.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
 // SIGINT during batch --write-runs left hundreds of run files and no summary; SIGHUP and SIGUSR1

@@ -78,7 +78,7 @@ TEST_F(InitialValuesCli, BadInputIsRefusedSayingWhich) {
       {"phi'", "--initial 'phi'': write it as NAME=VALUE"},
       {"=1", "--initial '=1': write it as NAME=VALUE"},
       {"phi'=foo", "--initial 'phi'=foo': "},
-      {"phi'=1/0", "--initial 'phi'=1/0': the value is inf; give a finite number"},
+      {"phi'=1/0", "--initial 'phi'=1/0': '1/0' has no finite value: it divides by zero"},
       {"y'=1", "blade (velocity level): residual 1"},
   };
   for (const auto& c : cases) {

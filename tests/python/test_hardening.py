@@ -136,6 +136,12 @@ def test_a_non_finite_parameter_value_names_its_run(oscillator):
         nhdyn.simulate_batch(oscillator, parameters={"k": [1.0, 2.0, 3.0, float("nan")]}, t_end=0.1)
 
 
+def test_a_non_finite_initial_value_names_its_run(oscillator):
+    # It was run, and failed with words that blamed the model's overflow.
+    with pytest.raises(nhdyn.InputError, match=r"batch run 1: the initial value x'\(0\) = nan is not a finite number"):
+        nhdyn.simulate_batch(oscillator, initial={"qd": [[0.0], [float("nan")]]}, t_end=0.1)
+
+
 # Each call passes a keyword that the command line spells as an option; the message must name the
 # keyword (or the Python way to do it), never the option ("--set", "--cyclic", ...).
 SLED = """name = "sled"

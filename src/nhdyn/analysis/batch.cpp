@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <exception>
 #include <mutex>
@@ -150,6 +151,16 @@ std::vector<BatchResult> simulate_batch(const std::vector<BatchRun>& runs, const
     if (run.v0 && run.v0->size() != n)
       throw InputError(fmt::format("batch run {}: {} initial velocities for a model with {} ({})", i, run.v0->size(),
                                    n, run.model->name));
+    // Refused with the others, before any run: as a failed run it read as the model's overflow.
+    for (int k = 0; k < n; ++k) {
+      const std::string& name = run.model->coordinates[static_cast<std::size_t>(k)];
+      if (run.q0 && !std::isfinite((*run.q0)(k)))
+        throw InputError(fmt::format("batch run {}: the initial value {}(0) = {} is not a finite number", i, name,
+                                     (*run.q0)(k)));
+      if (run.v0 && !std::isfinite((*run.v0)(k)))
+        throw InputError(fmt::format("batch run {}: the initial value {}'(0) = {} is not a finite number", i, name,
+                                     (*run.v0)(k)));
+    }
   }
   std::vector<BatchResult> results(runs.size());
   for (BatchResult& result : results) result.interrupted = true;  // until its run starts
