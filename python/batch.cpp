@@ -4,10 +4,13 @@
 #include <pybind11/stl.h>
 
 #include <chrono>
+#include <cmath>
 #include <limits>
 
 #include "bindings.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/io/results.hpp"
+#include "nhdyn/model/data.hpp"
 
 namespace nhdyn::python {
 namespace {
@@ -62,6 +65,23 @@ int thread_count(const py::object& value) {
   return big.cast<int>();
 }
 
+// The batch's results are held whole, each run's rows then the stacked arrays: refused before any
+// run when they would not fit in this machine's memory (the runs went on until the system ended
+// Python). The rows are the output times (the events' rows apart), each of the CSV's columns.
+void check_batch_memory(const Model& model, const SimulationOptions& options, std::size_t runs) {
+  const double rows = options.output_times.empty()
+                          ? std::floor((options.t_end - model.t0) / options.output_step) + 2.0
+                          : static_cast<double>(options.output_times.size());
+  const double columns = static_cast<double>(make_result_columns(model).all.size());
+  const double needed = 2.0 * 8.0 * static_cast<double>(runs) * rows * columns;
+  const double available = physical_memory_bytes();
+  if (available > 0.0 && needed > available)
+    throw InputError(fmt::format("simulate_batch: {} runs of {:.0f} rows of {:.0f} values need about {:.3g} GB held at "
+                                 "once, more than this machine's {:.3g} GB; give fewer runs or a larger output_step, or "
+                                 "run them with the command `nhdyn batch`, which writes each run's rows as it ends",
+                                 runs, rows, columns, needed / 1e9, available / 1e9));
+}
+
 }  // namespace
 
 void bind_batch(py::module_& m) {
@@ -81,6 +101,7 @@ void bind_batch(py::module_& m) {
         options.simulation = make_options(*models.front(), kwargs);
         options.threads = threads;
         options.keep_trajectories = keep_trajectories;
+        if (keep_trajectories) check_batch_memory(*models.front(), options.simulation, models.size());
         const std::vector<std::optional<Vector>> q = initial_states(q0, "q", models.size(), n);
         const std::vector<std::optional<Vector>> v = initial_states(v0, "qd", models.size(), n);
         std::vector<BatchRun> runs(models.size());

@@ -136,6 +136,13 @@ def test_a_non_finite_parameter_value_names_its_run(oscillator):
         nhdyn.simulate_batch(oscillator, parameters={"k": [1.0, 2.0, 3.0, float("nan")]}, t_end=0.1)
 
 
+def test_a_batch_larger_than_memory_is_refused_before_any_run(oscillator):
+    # It ran until the system ended Python (or the machine thrashed for minutes).
+    with pytest.raises(nhdyn.InputError, match=r"simulate_batch: 100 runs of 100000002 rows .* GB held at once, more "
+                                               r"than this machine's"):
+        nhdyn.simulate_batch(oscillator, parameters={"k": np.linspace(1.0, 2.0, 100)}, t_end=1e5, output_step=1e-3)
+
+
 def test_a_non_finite_initial_value_names_its_run(oscillator):
     # It was run, and failed with words that blamed the model's overflow.
     with pytest.raises(nhdyn.InputError, match=r"batch run 1: the initial value x'\(0\) = nan is not a finite number"):
