@@ -183,6 +183,17 @@ TEST_F(Hardening, DamagedCompiledModelCacheIsRebuilt) {
   }
 }
 
+// A relative XDG_CACHE_HOME made the compiled models' cache in the folder a command ran from; it
+// is ignored, as the XDG rules say and the cache of derived models does: $HOME/.cache/nhdyn.
+TEST_F(Hardening, ARelativeCacheHomeIsIgnoredByTheCompiledModelsCache) {
+  ProcessOptions relative;
+  relative.env = {{"XDG_CACHE_HOME", "relcache"}, {"HOME", (dir_ / "home").string()}};
+  const ProcessRun r = nhdyn({"simulate", "sled.toml", "--evaluator", "compiled", "-q", "-o", "sled.csv"}, relative);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "relcache"));
+  EXPECT_EQ(cache_entries(dir_ / "home" / ".cache" / "nhdyn", ".so").size(), 1u);
+}
+
 // An interrupted compile left its source and log, and the compiler ran on; now the compiler's
 // process group is ended and nothing is left in the cache.
 TEST_F(Hardening, InterruptedCompileLeavesNothing) {

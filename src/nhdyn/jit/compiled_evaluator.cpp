@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "nhdyn/jit/detail/source.hpp"
+#include "nhdyn/core/detail/cache_root.hpp"
 #include "nhdyn/core/detail/hash.hpp"
 #include "nhdyn/core/detail/signals.hpp"
 #include "nhdyn/model/contact_forces.hpp"
@@ -177,11 +178,8 @@ std::string first_error(const std::string& output) {
 
 fs::path cache_directory(const JitOptions& options) {
   if (!options.cache_dir.empty()) return options.cache_dir;
-  const std::string xdg = env("XDG_CACHE_HOME");
-  if (!xdg.empty()) return fs::path(xdg) / "nhdyn";
-  const std::string home = env("HOME");
-  if (home.empty()) throw JitError("no cache directory: neither XDG_CACHE_HOME nor HOME is set");
-  return fs::path(home) / ".cache" / "nhdyn";
+  if (std::optional<fs::path> root = nhdyn_cache_root()) return *root;
+  throw JitError("no cache directory: neither XDG_CACHE_HOME nor HOME is set to an absolute path");
 }
 
 // A name no other process or thread uses at the same time.

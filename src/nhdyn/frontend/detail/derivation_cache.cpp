@@ -22,6 +22,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "nhdyn/core/detail/cache_root.hpp"
 #include "nhdyn/core/detail/hash.hpp"
 #include "nhdyn/symbolic/derivation_archive.hpp"
 #include "nhdyn/symbolic/description.hpp"
@@ -41,12 +42,8 @@ std::string env(const char* name) {
 }
 
 std::optional<fs::path> cache_directory() {
-  const std::string xdg = env("XDG_CACHE_HOME");
-  // The XDG Base Directory rules: a relative path there is ignored.
-  if (!xdg.empty() && fs::path(xdg).is_absolute()) return fs::path(xdg) / "nhdyn" / "derivations";
-  const std::string home = env("HOME");
-  if (home.empty() || !fs::path(home).is_absolute()) return std::nullopt;
-  return fs::path(home) / ".cache" / "nhdyn" / "derivations";
+  if (std::optional<fs::path> root = nhdyn_cache_root()) return *root / "derivations";
+  return std::nullopt;
 }
 
 void trim(const fs::path& dir);
