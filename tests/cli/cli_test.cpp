@@ -726,6 +726,7 @@ INSTANTIATE_TEST_SUITE_P(
                  {"sled", "--stabilize", "projection", "--projection-tolerance", "0", o, out}, {"tolerance"}},
         BadInput{"rtol_negative", {"appell", "--rtol", "-1e-6", o, out}, {"-1e-06|-1e-6"}},
         BadInput{"rtol_below_double_precision", {"appell", "--rtol", "1e-16", o, out}, {"1e-16"}},
+        BadInput{"rtol_one_or_more", {"appell", "--rtol", "1", o, out}, {"rtol = 1 must be below 1"}},
         BadInput{"atol_zero", {"appell", "--atol", "0", o, out}, {"atol = 0|--atol 0"}},
         BadInput{"atol_zero_cvode", {"appell", "--integrator", "cvode-bdf", "--atol", "0", o, out}, {"atol = 0|--atol 0"}},
         BadInput{"step_negative", {"appell", "--step", "-1", o, out}, {"step -1"}},

@@ -426,6 +426,12 @@ void check_simulation_options(const Model& model, const SimulationOptions& optio
     if (io.rtol < 1e-15)
       throw InputError(fmt::format("the relative tolerance rtol = {} is below what double precision can "
                                    "deliver; use 1e-14 or more", io.rtol));
+    // A relative error of 100 % or more bounds nothing: the steps grew until the state overflowed,
+    // and the run ended blaming the model.
+    if (io.rtol >= 1.0)
+      throw InputError(fmt::format("the relative tolerance rtol = {} must be below 1 (a relative error of 100 %); "
+                                   "the default is 1e-8",
+                                   io.rtol));
   }
   // The one check of the step budget, for the command line and Python alike.
   if (io.max_steps < 1)
