@@ -3,6 +3,8 @@
 // while the GIL is held, so two Python threads never compile at once (GiNaC is not thread-safe).
 #include <pybind11/stl.h>
 
+#include <cmath>
+
 #include "bindings.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/io/results.hpp"
@@ -29,12 +31,17 @@ ParameterOverrides to_overrides(const py::iterable& pairs) {
     else if (py::isinstance<py::bool_>(value))
       throw InputError(fmt::format("parameter {} = {}: give a number, not a bool", name, py::str(value).cast<std::string>()));
     else {
+      double number = 0.0;
       try {
-        out.emplace_back(name, value.cast<double>());
+        number = value.cast<double>();
       } catch (const py::cast_error&) {
         throw InputError(fmt::format("parameter {} = {}: give a number or the text of one", name,
                                      py::repr(value).cast<std::string>()));
       }
+      // Named here: as text, float('nan') read as an unknown parameter 'nan'.
+      if (!std::isfinite(number))
+        throw InputError(fmt::format("parameter {} = {}: the value is not a finite number", name, number));
+      out.emplace_back(name, number);
     }
   }
   return out;

@@ -143,6 +143,15 @@ def test_a_batch_larger_than_memory_is_refused_before_any_run(oscillator):
         nhdyn.simulate_batch(oscillator, parameters={"k": np.linspace(1.0, 2.0, 100)}, t_end=1e5, output_step=1e-3)
 
 
+def test_a_non_finite_number_for_a_parameter_is_named(tmp_path):
+    # float('nan') was read as the text 'nan', an unknown parameter ("did you mean ...").
+    path = tmp_path / "oscillator.toml"
+    path.write_text(OSCILLATOR)
+    for value in (float("nan"), float("inf"), -float("inf")):
+        with pytest.raises(nhdyn.InputError, match=r"parameter k = -?(nan|inf): the value is not a finite number"):
+            nhdyn.load(path, k=value)
+
+
 def test_a_non_finite_initial_value_names_its_run(oscillator):
     # It was run, and failed with words that blamed the model's overflow.
     with pytest.raises(nhdyn.InputError, match=r"batch run 1: the initial value x'\(0\) = nan is not a finite number"):
