@@ -7,7 +7,9 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cmath>
 #include <csignal>
 #include <filesystem>
@@ -123,6 +125,26 @@ std::string csv_text(const std::string& text) {
     out += c == '\n' ? ' ' : c;
   }
   return out + "\"";
+}
+
+// A folder that held an earlier batch's run files keeps those this batch does not replace (they are
+// not its own to remove): said once, so that they are not read as this batch's.
+void note_other_run_files(const std::filesystem::path& dir, std::size_t runs, int digits) {
+  std::vector<std::string> others;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (!name.starts_with("run_") || !name.ends_with(".csv")) continue;
+    const std::string number = name.substr(4, name.size() - 8);
+    const bool ours = !number.empty() && std::all_of(number.begin(), number.end(), [](unsigned char c) { return std::isdigit(c) != 0; }) &&
+                      number.size() == static_cast<std::size_t>(digits) && std::stoull(number) < runs;
+    if (!ours) others.push_back(name);
+  }
+  if (others.empty()) return;
+  std::sort(others.begin(), others.end());
+  fmt::print(stderr, "nhdyn: note: {} also holds {} run file{} not of this batch of {} runs ({}{}); they were left as they were\n",
+             dir.string(), others.size(), others.size() == 1 ? "" : "s", runs, others.front(),
+             others.size() > 1 ? ", ..., " + others.back() : std::string());
 }
 
 void print_batch_outcome(const BatchArgs& args, const Model& base, const std::vector<BatchResult>& results, long failed,
@@ -439,6 +461,7 @@ int run_batch(const BatchArgs& args) {
 
   const long failed = write_summary(summary, summary_provenance, names, table, results, base);
   files.commit();  // the run files moved into place, then the summary
+  if (args.write_runs) note_other_run_files(dir, table.size(), digits);
   print_batch_outcome(args, base, results, failed, dir);
   return failed > 0 ? 1 : 0;
 }

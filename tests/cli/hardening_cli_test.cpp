@@ -314,6 +314,23 @@ TEST_F(Hardening, BatchTablesAreCheckedFirst) {
   EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
+// A folder that held a larger earlier batch kept its extra run files beside the new summary without
+// a word; they are not this batch's to remove, and a note says they are there.
+TEST_F(Hardening, BatchNamesRunFilesThatAreNotItsOwn) {
+  ASSERT_EQ(nhdyn({"batch", "sled.toml", "--grid", "a=0.2:0.6:5", "--t-end", "0.1", "--write-runs", "-q", "-o", "st"}).code,
+            0);
+  const ProcessRun again =
+      nhdyn({"batch", "sled.toml", "--grid", "m=1:2:2", "--t-end", "0.1", "--write-runs", "-q", "-o", "st"});
+  EXPECT_EQ(again.code, 0) << again.err;
+  EXPECT_TRUE(contains(again.err, "holds 3 run files not of this batch of 2 runs (run_2.csv, ..., run_4.csv)"))
+      << again.err;
+  EXPECT_TRUE(fs::exists(dir_ / "st" / "run_4.csv"));
+  const ProcessRun alone =
+      nhdyn({"batch", "sled.toml", "--grid", "m=1:2:2", "--t-end", "0.1", "--write-runs", "-q", "-o", "fresh"});
+  EXPECT_EQ(alone.code, 0) << alone.err;
+  EXPECT_FALSE(contains(alone.err, "not of this batch")) << alone.err;
+}
+
 // SIGINT during batch --write-runs left hundreds of run files and no summary; SIGHUP and SIGUSR1
 // left temporaries. A batch's outputs are written whole or not at all.
 TEST_F(Hardening, InterruptedBatchLeavesNothing) {
