@@ -10,6 +10,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <cerrno>
+#include <cfloat>
+#include <cstdlib>
 #include <cmath>
 #include <csignal>
 #include <filesystem>
@@ -77,14 +80,16 @@ Varied classify(const std::string& name, const Model& model) {
 }
 
 double parse_number(const std::string& text, const std::string& what) {
-  std::size_t used = 0;
-  double value = 0.0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(value))
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(text.c_str(), &end);
+  const bool whole = end != text.c_str() && end == text.c_str() + text.size();
+  // Below the normal range (1e-320), as the parameters' own reader says it (model/parameters.cpp).
+  if (whole && (value != 0.0 || errno == ERANGE) && std::abs(value) < DBL_MIN)
+    throw InputError(fmt::format("{}: the number {} is subnormal: below 2.2e-308 a double loses precision; write 0 or "
+                                 "a normal number",
+                                 what, text));
+  if (!whole || !std::isfinite(value) || errno == ERANGE)
     throw InputError(fmt::format("{}: '{}' is not a finite number", what, text));
   return value;
 }

@@ -312,6 +312,10 @@ TEST_F(Hardening, BatchTablesAreCheckedFirst) {
   EXPECT_TRUE(contains(infinite.err, "batch run 1: the initial value phi'(0) = inf is not a finite number"))
       << infinite.err;
   EXPECT_FALSE(fs::exists(dir_ / "out"));
+  // A subnormal grid value is named as one, as --set names it (it read "not a finite number").
+  const ProcessRun subnormal = nhdyn({"batch", "sled.toml", "--grid", "m=1e-320:1:2", "--t-end", "0.1", "-o", "out"});
+  EXPECT_EQ(subnormal.code, 2) << subnormal.err;
+  EXPECT_TRUE(contains(subnormal.err, "--grid m FROM: the number 1e-320 is subnormal")) << subnormal.err;
 }
 
 // A folder that held a larger earlier batch kept its extra run files beside the new summary without
