@@ -188,6 +188,10 @@ TEST(SpecBuilderErrors, ConstraintLevelMustMatchTheExpression) {
   // A velocity that cancels does not count.
   expect_error([&] { b.constraint("c", ConstraintLevel::velocity, "x' - x' + y", at); }, {"must contain some velocity"});
   expect_error([&] { b.constraint("", ConstraintLevel::velocity, "x'", at); }, {"not a valid constraint name"});
+  // A refused name's control characters are escaped: a line break broke the message's line.
+  const std::string broken = error_of([&] { b.constraint("bl\nade\x1b", ConstraintLevel::velocity, "x'", at); });
+  EXPECT_NE(broken.find("constraint 'bl\\nade\\x1b': not a valid constraint name"), std::string::npos) << broken;
+  EXPECT_EQ(broken.find('\n'), std::string::npos) << broken;
   expect_error([&] { b.constraint("c", "x' = y' = phi'", at); }, {"c.toml:4:28: ", "at most one '='"});
   // The right-hand side of `=` keeps its columns.
   expect_error([&] { b.constraint("c", "x' = rh0", at); }, {"c.toml:4:25: ", "unknown symbol 'rh0'"});

@@ -74,6 +74,20 @@ std::string internal_name(const std::string& name) {
 
 bool identifier_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) != 0 || c == '_'; }
 bool identifier_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_'; }
+
+// A refused name as the message shows it: its control characters escaped (\n, \t, \x1b), so
+// that a name with a line break does not break the message's line.
+std::string shown_name(const std::string& name) {
+  std::string out;
+  for (const char c : name) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (c == '\n') out += "\\n";
+    else if (c == '\t') out += "\\t";
+    else if (byte < 0x20 || byte == 0x7f) out += fmt::format("\\x{:02x}", byte);
+    else out += c;
+  }
+  return out;
+}
 bool digit(char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; }
 
 enum class SymbolKind { time, constant, coordinate, velocity, acceleration, parameter };
@@ -701,7 +715,7 @@ std::string did_you_mean(const std::string& name, const std::vector<std::string>
 // Names of coordinates and parameters share one space with t, pi and the functions.
 void check_new_name(const Spec& spec, bool is_coordinate, const std::string& name, const char* what,
                     const SourceLocation& where) {
-  const std::string context = fmt::format("{} '{}'", what, name);
+  const std::string context = fmt::format("{} '{}'", what, shown_name(name));
   if (!valid_name(name))
     fail(where, context, "not a valid name: use letters, digits and single underscores, starting with a letter");
   if (name == "t") fail(where, context, "'t' is the time and cannot be declared");
@@ -797,7 +811,7 @@ SpecBuilder& SpecBuilder::force(const std::string& coordinate, const std::string
 }
 
 void SpecBuilder::check_constraint_name(const std::string& name, const SourceLocation& where) const {
-  const std::string context = fmt::format("constraint '{}'", name);
+  const std::string context = fmt::format("constraint '{}'", shown_name(name));
   if (name.empty() || !std::isalpha(static_cast<unsigned char>(name[0])) ||
       !std::all_of(name.begin(), name.end(), [](char c) { return identifier_char(c) || c == '-'; }))
     fail(where, context, "not a valid constraint name: use letters, digits, '_' and '-', starting with a letter");
