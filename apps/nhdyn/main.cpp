@@ -7,6 +7,7 @@
 #include <exception>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "commands.hpp"
@@ -60,6 +61,17 @@ int main(int argc, char** argv) {
       known = known || sub->get_name() == argv[1];
     if (!known) {
       fmt::print(stderr, "nhdyn: error: unknown command '{}'; the commands are {} (see nhdyn --help)\n", argv[1], names);
+      return 2;
+    }
+  }
+  // A comma-separated list with nothing but commas (--integrators ",,") is split by CLI11 into no
+  // value, and the option then took the next argument ("-o") as its value: refused as empty first.
+  for (int i = 2; i < argc; ++i) {
+    const std::string_view value = argv[i];
+    if (argv[i - 1][0] == '-' && !value.empty() && value.find_first_not_of(", ") == std::string_view::npos) {
+      fmt::print(stderr, "nhdyn: error: {} '{}': the list is empty; give its items separated by commas (or leave the "
+                         "option out)\n",
+                 argv[i - 1], value);
       return 2;
     }
   }

@@ -269,6 +269,13 @@ TEST_F(Hardening, EmptyOptionValuesAreRefused) {
     EXPECT_EQ(r.code, 2) << option;
     EXPECT_TRUE(contains(r.err, "the value is empty")) << r.err;
   }
+  // A list of nothing but commas took the next argument as its value ("unknown integrator '-o'").
+  for (const char* list : {",,", ",", " , "}) {
+    const ProcessRun r = nhdyn({"compare", "sled.toml", "--integrators", list, "-o", "c.csv"});
+    EXPECT_EQ(r.code, 2) << list;
+    EXPECT_TRUE(contains(r.err, std::string("--integrators '") + list + "': the list is empty")) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "c.csv"));
+  }
 }
 
 // The CLI's batch ignored the model file's [[events]]; a stop event now ends each run where the
