@@ -237,6 +237,13 @@ std::vector<SpecContactWatch> convexity_watches(const SpecConvexity& check, bool
   }
   const auto [body_det, body_trace] = tangent_determinant_and_trace(check.body, n);
   const GiNaC::ex scale = body_trace * body_trace / 4;
+  // A surface without curvature (a plane f = Z - r, linear in X, Y, Z) has no contact point of its
+  // own to roll on: refused here, where its measures would divide by its zero curvature.
+  if (own && scale.is_zero())
+    throw_model_error(check.where, fmt::format("contact '{}'", check.contact),
+                      "the shape's surface is flat (its curvature is zero everywhere): a contact shape is a closed, "
+                      "strictly convex body surface such as \"X^2/a^2 + Y^2/b^2 + Z^2/c^2 - 1\"; a flat ground is "
+                      "the contact's ground, not its shape");
   const GiNaC::matrix relative = check.body.sub(check.ground);
   std::vector<SpecContactWatch> watches;
   // The shape's own first: on a plane (K = 0) the two are the same measure, and the cause is the shape.
