@@ -199,6 +199,34 @@ def _warn_unmet_stops(model_name, summaries, stacklevel, batch=False):
                       stacklevel=stacklevel + 1)
 
 
+def _output_path(path, what, source=None):
+    """`path` as a file name for `what` to write: a str, bytes or os.PathLike (an int would be a
+    file descriptor, which open() then closes), never the model file the result was run from
+    (the command line refuses it too)."""
+    if isinstance(path, (bool, int)) or not isinstance(path, (str, bytes, os.PathLike)):
+        raise InputError("{}: expected a file path, got {!r}".format(what, path))
+    path = os.fsdecode(os.fspath(path))
+    model_file = getattr(source, "file_name", "") if source is not None and not source.is_builtin else ""
+    if model_file and os.path.exists(path) and os.path.exists(model_file) and os.path.samefile(path, model_file):
+        raise InputError("{}: '{}' is the model file of this run; write to another path".format(what, path))
+    return path
+
+
+def _write_whole(path, text):
+    """Writes `text` to `path` through a temporary file beside it, renamed into place once whole, so
+    that a failure leaves the old file (or none), never half of the new one."""
+    folder = os.path.dirname(os.path.abspath(path))
+    temporary = os.path.join(folder, ".{}.{}.tmp".format(os.path.basename(path), os.getpid()))
+    try:
+        with open(temporary, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.remove(temporary)
+        raise
+
+
 def builtin_models():
     """The built-in models as a dict name -> description (what `nhdyn list` shows)."""
     return dict(_nhdyn.builtin_models())
@@ -383,6 +411,7 @@ class Model:
                              "report on the model that made it".format(
                                  result.model_name, result._source.file_name or result._source.builtin, self.name,
                                  self.source.file_name or self.source.builtin))
+        path = _output_path(path, "report", self.source)
         names, rows = result.table()
         comments = [line[1:] for line in result.provenance.splitlines()]
         title = "{}: {}".format(result.model_name, os.fspath(path))
@@ -537,14 +566,14 @@ class Result:
     def to_csv(self, path):
         """Writes the result as `nhdyn simulate` writes its CSV: the provenance header, the column
         names, one row per output time (numbers in the shortest form that reads back the same)."""
+        path = _output_path(path, "to_csv", self._source)
         names, values = self.table()
-        with open(path, "w") as f:
-            f.write(self.provenance)
-            f.write(",".join(names) + "\n")
-            for row in values:
-                f.write(",".join(repr(float(x)) if np.isfinite(x) else ("nan" if np.isnan(x) else
-                                                                       ("inf" if x > 0 else "-inf")) for x in row))
-                f.write("\n")
+        lines = [self.provenance, ",".join(names) + "\n"]
+        for row in values:
+            lines.append(",".join(repr(float(x)) if np.isfinite(x) else ("nan" if np.isnan(x) else
+                                                                        ("inf" if x > 0 else "-inf")) for x in row))
+            lines.append("\n")
+        _write_whole(path, "".join(lines))
 
     def plot(self, columns=None, path=None):
         """The run's panels with matplotlib: the coordinates, the velocities, the constraint
@@ -626,10 +655,9 @@ class Optimum:
 
     def to_csv(self, path):
         """Writes the CSV of `nhdyn optimize -o` to `path`."""
-        with open(path, "w", encoding="utf-8") as f:
-            f.write(",".join(self.columns) + "\n")
-            for row in self.rows:
-                f.write(",".join(repr(float(v)) for v in row) + "\n")
+        path = _output_path(path, "to_csv")
+        _write_whole(path, "".join(",".join(row) + "\n" for row in
+                                   [self.columns] + [[repr(float(v)) for v in r] for r in self.rows]))
 
     def __repr__(self):
         return "<nhdyn.Optimum {!r}: {}, objective {:.10g}, {} points>".format(

@@ -218,3 +218,23 @@ def test_a_size_or_mass_set_negative_is_refused_and_the_model_kept(examples):
         nhdyn.simulate_batch(m, parameters={"m": [1.0, -1.0]}, t_end=0.01)
     m.parameters["r"] = 0.04  # a positive one is taken
     assert m.parameters["r"] == 0.04
+
+
+def test_outputs_never_replace_the_model_file_and_take_only_paths(tmp_path):
+    # to_csv and report wrote over the model file they were run from (the command line refuses
+    # it), to_csv truncated before writing, and an int was taken as a file descriptor and closed.
+    path = tmp_path / "oscillator.toml"
+    path.write_text(OSCILLATOR)
+    m = nhdyn.load(path)
+    r = m.simulate(0.1)
+    for call in (lambda: r.to_csv(path), lambda: m.report(r, path), lambda: r.to_csv(str(path))):
+        with pytest.raises(nhdyn.InputError, match="is the model file of this run; write to another path"):
+            call()
+    assert path.read_text() == OSCILLATOR
+    for bad in (True, 1, 3.5, None):
+        with pytest.raises(nhdyn.InputError, match="to_csv: expected a file path"):
+            r.to_csv(bad)
+    out = tmp_path / "run.csv"
+    r.to_csv(out)
+    assert out.read_text().startswith("# nhdyn version")
+    assert [p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")] == []
