@@ -1,6 +1,8 @@
 // `nhdyn study NAME`: the command that holds the studies (study.hpp); each study is a subcommand
 // defined in its own file.
 
+#include <fmt/format.h>
+
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,6 +16,13 @@ std::filesystem::path by_tolerance_path(const std::filesystem::path& table) {
   std::filesystem::path series = table;
   series.replace_filename(table.stem().string() + "-by-tolerance.csv");
   return series;
+}
+
+int study_exit(const std::string& study, const Model& model, std::size_t runs, const std::vector<std::string>& failures) {
+  if (failures.empty()) return 0;
+  fmt::print(stderr, "nhdyn: error: study {} of '{}': {} of its {} runs failed (marked FAILED in the table); the first: {}\n",
+             study, model.name, failures.size(), runs, failures.front());
+  return 1;
 }
 
 std::function<int()> add_study_command(CLI::App& app) {

@@ -6,6 +6,8 @@
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <functional>
+#include <string>
+#include <vector>
 
 #include "nhdyn/model/model.hpp"
 
@@ -22,5 +24,10 @@ std::function<int()> add_tracking_study(CLI::App& study);
 
 // Where a tolerance study writes its series beside its table: TABLE.csv -> TABLE-by-tolerance.csv.
 std::filesystem::path by_tolerance_path(const std::filesystem::path& table);
+
+// The exit code of a study whose table is written: 1 when some of its `runs` failed, after one
+// line on stderr, with or without -q (the table marks them; the failure must show without it).
+// `failures` holds each failed run's message.
+int study_exit(const std::string& study, const Model& model, std::size_t runs, const std::vector<std::string>& failures);
 
 }  // namespace nhdyn::cli

@@ -193,9 +193,10 @@ int run_error_relation(const ErrorRelationArgs& args) {
 
   if (!args.plot.empty()) plot_error_relation(study, model, vel, series_path, args.plot);
   if (!args.quiet) print_error_relation(study, model, args, pos, vel, table_path, series_path);
+  std::vector<std::string> failures;
   for (const ErrorRelationRun& r : study.runs)
-    if (r.summary.status != Status::ok) return 1;
-  return 0;
+    if (r.summary.status != Status::ok) failures.push_back(r.summary.message);
+  return study_exit("error-relation", model, study.runs.size(), failures);
 }
 
 }  // namespace

@@ -165,9 +165,10 @@ int run_tracking(const TrackingArgs& args) {
   if (!args.plot.empty()) plot_tracking(study, model, pos, series_path, args.plot);
 
   if (!args.quiet) print_tracking(study, model, args, table_path, series_path);
+  std::vector<std::string> failures;
   for (const TrackingRun& r : study.runs)
-    if (r.summary.status != Status::ok) return 1;
-  return 0;
+    if (r.summary.status != Status::ok) failures.push_back(r.summary.message);
+  return study_exit("tracking", model, study.runs.size(), failures);
 }
 
 }  // namespace

@@ -183,6 +183,16 @@ TEST_F(Hardening, DamagedCompiledModelCacheIsRebuilt) {
   }
 }
 
+// A study with -q whose runs failed exited 1 with nothing on stderr; the failure is said in one
+// line with or without -q (the table marks the runs FAILED).
+TEST_F(Hardening, AStudyWithFailedRunsSaysSoEvenQuiet) {
+  const ProcessRun r = nhdyn({"study", "error-relation", "--tolerances", "1e-3", "--atol-factor", "1e300", "-q", "-o",
+                              "er.csv"});
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_TRUE(contains(r.err, "nhdyn: error: study error-relation of 'appell': ")) << r.err;
+  EXPECT_TRUE(contains(r.err, "runs failed (marked FAILED in the table); the first: ")) << r.err;
+}
+
 // A relative XDG_CACHE_HOME made the compiled models' cache in the folder a command ran from; it
 // is ignored, as the XDG rules say and the cache of derived models does: $HOME/.cache/nhdyn.
 TEST_F(Hardening, ARelativeCacheHomeIsIgnoredByTheCompiledModelsCache) {

@@ -137,9 +137,14 @@ TEST(SpreadMasses, RefusesBadInputNamingTheValue) {
   options.ratios = {1.0};
   options.samples = 0;
   expect_input_error(spec, options, "0 samples");
+  // 1e8 samples grew the memory for days of work before the first result.
+  options.samples = kMaxSpreadMassesSamples + 1;
+  expect_input_error(spec, options, "--samples 100001: at most 100000 states per ratio");
   options.samples = 1;
   options.digits = 19;
   expect_input_error(spec, options, "19 digits");
+  options.digits = kMaxSpreadMassesDigits + 1;
+  expect_input_error(spec, options, "--digits 1001: at most 1000 digits");
   options.digits = 50;
   options.parameter = "mass_ratio";
   expect_input_error(spec, options, "no parameter 'mass_ratio'");

@@ -21,10 +21,14 @@ struct Spec;  // symbolic/spec.hpp: taken by reference, so that this header incl
 
 namespace nhdyn {
 
+// The most states per ratio and digits of the reference a study takes (check_spread_masses_options).
+inline constexpr int kMaxSpreadMassesSamples = 100000;
+inline constexpr int kMaxSpreadMassesDigits = 1000;
+
 struct SpreadMassesOptions {
   std::vector<double> ratios{1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12};
-  int samples = 3;                             // states per ratio, >= 1
-  int digits = 50;                             // of the reference, >= 20
+  int samples = 3;                             // states per ratio, 1 to kMaxSpreadMassesSamples
+  int digits = 50;                             // of the reference, 20 to kMaxSpreadMassesDigits
   std::string parameter = "ratio";             // the model parameter the study varies
   std::vector<StudyFormulation> formulations;  // empty: every formulation the model allows
 };
