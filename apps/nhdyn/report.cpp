@@ -60,8 +60,10 @@ std::function<int()> add_report_command(CLI::App& app) {
       overrides = check_provenance(*provenance, source, args->csv);
     for (auto& set : parse_parameter_sets(args->sets)) overrides.push_back(std::move(set));
     const LoadedModel resolved = load_model_described(source, overrides);
-    check_report_columns(table.header, make_result_columns(resolved.model), args->csv, resolved.model.name);
-    check_report_times(table, args->csv);  // finite and never decreasing
+    const ResultColumns columns = make_result_columns(resolved.model);
+    check_report_columns(table.header, columns, args->csv, resolved.model.name);
+    check_report_times(table, args->csv);            // finite and never decreasing
+    check_report_values(table, columns, args->csv);  // finite but for the contact forces
     files.commit();  // nothing of its own to commit: the report's writer writes it whole
     const std::string notice = write_model_report(resolved.model, resolved.description.get(), table,
                        fmt::format("{}: {}", resolved.model.name, args->csv), {{"results", args->csv}}, args->output,

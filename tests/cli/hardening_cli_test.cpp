@@ -481,6 +481,39 @@ TEST_F(Hardening, ReportReadsItsOwnPartialFilesAndChecksTimes) {
   const ProcessRun nan = nhdyn({"report", "nan.csv", "--model", "sled.toml", "-q", "-o", "nan.html"});
   EXPECT_EQ(nan.code, 2);
   EXPECT_TRUE(contains(nan.err, "not finite")) << nan.err;
+  // Any other value that is not finite was drawn: E0 = nan gave an energy drift of 0, a NaN
+  // residual was left out of its maximum. The row and the column are named; no page is written.
+  std::vector<std::string> clean;
+  std::stringstream again(csv);
+  for (std::string line; std::getline(again, line);) clean.push_back(line);
+  const auto split_commas = [](const std::string& line) {
+    std::vector<std::string> cells;
+    std::stringstream cells_in(line);
+    for (std::string cell; std::getline(cells_in, cell, ',');) cells.push_back(cell);
+    return cells;
+  };
+  const auto join_commas = [](const std::vector<std::string>& cells) {
+    std::string line;
+    for (std::size_t i = 0; i < cells.size(); ++i) line += (i ? "," : "") + cells[i];
+    return line;
+  };
+  const std::vector<std::string> header = split_commas(clean[names]);
+  for (const std::string column : {"x", "energy", "residual_vel_blade"}) {
+    const auto at = std::find(header.begin(), header.end(), column);
+    ASSERT_NE(at, header.end()) << column;
+    std::vector<std::string> cells = split_commas(clean[names + 2]);
+    cells[static_cast<std::size_t>(at - header.begin())] = column == "x" ? "-inf" : "nan";
+    std::vector<std::string> edited = clean;
+    edited[names + 2] = join_commas(cells);
+    std::string text;
+    for (const std::string& line : edited) text += line + "\n";
+    write("edited.csv", text);
+    const ProcessRun r = nhdyn({"report", "edited.csv", "--model", "sled.toml", "-q", "-o", "edited.html"});
+    EXPECT_EQ(r.code, 2) << column << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, "edited.csv: row 2: " + column + " = ")) << r.err;
+    EXPECT_TRUE(contains(r.err, "is not finite; a run writes finite values")) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "edited.html")) << column;
+  }
 }
 
 // codegen emitted parameters named INFINITY, EOF, errno, NULL as identifiers: the preprocessor

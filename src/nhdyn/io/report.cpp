@@ -696,6 +696,19 @@ void check_report_times(const CsvTable& table, const std::string& csv) {
   }
 }
 
+void check_report_values(const CsvTable& table, const ResultColumns& columns, const std::string& csv) {
+  std::vector<bool> may_be_nan(table.header.size(), false);
+  for (std::size_t c = 0; c < table.header.size(); ++c)
+    may_be_nan[c] = std::find(columns.contact_forces.begin(), columns.contact_forces.end(), table.header[c]) !=
+                    columns.contact_forces.end();
+  for (std::size_t r = 0; r < table.rows.size(); ++r)
+    for (std::size_t c = 0; c < table.rows[r].size() && c < may_be_nan.size(); ++c)
+      if (!may_be_nan[c] && !std::isfinite(table.rows[r][c]))
+        throw InputError(fmt::format("{}: row {}: {} = {} is not finite; a run writes finite values (only contact "
+                                     "forces are NaN, where undetermined): give the CSV as `nhdyn simulate` wrote it",
+                                     csv, r + 1, table.header[c], table.rows[r][c]));
+}
+
 namespace {
 
 // The values of a column at the frames drawn (NaN for a column the table does not have).

@@ -80,6 +80,12 @@ void check_report_columns(const std::vector<std::string>& header, const ResultCo
 // the row and the value. A table without a "t" column passes (check_report_columns refuses it).
 void check_report_times(const CsvTable& table, const std::string& csv);
 
+// Throws InputError, naming the row, the column and the value, when a value of `table` outside the
+// contact forces of `columns` (which are NaN where undetermined) is not finite: a run never writes
+// one, so the CSV was edited or damaged, and its summary and scene would hide it (a NaN residual
+// left out of a maximum, an energy drift of 0 from E0 = nan).
+void check_report_values(const CsvTable& table, const ResultColumns& columns, const std::string& csv);
+
 // The page as text. Throws InputError when the table has no row or its header is not
 // input.columns.all, when input.parameters are not the scene's, or when a size of the scene is not
 // positive with these values (naming the [visual] item, its place and the value). Same input -> same bytes. `notice`, when given, receives the note the page
