@@ -193,6 +193,24 @@ TEST_F(Hardening, AStudyWithFailedRunsSaysSoEvenQuiet) {
   EXPECT_TRUE(contains(r.err, "runs failed (marked FAILED in the table); the first: ")) << r.err;
 }
 
+// An inertia matrix that is not positive definite (on the constraints), which simulate refuses,
+// was linearized as if it were a motion, and a sweep through the value where it turns singular
+// reported the eigenvalue passing through infinity as a crossing of zero (a divergence).
+TEST_F(Hardening, LinearizeAndSweepRefuseAnInertiaSimulateRefuses) {
+  const std::string model = (fs::path(NHDYN_SOURCE_DIR) / "examples" / "bicycle_linear.toml").string();
+  const ProcessRun one = nhdyn({"linearize", model, "--set", "M_pp=1"});
+  EXPECT_EQ(one.code, 2) << one.err;
+  EXPECT_TRUE(contains(one.err, "the inertia matrix A is not positive definite at the initial state")) << one.err;
+  EXPECT_TRUE(contains(one.err, "smallest eigenvalue -1.69691")) << one.err;
+  const ProcessRun sweep = nhdyn({"sweep", model, "--param", "M_pp", "--from", "0", "--to", "40", "--steps", "41", "-q",
+                                  "-o", "pole.csv"});
+  EXPECT_EQ(sweep.code, 2) << sweep.err;
+  EXPECT_TRUE(contains(sweep.err, "at M_pp = 0: model 'bicycle-linear': the inertia matrix A is not positive definite"))
+      << sweep.err;
+  EXPECT_FALSE(fs::exists(dir_ / "pole.csv"));
+  EXPECT_EQ(nhdyn({"linearize", model, "--set", "M_pp=30"}).code, 0);
+}
+
 // A relative XDG_CACHE_HOME made the compiled models' cache in the folder a command ran from; it
 // is ignored, as the XDG rules say and the cache of derived models does: $HOME/.cache/nhdyn.
 TEST_F(Hardening, ARelativeCacheHomeIsIgnoredByTheCompiledModelsCache) {

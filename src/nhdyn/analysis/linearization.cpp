@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/formulation/diagnosis.hpp"
 #include "nhdyn/model/tape.hpp"
 #include "nhdyn/model/detail/tape_tangent.hpp"
 
@@ -328,6 +329,14 @@ KktSolution solve_kkt(const Model& model, const Layout& layout, const Vector& ba
     throw ModelError(fmt::format("model '{}': the KKT matrix [A b^T; b 0] is singular at the initial state (A not "
                                  "positive definite on the constraints, or dependent constraints)",
                                  model.name));
+  // The inertia test simulate applies (formulation/diagnosis.hpp): a regular KKT matrix with an A
+  // indefinite on the constraints gave the eigenvalues of a motion that does not exist, and in a
+  // sweep, an eigenvalue through the pole where A turns singular reported as a crossing of zero.
+  if (double smallest = 0.0; !inertia_positive_on_constraints(A, b, smallest))
+    throw ModelError(fmt::format("model '{}': the inertia matrix A is not positive definite at the initial state, not even "
+                                 "on the velocities the constraints allow (smallest eigenvalue {:.6g}): check the kinetic "
+                                 "energy, its masses and inertias",
+                                 model.name, smallest));
   Vector rhs(n + s);
   rhs.head(n) = Q + G;
   rhs.tail(s) = -b0;

@@ -210,17 +210,24 @@ bool a_is_positive_definite(const Model& model, const Data& data) {
 // Sanh form needs no inverse of A: coordinates with no inertia of their own, held by constraints
 // (the surface parameters of a rolling contact, docs/derivations/rolling-bodies.md section 8).
 // Checked only when A is not positive definite; dense (O(n^3)).
+bool positive_on_the_null_space(const Matrix& A, const Matrix& b, double* smallest) {
+  if (!A.isApprox(A.transpose(), 1e-12)) return false;
+  Eigen::FullPivLU<Matrix> lu(b);
+  if (lu.rank() == A.rows()) return true;  // the constraints fix every velocity
+  const Matrix N = lu.kernel();
+  const Matrix reduced = N.transpose() * A * N;
+  Eigen::LLT<Matrix> llt(reduced);
+  if (llt.info() == Eigen::Success) return true;
+  if (smallest != nullptr)
+    *smallest = Eigen::SelfAdjointEigenSolver<Matrix>(reduced, Eigen::EigenvaluesOnly).eigenvalues()(0);
+  return false;
+}
+
 bool a_is_positive_definite_on_the_constraints(const Model& model, const Data& data) {
   if (model.s() == 0) return false;
   const Matrix A = data.sparse ? Matrix(data.A_sparse) : data.A;
-  if (!A.isApprox(A.transpose(), 1e-12)) return false;
   const Matrix b = data.sparse ? Matrix(data.b_sparse) : data.b;
-  Eigen::FullPivLU<Matrix> lu(b);
-  const Matrix N = lu.kernel();
-  if (lu.rank() == model.n()) return true;  // the constraints fix every velocity
-  const Matrix reduced = N.transpose() * A * N;
-  Eigen::LLT<Matrix> llt(reduced);
-  return llt.info() == Eigen::Success;
+  return positive_on_the_null_space(A, b, nullptr);
 }
 
 }  // namespace
@@ -318,6 +325,13 @@ Status check_terms(const Model& model, Data& data) {
   if (model.s() > 0 && b_is_rank_deficient(model, data))
     return record_failure(data, Status::dependent_constraints, "constraint matrix b");
   return Status::ok;
+}
+
+bool inertia_positive_on_constraints(const Matrix& A, const Matrix& b, double& smallest) {
+  Eigen::LLT<Matrix> llt(A);
+  if (llt.info() == Eigen::Success && A.isApprox(A.transpose(), 1e-12)) return true;
+  smallest = Eigen::SelfAdjointEigenSolver<Matrix>(A, Eigen::EigenvaluesOnly).eigenvalues()(0);
+  return b.rows() > 0 && positive_on_the_null_space(A, b, &smallest);
 }
 
 void check_state_or_throw(const Model& model, Data& data, double t, const double* q, const double* v) {

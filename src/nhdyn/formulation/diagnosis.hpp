@@ -24,4 +24,9 @@ Status check_terms(const Model& model, Data& data);
 // compute_terms at (t, q, v) then check_terms; throws ModelError with explain_failure's words.
 void check_state_or_throw(const Model& model, Data& data, double t, const double* q, const double* v);
 
+// The inertia test of check_terms on dense matrices: A (n x n) symmetric positive definite, or
+// positive definite on the velocities b (s x n) allows, N^T A N with N a basis of null(b). False
+// otherwise, with the smallest eigenvalue of the matrix tested (A, or N^T A N) in `smallest`.
+bool inertia_positive_on_constraints(const Matrix& A, const Matrix& b, double& smallest);
+
 }  // namespace nhdyn
