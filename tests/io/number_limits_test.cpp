@@ -51,6 +51,17 @@ TEST(NumberLimits, ASubnormalLiteralIsAUserError) {
   EXPECT_EQ(refusal(oscillator("m/2*(x'^2+y'^2+z'^2)", "0e-400*x^2 + x^2", "1"), seconds), "");
 }
 
+// A literal beyond 1.3e154, as a parameter's value: its square overflows (a turntable's rate of
+// 1e200 wrote a column of NaN slip speeds with exit 0).
+TEST(NumberLimits, AHugeLiteralIsAUserError) {
+  double seconds = 0;
+  for (const char* V : {"1e200*x^2", "x^2 - 2e154*y", "1.8e308*x^2"}) {
+    const std::string m = refusal(oscillator("m/2*(x'^2+y'^2+z'^2)", V, "1"), seconds);
+    EXPECT_NE(m.find("is too large: above 1.3e154 in magnitude its square"), std::string::npos) << V << ": " << m;
+  }
+  EXPECT_EQ(refusal(oscillator("m/2*(x'^2+y'^2+z'^2)", "1e154*x^2", "1"), seconds), "");
+}
+
 TEST(NumberLimits, AProductOfPowersOfSumsIsRefusedAtOnce) {
   double seconds = 0;
   const std::string m = refusal(oscillator("(x'^2+y'^2+z'^2)*(1+(x+y+z)^2)^32", "0", "1"), seconds);

@@ -449,6 +449,12 @@ class Reader {
                                                  spelled(token)));
         if (std::isinf(rounded))
           site_.fail_at(token.begin, fmt::format("the number {} is out of the range of double precision", spelled(token)));
+        // As a parameter's value (model/parameters.cpp): beyond, the first product a term forms
+        // overflows, and a turntable's rate of 1e200 wrote a column of NaN slip speeds.
+        if (std::abs(rounded) > std::sqrt(std::numeric_limits<double>::max()))
+          site_.fail_at(token.begin, fmt::format("the number {} is too large: above 1.3e154 in magnitude its square, the "
+                                                 "first product a term forms, overflows a double; rescale the units",
+                                                 spelled(token)));
         out_ += exact;
         return;
       }
