@@ -198,6 +198,16 @@ TEST(OutputTimes, EndExactlyAtTheEndTime) {
   EXPECT_DOUBLE_EQ(t.back(), 1.0);
   EXPECT_EQ(make_output_times(0.0, 1.0, 0.1).size(), 11u);
   EXPECT_THROW(make_output_times(0.0, 1e9, 1e-9), InputError);
+  // A run much shorter than its output step keeps its start row: 1e-9 of the step (1e-11) merged
+  // the row of t0 into t_end's at t_end = 1e-13.
+  EXPECT_EQ(make_output_times(0.0, 1e-13, 0.01), (std::vector<double>{0.0, 1e-13}));
+  // A run shorter than the times nhdyn tells apart failed as a step size underflow.
+  try {
+    make_output_times(0.0, 5e-324, 0.01);
+    ADD_FAILURE() << "t_end = 5e-324 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("closer than nhdyn tells times apart"), std::string::npos) << e.what();
+  }
 }
 
 // Given output times that all sit on the start leave no interval to integrate: the library refuses

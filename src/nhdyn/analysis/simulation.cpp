@@ -356,6 +356,11 @@ std::vector<double> make_output_times(double t0, double t_end, double output_ste
   if (!std::isfinite(t_end) || !(t_end > t0))
     throw InputError(fmt::format("the end time t_end = {} must be a finite time after the start time {}",
                                  t_end, t0));
+  // A run shorter than the times nhdyn tells apart (--t-end 5e-324) failed as a step size underflow.
+  if (!(t_end - t0 > time_resolution(t0, t_end)))
+    throw InputError(fmt::format("the end time t_end = {} is within {:.3g} of the start time {}, closer than nhdyn tells "
+                                 "times apart; choose a later end time",
+                                 t_end, time_resolution(t0, t_end), t0));
   if (!std::isfinite(output_step) || !(output_step > 0.0))
     throw InputError(fmt::format("the output step {} must be a positive, finite time", output_step));
   if (!(output_step > time_resolution(t0, t_end)))
@@ -372,7 +377,10 @@ std::vector<double> make_output_times(double t0, double t_end, double output_ste
   for (long i = 0; i <= static_cast<long>(count); ++i) times.push_back(t0 + static_cast<double>(i) * output_step);
   // The last output is t_end itself, whether or not the step divides the interval.
   // (A last grid time within the resolution of t_end would be merged with its row: it becomes t_end.)
-  if (t_end - times.back() > std::max(1e-9 * output_step, time_resolution(times.back(), t_end)))
+  // (Relative to the run's span too: with --t-end 1e-13 and a step of 0.01, 1e-9 of the step merged
+  // the row of t0 into t_end's.)
+  if (t_end - times.back() >
+      std::max(1e-9 * std::min(output_step, t_end - t0), time_resolution(times.back(), t_end)))
     times.push_back(t_end);
   else times.back() = t_end;
   return times;
