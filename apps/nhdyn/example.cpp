@@ -14,6 +14,7 @@
 
 #include "commands.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/chain.hpp"
 #include "run_files.hpp"
 
@@ -52,19 +53,22 @@ int parse_bodies(const std::string& text, int most) {
   return static_cast<int>(value);
 }
 
-// One --set NAME=VALUE of a generator: its name and its finite value.
+// One --set NAME=EXPR of a generator: its name and its value, read as a parameter's (numbers,
+// + - * / ^, functions, pi and e: model/parameters.hpp) and within a parameter's range, so that
+// the model file written loads (1e200 was written, then refused by simulate).
 std::pair<std::string, double> parse_set(const std::string& set) {
   const std::size_t eq = set.find('=');
   if (eq == std::string::npos)
     throw InputError(fmt::format("--set '{}': write it as NAME=VALUE, e.g. --set m=2", set));
   const std::string name = set.substr(0, eq);
   const std::string text = set.substr(eq + 1);
-  char* end = nullptr;
-  errno = 0;
-  const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(value))
-    throw InputError(fmt::format("--set {}: '{}' is not a finite number", name, text));
-  return {name, value};
+  try {
+    const double value = calc_parameter_expression(text, {});
+    check_parameter_value(name, value);
+    return {name, value};
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("--set {}={}: {}", name, text, e.what()));
+  }
 }
 
 void apply_chain_sets(symbolic::ChainParameters& p, const std::vector<std::string>& sets) {

@@ -211,6 +211,18 @@ TEST_F(Hardening, LinearizeAndSweepRefuseAnInertiaSimulateRefuses) {
   EXPECT_EQ(nhdyn({"linearize", model, "--set", "M_pp=30"}).code, 0);
 }
 
+// `example chain --set` takes an expression, as documented (2/3 was "not a finite number"), within
+// a parameter's range (1e200 was written into a file that simulate then refused).
+TEST_F(Hardening, ExampleSetsTakeExpressionsWithinAParametersRange) {
+  ASSERT_EQ(nhdyn({"example", "chain", "--bodies", "2", "--set", "m=2/3", "--set", "J=pi/10", "-o", "c.toml"}).code, 0);
+  EXPECT_TRUE(contains(read_whole(dir_ / "c.toml"), "0.6666666666666666")) << read_whole(dir_ / "c.toml");
+  EXPECT_EQ(nhdyn({"simulate", "c.toml", "--t-end", "0.1", "-q", "-o", "c.csv"}).code, 0);
+  const ProcessRun huge = nhdyn({"example", "chain", "--bodies", "2", "--set", "a=1e200", "-o", "h.toml"});
+  EXPECT_EQ(huge.code, 2) << huge.err;
+  EXPECT_TRUE(contains(huge.err, "--set a=1e200: parameter 'a' = 1e+200 is too large")) << huge.err;
+  EXPECT_FALSE(fs::exists(dir_ / "h.toml"));
+}
+
 // A relative XDG_CACHE_HOME made the compiled models' cache in the folder a command ran from; it
 // is ignored, as the XDG rules say and the cache of derived models does: $HOME/.cache/nhdyn.
 TEST_F(Hardening, ARelativeCacheHomeIsIgnoredByTheCompiledModelsCache) {
