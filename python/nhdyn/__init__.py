@@ -277,6 +277,12 @@ class Parameters(MutableMapping):
         return repr(dict(self.items()))
 
 
+def _names(value):
+    """A list of coordinate names: one name given as a str is that name (list("psi") read as the
+    letters p, s, i)."""
+    return [value] if isinstance(value, str) else list(value)
+
+
 class Model:
     """A model and where it came from: its source (a built-in name or a model file's text) and
     the parameter overrides, from which it can be compiled again (here, or on a Dask worker)."""
@@ -451,7 +457,7 @@ class Model:
     def linearize(self, cyclic=(), independent=(), speeds=(), detect_cyclic=True):
         """The linearization about the model's steady motion (its initial state): state names,
         state matrix and eigenvalues (docs/linearization.md)."""
-        return Linearization(_nhdyn.linearize(self._cpp, list(cyclic), list(independent), list(speeds),
+        return Linearization(_nhdyn.linearize(self._cpp, _names(cyclic), _names(independent), _names(speeds),
                                               detect_cyclic))
 
     @_python_errors
@@ -470,7 +476,7 @@ class Model:
         if not np.allclose(values, grid, rtol=0, atol=1e-12 * max(1.0, abs(first), abs(last))):
             raise InputError("sweep values: give evenly spaced increasing values, e.g. np.linspace(0, 10, 101)")
         return Sweep(_nhdyn.sweep(self.source, list(self.overrides.items()), parameter, first, last, values.size,
-                                  list(cyclic), list(independent), list(speeds), detect_cyclic, find_crossings))
+                                  _names(cyclic), _names(independent), _names(speeds), detect_cyclic, find_crossings))
 
 
 class Result:

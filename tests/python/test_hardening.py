@@ -238,3 +238,12 @@ def test_outputs_never_replace_the_model_file_and_take_only_paths(tmp_path):
     r.to_csv(out)
     assert out.read_text().startswith("# nhdyn version")
     assert [p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")] == []
+
+
+def test_one_coordinate_name_given_as_a_string_is_that_name(examples):
+    # cyclic="psi" was read as the letters p, s, i ("'p' is not a coordinate").
+    m = nhdyn.load(examples / "rolling_disk_upright.toml")
+    one = m.linearize(cyclic="psi")
+    listed = m.linearize(cyclic=["psi"])
+    assert "psi" in one.cyclic and one.cyclic == listed.cyclic
+    np.testing.assert_array_equal(one.state_matrix, listed.state_matrix)
