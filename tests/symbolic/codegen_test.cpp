@@ -91,6 +91,16 @@ TEST(Codegen, NamespaceAndIdentifierAreConfigurable) {
   EXPECT_THROW(generate_code(built.spec, built.derivation, options), InputError);
   options.namespace_name = "std";
   EXPECT_THROW(generate_code(built.spec, built.derivation, options), InputError);
+  // Inside a::std the generated std::shared_ptr named a::std::shared_ptr: the header did not compile.
+  for (const char* hiding : {"a::std", "lab::std::models"}) {
+    options.namespace_name = hiding;
+    try {
+      generate_code(built.spec, built.derivation, options);
+      ADD_FAILURE() << hiding << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_TRUE(contains(e.what(), "has a part 'std' that would hide the standard library")) << e.what();
+    }
+  }
 }
 
 TEST(Codegen, IdentifiersAreSanitized) {

@@ -213,6 +213,14 @@ std::vector<std::string> split_namespace(const CodegenOptions& options) {
         throw InputError(fmt::format("codegen: the namespace '{}' is not '::'-separated C++ identifiers",
                                      options.namespace_name));
     if (namespaces.front() == "std") throw InputError("codegen: the generated code may not go into namespace std");
+    // Inside a::std, the generated code's std::shared_ptr would name a::std::shared_ptr, and a
+    // keyword is no name at all: neither header compiled.
+    for (const std::string& part : namespaces)
+      if (part == "std" || is_keyword(part))
+        throw InputError(fmt::format("codegen: the namespace '{}' has a part '{}' that {}; choose another name",
+                                     options.namespace_name, part,
+                                     part == "std" ? "would hide the standard library the generated code calls"
+                                                   : "is a C++ keyword"));
   }
   return namespaces;
 }
