@@ -6,6 +6,7 @@
 #include <chrono>
 #include <map>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "bindings.hpp"
@@ -22,6 +23,10 @@ std::optional<T> get(const py::dict& kwargs, const char* key) {
   if (!kwargs.contains(key)) return std::nullopt;
   const py::object value = kwargs[key];
   if (value.is_none()) return std::nullopt;
+  // A bool is an int to Python, and would run t_end=True as 1 s: only a flag takes one.
+  if constexpr (!std::is_same_v<T, bool>)
+    if (py::isinstance<py::bool_>(value))
+      throw InputError(fmt::format("{}={}: give a number, not a bool", key, py::repr(value).cast<std::string>()));
   try {
     return value.cast<T>();
   } catch (const py::cast_error&) {

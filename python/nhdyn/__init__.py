@@ -534,6 +534,10 @@ class Result:
             self._provenance = self._provenance()
         return self._provenance or ""
 
+    # Not iterable: result[name] takes a column's name, and Python's fallback iteration asked for
+    # result[0], result[1], ... ("KeyError: 0 is not a column"). result.columns["all"] lists them.
+    __iter__ = None
+
     def __getitem__(self, name):
         """One column by its CSV name: r["x"], r["phi'"], r["R_x"], r["energy"], an output's name."""
         if not hasattr(self, "_index"):
@@ -593,6 +597,9 @@ class Result:
 
         if columns is not None:
             panels = [(str(c), [str(c)], False) for c in ([columns] if isinstance(columns, str) else columns)]
+            if not panels:
+                raise InputError("plot: columns=[] names no column; give at least one, or leave it out for the "
+                                 "default panels")
             for _, names, _ in panels:
                 self[names[0]]  # KeyError naming the columns
         else:

@@ -247,3 +247,18 @@ def test_one_coordinate_name_given_as_a_string_is_that_name(examples):
     listed = m.linearize(cyclic=["psi"])
     assert "psi" in one.cyclic and one.cyclic == listed.cyclic
     np.testing.assert_array_equal(one.state_matrix, listed.state_matrix)
+
+
+def test_a_bool_is_not_a_number_and_a_result_is_not_iterable(oscillator):
+    # t_end=True ran for 1 s; iter(result) asked for result[0] ("KeyError: 0 is not a column");
+    # plot([]) failed inside matplotlib.
+    with pytest.raises(nhdyn.InputError, match=r"t_end=True: give a number, not a bool"):
+        oscillator.simulate(t_end=True)
+    with pytest.raises(nhdyn.InputError, match=r"rtol=False: give a number, not a bool"):
+        oscillator.simulate(0.1, rtol=False)
+    r = oscillator.simulate(0.1)
+    with pytest.raises(TypeError, match="not iterable"):
+        iter(r)
+    with pytest.raises(nhdyn.InputError, match=r"plot: columns=\[\] names no column"):
+        r.plot([])
+    assert r["x"][0] == 1.0
