@@ -544,6 +544,17 @@ TEST_F(Hardening, ReportReadsItsOwnPartialFilesAndChecksTimes) {
     EXPECT_TRUE(contains(r.err, "is not finite; a run writes finite values")) << r.err;
     EXPECT_FALSE(fs::exists(dir_ / "edited.html")) << column;
   }
+  // strtod read 0x10 as 16.
+  std::vector<std::string> cells = split_commas(clean[names + 2]);
+  cells[1] = "0x10";
+  std::vector<std::string> hexadecimal = clean;
+  hexadecimal[names + 2] = join_commas(cells);
+  std::string text;
+  for (const std::string& line : hexadecimal) text += line + "\n";
+  write("hex.csv", text);
+  const ProcessRun hex = nhdyn({"report", "hex.csv", "--model", "sled.toml", "-q", "-o", "hex.html"});
+  EXPECT_EQ(hex.code, 2) << hex.err;
+  EXPECT_TRUE(contains(hex.err, "'0x10' at column 2 is not a decimal number")) << hex.err;
 }
 
 // codegen emitted parameters named INFINITY, EOF, errno, NULL as identifiers: the preprocessor

@@ -130,6 +130,22 @@ TEST_F(ProvenanceCli, ReportRefusesATruncatedHeader) {
   EXPECT_EQ(r.exit_code, 2) << r.out;
   EXPECT_NE(r.out.find("cut.csv: the provenance header is truncated: it has no 'parameters' line"), std::string::npos)
       << r.out;
+  // An edited parameters line was named as a --set the user never gave ("--set m=nan: 'nan' uses
+  // 'nan' ..."): the CSV's line is named.
+  const std::size_t m = csv.find("# parameters: m=");
+  ASSERT_NE(m, std::string::npos);
+  for (const auto& [edit, expected] :
+       {std::pair<std::string, std::string>{"# parameters: m=nan, junk=", "gives m = nan, which is not a finite number"},
+        {"# parameters: zz=3, m=", "names 'zz', which is not a parameter of model 'sled'"}}) {
+    std::string edited = csv;
+    edited.replace(m, std::string("# parameters: m=").size(), edit);
+    provenance_write(dir_ / "a" / "edited.csv", edited);
+    const nhdyn::test::CliOutcome e =
+        nhdyn::test::run_nhdyn("report edited.csv --model sled.toml -o page.html", dir_ / "a");
+    EXPECT_EQ(e.exit_code, 2) << e.out;
+    EXPECT_NE(e.out.find("edited.csv: its '# parameters:' line " + expected), std::string::npos) << e.out;
+    EXPECT_EQ(e.out.find("--set"), std::string::npos) << e.out;
+  }
 }
 
 TEST_F(ProvenanceCli, AFailedRunsPartialFileCarriesIt) {

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "nhdyn/core/error.hpp"
@@ -105,8 +107,22 @@ ParameterOverrides check_provenance(const Provenance& provenance, const ModelSou
                                  "Give --model the model the run used, or run nhdyn simulate again with this one",
                                  csv, provenance.model, origin, provenance.model_hash, given, hash, why));
   }
+  // The parameters line names the model's parameters with finite values; an edited one was named
+  // as a --set the user never gave.
+  std::vector<std::string> known;
+  for (const auto& [name, value] : model_parameters(source)) known.push_back(name);
   ParameterOverrides overrides;
-  for (const auto& [name, value] : provenance.parameters) overrides.emplace_back(name, value);
+  for (const auto& [name, value] : provenance.parameters) {
+    if (std::find(known.begin(), known.end(), name) == known.end())
+      throw InputError(fmt::format("{}: its '# parameters:' line names '{}', which is not a parameter of model '{}' ({}): "
+                                   "the line was edited; run nhdyn simulate again",
+                                   csv, name, provenance.model, join(known)));
+    if (!std::isfinite(value))
+      throw InputError(fmt::format("{}: its '# parameters:' line gives {} = {}, which is not a finite number: the line "
+                                   "was edited; run nhdyn simulate again",
+                                   csv, name, value));
+    overrides.emplace_back(name, value);
+  }
   return overrides;
 }
 

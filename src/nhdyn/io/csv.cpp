@@ -253,6 +253,10 @@ CsvTable load_csv(const std::filesystem::path& path) {
       const double value = std::strtod(p, &end);
       if (end == p)
         throw FileError(fmt::format("{}:{}: not a number at column {}", path.string(), line_number, row.size() + 1));
+      // strtod reads hexadecimal too (0x10 as 16); a table of nhdyn's, or a user's, is decimal.
+      if (std::find_if(p, static_cast<const char*>(end), [](char c) { return c == 'x' || c == 'X'; }) != end)
+        throw FileError(fmt::format("{}:{}: '{}' at column {} is not a decimal number", path.string(), line_number,
+                                    std::string(p, static_cast<const char*>(end)), row.size() + 1));
       row.push_back(value);
       p = end;
       if (*p == ',') ++p;
