@@ -12,9 +12,9 @@
 #include <cctype>
 #include <cerrno>
 #include <cfloat>
-#include <cstdlib>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <optional>

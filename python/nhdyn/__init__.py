@@ -669,8 +669,9 @@ class Optimum:
     def to_csv(self, path):
         """Writes the CSV of `nhdyn optimize -o` to `path`."""
         path = _output_path(path, "to_csv")
-        _write_whole(path, "".join(",".join(row) + "\n" for row in
-                                   [self.columns] + [[repr(float(v)) for v in r] for r in self.rows]))
+        lines = [",".join(self.columns) + "\n"]
+        lines += [",".join(repr(float(v)) for v in row) + "\n" for row in self.rows]
+        _write_whole(path, "".join(lines))
 
     def __repr__(self):
         return "<nhdyn.Optimum {!r}: {}, objective {:.10g}, {} points>".format(

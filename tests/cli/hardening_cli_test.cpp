@@ -522,37 +522,35 @@ TEST_F(Hardening, ReportReadsItsOwnPartialFilesAndChecksTimes) {
     for (std::string cell; std::getline(cells_in, cell, ',');) cells.push_back(cell);
     return cells;
   };
-  const auto join_commas = [](const std::vector<std::string>& cells) {
-    std::string line;
-    for (std::size_t i = 0; i < cells.size(); ++i) line += (i ? "," : "") + cells[i];
-    return line;
-  };
   const std::vector<std::string> header = split_commas(clean[names]);
+  // The CSV with the cell of `column` in its second row replaced by `value`, reported from `file`.
+  const auto report_edited = [&](std::size_t column, const std::string& value, const std::string& file) {
+    std::vector<std::string> cells = split_commas(clean[names + 2]);
+    cells[column] = value;
+    std::string text;
+    for (std::size_t i = 0; i < clean.size(); ++i) {
+      if (i != names + 2) {
+        text += clean[i] + "\n";
+        continue;
+      }
+      for (std::size_t c = 0; c < cells.size(); ++c) text += (c ? "," : "") + cells[c];
+      text += "\n";
+    }
+    write(file + ".csv", text);
+    return nhdyn({"report", file + ".csv", "--model", "sled.toml", "-q", "-o", file + ".html"});
+  };
   for (const std::string column : {"x", "energy", "residual_vel_blade"}) {
     const auto at = std::find(header.begin(), header.end(), column);
     ASSERT_NE(at, header.end()) << column;
-    std::vector<std::string> cells = split_commas(clean[names + 2]);
-    cells[static_cast<std::size_t>(at - header.begin())] = column == "x" ? "-inf" : "nan";
-    std::vector<std::string> edited = clean;
-    edited[names + 2] = join_commas(cells);
-    std::string text;
-    for (const std::string& line : edited) text += line + "\n";
-    write("edited.csv", text);
-    const ProcessRun r = nhdyn({"report", "edited.csv", "--model", "sled.toml", "-q", "-o", "edited.html"});
+    const ProcessRun r = report_edited(static_cast<std::size_t>(at - header.begin()), column == "x" ? "-inf" : "nan",
+                                       "edited");
     EXPECT_EQ(r.code, 2) << column << ": " << r.err;
     EXPECT_TRUE(contains(r.err, "edited.csv: row 2: " + column + " = ")) << r.err;
     EXPECT_TRUE(contains(r.err, "is not finite; a run writes finite values")) << r.err;
     EXPECT_FALSE(fs::exists(dir_ / "edited.html")) << column;
   }
   // strtod read 0x10 as 16.
-  std::vector<std::string> cells = split_commas(clean[names + 2]);
-  cells[1] = "0x10";
-  std::vector<std::string> hexadecimal = clean;
-  hexadecimal[names + 2] = join_commas(cells);
-  std::string text;
-  for (const std::string& line : hexadecimal) text += line + "\n";
-  write("hex.csv", text);
-  const ProcessRun hex = nhdyn({"report", "hex.csv", "--model", "sled.toml", "-q", "-o", "hex.html"});
+  const ProcessRun hex = report_edited(1, "0x10", "hex");
   EXPECT_EQ(hex.code, 2) << hex.err;
   EXPECT_TRUE(contains(hex.err, "'0x10' at column 2 is not a decimal number")) << hex.err;
 }

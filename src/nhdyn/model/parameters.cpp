@@ -7,9 +7,9 @@
 #include <cerrno>
 #include <cfloat>
 #include <cmath>
-#include <limits>
 #include <cstdlib>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <utility>
