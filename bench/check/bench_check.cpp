@@ -14,6 +14,9 @@
 //                                        CsvWriter): 1001 rows (output step 0.01 s) over 2 rows,
 //                                        interpreted
 //   bicycle_rows_1001_vs_2_compiled      the same with the compiled evaluator
+//   bicycle_rows_1001_vs_2_in_memory     the same 10 s with the rows kept in memory (Trajectory,
+//                                        what nhdyn.simulate returns) instead of written as CSV
+//   bicycle_rows_1001_vs_2_in_memory_compiled  the same with the compiled evaluator
 //   sled_watch_on_vs_off                 simulate() 200 s of examples/sled.toml (dopri5 at rtol 1e-8,
 //                                        atol 1e-10, 2001 rows, nothing written) with the constraint
 //                                        watch over the same without it: what the watch costs a
@@ -58,6 +61,7 @@
 #include <string>
 #include <vector>
 
+#include "nhdyn/analysis/batch.hpp"
 #include "nhdyn/analysis/constraint_watch.hpp"
 #include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/analysis/simulation.hpp"
@@ -162,6 +166,26 @@ void run_with_rows(const Model& model, double output_step, const fs::path& csv) 
     std::exit(1);
   }
   writer.commit();
+}
+
+// The same run with its rows kept in memory as a Trajectory (analysis/batch.hpp): every row's
+// calculations (q'', R, residuals, energy balance, contact forces, outputs) without the CSV text,
+// what nhdyn.simulate in Python and the C++ batches return.
+void run_with_rows_in_memory(const Model& model, double output_step) {
+  SimulationOptions options;
+  options.t_end = 10.0;
+  options.output_step = output_step;
+  options.formulation = {Formulation::sanh, Complement::qr};
+  options.integrator.kind = IntegratorKind::dopri5;
+  options.integrator.rtol = 1e-10;
+  options.integrator.atol = 1e-12;
+  Trajectory trajectory;
+  trajectory.reset(model, static_cast<long>(options.t_end / output_step) + 1);
+  const SimulationSummary summary = simulate(model, options, [&](const Data& data) { trajectory.append(data); });
+  if (summary.status != Status::ok || trajectory.rows() != static_cast<long>(options.t_end / output_step + 0.5) + 1) {
+    std::fprintf(stderr, "bench-check: the bicycle run in memory failed: %s\n", summary.message.c_str());
+    std::exit(1);
+  }
 }
 
 // A run whose rows are not written: what the integration and the watch cost alone.
@@ -344,6 +368,10 @@ int main(int argc, char** argv) {
     pair("bicycle_rows_1001_vs_2_compiled", pairs, [&] { run_with_rows(compiled, 0.01, csv); },
          [&] { run_with_rows(compiled, 10.0, csv); });
     fs::remove_all(dir);
+    pair("bicycle_rows_1001_vs_2_in_memory", pairs, [&] { run_with_rows_in_memory(interpreted, 0.01); },
+         [&] { run_with_rows_in_memory(interpreted, 10.0); });
+    pair("bicycle_rows_1001_vs_2_in_memory_compiled", pairs, [&] { run_with_rows_in_memory(compiled, 0.01); },
+         [&] { run_with_rows_in_memory(compiled, 10.0); });
 
     const Model sled = load_model((examples / "sled.toml").string());
     pair("sled_watch_on_vs_off", pairs, [&] { run_watched(sled, 200.0, 0.1, 1e-8, 1e-10, true); },
