@@ -226,6 +226,50 @@ TEST_F(ProgramCli, ActuatorThatTheConstraintsAbsorbIsRefused) {
       << run.out;
 }
 
+// An actuator written as 1e-200 times a direction acts along that direction: the motion is the
+// plain actuator's and its force u is 1e200 times larger (the test of D B = 0 squared the entries,
+// which underflowed to 0 and blamed the constraints).
+TEST_F(ProgramCli, AnActuatorOfTinyMagnitudeActsAlongItsDirection) {
+  // Weight along -y; the slope x' + y' = 0 and the program x - y = t hold x'' = y'' = 0, so the
+  // slope's reaction carries the weight, lambda = m g, and the actuator balances it: u = -m g.
+  const std::string program = "[forces]\ny = \"-9.81*m\"\n"
+                              "[[programs]]\nname = \"px\"\nposition = \"x - y - t\"\nactuator = [{}, 0]\n"
+                              "[initial]\nposition = { x = 0, y = 0 }\nvelocity = { x = 0.5, y = -0.5 }\n";
+  const auto with = [&](const std::string& magnitude) {
+    std::string text = program;
+    text.replace(text.find("{}"), 2, magnitude);
+    return plane_model(text, "[[constraints]]\nname = \"slope\"\nvelocity = \"x' + y'\"\n");
+  };
+  write("plain.toml", with("1"));
+  write("tiny.toml", with("\"1e-200\""));
+  const Outcome plain = run_nhdyn("simulate plain.toml --t-end 1 -q -o plain.csv", dir_);
+  ASSERT_EQ(plain.exit_code, 0) << plain.out;
+  const Outcome tiny = run_nhdyn("simulate tiny.toml --t-end 1 -q -o tiny.csv", dir_);
+  ASSERT_EQ(tiny.exit_code, 0) << tiny.out;
+  const auto last_row = [&](const std::string& file) {
+    const std::string body = nhdyn::test::csv_body(read(file));
+    std::istringstream lines(body);
+    std::string header, line, last;
+    std::getline(lines, header);
+    while (std::getline(lines, line)) last = line;
+    return std::pair{split(header), split(last)};
+  };
+  const auto [names, a] = last_row("plain.csv");
+  const auto [names_tiny, b] = last_row("tiny.csv");
+  ASSERT_EQ(names, names_tiny);
+  ASSERT_EQ(a.size(), names.size());
+  ASSERT_EQ(b.size(), names.size());
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const double x = std::stod(a[i]), y = std::stod(b[i]);
+    if (names[i] == "u_px") {
+      EXPECT_NEAR(x, -9.81 * 2.0, 1e-9) << "the plain actuator's force";
+      EXPECT_NEAR(y * 1e-200, x, 1e-9 * std::abs(x)) << names[i];
+    } else if (names[i] == "x" || names[i] == "y" || names[i] == "x'" || names[i] == "y'") {
+      EXPECT_NEAR(y, x, 1e-9 * (1.0 + std::abs(x))) << names[i];
+    }
+  }
+}
+
 TEST_F(ProgramCli, ProgramsInConflictWithTheConstraintsAreReportedWithTheirResiduals) {
   // The rail holds y = 0; the program asks for y = 1 + t: violated at the initial state.
   write("m.toml", plane_model("[[programs]]\nname = \"lift\"\nposition = \"y - 1 - t\"\nactuator = \"y\"\n"

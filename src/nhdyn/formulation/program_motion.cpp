@@ -88,11 +88,13 @@ Status compute_program_motion(const Model& model, Data& data, Complement complem
   data.rhs.tail(s) = -data.b0;
   w.DB.topRows(k).noalias() = data.D * w.B;
   w.DB.bottomRows(s).setZero();
-  // An actuator that the physical constraints take up entirely (D B_j = 0), judged on D B as it is.
+  // An actuator that the physical constraints take up entirely (D B_j = 0), judged on D B as it is;
+  // norms that do not square their entries, so that an actuator written as 1e200 or 1e-200 times a
+  // direction is judged by its direction (a plain norm overflows to inf or underflows to 0 there).
   w.absorbed = -1;
-  const double d_norm = data.D.norm();
+  const double d_norm = data.D.stableNorm();
   for (int j = 0; j < m && w.absorbed < 0; ++j)
-    if (!(w.DB.col(j).norm() > kAbsorbed * d_norm * w.B.col(j).norm())) w.absorbed = j;
+    if (!(w.DB.col(j).stableNorm() > kAbsorbed * d_norm * w.B.col(j).stableNorm())) w.absorbed = j;
   // Rows in different units (the masses' --set m=1e-100) scaled exactly first, as sanh does
   // (row_scaling.hpp): D B is a second right-hand side of [D A; b] and takes the same scaling.
   scale_rows_by_powers_of_two(
