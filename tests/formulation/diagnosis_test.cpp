@@ -47,6 +47,35 @@ TEST(Diagnosis, DependentConstraintsAreNamedWithAConditionEstimate) {
   }
 }
 
+// A b that is singular in double precision only through the scale of a column (a coordinate in
+// units out of proportion with the others) is said to be so, naming the columns; a true
+// dependency among the same columns is still called one.
+TEST(Diagnosis, ColumnsOutOfProportionAreNotCalledDependentConstraints) {
+  Matrix b(2, 3);
+  b << 1, 0, 1e20,
+       0, 1, 0;
+  const Model model = testing::make_constant_model(Matrix::Identity(3, 3), Vector::Ones(3), b, Vector::Zero(2));
+  Data data = make_data(model);
+  ASSERT_EQ(compute_dynamics(model, data, {Formulation::sanh, Complement::qr}, 0.0, model.q0.data(), model.v0.data()),
+            Status::dependent_constraints);
+  const std::string message = explain_failure(model, data);
+  EXPECT_TRUE(contains(message, "only through the units of the coordinates")) << message;
+  EXPECT_TRUE(contains(message, "the column of 'q3'") && contains(message, "1e+20 times")) << message;
+  EXPECT_TRUE(contains(message, "'c1'") && !contains(message, "'c2'")) << message;
+
+  Matrix dependent(2, 3);
+  dependent << 1, 0, 1e20,
+               2, 0, 2e20;  // c2 = 2 c1
+  const Model truly = testing::make_constant_model(Matrix::Identity(3, 3), Vector::Ones(3), dependent, Vector::Zero(2));
+  Data truly_data = make_data(truly);
+  ASSERT_NE(compute_dynamics(truly, truly_data, {Formulation::sanh, Complement::qr}, 0.0, truly.q0.data(),
+                             truly.v0.data()),
+            Status::ok);
+  const std::string said = explain_failure(truly, truly_data);
+  EXPECT_TRUE(contains(said, "dependent or conflicting")) << said;
+  EXPECT_FALSE(contains(said, "units of the coordinates")) << said;
+}
+
 TEST(Diagnosis, IndefiniteInertiaIsReportedWithItsSmallestEigenvalue) {
   Matrix A = Matrix::Identity(3, 3);
   A(2, 2) = -2.0;

@@ -106,10 +106,49 @@ Matrix rows_of_b(const Data& data, const std::vector<int>& rows) {
   return b;
 }
 
+// A b of full rank once its columns have unit norms: coordinates in units out of proportion (a
+// rolling sphere of radius 1e20 m puts r next to 1 in the rows of its contact), which no row
+// scaling can mend. The message names the largest and smallest columns, or "" when b stays
+// rank-deficient with unit columns (a true dependency).
+std::string explain_disproportionate_columns(const Model& model, const Data& data, const std::vector<int>& rows,
+                                             const Matrix& b) {
+  if (b.rows() == 0 || b.cols() == 0) return "";
+  Vector norms(b.cols());
+  for (Eigen::Index j = 0; j < b.cols(); ++j) norms(j) = b.col(j).stableNorm();
+  Eigen::Index largest = 0, smallest = -1;
+  for (Eigen::Index j = 0; j < b.cols(); ++j) {
+    if (norms(j) > norms(largest)) largest = j;
+    if (norms(j) > 0.0 && (smallest < 0 || norms(j) < norms(smallest))) smallest = j;
+  }
+  if (smallest < 0 || !(norms(largest) > 1e6 * norms(smallest))) return "";
+  Matrix scaled = b;
+  for (Eigen::Index j = 0; j < b.cols(); ++j)
+    if (norms(j) > 0.0) scaled.col(j) /= norms(j);
+  const Vector sv = Eigen::JacobiSVD<Matrix>(scaled).singularValues();
+  if (!(sv(sv.size() - 1) > kRankTolerance * sv(0))) return "";
+  const auto name = [&](Eigen::Index j) { return model.coordinates[static_cast<std::size_t>(j)]; };
+  std::string involved;
+  for (Eigen::Index i = 0; i < b.rows(); ++i) {
+    if (b(i, largest) == 0.0) continue;
+    const Constraint& c = model.constraints[static_cast<std::size_t>(rows[static_cast<std::size_t>(i)])];
+    if (involved.find("'" + c.name + "'") == std::string::npos)
+      involved += (involved.empty() ? "" : ", ") + ("'" + c.name + "'") + (c.where.empty() ? "" : " (" + c.where + ")");
+  }
+  return fmt::format(
+      "the constraints {} are numerically singular at t = {:.6g}, but only through the units of the coordinates: "
+      "the column of '{}' in the constraint matrix b is {:.3g} times the column of '{}' (a length of that size "
+      "against an angle, say), beyond what double precision separates; with the columns in proportion the "
+      "constraints are independent. Rescale the model's lengths or masses (km or mm in place of m) so that its "
+      "parameters are within a few orders of magnitude of each other.",
+      involved, data.t, name(largest), norms(largest) / norms(smallest), name(smallest));
+}
+
 // Singular values of b and, for each small one, the constraints taking part in the dependency.
 std::string explain_dependent_constraints(const Model& model, const Data& data) {
   if (sparse_checks(model, data)) return explain_dependent_constraints_sparse(model, data);
   const std::vector<int> rows = held_rows(model, data);
+  if (std::string units = explain_disproportionate_columns(model, data, rows, rows_of_b(data, rows)); !units.empty())
+    return units;
   Eigen::JacobiSVD<Matrix> svd(rows_of_b(data, rows), Eigen::ComputeFullU);
   const Vector& sv = svd.singularValues();
   const double largest = sv.size() > 0 ? sv(0) : 0.0;
