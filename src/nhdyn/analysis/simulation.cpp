@@ -671,6 +671,23 @@ void note_unmet_stops(const Model& model, const std::vector<const Event*>& event
 }
 
 // The message of a run that failed, in the most telling words there are.
+// A run that blew up or stalled under an absolute tolerance at least the size of every state at
+// the start: its error test bounded nothing, the steps grew until the integrator went unstable,
+// and the model is not at fault. Said after the failure's own words; "" otherwise.
+std::string loose_tolerance_hint(const IntegratorOptions& integrator, Status status, const Vector& q0,
+                                 const Vector& v0) {
+  if (integrator.kind == IntegratorKind::rk4) return "";  // its steps do not follow the tolerances
+  if (status != Status::non_finite && status != Status::too_many_steps && status != Status::step_size_underflow)
+    return "";
+  const double largest = std::max(q0.size() ? q0.cwiseAbs().maxCoeff() : 0.0, v0.size() ? v0.cwiseAbs().maxCoeff() : 0.0);
+  if (!(integrator.atol >= std::max(largest, 1e-3))) return "";
+  return fmt::format(
+      ". Note the absolute tolerance atol = {:g}: at least the size of every state at the start (largest |q|, |q'| "
+      "{:g}), so the error test bounds nothing and the steps grow until the integrator is unstable, whatever the "
+      "model; give an atol well below the states' size (the default is 1e-10)",
+      integrator.atol, largest);
+}
+
 std::string explain_run_failure(const Model& model, const Data& data, const ModelEventFunctions& event_functions,
                                 const WatchedEvents& watched, const IntegrationResult& result,
                                 const std::string& output_message, Status status) {
@@ -784,7 +801,8 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.watch.watched_states = watch.states;
   if (summary.status != Status::ok)
     summary.message = explain_run_failure(model, data, event_functions, watched, result, recorder.message(),
-                                          summary.status);
+                                          summary.status) +
+                      loose_tolerance_hint(options.integrator, summary.status, q0, v0);
   return summary;
 }
 
