@@ -124,9 +124,19 @@ def _python_errors(function):
     return wrapper
 
 
+def _real_numbers(values, what):
+    """`values` as a float array, or InputError naming `what` for booleans, complex numbers or text
+    (NumPy would read True as 1 and drop an imaginary part with a warning only)."""
+    raw = np.asarray(values)
+    if raw.dtype == bool or raw.dtype.kind not in "iuf":
+        raise InputError("{}: expected real numbers, got {} values (dtype {}); booleans, complex numbers and text "
+                         "are not accepted".format(what, raw.size, raw.dtype))
+    return raw.astype(float)
+
+
 def _check_t_eval(t_eval, t0, t_end):
     """t_eval as a 1-D float array of finite, strictly increasing times in [t0, t_end], or InputError."""
-    times = np.asarray(t_eval, dtype=float)
+    times = _real_numbers(t_eval, "t_eval")
     if times.ndim != 1 or times.size == 0:
         raise InputError("t_eval: expected a non-empty 1-D array of times, got shape {}".format(times.shape))
     if not np.all(np.isfinite(times)):
@@ -465,7 +475,7 @@ class Model:
               find_crossings=True):
         """The eigenvalues of the linearization at each of `values` (evenly spaced, increasing) of
         a parameter, and the values where a real part crosses zero (located by bisection)."""
-        values = np.asarray(values, dtype=float)
+        values = _real_numbers(values, "sweep values")
         if values.ndim != 1 or values.size < 2:
             raise InputError("sweep values: give at least two values in a 1-D array")
         first, last = float(values[0]), float(values[-1])
@@ -795,11 +805,7 @@ def _batch_runs(model, parameters, initial):
     columns = []
     runs = None
     for name in names:
-        raw = np.asarray(parameters[name])
-        if raw.dtype == bool or raw.dtype.kind not in "iuf":
-            raise InputError("parameters[{!r}]: expected numbers, got {} values (dtype {}); booleans and text are not "
-                             "parameter values".format(name, raw.size, raw.dtype))
-        values = raw.astype(float)
+        values = _real_numbers(parameters[name], "parameters[{!r}]".format(name))
         if values.ndim != 1:
             raise InputError("parameters[{!r}]: expected a 1-D array of values, got shape {}".format(
                 name, values.shape))

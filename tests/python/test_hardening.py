@@ -61,6 +61,20 @@ def test_boolean_parameter_values_are_refused(oscillator):
         nhdyn.simulate_batch(oscillator, parameters={"k": [True, False]}, t_end=0.1)
 
 
+def test_complex_and_boolean_times_and_sweep_values_are_refused(oscillator):
+    # NumPy would drop the imaginary part with a warning only, and read True as 1.
+    with pytest.raises(nhdyn.InputError, match="t_eval: expected real numbers.*complex"):
+        oscillator.simulate(t_eval=np.array([0.0, 1.0 + 1e-3j, 2.0]))
+    with pytest.raises(nhdyn.InputError, match="t_eval: expected real numbers.*booleans"):
+        oscillator.simulate(t_eval=[False, True])
+    with pytest.raises(nhdyn.InputError, match="sweep values: expected real numbers"):
+        oscillator.sweep("k", [True, False])
+    with pytest.raises(nhdyn.InputError, match="sweep values: expected real numbers"):
+        oscillator.sweep("k", np.linspace(1, 2, 3) + 0j)
+    # Whole numbers stay numbers: times 0, 1, 2 as integers run.
+    assert list(oscillator.simulate(t_eval=[0, 1, 2]).t) == [0.0, 1.0, 2.0]
+
+
 def test_one_coordinate_keeps_the_documented_shapes(oscillator):
     b = nhdyn.simulate_batch(oscillator, parameters={"k": [1.0, 4.0]}, t_end=1.0)
     rows = len(b.t)
