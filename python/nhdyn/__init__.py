@@ -287,10 +287,20 @@ class Parameters(MutableMapping):
         return repr(dict(self.items()))
 
 
-def _names(value):
+def _names(value, keyword):
     """A list of coordinate names: one name given as a str is that name (list("psi") read as the
-    letters p, s, i)."""
-    return [value] if isinstance(value, str) else list(value)
+    letters p, s, i); anything but names is an InputError naming the keyword."""
+    if isinstance(value, str):
+        return [value]
+    try:
+        names = list(value)
+    except TypeError:
+        raise InputError("{}={!r}: expected a coordinate name or a list of names".format(keyword, value)) from None
+    for i, name in enumerate(names):
+        if not isinstance(name, str):  # numpy.str_ is one
+            raise InputError("{}: entry {} is {!r} ({}), not a coordinate name; give names as strings, e.g. "
+                             "{}=[\"psi\"]".format(keyword, i, name, type(name).__name__, keyword))
+    return [str(name) for name in names]
 
 
 class Model:
@@ -467,8 +477,8 @@ class Model:
     def linearize(self, cyclic=(), independent=(), speeds=(), detect_cyclic=True):
         """The linearization about the model's steady motion (its initial state): state names,
         state matrix and eigenvalues (docs/linearization.md)."""
-        return Linearization(_nhdyn.linearize(self._cpp, _names(cyclic), _names(independent), _names(speeds),
-                                              detect_cyclic))
+        return Linearization(_nhdyn.linearize(self._cpp, _names(cyclic, "cyclic"), _names(independent, "independent"),
+                                              _names(speeds, "speeds"), detect_cyclic))
 
     @_python_errors
     def sweep(self, parameter, values, cyclic=(), independent=(), speeds=(), detect_cyclic=True,
@@ -486,7 +496,8 @@ class Model:
         if not np.allclose(values, grid, rtol=0, atol=1e-12 * max(1.0, abs(first), abs(last))):
             raise InputError("sweep values: give evenly spaced increasing values, e.g. np.linspace(0, 10, 101)")
         return Sweep(_nhdyn.sweep(self.source, list(self.overrides.items()), parameter, first, last, values.size,
-                                  _names(cyclic), _names(independent), _names(speeds), detect_cyclic, find_crossings))
+                                  _names(cyclic, "cyclic"), _names(independent, "independent"),
+                                  _names(speeds, "speeds"), detect_cyclic, find_crossings))
 
 
 class Result:

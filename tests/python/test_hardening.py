@@ -261,6 +261,11 @@ def test_one_coordinate_name_given_as_a_string_is_that_name(examples):
     listed = m.linearize(cyclic=["psi"])
     assert "psi" in one.cyclic and one.cyclic == listed.cyclic
     np.testing.assert_array_equal(one.state_matrix, listed.state_matrix)
+    # A name that is not a string is named with its keyword (pybind11 listed its C++ signatures).
+    with pytest.raises(nhdyn.InputError, match=r"cyclic: entry 0 is 1 \(int\), not a coordinate name"):
+        m.linearize(cyclic=[1])
+    with pytest.raises(nhdyn.InputError, match=r"speeds=3: expected a coordinate name or a list of names"):
+        m.sweep("m", np.linspace(1, 2, 3), speeds=3)
 
 
 def test_a_bool_is_not_a_number_and_a_result_is_not_iterable(oscillator):
