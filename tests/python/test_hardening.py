@@ -268,6 +268,18 @@ def test_one_coordinate_name_given_as_a_string_is_that_name(examples):
         m.sweep("m", np.linspace(1, 2, 3), speeds=3)
 
 
+def test_report_frames_are_a_whole_number(oscillator, tmp_path):
+    r = oscillator.simulate(t_end=1.0)
+    for bad in (1.5, "3", True):
+        with pytest.raises(nhdyn.InputError, match=r"max_frames=.*: give a whole number of rows"):
+            oscillator.report(r, tmp_path / "r.html", max_frames=bad)
+    with pytest.raises(nhdyn.InputError, match=r"max_frames = 1 must be at least 2"):
+        oscillator.report(r, tmp_path / "r.html", max_frames=np.int64(1))
+    assert not (tmp_path / "r.html").exists()
+    oscillator.report(r, tmp_path / "r.html", max_frames=10**30)  # beyond a C int: every row
+    assert (tmp_path / "r.html").read_text().startswith("<!DOCTYPE html>")
+
+
 def test_a_bool_is_not_a_number_and_a_result_is_not_iterable(oscillator):
     # t_end=True ran for 1 s; iter(result) asked for result[0] ("KeyError: 0 is not a column");
     # plot([]) failed inside matplotlib.
