@@ -146,7 +146,8 @@ void rhs_loop(const Model& model, Data& data, long calls) {
   }
 }
 
-void run_with_rows(const Model& model, double output_step, const fs::path& csv) {
+// The bicycle's 10 s of the rows ratios: dopri5 at rtol 1e-10, atol 1e-12, rows every output_step.
+SimulationOptions bicycle_row_options(double output_step) {
   SimulationOptions options;
   options.t_end = 10.0;
   options.output_step = output_step;
@@ -154,6 +155,12 @@ void run_with_rows(const Model& model, double output_step, const fs::path& csv) 
   options.integrator.kind = IntegratorKind::dopri5;
   options.integrator.rtol = 1e-10;
   options.integrator.atol = 1e-12;
+  return options;
+}
+
+// The run with its rows filled and written as CSV, as `nhdyn simulate` writes them.
+void run_with_rows(const Model& model, double output_step, const fs::path& csv) {
+  const SimulationOptions options = bicycle_row_options(output_step);
   const ResultColumns columns = make_result_columns(model);
   CsvWriter writer(csv, columns.all);
   std::vector<double> row(columns.all.size());
@@ -172,13 +179,7 @@ void run_with_rows(const Model& model, double output_step, const fs::path& csv) 
 // calculations (q'', R, residuals, energy balance, contact forces, outputs) without the CSV text,
 // what nhdyn.simulate in Python and the C++ batches return.
 void run_with_rows_in_memory(const Model& model, double output_step) {
-  SimulationOptions options;
-  options.t_end = 10.0;
-  options.output_step = output_step;
-  options.formulation = {Formulation::sanh, Complement::qr};
-  options.integrator.kind = IntegratorKind::dopri5;
-  options.integrator.rtol = 1e-10;
-  options.integrator.atol = 1e-12;
+  const SimulationOptions options = bicycle_row_options(output_step);
   Trajectory trajectory;
   trajectory.reset(model, static_cast<long>(options.t_end / output_step) + 1);
   const SimulationSummary summary = simulate(model, options, [&](const Data& data) { trajectory.append(data); });
