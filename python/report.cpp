@@ -1,6 +1,7 @@
-// nhdyn._nhdyn.provenance and write_report: a Python run's provenance header (io/provenance.hpp),
-// the same lines `nhdyn simulate` writes into its CSV, and the HTML report of a Python Result
-// (io/report.hpp), the page `nhdyn simulate --html` writes, with that provenance at its top.
+// nhdyn._nhdyn.provenance, write_report and write_file: a Python run's provenance header
+// (io/provenance.hpp), the same lines `nhdyn simulate` writes into its CSV; the HTML report of a
+// Python Result (io/report.hpp), the page `nhdyn simulate --html` writes, with that provenance at
+// its top; and a text written by the command line's rules (io/atomic_file.hpp).
 #include <pybind11/stl.h>
 
 #include <string>
@@ -9,6 +10,7 @@
 #include "bindings.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/frontend/provenance.hpp"
+#include "nhdyn/io/atomic_file.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/io/report.hpp"
 
@@ -61,6 +63,17 @@ void bind_report(py::module_& m) {
       py::arg("max_frames") = ReportOptions{}.max_frames,
       "write_report(source, overrides, names, rows, comments, path, title, extra) -> the page's notice; extra: "
       "(label, value) pairs shown first in the summary");
+  // The tables of Result.to_csv and Optimum.to_csv: whole or not at all, a device or pipe written
+  // straight, a symbolic link written through, a replaced file's mode kept, a full disk a FileError.
+  m.def(
+      "write_file",
+      [](const std::string& path, const std::string& text) {
+        py::gil_scoped_release release;
+        AtomicFile file(path);
+        file.write(text);
+        file.commit();
+      },
+      py::arg("path"), py::arg("text"), "write_file(path, text): text written whole to path, as the CLI writes");
 }
 
 }  // namespace nhdyn::python

@@ -223,18 +223,11 @@ def _output_path(path, what, source=None):
 
 
 def _write_whole(path, text):
-    """Writes `text` to `path` through a temporary file beside it, renamed into place once whole, so
-    that a failure leaves the old file (or none), never half of the new one."""
-    folder = os.path.dirname(os.path.abspath(path))
-    temporary = os.path.join(folder, ".{}.{}.tmp".format(os.path.basename(path), os.getpid()))
-    try:
-        with open(temporary, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(temporary, path)
-    except BaseException:
-        if os.path.exists(temporary):
-            os.remove(temporary)
-        raise
+    """Writes `text` to `path` as the command line writes its outputs (io/atomic_file.hpp): through a
+    temporary file renamed into place once whole, so that a failure leaves the old file (or none);
+    a device or a pipe written straight, a symbolic link written through, a replaced file's mode
+    kept, a full disk a FileError."""
+    _nhdyn.write_file(path, text)
 
 
 def builtin_models():
@@ -674,6 +667,7 @@ class Optimum:
 
     def __init__(self, model, out):
         self.model_name = model.name
+        self._source = model.source  # to_csv never writes over the model file
         self.coordinates = model.coordinates
         self.controls = list(out["controls"])
         self.t, self.q, self.qd, self.qdd, self.u = out["t"], out["q"], out["qd"], out["qdd"], out["u"]
@@ -692,7 +686,7 @@ class Optimum:
 
     def to_csv(self, path):
         """Writes the CSV of `nhdyn optimize -o` to `path`."""
-        path = _output_path(path, "to_csv")
+        path = _output_path(path, "to_csv", self._source)
         lines = [",".join(self.columns) + "\n"]
         lines += [",".join(repr(float(v)) for v in row) + "\n" for row in self.rows]
         _write_whole(path, "".join(lines))

@@ -5,6 +5,7 @@ gives each run its own times and events (the same as one run), and Ctrl-C stops 
 
 import os
 import signal
+import stat
 import subprocess
 import sys
 import textwrap
@@ -251,6 +252,45 @@ def test_outputs_never_replace_the_model_file_and_take_only_paths(tmp_path):
     out = tmp_path / "run.csv"
     r.to_csv(out)
     assert out.read_text().startswith("# nhdyn version")
+    assert [p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")] == []
+
+
+def test_to_csv_writes_by_the_command_lines_rules(examples, tmp_path):
+    # Both to_csv replaced a device, a pipe or a symbolic link by a regular file (as root, /dev/full
+    # itself), reset a replaced file's mode to the umask's, took a full disk silently, and
+    # Optimum.to_csv wrote over its model file.
+    model_path = tmp_path / "double_integrator.toml"
+    model_path.write_text((examples / "double_integrator.toml").read_text())
+    model = nhdyn.load(model_path)
+    optimum = model.optimize()
+    result = nhdyn.load("sled").simulate(t_end=0.5)
+    with pytest.raises(nhdyn.InputError, match="is the model file of this run"):
+        optimum.to_csv(model_path)
+    assert model_path.read_text() == (examples / "double_integrator.toml").read_text()
+    for table in (optimum, result):
+        target = tmp_path / "target.csv"
+        target.write_text("old\n")
+        link = tmp_path / "link.csv"
+        if link.is_symlink():
+            link.unlink()
+        link.symlink_to(target.name)
+        table.to_csv(link)
+        first_line = "t,x,x',x'',u_F" if table is optimum else "# nhdyn version"
+        assert link.is_symlink() and target.read_text().startswith(first_line), "written through the link"
+        private = tmp_path / "private.csv"
+        private.write_text("old\n")
+        private.chmod(0o600)
+        table.to_csv(private)
+        assert private.stat().st_mode & 0o777 == 0o600 and private.read_text() != "old\n"
+        if os.geteuid() == 0:  # device nodes of our own (mknod needs root); CI runs as root
+            null, full = tmp_path / "null", tmp_path / "full"
+            for node, minor in ((null, 3), (full, 7)):
+                if not node.exists():
+                    os.mknod(node, 0o666 | stat.S_IFCHR, os.makedev(1, minor))
+            table.to_csv(null)
+            with pytest.raises(nhdyn.FileError, match="No space left on device"):
+                table.to_csv(full)
+            assert null.is_char_device() and full.is_char_device()
     assert [p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")] == []
 
 
