@@ -600,6 +600,9 @@ constexpr long kLargestExponent = 64;
 // walk of every subtree again at each level, cost a tenth of reading a long kinetic energy.
 struct Measures {
   bool huge_exponent = false;  // a number exponent larger than kLargestExponent in magnitude
+  // 0^x with an exponent that is not a number (GiNaC keeps it as written; (x - x)^y is one): 0
+  // where x > 0, undefined elsewhere, and its derivative 0^x log(0) makes GiNaC throw.
+  bool zero_to_a_variable = false;
   // The number of terms that multiplying out the expression can produce (an upper bound: a sum's
   // terms add, a product's multiply, (t terms)^n gives at most C(n + t - 1, t - 1)); function
   // arguments and the bases of non-integer powers are atoms here and measured on their own.
@@ -616,6 +619,7 @@ Measures measure(const GiNaC::ex& e) {
   const bool integer_power = number_exponent && GiNaC::ex_to<GiNaC::numeric>(e.op(1)).is_integer();
   if (number_exponent && GiNaC::abs(GiNaC::ex_to<GiNaC::numeric>(e.op(1))) > GiNaC::numeric(kLargestExponent))
     out.huge_exponent = true;
+  if (power && !number_exponent && e.op(0).is_zero()) out.zero_to_a_variable = true;
   // The subexpressions whose own expansion counts: those of sums, products, powers and functions.
   const bool inner = sum || product || power || GiNaC::is_a<GiNaC::function>(e);
   double base_terms = 1.0;
@@ -624,6 +628,7 @@ Measures measure(const GiNaC::ex& e) {
   for (std::size_t i = 0; i < e.nops(); ++i) {
     const Measures m = measure(e.op(i));
     out.huge_exponent = out.huge_exponent || m.huge_exponent;
+    out.zero_to_a_variable = out.zero_to_a_variable || m.zero_to_a_variable;
     out.nodes += m.nodes;
     if (inner) largest = std::max(largest, m.largest);
     if (sum) out.terms += m.terms;
@@ -663,6 +668,10 @@ Parsed read(const Spec& spec, const Site& site, std::size_t begin, std::size_t e
     site.fail_whole(fmt::format("an exponent larger than {} in magnitude; nhdyn expands powers symbolically, "
                                 "so rewrite the expression (e.g. with exp and log) or use a smaller power",
                                 kLargestExponent));
+  if (measures.zero_to_a_variable)
+    site.fail_whole("the expression raises 0 to a power that is not a number (0^x, or a base such as x - x that is "
+                    "identically 0): that is 0 where the exponent is positive and undefined where it is not, and has no "
+                    "derivative; write 0, or the base meant");
   const double terms = measures.largest;
   if (terms > kLargestExpansion + 10.0 * static_cast<double>(measures.nodes))
     site.fail_whole(fmt::format("multiplied out, this expression could have about {:.2g} terms (the limit is {:g}): "
