@@ -603,6 +603,41 @@ std::string dropped_ball(double e) {
   return text;
 }
 
+// A unilateral contact whose body starts inside the ground (the dropped ball 1 cm into the floor,
+// given mode = "free" or left to choose) is refused before the run with its gap: free, it fell
+// through the floor with exit 0 (a touchdown is a gap closing from above); on the wrong side of a
+// sphere it was refused for its normal force, whose advice (start it free) then ran the same fall.
+TEST(ContactModes, AUnilateralContactStartingInsideTheGroundIsRefusedWithItsGap) {
+  for (const char* mode : {"", "mode = \"free\"\n"}) {
+    std::string text = dropped_ball(0.5);
+    text.replace(text.find("z = \"r + 0.2\""), 13, "z = \"r - 0.01\"");
+    text.replace(text.find("unilateral = true\n"), 18, std::string("unilateral = true\n") + mode);
+    const Model model = load_model_text(text, "drop.toml");
+    SimulationOptions options;
+    options.t_end = 0.1;
+    try {
+      simulate(model, options, [](const Data&) {});
+      ADD_FAILURE() << "accepted, " << mode;
+    } catch (const ModelError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("drop.toml:"), std::string::npos) << message;
+      EXPECT_NE(message.find("contact 'ball' is unilateral, but at t0 its gap is -0.01 m < 0"), std::string::npos)
+          << message;
+    }
+  }
+  // Started on the far side of the sphere (its gap about minus twice the ball's radius): the gap,
+  // not the normal force.
+  std::string text = test::read_text(example("ball_on_sphere.toml"));
+  ASSERT_NE(text.find("side = \"outside\""), std::string::npos);
+  text.replace(text.find("side = \"outside\""), 16, "side = \"inside\"");
+  try {
+    simulate(load_model_text(text, "sphere.toml"), SimulationOptions{}, [](const Data&) {});
+    ADD_FAILURE() << "accepted";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("its gap is -"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ContactModes, DroppedBallBouncesWithNewtonsLawUntilTheTouchdownsAccumulate) {
   const double g = 9.81, h0 = 0.2, e = 0.5;
   const double t1 = std::sqrt(2 * h0 / g), v1 = std::sqrt(2 * g * h0);

@@ -240,8 +240,15 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
   for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
     const ContactModeContact& c = cm.contacts[i];
     w.mode[i] = starts_free(c, data.phi(c.gap_position)) ? ContactMode::free : ContactMode::rolling;
-    // Free on the ground and moving into it: an impact at t0, which no event would find.
     const double gap = data.phi(c.gap_position), rate = w.velocity_residuals[static_cast<std::size_t>(c.gap_velocity)];
+    // Inside the ground: free, the gap would never close again (no touchdown is a crossing of 0
+    // from above); checked before any normal force, which a body in the ground gets wrong.
+    if (c.unilateral && gap < -1e-9)
+      throw ModelError(fmt::format("{}: contact '{}' is unilateral, but at t0 its gap is {:.6g} m < 0: the body starts "
+                                   "inside the ground (a gap of about minus twice the body's size says it is on the "
+                                   "other side of the surface); start it on the ground (gap 0) or above it",
+                                   c.where, c.name, gap));
+    // Free on the ground and moving into it: an impact at t0, which no event would find.
     if (w.mode[i] == ContactMode::free && gap <= 1e-9 && rate < -slip_floor(data))
       throw ModelError(fmt::format("{}: contact '{}' is given mode = \"free\", but at t0 it touches the ground (gap "
                                    "{:.6g} m) and moves into it ({:.6g} m/s): a free start needs the gap open or "
