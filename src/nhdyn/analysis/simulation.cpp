@@ -37,6 +37,26 @@ std::string non_finite_message(const std::string& kind, const std::string& where
                      where.empty() ? "" : where + ": ", kind, name, expression, text, t, state);
 }
 
+// The first constraint residual of a row that is NaN or infinite (a terrain with a pole, its
+// slope infinite where the contact point reaches it), as non_finite_message words it; "" when all
+// are finite. The residuals are the columns residual_pos_, residual_vel_, residual_acc_ (Data's
+// phi, f and e, in the constraints' order).
+std::string non_finite_residual(const Model& model, const Data& data, double t) {
+  Eigen::Index position = 0, velocity = 0;
+  for (std::size_t i = 0; i < model.constraints.size(); ++i) {
+    const Constraint& c = model.constraints[i];
+    double value = 0.0;
+    const char* level = nullptr;
+    if (c.level == ConstraintLevel::position && !std::isfinite(value = data.phi(position++))) level = "position";
+    else if (c.level != ConstraintLevel::acceleration && !std::isfinite(value = data.f(velocity++))) level = "velocity";
+    else if (!std::isfinite(value = data.e(static_cast<Eigen::Index>(i)))) level = "acceleration";
+    if (level)
+      return non_finite_message(fmt::format("the {} residual of constraint", level), c.where, c.name, c.expression,
+                                value, t, describe_state(model, data.q.data(), data.v.data()));
+  }
+  return "";
+}
+
 // The index of the contact `name` among the contacts with modes (model/contact_modes.hpp), or -1.
 int mode_contact_index(const Model& model, const std::string& name) {
   if (!model.contact_modes) return -1;
@@ -569,6 +589,11 @@ class RowRecorder {
     }
     if (options_.watch_constraints) compute_constraint_watch(model_, data_, watch_);
     compute_residuals(model_, data_);
+    if (std::string bad = non_finite_residual(model_, data_, t); !bad.empty()) {
+      message_ = std::move(bad);
+      failure_ = Status::non_finite;
+      return Status::stopped;
+    }
     record_contact_gaps(model_, data_);  // nothing without contact modes
     compute_energy(model_, data_);
     compute_contact_forces(model_, data_);  // nothing for a model without contacts
