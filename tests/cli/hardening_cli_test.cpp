@@ -760,6 +760,20 @@ TEST_F(Hardening, GinacWordsAreTranslated) {
 
 namespace {
 
+// An ellipsoid one of whose semi-axes is set more than 1e6 times smaller than another is flat to
+// double precision (a = 1e-100 fell through the floor with exit 0): refused with both sizes, from
+// the file or --set; 1.5e5 apart it runs.
+TEST_F(Hardening, ContactShapeSizesFarApartAreRefused) {
+  const std::string model = (fs::path(NHDYN_SOURCE_DIR) / "examples" / "rattleback.toml").string();
+  const ProcessRun thin = nhdyn({"simulate", model, "--set", "a=1e-9", "--t-end", "0.1", "-q", "-o", "r.csv"});
+  EXPECT_EQ(thin.code, 2) << thin.err;
+  EXPECT_TRUE(contains(thin.err, "rattleback.toml:53:") &&
+              contains(thin.err, "its sizes \"a\" = 1e-09 and \"b\" = 0.03 are more than 1e+06 apart"))
+      << thin.err;
+  EXPECT_FALSE(fs::exists(dir_ / "r.csv"));
+  EXPECT_EQ(nhdyn({"simulate", model, "--set", "a=2e-7", "--t-end", "0.1", "-q", "-o", "r.csv"}).code, 0);
+}
+
 // --set m=1e154 or 1e-300 (allowed; the sled's motion does not depend on m) failed as "[D A; b] is
 // singular": the rows D A scale with m, the row b does not. The same motion at every mass.
 TEST_F(Hardening, ExtremeParameterMagnitudesAreNotSingular) {

@@ -233,6 +233,11 @@ def test_a_size_or_mass_set_negative_is_refused_and_the_model_kept(examples):
         nhdyn.simulate_batch(m, parameters={"m": [1.0, -1.0]}, t_end=0.01)
     m.parameters["r"] = 0.04  # a positive one is taken
     assert m.parameters["r"] == 0.04
+    # The semi-axes of an ellipsoid more than 1e6 apart: flat to double precision.
+    rattleback = nhdyn.load(examples / "rattleback.toml")
+    with pytest.raises(nhdyn.InputError, match=r'its sizes "a" = 1e-09 and "b" = 0.03 are more than 1e\+06 apart'):
+        rattleback.parameters["a"] = 1e-9
+    assert rattleback.parameters["a"] == 0.2
 
 
 def test_outputs_never_replace_the_model_file_and_take_only_paths(tmp_path):

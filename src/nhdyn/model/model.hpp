@@ -108,6 +108,9 @@ struct PositiveValue {
   std::string what;   // "contact 'ball': sphere r"
   std::string text;   // as written: "r"
   Tape value;
+  // The sizes of one contact shape share a group ("contact 'foot'"), within which they must stay
+  // within kLargestSizeRatio of each other (model/parameters.hpp); "" for a value on its own.
+  std::string group = {};
 };
 
 struct Model {

@@ -401,15 +401,36 @@ void check_positive_values(const Model& model, const std::vector<Parameter>& par
   std::vector<double> values;
   values.reserve(parameters.size());
   for (const Parameter& p : parameters) values.push_back(p.value);
+  std::vector<double> checked;
   for (const PositiveValue& check : model.positive_values) {
     const Tape tape = check.value.bind(values.data(), values.size());
     std::vector<double> registers(static_cast<std::size_t>(tape.registers()));
     double value = 0.0;
     tape.run(model.t0, model.q0.data(), model.v0.data(), registers.data(), &value);
+    checked.push_back(value);
     if (value > 0.0 && std::isfinite(value)) continue;
     throw InputError(fmt::format("{}{}: \"{}\" must be positive, but it is {:.6g} with the parameters set; give "
                                  "values that keep it positive",
                                  check.where.empty() ? "" : check.where + ": ", check.what, check.text, value));
+  }
+  // The sizes of one shape, in a row of positive_values: the smallest against the largest.
+  for (std::size_t first = 0; first < checked.size();) {
+    const std::string& group = model.positive_values[first].group;
+    std::size_t end = first + 1;
+    while (end < checked.size() && !group.empty() && model.positive_values[end].group == group) ++end;
+    const auto [smallest, largest] = std::minmax_element(checked.begin() + static_cast<std::ptrdiff_t>(first),
+                                                         checked.begin() + static_cast<std::ptrdiff_t>(end));
+    if (*largest > kLargestSizeRatio * *smallest) {
+      const PositiveValue& a = model.positive_values[static_cast<std::size_t>(smallest - checked.begin())];
+      const PositiveValue& b = model.positive_values[static_cast<std::size_t>(largest - checked.begin())];
+      throw InputError(fmt::format(
+          "{}{}: its sizes \"{}\" = {:.6g} and \"{}\" = {:.6g} are more than {:g} apart: to double precision the "
+          "shape is flat (or a needle), where its contact point is not defined; model a flat body as a disk, or give "
+          "sizes within {:g} of each other",
+          a.where.empty() ? "" : a.where + ": ", group, a.text, *smallest, b.text, *largest, kLargestSizeRatio,
+          kLargestSizeRatio));
+    }
+    first = end;
   }
 }
 

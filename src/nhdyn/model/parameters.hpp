@@ -72,7 +72,10 @@ void set_parameter_expression(Model& model, std::string_view name, std::string_v
 void apply_parameter_sets(Model& model, const std::vector<std::string>& sets);
 
 // Throws InputError, naming the file's line, the entry and its text, where one of
-// model.positive_values is not positive at `parameters` (a --set r=-0.1 of a ball's radius).
+// model.positive_values is not positive at `parameters` (a --set r=-0.1 of a ball's radius), or
+// where the sizes of one contact shape are more than kLargestSizeRatio apart (an ellipsoid 1e-100
+// thin: to double precision flat, its contact point undefined across its rim).
+constexpr double kLargestSizeRatio = 1e6;
 void check_positive_values(const Model& model, const std::vector<Parameter>& parameters);
 
 // Re-binds `model`'s evaluator to the values of model.parameters (after re-evaluating the derived

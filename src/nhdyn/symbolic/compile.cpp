@@ -1258,7 +1258,8 @@ void compile_contact_coordinates(const Spec& spec, Model& model) {
                                      w.threshold, w.reason, w.quantity, w.every_step, w.touching_only,
                                      w.free_only, w.entry});
   for (const SpecPositive& v : spec.positive_values)
-    model.positive_values.push_back({v.where.describe(), v.what, v.text, compile_expression(spec, v.value, v.what)});
+    model.positive_values.push_back(
+        {v.where.describe(), v.what, v.text, compile_expression(spec, v.value, v.what), v.group});
 }
 
 }  // namespace
