@@ -46,7 +46,7 @@ build: configure
 
 # The main job needs the CLI only (about half of the whole build).
 run: configure-run
-	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_cli
+	@cmake --build $(BUILD) -j $(JOBS) --target nhdyn_command
 	@mkdir -p results
 	$(BUILD)/apps/nhdyn/nhdyn simulate $(MODEL) -o results/$(NAME).csv --plot results/$(NAME).png
 

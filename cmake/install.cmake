@@ -73,6 +73,15 @@ if(TARGET nhdyn_cli)
   else()
     message(STATUS "help2man not found: no man page (apt-get install help2man, or scripts/install-deps)")
   endif()
+  # What `make run` builds: the command and every file its install takes (the man page, IPOPT's
+  # module), so that `cmake --install` after `make run` finds them all.
+  add_custom_target(nhdyn_command)
+  add_dependencies(nhdyn_command nhdyn_cli)
+  foreach(part nhdyn_man nhdyn_ipopt_solver)
+    if(TARGET ${part})
+      add_dependencies(nhdyn_command ${part})
+    endif()
+  endforeach()
 endif()
 
 # --- The Python package, in the layout of the interpreter it was built for: for the prefix /usr,
