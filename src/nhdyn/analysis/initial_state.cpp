@@ -215,13 +215,17 @@ void fix_keeping_written(const Model& model, Data& data, double t, double tolera
     const char* level_name = level == ConstraintLevel::position ? "position" : "velocity";
     if (worst_row >= 0) {
       const bool alone = std::find(fixed_rows.begin(), fixed_rows.end(), worst_row) != fixed_rows.end();
+      const std::string label = row_label(model, worst_row, level_name);
+      const double value = whole(at[static_cast<std::size_t>(worst_row)]);
       throw ModelError(fmt::format(
-          "model '{}': --fix-initial keeps every value [initial] writes and moves only the others ({} at {} level: "
-          "{}); {} {} keeps the residual {:.6g}, so the values written cannot satisfy it. Correct them, or leave "
-          "out of [initial] a value that --fix-initial may move.",
-          model.name, free.empty() ? "none is free" : "free", level_name, free.empty() ? "none" : join(free_names),
-          alone ? "no free value enters" : fmt::format("moving them ({} Newton steps),", iterations),
-          row_label(model, worst_row, level_name), whole(at[static_cast<std::size_t>(worst_row)])));
+          "model '{}': --fix-initial keeps every value [initial] writes and moves only the others ({}); {}, so the "
+          "values written cannot satisfy it. Correct them, or leave out of [initial] a value that --fix-initial may "
+          "move.",
+          model.name,
+          free.empty() ? fmt::format("none is free at {} level", level_name)
+                       : fmt::format("free at {} level: {}", level_name, join(free_names)),
+          alone ? fmt::format("no free value enters {}, whose residual stays {:.6g}", label, value)
+                : fmt::format("moving them ({} Newton steps), {} keeps the residual {:.6g}", iterations, label, value)));
     }
     (level == ConstraintLevel::position ? fix.position_iterations : fix.velocity_iterations) = iterations;
     (level == ConstraintLevel::position ? fix.position_residual : fix.velocity_residual) =

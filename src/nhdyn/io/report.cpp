@@ -1083,7 +1083,7 @@ std::string make_report_html(const ReportInput& input, const ReportOptions& opti
     note = append_scene_path(data, input, column);
   data += '}';
   if (frames.size() < table.rows.size())
-    note += fmt::format("{}The page shows {} of the run's {} rows (every {}th, and the last); the CSV has them all.",
+    note += fmt::format("{}The page shows {} of the run's {} rows (one row in {}, and the last); the CSV has them all.",
                         note.empty() ? "" : " ", frames.size(), table.rows.size(), frames.size() > 1 ? frames[1] : 1);
   data += ",\"note\":";
   append_string(data, note);
