@@ -583,6 +583,54 @@ TEST_F(OptimizeCli, BadInputExitsTwoNamingWhere) {
   }
 }
 
+// optimize imposes a contact's constraints at every point, rolling and bilateral: a contact that
+// may slide or lift off is refused before any work, at its [[contacts]] entry, rather than
+// optimized under another law than the model's (a ball "rolled" by 21 N where mu m g is 0.01 N).
+TEST_F(OptimizeCli, ContactsThatMaySlideOrLiftOffAreRefusedBeforeAnyWork) {
+  const std::string section = R"toml(
+[optimize]
+controls = [{ name = "F", actuator = "x" }]
+objective = "F^2"
+t_end = 0.2
+nodes = 5
+initial = { position = { x = 0, y = 0, z = "r", a = 0, b = 0, c = 0 }, velocity = { x = 0, y = 0, z = 0, a = 0, b = 0, c = 0 } }
+final = { position = { x = 1 }, velocity = { x = 0 } }
+)toml";
+  const std::string base = read_example("ball_thrown_sliding.toml") + section;
+  const auto variant = [&](const std::string& file, const std::string& keys) {
+    std::string text = base;
+    const std::string from = "friction = \"mu\"\nmode = \"sliding\"\n";
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos);
+    text.replace(at, from.size(), keys);
+    write(file, text);
+  };
+  variant("unilateral.toml", "friction = \"mu\"\nunilateral = true\n");
+  variant("sliding.toml", "friction = \"mu\"\nmode = \"sliding\"\n");
+  variant("rolling.toml", "");
+  for (const auto& [file, keys] : {std::pair<std::string, std::string>{"unilateral", "friction and unilateral"},
+                                   {"sliding", "friction and mode"}}) {
+    const Outcome run = run_nhdyn("optimize " + file + ".toml --set mu=0.01 -o out.csv --html out.html", dir_);
+    EXPECT_EQ(run.exit_code, 2) << run.out;
+    EXPECT_NE(run.out.find(file + ".toml:37"), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("contact 'ball' has " + keys + ": optimize takes contacts as rolling, bilateral "
+                           "constraints"),
+              std::string::npos)
+        << run.out;
+    EXPECT_NE(run.out.find("remove friction, unilateral, restitution and mode from the contact"), std::string::npos)
+        << run.out;
+    EXPECT_EQ(run.out.find("status:"), std::string::npos) << run.out;  // no solve
+    EXPECT_FALSE(fs::exists(dir_ / "out.csv"));
+    EXPECT_FALSE(fs::exists(dir_ / "out.partial.csv"));
+    EXPECT_FALSE(fs::exists(dir_ / "out.html"));
+  }
+  // The same ball without the keys rolls, and is optimized as such.
+  const Outcome rolling = optimize("rolling.toml -o rolling.csv");
+  SKIP_WITHOUT_IPOPT(rolling);
+  EXPECT_EQ(rolling.exit_code, 0) << rolling.out;
+  EXPECT_NE(rolling.out.find("status: solved"), std::string::npos) << rolling.out;
+}
+
 // IPOPT is a module loaded when a program is first solved (src/nhdyn/optimize/ipopt/solver_module.cpp):
 // the dynamic loader's own account (LD_DEBUG=files lists every object it opens) shows that a
 // simulation opens none of IPOPT's libraries and that `optimize` does.

@@ -20,6 +20,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/core/detail/suggest.hpp"
+#include "nhdyn/model/contact_modes.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
 
@@ -71,6 +72,7 @@ class SectionReader {
     if (model_.m() > 0)
       fail(*node, "the model has [[programs]]; optimize finds the program itself: leave the [[programs]] out of "
                   "this model file");
+    require_rolling_contacts();
     read_controls(*section, p);
     declare_layout();
     read_method(*section, p);
@@ -115,6 +117,25 @@ class SectionReader {
       const std::string nearest = nearest_name(name, keys);
       fail(value, fmt::format("unknown key '{}' {}; {}the keys are: {}", name, where,
                               nearest.empty() ? "" : fmt::format("did you mean '{}'? ", nearest), join(keys)));
+    }
+  }
+
+  // The transcription imposes every contact's constraints at every point, as rolling and
+  // bilateral; a contact that may slide or lift off (friction, unilateral, restitution, mode:
+  // docs/contact-modes.md) would be optimized under another law than the model's, silently.
+  void require_rolling_contacts() const {
+    if (!model_.contact_modes) return;
+    for (const ContactModeContact& c : model_.contact_modes->contacts) {
+      std::vector<std::string> keys;
+      if (c.friction) keys.emplace_back("friction");
+      if (c.unilateral) keys.emplace_back("unilateral");
+      if (c.initial >= 0) keys.emplace_back("mode");
+      throw InputError(fmt::format(
+          "{}{}contact '{}' has {}: optimize takes contacts as rolling, bilateral constraints (it cannot let one "
+          "slide, lift off or bounce), so it would optimize another motion than the model's; for an optimization, "
+          "remove friction, unilateral, restitution and mode from the contact (docs/optimize.md)",
+          c.where, c.where.empty() ? "" : ": ", c.name,
+          keys.empty() ? std::string("contact-mode keys") : join(keys, " and ")));
     }
   }
 
