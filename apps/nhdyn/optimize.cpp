@@ -79,11 +79,19 @@ void write_plot_of(const OptimalControlProblem& problem, const fs::path& csv, co
 // outputs from the model's kernels at each point; the energy balance with the controls' work
 // booked with the forces (as for program motion) and the works by the trapezoidal rule over the
 // points, so that its error column shows the quadrature's error.
+// The report's columns are a simulation's without contact forces or programs (optimum_table):
+// --html on another model is refused before any work, so that the refusal costs no solve and
+// leaves no file.
+void require_optimum_report(const Model& model) {
+  if (!make_result_columns(model).contact_forces.empty() || model.m() > 0)
+    throw InputError(fmt::format("--html: the report of an optimum is for models without contacts and [[programs]], "
+                                 "and {} has {}; leave --html out (-o and --plot take this model)",
+                                 model.name, model.m() > 0 ? "[[programs]]" : "contacts"));
+}
+
 CsvTable optimum_table(const OptimalControlProblem& problem, const OptimizeResult& result) {
   const Model& model = problem.model;
   const ResultColumns columns = make_result_columns(model);
-  if (!columns.contact_forces.empty() || model.m() > 0)
-    throw InputError("--html: the report of an optimum is for models without contacts and [[programs]]");
   const int n = model.n(), m = problem.m();
   Data data = make_data(model);
   std::vector<double> registers(static_cast<std::size_t>(problem.force.registers())), layout_q(static_cast<std::size_t>(n + m)),
@@ -158,6 +166,8 @@ int run_optimize(const OptimizeArgs& args) {
   if (!args.html.empty() && args.output.empty())
     throw InputError("--html reports the CSV of -o: give -o FILE.csv too");
   if (!args.plot.empty() && args.output.empty()) throw InputError("--plot draws the CSV of -o: give -o FILE.csv too");
+  const OptimalControlProblem problem = load_optimal_control_problem(source, loaded);
+  if (!args.html.empty()) require_optimum_report(problem.model);
   // Every file of the command, checked together before the solve (run_files.hpp); their folders
   // are made, and -o opened, so that an unwritable path never costs a solve.
   files.output(args.output, "-o", Folder::make);
@@ -166,7 +176,6 @@ int run_optimize(const OptimizeArgs& args) {
   files.page(args.html, "--html", Folder::make);
   files.check();
   AtomicFile* csv = args.output.empty() ? nullptr : &files.open(args.output);
-  const OptimalControlProblem problem = load_optimal_control_problem(source, loaded);
   OptimizeOptions options;
   options.nlp.tolerance = args.tolerance;
   options.nlp.constraint_tolerance = args.tolerance;

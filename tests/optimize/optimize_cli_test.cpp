@@ -631,6 +631,33 @@ final = { position = { x = 1 }, velocity = { x = 0 } }
   EXPECT_NE(rolling.out.find("status: solved"), std::string::npos) << rolling.out;
 }
 
+// --html takes models without contacts: the refusal comes before the solve and writes nothing
+// (it came after the whole solve, and left -o's CSV behind with exit 2).
+TEST_F(OptimizeCli, HtmlOnAContactModelIsRefusedBeforeAnyWork) {
+  std::string text = read_example("ball_thrown_sliding.toml");
+  const std::string from = "friction = \"mu\"\nmode = \"sliding\"\n";
+  const std::size_t at = text.find(from);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, from.size(), "");  // a rolling, bilateral contact: optimize takes it
+  write("rolling.toml", text + R"toml(
+[optimize]
+controls = [{ name = "F", actuator = "x" }]
+objective = "F^2"
+t_end = 0.2
+nodes = 5
+initial = { position = { x = 0, y = 0, z = "r", a = 0, b = 0, c = 0 }, velocity = { x = 0, y = 0, z = 0, a = 0, b = 0, c = 0 } }
+final = { position = { x = 1 }, velocity = { x = 0 } }
+)toml");
+  const Outcome run = run_nhdyn("optimize rolling.toml -o out/x.csv --plot out/x.png --html out/x.html", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("--html: the report of an optimum is for models without contacts and [[programs]], and "
+                         "ball-thrown-sliding has contacts; leave --html out"),
+            std::string::npos)
+      << run.out;
+  EXPECT_EQ(run.out.find("status:"), std::string::npos) << run.out;  // no solve
+  EXPECT_FALSE(fs::exists(dir_ / "out")) << run.out;                   // nothing written, no folder made
+}
+
 // IPOPT is a module loaded when a program is first solved (src/nhdyn/optimize/ipopt/solver_module.cpp):
 // the dynamic loader's own account (LD_DEBUG=files lists every object it opens) shows that a
 // simulation opens none of IPOPT's libraries and that `optimize` does.
