@@ -169,7 +169,13 @@ int run_optimize(const OptimizeArgs& args) {
   const OptimalControlProblem problem = load_optimal_control_problem(source, loaded);
   if (!args.html.empty()) require_optimum_report(problem.model);
   // Every file of the command, checked together before the solve (run_files.hpp); their folders
-  // are made, and -o opened, so that an unwritable path never costs a solve.
+  // are made, and -o opened, so that an unwritable path never costs a solve. The first guess is
+  // an input: no output may replace it (a failed solve's FILE.partial.csv given back as --guess
+  // included).
+  if (!args.guess.empty())
+    files.input(args.guess, "--guess");
+  else
+    files.input(problem.guess, "the first guess (guess = in [optimize])");
   files.output(args.output, "-o", Folder::make);
   if (!args.output.empty()) files.output(partial_path(args.output), "the partial-results file", Folder::make);
   files.plot(args.plot, "--plot", Folder::make);

@@ -658,6 +658,49 @@ final = { position = { x = 1 }, velocity = { x = 0 } }
   EXPECT_FALSE(fs::exists(dir_ / "out")) << run.out;                   // nothing written, no folder made
 }
 
+// A first guess is an input of the run (docs/cli.md, "One rule for the files of a command"):
+// neither -o, --plot, --html nor a failed solve's FILE.partial.csv may replace it, whether it
+// comes from --guess or from guess = in [optimize]; refused before any work, naming both.
+TEST_F(OptimizeCli, TheFirstGuessIsAnInputThatNoOutputReplaces) {
+  const std::string guess = "t,x,x'\n0,0,0\n2,1,0\n";
+  write("g.csv", guess);
+  write("h.partial.csv", guess);
+  const auto unchanged = [&](const std::string& file) {
+    std::ifstream in(dir_ / file);
+    std::stringstream s;
+    s << in.rdbuf();
+    EXPECT_EQ(s.str(), guess) << file;
+  };
+  const std::string di = example("double_integrator.toml");
+  for (const auto& [args, role] :
+       {std::pair<std::string, std::string>{"--guess g.csv -o g.csv", "-o 'g.csv'"},
+        {"--guess h.partial.csv -o h.csv", "the partial-results file 'h.partial.csv'"},
+        {"--guess g.csv -o x.csv --html g.csv", "--html 'g.csv'"}}) {
+    const Outcome run = run_nhdyn("optimize " + di + " " + args, dir_);
+    EXPECT_EQ(run.exit_code, 2) << args << "\n" << run.out;
+    EXPECT_NE(run.out.find("refusing to write " + role + ": it is --guess"), std::string::npos) << run.out;
+    EXPECT_EQ(run.out.find("status:"), std::string::npos) << run.out;
+    unchanged("g.csv");
+    unchanged("h.partial.csv");
+    EXPECT_FALSE(fs::exists(dir_ / "x.csv"));
+    EXPECT_FALSE(fs::exists(dir_ / "h.csv"));
+  }
+  // guess = in the file, given back as the partial-results file of -o.
+  write_variant("double_integrator.toml", "di.toml", {{"final =", "guess = \"h.partial.csv\"\nfinal ="}});
+  const Outcome named = run_nhdyn("optimize di.toml -o h.csv", dir_);
+  EXPECT_EQ(named.exit_code, 2) << named.out;
+  EXPECT_NE(named.out.find("refusing to write the partial-results file 'h.partial.csv': it is the first guess "
+                           "(guess = in [optimize])"),
+            std::string::npos)
+      << named.out;
+  unchanged("h.partial.csv");
+  // Outputs that are not the guess are taken.
+  const Outcome other = optimize(di + " --guess h.partial.csv -o other.csv");
+  SKIP_WITHOUT_IPOPT(other);
+  EXPECT_EQ(other.exit_code, 0) << other.out;
+  unchanged("h.partial.csv");
+}
+
 // IPOPT is a module loaded when a program is first solved (src/nhdyn/optimize/ipopt/solver_module.cpp):
 // the dynamic loader's own account (LD_DEBUG=files lists every object it opens) shows that a
 // simulation opens none of IPOPT's libraries and that `optimize` does.
