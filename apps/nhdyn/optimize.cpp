@@ -151,7 +151,7 @@ std::string write_optimum_report(const OptimizeArgs& args, const LoadedModel& lo
       problem.model, loaded.description.get(), optimum_table(problem, result),
       fmt::format("{}: optimal program, {} nodes, {}", problem.model.name, problem.nodes,
                   collocation_method_name(problem.method)),
-      {{"status", fmt::format("{} ({})", nlp_status_name(result.solver.status), result.solver.message)},
+      {{"status", fmt::format("{} ({})", optimize_status_name(result), result.solver.message)},
        {"iterations", fmt::format("{}", result.solver.iterations)},
        {"objective", fmt::format("{:.10g}", result.objective)},
        {"replay difference", result.replayed ? fmt::format("{:.3e}", result.replay_difference) : "none"},
@@ -193,17 +193,26 @@ int run_optimize(const OptimizeArgs& args) {
   if (result.solver.status == NlpStatus::unavailable) throw InputError(result.solver.message);
   fmt::print("{}", format_optimize_summary(problem, result));
   const std::string table = format_table(optimize_columns(problem), optimize_rows(problem, result));
-  if (!result.converged()) {
+  if (!result.solved()) {
+    // -o is left as it was; the last iterate (or the discrete optimum the replay rejects) goes
+    // beside it.
     if (csv) {
-      // -o is left as it was; the last iterate goes beside it.
       files.write_now(partial_path(args.output),
-                      fmt::format("# nhdyn optimize: IPOPT stopped ({}: {}); the last iterate\n",
-                                  nlp_status_name(result.solver.status), result.solver.message) +
+                      (result.replay_rejected
+                           ? fmt::format("# nhdyn optimize: not a motion of the model (replay difference {:.3e}, limit "
+                                         "{:.3e}); the discrete optimum\n",
+                                         result.replay_difference, result.replay_limit)
+                           : fmt::format("# nhdyn optimize: IPOPT stopped ({}: {}); the last iterate\n",
+                                         nlp_status_name(result.solver.status), result.solver.message)) +
                           table);
-      fmt::print("last iterate -> {}\n", partial_path(args.output).string());
+      fmt::print("{} -> {}\n", result.replay_rejected ? "discrete optimum" : "last iterate",
+                 partial_path(args.output).string());
     }
-    fmt::print(stderr, "nhdyn: error: IPOPT did not converge: {} ({})\n", nlp_status_name(result.solver.status),
-               result.solver.message);
+    if (result.replay_rejected)
+      fmt::print(stderr, "nhdyn: error: {}\n", result.replay_verdict);
+    else
+      fmt::print(stderr, "nhdyn: error: IPOPT did not converge: {} ({})\n", nlp_status_name(result.solver.status),
+                 result.solver.message);
     return 1;
   }
   if (csv) csv->write(table);

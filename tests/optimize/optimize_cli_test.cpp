@@ -701,6 +701,51 @@ TEST_F(OptimizeCli, TheFirstGuessIsAnInputThatNoOutputReplaces) {
   unchanged("h.partial.csv");
 }
 
+// The replay rule (docs/optimize.md): a result IPOPT calls solved whose replay difference exceeds
+// a tenth of the largest range of a coordinate over it is no motion of the model: exit 1, the
+// discrete optimum in FILE.partial.csv, no FILE.csv, and the reason with what to do.
+TEST_F(OptimizeCli, AnOptimumTheReplayDoesNotConfirmIsNotCalledSolved) {
+  const auto rejected = [&](const Outcome& run, const std::string& stem) {
+    EXPECT_EQ(run.exit_code, 1) << run.out;
+    EXPECT_NE(run.out.find("status: not a motion of the model (IPOPT: "), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("IPOPT solved the discrete problem, but its optimum is not a motion of the model"),
+              std::string::npos)
+        << run.out;
+    EXPECT_NE(run.out.find("give more nodes, a tighter --tolerance or a first guess"), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("discrete optimum -> " + stem + ".partial.csv"), std::string::npos) << run.out;
+    EXPECT_FALSE(fs::exists(dir_ / (stem + ".csv")));
+    std::ifstream in(dir_ / (stem + ".partial.csv"));
+    std::string first;
+    std::getline(in, first);
+    EXPECT_EQ(first.rfind("# nhdyn optimize: not a motion of the model (replay difference ", 0), 0U) << first;
+    EXPECT_GT(summary_value(run.out, "replay difference"), 0.1);
+  };
+  // x'' = x F / m from rest at x = 0: x stays 0 whatever F, so x = 1 is out of reach; the discrete
+  // problem "reached" it by a jump in the last interval (replay difference 1 for a range of 1).
+  write_variant("double_integrator.toml", "stuck.toml", {{"actuator = \"x\"", "actuator = [\"x\"]"}});
+  const Outcome stuck = optimize("stuck.toml -o stuck.csv");
+  SKIP_WITHOUT_IPOPT(stuck);
+  rejected(stuck, "stuck");
+  EXPECT_NE(stuck.out.find("the problem may have no solution (an actuator that cannot move the system"),
+            std::string::npos)
+      << stuck.out;
+  // Parking at 3 nodes: 3.6 m off for a 2 m manoeuvre.
+  rejected(optimize(example("parking.toml") + " --set node_count=3 -o park.csv"), "park");
+  // A free final time over [1e-9, 1e9]: IPOPT's "acceptable" at t_end = 5e8 s for the bead that
+  // reaches its end point in 0.806 s.
+  write_variant("brachistochrone.toml", "wide.toml", {{"t_end = { free = [0.1, 5] }", "t_end = { free = [1e-9, 1e9] }"}});
+  rejected(optimize("wide.toml -o wide.csv"), "wide");
+  // The shipped examples stay far inside the limit (the double integrator, exact, and the
+  // brachistochrone here; the others in their own tests).
+  for (const char* name : {"double_integrator.toml", "brachistochrone.toml"}) {
+    const Outcome run = optimize(example(name) + " -o ok.csv");
+    EXPECT_EQ(run.exit_code, 0) << run.out;
+    const std::size_t at = run.out.find("; limit ");
+    ASSERT_NE(at, std::string::npos) << run.out;
+    EXPECT_LT(summary_value(run.out, "replay difference"), 1e-3 * std::stod(run.out.substr(at + 8))) << run.out;
+  }
+}
+
 // IPOPT is a module loaded when a program is first solved (src/nhdyn/optimize/ipopt/solver_module.cpp):
 // the dynamic loader's own account (LD_DEBUG=files lists every object it opens) shows that a
 // simulation opens none of IPOPT's libraries and that `optimize` does.

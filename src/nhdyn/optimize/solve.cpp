@@ -88,7 +88,42 @@ void check_nlp_options(const NlpOptions& options) {
                                  options.max_iterations));
 }
 
+// The replay rule (solve.hpp, docs/optimize.md): the discretized optimum replayed by the
+// simulator must stay within a tenth of the motion's own size. Beyond that the controls do not
+// produce the motion IPOPT found: a grid too coarse for it (parking at 3 nodes: 3.6 m off for a
+// 2 m manoeuvre), or a problem with no solution whose discrete equations have one (an actuator
+// x F on a mass at rest at x = 0, which never moves, "reached" x = 1 by a jump in the last
+// interval), or a free final time run off to its bound.
+void apply_replay_rule(OptimizeResult& result, int n) {
+  double largest = 0.0;
+  for (int i = 0; i < n; ++i) {
+    double lo = kNoBound, hi = -kNoBound;
+    for (int p = 0; p < result.points; ++p) {
+      const double q = result.q[static_cast<std::size_t>(p * n + i)];
+      lo = std::min(lo, q);
+      hi = std::max(hi, q);
+      largest = std::max(largest, std::abs(q));
+    }
+    if (result.points > 0) result.motion_range = std::max(result.motion_range, hi - lo);
+  }
+  result.replay_limit = std::max(kReplayShare * result.motion_range, kReplayFloor * (1.0 + largest));
+  if (!result.converged() || !result.replayed || result.replay_difference <= result.replay_limit) return;
+  result.replay_rejected = true;
+  result.replay_verdict = fmt::format(
+      "IPOPT solved the discrete problem, but its optimum is not a motion of the model: the controls, replayed "
+      "by the simulator, move the coordinates {:.3e} away from it, against a largest range of a coordinate of "
+      "{:.3e} over the motion (the limit is a tenth of it, {:.3e}; docs/optimize.md). The grid may be too coarse "
+      "for the motion: give more nodes, a tighter --tolerance or a first guess (--guess FILE.csv). Or the problem "
+      "may have no solution (an actuator that cannot move the system, a final state out of reach, a free final "
+      "time run off to its bound) whose discrete form has one",
+      result.replay_difference, result.motion_range, result.replay_limit);
+}
+
 }  // namespace
+
+const char* optimize_status_name(const OptimizeResult& result) {
+  return result.replay_rejected ? "not a motion of the model" : nlp_status_name(result.solver.status);
+}
 
 OptimizeResult solve_optimal_control(const OptimalControlProblem& problem, const OptimizeOptions& options) {
   check_nlp_options(options.nlp);
@@ -126,6 +161,7 @@ OptimizeResult solve_optimal_control(const OptimalControlProblem& problem, const
   result.replayed = replay.ok;
   result.replay_difference = replay.difference;
   result.replay_message = replay.message;
+  apply_replay_rule(result, n);
   if (!result.converged() && guess.empty())
     result.notes.push_back("IPOPT did not converge from the straight line between the boundary states, which can be a "
                            "stationary point of the constraints' violation (as for the Brockett integrator): give a "
@@ -160,15 +196,17 @@ std::string format_optimize_summary(const OptimalControlProblem& problem, const 
   std::string out = fmt::format("nhdyn optimize {}: {} nodes, {}, controls {}, objective {}\n", problem.model.name,
                                 problem.nodes, collocation_method_name(problem.method), controls,
                                 problem.minimum_time ? "time" : "\"" + problem.objective_text + "\"");
-  out += fmt::format("status: {} ({})\n", nlp_status_name(result.solver.status), result.solver.message);
+  out += fmt::format("status: {} ({}{})\n", optimize_status_name(result), result.replay_rejected ? "IPOPT: " : "",
+                     result.solver.message);
   if (result.solver.status == NlpStatus::unavailable) return out;
   out += fmt::format("iterations: {}\n", result.solver.iterations);
   out += fmt::format("objective: {:.10g}\n", result.objective);
   if (problem.free_time) out += fmt::format("t_end: {:.10g}\n", result.t_end);
   out += fmt::format("constraint violation: {:.3e}\n", result.constraint_violation);
   if (result.replayed)
-    out += fmt::format("replay difference: {:.3e} (largest |q - q_replayed| at the nodes; dop853, rtol 1e-11)\n",
-                       result.replay_difference);
+    out += fmt::format("replay difference: {:.3e} (largest |q - q_replayed| at the nodes; dop853, rtol 1e-11; "
+                       "limit {:.3e})\n",
+                       result.replay_difference, result.replay_limit);
   else
     out += fmt::format("replay difference: none ({})\n", result.replay_message);
   for (const std::string& note : result.notes) out += "note: " + note + "\n";
