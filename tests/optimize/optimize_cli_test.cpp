@@ -516,6 +516,46 @@ final = { position = { x = 1, y = 0.1, theta = 0.2 }, velocity = { x = 0, y = 0,
   EXPECT_GT(std::abs(t.column("y'").back()), 0.0);  // left free: the drift, not pinned
 }
 
+// A final value the constraints determine is released only when it agrees with them: x - y = 0
+// with x = 1, y = 0 at t_end is a contradiction, refused before any work with the constraint and
+// its residual (released, x met 0 with exit 0 and a note that said it met its value).
+TEST_F(OptimizeCli, FinalValuesThatContradictTheConstraintsAreRefused) {
+  const std::string model = R"toml(name = "pair"
+coordinates = ["x", "y", "z"]
+kinetic_energy = "m/2 * (x'^2 + y'^2 + z'^2)"
+[parameters]
+m = 1.0
+[[constraints]]
+name = "c1"
+position = "x - y"
+[optimize]
+controls = [{ name = "Fx", actuator = "x" }, { name = "Fy", actuator = "y" }]
+objective = "Fx^2 + Fy^2"
+t_end = 1
+nodes = 9
+initial = { position = { x = 0, y = 0, z = 0 }, velocity = { x = 0, y = 0, z = 0 } }
+)toml";
+  write("contradict.toml", model + "final = { position = { x = 1, y = 0 } }\n");
+  const Outcome run = run_nhdyn("optimize contradict.toml -o c.csv", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("the final values of [optimize] violate the constraint c1 (position): with x = 1, y = 0 its "
+                         "residual at t_end is 1.000e+00, and no free final value can change it"),
+            std::string::npos)
+      << run.out;
+  EXPECT_EQ(run.out.find("status:"), std::string::npos) << run.out;
+  EXPECT_FALSE(fs::exists(dir_ / "c.csv"));
+  EXPECT_FALSE(fs::exists(dir_ / "c.partial.csv"));
+  // Values on the constraint: one of them released, both met.
+  write("agree.toml", model + "final = { position = { x = 1, y = 1 } }\n");
+  const Outcome agree = optimize("agree.toml -o a.csv");
+  SKIP_WITHOUT_IPOPT(agree);
+  ASSERT_EQ(agree.exit_code, 0) << agree.out;
+  EXPECT_NE(agree.out.find("is determined by the constraints (c1)"), std::string::npos) << agree.out;
+  const Table t = read_csv(dir_ / "a.csv");
+  EXPECT_NEAR(t.column("x").back(), 1.0, 1e-8);
+  EXPECT_NEAR(t.column("y").back(), 1.0, 1e-8);
+}
+
 TEST_F(OptimizeCli, InfeasibleProblemIsSaidPlainlyAndItsLastIterateKept) {
   // |F| <= 0.1 moves the mass at most 0.1 T^2/4 = 0.1 from rest to rest in T = 2, not d = 1.
   write_variant("double_integrator.toml", "weak.toml", {{"final =", "bounds = { F = [-0.1, 0.1] }\nfinal ="}});

@@ -321,6 +321,7 @@ void Transcription::release_determined_final_values() {
   }
   if (Z.cols() == 0) return;
   const Eigen::MatrixXd relations = Z.transpose() * Cfixed;  // relations among the fixed final values
+  require_final_values_agree(Z, relations, values, fixed_columns);
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(relations);
   const double tol = 1e-9 * std::max(1.0, relations.cwiseAbs().maxCoeff());
   int count = 0;
@@ -338,6 +339,45 @@ void Transcription::release_determined_final_values() {
     notes_.push_back(fmt::format("the final {} is determined by the constraints ({}) with the other final values: "
                                  "left free, it meets its value up to the discretization's drift",
                                  name, join(names)));
+  }
+}
+
+// Before a determined final value is released, the relation must hold with the values the user
+// gave: a released value is then met up to the drift. One that does not hold is a contradiction
+// (x - y = 0 with x = 1, y = 0 at t_end), which releasing would hide: the result met another
+// value than the one asked, with exit 0. Refused as the initial values are (the residual beyond
+// round-off of the values, 1e-8 (1 + largest |value|)).
+void Transcription::require_final_values_agree(const Eigen::MatrixXd& Z, const Eigen::MatrixXd& relations,
+                                               const std::vector<double>& residuals,
+                                               const std::vector<int>& fixed_columns) const {
+  const Model& model = problem_.model;
+  std::vector<std::string> rows;  // the names of the residuals' rows, as choose_splits_and_initial_rows gives them
+  for (const Constraint& c : model.constraints)
+    if (c.level == ConstraintLevel::position) rows.push_back(c.name + " (position)");
+  for (const Constraint& c : model.constraints)
+    if (c.level != ConstraintLevel::acceleration) rows.push_back(c.name + " (velocity)");
+  double largest = 0.0;
+  for (const BoundaryValue& b : problem_.final) largest = std::max(largest, std::abs(b.value));
+  const Eigen::Map<const Eigen::VectorXd> r(residuals.data(), static_cast<Eigen::Index>(residuals.size()));
+  for (Eigen::Index k = 0; k < Z.cols(); ++k) {
+    const double residual = Z.col(k).dot(r);
+    if (std::abs(residual) <= 1e-8 * (1.0 + largest)) continue;
+    std::vector<std::string> names, values;
+    for (Eigen::Index i = 0; i < Z.rows(); ++i)
+      if (std::abs(Z(i, k)) > 1e-6) names.push_back(rows[static_cast<std::size_t>(i)]);
+    const double scale = relations.row(k).cwiseAbs().maxCoeff();
+    for (std::size_t c = 0; c < fixed_columns.size(); ++c) {
+      if (scale > 0.0 && std::abs(relations(k, static_cast<Eigen::Index>(c))) <= 1e-9 * scale) continue;
+      const int column = fixed_columns[c];
+      for (const BoundaryValue& b : problem_.final)
+        if (b.index + (b.velocity ? n_ : 0) == column)
+          values.push_back(fmt::format("{}{} = {}", model.coordinates[static_cast<std::size_t>(b.index)],
+                                       b.velocity ? "'" : "", b.value));
+    }
+    throw InputError(fmt::format(
+        "the final values of [optimize] violate the constraint{} {}: with {} its residual at t_end is {:.3e}, and no "
+        "free final value can change it; give final values on the constraint, or leave one of them out of final",
+        names.size() > 1 ? "s" : "", join(names, " and "), join(values), residual));
   }
 }
 

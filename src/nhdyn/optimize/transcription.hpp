@@ -32,8 +32,9 @@ namespace nhdyn {
 class Transcription final : public Nlp {
  public:
   // Throws InputError when the model is compiled sparse, when a control's force is absorbed by the
-  // constraints (D B_j = 0 at the start), when fixed boundary values lie outside the bounds, when the fixed initial values violate a constraint (naming it and its residual),
-  // or when the constraints are dependent at the starting point.
+  // constraints (D B_j = 0 at the start), when fixed boundary values lie outside the bounds, when
+  // the fixed initial values violate a constraint or the fixed final values contradict one (naming
+  // it and its residual), or when the constraints are dependent at the starting point.
   explicit Transcription(const OptimalControlProblem& problem);
 
   const OptimalControlProblem& problem() const { return problem_; }
@@ -93,6 +94,10 @@ class Transcription final : public Nlp {
   void make_start();
   void check_controls_act();
   void release_determined_final_values();
+  // Throws InputError when a relation among the fixed final values (a column of Z, the
+  // combinations of the constraint rows that no free final value enters) does not hold with them.
+  void require_final_values_agree(const Eigen::MatrixXd& Z, const Eigen::MatrixXd& relations,
+                                  const std::vector<double>& residuals, const std::vector<int>& fixed_columns) const;
   // The terms, B u, the split's factorization and r at point p of x (fills the work arrays).
   bool evaluate_point(int p, const double* x);
   // The dynamics rows of the point last evaluated into `out` (n values).
