@@ -786,6 +786,44 @@ TEST_F(OptimizeCli, AnOptimumTheReplayDoesNotConfirmIsNotCalledSolved) {
   }
 }
 
+// A guess is read as a table of finite numbers over [t0, t_end], times never decreasing, each
+// column once: anything else is refused before any work by file, row and column (NaN reached IPOPT
+// as "Invalid number", unsorted or outside times were interpolated as they fell); columns that
+// name nothing in the problem, and a guess covering part of [t0, t_end], are named in a note.
+TEST_F(OptimizeCli, AGuessThatIsNotATableOfTheMotionIsRefusedByRowAndColumn) {
+  const std::string di = example("double_integrator.toml");
+  const auto refused = [&](const std::string& csv, const std::string& message) {
+    write("g.csv", csv);
+    const Outcome run = run_nhdyn("optimize " + di + " --guess g.csv -o o.csv", dir_);
+    EXPECT_EQ(run.exit_code, 2) << csv << "\n" << run.out;
+    EXPECT_NE(run.out.find("g.csv: " + message), std::string::npos) << csv << "\n" << run.out;
+    EXPECT_EQ(run.out.find("status:"), std::string::npos) << run.out;
+    EXPECT_FALSE(fs::exists(dir_ / "o.csv"));
+    EXPECT_FALSE(fs::exists(dir_ / "o.partial.csv"));
+  };
+  refused("t,x,x'\n0,0,0\n1,nan,0\n2,1,0\n", "row 2: x = nan is not finite");
+  refused("t,x,x'\n0,0,0\n1,0.5,inf\n2,1,0\n", "row 2: x' = inf is not finite");
+  refused("t,x,x'\n0,0,0\n2,1,0\n1,0.5,0\n", "row 3: t = 1 is before the row above (t = 2)");
+  refused("t,x,x'\n5,0,0\n7,1,0\n", "the guess covers t = 5 to 7, outside the problem's [0, 2]");
+  refused("t,x,x'\n1,0,0\n1,1,0\n", "the guess's times span nothing (every row at t = 1)");
+  refused("t,x,x',x\n0,0,0,0\n2,1,0,1\n", "the guess names the column 'x' twice (columns 2 and 4)");
+  // Taken, with what it does not use and what it does not cover named.
+  write("g.csv", "t,x,x',u_G,speed\n0,0,0,1,0\n1.5,1,0,1,0\n");
+  const Outcome taken = optimize(di + " --guess g.csv -o o.csv");
+  SKIP_WITHOUT_IPOPT(taken);
+  EXPECT_EQ(taken.exit_code, 0) << taken.out;
+  EXPECT_NE(taken.out.find("note: the guess g.csv has columns that name nothing in the problem, ignored: u_G, speed"),
+            std::string::npos)
+      << taken.out;
+  EXPECT_NE(taken.out.find("note: the guess g.csv covers t = 0 to 1.5 of [0, 2]: its last row is held beyond"),
+            std::string::npos)
+      << taken.out;
+  // A previous result, which covers [t0, t_end] with the problem's columns, gets neither note.
+  const Outcome again = optimize(di + " --guess o.csv -o o2.csv");
+  EXPECT_EQ(again.exit_code, 0) << again.out;
+  EXPECT_EQ(again.out.find("note: the guess"), std::string::npos) << again.out;
+}
+
 // IPOPT is a module loaded when a program is first solved (src/nhdyn/optimize/ipopt/solver_module.cpp):
 // the dynamic loader's own account (LD_DEBUG=files lists every object it opens) shows that a
 // simulation opens none of IPOPT's libraries and that `optimize` does.
