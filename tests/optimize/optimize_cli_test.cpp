@@ -824,6 +824,51 @@ TEST_F(OptimizeCli, AGuessThatIsNotATableOfTheMotionIsRefusedByRowAndColumn) {
   EXPECT_EQ(again.out.find("note: the guess"), std::string::npos) << again.out;
 }
 
+// What can be decided before IPOPT is, with the expression's file:line:column: an objective, path
+// constraint or actuator that is not finite on the first guess (IPOPT stopped on "Invalid number"
+// and the note blamed the straight line), and a path constraint that the fixed initial or final
+// values, or nothing at all, make fail (IPOPT ran 38 iterations to "infeasible").
+TEST_F(OptimizeCli, WhatFailsOnTheFirstGuessOrAtTheFixedEndsIsNamedBeforeTheSolve) {
+  const auto refused = [&](const std::string& file, const std::vector<std::pair<std::string, std::string>>& changes,
+                           const std::string& message) {
+    write_variant("double_integrator.toml", file, changes);
+    const Outcome run = run_nhdyn("optimize " + file + " -o o.csv", dir_);
+    EXPECT_EQ(run.exit_code, 2) << run.out;
+    EXPECT_NE(run.out.find(message), std::string::npos) << run.out;
+    EXPECT_EQ(run.out.find("status:"), std::string::npos) << run.out;
+    EXPECT_EQ(run.out.find("IPOPT did not converge"), std::string::npos) << run.out;
+    EXPECT_FALSE(fs::exists(dir_ / "o.csv"));
+    EXPECT_FALSE(fs::exists(dir_ / "o.partial.csv"));
+    return run.out;
+  };
+  const std::string sqrt = refused("sqrt.toml", {{"objective = \"F^2\"", "objective = \"F^2 + sqrt(x - 0.5)\""}},
+                                   "sqrt.toml:13:13: the objective \"F^2 + sqrt(x - 0.5)\" is not finite (");
+  EXPECT_NE(sqrt.find("at the first guess's point t = 0, x = 0, x' = 0, F = 0: give a first guess where it is defined"),
+            std::string::npos)
+      << sqrt;
+  refused("inverse.toml", {{"final =", "path = [\"1/x <= 100\"]\nfinal ="}},
+          "inverse.toml:18:9: the path constraint \"1/x <= 100\" is not finite (inf) at the first guess's point t = 0, "
+          "x = 0, x' = 0, F = 0");
+  // The straight line from 0 to 1 passes x = 0.5 at its middle point, t = 1.
+  refused("pole.toml", {{"actuator = \"x\"", "actuator = [\"1/(x - 0.5)\"]"}},
+          "pole.toml:12:38: the actuator [1/(x - 0.5)] of control 'F' (its entry on x) is not finite (inf) at the first "
+          "guess's point t = 1, x = 0.5, x' = 0, F = 0");
+  refused("start.toml", {{"final =", "path = [\"x >= 2\"]\nfinal ="}},
+          "start.toml:18:9: the path constraint \"x >= 2\" cannot hold at t = 0: with the fixed initial values x = 0, "
+          "its left side less its right side is -2, which must be >= 0");
+  refused("end.toml", {{"final =", "path = [\"x + x' <= 0.5\"]\nfinal ="}},
+          "end.toml:18:9: the path constraint \"x + x' <= 0.5\" cannot hold at t = 2: with the fixed final values x = "
+          "1, x' = 0, its left side less its right side is 0.5, which must be <= 0; change the final values");
+  refused("never.toml", {{"final =", "path = [\"1 >= 2\"]\nfinal ="}},
+          "never.toml:18:9: the path constraint \"1 >= 2\" cannot hold at t = 0: it reads no coordinate, velocity or "
+          "control");
+  // A path constraint the free values can meet is left to IPOPT: x <= 1.2 along the way.
+  write_variant("double_integrator.toml", "fine.toml", {{"final =", "path = [\"x <= 1.2\", \"2 >= 1\"]\nfinal ="}});
+  const Outcome fine = optimize("fine.toml -o fine.csv");
+  SKIP_WITHOUT_IPOPT(fine);
+  EXPECT_EQ(fine.exit_code, 0) << fine.out;
+}
+
 // IPOPT is a module loaded when a program is first solved (src/nhdyn/optimize/ipopt/solver_module.cpp):
 // the dynamic loader's own account (LD_DEBUG=files lists every object it opens) shows that a
 // simulation opens none of IPOPT's libraries and that `optimize` does.

@@ -201,6 +201,7 @@ class SectionReader {
                                 control.name));
       taken.push_back(control.name);
       actuator_nodes_.push_back(actuator);
+      control.where = at(*actuator).describe();
       if (const auto* s = actuator->as_string()) {
         control.actuator = s->get();
       } else if (const auto* entries = actuator->as_array()) {
@@ -415,6 +416,7 @@ class SectionReader {
       fail(section, "[optimize] has no objective: give the integrand, objective = \"F^2\", or objective = \"time\"");
     const auto* s = node->as_string();
     p.objective_text = s != nullptr ? s->get() : text_of(*node, "objective");
+    p.objective_where = at(*node).describe();
     if (s != nullptr && s->get() == "time" && !symbols().has("time")) {
       if (!p.free_time)
         fail(*node, "objective = \"time\" needs a free final time, t_end = { free = [earliest, latest] }");
@@ -434,6 +436,7 @@ class SectionReader {
     if (f != nullptr) {
       const GiNaC::ex e = parse(*f, "objective_final", true, false);
       p.final_term = compile({e}, {"objective_final"});
+      p.final_term_where = at(*f).describe();
       objective_ += e;
     }
   }
@@ -470,7 +473,13 @@ class SectionReader {
       what.push_back(fmt::format("path constraint \"{}\"", text));
       PathConstraint c;
       c.text = text;
+      c.where = at(element).describe();
       (greater ? c.lower : c.upper) = 0.0;
+      const GiNaC::ex g = lhs - rhs;
+      for (int i = 0; i < n(); ++i) c.reads.push_back(g.has(symbols().coordinate(i)) ? 1 : 0);
+      for (int i = 0; i < n(); ++i) c.reads.push_back(g.has(symbols().velocity(i)) ? 1 : 0);
+      for (int j = 0; j < m(); ++j) c.reads.push_back(g.has(symbols().coordinate(n() + j)) ? 1 : 0);
+      c.reads_time = g.has(symbols().time());
       p.path_constraints.push_back(c);
       path_.push_back(lhs - rhs);
     }
@@ -479,7 +488,8 @@ class SectionReader {
 
   // B u from the actuators: a coordinate (a unit column) or a direction with one entry per coordinate.
   void compile_force(OptimalControlProblem& p) const {
-    std::vector<GiNaC::ex> force(static_cast<std::size_t>(n()), GiNaC::ex(0));
+    std::vector<GiNaC::ex> force(static_cast<std::size_t>(n()), GiNaC::ex(0)), columns;
+    std::vector<std::string> entries_what;
     for (int j = 0; j < m(); ++j) {
       const toml::node& node = *actuator_nodes_[static_cast<std::size_t>(j)];
       const GiNaC::symbol& u = symbols().coordinate(n() + j);
@@ -512,8 +522,13 @@ class SectionReader {
         fail(node, fmt::format("control '{}' acts on nothing: its actuator direction is zero; give the coordinate its "
                                "force acts on or a nonzero direction",
                                name_of(n() + j)));
-      for (int i = 0; i < n(); ++i) force[static_cast<std::size_t>(i)] += column[static_cast<std::size_t>(i)] * u;
+      for (int i = 0; i < n(); ++i) {
+        force[static_cast<std::size_t>(i)] += column[static_cast<std::size_t>(i)] * u;
+        columns.push_back(column[static_cast<std::size_t>(i)]);
+        entries_what.push_back(fmt::format("the actuator of control '{}' on {}", name_of(n() + j), name_of(i)));
+      }
     }
+    p.actuators = compile(columns, entries_what);
     std::vector<std::string> what;
     for (int i = 0; i < n(); ++i) what.push_back(fmt::format("actuator force on {}", name_of(i)));
     p.force = compile(force, what);

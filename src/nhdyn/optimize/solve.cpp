@@ -192,6 +192,7 @@ OptimizeResult solve_optimal_control(const OptimalControlProblem& problem, const
     result.notes.push_back("first guess: " + guess.string());
     result.notes.insert(result.notes.end(), notes.begin(), notes.end());
   }
+  nlp.require_defined_at_start();
   result.solver = solve_nlp(nlp, options.nlp);
   if (result.solver.status == NlpStatus::unavailable) return result;
   std::vector<double> x = result.solver.x.empty() ? nlp.start() : result.solver.x;

@@ -57,6 +57,11 @@ class Transcription final : public Nlp {
   void set_start(std::vector<double> x) { start_ = std::move(x); }
   // The largest violation of the variable bounds and the constraint bounds at x.
   double constraint_violation(const double* x);
+  // Before IPOPT: throws InputError naming the expression (its file:line:column), the point's t
+  // and state when the objective, the final term, a path constraint, an actuator or the model's
+  // terms are not finite at a point of the starting point (start(), the guess set in it), where
+  // IPOPT would stop on "Invalid number" with nothing to say where.
+  void require_defined_at_start();
 
   int variables() const override { return variables_; }
   int constraints() const override { return rows_; }
@@ -94,6 +99,11 @@ class Transcription final : public Nlp {
   void make_start();
   void check_controls_act();
   void release_determined_final_values();
+  // A path constraint that reads only fixed values at the first or last node (a constant one
+  // included) is decided before the solve: throws InputError naming it and its value when it fails.
+  void require_path_at_fixed_ends();
+  // "t = 0, x = 0.5, x' = 0, F = 0": the point p of x, for messages.
+  std::string describe_point(int p, const double* x) const;
   // Throws InputError when a relation among the fixed final values (a column of Z, the
   // combinations of the constraint rows that no free final value enters) does not hold with them.
   void require_final_values_agree(const Eigen::MatrixXd& Z, const Eigen::MatrixXd& relations,
