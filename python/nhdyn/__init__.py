@@ -462,6 +462,17 @@ class Model:
         if self.source.is_builtin:
             raise InputError("optimize: '{}' is a built-in model; optimize reads the [optimize] section of a model "
                              "file".format(self.name))
+        # float() and int() took tolerance="1e-3" and max_iterations=1.9 or True silently, and a
+        # budget beyond a C int reached pybind11's signature error.
+        if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float, np.integer, np.floating)):
+            raise InputError("optimize: tolerance={!r}: give a real number above 0 and at most 0.01 (the default is "
+                             "1e-8)".format(tolerance))
+        if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)):
+            raise InputError("optimize: max_iterations={!r}: give a whole number of iterations, at least 1 (the "
+                             "default is 3000)".format(max_iterations))
+        if not -2**31 <= max_iterations <= 2**31 - 1:
+            raise InputError("optimize: max_iterations={}: give a whole number from 1 to {} (IPOPT counts its "
+                             "iterations in a C int; the default is 3000)".format(max_iterations, 2**31 - 1))
         out = _nhdyn.optimize(self.source, list(self.overrides.items()), "" if guess is None else os.fspath(guess),
                               float(tolerance), int(max_iterations))
         result = Optimum(self, out)

@@ -869,6 +869,44 @@ TEST_F(OptimizeCli, WhatFailsOnTheFirstGuessOrAtTheFixedEndsIsNamedBeforeTheSolv
   EXPECT_EQ(fine.exit_code, 0) << fine.out;
 }
 
+// Messages about boundary values, bounds, control names and the guess file say where and what:
+// file:line:column for a value outside its bounds (and the bounds' own place), no IPOPT infinity
+// shown as if the user had given bounds, "control" for a control, a directory called one.
+TEST_F(OptimizeCli, BoundsControlNamesAndTheGuessFileAreNamedWhereTheyAreWritten) {
+  const auto refused = [&](const std::string& args, const std::string& message) {
+    const Outcome run = run_nhdyn("optimize " + args + " -o o.csv", dir_);
+    EXPECT_EQ(run.exit_code, 2) << args << "\n" << run.out;
+    EXPECT_NE(run.out.find(message), std::string::npos) << args << "\n" << run.out;
+    EXPECT_FALSE(fs::exists(dir_ / "o.csv"));
+  };
+  write_variant("double_integrator.toml", "final.toml", {{"final =", "bounds = { x = [0, 0.5] }\nfinal ="}});
+  refused("final.toml", "final.toml:19:28: the final value x = 1 lies outside its bounds [0, 0.5] (given at "
+                        "final.toml:18:16): change one of them");
+  write_variant("double_integrator.toml", "initial.toml",
+                {{"final =", "bounds = { \"x'\" = [1, 2] }\nfinal ="}});
+  refused("initial.toml", "initial.toml:17:52: the initial value x' = 0 lies outside its bounds [1, 2] (given at "
+                          "initial.toml:18:19)");
+  // No bounds given: IPOPT's infinity is not shown as bounds.
+  const std::string huge = example("double_integrator.toml") + " --set d=1e150";
+  const Outcome run = run_nhdyn("optimize " + huge + " -o o.csv", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("double_integrator.toml:18:28: the final value x = 1e+150 is too large for the optimizer"),
+            std::string::npos)
+      << run.out;
+  EXPECT_EQ(run.out.find("1e+20"), std::string::npos) << run.out;
+  // A control's name refused as a control's, at its name.
+  for (const auto& [name, why] : {std::pair<std::string, std::string>{"t", "'t' is the time"},
+                                  {"F G", "not a valid name"},
+                                  {"sin", "'sin' is the name of a function"}}) {
+    write_variant("double_integrator.toml", "name.toml", {{"name = \"F\"", "name = \"" + name + "\""}, {"F^2", "x^2"}});
+    refused("name.toml", "name.toml:12:22: control '");
+    refused("name.toml", why);
+  }
+  // guess = a directory says so.
+  write_variant("double_integrator.toml", "dir.toml", {{"final =", "guess = \".\"\nfinal ="}});
+  refused("dir.toml", "dir.toml:18:9: the guess file . is a directory");
+}
+
 // IPOPT is a module loaded when a program is first solved (src/nhdyn/optimize/ipopt/solver_module.cpp):
 // the dynamic loader's own account (LD_DEBUG=files lists every object it opens) shows that a
 // simulation opens none of IPOPT's libraries and that `optimize` does.

@@ -129,3 +129,22 @@ def test_an_optimum_the_replay_does_not_confirm_is_not_converged(examples, tmp_p
     ok = needs_ipopt(lambda: nhdyn.load(examples / "double_integrator.toml").optimize())
     assert ok.converged and ok.status == "solved" and ok.replay_verdict == ""
     assert ok.replay_difference < 1e-6 * ok.replay_limit
+
+
+def test_solver_options_of_the_wrong_type_are_refused_in_words(examples):
+    # float() and int() took "1e-3" and 1.9 or True (as 1) silently; 10**30 reached pybind11's
+    # "incompatible function arguments", which shows the binding's internals.
+    m = nhdyn.load(examples / "double_integrator.toml")
+    for tolerance in ("1e-3", True, None, 1e-3j):
+        with pytest.raises(nhdyn.InputError, match=r"optimize: tolerance=.*: give a real number above 0"):
+            m.optimize(tolerance=tolerance)
+    for budget in (1.9, True, "10", 3000.0):
+        with pytest.raises(nhdyn.InputError, match=r"optimize: max_iterations=.*: give a whole number of iterations"):
+            m.optimize(max_iterations=budget)
+    for budget in (10**30, -10**30):
+        with pytest.raises(nhdyn.InputError, match=r"max_iterations=-?1000000000000000000000000000000: give a whole "
+                                                   r"number from 1 to 2147483647"):
+            m.optimize(max_iterations=budget)
+    # NumPy's numbers are numbers.
+    r = needs_ipopt(lambda: m.optimize(tolerance=np.float64(1e-9), max_iterations=np.int64(100)))
+    assert r.converged and r.objective == pytest.approx(1.5, rel=1e-9)

@@ -79,6 +79,7 @@ class SectionReader {
     read_time(*section, p);
     p.state_lower.assign(static_cast<std::size_t>(2 * n), -kNoBound);
     p.state_upper.assign(static_cast<std::size_t>(2 * n), kNoBound);
+    p.state_bounds_where.assign(static_cast<std::size_t>(2 * n), "");
     if (const toml::node* b = section->get("bounds")) read_bounds(*b, p);
     if (const toml::node* v = section->get("initial")) p.initial = read_state(*v, "initial");
     // final = { ... } is the final state; final = "..." (the spelling of the Mayer term) is
@@ -150,6 +151,8 @@ class SectionReader {
     const std::filesystem::path file(file_);
     if (path.is_relative() && file_ != "<string>" && file.has_parent_path()) path = file.parent_path() / path;
     std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+      fail(node, fmt::format("the guess file {} is a directory: write the path of a CSV in it", path.string()));
     if (!std::filesystem::is_regular_file(path, ec))
       fail(node, fmt::format("the guess file {} does not exist (guess is relative to the model file's folder); "
                              "write its path, or leave guess out and give --guess FILE.csv",
@@ -201,6 +204,7 @@ class SectionReader {
                                 control.name));
       taken.push_back(control.name);
       actuator_nodes_.push_back(actuator);
+      name_nodes_.push_back(name);
       control.where = at(*actuator).describe();
       if (const auto* s = actuator->as_string()) {
         control.actuator = s->get();
@@ -218,7 +222,18 @@ class SectionReader {
 
   void declare_layout() {
     for (const std::string& c : model_.coordinates) layout_.coordinate(c);
-    for (const OptimizeControl& c : controls_) layout_.coordinate(c.name);
+    for (std::size_t j = 0; j < controls_.size(); ++j) {
+      try {
+        layout_.coordinate(controls_[j].name);
+      } catch (const ModelError& e) {
+        // The layout declares a control as a coordinate, and SpecBuilder's refusal of its name
+        // ("coordinate 't': 't' is the time ...") says so: said again of the control, at its name.
+        const std::string text = e.what();
+        const std::size_t quote = text.find("coordinate '"), end = text.find("': ", quote);
+        if (quote == std::string::npos || end == std::string::npos) throw;
+        fail(*name_nodes_[j], "control " + text.substr(quote + 11, end + 1 - quote - 11) + ": " + text.substr(end + 3));
+      }
+    }
     for (const Parameter& q : model_.parameters) layout_.parameter(q.name, q.value);
   }
 
@@ -362,7 +377,7 @@ class SectionReader {
         fail(value, fmt::format("{} gives {}{} twice", what, model_.coordinates[static_cast<std::size_t>(index)],
                                 velocity ? "'" : ""));
       seen.emplace_back(index, velocity);
-      values.push_back({index, velocity, number(value, fmt::format("{}.{}", what, key))});
+      values.push_back({index, velocity, number(value, fmt::format("{}.{}", what, key)), at(value).describe()});
     };
     for (auto&& [key, value] : *table) {
       const std::string name(key.str());
@@ -407,6 +422,7 @@ class SectionReader {
       const std::size_t slot = static_cast<std::size_t>(index + (velocity ? n() : 0));
       p.state_lower[slot] = lo;
       p.state_upper[slot] = hi;
+      p.state_bounds_where[slot] = at(value).describe();
     }
   }
 
@@ -555,7 +571,7 @@ class SectionReader {
   const Model& model_;
   symbolic::SpecBuilder layout_;
   std::vector<OptimizeControl> controls_;
-  std::vector<const toml::node*> actuator_nodes_;
+  std::vector<const toml::node*> actuator_nodes_, name_nodes_;
   GiNaC::ex objective_ = 0;
   std::vector<GiNaC::ex> path_;
 };

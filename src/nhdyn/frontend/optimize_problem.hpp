@@ -45,6 +45,7 @@ struct BoundaryValue {
   int index = 0;
   bool velocity = false;
   double value = 0.0;
+  std::string where;  // file:line:column of the value, for messages
 };
 
 // A path constraint lower <= g(t, q, q', u) <= upper, imposed at every point.
@@ -83,6 +84,7 @@ struct OptimalControlProblem {
   std::vector<BoundaryValue> initial, final;
   // Bounds on the coordinates and velocities at every point: 2n each, [q; q'].
   std::vector<double> state_lower, state_upper;
+  std::vector<std::string> state_bounds_where;  // 2n: file:line:column of each bound given, else ""
   std::vector<std::string> warnings;  // e.g. a control that neither the objective nor a bound sees
   // [optimize] guess = "FILE.csv": the first guess when none is given (--guess, guess=), its path
   // relative to the model file's folder resolved; empty without the key.

@@ -83,12 +83,23 @@ Transcription::Transcription(const OptimalControlProblem& problem) : problem_(pr
       x_upper_[static_cast<std::size_t>(u_index(p, j))] = nlp_bound(problem_.controls[static_cast<std::size_t>(j)].upper);
     }
   }
+  // The messages give the bounds as written (none is IPOPT's +-kNlpInfinity), at their file:line.
   const auto fix = [&](int p, const BoundaryValue& b, const char* which) {
     const std::size_t at = static_cast<std::size_t>(b.velocity ? v_index(p, b.index) : q_index(p, b.index));
+    const std::size_t slot = static_cast<std::size_t>(b.index + (b.velocity ? n_ : 0));
     const std::string name = model.coordinates[static_cast<std::size_t>(b.index)] + (b.velocity ? "'" : "");
-    if (b.value < x_lower_[at] || b.value > x_upper_[at])
-      throw InputError(fmt::format("the {} value {} = {} lies outside its bounds [{}, {}]: change one of them", which,
-                                   name, b.value, x_lower_[at], x_upper_[at]));
+    const std::string place = b.where.empty() ? "" : b.where + ": ";
+    if (!(std::abs(b.value) < 0.5 * kNlpInfinity))
+      throw InputError(fmt::format("{}the {} value {} = {} is too large for the optimizer, which reads a bound beyond "
+                                   "{:g} as no bound: give the model in units that make it smaller",
+                                   place, which, name, b.value, 0.5 * kNlpInfinity));
+    const double lower = problem_.state_lower[slot], upper = problem_.state_upper[slot];
+    if (b.value < lower || b.value > upper) {
+      const std::string bounds = slot < problem_.state_bounds_where.size() ? problem_.state_bounds_where[slot] : "";
+      throw InputError(fmt::format("{}the {} value {} = {} lies outside its bounds [{}, {}]{}: change one of them",
+                                   place, which, name, b.value, lower, upper,
+                                   bounds.empty() ? "" : " (given at " + bounds + ")"));
+    }
     x_lower_[at] = x_upper_[at] = b.value;
   };
   for (const BoundaryValue& b : problem_.initial) fix(0, b, "initial");
