@@ -538,7 +538,8 @@ initial = { position = { x = 0, y = 0, z = 0 }, velocity = { x = 0, y = 0, z = 0
   write("contradict.toml", model + "final = { position = { x = 1, y = 0 } }\n");
   const Outcome run = run_nhdyn("optimize contradict.toml -o c.csv", dir_);
   EXPECT_EQ(run.exit_code, 2) << run.out;
-  EXPECT_NE(run.out.find("the final values of [optimize] violate the constraint c1 (position): with x = 1, y = 0 its "
+  EXPECT_NE(run.out.find("contradict.toml:15:28: the final values of [optimize] violate the constraint c1 (position): "
+                         "with x = 1, y = 0 its "
                          "residual at t_end is 1.000e+00, and no free final value can change it"),
             std::string::npos)
       << run.out;

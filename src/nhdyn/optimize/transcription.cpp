@@ -469,6 +469,7 @@ void Transcription::require_final_values_agree(const Eigen::MatrixXd& Z, const E
     const double residual = Z.col(k).dot(r);
     if (std::abs(residual) <= 1e-8 * (1.0 + largest)) continue;
     std::vector<std::string> names, values;
+    std::string where;  // the first of the values' places in the file
     for (Eigen::Index i = 0; i < Z.rows(); ++i)
       if (std::abs(Z(i, k)) > 1e-6) names.push_back(rows[static_cast<std::size_t>(i)]);
     const double scale = relations.row(k).cwiseAbs().maxCoeff();
@@ -476,14 +477,16 @@ void Transcription::require_final_values_agree(const Eigen::MatrixXd& Z, const E
       if (scale > 0.0 && std::abs(relations(k, static_cast<Eigen::Index>(c))) <= 1e-9 * scale) continue;
       const int column = fixed_columns[c];
       for (const BoundaryValue& b : problem_.final)
-        if (b.index + (b.velocity ? n_ : 0) == column)
+        if (b.index + (b.velocity ? n_ : 0) == column) {
           values.push_back(fmt::format("{}{} = {}", model.coordinates[static_cast<std::size_t>(b.index)],
                                        b.velocity ? "'" : "", b.value));
+          if (where.empty() && !b.where.empty()) where = b.where + ": ";
+        }
     }
     throw InputError(fmt::format(
-        "the final values of [optimize] violate the constraint{} {}: with {} its residual at t_end is {:.3e}, and no "
+        "{}the final values of [optimize] violate the constraint{} {}: with {} its residual at t_end is {:.3e}, and no "
         "free final value can change it; give final values on the constraint, or leave one of them out of final",
-        names.size() > 1 ? "s" : "", join(names, " and "), join(values), residual));
+        where, names.size() > 1 ? "s" : "", join(names, " and "), join(values), residual));
   }
 }
 
