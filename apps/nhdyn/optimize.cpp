@@ -178,8 +178,8 @@ int run_optimize(const OptimizeArgs& args) {
     files.input(problem.guess, "the first guess (guess = in [optimize])");
   files.output(args.output, "-o", Folder::make);
   if (!args.output.empty()) files.output(partial_path(args.output), "the partial-results file", Folder::make);
-  files.plot(args.plot, "--plot", Folder::make);
-  files.page(args.html, "--html", Folder::make);
+  files.plot(args.plot, "--plot");  // in a folder that exists, or the one made for -o
+  files.page(args.html, "--html");
   files.check();
   AtomicFile* csv = args.output.empty() ? nullptr : &files.open(args.output);
   OptimizeOptions options;

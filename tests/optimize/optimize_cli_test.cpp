@@ -903,6 +903,14 @@ TEST_F(OptimizeCli, BoundsControlNamesAndTheGuessFileAreNamedWhereTheyAreWritten
     refused("name.toml", "name.toml:12:22: control '");
     refused("name.toml", why);
   }
+  // A one-sided bound: what to write instead of inf.
+  write_variant("double_integrator.toml", "inf.toml", {{"final =", "bounds = { F = [-inf, 10] }\nfinal ="}});
+  refused("inf.toml", "inf.toml:18:17: the bounds of F are finite numbers: for a bound on one side only, give the "
+                      "other a value far beyond the motion, e.g. F = [-1e6, 10]");
+  // --html and --plot go into a folder that exists (or the one made for -o): optimize makes only
+  // the folders of its tables.
+  refused(example("double_integrator.toml") + " --html nodir/x.html", "the directory 'nodir' does not exist");
+  EXPECT_FALSE(fs::exists(dir_ / "nodir"));
   // guess = a directory says so.
   write_variant("double_integrator.toml", "dir.toml", {{"final =", "guess = \".\"\nfinal ="}});
   refused("dir.toml", "dir.toml:18:9: the guess file . is a directory");

@@ -398,6 +398,12 @@ class SectionReader {
       const toml::array* range = value.as_array();
       if (range == nullptr || range->size() != 2)
         fail(value, fmt::format("the bounds of {} are [lower, upper] (numbers or expressions in quotes)", name));
+      // A bound on one side only is written with the other far beyond the motion: inf is not a number here.
+      for (const toml::node& side : *range)
+        if (const auto* f = side.as_floating_point(); f != nullptr && !std::isfinite(f->get()))
+          fail(side, fmt::format("the bounds of {} are finite numbers: for a bound on one side only, give the other "
+                                 "a value far beyond the motion, e.g. {} = [-1e6, 10]",
+                                 name, name));
       const double lo = number(*range->get(0), fmt::format("the lower bound of {}", name));
       const double hi = number(*range->get(1), fmt::format("the upper bound of {}", name));
       if (lo > hi)
