@@ -42,9 +42,11 @@ void bind_optimize(py::module_& m) {
         const auto n = static_cast<py::ssize_t>(problem.n()), m_count = static_cast<py::ssize_t>(problem.m());
         py::dict d;
         d["summary_text"] = format_optimize_summary(problem, result);
-        d["status"] = std::string(nlp_status_name(result.solver.status));
+        d["status"] = std::string(optimize_status_name(result));
         d["solver_message"] = result.solver.message;
-        d["converged"] = result.converged();
+        d["converged"] = result.solved();  // IPOPT converged and the replay confirms a motion (solve.hpp)
+        d["replay_limit"] = result.replay_limit;
+        d["replay_verdict"] = result.replay_verdict;
         d["iterations"] = result.solver.iterations;
         d["objective"] = result.objective;
         d["t_end"] = result.t_end;

@@ -79,11 +79,19 @@ void write_plot_of(const OptimalControlProblem& problem, const fs::path& csv, co
 // outputs from the model's kernels at each point; the energy balance with the controls' work
 // booked with the forces (as for program motion) and the works by the trapezoidal rule over the
 // points, so that its error column shows the quadrature's error.
+// The report's columns are a simulation's without contact forces or programs (optimum_table):
+// --html on another model is refused before any work, so that the refusal costs no solve and
+// leaves no file.
+void require_optimum_report(const Model& model) {
+  if (!make_result_columns(model).contact_forces.empty() || model.m() > 0)
+    throw InputError(fmt::format("--html: the report of an optimum is for models without contacts and [[programs]], "
+                                 "and {} has {}; leave --html out (-o and --plot take this model)",
+                                 model.name, model.m() > 0 ? "[[programs]]" : "contacts"));
+}
+
 CsvTable optimum_table(const OptimalControlProblem& problem, const OptimizeResult& result) {
   const Model& model = problem.model;
   const ResultColumns columns = make_result_columns(model);
-  if (!columns.contact_forces.empty() || model.m() > 0)
-    throw InputError("--html: the report of an optimum is for models without contacts and [[programs]]");
   const int n = model.n(), m = problem.m();
   Data data = make_data(model);
   std::vector<double> registers(static_cast<std::size_t>(problem.force.registers())), layout_q(static_cast<std::size_t>(n + m)),
@@ -143,7 +151,7 @@ std::string write_optimum_report(const OptimizeArgs& args, const LoadedModel& lo
       problem.model, loaded.description.get(), optimum_table(problem, result),
       fmt::format("{}: optimal program, {} nodes, {}", problem.model.name, problem.nodes,
                   collocation_method_name(problem.method)),
-      {{"status", fmt::format("{} ({})", nlp_status_name(result.solver.status), result.solver.message)},
+      {{"status", fmt::format("{} ({})", optimize_status_name(result), result.solver.message)},
        {"iterations", fmt::format("{}", result.solver.iterations)},
        {"objective", fmt::format("{:.10g}", result.objective)},
        {"replay difference", result.replayed ? fmt::format("{:.3e}", result.replay_difference) : "none"},
@@ -158,15 +166,22 @@ int run_optimize(const OptimizeArgs& args) {
   if (!args.html.empty() && args.output.empty())
     throw InputError("--html reports the CSV of -o: give -o FILE.csv too");
   if (!args.plot.empty() && args.output.empty()) throw InputError("--plot draws the CSV of -o: give -o FILE.csv too");
+  const OptimalControlProblem problem = load_optimal_control_problem(source, loaded);
+  if (!args.html.empty()) require_optimum_report(problem.model);
   // Every file of the command, checked together before the solve (run_files.hpp); their folders
-  // are made, and -o opened, so that an unwritable path never costs a solve.
+  // are made, and -o opened, so that an unwritable path never costs a solve. The first guess is
+  // an input: no output may replace it (a failed solve's FILE.partial.csv given back as --guess
+  // included).
+  if (!args.guess.empty())
+    files.input(args.guess, "--guess");
+  else
+    files.input(problem.guess, "the first guess (guess = in [optimize])");
   files.output(args.output, "-o", Folder::make);
   if (!args.output.empty()) files.output(partial_path(args.output), "the partial-results file", Folder::make);
-  files.plot(args.plot, "--plot", Folder::make);
-  files.page(args.html, "--html", Folder::make);
+  files.plot(args.plot, "--plot");  // in a folder that exists, or the one made for -o
+  files.page(args.html, "--html");
   files.check();
   AtomicFile* csv = args.output.empty() ? nullptr : &files.open(args.output);
-  const OptimalControlProblem problem = load_optimal_control_problem(source, loaded);
   OptimizeOptions options;
   options.nlp.tolerance = args.tolerance;
   options.nlp.constraint_tolerance = args.tolerance;
@@ -178,17 +193,26 @@ int run_optimize(const OptimizeArgs& args) {
   if (result.solver.status == NlpStatus::unavailable) throw InputError(result.solver.message);
   fmt::print("{}", format_optimize_summary(problem, result));
   const std::string table = format_table(optimize_columns(problem), optimize_rows(problem, result));
-  if (!result.converged()) {
+  if (!result.solved()) {
+    // -o is left as it was; the last iterate (or the discrete optimum the replay rejects) goes
+    // beside it.
     if (csv) {
-      // -o is left as it was; the last iterate goes beside it.
       files.write_now(partial_path(args.output),
-                      fmt::format("# nhdyn optimize: IPOPT stopped ({}: {}); the last iterate\n",
-                                  nlp_status_name(result.solver.status), result.solver.message) +
+                      (result.replay_rejected
+                           ? fmt::format("# nhdyn optimize: not a motion of the model (replay difference {:.3e}, limit "
+                                         "{:.3e}); the discrete optimum\n",
+                                         result.replay_difference, result.replay_limit)
+                           : fmt::format("# nhdyn optimize: IPOPT stopped ({}: {}); the last iterate\n",
+                                         nlp_status_name(result.solver.status), result.solver.message)) +
                           table);
-      fmt::print("last iterate -> {}\n", partial_path(args.output).string());
+      fmt::print("{} -> {}\n", result.replay_rejected ? "discrete optimum" : "last iterate",
+                 partial_path(args.output).string());
     }
-    fmt::print(stderr, "nhdyn: error: IPOPT did not converge: {} ({})\n", nlp_status_name(result.solver.status),
-               result.solver.message);
+    if (result.replay_rejected)
+      fmt::print(stderr, "nhdyn: error: {}\n", result.replay_verdict);
+    else
+      fmt::print(stderr, "nhdyn: error: IPOPT did not converge: {} ({})\n", nlp_status_name(result.solver.status),
+                 result.solver.message);
     return 1;
   }
   if (csv) csv->write(table);

@@ -86,7 +86,7 @@ _PYTHON_TERMS = {
     "--set": "m.parameters[NAME] = value", "--initial": "q0/qd0", "--threads": "threads",
     "--cyclic": "cyclic=[...]", "--independent": "independent=[...]", "--speeds": "speeds=[...]",
     "--from": "values[0]", "--to": "values[-1]", "--steps": "len(values)", "--guess": "guess",
-    "--max-frames": "max_frames",
+    "--max-frames": "max_frames", "--tolerance": "tolerance", "--max-iterations": "max_iterations",
 }
 _OPTION = re.compile(r"--[a-z][a-z-]*[a-z]")
 # "max_steps (--max-steps)" names the keyword twice once translated.
@@ -450,14 +450,29 @@ class Model:
         parameters. guess: a CSV path with the columns `nhdyn optimize` writes (t, the coordinates
         and their velocities, optionally x'' and u_NAME), else the straight line between the
         boundary states. Returns an Optimum; one that did not converge (Optimum.converged False,
-        its last iterate in it) also warns."""
+        its last iterate in it), or whose replay says it is not a motion of the model (the replay
+        rule of docs/optimize.md: converged False, replay_verdict says why), also warns."""
         if self.source.is_builtin:
             raise InputError("optimize: '{}' is a built-in model; optimize reads the [optimize] section of a model "
                              "file".format(self.name))
+        # float() and int() took tolerance="1e-3" and max_iterations=1.9 or True silently, and a
+        # budget beyond a C int reached pybind11's signature error.
+        if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float, np.integer, np.floating)):
+            raise InputError("optimize: tolerance={!r}: give a real number above 0 and at most 0.01 (the default is "
+                             "1e-8)".format(tolerance))
+        if isinstance(max_iterations, bool) or not isinstance(max_iterations, (int, np.integer)):
+            raise InputError("optimize: max_iterations={!r}: give a whole number of iterations, at least 1 (the "
+                             "default is 3000)".format(max_iterations))
+        if not -2**31 <= max_iterations <= 2**31 - 1:
+            raise InputError("optimize: max_iterations={}: give a whole number from 1 to {} (IPOPT counts its "
+                             "iterations in a C int; the default is 3000)".format(max_iterations, 2**31 - 1))
         out = _nhdyn.optimize(self.source, list(self.overrides.items()), "" if guess is None else os.fspath(guess),
                               float(tolerance), int(max_iterations))
         result = Optimum(self, out)
-        if not result.converged:
+        if result.replay_verdict:
+            warnings.warn("optimize '{}': {}; the result is the discrete optimum".format(
+                self.name, result.replay_verdict), RuntimeWarning, stacklevel=2)
+        elif not result.converged:
             warnings.warn("optimize '{}': IPOPT did not converge: {} ({}); the result is its last iterate".format(
                 self.name, result.status, result.solver_message), RuntimeWarning, stacklevel=2)
         return result
@@ -661,9 +676,11 @@ class Optimum:
     the midpoints): t (points), q, qd, qdd (points x n), u (points x controls, named in
     `controls`). `columns` and `rows` are the CSV that `nhdyn optimize -o` writes (t, the
     coordinates, x', x'', u_NAME); `summary` its summary text. status ("solved", "solved to
-    acceptable level", "infeasible", "iteration limit", "failed"), iterations, objective, t_end,
-    constraint_violation, replay_difference (None when the replay failed: replay_message says why)
-    and notes are the summary's values."""
+    acceptable level", "infeasible", "iteration limit", "failed", "not a motion of the model"),
+    iterations, objective, t_end, constraint_violation, replay_difference (None when the replay
+    failed: replay_message says why), replay_limit and notes are the summary's values. converged
+    is True when IPOPT converged and the replay confirms a motion of the model; replay_verdict
+    says why not when the replay rule rejects the result ("" otherwise)."""
 
     def __init__(self, model, out):
         self.model_name = model.name
@@ -674,8 +691,9 @@ class Optimum:
         self.columns, self.rows = list(out["columns"]), out["table"]
         self.summary = out["summary_text"]
         for key in ("status", "solver_message", "converged", "iterations", "objective", "t_end", "free_time",
-                    "constraint_violation", "replay_difference", "replay_message"):
+                    "constraint_violation", "replay_difference", "replay_message", "replay_limit"):
             setattr(self, key, out[key])
+        self.replay_verdict = _python_text(out["replay_verdict"])
         self.notes = [_python_text(note) for note in out["notes"]]
 
     def column(self, name):

@@ -516,6 +516,47 @@ final = { position = { x = 1, y = 0.1, theta = 0.2 }, velocity = { x = 0, y = 0,
   EXPECT_GT(std::abs(t.column("y'").back()), 0.0);  // left free: the drift, not pinned
 }
 
+// A final value the constraints determine is released only when it agrees with them: x - y = 0
+// with x = 1, y = 0 at t_end is a contradiction, refused before any work with the constraint and
+// its residual (released, x met 0 with exit 0 and a note that said it met its value).
+TEST_F(OptimizeCli, FinalValuesThatContradictTheConstraintsAreRefused) {
+  const std::string model = R"toml(name = "pair"
+coordinates = ["x", "y", "z"]
+kinetic_energy = "m/2 * (x'^2 + y'^2 + z'^2)"
+[parameters]
+m = 1.0
+[[constraints]]
+name = "c1"
+position = "x - y"
+[optimize]
+controls = [{ name = "Fx", actuator = "x" }, { name = "Fy", actuator = "y" }]
+objective = "Fx^2 + Fy^2"
+t_end = 1
+nodes = 9
+initial = { position = { x = 0, y = 0, z = 0 }, velocity = { x = 0, y = 0, z = 0 } }
+)toml";
+  write("contradict.toml", model + "final = { position = { x = 1, y = 0 } }\n");
+  const Outcome run = run_nhdyn("optimize contradict.toml -o c.csv", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("contradict.toml:15:28: the final values of [optimize] violate the constraint c1 (position): "
+                         "with x = 1, y = 0 its "
+                         "residual at t_end is 1.000e+00, and no free final value can change it"),
+            std::string::npos)
+      << run.out;
+  EXPECT_EQ(run.out.find("status:"), std::string::npos) << run.out;
+  EXPECT_FALSE(fs::exists(dir_ / "c.csv"));
+  EXPECT_FALSE(fs::exists(dir_ / "c.partial.csv"));
+  // Values on the constraint: one of them released, both met.
+  write("agree.toml", model + "final = { position = { x = 1, y = 1 } }\n");
+  const Outcome agree = optimize("agree.toml -o a.csv");
+  SKIP_WITHOUT_IPOPT(agree);
+  ASSERT_EQ(agree.exit_code, 0) << agree.out;
+  EXPECT_NE(agree.out.find("is determined by the constraints (c1)"), std::string::npos) << agree.out;
+  const Table t = read_csv(dir_ / "a.csv");
+  EXPECT_NEAR(t.column("x").back(), 1.0, 1e-8);
+  EXPECT_NEAR(t.column("y").back(), 1.0, 1e-8);
+}
+
 TEST_F(OptimizeCli, InfeasibleProblemIsSaidPlainlyAndItsLastIterateKept) {
   // |F| <= 0.1 moves the mass at most 0.1 T^2/4 = 0.1 from rest to rest in T = 2, not d = 1.
   write_variant("double_integrator.toml", "weak.toml", {{"final =", "bounds = { F = [-0.1, 0.1] }\nfinal ="}});
@@ -581,6 +622,298 @@ TEST_F(OptimizeCli, BadInputExitsTwoNamingWhere) {
         << none.out;
     EXPECT_FALSE(fs::exists(dir_ / "i.csv")) << budget;
   }
+}
+
+// optimize imposes a contact's constraints at every point, rolling and bilateral: a contact that
+// may slide or lift off is refused before any work, at its [[contacts]] entry, rather than
+// optimized under another law than the model's (a ball "rolled" by 21 N where mu m g is 0.01 N).
+TEST_F(OptimizeCli, ContactsThatMaySlideOrLiftOffAreRefusedBeforeAnyWork) {
+  const std::string section = R"toml(
+[optimize]
+controls = [{ name = "F", actuator = "x" }]
+objective = "F^2"
+t_end = 0.2
+nodes = 5
+initial = { position = { x = 0, y = 0, z = "r", a = 0, b = 0, c = 0 }, velocity = { x = 0, y = 0, z = 0, a = 0, b = 0, c = 0 } }
+final = { position = { x = 1 }, velocity = { x = 0 } }
+)toml";
+  const std::string base = read_example("ball_thrown_sliding.toml") + section;
+  const auto variant = [&](const std::string& file, const std::string& keys) {
+    std::string text = base;
+    const std::string from = "friction = \"mu\"\nmode = \"sliding\"\n";
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos);
+    text.replace(at, from.size(), keys);
+    write(file, text);
+  };
+  variant("unilateral.toml", "friction = \"mu\"\nunilateral = true\n");
+  variant("sliding.toml", "friction = \"mu\"\nmode = \"sliding\"\n");
+  variant("rolling.toml", "");
+  for (const auto& [file, keys] : {std::pair<std::string, std::string>{"unilateral", "friction and unilateral"},
+                                   {"sliding", "friction and mode"}}) {
+    const Outcome run = run_nhdyn("optimize " + file + ".toml --set mu=0.01 -o out.csv --html out.html", dir_);
+    EXPECT_EQ(run.exit_code, 2) << run.out;
+    EXPECT_NE(run.out.find(file + ".toml:37"), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("contact 'ball' has " + keys + ": optimize takes contacts as rolling, bilateral "
+                           "constraints"),
+              std::string::npos)
+        << run.out;
+    EXPECT_NE(run.out.find("remove friction, unilateral, restitution and mode from the contact"), std::string::npos)
+        << run.out;
+    EXPECT_EQ(run.out.find("status:"), std::string::npos) << run.out;  // no solve
+    EXPECT_FALSE(fs::exists(dir_ / "out.csv"));
+    EXPECT_FALSE(fs::exists(dir_ / "out.partial.csv"));
+    EXPECT_FALSE(fs::exists(dir_ / "out.html"));
+  }
+  // The same ball without the keys rolls, and is optimized as such.
+  const Outcome rolling = optimize("rolling.toml -o rolling.csv");
+  SKIP_WITHOUT_IPOPT(rolling);
+  EXPECT_EQ(rolling.exit_code, 0) << rolling.out;
+  EXPECT_NE(rolling.out.find("status: solved"), std::string::npos) << rolling.out;
+}
+
+// --html takes models without contacts: the refusal comes before the solve and writes nothing
+// (it came after the whole solve, and left -o's CSV behind with exit 2).
+TEST_F(OptimizeCli, HtmlOnAContactModelIsRefusedBeforeAnyWork) {
+  std::string text = read_example("ball_thrown_sliding.toml");
+  const std::string from = "friction = \"mu\"\nmode = \"sliding\"\n";
+  const std::size_t at = text.find(from);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, from.size(), "");  // a rolling, bilateral contact: optimize takes it
+  write("rolling.toml", text + R"toml(
+[optimize]
+controls = [{ name = "F", actuator = "x" }]
+objective = "F^2"
+t_end = 0.2
+nodes = 5
+initial = { position = { x = 0, y = 0, z = "r", a = 0, b = 0, c = 0 }, velocity = { x = 0, y = 0, z = 0, a = 0, b = 0, c = 0 } }
+final = { position = { x = 1 }, velocity = { x = 0 } }
+)toml");
+  const Outcome run = run_nhdyn("optimize rolling.toml -o out/x.csv --plot out/x.png --html out/x.html", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("--html: the report of an optimum is for models without contacts and [[programs]], and "
+                         "ball-thrown-sliding has contacts; leave --html out"),
+            std::string::npos)
+      << run.out;
+  EXPECT_EQ(run.out.find("status:"), std::string::npos) << run.out;  // no solve
+  EXPECT_FALSE(fs::exists(dir_ / "out")) << run.out;                   // nothing written, no folder made
+}
+
+// A first guess is an input of the run (docs/cli.md, "One rule for the files of a command"):
+// neither -o, --plot, --html nor a failed solve's FILE.partial.csv may replace it, whether it
+// comes from --guess or from guess = in [optimize]; refused before any work, naming both.
+TEST_F(OptimizeCli, TheFirstGuessIsAnInputThatNoOutputReplaces) {
+  const std::string guess = "t,x,x'\n0,0,0\n2,1,0\n";
+  write("g.csv", guess);
+  write("h.partial.csv", guess);
+  const auto unchanged = [&](const std::string& file) {
+    std::ifstream in(dir_ / file);
+    std::stringstream s;
+    s << in.rdbuf();
+    EXPECT_EQ(s.str(), guess) << file;
+  };
+  const std::string di = example("double_integrator.toml");
+  for (const auto& [args, role] :
+       {std::pair<std::string, std::string>{"--guess g.csv -o g.csv", "-o 'g.csv'"},
+        {"--guess h.partial.csv -o h.csv", "the partial-results file 'h.partial.csv'"},
+        {"--guess g.csv -o x.csv --html g.csv", "--html 'g.csv'"}}) {
+    const Outcome run = run_nhdyn("optimize " + di + " " + args, dir_);
+    EXPECT_EQ(run.exit_code, 2) << args << "\n" << run.out;
+    EXPECT_NE(run.out.find("refusing to write " + role + ": it is --guess"), std::string::npos) << run.out;
+    EXPECT_EQ(run.out.find("status:"), std::string::npos) << run.out;
+    unchanged("g.csv");
+    unchanged("h.partial.csv");
+    EXPECT_FALSE(fs::exists(dir_ / "x.csv"));
+    EXPECT_FALSE(fs::exists(dir_ / "h.csv"));
+  }
+  // guess = in the file, given back as the partial-results file of -o.
+  write_variant("double_integrator.toml", "di.toml", {{"final =", "guess = \"h.partial.csv\"\nfinal ="}});
+  const Outcome named = run_nhdyn("optimize di.toml -o h.csv", dir_);
+  EXPECT_EQ(named.exit_code, 2) << named.out;
+  EXPECT_NE(named.out.find("refusing to write the partial-results file 'h.partial.csv': it is the first guess "
+                           "(guess = in [optimize])"),
+            std::string::npos)
+      << named.out;
+  unchanged("h.partial.csv");
+  // Outputs that are not the guess are taken.
+  const Outcome other = optimize(di + " --guess h.partial.csv -o other.csv");
+  SKIP_WITHOUT_IPOPT(other);
+  EXPECT_EQ(other.exit_code, 0) << other.out;
+  unchanged("h.partial.csv");
+}
+
+// The replay rule (docs/optimize.md): a result IPOPT calls solved whose replay difference exceeds
+// a tenth of the largest range of a coordinate over it is no motion of the model: exit 1, the
+// discrete optimum in FILE.partial.csv, no FILE.csv, and the reason with what to do.
+TEST_F(OptimizeCli, AnOptimumTheReplayDoesNotConfirmIsNotCalledSolved) {
+  const auto rejected = [&](const Outcome& run, const std::string& stem) {
+    EXPECT_EQ(run.exit_code, 1) << run.out;
+    EXPECT_NE(run.out.find("status: not a motion of the model (IPOPT: "), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("IPOPT solved the discrete problem, but its optimum is not a motion of the model"),
+              std::string::npos)
+        << run.out;
+    EXPECT_NE(run.out.find("give more nodes, a tighter --tolerance or a first guess"), std::string::npos) << run.out;
+    EXPECT_NE(run.out.find("discrete optimum -> " + stem + ".partial.csv"), std::string::npos) << run.out;
+    EXPECT_FALSE(fs::exists(dir_ / (stem + ".csv")));
+    std::ifstream in(dir_ / (stem + ".partial.csv"));
+    std::string first;
+    std::getline(in, first);
+    EXPECT_EQ(first.rfind("# nhdyn optimize: not a motion of the model (replay difference ", 0), 0U) << first;
+    EXPECT_GT(summary_value(run.out, "replay difference"), 0.1);
+  };
+  // x'' = x F / m from rest at x = 0: x stays 0 whatever F, so x = 1 is out of reach; the discrete
+  // problem "reached" it by a jump in the last interval (replay difference 1 for a range of 1).
+  write_variant("double_integrator.toml", "stuck.toml", {{"actuator = \"x\"", "actuator = [\"x\"]"}});
+  const Outcome stuck = optimize("stuck.toml -o stuck.csv");
+  SKIP_WITHOUT_IPOPT(stuck);
+  rejected(stuck, "stuck");
+  EXPECT_NE(stuck.out.find("the problem may have no solution (an actuator that cannot move the system"),
+            std::string::npos)
+      << stuck.out;
+  // Parking at 3 nodes: 3.6 m off for a 2 m manoeuvre.
+  rejected(optimize(example("parking.toml") + " --set node_count=3 -o park.csv"), "park");
+  // A free final time over [1e-9, 1e9]: IPOPT's "acceptable" at t_end = 5e8 s for the bead that
+  // reaches its end point in 0.806 s.
+  write_variant("brachistochrone.toml", "wide.toml", {{"t_end = { free = [0.1, 5] }", "t_end = { free = [1e-9, 1e9] }"}});
+  rejected(optimize("wide.toml -o wide.csv"), "wide");
+  // The shipped examples stay far inside the limit (the double integrator, exact, and the
+  // brachistochrone here; the others in their own tests).
+  for (const char* name : {"double_integrator.toml", "brachistochrone.toml"}) {
+    const Outcome run = optimize(example(name) + " -o ok.csv");
+    EXPECT_EQ(run.exit_code, 0) << run.out;
+    const std::size_t at = run.out.find("; limit ");
+    ASSERT_NE(at, std::string::npos) << run.out;
+    EXPECT_LT(summary_value(run.out, "replay difference"), 1e-3 * std::stod(run.out.substr(at + 8))) << run.out;
+  }
+}
+
+// A guess is read as a table of finite numbers over [t0, t_end], times never decreasing, each
+// column once: anything else is refused before any work by file, row and column (NaN reached IPOPT
+// as "Invalid number", unsorted or outside times were interpolated as they fell); columns that
+// name nothing in the problem, and a guess covering part of [t0, t_end], are named in a note.
+TEST_F(OptimizeCli, AGuessThatIsNotATableOfTheMotionIsRefusedByRowAndColumn) {
+  const std::string di = example("double_integrator.toml");
+  const auto refused = [&](const std::string& csv, const std::string& message) {
+    write("g.csv", csv);
+    const Outcome run = run_nhdyn("optimize " + di + " --guess g.csv -o o.csv", dir_);
+    EXPECT_EQ(run.exit_code, 2) << csv << "\n" << run.out;
+    EXPECT_NE(run.out.find("g.csv: " + message), std::string::npos) << csv << "\n" << run.out;
+    EXPECT_EQ(run.out.find("status:"), std::string::npos) << run.out;
+    EXPECT_FALSE(fs::exists(dir_ / "o.csv"));
+    EXPECT_FALSE(fs::exists(dir_ / "o.partial.csv"));
+  };
+  refused("t,x,x'\n0,0,0\n1,nan,0\n2,1,0\n", "row 2: x = nan is not finite");
+  refused("t,x,x'\n0,0,0\n1,0.5,inf\n2,1,0\n", "row 2: x' = inf is not finite");
+  refused("t,x,x'\n0,0,0\n2,1,0\n1,0.5,0\n", "row 3: t = 1 is before the row above (t = 2)");
+  refused("t,x,x'\n5,0,0\n7,1,0\n", "the guess covers t = 5 to 7, outside the problem's [0, 2]");
+  refused("t,x,x'\n1,0,0\n1,1,0\n", "the guess's times span nothing (every row at t = 1)");
+  refused("t,x,x',x\n0,0,0,0\n2,1,0,1\n", "the guess names the column 'x' twice (columns 2 and 4)");
+  // Taken, with what it does not use and what it does not cover named.
+  write("g.csv", "t,x,x',u_G,speed\n0,0,0,1,0\n1.5,1,0,1,0\n");
+  const Outcome taken = optimize(di + " --guess g.csv -o o.csv");
+  SKIP_WITHOUT_IPOPT(taken);
+  EXPECT_EQ(taken.exit_code, 0) << taken.out;
+  EXPECT_NE(taken.out.find("note: the guess g.csv has columns that name nothing in the problem, ignored: u_G, speed"),
+            std::string::npos)
+      << taken.out;
+  EXPECT_NE(taken.out.find("note: the guess g.csv covers t = 0 to 1.5 of [0, 2]: its last row is held beyond"),
+            std::string::npos)
+      << taken.out;
+  // A previous result, which covers [t0, t_end] with the problem's columns, gets neither note.
+  const Outcome again = optimize(di + " --guess o.csv -o o2.csv");
+  EXPECT_EQ(again.exit_code, 0) << again.out;
+  EXPECT_EQ(again.out.find("note: the guess"), std::string::npos) << again.out;
+}
+
+// What can be decided before IPOPT is, with the expression's file:line:column: an objective, path
+// constraint or actuator that is not finite on the first guess (IPOPT stopped on "Invalid number"
+// and the note blamed the straight line), and a path constraint that the fixed initial or final
+// values, or nothing at all, make fail (IPOPT ran 38 iterations to "infeasible").
+TEST_F(OptimizeCli, WhatFailsOnTheFirstGuessOrAtTheFixedEndsIsNamedBeforeTheSolve) {
+  const auto refused = [&](const std::string& file, const std::vector<std::pair<std::string, std::string>>& changes,
+                           const std::string& message) {
+    write_variant("double_integrator.toml", file, changes);
+    const Outcome run = run_nhdyn("optimize " + file + " -o o.csv", dir_);
+    EXPECT_EQ(run.exit_code, 2) << run.out;
+    EXPECT_NE(run.out.find(message), std::string::npos) << run.out;
+    EXPECT_EQ(run.out.find("status:"), std::string::npos) << run.out;
+    EXPECT_EQ(run.out.find("IPOPT did not converge"), std::string::npos) << run.out;
+    EXPECT_FALSE(fs::exists(dir_ / "o.csv"));
+    EXPECT_FALSE(fs::exists(dir_ / "o.partial.csv"));
+    return run.out;
+  };
+  const std::string sqrt = refused("sqrt.toml", {{"objective = \"F^2\"", "objective = \"F^2 + sqrt(x - 0.5)\""}},
+                                   "sqrt.toml:13:13: the objective \"F^2 + sqrt(x - 0.5)\" is not finite (");
+  EXPECT_NE(sqrt.find("at the first guess's point t = 0, x = 0, x' = 0, F = 0: give a first guess where it is defined"),
+            std::string::npos)
+      << sqrt;
+  refused("inverse.toml", {{"final =", "path = [\"1/x <= 100\"]\nfinal ="}},
+          "inverse.toml:18:9: the path constraint \"1/x <= 100\" is not finite (inf) at the first guess's point t = 0, "
+          "x = 0, x' = 0, F = 0");
+  // The straight line from 0 to 1 passes x = 0.5 at its middle point, t = 1.
+  refused("pole.toml", {{"actuator = \"x\"", "actuator = [\"1/(x - 0.5)\"]"}},
+          "pole.toml:12:38: the actuator [1/(x - 0.5)] of control 'F' (its entry on x) is not finite (inf) at the first "
+          "guess's point t = 1, x = 0.5, x' = 0, F = 0");
+  refused("start.toml", {{"final =", "path = [\"x >= 2\"]\nfinal ="}},
+          "start.toml:18:9: the path constraint \"x >= 2\" cannot hold at t = 0: with the fixed initial values x = 0, "
+          "its left side less its right side is -2, which must be >= 0");
+  refused("end.toml", {{"final =", "path = [\"x + x' <= 0.5\"]\nfinal ="}},
+          "end.toml:18:9: the path constraint \"x + x' <= 0.5\" cannot hold at t = 2: with the fixed final values x = "
+          "1, x' = 0, its left side less its right side is 0.5, which must be <= 0; change the final values");
+  refused("never.toml", {{"final =", "path = [\"1 >= 2\"]\nfinal ="}},
+          "never.toml:18:9: the path constraint \"1 >= 2\" cannot hold at t = 0: it reads no coordinate, velocity or "
+          "control");
+  // A path constraint the free values can meet is left to IPOPT: x <= 1.2 along the way.
+  write_variant("double_integrator.toml", "fine.toml", {{"final =", "path = [\"x <= 1.2\", \"2 >= 1\"]\nfinal ="}});
+  const Outcome fine = optimize("fine.toml -o fine.csv");
+  SKIP_WITHOUT_IPOPT(fine);
+  EXPECT_EQ(fine.exit_code, 0) << fine.out;
+}
+
+// Messages about boundary values, bounds, control names and the guess file say where and what:
+// file:line:column for a value outside its bounds (and the bounds' own place), no IPOPT infinity
+// shown as if the user had given bounds, "control" for a control, a directory called one.
+TEST_F(OptimizeCli, BoundsControlNamesAndTheGuessFileAreNamedWhereTheyAreWritten) {
+  const auto refused = [&](const std::string& args, const std::string& message) {
+    const Outcome run = run_nhdyn("optimize " + args + " -o o.csv", dir_);
+    EXPECT_EQ(run.exit_code, 2) << args << "\n" << run.out;
+    EXPECT_NE(run.out.find(message), std::string::npos) << args << "\n" << run.out;
+    EXPECT_FALSE(fs::exists(dir_ / "o.csv"));
+  };
+  write_variant("double_integrator.toml", "final.toml", {{"final =", "bounds = { x = [0, 0.5] }\nfinal ="}});
+  refused("final.toml", "final.toml:19:28: the final value x = 1 lies outside its bounds [0, 0.5] (given at "
+                        "final.toml:18:16): change one of them");
+  write_variant("double_integrator.toml", "initial.toml",
+                {{"final =", "bounds = { \"x'\" = [1, 2] }\nfinal ="}});
+  refused("initial.toml", "initial.toml:17:52: the initial value x' = 0 lies outside its bounds [1, 2] (given at "
+                          "initial.toml:18:19)");
+  // No bounds given: IPOPT's infinity is not shown as bounds.
+  const std::string huge = example("double_integrator.toml") + " --set d=1e150";
+  const Outcome run = run_nhdyn("optimize " + huge + " -o o.csv", dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.out;
+  EXPECT_NE(run.out.find("double_integrator.toml:18:28: the final value x = 1e+150 is too large for the optimizer"),
+            std::string::npos)
+      << run.out;
+  EXPECT_EQ(run.out.find("1e+20"), std::string::npos) << run.out;
+  // A control's name refused as a control's, at its name.
+  for (const auto& [name, why] : {std::pair<std::string, std::string>{"t", "'t' is the time"},
+                                  {"F G", "not a valid name"},
+                                  {"sin", "'sin' is the name of a function"}}) {
+    write_variant("double_integrator.toml", "name.toml", {{"name = \"F\"", "name = \"" + name + "\""}, {"F^2", "x^2"}});
+    refused("name.toml", "name.toml:12:22: control '");
+    refused("name.toml", why);
+  }
+  // A one-sided bound: what to write instead of inf.
+  write_variant("double_integrator.toml", "inf.toml", {{"final =", "bounds = { F = [-inf, 10] }\nfinal ="}});
+  refused("inf.toml", "inf.toml:18:17: the bounds of F are finite numbers: for a bound on one side only, give the "
+                      "other a value far beyond the motion, e.g. F = [-1e6, 10]");
+  // --html and --plot go into a folder that exists (or the one made for -o): optimize makes only
+  // the folders of its tables.
+  refused(example("double_integrator.toml") + " --html nodir/x.html", "the directory 'nodir' does not exist");
+  EXPECT_FALSE(fs::exists(dir_ / "nodir"));
+  // guess = a directory says so.
+  write_variant("double_integrator.toml", "dir.toml", {{"final =", "guess = \".\"\nfinal ="}});
+  refused("dir.toml", "dir.toml:18:9: the guess file . is a directory");
 }
 
 // IPOPT is a module loaded when a program is first solved (src/nhdyn/optimize/ipopt/solver_module.cpp):

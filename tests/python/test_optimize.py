@@ -108,3 +108,43 @@ def test_solver_options_are_checked_before_any_work(examples):
     for budget in (0, -5):
         with pytest.raises(nhdyn.InputError, match=f"the optimizer's iteration budget {budget} must be at least 1"):
             m.optimize(max_iterations=budget)
+
+
+def test_an_optimum_the_replay_does_not_confirm_is_not_converged(examples, tmp_path):
+    # x'' = x F / m from rest at x = 0 never moves, whatever F: IPOPT "solves" the discrete
+    # problem by a jump in the last interval, the replay stays at 0 (docs/optimize.md, the replay
+    # rule). The CLI exits 1; Python warns and says converged False, as for a failed solve.
+    text = (examples / "double_integrator.toml").read_text().replace('actuator = "x"', 'actuator = ["x"]')
+    (tmp_path / "stuck.toml").write_text(text)
+    m = nhdyn.load(tmp_path / "stuck.toml")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = needs_ipopt(lambda: m.optimize())
+    assert not r.converged and r.status == "not a motion of the model"
+    assert r.replay_difference > r.replay_limit > 0
+    assert "its optimum is not a motion of the model" in r.replay_verdict
+    assert "a tighter tolerance" in r.replay_verdict and "--" not in r.replay_verdict
+    assert any("not a motion of the model" in str(w.message) for w in caught)
+    # A confirmed optimum: converged, no verdict, the replay far inside its limit.
+    ok = needs_ipopt(lambda: nhdyn.load(examples / "double_integrator.toml").optimize())
+    assert ok.converged and ok.status == "solved" and ok.replay_verdict == ""
+    assert ok.replay_difference < 1e-6 * ok.replay_limit
+
+
+def test_solver_options_of_the_wrong_type_are_refused_in_words(examples):
+    # float() and int() took "1e-3" and 1.9 or True (as 1) silently; 10**30 reached pybind11's
+    # "incompatible function arguments", which shows the binding's internals.
+    m = nhdyn.load(examples / "double_integrator.toml")
+    for tolerance in ("1e-3", True, None, 1e-3j):
+        with pytest.raises(nhdyn.InputError, match=r"optimize: tolerance=.*: give a real number above 0"):
+            m.optimize(tolerance=tolerance)
+    for budget in (1.9, True, "10", 3000.0):
+        with pytest.raises(nhdyn.InputError, match=r"optimize: max_iterations=.*: give a whole number of iterations"):
+            m.optimize(max_iterations=budget)
+    for budget in (10**30, -10**30):
+        with pytest.raises(nhdyn.InputError, match=r"max_iterations=-?1000000000000000000000000000000: give a whole "
+                                                   r"number from 1 to 2147483647"):
+            m.optimize(max_iterations=budget)
+    # NumPy's numbers are numbers.
+    r = needs_ipopt(lambda: m.optimize(tolerance=np.float64(1e-9), max_iterations=np.int64(100)))
+    assert r.converged and r.objective == pytest.approx(1.5, rel=1e-9)

@@ -20,6 +20,7 @@
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/core/detail/suggest.hpp"
+#include "nhdyn/model/contact_modes.hpp"
 #include "nhdyn/symbolic/compile.hpp"
 #include "nhdyn/symbolic/spec_builder.hpp"
 
@@ -71,12 +72,14 @@ class SectionReader {
     if (model_.m() > 0)
       fail(*node, "the model has [[programs]]; optimize finds the program itself: leave the [[programs]] out of "
                   "this model file");
+    require_rolling_contacts();
     read_controls(*section, p);
     declare_layout();
     read_method(*section, p);
     read_time(*section, p);
     p.state_lower.assign(static_cast<std::size_t>(2 * n), -kNoBound);
     p.state_upper.assign(static_cast<std::size_t>(2 * n), kNoBound);
+    p.state_bounds_where.assign(static_cast<std::size_t>(2 * n), "");
     if (const toml::node* b = section->get("bounds")) read_bounds(*b, p);
     if (const toml::node* v = section->get("initial")) p.initial = read_state(*v, "initial");
     // final = { ... } is the final state; final = "..." (the spelling of the Mayer term) is
@@ -118,6 +121,25 @@ class SectionReader {
     }
   }
 
+  // The transcription imposes every contact's constraints at every point, as rolling and
+  // bilateral; a contact that may slide or lift off (friction, unilateral, restitution, mode:
+  // docs/contact-modes.md) would be optimized under another law than the model's, silently.
+  void require_rolling_contacts() const {
+    if (!model_.contact_modes) return;
+    for (const ContactModeContact& c : model_.contact_modes->contacts) {
+      std::vector<std::string> keys;
+      if (c.friction) keys.emplace_back("friction");
+      if (c.unilateral) keys.emplace_back("unilateral");
+      if (c.initial >= 0) keys.emplace_back("mode");
+      throw InputError(fmt::format(
+          "{}{}contact '{}' has {}: optimize takes contacts as rolling, bilateral constraints (it cannot let one "
+          "slide, lift off or bounce), so it would optimize another motion than the model's; for an optimization, "
+          "remove friction, unilateral, restitution and mode from the contact (docs/optimize.md)",
+          c.where, c.where.empty() ? "" : ": ", c.name,
+          keys.empty() ? std::string("contact-mode keys") : join(keys, " and ")));
+    }
+  }
+
   // guess = "FILE.csv": relative to the model file's folder (a model given as text: to the
   // working directory); it must exist, so that a typo is caught before the solve.
   std::string read_guess(const toml::node& node) const {
@@ -129,6 +151,8 @@ class SectionReader {
     const std::filesystem::path file(file_);
     if (path.is_relative() && file_ != "<string>" && file.has_parent_path()) path = file.parent_path() / path;
     std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+      fail(node, fmt::format("the guess file {} is a directory: write the path of a CSV in it", path.string()));
     if (!std::filesystem::is_regular_file(path, ec))
       fail(node, fmt::format("the guess file {} does not exist (guess is relative to the model file's folder); "
                              "write its path, or leave guess out and give --guess FILE.csv",
@@ -180,6 +204,8 @@ class SectionReader {
                                 control.name));
       taken.push_back(control.name);
       actuator_nodes_.push_back(actuator);
+      name_nodes_.push_back(name);
+      control.where = at(*actuator).describe();
       if (const auto* s = actuator->as_string()) {
         control.actuator = s->get();
       } else if (const auto* entries = actuator->as_array()) {
@@ -196,7 +222,18 @@ class SectionReader {
 
   void declare_layout() {
     for (const std::string& c : model_.coordinates) layout_.coordinate(c);
-    for (const OptimizeControl& c : controls_) layout_.coordinate(c.name);
+    for (std::size_t j = 0; j < controls_.size(); ++j) {
+      try {
+        layout_.coordinate(controls_[j].name);
+      } catch (const ModelError& e) {
+        // The layout declares a control as a coordinate, and SpecBuilder's refusal of its name
+        // ("coordinate 't': 't' is the time ...") says so: said again of the control, at its name.
+        const std::string text = e.what();
+        const std::size_t quote = text.find("coordinate '"), end = text.find("': ", quote);
+        if (quote == std::string::npos || end == std::string::npos) throw;
+        fail(*name_nodes_[j], "control " + text.substr(quote + 11, end + 1 - quote - 11) + ": " + text.substr(end + 3));
+      }
+    }
     for (const Parameter& q : model_.parameters) layout_.parameter(q.name, q.value);
   }
 
@@ -340,7 +377,7 @@ class SectionReader {
         fail(value, fmt::format("{} gives {}{} twice", what, model_.coordinates[static_cast<std::size_t>(index)],
                                 velocity ? "'" : ""));
       seen.emplace_back(index, velocity);
-      values.push_back({index, velocity, number(value, fmt::format("{}.{}", what, key))});
+      values.push_back({index, velocity, number(value, fmt::format("{}.{}", what, key)), at(value).describe()});
     };
     for (auto&& [key, value] : *table) {
       const std::string name(key.str());
@@ -361,6 +398,12 @@ class SectionReader {
       const toml::array* range = value.as_array();
       if (range == nullptr || range->size() != 2)
         fail(value, fmt::format("the bounds of {} are [lower, upper] (numbers or expressions in quotes)", name));
+      // A bound on one side only is written with the other far beyond the motion: inf is not a number here.
+      for (const toml::node& side : *range)
+        if (const auto* f = side.as_floating_point(); f != nullptr && !std::isfinite(f->get()))
+          fail(side, fmt::format("the bounds of {} are finite numbers: for a bound on one side only, give the other "
+                                 "a value far beyond the motion, e.g. {} = [-1e6, 10]",
+                                 name, name));
       const double lo = number(*range->get(0), fmt::format("the lower bound of {}", name));
       const double hi = number(*range->get(1), fmt::format("the upper bound of {}", name));
       if (lo > hi)
@@ -385,6 +428,7 @@ class SectionReader {
       const std::size_t slot = static_cast<std::size_t>(index + (velocity ? n() : 0));
       p.state_lower[slot] = lo;
       p.state_upper[slot] = hi;
+      p.state_bounds_where[slot] = at(value).describe();
     }
   }
 
@@ -394,6 +438,7 @@ class SectionReader {
       fail(section, "[optimize] has no objective: give the integrand, objective = \"F^2\", or objective = \"time\"");
     const auto* s = node->as_string();
     p.objective_text = s != nullptr ? s->get() : text_of(*node, "objective");
+    p.objective_where = at(*node).describe();
     if (s != nullptr && s->get() == "time" && !symbols().has("time")) {
       if (!p.free_time)
         fail(*node, "objective = \"time\" needs a free final time, t_end = { free = [earliest, latest] }");
@@ -413,6 +458,7 @@ class SectionReader {
     if (f != nullptr) {
       const GiNaC::ex e = parse(*f, "objective_final", true, false);
       p.final_term = compile({e}, {"objective_final"});
+      p.final_term_where = at(*f).describe();
       objective_ += e;
     }
   }
@@ -449,7 +495,13 @@ class SectionReader {
       what.push_back(fmt::format("path constraint \"{}\"", text));
       PathConstraint c;
       c.text = text;
+      c.where = at(element).describe();
       (greater ? c.lower : c.upper) = 0.0;
+      const GiNaC::ex g = lhs - rhs;
+      for (int i = 0; i < n(); ++i) c.reads.push_back(g.has(symbols().coordinate(i)) ? 1 : 0);
+      for (int i = 0; i < n(); ++i) c.reads.push_back(g.has(symbols().velocity(i)) ? 1 : 0);
+      for (int j = 0; j < m(); ++j) c.reads.push_back(g.has(symbols().coordinate(n() + j)) ? 1 : 0);
+      c.reads_time = g.has(symbols().time());
       p.path_constraints.push_back(c);
       path_.push_back(lhs - rhs);
     }
@@ -458,7 +510,8 @@ class SectionReader {
 
   // B u from the actuators: a coordinate (a unit column) or a direction with one entry per coordinate.
   void compile_force(OptimalControlProblem& p) const {
-    std::vector<GiNaC::ex> force(static_cast<std::size_t>(n()), GiNaC::ex(0));
+    std::vector<GiNaC::ex> force(static_cast<std::size_t>(n()), GiNaC::ex(0)), columns;
+    std::vector<std::string> entries_what;
     for (int j = 0; j < m(); ++j) {
       const toml::node& node = *actuator_nodes_[static_cast<std::size_t>(j)];
       const GiNaC::symbol& u = symbols().coordinate(n() + j);
@@ -491,8 +544,13 @@ class SectionReader {
         fail(node, fmt::format("control '{}' acts on nothing: its actuator direction is zero; give the coordinate its "
                                "force acts on or a nonzero direction",
                                name_of(n() + j)));
-      for (int i = 0; i < n(); ++i) force[static_cast<std::size_t>(i)] += column[static_cast<std::size_t>(i)] * u;
+      for (int i = 0; i < n(); ++i) {
+        force[static_cast<std::size_t>(i)] += column[static_cast<std::size_t>(i)] * u;
+        columns.push_back(column[static_cast<std::size_t>(i)]);
+        entries_what.push_back(fmt::format("the actuator of control '{}' on {}", name_of(n() + j), name_of(i)));
+      }
     }
+    p.actuators = compile(columns, entries_what);
     std::vector<std::string> what;
     for (int i = 0; i < n(); ++i) what.push_back(fmt::format("actuator force on {}", name_of(i)));
     p.force = compile(force, what);
@@ -519,7 +577,7 @@ class SectionReader {
   const Model& model_;
   symbolic::SpecBuilder layout_;
   std::vector<OptimizeControl> controls_;
-  std::vector<const toml::node*> actuator_nodes_;
+  std::vector<const toml::node*> actuator_nodes_, name_nodes_;
   GiNaC::ex objective_ = 0;
   std::vector<GiNaC::ex> path_;
 };

@@ -35,6 +35,7 @@ inline constexpr double kNoBound = std::numeric_limits<double>::infinity();
 struct OptimizeControl {
   std::string name;      // the CSV column is u_<name>
   std::string actuator;  // as written: a coordinate or "[e1, ..., en]"
+  std::string where;     // file:line:column of the actuator, for messages
   double lower = -kNoBound;
   double upper = kNoBound;
 };
@@ -44,13 +45,19 @@ struct BoundaryValue {
   int index = 0;
   bool velocity = false;
   double value = 0.0;
+  std::string where;  // file:line:column of the value, for messages
 };
 
 // A path constraint lower <= g(t, q, q', u) <= upper, imposed at every point.
 struct PathConstraint {
   std::string text;  // as written, e.g. "(x - 5)^2 + (y - 1)^2 >= 1"
+  std::string where;  // file:line:column, for messages
   double lower = -kNoBound;
   double upper = kNoBound;
+  // What g reads, 2n + m flags in the order (q, q', u), and t: a constraint that reads only fixed
+  // boundary values is decided before the solve (Transcription).
+  std::vector<char> reads;
+  bool reads_time = false;
 };
 
 struct OptimalControlProblem {
@@ -59,12 +66,14 @@ struct OptimalControlProblem {
   // Programs over the control layout (n + m coordinates [q; u], velocities [q'; 0]), bound to the
   // model's parameter values:
   Tape force;                  // n outputs: B(t, q, q') u, the actuators' generalized force
+  Tape actuators;              // n m outputs: B(t, q, q') column by column, for the checks of a first guess
   Tape integrand;              // 1 output: L(t, q, q', u) (the constant 0 when not given)
   std::optional<Tape> final_term;  // 1 output: the Mayer term M(t, q, q') at t_end
   Tape path;                   // one output per path constraint
   std::vector<PathConstraint> path_constraints;
   bool minimum_time = false;      // objective = "time": J = t_end - t0
   std::string objective_text;     // as written, for the summary
+  std::string objective_where, final_term_where;  // file:line:column of objective and objective_final
   double t0 = 0.0;
   double t_end = 1.0;             // fixed final time, or the first guess of a free one
   bool free_time = false;         // t_end = { free = [min, max] }
@@ -75,6 +84,7 @@ struct OptimalControlProblem {
   std::vector<BoundaryValue> initial, final;
   // Bounds on the coordinates and velocities at every point: 2n each, [q; q'].
   std::vector<double> state_lower, state_upper;
+  std::vector<std::string> state_bounds_where;  // 2n: file:line:column of each bound given, else ""
   std::vector<std::string> warnings;  // e.g. a control that neither the objective nor a bound sees
   // [optimize] guess = "FILE.csv": the first guess when none is given (--guess, guess=), its path
   // relative to the model file's folder resolved; empty without the key.

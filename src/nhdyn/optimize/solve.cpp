@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/join.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/optimize/replay.hpp"
 #include "nhdyn/optimize/transcription.hpp"
@@ -29,26 +30,31 @@ const char* nlp_status_name(NlpStatus status) {
 
 namespace {
 
-// The guess CSV interpolated linearly at each point's time (columns found by name).
-void apply_guess(const Transcription& nlp, const std::filesystem::path& path, std::vector<double>& x) {
+// The guess CSV interpolated linearly at each point's time (columns found by name), after the
+// checks that keep a bad file from reaching IPOPT as numbers it cannot use: every value read
+// finite, the times never decreasing and spanning an interval that meets [t0, t_end], each column
+// named once. Returns the notes: columns that name nothing in the problem (ignored), and a guess
+// that covers only part of [t0, t_end] (its end rows held beyond).
+std::vector<std::string> apply_guess(const Transcription& nlp, const std::filesystem::path& path,
+                                     std::vector<double>& x) {
   const OptimalControlProblem& problem = nlp.problem();
+  const std::string file = path.string();
   const CsvTable table = load_csv(path);
   const auto column = [&](const std::string& name) -> int {
     return table.column(name);
   };
+  for (std::size_t c = 0; c < table.header.size(); ++c)
+    for (std::size_t d = 0; d < c; ++d)
+      if (table.header[c] == table.header[d])
+        throw InputError(fmt::format("{}: the guess names the column '{}' twice (columns {} and {}): keep one",
+                                     file, table.header[c], d + 1, c + 1));
   const int t_column = column("t");
   if (t_column < 0 || table.rows.size() < 2)
-    throw InputError(fmt::format("{}: a guess needs a column t and at least two rows", path.string()));
-  const auto value = [&](int c, double t) {
-    const std::size_t rows = table.rows.size();
-    std::size_t hi = 1;
-    while (hi + 1 < rows && table.rows[hi][static_cast<std::size_t>(t_column)] < t) ++hi;
-    const double t0 = table.rows[hi - 1][static_cast<std::size_t>(t_column)], t1 = table.rows[hi][static_cast<std::size_t>(t_column)];
-    const double s = t1 > t0 ? std::clamp((t - t0) / (t1 - t0), 0.0, 1.0) : 0.0;
-    return (1 - s) * table.rows[hi - 1][static_cast<std::size_t>(c)] + s * table.rows[hi][static_cast<std::size_t>(c)];
-  };
+    throw InputError(fmt::format("{}: a guess needs a column t and at least two rows", file));
   const int n = problem.n(), m = problem.m();
   std::vector<std::pair<int, int>> map;  // (variable offset in a point, csv column)
+  std::vector<char> known(table.header.size(), 0);
+  known[static_cast<std::size_t>(t_column)] = 1;
   for (int i = 0; i < n; ++i) {
     const std::string& name = problem.model.coordinates[static_cast<std::size_t>(i)];
     for (int level = 0; level < 3; ++level) {
@@ -56,7 +62,7 @@ void apply_guess(const Transcription& nlp, const std::filesystem::path& path, st
       if (c < 0 && level < 2)
         throw InputError(fmt::format("{}: the guess has no column '{}{}': give t, the coordinates and their velocities "
                                      "(and optionally x'' and u_NAME) as nhdyn optimize writes them",
-                                     path.string(), name, level == 1 ? "'" : ""));
+                                     file, name, level == 1 ? "'" : ""));
       if (c >= 0) map.emplace_back(level * n + i, c);
     }
   }
@@ -64,10 +70,56 @@ void apply_guess(const Transcription& nlp, const std::filesystem::path& path, st
     const int c = column("u_" + problem.controls[static_cast<std::size_t>(j)].name);
     if (c >= 0) map.emplace_back(3 * n + j, c);
   }
+  for (const auto& [offset, c] : map) known[static_cast<std::size_t>(c)] = 1;
+  const std::size_t tc = static_cast<std::size_t>(t_column);
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    for (std::size_t c = 0; c < table.header.size(); ++c)
+      if (known[c] && !std::isfinite(table.rows[r][c]))
+        throw InputError(fmt::format("{}: row {}: {} = {} is not finite; a guess holds finite values", file, r + 1,
+                                     table.header[c], table.rows[r][c]));
+    if (r > 0 && table.rows[r][tc] < table.rows[r - 1][tc])
+      throw InputError(fmt::format("{}: row {}: t = {} is before the row above (t = {}); a guess's times never "
+                                   "decrease",
+                                   file, r + 1, table.rows[r][tc], table.rows[r - 1][tc]));
+  }
+  const double first = table.rows.front()[tc], last = table.rows.back()[tc];
+  const double t0 = problem.t0, t_end = nlp.time(nlp.points() - 1, x.data());
+  if (!(last > first))
+    throw InputError(fmt::format("{}: the guess's times span nothing (every row at t = {}): give rows over [{}, {}]",
+                                 file, first, t0, t_end));
+  if (last < t0 || first > t_end)
+    throw InputError(fmt::format("{}: the guess covers t = {} to {}, outside the problem's [{}, {}]: give rows over "
+                                 "[t0, t_end]",
+                                 file, first, last, t0, t_end));
+  std::vector<std::string> notes;
+  const double slack = 1e-9 * (t_end - t0);  // a previous result's last time, rounded in its CSV
+  const bool late = first > t0 + slack, early = last < t_end - slack;
+  if (late || early)
+    notes.push_back(fmt::format("the guess {} covers t = {} to {} of [{}, {}]: its {} held beyond", file, first, last,
+                                t0, t_end,
+                                late && early ? "first and last rows are"
+                                : late        ? "first row is"
+                                              : "last row is"));
+  std::vector<std::string> ignored;
+  for (std::size_t c = 0; c < table.header.size(); ++c)
+    if (!known[c]) ignored.push_back(table.header[c]);
+  if (!ignored.empty())
+    notes.push_back(fmt::format("the guess {} has column{} that name{} nothing in the problem, ignored: {} (it takes t, "
+                                "the coordinates, x', x'' and u_NAME of the controls)",
+                                file, ignored.size() > 1 ? "s" : "", ignored.size() > 1 ? "" : "s", join(ignored)));
+  const auto value = [&](int c, double t) {
+    const std::size_t rows = table.rows.size();
+    std::size_t hi = 1;
+    while (hi + 1 < rows && table.rows[hi][tc] < t) ++hi;
+    const double ta = table.rows[hi - 1][tc], tb = table.rows[hi][tc];
+    const double s = tb > ta ? std::clamp((t - ta) / (tb - ta), 0.0, 1.0) : 0.0;
+    return (1 - s) * table.rows[hi - 1][static_cast<std::size_t>(c)] + s * table.rows[hi][static_cast<std::size_t>(c)];
+  };
   for (int p = 0; p < nlp.points(); ++p) {
     const double t = nlp.time(p, x.data());
     for (const auto& [offset, c] : map) x[static_cast<std::size_t>(p * nlp.width() + offset)] = value(c, t);
   }
+  return notes;
 }
 
 // The solver's options, before any work: IPOPT takes only tol > 0 and max_iter >= 0, and drops
@@ -88,7 +140,42 @@ void check_nlp_options(const NlpOptions& options) {
                                  options.max_iterations));
 }
 
+// The replay rule (solve.hpp, docs/optimize.md): the discretized optimum replayed by the
+// simulator must stay within a tenth of the motion's own size. Beyond that the controls do not
+// produce the motion IPOPT found: a grid too coarse for it (parking at 3 nodes: 3.6 m off for a
+// 2 m manoeuvre), or a problem with no solution whose discrete equations have one (an actuator
+// x F on a mass at rest at x = 0, which never moves, "reached" x = 1 by a jump in the last
+// interval), or a free final time run off to its bound.
+void apply_replay_rule(OptimizeResult& result, int n) {
+  double largest = 0.0;
+  for (int i = 0; i < n; ++i) {
+    double lo = kNoBound, hi = -kNoBound;
+    for (int p = 0; p < result.points; ++p) {
+      const double q = result.q[static_cast<std::size_t>(p * n + i)];
+      lo = std::min(lo, q);
+      hi = std::max(hi, q);
+      largest = std::max(largest, std::abs(q));
+    }
+    if (result.points > 0) result.motion_range = std::max(result.motion_range, hi - lo);
+  }
+  result.replay_limit = std::max(kReplayShare * result.motion_range, kReplayFloor * (1.0 + largest));
+  if (!result.converged() || !result.replayed || result.replay_difference <= result.replay_limit) return;
+  result.replay_rejected = true;
+  result.replay_verdict = fmt::format(
+      "IPOPT solved the discrete problem, but its optimum is not a motion of the model: the controls, replayed "
+      "by the simulator, move the coordinates {:.3e} away from it, against a largest range of a coordinate of "
+      "{:.3e} over the motion (the limit is a tenth of it, {:.3e}; docs/optimize.md). The grid may be too coarse "
+      "for the motion: give more nodes, a tighter --tolerance or a first guess (--guess FILE.csv). Or the problem "
+      "may have no solution (an actuator that cannot move the system, a final state out of reach, a free final "
+      "time run off to its bound) whose discrete form has one",
+      result.replay_difference, result.motion_range, result.replay_limit);
+}
+
 }  // namespace
+
+const char* optimize_status_name(const OptimizeResult& result) {
+  return result.replay_rejected ? "not a motion of the model" : nlp_status_name(result.solver.status);
+}
 
 OptimizeResult solve_optimal_control(const OptimalControlProblem& problem, const OptimizeOptions& options) {
   check_nlp_options(options.nlp);
@@ -100,10 +187,12 @@ OptimizeResult solve_optimal_control(const OptimalControlProblem& problem, const
   const std::filesystem::path guess = options.guess.empty() ? std::filesystem::path(problem.guess) : options.guess;
   if (!guess.empty()) {
     std::vector<double> x = nlp.start();
-    apply_guess(nlp, guess, x);
+    const std::vector<std::string> notes = apply_guess(nlp, guess, x);
     nlp.set_start(std::move(x));
     result.notes.push_back("first guess: " + guess.string());
+    result.notes.insert(result.notes.end(), notes.begin(), notes.end());
   }
+  nlp.require_defined_at_start();
   result.solver = solve_nlp(nlp, options.nlp);
   if (result.solver.status == NlpStatus::unavailable) return result;
   std::vector<double> x = result.solver.x.empty() ? nlp.start() : result.solver.x;
@@ -126,6 +215,7 @@ OptimizeResult solve_optimal_control(const OptimalControlProblem& problem, const
   result.replayed = replay.ok;
   result.replay_difference = replay.difference;
   result.replay_message = replay.message;
+  apply_replay_rule(result, n);
   if (!result.converged() && guess.empty())
     result.notes.push_back("IPOPT did not converge from the straight line between the boundary states, which can be a "
                            "stationary point of the constraints' violation (as for the Brockett integrator): give a "
@@ -160,15 +250,17 @@ std::string format_optimize_summary(const OptimalControlProblem& problem, const 
   std::string out = fmt::format("nhdyn optimize {}: {} nodes, {}, controls {}, objective {}\n", problem.model.name,
                                 problem.nodes, collocation_method_name(problem.method), controls,
                                 problem.minimum_time ? "time" : "\"" + problem.objective_text + "\"");
-  out += fmt::format("status: {} ({})\n", nlp_status_name(result.solver.status), result.solver.message);
+  out += fmt::format("status: {} ({}{})\n", optimize_status_name(result), result.replay_rejected ? "IPOPT: " : "",
+                     result.solver.message);
   if (result.solver.status == NlpStatus::unavailable) return out;
   out += fmt::format("iterations: {}\n", result.solver.iterations);
   out += fmt::format("objective: {:.10g}\n", result.objective);
   if (problem.free_time) out += fmt::format("t_end: {:.10g}\n", result.t_end);
   out += fmt::format("constraint violation: {:.3e}\n", result.constraint_violation);
   if (result.replayed)
-    out += fmt::format("replay difference: {:.3e} (largest |q - q_replayed| at the nodes; dop853, rtol 1e-11)\n",
-                       result.replay_difference);
+    out += fmt::format("replay difference: {:.3e} (largest |q - q_replayed| at the nodes; dop853, rtol 1e-11; "
+                       "limit {:.3e})\n",
+                       result.replay_difference, result.replay_limit);
   else
     out += fmt::format("replay difference: none ({})\n", result.replay_message);
   for (const std::string& note : result.notes) out += "note: " + note + "\n";

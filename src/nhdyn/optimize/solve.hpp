@@ -35,8 +35,28 @@ struct OptimizeResult {
   std::vector<double> times;        // P
   std::vector<double> q, v, a, u;   // P x n (or m), a row per point
   std::vector<std::string> notes;   // the rank rule's rows left out, the guess's source, warnings
+  // The replay rule (docs/optimize.md, "When the result is not a motion of the model"): a result
+  // IPOPT calls solved whose replay difference exceeds replay_limit is a solution of the discrete
+  // equations only, not a motion of the model (a grid too coarse for it, or a problem without
+  // solution whose discrete form has one).
+  double motion_range = 0.0;        // the largest range (max - min) of a coordinate over the points
+  double replay_limit = 0.0;        // kReplayShare motion_range, at least kReplayFloor (1 + largest |q|)
+  bool replay_rejected = false;     // converged(), replayed, and replay_difference > replay_limit
+  std::string replay_verdict;       // when replay_rejected: the sentence that says so and what to do
+  // IPOPT converged (solved, or solved to its acceptable level).
   bool converged() const { return nlp_converged(solver.status); }
+  // IPOPT converged and the replay confirms a motion of the model: a result to use.
+  bool solved() const { return converged() && !replay_rejected; }
 };
+
+// The replay rule's limit: a tenth of the largest range of a coordinate over the optimum, and for a
+// motion that (nearly) stays still 1e-8 (1 + largest |q|), above the replay's own round-off.
+inline constexpr double kReplayShare = 0.1;
+inline constexpr double kReplayFloor = 1e-8;
+
+// nlp_status_name of the solver's status, or "not a motion of the model" for a result the
+// replay rule rejects.
+const char* optimize_status_name(const OptimizeResult& result);
 
 // Throws InputError for a problem the transcription refuses (transcription.hpp) or a guess file
 // that lacks a column or does not cover [t0, t_end]; never for the solver's failure, which the

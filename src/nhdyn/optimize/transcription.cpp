@@ -47,7 +47,7 @@ Transcription::Transcription(const OptimalControlProblem& problem) : problem_(pr
 
   std::size_t registers = 0;
   for (const Tape* program : std::initializer_list<const Tape*>{terms_, position_residual_, velocity_residual_,
-                                 &problem_.force, &problem_.integrand, &problem_.path})
+                                 &problem_.force, &problem_.actuators, &problem_.integrand, &problem_.path})
     registers = std::max(registers, static_cast<std::size_t>(program->registers()));
   if (problem_.final_term) registers = std::max(registers, static_cast<std::size_t>(problem_.final_term->registers()));
   terms_registers_.assign(static_cast<std::size_t>(terms_->registers()), 0.0);
@@ -83,12 +83,23 @@ Transcription::Transcription(const OptimalControlProblem& problem) : problem_(pr
       x_upper_[static_cast<std::size_t>(u_index(p, j))] = nlp_bound(problem_.controls[static_cast<std::size_t>(j)].upper);
     }
   }
+  // The messages give the bounds as written (none is IPOPT's +-kNlpInfinity), at their file:line.
   const auto fix = [&](int p, const BoundaryValue& b, const char* which) {
     const std::size_t at = static_cast<std::size_t>(b.velocity ? v_index(p, b.index) : q_index(p, b.index));
+    const std::size_t slot = static_cast<std::size_t>(b.index + (b.velocity ? n_ : 0));
     const std::string name = model.coordinates[static_cast<std::size_t>(b.index)] + (b.velocity ? "'" : "");
-    if (b.value < x_lower_[at] || b.value > x_upper_[at])
-      throw InputError(fmt::format("the {} value {} = {} lies outside its bounds [{}, {}]: change one of them", which,
-                                   name, b.value, x_lower_[at], x_upper_[at]));
+    const std::string place = b.where.empty() ? "" : b.where + ": ";
+    if (!(std::abs(b.value) < 0.5 * kNlpInfinity))
+      throw InputError(fmt::format("{}the {} value {} = {} is too large for the optimizer, which reads a bound beyond "
+                                   "{:g} as no bound: give the model in units that make it smaller",
+                                   place, which, name, b.value, 0.5 * kNlpInfinity));
+    const double lower = problem_.state_lower[slot], upper = problem_.state_upper[slot];
+    if (b.value < lower || b.value > upper) {
+      const std::string bounds = slot < problem_.state_bounds_where.size() ? problem_.state_bounds_where[slot] : "";
+      throw InputError(fmt::format("{}the {} value {} = {} lies outside its bounds [{}, {}]{}: change one of them",
+                                   place, which, name, b.value, lower, upper,
+                                   bounds.empty() ? "" : " (given at " + bounds + ")"));
+    }
     x_lower_[at] = x_upper_[at] = b.value;
   };
   for (const BoundaryValue& b : problem_.initial) fix(0, b, "initial");
@@ -110,6 +121,101 @@ Transcription::Transcription(const OptimalControlProblem& problem) : problem_(pr
   build_pattern();
   build_hessian_pattern();
   check_controls_act();
+  require_path_at_fixed_ends();
+}
+
+std::string Transcription::describe_point(int p, const double* x) const {
+  const Model& model = problem_.model;
+  std::string out = fmt::format("t = {}", time(p, x));
+  for (int i = 0; i < n_; ++i) out += fmt::format(", {} = {}", model.coordinates[static_cast<std::size_t>(i)], x[q_index(p, i)]);
+  for (int i = 0; i < n_; ++i) out += fmt::format(", {}' = {}", model.coordinates[static_cast<std::size_t>(i)], x[v_index(p, i)]);
+  for (int j = 0; j < m_; ++j) out += fmt::format(", {} = {}", problem_.controls[static_cast<std::size_t>(j)].name, x[u_index(p, j)]);
+  return out;
+}
+
+void Transcription::require_path_at_fixed_ends() {
+  if (path_count_ == 0) return;
+  const Model& model = problem_.model;
+  std::vector<double> g(static_cast<std::size_t>(path_count_));
+  for (const int p : {0, points_ - 1}) {
+    layout_inputs(p, start_.data());
+    problem_.path.run(time(p, start_.data()), layout_q_.data(), layout_v_.data(), other_registers_.data(), g.data());
+    for (int k = 0; k < path_count_; ++k) {
+      const PathConstraint& c = problem_.path_constraints[static_cast<std::size_t>(k)];
+      if (c.reads_time && problem_.free_time && p > 0) continue;  // t_end is not known
+      if (c.reads.size() != static_cast<std::size_t>(2 * n_ + m_)) continue;  // what it reads is not known
+      std::vector<std::string> read;
+      bool decided = true;
+      for (int v = 0; v < 2 * n_ + m_ && decided; ++v) {
+        if (!c.reads[static_cast<std::size_t>(v)]) continue;
+        const int index = v < 2 * n_ ? q_index(p, v) : u_index(p, v - 2 * n_);
+        decided = x_lower_[static_cast<std::size_t>(index)] == x_upper_[static_cast<std::size_t>(index)];
+        const std::string name = v < n_    ? model.coordinates[static_cast<std::size_t>(v)]
+                                 : v < 2 * n_ ? model.coordinates[static_cast<std::size_t>(v - n_)] + "'"
+                                              : problem_.controls[static_cast<std::size_t>(v - 2 * n_)].name;
+        read.push_back(fmt::format("{} = {}", name, start_[static_cast<std::size_t>(index)]));
+      }
+      const double value = g[static_cast<std::size_t>(k)];
+      // Not finite: require_defined_at_start names it with the point.
+      if (!decided || !std::isfinite(value) || (value >= c.lower - 1e-8 && value <= c.upper + 1e-8)) continue;
+      throw InputError(fmt::format(
+          "{}{}the path constraint \"{}\" cannot hold at t = {}: {}, its left side less its right side is {:.6g}, "
+          "which must be {} 0; change the {} values or the constraint",
+          c.where, c.where.empty() ? "" : ": ", c.text, time(p, start_.data()),
+          read.empty() ? std::string("it reads no coordinate, velocity or control (a condition fixed in advance)")
+                       : fmt::format("with the fixed {} values {}", p == 0 ? "initial" : "final", join(read)),
+          value, std::isfinite(c.lower) ? ">=" : "<=", p == 0 ? "initial" : "final"));
+    }
+  }
+}
+
+void Transcription::require_defined_at_start() {
+  const double* x = start_.data();
+  const std::string what_to_do =
+      "give a first guess where it is defined (--guess FILE.csv), bounds that keep the motion there, or another "
+      "expression";
+  const auto undefined = [&](const std::string& what, const std::string& where, double value, int p) {
+    return InputError(fmt::format("{}{}{} is not finite ({}) at the first guess's point {}: {}", where,
+                                  where.empty() ? "" : ": ", what, value, describe_point(p, x), what_to_do));
+  };
+  std::vector<double> g(static_cast<std::size_t>(std::max(path_count_, 1))),
+      columns(static_cast<std::size_t>(n_ * m_));
+  double value = 0.0;
+  for (int p = 0; p < points_; ++p) {
+    const double t = time(p, x);
+    terms_->run(t, x + q_index(p, 0), x + v_index(p, 0), terms_registers_.data(), terms_out_.data());
+    for (double v : terms_out_)
+      if (!std::isfinite(v))
+        throw undefined("the model's equations (A, Q, G, b, b0)", "", v, p);
+    layout_inputs(p, x);
+    problem_.integrand.run(t, layout_q_.data(), layout_v_.data(), other_registers_.data(), &value);
+    if (!std::isfinite(value))
+      throw undefined(fmt::format("the objective \"{}\"", problem_.objective_text), problem_.objective_where, value, p);
+    if (problem_.final_term && p == points_ - 1) {
+      problem_.final_term->run(t, layout_q_.data(), layout_v_.data(), other_registers_.data(), &value);
+      if (!std::isfinite(value)) throw undefined("objective_final", problem_.final_term_where, value, p);
+    }
+    if (path_count_ > 0) {
+      problem_.path.run(t, layout_q_.data(), layout_v_.data(), other_registers_.data(), g.data());
+      for (int k = 0; k < path_count_; ++k)
+        if (!std::isfinite(g[static_cast<std::size_t>(k)])) {
+          const PathConstraint& c = problem_.path_constraints[static_cast<std::size_t>(k)];
+          throw undefined(fmt::format("the path constraint \"{}\"", c.text), c.where, g[static_cast<std::size_t>(k)], p);
+        }
+    }
+    if (m_ > 0) {
+      problem_.actuators.run(t, layout_q_.data(), layout_v_.data(), other_registers_.data(), columns.data());
+      for (int j = 0; j < m_; ++j)
+        for (int i = 0; i < n_; ++i) {
+          const double b = columns[static_cast<std::size_t>(j * n_ + i)];
+          if (std::isfinite(b)) continue;
+          const OptimizeControl& c = problem_.controls[static_cast<std::size_t>(j)];
+          throw undefined(fmt::format("the actuator {} of control '{}' (its entry on {})", c.actuator, c.name,
+                                      problem_.model.coordinates[static_cast<std::size_t>(i)]),
+                          c.where, b, p);
+        }
+    }
+  }
 }
 
 // A control whose force the constraints absorb (D B_j = 0: it pushes along a constrained
@@ -321,6 +427,7 @@ void Transcription::release_determined_final_values() {
   }
   if (Z.cols() == 0) return;
   const Eigen::MatrixXd relations = Z.transpose() * Cfixed;  // relations among the fixed final values
+  require_final_values_agree(Z, relations, values, fixed_columns);
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(relations);
   const double tol = 1e-9 * std::max(1.0, relations.cwiseAbs().maxCoeff());
   int count = 0;
@@ -338,6 +445,48 @@ void Transcription::release_determined_final_values() {
     notes_.push_back(fmt::format("the final {} is determined by the constraints ({}) with the other final values: "
                                  "left free, it meets its value up to the discretization's drift",
                                  name, join(names)));
+  }
+}
+
+// Before a determined final value is released, the relation must hold with the values the user
+// gave: a released value is then met up to the drift. One that does not hold is a contradiction
+// (x - y = 0 with x = 1, y = 0 at t_end), which releasing would hide: the result met another
+// value than the one asked, with exit 0. Refused as the initial values are (the residual beyond
+// round-off of the values, 1e-8 (1 + largest |value|)).
+void Transcription::require_final_values_agree(const Eigen::MatrixXd& Z, const Eigen::MatrixXd& relations,
+                                               const std::vector<double>& residuals,
+                                               const std::vector<int>& fixed_columns) const {
+  const Model& model = problem_.model;
+  std::vector<std::string> rows;  // the names of the residuals' rows, as choose_splits_and_initial_rows gives them
+  for (const Constraint& c : model.constraints)
+    if (c.level == ConstraintLevel::position) rows.push_back(c.name + " (position)");
+  for (const Constraint& c : model.constraints)
+    if (c.level != ConstraintLevel::acceleration) rows.push_back(c.name + " (velocity)");
+  double largest = 0.0;
+  for (const BoundaryValue& b : problem_.final) largest = std::max(largest, std::abs(b.value));
+  const Eigen::Map<const Eigen::VectorXd> r(residuals.data(), static_cast<Eigen::Index>(residuals.size()));
+  for (Eigen::Index k = 0; k < Z.cols(); ++k) {
+    const double residual = Z.col(k).dot(r);
+    if (std::abs(residual) <= 1e-8 * (1.0 + largest)) continue;
+    std::vector<std::string> names, values;
+    std::string where;  // the first of the values' places in the file
+    for (Eigen::Index i = 0; i < Z.rows(); ++i)
+      if (std::abs(Z(i, k)) > 1e-6) names.push_back(rows[static_cast<std::size_t>(i)]);
+    const double scale = relations.row(k).cwiseAbs().maxCoeff();
+    for (std::size_t c = 0; c < fixed_columns.size(); ++c) {
+      if (scale > 0.0 && std::abs(relations(k, static_cast<Eigen::Index>(c))) <= 1e-9 * scale) continue;
+      const int column = fixed_columns[c];
+      for (const BoundaryValue& b : problem_.final)
+        if (b.index + (b.velocity ? n_ : 0) == column) {
+          values.push_back(fmt::format("{}{} = {}", model.coordinates[static_cast<std::size_t>(b.index)],
+                                       b.velocity ? "'" : "", b.value));
+          if (where.empty() && !b.where.empty()) where = b.where + ": ";
+        }
+    }
+    throw InputError(fmt::format(
+        "{}the final values of [optimize] violate the constraint{} {}: with {} its residual at t_end is {:.3e}, and no "
+        "free final value can change it; give final values on the constraint, or leave one of them out of final",
+        where, names.size() > 1 ? "s" : "", join(names, " and "), join(values), residual));
   }
 }
 

@@ -32,8 +32,9 @@ namespace nhdyn {
 class Transcription final : public Nlp {
  public:
   // Throws InputError when the model is compiled sparse, when a control's force is absorbed by the
-  // constraints (D B_j = 0 at the start), when fixed boundary values lie outside the bounds, when the fixed initial values violate a constraint (naming it and its residual),
-  // or when the constraints are dependent at the starting point.
+  // constraints (D B_j = 0 at the start), when fixed boundary values lie outside the bounds, when
+  // the fixed initial values violate a constraint or the fixed final values contradict one (naming
+  // it and its residual), or when the constraints are dependent at the starting point.
   explicit Transcription(const OptimalControlProblem& problem);
 
   const OptimalControlProblem& problem() const { return problem_; }
@@ -56,6 +57,11 @@ class Transcription final : public Nlp {
   void set_start(std::vector<double> x) { start_ = std::move(x); }
   // The largest violation of the variable bounds and the constraint bounds at x.
   double constraint_violation(const double* x);
+  // Before IPOPT: throws InputError naming the expression (its file:line:column), the point's t
+  // and state when the objective, the final term, a path constraint, an actuator or the model's
+  // terms are not finite at a point of the starting point (start(), the guess set in it), where
+  // IPOPT would stop on "Invalid number" with nothing to say where.
+  void require_defined_at_start();
 
   int variables() const override { return variables_; }
   int constraints() const override { return rows_; }
@@ -93,6 +99,15 @@ class Transcription final : public Nlp {
   void make_start();
   void check_controls_act();
   void release_determined_final_values();
+  // A path constraint that reads only fixed values at the first or last node (a constant one
+  // included) is decided before the solve: throws InputError naming it and its value when it fails.
+  void require_path_at_fixed_ends();
+  // "t = 0, x = 0.5, x' = 0, F = 0": the point p of x, for messages.
+  std::string describe_point(int p, const double* x) const;
+  // Throws InputError when a relation among the fixed final values (a column of Z, the
+  // combinations of the constraint rows that no free final value enters) does not hold with them.
+  void require_final_values_agree(const Eigen::MatrixXd& Z, const Eigen::MatrixXd& relations,
+                                  const std::vector<double>& residuals, const std::vector<int>& fixed_columns) const;
   // The terms, B u, the split's factorization and r at point p of x (fills the work arrays).
   bool evaluate_point(int p, const double* x);
   // The dynamics rows of the point last evaluated into `out` (n values).
