@@ -1054,7 +1054,7 @@ TEST_F(Hardening, FixInitialMeetsThePrograms) {
   write("off.toml", replace(model, "position = { x = 0, y = 0, phi = 0 }", "position = { x = 0, y = 0, phi = 0.2 }"));
   const ProcessRun off = nhdyn({"simulate", "off.toml", "--t-end", "1", "-o", "off.csv", "--fix-initial"});
   EXPECT_EQ(off.code, 2);
-  EXPECT_TRUE(contains(off.err, "no free value enters the program 'heading' (position level), whose residual stays 0.2"))
+  EXPECT_TRUE(contains(off.err, "no free value enters the program 'heading' (position level), which keeps the residual 0.2"))
       << off.err;
 }
 

@@ -224,7 +224,7 @@ void fix_keeping_written(const Model& model, Data& data, double t, double tolera
           model.name,
           free.empty() ? fmt::format("none is free at {} level", level_name)
                        : fmt::format("free at {} level: {}", level_name, join(free_names)),
-          alone ? fmt::format("no free value enters {}, whose residual stays {:.6g}", label, value)
+          alone ? fmt::format("no free value enters {}, which keeps the residual {:.6g}", label, value)
                 : fmt::format("moving them ({} Newton steps), {} keeps the residual {:.6g}", iterations, label, value)));
     }
     (level == ConstraintLevel::position ? fix.position_iterations : fix.velocity_iterations) = iterations;
