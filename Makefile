@@ -7,7 +7,8 @@
 #   make asan   the tests again under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/)
 #   make fuzz   the model-file fuzzer (needs clang-14; fuzz/run says which packages)
 #   make bench  build and run the benchmarks
-#   make python build the Python package nhdyn only, and say how to import it
+#   make python install what make test needs (scripts/install-deps), configure as make test does, build
+#               the Python package nhdyn only, and say how to import it
 #   make bench-check   the performance guard: a few paired ratios against bench/baselines (fails
 #               when one is more than 1.5x its baseline; about 40 s on 2 busy cores)
 #   make bench-update  the same, and rewrites docs/performance.md's table (BASELINES=1: and
