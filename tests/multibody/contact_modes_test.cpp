@@ -638,6 +638,25 @@ TEST(ContactModes, AUnilateralContactStartingInsideTheGroundIsRefusedWithItsGap)
   }
 }
 
+// An elastic ball bouncing every 4 ms from 20 um: more than 10 000 touchdowns, evenly spread, are
+// regular switching, not an accumulation (a run was ended at its 10 001st switch, "Zeno or
+// chattering"); each bounce reaches the height it fell from.
+TEST(ContactModes, TenThousandRegularBouncesAreNotAnAccumulation) {
+  std::string text = dropped_ball(1.0);
+  text.replace(text.find("z = \"r + 0.2\""), 13, "z = \"r + 2e-5\"");
+  const Model model = load_model_text(text, "bounce.toml");
+  SimulationOptions options;
+  options.t_end = 42.5;
+  options.output_step = 42.5;
+  const SimulationSummary summary = simulate(model, options, [](const Data&) {});
+  ASSERT_EQ(summary.status, Status::ok) << summary.message;
+  const double period = 2.0 * std::sqrt(2.0 * 2e-5 / 9.81);  // 4.04 ms
+  ASSERT_GT(summary.events.crossings.size(), 10000u);
+  EXPECT_NEAR(static_cast<double>(summary.events.crossings.size()), std::floor((42.5 - period / 2) / period) + 1, 1.0);
+  EXPECT_NEAR(summary.events.crossings.back().t - summary.events.crossings[summary.events.crossings.size() - 2].t,
+              period, 1e-9);
+}
+
 TEST(ContactModes, DroppedBallBouncesWithNewtonsLawUntilTheTouchdownsAccumulate) {
   const double g = 9.81, h0 = 0.2, e = 0.5;
   const double t1 = std::sqrt(2 * h0 / g), v1 = std::sqrt(2 * g * h0);

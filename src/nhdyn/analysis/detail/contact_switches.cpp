@@ -23,7 +23,11 @@ namespace nhdyn {
 namespace {
 
 constexpr int kSlots = 3;               // event functions per contact
-constexpr long kMaxSwitches = 10000;    // switches of a run before it is called an accumulation
+constexpr long kMaxSwitches = 10000;    // switches judged together by ContactSwitches::count_switch
+// The last kMaxSwitches switches accumulate when they took less than this part of the time since
+// the first switch: a ball bouncing elastically every 0.4 s for hours is regular, chattering or a
+// Zeno sequence puts its 10000 switches into a vanishing stretch of the run.
+constexpr double kAccumulatedFraction = 1e-3;
 constexpr int kMaxSameTime = 8;         // successive switches without progress in t
 
 // The slip below which a contact is taken not to slip (the integration error of its velocity
@@ -325,6 +329,19 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
   }
 }
 
+bool ContactSwitches::count_switch(double t) {
+  if (switch_times_.empty()) {
+    switch_times_.assign(static_cast<std::size_t>(kMaxSwitches), t);
+    first_switch_t_ = t;
+  }
+  // The slot of the switch kMaxSwitches before this one, which this one replaces.
+  double& slot = switch_times_[static_cast<std::size_t>(switch_count_ % kMaxSwitches)];
+  const double oldest = slot;
+  slot = t;
+  ++switch_count_;
+  return switch_count_ > kMaxSwitches && t - oldest < kAccumulatedFraction * (t - first_switch_t_);
+}
+
 ContactSwitches::ContactSwitches(const Model& model, Data& data, const FormulationOptions& formulation,
                                  int state_size, EventFunctions* user, Handler handler)
     : model_(model), data_(data), formulation_(formulation), user_(user), handler_(std::move(handler)),
@@ -545,10 +562,10 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
     // its gap taken as it is (not as a fresh lift-off's), so that an integrator that locates roots
     // itself (CVODE) does not meet the same zero again at once.
     // Counted as switches are, so that grazes that keep coming back end the run rather than hang it.
-    ++switch_count_;
+    const bool accumulating = count_switch(t);
     same_graze_ = t == last_graze_t_ ? same_graze_ + 1 : 0;
     last_graze_t_ = t;
-    if (same_graze_ > kMaxSameTime || switch_count_ > kMaxSwitches) {
+    if (same_graze_ > kMaxSameTime || accumulating) {
       accumulation_ = fmt::format("contact '{}' grazed its ground {} times at t = {:.9g} ({} switches in the run): no "
                                   "consistent mode; the run ends here with its results so far",
                                   model_.contact_modes->contacts[static_cast<std::size_t>(contact)].name,
@@ -563,7 +580,7 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
     return Status::stopped;
   }
   grazed_ = -1;
-  ++switch_count_;
+  const bool accumulating = count_switch(t);
   same_time_ = switch_count_ > 1 && std::abs(t - last_switch_t_) <= 64 * std::numeric_limits<double>::epsilon() *
                                                                           std::max(1.0, std::abs(t))
                    ? same_time_ + 1
@@ -577,10 +594,12 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
                                 name, t, same_time_);
     return Status::integrator_failure;
   }
-  if (switch_count_ > kMaxSwitches) {
-    accumulation_ = fmt::format("the contacts switched {} times by t = {:.9g} (the last: '{}'), an accumulation of "
-                                "switches (Zeno or chattering); the run ends here with its results so far",
-                                switch_count_, t, name);
+  if (accumulating) {
+    const double span = t - switch_times_[static_cast<std::size_t>(switch_count_ % kMaxSwitches)];
+    accumulation_ = fmt::format("the contacts switched {} times by t = {:.9g} (the last: '{}'), the last {} of them "
+                                "within {:.3g} s, an accumulation of switches (Zeno or chattering); the run ends here "
+                                "with its results so far",
+                                switch_count_, t, name, kMaxSwitches, span);
     return Status::integrator_failure;
   }
   std::copy(y, y + size_, switch_y_.begin());  // a touchdown changes its velocities
@@ -610,7 +629,7 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
   for (std::size_t k = 0; impact && k < data_.modes.mode.size(); ++k) {
     const int next = closing_contact(t);
     if (next < 0) break;
-    ++switch_count_;
+    count_switch(t);  // the same instant as the impact's: judged with it
     const std::vector<double> before = switch_y_;
     const std::string also = switch_contact(next, 0, t, before.data());
     events.push_back(also);

@@ -77,6 +77,8 @@ class ContactSwitches final : public EventFunctions {
   // Set when the switches accumulate (Zeno or no consistent mode): the message ending the run.
   const std::string& accumulation() const { return accumulation_; }
   long switches() const { return switch_count_; }
+  // Counts a switch at t; true when the last kMaxSwitches of them accumulate (docs/contact-modes.md).
+  bool count_switch(double t);
   // Warnings for the run's summary (an impact that gains energy: once per run).
   const std::vector<std::string>& warnings() const { return warnings_; }
 
@@ -141,6 +143,10 @@ class ContactSwitches final : public EventFunctions {
   std::vector<double> switch_y_;
   std::string accumulation_;
   long switch_count_ = 0;
+  // The times of the last kMaxSwitches switches, a ring (accumulating): where they all fall within a
+  // small part of the time switching has taken, switches accumulate; spread out, they are regular.
+  std::vector<double> switch_times_;
+  double first_switch_t_ = 0.0;
   int same_time_ = 0;       // successive switches without progress in t
   double last_switch_t_ = 0.0;
   double start_t_ = -HUGE_VAL;  // the time the current segment started at (the last switch)
