@@ -73,6 +73,8 @@ _PYTHON_PHRASES = [
     # nhdyn.load(path, k="1/0") reaches the library as --set k=1/0.
     (re.compile(r"--set ([A-Za-z_][A-Za-z0-9_]*)="), r"\1="),
     (re.compile(r"--guess FILE\.csv"), 'guess="FILE.csv"'),
+    # The integrator and the stabilization a warning advises, as the keywords take them.
+    (re.compile(r"--(integrator|stabilize) ([a-z][a-z0-9-]*)"), r'\1="\2"'),
     (re.compile(r"--steps (\d+)"), r"len(values) = \1"),
     (re.compile(r"expected NAME=EXPR, a name"), "expected a name"),
     (re.compile(r"`nhdyn equations MODEL --format latex` prints them"), "Model.equations() gives them"),
@@ -183,10 +185,11 @@ class StiffnessWarning(UserWarning):
 def _warn_constraints(model_name, summary, stacklevel, run=None):
     where = "" if run is None else " (run {})".format(run)
     for text in summary.get("warnings", []):
-        warnings.warn("nhdyn: {}{}: {}".format(model_name, where, text), ConstraintWarning, stacklevel=stacklevel + 1)
-    if summary.get("stiffness"):
-        warnings.warn("nhdyn: {}{}: {}".format(model_name, where, summary["stiffness"]), StiffnessWarning,
+        warnings.warn("nhdyn: {}{}: {}".format(model_name, where, _python_text(text)), ConstraintWarning,
                       stacklevel=stacklevel + 1)
+    if summary.get("stiffness"):
+        warnings.warn("nhdyn: {}{}: {}".format(model_name, where, _python_text(summary["stiffness"])),
+                      StiffnessWarning, stacklevel=stacklevel + 1)
 
 
 class StopConditionWarning(UserWarning):

@@ -72,7 +72,7 @@ def test_a_stiff_stretch_is_a_stiffness_warning_not_a_constraint_warning(example
     m = nhdyn.load(examples / "sled.toml")
     with warnings.catch_warnings():
         warnings.simplefilter("error", nhdyn.ConstraintWarning)
-        with pytest.warns(nhdyn.StiffnessWarning, match=r"the run is stiff from t = 20\.\d+: .*--integrator cvode-bdf"):
+        with pytest.warns(nhdyn.StiffnessWarning, match=r'the run is stiff from t = 20\.\d+: .*integrator="cvode-bdf"'):
             r = m.simulate(t_end=100)
     assert r.summary["warnings"] == []
     assert 2 * r.summary["stiff_steps"] > r.summary["steps"] > 1000
@@ -81,3 +81,8 @@ def test_a_stiff_stretch_is_a_stiffness_warning_not_a_constraint_warning(example
         bdf = m.simulate(t_end=100, integrator="cvode-bdf")
     assert bdf.summary["stiffness"] == "" and bdf.summary["stiff_steps"] == 0
     assert 5 * bdf.summary["steps"] < r.summary["steps"]
+    # Under projection an implicit integrator restarts at every projected state: the warning says to
+    # keep the explicit one rather than advise cvode-bdf.
+    with pytest.warns(nhdyn.StiffnessWarning, match=r'with stabilize="projection" keep the explicit integrator') as caught:
+        m.simulate(t_end=100, stabilize="projection")
+    assert all("an implicit integrator takes far fewer steps there" not in str(w.message) for w in caught)

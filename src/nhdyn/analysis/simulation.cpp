@@ -207,7 +207,7 @@ class WatchedEvents final : public EventFunctions {
 // not, or for the other integrators. The friction's sentence only where a contact with friction
 // has a single coefficient (mu_k = mu_s, the last values `data` holds).
 std::string stiffness_warning(const Model& model, const Data& data, const IntegratorOptions& integrator,
-                              const IntegratorStats& stats) {
+                              const IntegratorStats& stats, bool projection) {
   if (stats.stiff_steps < std::max(1000L, stats.steps / 4)) return "";
   bool single = false;
   if (model.contact_modes)
@@ -218,8 +218,13 @@ std::string stiffness_warning(const Model& model, const Data& data, const Integr
   const std::string from = std::isnan(stats.stiff_from) ? "" : fmt::format(" from t = {:.6g}", stats.stiff_from);
   return fmt::format(
       "the run is stiff{}: {} of its {} steps were as short as the stability of {} requires, not as its accuracy "
-      "does; an implicit integrator takes far fewer steps there: --integrator cvode-bdf{}",
+      "does; {}{}",
       from, stats.stiff_steps, stats.steps, integrator_name(integrator.kind),
+      // CVODE starts again from every projected state, so that an implicit integrator under
+      // projection takes as many steps and drifts more (docs/stabilization.md).
+      projection ? "with --stabilize projection keep the explicit integrator (an implicit one restarts at every "
+                   "projection and takes as many steps); without projection, --integrator cvode-bdf takes far fewer"
+                 : "an implicit integrator takes far fewer steps there: --integrator cvode-bdf",
       single ? ". A contact that starts to slide with a single friction coefficient makes such a stretch (its slip "
                "grows from 0 as t^2, and its direction is stiff while the slip is small); friction = [mu_s, mu_k] "
                "with mu_k < mu_s does not"
@@ -820,7 +825,8 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.watch.warnings = watch.warnings;
   for (const ConstraintWarning& w : watch.warnings) summary.warnings.push_back(format_constraint_warning(model, w));
   summary.warnings.insert(summary.warnings.end(), switches.warnings().begin(), switches.warnings().end());
-  summary.stiffness = stiffness_warning(model, data, options.integrator, summary.stats);
+  summary.stiffness = stiffness_warning(model, data, options.integrator, summary.stats,
+                                        options.stabilization == Stabilization::projection);
   summary.watch.largest_row_factor = watch.largest_row_factor;
   summary.watch.largest_condition_factor = watch.largest_condition_factor;
   summary.watch.watched_states = watch.states;
