@@ -732,6 +732,30 @@ TEST_F(Hardening, BatchAndCompareSayWhenAStopConditionNeverHolds) {
 }
 
 // GiNaC's own words ("power::eval(): division by zero", "log_eval(): log(0)") reached the user.
+// A character pasted from a paper or a word processor is named by its code point, with what to
+// write instead; an invisible one is never shown raw (a no-break space read as "unexpected
+// character ' '").
+TEST_F(Hardening, InvisibleAndLookAlikeCharactersAreNamedByTheirCode) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"\u00a0", "unexpected character U+00A0 (a no-break space): write a plain space"},
+      {"\u200b", "unexpected character U+200B (a zero-width space, invisible): delete it"},
+      {"\u2212", "unexpected character '\u2212' U+2212 (a minus sign): write '-'"},
+      {"\u03a6", "unexpected character '\u03a6' (U+03A6): expressions are written in ASCII"}};
+  for (const auto& [character, words] : cases) {
+    std::string model = kOscillator;
+    model.replace(model.find("k/2 * x^2"), 9, "k/2 *" + character + "x^2");
+    write("c.toml", model);
+    const ProcessRun r = nhdyn({"simulate", "c.toml", "-q", "-o", "c.csv"});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_TRUE(contains(r.err, "c.toml:4:26: potential energy V: syntax error: " + words)) << r.err;
+  }
+  // A parameter's value, where --set reads it.
+  write("osc.toml", kOscillator);
+  const ProcessRun set = nhdyn({"simulate", "osc.toml", "--set", "k=2\u00a0", "-q", "-o", "c.csv"});
+  EXPECT_EQ(set.code, 2) << set.err;
+  EXPECT_TRUE(contains(set.err, "unexpected U+00A0 (a no-break space): write a plain space (column 2)")) << set.err;
+}
+
 TEST_F(Hardening, GinacWordsAreTranslated) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"m/2 * x'^2/(0*x)", "divides by zero"}, {"m/2 * x'^2 + 0^0*x", "0^0, which is undefined"},

@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/detail/characters.hpp"
 #include "nhdyn/core/detail/suggest.hpp"
 
 namespace nhdyn {
@@ -51,7 +52,7 @@ class ExpressionParser {
     if (pos_ == text_.size()) fail("it is empty");
     const double value = sum();
     skip_space();
-    if (pos_ != text_.size()) fail(fmt::format("unexpected '{}'", text_[pos_]));
+    if (pos_ != text_.size()) fail(fmt::format("unexpected {}", describe_character(text_, pos_)));
     return value;
   }
   const std::vector<std::string>& names() const { return names_; }
@@ -143,7 +144,7 @@ class ExpressionParser {
     }
     if (std::isdigit(static_cast<unsigned char>(ch)) || ch == '.') return number();
     if (std::isalpha(static_cast<unsigned char>(ch)) || ch == '_') return name();
-    fail(fmt::format("unexpected '{}'", ch));
+    fail(fmt::format("unexpected {}", describe_character(text_, pos_)));
   }
   double number() {
     const std::string rest(text_.substr(pos_));

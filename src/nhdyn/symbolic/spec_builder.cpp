@@ -19,6 +19,7 @@
 #include "nhdyn/symbolic/contact_forces.hpp"
 #include "nhdyn/symbolic/contact_modes.hpp"
 #include "nhdyn/symbolic/detail/occurrence.hpp"
+#include "nhdyn/core/detail/characters.hpp"
 #include "nhdyn/symbolic/detail/plain_words.hpp"
 #include "nhdyn/core/detail/suggest.hpp"
 
@@ -228,9 +229,7 @@ std::vector<Token> lex(const Site& site, std::size_t begin, std::size_t end) {
         case '=':
           site.fail_at(i, "syntax error: unexpected '=' (only a constraint may be written as lhs = rhs)");
         default: {
-          std::size_t j = i + 1;
-          while (j < end && (static_cast<unsigned char>(s[j]) & 0xC0) == 0x80) ++j;
-          site.fail_at(i, fmt::format("syntax error: unexpected character '{}'", s.substr(i, j - i)));
+          site.fail_at(i, fmt::format("syntax error: unexpected character {}", describe_character(s, i)));
         }
       }
     }

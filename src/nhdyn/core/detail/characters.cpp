@@ -1,0 +1,49 @@
+#include "nhdyn/core/detail/characters.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdint>
+
+namespace nhdyn {
+
+std::string describe_character(std::string_view text, std::size_t at) {
+  std::size_t end = at + 1;
+  while (end < text.size() && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) ++end;
+  const std::string_view utf8 = text.substr(at, end - at);
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(utf8[k]); };
+  if (utf8.size() == 1 && byte(0) >= 0x20 && byte(0) < 0x7f) return fmt::format("'{}'", utf8);
+  std::uint32_t code = byte(0);
+  if (utf8.size() == 2 && (byte(0) & 0xE0) == 0xC0) code = ((byte(0) & 0x1Fu) << 6) | (byte(1) & 0x3Fu);
+  else if (utf8.size() == 3 && (byte(0) & 0xF0) == 0xE0)
+    code = ((byte(0) & 0x0Fu) << 12) | ((byte(1) & 0x3Fu) << 6) | (byte(2) & 0x3Fu);
+  else if (utf8.size() == 4 && (byte(0) & 0xF8) == 0xF0)
+    code = ((byte(0) & 0x07u) << 18) | ((byte(1) & 0x3Fu) << 12) | ((byte(2) & 0x3Fu) << 6) | (byte(3) & 0x3Fu);
+  else if (utf8.size() != 1 || byte(0) >= 0x80)
+    return fmt::format("(the byte 0x{:02X}, not UTF-8 text)", byte(0));
+  struct Known {
+    std::uint32_t code;
+    const char* name;
+    const char* instead;
+  };
+  static constexpr Known known[] = {
+      {0x00A0, "a no-break space", "a plain space"},  {0x2009, "a thin space", "a plain space"},
+      {0x202F, "a narrow no-break space", "a plain space"}, {0x200B, "a zero-width space", "nothing"},
+      {0x200C, "a zero-width non-joiner", "nothing"}, {0x200D, "a zero-width joiner", "nothing"},
+      {0xFEFF, "a byte order mark", "nothing"},       {0x2212, "a minus sign", "'-'"},
+      {0x2013, "an en dash", "'-'"},                  {0x00D7, "a multiplication sign", "'*'"},
+      {0x00B7, "a middle dot", "'*'"},                {0x2217, "an asterisk operator", "'*'"},
+      {0x2019, "a right quotation mark", "a prime '"},  {0x2032, "a prime sign", "a prime '"},
+  };
+  const bool invisible = code < 0x20 || code == 0x7f || (code >= 0x80 && code < 0xA0);
+  for (const Known& k : known)
+    if (k.code == code) {
+      const std::string_view instead = k.instead;
+      if (instead == "nothing") return fmt::format("U+{:04X} ({}, invisible): delete it", code, k.name);
+      if (instead == "a plain space") return fmt::format("U+{:04X} ({}): write a plain space", code, k.name);
+      return fmt::format("'{}' U+{:04X} ({}): write {}", utf8, code, k.name, k.instead);
+    }
+  if (invisible) return fmt::format("U+{:04X} (an invisible control character): delete it", code);
+  return fmt::format("'{}' (U+{:04X}): expressions are written in ASCII (names of letters, digits and _)", utf8, code);
+}
+
+}  // namespace nhdyn
