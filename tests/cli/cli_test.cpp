@@ -771,16 +771,17 @@ TEST(CliFailure, NumericalFailureExitsWith1AndKeepsOnlyThePartialRows) {
 
 // An absolute tolerance as large as the states lets the steps grow until dopri5 blows up (the
 // sled's G overflows at t = 1.12): the failure says so, not only that the model overflows there.
-TEST(CliFailure, AFailureUnderAnAbsoluteToleranceAsLargeAsTheStatesNamesIt) {
+TEST(CliFailure, AFailureUnderAnAbsoluteToleranceAsLargeAsTheStatesOrALongFixedStepNamesIt) {
   ScratchDir dir;
   const std::vector<std::string> args{"simulate", "sled", "--atol", "1e300", "-q", "-o", "out.csv"};
   const RunResult r = nhdyn(args, dir.path());
   EXPECT_EQ(r.exit_code, 1) << context(args, r);
   EXPECT_TRUE(contains(r.err, "Note the absolute tolerance atol = 1e+300: at least the size of every state")) << r.err;
-  // The default atol says nothing of the kind when a run fails: rk4's 5 s steps.
+  // rk4's 5 s steps: its fixed step is named, not the tolerances it does not follow.
   const RunResult rk4 = nhdyn(diverging_sled, dir.path());
   EXPECT_EQ(rk4.exit_code, 1) << context(diverging_sled, rk4);
   EXPECT_FALSE(contains(rk4.err, "absolute tolerance")) << rk4.err;
+  EXPECT_TRUE(contains(rk4.err, "Note rk4's fixed step (--step 5): a step too long for the motion")) << rk4.err;
 }
 
 TEST(CliFailure, NumericalFailureLeavesAnExistingFileUntouched) {

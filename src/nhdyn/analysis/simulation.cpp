@@ -701,12 +701,22 @@ void note_unmet_stops(const Model& model, const std::vector<const Event*>& event
 }
 
 // The message of a run that failed, in the most telling words there are.
-// A run that blew up or stalled under an absolute tolerance at least the size of every state at
-// the start: its error test bounded nothing, the steps grew until the integrator went unstable,
-// and the model is not at fault. Said after the failure's own words; "" otherwise.
-std::string loose_tolerance_hint(const IntegratorOptions& integrator, Status status, const Vector& q0,
+// What the integrator's options may have done to a run that failed, said after the failure's own
+// words (which blame the model); "" otherwise. An adaptive run that blew up or stalled under an
+// absolute tolerance at least the size of every state at the start: its error test bounded
+// nothing, and the steps grew until the integrator went unstable.
+std::string integrator_hint(const IntegratorOptions& integrator, Status status, const Vector& q0,
                                  const Vector& v0) {
-  if (integrator.kind == IntegratorKind::rk4) return "";  // its steps do not follow the tolerances
+  // rk4's steps do not follow the tolerances: a stage that overflows is most often a step too long
+  // for the motion (its time is the stage's, inside the step from the time the run reached).
+  if (integrator.kind == IntegratorKind::rk4)
+    return status != Status::non_finite
+               ? ""
+               : fmt::format(". Note rk4's fixed step ({}): a step too long for the motion makes its stages overflow "
+                             "whatever the model, and the time above is that of the stage that did; try a smaller "
+                             "--step, or an adaptive integrator (dopri5)",
+                             integrator.step > 0.0 ? fmt::format("--step {:g}", integrator.step)
+                                                   : std::string("a tenth of the output step"));
   if (status != Status::non_finite && status != Status::too_many_steps && status != Status::step_size_underflow)
     return "";
   const double largest = std::max(q0.size() ? q0.cwiseAbs().maxCoeff() : 0.0, v0.size() ? v0.cwiseAbs().maxCoeff() : 0.0);
@@ -833,7 +843,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   if (summary.status != Status::ok)
     summary.message = explain_run_failure(model, data, event_functions, watched, result, recorder.message(),
                                           summary.status) +
-                      loose_tolerance_hint(options.integrator, summary.status, q0, v0);
+                      integrator_hint(options.integrator, summary.status, q0, v0);
   return summary;
 }
 
