@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "nhdyn/symbolic/spec_builder.hpp"
@@ -81,6 +82,23 @@ void expect_valid_latex(const std::string& latex) {
   EXPECT_FALSE(contains(body, "'")) << body;
   EXPECT_FALSE(contains(body, "*")) << body;
   EXPECT_FALSE(contains(body, "\\\\\n\\end")) << "a row break before \\end{align*}";
+}
+
+// The partition shown for a model that gives none is one regular at its initial state: a
+// pendulum x^2 + y^2 = l^2 started at y = 0 gets y independent (D = [-y/x, 1]), not x (D =
+// [1, -x/y], singular there; the suggestion to add it failed at t = 0); started at x = 0, x.
+TEST(Equations, ThePartitionShownIsRegularAtTheInitialState) {
+  for (const auto& [x0, y0, independent] : {std::tuple{"1", "0", "y"}, std::tuple{"0", "-1", "x"}}) {
+    SpecBuilder b("pendulum");
+    b.coordinate("x").coordinate("y").parameter("m", 1.0).parameter("g", 9.81).parameter("l", 1.0);
+    b.kinetic_energy("m/2*(x'^2 + y'^2)").potential_energy("m*g*y");
+    b.constraint("rod", ConstraintLevel::position, "x^2 + y^2 - l^2");
+    b.initial("x", x0, "0").initial("y", y0, "0");
+    const std::string text = show(b.build(), EquationFormat::text);
+    EXPECT_TRUE(contains(text, std::string("with ") + independent + " independent; add independent = [\"" +
+                                   independent + "\"] to the model"))
+        << text;
+  }
 }
 
 TEST(Equations, SledPaperTextShowsThePapersEquations) {

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -524,20 +525,52 @@ struct Content {
   std::optional<ex> energy;
 };
 
+// Whether every entry of D is a finite number at the model's initial state (t0, q0, q0', the
+// parameters' values): a partition singular there (x independent, D = [1, -x/y], for a pendulum
+// that starts at y = 0) would fail at once if the model took it.
+bool regular_at_start(const Spec& spec, const GiNaC::matrix& D) {
+  try {
+    GiNaC::lst at = spec.parameter_values();
+    at.append(spec.symbols.time() == GiNaC::numeric(spec.t0));
+    for (int i = 0; i < spec.n(); ++i) {
+      const std::size_t u = static_cast<std::size_t>(i);
+      if (u >= spec.q0.size() || u >= spec.v0.size()) return false;
+      at.append(spec.symbols.coordinate(i) == spec.q0[u].subs(spec.parameter_values()));
+      at.append(spec.symbols.velocity(i) == spec.v0[u].subs(spec.parameter_values()));
+    }
+    for (unsigned r = 0; r < D.rows(); ++r)
+      for (unsigned c = 0; c < D.cols(); ++c) {
+        const ex value = GiNaC::evalf(D(r, c).subs(at));
+        if (!GiNaC::is_a<GiNaC::numeric>(value) || !GiNaC::ex_to<GiNaC::numeric>(value).is_real() ||
+            !std::isfinite(GiNaC::ex_to<GiNaC::numeric>(value).to_double()))
+          return false;
+      }
+    return true;
+  } catch (const std::exception&) {  // a division by zero there (GiNaC throws)
+    return false;
+  }
+}
+
 // The first choice of k independent coordinates (in lexicographic order of their indices) for
-// which the partitioned D exists; at most `budget` choices are tried.
-std::optional<std::pair<std::vector<int>, GiNaC::matrix>> first_partition(const GiNaC::matrix& b, int n, int k) {
+// which the partitioned D exists, preferring one regular at the initial state; at most `budget`
+// choices are tried.
+std::optional<std::pair<std::vector<int>, GiNaC::matrix>> first_partition(const Spec& spec, const GiNaC::matrix& b,
+                                                                         int n, int k) {
   std::vector<int> choice(static_cast<std::size_t>(k));
   for (int i = 0; i < k; ++i) choice[static_cast<std::size_t>(i)] = i;
+  std::optional<std::pair<std::vector<int>, GiNaC::matrix>> first;
   for (int budget = 200; budget > 0; --budget) {
-    if (std::optional<GiNaC::matrix> D = partitioned_complement(b, choice)) return std::make_pair(choice, *D);
+    if (std::optional<GiNaC::matrix> D = partitioned_complement(b, choice)) {
+      if (regular_at_start(spec, *D)) return std::make_pair(choice, *D);
+      if (!first) first = std::make_pair(choice, *D);
+    }
     int i = k - 1;
     while (i >= 0 && choice[static_cast<std::size_t>(i)] == n - k + i) --i;
     if (i < 0) break;
     ++choice[static_cast<std::size_t>(i)];
     for (int j = i + 1; j < k; ++j) choice[static_cast<std::size_t>(j)] = choice[static_cast<std::size_t>(j - 1)] + 1;
   }
-  return std::nullopt;
+  return first;
 }
 
 // Whether some entry of m has more than kSimplifyLimit nodes (simplify_moderate leaves it as is).
@@ -628,7 +661,7 @@ Content make_content(const Spec& spec, const Derivation& d) {
     with_d.D = GiNaC::ex_to<GiNaC::matrix>(GiNaC::unit_matrix(static_cast<unsigned>(n)));
   } else if (large || total_nodes(d.b, kPartitionNodeLimit) > kPartitionNodeLimit) {
     c.origin = Content::Origin::too_large;
-  } else if (const auto partition = first_partition(d.b, n, k)) {
+  } else if (const auto partition = first_partition(spec, d.b, n, k)) {
     c.origin = Content::Origin::fallback;
     for (const int i : partition->first) c.independent.push_back(spec.coordinates[static_cast<std::size_t>(i)]);
     with_d.D = partition->second;
