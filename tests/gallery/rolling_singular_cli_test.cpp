@@ -13,6 +13,7 @@
 
 #include "nhdyn/io/csv.hpp"
 #include "support/cli_run.hpp"
+#include "support/text.hpp"
 
 namespace {
 
@@ -108,6 +109,22 @@ TEST(RollingSingularCli, WheelFallingFlatStopsWhereItsAxleMeetsTheNormal) {
                     "its rim is lowest",
                     "(|axle x normal| = 0.01) at t = 0.139164, where x = 0, y = -0.0135822, z = 0.002, psi = 0, "
                     "theta = 1.5608,");
+}
+
+// Started flat (theta0 = pi/2 on rolling_disk_hop.toml): a bad start, exit 2 before any row (the
+// run failed with exit 1 "at t = 0.01" after its first step, the message saying t = 0).
+TEST(RollingSingularCli, ADiskStartedFlatIsABadStart) {
+  const fs::path dir = fs::temp_directory_path() / "nhdyn_rolling_started_flat";
+  fs::create_directories(dir);
+  const nhdyn::test::CliOutcome outcome = nhdyn::test::run_nhdyn(
+      "simulate " + nhdyn::test::example("rolling_disk_hop.toml") + " --set theta0=pi/2 -q -o o.csv", dir);
+  EXPECT_EQ(outcome.exit_code, 2) << outcome.out;
+  EXPECT_NE(outcome.out.find("at the initial state: "), std::string::npos) << outcome.out;
+  EXPECT_NE(outcome.out.find("contact 'disk': the disk lies flat"), std::string::npos) << outcome.out;
+  EXPECT_NE(outcome.out.find("start it where the contact point is defined"), std::string::npos) << outcome.out;
+  EXPECT_FALSE(fs::exists(dir / "o.csv"));
+  EXPECT_FALSE(fs::exists(dir / "o.partial.csv"));
+  fs::remove_all(dir);
 }
 
 }  // namespace

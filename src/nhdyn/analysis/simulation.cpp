@@ -89,19 +89,18 @@ double calc_watch_measure(const Model& model, const ContactWatch& w, double t, c
 }
 
 std::string watch_message(const Model& model, const ContactWatch& w, double value, double t, const double* q,
-                          const double* v) {
-  return fmt::format("{}{} '{}': {} ({} = {:.3g}) at t = {:.6g}, where {}; the run stops there",
-                     w.where.empty() ? "" : w.where + ": ", w.entry, w.contact, w.reason, w.quantity, value, t,
-                     describe_state(model, q, v));
+                          const double* v, const char* ending = "the run stops there") {
+  return fmt::format("{}{} '{}': {} ({} = {:.3g}) at t = {:.6g}, where {}; {}", w.where.empty() ? "" : w.where + ": ",
+                     w.entry, w.contact, w.reason, w.quantity, value, t, describe_state(model, q, v), ending);
 }
 
 std::string singular_contact_message(const Model& model, const Data& data, double t, const double* q,
-                                     const double* v) {
+                                     const double* v, const char* ending = "the run stops there") {
   for (const ContactWatch& w : model.contact_watches) {
     if (!watched_in_mode(data, mode_contact_index(model, w.contact), w.touching_only, w.free_only)) continue;
     const double value = calc_watch_measure(model, w, t, q, v);
     if (value >= w.threshold) continue;
-    return watch_message(model, w, value, t, q, v);
+    return watch_message(model, w, value, t, q, v, ending);
   }
   return "";
 }
@@ -558,6 +557,12 @@ void prepare_start_state(const Model& model, Data& data, const SimulationOptions
   }
   // The mode each contact starts in, before the check: a sliding contact's slip is no violation.
   choose_initial_contact_modes(model, data, options.formulation, model.t0, q0, v0);
+  // A contact point not defined at the start (a disk lying flat) is a bad start, as a singular
+  // system there is: its watch would end the run only after the first step.
+  if (const std::string singular = singular_contact_message(model, data, model.t0, q0.data(), v0.data(),
+                                                            "start it where the contact point is defined");
+      !singular.empty())
+    throw ModelError(fmt::format("model '{}': at the initial state: {}", model.name, singular));
   if (!options.fix_initial) check_initial_state(model, data, model.t0, q0, v0, options.initial_tolerance);
   check_programs_at_initial_state(model, data, options.formulation, model.t0, q0, v0, options.initial_tolerance);
 }
