@@ -109,6 +109,9 @@ TEST(Diagnosis, NonFiniteTermsNameTheQuantityAndTime) {
     const std::string message = explain_failure(model, data);
     EXPECT_TRUE(contains(message, "constraint matrix b")) << message;
     EXPECT_TRUE(contains(message, "t = 2.5")) << message;
+    // The entry and the state: b(appell, x) = -a^2 x' / z' at z' = 0.
+    EXPECT_TRUE(contains(message, "(b(appell, x) = -inf, ")) << message;
+    EXPECT_TRUE(contains(message, "where x = 0, y = 0, z = 0, x' = 1, y' = 0, z' = 0)")) << message;
   }
   // A NaN in the state itself is named as such.
   q(0) = std::numeric_limits<double>::quiet_NaN();

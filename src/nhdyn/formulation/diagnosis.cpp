@@ -316,6 +316,41 @@ std::string explain_singular_with_regular_parts(const Model& model, const Data& 
                 "and masses at that state";
 }
 
+// Which entry of the terms named by data.failed_quantity is not finite, and the state there:
+// " (Q_x = inf, where x = 2, x' = 0)"; "" for any other quantity, or when none is (sparse terms).
+std::string non_finite_entry(const Model& model, const Data& data) {
+  const std::string& what = data.failed_quantity;
+  const auto coordinate = [&](Eigen::Index i) { return model.coordinates[static_cast<std::size_t>(i)]; };
+  const auto constraint = [&](Eigen::Index i) {
+    return static_cast<std::size_t>(i) < model.constraints.size() ? model.constraints[static_cast<std::size_t>(i)].name
+                                                                  : fmt::format("row {}", i + 1);
+  };
+  std::string entry;
+  double value = 0.0;
+  const auto first = [&](const Matrix& m, const auto& name) {
+    for (Eigen::Index j = 0; j < m.cols() && entry.empty(); ++j)
+      for (Eigen::Index i = 0; i < m.rows() && entry.empty(); ++i)
+        if (!std::isfinite(m(i, j))) {
+          entry = name(i, j);
+          value = m(i, j);
+        }
+  };
+  if (what == "generalized forces Q") first(data.Q, [&](Eigen::Index i, Eigen::Index) { return "Q_" + coordinate(i); });
+  else if (what == "velocity terms G") first(data.G, [&](Eigen::Index i, Eigen::Index) { return "G_" + coordinate(i); });
+  else if (what == "inertia matrix A" && !data.sparse)
+    first(data.A, [&](Eigen::Index i, Eigen::Index j) { return fmt::format("A({}, {})", coordinate(i), coordinate(j)); });
+  else if (what == "constraint matrix b" && !data.sparse)
+    first(data.b, [&](Eigen::Index i, Eigen::Index j) { return fmt::format("b({}, {})", constraint(i), coordinate(j)); });
+  else if (what == "constraint term b0")
+    first(data.b0, [&](Eigen::Index i, Eigen::Index) { return fmt::format("b0({})", constraint(i)); });
+  if (entry.empty()) return "";
+  std::string state;
+  for (int i = 0; i < model.n(); ++i) state += fmt::format("{}{} = {:.6g}", i ? ", " : "", coordinate(i), data.q(i));
+  for (int i = 0; i < model.n(); ++i) state += fmt::format(", {}' = {:.6g}", coordinate(i), data.v(i));
+  return fmt::format(" ({} = {}, where {})", entry, std::isnan(value) ? std::string("NaN") : fmt::format("{}", value),
+                     state);
+}
+
 }  // namespace
 
 std::string explain_failure(const Model& model, const Data& data) {
@@ -324,10 +359,10 @@ std::string explain_failure(const Model& model, const Data& data) {
     case Status::dependent_constraints: return explain_dependent_constraints(model, data);
     case Status::inertia_not_positive_definite: return explain_inertia(model, data);
     case Status::non_finite:
-      return fmt::format("non-finite value (NaN or infinity) in {} at t = {:.6g}; the model divides by "
+      return fmt::format("non-finite value (NaN or infinity) in {} at t = {:.6g}{}; the model divides by "
                          "zero or overflows there (for example a constraint written with 1/z' or "
                          "tan(phi) at its singular point)",
-                         data.failed_quantity, data.failed_t);
+                         data.failed_quantity, data.failed_t, non_finite_entry(model, data));
     case Status::singular_system:
       if (data.failed_quantity.rfind("program matrix", 0) == 0) return explain_program_failure(model, data);
       if (data.failed_quantity.rfind("contact '", 0) == 0)  // formulation/contact_modes.cpp
