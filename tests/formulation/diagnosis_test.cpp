@@ -76,6 +76,21 @@ TEST(Diagnosis, ColumnsOutOfProportionAreNotCalledDependentConstraints) {
   EXPECT_FALSE(contains(said, "units of the coordinates")) << said;
 }
 
+// A constraint whose row of b vanishes (x'^2 + y'^2 = 1 at rest) is named alone for that, not
+// called dependent on the others.
+TEST(Diagnosis, AZeroRowOfBIsNamedAsSuch) {
+  Matrix b(2, 3);
+  b << 1, 0, 0,
+       0, 0, 0;
+  const Model model = testing::make_constant_model(Matrix::Identity(3, 3), Vector::Ones(3), b, Vector::Zero(2));
+  Data data = make_data(model);
+  ASSERT_EQ(compute_dynamics(model, data, {Formulation::sanh, Complement::qr}, 0.0, model.q0.data(), model.v0.data()),
+            Status::dependent_constraints);
+  const std::string message = explain_failure(model, data);
+  EXPECT_TRUE(contains(message, "the constraint 'c2' has a zero row of b at t = 0")) << message;
+  EXPECT_FALSE(contains(message, "'c1'") || contains(message, "dependent")) << message;
+}
+
 TEST(Diagnosis, IndefiniteInertiaIsReportedWithItsSmallestEigenvalue) {
   Matrix A = Matrix::Identity(3, 3);
   A(2, 2) = -2.0;

@@ -147,6 +147,20 @@ std::string explain_disproportionate_columns(const Model& model, const Data& dat
 std::string explain_dependent_constraints(const Model& model, const Data& data) {
   if (sparse_checks(model, data)) return explain_dependent_constraints_sparse(model, data);
   const std::vector<int> rows = held_rows(model, data);
+  // A row of b that vanishes: the constraint does not involve q'' there at all, which for one
+  // nonlinear in the velocities (x'^2 + y'^2 = 1) happens where they are all 0; no other row is
+  // at fault, so "dependent" would mislead.
+  for (int row : rows)
+    if (data.b.row(row).lpNorm<Eigen::Infinity>() == 0.0) {
+      const Constraint& c = model.constraints[static_cast<std::size_t>(row)];
+      return fmt::format(
+          "the constraint '{}'{} has a zero row of b at t = {:.6g}: it does not involve the accelerations there, so "
+          "it cannot be solved for q'' (a constraint nonlinear in the velocities does this where the velocities it "
+          "reads are 0, as x'^2 + y'^2 = 1 at rest; a position constraint where its gradient vanishes). Start the "
+          "motion where its row of b is not zero, or write it so that its derivative by the velocities does not "
+          "vanish.",
+          c.name, c.where.empty() ? "" : " (" + c.where + ")", data.t);
+    }
   if (std::string units = explain_disproportionate_columns(model, data, rows, rows_of_b(data, rows)); !units.empty())
     return units;
   Eigen::JacobiSVD<Matrix> svd(rows_of_b(data, rows), Eigen::ComputeFullU);
