@@ -46,6 +46,8 @@ void bind_optimize(py::module_& m) {
         d["solver_message"] = result.solver.message;
         d["converged"] = result.solved();  // IPOPT converged and the replay confirms a motion (solve.hpp)
         d["replay_limit"] = result.replay_limit;
+        d["interval_replay"] = result.local_difference;
+        d["replay_coordinate"] = result.replay_coordinate;
         d["replay_verdict"] = result.replay_verdict;
         d["iterations"] = result.solver.iterations;
         d["objective"] = result.objective;

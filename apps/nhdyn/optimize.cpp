@@ -199,9 +199,9 @@ int run_optimize(const OptimizeArgs& args) {
     if (csv) {
       files.write_now(partial_path(args.output),
                       (result.replay_rejected
-                           ? fmt::format("# nhdyn optimize: not a motion of the model (replay difference {:.3e}, limit "
-                                         "{:.3e}); the discrete optimum\n",
-                                         result.replay_difference, result.replay_limit)
+                           ? fmt::format("# nhdyn optimize: not a motion of the model (interval replay {:.3e} in {}, "
+                                         "limit {:.3e}); the discrete optimum\n",
+                                         result.local_difference, result.replay_coordinate, result.replay_limit)
                            : fmt::format("# nhdyn optimize: IPOPT stopped ({}: {}); the last iterate\n",
                                          nlp_status_name(result.solver.status), result.solver.message)) +
                           table);

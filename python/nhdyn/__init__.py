@@ -681,9 +681,11 @@ class Optimum:
     coordinates, x', x'', u_NAME); `summary` its summary text. status ("solved", "solved to
     acceptable level", "infeasible", "iteration limit", "failed", "not a motion of the model"),
     iterations, objective, t_end, constraint_violation, replay_difference (None when the replay
-    failed: replay_message says why), replay_limit and notes are the summary's values. converged
-    is True when IPOPT converged and the replay confirms a motion of the model; replay_verdict
-    says why not when the replay rule rejects the result ("" otherwise)."""
+    failed: replay_message says why), interval_replay (the largest error of an interval replayed
+    from the optimum's state at its start, in the coordinate replay_coordinate), replay_limit and
+    notes are the summary's values. converged is True when IPOPT converged and the replay confirms
+    a motion of the model; replay_verdict says why not when the replay rule rejects the result
+    ("" otherwise)."""
 
     def __init__(self, model, out):
         self.model_name = model.name
@@ -694,7 +696,8 @@ class Optimum:
         self.columns, self.rows = list(out["columns"]), out["table"]
         self.summary = out["summary_text"]
         for key in ("status", "solver_message", "converged", "iterations", "objective", "t_end", "free_time",
-                    "constraint_violation", "replay_difference", "replay_message", "replay_limit"):
+                    "constraint_violation", "replay_difference", "replay_message", "replay_limit",
+                    "interval_replay", "replay_coordinate"):
             setattr(self, key, out[key])
         self.replay_verdict = _python_text(out["replay_verdict"])
         self.notes = [_python_text(note) for note in out["notes"]]

@@ -88,7 +88,7 @@ class ControlledSystem final : public OdeSystem {
 }  // namespace
 
 ReplayResult calc_replay(const OptimalControlProblem& problem, const std::vector<double>& times,
-                         const std::vector<double>& q, const std::vector<double>& v0, const std::vector<double>& u) {
+                         const std::vector<double>& q, const std::vector<double>& v, const std::vector<double>& u) {
   const int n = problem.n(), m = problem.m();
   const int points = static_cast<int>(times.size());
   const int stride = problem.method == CollocationMethod::hermite_simpson ? 2 : 1;
@@ -99,8 +99,12 @@ ReplayResult calc_replay(const OptimalControlProblem& problem, const std::vector
   options.atol = 1e-12;
   std::vector<double> y(static_cast<std::size_t>(2 * n));
   std::copy(q.begin(), q.begin() + n, y.begin());
-  std::copy(v0.begin(), v0.end(), y.begin() + n);
+  std::copy(v.begin(), v.begin() + n, y.begin() + n);
   ReplayResult result;
+  result.local.assign(static_cast<std::size_t>(n), 0.0);
+  result.local_ok = true;
+  bool open_loop_stopped = false;
+  std::vector<double> start(y.size()), local_end(y.size());
   for (int p = 0; p + stride < points; p += stride) {
     std::vector<std::vector<double>> values;
     for (int k = 0; k <= stride; ++k)
@@ -109,6 +113,29 @@ ReplayResult calc_replay(const OptimalControlProblem& problem, const std::vector
     const double ta = times[static_cast<std::size_t>(p)], tb = times[static_cast<std::size_t>(p + stride)];
     system.set_interval(ta, tb, std::move(values));
     const double output[] = {tb};
+    // From the optimum's own state at ta: the interval's error alone.
+    std::copy(q.begin() + static_cast<std::ptrdiff_t>(p * n), q.begin() + static_cast<std::ptrdiff_t>((p + 1) * n),
+              start.begin());
+    std::copy(v.begin() + static_cast<std::ptrdiff_t>(p * n), v.begin() + static_cast<std::ptrdiff_t>((p + 1) * n),
+              start.begin() + n);
+    if (result.local_ok) {
+      const IntegrationResult local = integrate(system, options, ta, start.data(), output, [&](double, const double* state) {
+        std::copy(state, state + 2 * n, local_end.begin());
+        return Status::ok;
+      });
+      if (local.status != Status::ok) {
+        result.local_ok = false;
+        result.local_message = fmt::format("the replay of [{:g}, {:g}] from the optimum's state at {:g} stopped at t = "
+                                           "{:g}: {}",
+                                           ta, tb, ta, local.t_reached, local.message);
+      } else {
+        for (int i = 0; i < n; ++i)
+          result.local[static_cast<std::size_t>(i)] =
+              std::max(result.local[static_cast<std::size_t>(i)],
+                       std::abs(local_end[static_cast<std::size_t>(i)] - q[static_cast<std::size_t>((p + stride) * n + i)]));
+      }
+    }
+    if (open_loop_stopped) continue;
     std::vector<double> end(y.size());
     const IntegrationResult run = integrate(system, options, ta, y.data(), output, [&](double, const double* state) {
       std::copy(state, state + 2 * n, end.begin());
@@ -116,15 +143,16 @@ ReplayResult calc_replay(const OptimalControlProblem& problem, const std::vector
     });
     if (run.status != Status::ok) {
       result.message = fmt::format("the replay stopped at t = {:g}: {}", run.t_reached, run.message);
-      return result;
+      open_loop_stopped = true;  // the intervals' own replays go on
+      continue;
     }
     y = end;
     for (int i = 0; i < n; ++i)
       result.difference =
           std::max(result.difference, std::abs(y[static_cast<std::size_t>(i)] - q[static_cast<std::size_t>((p + stride) * n + i)]));
   }
-  result.ok = true;
-  result.q_end.assign(y.begin(), y.begin() + n);
+  result.ok = !open_loop_stopped;
+  if (result.ok) result.q_end.assign(y.begin(), y.begin() + n);
   return result;
 }
 

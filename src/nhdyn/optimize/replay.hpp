@@ -21,12 +21,19 @@ struct ReplayResult {
   std::string message;        // why the replay stopped, when not ok
   double difference = 0.0;    // max over the nodes and coordinates of |q_replay - q_optimized|
   std::vector<double> q_end;  // n: the replayed coordinates at t_end
+  // Each interval replayed from the optimum's own state at its start (q and q' of its first
+  // point): the largest |q_replay - q_optimized| at its end, per coordinate (n). The error the
+  // discretization makes in one interval, which an unstable motion does not amplify over the run
+  // as it does the replay from t0.
+  bool local_ok = false;
+  std::string local_message;  // why an interval's replay stopped, when not local_ok
+  std::vector<double> local;  // n
 };
 
-// `times` (P point times), `q` (P x n, row per point), `u` (P x m, row per point) of the optimized
-// motion; `v0` the optimized initial velocities (n). Points are nodes, or for Hermite-Simpson the
-// nodes with the midpoints between them.
+// `times` (P point times), `q` and `v` (P x n, row per point), `u` (P x m, row per point) of the
+// optimized motion. Points are nodes, or for Hermite-Simpson the nodes with the midpoints between
+// them.
 ReplayResult calc_replay(const OptimalControlProblem& problem, const std::vector<double>& times,
-                         const std::vector<double>& q, const std::vector<double>& v0, const std::vector<double>& u);
+                         const std::vector<double>& q, const std::vector<double>& v, const std::vector<double>& u);
 
 }  // namespace nhdyn

@@ -36,12 +36,16 @@ struct OptimizeResult {
   std::vector<double> q, v, a, u;   // P x n (or m), a row per point
   std::vector<std::string> notes;   // the rank rule's rows left out, the guess's source, warnings
   // The replay rule (docs/optimize.md, "When the result is not a motion of the model"): a result
-  // IPOPT calls solved whose replay difference exceeds replay_limit is a solution of the discrete
-  // equations only, not a motion of the model (a grid too coarse for it, or a problem without
-  // solution whose discrete form has one).
+  // IPOPT calls solved one of whose intervals, replayed from the optimum's own state at its start,
+  // ends further from the optimum than replay_limit in some coordinate is a solution of the
+  // discrete equations only, not a motion of the model (a grid too coarse for it, or a problem
+  // without solution whose discrete form has one).
   double motion_range = 0.0;        // the largest range (max - min) of a coordinate over the points
-  double replay_limit = 0.0;        // kReplayShare motion_range, at least kReplayFloor (1 + largest |q|)
-  bool replay_rejected = false;     // converged(), replayed, and replay_difference > replay_limit
+  std::vector<double> local_replay;  // n: ReplayResult::local, each coordinate's largest interval error
+  std::string replay_coordinate;     // the coordinate judged: the largest local_replay against its limit
+  double local_difference = 0.0;     // its local_replay
+  double replay_limit = 0.0;         // its limit (replay_limit_of)
+  bool replay_rejected = false;     // converged() and local_difference > replay_limit, or an interval's replay failed
   std::string replay_verdict;       // when replay_rejected: the sentence that says so and what to do
   // IPOPT converged (solved, or solved to its acceptable level).
   bool converged() const { return nlp_converged(solver.status); }
@@ -49,9 +53,11 @@ struct OptimizeResult {
   bool solved() const { return converged() && !replay_rejected; }
 };
 
-// The replay rule's limit: a tenth of the largest range of a coordinate over the optimum, and for a
-// motion that (nearly) stays still 1e-8 (1 + largest |q|), above the replay's own round-off.
+// The replay rule's limit for a coordinate: a tenth of its own range over the optimum (a coordinate
+// that hardly moves: of a hundredth of the largest range), and for a motion that (nearly) stays
+// still 1e-8 (1 + largest |q|), above the replay's own round-off.
 inline constexpr double kReplayShare = 0.1;
+inline constexpr double kReplayRangeFloor = 1e-2;
 inline constexpr double kReplayFloor = 1e-8;
 
 // nlp_status_name of the solver's status, or "not a motion of the model" for a result the
