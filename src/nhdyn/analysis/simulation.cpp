@@ -820,7 +820,8 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
                              record_crossing(model, data, static_cast<int>(at - summary.events.names.begin()), name, t,
                                              summary);
                              return Status::ok;
-                           });
+                           },
+                           times.back() - model.t0);
   const IntegrationResult result =
       model.contact_modes ? integrate_contact_modes(ode, options.integrator, model.t0, y0.data(), times, output, switches)
                           : integrate(ode, options.integrator, model.t0, y0.data(), times, output,

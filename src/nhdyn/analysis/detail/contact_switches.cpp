@@ -24,9 +24,9 @@ namespace {
 
 constexpr int kSlots = 3;               // event functions per contact
 constexpr long kMaxSwitches = 10000;    // switches judged together by ContactSwitches::count_switch
-// The last kMaxSwitches switches accumulate when they took less than this part of the time since
-// the first switch: a ball bouncing elastically every 0.4 s for hours is regular, chattering or a
-// Zeno sequence puts its 10000 switches into a vanishing stretch of the run.
+// The last kMaxSwitches switches accumulate when they took less than this part of the run's length
+// (t_end - t0): a ball bouncing elastically every 0.4 s for hours is regular, chattering or a Zeno
+// sequence puts its 10000 switches into a vanishing stretch of the run.
 constexpr double kAccumulatedFraction = 1e-3;
 constexpr int kMaxSameTime = 8;         // successive switches without progress in t
 
@@ -329,25 +329,28 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
   }
 }
 
+double ContactSwitches::window_span(double t) const {
+  // The oldest of the last min(switch_count_, kMaxSwitches) switches: slot 0 until the ring is full.
+  const long oldest = switch_count_ < kMaxSwitches ? 0 : switch_count_ % kMaxSwitches;
+  return switch_count_ > 0 ? t - switch_times_[static_cast<std::size_t>(oldest)] : 0.0;
+}
+
 bool ContactSwitches::count_switch(double t) {
-  if (switch_times_.empty()) {
-    switch_times_.assign(static_cast<std::size_t>(kMaxSwitches), t);
-    first_switch_t_ = t;
-  }
   // The slot of the switch kMaxSwitches before this one, which this one replaces.
   double& slot = switch_times_[static_cast<std::size_t>(switch_count_ % kMaxSwitches)];
   const double oldest = slot;
   slot = t;
   ++switch_count_;
-  return switch_count_ > kMaxSwitches && t - oldest < kAccumulatedFraction * (t - first_switch_t_);
+  return switch_count_ > kMaxSwitches && t - oldest < kAccumulatedFraction * run_length_;
 }
 
 ContactSwitches::ContactSwitches(const Model& model, Data& data, const FormulationOptions& formulation,
-                                 int state_size, EventFunctions* user, Handler handler)
+                                 int state_size, EventFunctions* user, Handler handler, double run_length)
     : model_(model), data_(data), formulation_(formulation), user_(user), handler_(std::move(handler)),
       user_count_(user ? user->count() : 0), size_(state_size),
-      switch_y_(static_cast<std::size_t>(state_size), 0.0) {
+      switch_y_(static_cast<std::size_t>(state_size), 0.0), run_length_(run_length) {
   const std::size_t m = model.contact_modes ? model.contact_modes->contacts.size() : 0;
+  if (m > 0) switch_times_.assign(static_cast<std::size_t>(kMaxSwitches), -HUGE_VAL);
   last_touchdown_.assign(m, -HUGE_VAL);
   previous_touchdown_.assign(m, -HUGE_VAL);
   touchdowns_.assign(m, 0);
@@ -566,10 +569,12 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
     same_graze_ = t == last_graze_t_ ? same_graze_ + 1 : 0;
     last_graze_t_ = t;
     if (same_graze_ > kMaxSameTime || accumulating) {
-      accumulation_ = fmt::format("contact '{}' grazed its ground {} times at t = {:.9g} ({} switches in the run): no "
-                                  "consistent mode; the run ends here with its results so far",
-                                  model_.contact_modes->contacts[static_cast<std::size_t>(contact)].name,
-                                  same_graze_ + 1, t, switch_count_);
+      accumulation_ = fmt::format("contact '{}' grazed its ground at t = {:.9g} ({} times at that instant, {} switches "
+                                  "in the run, the last {} of them within {:.3g} s): no consistent mode; the run ends "
+                                  "here with its results so far",
+                                  model_.contact_modes->contacts[static_cast<std::size_t>(contact)].name, t,
+                                  same_graze_ + 1, switch_count_, std::min(switch_count_, kMaxSwitches),
+                                  window_span(t));
       return Status::integrator_failure;
     }
     std::copy(y, y + size_, switch_y_.begin());
@@ -595,7 +600,7 @@ Status ContactSwitches::on_event(int i, double t, const double* y) {
     return Status::integrator_failure;
   }
   if (accumulating) {
-    const double span = t - switch_times_[static_cast<std::size_t>(switch_count_ % kMaxSwitches)];
+    const double span = window_span(t);
     accumulation_ = fmt::format("the contacts switched {} times by t = {:.9g} (the last: '{}'), the last {} of them "
                                 "within {:.3g} s, an accumulation of switches (Zeno or chattering); the run ends here "
                                 "with its results so far",

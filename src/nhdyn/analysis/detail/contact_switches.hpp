@@ -55,9 +55,10 @@ class ContactSwitches final : public EventFunctions {
   // NAME_slip, NAME_liftoff or NAME_touchdown; returns its status.
   using Handler = std::function<Status(const std::string& name, double t, const double* y)>;
 
-  // `state_size`: the size of the integrated state y (q, q' and the works).
+  // `state_size`: the size of the integrated state y (q, q' and the works); `run_length`: t_end - t0,
+  // the time scale against which switches accumulate (count_switch).
   ContactSwitches(const Model& model, Data& data, const FormulationOptions& formulation, int state_size,
-                  EventFunctions* user, Handler handler);
+                  EventFunctions* user, Handler handler, double run_length);
 
   int count() const override;
   CrossingDirection direction(int i) const override;
@@ -77,8 +78,6 @@ class ContactSwitches final : public EventFunctions {
   // Set when the switches accumulate (Zeno or no consistent mode): the message ending the run.
   const std::string& accumulation() const { return accumulation_; }
   long switches() const { return switch_count_; }
-  // Counts a switch at t; true when the last kMaxSwitches of them accumulate (docs/contact-modes.md).
-  bool count_switch(double t);
   // Warnings for the run's summary (an impact that gains energy: once per run).
   const std::vector<std::string>& warnings() const { return warnings_; }
 
@@ -94,6 +93,11 @@ class ContactSwitches final : public EventFunctions {
   void set_output(const OutputFn* output) { output_ = output; }
 
  private:
+  // Counts a switch at t; true when the last kMaxSwitches of them accumulate (docs/contact-modes.md).
+  bool count_switch(double t);
+  // The time from the oldest of the last kMaxSwitches switches (or of all, when fewer) to t.
+  double window_span(double t) const;
+
   std::string switch_contact(int contact, int slot, double t, const double* y);
   // The impact of a touchdown (section 7): the velocities of switch_y_ after it, and the mode.
   std::string touchdown(int contact, double t);
@@ -143,10 +147,10 @@ class ContactSwitches final : public EventFunctions {
   std::vector<double> switch_y_;
   std::string accumulation_;
   long switch_count_ = 0;
-  // The times of the last kMaxSwitches switches, a ring (accumulating): where they all fall within a
-  // small part of the time switching has taken, switches accumulate; spread out, they are regular.
+  // The times of the last kMaxSwitches switches, a ring: where they all fall within a small part of
+  // the run, switches accumulate; spread over it, they are regular.
   std::vector<double> switch_times_;
-  double first_switch_t_ = 0.0;
+  double run_length_ = 0.0;
   int same_time_ = 0;       // successive switches without progress in t
   double last_switch_t_ = 0.0;
   double start_t_ = -HUGE_VAL;  // the time the current segment started at (the last switch)
