@@ -882,6 +882,10 @@ TEST_F(OptimizeCli, WhatFailsOnTheFirstGuessOrAtTheFixedEndsIsNamedBeforeTheSolv
   refused("pole.toml", {{"actuator = \"x\"", "actuator = [\"1/(x - 0.5)\"]"}},
           "pole.toml:12:38: the actuator [1/(x - 0.5)] of control 'F' (its entry on x) is not finite (inf) at the first "
           "guess's point t = 1, x = 0.5, x' = 0, F = 0");
+  // The model's own terms: Q = -dV/dx of V = sqrt(x - 0.5) at x = 0, named by its entry.
+  refused("terms.toml", {{"kinetic_energy = \"m/2 * x'^2\"", "kinetic_energy = \"m/2 * x'^2\"\npotential_energy = \"sqrt(x - 0.5)\""}},
+          "the model's term Q_x (from its kinetic and potential energy, forces and constraints) is not finite (NaN) at "
+          "the first guess's point t = 0, x = 0, x' = 0, F = 0");
   refused("start.toml", {{"final =", "path = [\"x >= 2\"]\nfinal ="}},
           "start.toml:18:9: the path constraint \"x >= 2\" cannot hold at t = 0: with the fixed initial values x = 0, "
           "its left side less its right side is -2, which must be >= 0");

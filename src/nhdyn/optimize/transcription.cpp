@@ -148,7 +148,7 @@ void Transcription::require_path_at_fixed_ends() {
       bool decided = true;
       for (int v = 0; v < 2 * n_ + m_ && decided; ++v) {
         if (!c.reads[static_cast<std::size_t>(v)]) continue;
-        const int index = v < 2 * n_ ? q_index(p, v) : u_index(p, v - 2 * n_);
+        const int index = v < n_ ? q_index(p, v) : v < 2 * n_ ? v_index(p, v - n_) : u_index(p, v - 2 * n_);
         decided = x_lower_[static_cast<std::size_t>(index)] == x_upper_[static_cast<std::size_t>(index)];
         const std::string name = v < n_    ? model.coordinates[static_cast<std::size_t>(v)]
                                  : v < 2 * n_ ? model.coordinates[static_cast<std::size_t>(v - n_)] + "'"
@@ -169,6 +169,22 @@ void Transcription::require_path_at_fixed_ends() {
   }
 }
 
+// Entry k of terms_out_ by name: A (n x n), Q, G (n), b (s x n), b0 (s), each column-major.
+std::string Transcription::term_name(int k) const {
+  const auto& model = problem_.model;
+  const auto coordinate = [&](int i) { return model.coordinates[static_cast<std::size_t>(i)]; };
+  const auto constraint = [&](int i) { return model.constraints[static_cast<std::size_t>(i)].name; };
+  if (k < n_ * n_) return fmt::format("A({}, {})", coordinate(k % n_), coordinate(k / n_));
+  k -= n_ * n_;
+  if (k < n_) return "Q_" + coordinate(k);
+  k -= n_;
+  if (k < n_) return "G_" + coordinate(k);
+  k -= n_;
+  if (k < s_ * n_) return fmt::format("b({}, {})", constraint(k % s_), coordinate(k / s_));
+  k -= s_ * n_;
+  return fmt::format("b0({})", constraint(k));
+}
+
 void Transcription::require_defined_at_start() {
   const double* x = start_.data();
   const std::string what_to_do =
@@ -176,7 +192,8 @@ void Transcription::require_defined_at_start() {
       "expression";
   const auto undefined = [&](const std::string& what, const std::string& where, double value, int p) {
     return InputError(fmt::format("{}{}{} is not finite ({}) at the first guess's point {}: {}", where,
-                                  where.empty() ? "" : ": ", what, value, describe_point(p, x), what_to_do));
+                                  where.empty() ? "" : ": ", what, std::isnan(value) ? std::string("NaN") : fmt::format("{}", value),
+                                  describe_point(p, x), what_to_do));
   };
   std::vector<double> g(static_cast<std::size_t>(std::max(path_count_, 1))),
       columns(static_cast<std::size_t>(n_ * m_));
@@ -184,9 +201,12 @@ void Transcription::require_defined_at_start() {
   for (int p = 0; p < points_; ++p) {
     const double t = time(p, x);
     terms_->run(t, x + q_index(p, 0), x + v_index(p, 0), terms_registers_.data(), terms_out_.data());
-    for (double v : terms_out_)
-      if (!std::isfinite(v))
-        throw undefined("the model's equations (A, Q, G, b, b0)", "", v, p);
+    for (std::size_t k = 0; k < terms_out_.size(); ++k)
+      if (!std::isfinite(terms_out_[k]))
+        throw undefined(fmt::format("the model's term {} (from its kinetic and potential energy, forces and "
+                                    "constraints)",
+                                    term_name(static_cast<int>(k))),
+                        "", terms_out_[k], p);
     layout_inputs(p, x);
     problem_.integrand.run(t, layout_q_.data(), layout_v_.data(), other_registers_.data(), &value);
     if (!std::isfinite(value))

@@ -62,6 +62,8 @@ class Transcription final : public Nlp {
   // terms are not finite at a point of the starting point (start(), the guess set in it), where
   // IPOPT would stop on "Invalid number" with nothing to say where.
   void require_defined_at_start();
+  // Entry k of the terms' outputs by name (A(x, y), Q_x, G_x, b(constraint, x), b0(constraint)).
+  std::string term_name(int k) const;
 
   int variables() const override { return variables_; }
   int constraints() const override { return rows_; }
