@@ -429,6 +429,8 @@ class Model:
             raise InputError("report: expected a Result of Model.simulate, got {}".format(type(result).__name__))
         if isinstance(max_frames, bool) or not isinstance(max_frames, (int, np.integer)):
             raise InputError("report: max_frames={!r}: give a whole number of rows (at least 2)".format(max_frames))
+        if max_frames < 2:
+            raise InputError("report: max_frames={}: give at least 2 (the first and the last row)".format(max_frames))
         max_frames = int(min(max_frames, 2**31 - 1))  # more frames than rows are the rows
         if result._source.is_builtin != self.source.is_builtin or result._source.text != self.source.text or \
                 result._source.builtin != self.source.builtin:

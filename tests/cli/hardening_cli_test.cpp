@@ -731,7 +731,6 @@ TEST_F(Hardening, BatchAndCompareSayWhenAStopConditionNeverHolds) {
   EXPECT_TRUE(contains(c.err, "the stop event 'high' (x - 3) is not applied by compare")) << c.err;
 }
 
-// GiNaC's own words ("power::eval(): division by zero", "log_eval(): log(0)") reached the user.
 // A character pasted from a paper or a word processor is named by its code point, with what to
 // write instead; an invisible one is never shown raw (a no-break space read as "unexpected
 // character ' '").
@@ -756,6 +755,7 @@ TEST_F(Hardening, InvisibleAndLookAlikeCharactersAreNamedByTheirCode) {
   EXPECT_TRUE(contains(set.err, "unexpected U+00A0 (a no-break space): write a plain space (column 2)")) << set.err;
 }
 
+// GiNaC's own words ("power::eval(): division by zero", "log_eval(): log(0)") reached the user.
 TEST_F(Hardening, GinacWordsAreTranslated) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"m/2 * x'^2/(0*x)", "divides by zero"}, {"m/2 * x'^2 + 0^0*x", "0^0, which is undefined"},

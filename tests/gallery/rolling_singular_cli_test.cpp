@@ -5,6 +5,7 @@
 // disk as a [[wheels]] entry likewise, located at every step (before, the wheel rolled on through
 // the plane, exit 0).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -114,7 +115,7 @@ TEST(RollingSingularCli, WheelFallingFlatStopsWhereItsAxleMeetsTheNormal) {
 // Started flat (theta0 = pi/2 on rolling_disk_hop.toml): a bad start, exit 2 before any row (the
 // run failed with exit 1 "at t = 0.01" after its first step, the message saying t = 0).
 TEST(RollingSingularCli, ADiskStartedFlatIsABadStart) {
-  const fs::path dir = fs::temp_directory_path() / "nhdyn_rolling_started_flat";
+  const fs::path dir = fs::temp_directory_path() / ("nhdyn_rolling_started_flat_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const nhdyn::test::CliOutcome outcome = nhdyn::test::run_nhdyn(
       "simulate " + nhdyn::test::example("rolling_disk_hop.toml") + " --set theta0=pi/2 -q -o o.csv", dir);

@@ -705,7 +705,6 @@ void note_unmet_stops(const Model& model, const std::vector<const Event*>& event
   }
 }
 
-// The message of a run that failed, in the most telling words there are.
 // What the integrator's options may have done to a run that failed, said after the failure's own
 // words (which blame the model); "" otherwise. An adaptive run that blew up or stalled under an
 // absolute tolerance at least the size of every state at the start: its error test bounded
@@ -733,6 +732,7 @@ std::string integrator_hint(const IntegratorOptions& integrator, Status status, 
       integrator.atol, largest);
 }
 
+// The message of a run that failed, in the most telling words there are.
 std::string explain_run_failure(const Model& model, const Data& data, const ModelEventFunctions& event_functions,
                                 const WatchedEvents& watched, const IntegrationResult& result,
                                 const std::string& output_message, Status status) {

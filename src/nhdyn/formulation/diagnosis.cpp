@@ -134,13 +134,15 @@ std::string explain_disproportionate_columns(const Model& model, const Data& dat
     if (involved.find("'" + c.name + "'") == std::string::npos)
       involved += (involved.empty() ? "" : ", ") + ("'" + c.name + "'") + (c.where.empty() ? "" : " (" + c.where + ")");
   }
+  const bool one = involved.find("', '") == std::string::npos && involved.find("), '") == std::string::npos;
   return fmt::format(
-      "the constraints {} are numerically singular at t = {:.6g}, but only through the units of the coordinates: "
-      "the column of '{}' in the constraint matrix b is {:.3g} times the column of '{}' (a length of that size "
-      "against an angle, say), beyond what double precision separates; with the columns in proportion the "
-      "constraints are independent. Rescale the model's lengths or masses (km or mm in place of m) so that its "
-      "parameters are within a few orders of magnitude of each other.",
-      involved, data.t, name(largest), norms(largest) / norms(smallest), name(smallest));
+      "the constraint matrix b is numerically singular at t = {:.6g} in the rows of {} {}, but only through the units "
+      "of the coordinates: its column of '{}' is {:.3g} times its column of '{}' (a length of that size against an "
+      "angle, say), beyond what double precision separates; with the columns in proportion the constraints are "
+      "independent. Rescale the model's lengths (km or mm in place of m) so that its parameters are within a few "
+      "orders of magnitude of each other.",
+      data.t, one ? "the constraint" : "the constraints", involved, name(largest), norms(largest) / norms(smallest),
+      name(smallest));
 }
 
 // Singular values of b and, for each small one, the constraints taking part in the dependency.

@@ -108,8 +108,9 @@ struct PositiveValue {
   std::string what;   // "contact 'ball': sphere r"
   std::string text;   // as written: "r"
   Tape value;
-  // The sizes of one contact shape share a group ("contact 'foot'"), within which they must stay
-  // within kLargestSizeRatio of each other (model/parameters.hpp); "" for a value on its own.
+  // The sizes of one contact shape kept in proportion (an ellipsoid's semi-axes:
+  // ContactShape::sizes_in_proportion) share a group ("contact 'foot'"), within which they must
+  // stay within kLargestSizeRatio of each other (model/parameters.hpp); "" for a value on its own.
   std::string group = {};
 };
 

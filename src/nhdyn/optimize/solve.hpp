@@ -65,7 +65,8 @@ inline constexpr double kReplayFloor = 1e-8;
 const char* optimize_status_name(const OptimizeResult& result);
 
 // Throws InputError for a problem the transcription refuses (transcription.hpp) or a guess file
-// that lacks a column or does not cover [t0, t_end]; never for the solver's failure, which the
+// that lacks a column, holds a value that is not finite, has times that decrease or none inside
+// [t0, t_end] (a guess covering part of it gets a note); never for the solver's failure, which the
 // result's status says.
 OptimizeResult solve_optimal_control(const OptimalControlProblem& problem, const OptimizeOptions& options = {});
 

@@ -79,6 +79,10 @@ class ContactShape {
     GiNaC::ex curvature;
   };
   virtual std::optional<Rim> rim(const ShapeValues&, const Vector3&, const GiNaC::ex&) const { return std::nullopt; }
+  // Whether its sizes must stay within kLargestSizeRatio of each other (model/parameters.hpp): an
+  // ellipsoid whose semi-axes are further apart is flat or a needle to double precision, its
+  // contact point undefined across its rim; a thin torus is a hoop, well defined.
+  virtual bool sizes_in_proportion() const { return false; }
   // The size of the shape for the moment rows of the contact-force solve (a length).
   virtual GiNaC::ex length(const ShapeValues& values) const { return values.sizes.front(); }
   // Where the closed-form contact point is singular along the motion: a measure that is positive

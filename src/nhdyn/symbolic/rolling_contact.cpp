@@ -115,7 +115,8 @@ ParsedContact parse_contact(const ContactText& text, const ContactParsers& parse
       throw_model_error(text.shape_where, what,
                         fmt::format("\"{}\" must be positive, but it is {}", text.sizes[i],
                                     v ? fmt::format("{}", *v) : "not a number"));
-    out.positive.push_back(SpecPositive{text.shape_where, what, text.sizes[i], size, context});
+    out.positive.push_back(SpecPositive{text.shape_where, what, text.sizes[i], size,
+                                        shape.sizes_in_proportion() ? context : std::string()});
     out.values.sizes.push_back(size);
   }
   const std::vector<std::string> options = shape.options();

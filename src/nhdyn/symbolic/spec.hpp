@@ -196,7 +196,7 @@ struct SpecPositive {
   std::string what;  // what the message names: "contact 'ball': sphere r"
   std::string text;  // as written: "r"
   GiNaC::ex value;   // in the parameters
-  std::string group = {};  // PositiveValue::group: the sizes of one contact shape
+  std::string group = {};  // PositiveValue::group: the sizes of one contact shape kept in proportion
 };
 
 struct Spec {

@@ -12,6 +12,7 @@ class Ellipsoid final : public ContactShape {
   int size_count() const override { return 3; }
   std::vector<std::string> size_names() const override { return {"a", "b", "c"}; }
   std::string example() const override { return "shape = { ellipsoid = [\"a\", \"b\", \"c\"] }"; }
+  bool sizes_in_proportion() const override { return true; }
   ShapeSupport support(const ShapeValues& v, const Vector3& nu, const GiNaC::ex& length) const override {
     const Vector3 Minv_nu = {v.sizes[0] * v.sizes[0] * nu[0], v.sizes[1] * v.sizes[1] * nu[1],
                              v.sizes[2] * v.sizes[2] * nu[2]};
