@@ -16,6 +16,7 @@
 
 #include "nhdyn/io/csv.hpp"
 #include "support/cli_process.hpp"
+#include "support/models.hpp"
 #include "support/text.hpp"
 
 namespace {
@@ -115,35 +116,12 @@ TEST_F(NonFinite, AnInfiniteEventEndsTheRunToo) {
 // (they read the surface at the contact point's own coordinates) while the gap's rate, the velocity
 // residual of the contact, is -inf; the run went on to its end with exit 0 and -inf in 11 rows.
 TEST_F(NonFinite, AConstraintResidualThatIsNotFiniteEndsTheRun) {
-  std::ofstream(dir_ / "pole.toml") << R"toml(name = "pole"
-coordinates = ["x", "y", "z", "psi", "theta", "phi"]
-gravity = [0, 0, "-g"]
-[parameters]
-m = 0.2
-r = 0.05
-g = 9.81
-[[frames]]
-name = "ball"
-translation = ["x", "y", "z"]
-rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
-[[bodies]]
-name = "ball"
-frame = "ball"
-mass = "m"
-inertia = ["2/5*m*r^2", "2/5*m*r^2", "2/5*m*r^2"]
-[[contacts]]
-name = "ball"
-body = "ball"
-shape = { sphere = "r" }
-ground = { terrain = "0.001/(X-0.3)" }
-[initial]
-position = { x = 0, y = 0, psi = 0, theta = 0, phi = 0 }
-velocity = { x = 0.3 }
-)toml";
+  std::ofstream(dir_ / "pole.toml") << nhdyn::test::ball_on_terrain(
+      "0.001/(X-0.3)", "[initial]\nposition = { x = 0, y = 0, psi = 0, theta = 0, phi = 0 }\nvelocity = { x = 0.3 }\n");
   const ProcessRun r = nhdyn({"simulate", "pole.toml", "--fix-initial", "--t-end", "1.5", "--output-step", "0.01",
                               "-q", "-o", "pole.csv"});
   EXPECT_EQ(r.code, 1) << r.err;
-  EXPECT_TRUE(contains(r.err, "pole.toml:17:1: the velocity residual of constraint 'ball_contact'")) << r.err;
+  EXPECT_TRUE(contains(r.err, "pole.toml:24:1: the velocity residual of constraint 'ball_contact'")) << r.err;
   EXPECT_TRUE(contains(r.err, ") is -inf at t = ")) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "pole.csv"));
   const nhdyn::CsvTable partial = nhdyn::load_csv(dir_ / "pole.partial.csv");

@@ -11,6 +11,7 @@
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/io/results.hpp"
+#include "support/models.hpp"
 
 namespace nhdyn {
 namespace {
@@ -22,46 +23,11 @@ int terrain_column(const ResultColumns& columns, const std::string& name) {
   return 0;
 }
 
-// A solid ball (radius r, centre (x, y, z)) whose contact point on the terrain is (u, v, h(u, v)).
-std::string ball_on_terrain(const std::string& terrain, const std::string& initial) {
-  return R"toml(name = "ball-on-terrain"
-coordinates = ["x", "y", "z", "u", "v", "psi", "theta", "phi"]
-gravity = [0, 0, "-g"]
-
-[parameters]
-m = 1.5
-r = 0.1
-g = 9.81
-alpha = 0.3
-H = 0.05
-w = 0.3
-
-[[frames]]
-name = "ball"
-translation = ["x", "y", "z"]
-rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
-
-[[bodies]]
-name = "ball"
-frame = "ball"
-mass = "m"
-inertia = ["2/5*m*r^2", "2/5*m*r^2", "2/5*m*r^2"]
-
-[[contacts]]
-name = "ball"
-body = "ball"
-shape = { sphere = "r" }
-ground = { terrain = ")toml" +
-         terrain + R"toml(", coordinates = ["u", "v"] }
-
-)toml" + initial;
-}
-
 // The terrain h = X tan(alpha) is the plane through the origin inclined by alpha: a solid ball
 // released on it rolls down at a = 5/7 g sin(alpha) (rolling-bodies.md (6.8) with J = 2/5 m r^2),
 // pressed by N = m g cos(alpha), its contact point straight below the centre along the normal.
 TEST(RollingTerrain, BallOnAnInclinedTerrainRollsAtFiveSevenths) {
-  const Model model = load_model_text(ball_on_terrain("X*tan(alpha)", R"toml([initial]
+  const Model model = load_model_text(test::ball_on_terrain("X*tan(alpha)", R"toml([initial]
 position = { x = "-r*sin(alpha)", y = 0, z = "r*cos(alpha)", u = 0, v = 0, psi = 0, theta = 0, phi = 0 }
 )toml"));
   const double m = 1.5, r = 0.1, g = 9.81, alpha = 0.3, a = 5.0 / 7.0 * g * std::sin(alpha);
@@ -97,7 +63,7 @@ position = { x = "-r*sin(alpha)", y = 0, z = "r*cos(alpha)", u = 0, v = 0, psi =
 // Over a Gaussian bump, started off its axis with a velocity across it: the energy stays, the
 // contact point is on the terrain, at the distance r from the centre, along the terrain's normal.
 TEST(RollingTerrain, BallOverABumpKeepsItsEnergyAndTouchesTheTerrain) {
-  const Model model = load_model_text(ball_on_terrain("H*exp(-(X^2 + Y^2)/w^2)", R"toml([initial]
+  const Model model = load_model_text(test::ball_on_terrain("H*exp(-(X^2 + Y^2)/w^2)", R"toml([initial]
 position = { x = -0.6, y = 0.08, psi = 0, theta = 0, phi = 0 }
 velocity = { x = 1.2, y = 0, phi = 12 }
 )toml"));

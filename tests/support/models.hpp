@@ -93,4 +93,39 @@ position = { x = 0, y = 0, z = "r", psi = 0, theta = 0, phi = 0 }
 )toml" + initial;
 }
 
+// A solid ball (radius r, centre (x, y, z)) whose contact point on the terrain is (u, v, h(u, v)).
+inline std::string ball_on_terrain(const std::string& terrain, const std::string& initial) {
+  return R"toml(name = "ball-on-terrain"
+coordinates = ["x", "y", "z", "u", "v", "psi", "theta", "phi"]
+gravity = [0, 0, "-g"]
+
+[parameters]
+m = 1.5
+r = 0.1
+g = 9.81
+alpha = 0.3
+H = 0.05
+w = 0.3
+
+[[frames]]
+name = "ball"
+translation = ["x", "y", "z"]
+rotations = [["z", "psi"], ["x", "theta"], ["y", "phi"]]
+
+[[bodies]]
+name = "ball"
+frame = "ball"
+mass = "m"
+inertia = ["2/5*m*r^2", "2/5*m*r^2", "2/5*m*r^2"]
+
+[[contacts]]
+name = "ball"
+body = "ball"
+shape = { sphere = "r" }
+ground = { terrain = ")toml" +
+         terrain + R"toml(", coordinates = ["u", "v"] }
+
+)toml" + initial;
+}
+
 }  // namespace nhdyn::test
