@@ -16,11 +16,17 @@
 #include "nhdyn/model/detail/tape_tangent.hpp"
 
 namespace nhdyn {
-namespace {
 
-double nlp_bound(double b) { return std::isfinite(b) ? b : (b > 0 ? kNlpInfinity : -kNlpInfinity); }
+double Transcription::nlp_bound(double b) { return std::isfinite(b) ? b : (b > 0 ? kNlpInfinity : -kNlpInfinity); }
 
-}  // namespace
+std::vector<std::string> Transcription::residual_row_names() const {
+  std::vector<std::string> names;
+  for (const Constraint& c : problem_.model.constraints)
+    if (c.level == ConstraintLevel::position) names.push_back(c.name + " (position)");
+  for (const Constraint& c : problem_.model.constraints)
+    if (c.level != ConstraintLevel::acceleration) names.push_back(c.name + " (velocity)");
+  return names;
+}
 
 Transcription::Transcription(const OptimalControlProblem& problem) : problem_(problem) {
   const Model& model = problem_.model;
@@ -231,12 +237,7 @@ void Transcription::choose_splits_and_initial_rows() {
                   out.data() + pcount);
     for (int c = 0; c < candidates; ++c) J(c, col) = fixed[static_cast<std::size_t>(col)] ? 0.0 : out[static_cast<std::size_t>(c)];
   }
-  // The names of the rows: the position-level constraints, then the position- and velocity-level ones.
-  std::vector<std::string> names;
-  for (const Constraint& c : model.constraints)
-    if (c.level == ConstraintLevel::position) names.push_back(c.name + " (position)");
-  for (const Constraint& c : model.constraints)
-    if (c.level != ConstraintLevel::acceleration) names.push_back(c.name + " (velocity)");
+  const std::vector<std::string> names = residual_row_names();
   Eigen::MatrixXd basis(2 * n_, 0);
   for (int c = 0; c < candidates; ++c) {
     Eigen::VectorXd row = J.row(c).transpose();

@@ -64,6 +64,11 @@ class Transcription final : public Nlp {
   void require_defined_at_start();
   // Entry k of the terms' outputs by name (A(x, y), Q_x, G_x, b(constraint, x), b0(constraint)).
   std::string term_name(int k) const;
+  // The names of the residuals' rows: the position-level constraints, then the position- and
+  // velocity-level ones ("c1 (position)").
+  std::vector<std::string> residual_row_names() const;
+  // A bound for IPOPT: an infinite one as its kNlpInfinity.
+  static double nlp_bound(double b);
 
   int variables() const override { return variables_; }
   int constraints() const override { return rows_; }

@@ -13,6 +13,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
+#include "nhdyn/model/detail/tape_tangent.hpp"
 
 namespace nhdyn {
 
@@ -235,11 +236,7 @@ void Transcription::require_final_values_agree(const Eigen::MatrixXd& Z, const E
                                                const std::vector<double>& residuals,
                                                const std::vector<int>& fixed_columns) const {
   const Model& model = problem_.model;
-  std::vector<std::string> rows;  // the names of the residuals' rows, as choose_splits_and_initial_rows gives them
-  for (const Constraint& c : model.constraints)
-    if (c.level == ConstraintLevel::position) rows.push_back(c.name + " (position)");
-  for (const Constraint& c : model.constraints)
-    if (c.level != ConstraintLevel::acceleration) rows.push_back(c.name + " (velocity)");
+  const std::vector<std::string> rows = residual_row_names();
   double largest = 0.0;
   for (const BoundaryValue& b : problem_.final) largest = std::max(largest, std::abs(b.value));
   const Eigen::Map<const Eigen::VectorXd> r(residuals.data(), static_cast<Eigen::Index>(residuals.size()));
