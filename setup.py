@@ -62,6 +62,11 @@ class CMakeBuild(build_ext):
                     "NHDYN_PIP_BUILD_DIR={} was configured for Python {} but this build runs {}: use a build "
                     "directory configured with -DPYTHON_EXECUTABLE={}, or leave NHDYN_PIP_BUILD_DIR unset".format(
                         build_dir, configured_for, sys.executable, sys.executable))
+            if (cached(build_dir, "NHDYN_BUILD_PYTHON") or "").upper() not in ("ON", "1", "TRUE", "YES"):
+                raise RuntimeError(
+                    "NHDYN_PIP_BUILD_DIR={} was configured without the Python package (NHDYN_BUILD_PYTHON is not ON: "
+                    "`make run` configures it so): run `make python` there first, or leave NHDYN_PIP_BUILD_DIR "
+                    "unset".format(build_dir))
         else:
             generator = ["-G", "Ninja"] if shutil.which("ninja") else []
             subprocess.run(["cmake", "-S", str(ROOT), "-B", str(build_dir), *generator, "-DCMAKE_BUILD_TYPE=Release",
