@@ -72,15 +72,18 @@ std::vector<std::string> apply_guess(const Transcription& nlp, const std::filesy
   }
   for (const auto& [offset, c] : map) known[static_cast<std::size_t>(c)] = 1;
   const std::size_t tc = static_cast<std::size_t>(t_column);
+  // The file's line of data row r: after the comment lines (a FILE.partial.csv's reason) and the
+  // header, as load_csv counts them.
+  const auto file_line = [&](std::size_t r) { return table.comments.size() + 2 + r; };
   for (std::size_t r = 0; r < table.rows.size(); ++r) {
     for (std::size_t c = 0; c < table.header.size(); ++c)
       if (known[c] && !std::isfinite(table.rows[r][c]))
-        throw InputError(fmt::format("{}: row {}: {} = {} is not finite; a guess holds finite values", file, r + 1,
-                                     table.header[c], table.rows[r][c]));
+        throw InputError(fmt::format("{}:{}: {} = {} is not finite; a guess holds finite values", file,
+                                     file_line(r), table.header[c], table.rows[r][c]));
     if (r > 0 && table.rows[r][tc] < table.rows[r - 1][tc])
-      throw InputError(fmt::format("{}: row {}: t = {} is before the row above (t = {}); a guess's times never "
+      throw InputError(fmt::format("{}:{}: t = {} is before the row above (t = {}); a guess's times never "
                                    "decrease",
-                                   file, r + 1, table.rows[r][tc], table.rows[r - 1][tc]));
+                                   file, file_line(r), table.rows[r][tc], table.rows[r - 1][tc]));
   }
   const double first = table.rows.front()[tc], last = table.rows.back()[tc];
   const double t0 = problem.t0, t_end = nlp.time(nlp.points() - 1, x.data());
