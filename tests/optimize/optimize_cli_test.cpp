@@ -545,6 +545,29 @@ initial = { position = { x = 0, y = 0, z = 0 }, velocity = { x = 0, y = 0, z = 0
       << run.out;
   EXPECT_EQ(run.out.find("status:"), std::string::npos) << run.out;
   EXPECT_FALSE(fs::exists(dir_ / "c.csv"));
+  // A constraint not defined at the final values (sqrt(y - 0.5) at the straight line's y = 0) is
+  // named so, not said to be violated by values that leave y free (it read "the constraint :" and
+  // "-nan").
+  write("undefined.toml", R"toml(name = "undefined"
+coordinates = ["x", "y"]
+kinetic_energy = "1/2 * x'^2 + 1/2*y'^2"
+[[constraints]]
+name = "c1"
+velocity = "x' - sqrt(y - 0.5)*y'"
+[optimize]
+controls = [{ name = "F", actuator = "x" }]
+objective = "F^2"
+t_end = 1
+nodes = 5
+initial = { position = { x = 0, y = 0 }, velocity = { x = 0, y = 0 } }
+final = { position = { x = 1 }, velocity = { x = 0 } }
+)toml");
+  const Outcome undefined = run_nhdyn("optimize undefined.toml -o u.csv", dir_);
+  EXPECT_EQ(undefined.exit_code, 2) << undefined.out;
+  EXPECT_NE(undefined.out.find("the constraint c1 (velocity) is not defined at the final values of [optimize]"),
+            std::string::npos)
+      << undefined.out;
+  EXPECT_NE(undefined.out.find("(its residual at t_end is NaN)"), std::string::npos) << undefined.out;
   EXPECT_FALSE(fs::exists(dir_ / "c.partial.csv"));
   // Values on the constraint: one of them released, both met.
   write("agree.toml", model + "final = { position = { x = 1, y = 1 } }\n");
@@ -787,6 +810,41 @@ TEST_F(OptimizeCli, AnOptimumTheReplayDoesNotConfirmIsNotCalledSolved) {
     ASSERT_NE(at, std::string::npos) << run.out;
     EXPECT_LT(summary_value(run.out, "interval replay"), 1e-3 * std::stod(run.out.substr(at + 8))) << run.out;
   }
+  // Each coordinate against its own range and size: a height standing still at 1e9 (whose floor
+  // is 10) or a flywheel turning through 5000 rad (whose range is 5000) left the impossible x of
+  // a mass that x F cannot move, and an x that the controls take 1 m off within an interval,
+  // inside a limit set by the other coordinate.
+  write("tall.toml", R"toml(name = "tall"
+coordinates = ["x", "z"]
+kinetic_energy = "1/2 * x'^2 + 1/2*z'^2"
+[optimize]
+controls = [{ name = "F", actuator = ["x", "0"] }]
+objective = "F^2"
+t_end = 1
+nodes = 11
+initial = { position = { x = 0, z = 1e9 }, velocity = { x = 0, z = 0 } }
+final = { position = { x = 1 }, velocity = { x = 0 } }
+)toml");
+  rejected(optimize("tall.toml -o tall.csv"), "tall");
+  write("flywheel.toml", R"toml(name = "flywheel"
+coordinates = ["x", "phi"]
+kinetic_energy = "1/2 * x'^2 + 1/2*phi'^2"
+potential_energy = "-c*sin(5000*t)*x"
+[parameters]
+c = 1e3
+[optimize]
+controls = [{ name = "F", actuator = "x" }]
+objective = "1e-6*F^2 + 1e6*x^2"
+t_end = 1
+nodes = 21
+method = "trapezoidal"
+initial = { position = { x = 0, phi = 0 }, velocity = { x = 0, phi = 5000 } }
+final = { position = { x = 0 }, velocity = { x = 0 } }
+)toml");
+  const Outcome flywheel = optimize("flywheel.toml -o flywheel.csv");
+  rejected(flywheel, "flywheel");
+  EXPECT_NE(flywheel.out.find("interval replay: 1.0"), std::string::npos) << flywheel.out;
+  EXPECT_NE(flywheel.out.find(" in x ("), std::string::npos) << flywheel.out;
   // An unstable motion: a pendulum on a cart swung up from hanging, whose replay from t0 drifts
   // with the instability (0.42 at 41 nodes, 0.10 at 81: as h^2) while each interval's error is
   // small (1.3e-3): accepted, the replay from t0 reported.

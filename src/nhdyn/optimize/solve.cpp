@@ -153,15 +153,14 @@ void check_nlp_options(const NlpOptions& options) {
 // whatever the grid, is not taken for a wrong one.
 void apply_replay_rule(OptimizeResult& result, const std::vector<std::string>& coordinates, const ReplayResult& replay) {
   const int n = static_cast<int>(coordinates.size());
-  std::vector<double> range(static_cast<std::size_t>(n), 0.0);
-  double largest = 0.0;
+  std::vector<double> range(static_cast<std::size_t>(n), 0.0), largest(static_cast<std::size_t>(n), 0.0);
   for (int i = 0; i < n; ++i) {
     double lo = kNoBound, hi = -kNoBound;
     for (int p = 0; p < result.points; ++p) {
       const double q = result.q[static_cast<std::size_t>(p * n + i)];
       lo = std::min(lo, q);
       hi = std::max(hi, q);
-      largest = std::max(largest, std::abs(q));
+      largest[static_cast<std::size_t>(i)] = std::max(largest[static_cast<std::size_t>(i)], std::abs(q));
     }
     if (result.points > 0) range[static_cast<std::size_t>(i)] = hi - lo;
     result.motion_range = std::max(result.motion_range, range[static_cast<std::size_t>(i)]);
@@ -169,9 +168,10 @@ void apply_replay_rule(OptimizeResult& result, const std::vector<std::string>& c
   result.local_replay = replay.local;
   double worst = -1.0;
   for (int i = 0; i < n && replay.local_ok; ++i) {
+    // Each coordinate against its own range and magnitude: another's (a flywheel's 5000 rad, a
+    // height of 1e9 standing still) says nothing of this one's error.
     const std::size_t u = static_cast<std::size_t>(i);
-    const double limit = std::max(kReplayShare * std::max(range[u], kReplayRangeFloor * result.motion_range),
-                                  kReplayFloor * (1.0 + largest));
+    const double limit = std::max(kReplayShare * range[u], kReplayFloor * (1.0 + largest[u]));
     if (replay.local[u] / limit > worst) {
       worst = replay.local[u] / limit;
       result.replay_coordinate = coordinates[u];

@@ -53,11 +53,9 @@ struct OptimizeResult {
   bool solved() const { return converged() && !replay_rejected; }
 };
 
-// The replay rule's limit for a coordinate: a tenth of its own range over the optimum (a coordinate
-// that hardly moves: of a hundredth of the largest range), and for a motion that (nearly) stays
-// still 1e-8 (1 + largest |q|), above the replay's own round-off.
+// The replay rule's limit for a coordinate: a tenth of its own range over the optimum, and for a
+// coordinate that (nearly) stays still 1e-8 (1 + its largest |q|), above the replay's own round-off.
 inline constexpr double kReplayShare = 0.1;
-inline constexpr double kReplayRangeFloor = 1e-2;
 inline constexpr double kReplayFloor = 1e-8;
 
 // nlp_status_name of the solver's status, or "not a motion of the model" for a result the

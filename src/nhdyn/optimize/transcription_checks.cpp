@@ -240,6 +240,15 @@ void Transcription::require_final_values_agree(const Eigen::MatrixXd& Z, const E
   double largest = 0.0;
   for (const BoundaryValue& b : problem_.final) largest = std::max(largest, std::abs(b.value));
   const Eigen::Map<const Eigen::VectorXd> r(residuals.data(), static_cast<Eigen::Index>(residuals.size()));
+  // A constraint not defined at the final values (sqrt of a negative number) says nothing of
+  // agreement: named as such, before any combination of the rows.
+  for (std::size_t i = 0; i < residuals.size() && i < rows.size(); ++i)
+    if (!std::isfinite(residuals[i]))
+      throw InputError(fmt::format(
+          "the constraint {} is not defined at the final values of [optimize] and the straight line's other final "
+          "values (its residual at t_end is {}): give final values where the model is defined, or a first guess "
+          "(--guess FILE.csv) that ends there",
+          rows[i], std::isnan(residuals[i]) ? std::string("NaN") : fmt::format("{}", residuals[i])));
   for (Eigen::Index k = 0; k < Z.cols(); ++k) {
     const double residual = Z.col(k).dot(r);
     if (std::abs(residual) <= 1e-8 * (1.0 + largest)) continue;
