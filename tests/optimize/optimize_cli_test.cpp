@@ -946,6 +946,16 @@ TEST_F(OptimizeCli, WhatFailsOnTheFirstGuessOrAtTheFixedEndsIsNamedBeforeTheSolv
   refused("terms.toml", {{"kinetic_energy = \"m/2 * x'^2\"", "kinetic_energy = \"m/2 * x'^2\"\npotential_energy = \"sqrt(x - 0.5)\""}},
           "the model's term Q_x (from its kinetic and potential energy, forces and constraints) is not finite (NaN) at "
           "the first guess's point t = 0, x = 0, x' = 0, F = 0");
+  // A mass of 0 or below: x moved from 0 to 1 under F = 0, exit 0 (simulate refuses the inertia).
+  for (const char* mass : {"0", "-1"}) {
+    const Outcome run = run_nhdyn("optimize " + example("double_integrator.toml") + " --set m=" + mass + " -o o.csv", dir_);
+    EXPECT_EQ(run.exit_code, 2) << run.out;
+    EXPECT_NE(run.out.find("the inertia matrix A of model 'double_integrator' is not positive definite on the motions "
+                           "its constraints allow at the first guess's point t = 0"),
+              std::string::npos)
+        << run.out;
+    EXPECT_FALSE(fs::exists(dir_ / "o.csv"));
+  }
   refused("start.toml", {{"final =", "path = [\"x >= 2\"]\nfinal ="}},
           "start.toml:18:9: the path constraint \"x >= 2\" cannot hold at t = 0: with the fixed initial values x = 0, "
           "its left side less its right side is -2, which must be >= 0");

@@ -13,6 +13,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
+#include "nhdyn/formulation/diagnosis.hpp"
 #include "nhdyn/model/detail/tape_tangent.hpp"
 
 namespace nhdyn {
@@ -100,6 +101,19 @@ void Transcription::require_defined_at_start() {
                                     "constraints)",
                                     term_name(static_cast<int>(k))),
                         "", terms_out_[k], p);
+    // An inertia that is not positive on the motions the constraints allow (a mass set to 0 or
+    // -1) makes no dynamics: simulate refuses it; the transcription solved it (F = 0 moving x).
+    if (p == 0) {
+      const Eigen::Map<const Eigen::MatrixXd> A(terms_out_.data(), n_, n_);
+      const Eigen::Map<const Eigen::MatrixXd> b(terms_out_.data() + n_ * n_ + 2 * n_, s_, n_);
+      double smallest = 0.0;
+      if (!inertia_positive_on_constraints(A, b, smallest))
+        throw InputError(fmt::format(
+            "the inertia matrix A of model '{}' is not positive definite on the motions its constraints allow at "
+            "the first guess's point {} (smallest eigenvalue {:.6g}): every coordinate needs a positive mass or "
+            "inertia (a mass of 0 or below moves under no force); simulate refuses it too",
+            problem_.model.name, describe_point(p, x), smallest));
+    }
     layout_inputs(p, x);
     problem_.integrand.run(t, layout_q_.data(), layout_v_.data(), other_registers_.data(), &value);
     if (!std::isfinite(value))
