@@ -133,6 +133,10 @@ def _real_numbers(values, what):
     if raw.dtype == bool or raw.dtype.kind not in "iuf":
         raise InputError("{}: expected real numbers, got {} values (dtype {}); booleans, complex numbers and text "
                          "are not accepted".format(what, raw.size, raw.dtype))
+    if not isinstance(values, np.ndarray):  # a list mixing True with numbers becomes numbers
+        for i, value in enumerate(np.asarray(values, dtype=object).ravel()):
+            if isinstance(value, (bool, np.bool_)):
+                raise InputError("{}: entry {} is {!r}, a boolean, not a number".format(what, i, value))
     return raw.astype(float)
 
 

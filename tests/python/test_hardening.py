@@ -72,6 +72,11 @@ def test_complex_and_boolean_times_and_sweep_values_are_refused(oscillator):
         oscillator.sweep("k", [True, False])
     with pytest.raises(nhdyn.InputError, match="sweep values: expected real numbers"):
         oscillator.sweep("k", np.linspace(1, 2, 3) + 0j)
+    # A boolean among numbers (NumPy makes the list numbers, True 1).
+    with pytest.raises(nhdyn.InputError, match="t_eval: entry 1 is True, a boolean, not a number"):
+        oscillator.simulate(t_eval=[0, True, 1.5])
+    with pytest.raises(nhdyn.InputError, match="sweep values: entry 0 is True, a boolean"):
+        oscillator.sweep("k", [np.bool_(True), 2.0])
     # Whole numbers stay numbers: times 0, 1, 2 as integers run.
     assert list(oscillator.simulate(t_eval=[0, 1, 2]).t) == [0.0, 1.0, 2.0]
 

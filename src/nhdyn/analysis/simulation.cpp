@@ -91,7 +91,8 @@ double calc_watch_measure(const Model& model, const ContactWatch& w, double t, c
 std::string watch_message(const Model& model, const ContactWatch& w, double value, double t, const double* q,
                           const double* v, const char* ending = "the run stops there") {
   return fmt::format("{}{} '{}': {} ({} = {:.3g}) at t = {:.6g}, where {}; {}", w.where.empty() ? "" : w.where + ": ",
-                     w.entry, w.contact, w.reason, w.quantity, value, t, describe_state(model, q, v), ending);
+                     w.entry, w.contact, w.reason, w.quantity, value + 0.0 /* -0 as 0 */, t, describe_state(model, q, v),
+                     ending);
 }
 
 std::string singular_contact_message(const Model& model, const Data& data, double t, const double* q,
