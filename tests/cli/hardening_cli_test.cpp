@@ -739,7 +739,9 @@ TEST_F(Hardening, InvisibleAndLookAlikeCharactersAreNamedByTheirCode) {
       {"\u00a0", "unexpected character U+00A0 (a no-break space): write a plain space"},
       {"\u200b", "unexpected character U+200B (a zero-width space, invisible): delete it"},
       {"\u2212", "unexpected character '\u2212' U+2212 (a minus sign): write '-'"},
-      {"\u03a6", "unexpected character '\u03a6' (U+03A6): expressions are written in ASCII"}};
+      {"\u03a6", "unexpected character '\u03a6' (U+03A6): expressions are written in ASCII"},
+      // A right-to-left override would turn the rest of the message around if shown.
+      {"\u202e", "unexpected character U+202E (an invisible control or format character): delete it"}};
   for (const auto& [character, words] : cases) {
     std::string model = kOscillator;
     model.replace(model.find("k/2 * x^2"), 9, "k/2 *" + character + "x^2");

@@ -34,7 +34,11 @@ std::string describe_character(std::string_view text, std::size_t at) {
       {0x00B7, "a middle dot", "'*'"},                {0x2217, "an asterisk operator", "'*'"},
       {0x2019, "a right quotation mark", "a prime '"},  {0x2032, "a prime sign", "a prime '"},
   };
-  const bool invisible = code < 0x20 || code == 0x7f || (code >= 0x80 && code < 0xA0);
+  // Control characters, and the format characters that change how the text around them shows
+  // (zero-width marks, the bidirectional overrides U+202A-E and isolates U+2066-9).
+  const bool invisible = code < 0x20 || code == 0x7f || (code >= 0x80 && code < 0xA0) ||
+                         (code >= 0x200B && code <= 0x200F) || (code >= 0x202A && code <= 0x202E) ||
+                         (code >= 0x2060 && code <= 0x2069);
   for (const Known& k : known)
     if (k.code == code) {
       const std::string_view instead = k.instead;
@@ -42,7 +46,7 @@ std::string describe_character(std::string_view text, std::size_t at) {
       if (instead == "a plain space") return fmt::format("U+{:04X} ({}): write a plain space", code, k.name);
       return fmt::format("'{}' U+{:04X} ({}): write {}", utf8, code, k.name, k.instead);
     }
-  if (invisible) return fmt::format("U+{:04X} (an invisible control character): delete it", code);
+  if (invisible) return fmt::format("U+{:04X} (an invisible control or format character): delete it", code);
   return fmt::format("'{}' (U+{:04X}): expressions are written in ASCII (names of letters, digits and _)", utf8, code);
 }
 
