@@ -755,6 +755,10 @@ TEST_F(Hardening, InvisibleAndLookAlikeCharactersAreNamedByTheirCode) {
   const ProcessRun set = nhdyn({"simulate", "osc.toml", "--set", "k=2\u00a0", "-q", "-o", "c.csv"});
   EXPECT_EQ(set.code, 2) << set.err;
   EXPECT_TRUE(contains(set.err, "unexpected U+00A0 (a no-break space): write a plain space (column 2)")) << set.err;
+  // The exponent's minus sign pasted as U+2212: named at its own column, not as the 'e' before it.
+  const ProcessRun exponent = nhdyn({"simulate", "osc.toml", "--set", "k=1e\u22123", "-q", "-o", "c.csv"});
+  EXPECT_EQ(exponent.code, 2) << exponent.err;
+  EXPECT_TRUE(contains(exponent.err, "unexpected '\u2212' U+2212 (a minus sign): write '-' (column 3)")) << exponent.err;
 }
 
 // GiNaC's own words ("power::eval(): division by zero", "log_eval(): log(0)") reached the user.

@@ -160,6 +160,12 @@ class ExpressionParser {
                                    "(down to none at 4.9e-324); write 0 or a normal number",
                                    literal));
     pos_ += static_cast<std::size_t>(end - rest.c_str());
+    // 1e−3 with a pasted minus sign: strtod stops before the 'e'; the character at fault is the one after it.
+    if (pos_ + 1 < text_.size() && (text_[pos_] == 'e' || text_[pos_] == 'E') &&
+        static_cast<unsigned char>(text_[pos_ + 1]) >= 0x80) {
+      ++pos_;
+      fail(fmt::format("unexpected {}", describe_character(text_, pos_)));
+    }
     return value;
   }
   double name() {
