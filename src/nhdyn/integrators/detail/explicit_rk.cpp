@@ -651,13 +651,18 @@ IntegrationResult integrate_adaptive(std::string_view method, OdeSystem& system,
     double t_fail = t;
     Status status = run.stepper.step(system, t, run.y.data(), h, run.y1.data(), run.stats, t_fail,
                                      error_uses_last_stage<Tableau>);
-    if (status != Status::ok) return rhs_failure(method, status, t_fail, t, run.stats);
-
-    const double err = step_error(run.stepper, system.error_size(), run.y.data(), run.y1.data(), h, options);
+    // A trial stage where the model is not finite (a step reaching past where the motion is
+    // defined, sqrt(1 - t) at t > 1) is rejected as an overflowing step is: the run fails only
+    // when no step size down to the floor gets past, at the place it cannot pass.
+    if (status != Status::ok && status != Status::non_finite) return rhs_failure(method, status, t_fail, t, run.stats);
+    const double err = status == Status::ok
+                           ? step_error(run.stepper, system.error_size(), run.y.data(), run.y1.data(), h, options)
+                           : std::numeric_limits<double>::quiet_NaN();
     last_error_finite = std::isfinite(err) && all_finite(run.y1.data(), run.n);
 
     if (!last_error_finite) {
-      // An overflow in a too-long step: retreat as far as the controller ever does.
+      // An overflow in a too-long step, or a stage past the model's domain: retreat as far as
+      // the controller ever does.
       ++run.stats.rejected_steps;
       last_rejected = true;
       h *= fac_min;
