@@ -17,16 +17,6 @@
 namespace nhdyn {
 namespace {
 
-// "x = 1, phi = 0.5, x' = 0, phi' = 2": the state where an output or an event was not finite.
-std::string describe_state(const Model& model, const double* q, const double* v) {
-  std::string text;
-  for (int i = 0; i < model.n(); ++i)
-    text += fmt::format("{}{} = {:.6g}", i == 0 ? "" : ", ", model.coordinates[static_cast<std::size_t>(i)], q[i]);
-  for (int i = 0; i < model.n(); ++i)
-    text += fmt::format(", {}' = {:.6g}", model.coordinates[static_cast<std::size_t>(i)], v[i]);
-  return text;
-}
-
 // The rule for a derived output or an event that is NaN or infinite during a run (docs/cli.md):
 // the run ends there, as a numerical failure, with this message; the rows before are kept.
 std::string non_finite_message(const std::string& kind, const std::string& where, const std::string& name,

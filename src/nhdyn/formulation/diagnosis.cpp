@@ -360,14 +360,20 @@ std::string non_finite_entry(const Model& model, const Data& data) {
   else if (what == "constraint term b0")
     first(data.b0, [&](Eigen::Index i, Eigen::Index) { return fmt::format("b0({})", constraint(i)); });
   if (entry.empty()) return "";
-  std::string state;
-  for (int i = 0; i < model.n(); ++i) state += fmt::format("{}{} = {:.6g}", i ? ", " : "", coordinate(i), data.q(i));
-  for (int i = 0; i < model.n(); ++i) state += fmt::format(", {}' = {:.6g}", coordinate(i), data.v(i));
   return fmt::format(" ({} = {}, where {})", entry, std::isnan(value) ? std::string("NaN") : fmt::format("{}", value),
-                     state);
+                     describe_state(model, data.q.data(), data.v.data()));
 }
 
 }  // namespace
+
+std::string describe_state(const Model& model, const double* q, const double* v) {
+  std::string text;
+  for (int i = 0; i < model.n(); ++i)
+    text += fmt::format("{}{} = {:.6g}", i == 0 ? "" : ", ", model.coordinates[static_cast<std::size_t>(i)], q[i]);
+  for (int i = 0; i < model.n(); ++i)
+    text += fmt::format(", {}' = {:.6g}", model.coordinates[static_cast<std::size_t>(i)], v[i]);
+  return text;
+}
 
 std::string explain_failure(const Model& model, const Data& data) {
   switch (data.status) {

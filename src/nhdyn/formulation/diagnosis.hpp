@@ -15,6 +15,9 @@ namespace nhdyn {
 // Explains data.status for the state held in data (terms must have been computed for it).
 std::string explain_failure(const Model& model, const Data& data);
 
+// "x = 1, phi = 0.5, x' = 0, phi' = 2": a state as the messages of failures show it.
+std::string describe_state(const Model& model, const double* q, const double* v);
+
 // Checks the terms in data (after compute_terms): A symmetric positive definite, or, where it is
 // singular, positive definite on the velocities the constraints allow ([D A; b] regular), and b
 // of full row rank. Returns the first problem found, recording it in data, or Status::ok. A model
