@@ -5,10 +5,13 @@
 // projected on null(b), so that two paths that agreed on a wrong answer would still fail.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 #include <string>
 #include <utility>
+#include <vector>
 
+#include "nhdyn/formulation/detail/small_dense.hpp"
 #include "nhdyn/formulation/formulation.hpp"
 #include "nhdyn/model/data.hpp"
 #include "support/test_models.hpp"
@@ -137,6 +140,76 @@ TEST(SmallKernels, OverflowInTheAccelerationsOrTheReactionsIsNamedAsOnTheDynamic
     const auto [status, quantity] = failure(huge_masses, small);
     EXPECT_EQ(status, Status::non_finite) << small;
     EXPECT_EQ(quantity, "reactions R") << small;
+  }
+}
+
+// compute_dynamics takes the fused kernel without testing the terms apart: it relies on a NaN or
+// an infinity anywhere in A, Q, G, b or b0 making the kernel fail (q'' or R not finite, or a
+// rank or pivot test failing). Every entry of every term, at every size the kernel covers, with
+// each of NaN, +inf and -inf, on an otherwise regular system.
+TEST(SmallKernels, EveryNonFiniteTermMakesTheFusedKernelFail) {
+  std::mt19937 rng(20261205);
+  const double bad_values[] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+                               -std::numeric_limits<double>::infinity()};
+  long tried = 0;
+  for (int n = 1; n <= small::kSmallMaxN; ++n) {
+    for (int s = 0; s <= n; ++s) {
+      const small::Kernels* kernels = small::find_kernels(n, s);
+      ASSERT_NE(kernels, nullptr) << n << " " << s;
+      const RandomSystem sys = random_system(n, s, rng);
+      const Vector G = Vector::NullaryExpr(n, [&] { return std::uniform_real_distribution<double>(-1, 1)(rng); });
+      std::vector<std::vector<double>> terms = {
+          std::vector<double>(sys.A.data(), sys.A.data() + sys.A.size()),
+          std::vector<double>(sys.Q.data(), sys.Q.data() + n), std::vector<double>(G.data(), G.data() + n),
+          std::vector<double>(sys.b.data(), sys.b.data() + sys.b.size()),
+          std::vector<double>(sys.b0.data(), sys.b0.data() + s)};
+      std::vector<double> D(static_cast<std::size_t>((n - s) * n) + 1), h(static_cast<std::size_t>(n)),
+          qdd(static_cast<std::size_t>(n)), R(static_cast<std::size_t>(n));
+      const auto run = [&] {
+        return kernels->sanh_qr(terms[0].data(), terms[1].data(), terms[2].data(), terms[3].data(), terms[4].data(),
+                                D.data(), h.data(), qdd.data(), R.data());
+      };
+      // The system itself is regular, s = n (a single point) included.
+      ASSERT_EQ(run(), small::SanhResult::ok) << "n = " << n << ", s = " << s;
+      const char* names[] = {"A", "Q", "G", "b", "b0"};
+      for (std::size_t term = 0; term < terms.size(); ++term)
+        for (double& entry : terms[term]) {
+          const double kept = entry;
+          for (double bad : bad_values) {
+            entry = bad;
+            EXPECT_NE(run(), small::SanhResult::ok) << "n = " << n << ", s = " << s << ", " << names[term] << "["
+                                                     << (&entry - terms[term].data()) << "] = " << bad;
+            ++tried;
+          }
+          entry = kept;
+        }
+    }
+  }
+  EXPECT_GT(tried, 3000);
+}
+
+// The fused path of compute_dynamics names a non-finite term as the separate kernels do: the
+// same status and the same quantity as with the fixed-size kernels off, for each term.
+TEST(SmallKernels, ANonFiniteTermIsNamedAsOnTheDynamicPath) {
+  std::mt19937 rng(5);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const char* term : {"inertia matrix A", "generalized forces Q", "constraint matrix b", "constraint term b0"}) {
+    RandomSystem sys = random_system(3, 1, rng);
+    const std::string name = term;
+    if (name == "inertia matrix A") sys.A(2, 1) = nan;
+    if (name == "generalized forces Q") sys.Q(1) = std::numeric_limits<double>::infinity();
+    if (name == "constraint matrix b") sys.b(0, 2) = nan;
+    if (name == "constraint term b0") sys.b0(0) = -std::numeric_limits<double>::infinity();
+    const Model model = testing::make_constant_model(sys.A, sys.Q, sys.b, sys.b0);
+    for (bool small : {true, false}) {
+      Data data = make_data(model);
+      data.small_kernels = small;
+      const Status status =
+          compute_dynamics(model, data, {Formulation::sanh, Complement::qr}, 0.0, model.q0.data(), model.v0.data());
+      EXPECT_EQ(status, Status::non_finite) << name << " " << small;
+      EXPECT_EQ(data.failed_quantity, name) << small;
+      EXPECT_EQ(data.stage, Stage::empty) << name << " " << small;
+    }
   }
 }
 

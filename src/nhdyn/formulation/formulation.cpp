@@ -32,6 +32,20 @@ Complement parse_complement(std::string_view name) {
   throw InputError("unknown choice of D '" + std::string(name) + "'; choose one of: " + list_names(kComplements));
 }
 
+namespace {
+
+// The kernels of the common small case, sanh with the QR complement on a small dense model
+// without programs, contact modes or Baumgarte terms, in one fused call (small_dense.hpp's
+// sanh_qr); null for every other case.
+const small::Kernels* fused_kernels(const Model& model, const Data& data, const FormulationOptions& options) {
+  if (options.method != Formulation::sanh || options.complement != Complement::qr || options.baumgarte.enabled ||
+      data.modes.active || data.sparse || !data.small_kernels || model.m() != 0)
+    return nullptr;
+  return small::find_kernels(model.n(), model.s());
+}
+
+}  // namespace
+
 Status compute_acceleration(const Model& model, Data& data, const FormulationOptions& options) {
   if (data.stage < Stage::terms)
     throw std::logic_error("compute_acceleration: call compute_terms first for the current state");
@@ -50,23 +64,21 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
   data.has_multipliers = false;
   // The common small case in one fused kernel (small_dense.hpp's sanh_qr): the same operations
   // and checks, in the same order, as the general path below.
-  if (options.method == Formulation::sanh && options.complement == Complement::qr && !options.baumgarte.enabled &&
-      !data.modes.active && !data.sparse && model.m() == 0 && data.small_kernels)
-    if (const small::Kernels* kernels = small::find_kernels(model.n(), model.s())) {
-      switch (kernels->sanh_qr(data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data(),
-                               data.D.data(), data.h.data(), data.qdd.data(), data.R.data())) {
-        case small::SanhResult::ok: break;
-        case small::SanhResult::dependent_constraints:
-          return record_failure(data, Status::dependent_constraints, "constraint matrix b");
-        case small::SanhResult::singular:
-          return record_failure(data, Status::singular_system, "stacked matrix [D A; b]");
-        case small::SanhResult::non_finite_qdd: return record_failure(data, Status::non_finite, "accelerations q''");
-        case small::SanhResult::non_finite_R: return record_failure(data, Status::non_finite, "reactions R");
-      }
-      data.stage = Stage::acceleration;
-      ++data.acceleration_solves;
-      return Status::ok;
+  if (const small::Kernels* kernels = fused_kernels(model, data, options)) {
+    switch (kernels->sanh_qr(data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data(),
+                             data.D.data(), data.h.data(), data.qdd.data(), data.R.data())) {
+      case small::SanhResult::ok: break;
+      case small::SanhResult::dependent_constraints:
+        return record_failure(data, Status::dependent_constraints, "constraint matrix b");
+      case small::SanhResult::singular:
+        return record_failure(data, Status::singular_system, "stacked matrix [D A; b]");
+      case small::SanhResult::non_finite_qdd: return record_failure(data, Status::non_finite, "accelerations q''");
+      case small::SanhResult::non_finite_R: return record_failure(data, Status::non_finite, "reactions R");
     }
+    data.stage = Stage::acceleration;
+    ++data.acceleration_solves;
+    return Status::ok;
+  }
   if (options.baumgarte.enabled) {
     compute_baumgarte_terms(model, data, options.baumgarte);
     data.b0_model = data.b0;
@@ -102,6 +114,38 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
 
 Status compute_dynamics(const Model& model, Data& data, const FormulationOptions& options, double t,
                         const double* q, const double* v) {
+  // The common small case, a right-hand side of an integration, in one pass: the terms from the
+  // caller's state, the state stored in Data as it is tested, then the fused kernel. The terms
+  // are not tested apart: a NaN or an infinity in A, Q, G, b or b0 always reaches q'' or R, which
+  // the kernel tests (IEEE arithmetic, no entry skipped: tests/formulation/small_dense_test.cpp
+  // tries every entry), so that finite q'' and R vouch for the terms. A failure of any kind is
+  // evaluated again by the separate kernels below, which name it as they always do (the state,
+  // then the terms, then the solve).
+  if (const small::Kernels* kernels = fused_kernels(model, data, options);
+      kernels && (!data.method || *data.method == Formulation::sanh)) {
+    const int n = model.n();
+    model.evaluator->terms(t, q, v, data.scratch.data(),
+                           TermsOut{data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data()});
+    double* q_data = data.q.data();
+    double* v_data = data.v.data();
+    double acc = 0.0;
+    for (int i = 0; i < n; ++i) {
+      acc += q[i] * 0.0 + v[i] * 0.0;  // 0 while both are finite (core/detail/finite.hpp)
+      q_data[i] = q[i];
+      v_data[i] = v[i];
+    }
+    if (acc == 0.0 && kernels->sanh_qr(data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data(),
+                                       data.D.data(), data.h.data(), data.qdd.data(),
+                                       data.R.data()) == small::SanhResult::ok) {
+      data.t = t;
+      data.status = Status::ok;
+      data.has_multipliers = false;
+      data.stage = Stage::acceleration;
+      ++data.term_evaluations;
+      ++data.acceleration_solves;
+      return Status::ok;
+    }
+  }
   const Status status = compute_terms(model, data, t, q, v);
   if (status != Status::ok) return status;
   return compute_acceleration(model, data, options);
