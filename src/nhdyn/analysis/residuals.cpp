@@ -40,7 +40,7 @@ void compute_power(const Model& model, Data& data) {
   if (data.stage < Stage::acceleration)
     throw std::logic_error("compute_power: call compute_acceleration first for the current state");
   double out[2] = {0.0, 0.0};
-  model.evaluator->power(data.t, data.q.data(), data.v.data(), data.scratch.data(), out);
+  if (!data.power_is_zero) model.evaluator->power(data.t, data.q.data(), data.v.data(), data.scratch.data(), out);
   data.power_forces = out[0];
   data.power_time = out[1];
   // A sliding contact's friction is booked apart (power_friction, contact_modes.hpp; 0 without).

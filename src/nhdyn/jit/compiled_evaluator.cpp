@@ -346,6 +346,7 @@ class OverInterpreter : public Evaluator {
   }
   bool has_energy() const override { return base_->has_energy(); }
   bool has_energy_balance() const override { return base_->has_energy_balance(); }
+  bool power_is_zero() const override { return base_->power_is_zero(); }
   bool energy_function_is_energy() const override { return base_->energy_function_is_energy(); }
   double energy_function(double t, const double* q, const double* v, double* scratch) const override {
     return base_->energy_function(t, q, v, scratch);

@@ -369,6 +369,7 @@ Data make_data(const Model& model, const DataOptions& options) {
   // Long enough for every quantity name the kernels report, so that setting it never allocates.
   d.failed_quantity.reserve(64);
   d.scratch.assign(model.evaluator->scratch_size(), 0.0);
+  d.power_is_zero = model.evaluator->power_is_zero();
   d.outputs = make_output_data(model);
   d.h = Vector::Zero(n);
   d.kkt_rhs = Vector::Zero(n + s);

@@ -141,6 +141,7 @@ struct Data {
   // done by each since t0, integrated along the run (set by simulate at every output).
   double energy_function = 0.0;
   double power_forces = 0.0, power_reactions = 0.0, power_time = 0.0;
+  bool power_is_zero = false;  // the evaluator's power_is_zero(), read once by make_data
   double work_forces = 0.0, work_reactions = 0.0, work_time = 0.0;
   // Contacts that slide (contact_modes.hpp): the friction's power -mu_k N |s| (booked apart from
   // power_reactions, which keeps the rest of R . q') and its work since t0 (set by simulate).

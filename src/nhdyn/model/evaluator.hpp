@@ -108,6 +108,9 @@ class Evaluator {
                      double* out) const {
     out[0] = out[1] = 0.0;
   }
+  // Whether power() gives 0 at every state (no nonconservative forces, no explicit time
+  // dependence: most models): compute_power then leaves it uncalled, at every stage of a run.
+  virtual bool power_is_zero() const { return false; }
 
   // Whether solution() is defined: the model knows its exact motion from its own initial state
   // (a closed form), which `nhdyn compare --reference analytic` measures the runs against.

@@ -351,6 +351,7 @@ class TapeEvaluator final : public Evaluator {
   void program_constraint_velocity_residual(double t, const double* q, const double* v, double* scratch,
                                             double* f) const override;
   bool has_energy_balance() const override { return tapes_.energy_balance && tapes_.energy.has_value(); }
+  bool power_is_zero() const override { return !tapes_.power.has_value(); }
   bool energy_function_is_energy() const override { return !tapes_.energy_function.has_value(); }
   double energy_function(double t, const double* q, const double* v, double* scratch) const override;
   void power(double t, const double* q, const double* v, double* scratch, double* out) const override;
