@@ -261,8 +261,12 @@ class MechanicalOde final : public OdeSystem {
     const Status status = compute_dynamics(model_, data_, options_, t, y, y + n_);
     data_.modes.defer_forces = false;
     if (status != Status::ok) return status;
-    std::memcpy(ydot, y + n_, sizeof(double) * static_cast<std::size_t>(n_));
-    std::memcpy(ydot + n_, data_.qdd.data(), sizeof(double) * static_cast<std::size_t>(n_));
+    // One loop, not two calls of memcpy: n is small where a right-hand side is cheap.
+    const double* qdd = data_.qdd.data();
+    for (int i = 0; i < n_; ++i) {
+      ydot[i] = y[n_ + i];
+      ydot[n_ + i] = qdd[i];
+    }
     if (balance_) {
       compute_power(model_, data_);
       ydot[2 * n_] = data_.power_forces;
