@@ -99,6 +99,8 @@ class Stepper {
   // Each entry's sum is formed in a register, in the order of j, and stored once: the same
   // additions as adding one stage after another to the whole target, without storing and loading
   // the target for every stage; with the weights known at compile time the sum over j is unrolled.
+  // The states the right-hand side reads of a small system (2 n <= kFixedStates) are summed by a
+  // loop whose length is known at compile time, unrolled whole (the same additions).
   template <int row>
   void combine(const double* y, double h, double* target, int count) const {
     constexpr auto nonzero = nonzero_weights<row>();
@@ -111,13 +113,36 @@ class Stepper {
       coef[static_cast<std::size_t>(m)] = h * w[j];
       from[static_cast<std::size_t>(m)] = k_[j].data();
     }
-    for (int i = 0; i < count; ++i) {
-      double sum = y[i];
-#pragma GCC unroll 16
-      for (int m = 0; m < used; ++m) sum += coef[static_cast<std::size_t>(m)] * from[static_cast<std::size_t>(m)][i];
-      target[i] = sum;
+    int done = 0;
+    if (count >= read_) {
+      [&]<int... F>(std::integer_sequence<int, F...>) {
+        (void)((read_ == 2 * (F + 1) ? (sum_entries<used, 2 * (F + 1)>(coef, from, y, target), done = read_, true)
+                                     : false) ||
+               ...);
+      }(std::make_integer_sequence<int, kFixedStates / 2>{});
     }
+    for (int i = done; i < count; ++i) target[i] = sum_entry<used>(coef, from, y, i);
   }
+
+  // Entry i of the stage sum.
+  template <int used>
+  static double sum_entry(const std::array<double, used>& coef, const std::array<const double*, used>& from,
+                          const double* y, int i) {
+    double sum = y[i];
+#pragma GCC unroll 16
+    for (int m = 0; m < used; ++m) sum += coef[static_cast<std::size_t>(m)] * from[static_cast<std::size_t>(m)][i];
+    return sum;
+  }
+
+  // Entries 0..count-1, count known at compile time.
+  template <int used, int count>
+  static void sum_entries(const std::array<double, used>& coef, const std::array<const double*, used>& from,
+                          const double* y, double* target) {
+#pragma GCC unroll 16
+    for (int i = 0; i < count; ++i) target[i] = sum_entry<used>(coef, from, y, i);
+  }
+
+  static constexpr int kFixedStates = 12;
 
   int n_;
   int read_;
