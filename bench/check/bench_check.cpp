@@ -40,6 +40,7 @@
 //                                        compared first
 //   sled_dop853_vs_hand_written          the same with dop853 (Dormand-Prince 8(5,3)) on both sides
 //   sled_dopri5_compiled_vs_hand_written the dopri5 pair with the sled's terms compiled
+//   sled_dop853_compiled_vs_hand_written the dop853 pair with the sled's terms compiled
 //   chain_rhs_sparse_vs_reference        one right-hand side of the 300-body chain (n = 900) on the
 //                                        sparse path (compute_dynamics, sparse sanh: KLU refactorizes
 //                                        b_dep in place), 100 times, over 20 hand-written sled
@@ -407,6 +408,9 @@ int main(int argc, char** argv) {
     if (std::string("sled_dopri5_compiled_vs_hand_written").find(filter) != std::string::npos)
       sled_pair("sled_dopri5_compiled_vs_hand_written", jit::make_compiled(sled), IntegratorKind::dopri5,
                 rk::DormandPrince54{});
+    if (std::string("sled_dop853_compiled_vs_hand_written").find(filter) != std::string::npos)
+      sled_pair("sled_dop853_compiled_vs_hand_written", jit::make_compiled(sled), IntegratorKind::dop853,
+                rk::DormandPrince853{});
 
     // The sparse path: one right-hand side of the 300-body chain (n = 900, sparse sanh, KLU's LU of
     // b_dep refactorized in place) against a fixed amount of hand-written work, as the loads are.
