@@ -351,7 +351,7 @@ void print_summary(const SimulateArgs& args, const Model& model, const Simulatio
   fmt::print("{}", format_program(model, summary.program, options.formulation.program_feedback));
   if (summary.initial_fix) fmt::print("{}", format_initial_fix(model, *summary.initial_fix));
   fmt::print("{}", format_energy(model, summary.energy));
-  fmt::print("{}", format_constraint_watch(model, summary.watch, summary.warnings.size(), summary.sparse));
+  fmt::print("{}", format_constraint_watch(model, summary.watch, summary.watch.warnings.size(), summary.sparse));
   if (!args.plot.empty()) fmt::print("  plot -> {}\n", args.plot);
   if (!args.html.empty()) fmt::print("  report -> {}{}\n", args.html, html_notice.empty() ? "" : "\n  note: " + html_notice);
 }

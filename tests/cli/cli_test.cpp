@@ -784,6 +784,27 @@ TEST(CliFailure, AFailureUnderAnAbsoluteToleranceAsLargeAsTheStatesOrALongFixedS
   EXPECT_TRUE(contains(rk4.err, "Note rk4's fixed step (--step 5): a step too long for the motion")) << rk4.err;
 }
 
+// The same tolerance on a run short enough to get through (the sled's first second, 7 steps):
+// its numbers are the integrator's (the blade's residual reaches 16.9, 3e-9 at the default
+// tolerances), so the run warns of the tolerance; the watch, which found nothing, says so.
+TEST(CliSimulate, ARunThatGetsThroughUnderAnAbsoluteToleranceAsLargeAsTheStatesWarns) {
+  ScratchDir dir;
+  const std::vector<std::string> args{"simulate", "sled", "--atol", "1e300", "--t-end", "1", "-o", "out.csv"};
+  const RunResult r = nhdyn(args, dir.path());
+  EXPECT_EQ(r.exit_code, 0) << context(args, r);
+  EXPECT_TRUE(contains(r.err, "nhdyn: warning: the absolute tolerance atol = 1e+300 is at least the size of every "
+                              "state at the start (largest |q|, |q'| 1): the error test bounded nothing"))
+      << r.err;
+  EXPECT_TRUE(contains(r.out, "constraint watch: no warning")) << r.out;
+  // The default tolerances, and an atol below the states' size, say nothing of the kind.
+  for (const char* atol : {"1e-10", "1e-4"}) {
+    const std::vector<std::string> fine{"simulate", "sled", "--atol", atol, "--t-end", "1", "-o", "out.csv"};
+    const RunResult ok = nhdyn(fine, dir.path());
+    EXPECT_EQ(ok.exit_code, 0) << context(fine, ok);
+    EXPECT_FALSE(contains(ok.err, "absolute tolerance")) << ok.err;
+  }
+}
+
 TEST(CliFailure, NumericalFailureLeavesAnExistingFileUntouched) {
   ScratchDir dir;
   const std::string old_bytes = "previous results\n";

@@ -700,6 +700,18 @@ void note_unmet_stops(const Model& model, const std::vector<const Event*>& event
   }
 }
 
+// The largest |q|, |q'| of a start state.
+double largest_state(const Vector& q0, const Vector& v0) {
+  return std::max(q0.size() ? q0.cwiseAbs().maxCoeff() : 0.0, v0.size() ? v0.cwiseAbs().maxCoeff() : 0.0);
+}
+
+// An absolute tolerance at least the size of every state at the start (and not below 1e-3, for a
+// state that starts at rest at the origin): the error test of an adaptive integrator accepts any
+// step, whatever the model.
+bool atol_bounds_nothing(const IntegratorOptions& integrator, double largest) {
+  return integrator.kind != IntegratorKind::rk4 && integrator.atol >= std::max(largest, 1e-3);
+}
+
 // What the integrator's options may have done to a run that failed, said after the failure's own
 // words (which blame the model); "" otherwise. An adaptive run that blew up or stalled under an
 // absolute tolerance at least the size of every state at the start: its error test bounded
@@ -718,8 +730,8 @@ std::string integrator_hint(const IntegratorOptions& integrator, Status status, 
                                                    : std::string("a tenth of the output step"));
   if (status != Status::non_finite && status != Status::too_many_steps && status != Status::step_size_underflow)
     return "";
-  const double largest = std::max(q0.size() ? q0.cwiseAbs().maxCoeff() : 0.0, v0.size() ? v0.cwiseAbs().maxCoeff() : 0.0);
-  if (!(integrator.atol >= std::max(largest, 1e-3))) return "";
+  const double largest = largest_state(q0, v0);
+  if (!atol_bounds_nothing(integrator, largest)) return "";
   return fmt::format(
       ". Note the absolute tolerance atol = {:g}: at least the size of every state at the start (largest |q|, |q'| "
       "{:g}), so the error test bounds nothing and the steps grow until the integrator is unstable, whatever the "
@@ -841,6 +853,15 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.watch.largest_row_factor = watch.largest_row_factor;
   summary.watch.largest_condition_factor = watch.largest_condition_factor;
   summary.watch.watched_states = watch.states;
+  // A run that got through with such an atol took steps as long as its outputs allowed: its
+  // numbers are the integrator's, not the model's, and nothing else would say so.
+  if (summary.status == Status::ok && atol_bounds_nothing(options.integrator, largest_state(q0, v0)))
+    summary.warnings.push_back(fmt::format(
+        "the absolute tolerance atol = {:g} is at least the size of every state at the start (largest |q|, |q'| "
+        "{:g}): the error test bounded nothing, the steps were as long as the outputs allowed, and the motion may "
+        "be far from the model's (see the residuals and the energy balance above); give an atol well below the "
+        "states' size (the default is 1e-10)",
+        options.integrator.atol, largest_state(q0, v0)));
   if (summary.status != Status::ok)
     summary.message = explain_run_failure(model, data, event_functions, watched, result, recorder.message(),
                                           summary.status) +
