@@ -109,6 +109,33 @@ TEST(CliContactForceNote, BallOnTerrainHasNoFalseNoteAndItsForceIsItsMomentumBal
   fs::remove_all(dir);
 }
 
+// The verdict does not depend on the units: the Chaplygin ball 1e8 m across (its balance of moments
+// 1e8 times its balance of forces) had its normal force called undetermined, written as NaN under a
+// note blaming a statically indeterminate support. On a horizontal plane the centre stays at height
+// r, so the contact force is m (x'', y'', g) at every row, whatever the radius.
+TEST(CliContactForceNote, TheVerdictDoesNotDependOnTheBodysSize) {
+  const fs::path dir = fresh_directory("nhdyn-contact-note-size");
+  for (const char* r : {"0.1", "1e8"}) {
+    const std::string csv_name = std::string("ball-") + r + ".csv", err_name = std::string("ball-") + r + ".err";
+    ASSERT_EQ(run(dir, "simulate '" + example("chaplygin_ball.toml") + "' --set r=" + r + " --t-end 1 -o " + csv_name,
+                  err_name),
+              0)
+        << read_text(dir / err_name);
+    EXPECT_EQ(read_text(dir / err_name).find("note: contact forces"), std::string::npos) << read_text(dir / err_name);
+    const Csv csv = read_csv(dir / csv_name);
+    ASSERT_EQ(csv.rows.size(), 101u) << r;
+    const double m = 1.0, g = 9.81;  // the example's parameters
+    for (const std::vector<double>& row : csv.rows) {
+      const double scale = 1e-12 * std::max(1.0, std::abs(row[csv.column("x''")]) + std::abs(row[csv.column("y''")]));
+      EXPECT_NEAR(row[csv.column("ball_Fx")], m * row[csv.column("x''")], scale) << r;
+      EXPECT_NEAR(row[csv.column("ball_Fy")], m * row[csv.column("y''")], scale) << r;
+      EXPECT_NEAR(row[csv.column("ball_Fz")], m * g, 1e-9) << r;
+      EXPECT_NEAR(row[csv.column("ball_N")], m * g, 1e-9) << r;
+    }
+  }
+  fs::remove_all(dir);
+}
+
 // Where the note is true it stays: a sled held flat by its frames (test::kFlatSledBodies).
 TEST(CliContactForceNote, SledHeldByItsFramesKeepsItsNote) {
   const fs::path dir = fresh_directory("nhdyn-contact-note-sled");

@@ -329,6 +329,41 @@ void append_contact_force_values(const Model& model, const Data& data, std::vect
   append_contact_mode_values(model, data, row);
 }
 
+namespace {
+
+// The combinations of unknowns a stacked system M x = rhs does not fix: an orthonormal basis of
+// the null space of M S, M with its columns (S), then its rows, scaled to unit norm, so that the
+// units do not decide (the balance of moments of a ball 1e8 m across is 1e8 times that of its
+// forces: unscaled, its smallest singular value fell below the threshold relative to the largest).
+// A null vector u of M S is S u of M, so a functional c of the unknowns is fixed when S c is
+// orthogonal to every column of the basis.
+struct NullSpace {
+  Vector column_scale;  // S
+  Matrix basis;
+};
+
+NullSpace scaled_null_space(const Matrix& M) {
+  NullSpace null;
+  null.column_scale = Vector::Ones(M.cols());
+  for (Eigen::Index j = 0; j < M.cols(); ++j)
+    if (const double norm = M.col(j).norm(); norm > 0.0 && std::isfinite(norm)) null.column_scale(j) = 1.0 / norm;
+  Matrix scaled = M * null.column_scale.asDiagonal();
+  for (Eigen::Index i = 0; i < scaled.rows(); ++i)
+    if (const double norm = scaled.row(i).norm(); norm > 0.0 && std::isfinite(norm)) scaled.row(i) /= norm;
+  const Eigen::JacobiSVD<Matrix> svd(scaled, Eigen::ComputeFullV);
+  const Vector& sigma = svd.singularValues();
+  const double largest = sigma.size() > 0 ? sigma(0) : 0.0;
+  std::vector<Eigen::Index> columns;
+  for (Eigen::Index j = 0; j < M.cols(); ++j)
+    if (j >= sigma.size() || sigma(j) <= kDetermined * largest) columns.push_back(j);
+  null.basis.resize(M.cols(), static_cast<Eigen::Index>(columns.size()));
+  for (std::size_t k = 0; k < columns.size(); ++k)
+    null.basis.col(static_cast<Eigen::Index>(k)) = svd.matrixV().col(columns[k]);
+  return null;
+}
+
+}  // namespace
+
 void analyse_contact_forces(const Model& model, ContactForceModel& c) {
   const int n = model.n();
   const int s = model.s();
@@ -411,13 +446,7 @@ void analyse_contact_forces(const Model& model, ContactForceModel& c) {
   c.balance_rows = rows;
   probe.balance_rows = rows;
   assemble(probe, o, qdd.data(), R.data(), M, rhs);
-  // The null space of M: the combinations of unknowns the stacked system does not fix.
-  const Eigen::JacobiSVD<Matrix> svd(M, Eigen::ComputeFullV);
-  const Vector& sigma = svd.singularValues();
-  const double largest = sigma.size() > 0 ? sigma(0) : 0.0;
-  std::vector<int> null_columns;
-  for (int j = 0; j < c.columns(); ++j)
-    if (j >= sigma.size() || sigma(j) <= kDetermined * largest) null_columns.push_back(j);
+  const NullSpace null = scaled_null_space(M);
   Vector coefficients(c.columns());
   int index = 0;
   for (const ContactForceContact& contact : c.contacts) {
@@ -426,10 +455,11 @@ void analyse_contact_forces(const Model& model, ContactForceModel& c) {
     for (std::size_t j = 0; j < contact.components.size(); ++j) {
       const ContactComponent component = contact.components[j];
       functional(c, contact, index, o, component, coefficients);
+      coefficients = coefficients.cwiseProduct(null.column_scale);
       const double size = coefficients.norm();
       bool determined = true;
-      for (int j : null_columns)
-        if (std::abs(coefficients.dot(svd.matrixV().col(j))) > kDetermined * std::max(size, 1.0)) determined = false;
+      for (Eigen::Index j = 0; j < null.basis.cols(); ++j)
+        if (std::abs(coefficients.dot(null.basis.col(j))) > kDetermined * size) determined = false;
       c.determined[static_cast<std::size_t>(contact.first_value) + j] = determined ? 1 : 0;
       if (!determined) missing += fmt::format("{}{}_{}", missing.empty() ? "" : ", ", contact.name, contact_component_name(component));
     }
