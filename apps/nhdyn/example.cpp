@@ -56,19 +56,11 @@ int parse_bodies(const std::string& text, int most) {
 // One --set NAME=EXPR of a generator: its name and its value, read as a parameter's (numbers,
 // + - * / ^, functions, pi and e: model/parameters.hpp) and within a parameter's range, so that
 // the model file written loads (1e200 was written, then refused by simulate).
+// The messages are model/parameters.hpp's, which show an invisible character by its code.
 std::pair<std::string, double> parse_set(const std::string& set) {
-  const std::size_t eq = set.find('=');
-  if (eq == std::string::npos)
-    throw InputError(fmt::format("--set '{}': write it as NAME=VALUE, e.g. --set m=2", set));
-  const std::string name = set.substr(0, eq);
-  const std::string text = set.substr(eq + 1);
-  try {
-    const double value = calc_parameter_expression(text, {});
-    check_parameter_value(name, value);
-    return {name, value};
-  } catch (const InputError& e) {
-    throw InputError(fmt::format("--set {}={}: {}", name, text, e.what()));
-  }
+  std::vector<Parameter> one{{split_parameter_set(set).first, 0.0, ""}};
+  apply_parameter_sets(one, {set}, "example");
+  return {one.front().name, one.front().value};
 }
 
 void apply_chain_sets(symbolic::ChainParameters& p, const std::vector<std::string>& sets) {

@@ -12,6 +12,7 @@
 
 #include "commands.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/core/version.hpp"
 #include "output_guard.hpp"
 
@@ -60,7 +61,8 @@ int main(int argc, char** argv) {
     for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
       known = known || sub->get_name() == argv[1];
     if (!known) {
-      fmt::print(stderr, "nhdyn: error: unknown command '{}'; the commands are {} (see nhdyn --help)\n", argv[1], names);
+      fmt::print(stderr, "nhdyn: error: unknown command '{}'; the commands are {} (see nhdyn --help)\n",
+                 nhdyn::shown_text(argv[1]), names);
       return 2;
     }
   }
@@ -71,10 +73,15 @@ int main(int argc, char** argv) {
     if (argv[i - 1][0] == '-' && !value.empty() && value.find_first_not_of(", ") == std::string_view::npos) {
       fmt::print(stderr, "nhdyn: error: {} '{}': the list is empty; give its items separated by commas (or leave the "
                          "option out)\n",
-                 argv[i - 1], value);
+                 nhdyn::shown_text(argv[i - 1]), nhdyn::shown_text(value));
       return 2;
     }
   }
+  // Every message shows what it echoes of the arguments with its invisible characters by code
+  // (core/shown_text.hpp): CLI11's own, and nhdyn's below.
+  app.failure_message([](const CLI::App* failed, const CLI::Error& e) {
+    return nhdyn::shown_text(CLI::FailureMessage::simple(failed, e), true);
+  });
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -83,7 +90,8 @@ int main(int argc, char** argv) {
   // An empty value (-o '', --html '', --plot '') would otherwise read as "not given" and be
   // ignored silently: every option that takes a value needs a non-empty one.
   if (const std::string empty = nhdyn::cli::first_empty_value(app); !empty.empty()) {
-    fmt::print(stderr, "nhdyn: error: {} '': the value is empty; give one (or leave the option out)\n", empty);
+    fmt::print(stderr, "nhdyn: error: {} '': the value is empty; give one (or leave the option out)\n",
+               nhdyn::shown_text(empty));
     return 2;
   }
   nhdyn::cli::install_interrupt_handlers();
@@ -91,10 +99,10 @@ int main(int argc, char** argv) {
     for (std::size_t i = 0; i < runs.size(); ++i)
       if (app.got_subcommand(nhdyn::cli::kSubcommands[i].name)) return runs[i]();
   } catch (const nhdyn::Error& e) {
-    fmt::print(stderr, "nhdyn: error: {}\n", e.what());
+    fmt::print(stderr, "nhdyn: error: {}\n", nhdyn::shown_text(e.what(), true));
     return 2;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "nhdyn: internal error: {}\n", e.what());
+    fmt::print(stderr, "nhdyn: internal error: {}\n", nhdyn::shown_text(e.what(), true));
     return 3;
   }
   return 0;

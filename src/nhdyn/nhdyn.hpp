@@ -16,6 +16,7 @@
 
 #include "nhdyn/core/error.hpp"             // InputError, FileError, ModelError
 #include "nhdyn/core/status.hpp"            // Status of a kernel or a run
+#include "nhdyn/core/shown_text.hpp"        // a text as a message shows it (invisible characters by code)
 #include "nhdyn/model/model.hpp"            // Model: frozen, numeric
 #include "nhdyn/model/data.hpp"             // Data: the workspace of one thread; Formulation
 #include "nhdyn/model/parameters.hpp"       // set_parameter: parameters are data

@@ -761,6 +761,40 @@ TEST_F(Hardening, InvisibleAndLookAlikeCharactersAreNamedByTheirCode) {
   EXPECT_TRUE(contains(exponent.err, "unexpected '\u2212' U+2212 (a minus sign): write '-' (column 3)")) << exponent.err;
 }
 
+// The value a message echoes (--set's, a generator's, in the same words) shows an invisible character by its code and
+// a byte that is not UTF-8 by its value: echoed raw, a right-to-left override turned the rest of
+// the line around, and 0xFF reached the terminal as it was.
+TEST_F(Hardening, AnEchoedValueNeverCarriesAnInvisibleCharacterOrABadByte) {
+  write("osc.toml", kOscillator);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"k=2\u200b", "--set k=2<U+200B>: '2<U+200B>' is not a valid expression"},
+      {"k=\u202e2", "--set k=<U+202E>2: '<U+202E>2' is not a valid expression"},
+      {"k=\xff", "--set k=<0xFF>: '<0xFF>' is not a valid expression: unexpected (the byte 0xFF, not UTF-8 text)"},
+      {"k\u200b", "--set 'k<U+200B>': write it as NAME=VALUE"}};
+  for (const auto& [set, words] : cases) {
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"simulate", "osc.toml", "--set", set, "-q", "-o", "c.csv"},
+          std::vector<std::string>{"example", "chain", "--set", set}}) {
+      const ProcessRun r = nhdyn(args);
+      EXPECT_EQ(r.code, 2) << r.err;
+      EXPECT_TRUE(contains(r.err, words)) << r.err;
+      for (const char* raw : {"\u200b", "\u202e", "\xff"}) EXPECT_FALSE(contains(r.err, raw)) << r.err;
+    }
+  }
+  // Whatever a message echoes of the arguments: an unknown command, option, model or event.
+  const std::vector<std::pair<std::vector<std::string>, std::string>> echoes = {
+      {{"si\u200bm"}, "unknown command 'si<U+200B>m'"},
+      {{"simulate", "osc.toml", "--\u202ex"}, "The following argument was not expected: --<U+202E>x"},
+      {{"simulate", "sl\u202eed"}, "unknown model 'sl<U+202E>ed'"},
+      {{"simulate", "osc.toml", "--event", "e=x\xff", "-o", "c.csv"}, "--event \"e=x<0xFF>\""}};
+  for (const auto& [args, words] : echoes) {
+    const ProcessRun r = nhdyn(args);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_TRUE(contains(r.err, words)) << r.err;
+    for (const char* raw : {"\u200b", "\u202e", "\xff"}) EXPECT_FALSE(contains(r.err, raw)) << r.err;
+  }
+}
+
 // GiNaC's own words ("power::eval(): division by zero", "log_eval(): log(0)") reached the user.
 TEST_F(Hardening, GinacWordsAreTranslated) {
   const std::vector<std::pair<std::string, std::string>> cases = {

@@ -16,6 +16,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/detail/characters.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/core/detail/suggest.hpp"
 
 namespace nhdyn {
@@ -30,9 +31,14 @@ std::string did_you_mean(std::string_view name, const std::vector<Parameter>& kn
 }
 
 // A hostile text may be megabytes long: messages quote its start only.
+// A value as a message echoes it: invisible characters shown by code (shown_text), and a long one
+// cut on a character's boundary.
 std::string shorten(std::string_view text) {
-  if (text.size() <= 80) return std::string(text);
-  return fmt::format("{}... ({} characters)", text.substr(0, 60), text.size());
+  const std::string shown = shown_text(text);
+  if (shown.size() <= 80) return shown;
+  std::size_t cut = 60;
+  while (cut > 0 && (static_cast<unsigned char>(shown[cut]) & 0xC0) == 0x80) --cut;
+  return fmt::format("{}... ({} characters)", shown.substr(0, cut), text.size());
 }
 
 std::string list_names(const std::vector<Parameter>& known) {

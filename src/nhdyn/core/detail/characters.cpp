@@ -1,25 +1,69 @@
 #include "nhdyn/core/detail/characters.hpp"
 
+#include "nhdyn/core/shown_text.hpp"
+
 #include <fmt/format.h>
 
 #include <cstdint>
 
 namespace nhdyn {
 
-std::string describe_character(std::string_view text, std::size_t at) {
+namespace {
+
+// The character that starts at byte `at`: its UTF-8 sequence and code point; `valid` false for a
+// byte that starts no UTF-8 sequence (its sequence is then that byte alone).
+struct Character {
+  std::string_view utf8;
+  std::uint32_t code = 0;
+  bool valid = true;
+};
+
+Character character_at(std::string_view text, std::size_t at) {
   std::size_t end = at + 1;
   while (end < text.size() && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) ++end;
-  const std::string_view utf8 = text.substr(at, end - at);
-  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(utf8[k]); };
-  if (utf8.size() == 1 && byte(0) >= 0x20 && byte(0) < 0x7f) return fmt::format("'{}'", utf8);
-  std::uint32_t code = byte(0);
-  if (utf8.size() == 2 && (byte(0) & 0xE0) == 0xC0) code = ((byte(0) & 0x1Fu) << 6) | (byte(1) & 0x3Fu);
-  else if (utf8.size() == 3 && (byte(0) & 0xF0) == 0xE0)
-    code = ((byte(0) & 0x0Fu) << 12) | ((byte(1) & 0x3Fu) << 6) | (byte(2) & 0x3Fu);
-  else if (utf8.size() == 4 && (byte(0) & 0xF8) == 0xF0)
-    code = ((byte(0) & 0x07u) << 18) | ((byte(1) & 0x3Fu) << 12) | ((byte(2) & 0x3Fu) << 6) | (byte(3) & 0x3Fu);
-  else if (utf8.size() != 1 || byte(0) >= 0x80)
-    return fmt::format("(the byte 0x{:02X}, not UTF-8 text)", byte(0));
+  Character c{text.substr(at, end - at)};
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(c.utf8[k]); };
+  c.code = byte(0);
+  if (c.utf8.size() == 2 && (byte(0) & 0xE0) == 0xC0) c.code = ((byte(0) & 0x1Fu) << 6) | (byte(1) & 0x3Fu);
+  else if (c.utf8.size() == 3 && (byte(0) & 0xF0) == 0xE0)
+    c.code = ((byte(0) & 0x0Fu) << 12) | ((byte(1) & 0x3Fu) << 6) | (byte(2) & 0x3Fu);
+  else if (c.utf8.size() == 4 && (byte(0) & 0xF8) == 0xF0)
+    c.code = ((byte(0) & 0x07u) << 18) | ((byte(1) & 0x3Fu) << 12) | ((byte(2) & 0x3Fu) << 6) | (byte(3) & 0x3Fu);
+  else if (c.utf8.size() != 1 || byte(0) >= 0x80) {
+    c.utf8 = text.substr(at, 1);
+    c.valid = false;
+  }
+  return c;
+}
+
+// Control characters, and the format characters that change how the text around them shows
+// (zero-width marks, the bidirectional overrides U+202A-E and isolates U+2066-9, the byte order mark).
+bool invisible(std::uint32_t code) {
+  return code < 0x20 || code == 0x7f || (code >= 0x80 && code < 0xA0) || (code >= 0x200B && code <= 0x200F) ||
+         (code >= 0x202A && code <= 0x202E) || (code >= 0x2060 && code <= 0x2069) || code == 0xFEFF;
+}
+
+}  // namespace
+
+std::string shown_text(std::string_view text, bool keep_line_breaks) {
+  std::string shown;
+  for (std::size_t at = 0; at < text.size();) {
+    const Character c = character_at(text, at);
+    if (keep_line_breaks && c.code == '\n') shown += '\n';
+    else if (!c.valid) shown += fmt::format("<0x{:02X}>", static_cast<unsigned char>(c.utf8[0]));
+    else if (invisible(c.code)) shown += fmt::format("<U+{:04X}>", c.code);
+    else shown += c.utf8;
+    at += c.utf8.size();
+  }
+  return shown;
+}
+
+std::string describe_character(std::string_view text, std::size_t at) {
+  const Character c = character_at(text, at);
+  const std::string_view utf8 = c.utf8;
+  const std::uint32_t code = c.code;
+  if (utf8.size() == 1 && code >= 0x20 && code < 0x7f) return fmt::format("'{}'", utf8);
+  if (!c.valid) return fmt::format("(the byte 0x{:02X}, not UTF-8 text)", static_cast<unsigned char>(utf8[0]));
   struct Known {
     std::uint32_t code;
     const char* name;
@@ -34,11 +78,6 @@ std::string describe_character(std::string_view text, std::size_t at) {
       {0x00B7, "a middle dot", "'*'"},                {0x2217, "an asterisk operator", "'*'"},
       {0x2019, "a right quotation mark", "a prime '"},  {0x2032, "a prime sign", "a prime '"},
   };
-  // Control characters, and the format characters that change how the text around them shows
-  // (zero-width marks, the bidirectional overrides U+202A-E and isolates U+2066-9).
-  const bool invisible = code < 0x20 || code == 0x7f || (code >= 0x80 && code < 0xA0) ||
-                         (code >= 0x200B && code <= 0x200F) || (code >= 0x202A && code <= 0x202E) ||
-                         (code >= 0x2060 && code <= 0x2069);
   for (const Known& k : known)
     if (k.code == code) {
       const std::string_view instead = k.instead;
@@ -46,7 +85,7 @@ std::string describe_character(std::string_view text, std::size_t at) {
       if (instead == "a plain space") return fmt::format("U+{:04X} ({}): write a plain space", code, k.name);
       return fmt::format("'{}' U+{:04X} ({}): write {}", utf8, code, k.name, k.instead);
     }
-  if (invisible) return fmt::format("U+{:04X} (an invisible control or format character): delete it", code);
+  if (invisible(code)) return fmt::format("U+{:04X} (an invisible control or format character): delete it", code);
   return fmt::format("'{}' (U+{:04X}): expressions are written in ASCII (names of letters, digits and _)", utf8, code);
 }
 
