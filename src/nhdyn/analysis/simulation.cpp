@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "nhdyn/analysis/detail/contact_switches.hpp"
+#include "nhdyn/analysis/detail/contact_watches.hpp"
 #include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
@@ -46,151 +47,6 @@ std::string non_finite_residual(const Model& model, const Data& data, double t) 
   }
   return "";
 }
-
-// The index of the contact `name` among the contacts with modes (model/contact_modes.hpp), or -1.
-int mode_contact_index(const Model& model, const std::string& name) {
-  if (!model.contact_modes) return -1;
-  const std::vector<ContactModeContact>& contacts = model.contact_modes->contacts;
-  for (std::size_t i = 0; i < contacts.size(); ++i)
-    if (contacts[i].name == name) return static_cast<int>(i);
-  return -1;
-}
-
-// Whether a contact's watch applies in its current mode (ContactWatch::touching_only, free_only):
-// in the air a convexity describes no touching body, and the free flight's watch no contact.
-bool watched_in_mode(const Data& data, int mode_contact, bool touching_only, bool free_only) {
-  const bool free = mode_contact >= 0 && data.modes.active &&
-                    data.modes.mode[static_cast<std::size_t>(mode_contact)] == ContactMode::free;
-  return free ? !touching_only : !free_only;
-}
-
-// The contact whose closed-form point is singular at (t, q, v) (model.hpp, ContactWatch: a disk
-// lying flat), as the message of the run that failed there; "" when none is. A measure that is not
-// a number counts as singular.
-// Watch `w`'s measure at (t, q, v), bound to the model's parameter values. Cold path: allocates.
-double calc_watch_measure(const Model& model, const ContactWatch& w, double t, const double* q, const double* v) {
-  std::vector<double> values;
-  for (const Parameter& p : model.parameters) values.push_back(p.value);
-  const Tape measure = w.measure.bind(values.data(), values.size());
-  std::vector<double> registers(static_cast<std::size_t>(measure.registers()));
-  double value = 0.0;
-  measure.run(t, q, v, registers.data(), &value);
-  return value;
-}
-
-std::string watch_message(const Model& model, const ContactWatch& w, double value, double t, const double* q,
-                          const double* v, const char* ending = "the run stops there") {
-  return fmt::format("{}{} '{}': {} ({} = {:.3g}) at t = {:.6g}, where {}; {}", w.where.empty() ? "" : w.where + ": ",
-                     w.entry, w.contact, w.reason, w.quantity, value + 0.0 /* -0 as 0 */, t, describe_state(model, q, v),
-                     ending);
-}
-
-std::string singular_contact_message(const Model& model, const Data& data, double t, const double* q,
-                                     const double* v, const char* ending = "the run stops there") {
-  for (const ContactWatch& w : model.contact_watches) {
-    if (!watched_in_mode(data, mode_contact_index(model, w.contact), w.touching_only, w.free_only)) continue;
-    const double value = calc_watch_measure(model, w, t, q, v);
-    if (value >= w.threshold) continue;
-    return watch_message(model, w, value, t, q, v, ending);
-  }
-  return "";
-}
-
-// The contact watches checked along the run (ContactWatch::every_step), bound to the parameter
-// values: at every accepted step's end (after_step: every integrator), and, for an integrator that
-// locates events, as events falling through their thresholds, so that the run stops where a
-// measure reaches its limit and not at the end of the step past it. Forwards the run's own events
-// (`user`, may be null) as its first ones.
-class WatchedEvents final : public EventFunctions {
- public:
-  WatchedEvents(const Model& model, Data& data)
-      : data_(data), n_(model.n()), fired_y_(static_cast<std::size_t>(2 * model.n()), 0.0) {
-    std::vector<double> values;
-    for (const Parameter& p : model.parameters) values.push_back(p.value);
-    for (std::size_t i = 0; i < model.contact_watches.size(); ++i) {
-      const ContactWatch& w = model.contact_watches[i];
-      if (!w.every_step) continue;
-      watches_.push_back({w.measure.bind(values.data(), values.size()),
-                          w.threshold, mode_contact_index(model, w.contact), w.touching_only, w.free_only,
-                          static_cast<int>(i)});
-      registers_.resize(std::max(registers_.size(), static_cast<std::size_t>(watches_.back().measure.registers())));
-    }
-  }
-
-  bool empty() const { return watches_.empty(); }
-  void set_user(EventFunctions* user) {
-    user_ = user;
-    user_count_ = user ? user->count() : 0;
-  }
-  int count() const override { return user_count_ + static_cast<int>(watches_.size()); }
-  CrossingDirection direction(int i) const override {
-    return i < user_count_ ? user_->direction(i) : CrossingDirection::falling;
-  }
-  bool may_dip(int i) const override { return i < user_count_ && user_->may_dip(i); }
-  // A watch out of its mode is +1 (no crossing); a measure that is not a number counts as below
-  // its threshold (-1): the step's end finds it (check), as it finds a jump.
-  Status evaluate(double t, const double* y, double* g) override {
-    if (user_) {
-      const Status status = user_->evaluate(t, y, g);
-      if (status != Status::ok) return status;
-    }
-    for (std::size_t k = 0; k < watches_.size(); ++k) {
-      const Watch& w = watches_[k];
-      double& gk = g[static_cast<std::size_t>(user_count_) + k];
-      if (!watched_in_mode(data_, w.mode_contact, w.touching_only, w.free_only)) {
-        gk = 1.0;
-        continue;
-      }
-      double value = 0.0;
-      w.measure.run(t, y, y + n_, registers_.data(), &value);
-      gk = std::isfinite(value) ? value - w.threshold : -1.0;
-    }
-    return Status::ok;
-  }
-  Status on_event(int i, double t, const double* y) override {
-    if (i < user_count_) return user_->on_event(i, t, y);
-    return stop(watches_[static_cast<std::size_t>(i - user_count_)].index, t, y);
-  }
-  // At a step's end: the first watch below its threshold ends the run there.
-  Status check(double t, const double* y) {
-    for (const Watch& w : watches_) {
-      if (!watched_in_mode(data_, w.mode_contact, w.touching_only, w.free_only)) continue;
-      double value = 0.0;
-      w.measure.run(t, y, y + n_, registers_.data(), &value);
-      if (!(value >= w.threshold)) return stop(w.index, t, y);
-    }
-    return Status::ok;
-  }
-  // The watch (index in Model::contact_watches) that ended the run, or -1; where, and the state
-  // y = [q; q'] there.
-  int fired() const { return fired_; }
-  double fired_t() const { return fired_t_; }
-  const double* fired_y() const { return fired_y_.data(); }
-
- private:
-  struct Watch {
-    Tape measure;
-    double threshold;
-    int mode_contact;  // the contact's index among those with modes, or -1
-    bool touching_only, free_only;
-    int index;         // in Model::contact_watches
-  };
-  Status stop(int index, double t, const double* y) {
-    fired_ = index;
-    fired_t_ = t;
-    std::memcpy(fired_y_.data(), y, sizeof(double) * fired_y_.size());
-    return Status::singular_system;
-  }
-  Data& data_;
-  EventFunctions* user_ = nullptr;
-  int user_count_ = 0;
-  int n_;
-  std::vector<Watch> watches_;
-  std::vector<double> registers_;
-  int fired_ = -1;
-  double fired_t_ = 0.0;
-  std::vector<double> fired_y_;
-};
 
 // A run whose explicit integrator spent a large share of its steps held by stability, not accuracy
 // (IntegratorStats::stiff_steps, Hairer's test): at least 1000 steps and a quarter of all. "" when
@@ -855,13 +711,14 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.watch.watched_states = watch.states;
   // A run that got through with such an atol took steps as long as its outputs allowed: its
   // numbers are the integrator's, not the model's, and nothing else would say so.
-  if (summary.status == Status::ok && atol_bounds_nothing(options.integrator, largest_state(q0, v0)))
+  if (const double largest = largest_state(q0, v0);
+      summary.status == Status::ok && atol_bounds_nothing(options.integrator, largest))
     summary.warnings.push_back(fmt::format(
         "the absolute tolerance atol = {:g} is at least the size of every state at the start (largest |q|, |q'| "
         "{:g}): the error test bounded nothing, the steps were as long as the outputs allowed, and the motion may "
         "be far from the model's (its residuals and energy balance say how far); give an atol well below the "
         "states' size (the default is 1e-10)",
-        options.integrator.atol, largest_state(q0, v0)));
+        options.integrator.atol, largest));
   if (summary.status != Status::ok)
     summary.message = explain_run_failure(model, data, event_functions, watched, result, recorder.message(),
                                           summary.status) +
