@@ -3,6 +3,7 @@
 
 #include "bindings.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/core/version.hpp"
 
 namespace py = pybind11;
@@ -28,19 +29,21 @@ PYBIND11_MODULE(_nhdyn, m) {
   m.attr("ModelError") = model_error;
   m.attr("FileError") = file_error;
   m.attr("SimulationError") = simulation_error;
+  // The messages show an invisible character of what they echo by its code (core/shown_text.hpp),
+  // as the CLI's do; a byte that is not UTF-8 would not even become a Python str.
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const nhdyn::InputError& e) {
-      PyErr_SetString(input_error.ptr(), e.what());
+      PyErr_SetString(input_error.ptr(), nhdyn::shown_text(e.what(), true).c_str());
     } catch (const nhdyn::ModelError& e) {
-      PyErr_SetString(model_error.ptr(), e.what());
+      PyErr_SetString(model_error.ptr(), nhdyn::shown_text(e.what(), true).c_str());
     } catch (const nhdyn::FileError& e) {
-      PyErr_SetString(file_error.ptr(), e.what());
+      PyErr_SetString(file_error.ptr(), nhdyn::shown_text(e.what(), true).c_str());
     } catch (const nhdyn::SimulationError& e) {
-      PyErr_SetString(simulation_error.ptr(), e.what());
+      PyErr_SetString(simulation_error.ptr(), nhdyn::shown_text(e.what(), true).c_str());
     } catch (const nhdyn::Error& e) {
-      PyErr_SetString(error.ptr(), e.what());
+      PyErr_SetString(error.ptr(), nhdyn::shown_text(e.what(), true).c_str());
     }
   });
   nhdyn::python::bind_model(m);

@@ -13,6 +13,7 @@
 #include "nhdyn/analysis/batch.hpp"
 #include "nhdyn/analysis/run_options.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/frontend/events.hpp"
 
 namespace nhdyn::python {
@@ -149,7 +150,7 @@ namespace {
 
 void add_run(py::dict& d, const SimulationSummary& s) {
   d["status"] = std::string(describe(s.status));
-  d["message"] = s.message;
+  d["message"] = shown_text(s.message, true);  // as the CLI shows it (core/shown_text.hpp)
   d["t_reached"] = s.t_reached;
   d["steps"] = s.stats.steps;
   d["rejected_steps"] = s.stats.rejected_steps;

@@ -162,7 +162,7 @@ void print_batch_outcome(const BatchArgs& args, const Model& base, const std::ve
     if (warned++ == 0)
       for (const std::string& w : results[r].summary.warnings) fmt::print(stderr, "nhdyn: warning: run {}: {}\n", r, w);
   }
-  if (warned > 1) fmt::print(stderr, "nhdyn: warning: {} of {} runs had constraint-watch warnings\n", warned, results.size());
+  if (warned > 1) fmt::print(stderr, "nhdyn: warning: {} of {} runs had warnings\n", warned, results.size());
   // A stiff stretch (analysis/simulation_summary.hpp): the first run's words and how many runs had one.
   std::size_t stiff = 0;
   for (std::size_t r = 0; r < results.size(); ++r)

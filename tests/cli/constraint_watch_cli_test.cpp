@@ -187,7 +187,7 @@ TEST_F(ConstraintWatchCli, CompareAndBatchPassTheWarningsOn) {
   const test::CliOutcome batch = run_nhdyn("batch tan.toml --grid rho=0.5:0.7:3 --t-end 2 -o runs --threads 1", dir_);
   EXPECT_EQ(batch.exit_code, 0) << batch.out;
   EXPECT_TRUE(contains(batch.out, "nhdyn: warning: run 0: constraint 'blade'")) << batch.out;
-  EXPECT_TRUE(contains(batch.out, "nhdyn: warning: 3 of 3 runs had constraint-watch warnings")) << batch.out;
+  EXPECT_TRUE(contains(batch.out, "nhdyn: warning: 3 of 3 runs had warnings")) << batch.out;
 }
 
 TEST_F(ConstraintWatchCli, SparseChainRunsWatchedAndSilent) {

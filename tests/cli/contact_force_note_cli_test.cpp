@@ -136,6 +136,25 @@ TEST(CliContactForceNote, TheVerdictDoesNotDependOnTheBodysSize) {
   fs::remove_all(dir);
 }
 
+// And where the forces are not determined it still says so: the bicycle steered by a program, whose
+// rear wheel's normal force its coordinates share (examples/bicycle_roll_program.toml). A column
+// of the system at round-off once scaled to unit norm made it look determined, written as 0.
+TEST(CliContactForceNote, AnUndeterminedNormalForceStaysNaNWithItsNote) {
+  const fs::path dir = fresh_directory("nhdyn-contact-note-program");
+  ASSERT_EQ(run(dir, "simulate '" + example("bicycle_roll_program.toml") + "' --t-end 0.1 -o b.csv", "b.err"), 0)
+      << read_text(dir / "b.err");
+  EXPECT_NE(read_text(dir / "b.err").find("contact 'rear': rear_Fz, rear_N not determined by the model, written as NaN"),
+            std::string::npos)
+      << read_text(dir / "b.err");
+  const Csv csv = read_csv(dir / "b.csv");
+  ASSERT_FALSE(csv.rows.empty());
+  for (const std::vector<double>& row : csv.rows) {
+    EXPECT_TRUE(std::isnan(row[csv.column("rear_N")]));
+    EXPECT_GT(row[csv.column("front_N")], 100.0);
+  }
+  fs::remove_all(dir);
+}
+
 // Where the note is true it stays: a sled held flat by its frames (test::kFlatSledBodies).
 TEST(CliContactForceNote, SledHeldByItsFramesKeepsItsNote) {
   const fs::path dir = fresh_directory("nhdyn-contact-note-sled");

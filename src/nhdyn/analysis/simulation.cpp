@@ -715,7 +715,7 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
       summary.status == Status::ok && atol_bounds_nothing(options.integrator, largest))
     summary.warnings.push_back(fmt::format(
         "the absolute tolerance atol = {:g} is at least the size of every state at the start (largest |q|, |q'| "
-        "{:g}): the error test bounded nothing, the steps were as long as the outputs allowed, and the motion may "
+        "{:g}): the error test bounded nothing, the steps were not chosen for accuracy, and the motion may "
         "be far from the model's (its residuals and energy balance say how far); give an atol well below the "
         "states' size (the default is 1e-10)",
         options.integrator.atol, largest));

@@ -21,6 +21,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kConsistent = 1e-8;
 // A null vector of M with a component above this (relative) along an output leaves it undetermined.
 constexpr double kDetermined = 1e-8;
+// A row of the contact-force system at most this part of the largest is round-off (scaled_null_space).
+constexpr double kRoundOffRow = 1e-12;
 
 // A state counts as on the constraints when every position and velocity residual is at most this.
 constexpr double kOnConstraints = 1e-11;
@@ -332,24 +334,25 @@ void append_contact_force_values(const Model& model, const Data& data, std::vect
 namespace {
 
 // The combinations of unknowns a stacked system M x = rhs does not fix: an orthonormal basis of
-// the null space of M S, M with its columns (S), then its rows, scaled to unit norm, so that the
-// units do not decide (the balance of moments of a ball 1e8 m across is 1e8 times that of its
-// forces: unscaled, its smallest singular value fell below the threshold relative to the largest).
-// A null vector u of M S is S u of M, so a functional c of the unknowns is fixed when S c is
-// orthogonal to every column of the basis.
+// the null space of M with its rows scaled to unit norm, so that the units do not decide (the
+// balance of moments of a ball 1e8 m across is 1e8 times that of its forces: unscaled, its
+// smallest singular value fell below the threshold relative to the largest). Rows are equations,
+// so scaling them leaves the null space as it is; a row at round-off of the largest (a balance
+// that cancels) is left as it is, not blown up into a row of noise. The columns, the unknowns, are
+// not scaled: a column at round-off (an unknown that no equation sees) scaled to unit norm looked
+// like one that every equation fixes.
 struct NullSpace {
-  Vector column_scale;  // S
   Matrix basis;
 };
 
 NullSpace scaled_null_space(const Matrix& M) {
   NullSpace null;
-  null.column_scale = Vector::Ones(M.cols());
-  for (Eigen::Index j = 0; j < M.cols(); ++j)
-    if (const double norm = M.col(j).norm(); norm > 0.0 && std::isfinite(norm)) null.column_scale(j) = 1.0 / norm;
-  Matrix scaled = M * null.column_scale.asDiagonal();
+  Matrix scaled = M;
+  double largest_row = 0.0;
+  for (Eigen::Index i = 0; i < M.rows(); ++i) largest_row = std::max(largest_row, M.row(i).norm());
   for (Eigen::Index i = 0; i < scaled.rows(); ++i)
-    if (const double norm = scaled.row(i).norm(); norm > 0.0 && std::isfinite(norm)) scaled.row(i) /= norm;
+    if (const double norm = scaled.row(i).norm(); norm > kRoundOffRow * largest_row && std::isfinite(norm))
+      scaled.row(i) /= norm;
   const Eigen::JacobiSVD<Matrix> svd(scaled, Eigen::ComputeFullV);
   const Vector& sigma = svd.singularValues();
   const double largest = sigma.size() > 0 ? sigma(0) : 0.0;
@@ -455,7 +458,6 @@ void analyse_contact_forces(const Model& model, ContactForceModel& c) {
     for (std::size_t j = 0; j < contact.components.size(); ++j) {
       const ContactComponent component = contact.components[j];
       functional(c, contact, index, o, component, coefficients);
-      coefficients = coefficients.cwiseProduct(null.column_scale);
       const double size = coefficients.norm();
       bool determined = true;
       for (Eigen::Index j = 0; j < null.basis.cols(); ++j)
