@@ -14,6 +14,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "support/cli_process.hpp"
@@ -780,6 +781,27 @@ TEST_F(Hardening, AnEchoedValueNeverCarriesAnInvisibleCharacterOrABadByte) {
       EXPECT_TRUE(contains(r.err, words)) << r.err;
       for (const char* raw : {"\u200b", "\u202e", "\xff"}) EXPECT_FALSE(contains(r.err, raw)) << r.err;
     }
+  }
+  // A model file's name and description, printed on terminals and into every file a run writes,
+  // refuse such characters at their line (a raw escape is TOML's own error; written as \u001b it
+  // is ours); visible ones (an accent, a Greek letter) stay.
+  for (const auto& [key, text, shown] :
+       std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"name", "sl\u202eed", "sl<U+202E>ed"}, {"description", "a \\u001b[2J sled", "a <U+001B>[2J sled"}}) {
+    std::string model = kOscillator;
+    if (key == "name") model.replace(model.find("name = \""), 8, "name = \"" + text);
+    else model = "description = \"" + text + "\"\n" + model;
+    write("named.toml", model);
+    const ProcessRun r = nhdyn({"simulate", "named.toml", "-q", "-o", "c.csv"});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_TRUE(contains(r.err, "named.toml:1:") && contains(r.err, key + " \"") && contains(r.err, shown) &&
+                contains(r.err, "has an invisible character or a byte that is not UTF-8"))
+        << r.err;
+  }
+  {
+    write("named.toml", "description = \"Schlitten \u00e9\u03a6\"\n" + std::string(kOscillator));
+    const ProcessRun r = nhdyn({"simulate", "named.toml", "-q", "-o", "c.csv"});
+    EXPECT_EQ(r.code, 0) << r.err;
   }
   // Whatever a message echoes of the arguments: an unknown command, option, model or event.
   const std::vector<std::pair<std::vector<std::string>, std::string>> echoes = {

@@ -24,6 +24,7 @@
 #include <toml++/toml.h>
 
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/frontend/detail/model_file_sections.hpp"
 #include "nhdyn/model/parameters.hpp"
 #include "nhdyn/symbolic/rolling_contact.hpp"
@@ -58,10 +59,21 @@ symbolic::Spec load_sections(LoadContext& cx) {
   }
   c.check_keys(root, top_level_keys(), "at the top level");
 
+  // The name and the description are printed on terminals and into every file a run writes: an
+  // invisible character (a right-to-left override, an escape) or a byte that is not UTF-8 there
+  // is refused, shown by its code (core/shown_text.hpp).
+  const auto visible = [&](const toml::node& node, const char* key, std::string text) {
+    if (shown_text(text, true) != text)
+      c.fail(c.at(node), fmt::format("{} \"{}\" has an invisible character or a byte that is not UTF-8 (shown here "
+                                     "by its code): delete it",
+                                     key, shown_text(text, true)));
+    return text;
+  };
   const toml::node* name = c.required(root, "name", "the model's name, e.g. name = \"sled\"");
-  SpecBuilder builder(c.string_of(*name, "name", "name = \"sled\""), c.at(*name));
+  SpecBuilder builder(visible(*name, "name", c.string_of(*name, "name", "name = \"sled\"")), c.at(*name));
   if (const toml::node* description = root.get("description"))
-    builder.description(c.string_of(*description, "description", "description = \"A sled on an inclined plane\""));
+    builder.description(visible(*description, "description",
+                                c.string_of(*description, "description", "description = \"A sled on an inclined plane\"")));
 
   load_coordinates(cx, root, builder);
   if (const toml::node* parameters = root.get("parameters")) load_parameters(cx, *parameters, builder);
