@@ -4,6 +4,7 @@
 // under gravity (no constraint; the size benchmark of docs/performance.md).
 #include <fmt/format.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -58,7 +59,9 @@ int parse_bodies(const std::string& text, int most) {
 // the model file written loads (1e200 was written, then refused by simulate).
 // The messages are model/parameters.hpp's, which show an invisible character by its code.
 std::pair<std::string, double> parse_set(const std::string& set) {
-  std::vector<Parameter> one{{split_parameter_set(set).first, 0.0, ""}};
+  std::string name = split_parameter_set(set).first;
+  while (!name.empty() && std::isspace(static_cast<unsigned char>(name.back()))) name.pop_back();  // as a model's
+  std::vector<Parameter> one{{name, 0.0, ""}};
   apply_parameter_sets(one, {set}, "example");
   return {one.front().name, one.front().value};
 }

@@ -711,11 +711,12 @@ SimulationSummary simulate(const Model& model, const SimulationOptions& options,
   summary.watch.watched_states = watch.states;
   // A run that got through with such an atol took steps as long as its outputs allowed: its
   // numbers are the integrator's, not the model's, and nothing else would say so.
-  if (const double largest = largest_state(q0, v0);
+  // The largest state at the start or at the end: a run from rest at the origin may move far.
+  if (const double largest = std::max(largest_state(q0, v0), largest_state(data.q, data.v));
       summary.status == Status::ok && atol_bounds_nothing(options.integrator, largest))
     summary.warnings.push_back(fmt::format(
-        "the absolute tolerance atol = {:g} is at least the size of every state at the start (largest |q|, |q'| "
-        "{:g}): the error test bounded nothing, the steps were not chosen for accuracy, and the motion may "
+        "the absolute tolerance atol = {:g} is at least the size of every state at the start and at the end "
+        "(largest |q|, |q'| {:g}): the error test bounded nothing, the steps were not chosen for accuracy, and the motion may "
         "be far from the model's (its residuals and energy balance say how far); give an atol well below the "
         "states' size (the default is 1e-10)",
         options.integrator.atol, largest));

@@ -124,6 +124,8 @@ Status compute_dynamics(const Model& model, Data& data, const FormulationOptions
   if (const small::Kernels* kernels = fused_kernels(model, data, options);
       kernels && (!data.method || *data.method == Formulation::sanh)) {
     const int n = model.n();
+    data.t = t;  // as compute_terms: an evaluator that throws leaves no stage claimed
+    data.stage = Stage::empty;
     model.evaluator->terms(t, q, v, data.scratch.data(),
                            TermsOut{data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data()});
     double* q_data = data.q.data();
@@ -137,7 +139,6 @@ Status compute_dynamics(const Model& model, Data& data, const FormulationOptions
     if (acc == 0.0 && kernels->sanh_qr(data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data(),
                                        data.D.data(), data.h.data(), data.qdd.data(),
                                        data.R.data()) == small::SanhResult::ok) {
-      data.t = t;
       data.status = Status::ok;
       data.has_multipliers = false;
       data.stage = Stage::acceleration;

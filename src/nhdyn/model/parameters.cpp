@@ -32,13 +32,14 @@ std::string did_you_mean(std::string_view name, const std::vector<Parameter>& kn
 
 // A hostile text may be megabytes long: messages quote its start only.
 // A value as a message echoes it: invisible characters shown by code (shown_text), and a long one
-// cut on a character's boundary.
+// cut on a character's boundary before it is shown, so that no code is cut in two.
 std::string shorten(std::string_view text) {
-  const std::string shown = shown_text(text);
-  if (shown.size() <= 80) return shown;
+  if (text.size() <= 80) return shown_text(text);
   std::size_t cut = 60;
-  while (cut > 0 && (static_cast<unsigned char>(shown[cut]) & 0xC0) == 0x80) --cut;
-  return fmt::format("{}... ({} characters)", shown.substr(0, cut), text.size());
+  while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
+  const auto characters = std::count_if(text.begin(), text.end(),
+                                        [](char b) { return (static_cast<unsigned char>(b) & 0xC0) != 0x80; });
+  return fmt::format("{}... ({} characters)", shown_text(text.substr(0, cut)), characters);
 }
 
 std::string list_names(const std::vector<Parameter>& known) {

@@ -11,7 +11,8 @@ namespace nhdyn {
 namespace {
 
 // The character that starts at byte `at`: its UTF-8 sequence and code point; `valid` false for a
-// byte that starts no UTF-8 sequence (its sequence is then that byte alone).
+// byte that starts no well-formed UTF-8 sequence (a stray continuation byte, a truncated or overlong
+// sequence, a surrogate, a code point past U+10FFFF): its sequence is then that byte alone.
 struct Character {
   std::string_view utf8;
   std::uint32_t code = 0;
@@ -19,28 +20,30 @@ struct Character {
 };
 
 Character character_at(std::string_view text, std::size_t at) {
-  std::size_t end = at + 1;
-  while (end < text.size() && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) ++end;
-  Character c{text.substr(at, end - at)};
-  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(c.utf8[k]); };
-  c.code = byte(0);
-  if (c.utf8.size() == 2 && (byte(0) & 0xE0) == 0xC0) c.code = ((byte(0) & 0x1Fu) << 6) | (byte(1) & 0x3Fu);
-  else if (c.utf8.size() == 3 && (byte(0) & 0xF0) == 0xE0)
-    c.code = ((byte(0) & 0x0Fu) << 12) | ((byte(1) & 0x3Fu) << 6) | (byte(2) & 0x3Fu);
-  else if (c.utf8.size() == 4 && (byte(0) & 0xF8) == 0xF0)
-    c.code = ((byte(0) & 0x07u) << 18) | ((byte(1) & 0x3Fu) << 12) | ((byte(2) & 0x3Fu) << 6) | (byte(3) & 0x3Fu);
-  else if (c.utf8.size() != 1 || byte(0) >= 0x80) {
-    c.utf8 = text.substr(at, 1);
-    c.valid = false;
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[at + k]); };
+  const unsigned char lead = byte(0);
+  const std::size_t length = lead < 0x80 ? 1 : (lead & 0xE0) == 0xC0 ? 2 : (lead & 0xF0) == 0xE0 ? 3
+                                          : (lead & 0xF8) == 0xF0 ? 4 : 0;
+  Character bad{text.substr(at, 1), lead, false};
+  if (length == 0 || at + length > text.size()) return bad;
+  std::uint32_t code = length == 1 ? lead : length == 2 ? lead & 0x1Fu : length == 3 ? lead & 0x0Fu : lead & 0x07u;
+  for (std::size_t k = 1; k < length; ++k) {
+    if ((byte(k) & 0xC0) != 0x80) return bad;
+    code = (code << 6) | (byte(k) & 0x3Fu);
   }
-  return c;
+  constexpr std::uint32_t smallest[] = {0, 0, 0x80, 0x800, 0x10000};  // shorter forms are overlong
+  if (code < smallest[length] || (code >= 0xD800 && code <= 0xDFFF) || code > 0x10FFFF) return bad;
+  return {text.substr(at, length), code, true};
 }
 
-// Control characters, and the format characters that change how the text around them shows
-// (zero-width marks, the bidirectional overrides U+202A-E and isolates U+2066-9, the byte order mark).
+// Control characters, and the format characters that change how the text around them shows or
+// hide in it (a soft hyphen, zero-width marks, the Arabic letter mark, the line and paragraph
+// separators, the bidirectional overrides U+202A-E and isolates U+2066-9, the byte order mark,
+// the tags U+E0000-7F).
 bool invisible(std::uint32_t code) {
-  return code < 0x20 || code == 0x7f || (code >= 0x80 && code < 0xA0) || (code >= 0x200B && code <= 0x200F) ||
-         (code >= 0x202A && code <= 0x202E) || (code >= 0x2060 && code <= 0x2069) || code == 0xFEFF;
+  return code < 0x20 || code == 0x7f || (code >= 0x80 && code < 0xA0) || code == 0xAD || code == 0x61C ||
+         code == 0x180E || (code >= 0x200B && code <= 0x200F) || (code >= 0x2028 && code <= 0x202E) ||
+         (code >= 0x2060 && code <= 0x2069) || code == 0xFEFF || (code >= 0xE0000 && code <= 0xE007F);
 }
 
 }  // namespace
@@ -62,8 +65,8 @@ std::string describe_character(std::string_view text, std::size_t at) {
   const Character c = character_at(text, at);
   const std::string_view utf8 = c.utf8;
   const std::uint32_t code = c.code;
-  if (utf8.size() == 1 && code >= 0x20 && code < 0x7f) return fmt::format("'{}'", utf8);
   if (!c.valid) return fmt::format("(the byte 0x{:02X}, not UTF-8 text)", static_cast<unsigned char>(utf8[0]));
+  if (utf8.size() == 1 && code >= 0x20 && code < 0x7f) return fmt::format("'{}'", utf8);
   struct Known {
     std::uint32_t code;
     const char* name;
