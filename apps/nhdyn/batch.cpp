@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "run_files.hpp"
 #include "run_overrides.hpp"
 #include "nhdyn/analysis/batch.hpp"
@@ -175,7 +176,7 @@ void print_batch_outcome(const BatchArgs& args, const Model& base, const std::ve
   for (const std::string& w : format_batch_unmet_stops(unmet)) fmt::print(stderr, "nhdyn: warning: {}\n", w);
   if (!args.quiet) {
     fmt::print("nhdyn batch {}: {} runs on {} threads, {} failed -> {}\n", base.name, results.size(),
-               batch_threads(args.threads, results.size()), failed, (dir / "summary.csv").string());
+               batch_threads(args.threads, results.size()), failed, shown_text((dir / "summary.csv").string()));
     for (std::size_t r = 0; r < results.size() && failed > 0; ++r)
       if (!results[r].ok) {
         fmt::print(stderr, "nhdyn: run {} failed: {}\n", r, results[r].message);

@@ -15,6 +15,7 @@
 #include "nhdyn/analysis/exact_solution.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/atomic_file.hpp"
@@ -220,8 +221,8 @@ void print_comparison(const CompareArgs& args, const Model& model, const Compari
                energy_error(s), r.max_error_q, r.max_error_v,
                format_failure_note(s));
   }
-  fmt::print("table -> {}\nseries -> {}\n", table_path.string(), series_path.string());
-  if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
+  fmt::print("table -> {}\nseries -> {}\n", shown_text(table_path.string()), shown_text(series_path.string()));
+  if (!args.plot.empty()) fmt::print("plot -> {}\n", shown_text(args.plot));
 }
 
 int run_compare(const CompareArgs& args) {

@@ -12,6 +12,7 @@
 #include "nhdyn/analysis/linearization.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/atomic_file.hpp"
@@ -96,7 +97,7 @@ int run_linearize(const LinearizeArgs& args) {
   fmt::print("{:>4} {:>24} {:>24}\n", "#", "real", "imag");
   for (std::size_t i = 0; i < l.eigenvalues.size(); ++i)
     fmt::print("{:>4} {:>24.16g} {:>24.16g}\n", i + 1, l.eigenvalues[i].real(), l.eigenvalues[i].imag());
-  if (!args.output.empty()) fmt::print("eigenvalues -> {}\n", args.output);
+  if (!args.output.empty()) fmt::print("eigenvalues -> {}\n", shown_text(args.output));
   return 0;
 }
 

@@ -14,6 +14,7 @@
 #include "commands.hpp"
 #include "nhdyn/analysis/residuals.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/frontend/optimize_problem.hpp"
 #include "nhdyn/io/atomic_file.hpp"
@@ -206,7 +207,7 @@ int run_optimize(const OptimizeArgs& args) {
                                          nlp_status_name(result.solver.status), result.solver.message)) +
                           table);
       fmt::print("{} -> {}\n", result.replay_rejected ? "discrete optimum" : "last iterate",
-                 partial_path(args.output).string());
+                 shown_text(partial_path(args.output).string()));
     }
     if (result.replay_rejected)
       fmt::print(stderr, "nhdyn: error: {}\n", result.replay_verdict);
@@ -217,14 +218,14 @@ int run_optimize(const OptimizeArgs& args) {
   }
   if (csv) csv->write(table);
   files.commit();
-  if (csv) fmt::print("results -> {}\n", args.output);
+  if (csv) fmt::print("results -> {}\n", shown_text(args.output));
   if (!args.plot.empty()) {
     write_plot_of(problem, args.output, args.plot);
-    fmt::print("plot -> {}\n", args.plot);
+    fmt::print("plot -> {}\n", shown_text(args.plot));
   }
   if (!args.html.empty()) {
     const std::string notice = write_optimum_report(args, loaded, problem, result);
-    fmt::print("report -> {}{}\n", args.html, notice.empty() ? "" : "\nnote: " + notice);
+    fmt::print("report -> {}{}\n", shown_text(args.html), notice.empty() ? "" : "\nnote: " + notice);
   }
   return 0;
 }

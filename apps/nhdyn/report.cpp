@@ -12,6 +12,7 @@
 
 #include "commands.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/csv.hpp"
@@ -69,7 +70,7 @@ std::function<int()> add_report_command(CLI::App& app) {
                        fmt::format("{}: {}", resolved.model.name, args->csv), {{"results", args->csv}}, args->output,
                        options);
     if (!args->quiet) {
-      fmt::print("nhdyn report {}: {} rows -> {}\n", resolved.model.name, table.rows.size(), args->output);
+      fmt::print("nhdyn report {}: {} rows -> {}\n", resolved.model.name, table.rows.size(), shown_text(args->output));
       if (!notice.empty()) fmt::print("  note: {}\n", notice);
     }
     return 0;

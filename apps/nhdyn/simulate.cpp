@@ -18,6 +18,7 @@
 #include "nhdyn/analysis/run_options.hpp"
 #include "nhdyn/analysis/simulation.hpp"
 #include "nhdyn/core/error.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/frontend/describe.hpp"
 #include "nhdyn/frontend/events.hpp"
 #include "nhdyn/frontend/load_model.hpp"
@@ -241,7 +242,7 @@ int report_failure(const Model& model, const SimulationSummary& summary, const R
   fmt::print(stderr, "nhdyn: simulation of '{}' failed at t = {:.6g}: {}\n", model.name, summary.t_reached,
              summary.message);
   if (!out.companions) {
-    fmt::print(stderr, "nhdyn: no results written ({} is left as it was)\n", out.csv.string());
+    fmt::print(stderr, "nhdyn: no results written ({} is left as it was)\n", shown_text(out.csv.string()));
     return 1;
   }
   std::string reason = fmt::format("# nhdyn: simulation of '{}' failed at t = {:.6g}: {}", model.name,
@@ -250,7 +251,7 @@ int report_failure(const Model& model, const SimulationSummary& summary, const R
     if (c == '\n' || c == '\r') c = ' ';
   files.write_now(out.partial, reason + "\n" + out.writer->written());
   fmt::print(stderr, "nhdyn: the {} rows up to the failure are in {} ({} is left as it was)\n", summary.outputs,
-             out.partial.string(), out.csv.string());
+             shown_text(out.partial.string()), shown_text(out.csv.string()));
   return 1;
 }
 
@@ -342,18 +343,18 @@ void print_summary(const SimulateArgs& args, const Model& model, const Simulatio
   if (summary.events.stopped_by >= 0)
     fmt::print("  t = {:g} .. {:.10g} s: stopped by event '{}', {} rows -> {}\n", model.t0, summary.t_reached,
                summary.events.names[static_cast<std::size_t>(summary.events.stopped_by)], summary.outputs,
-               files.csv.string());
+               shown_text(files.csv.string()));
   else
-    fmt::print("  t = {:g} .. {:g} s, {} rows -> {}\n", model.t0, options.t_end, summary.outputs, files.csv.string());
-  fmt::print("{}", format_events(summary.events, files.events_file ? files.events.string() : std::string()));
+    fmt::print("  t = {:g} .. {:g} s, {} rows -> {}\n", model.t0, options.t_end, summary.outputs, shown_text(files.csv.string()));
+  fmt::print("{}", format_events(summary.events, files.events_file ? shown_text(files.events.string()) : std::string()));
   fmt::print("{}", format_steps(summary));
   fmt::print("{}", format_residuals(model, summary.residuals));
   fmt::print("{}", format_program(model, summary.program, options.formulation.program_feedback));
   if (summary.initial_fix) fmt::print("{}", format_initial_fix(model, *summary.initial_fix));
   fmt::print("{}", format_energy(model, summary.energy));
   fmt::print("{}", format_constraint_watch(model, summary.watch, summary.watch.warnings.size(), summary.sparse));
-  if (!args.plot.empty()) fmt::print("  plot -> {}\n", args.plot);
-  if (!args.html.empty()) fmt::print("  report -> {}{}\n", args.html, html_notice.empty() ? "" : "\n  note: " + html_notice);
+  if (!args.plot.empty()) fmt::print("  plot -> {}\n", shown_text(args.plot));
+  if (!args.html.empty()) fmt::print("  report -> {}{}\n", shown_text(args.html), html_notice.empty() ? "" : "\n  note: " + html_notice);
 }
 
 // The command is the process's last work: the symbolic description of the model (every derived

@@ -13,6 +13,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/atomic_file.hpp"
@@ -128,8 +129,8 @@ void print_error_relation(const ErrorRelation& study, const Model& model, const 
                level(r.max_residual_vel, vel), r.summary.stats.steps,
                format_failure_note(r.summary));
   }
-  fmt::print("table -> {}\nby tolerance -> {}\n", table_path.string(), series_path.string());
-  if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
+  fmt::print("table -> {}\nby tolerance -> {}\n", shown_text(table_path.string()), shown_text(series_path.string()));
+  if (!args.plot.empty()) fmt::print("plot -> {}\n", shown_text(args.plot));
 }
 
 // Both files say what made them (io/provenance.hpp): the model as loaded and the study's options.

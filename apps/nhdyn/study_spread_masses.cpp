@@ -13,6 +13,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/frontend/describe.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/frontend/provenance.hpp"
@@ -119,9 +120,9 @@ void print_spread_masses(const SpreadMasses& study, const std::filesystem::path&
   for (const SpreadMassesRatio& r : study.ratios) reference_error = std::max(reference_error, r.reference_error);
   fmt::print("\nreference: estimated relative error at most {:.1e} (against {} digits)\n", reference_error,
              study.digits + 20);
-  fmt::print("table -> {}\n", table_path.string());
+  fmt::print("table -> {}\n", shown_text(table_path.string()));
   if (!plot.empty())
-    fmt::print("plots -> {}, {}\n", plot, reactions_plot_path(plot).string());
+    fmt::print("plots -> {}, {}\n", shown_text(plot), shown_text(reactions_plot_path(plot).string()));
 }
 
 int run_spread_masses(const SpreadMassesArgs& args) {

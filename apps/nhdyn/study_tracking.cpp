@@ -13,6 +13,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/atomic_file.hpp"
@@ -121,8 +122,8 @@ void print_tracking(const Tracking& study, const Model& model, const TrackingArg
                r.tolerance, r.max_error_q, r.max_error_v, r.max_residual_pos, r.max_residual_vel, r.max_residual_acc,
                r.summary.stats.steps,
                format_failure_note(r.summary));
-  fmt::print("table -> {}\nby tolerance -> {}\n", table_path.string(), series_path.string());
-  if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
+  fmt::print("table -> {}\nby tolerance -> {}\n", shown_text(table_path.string()), shown_text(series_path.string()));
+  if (!args.plot.empty()) fmt::print("plot -> {}\n", shown_text(args.plot));
 }
 
 int run_tracking(const TrackingArgs& args) {

@@ -17,6 +17,7 @@
 #include "nhdyn/analysis/sweep.hpp"
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/frontend/load_model.hpp"
 #include "nhdyn/frontend/provenance.hpp"
 #include "nhdyn/io/atomic_file.hpp"
@@ -154,8 +155,8 @@ void print_sweep(const Sweep& sweep, const Model& base, const SweepArgs& args, c
                c.oscillatory ? "a complex pair crosses the imaginary axis" : "a real eigenvalue crosses zero",
                c.oscillatory ? fmt::format("frequency {:.6g} rad/s", c.frequency) : std::string("divergence"),
                c.unstable_before, c.unstable_after);
-  fmt::print("eigenvalues -> {}\ncrossings -> {}\n", table_path.string(), crossings_path.string());
-  if (!args.plot.empty()) fmt::print("plot -> {}\n", args.plot);
+  fmt::print("eigenvalues -> {}\ncrossings -> {}\n", shown_text(table_path.string()), shown_text(crossings_path.string()));
+  if (!args.plot.empty()) fmt::print("plot -> {}\n", shown_text(args.plot));
 }
 
 int run_sweep(const SweepArgs& args) {

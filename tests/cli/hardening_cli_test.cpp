@@ -803,6 +803,13 @@ TEST_F(Hardening, AnEchoedValueNeverCarriesAnInvisibleCharacterOrABadByte) {
     const ProcessRun r = nhdyn({"simulate", "named.toml", "-q", "-o", "c.csv"});
     EXPECT_EQ(r.code, 0) << r.err;
   }
+  // An output's path, as the summary names it (the file itself is written where it was asked).
+  {
+    const ProcessRun r = nhdyn({"simulate", "osc.toml", "--t-end", "0.1", "-o", "a\u202e.csv"});
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(contains(r.out, "rows -> a<U+202E>.csv")) << r.out;
+    EXPECT_FALSE(contains(r.out, "\u202e")) << r.out;
+  }
   // Whatever a message echoes of the arguments: an unknown command, option, model or event.
   const std::vector<std::pair<std::vector<std::string>, std::string>> echoes = {
       {{"si\u200bm"}, "unknown command 'si<U+200B>m'"},

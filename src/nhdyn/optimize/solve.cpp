@@ -10,6 +10,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/join.hpp"
+#include "nhdyn/core/shown_text.hpp"
 #include "nhdyn/io/csv.hpp"
 #include "nhdyn/optimize/replay.hpp"
 #include "nhdyn/optimize/transcription.hpp"
@@ -98,7 +99,7 @@ std::vector<std::string> apply_guess(const Transcription& nlp, const std::filesy
   const double slack = 1e-9 * (t_end - t0);  // a previous result's last time, rounded in its CSV
   const bool late = first > t0 + slack, early = last < t_end - slack;
   if (late || early)
-    notes.push_back(fmt::format("the guess {} covers t = {} to {} of [{}, {}]: its {} held beyond", file, first, last,
+    notes.push_back(fmt::format("the guess {} covers t = {} to {} of [{}, {}]: its {} held beyond", shown_text(file), first, last,
                                 t0, t_end,
                                 late && early ? "first and last rows are"
                                 : late        ? "first row is"
@@ -109,7 +110,8 @@ std::vector<std::string> apply_guess(const Transcription& nlp, const std::filesy
   if (!ignored.empty())
     notes.push_back(fmt::format("the guess {} has column{} that name{} nothing in the problem, ignored: {} (it takes t, "
                                 "the coordinates, x', x'' and u_NAME of the controls)",
-                                file, ignored.size() > 1 ? "s" : "", ignored.size() > 1 ? "" : "s", join(ignored)));
+                                shown_text(file), ignored.size() > 1 ? "s" : "", ignored.size() > 1 ? "" : "s",
+                                shown_text(join(ignored))));
   const auto value = [&](int c, double t) {
     const std::size_t rows = table.rows.size();
     std::size_t hi = 1;
