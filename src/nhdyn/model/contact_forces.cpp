@@ -108,7 +108,24 @@ Vector ideal_acceleration(const Matrix& A, const Vector& h, const Matrix& b, con
   Vector k(n + s);
   k.head(n) = h.unaryExpr(unit);
   k.tail(s) = -b0;
-  return K.fullPivLu().solve(k).head(n);
+  // Then rows and columns together by powers of two (a few passes of Ruiz's equilibration, which
+  // keeps K symmetric): b's rows hold lengths (a ball's moment arm r) beside ones, and a ball
+  // 1e5 m across spread K's entries over 14 decades, where the LU took pivots for round-off and
+  // dropped the constraints' multipliers (R = 0). Powers of two: the scaling itself rounds nothing.
+  Vector d = Vector::Ones(n + s);
+  for (int pass = 0; pass < 4; ++pass)
+    for (Eigen::Index i = 0; i < n + s; ++i) {
+      const double row = K.row(i).cwiseAbs().maxCoeff();
+      if (!(row > 0.0) || !std::isfinite(row)) continue;
+      int exponent = 0;
+      std::frexp(row, &exponent);
+      const int half = -exponent / 2;
+      d(i) = std::ldexp(d(i), half);
+      K.row(i) = K.row(i).unaryExpr([&](double x) { return std::ldexp(x, half); });
+      K.col(i) = K.col(i).unaryExpr([&](double x) { return std::ldexp(x, half); });
+    }
+  const Vector y = K.fullPivLu().solve(k.cwiseProduct(d));
+  return y.cwiseProduct(d).head(n);
 }
 
 // M and rhs from the tape's outputs, q'' and R (docs/derivations/contact-forces.md step 6).
