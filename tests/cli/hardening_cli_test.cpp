@@ -550,6 +550,15 @@ TEST_F(Hardening, ReportReadsItsOwnPartialFilesAndChecksTimes) {
     EXPECT_TRUE(contains(r.err, "is not finite; a run writes finite values")) << r.err;
     EXPECT_FALSE(fs::exists(dir_ / "edited.html")) << column;
   }
+  // A character after a number is named as the expression readers name it (0xFF was called "an
+  // invisible character").
+  const ProcessRun zero_width = report_edited(1, "1\u200b", "zw");
+  EXPECT_EQ(zero_width.code, 2) << zero_width.err;
+  EXPECT_TRUE(contains(zero_width.err, "unexpected character U+200B (a zero-width space, invisible): delete it"))
+      << zero_width.err;
+  const ProcessRun bad_byte = report_edited(1, "1\xff", "ff");
+  EXPECT_EQ(bad_byte.code, 2) << bad_byte.err;
+  EXPECT_TRUE(contains(bad_byte.err, "unexpected character (the byte 0xFF, not UTF-8 text)")) << bad_byte.err;
   // strtod read 0x10 as 16.
   const ProcessRun hex = report_edited(1, "0x10", "hex");
   EXPECT_EQ(hex.code, 2) << hex.err;

@@ -13,6 +13,7 @@
 #include <system_error>
 #include <thread>
 
+#include "nhdyn/core/detail/characters.hpp"
 #include "nhdyn/core/detail/signals.hpp"
 #include "nhdyn/core/error.hpp"
 
@@ -262,11 +263,9 @@ CsvTable load_csv(const std::filesystem::path& path) {
       if (*p == ',') ++p;
       else if (*p == '\r') ++p;
       else if (*p) {
-        const auto byte = static_cast<unsigned char>(*p);
-        throw FileError(byte >= 0x20 && byte < 0x7f
-                            ? fmt::format("{}:{}: unexpected character '{}'", path.string(), line_number, *p)
-                            : fmt::format("{}:{}: unexpected byte 0x{:02X} (an invisible character)", path.string(),
-                                          line_number, byte));
+        // Named as the expression readers name it: its code point, what it is, what to write.
+        throw FileError(fmt::format("{}:{}: unexpected character {}", path.string(), line_number,
+                                    describe_character(line, static_cast<std::size_t>(p - line.c_str()))));
       }
     }
     if (row.size() != table.header.size())
