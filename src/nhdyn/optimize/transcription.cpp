@@ -217,26 +217,11 @@ void Transcription::choose_splits_and_initial_rows() {
   if (candidates == 0) return;
   std::vector<char> fixed(static_cast<std::size_t>(2 * n_), 0);
   for (const BoundaryValue& b : problem_.initial) fixed[static_cast<std::size_t>(b.index + (b.velocity ? n_ : 0))] = 1;
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(candidates, 2 * n_);
-  Eigen::VectorXd values(candidates);
-  const double t = time(0, x);
-  const double* q = x + q_index(0, 0);
-  const double* v = x + v_index(0, 0);
-  std::vector<double> out(static_cast<std::size_t>(candidates), 0.0), dq(static_cast<std::size_t>(n_), 0.0),
-      dv(static_cast<std::size_t>(n_), 0.0);
-  if (pcount > 0) position_residual_->run(t, q, v, other_registers_.data(), out.data());
-  if (rcount > 0) velocity_residual_->run(t, q, v, velocity_registers_.data(), out.data() + pcount);
-  for (int c = 0; c < candidates; ++c) values(c) = out[static_cast<std::size_t>(c)];
-  for (int col = 0; col < 2 * n_; ++col) {
-    std::fill(dq.begin(), dq.end(), 0.0);
-    std::fill(dv.begin(), dv.end(), 0.0);
-    (col < n_ ? dq[static_cast<std::size_t>(col)] : dv[static_cast<std::size_t>(col - n_)]) = 1.0;
-    if (pcount > 0) run_tangent(*position_residual_, other_registers_.data(), 0.0, dq.data(), nullptr, tangents_.data(), out.data());
-    if (rcount > 0)
-      run_tangent(*velocity_residual_, velocity_registers_.data(), 0.0, dq.data(), dv.data(), tangents_.data(),
-                  out.data() + pcount);
-    for (int c = 0; c < candidates; ++c) J(c, col) = fixed[static_cast<std::size_t>(col)] ? 0.0 : out[static_cast<std::size_t>(c)];
-  }
+  std::vector<double> values;
+  Eigen::MatrixXd J;
+  constraint_rows(time(0, x), x + q_index(0, 0), x + v_index(0, 0), values, J);
+  for (int col = 0; col < 2 * n_; ++col)
+    if (fixed[static_cast<std::size_t>(col)]) J.col(col).setZero();
   const std::vector<std::string> names = residual_row_names();
   Eigen::MatrixXd basis(2 * n_, 0);
   for (int c = 0; c < candidates; ++c) {
@@ -249,10 +234,10 @@ void Transcription::choose_splits_and_initial_rows() {
       initial_rows_.push_back(c);
       continue;
     }
-    if (std::abs(values(c)) > 1e-8)
+    if (std::abs(values[static_cast<std::size_t>(c)]) > 1e-8)
       throw InputError(fmt::format("the initial values of [optimize] violate the constraint {}: its residual is {:.3e} "
                                    "and no free initial value can change it; give initial values on the constraint",
-                                   names[static_cast<std::size_t>(c)], values(c)));
+                                   names[static_cast<std::size_t>(c)], values[static_cast<std::size_t>(c)]));
     notes_.push_back(fmt::format("the constraint {} holds at the first node by the fixed initial values: not imposed "
                                  "there again",
                                  names[static_cast<std::size_t>(c)]));
@@ -522,6 +507,27 @@ void Transcription::jacobian_pattern(int* rows, int* columns) const {
   std::copy(jac_columns_.begin(), jac_columns_.end(), columns);
 }
 
+void Transcription::constraint_rows(double t, const double* q, const double* v, std::vector<double>& values,
+                                    Eigen::MatrixXd& jacobian) {
+  const int pcount = problem_.model.position_constraints(), rcount = problem_.model.velocity_constraints();
+  const int rows = pcount + rcount;
+  values.assign(static_cast<std::size_t>(rows), 0.0);
+  jacobian.resize(rows, 2 * n_);
+  if (pcount > 0) position_residual_->run(t, q, v, other_registers_.data(), values.data());
+  if (rcount > 0) velocity_residual_->run(t, q, v, velocity_registers_.data(), values.data() + pcount);
+  std::vector<double> d(static_cast<std::size_t>(rows)), dq(static_cast<std::size_t>(n_)), dv(static_cast<std::size_t>(n_));
+  for (int c = 0; c < 2 * n_; ++c) {
+    std::fill(dq.begin(), dq.end(), 0.0);
+    std::fill(dv.begin(), dv.end(), 0.0);
+    (c < n_ ? dq[static_cast<std::size_t>(c)] : dv[static_cast<std::size_t>(c - n_)]) = 1.0;
+    if (pcount > 0) run_tangent(*position_residual_, other_registers_.data(), 0.0, dq.data(), nullptr, tangents_.data(), d.data());
+    if (rcount > 0)
+      run_tangent(*velocity_residual_, velocity_registers_.data(), 0.0, dq.data(), dv.data(), tangents_.data(),
+                  d.data() + pcount);
+    for (int r = 0; r < rows; ++r) jacobian(r, c) = d[static_cast<std::size_t>(r)];
+  }
+}
+
 bool Transcription::jacobian_values(const double* x, double* values) {
   std::size_t at = 0;
   const double h = duration(x) / intervals_;
@@ -563,24 +569,9 @@ bool Transcription::jacobian_values(const double* x, double* values) {
       for (int c = 0; c < columns; ++c) values[at++] = block(row, c);
   }
   if (!initial_rows_.empty()) {
-    const int pcount = problem_.model.position_constraints();
-    const std::size_t count = static_cast<std::size_t>(pcount + problem_.model.velocity_constraints());
-    std::vector<double> all(count), d(count);
-    Eigen::MatrixXd J(static_cast<Eigen::Index>(count), 2 * n_);
-    const double t = time(0, x);
-    const double* q = x + q_index(0, 0);
-    const double* v = x + v_index(0, 0);
-    if (pcount > 0) position_residual_->run(t, q, v, other_registers_.data(), all.data());
-    if (count > static_cast<std::size_t>(pcount)) velocity_residual_->run(t, q, v, velocity_registers_.data(), all.data() + pcount);
-    for (int c = 0; c < 2 * n_; ++c) {
-      std::vector<double> dq(static_cast<std::size_t>(n_), 0.0), dv(static_cast<std::size_t>(n_), 0.0);
-      (c < n_ ? dq[static_cast<std::size_t>(c)] : dv[static_cast<std::size_t>(c - n_)]) = 1.0;
-      if (pcount > 0) run_tangent(*position_residual_, other_registers_.data(), 0.0, dq.data(), nullptr, tangents_.data(), d.data());
-      if (count > static_cast<std::size_t>(pcount))
-        run_tangent(*velocity_residual_, velocity_registers_.data(), 0.0, dq.data(), dv.data(), tangents_.data(),
-                    d.data() + pcount);
-      for (std::size_t r = 0; r < count; ++r) J(static_cast<Eigen::Index>(r), c) = d[r];
-    }
+    std::vector<double> all;
+    Eigen::MatrixXd J;
+    constraint_rows(time(0, x), x + q_index(0, 0), x + v_index(0, 0), all, J);
     for (int r : initial_rows_)
       for (int c = 0; c < 2 * n_; ++c) values[at++] = J(r, c);
   }

@@ -106,6 +106,11 @@ class Transcription final : public Nlp {
   void make_start();
   void check_controls_act();
   void release_determined_final_values();
+  // The constraint rows [phi; f] (position level, then velocity level) at (t, q, q') into `values`,
+  // and their derivatives by (q, q') into `jacobian` (rows x 2 n): the linearization that the rank
+  // rules at both ends and the first node's rows of the Jacobian read.
+  void constraint_rows(double t, const double* q, const double* v, std::vector<double>& values,
+                       Eigen::MatrixXd& jacobian);
   // A path constraint that reads only fixed values at the first or last node (a constant one
   // included) is decided before the solve: throws InputError naming it and its value when it fails.
   void require_path_at_fixed_ends();

@@ -181,22 +181,9 @@ void Transcription::release_determined_final_values() {
   // The starting point's final state with the fixed values in it.
   std::vector<double> q(x + q_index(last, 0), x + q_index(last, 0) + n_), v(x + v_index(last, 0), x + v_index(last, 0) + n_);
   for (const BoundaryValue& b : problem_.final) (b.velocity ? v : q)[static_cast<std::size_t>(b.index)] = b.value;
-  const double t = problem_.t_end;
-  std::vector<double> values(static_cast<std::size_t>(rows)), d(static_cast<std::size_t>(rows)),
-      dq(static_cast<std::size_t>(n_)), dv(static_cast<std::size_t>(n_));
-  std::vector<double> position_registers(static_cast<std::size_t>(position_residual_->registers()));
-  if (pcount > 0) position_residual_->run(t, q.data(), v.data(), position_registers.data(), values.data());
-  if (rcount > 0) velocity_residual_->run(t, q.data(), v.data(), velocity_registers_.data(), values.data() + pcount);
-  Eigen::MatrixXd C(rows, 2 * n_);
-  for (int c = 0; c < 2 * n_; ++c) {
-    std::fill(dq.begin(), dq.end(), 0.0);
-    std::fill(dv.begin(), dv.end(), 0.0);
-    (c < n_ ? dq[static_cast<std::size_t>(c)] : dv[static_cast<std::size_t>(c - n_)]) = 1.0;
-    if (pcount > 0) run_tangent(*position_residual_, position_registers.data(), 0.0, dq.data(), nullptr, tangents_.data(), d.data());
-    if (rcount > 0)
-      run_tangent(*velocity_residual_, velocity_registers_.data(), 0.0, dq.data(), dv.data(), tangents_.data(), d.data() + pcount);
-    for (int r = 0; r < rows; ++r) C(r, c) = d[static_cast<std::size_t>(r)];
-  }
+  std::vector<double> values;
+  Eigen::MatrixXd C;
+  constraint_rows(problem_.t_end, q.data(), v.data(), values, C);
   std::vector<int> fixed_columns, free_columns;
   for (int c = 0; c < 2 * n_; ++c) {
     const bool fixed = std::any_of(problem_.final.begin(), problem_.final.end(), [&](const BoundaryValue& b) {
