@@ -59,9 +59,25 @@ Status fail(Data& data, const ContactModeModel& cm, int contact, const std::stri
   return Status::singular_system;
 }
 
-// The coefficients y of f (n) on the columns of B~^T (r), f = B~^T y, by the QR of B~^T (least
-// squares; exact when f lies in their span). Overwrites f.
+// The coordinates' scales S (powers of two, w.coordinate_scale) in which the solve works when
+// their inertias A_jj are more than kRowScaleRatio apart; 1 otherwise. A body 1e-6 m across has
+// A_jj = m for its position and about m r^2 = 1e-12 m for its angles: the QR of B~^T, and with it
+// D, mixes these directions in whatever units they have, and the rows D A then carry entries 1e12
+// apart, below what double precision keeps beside each other (the stacked matrix was judged
+// singular, "Painleve", for a sliding tippe top 40 nm across). In the coordinates q = S q~ with
+// S_jj about 1 / sqrt(A_jj), every coordinate has an inertia of order 1 (the kinetic energy's own
+// metric, whatever the units): B~^T becomes S B~^T and D = D~ S, with D~ from the QR of S B~^T.
+void coordinate_scales(const Data& data, ContactModeData& w) {
+  w.coordinate_scale.setOnes();
+  scale_rows_by_powers_of_two(
+      static_cast<int>(w.coordinate_scale.size()), [&](int j) { return std::abs(data.A(j, j)); },
+      [&](int j, int exponent) { w.coordinate_scale(j) = std::ldexp(1.0, -exponent / 2); });
+}
+
+// The coefficients y of f (n) on the columns of B~^T (r), f = B~^T y, by the QR of S B~^T (least
+// squares; exact when f lies in their span): S f = (S B~^T) y. Overwrites f.
 void reaction_coefficients(ContactModeData& w, int r, Vector& f, Vector& y) {
+  f.array() *= w.coordinate_scale.array();
   f.applyOnTheLeft(w.qr.householderQ().adjoint());
   w.qr.matrixQR().topLeftCorner(r, r).triangularView<Eigen::Upper>().solveInPlace(f.head(r));
   for (int j = 0; j < r; ++j) y(w.qr.colsPermutation().indices()(j)) = f(j);
@@ -73,10 +89,12 @@ void effective_inverse_mass(const Model& model, Data& data, int contact_gap_row,
                             double& lambda_nn) {
   ContactModeData& w = data.modes;
   const int n = model.n();
-  // The probes are right-hand sides of M: they take its rows' scaling (w.row_scale).
+  // The probes are right-hand sides of M: they take its rows' scaling (w.row_scale), and the
+  // responses its columns' (the coordinates' scales S: q'' = S y).
   w.probe.setZero();
   w.probe(k + j) = w.row_scale(k + j);
   w.response.noalias() = w.lu.solve(w.probe);
+  w.response.array() *= w.coordinate_scale.array();
   data.tmp_n.noalias() = data.A * w.response;
   reaction_coefficients(w, r, data.tmp_n, w.coefficients);
   const double inverse = w.coefficients(j);  // 1 / w_eff
@@ -84,6 +102,7 @@ void effective_inverse_mass(const Model& model, Data& data, int contact_gap_row,
   w.probe.tail(n - k).setZero();
   w.probe.head(k).array() *= w.row_scale.head(k).array();
   w.response.noalias() = w.lu.solve(w.probe);
+  w.response.array() *= w.coordinate_scale.array();
   data.tmp_n.noalias() = data.A * w.response;
   data.tmp_n -= data.b.row(contact_gap_row).transpose();
   reaction_coefficients(w, r, data.tmp_n, w.coefficients);
@@ -113,7 +132,8 @@ void scale_rows(ContactModeData& w) {
 
 // (S4) with D the last n - r columns of the orthogonal factor of B~^T (D B~^T = 0), the kept rows
 // in w.reaction_rows: q'' and R. With no row kept (a free body and nothing else) D is the
-// identity: A q'' = Q + G.
+// identity: A q'' = Q + G. In scaled coordinates (coordinate_scales: w.reaction_rows holds
+// S B~^T), D = D~ S and the unknown is y = S^-1 q'': [D A S; b S] y = [D (Q + G); -b0].
 Status mode_acceleration(const Model& model, Data& data, int r) {
   const ContactModeModel& cm = *model.contact_modes;
   ContactModeData& w = data.modes;
@@ -132,6 +152,8 @@ Status mode_acceleration(const Model& model, Data& data, int r) {
     return record_failure(data, Status::dependent_constraints, "b");
   }
   if (r > 0) w.qr.householderQ().evalTo(data.Q_full, data.hh_work);
+  // D^T = S D~^T: the rows of the orthogonal factor scaled in place (Q_full is this solve's own).
+  data.Q_full.array().colwise() *= w.coordinate_scale.array();
   w.M.topRows(k).noalias() = data.Q_full.rightCols(k).transpose() * data.A;
   w.rhs.head(k).noalias() = data.Q_full.rightCols(k).transpose() * (data.Q + data.G);
   for (int j = 0; j < r; ++j) {
@@ -139,6 +161,7 @@ Status mode_acceleration(const Model& model, Data& data, int r) {
     w.M.row(k + j) = data.b.row(row);
     w.rhs(k + j) = -data.b0(row);
   }
+  w.M.array().rowwise() *= w.coordinate_scale.transpose().array();
   scale_rows(w);
   w.lu.compute(w.M);
   const double rcond = w.lu.rcond();
@@ -153,6 +176,7 @@ Status mode_acceleration(const Model& model, Data& data, int r) {
     return record_failure(data, Status::singular_system, "stacked matrix [D A; b] of the contact modes");
   }
   data.qdd = w.lu.solve(w.rhs);
+  data.qdd.array() *= w.coordinate_scale.array();
   data.R.noalias() = data.A * data.qdd;
   data.R -= data.Q;
   data.R -= data.G;
@@ -248,6 +272,8 @@ Status solve_modes(const Model& model, Data& data, bool rolling, bool forces_onl
       w.reaction_rows.col(gap_column[i]) -=
           (w.mu_k[i] * w.normal_sign[i] * w.sliding_direction[i][a] / lengths[i][a]) * data.b.row(c.roll[a]).transpose();
   }
+  coordinate_scales(data, w);
+  w.reaction_rows.array().colwise() *= w.coordinate_scale.array();
 
   // Every contact rolling: the ordinary Do Sanh form with D from b (sanh.hpp), as cheap as the
   // model without modes; B~ = b, whose QR below gives only the multipliers.

@@ -56,6 +56,7 @@ ContactModeData make_contact_mode_data(const Model& model) {
   w.M = Matrix::Zero(n, n);
   w.rhs = Vector::Zero(n);
   w.row_scale = Vector::Ones(n);
+  w.coordinate_scale = Vector::Ones(n);
   w.probe = Vector::Zero(n);
   w.response = Vector::Zero(n);
   w.lu = Eigen::PartialPivLU<Matrix>(n);

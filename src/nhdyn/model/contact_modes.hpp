@@ -109,6 +109,7 @@ struct ContactModeData {
   Matrix M;                                // n x n, [D A; b_kept]
   Vector rhs, multipliers;                 // n; r
   Vector row_scale;                        // n, the powers of two the rows of M and rhs were scaled by (1: none)
+  Vector coordinate_scale;                 // n, S: the coordinates' scales, q'' = S y (formulation/contact_modes.cpp)
   Vector probe, response, coefficients;    // n, n, r: the solves of (S9) and (S10)
   Eigen::ColPivHouseholderQR<Matrix> qr;   // of reaction_rows
   Eigen::PartialPivLU<Matrix> lu;          // of M
