@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include "nhdyn/analysis/simulation.hpp"
@@ -27,6 +28,36 @@ TEST(InitialState, AViolatedConstraintIsRefusedWithItsResidual) {
     const std::string message = e.what();
     EXPECT_NE(message.find("blade (velocity level): residual 0.25"), std::string::npos) << message;
     EXPECT_NE(message.find("--fix-initial"), std::string::npos) << message;
+  }
+}
+
+// The tolerance of a residual grows with the round-off of its terms (check_initial_state): a
+// pendulum 1500 km long (x^2 + y^2 - l^2, the bob at 1.2 rad from the downward vertical) has its
+// residual at -4.9e-4 from rounding alone, and was refused at such a state; it starts now,
+// while the same pendulum with its bob 1.5 m off the circle (1e-6 of its length: a residual of
+// 4.5e6) is still refused, as is the 1.5 m pendulum with its bob 1.5 um off.
+TEST(InitialState, TheToleranceOfAResidualIsThatOfItsTermsRoundOff) {
+  const auto refused = [](double l, double off) -> std::string {
+    Model model = testing::make_pendulum_model(0.5, 9.81 * l / 1.5, l);
+    model.q0 << l * std::sin(1.2) + off, -l * std::cos(1.2);
+    SimulationOptions options;
+    options.t_end = 0.01;
+    try {
+      const SimulationSummary summary = simulate(model, options, [](const Data&) {});
+      EXPECT_EQ(summary.status, Status::ok) << summary.message;
+      return "";
+    } catch (const ModelError& e) {
+      return e.what();
+    }
+  };
+  const double x = 1.5e6 * std::sin(1.2), y = -1.5e6 * std::cos(1.2);
+  ASSERT_GT(std::abs(x * x + y * y - 1.5e6 * 1.5e6), 1e-4);  // the round-off the old tolerance refused
+  EXPECT_EQ(refused(1.5e6, 0.0), "");
+  EXPECT_EQ(refused(1.5, 0.0), "");
+  for (const double l : {1.5e6, 1.5}) {
+    const std::string message = refused(l, 1e-6 * l);
+    EXPECT_NE(message.find("rod (position level): residual"), std::string::npos) << "l = " << l << ": " << message;
+    EXPECT_NE(message.find("1024 units of round-off"), std::string::npos) << message;
   }
 }
 
