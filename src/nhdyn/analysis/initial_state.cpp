@@ -15,6 +15,7 @@
 #include "nhdyn/core/join.hpp"
 #include "nhdyn/formulation/diagnosis.hpp"
 #include "nhdyn/model/contact_modes.hpp"
+#include "nhdyn/model/detail/residual_round_off.hpp"
 #include "nhdyn/model/terms.hpp"
 
 namespace nhdyn {
@@ -324,13 +325,10 @@ InitialFix fix_free_initial_values(const Model& model, Data& data, double t, con
 
 namespace {
 
-// A residual's round-off is that of the terms it sums: for a row of b, about eps sum_j |b_ij x_j|
-// (x = q at the position level; at the velocity level x = q' and the row's own term
-// r_i - (b q')_i with it), the change of the residual through the rounding of each coordinate. A
-// pendulum 1000 km long has x^2 + y^2 - l^2 at 1e-4 from the rounding of l^2 = 1e12 alone, and
-// an absolute tolerance of 1e-9 refused every state it could start from. So the tolerance of a row
-// is the larger of the given one and kRoundOffUnits units of round-off of its terms.
-constexpr double kRoundOffUnits = 1024.0;
+// A residual's round-off is that of the terms it sums (model/detail/residual_round_off.hpp): a
+// pendulum 1000 km long has x^2 + y^2 - l^2 at 1e-4 from rounding alone, and an absolute
+// tolerance of 1e-9 refused every state it could start from. So the tolerance of a row is the
+// larger of the given one and kResidualRoundOffUnits units of round-off of its terms.
 
 // Per constraint row (model.s()), that allowance at (t, q, v) for `level`; the given tolerance
 // alone where the terms cannot be evaluated (the residual check then names what is wrong).
@@ -343,14 +341,8 @@ std::vector<double> residual_tolerances(const Model& model, Data& data, double t
   const bool position = level == ConstraintLevel::position;
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const int i = rows[k];
-    double terms = 0.0, dot = 0.0;
-    for (int j = 0; j < model.n(); ++j) {
-      const double x = position ? q(j) : v(j);
-      terms += std::abs(b(i, j) * x);
-      dot += b(i, j) * x;
-    }
-    if (!position) terms += std::abs(r(static_cast<Eigen::Index>(k)) - dot);
-    const double allowance = kRoundOffUnits * std::numeric_limits<double>::epsilon() * terms;
+    const double allowance =
+        residual_round_off(b.row(i), position ? q : v, model.n(), r(static_cast<Eigen::Index>(k)), !position);
     if (std::isfinite(allowance)) out[static_cast<std::size_t>(i)] = std::max(tolerance, allowance);
   }
   return out;
@@ -385,7 +377,7 @@ void check_initial_state(const Model& model, Data& data, double t, const Vector&
                                  "units of round-off of a constraint's terms where that is larger):{}\n"
                                  "Correct the initial values, or run with --fix-initial to move them onto the "
                                  "constraints with the smallest inertia-weighted change.",
-                                 model.name, tolerance, kRoundOffUnits, report));
+                                 model.name, tolerance, kResidualRoundOffUnits, report));
 }
 
 }  // namespace nhdyn
