@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -46,14 +47,14 @@ struct ModeRun {
   }
 };
 
-ModeRun run_modes(const Model& model, double t_end) {
+ModeRun run_modes(const Model& model, double t_end, double atol = 1e-12) {
   ModeRun out;
   out.columns = make_result_columns(model);
   SimulationOptions options;
   options.t_end = t_end;
   options.output_step = 0.01;
   options.integrator.rtol = 1e-10;
-  options.integrator.atol = 1e-12;
+  options.integrator.atol = atol;
   out.summary = simulate(model, options, [&](const Data& data) {
     std::vector<double> row;
     fill_result_row(model, data, row);
@@ -68,19 +69,9 @@ ModeRun run_modes(const Model& model, double t_end) {
 // (z / scale; the quaternion has none).
 ModeRun run_scaled_tippe_top(double scale, double t_end) {
   const Model model = load_model(example("tippe_top.toml"), {{"R", 0.02 * scale}, {"g", 9.81 * scale}});
-  ModeRun out;
-  out.columns = make_result_columns(model);
-  SimulationOptions options;
-  options.t_end = t_end;
-  options.output_step = 0.01;
-  options.integrator.rtol = 1e-10;
-  options.integrator.atol = 1e-13 * std::min(1.0, scale);
-  out.summary = simulate(model, options, [&](const Data& data) {
-    std::vector<double> row;
-    fill_result_row(model, data, row);
-    row.at(static_cast<std::size_t>(mode_column(out.columns, "z"))) /= scale;
-    out.rows.push_back(std::move(row));
-  });
+  ModeRun out = run_modes(model, t_end, 1e-13 * std::min(1.0, scale));
+  const std::size_t z = static_cast<std::size_t>(mode_column(out.columns, "z"));
+  for (std::vector<double>& row : out.rows) row.at(z) /= scale;
   return out;
 }
 
