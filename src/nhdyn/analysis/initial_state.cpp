@@ -203,11 +203,21 @@ void fix_keeping_written(const Model& model, Data& data, double t, double tolera
     const std::vector<int> at = residual_rows(model, level, true);
     int worst_row = -1;
     double worst = 0.0;
-    // Newton aims at `tolerance`; what round-off leaves above it is no reason to refuse.
+    // Newton aims at `tolerance`; what round-off leaves above it is no reason to refuse: 1e-10, or
+    // the round-off of a row's terms where that is larger (model/detail/residual_round_off.hpp),
+    // as the check without --fix-initial allows.
     const double refuse_above = std::max(tolerance, 1e-10);
+    Matrix b_end;
     for (int row : all) {
       const double value = std::abs(whole(at[static_cast<std::size_t>(row)]));
       if (value <= refuse_above) continue;
+      if (b_end.size() == 0 && compute_terms(model, data, t, fix.q.data(), fix.v.data()) == Status::ok)
+        b_end = gradient_rows(model, data, t, fix.q, fix.v, true);
+      const bool position = level == ConstraintLevel::position;
+      if (b_end.rows() > row &&
+          value <= residual_round_off(b_end.row(row), position ? fix.q : fix.v, model.n(),
+                                      whole(at[static_cast<std::size_t>(row)]), !position))
+        continue;
       if (worst_row < 0 || !(value <= worst)) {
         worst_row = row;
         worst = value;
