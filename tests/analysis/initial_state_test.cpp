@@ -58,6 +58,10 @@ TEST(InitialState, TheToleranceOfAResidualIsThatOfItsTermsRoundOff) {
   ASSERT_GT(std::abs(x * x + y * y - 1.5e6 * 1.5e6), 1e-4);  // the round-off the old tolerance refused
   EXPECT_EQ(refused(1.5e6, 0.0), "");
   EXPECT_EQ(refused(1.5, 0.0), "");
+  // The allowance is 32 units of round-off of the terms (2 l^2 = 4.5e12, a unit 1e-3), not more:
+  // the bob 3e-15 l off (a residual of 13 units) starts, 1e-13 l off (450 units) is refused.
+  EXPECT_EQ(refused(1.5e6, 3e-15 * 1.5e6), "");
+  EXPECT_NE(refused(1.5e6, 1e-13 * 1.5e6).find("rod (position level): residual"), std::string::npos);
   EXPECT_EQ(refused(1.5e6, 0.0, true), "");
   EXPECT_NE(refused(1.5e6, 1.5, true).find("the values written cannot satisfy it"), std::string::npos);
   for (const double l : {1.5e6, 1.5}) {

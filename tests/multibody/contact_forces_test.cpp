@@ -298,6 +298,7 @@ TEST(ContactForces, TheCheckAtLoadGivesTheSameVerdictInAnyUnits) {
       const Model scaled = load_model(example(c.file), sets);
       ASSERT_TRUE(scaled.contact_forces);
       EXPECT_EQ(scaled.contact_forces->notes, metres.contact_forces->notes) << c.file << " scaled by " << scale;
+      EXPECT_EQ(scaled.contact_forces->determined, metres.contact_forces->determined) << c.file << " scaled by " << scale;
     }
   }
 }
