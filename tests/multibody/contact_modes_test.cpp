@@ -1058,5 +1058,30 @@ TEST(ContactModes, ATippeTopFortyNanometresOrFortyKilometresAcrossSlidesAsTheExa
   }
 }
 
+// The coefficients are checked as the run evaluates them, after --set: the model file's checks
+// (expect_mode_keys_refused above) saw the file's values only, and a friction of -0.1 made the
+// thrown ball speed up, a restitution of -0.5 sank the disk into the floor, both with exit 0.
+TEST(ContactModes, CoefficientsGivenThroughParametersAreCheckedAsEvaluated) {
+  const auto refused = [](const char* file, const char* name, double value) -> std::string {
+    const Model model = load_model(example(file), {{name, value}});
+    SimulationOptions options;
+    options.t_end = 0.01;
+    try {
+      simulate(model, options, [](const Data&) {});
+    } catch (const ModelError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_NE(refused("ball_thrown_sliding.toml", "mu", -0.1).find("contact 'ball': its friction coefficients are "
+                                                                 "mu_s = -0.1, mu_k = -0.1"),
+            std::string::npos);
+  EXPECT_NE(refused("rolling_disk_hop.toml", "e", -0.5).find("contact 'disk': its restitution is -0.5"),
+            std::string::npos);
+  EXPECT_NE(refused("rolling_disk_hop.toml", "e", 2.0).find("its restitution is 2"), std::string::npos);
+  EXPECT_EQ(refused("rolling_disk_hop.toml", "e", 1.0), "");
+  EXPECT_EQ(refused("ball_thrown_sliding.toml", "mu", 0.0), "");
+}
+
 }  // namespace
 }  // namespace nhdyn

@@ -234,6 +234,25 @@ void choose_initial_contact_modes(const Model& model, Data& data, const Formulat
   if (!data.modes.active || !model.contact_modes) return;
   const ContactModeModel& cm = *model.contact_modes;
   ContactModeData& w = data.modes;
+  // The coefficients as the run evaluates them: the model file's checks saw the file's values, and
+  // `--set mu=-0.1` made a ball speed up under its friction, `--set e=-0.5` sank a disk into the floor.
+  w.tape.run(t0, q0.data(), v0.data(), w.registers.data(), w.outputs.data());
+  for (std::size_t i = 0; i < cm.contacts.size(); ++i) {
+    const ContactModeContact& c = cm.contacts[i];
+    const double* o = w.outputs.data() + ContactModeModel::kOutputs * i;
+    if (c.friction && !(o[0] >= 0.0 && o[1] >= 0.0 && std::isfinite(o[0]) && std::isfinite(o[1])))
+      throw ModelError(fmt::format("{}: contact '{}': its friction coefficients are mu_s = {:.6g}, mu_k = {:.6g} with "
+                                   "the parameters' values; a Coulomb friction coefficient is a number >= 0",
+                                   c.where, c.name, o[0], o[1]));
+    if (c.friction && !(o[0] >= o[1]))
+      throw ModelError(fmt::format("{}: contact '{}': its friction has mu_s = {:.6g} below mu_k = {:.6g} with the "
+                                   "parameters' values; the static coefficient must be at least the kinetic one",
+                                   c.where, c.name, o[0], o[1]));
+    if (!(o[2] >= 0.0 && o[2] <= 1.0))
+      throw ModelError(fmt::format("{}: contact '{}': its restitution is {:.6g} with the parameters' values; Newton's "
+                                   "coefficient of restitution is between 0 (a plastic impact) and 1 (an elastic one)",
+                                   c.where, c.name, o[2]));
+  }
   if (model.position_constraints() > 0)
     model.evaluator->position_residual(t0, q0.data(), data.scratch.data(), data.phi.data());
   // The contacts that start free say so without the dynamics: given mode = "free", or unilateral
