@@ -19,8 +19,8 @@ inline constexpr double kResidualRoundOffUnits = 32.0;
 
 // kResidualRoundOffUnits units of round-off of the residual r of one constraint row: its terms
 // sum_j |b_j x_j| over the n entries of its row of b (x = q at the position level, q' at the
-// velocity level), with, at the velocity level, its own term r - b x' (`own_term`). Infinite
-// when a term is not finite.
+// velocity level), with, at the velocity level, its own term r - b x' (`own_term`). 0 when a
+// term is not finite: no allowance, the residual alone decides.
 template <class Row, class State>
 double residual_round_off(const Row& b_row, const State& x, int n, double r, bool own_term) {
   double terms = 0.0, dot = 0.0;
@@ -30,7 +30,7 @@ double residual_round_off(const Row& b_row, const State& x, int n, double r, boo
   }
   if (own_term) terms += std::abs(r - dot);
   const double allowance = kResidualRoundOffUnits * std::numeric_limits<double>::epsilon() * terms;
-  return std::isfinite(allowance) ? allowance : std::numeric_limits<double>::infinity();
+  return std::isfinite(allowance) ? allowance : 0.0;
 }
 
 }  // namespace nhdyn
