@@ -335,12 +335,10 @@ InitialFix fix_free_initial_values(const Model& model, Data& data, double t, con
 
 namespace {
 
-// A residual's round-off is that of the terms it sums (model/detail/residual_round_off.hpp): a
-// pendulum 1000 km long has x^2 + y^2 - l^2 at 1e-4 from rounding alone, and an absolute
-// tolerance of 1e-9 refused every state it could start from. So the tolerance of a row is the
-// larger of the given one and kResidualRoundOffUnits units of round-off of its terms.
-
-// Per constraint row (model.s()), that allowance at (t, q, v) for `level`; the given tolerance
+// Per constraint row (model.s()), the tolerance of its residual at (t, q, v) for `level`: the
+// larger of the given one and the round-off of the terms it sums (model/detail/
+// residual_round_off.hpp; a pendulum 1500 km long has x^2 + y^2 - l^2 at 5e-4 from rounding
+// alone, and an absolute tolerance refused every state it could start from). The given tolerance
 // alone where the terms cannot be evaluated (the residual check then names what is wrong).
 std::vector<double> residual_tolerances(const Model& model, Data& data, double t, const Vector& q, const Vector& v,
                                         ConstraintLevel level, const Vector& r, double tolerance) {
@@ -351,9 +349,8 @@ std::vector<double> residual_tolerances(const Model& model, Data& data, double t
   const bool position = level == ConstraintLevel::position;
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const int i = rows[k];
-    const double allowance =
-        residual_round_off(b.row(i), position ? q : v, model.n(), r(static_cast<Eigen::Index>(k)), !position);
-    if (std::isfinite(allowance)) out[static_cast<std::size_t>(i)] = std::max(tolerance, allowance);
+    out[static_cast<std::size_t>(i)] = std::max(
+        tolerance, residual_round_off(b.row(i), position ? q : v, model.n(), r(static_cast<Eigen::Index>(k)), !position));
   }
   return out;
 }
