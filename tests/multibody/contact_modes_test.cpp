@@ -1058,6 +1058,41 @@ TEST(ContactModes, ATippeTopFortyNanometresOrFortyKilometresAcrossSlidesAsTheExa
   }
 }
 
+// The impulse at a touchdown is solved in the same coordinates' scales (analysis/detail/
+// contact_switches.cpp, solve_impulse): the disk of examples/rolling_disk_hop.toml a micrometre
+// across (its angles' inertias 1e-13 below its mass) ended at its first touchdown, "the impulse
+// equations are singular", as it did at 1e8 times the example's lengths. At both it lands, bounces
+// and lands again at the example's times, every state in the example's units to the tolerance.
+TEST(ContactModes, ADiskAMicrometreOrAHundredThousandKilometresAcrossHopsAsTheExampleDoes) {
+  const auto run = [](double scale) {
+    const Model model = load_model(example("rolling_disk_hop.toml"),
+                                   {{"r", 0.2 * scale}, {"g", 9.81 * scale}, {"h", 0.05 * scale}});
+    ModeRun out = run_modes(model, 0.3, 1e-12 * std::min(1.0, scale));
+    for (const char* name : {"x", "y", "z"})
+      for (std::vector<double>& row : out.rows) row.at(static_cast<std::size_t>(mode_column(out.columns, name))) /= scale;
+    return out;
+  };
+  const ModeRun reference = run(1.0);
+  ASSERT_EQ(reference.summary.status, Status::ok) << reference.summary.message;
+  // Three touchdowns in 0.3 s (rows off the 0.01 s grid), the first at t1 = 0.1009637...
+  std::vector<double> touchdowns;
+  for (const std::vector<double>& row : reference.rows)
+    if (std::abs(row[0] * 100.0 - std::round(row[0] * 100.0)) > 1e-6) touchdowns.push_back(row[0]);
+  ASSERT_EQ(touchdowns.size(), 3u);
+  for (const double scale : {1e-6, 1e8}) {
+    const ModeRun scaled = run(scale);
+    ASSERT_EQ(scaled.summary.status, Status::ok) << "scale " << scale << ": " << scaled.summary.message;
+    ASSERT_EQ(scaled.rows.size(), reference.rows.size()) << "scale " << scale;
+    for (std::size_t i = 0; i < reference.rows.size(); ++i) {
+      EXPECT_NEAR(scaled.rows[i][0], reference.rows[i][0], 1e-10) << "scale " << scale;
+      EXPECT_EQ(scaled.at(i, "disk_mode"), reference.at(i, "disk_mode")) << "scale " << scale << ", t = " << reference.rows[i][0];
+      for (const char* name : {"x", "y", "z", "psi", "theta", "phi", "theta'"})
+        EXPECT_NEAR(scaled.at(i, name), reference.at(i, name), 1e-8)
+            << "scale " << scale << ", " << name << " at t = " << reference.rows[i][0];
+    }
+  }
+}
+
 // The coefficients are checked as the run evaluates them, after --set: the model file's checks
 // (expect_mode_keys_refused above) saw the file's values only, and a friction of -0.1 made the
 // thrown ball speed up, a restitution of -0.5 sank the disk into the floor, both with exit 0.

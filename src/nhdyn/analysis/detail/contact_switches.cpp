@@ -820,6 +820,12 @@ Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, b
           Bt.col(j) -= (w.mu_k[o] * d[a] / w.tangent_length[o][a]) * data_.b.row(other.roll[a]).transpose();
     }
   }
+  // In the coordinates' own scales S of the modes' solve at this state (w.coordinate_scale,
+  // formulation/contact_modes.cpp; ones where the inertias are within 2^26 of each other): the QR
+  // of S B~^T, D = D~ S and v+ = S y, so that a disk a micrometre across, whose angles have
+  // inertias 1e12 below its position's, is not judged singular for its units.
+  const Vector& S = w.coordinate_scale;
+  Bt.array().colwise() *= S.array();
   Eigen::ColPivHouseholderQR<Matrix> qr(Bt);
   if (qr.rank() < r || r >= n || gap_column < 0) {
     // Name the contacts held through the impact: with two of them on one body (a ball rolling
@@ -838,7 +844,8 @@ Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, b
     return out;
   }
   const Matrix Qf = qr.householderQ();
-  const Matrix D = Qf.rightCols(n - r).transpose();
+  Matrix D = Qf.rightCols(n - r).transpose();
+  D.array().rowwise() *= S.transpose().array();  // D = D~ S
   Matrix M(n, n);
   Vector rhs(n);
   M.topRows(n - r) = D * data_.A;
@@ -847,6 +854,7 @@ Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, b
     M.row(n - r + j) = data_.b.row(rows[static_cast<std::size_t>(j)]);
     rhs(n - r + j) = target[static_cast<std::size_t>(j)];
   }
+  M.array().rowwise() *= S.transpose().array();  // the unknown is y, v+ = S y
   // Rows in different units scaled exactly first, as every solve of [D A; b] (formulation/detail/row_scaling.hpp).
   scale_rows_by_powers_of_two(
       n, [&](int i) { return M.row(i).cwiseAbs().maxCoeff(); },
@@ -863,8 +871,10 @@ Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, b
     return out;
   }
   out.v = lu.solve(rhs);
-  // The impulse, A (q'+ - q'-) = B~^T Pi, read on the columns as N is from R.
-  const Vector impulse = data_.A * (out.v - v_before);
+  out.v.array() *= S.array();
+  // The impulse, A (q'+ - q'-) = B~^T Pi, read on the columns as N is from R: S A (q'+ - q'-) = (S B~^T) Pi.
+  Vector impulse = data_.A * (out.v - v_before);
+  impulse.array() *= S.array();
   const Vector Pi = qr.solve(impulse);
   out.normal = Pi(gap_column);
   const double largest = Pi.size() > 0 ? Pi.cwiseAbs().maxCoeff() : 0.0;
