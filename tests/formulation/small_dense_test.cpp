@@ -88,6 +88,49 @@ TEST(SmallKernels, SameAccelerationsAsTheDynamicPathForEverySize) {
   }
 }
 
+// The coordinates b does not touch are rows of D of their own (null_space_basis): a free body's
+// position x, y, z before its unit quaternion, b = 2 e^T on the last four. Taken first, x was the
+// reflector's coordinate and every other row of D mixed it into the quaternion's. Both paths, a
+// quaternion at a general orientation.
+TEST(SmallKernels, CoordinatesTheConstraintsDoNotTouchAreRowsOfDOfTheirOwn) {
+  std::mt19937 rng(3);
+  RandomSystem sys = random_system(7, 1, rng);
+  Eigen::Vector4d e(0.3, -0.5, 0.7, 0.4);
+  e.normalize();
+  sys.b.setZero();
+  sys.b.rightCols(4) = 2.0 * e.transpose();
+  const Model model = testing::make_constant_model(sys.A, sys.Q, sys.b, sys.b0);
+  for (const bool small : {true, false}) {
+    const SmallSolution r = solve(model, small, Complement::qr);
+    ASSERT_EQ(r.status, Status::ok);
+    ASSERT_EQ(r.D.rows(), 6);
+    // Three rows are the unit vectors of x, y and z (up to sign), exactly; the three others have
+    // no x, y, z part at all.
+    std::vector<int> unit_of(3, 0);
+    for (int i = 0; i < 6; ++i) {
+      const double position_part = r.D.row(i).head(3).cwiseAbs().maxCoeff();
+      if (position_part == 0.0) continue;
+      int j = 0;
+      r.D.row(i).head(3).cwiseAbs().maxCoeff(&j);
+      EXPECT_EQ(std::abs(r.D(i, j)), 1.0) << "small " << small << ", row " << i;
+      EXPECT_EQ(r.D.row(i).cwiseAbs().sum(), 1.0) << "small " << small << ", row " << i;
+      ++unit_of[static_cast<std::size_t>(j)];
+    }
+    EXPECT_EQ(unit_of, (std::vector<int>{1, 1, 1})) << "small " << small;
+    EXPECT_LT((r.D * sys.b.transpose()).norm(), 1e-15) << "small " << small;
+    EXPECT_LT((r.D * r.D.transpose() - Matrix::Identity(6, 6)).norm(), 1e-14) << "small " << small;
+    EXPECT_LT((sys.b * r.qdd + sys.b0).norm(), 1e-13) << "small " << small;
+    EXPECT_LT((r.D * (sys.A * r.qdd - sys.Q)).norm(), 1e-12 * (1.0 + r.qdd.norm())) << "small " << small;
+  }
+  // The nullspace formulation reads the same factorization for its particular solution.
+  const SmallSolution stacked = solve(model, false, Complement::qr);
+  for (const bool small : {true, false}) {
+    const SmallSolution nullspace = solve(model, small, Complement::qr, Formulation::nullspace);
+    ASSERT_EQ(nullspace.status, Status::ok);
+    EXPECT_LT((nullspace.qdd - stacked.qdd).norm(), 1e-12 * (1.0 + stacked.qdd.norm())) << "small " << small;
+  }
+}
+
 TEST(SmallKernels, DependentConstraintsAreRefusedAsOnTheDynamicPath) {
   std::mt19937 rng(7);
   for (int n : {3, 4, 8}) {

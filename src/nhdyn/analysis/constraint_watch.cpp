@@ -60,10 +60,11 @@ double smallest_singular_value_bound(const Matrix& R, Eigen::Index m, Vector& un
   return std::isfinite(bound) ? bound : 0.0;
 }
 
-// The watched rows (the stacked [D A; b], or b alone) scaled to unit norm into watch.rows, and
-// their squared distance from the rows of the last estimate; infinity when a row's norm is not
-// finite. Plain loops over the column-major storage: Eigen's dynamic-size product and row
-// expressions cost more in dispatch than in arithmetic at the sizes where a step is cheap.
+// The watched rows (the stacked [D A; b], or b alone), their columns scaled by
+// watch.column_scale and then each row to unit norm, into watch.rows, and their squared distance
+// from the rows of the last estimate; infinity when a row's norm is not finite. Plain loops over
+// the column-major storage: Eigen's dynamic-size product and row expressions cost more in
+// dispatch than in arithmetic at the sizes where a step is cheap.
 double scale_rows(const Model& model, const Data& data, ConstraintWatch& watch) {
   const int k = model.k();
   const int s = model.s();
@@ -71,6 +72,7 @@ double scale_rows(const Model& model, const Data& data, ConstraintWatch& watch) 
   const Eigen::Index n = rows.cols(), watched = rows.rows();
   const Eigen::Index top = watched - s;
   double* M = rows.data();
+  const double* column = watch.column_scale.data();
   if (watch.stacked && k > 0) {
     const double* D = data.D.data();
     const double* A = data.A.data();
@@ -78,23 +80,18 @@ double scale_rows(const Model& model, const Data& data, ConstraintWatch& watch) 
       for (Eigen::Index i = 0; i < k; ++i) {
         double acc = 0.0;
         for (Eigen::Index l = 0; l < n; ++l) acc += D[i + k * l] * A[l + n * c];
-        M[i + watched * c] = acc;
+        M[i + watched * c] = acc * column[c];
       }
   }
   const double* b = data.b.data();
   for (Eigen::Index c = 0; c < n; ++c)
-    for (Eigen::Index i = 0; i < s; ++i) M[top + i + watched * c] = b[i + s * c];
+    for (Eigen::Index i = 0; i < s; ++i) M[top + i + watched * c] = b[i + s * c] * column[c];
   const double* estimated = watch.estimated_rows.data();
   double moved = 0.0;
   for (Eigen::Index i = 0; i < watched; ++i) {
-    // The rows of b have their norms in watch.norm already.
     double norm = 0.0;
-    if (i < top) {
-      for (Eigen::Index c = 0; c < n; ++c) norm += M[i + watched * c] * M[i + watched * c];
-      norm = std::sqrt(norm);
-    } else {
-      norm = watch.norm(i - top);
-    }
+    for (Eigen::Index c = 0; c < n; ++c) norm += M[i + watched * c] * M[i + watched * c];
+    norm = std::sqrt(norm);
     if (!std::isfinite(norm)) return kInfinity;
     const double scale = norm > 0.0 ? norm : 1.0;
     for (Eigen::Index c = 0; c < n; ++c) {
@@ -106,23 +103,26 @@ double scale_rows(const Model& model, const Data& data, ConstraintWatch& watch) 
   return moved;
 }
 
-// The rows of the stacked [D A; b] (n x n, column-major, n and s known at compile time) scaled to
-// unit norm into `rows`, and their squared distance from the rows of the last estimate: the same
-// operations in the same order as scale_rows above, unrolled, for the small models whose steps
-// are cheapest (the sled's watch took a twentieth of its run with the loops above). Infinity when
-// a row's norm is not finite.
+// The rows of the stacked [D A; b] (n x n, column-major, n and s known at compile time), columns
+// scaled by `column` and rows to unit norm, into `rows`, and their squared distance from the rows
+// of the last estimate: the same operations in the same order as scale_rows above, unrolled, for
+// the small models whose steps are cheapest (the sled's watch took a twentieth of its run with
+// the loops above). Infinity when a row's norm is not finite.
 template <int N, int S>
-double scaled_stacked_rows(const double* D, const double* A, const double* b, const double* b_norm,
+double scaled_stacked_rows(const double* D, const double* A, const double* b, const double* column,
                            const double* estimated, double* rows) {
   constexpr int K = N - S;
   double moved = 0.0;
-  for (int i = 0; i < K; ++i) {
+  for (int i = 0; i < N; ++i) {
     double row[N];
     double norm = 0.0;
     for (int c = 0; c < N; ++c) {
       double acc = 0.0;
-      for (int l = 0; l < N; ++l) acc += D[i + K * l] * A[l + N * c];
-      row[c] = acc;
+      if (i < K)
+        for (int l = 0; l < N; ++l) acc += D[i + K * l] * A[l + N * c];
+      else
+        acc = b[i - K + S * c];
+      row[c] = acc * column[c];
     }
     for (int c = 0; c < N; ++c) norm += row[c] * row[c];
     norm = std::sqrt(norm);
@@ -131,16 +131,6 @@ double scaled_stacked_rows(const double* D, const double* A, const double* b, co
     for (int c = 0; c < N; ++c) {
       rows[i + N * c] = row[c] / scale;
       const double d = rows[i + N * c] - estimated[i + N * c];
-      moved += d * d;
-    }
-  }
-  for (int i = 0; i < S; ++i) {
-    const double norm = b_norm[i];
-    if (!std::isfinite(norm)) return kInfinity;
-    const double scale = norm > 0.0 ? norm : 1.0;
-    for (int c = 0; c < N; ++c) {
-      rows[K + i + N * c] = b[i + S * c] / scale;
-      const double d = rows[K + i + N * c] - estimated[K + i + N * c];
       moved += d * d;
     }
   }
@@ -177,7 +167,8 @@ double stacked_condition(const Model& model, const Data& data, ConstraintWatch& 
   double moved = 0.0;  // ||M - M at the last estimate||_F^2, in the same pass as the scaling
   if (watch.stacked && k > 0 && n <= kFixedWatchMaxN && watched == n) {
     moved = kScaledStackedRows[static_cast<std::size_t>(n)][static_cast<std::size_t>(s)](
-        data.D.data(), data.A.data(), data.b.data(), watch.norm.data(), watch.estimated_rows.data(), rows.data());
+        data.D.data(), data.A.data(), data.b.data(), watch.column_scale.data(), watch.estimated_rows.data(),
+        rows.data());
     if (moved == kInfinity) return kInfinity;
   } else {
     moved = scale_rows(model, data, watch);
@@ -188,6 +179,20 @@ double stacked_condition(const Model& model, const Data& data, ConstraintWatch& 
     return watch.condition;
   }
   ++watch.estimates;
+  // The columns in the kinetic energy's metric, 1 / sqrt(A_jj) at this state (1 for a coordinate
+  // without inertia there), the rows to unit norm again: a change of units scales M's columns,
+  // and A's diagonal with them, so that the estimate does not follow it. The columns' scales are
+  // kept until the next estimate, whose distance `moved` is measured in them.
+  for (Eigen::Index c = 0; c < n; ++c) {
+    const double inertia = data.A(c, c);
+    const double scale = inertia > 0.0 && std::isfinite(inertia) ? 1.0 / std::sqrt(inertia) : 1.0;
+    rows.col(c) *= scale / watch.column_scale(c);
+    watch.column_scale(c) = scale;
+  }
+  for (Eigen::Index i = 0; i < watched; ++i) {
+    const double norm = rows.row(i).norm();
+    if (norm > 0.0 && std::isfinite(norm)) rows.row(i) /= norm;
+  }
   watch.rows_t = rows.transpose();
   watch.qr.compute(watch.rows_t);
   const Matrix& R = watch.qr.matrixQR();
@@ -248,6 +253,7 @@ ConstraintWatch make_constraint_watch(const Model& model, const Data& data, std:
     watch.rows_t = Matrix::Zero(n, watched);
     watch.qr = Eigen::ColPivHouseholderQR<Matrix>(n, watched);
     watch.estimated_rows = Matrix::Zero(watched, n);
+    watch.column_scale = Vector::Ones(n);
     watch.unit = Vector::Zero(watched);
   }
   return watch;
@@ -336,9 +342,10 @@ std::string format_constraint_warning(const Model& model, const ConstraintWarnin
           ? fmt::format("constraint '{}'", model.constraints[static_cast<std::size_t>(w.constraint)].name)
           : std::string("the complement rows D A");
   return fmt::format(
-      "{}: the stacked matrix [D A; b] (rows scaled to unit norm) lost conditioning by a factor of {} by t = {:.6g} "
-      "(estimate {:.3g}, {:.3g} at the start), this row the most nearly dependent on the others; the constraints "
-      "are becoming dependent or the coordinates singular there, and the motion past that point may be wrong",
+      "{}: the stacked matrix [D A; b] (its columns in the kinetic energy's metric, its rows scaled to unit norm) "
+      "lost conditioning by a factor of {} by t = {:.6g} (estimate {:.3g}, {:.3g} at the start), this row the most "
+      "nearly dependent on the others; the constraints are becoming dependent or the coordinates singular there, and "
+      "the motion past that point may be wrong",
       who, factor, w.t, w.value, w.initial);
 }
 

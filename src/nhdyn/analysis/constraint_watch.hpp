@@ -6,9 +6,15 @@
 //   1. the Euclidean norm of its row of b (the tan(phi) form grows like 1/|cos(phi)|), on the dense
 //      and the sparse path, O(nonzeros of b);
 //   2. on the dense path, a conditioning estimate of the stacked matrix [D A; b] with its rows
-//      scaled to unit norm (so that 1. alone speaks about scale and 2. about directions): the ratio
-//      of the largest to the smallest |R_ii| of a QR with column pivoting of its transpose, the
-//      last pivot naming the row most nearly dependent on the others. O(n^3), in workspace
+//      scaled to unit norm (so that 1. alone speaks about scale and 2. about directions) and its
+//      columns in the kinetic energy's metric, column j times 1 / sqrt(A_jj) as at the last
+//      estimate (so that the coordinates' units do not speak either: in millimetres the slider
+//      crank's column of its slider's x is a thousand times off its columns of angles, and the
+//      estimate with the rows alone scaled followed how the motion mixes the two, a matter of
+//      units; in the metric, constraints that merge still do, x' and cos(phi) x' + sin(phi) y' as
+//      phi goes to 0, where scaling each column to unit norm would have hidden it):
+//      the ratio of the largest to the smallest |R_ii| of a QR with column pivoting of its
+//      transpose, the last pivot naming the row most nearly dependent on the others. O(n^3), in workspace
 //      allocated once. For a formulation without D (lagrange, udwadia-kalaba) the rows of b alone.
 //      The factorization is amortized: the rows of b change slowly, so the estimate is made again
 //      only once the row-scaled matrix M has moved, in the Frobenius norm, by more than
@@ -80,6 +86,7 @@ struct ConstraintWatch {
   Matrix rows_t;                            // n x (rows watched), its transpose for the QR
   Eigen::ColPivHouseholderQR<Matrix> qr;    // of rows_t
   Matrix estimated_rows;                    // rows at the last estimate
+  Vector column_scale;                      // n, the columns' scales 1 / sqrt(A_jj) at the last estimate
   double reuse_radius = 0.0;                // kConditioningReuse / ||R^-1||_F there; 0: estimate again
   Eigen::Index last_pivot = 0;              // the last pivot's row at the last estimate
   Vector unit;                              // workspace of the bound, (rows watched)

@@ -59,7 +59,16 @@ Status compute_partitioned(const Model& model, Data& data) {
 
 Status compute_constraint_basis(const Model& model, Data& data) {
   const int s = model.s();
-  data.bt = data.b.transpose();
+  const int n = model.n();
+  // The coordinates b does not touch go last, as in the fixed-size kernel (small_dense.hpp,
+  // null_space_basis: why).
+  small::order_touched_first(data.b.data(), n, s, data.bt_order.data());
+  data.bt_in_order = true;
+  for (int j = 0; j < n; ++j) data.bt_in_order = data.bt_in_order && data.bt_order[static_cast<std::size_t>(j)] == j;
+  if (data.bt_in_order)
+    data.bt = data.b.transpose();
+  else
+    for (int j = 0; j < n; ++j) data.bt.row(j) = data.b.col(data.bt_order[static_cast<std::size_t>(j)]).transpose();
   data.qr_bt.compute(data.bt);
   if (!pivots_show_full_rank(data.qr_bt.matrixQR(), s))
     return record_failure(data, Status::dependent_constraints, "constraint matrix b");
@@ -100,7 +109,12 @@ Status compute_complement(const Model& model, Data& data, Complement complement)
       }
       const Status status = compute_constraint_basis(model, data);
       if (status != Status::ok) return status;
-      data.D = data.Q_full.rightCols(k).transpose();
+      if (data.bt_in_order) {
+        data.D = data.Q_full.rightCols(k).transpose();
+      } else {
+        for (int j = 0; j < model.n(); ++j)
+          data.D.col(data.bt_order[static_cast<std::size_t>(j)]) = data.Q_full.row(j).tail(k).transpose();
+      }
       return Status::ok;
     }
     case Complement::partition:

@@ -27,7 +27,9 @@ inline constexpr double kComplementTolerance = 1e-8;
 
 // The column-pivoted QR factorization b^T P = Q [R1; 0] in data.qr_bt and the full orthogonal
 // factor in data.Q_full (n x n): its first s columns span range(b^T), the last k span null(b).
-// Returns Status::dependent_constraints when b has rank below s. Allocates nothing.
+// Its rows are the coordinates in data.bt_order (those b touches first; 0 .. n-1 when
+// data.bt_in_order), as are those of data.bt. Returns Status::dependent_constraints when b has
+// rank below s. Allocates nothing.
 Status compute_constraint_basis(const Model& model, Data& data);
 
 }  // namespace nhdyn

@@ -24,7 +24,13 @@ Status compute_nullspace_acceleration(const Model& model, Data& data, Complement
     const auto& perm = data.qr_bt.colsPermutation().indices();
     for (int j = 0; j < s; ++j) data.tmp_s(j) = -data.b0(perm(j));
     data.qr_bt.matrixQR().topLeftCorner(s, s).triangularView<Eigen::Upper>().transpose().solveInPlace(data.tmp_s);
-    data.p.noalias() = data.Q_full.leftCols(s) * data.tmp_s;
+    // Q_full's rows are the coordinates in bt_order (compute_constraint_basis).
+    if (data.bt_in_order) {
+      data.p.noalias() = data.Q_full.leftCols(s) * data.tmp_s;
+    } else {
+      data.tmp_n.noalias() = data.Q_full.leftCols(s) * data.tmp_s;
+      for (int j = 0; j < model.n(); ++j) data.p(data.bt_order[static_cast<std::size_t>(j)]) = data.tmp_n(j);
+    }
   }
   data.h = data.Q + data.G;
   data.DA.noalias() = data.D * data.A;

@@ -79,6 +79,7 @@ Data make_dense_data(const Model& model, const DataOptions& options) {
   d.rhs = Vector::Zero(n);
   d.K = sized(use.kkt, n + s, n + s);
   d.bt = sized(use.complement, n, s);
+  d.bt_order.assign(use.complement ? static_cast<std::size_t>(n) : 0, 0);
   d.Q_full = sized(use.orthogonal, n, n);
   d.DA = sized(use.reduced, k, n);
   d.DAD = sized(use.reduced, k, k);

@@ -198,7 +198,10 @@ struct Data {
   Matrix K;                      // (n + s) x (n + s), KKT matrix (dense lagrange, projection)
   Vector kkt_rhs;                // n + s
   Vector kkt_sol;                // n + s
-  Matrix bt;                     // n x s, b^T (QR complement)
+  Matrix bt;                     // n x s, b^T (QR complement), its rows in the order bt_order
+  std::vector<int> bt_order;     // n, the coordinates in the order of bt's rows (and of Q_full's
+                                 // after compute_constraint_basis): those b touches first
+  bool bt_in_order = true;       // whether bt_order is 0 .. n-1
   Matrix Q_full;                 // n x n, orthogonal factor of b^T (QR complement, udwadia-kalaba)
   Vector hh_work;                // n, Householder workspace
   Matrix DA;                     // k x n, D A (nullspace)

@@ -762,6 +762,29 @@ bool ContactSwitches::check_sliding(int contact, double t) {
   return false;
 }
 
+namespace {
+
+// Why the impulse of contact `i`'s touchdown has no Do Sanh form: the contacts held through the
+// impact keep r rows of this rank on n coordinates. Named, since with two of them on one body (a
+// ball rolling into a wall) their rows may be dependent, or as many as the coordinates.
+std::string held_rows_failure(const Model& model, const ContactModeData& w, std::size_t i, bool sliding, double t,
+                              int r, int rank) {
+  const ContactModeModel& cm = *model.contact_modes;
+  std::string held;
+  for (std::size_t j = 0; j < cm.contacts.size(); ++j)
+    if (j == i || w.mode[j] != ContactMode::free)
+      held += fmt::format("{}'{}' ({})", held.empty() ? "" : ", ", cm.contacts[j].name,
+                          j == i ? (sliding ? "sliding" : "touching down") : contact_mode_name(w.mode[j]));
+  return fmt::format(
+      "contact '{}' touches down at t = {:.9g}, where the contacts held through the impact, {}, keep {} constraint "
+      "rows of rank {} on {} coordinates: the impact's equations in the Do Sanh form need fewer rows than "
+      "coordinates, and independent ones (docs/contact-modes.md, \"More contacts than freedom\"); the run ends "
+      "here with its results so far",
+      cm.contacts[i].name, t, held, r, rank, model.n());
+}
+
+}  // namespace
+
 Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, bool sliding,
                                        const std::array<double, 2>& direction) {
   Impulse out;
@@ -828,19 +851,7 @@ Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, b
   Bt.array().colwise() *= S.array();
   Eigen::ColPivHouseholderQR<Matrix> qr(Bt);
   if (qr.rank() < r || r >= n || gap_column < 0) {
-    // Name the contacts held through the impact: with two of them on one body (a ball rolling
-    // into a wall) their rows may be dependent, or as many as the coordinates.
-    std::string held;
-    for (std::size_t j = 0; j < cm.contacts.size(); ++j)
-      if (j == i || w.mode[j] != ContactMode::free)
-        held += fmt::format("{}'{}' ({})", held.empty() ? "" : ", ", cm.contacts[j].name,
-                            j == i ? (sliding ? "sliding" : "touching down") : contact_mode_name(w.mode[j]));
-    out.failure = fmt::format(
-        "contact '{}' touches down at t = {:.9g}, where the contacts held through the impact, {}, keep {} constraint "
-        "rows of rank {} on {} coordinates: the impact's equations in the Do Sanh form need fewer rows than "
-        "coordinates, and independent ones (docs/contact-modes.md, \"More contacts than freedom\"); the run ends "
-        "here with its results so far",
-        c.name, t, held, r, static_cast<int>(qr.rank()), n);
+    out.failure = held_rows_failure(model_, w, i, sliding, t, r, static_cast<int>(qr.rank()));
     return out;
   }
   const Matrix Qf = qr.householderQ();

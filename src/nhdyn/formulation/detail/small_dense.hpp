@@ -23,12 +23,67 @@ namespace nhdyn::small {
 inline constexpr int kSmallMaxN = 8;
 inline constexpr double kEps = std::numeric_limits<double>::epsilon();
 
+// Whether the coordinates that b does not touch (a zero column) all come after those it does:
+// false when they must be taken in another order first (null_space_basis).
+template <int N, int S>
+bool untouched_coordinates_last(const double* b) {
+  bool in_order = true, past = false;
+  for (int j = 0; j < N; ++j) {
+    bool touched = false;
+    for (int i = 0; i < S; ++i) touched = touched || b[i + S * j] != 0.0;
+    in_order = in_order && !(touched && past);
+    past = past || !touched;
+  }
+  return in_order;
+}
+
+// The coordinates in the order the QR of b^T takes them (coordinate_order): those b touches,
+// then those it does not, each in their own order. n entries into `order`.
+inline void order_touched_first(const double* b, int n, int s, int* order) {
+  int next = 0;
+  for (int pass = 0; pass < 2; ++pass)
+    for (int j = 0; j < n; ++j) {
+      bool touched = false;
+      for (int i = 0; i < s; ++i) touched = touched || b[i + s * j] != 0.0;
+      if (touched == (pass == 0)) order[next++] = j;
+    }
+}
+
 // An orthonormal basis of null(b) as the rows of D (k x n): the last k columns of Q in a
 // Householder QR factorization with column pivoting b^T P = Q [R1; 0]. The rank test is that of
 // the dynamic path (complement.cpp): the last pivot of R1 against the first. Returns false when
 // b has rank below s.
+//
+// The rows of b^T (the coordinates) are taken with those b touches first, as compute_constraint_basis
+// takes them: a reflector H_j = I - tau v v^T maps its column onto the j-th coordinate, so that
+// with an untouched coordinate first (the position of a free body before its quaternion, held
+// to unit norm) v, and with it every row of D, would mix that coordinate into the constrained
+// ones. Such a D is a complement all the same, but its rows D A then mix the body's mass with its
+// inertias, in whatever units they have (a body in millimetres: 1 against 1e6), and the stacked
+// matrix loses digits it need not. Taken last, the untouched coordinates are rows of D of their
+// own (unit vectors), and a model whose untouched coordinates come last already gets the same D
+// as before, bit for bit.
+template <int N, int S>
+bool null_space_basis(const double* b, double* D);
+
+template <int N, int S>
+bool null_space_basis_in_order(const double* b, const int* order, double* D);
+
 template <int N, int S>
 bool null_space_basis(const double* b, double* D) {
+  if constexpr (S > 0) {
+    if (!untouched_coordinates_last<N, S>(b)) [[unlikely]] {
+      std::array<int, N> order;
+      order_touched_first(b, N, S, order.data());
+      return null_space_basis_in_order<N, S>(b, order.data(), D);
+    }
+  }
+  return null_space_basis_in_order<N, S>(b, nullptr, D);
+}
+
+// null_space_basis with the coordinates taken in `order` (n indices; null: their own order).
+template <int N, int S>
+bool null_space_basis_in_order(const double* b, const int* order, double* D) {
   constexpr int K = N - S;
   if constexpr (S == 0) {
     for (int i = 0; i < K * N; ++i) D[i] = 0.0;
@@ -37,8 +92,13 @@ bool null_space_basis(const double* b, double* D) {
   } else {
     std::array<double, N * S> bt;  // b^T, overwritten by the reflectors
     std::array<double, S> tau;
-    for (int i = 0; i < S; ++i)
-      for (int j = 0; j < N; ++j) bt[j + N * i] = b[i + S * j];
+    if (order == nullptr) {
+      for (int i = 0; i < S; ++i)
+        for (int j = 0; j < N; ++j) bt[j + N * i] = b[i + S * j];
+    } else {
+      for (int i = 0; i < S; ++i)
+        for (int j = 0; j < N; ++j) bt[j + N * i] = b[i + S * order[j]];
+    }
     double first_pivot = 0.0;
     for (int j = 0; j < S; ++j) {
       int p = j;
@@ -86,8 +146,13 @@ bool null_space_basis(const double* b, double* D) {
         for (int i = j + 1; i < N; ++i) yr[i] -= d * v[i];
       }
     }
-    for (int r = 0; r < K; ++r)
-      for (int i = 0; i < N; ++i) D[r + K * i] = y[i + N * r];
+    if (order == nullptr) {
+      for (int r = 0; r < K; ++r)
+        for (int i = 0; i < N; ++i) D[r + K * i] = y[i + N * r];
+    } else {
+      for (int r = 0; r < K; ++r)
+        for (int i = 0; i < N; ++i) D[r + K * order[i]] = y[i + N * r];
+    }
     return true;
   }
 }
