@@ -88,10 +88,10 @@ TEST(SmallKernels, SameAccelerationsAsTheDynamicPathForEverySize) {
   }
 }
 
-// The coordinates b does not touch are rows of D of their own (null_space_basis): a free body's
-// position x, y, z before its unit quaternion, b = 2 e^T on the last four. Taken first, x was the
-// reflector's coordinate and every other row of D mixed it into the quaternion's. Both paths, a
-// quaternion at a general orientation.
+// The coordinates b never touches are rows of D of their own (null_space_basis, Data::bt_order):
+// a free body's position x, y, z before its unit quaternion, b = 2 e^T on the last four. Taken
+// first, x was the reflector's coordinate and every other row of D mixed it into the quaternion's.
+// Both paths, a quaternion at a general orientation.
 TEST(SmallKernels, CoordinatesTheConstraintsDoNotTouchAreRowsOfDOfTheirOwn) {
   std::mt19937 rng(3);
   RandomSystem sys = random_system(7, 1, rng);
@@ -210,7 +210,7 @@ TEST(SmallKernels, EveryNonFiniteTermMakesTheFusedKernelFail) {
           qdd(static_cast<std::size_t>(n)), R(static_cast<std::size_t>(n));
       const auto run = [&] {
         return kernels->sanh_qr(terms[0].data(), terms[1].data(), terms[2].data(), terms[3].data(), terms[4].data(),
-                                D.data(), h.data(), qdd.data(), R.data());
+                                nullptr, D.data(), h.data(), qdd.data(), R.data());
       };
       // The system itself is regular, s = n (a single point) included.
       ASSERT_EQ(run(), small::SanhResult::ok) << "n = " << n << ", s = " << s;

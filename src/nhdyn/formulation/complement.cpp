@@ -60,11 +60,8 @@ Status compute_partitioned(const Model& model, Data& data) {
 Status compute_constraint_basis(const Model& model, Data& data) {
   const int s = model.s();
   const int n = model.n();
-  // The coordinates b does not touch go last, as in the fixed-size kernel (small_dense.hpp,
-  // null_space_basis: why).
-  small::order_touched_first(data.b.data(), n, s, data.bt_order.data());
-  data.bt_in_order = true;
-  for (int j = 0; j < n; ++j) data.bt_in_order = data.bt_in_order && data.bt_order[static_cast<std::size_t>(j)] == j;
+  // The coordinates b never touches last, as in the fixed-size kernel (small_dense.hpp,
+  // null_space_basis: why; Data::bt_order).
   if (data.bt_in_order)
     data.bt = data.b.transpose();
   else
@@ -103,7 +100,8 @@ Status compute_complement(const Model& model, Data& data, Complement complement)
         return Status::ok;
       }
       if (const small::Kernels* kernels = data.small_kernels ? small::find_kernels(model.n(), s) : nullptr) {
-        if (!kernels->null_space_basis(data.b.data(), data.D.data()))
+        if (!kernels->null_space_basis(data.b.data(), data.bt_in_order ? nullptr : data.bt_order.data(),
+                                       data.D.data()))
           return record_failure(data, Status::dependent_constraints, "constraint matrix b");
         return Status::ok;
       }

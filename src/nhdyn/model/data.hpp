@@ -200,7 +200,8 @@ struct Data {
   Vector kkt_sol;                // n + s
   Matrix bt;                     // n x s, b^T (QR complement), its rows in the order bt_order
   std::vector<int> bt_order;     // n, the coordinates in the order of bt's rows (and of Q_full's
-                                 // after compute_constraint_basis): those b touches first
+                                 // after compute_constraint_basis, and in the fixed-size QR): those
+                                 // b never touches last (make_data; small_dense.hpp null_space_basis)
   bool bt_in_order = true;       // whether bt_order is 0 .. n-1
   Matrix Q_full;                 // n x n, orthogonal factor of b^T (QR complement, udwadia-kalaba)
   Vector hh_work;                // n, Householder workspace

@@ -23,82 +23,37 @@ namespace nhdyn::small {
 inline constexpr int kSmallMaxN = 8;
 inline constexpr double kEps = std::numeric_limits<double>::epsilon();
 
-// Whether the coordinates that b does not touch (a zero column) all come after those it does:
-// false when they must be taken in another order first (null_space_basis).
-template <int N, int S>
-bool untouched_coordinates_last(const double* b) {
-  bool in_order = true, past = false;
-  for (int j = 0; j < N; ++j) {
-    bool touched = false;
-    for (int i = 0; i < S; ++i) touched = touched || b[i + S * j] != 0.0;
-    in_order = in_order && !(touched && past);
-    past = past || !touched;
-  }
-  return in_order;
-}
-
-// The coordinates in the order the QR of b^T takes them (coordinate_order): those b touches,
-// then those it does not, each in their own order. n entries into `order`.
-inline void order_touched_first(const double* b, int n, int s, int* order) {
-  int next = 0;
-  for (int pass = 0; pass < 2; ++pass)
-    for (int j = 0; j < n; ++j) {
-      bool touched = false;
-      for (int i = 0; i < s; ++i) touched = touched || b[i + s * j] != 0.0;
-      if (touched == (pass == 0)) order[next++] = j;
-    }
-}
-
 // An orthonormal basis of null(b) as the rows of D (k x n): the last k columns of Q in a
 // Householder QR factorization with column pivoting b^T P = Q [R1; 0]. The rank test is that of
 // the dynamic path (complement.cpp): the last pivot of R1 against the first. Returns false when
 // b has rank below s.
 //
-// The rows of b^T (the coordinates) are taken with those b touches first, as compute_constraint_basis
+// The rows of b^T (the coordinates) are taken in `order` (n indices; null: their own order),
+// Data::bt_order, which puts the coordinates b never touches last, as compute_constraint_basis
 // takes them: a reflector H_j = I - tau v v^T maps its column onto the j-th coordinate, so that
-// with an untouched coordinate first (the position of a free body before its quaternion, held
-// to unit norm) v, and with it every row of D, would mix that coordinate into the constrained
-// ones. Such a D is a complement all the same, but its rows D A then mix the body's mass with its
+// with an untouched coordinate first (the position of a free body before its quaternion, held to
+// unit norm) v, and with it every row of D, would mix that coordinate into the constrained ones.
+// Such a D is a complement all the same, but its rows D A then mix the body's mass with its
 // inertias, in whatever units they have (a body in millimetres: 1 against 1e6), and the stacked
 // matrix loses digits it need not. Taken last, the untouched coordinates are rows of D of their
-// own (unit vectors), and a model whose untouched coordinates come last already gets the same D
-// as before, bit for bit.
+// own (unit vectors).
 template <int N, int S>
-bool null_space_basis(const double* b, double* D);
+bool null_space_basis_reordered(const double* b, const int* order, double* D);
 
 template <int N, int S>
-bool null_space_basis_in_order(const double* b, const int* order, double* D);
-
-template <int N, int S>
-bool null_space_basis(const double* b, double* D) {
-  if constexpr (S > 0) {
-    if (!untouched_coordinates_last<N, S>(b)) [[unlikely]] {
-      std::array<int, N> order;
-      order_touched_first(b, N, S, order.data());
-      return null_space_basis_in_order<N, S>(b, order.data(), D);
-    }
-  }
-  return null_space_basis_in_order<N, S>(b, nullptr, D);
-}
-
-// null_space_basis with the coordinates taken in `order` (n indices; null: their own order).
-template <int N, int S>
-bool null_space_basis_in_order(const double* b, const int* order, double* D) {
+bool null_space_basis(const double* b, const int* order, double* D) {
   constexpr int K = N - S;
   if constexpr (S == 0) {
     for (int i = 0; i < K * N; ++i) D[i] = 0.0;
     for (int i = 0; i < N; ++i) D[i + K * i] = 1.0;
     return true;
   } else {
+    if (order != nullptr) [[unlikely]]
+      return null_space_basis_reordered<N, S>(b, order, D);
     std::array<double, N * S> bt;  // b^T, overwritten by the reflectors
     std::array<double, S> tau;
-    if (order == nullptr) {
-      for (int i = 0; i < S; ++i)
-        for (int j = 0; j < N; ++j) bt[j + N * i] = b[i + S * j];
-    } else {
-      for (int i = 0; i < S; ++i)
-        for (int j = 0; j < N; ++j) bt[j + N * i] = b[i + S * order[j]];
-    }
+    for (int i = 0; i < S; ++i)
+      for (int j = 0; j < N; ++j) bt[j + N * i] = b[i + S * j];
     double first_pivot = 0.0;
     for (int j = 0; j < S; ++j) {
       int p = j;
@@ -146,15 +101,26 @@ bool null_space_basis_in_order(const double* b, const int* order, double* D) {
         for (int i = j + 1; i < N; ++i) yr[i] -= d * v[i];
       }
     }
-    if (order == nullptr) {
-      for (int r = 0; r < K; ++r)
-        for (int i = 0; i < N; ++i) D[r + K * i] = y[i + N * r];
-    } else {
-      for (int r = 0; r < K; ++r)
-        for (int i = 0; i < N; ++i) D[r + K * order[i]] = y[i + N * r];
-    }
+    for (int r = 0; r < K; ++r)
+      for (int i = 0; i < N; ++i) D[r + K * i] = y[i + N * r];
     return true;
   }
+}
+
+// null_space_basis with the coordinates taken in `order`: b's columns gathered in that order, the
+// basis of the gathered b, and its columns put back. Out of line, so that the kernels inlined
+// into the fused one (flatten) keep the common case's code as it is.
+template <int N, int S>
+[[gnu::noinline]] bool null_space_basis_reordered(const double* b, const int* order, double* D) {
+  constexpr int K = N - S;
+  std::array<double, S * N> gathered;
+  std::array<double, K * N> basis;
+  for (int j = 0; j < N; ++j)
+    for (int i = 0; i < S; ++i) gathered[i + S * j] = b[i + S * order[j]];
+  if (!null_space_basis<N, S>(gathered.data(), nullptr, basis.data())) return false;
+  for (int j = 0; j < N; ++j)
+    for (int r = 0; r < K; ++r) D[r + K * order[j]] = basis[r + K * j];
+  return true;
 }
 
 // Gaussian elimination with partial pivoting of the N x N matrix M (column-major) and its right-
@@ -282,8 +248,9 @@ enum class SanhResult { ok, dependent_constraints, singular, non_finite_qdd, non
 // faster than the four calls.
 template <int N, int S>
 [[gnu::flatten]] SanhResult sanh_qr(const double* A, const double* Q, const double* G, const double* b,
-                                    const double* b0, double* D, double* h, double* qdd, double* R) {
-  if (!null_space_basis<N, S>(b, D)) return SanhResult::dependent_constraints;
+                                    const double* b0, const int* order, double* D, double* h, double* qdd,
+                                    double* R) {
+  if (!null_space_basis<N, S>(b, order, D)) return SanhResult::dependent_constraints;
   if (!solve_stacked<N, S>(A, Q, G, b, b0, D, h, qdd, R)) return SanhResult::singular;
   if (accumulate_non_finite(0.0, qdd, N) != 0.0) return SanhResult::non_finite_qdd;  // NaN != 0 too
   if (accumulate_non_finite(0.0, R, N) != 0.0) return SanhResult::non_finite_R;
@@ -296,11 +263,11 @@ namespace nhdyn::small {
 
 // The instantiations of the kernels above for one (n, s).
 struct Kernels {
-  bool (*null_space_basis)(const double* b, double* D);
+  bool (*null_space_basis)(const double* b, const int* order, double* D);
   bool (*solve_stacked)(const double* A, const double* Q, const double* G, const double* b, const double* b0,
                         const double* D, double* h, double* qdd, double* R);
   SanhResult (*sanh_qr)(const double* A, const double* Q, const double* G, const double* b, const double* b0,
-                        double* D, double* h, double* qdd, double* R);
+                        const int* order, double* D, double* h, double* qdd, double* R);
 };
 
 // The kernels for n coordinates and s constraints, or nullptr when n > kSmallMaxN (the caller
