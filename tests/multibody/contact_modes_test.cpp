@@ -1060,7 +1060,7 @@ TEST(ContactModes, ATippeTopFortyNanometresOrFortyKilometresAcrossSlidesAsTheExa
 
 // The impulse at a touchdown is solved in the same coordinates' scales (analysis/detail/
 // contact_switches.cpp, solve_impulse): the disk of examples/rolling_disk_hop.toml a micrometre
-// across (its angles' inertias 1e-13 below its mass) ended at its first touchdown, "the impulse
+// across (its angles' inertias 1e-14 of its mass) ended at its first touchdown, "the impulse
 // equations are singular", as it did at 1e8 times the example's lengths. At both it lands, bounces
 // and lands again at the example's times, every state in the example's units to the tolerance.
 TEST(ContactModes, ADiskAMicrometreOrAHundredThousandKilometresAcrossHopsAsTheExampleDoes) {

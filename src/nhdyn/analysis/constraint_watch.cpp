@@ -179,13 +179,20 @@ double stacked_condition(const Model& model, const Data& data, ConstraintWatch& 
     return watch.condition;
   }
   ++watch.estimates;
-  // The columns in the kinetic energy's metric, 1 / sqrt(A_jj) at this state (1 for a coordinate
-  // without inertia there), the rows to unit norm again: a change of units scales M's columns,
-  // and A's diagonal with them, so that the estimate does not follow it. The columns' scales are
-  // kept until the next estimate, whose distance `moved` is measured in them.
+  // The columns in the kinetic energy's metric, 1 / sqrt(A_jj) at this state, the rows to unit
+  // norm again: a change of units scales M's columns, and A's diagonal with them, so that the
+  // estimate does not follow it. Taken relative to the lightest coordinate, sqrt(A_min / A_jj) <= 1
+  // (a factor common to every column changes nothing once the rows are scaled, and the entries
+  // then only shrink: a mass of 1e-300 does not overflow a row's norm), and a coordinate without
+  // inertia at this state as the lightest. The columns' scales are kept until the next estimate,
+  // whose distance `moved` is measured in them.
+  double lightest = kInfinity;
+  for (Eigen::Index c = 0; c < n; ++c)
+    if (const double inertia = data.A(c, c); inertia > 0.0 && inertia < lightest) lightest = inertia;
   for (Eigen::Index c = 0; c < n; ++c) {
     const double inertia = data.A(c, c);
-    const double scale = inertia > 0.0 && std::isfinite(inertia) ? 1.0 / std::sqrt(inertia) : 1.0;
+    const double scale =
+        inertia > 0.0 && std::isfinite(inertia) && std::isfinite(lightest) ? std::sqrt(lightest / inertia) : 1.0;
     rows.col(c) *= scale / watch.column_scale(c);
     watch.column_scale(c) = scale;
   }

@@ -8,11 +8,14 @@
 //   2. on the dense path, a conditioning estimate of the stacked matrix [D A; b] with its rows
 //      scaled to unit norm (so that 1. alone speaks about scale and 2. about directions) and its
 //      columns in the kinetic energy's metric, column j times 1 / sqrt(A_jj) as at the last
-//      estimate (so that the coordinates' units do not speak either: in millimetres the slider
-//      crank's column of its slider's x is a thousand times off its columns of angles, and the
-//      estimate with the rows alone scaled followed how the motion mixes the two, a matter of
-//      units; in the metric, constraints that merge still do, x' and cos(phi) x' + sin(phi) y' as
-//      phi goes to 0, where scaling each column to unit norm would have hidden it):
+//      estimate (so that the units of the coordinates' columns do not speak either: in
+//      kilometres the slider crank's column of its slider's x is a thousand times off its
+//      columns of angles, and the estimate with the rows alone scaled followed how the motion
+//      mixes the two, a matter of units; in the metric, constraints that merge still do, x' and
+//      cos(phi) x' + sin(phi) y' as phi goes to 0, where scaling each column to unit norm would
+//      have hidden it). What the metric does not remove is the solve's own D mixing coordinates
+//      of different units in one row (k >= 2 with lengths and angles in a constraint), which
+//      carries them into the rows D A:
 //      the ratio of the largest to the smallest |R_ii| of a QR with column pivoting of its
 //      transpose, the last pivot naming the row most nearly dependent on the others. O(n^3), in workspace
 //      allocated once. For a formulation without D (lagrange, udwadia-kalaba) the rows of b alone.

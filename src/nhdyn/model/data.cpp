@@ -358,8 +358,9 @@ void order_untouched_coordinates_last(const Model& model, Data& d) {
   Vector q(n), v(n);
   for (int pass = 0; pass < 2; ++pass) {
     for (int j = 0; j < n; ++j) {
-      q(j) = 0.3183 + 0.1077 * j + 0.2371 * pass;
-      v(j) = 0.4142 - 0.0931 * j + 0.1713 * pass;
+      // Other increments in the second pass, so that no difference q_i - q_j is the same in both.
+      q(j) = 0.3183 + 0.1077 * j + pass * (0.2371 + 0.0413 * j);
+      v(j) = 0.4142 - 0.0931 * j + pass * (0.1713 - 0.0279 * j);
     }
     const TermsOut out{d.A.data(), d.Q.data(), d.G.data(), d.b.data(), d.b0.data()};
     try {

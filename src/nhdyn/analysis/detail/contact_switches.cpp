@@ -845,8 +845,8 @@ Impulse ContactSwitches::solve_impulse(int contact, double t, const double* v, b
   }
   // In the coordinates' own scales S of the modes' solve at this state (w.coordinate_scale,
   // formulation/contact_modes.cpp; ones where the inertias are within 2^26 of each other): the QR
-  // of S B~^T, D = D~ S and v+ = S y, so that a disk a micrometre across, whose angles have
-  // inertias 1e12 below its position's, is not judged singular for its units.
+  // of S B~^T, D = D~ S and v+ = S y, so that a disk 0.4 micrometres across, whose angles have
+  // inertias 1e-14 of its mass, is not judged singular for its units.
   const Vector& S = w.coordinate_scale;
   Bt.array().colwise() *= S.array();
   Eigen::ColPivHouseholderQR<Matrix> qr(Bt);
