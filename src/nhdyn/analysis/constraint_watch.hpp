@@ -13,14 +13,13 @@
 //      columns of angles, and the estimate with the rows alone scaled followed how the motion
 //      mixes the two, a matter of units; in the metric, constraints that merge still do, x' and
 //      cos(phi) x' + sin(phi) y' as phi goes to 0, where scaling each column to unit norm would
-//      have hidden it). What the metric does not remove is the solve's own D mixing coordinates
-//      of different units in one row (k >= 2 with lengths and angles in a constraint), which
-//      carries them into the rows D A:
-//      the ratio of the largest to the smallest |R_ii| of a QR with column pivoting of its
-//      transpose, the last pivot naming the row most nearly dependent on the others. O(n^3), in workspace
-//      allocated once. For a formulation without D (lagrange, udwadia-kalaba) the rows of b alone.
-//      The factorization is amortized: the rows of b change slowly, so the estimate is made again
-//      only once the row-scaled matrix M has moved, in the Frobenius norm, by more than
+//      have hidden it; what the metric does not remove is the solve's own D mixing coordinates of
+//      different units in one row, k >= 2 with lengths and angles in a constraint, which carries
+//      them into the rows D A): the ratio of the largest to the smallest |R_ii| of a QR with
+//      column pivoting of its transpose, the last pivot naming the row most nearly dependent on
+//      the others. O(n^3), in workspace allocated once. For a formulation without D (lagrange,
+//      udwadia-kalaba) the rows of b alone. The factorization is amortized: the rows of b change
+//      slowly, so the estimate is made again only once the scaled matrix M has moved, in the Frobenius norm, by more than
 //      kConditioningReuse times a lower bound of its smallest singular value at the last estimate
 //      (1 / ||R^-1||_F). By Weyl's inequality the true condition number of M in between stays
 //      within a factor (1 + r) / (1 - r), r = kConditioningReuse, of its value there, so a loss by

@@ -100,8 +100,7 @@ Status compute_complement(const Model& model, Data& data, Complement complement)
         return Status::ok;
       }
       if (const small::Kernels* kernels = data.small_kernels ? small::find_kernels(model.n(), s) : nullptr) {
-        if (!kernels->null_space_basis(data.b.data(), data.bt_in_order ? nullptr : data.bt_order.data(),
-                                       data.D.data()))
+        if (!kernels->null_space_basis(data.b.data(), coordinate_order(data), data.D.data()))
           return record_failure(data, Status::dependent_constraints, "constraint matrix b");
         return Status::ok;
       }

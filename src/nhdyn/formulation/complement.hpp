@@ -32,4 +32,10 @@ inline constexpr double kComplementTolerance = 1e-8;
 // rank below s. Allocates nothing.
 Status compute_constraint_basis(const Model& model, Data& data);
 
+// The order in which the QR of b^T takes the coordinates (Data::bt_order), or null where it is
+// their own: what the fixed-size kernels take (small_dense.hpp, null_space_basis).
+inline const int* coordinate_order(const Data& data) {
+  return data.bt_in_order ? nullptr : data.bt_order.data();
+}
+
 }  // namespace nhdyn

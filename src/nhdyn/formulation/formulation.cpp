@@ -5,6 +5,7 @@
 
 #include "nhdyn/core/error.hpp"
 #include "nhdyn/core/detail/finite.hpp"
+#include "nhdyn/formulation/complement.hpp"
 #include "nhdyn/formulation/contact_modes.hpp"
 #include "nhdyn/formulation/detail/small_dense.hpp"
 #include "nhdyn/formulation/lagrange.hpp"
@@ -66,8 +67,7 @@ Status compute_acceleration(const Model& model, Data& data, const FormulationOpt
   // and checks, in the same order, as the general path below.
   if (const small::Kernels* kernels = fused_kernels(model, data, options)) {
     switch (kernels->sanh_qr(data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data(),
-                             data.bt_in_order ? nullptr : data.bt_order.data(), data.D.data(), data.h.data(),
-                             data.qdd.data(), data.R.data())) {
+                             coordinate_order(data), data.D.data(), data.h.data(), data.qdd.data(), data.R.data())) {
       case small::SanhResult::ok: break;
       case small::SanhResult::dependent_constraints:
         return record_failure(data, Status::dependent_constraints, "constraint matrix b");
@@ -138,8 +138,8 @@ Status compute_dynamics(const Model& model, Data& data, const FormulationOptions
       v_data[i] = v[i];
     }
     if (acc == 0.0 && kernels->sanh_qr(data.A.data(), data.Q.data(), data.G.data(), data.b.data(), data.b0.data(),
-                                       data.bt_in_order ? nullptr : data.bt_order.data(), data.D.data(),
-                                       data.h.data(), data.qdd.data(), data.R.data()) == small::SanhResult::ok) {
+                                       coordinate_order(data), data.D.data(), data.h.data(), data.qdd.data(),
+                                       data.R.data()) == small::SanhResult::ok) {
       data.status = Status::ok;
       data.has_multipliers = false;
       data.stage = Stage::acceleration;
